@@ -1,0 +1,261 @@
+/*
+ * sim.h - public interface of the conveyor simulation core.
+ *
+ * A `sim` is one simulation instance (one session): the machine of MODEL.md
+ * (trough, vibrator, two Frahm eliminators on guides at angle beta), the
+ * optional feed (columns x layers of point masses with the paper's contact
+ * law), the chosen integrator and the model reductions the scene allows.
+ * The core uses libc and libm only, keeps no global mutable state, never
+ * calls back into its caller and never aborts: any number of instances may
+ * run in parallel threads, one thread per instance.
+ *
+ * Units are SI throughout except where a name says otherwise: angles that a
+ * user types (beta, beta_rate) are in degrees, everything internal and every
+ * observable angle is in radians.
+ */
+#ifndef CONVSIM_SIM_H
+#define CONVSIM_SIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Return codes: one list, expanded into the enum, sim_strerror() and (in
+ * api/) the HTTP status. X(name, http_status, message). */
+#define SIM_ERRNO_MAP(X)                                                      \
+	X(OK, 200, "ok")                                                      \
+	X(EPARAM, 422, "parameter out of range")                              \
+	X(EUNKNOWN, 422, "unknown name")                                      \
+	X(ENOMEM, 503, "out of memory")                                       \
+	X(EDIVERGED, 422, "simulation diverged")                              \
+	X(ESTEP, 422, "step size underflow")                                  \
+	X(ETIME, 422, "requested time lies in the past")
+
+typedef enum {
+#define SIM_ERR_ENUM(name, status, msg) SIM_##name,
+	SIM_ERRNO_MAP(SIM_ERR_ENUM)
+#undef SIM_ERR_ENUM
+	SIM_NERR
+} sim_err;
+
+/* Static text for a return code; never NULL. */
+const char *sim_strerror(int err);
+
+/* ---- parameters ------------------------------------------------------ */
+
+enum { SIM_CW = -1, SIM_CCW = 1 };
+enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
+enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
+
+/* Physical parameters, MODEL.md names. Angles in radians here; the name
+ * table below converts beta from degrees. */
+typedef struct sim_params {
+	/* suspension */
+	double l1, l2, h;         /* m: spring sets at (l1,-h), (-l2,-h) */
+	double k_x, k_y;          /* N/m per spring set */
+	double b_x, b_y;          /* N s/m per spring set */
+	/* trough */
+	double M_r, J_r;          /* kg, kg m^2 */
+	/* vibrator */
+	double m, e, J_w;         /* kg, m, kg m^2 */
+	double w_x, w_y;          /* m: axle, body frame */
+	double b_phi;             /* N m s^2: bearing drag b_phi*w|w| */
+	/* motor (Kloss) */
+	double M_ut;              /* N m breakdown torque */
+	double omega_ss;          /* rad/s synchronous speed (>0) */
+	double slip_ut;           /* rad/s omega_ss - omega_ut */
+	int rotation;             /* SIM_CW or SIM_CCW */
+	/* eliminators */
+	double m1, m2;            /* kg */
+	double k_s1, k_s2;        /* N/m */
+	double b_s1, b_s2;        /* N s/m */
+	double p1_x, p1_y, p2_x, p2_y; /* m guide points, body frame */
+	double c;                 /* m offset of the mass along the guide */
+	double beta;              /* rad, initial guide angle */
+	double beta_rate;         /* rad/s slew rate of beta ramps */
+	double beta_accel;        /* rad/s^2 bound on beta'' in ramps */
+	/* feed */
+	double m_n;               /* kg per element */
+	double k_c;               /* contact stiffness k, N/m^p */
+	double p;                 /* contact exponent */
+	double R;                 /* restitution coefficient */
+	double mu;                /* friction coefficient */
+	double h_d;               /* m deck height above G */
+	double column_span;       /* m columns at d_k evenly in [-span, span] */
+	/* environment */
+	double g;                 /* m/s^2 */
+	double drive_accel;       /* rad/s^2 speed ramp of the ideal drive */
+} sim_params;
+
+/* Scene: what the user needs; the engine builds the cheapest model for it. */
+typedef struct sim_scene {
+	int feed;             /* 0: no feed degrees of freedom */
+	int columns, layers;  /* K, L */
+	int drive;            /* SIM_DRIVE_MOTOR (Kloss) or SIM_DRIVE_IDEAL */
+	int trough_rotation;  /* 0: alpha may be dropped if the machine is symmetric */
+	int feed_coupling;    /* 0: one-way (feed does not act on the trough) */
+	int friction;         /* SIM_FRICTION_* */
+	double friction_eps;  /* m/s, regularised friction width */
+	int motor_on;         /* drive on at t = 0 */
+	double transient;     /* s: transport velocity ignores t < transient */
+} sim_scene;
+
+/* Integrator choice. dt: fixed step (or macro step) in s; rtol/atol for
+ * adaptive methods; substeps: feed sub-steps per macro step (method "dem"). */
+typedef struct sim_method {
+	char name[24];
+	double dt;
+	double rtol, atol;
+	int substeps;
+} sim_method;
+
+/* Description of one named setting, for validation, docs and OpenAPI. */
+typedef enum { SIM_KIND_REAL, SIM_KIND_INT, SIM_KIND_BOOL, SIM_KIND_ENUM } sim_kind;
+typedef struct sim_setting {
+	const char *name;     /* MODEL.md name, e.g. "beta", "k_s1" */
+	const char *group;    /* "params", "scene" or "integrator" */
+	sim_kind kind;
+	const char *unit;     /* as the user writes it: "deg", "N/m", ... */
+	double min, max;      /* allowed closed range in user units */
+	const char *choices;  /* SIM_KIND_ENUM: "cw|ccw" (index = value) */
+	const char *doc;
+} sim_setting;
+
+/* The table of every named setting; *n receives its length. Static. */
+const sim_setting *sim_settings(size_t *n);
+
+/* The czubak2016 preset (MODEL.md), default scene and default method. */
+void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
+
+/* Names of known presets, NULL-terminated, static. Fill by name. */
+extern const char *const sim_preset_names[];
+int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m);
+
+/* Set one named setting from a number in user units (beta in degrees; enum
+ * and bool settings take their index 0/1/...). Checks range and finiteness.
+ * On error returns SIM_EPARAM or SIM_EUNKNOWN and, if msg != NULL, writes a
+ * sentence naming the setting and its range into msg (msglen bytes). */
+int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name,
+	    double value, char *msg, size_t msglen);
+/* The same for a string value: enum choices ("cw", "ideal", "rk4" for
+ * the integrator "method") or a number. */
+int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
+		const char *value, char *msg, size_t msglen);
+/* Read one named setting in user units; SIM_EUNKNOWN if no such name. */
+int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
+	    const char *name, double *value);
+
+/* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
+ * method). Same error convention as sim_set. */
+int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m,
+		 char *msg, size_t msglen);
+
+/* ---- integrators ----------------------------------------------------- */
+
+typedef struct sim_method_info {
+	const char *name;
+	int order;        /* classical order on smooth problems */
+	int adaptive;     /* 1 if rtol/atol drive the step */
+	const char *doc;
+} sim_method_info;
+/* Registry of integrators; *n receives the count. Static. */
+const sim_method_info *sim_methods(size_t *n);
+
+/* ---- instances ------------------------------------------------------- */
+
+typedef struct sim sim;
+
+/* Create an instance in static equilibrium at t = 0 (feed settled). The
+ * arguments are copied. Returns NULL on error and sets *err (may be NULL)
+ * and msg as sim_validate does. The instance allocates its whole
+ * workspace here; stepping never allocates. */
+sim *sim_new(const sim_params *p, const sim_scene *s, const sim_method *m,
+	     int *err, char *msg, size_t msglen);
+/* Free an instance; NULL is accepted. */
+void sim_free(sim *s);
+
+/* Advance the observed time to t_end (s, >= current). Fixed-step methods
+ * shorten the last step to land on t_end; adaptive methods step past and
+ * interpolate (dense output), so the integrator may stand ahead of the
+ * observed time. Returns SIM_OK, SIM_ETIME, or SIM_EDIVERGED / SIM_ESTEP
+ * (the instance is then frozen; sim_last_error() tells time and cause). */
+int sim_advance(sim *s, double t_end);
+const char *sim_last_error(const sim *s);
+
+/* ---- controls (take effect at sim_effective_time()) ------------------ */
+
+/* Time (s) at which a control set now takes effect: the integrator's time. */
+double sim_effective_time(const sim *s);
+/* Ramp beta to target_deg (deg, within the beta range) at rate_deg_s
+ * (deg/s, > 0; <= 0 keeps the current rate). Returns SIM_OK or SIM_EPARAM. */
+int sim_set_beta(sim *s, double target_deg, double rate_deg_s);
+int sim_set_rotation(sim *s, int rotation);    /* SIM_CW / SIM_CCW */
+int sim_set_omega_ss(sim *s, double omega_ss); /* rad/s */
+int sim_set_drive_on(sim *s, int on);
+
+/* ---- observables at the observed time -------------------------------- */
+
+enum {
+	SIM_RED_NO_FEED = 1 << 0,
+	SIM_RED_SYMMETRIC = 1 << 1,
+	SIM_RED_IDEAL_DRIVE = 1 << 2,
+	SIM_RED_ONE_WAY = 1 << 3,
+};
+/* Name of reduction bit i (0..3), NULL past the end. */
+const char *sim_reduction_name(int bit);
+
+typedef struct sim_status {
+	double t;                 /* s observed time */
+	double t_int;             /* s integrator time */
+	double beta, beta_dot;    /* rad, rad/s now */
+	double beta_target;       /* rad */
+	int rotation;             /* SIM_CW / SIM_CCW commanded */
+	int drive_on;
+	double omega_ss;          /* rad/s commanded */
+	double q[6], qd[6];       /* x y alpha phi s1 s2 and rates */
+	double rotor_speed;       /* rad/s, phi' - alpha' */
+	double motor_torque;      /* N m on the rotor */
+	double power;             /* W, torque * rotor_speed */
+	double deck[2], deck_vel[2]; /* centre deck point displacement, m, m/s */
+	double feed_displacement; /* m, mean over all elements since t = 0 */
+	double transport_velocity;/* m/s: slope of feed_displacement over the
+				     whole excitation periods since the
+				     estimator start (scene.transient or the
+				     last sim_restart_transport); NaN before
+				     one whole period */
+	double transport_periods; /* whole periods the estimate spans */
+	double feed_velocity;     /* m/s: mean over the last whole period (NaN
+				     before one); for reversal detection */
+	double period;            /* s: length of the last whole period */
+	double e_input, e_kinetic, e_potential, e_dissipated; /* J */
+	double e_residual;        /* J: stored change + dissipated - input */
+	uint64_t steps, rhs_evals;
+	unsigned reductions;      /* SIM_RED_* bits */
+	int n_dof;                /* integrated machine + feed coordinates */
+} sim_status;
+
+void sim_get_status(const sim *s, sim_status *st);
+
+/* Restart the transport-velocity estimator at the next period boundary
+ * (for example after a beta change, to measure the new steady state). */
+void sim_restart_transport(sim *s);
+
+/* Create a fresh instance, run it to t_end (s) and return its transport
+ * velocity (m/s) in *v; msg as sim_new. For sweeps (thread-safe). */
+int sim_measure_velocity(const sim_params *p, const sim_scene *s,
+			 const sim_method *m, double t_end, double *v,
+			 char *msg, size_t msglen);
+
+/* Feed geometry of the instance. */
+int sim_columns(const sim *s);
+int sim_layers(const sim *s);
+/* Per column k: mean feed displacement xi_bar_k(t) - xi_bar_k(0), m.
+ * out has sim_columns() entries. Zeros when there is no feed. */
+void sim_column_displacement(const sim *s, double *out);
+/* Deck points: out[2k], out[2k+1] = displacement (x, y) of column k's deck
+ * point from its rest position, m. sim_columns() pairs. */
+void sim_deck_points(const sim *s, double *out);
+/* Feed elements: xi[k*L + j], eta[k*L + j] (layer j = 0 bottom), absolute, m.
+ * Either may be NULL. */
+void sim_feed_state(const sim *s, double *xi, double *eta);
+
+#endif
