@@ -1,0 +1,539 @@
+/*
+ * api.js - the dashboard's one link to the convsimd daemon.
+ *
+ * Everything that knows a URL, a request body or a JSON field name of the
+ * daemon's /api/v1 lives here. The rest of the page sees only the plain
+ * objects the normalize* functions return (units: SI, beta in degrees,
+ * rotation "cw"/"ccw"). When the API renames a field, change the lookup
+ * lists in FIELDS below; nothing else should need to move.
+ *
+ * Errors: a refused request throws ApiError carrying the problem+json body
+ * (RFC 9457: type, title, status, detail and any extension members such as
+ * the offending field and its range); an unreachable daemon throws
+ * NetworkError. This module touches no DOM and runs under node:test.
+ */
+
+export const BASE = '/api/v1';
+
+/* Alternative names for each normalized field, first match wins. A dotted
+ * name looks inside nested objects ("status.t" = raw.status.t). */
+export const FIELDS = {
+	session: {
+		id: ['id', 'session_id'],
+		t: ['status.t', 't', 'time', 'status.time'],
+		beta: ['status.beta.now', 'beta.now', 'status.beta', 'beta_now', 'status.beta_now', 'beta'],
+		betaTarget: ['status.beta.target', 'beta.target', 'status.beta_target', 'beta_target'],
+		betaRate: ['status.beta.rate', 'beta.rate', 'status.beta_rate', 'beta_rate', 'spec.params.beta_rate'],
+		rotation: ['status.rotation', 'rotation', 'spec.params.rotation', 'params.rotation'],
+		rotorSpeed: ['status.rotor_speed', 'rotor_speed', 'status.rotor.speed', 'rotor.speed'],
+		omegaSs: ['status.omega_ss', 'omega_ss', 'spec.params.omega_ss', 'params.omega_ss'],
+		transportVelocity: ['status.transport_velocity', 'transport_velocity', 'status.transport.velocity', 'transport.velocity'],
+		feedVelocity: ['status.feed_velocity', 'feed_velocity'],
+		running: ['status.running', 'running'],
+		state: ['status.state', 'state'],
+		pace: ['status.pace', 'pace', 'spec.pace'],
+		realTimeFactor: ['status.real_time_factor', 'real_time_factor', 'status.rtf', 'rtf'],
+		stepsPerSecond: ['status.steps_per_s', 'steps_per_s', 'status.steps_per_second', 'steps_per_second'],
+		steps: ['status.steps', 'steps'],
+		reductions: ['status.reductions', 'reductions', 'model.reductions'],
+		columns: ['spec.scene.columns', 'scene.columns', 'status.columns', 'columns'],
+		layers: ['spec.scene.layers', 'scene.layers', 'status.layers', 'layers'],
+		feed: ['spec.scene.feed', 'scene.feed'],
+		drive: ['spec.scene.drive', 'scene.drive'],
+		method: ['spec.integrator.method', 'integrator.method'],
+		preset: ['spec.preset', 'preset'],
+		error: ['status.error', 'error'],
+	},
+	sample: {
+		index: ['i', 'index', 'sample'],
+		t: ['t', 'time'],
+		beta: ['beta', 'beta_now'],
+		rotation: ['rotation'],
+		deck: ['orbit.deck', 'orbit', 'deck'],
+		trough: ['trough'],
+		rotorSpeed: ['rotor.speed', 'rotor.rotor_speed', 'rotor.omega', 'rotor_speed', 'rotor'],
+		motorTorque: ['rotor.torque', 'rotor.motor_torque', 'motor_torque'],
+		strokes: ['eliminators.s', 'eliminators.strokes', 'eliminators', 'strokes'],
+		columns: ['feed.columns', 'feed.column_displacement', 'feed.displacement', 'feed.xi', 'feed'],
+		feedMean: ['feed.mean', 'feed.feed_displacement', 'feed_displacement'],
+		transportVelocity: ['transport_velocity', 'feed.transport_velocity'],
+	},
+	control: {
+		t: ['t', 'time', 't_effective', 'effective_t', 'at'],
+		beta: ['beta', 'beta_target', 'target'],
+		betaRate: ['beta_rate'],
+		rotation: ['rotation'],
+		running: ['running'],
+		omegaSs: ['omega_ss'],
+		pace: ['pace'],
+	},
+	sweep: {
+		id: ['id'],
+		state: ['status.state', 'state', 'status'],
+		progress: ['progress.fraction', 'progress', 'status.progress'],
+		done: ['progress.done', 'done', 'completed'],
+		total: ['progress.total', 'total'],
+		results: ['results', 'points', 'result', 'data'],
+	},
+	experiment: {
+		id: ['id'],
+		state: ['status.state', 'state', 'status'],
+		progress: ['progress.fraction', 'progress', 'status.progress'],
+		t: ['t', 'status.t', 'progress.t'],
+		tEnd: ['t_end', 'spec.t_end'],
+		segments: ['segments', 'results.segments', 'result.segments', 'results'],
+		trace: ['trace', 'results.trace', 'feed_velocity'],
+		sessionId: ['session_id', 'session', 'session.id'],
+	},
+};
+
+/* ---- small value helpers ---------------------------------------------- */
+
+function lookup(obj, path) {
+	let v = obj;
+	for (const key of path.split('.')) {
+		if (v === null || typeof v !== 'object' || !(key in v)) return undefined;
+		v = v[key];
+	}
+	return v;
+}
+
+/* First value found under any of the paths (undefined if none). */
+export function pick(obj, paths) {
+	if (obj === null || typeof obj !== 'object') return undefined;
+	for (const p of paths) {
+		const v = lookup(obj, p);
+		if (v !== undefined) return v;
+	}
+	return undefined;
+}
+
+/* A finite number or NaN (JSON null, strings and objects become NaN). */
+export function num(v) {
+	if (typeof v === 'number') return Number.isFinite(v) ? v : NaN;
+	if (typeof v === 'string' && v.trim() !== '') {
+		const x = Number(v);
+		return Number.isFinite(x) ? x : NaN;
+	}
+	return NaN;
+}
+
+/* "cw"/"ccw" from the API's spellings (strings, or the core's -1/+1). */
+export function rotationName(v) {
+	if (v === -1 || v === 'cw' || v === 'CW' || v === 'clockwise') return 'cw';
+	if (v === 1 || v === 'ccw' || v === 'CCW' || v === 'counterclockwise' || v === 'counter-clockwise') return 'ccw';
+	return undefined;
+}
+
+/* A number list from an array, or from an object's values in key order
+ * ({s1, s2} or {x, y}); [] when absent. */
+export function numList(v, keys) {
+	if (Array.isArray(v)) return v.map(num);
+	if (v && typeof v === 'object') {
+		if (keys) return keys.map(k => num(v[k]));
+		return Object.values(v).filter(x => typeof x === 'number' || x === null).map(num);
+	}
+	if (typeof v === 'number') return [num(v)];
+	return [];
+}
+
+/* ---- normalizers ------------------------------------------------------- */
+
+function scalar(raw, paths) {
+	const v = pick(raw, paths);
+	if (v && typeof v === 'object') return NaN;
+	return num(v);
+}
+
+function reductionList(v) {
+	if (!v) return [];
+	const list = Array.isArray(v) ? v : Object.entries(v).map(([name, r]) =>
+		(r && typeof r === 'object') ? { name, ...r } : (r ? { name } : null)).filter(Boolean);
+	return list.map(r => typeof r === 'string' ? { name: r, speedup: NaN, error: NaN } : {
+		name: String(r.name ?? r.reduction ?? r.id ?? '?'),
+		speedup: num(r.speedup ?? r.speed_up),
+		error: num(r.error ?? r.measured_error ?? r.max_error),
+	});
+}
+
+/* A session resource (POST answer, GET item, list element) as
+ * {id, t, beta, betaTarget, rotation, rotorSpeed, transportVelocity, ...}. */
+export function normalizeSession(raw) {
+	const F = FIELDS.session;
+	const state = pick(raw, F.state);
+	let running = pick(raw, F.running);
+	if (typeof running !== 'boolean')
+		running = typeof state === 'string' ? /run/i.test(state) : undefined;
+	const pace = pick(raw, F.pace);
+	return {
+		id: pick(raw, F.id) !== undefined ? String(pick(raw, F.id)) : undefined,
+		t: scalar(raw, F.t),
+		beta: scalar(raw, F.beta),
+		betaTarget: scalar(raw, F.betaTarget),
+		betaRate: scalar(raw, F.betaRate),
+		rotation: rotationName(pick(raw, F.rotation)),
+		rotorSpeed: scalar(raw, F.rotorSpeed),
+		omegaSs: scalar(raw, F.omegaSs),
+		transportVelocity: scalar(raw, F.transportVelocity),
+		feedVelocity: scalar(raw, F.feedVelocity),
+		running,
+		state: typeof state === 'string' ? state : (running === false ? 'paused' : running ? 'running' : ''),
+		pace: pace === 'max' ? 'max' : num(pace),
+		realTimeFactor: scalar(raw, F.realTimeFactor),
+		stepsPerSecond: scalar(raw, F.stepsPerSecond),
+		steps: scalar(raw, F.steps),
+		reductions: reductionList(pick(raw, F.reductions)),
+		columns: scalar(raw, F.columns),
+		layers: scalar(raw, F.layers),
+		feed: pick(raw, F.feed),
+		drive: pick(raw, F.drive),
+		method: pick(raw, F.method),
+		preset: pick(raw, F.preset),
+		error: pick(raw, F.error),
+	};
+}
+
+/* One stream sample as {index, t, beta, deck:[x,y], trough:[x,y,alpha],
+ * rotorSpeed, motorTorque, strokes:[s1,s2], columns:[...], feedMean}. */
+export function normalizeSample(raw, eventId) {
+	const F = FIELDS.sample;
+	const index = num(pick(raw, F.index));
+	let columns = pick(raw, F.columns);
+	if (columns && !Array.isArray(columns) && typeof columns === 'object') columns = undefined;
+	columns = numList(columns);
+	let feedMean = scalar(raw, F.feedMean);
+	if (!Number.isFinite(feedMean) && columns.length)
+		feedMean = columns.reduce((a, b) => a + b, 0) / columns.length;
+	const rotor = pick(raw, F.rotorSpeed);
+	return {
+		index: Number.isFinite(index) ? index : num(eventId),
+		t: scalar(raw, F.t),
+		beta: scalar(raw, F.beta),
+		rotation: rotationName(pick(raw, F.rotation)),
+		deck: numList(pick(raw, F.deck), ['x', 'y']).slice(0, 2),
+		trough: numList(pick(raw, F.trough), ['x', 'y', 'alpha']),
+		rotorSpeed: typeof rotor === 'object' ? NaN : num(rotor),
+		motorTorque: scalar(raw, F.motorTorque),
+		strokes: numList(pick(raw, F.strokes), ['s1', 's2']).slice(0, 2),
+		columns,
+		feedMean,
+		transportVelocity: scalar(raw, F.transportVelocity),
+	};
+}
+
+/* A control event (or a PATCH answer) as {t, beta, betaRate, rotation,
+ * running, omegaSs, pace}; absent members stay undefined/NaN. */
+export function normalizeControl(raw) {
+	const F = FIELDS.control;
+	const running = pick(raw, F.running);
+	return {
+		t: scalar(raw, F.t),
+		beta: scalar(raw, F.beta),
+		betaRate: scalar(raw, F.betaRate),
+		rotation: rotationName(pick(raw, F.rotation)),
+		running: typeof running === 'boolean' ? running : undefined,
+		omegaSs: scalar(raw, F.omegaSs),
+		pace: pick(raw, F.pace),
+	};
+}
+
+function progressOf(raw, F) {
+	let p = pick(raw, F.progress);
+	if (p && typeof p === 'object') p = p.fraction ?? (p.total ? p.done / p.total : undefined);
+	p = num(p);
+	if (!Number.isFinite(p) && F.done) {
+		const done = num(pick(raw, F.done)), total = num(pick(raw, F.total));
+		if (total > 0) p = done / total;
+	}
+	if (p > 1.0001) p /= 100; /* a percentage */
+	return p;
+}
+
+function stateOf(raw, F) {
+	const s = pick(raw, F.state);
+	return typeof s === 'string' ? s : (s && typeof s.state === 'string' ? s.state : '');
+}
+
+/* v(beta) points of a sweep, flattened to [{beta, rotation, v}]. Accepts a
+ * list of points or an object keyed by rotation holding lists or columns. */
+export function sweepPoints(results) {
+	const out = [];
+	const push = (beta, rotation, v) => {
+		const b = num(beta);
+		if (Number.isFinite(b)) out.push({ beta: b, rotation: rotationName(rotation), v: num(v) });
+	};
+	const vOf = p => p.transport_velocity ?? p.v ?? p.velocity;
+	if (Array.isArray(results)) {
+		for (const p of results) if (p && typeof p === 'object') push(p.beta, p.rotation, vOf(p));
+	} else if (results && typeof results === 'object') {
+		for (const [rot, list] of Object.entries(results)) {
+			if (Array.isArray(list)) {
+				for (const p of list) if (p && typeof p === 'object') push(p.beta, p.rotation ?? rot, vOf(p));
+			} else if (list && Array.isArray(list.beta)) {
+				const vs = list.transport_velocity ?? list.v ?? [];
+				list.beta.forEach((b, i) => push(b, rot, vs[i]));
+			}
+		}
+	}
+	return out.filter(p => p.rotation);
+}
+
+export function normalizeSweep(raw) {
+	const F = FIELDS.sweep;
+	const state = stateOf(raw, F);
+	return {
+		id: pick(raw, F.id) !== undefined ? String(pick(raw, F.id)) : undefined,
+		state,
+		progress: progressOf(raw, F),
+		points: sweepPoints(pick(raw, F.results)),
+		done: isFinished(state),
+		failed: isFailed(state),
+		error: raw && (raw.error ?? raw.detail),
+	};
+}
+
+export function normalizeExperiment(raw) {
+	const F = FIELDS.experiment;
+	const state = stateOf(raw, F);
+	let segs = pick(raw, F.segments);
+	if (!Array.isArray(segs)) segs = [];
+	const segments = segs.filter(s => s && typeof s === 'object').map(s => ({
+		beta: num(s.beta ?? s.beta_deg ?? s.target),
+		tStart: num(s.t_start ?? s.from ?? s.t),
+		tEnd: num(s.t_end ?? s.to ?? s.until),
+		v: num(s.transport_velocity ?? s.steady_velocity ?? s.v_steady ?? s.v),
+		reversalTime: num(s.reversal_time ?? s.t_reversal ?? s.reversal),
+	}));
+	const trace = pick(raw, F.trace);
+	let traceT = [], traceV = [];
+	if (trace && Array.isArray(trace.t)) {
+		traceT = trace.t.map(num);
+		traceV = (trace.v ?? trace.feed_velocity ?? trace.velocity ?? []).map(num);
+	} else if (Array.isArray(trace)) {
+		for (const p of trace) {
+			if (Array.isArray(p)) { traceT.push(num(p[0])); traceV.push(num(p[1])); }
+			else if (p && typeof p === 'object') { traceT.push(num(p.t)); traceV.push(num(p.v ?? p.feed_velocity)); }
+		}
+	}
+	const sid = pick(raw, F.sessionId);
+	return {
+		id: pick(raw, F.id) !== undefined ? String(pick(raw, F.id)) : undefined,
+		state,
+		progress: progressOf(raw, F),
+		t: scalar(raw, F.t),
+		tEnd: scalar(raw, F.tEnd),
+		segments,
+		trace: { t: traceT, v: traceV },
+		sessionId: sid !== undefined && typeof sid !== 'object' ? String(sid) : undefined,
+		done: isFinished(state),
+		failed: isFailed(state),
+		error: raw && (raw.error ?? raw.detail),
+	};
+}
+
+export function isFinished(state) {
+	return /^(done|finished|complete|completed|succeeded|success|ok|failed|error|cancel+ed)$/i.test(state || '');
+}
+export function isFailed(state) {
+	return /^(failed|error|cancel+ed)$/i.test(state || '');
+}
+
+/* A preset list from {presets:[...]}, [...] of names, or [...] of objects. */
+export function normalizePresets(raw) {
+	let list = Array.isArray(raw) ? raw : (raw && (raw.presets ?? raw.items)) ?? [];
+	if (!Array.isArray(list) && typeof list === 'object') list = Object.keys(list);
+	return list.map(p => typeof p === 'string' ? { name: p, doc: '' }
+		: { name: String(p.name ?? p.id), doc: String(p.doc ?? p.description ?? p.title ?? ''), params: p.params, scene: p.scene, integrator: p.integrator });
+}
+
+/* ---- request bodies ---------------------------------------------------- */
+
+/* The POST /sessions body from the form's values (see main.js readForm). */
+export function sessionRequest(f) {
+	const body = {
+		preset: f.preset,
+		params: { beta: f.beta, rotation: f.rotation },
+		scene: { columns: f.columns, layers: f.layers, feed: f.feed, drive: f.drive },
+		integrator: { method: f.method },
+		pace: f.pace,
+	};
+	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.params.beta_rate = f.betaRate;
+	if (Number.isFinite(f.dt) && f.dt > 0) body.integrator.dt = f.dt;
+	return body;
+}
+
+export function sweepRequest(f) {
+	return {
+		preset: f.preset,
+		params: {},
+		scene: { columns: f.columns, layers: f.layers, feed: true, drive: f.drive },
+		integrator: { method: f.method },
+		beta: { from: f.from, to: f.to, step: f.step },
+		rotations: ['cw', 'ccw'],
+		t_end: f.tEnd,
+	};
+}
+
+export function experimentRequest(f) {
+	return {
+		preset: f.preset,
+		params: { beta: f.beta1, rotation: f.rotation },
+		scene: { columns: f.columns, layers: f.layers, feed: true, drive: f.drive },
+		integrator: { method: f.method },
+		schedule: [{ t: 0, beta: f.beta1 }, { t: f.tSwitch, beta: f.beta2 }],
+		t_end: f.tEnd,
+	};
+}
+
+/* Query string of the stream: which fields, samples per simulated second. */
+export function streamQuery(opts = {}) {
+	const q = new URLSearchParams();
+	q.set('fields', (opts.fields ?? ['trough', 'orbit', 'rotor', 'eliminators', 'feed']).join(','));
+	if (opts.rate) q.set('rate', String(opts.rate));
+	return q.toString();
+}
+
+/* ---- errors ------------------------------------------------------------ */
+
+export class ApiError extends Error {
+	constructor(status, problem) {
+		const p = problem && typeof problem === 'object' ? problem : {};
+		const detail = p.detail || p.title || (typeof problem === 'string' && problem) || `HTTP ${status}`;
+		super(detail);
+		this.name = 'ApiError';
+		this.status = status;
+		this.problem = p;
+		this.title = p.title || '';
+		this.detail = detail;
+		this.field = p.field ?? p.name ?? p.parameter ?? p.pointer;
+	}
+}
+
+export class NetworkError extends Error {
+	constructor(cause) {
+		super('The convsim daemon does not answer. Is build/convsimd running, and is this page served by it?');
+		this.name = 'NetworkError';
+		this.cause = cause;
+	}
+}
+
+/* ---- HTTP -------------------------------------------------------------- */
+
+async function request(method, path, body) {
+	const init = { method, headers: { Accept: 'application/json, application/problem+json' } };
+	if (body !== undefined) {
+		init.headers['Content-Type'] = 'application/json';
+		init.body = JSON.stringify(body);
+	}
+	let res;
+	try {
+		res = await fetch(BASE + path, init);
+	} catch (e) {
+		throw new NetworkError(e);
+	}
+	const text = await res.text().catch(() => '');
+	let data = null;
+	if (text) {
+		try { data = JSON.parse(text); } catch { data = text; }
+	}
+	if (!res.ok) throw new ApiError(res.status, data);
+	return { data, status: res.status, location: res.headers.get('Location') };
+}
+
+const enc = encodeURIComponent;
+
+export async function health() {
+	return (await request('GET', '/health')).data;
+}
+export async function presets() {
+	return normalizePresets((await request('GET', '/presets')).data);
+}
+export async function listSessions() {
+	const d = (await request('GET', '/sessions')).data;
+	const list = Array.isArray(d) ? d : (d && (d.sessions ?? d.items)) ?? [];
+	return list.map(normalizeSession);
+}
+export async function createSession(form) {
+	const r = await request('POST', '/sessions', sessionRequest(form));
+	const s = normalizeSession(r.data);
+	if (s.id === undefined && r.location) s.id = r.location.split('/').pop();
+	return s;
+}
+export async function getSession(id) {
+	return normalizeSession((await request('GET', `/sessions/${enc(id)}`)).data);
+}
+/* patch: any of {beta, beta_rate, rotation, omega_ss, running, pace}. */
+export async function patchSession(id, patch) {
+	const d = (await request('PATCH', `/sessions/${enc(id)}`, patch)).data;
+	return { raw: d, control: normalizeControl(d), session: normalizeSession(d) };
+}
+export async function deleteSession(id) {
+	await request('DELETE', `/sessions/${enc(id)}`);
+}
+export async function createSweep(form) {
+	return normalizeSweep((await request('POST', '/sweeps', sweepRequest(form))).data);
+}
+export async function getSweep(id) {
+	return normalizeSweep((await request('GET', `/sweeps/${enc(id)}`)).data);
+}
+export async function createExperiment(form) {
+	return normalizeExperiment((await request('POST', '/experiments', experimentRequest(form))).data);
+}
+export async function getExperiment(id) {
+	return normalizeExperiment((await request('GET', `/experiments/${enc(id)}`)).data);
+}
+
+/* Open the session's SSE stream. handlers: sample(s), control(c, raw),
+ * dropped(n), open(), error(), end(). Returns {close()}. The browser's
+ * EventSource resumes by itself with Last-Event-ID after a drop. */
+export function openStream(id, opts, handlers) {
+	const url = `${BASE}/sessions/${enc(id)}/stream?${streamQuery(opts)}`;
+	const es = new EventSource(url);
+	const h = handlers;
+	const dispatch = (type, ev) => {
+		let d;
+		try { d = JSON.parse(ev.data); } catch { return; }
+		const kind = (d && typeof d === 'object' && !Array.isArray(d) && (d.type ?? d.event)) || type;
+		if (/control|change|command/i.test(kind)) {
+			h.control?.(normalizeControl(d.control ?? d), d);
+		} else if (/drop|miss|lag/i.test(kind)) {
+			h.dropped?.(num(d.dropped ?? d.missed ?? d.count ?? d.n));
+		} else if (/end|close|stop|done|error/i.test(kind) && !/sample/i.test(kind)) {
+			h.end?.(d);
+		} else if (Array.isArray(d)) {
+			for (const s of d) h.sample?.(normalizeSample(s));
+		} else if (d && Array.isArray(d.samples)) {
+			for (const s of d.samples) h.sample?.(normalizeSample(s));
+		} else {
+			h.sample?.(normalizeSample(d.sample ?? d, ev.lastEventId));
+			if (typeof d.dropped === 'number' && d.dropped > 0) h.dropped?.(d.dropped);
+		}
+	};
+	for (const type of ['message', 'sample', 'samples', 'control', 'dropped', 'missed', 'end', 'status'])
+		es.addEventListener(type, ev => dispatch(type, ev));
+	es.onopen = () => h.open?.();
+	es.onerror = () => h.error?.(es.readyState);
+	return { close: () => es.close(), source: es };
+}
+
+/* Integrator names: the enum of a "method" property anywhere in the
+ * daemon's OpenAPI document; [] if it has none. */
+export function methodEnum(doc) {
+	const seen = new Set();
+	const walk = v => {
+		if (!v || typeof v !== 'object' || seen.has(v)) return undefined;
+		seen.add(v);
+		const m = v.properties?.method;
+		if (m && Array.isArray(m.enum)) return m.enum.map(String);
+		for (const x of Object.values(v)) {
+			const r = walk(x);
+			if (r) return r;
+		}
+		return undefined;
+	};
+	return walk(doc) ?? [];
+}
+
+export async function integratorNames() {
+	return methodEnum((await request('GET', '/openapi.json')).data);
+}

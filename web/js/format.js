@@ -1,0 +1,90 @@
+/*
+ * format.js - numbers, units and directions as the dashboard shows them.
+ * SI throughout (displacements in mm where metres would be all zeros),
+ * beta in degrees. No DOM here; node:test covers it.
+ */
+
+export const DASH = '–';
+
+/* Fixed-point text with a unit, or a dash for a missing value. */
+export function fmt(v, digits = 3, unit = '') {
+	if (!Number.isFinite(v)) return DASH;
+	const s = v.toFixed(digits);
+	const z = /^-0\.?0*$/.test(s) ? s.slice(1) : s; /* no "-0.000" */
+	return unit ? `${z} ${unit}` : z;
+}
+
+/* Significant-digit text for values of any magnitude (steps/s, speed-ups). */
+export function fmtSig(v, sig = 3, unit = '') {
+	if (!Number.isFinite(v)) return DASH;
+	let s;
+	const a = Math.abs(v);
+	if (a !== 0 && (a >= 1e6 || a < 1e-3)) s = v.toExponential(sig - 1);
+	else s = String(Number(v.toPrecision(sig)));
+	return unit ? `${s} ${unit}` : s;
+}
+
+/* Simulated time as "12.345 s". */
+export function fmtTime(t) {
+	return fmt(t, 3, 's');
+}
+
+/* Transport direction from a velocity (m/s): "right", "left" or "still"
+ * when |v| is below `still` (default 1 mm/s), or "" when unknown. */
+export function direction(v, still = 1e-3) {
+	if (!Number.isFinite(v)) return '';
+	if (Math.abs(v) < still) return 'still';
+	return v > 0 ? 'right' : 'left';
+}
+
+export const ARROW = { right: '→', left: '←', still: '·', '': DASH };
+
+/* Velocity with explicit sign, m/s: "+0.123 m/s". */
+export function fmtVelocity(v, digits = 3) {
+	if (!Number.isFinite(v)) return DASH;
+	const s = fmt(v, digits);
+	return (v > 0 && Number(s) !== 0 ? '+' : '') + s + ' m/s';
+}
+
+/* beta reduced to [0, 180) degrees: beta is periodic with 180 degrees. */
+export function wrapBeta(deg) {
+	if (!Number.isFinite(deg)) return NaN;
+	const r = ((deg % 180) + 180) % 180;
+	return r === 180 ? 0 : r;
+}
+
+export const RAD_S_TO_RPM = 60 / (2 * Math.PI);
+
+export function rotationLabel(r) {
+	return r === 'cw' ? 'clockwise' : r === 'ccw' ? 'counter-clockwise' : DASH;
+}
+
+/* Pace as shown: "max" or "1×". */
+export function fmtPace(p) {
+	if (p === 'max') return 'max';
+	return Number.isFinite(p) ? `${fmtSig(p, 3)}×` : DASH;
+}
+
+/* Parse the pace field: "max" or a positive number; undefined if neither. */
+export function parsePace(text) {
+	const s = String(text).trim().toLowerCase();
+	if (s === 'max') return 'max';
+	const x = Number(s);
+	return Number.isFinite(x) && x > 0 ? x : undefined;
+}
+
+/* The text of a refused request: the problem's title, detail and the
+ * field it names, each once. */
+export function problemText(err) {
+	if (!err) return '';
+	const p = err.problem || {};
+	const parts = [];
+	const detail = p.detail || err.detail || err.message || '';
+	if (p.title && !detail.toLowerCase().startsWith(String(p.title).toLowerCase())) parts.push(p.title + ':');
+	parts.push(detail);
+	const field = err.field ?? p.field;
+	if (field && !detail.includes(String(field))) parts.push(`(field: ${field})`);
+	const status = err.status ?? p.status;
+	const head = status ? `${status} ` : '';
+	return head + parts.join(' ').trim();
+}

@@ -1,0 +1,231 @@
+/*
+ * plots.js - the dashboard's charts, thin wrappers around the vendored uPlot.
+ *
+ * TimePlot: values against simulated time (uPlot's ordinary mode, shared x).
+ * XYPlot:   curves in the plane (uPlot's mode 2, one [xs, ys] pair per
+ *           series) drawn as polylines in data order, so a closed orbit
+ *           stays closed; optional equal scaling keeps its true shape and so
+ *           its direction.
+ * Each plot resizes with its container and records how many points it
+ * drew in data-points on the container (the browser test reads it).
+ */
+
+import uPlot from '../vendor/uplot/uPlot.esm.js';
+
+export const PALETTE = ['#2563eb', '#dc2626', '#059669', '#d97706', '#7c3aed',
+	'#0891b2', '#db2777', '#65a30d', '#475569', '#b45309'];
+
+const AXIS = {
+	stroke: '#475569',
+	grid: { stroke: '#e2e8f0', width: 1 },
+	ticks: { stroke: '#cbd5e1', width: 1 },
+	font: '11px system-ui, sans-serif',
+	labelFont: '600 11px system-ui, sans-serif',
+};
+
+function axis(label, extra = {}) {
+	return { ...AXIS, label, labelSize: 18, ...extra };
+}
+
+function sizeOf(el, aspect) {
+	const w = Math.max(200, Math.floor(el.clientWidth || 400));
+	const h = Math.max(140, Math.floor(aspect ? w * aspect : (el.clientHeight || 220)));
+	return { width: w, height: h };
+}
+
+function observe(el, plot, aspect, legendRoom) {
+	const ro = new ResizeObserver(() => {
+		const s = sizeOf(el, aspect);
+		if (Math.abs(s.width - plot.width) > 2) plot.setSize({ width: s.width, height: s.height - legendRoom });
+	});
+	ro.observe(el);
+	return ro;
+}
+
+export class TimePlot {
+	/* series: [{label, color, scale ('y' or 'y2'), width, dash}];
+	 * axes: {y: label, y2: label (optional)}; aspect = height / width. */
+	constructor(el, { series, yLabel, y2Label, aspect = 0.55, xLabel = 't / s', yRange, legend = true }) {
+		this.el = el;
+		const s = sizeOf(el, aspect);
+		const legendRoom = legend ? 26 : 0;
+		const scales = { x: { time: false } };
+		if (yRange) scales.y = { range: yRange };
+		if (y2Label) scales.y2 = { auto: true };
+		const axes = [axis(xLabel), axis(yLabel, { size: 56 })];
+		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 56, grid: { show: false } }));
+		this.plot = new uPlot({
+			width: s.width,
+			height: s.height - legendRoom,
+			scales,
+			axes,
+			legend: { show: legend, live: false },
+			cursor: { drag: { x: false, y: false }, points: { size: 5 } },
+			series: [{ label: 't / s', value: (u, v) => v == null ? '–' : v.toFixed(3) },
+				...series.map((d, i) => ({
+					label: d.label,
+					stroke: d.color ?? PALETTE[i % PALETTE.length],
+					width: d.width ?? 1.5,
+					dash: d.dash,
+					scale: d.scale ?? 'y',
+					spanGaps: true,
+					points: { show: false },
+					value: (u, v) => v == null ? '–' : fmtVal(v),
+				}))],
+		}, [[], ...series.map(() => [])], el);
+		this.ro = observe(el, this.plot, aspect, legendRoom);
+		el.dataset.points = '0';
+	}
+
+	setData(cols) {
+		this.plot.setData(cols);
+		this.el.dataset.points = String(cols[0].length);
+	}
+
+	destroy() {
+		this.ro.disconnect();
+		this.plot.destroy();
+	}
+}
+
+function fmtVal(v) {
+	const a = Math.abs(v);
+	if (a !== 0 && (a < 1e-3 || a >= 1e5)) return v.toExponential(3);
+	return v.toPrecision(4);
+}
+
+/* A polyline through the finite points of series sidx (data order), with
+ * optional round markers. Returns uPlot's path object. */
+function polylinePaths(markers) {
+	return (u, sidx) => {
+		const [xs, ys] = u.data[sidx];
+		const s = u.series[sidx];
+		const xk = s.facets[0].scale, yk = s.facets[1].scale;
+		const line = new Path2D();
+		let pen = false;
+		const r = 3 * uPlot.pxRatio;
+		for (let i = 0; i < xs.length; i++) {
+			const x = xs[i], y = ys[i];
+			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) { pen = false; continue; }
+			const X = u.valToPos(x, xk, true), Y = u.valToPos(y, yk, true);
+			if (pen) line.lineTo(X, Y); else line.moveTo(X, Y);
+			pen = true;
+		}
+		if (markers) {
+			for (let i = 0; i < xs.length; i++) {
+				const x = xs[i], y = ys[i];
+				if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) continue;
+				const X = u.valToPos(x, xk, true), Y = u.valToPos(y, yk, true);
+				line.moveTo(X + r, Y);
+				line.arc(X, Y, r, 0, 2 * Math.PI);
+				line.moveTo(X, Y);
+			}
+		}
+		return { stroke: line, fill: null, clip: null, band: null, gaps: null, flags: 0 };
+	};
+}
+
+/* Axis ranges over every finite x and y of the data. */
+export function extent(data) {
+	let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+	for (let i = 1; i < data.length; i++) {
+		const [xs, ys] = data[i];
+		for (let j = 0; j < xs.length; j++) {
+			const x = xs[j], y = ys[j];
+			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) continue;
+			if (x < x0) x0 = x; if (x > x1) x1 = x;
+			if (y < y0) y0 = y; if (y > y1) y1 = y;
+		}
+	}
+	return { x0, x1, y0, y1 };
+}
+
+/* Ranges for equal scaling: both axes get the same units per pixel, the
+ * larger of the two spans (padded by `pad`) decides. w, h: plot box px. */
+export function equalRanges(ext, w, h, pad = 0.12, minSpan = 1e-9) {
+	if (!Number.isFinite(ext.x0)) return { x: [-1, 1], y: [-1, 1] };
+	const cx = (ext.x0 + ext.x1) / 2, cy = (ext.y0 + ext.y1) / 2;
+	const unitsPerPx = Math.max((ext.x1 - ext.x0) / w, (ext.y1 - ext.y0) / h, minSpan / Math.min(w, h)) * (1 + 2 * pad);
+	const hx = unitsPerPx * w / 2, hy = unitsPerPx * h / 2;
+	return { x: [cx - hx, cx + hx], y: [cy - hy, cy + hy] };
+}
+
+function padRange(min, max, pad = 0.08) {
+	if (!Number.isFinite(min) || !Number.isFinite(max)) return [-1, 1];
+	if (max - min < 1e-12) { const d = Math.abs(max) * 0.1 || 1; return [min - d, max + d]; }
+	const d = (max - min) * pad;
+	return [min - d, max + d];
+}
+
+export class XYPlot {
+	/* series: [{label, color}]; equal: keep aspect 1:1 in data units;
+	 * markers: draw a dot per point; zeroLine: draw y = 0. */
+	constructor(el, { series, xLabel, yLabel, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange }) {
+		this.el = el;
+		this.equal = equal;
+		this.xRange = xRange;
+		const s = sizeOf(el, aspect);
+		const legend = series.length > 1;
+		const legendRoom = legend ? 26 : 0;
+		this.ext = extent([]);
+		const self = this;
+		const rangeFn = axisKey => (u, min, max) => {
+			if (self.equal) {
+				const r = equalRanges(self.ext, u.bbox.width || 300, u.bbox.height || 200);
+				return r[axisKey];
+			}
+			if (axisKey === 'x' && self.xRange) return self.xRange;
+			const e = self.ext;
+			return axisKey === 'x' ? padRange(e.x0, e.x1, 0.02) : padRange(Math.min(e.y0, zeroLine ? 0 : e.y0), Math.max(e.y1, zeroLine ? 0 : e.y1));
+		};
+		const hooks = {};
+		if (zeroLine) {
+			hooks.drawAxes = [u => {
+				const ctx = u.ctx;
+				const y = u.valToPos(0, 'y', true);
+				if (y < u.bbox.top || y > u.bbox.top + u.bbox.height) return;
+				ctx.save();
+				ctx.strokeStyle = '#94a3b8';
+				ctx.lineWidth = uPlot.pxRatio;
+				ctx.beginPath();
+				ctx.moveTo(u.bbox.left, y);
+				ctx.lineTo(u.bbox.left + u.bbox.width, y);
+				ctx.stroke();
+				ctx.restore();
+			}];
+		}
+		this.plot = new uPlot({
+			mode: 2,
+			width: s.width,
+			height: s.height - legendRoom,
+			legend: { show: legend, live: false },
+			cursor: { show: false, drag: { x: false, y: false } },
+			scales: { x: { time: false, range: rangeFn('x') }, y: { range: rangeFn('y') } },
+			axes: [axis(xLabel), axis(yLabel, { size: 56 })],
+			hooks,
+			series: [{}, ...series.map((d, i) => ({
+				label: d.label,
+				stroke: d.color ?? PALETTE[i % PALETTE.length],
+				width: d.width ?? 1.5,
+				facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }],
+				paths: polylinePaths(markers),
+				points: { show: false },
+			}))],
+		}, [null, ...series.map(() => [[], []])], el);
+		this.ro = observe(el, this.plot, aspect, legendRoom);
+		el.dataset.points = '0';
+	}
+
+	/* pairs: one [xs, ys] per series. */
+	setData(pairs) {
+		const data = [null, ...pairs];
+		this.ext = extent(data);
+		this.plot.setData(data);
+		this.el.dataset.points = String(pairs.reduce((n, p) => n + p[0].length, 0));
+	}
+
+	destroy() {
+		this.ro.disconnect();
+		this.plot.destroy();
+	}
+}
