@@ -21,8 +21,8 @@ export const FIELDS = {
 	session: {
 		id: ['id', 'session_id'],
 		t: ['status.t', 't', 'time', 'status.time'],
-		beta: ['status.beta.now', 'beta.now', 'status.beta', 'beta_now', 'status.beta_now', 'beta'],
-		betaTarget: ['status.beta.target', 'beta.target', 'status.beta_target', 'beta_target'],
+		beta: ['status.beta', 'status.beta.now', 'beta.now', 'beta_now', 'status.beta_now', 'beta'],
+		betaTarget: ['status.beta_target', 'status.beta.target', 'beta.target', 'beta_target'],
 		betaRate: ['status.beta.rate', 'beta.rate', 'status.beta_rate', 'beta_rate', 'spec.params.beta_rate'],
 		rotation: ['status.rotation', 'rotation', 'spec.params.rotation', 'params.rotation'],
 		rotorSpeed: ['status.rotor_speed', 'rotor_speed', 'status.rotor.speed', 'rotor.speed'],
@@ -30,42 +30,51 @@ export const FIELDS = {
 		transportVelocity: ['status.transport_velocity', 'transport_velocity', 'status.transport.velocity', 'transport.velocity'],
 		feedVelocity: ['status.feed_velocity', 'feed_velocity'],
 		running: ['status.running', 'running'],
-		state: ['status.state', 'state'],
+		state: ['state', 'status.state'],
+		experiment: ['experiment'],
+		sampleRate: ['sample_rate'],
 		pace: ['status.pace', 'pace', 'spec.pace'],
 		realTimeFactor: ['status.real_time_factor', 'real_time_factor', 'status.rtf', 'rtf'],
 		stepsPerSecond: ['status.steps_per_s', 'steps_per_s', 'status.steps_per_second', 'steps_per_second'],
 		steps: ['status.steps', 'steps'],
 		reductions: ['status.reductions', 'reductions', 'model.reductions'],
-		columns: ['spec.scene.columns', 'scene.columns', 'status.columns', 'columns'],
-		layers: ['spec.scene.layers', 'scene.layers', 'status.layers', 'layers'],
+		columns: ['columns', 'spec.scene.columns', 'scene.columns', 'status.columns'],
+		layers: ['layers', 'spec.scene.layers', 'scene.layers', 'status.layers'],
 		feed: ['spec.scene.feed', 'scene.feed'],
 		drive: ['spec.scene.drive', 'scene.drive'],
 		method: ['spec.integrator.method', 'integrator.method'],
-		preset: ['spec.preset', 'preset'],
-		error: ['status.error', 'error'],
+		preset: ['preset', 'spec.preset'],
+		error: ['error', 'status.error'],
 	},
 	sample: {
-		index: ['i', 'index', 'sample'],
+		index: ['i', 'index', 'id'],
 		t: ['t', 'time'],
 		beta: ['beta', 'beta_now'],
+		betaTarget: ['beta_target'],
 		rotation: ['rotation'],
-		deck: ['orbit.deck', 'orbit', 'deck'],
-		trough: ['trough'],
-		rotorSpeed: ['rotor.speed', 'rotor.rotor_speed', 'rotor.omega', 'rotor_speed', 'rotor'],
-		motorTorque: ['rotor.torque', 'rotor.motor_torque', 'motor_torque'],
-		strokes: ['eliminators.s', 'eliminators.strokes', 'eliminators', 'strokes'],
-		columns: ['feed.columns', 'feed.column_displacement', 'feed.displacement', 'feed.xi', 'feed'],
-		feedMean: ['feed.mean', 'feed.feed_displacement', 'feed_displacement'],
+		deckX: ['deck_x', 'orbit.x', 'deck.x'],
+		deckY: ['deck_y', 'orbit.y', 'deck.y'],
+		troughX: ['x', 'trough.x'],
+		troughY: ['y', 'trough.y'],
+		alpha: ['alpha', 'trough.alpha'],
+		phi: ['phi', 'rotor.phi'],
+		rotorSpeed: ['rotor_speed', 'rotor.speed'],
+		motorTorque: ['motor_torque', 'rotor.torque'],
+		s1: ['s1', 'eliminators.s1'],
+		s2: ['s2', 'eliminators.s2'],
+		columns: ['columns', 'feed.columns'],
+		feedMean: ['feed_displacement', 'feed.mean'],
+		feedVelocity: ['feed_velocity', 'feed.velocity'],
 		transportVelocity: ['transport_velocity', 'feed.transport_velocity'],
 	},
 	control: {
-		t: ['t', 'time', 't_effective', 'effective_t', 'at'],
-		beta: ['beta', 'beta_target', 'target'],
-		betaRate: ['beta_rate'],
-		rotation: ['rotation'],
-		running: ['running'],
-		omegaSs: ['omega_ss'],
-		pace: ['pace'],
+		t: ['t_effective', 'effective_t', 't', 'time'],
+		beta: ['applied.beta', 'beta', 'beta_target'],
+		betaRate: ['applied.beta_rate', 'beta_rate'],
+		rotation: ['applied.rotation', 'rotation'],
+		running: ['applied.running', 'running'],
+		omegaSs: ['applied.omega_ss', 'omega_ss'],
+		pace: ['applied.pace', 'pace'],
 	},
 	sweep: {
 		id: ['id'],
@@ -80,10 +89,11 @@ export const FIELDS = {
 		state: ['status.state', 'state', 'status'],
 		progress: ['progress.fraction', 'progress', 'status.progress'],
 		t: ['t', 'status.t', 'progress.t'],
+		tStart: ['t_start'],
 		tEnd: ['t_end', 'spec.t_end'],
 		segments: ['segments', 'results.segments', 'result.segments', 'results'],
 		trace: ['trace', 'results.trace', 'feed_velocity'],
-		sessionId: ['session_id', 'session', 'session.id'],
+		sessionId: ['session', 'session_id', 'session.id'],
 	},
 };
 
@@ -190,34 +200,46 @@ export function normalizeSession(raw) {
 		method: pick(raw, F.method),
 		preset: pick(raw, F.preset),
 		error: pick(raw, F.error),
+		experiment: pick(raw, F.experiment) ?? null,
+		sampleRate: scalar(raw, F.sampleRate),
 	};
 }
 
-/* One stream sample as {index, t, beta, deck:[x,y], trough:[x,y,alpha],
- * rotorSpeed, motorTorque, strokes:[s1,s2], columns:[...], feedMean}. */
+/* One stream sample as {index, t, beta, betaTarget, rotation, deck:[x,y],
+ * trough:[x,y,alpha], phi, rotorSpeed, motorTorque, strokes:[s1,s2],
+ * columns:[...], feedMean, feedVelocity, transportVelocity}; vectors are
+ * [] when the stream does not carry them. */
 export function normalizeSample(raw, eventId) {
 	const F = FIELDS.sample;
-	const index = num(pick(raw, F.index));
+	const v = name => scalar(raw, F[name]);
+	const pair = (a, b) => {
+		const x = v(a), y = v(b);
+		return Number.isFinite(x) || Number.isFinite(y) ? [x, y] : [];
+	};
+	const index = v('index');
 	let columns = pick(raw, F.columns);
-	if (columns && !Array.isArray(columns) && typeof columns === 'object') columns = undefined;
-	columns = numList(columns);
-	let feedMean = scalar(raw, F.feedMean);
+	columns = Array.isArray(columns) ? columns.map(num) : [];
+	let feedMean = v('feedMean');
 	if (!Number.isFinite(feedMean) && columns.length)
 		feedMean = columns.reduce((a, b) => a + b, 0) / columns.length;
-	const rotor = pick(raw, F.rotorSpeed);
+	const trough = pair('troughX', 'troughY');
+	if (trough.length) trough.push(v('alpha'));
 	return {
 		index: Number.isFinite(index) ? index : num(eventId),
-		t: scalar(raw, F.t),
-		beta: scalar(raw, F.beta),
+		t: v('t'),
+		beta: v('beta'),
+		betaTarget: v('betaTarget'),
 		rotation: rotationName(pick(raw, F.rotation)),
-		deck: numList(pick(raw, F.deck), ['x', 'y']).slice(0, 2),
-		trough: numList(pick(raw, F.trough), ['x', 'y', 'alpha']),
-		rotorSpeed: typeof rotor === 'object' ? NaN : num(rotor),
-		motorTorque: scalar(raw, F.motorTorque),
-		strokes: numList(pick(raw, F.strokes), ['s1', 's2']).slice(0, 2),
+		deck: pair('deckX', 'deckY'),
+		trough,
+		phi: v('phi'),
+		rotorSpeed: v('rotorSpeed'),
+		motorTorque: v('motorTorque'),
+		strokes: pair('s1', 's2'),
 		columns,
 		feedMean,
-		transportVelocity: scalar(raw, F.transportVelocity),
+		feedVelocity: v('feedVelocity'),
+		transportVelocity: v('transportVelocity'),
 	};
 }
 
@@ -298,11 +320,15 @@ export function normalizeExperiment(raw) {
 	let segs = pick(raw, F.segments);
 	if (!Array.isArray(segs)) segs = [];
 	const segments = segs.filter(s => s && typeof s === 'object').map(s => ({
-		beta: num(s.beta ?? s.beta_deg ?? s.target),
-		tStart: num(s.t_start ?? s.from ?? s.t),
-		tEnd: num(s.t_end ?? s.to ?? s.until),
-		v: num(s.transport_velocity ?? s.steady_velocity ?? s.v_steady ?? s.v),
-		reversalTime: num(s.reversal_time ?? s.t_reversal ?? s.reversal),
+		beta: num(s.beta ?? s.target),
+		until: num(s.until),
+		state: typeof s.state === 'string' ? s.state : '',
+		tStart: num(s.t_command ?? s.t_start ?? s.from),
+		tEnd: num(s.t_end ?? s.to),
+		v: num(s.steady_velocity ?? s.transport_velocity ?? s.v),
+		meanVelocity: num(s.mean_velocity),
+		startVelocity: num(s.start_velocity),
+		reversalTime: num(s.reversal_time ?? s.t_reversal),
 	}));
 	const trace = pick(raw, F.trace);
 	let traceT = [], traceV = [];
@@ -321,6 +347,7 @@ export function normalizeExperiment(raw) {
 		state,
 		progress: progressOf(raw, F),
 		t: scalar(raw, F.t),
+		tStart: scalar(raw, F.tStart),
 		tEnd: scalar(raw, F.tEnd),
 		segments,
 		trace: { t: traceT, v: traceV },
@@ -346,9 +373,19 @@ export function normalizePresets(raw) {
 		: { name: String(p.name ?? p.id), doc: String(p.doc ?? p.description ?? p.title ?? ''), params: p.params, scene: p.scene, integrator: p.integrator });
 }
 
+/* Integrators as [{name, order, adaptive, doc}] from names or objects. */
+export function normalizeMethods(list) {
+	if (!Array.isArray(list)) return [];
+	return list.map(m => typeof m === 'string' ? { name: m, order: NaN, adaptive: false, doc: '' }
+		: { name: String(m.name), order: num(m.order), adaptive: !!m.adaptive, doc: String(m.doc ?? '') })
+		.filter(m => m.name && m.name !== 'undefined');
+}
+
 /* ---- request bodies ---------------------------------------------------- */
 
-/* The POST /sessions body from the form's values (see main.js readForm). */
+/* The POST /sessions body from the form's values (see main.js readForm):
+ * {preset, params: {beta, rotation[, beta_rate]}, scene: {columns, layers,
+ * feed, drive}, integrator: {method[, dt]}, pace[, sample_rate]}. */
 export function sessionRequest(f) {
 	const body = {
 		preset: f.preset,
@@ -359,37 +396,44 @@ export function sessionRequest(f) {
 	};
 	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.params.beta_rate = f.betaRate;
 	if (Number.isFinite(f.dt) && f.dt > 0) body.integrator.dt = f.dt;
+	if (Number.isFinite(f.rate) && f.rate > 0) body.sample_rate = f.rate;
 	return body;
 }
 
+/* POST /sweeps: the session form's model, a beta grid, both rotations. */
 export function sweepRequest(f) {
-	return {
-		preset: f.preset,
-		params: {},
-		scene: { columns: f.columns, layers: f.layers, feed: true, drive: f.drive },
-		integrator: { method: f.method },
-		beta: { from: f.from, to: f.to, step: f.step },
-		rotations: ['cw', 'ccw'],
-		t_end: f.tEnd,
-	};
+	const body = sessionRequest(f);
+	delete body.pace;
+	delete body.sample_rate;
+	delete body.params.beta;
+	delete body.params.rotation;
+	body.scene.feed = true;
+	body.beta = { from: f.from, to: f.to, step: f.step };
+	body.rotations = ['cw', 'ccw'];
+	body.t_end = f.tEnd;
+	return body;
 }
 
+/* POST /experiments: a fresh session from the form's model (the daemon
+ * runs it at pace "max" unless told otherwise) and the schedule beta1
+ * until tSwitch, then beta2 until tEnd. */
 export function experimentRequest(f) {
-	return {
-		preset: f.preset,
-		params: { beta: f.beta1, rotation: f.rotation },
-		scene: { columns: f.columns, layers: f.layers, feed: true, drive: f.drive },
-		integrator: { method: f.method },
-		schedule: [{ t: 0, beta: f.beta1 }, { t: f.tSwitch, beta: f.beta2 }],
-		t_end: f.tEnd,
+	const session = sessionRequest({ ...f, beta: f.beta1 });
+	session.scene.feed = true;
+	if (f.experimentPace !== undefined) session.pace = f.experimentPace;
+	else delete session.pace;
+	const body = {
+		session,
+		schedule: [{ beta: f.beta1, until: f.tSwitch }, { beta: f.beta2, until: f.tEnd }],
 	};
+	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.beta_rate = f.betaRate;
+	return body;
 }
 
 /* Query string of the stream: which fields, samples per simulated second. */
 export function streamQuery(opts = {}) {
 	const q = new URLSearchParams();
 	q.set('fields', (opts.fields ?? ['trough', 'orbit', 'rotor', 'eliminators', 'feed']).join(','));
-	if (opts.rate) q.set('rate', String(opts.rate));
 	return q.toString();
 }
 
@@ -445,8 +489,11 @@ const enc = encodeURIComponent;
 export async function health() {
 	return (await request('GET', '/health')).data;
 }
-export async function presets() {
-	return normalizePresets((await request('GET', '/presets')).data);
+/* GET /presets: {presets: [{name, doc, params, scene, integrator}],
+ * methods: [{name, order, adaptive, doc}]}. */
+export async function catalog() {
+	const d = (await request('GET', '/presets')).data;
+	return { presets: normalizePresets(d), methods: normalizeMethods(d && d.methods) };
 }
 export async function listSessions() {
 	const d = (await request('GET', '/sessions')).data;
@@ -497,7 +544,7 @@ export function openStream(id, opts, handlers) {
 		if (/control|change|command/i.test(kind)) {
 			h.control?.(normalizeControl(d.control ?? d), d);
 		} else if (/drop|miss|lag/i.test(kind)) {
-			h.dropped?.(num(d.dropped ?? d.missed ?? d.count ?? d.n));
+			h.dropped?.(num(d.missed ?? d.dropped ?? d.count ?? d.n));
 		} else if (/end|close|stop|done|error/i.test(kind) && !/sample/i.test(kind)) {
 			h.end?.(d);
 		} else if (Array.isArray(d)) {

@@ -329,6 +329,8 @@ function onSample(s) {
 	tr.rotor.push(s.t, [s.rotorSpeed, beta]);
 	if (s.columns.length) tr.feed.push(s.t, s.columns.map(x => x * MM));
 	if (Number.isFinite(s.feedMean)) tr.feedMean.push(s.t, [s.feedMean]);
+	if (app.experiment && app.experiment.sessionId === app.id && app.expTrace)
+		app.expTrace.push(s.t, [s.feedVelocity, beta]);
 	app.lastSample = s;
 	app.dirty = true;
 }
@@ -505,6 +507,7 @@ function draw() {
 		betaTarget: s?.betaTarget,
 		rotation: last?.rotation ?? s?.rotation ?? $('#session-form').elements.rotation.value,
 		strokes: last?.strokes,
+		phase: last?.phi,
 		strokeRange: range,
 		columns: app.columns || (s?.feed === false ? 0 : s?.columns),
 		layers: s?.layers ?? numberOf($('#session-form').elements.layers),
@@ -588,11 +591,18 @@ async function runExperiment(ev) {
 	const btn = $('#experiment-run');
 	const box = $('#experiment-progress');
 	busy(btn, true);
+	app.experiment = null;
+	app.expTrace = new Trace(2, { policy: 'history', capacity: 4000 });
 	try {
 		const j = await api.createExperiment(form);
 		setOnline(true);
+		app.experiment = { id: j.id, sessionId: j.sessionId };
 		progress(box, j.progress, 'started');
 		showExperiment(j, form);
+		if (f.watch.checked && j.sessionId) {
+			attach(j.sessionId, await api.getSession(j.sessionId).catch(() => null));
+			message('ok', `Experiment ${j.id} runs on session ${j.sessionId}; the plots follow it.`);
+		}
 		const end = await poll(api.getExperiment, j.id, u => {
 			showExperiment(u, form);
 			const tText = Number.isFinite(u.t) ? ` · t = ${fmtTime(u.t)}` : '';
@@ -624,10 +634,13 @@ function showExperiment(j, form) {
 		vc.textContent = `${fmtVelocity(s.v).replace(' m/s', '')} ${ARROW[direction(s.v)]}`;
 		row.insertCell().textContent = fmt(s.reversalTime, 3);
 	});
-	/* the measured trace if the daemon gives one, else the segments' steady
-	 * velocities as steps, with beta's schedule on the right axis */
+	/* the feed velocity as streamed (when the plots follow the experiment's
+	 * session), else the daemon's trace if it gives one, else the segments'
+	 * steady velocities as steps; beta on the right axis */
 	const betaAt = x => x < form.tSwitch ? form.beta1 : form.beta2;
 	let t = j.trace.t, v = j.trace.v, b = t.map(betaAt);
+	const live = app.expTrace?.data();
+	if (live && live[0].length > 1) [t, v, b] = live;
 	if (!t.length && j.segments.length) {
 		t = []; v = []; b = [];
 		j.segments.forEach((s, i) => {
@@ -702,24 +715,34 @@ function applyPreset(name) {
 }
 
 async function loadPresets() {
+	let methods = [];
 	try {
-		presetList = await api.presets();
+		const cat = await api.catalog();
 		setOnline(true);
-		if (!presetList.length) return;
-		const sel = $('#session-form').elements.preset;
-		const keep = sel.value;
-		sel.replaceChildren(...presetList.map(p => {
-			const o = new Option(p.name, p.name);
-			if (p.doc) o.title = p.doc;
-			return o;
-		}));
-		sel.value = presetList.some(p => p.name === keep) ? keep : presetList[0].name;
-		applyPreset(sel.value);
+		presetList = cat.presets;
+		methods = cat.methods;
+		if (presetList.length) {
+			const sel = $('#session-form').elements.preset;
+			const keep = sel.value;
+			sel.replaceChildren(...presetList.map(p => {
+				const o = new Option(p.name, p.name);
+				if (p.doc) o.title = p.doc;
+				return o;
+			}));
+			sel.value = presetList.some(p => p.name === keep) ? keep : presetList[0].name;
+			applyPreset(sel.value);
+		}
 	} catch (err) {
 		if (err instanceof api.NetworkError) setOnline(false);
 	}
-	const methods = await api.integratorNames().catch(() => []);
-	if (methods.length) $('#methods').replaceChildren(...methods.map(m => new Option(m, m)));
+	if (!methods.length) methods = (await api.integratorNames().catch(() => [])).map(name => ({ name, doc: '' }));
+	if (methods.length) {
+		$('#methods').replaceChildren(...methods.map(m => {
+			const o = new Option(m.name, m.name);
+			o.label = m.doc ? `${m.name} · ${m.doc}` : m.name;
+			return o;
+		}));
+	}
 }
 
 async function healthLoop() {

@@ -1,0 +1,200 @@
+// Unit tests of the dashboard's pure modules (no browser, no daemon):
+// the API field mapping, the sample buffers and velocity fit, number
+// formatting and the schematic's geometry.
+import test from 'node:test';
+import assert from 'node:assert/strict';
+import * as api from '../../web/js/api.js';
+import { Trace, slope, recentVelocity } from '../../web/js/series.js';
+import { fmt, fmtVelocity, direction, wrapBeta, parsePace, problemText } from '../../web/js/format.js';
+import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
+
+const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
+
+test('session document maps to the page model', () => {
+	const s = api.normalizeSession({
+		id: 'a7', state: 'paused', preset: 'czubak2016', pace: 'max', columns: 5, layers: 8,
+		status: { t: 2.5, beta: 38, beta_target: 128, rotation: 'cw', rotor_speed: -157.08,
+			transport_velocity: 0.12, rtf: 4.5, steps_per_s: 2e5, reductions: ['symmetric', 'ideal_drive'] },
+	});
+	assert.equal(s.id, 'a7');
+	assert.equal(s.t, 2.5);
+	assert.equal(s.beta, 38);
+	assert.equal(s.betaTarget, 128);
+	assert.equal(s.rotation, 'cw');
+	assert.equal(s.rotorSpeed, -157.08);
+	assert.equal(s.transportVelocity, 0.12);
+	assert.equal(s.running, false);
+	assert.equal(s.pace, 'max');
+	assert.equal(s.realTimeFactor, 4.5);
+	assert.equal(s.columns, 5);
+	assert.deepEqual(s.reductions.map(r => r.name), ['symmetric', 'ideal_drive']);
+});
+
+test('a session without status yet gives NaN, not zeros', () => {
+	const s = api.normalizeSession({ id: 'b', state: 'running', status: null });
+	assert.ok(Number.isNaN(s.t));
+	assert.ok(Number.isNaN(s.beta));
+	assert.equal(s.running, true);
+});
+
+test('stream sample maps flat members to vectors; null becomes NaN', () => {
+	const s = api.normalizeSample({ t: 1.25, beta: 40, x: 1e-3, y: -2e-3, alpha: 0, deck_x: 3e-3, deck_y: 4e-3,
+		rotor_speed: -150, s1: 0.004, s2: null, columns: [0.1, 0.2, 0.3], feed_velocity: 0.2 }, '17');
+	assert.equal(s.index, 17);
+	assert.deepEqual(s.deck, [3e-3, 4e-3]);
+	assert.deepEqual(s.trough, [1e-3, -2e-3, 0]);
+	assert.equal(s.strokes[0], 0.004);
+	assert.ok(Number.isNaN(s.strokes[1]));
+	close(s.feedMean, 0.2, 1e-15);   /* mean of the columns when feed_displacement is absent */
+	assert.equal(s.feedVelocity, 0.2);
+	const bare = api.normalizeSample({ t: 0 });
+	assert.deepEqual(bare.deck, []);
+	assert.deepEqual(bare.columns, []);
+});
+
+test('control event and PATCH answer give beta and effective time', () => {
+	const ev = api.normalizeControl({ beta: 128, t_effective: 3.1 });
+	assert.equal(ev.beta, 128);
+	assert.equal(ev.t, 3.1);
+	const answer = api.normalizeControl({ id: 'x', status: { t: 9 }, applied: { rotation: 'ccw' }, t_effective: 3.2 });
+	assert.equal(answer.rotation, 'ccw');
+	assert.equal(answer.t, 3.2);
+});
+
+test('sweep points from a list, and from per-rotation columns', () => {
+	const j = api.normalizeSweep({ id: 'w1', state: 'running', total: 4, done: 2, progress: 0.5, points: [
+		{ beta: 30, rotation: 'cw', state: 'done', velocity: 0.1 },
+		{ beta: 30, rotation: 'ccw', state: 'done', velocity: -0.02 },
+		{ beta: 60, rotation: 'cw', state: 'pending', velocity: null }] });
+	assert.equal(j.progress, 0.5);
+	assert.equal(j.done, false);
+	assert.equal(j.points.length, 3);
+	assert.ok(Number.isNaN(j.points[2].v));
+	const k = api.sweepPoints({ cw: { beta: [0, 10], v: [0.01, 0.05] } });
+	assert.deepEqual(k, [{ beta: 0, rotation: 'cw', v: 0.01 }, { beta: 10, rotation: 'cw', v: 0.05 }]);
+	assert.equal(api.normalizeSweep({ state: 'done' }).done, true);
+	assert.equal(api.normalizeSweep({ state: 'cancelled' }).failed, true);
+});
+
+test('experiment segments carry steady velocity and reversal time', () => {
+	const e = api.normalizeExperiment({ id: 'e1', session: 's9', state: 'done', progress: 1, t: 6, segments: [
+		{ beta: 38, until: 3, state: 'done', t_command: 0, t_end: 3, steady_velocity: 0.15, reversal_time: null },
+		{ beta: 128, until: 6, state: 'done', t_command: 3, t_end: 6, steady_velocity: -0.14, reversal_time: 0.42 }] });
+	assert.equal(e.sessionId, 's9');
+	assert.equal(e.done, true);
+	assert.equal(e.segments[1].v, -0.14);
+	assert.equal(e.segments[1].reversalTime, 0.42);
+	assert.equal(e.segments[1].tStart, 3);
+	assert.ok(Number.isNaN(e.segments[0].reversalTime));
+});
+
+test('request bodies follow the API request shapes', () => {
+	const form = { preset: 'czubak2016', beta: 38, rotation: 'cw', columns: 5, layers: 8, feed: true,
+		drive: 'ideal', method: 'rk4', dt: NaN, pace: 'max', rate: 500, betaRate: NaN };
+	assert.deepEqual(api.sessionRequest(form), {
+		preset: 'czubak2016', params: { beta: 38, rotation: 'cw' },
+		scene: { columns: 5, layers: 8, feed: true, drive: 'ideal' },
+		integrator: { method: 'rk4' }, pace: 'max', sample_rate: 500 });
+	const sw = api.sweepRequest({ ...form, from: 0, to: 180, step: 10, tEnd: 3 });
+	assert.deepEqual(sw.beta, { from: 0, to: 180, step: 10 });
+	assert.deepEqual(sw.rotations, ['cw', 'ccw']);
+	assert.equal(sw.pace, undefined);
+	const ex = api.experimentRequest({ ...form, beta1: 38, beta2: 128, tSwitch: 3, tEnd: 6 });
+	assert.deepEqual(ex.schedule, [{ beta: 38, until: 3 }, { beta: 128, until: 6 }]);
+	assert.equal(ex.session.params.beta, 38);
+	assert.equal(ex.session.pace, undefined);
+	assert.equal(api.streamQuery(), 'fields=trough%2Corbit%2Crotor%2Celiminators%2Cfeed');
+});
+
+test('problem+json becomes an ApiError naming the field', () => {
+	const e = new api.ApiError(422, { type: 'out-of-range', title: 'Value out of range', status: 422,
+		detail: 'layers = 999 is out of range [1, 64]', field: 'scene.layers', min: 1, max: 64 });
+	assert.equal(e.field, 'scene.layers');
+	assert.equal(e.message, 'layers = 999 is out of range [1, 64]');
+	const text = problemText(e);
+	assert.match(text, /^422 Value out of range: layers = 999 is out of range \[1, 64\] \(field: scene\.layers\)$/);
+	assert.equal(new api.ApiError(500, null).message, 'HTTP 500');
+});
+
+test('pick, num and rotation spellings', () => {
+	assert.equal(api.pick({ a: { b: 2 } }, ['a.c', 'a.b']), 2);
+	assert.equal(api.pick(null, ['a']), undefined);
+	assert.ok(Number.isNaN(api.num(null)));
+	assert.equal(api.num('1.5'), 1.5);
+	assert.equal(api.rotationName(-1), 'cw');
+	assert.equal(api.rotationName('ccw'), 'ccw');
+	assert.equal(api.rotationName('up'), undefined);
+	assert.deepEqual(api.methodEnum({ a: { properties: { method: { enum: ['rk4', 'dopri5'] } } } }), ['rk4', 'dopri5']);
+});
+
+test('window trace keeps the last span seconds and ignores repeats', () => {
+	const tr = new Trace(1, { policy: 'window', span: 1, capacity: 10000 });
+	for (let i = 0; i <= 300; i++) tr.push(i * 0.01, [i]);
+	assert.equal(tr.push(1.0, [0]), false, 'a sample back in time is ignored');
+	const [t, v] = tr.data();
+	close(t[0], 2.0, 1e-9);
+	close(t[t.length - 1], 3.0, 1e-9);
+	assert.equal(v[v.length - 1], 300);
+	assert.equal(t.length, 101);
+});
+
+test('history trace halves its resolution at capacity and keeps the start', () => {
+	const tr = new Trace(1, { policy: 'history', capacity: 100 });
+	for (let i = 0; i < 1000; i++) tr.push(i, [2 * i]);
+	assert.ok(tr.length < 100, `length ${tr.length}`);
+	assert.ok(tr.length >= 50, `length ${tr.length}`);
+	assert.equal(tr.cols[0][0], 0);
+	assert.ok(tr.cols[0][tr.length - 1] > 900);
+	for (let i = 0; i < tr.length; i++) assert.equal(tr.cols[1][i], 2 * tr.cols[0][i]);
+});
+
+test('least-squares slope and the recent transport velocity', () => {
+	close(slope([0, 1, 2, 3], [1, 3, 5, 7]), 2);
+	assert.ok(Number.isNaN(slope([1], [1])));
+	/* hops within each 40 ms period on top of a 0.1 m/s drift */
+	const ts = [], xs = [];
+	for (let i = 0; i < 2000; i++) {
+		const t = i * 1e-3;
+		ts.push(t);
+		xs.push(0.1 * t + 2e-4 * Math.sin(2 * Math.PI * t / 0.04));
+		if (t > 1) xs[i] = 0.1 * 1 - 0.05 * (t - 1) + 2e-4 * Math.sin(2 * Math.PI * t / 0.04);
+	}
+	close(recentVelocity(ts, xs, 0.5), -0.05, 2e-3);
+	assert.ok(Number.isNaN(recentVelocity(ts.slice(0, 50), xs.slice(0, 50), 0.5, 0.2)), 'too short');
+});
+
+test('formatting: units, signs, directions', () => {
+	assert.equal(fmt(-0.0001, 3), '0.000');
+	assert.equal(fmt(NaN), '–');
+	assert.equal(fmt(1.5, 1, 's'), '1.5 s');
+	assert.equal(fmtVelocity(0.1234), '+0.123 m/s');
+	assert.equal(fmtVelocity(-0.05), '-0.050 m/s');
+	assert.equal(direction(0.2), 'right');
+	assert.equal(direction(-0.2), 'left');
+	assert.equal(direction(5e-4), 'still');
+	assert.equal(direction(NaN), '');
+	assert.equal(wrapBeta(200), 20);
+	assert.equal(wrapBeta(-10), 170);
+	assert.equal(parsePace('max'), 'max');
+	assert.equal(parsePace(' 2 '), 2);
+	assert.equal(parsePace('0'), undefined);
+});
+
+test('schematic geometry: n(beta) and u(beta) are orthonormal, guides at beta', () => {
+	for (const b of [0, 38, 90, 128, 179]) {
+		const n = vibrationDirection(b), u = guideDirection(b);
+		close(n[0] * u[0] + n[1] * u[1], 0, 1e-12);
+		close(Math.hypot(...n), 1);
+		close(Math.hypot(...u), 1);
+	}
+	const [a, c] = guideEnds([0.3, 0], 38, 0.2);
+	const ang = Math.atan2(c[1] - a[1], c[0] - a[0]) * 180 / Math.PI;
+	close(ang, 128, 1e-9); /* the guide lies at beta + 90 degrees */
+	const n = vibrationDirection(38);
+	assert.ok(n[0] > 0 && n[1] > 0, 'beta = 38 deg points up and to the right');
+	columnPositions(5).forEach((x, i) => close(x, [-0.8, -0.4, 0, 0.4, 0.8][i], 1e-12));
+	assert.deepEqual(columnPositions(1), [0]);
+	const [x, y] = toSvg(0, 1);
+	assert.equal(x, VIEW.x0);
+	assert.ok(y < VIEW.y0, 'model up is screen up');
+});
