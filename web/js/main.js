@@ -207,9 +207,11 @@ function attach(id, initial, form) {
 	if (initial) showStatus(initial);
 }
 
+let polls = 0;
 async function pollStatus() {
 	const id = app.id;
 	if (!id) return;
+	if (++polls % 10 === 0) refreshSessionList();
 	try {
 		const s = await api.getSession(id);
 		if (id !== app.id) return;

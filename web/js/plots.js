@@ -176,7 +176,7 @@ export class XYPlot {
 			}
 			if (axisKey === 'x' && self.xRange) return self.xRange;
 			const e = self.ext;
-			return axisKey === 'x' ? padRange(e.x0, e.x1, 0.02) : padRange(Math.min(e.y0, zeroLine ? 0 : e.y0), Math.max(e.y1, zeroLine ? 0 : e.y1));
+			return axisKey === 'x' ? padRange(e.x0, e.x1, 0.05) : padRange(Math.min(e.y0, zeroLine ? 0 : e.y0), Math.max(e.y1, zeroLine ? 0 : e.y1));
 		};
 		const hooks = {};
 		if (zeroLine) {

@@ -1,0 +1,225 @@
+// Browser test of the dashboard against the real daemon: starts
+// $CONVSIMD (default build/convsimd) on port 0, drives web/ in Debian's
+// chromium through playwright-core and checks what a user sees against
+// what the API says. Saves tests/out/dashboard.png.
+//
+// Scene: ideal drive, 5 columns x 2 layers, pace 2 (cheap to simulate; the
+// point here is the UI, not the physics).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { mkdirSync } from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from '../node_modules/playwright-core/index.mjs';
+
+const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const DAEMON = path.resolve(ROOT, process.env.CONVSIMD || 'build/convsimd');
+const OUT = path.join(ROOT, 'tests/out');
+const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
+const PACE = process.env.DASHBOARD_PACE || '2';
+
+let daemon, base, browser, page;
+const pageErrors = [];
+
+function startDaemon() {
+	return new Promise((resolve, reject) => {
+		const p = spawn(DAEMON, ['--port', '0'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
+		let out = '';
+		const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`no "listening on" line from ${DAEMON} in 15 s:\n${out}`)); }, 15000);
+		const scan = chunk => {
+			out += chunk;
+			const m = /listening on (http:\/\/[^\s]+)/.exec(out);
+			if (m) { clearTimeout(timer); resolve({ proc: p, url: m[1].replace(/\/$/, '') }); }
+		};
+		p.stdout.setEncoding('utf8').on('data', scan);
+		p.stderr.setEncoding('utf8').on('data', scan);
+		p.on('error', e => { clearTimeout(timer); reject(e); });
+		p.on('exit', code => { clearTimeout(timer); reject(new Error(`${DAEMON} exited (${code}) before listening:\n${out}`)); });
+	});
+}
+
+async function stopDaemon() {
+	if (!daemon || daemon.exitCode !== null || daemon.signalCode) return;
+	const exited = new Promise(r => daemon.once('exit', r));
+	daemon.kill('SIGTERM');
+	const t = setTimeout(() => daemon.kill('SIGKILL'), 5000);
+	await exited;
+	clearTimeout(t);
+}
+
+async function apiGet(p) {
+	const res = await fetch(base + p);
+	assert.equal(res.status, 200, `GET ${p}`);
+	return res.json();
+}
+
+/* Poll fn until it returns a truthy value or ms pass. */
+async function until(fn, ms, what) {
+	const end = Date.now() + ms;
+	let last;
+	while (Date.now() < end) {
+		last = await fn();
+		if (last) return last;
+		await new Promise(r => setTimeout(r, 200));
+	}
+	throw new Error(`timed out after ${ms} ms waiting for ${what} (last: ${JSON.stringify(last)})`);
+}
+
+const attr = (sel, name) => page.$eval(sel, (e, n) => e.dataset[n], name);
+const count = async sel => Number(await attr(sel, 'points'));
+const samples = async () => Number(await attr('#live-state', 'samples'));
+const shownDirection = () => attr('#v-arrow', 'direction');
+
+before(async () => {
+	mkdirSync(OUT, { recursive: true });
+	const d = await startDaemon();
+	daemon = d.proc;
+	daemon.removeAllListeners('exit');
+	base = d.url.replace('0.0.0.0', '127.0.0.1');
+	browser = await chromium.launch({
+		executablePath: CHROMIUM,
+		args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+			'--disable-background-networking', '--disable-component-update', '--disable-sync'],
+	});
+	page = await browser.newPage({ viewport: { width: 1600, height: 1300 } });
+	page.on('pageerror', e => pageErrors.push(e.message));
+});
+
+after(async () => {
+	await browser?.close();
+	await stopDaemon();
+});
+
+let sessionId;
+
+test('the page loads from the daemon and finds it online', async () => {
+	const res = await page.goto(base + '/');
+	assert.equal(res.status(), 200);
+	await page.waitForSelector('body[data-ready="true"]', { timeout: 15000 });
+	assert.match(await page.title(), /convsim/);
+	await page.waitForSelector('#conn[data-state="online"]', { timeout: 10000 });
+	const presets = await page.$$eval('#f-preset option', o => o.map(x => x.value));
+	assert.ok(presets.includes('czubak2016'), `presets offered: ${presets}`);
+	assert.deepEqual(pageErrors, []);
+});
+
+test('a session starts from the form', async () => {
+	await page.selectOption('select[name="drive"]', 'ideal');
+	await page.fill('input[name="layers"]', '2');
+	await page.fill('input[name="columns"]', '5');
+	await page.fill('input[name="beta"]', '38');
+	await page.selectOption('select[name="rotation"]', 'cw');
+	await page.fill('input[name="pace"]', PACE);
+	await page.fill('input[name="rate"]', '500');
+	await page.click('#start');
+	sessionId = await until(() => page.$eval('body', b => b.dataset.sessionId), 10000, 'a session id on the page');
+	const s = await apiGet(`/api/v1/sessions/${sessionId}`);
+	assert.equal(s.id, sessionId);
+	assert.equal(s.columns, 5);
+	assert.equal(s.layers, 2);
+	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
+});
+
+test('stream samples arrive and the plots grow', async () => {
+	await until(async () => await samples() > 20, 20000, 'stream samples');
+	const a = { n: await samples(), feed: await count('#plot-feed'), rotor: await count('#plot-rotor'), orbit: await count('#plot-orbit') };
+	assert.ok(a.orbit > 1, `orbit points ${a.orbit}`);
+	await new Promise(r => setTimeout(r, 1500));
+	const b = { n: await samples(), feed: await count('#plot-feed'), rotor: await count('#plot-rotor') };
+	assert.ok(b.n > a.n, `samples ${a.n} -> ${b.n}`);
+	assert.ok(b.rotor > a.rotor, `rotor plot points ${a.rotor} -> ${b.rotor}`);
+	assert.ok(b.feed > a.feed, `feed plot points ${a.feed} -> ${b.feed}`);
+	const t = await page.$eval('#t-now', e => e.textContent);
+	assert.match(t, /^\d+\.\d{3} s$/);
+});
+
+test('β = 38°, clockwise: the page shows transport to the right', async () => {
+	await until(async () => await shownDirection() === 'right', 30000, 'direction "right"');
+	const text = await page.$eval('#v-value', e => e.textContent);
+	assert.match(text, /^\+\d\.\d{3} m\/s$/);
+	assert.equal(await page.$eval('#schematic', e => e.dataset.direction), 'right');
+});
+
+test('moving the β slider turns the session to 128° and reverses the shown direction', async () => {
+	await page.locator('#beta-slider').fill('128');
+	const s = await until(async () => {
+		const j = await apiGet(`/api/v1/sessions/${sessionId}`);
+		return j.status && Math.abs(j.status.beta_target - 128) < 1e-9 ? j : null;
+	}, 5000, 'beta_target = 128 in the API');
+	assert.ok(s.status.beta_target === 128);
+	await until(async () => {
+		const j = await apiGet(`/api/v1/sessions/${sessionId}`);
+		return Math.abs(j.status.beta - 128) < 1e-6;
+	}, 30000, 'beta to reach 128 in the API');
+	assert.equal(await page.$eval('#beta-number', e => e.value), '128');
+	await until(async () => await shownDirection() === 'left', 30000, 'direction "left"');
+	assert.match(await page.$eval('#v-value', e => e.textContent), /^-\d\.\d{3} m\/s$/);
+	await until(async () => await page.$eval('#beta-now', e => e.textContent) === '128.0 °', 5000, 'β now 128.0 ° on the page');
+	await until(async () => await page.$eval('#schematic', e => e.dataset.beta) === '128.00', 5000, 'the schematic at 128°');
+});
+
+test('a refused input shows the daemon\'s problem detail', async () => {
+	const body = { preset: 'czubak2016', params: { beta: 38, rotation: 'cw' },
+		scene: { columns: 5, layers: 999, feed: true, drive: 'ideal' }, integrator: { method: 'rk4' }, pace: 1 };
+	const res = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+	assert.equal(res.status, 422);
+	assert.match(res.headers.get('content-type'), /application\/problem\+json/);
+	const problem = await res.json();
+	await page.fill('input[name="layers"]', '999');
+	await page.fill('input[name="pace"]', '1');
+	await page.click('#start');
+	const msg = await page.waitForSelector('#messages .msg.error', { timeout: 5000 });
+	const text = await msg.textContent();
+	assert.ok(text.includes(problem.detail), `message "${text}" lacks the detail "${problem.detail}"`);
+	assert.match(text, /422/);
+	assert.equal(await page.$eval('input[name="layers"]', e => e.getAttribute('aria-invalid')), 'true');
+	/* nothing else was created, and the page still follows the same session */
+	const list = await apiGet('/api/v1/sessions');
+	assert.equal(list.sessions.length, 1);
+	assert.equal(await page.$eval('body', b => b.dataset.sessionId), sessionId);
+	await page.fill('input[name="layers"]', '2');
+});
+
+test('a sweep draws v(β) for both rotations', async () => {
+	await page.fill('#sweep-form input[name="from"]', '30');
+	await page.fill('#sweep-form input[name="to"]', '130');
+	await page.fill('#sweep-form input[name="step"]', '50');
+	await page.fill('#sweep-form input[name="t_end"]', '1.5');
+	await page.click('#sweep-run');
+	await until(async () => await count('#plot-sweep') >= 6, 60000, 'six sweep points');
+	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));
+	assert.deepEqual(rows.map(r => r[0]), ['30.0', '80.0', '130.0']);
+	const v = rows.map(r => [Number(r[1]), Number(r[2])]);
+	assert.ok(v.flat().every(Number.isFinite), `sweep table ${JSON.stringify(rows)}`);
+});
+
+test('a β-change experiment reports its reversal time', async () => {
+	await page.fill('#experiment-form input[name="beta1"]', '38');
+	await page.fill('#experiment-form input[name="beta2"]', '128');
+	await page.fill('#experiment-form input[name="t_switch"]', '1.5');
+	await page.fill('#experiment-form input[name="t_end"]', '4');
+	await page.uncheck('#experiment-form input[name="watch"]');
+	await page.click('#experiment-run');
+	const shown = await until(async () => {
+		const t = await page.$eval('#reversal-time', e => e.textContent);
+		return /^\d+\.\d{3} s$/.test(t) ? t : null;
+	}, 60000, 'a reversal time');
+	assert.ok(Number.parseFloat(shown) > 0);
+	assert.ok(await count('#plot-experiment') > 0);
+});
+
+test('screenshot of the dashboard', async () => {
+	await page.waitForTimeout(300);
+	await page.screenshot({ path: path.join(OUT, 'dashboard.png'), fullPage: true });
+	assert.deepEqual(pageErrors, []);
+});
+
+test('the page says so when the daemon goes away', async () => {
+	await page.click('#delete');
+	await until(async () => !(await page.$eval('body', b => b.dataset.sessionId)), 5000, 'the session detached');
+	await stopDaemon();
+	await page.waitForSelector('#conn[data-state="offline"]', { timeout: 10000 });
+	const text = await page.$eval('#messages', e => e.textContent);
+	assert.match(text, /does not answer/);
+});
