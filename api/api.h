@@ -1,0 +1,322 @@
+/*
+ * api.h - the JSON face of the conveyor simulator.
+ *
+ * api/ turns request bodies into core settings and controls, and core
+ * state back into JSON, CSV and stream records. It is the only module that
+ * sees cJSON; the server hands it byte buffers and plain structs and gets
+ * back malloc'd text (caller frees) or text written into its own buffers.
+ * Every double that leaves here is printed so that it round-trips (the
+ * shortest of %.15g/%.16g/%.17g that parses back to the same value);
+ * non-finite values are written as null. Nothing here keeps state or
+ * aborts on bad input: errors are reported as api_problem values that
+ * map to an HTTP status and an RFC 9457 problem+json body.
+ */
+#ifndef CONVSIM_API_H
+#define CONVSIM_API_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sim.h"
+
+/* ---- errors ----------------------------------------------------------- */
+
+/* X(name, http_status, type slug, title). 400: the body is not JSON or a
+ * value has the wrong JSON type; 422: well-formed but unacceptable (out of
+ * range, unknown name, inconsistent set). */
+#define API_ERRNO_MAP(X)                                                      \
+	X(OK, 200, "ok", "OK")                                                \
+	X(MALFORMED, 400, "malformed-json", "Malformed JSON")                 \
+	X(TYPE, 400, "wrong-type", "Wrong type")                              \
+	X(QUERY, 400, "bad-query", "Bad query parameter")                     \
+	X(NOTFOUND, 404, "not-found", "Not found")                            \
+	X(METHOD, 405, "method-not-allowed", "Method not allowed")            \
+	X(CONFLICT, 409, "conflict", "Conflict")                              \
+	X(TOOLARGE, 413, "body-too-large", "Request body too large")          \
+	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type") \
+	X(RANGE, 422, "out-of-range", "Value out of range")                   \
+	X(UNKNOWN, 422, "unknown-field", "Unknown field")                     \
+	X(INVALID, 422, "invalid-value", "Invalid value")                     \
+	X(LIMIT, 429, "limit-reached", "Limit reached")                       \
+	X(UNAVAILABLE, 503, "unavailable", "Service unavailable")
+
+typedef enum {
+#define API_ERR_ENUM(name, status, slug, title) API_##name,
+	API_ERRNO_MAP(API_ERR_ENUM)
+#undef API_ERR_ENUM
+	API_NERR
+} api_err;
+
+/* One problem report. field is the JSON path of the offending member
+ * ("params.k_s1"), empty when none; the range or choices are filled when
+ * the field is a known setting. */
+typedef struct api_problem {
+	api_err code;
+	char field[64];
+	char detail[320];
+	int has_range;
+	double min, max;
+	char choices[96];
+} api_problem;
+
+/* HTTP status of an api_err (500 for an unknown code). */
+int api_status(api_err code);
+/* HTTP status of a core return code, from SIM_ERRNO_MAP. */
+int api_sim_status(int sim_err);
+/* The api_err a core return code maps to. */
+api_err api_from_sim(int sim_err);
+/* Fill *pb: code, field (may be NULL) and a printf-style detail. If field
+ * ends in a setting name of sim_settings(), its range or choices are added.
+ * Returns code, so handlers can `return api_fail(...)`. */
+api_err api_fail(api_problem *pb, api_err code, const char *field,
+		 const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* The RFC 9457 body for *pb (type, title, status, detail, instance and the
+ * extensions field/min/max/choices). instance (borrowed) may be NULL.
+ * Returns malloc'd text, NULL only when out of memory. */
+char *api_problem_json(const api_problem *pb, const char *instance);
+
+/* Shortest text of v that parses back to v; "null" if not finite. Returns
+ * the length written (buf of at least 32 bytes). */
+int api_fmt_double(char *buf, size_t len, double v);
+
+/* ---- sessions ----------------------------------------------------------- */
+
+#define API_PACE_MAX 0.0         /* pace value meaning "as fast as possible" */
+#define API_DEFAULT_MAX_UNTIL 60.0 /* s: "until" for pace "max" if none given */
+#define API_DEFAULT_SAMPLE_RATE 250.0
+
+/* A session as created: preset, settings, pace, optional end time. */
+typedef struct api_spec {
+	char preset[32];
+	sim_params params;
+	sim_scene scene;
+	sim_method method;
+	double pace;        /* real-time factor, API_PACE_MAX for "max" */
+	double until;       /* s simulated end time, 0 = none */
+	double sample_rate; /* samples recorded per simulated second */
+} api_spec;
+
+/* Parse a POST /sessions body (len bytes, need not be NUL-terminated; an
+ * empty body means {}). Fills *spec from the preset and overrides, checks
+ * every value with sim_set/sim_validate. Returns API_OK or the error in
+ * *pb; *spec is then unspecified. */
+api_err api_parse_session(const char *body, size_t len, api_spec *spec,
+			  api_problem *pb);
+
+/* Control changes of PATCH /sessions/{id}; set has API_C_* bits. */
+enum {
+	API_C_BETA = 1 << 0,
+	API_C_BETA_RATE = 1 << 1,
+	API_C_ROTATION = 1 << 2,
+	API_C_OMEGA_SS = 1 << 3,
+	API_C_RUNNING = 1 << 4,
+	API_C_PACE = 1 << 5,
+	API_C_UNTIL = 1 << 6,
+};
+typedef struct api_control {
+	unsigned set;
+	double beta;      /* deg */
+	double beta_rate; /* deg/s */
+	int rotation;     /* SIM_CW / SIM_CCW */
+	double omega_ss;  /* rad/s */
+	int running;
+	double pace;      /* API_PACE_MAX for "max" */
+	double until;     /* s, 0 = none */
+} api_control;
+
+/* Parse a PATCH body against the session's spec (ranges from the settings
+ * table). All or nothing: on error *c is unspecified and nothing is to be
+ * applied. An empty object is a 422. */
+api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
+			  api_control *c, api_problem *pb);
+/* The control as a stream event payload, a JSON object with t_effective
+ * (s); written into buf, returns the length (truncated text if too
+ * small). */
+int api_control_event(char *buf, size_t len, const api_control *c,
+		      double t_effective);
+
+/* Everything GET /sessions/{id} shows, filled by the server. */
+typedef struct api_view {
+	char id[24];
+	const api_spec *spec;  /* borrowed */
+	const char *state;     /* running, paused, finished, failed */
+	char error[256];
+	double pace, until;    /* current values */
+	double created;        /* unix time, s */
+	int has_status;
+	sim_status st;
+	double steps_per_s, rtf; /* achieved over the last wall second */
+	uint64_t samples;      /* samples recorded so far */
+	int streams;           /* open stream clients */
+	int columns, layers;
+	char experiment[24];   /* running experiment id or "" */
+} api_view;
+
+/* Session as JSON; with_spec adds the full settings. malloc'd text. */
+char *api_session_json(const api_view *v, int with_spec);
+/* {"sessions": [...]} of n views (no spec). malloc'd text. */
+char *api_session_list_json(const api_view *v, size_t n);
+/* PATCH answer: the session plus "applied" (the changes), "t_effective"
+ * (s, null if the worker did not acknowledge in time). malloc'd text. */
+char *api_control_result_json(const api_view *v, const api_control *c,
+			      int acked, double t_effective);
+
+/* ---- streams ------------------------------------------------------------ */
+
+enum {
+	API_F_TROUGH = 1 << 0,
+	API_F_ORBIT = 1 << 1,
+	API_F_ROTOR = 1 << 2,
+	API_F_ELIMINATORS = 1 << 3,
+	API_F_FEED = 1 << 4,
+	API_F_ENERGY = 1 << 5,
+	API_F_ELEMENTS = 1 << 6,
+	API_F_DEFAULT = API_F_TROUGH | API_F_ORBIT | API_F_ROTOR |
+			API_F_ELIMINATORS | API_F_FEED,
+	API_F_ALL = API_F_DEFAULT | API_F_ENERGY | API_F_ELEMENTS,
+};
+/* Parse a comma list of field groups ("trough,feed" or "all"). Returns the
+ * mask, or 0 and *pb (API_QUERY) on an unknown name. */
+unsigned api_parse_fields(const char *list, api_problem *pb);
+
+enum { API_REC_SAMPLE = 0, API_REC_EVENT = 1 };
+#define API_EVENT_MAX 512
+/* One stream record. Arrays are owned by whoever made the record (the
+ * server's ring), sized for columns and columns*layers. */
+typedef struct api_sample {
+	uint64_t index;      /* sequence number in the session: the SSE id */
+	int kind;            /* API_REC_SAMPLE or API_REC_EVENT */
+	sim_status st;       /* API_REC_SAMPLE */
+	int columns, layers; /* 0 when the scene has no feed */
+	double *column_disp; /* columns entries */
+	double *xi, *eta;    /* columns*layers entries each */
+	char event_type[16]; /* API_REC_EVENT: "control", "finished", ... */
+	char event[API_EVENT_MAX]; /* API_REC_EVENT: JSON object text */
+} api_sample;
+
+/* Largest text api_format_record can write for this feed size. */
+size_t api_record_max(int columns, int layers);
+/* Write one record as SSE ("id:", "event:", "data:") or as one NDJSON
+ * line with "type" and "id". buf holds api_record_max() bytes. Returns the
+ * length. Doubles round-trip. */
+size_t api_format_record(char *buf, size_t len, const api_sample *s,
+			 unsigned fields, int ndjson);
+/* Stream notices: missed samples, heartbeat, end (reason: finished,
+ * deleted, failed, shutdown, limit). Return the length. */
+size_t api_format_dropped(char *buf, size_t len, uint64_t missed,
+			  uint64_t next_id, int ndjson);
+size_t api_format_heartbeat(char *buf, size_t len, double t, int ndjson);
+size_t api_format_end(char *buf, size_t len, const char *reason, int ndjson);
+
+/* ---- trajectory --------------------------------------------------------- */
+
+#define API_HISTORY_COLS 17
+extern const char *const api_history_names[API_HISTORY_COLS];
+/* One trajectory row (API_HISTORY_COLS doubles, column 0 is t) from a
+ * status. */
+void api_history_row(const sim_status *st, double *row);
+/* n rows of API_HISTORY_COLS (borrowed) as JSON {"fields","rows"} or as
+ * CSV with a header line. malloc'd text. */
+char *api_trajectory_json(const double *rows, size_t n, double stride);
+char *api_trajectory_csv(const double *rows, size_t n);
+
+/* ---- experiments --------------------------------------------------------- */
+
+#define API_EXP_MAX_SEGMENTS 32
+typedef struct api_segment {
+	double beta;            /* deg commanded at the segment start */
+	double until;           /* s after the experiment start */
+	/* results, filled by the server */
+	int state;              /* 0 pending, 1 running, 2 done */
+	double t_command;       /* s simulated time of the beta command */
+	double t_end;           /* s */
+	double steady_velocity; /* m/s mean feed velocity, last half */
+	double mean_velocity;   /* m/s transport estimate over the segment */
+	double reversal_time;   /* s command -> 90 % of steady; NaN if never */
+	double start_velocity;  /* m/s feed velocity at the command */
+} api_segment;
+
+typedef struct api_experiment_req {
+	int fresh;              /* 1: create a session from spec */
+	api_spec spec;
+	char session_id[24];    /* fresh == 0 */
+	double beta_rate;       /* deg/s, 0 = keep */
+	int nseg;
+	api_segment seg[API_EXP_MAX_SEGMENTS];
+} api_experiment_req;
+
+/* Parse POST /experiments: {"session": ID} or {"session": {create body}}
+ * (or none: a fresh czubak2016 session at pace "max"), "schedule":
+ * [{"beta": DEG, "until": S}, ...] with increasing until, optional
+ * "beta_rate". Returns API_OK or the error in *pb. */
+api_err api_parse_experiment(const char *body, size_t len,
+			     api_experiment_req *req, api_problem *pb);
+
+typedef struct api_experiment_view {
+	char id[24];
+	char session_id[24];
+	const char *state;      /* running, done, aborted, failed */
+	char error[256];
+	double t_start, t_now;  /* s simulated */
+	double progress;        /* 0..1 */
+	int nseg;
+	const api_segment *seg; /* borrowed */
+} api_experiment_view;
+char *api_experiment_json(const api_experiment_view *v);
+/* {"experiments": [...]} of n views. malloc'd text. */
+char *api_experiment_list_json(const api_experiment_view *v, size_t n);
+
+/* ---- sweeps --------------------------------------------------------------- */
+
+#define API_SWEEP_MAX_POINTS 2000
+typedef struct api_sweep_req {
+	api_spec spec;
+	int nbeta;
+	double *betas;         /* deg, malloc'd by the parser (caller frees) */
+	int nrot;
+	int rotations[2];      /* SIM_CW / SIM_CCW */
+	double t_end;          /* s simulated per point */
+} api_sweep_req;
+/* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
+ * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],
+ * "t_end". */
+api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
+			api_problem *pb);
+
+typedef struct api_sweep_point {
+	double beta;     /* deg */
+	int rotation;    /* SIM_CW / SIM_CCW */
+	int state;       /* 0 pending, 1 running, 2 done, 3 failed */
+	double velocity; /* m/s */
+	char error[160];
+} api_sweep_point;
+typedef struct api_sweep_view {
+	char id[24];
+	const char *state;  /* queued, running, done, cancelled */
+	size_t total, done;
+	double t_end;
+	const api_sweep_point *pt; /* borrowed, total entries */
+} api_sweep_view;
+char *api_sweep_json(const api_sweep_view *v);
+char *api_sweep_csv(const api_sweep_view *v);
+/* {"sweeps": [...]} of n views without their points. malloc'd text. */
+char *api_sweep_list_json(const api_sweep_view *v, size_t n);
+
+/* ---- catalogue ------------------------------------------------------------- */
+
+/* {"presets": [{name, params, scene, integrator}], "settings": [...],
+ * "methods": [...]}. malloc'd text. */
+char *api_presets_json(void);
+/* GET /api/v1/health. */
+typedef struct api_health {
+	const char *status;   /* "ok" or "stopping" */
+	double uptime;        /* s */
+	int sessions, max_sessions;
+	int stream_clients, max_streams;
+	int pool_threads, pool_queued;
+} api_health;
+char *api_health_json(const api_health *h);
+/* The OpenAPI 3.1 document of the HTTP API. malloc'd text. */
+char *api_openapi_json(void);
+
+#endif

@@ -1,0 +1,203 @@
+/*
+ * experiment_json.c - the beta-schedule experiment in JSON.
+ *
+ * An experiment is the paper's remote reversal test: a schedule of beta
+ * set-points ("38 deg until 3 s, then 128 deg until 6 s") run on a fresh
+ * or an existing session, reporting per segment the steady transport
+ * velocity and the reversal time. This file parses the request and
+ * writes the progress and results; the server runs it.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "json_int.h"
+
+static api_err parse_segment(const cJSON *it, int i, double prev,
+			     const api_spec *spec, api_segment *seg,
+			     api_problem *pb)
+{
+	static const char *const members[] = {"beta", "until", NULL};
+	char prefix[40], field[48], msg[256] = "";
+	snprintf(prefix, sizeof prefix, "schedule[%d].", i);
+	if (!cJSON_IsObject(it))
+		return api_fail(pb, API_TYPE, prefix,
+				"schedule[%d] must be an object {\"beta\": "
+				"DEG, \"until\": S}", i);
+	api_err e = api_check_members(it, members, prefix, pb);
+	if (e != API_OK)
+		return e;
+	const cJSON *beta = cJSON_GetObjectItemCaseSensitive(it, "beta");
+	const cJSON *until = cJSON_GetObjectItemCaseSensitive(it, "until");
+	snprintf(field, sizeof field, "%sbeta", prefix);
+	if (!cJSON_IsNumber(beta))
+		return api_fail(pb, API_TYPE, field, "%s must be a number (deg)",
+				field);
+	sim_params p = spec->params;
+	sim_scene s = spec->scene;
+	sim_method m = spec->method;
+	int rc = sim_set(&p, &s, &m, "beta", beta->valuedouble, msg,
+			 sizeof msg);
+	if (rc != SIM_OK) {
+		api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);
+		snprintf(pb->field, sizeof pb->field, "%s", field);
+		return pb->code;
+	}
+	snprintf(field, sizeof field, "%suntil", prefix);
+	if (!cJSON_IsNumber(until))
+		return api_fail(pb, API_TYPE, field,
+				"%s must be a number (s after the experiment "
+				"start)", field);
+	if (!(until->valuedouble > prev && until->valuedouble <= 1e4)) {
+		api_fail(pb, API_RANGE, field,
+			 "%s must exceed the previous segment's end (%g s) "
+			 "and be at most 10000 s", field, prev);
+		pb->has_range = 1, pb->min = prev, pb->max = 1e4;
+		return API_RANGE;
+	}
+	memset(seg, 0, sizeof *seg);
+	seg->beta = beta->valuedouble;
+	seg->until = until->valuedouble;
+	seg->steady_velocity = seg->mean_velocity = NAN;
+	seg->reversal_time = seg->start_velocity = NAN;
+	seg->t_command = seg->t_end = NAN;
+	return API_OK;
+}
+
+api_err api_parse_experiment(const char *body, size_t len,
+			     api_experiment_req *req, api_problem *pb)
+{
+	static const char *const members[] = {"session", "schedule",
+					      "beta_rate", NULL};
+	static const char *const session_members[] = {
+		"preset", "params", "scene", "integrator", "pace",
+		"sample_rate", NULL};
+	memset(req, 0, sizeof *req);
+	cJSON *root = api_parse_object(body, len, 0, pb);
+	if (!root)
+		return pb->code;
+	api_err e = api_check_members(root, members, "", pb);
+	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
+	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
+	const cJSON *rate = cJSON_GetObjectItemCaseSensitive(root, "beta_rate");
+	const cJSON *empty = NULL;
+	if (e == API_OK && sess && cJSON_IsString(sess)) {
+		snprintf(req->session_id, sizeof req->session_id, "%s",
+			 sess->valuestring);
+		if (sim_preset("czubak2016", &req->spec.params,
+			       &req->spec.scene, &req->spec.method) != SIM_OK)
+			e = api_fail(pb, API_UNAVAILABLE, NULL,
+				     "the default preset is missing");
+	} else if (e == API_OK && (!sess || cJSON_IsObject(sess))) {
+		req->fresh = 1;
+		cJSON *obj = sess ? NULL : (cJSON *)(empty = cJSON_CreateObject());
+		const cJSON *src = sess ? sess : obj;
+		e = api_check_members(src, session_members, "session.", pb);
+		if (e == API_OK)
+			e = api_apply_model(src, &req->spec, pb);
+		if (e == API_OK)
+			e = api_apply_session_extras(src, &req->spec, pb);
+		if (e == API_OK &&
+		    !cJSON_GetObjectItemCaseSensitive(src, "pace"))
+			req->spec.pace = API_PACE_MAX;
+		if (e == API_OK)
+			e = api_validate_spec(&req->spec, pb);
+	} else if (e == API_OK) {
+		e = api_fail(pb, API_TYPE, "session",
+			     "session must be a session id or a session "
+			     "body object");
+	}
+	if (e == API_OK && rate && !cJSON_IsNull(rate)) {
+		char msg[256] = "";
+		sim_params p = req->spec.params;
+		if (!cJSON_IsNumber(rate))
+			e = api_fail(pb, API_TYPE, "beta_rate",
+				     "beta_rate must be a number (deg/s)");
+		else if (sim_set(&p, &req->spec.scene, &req->spec.method,
+				 "beta_rate", rate->valuedouble, msg,
+				 sizeof msg) != SIM_OK)
+			e = api_fail(pb, API_RANGE, "beta_rate", "%s", msg);
+		else
+			req->beta_rate = rate->valuedouble;
+	}
+	if (e == API_OK && !cJSON_IsArray(sched))
+		e = api_fail(pb, sched ? API_TYPE : API_INVALID, "schedule",
+			     "schedule must be an array of {\"beta\": DEG, "
+			     "\"until\": S}");
+	if (e == API_OK) {
+		int n = cJSON_GetArraySize(sched);
+		if (n < 1 || n > API_EXP_MAX_SEGMENTS) {
+			e = api_fail(pb, API_RANGE, "schedule",
+				     "schedule must have 1 to %d segments",
+				     API_EXP_MAX_SEGMENTS);
+		} else {
+			double prev = 0;
+			int i = 0;
+			for (const cJSON *it = sched->child; it && e == API_OK;
+			     it = it->next, i++) {
+				e = parse_segment(it, i, prev, &req->spec,
+						  &req->seg[i], pb);
+				prev = req->seg[i].until;
+			}
+			req->nseg = n;
+			if (req->fresh)
+				req->spec.until = prev;
+		}
+	}
+	cJSON_Delete((cJSON *)empty);
+	cJSON_Delete(root);
+	return e;
+}
+
+static cJSON *experiment_object(const api_experiment_view *v)
+{
+	static const char *const seg_state[] = {"pending", "running", "done"};
+	char link[96];
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "id", v->id);
+	cJSON_AddStringToObject(o, "session", v->session_id);
+	cJSON_AddStringToObject(o, "state", v->state);
+	if (v->error[0])
+		cJSON_AddStringToObject(o, "error", v->error);
+	api_add_number(o, "t_start", v->t_start);
+	api_add_number(o, "t", v->t_now);
+	api_add_number(o, "progress", v->progress);
+	cJSON *arr = cJSON_AddArrayToObject(o, "segments");
+	for (int i = 0; i < v->nseg; i++) {
+		const api_segment *s = &v->seg[i];
+		cJSON *so = cJSON_CreateObject();
+		api_add_number(so, "beta", s->beta);
+		api_add_number(so, "until", s->until);
+		cJSON_AddStringToObject(so, "state",
+					seg_state[s->state < 0 || s->state > 2
+							  ? 0
+							  : s->state]);
+		api_add_number(so, "t_command", s->t_command);
+		api_add_number(so, "t_end", s->t_end);
+		api_add_number(so, "start_velocity", s->start_velocity);
+		api_add_number(so, "steady_velocity", s->steady_velocity);
+		api_add_number(so, "mean_velocity", s->mean_velocity);
+		api_add_number(so, "reversal_time", s->reversal_time);
+		cJSON_AddItemToArray(arr, so);
+	}
+	cJSON *links = cJSON_AddObjectToObject(o, "links");
+	snprintf(link, sizeof link, "/api/v1/experiments/%s", v->id);
+	cJSON_AddStringToObject(links, "self", link);
+	snprintf(link, sizeof link, "/api/v1/sessions/%s", v->session_id);
+	cJSON_AddStringToObject(links, "session", link);
+	return o;
+}
+
+char *api_experiment_json(const api_experiment_view *v)
+{
+	return api_print_free(experiment_object(v));
+}
+
+char *api_experiment_list_json(const api_experiment_view *v, size_t n)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON *arr = cJSON_AddArrayToObject(o, "experiments");
+	for (size_t i = 0; i < n; i++)
+		cJSON_AddItemToArray(arr, experiment_object(&v[i]));
+	return api_print_free(o);
+}

@@ -1,0 +1,77 @@
+/*
+ * json_int.h - helpers shared inside api/ (not for the server): an exact
+ * printer for cJSON trees, a growable text buffer, and the lookups that
+ * tie JSON members to the core's settings table.
+ */
+#ifndef CONVSIM_API_JSON_INT_H
+#define CONVSIM_API_JSON_INT_H
+
+#include <cjson/cJSON.h>
+#include <stddef.h>
+
+#include "api.h"
+
+/* Growable text; on allocation failure `failed` is set and appends stop. */
+typedef struct api_buf {
+	char *text;
+	size_t len, cap;
+	int failed;
+} api_buf;
+
+void api_buf_put(api_buf *b, const char *s, size_t n);
+void api_buf_puts(api_buf *b, const char *s);
+void api_buf_printf(api_buf *b, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+void api_buf_double(api_buf *b, double v);
+/* A JSON string literal, escaped. */
+void api_buf_jstr(api_buf *b, const char *s);
+/* Hand over the text (NULL if any append failed; then it is freed). */
+char *api_buf_take(api_buf *b);
+
+/* Print a cJSON tree compactly with exact doubles (null if not finite).
+ * malloc'd text, NULL when out of memory. Does not free the tree. */
+char *api_print(const cJSON *item);
+/* Print and free the tree; NULL when tree is NULL or out of memory. */
+char *api_print_free(cJSON *item);
+
+/* Parse len bytes as one JSON object (empty or blank text gives {} when
+ * empty_ok). Returns the tree or NULL with *pb set (400). */
+cJSON *api_parse_object(const char *body, size_t len, int empty_ok,
+			api_problem *pb);
+
+/* The settings-table entry of name in group, or NULL. */
+const sim_setting *api_setting(const char *group, const char *name);
+/* Apply one JSON member to the settings of its group ("params", "scene",
+ * "integrator"), by its kind: numbers, booleans and enum strings. The
+ * problem names the field as "group.name". */
+api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
+			  const char *group, const cJSON *item,
+			  api_problem *pb);
+/* Apply preset/params/scene/integrator members of obj (others ignored)
+ * to *spec, starting from the preset (default czubak2016). */
+api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb);
+/* The settings of one group with their current values as a JSON object. */
+cJSON *api_settings_object(const sim_params *p, const sim_scene *s,
+			   const sim_method *m, const char *group);
+/* pace: a real-time factor in [0.001, 1000] or "max" (API_PACE_MAX). */
+api_err api_parse_pace(const cJSON *it, const char *field, double *pace,
+		       api_problem *pb);
+/* A number within [lo, hi]; null gives 0 when null_ok. */
+api_err api_parse_real(const cJSON *it, const char *field, double lo,
+		       double hi, int null_ok, double *out, api_problem *pb);
+/* pace, until, sample_rate of a session body, with their defaults. */
+api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
+				 api_problem *pb);
+/* Every member of obj must be one of the NULL-terminated names (422
+ * naming prefix + member otherwise). */
+api_err api_check_members(const cJSON *obj, const char *const *names,
+			  const char *prefix, api_problem *pb);
+/* sim_validate on the spec, as a 422 problem. */
+api_err api_validate_spec(api_spec *spec, api_problem *pb);
+/* The settings table as a JSON array of {name, group, kind, unit,
+ * min, max | choices, doc}. */
+cJSON *api_settings_array(void);
+/* Add a number member; non-finite values become null. */
+void api_add_number(cJSON *obj, const char *name, double v);
+
+#endif

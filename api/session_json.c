@@ -1,0 +1,271 @@
+/*
+ * session_json.c - sessions in JSON: the PATCH control body and the
+ * session document (spec and live status) that GET, POST and PATCH answer.
+ *
+ * Controls are validated against the session's own settings with sim_set
+ * on a scratch copy, so the messages and ranges are the core's; a control
+ * is all or nothing. Angles leave here in degrees, as users type them.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "json_int.h"
+
+#define DEG (180.0 / M_PI)
+
+static api_err check_setting(const api_spec *spec, const char *name,
+			     const cJSON *it, double *value, api_problem *pb)
+{
+	sim_params p = spec->params;
+	sim_scene s = spec->scene;
+	sim_method m = spec->method;
+	char msg[256] = "";
+	if (!cJSON_IsNumber(it))
+		return api_fail(pb, API_TYPE, name, "%s must be a number",
+				name);
+	int rc = sim_set(&p, &s, &m, name, it->valuedouble, msg, sizeof msg);
+	if (rc != SIM_OK)
+		return api_fail(pb, api_from_sim(rc), name, "%s",
+				msg[0] ? msg : sim_strerror(rc));
+	*value = it->valuedouble;
+	return API_OK;
+}
+
+api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
+			  api_control *c, api_problem *pb)
+{
+	static const char *const members[] = {"beta", "beta_rate", "rotation",
+					      "omega_ss", "running", "pace",
+					      "until", NULL};
+	memset(c, 0, sizeof *c);
+	cJSON *root = api_parse_object(body, len, 0, pb);
+	if (!root)
+		return pb->code;
+	api_err e = api_check_members(root, members, "", pb);
+	const cJSON *it;
+	if (e == API_OK && !root->child)
+		e = api_fail(pb, API_INVALID, NULL,
+			     "no change given; expected any of beta, "
+			     "beta_rate, rotation, omega_ss, running, pace, "
+			     "until");
+	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "beta")) &&
+	    (e = check_setting(spec, "beta", it, &c->beta, pb)) == API_OK)
+		c->set |= API_C_BETA;
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "beta_rate")) &&
+	    (e = check_setting(spec, "beta_rate", it, &c->beta_rate, pb)) ==
+		    API_OK)
+		c->set |= API_C_BETA_RATE;
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "omega_ss")) &&
+	    (e = check_setting(spec, "omega_ss", it, &c->omega_ss, pb)) ==
+		    API_OK)
+		c->set |= API_C_OMEGA_SS;
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "rotation"))) {
+		if (!cJSON_IsString(it)) {
+			e = api_fail(pb, API_TYPE, "rotation",
+				     "rotation must be \"cw\" or \"ccw\"");
+		} else if (strcmp(it->valuestring, "cw") == 0) {
+			c->rotation = SIM_CW;
+			c->set |= API_C_ROTATION;
+		} else if (strcmp(it->valuestring, "ccw") == 0) {
+			c->rotation = SIM_CCW;
+			c->set |= API_C_ROTATION;
+		} else {
+			e = api_fail(pb, API_RANGE, "rotation",
+				     "rotation must be \"cw\" or \"ccw\"");
+			snprintf(pb->choices, sizeof pb->choices, "cw|ccw");
+		}
+	}
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "running"))) {
+		if (!cJSON_IsBool(it)) {
+			e = api_fail(pb, API_TYPE, "running",
+				     "running must be true or false");
+		} else {
+			c->running = cJSON_IsTrue(it);
+			c->set |= API_C_RUNNING;
+		}
+	}
+	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "pace")) &&
+	    (e = api_parse_pace(it, "pace", &c->pace, pb)) == API_OK)
+		c->set |= API_C_PACE;
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "until")) &&
+	    (e = api_parse_real(it, "until", 1e-6, 1e6, 1, &c->until, pb)) ==
+		    API_OK)
+		c->set |= API_C_UNTIL;
+	cJSON_Delete(root);
+	return e;
+}
+
+static void put_pace(cJSON *o, const char *name, double pace)
+{
+	if (pace == API_PACE_MAX)
+		cJSON_AddStringToObject(o, name, "max");
+	else
+		api_add_number(o, name, pace);
+}
+
+static cJSON *control_object(const api_control *c)
+{
+	cJSON *o = cJSON_CreateObject();
+	if (c->set & API_C_BETA)
+		api_add_number(o, "beta", c->beta);
+	if (c->set & API_C_BETA_RATE)
+		api_add_number(o, "beta_rate", c->beta_rate);
+	if (c->set & API_C_ROTATION)
+		cJSON_AddStringToObject(o, "rotation",
+					c->rotation == SIM_CW ? "cw" : "ccw");
+	if (c->set & API_C_OMEGA_SS)
+		api_add_number(o, "omega_ss", c->omega_ss);
+	if (c->set & API_C_RUNNING)
+		cJSON_AddBoolToObject(o, "running", c->running);
+	if (c->set & API_C_PACE)
+		put_pace(o, "pace", c->pace);
+	if (c->set & API_C_UNTIL) {
+		if (c->until > 0)
+			api_add_number(o, "until", c->until);
+		else
+			cJSON_AddNullToObject(o, "until");
+	}
+	return o;
+}
+
+int api_control_event(char *buf, size_t len, const api_control *c,
+		      double t_effective)
+{
+	cJSON *o = control_object(c);
+	api_add_number(o, "t_effective", t_effective);
+	char *text = api_print_free(o);
+	int n = snprintf(buf, len, "%s", text ? text : "{}");
+	free(text);
+	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
+}
+
+static cJSON *status_object(const api_view *v)
+{
+	const sim_status *st = &v->st;
+	cJSON *o = cJSON_CreateObject();
+	api_add_number(o, "t", st->t);
+	api_add_number(o, "t_integrator", st->t_int);
+	api_add_number(o, "beta", st->beta * DEG);
+	api_add_number(o, "beta_target", st->beta_target * DEG);
+	api_add_number(o, "beta_dot", st->beta_dot * DEG);
+	cJSON_AddStringToObject(o, "rotation",
+				st->rotation == SIM_CW ? "cw" : "ccw");
+	cJSON_AddBoolToObject(o, "drive_on", st->drive_on);
+	api_add_number(o, "omega_ss", st->omega_ss);
+	api_add_number(o, "rotor_speed", st->rotor_speed);
+	api_add_number(o, "motor_torque", st->motor_torque);
+	api_add_number(o, "power", st->power);
+	api_add_number(o, "transport_velocity", st->transport_velocity);
+	api_add_number(o, "transport_periods", st->transport_periods);
+	api_add_number(o, "feed_velocity", st->feed_velocity);
+	api_add_number(o, "feed_displacement", st->feed_displacement);
+	api_add_number(o, "period", st->period);
+	api_add_number(o, "steps", (double)st->steps);
+	api_add_number(o, "rhs_evals", (double)st->rhs_evals);
+	api_add_number(o, "steps_per_s", v->steps_per_s);
+	api_add_number(o, "rtf", v->rtf);
+	cJSON_AddNumberToObject(o, "n_dof", st->n_dof);
+	cJSON *red = cJSON_AddArrayToObject(o, "reductions");
+	for (int b = 0; sim_reduction_name(b); b++)
+		if (st->reductions & (1u << b))
+			cJSON_AddItemToArray(
+				red, cJSON_CreateString(sim_reduction_name(b)));
+	cJSON *en = cJSON_AddObjectToObject(o, "energy");
+	api_add_number(en, "input", st->e_input);
+	api_add_number(en, "kinetic", st->e_kinetic);
+	api_add_number(en, "potential", st->e_potential);
+	api_add_number(en, "dissipated", st->e_dissipated);
+	api_add_number(en, "residual", st->e_residual);
+	return o;
+}
+
+static cJSON *session_object(const api_view *v, int with_spec)
+{
+	cJSON *o = cJSON_CreateObject();
+	char link[96];
+	cJSON_AddStringToObject(o, "id", v->id);
+	cJSON_AddStringToObject(o, "state", v->state);
+	if (v->error[0])
+		cJSON_AddStringToObject(o, "error", v->error);
+	api_add_number(o, "created", v->created);
+	cJSON_AddStringToObject(o, "preset", v->spec->preset);
+	put_pace(o, "pace", v->pace);
+	if (v->until > 0)
+		api_add_number(o, "until", v->until);
+	else
+		cJSON_AddNullToObject(o, "until");
+	api_add_number(o, "sample_rate", v->spec->sample_rate);
+	cJSON_AddNumberToObject(o, "columns", v->columns);
+	cJSON_AddNumberToObject(o, "layers", v->layers);
+	api_add_number(o, "samples", (double)v->samples);
+	cJSON_AddNumberToObject(o, "streams", v->streams);
+	if (v->experiment[0])
+		cJSON_AddStringToObject(o, "experiment", v->experiment);
+	else
+		cJSON_AddNullToObject(o, "experiment");
+	if (v->has_status)
+		cJSON_AddItemToObject(o, "status", status_object(v));
+	else
+		cJSON_AddNullToObject(o, "status");
+	cJSON *links = cJSON_AddObjectToObject(o, "links");
+	snprintf(link, sizeof link, "/api/v1/sessions/%s", v->id);
+	cJSON_AddStringToObject(links, "self", link);
+	snprintf(link, sizeof link, "/api/v1/sessions/%s/stream", v->id);
+	cJSON_AddStringToObject(links, "stream", link);
+	snprintf(link, sizeof link, "/api/v1/sessions/%s/trajectory", v->id);
+	cJSON_AddStringToObject(links, "trajectory", link);
+	if (with_spec) {
+		const api_spec *sp = v->spec;
+		cJSON *spec = cJSON_AddObjectToObject(o, "spec");
+		cJSON_AddItemToObject(spec, "params",
+				      api_settings_object(&sp->params,
+							  &sp->scene,
+							  &sp->method,
+							  "params"));
+		cJSON_AddItemToObject(spec, "scene",
+				      api_settings_object(&sp->params,
+							  &sp->scene,
+							  &sp->method,
+							  "scene"));
+		cJSON_AddItemToObject(spec, "integrator",
+				      api_settings_object(&sp->params,
+							  &sp->scene,
+							  &sp->method,
+							  "integrator"));
+	}
+	return o;
+}
+
+char *api_session_json(const api_view *v, int with_spec)
+{
+	return api_print_free(session_object(v, with_spec));
+}
+
+char *api_session_list_json(const api_view *v, size_t n)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON *arr = cJSON_AddArrayToObject(o, "sessions");
+	for (size_t i = 0; i < n; i++)
+		cJSON_AddItemToArray(arr, session_object(&v[i], 0));
+	return api_print_free(o);
+}
+
+char *api_control_result_json(const api_view *v, const api_control *c,
+			      int acked, double t_effective)
+{
+	cJSON *o = session_object(v, 0);
+	cJSON_AddItemToObject(o, "applied", control_object(c));
+	cJSON_AddBoolToObject(o, "acknowledged", acked);
+	if (acked)
+		api_add_number(o, "t_effective", t_effective);
+	else
+		cJSON_AddNullToObject(o, "t_effective");
+	return api_print_free(o);
+}

@@ -1,0 +1,312 @@
+/*
+ * settings_json.c - JSON members to the core's named settings and back.
+ *
+ * The core's sim_settings() table is the single source of names, groups,
+ * kinds, units and ranges. A member {"k_s1": 444132} of "params" is looked
+ * up there, type-checked against the setting's kind (400 on a wrong JSON
+ * type) and handed to sim_set/sim_set_str, whose message names the field
+ * and its range (422). Also parses the whole POST /sessions body.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "json_int.h"
+
+/* The name of choice idx in "a|b|c" into out; 0 if there is none. */
+static int choice_name(const char *choices, int idx, char *out, size_t len)
+{
+	const char *p = choices;
+	for (int i = 0; p && *p; i++) {
+		const char *bar = strchr(p, '|');
+		size_t n = bar ? (size_t)(bar - p) : strlen(p);
+		if (i == idx && n < len) {
+			memcpy(out, p, n);
+			out[n] = '\0';
+			return 1;
+		}
+		p = bar ? bar + 1 : NULL;
+	}
+	return 0;
+}
+
+static api_err from_sim_set(int rc, const char *field, const char *msg,
+			    api_problem *pb)
+{
+	if (rc == SIM_OK)
+		return API_OK;
+	return api_fail(pb, api_from_sim(rc), field, "%s",
+			msg[0] ? msg : sim_strerror(rc));
+}
+
+api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
+			  const char *group, const cJSON *item,
+			  api_problem *pb)
+{
+	char field[64], msg[256] = "";
+	const char *name = item->string ? item->string : "";
+	snprintf(field, sizeof field, "%s.%s", group, name);
+	const sim_setting *set = api_setting(group, name);
+	if (!set) {
+		if (strcmp(group, "integrator") == 0 &&
+		    strcmp(name, "method") == 0 && cJSON_IsString(item))
+			return from_sim_set(sim_set_str(p, s, m, name,
+							item->valuestring,
+							msg, sizeof msg),
+					    field, msg, pb);
+		const sim_setting *other = api_setting(NULL, name);
+		if (other)
+			return api_fail(pb, API_UNKNOWN, field,
+					"%s is not a %s setting; it belongs "
+					"to \"%s\"", name, group, other->group);
+		return api_fail(pb, API_UNKNOWN, field,
+				"unknown %s setting \"%s\"", group, name);
+	}
+	int rc;
+	switch (set->kind) {
+	case SIM_KIND_REAL:
+	case SIM_KIND_INT:
+		if (!cJSON_IsNumber(item))
+			return api_fail(pb, API_TYPE, field,
+					"%s must be a number (%s)", field,
+					set->unit ? set->unit : "");
+		if (set->kind == SIM_KIND_INT &&
+		    item->valuedouble != floor(item->valuedouble))
+			return api_fail(pb, API_RANGE, field,
+					"%s must be an integer in [%g, %g]",
+					field, set->min, set->max);
+		rc = sim_set(p, s, m, name, item->valuedouble, msg, sizeof msg);
+		break;
+	case SIM_KIND_BOOL:
+		if (cJSON_IsBool(item))
+			rc = sim_set(p, s, m, name, cJSON_IsTrue(item) ? 1 : 0,
+				     msg, sizeof msg);
+		else
+			return api_fail(pb, API_TYPE, field,
+					"%s must be true or false", field);
+		break;
+	case SIM_KIND_ENUM:
+		if (cJSON_IsString(item))
+			rc = sim_set_str(p, s, m, name, item->valuestring, msg,
+					 sizeof msg);
+		else
+			return api_fail(pb, API_TYPE, field,
+					"%s must be one of the strings %s",
+					field, set->choices ? set->choices : "");
+		break;
+	default:
+		return api_fail(pb, API_INVALID, field, "%s cannot be set",
+				field);
+	}
+	return from_sim_set(rc, field, msg, pb);
+}
+
+api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)
+{
+	static const char *const groups[] = {"params", "scene", "integrator"};
+	const char *preset = "czubak2016";
+	const cJSON *pr = cJSON_GetObjectItemCaseSensitive(obj, "preset");
+	if (pr && !cJSON_IsNull(pr)) {
+		if (!cJSON_IsString(pr))
+			return api_fail(pb, API_TYPE, "preset",
+					"preset must be a string");
+		preset = pr->valuestring;
+	}
+	if (sim_preset(preset, &spec->params, &spec->scene, &spec->method) !=
+	    SIM_OK) {
+		api_fail(pb, API_RANGE, "preset", "unknown preset \"%.60s\"",
+			 preset);
+		size_t at = 0;
+		for (int i = 0; sim_preset_names[i]; i++)
+			at += (size_t)snprintf(pb->choices + at,
+					       at < sizeof pb->choices
+						       ? sizeof pb->choices - at
+						       : 0,
+					       "%s%s", i ? "|" : "",
+					       sim_preset_names[i]);
+		return API_RANGE;
+	}
+	snprintf(spec->preset, sizeof spec->preset, "%s", preset);
+	for (size_t g = 0; g < 3; g++) {
+		const cJSON *grp =
+			cJSON_GetObjectItemCaseSensitive(obj, groups[g]);
+		if (!grp || cJSON_IsNull(grp))
+			continue;
+		if (!cJSON_IsObject(grp))
+			return api_fail(pb, API_TYPE, groups[g],
+					"%s must be an object of NAME: VALUE",
+					groups[g]);
+		for (const cJSON *it = grp->child; it; it = it->next) {
+			api_err e = api_apply_setting(&spec->params,
+						      &spec->scene,
+						      &spec->method, groups[g],
+						      it, pb);
+			if (e != API_OK)
+				return e;
+		}
+	}
+	return API_OK;
+}
+
+cJSON *api_settings_object(const sim_params *p, const sim_scene *s,
+			   const sim_method *m, const char *group)
+{
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n);
+	cJSON *o = cJSON_CreateObject();
+	int has_method = 0;
+	for (size_t i = 0; tab && i < n; i++) {
+		if (strcmp(tab[i].group, group) != 0)
+			continue;
+		double v = NAN;
+		if (sim_get(p, s, m, tab[i].name, &v) != SIM_OK)
+			continue;
+		if (strcmp(tab[i].name, "method") == 0)
+			has_method = 1;
+		char name[48];
+		if (tab[i].kind == SIM_KIND_BOOL)
+			cJSON_AddBoolToObject(o, tab[i].name, v != 0);
+		else if (tab[i].kind == SIM_KIND_ENUM && tab[i].choices &&
+			 choice_name(tab[i].choices, (int)v, name, sizeof name))
+			cJSON_AddStringToObject(o, tab[i].name, name);
+		else
+			api_add_number(o, tab[i].name, v);
+	}
+	if (strcmp(group, "integrator") == 0 && !has_method)
+		cJSON_AddStringToObject(o, "method", m->name);
+	return o;
+}
+
+/* pace: a positive real-time factor or "max". */
+api_err api_parse_pace(const cJSON *it, const char *field, double *pace,
+			  api_problem *pb)
+{
+	if (cJSON_IsString(it)) {
+		if (strcmp(it->valuestring, "max") == 0) {
+			*pace = API_PACE_MAX;
+			return API_OK;
+		}
+		api_fail(pb, API_RANGE, field,
+			 "%s must be a real-time factor in [0.001, 1000] or "
+			 "\"max\"", field);
+		pb->has_range = 1, pb->min = 0.001, pb->max = 1000;
+		return API_RANGE;
+	}
+	if (!cJSON_IsNumber(it))
+		return api_fail(pb, API_TYPE, field,
+				"%s must be a number or \"max\"", field);
+	double v = it->valuedouble;
+	if (!(v >= 0.001 && v <= 1000)) {
+		api_fail(pb, API_RANGE, field,
+			 "%s must be a real-time factor in [0.001, 1000] or "
+			 "\"max\"", field);
+		pb->has_range = 1, pb->min = 0.001, pb->max = 1000;
+		return API_RANGE;
+	}
+	*pace = v;
+	return API_OK;
+}
+
+/* A positive number within [lo, hi] (null allowed when null_ok: 0). */
+api_err api_parse_real(const cJSON *it, const char *field, double lo,
+			  double hi, int null_ok, double *out,
+			  api_problem *pb)
+{
+	if (null_ok && cJSON_IsNull(it)) {
+		*out = 0;
+		return API_OK;
+	}
+	if (!cJSON_IsNumber(it))
+		return api_fail(pb, API_TYPE, field, "%s must be a number",
+				field);
+	if (!(it->valuedouble >= lo && it->valuedouble <= hi)) {
+		api_fail(pb, API_RANGE, field, "%s must lie in [%g, %g]", field,
+			 lo, hi);
+		pb->has_range = 1, pb->min = lo, pb->max = hi;
+		return API_RANGE;
+	}
+	*out = it->valuedouble;
+	return API_OK;
+}
+
+/* Members of a session body besides the model settings. */
+api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
+				 api_problem *pb)
+{
+	const cJSON *it;
+	api_err e;
+	spec->pace = 1.0;
+	spec->until = 0;
+	spec->sample_rate = API_DEFAULT_SAMPLE_RATE;
+	if ((it = cJSON_GetObjectItemCaseSensitive(root, "pace")) &&
+	    (e = api_parse_pace(it, "pace", &spec->pace, pb)) != API_OK)
+		return e;
+	if ((it = cJSON_GetObjectItemCaseSensitive(root, "until")) &&
+	    (e = api_parse_real(it, "until", 1e-6, 1e6, 1, &spec->until, pb)) !=
+		    API_OK)
+		return e;
+	if ((it = cJSON_GetObjectItemCaseSensitive(root, "sample_rate")) &&
+	    (e = api_parse_real(it, "sample_rate", 1, 10000, 0,
+			    &spec->sample_rate, pb)) != API_OK)
+		return e;
+	if (spec->pace == API_PACE_MAX && spec->until == 0)
+		spec->until = API_DEFAULT_MAX_UNTIL;
+	return API_OK;
+}
+
+/* Every member of obj must be one of the NULL-terminated names. */
+api_err api_check_members(const cJSON *obj, const char *const *names,
+			  const char *prefix, api_problem *pb)
+{
+	for (const cJSON *it = obj->child; it; it = it->next) {
+		int known = 0;
+		for (size_t i = 0; names[i] && !known; i++)
+			known = strcmp(it->string, names[i]) == 0;
+		if (!known) {
+			char field[64], list[256] = "";
+			snprintf(field, sizeof field, "%s%s", prefix,
+				 it->string);
+			size_t at = 0;
+			for (size_t i = 0; names[i] && at < sizeof list; i++)
+				at += (size_t)snprintf(list + at,
+						       sizeof list - at, "%s%s",
+						       i ? ", " : "", names[i]);
+			return api_fail(pb, API_UNKNOWN, field,
+					"unknown member \"%.40s\"; expected "
+					"any of: %s", it->string, list);
+		}
+	}
+	return API_OK;
+}
+
+api_err api_validate_spec(api_spec *spec, api_problem *pb)
+{
+	char msg[256] = "";
+	int rc = sim_validate(&spec->params, &spec->scene, &spec->method, msg,
+			      sizeof msg);
+	if (rc != SIM_OK)
+		return api_fail(pb, api_from_sim(rc), NULL, "%s",
+				msg[0] ? msg : sim_strerror(rc));
+	return API_OK;
+}
+
+api_err api_parse_session(const char *body, size_t len, api_spec *spec,
+			  api_problem *pb)
+{
+	static const char *const members[] = {
+		"preset", "params", "scene", "integrator", "pace", "until",
+		"sample_rate", NULL};
+	memset(spec, 0, sizeof *spec);
+	cJSON *root = api_parse_object(body, len, 1, pb);
+	if (!root)
+		return pb->code;
+	api_err e = api_check_members(root, members, "", pb);
+	if (e == API_OK)
+		e = api_apply_model(root, spec, pb);
+	if (e == API_OK)
+		e = api_apply_session_extras(root, spec, pb);
+	if (e == API_OK)
+		e = api_validate_spec(spec, pb);
+	cJSON_Delete(root);
+	return e;
+}

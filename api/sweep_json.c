@@ -1,0 +1,261 @@
+/*
+ * sweep_json.c - the v(beta) sweep in JSON and CSV.
+ *
+ * A sweep measures the steady transport velocity for a list of beta
+ * values and rotation directions (the paper's Figs. 9 and 11), one fresh
+ * instance per point. This file parses the request (the model members as
+ * for sessions, plus the beta grid, the rotations and the simulated time
+ * per point) and writes progress and results.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "json_int.h"
+
+static api_err check_beta(const api_spec *spec, const char *field, double v,
+			  api_problem *pb)
+{
+	sim_params p = spec->params;
+	sim_scene s = spec->scene;
+	sim_method m = spec->method;
+	char msg[256] = "";
+	int rc = sim_set(&p, &s, &m, "beta", v, msg, sizeof msg);
+	if (rc == SIM_OK)
+		return API_OK;
+	api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);
+	snprintf(pb->field, sizeof pb->field, "%s", field);
+	return pb->code;
+}
+
+static api_err parse_grid(const cJSON *it, api_sweep_req *req,
+			  api_problem *pb)
+{
+	char field[32];
+	if (!it) {
+		/* default: 0..180 deg every 10 deg */
+		req->nbeta = 19;
+		req->betas = malloc(19 * sizeof *req->betas);
+		if (!req->betas)
+			return api_fail(pb, API_UNAVAILABLE, NULL,
+					"out of memory");
+		for (int i = 0; i < 19; i++)
+			req->betas[i] = 10.0 * i;
+		return API_OK;
+	}
+	if (cJSON_IsArray(it)) {
+		int n = cJSON_GetArraySize(it);
+		if (n < 1 || n > API_SWEEP_MAX_POINTS / 2)
+			return api_fail(pb, API_RANGE, "beta",
+					"beta must list 1 to %d angles",
+					API_SWEEP_MAX_POINTS / 2);
+		req->betas = malloc((size_t)n * sizeof *req->betas);
+		if (!req->betas)
+			return api_fail(pb, API_UNAVAILABLE, NULL,
+					"out of memory");
+		int i = 0;
+		for (const cJSON *b = it->child; b; b = b->next, i++) {
+			snprintf(field, sizeof field, "beta[%d]", i);
+			if (!cJSON_IsNumber(b))
+				return api_fail(pb, API_TYPE, field,
+						"%s must be a number (deg)",
+						field);
+			api_err e = check_beta(&req->spec, field,
+					       b->valuedouble, pb);
+			if (e != API_OK)
+				return e;
+			req->betas[i] = b->valuedouble;
+		}
+		req->nbeta = n;
+		return API_OK;
+	}
+	if (!cJSON_IsObject(it))
+		return api_fail(pb, API_TYPE, "beta",
+				"beta must be {\"from\",\"to\",\"step\"} or an "
+				"array of angles");
+	static const char *const members[] = {"from", "to", "step", NULL};
+	api_err e = api_check_members(it, members, "beta.", pb);
+	double g[3];
+	for (int k = 0; k < 3 && e == API_OK; k++) {
+		const cJSON *v = cJSON_GetObjectItemCaseSensitive(it,
+								  members[k]);
+		snprintf(field, sizeof field, "beta.%s", members[k]);
+		if (!cJSON_IsNumber(v))
+			return api_fail(pb, API_TYPE, field,
+					"%s must be a number (deg)", field);
+		g[k] = v->valuedouble;
+		if (k < 2)
+			e = check_beta(&req->spec, field, g[k], pb);
+	}
+	if (e != API_OK)
+		return e;
+	if (!(g[2] > 0) || g[1] < g[0])
+		return api_fail(pb, API_RANGE, "beta.step",
+				"beta.step must be > 0 and beta.to >= "
+				"beta.from");
+	double count = floor((g[1] - g[0]) / g[2] + 1e-9) + 1;
+	if (count > API_SWEEP_MAX_POINTS / 2)
+		return api_fail(pb, API_RANGE, "beta.step",
+				"the grid has %.0f angles; at most %d are "
+				"allowed", count, API_SWEEP_MAX_POINTS / 2);
+	req->nbeta = (int)count;
+	req->betas = malloc((size_t)req->nbeta * sizeof *req->betas);
+	if (!req->betas)
+		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+	for (int i = 0; i < req->nbeta; i++)
+		req->betas[i] = g[0] + i * g[2];
+	return API_OK;
+}
+
+static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
+			       api_problem *pb)
+{
+	if (!it) {
+		req->nrot = 2;
+		req->rotations[0] = SIM_CW;
+		req->rotations[1] = SIM_CCW;
+		return API_OK;
+	}
+	int n = cJSON_IsArray(it) ? cJSON_GetArraySize(it) : -1;
+	if (n < 1 || n > 2)
+		return api_fail(pb, n < 0 ? API_TYPE : API_RANGE, "rotations",
+				"rotations must be an array of one or two of "
+				"\"cw\", \"ccw\"");
+	for (const cJSON *r = it->child; r; r = r->next) {
+		int rot;
+		if (cJSON_IsString(r) && strcmp(r->valuestring, "cw") == 0)
+			rot = SIM_CW;
+		else if (cJSON_IsString(r) && strcmp(r->valuestring, "ccw") == 0)
+			rot = SIM_CCW;
+		else
+			return api_fail(pb, cJSON_IsString(r) ? API_RANGE
+							      : API_TYPE,
+					"rotations",
+					"rotations lists \"cw\" and/or \"ccw\"");
+		if (req->nrot == 1 && req->rotations[0] == rot)
+			return api_fail(pb, API_INVALID, "rotations",
+					"rotations lists a direction twice");
+		req->rotations[req->nrot++] = rot;
+	}
+	return API_OK;
+}
+
+api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
+			api_problem *pb)
+{
+	static const char *const members[] = {"preset", "params", "scene",
+					      "integrator", "beta", "rotations",
+					      "t_end", NULL};
+	memset(req, 0, sizeof *req);
+	cJSON *root = api_parse_object(body, len, 1, pb);
+	if (!root)
+		return pb->code;
+	api_err e = api_check_members(root, members, "", pb);
+	if (e == API_OK)
+		e = api_apply_model(root, &req->spec, pb);
+	if (e == API_OK)
+		e = api_validate_spec(&req->spec, pb);
+	req->t_end = 5.0;
+	const cJSON *te = cJSON_GetObjectItemCaseSensitive(root, "t_end");
+	if (e == API_OK && te)
+		e = api_parse_real(te, "t_end", 0.01, 600, 0, &req->t_end, pb);
+	if (e == API_OK)
+		e = parse_grid(cJSON_GetObjectItemCaseSensitive(root, "beta"),
+			       req, pb);
+	if (e == API_OK)
+		e = parse_rotations(
+			cJSON_GetObjectItemCaseSensitive(root, "rotations"),
+			req, pb);
+	cJSON_Delete(root);
+	if (e != API_OK) {
+		free(req->betas);
+		req->betas = NULL;
+	}
+	return e;
+}
+
+static const char *point_state(int s)
+{
+	static const char *const names[] = {"pending", "running", "done",
+					    "failed"};
+	return s >= 0 && s <= 3 ? names[s] : "pending";
+}
+
+static cJSON *sweep_object(const api_sweep_view *v, int points)
+{
+	char link[96];
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "id", v->id);
+	cJSON_AddStringToObject(o, "state", v->state);
+	api_add_number(o, "total", (double)v->total);
+	api_add_number(o, "done", (double)v->done);
+	api_add_number(o, "progress",
+		       v->total ? (double)v->done / (double)v->total : 1.0);
+	api_add_number(o, "t_end", v->t_end);
+	cJSON *pts = points ? cJSON_AddArrayToObject(o, "points") : NULL;
+	cJSON *series = points ? cJSON_AddObjectToObject(o, "series") : NULL;
+	cJSON *cw = points ? cJSON_AddArrayToObject(series, "cw") : NULL;
+	cJSON *ccw = points ? cJSON_AddArrayToObject(series, "ccw") : NULL;
+	for (size_t i = 0; points && i < v->total; i++) {
+		const api_sweep_point *p = &v->pt[i];
+		cJSON *po = cJSON_CreateObject();
+		api_add_number(po, "beta", p->beta);
+		cJSON_AddStringToObject(po, "rotation",
+					p->rotation == SIM_CW ? "cw" : "ccw");
+		cJSON_AddStringToObject(po, "state", point_state(p->state));
+		if (p->state == 2)
+			api_add_number(po, "velocity", p->velocity);
+		else
+			cJSON_AddNullToObject(po, "velocity");
+		if (p->error[0])
+			cJSON_AddStringToObject(po, "error", p->error);
+		cJSON_AddItemToArray(pts, po);
+		if (p->state == 2) {
+			cJSON *pair = cJSON_CreateArray();
+			cJSON_AddItemToArray(pair,
+					     cJSON_CreateNumber(p->beta));
+			cJSON_AddItemToArray(
+				pair, isfinite(p->velocity)
+					      ? cJSON_CreateNumber(p->velocity)
+					      : cJSON_CreateNull());
+			cJSON_AddItemToArray(p->rotation == SIM_CW ? cw : ccw,
+					     pair);
+		}
+	}
+	cJSON *links = cJSON_AddObjectToObject(o, "links");
+	snprintf(link, sizeof link, "/api/v1/sweeps/%s", v->id);
+	cJSON_AddStringToObject(links, "self", link);
+	snprintf(link, sizeof link, "/api/v1/sweeps/%s?format=csv", v->id);
+	cJSON_AddStringToObject(links, "csv", link);
+	return o;
+}
+
+char *api_sweep_json(const api_sweep_view *v)
+{
+	return api_print_free(sweep_object(v, 1));
+}
+
+char *api_sweep_list_json(const api_sweep_view *v, size_t n)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON *arr = cJSON_AddArrayToObject(o, "sweeps");
+	for (size_t i = 0; i < n; i++)
+		cJSON_AddItemToArray(arr, sweep_object(&v[i], 0));
+	return api_print_free(o);
+}
+
+char *api_sweep_csv(const api_sweep_view *v)
+{
+	api_buf b = {0};
+	api_buf_puts(&b, "beta,rotation,velocity,state\n");
+	for (size_t i = 0; i < v->total; i++) {
+		const api_sweep_point *p = &v->pt[i];
+		api_buf_double(&b, p->beta);
+		api_buf_puts(&b, p->rotation == SIM_CW ? ",cw," : ",ccw,");
+		if (p->state == 2 && isfinite(p->velocity))
+			api_buf_double(&b, p->velocity);
+		api_buf_printf(&b, ",%s\n", point_state(p->state));
+	}
+	return api_buf_take(&b);
+}

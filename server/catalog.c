@@ -1,0 +1,59 @@
+/*
+ * catalog.c - the daemon's read-only resources: presets and the settings
+ * table, health, and the OpenAPI document (built once, on first use).
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "srv.h"
+
+static pthread_once_t openapi_once = PTHREAD_ONCE_INIT;
+static char *openapi_text;
+static double started;
+
+static void build_openapi(void)
+{
+	openapi_text = api_openapi_json();
+}
+
+void srv_catalog_shutdown(void)
+{
+	free(openapi_text);
+	openapi_text = NULL;
+}
+
+enum MHD_Result srv_h_openapi(srv_req *r)
+{
+	pthread_once(&openapi_once, build_openapi);
+	if (!openapi_text)
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	return srv_reply_static(r, 200, "application/json", openapi_text,
+				strlen(openapi_text));
+}
+
+enum MHD_Result srv_h_presets(srv_req *r)
+{
+	return srv_reply_json(r, 200, api_presets_json());
+}
+
+void srv_catalog_init(void)
+{
+	started = srv_now();
+}
+
+enum MHD_Result srv_h_health(srv_req *r)
+{
+	api_health h = {
+		.status = atomic_load(&srv_stopping) ? "stopping" : "ok",
+		.uptime = srv_now() - started,
+		.sessions = (int)srv_session_count(),
+		.max_sessions = srv_cfg.max_sessions,
+		.stream_clients = atomic_load(&srv_stats.stream_clients),
+		.max_streams = srv_cfg.max_streams,
+		.pool_threads = srv_cfg.pool_threads,
+		.pool_queued = srv_pool_queued(),
+	};
+	return srv_reply_json(r, atomic_load(&srv_stopping) ? 503 : 200,
+			      api_health_json(&h));
+}

@@ -1,0 +1,85 @@
+/*
+ * metrics.c - counters and the Prometheus text exposition at /metrics.
+ *
+ * Counters are atomics bumped where things happen (requests by status,
+ * steps, stream records, dropped samples); gauges (sessions, stream
+ * clients, steps per second) are read when scraped.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "srv.h"
+
+srv_metrics srv_stats;
+static atomic_ullong by_status[600];
+
+void srv_metrics_count(int status)
+{
+	if (status >= 100 && status < 600) {
+		atomic_fetch_add(&by_status[status], 1);
+		atomic_fetch_add(&srv_stats.requests[status / 100], 1);
+	}
+}
+
+static void metric(FILE *f, const char *name, const char *type,
+		   const char *help, double value)
+{
+	fprintf(f, "# HELP %s %s\n# TYPE %s %s\n%s %.17g\n", name, help, name,
+		type, name, value);
+}
+
+char *srv_metrics_text(void)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f)
+		return NULL;
+	metric(f, "convsim_sessions", "gauge", "Live simulation sessions.",
+	       (double)srv_session_count());
+	metric(f, "convsim_sessions_created_total", "counter",
+	       "Sessions created.", (double)srv_stats.sessions_created);
+	metric(f, "convsim_sessions_deleted_total", "counter",
+	       "Sessions deleted.", (double)srv_stats.sessions_deleted);
+	metric(f, "convsim_steps_total", "counter",
+	       "Integrator steps taken by all sessions.",
+	       (double)srv_stats.steps);
+	metric(f, "convsim_steps_per_second", "gauge",
+	       "Integrator steps per wall second, summed over sessions.",
+	       srv_sessions_steps_per_s());
+	metric(f, "convsim_stream_clients", "gauge",
+	       "Open stream connections.",
+	       (double)atomic_load(&srv_stats.stream_clients));
+	metric(f, "convsim_streams_opened_total", "counter",
+	       "Stream connections opened.", (double)srv_stats.streams_opened);
+	metric(f, "convsim_stream_records_total", "counter",
+	       "Records written to stream clients.",
+	       (double)srv_stats.stream_records);
+	metric(f, "convsim_stream_dropped_samples_total", "counter",
+	       "Records slow stream clients missed.",
+	       (double)srv_stats.dropped_samples);
+	metric(f, "convsim_experiments_total", "counter",
+	       "Experiments started.", (double)srv_stats.experiments);
+	metric(f, "convsim_sweep_points_total", "counter",
+	       "Sweep points measured.", (double)srv_stats.sweep_points);
+	metric(f, "convsim_pool_queued", "gauge",
+	       "Sweep jobs waiting for a pool thread.",
+	       (double)srv_pool_queued());
+	fprintf(f, "# HELP convsim_http_requests_total HTTP responses by "
+		   "status.\n# TYPE convsim_http_requests_total counter\n");
+	for (int s = 100; s < 600; s++) {
+		unsigned long long n = atomic_load(&by_status[s]);
+		if (n)
+			fprintf(f,
+				"convsim_http_requests_total{status=\"%d\"} "
+				"%llu\n", s, n);
+	}
+	fclose(f);
+	return text;
+}
+
+enum MHD_Result srv_h_metrics(srv_req *r)
+{
+	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
+			 srv_metrics_text(), NULL, NULL);
+}

@@ -1,0 +1,215 @@
+/*
+ * routes.c - the route table and the libmicrohttpd access handler.
+ *
+ * Routes are a static table {method, pattern, handler}; "*" in a pattern
+ * matches one path segment and becomes a path argument. The access
+ * handler collects the request body (refusing it with 413 before it is
+ * read when Content-Length exceeds --max-body, and while it is read for
+ * chunked bodies), checks its media type, then calls the one handler. A
+ * path that exists with another method gets 405 with Allow; unknown paths
+ * under /api/ get 404; everything else is a static file of web/.
+ * Per-request state is freed in the completion callback.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "srv.h"
+
+typedef struct route {
+	const char *method;
+	const char *pattern;
+	srv_handler handler;
+} route;
+
+static const route routes[] = {
+	{"POST", "/api/v1/sessions", srv_h_sessions_create},
+	{"GET", "/api/v1/sessions", srv_h_sessions_list},
+	{"GET", "/api/v1/sessions/*", srv_h_session_get},
+	{"PATCH", "/api/v1/sessions/*", srv_h_session_patch},
+	{"DELETE", "/api/v1/sessions/*", srv_h_session_delete},
+	{"GET", "/api/v1/sessions/*/stream", srv_h_stream},
+	{"GET", "/api/v1/sessions/*/trajectory", srv_h_trajectory},
+	{"POST", "/api/v1/experiments", srv_h_experiments_create},
+	{"GET", "/api/v1/experiments", srv_h_experiments_list},
+	{"GET", "/api/v1/experiments/*", srv_h_experiment_get},
+	{"POST", "/api/v1/sweeps", srv_h_sweeps_create},
+	{"GET", "/api/v1/sweeps", srv_h_sweeps_list},
+	{"GET", "/api/v1/sweeps/*", srv_h_sweep_get},
+	{"DELETE", "/api/v1/sweeps/*", srv_h_sweep_delete},
+	{"GET", "/api/v1/presets", srv_h_presets},
+	{"GET", "/api/v1/health", srv_h_health},
+	{"GET", "/api/v1/openapi.json", srv_h_openapi},
+	{"GET", "/metrics", srv_h_metrics},
+};
+
+typedef struct req_state {
+	srv_req r;
+	char *body;
+	size_t len, cap;
+	int too_large;
+} req_state;
+
+/* Match url against pattern; path arguments go to arg. */
+static int match(const char *pattern, const char *url, char arg[2][64])
+{
+	int nargs = 0;
+	const char *p = pattern, *u = url;
+	while (*p && *u) {
+		if (*p == '*') {
+			const char *end = strchr(u, '/');
+			size_t n = end ? (size_t)(end - u) : strlen(u);
+			if (n == 0 || n >= 64 || nargs >= 2)
+				return 0;
+			memcpy(arg[nargs], u, n);
+			arg[nargs++][n] = '\0';
+			u += n;
+			p++;
+		} else if (*p++ != *u++) {
+			return 0;
+		}
+	}
+	return *p == '\0' && *u == '\0';
+}
+
+static int json_type(const char *ct)
+{
+	static const char *const types[] = {"application/json",
+					    "application/merge-patch+json",
+					    "application/problem+json"};
+	while (*ct == ' ')
+		ct++;
+	for (size_t i = 0; i < sizeof types / sizeof *types; i++) {
+		size_t n = strlen(types[i]);
+		if (strncasecmp(ct, types[i], n) == 0 &&
+		    (ct[n] == '\0' || ct[n] == ';' || ct[n] == ' '))
+			return 1;
+	}
+	return 0;
+}
+
+static enum MHD_Result route_request(srv_req *r)
+{
+	char allow[96] = "";
+	const char *method = strcmp(r->method, "HEAD") == 0 ? "GET" : r->method;
+	int path_known = 0;
+	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
+		char arg[2][64];
+		if (!match(routes[i].pattern, r->url, arg))
+			continue;
+		path_known = 1;
+		if (strcmp(routes[i].method, method) == 0) {
+			memcpy(r->arg, arg, sizeof arg);
+			return routes[i].handler(r);
+		}
+		if (!strstr(allow, routes[i].method)) {
+			size_t at = strlen(allow);
+			snprintf(allow + at, sizeof allow - at, "%s%s",
+				 at ? ", " : "", routes[i].method);
+			if (strcmp(routes[i].method, "GET") == 0) {
+				at = strlen(allow);
+				snprintf(allow + at, sizeof allow - at,
+					 ", HEAD");
+			}
+		}
+	}
+	api_problem pb;
+	if (path_known) {
+		api_fail(&pb, API_METHOD, NULL,
+			 "%s is not allowed on %s; allowed: %s", r->method,
+			 r->url, allow);
+		return srv_reply_problem(r, &pb, allow);
+	}
+	if (strncmp(r->url, "/api/", 5) == 0 || strcmp(r->url, "/api") == 0) {
+		api_fail(&pb, API_NOTFOUND, NULL, "no such resource: %s",
+			 r->url);
+		return srv_reply_problem(r, &pb, NULL);
+	}
+	if (strcmp(method, "GET") != 0) {
+		api_fail(&pb, API_METHOD, NULL,
+			 "static files allow GET and HEAD only");
+		return srv_reply_problem(r, &pb, "GET, HEAD");
+	}
+	return srv_h_static(r);
+}
+
+enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
+			     const char *url, const char *method,
+			     const char *version, const char *upload_data,
+			     size_t *upload_data_size, void **con_cls)
+{
+	(void)cls;
+	(void)version;
+	req_state *st = *con_cls;
+	if (!st) {
+		st = calloc(1, sizeof *st);
+		if (!st)
+			return MHD_NO;
+		*con_cls = st;
+		st->r.conn = conn;
+		st->r.method = method;
+		st->r.url = url;
+		const char *ct = MHD_lookup_connection_value(
+			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+		st->r.has_content_type = ct != NULL;
+		st->r.json_body = ct && json_type(ct);
+		const char *cl = MHD_lookup_connection_value(
+			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+		if (cl && strtoull(cl, NULL, 10) > srv_cfg.max_body) {
+			/* refuse before reading the body */
+			st->r.body = "";
+			return srv_fail(&st->r, API_TOOLARGE, NULL,
+					"the body has %s bytes; the limit is "
+					"%zu (--max-body)", cl,
+					srv_cfg.max_body);
+		}
+		return MHD_YES;
+	}
+	if (*upload_data_size) {
+		size_t n = *upload_data_size;
+		*upload_data_size = 0;
+		if (st->too_large || st->len + n > srv_cfg.max_body) {
+			st->too_large = 1;
+			return MHD_YES;
+		}
+		if (st->len + n + 1 > st->cap) {
+			size_t cap = st->cap ? st->cap : 1024;
+			while (cap < st->len + n + 1)
+				cap *= 2;
+			char *b = realloc(st->body, cap);
+			if (!b)
+				return MHD_NO;
+			st->body = b;
+			st->cap = cap;
+		}
+		memcpy(st->body + st->len, upload_data, n);
+		st->len += n;
+		st->body[st->len] = '\0';
+		return MHD_YES;
+	}
+	st->r.body = st->body ? st->body : "";
+	st->r.body_len = st->len;
+	if (st->too_large)
+		return srv_fail(&st->r, API_TOOLARGE, NULL,
+				"the body exceeds the limit of %zu bytes "
+				"(--max-body)", srv_cfg.max_body);
+	if (atomic_load(&srv_stopping) && strncmp(url, "/api/", 5) == 0)
+		return srv_fail(&st->r, API_UNAVAILABLE, NULL,
+				"the daemon is shutting down");
+	return route_request(&st->r);
+}
+
+void srv_request_done(void *cls, struct MHD_Connection *conn,
+		      void **con_cls, enum MHD_RequestTerminationCode toe)
+{
+	(void)cls;
+	(void)conn;
+	(void)toe;
+	req_state *st = *con_cls;
+	if (!st)
+		return;
+	free(st->body);
+	free(st);
+	*con_cls = NULL;
+}

@@ -1,0 +1,173 @@
+/*
+ * session_http.c - the session resources: POST/GET /api/v1/sessions,
+ * GET/PATCH/DELETE /api/v1/sessions/{id} and its trajectory.
+ *
+ * Handlers parse with api/, act through session.c (never the core) and
+ * answer with api/'s text. A rejected request changes nothing: bodies are
+ * validated whole before anything is queued.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "srv.h"
+
+#define CONTROL_TIMEOUT_S 5.0
+
+static enum MHD_Result not_found(srv_req *r, const char *id)
+{
+	return srv_fail(r, API_NOTFOUND, NULL, "no session with id \"%.40s\"",
+			id);
+}
+
+enum MHD_Result srv_h_sessions_create(srv_req *r)
+{
+	enum MHD_Result res;
+	api_spec spec;
+	api_problem pb;
+	if (!srv_need_json(r, 1, &res))
+		return res;
+	if (api_parse_session(r->body, r->body_len, &spec, &pb) != API_OK)
+		return srv_reply_problem(r, &pb, NULL);
+	srv_session *s = srv_session_create(&spec, NULL, &pb);
+	if (!s)
+		return srv_reply_problem(r, &pb, NULL);
+	api_view v;
+	char location[96];
+	srv_session_view(s, &v);
+	snprintf(location, sizeof location, "/api/v1/sessions/%s", v.id);
+	res = srv_reply(r, 201, "application/json", api_session_json(&v, 1),
+			MHD_HTTP_HEADER_LOCATION, location);
+	srv_session_put(s);
+	return res;
+}
+
+enum MHD_Result srv_h_sessions_list(srv_req *r)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all);
+	api_view *views = calloc(n ? n : 1, sizeof *views);
+	char *text = NULL;
+	if (views) {
+		for (size_t i = 0; i < n; i++)
+			srv_session_view(all[i], &views[i]);
+		text = api_session_list_json(views, n);
+	}
+	for (size_t i = 0; i < n; i++)
+		srv_session_put(all[i]);
+	free(all);
+	free(views);
+	return srv_reply_json(r, 200, text);
+}
+
+enum MHD_Result srv_h_session_get(srv_req *r)
+{
+	srv_session *s = srv_session_get(r->arg[0]);
+	if (!s)
+		return not_found(r, r->arg[0]);
+	api_view v;
+	srv_session_view(s, &v);
+	enum MHD_Result res = srv_reply_json(r, 200, api_session_json(&v, 1));
+	srv_session_put(s);
+	return res;
+}
+
+enum MHD_Result srv_h_session_patch(srv_req *r)
+{
+	enum MHD_Result res;
+	srv_session *s = srv_session_get(r->arg[0]);
+	if (!s)
+		return not_found(r, r->arg[0]);
+	api_control c;
+	api_problem pb;
+	double t_eff = NAN;
+	api_view v;
+	if (!srv_need_json(r, 0, &res))
+		goto out;
+	srv_session_view(s, &v);
+	if (api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
+		    API_OK ||
+	    srv_session_control(s, &c, CONTROL_TIMEOUT_S, &t_eff, &pb) !=
+		    API_OK) {
+		res = srv_reply_problem(r, &pb, NULL);
+		goto out;
+	}
+	srv_session_view(s, &v);
+	res = srv_reply_json(r, 200, api_control_result_json(&v, &c, 1, t_eff));
+out:
+	srv_session_put(s);
+	return res;
+}
+
+enum MHD_Result srv_h_session_delete(srv_req *r)
+{
+	srv_session *s = srv_session_get(r->arg[0]);
+	if (!s)
+		return not_found(r, r->arg[0]);
+	srv_session_delete(s);
+	srv_session_put(s);
+	struct MHD_Response *resp =
+		MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT);
+	return srv_queue(r, 204, resp);
+}
+
+/* A finite number from a query argument; 0 and *pb if malformed. */
+static int query_number(srv_req *r, const char *key, double *out,
+			api_problem *pb)
+{
+	const char *v = srv_query(r, key);
+	if (!v || !*v)
+		return 1;
+	char *end;
+	double x = strtod(v, &end);
+	if (*end || !isfinite(x)) {
+		api_fail(pb, API_QUERY, key,
+			 "%s must be a number of seconds (got \"%.40s\")", key,
+			 v);
+		return 0;
+	}
+	*out = x;
+	return 1;
+}
+
+int srv_table_format(srv_req *r, api_problem *pb)
+{
+	const char *f = srv_query(r, "format");
+	if (f) {
+		if (strcmp(f, "json") == 0)
+			return 0;
+		if (strcmp(f, "csv") == 0)
+			return 1;
+		api_fail(pb, API_QUERY, "format",
+			 "format must be json or csv (got \"%.40s\")", f);
+		return -1;
+	}
+	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
+	return accept && strstr(accept, "text/csv") ? 1 : 0;
+}
+
+enum MHD_Result srv_h_trajectory(srv_req *r)
+{
+	api_problem pb;
+	double from = -INFINITY, to = INFINITY, stride = 0, *rows = NULL;
+	int csv;
+	if (!query_number(r, "from", &from, &pb) ||
+	    !query_number(r, "to", &to, &pb) ||
+	    (csv = srv_table_format(r, &pb)) < 0)
+		return srv_reply_problem(r, &pb, NULL);
+	if (from > to)
+		return srv_fail(r, API_QUERY, "from",
+				"from (%g) must not exceed to (%g)", from, to);
+	srv_session *s = srv_session_get(r->arg[0]);
+	if (!s)
+		return not_found(r, r->arg[0]);
+	size_t n = srv_session_history(s, from, to, &rows, &stride);
+	srv_session_put(s);
+	char *text = !rows  ? NULL
+		     : csv ? api_trajectory_csv(rows, n)
+			   : api_trajectory_json(rows, n, stride);
+	free(rows);
+	return srv_reply(r, 200, csv ? "text/csv" : "application/json", text,
+			 NULL, NULL);
+}

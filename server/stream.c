@@ -1,0 +1,279 @@
+/*
+ * stream.c - GET /api/v1/sessions/{id}/stream: Server-Sent Events or
+ * NDJSON.
+ *
+ * Each client has a cursor into its session's record ring. The
+ * connection's own thread (libmicrohttpd runs one per connection) waits on
+ * the session's condition variable for new records, copies them out
+ * under the lock one at a time and formats them outside it, so a client
+ * only ever slows itself: the worker overwrites the ring regardless, and
+ * a client that fell behind the oldest record gets a "dropped" notice with
+ * the number of records it missed, then continues from the oldest one.
+ * Resume with Last-Event-ID (or ?since=ID) from the ring; heartbeats keep
+ * idle connections alive; the stream ends with an "end" record when the
+ * session finishes, fails or is deleted, at ?limit=N records, or when the
+ * daemon shuts down.
+ */
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "srv.h"
+
+typedef struct stream {
+	srv_session *s;
+	int ndjson;
+	unsigned fields;
+	double rate;       /* samples per simulated second, 0: all */
+	double next_t;
+	uint64_t cursor;   /* next record index to send */
+	uint64_t limit, sent;
+	api_sample rec;
+	size_t rec_max;
+	char *out;
+	size_t out_len, out_pos, out_cap;
+	double last_write;
+	int ended;
+} stream;
+
+static void end_stream(stream *k, const char *reason)
+{
+	k->out_len += api_format_end(k->out + k->out_len,
+				     k->out_cap - k->out_len, reason,
+				     k->ndjson);
+	k->ended = 1;
+}
+
+/* Wait for and format the next batch of records into k->out. */
+static void fill(stream *k)
+{
+	pthread_mutex_t *lock = srv_session_lock(k->s);
+	pthread_cond_t *cond = srv_session_data_cond(k->s);
+	pthread_mutex_lock(lock);
+	while (!k->ended) {
+		int removed, state = srv_session_state(k->s, &removed);
+		srv_ring_view rv = srv_session_ring(k->s);
+		if (atomic_load(&srv_stopping)) {
+			end_stream(k, "shutdown");
+			break;
+		}
+		if (removed) {
+			end_stream(k, "deleted");
+			break;
+		}
+		if (k->cursor < rv.oldest) {
+			uint64_t missed = rv.oldest - k->cursor;
+			atomic_fetch_add(&srv_stats.dropped_samples, missed);
+			k->out_len += api_format_dropped(
+				k->out + k->out_len, k->out_cap - k->out_len,
+				missed, rv.oldest, k->ndjson);
+			k->cursor = rv.oldest;
+		}
+		if (k->cursor < rv.head) {
+			srv_session_copy(k->s, k->cursor++, &k->rec);
+			pthread_mutex_unlock(lock);
+			int skip = 0;
+			if (k->rec.kind == API_REC_SAMPLE && k->rate > 0) {
+				double t = k->rec.st.t;
+				skip = t < k->next_t - 1e-9;
+				if (!skip)
+					k->next_t = (floor(t * k->rate + 1e-6) +
+						     1) / k->rate;
+			}
+			if (!skip) {
+				k->out_len += api_format_record(
+					k->out + k->out_len,
+					k->out_cap - k->out_len, &k->rec,
+					k->fields, k->ndjson);
+				k->sent++;
+				atomic_fetch_add(&srv_stats.stream_records, 1);
+				if (k->limit && k->sent >= k->limit)
+					end_stream(k, "limit");
+			}
+			pthread_mutex_lock(lock);
+			if (k->out_len + k->rec_max > k->out_cap)
+				break;
+			continue;
+		}
+		if (k->out_len)
+			break;
+		if (state == SRV_FINISHED || state == SRV_FAILED) {
+			end_stream(k, state == SRV_FINISHED ? "finished"
+							    : "failed");
+			break;
+		}
+		double idle = srv_now() - k->last_write;
+		if (idle >= srv_cfg.heartbeat) {
+			k->out_len += api_format_heartbeat(
+				k->out + k->out_len, k->out_cap - k->out_len,
+				srv_session_time(k->s), k->ndjson);
+			break;
+		}
+		double wait = srv_cfg.heartbeat - idle;
+		struct timespec ts = srv_deadline(wait < 0.5 ? wait : 0.5);
+		pthread_cond_timedwait(cond, lock, &ts);
+	}
+	pthread_mutex_unlock(lock);
+	k->last_write = srv_now();
+}
+
+static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
+{
+	(void)pos;
+	stream *k = cls;
+	if (k->out_pos == k->out_len) {
+		k->out_pos = k->out_len = 0;
+		if (k->ended)
+			return MHD_CONTENT_READER_END_OF_STREAM;
+		fill(k);
+		if (k->out_len == 0)
+			return MHD_CONTENT_READER_END_OF_STREAM;
+	}
+	size_t n = k->out_len - k->out_pos;
+	if (n > max)
+		n = max;
+	memcpy(buf, k->out + k->out_pos, n);
+	k->out_pos += n;
+	return (ssize_t)n;
+}
+
+static void stream_free(void *cls)
+{
+	stream *k = cls;
+	srv_session_stream_count(k->s, -1);
+	atomic_fetch_sub(&srv_stats.stream_clients, 1);
+	srv_session_put(k->s);
+	srv_sample_free(&k->rec);
+	free(k->out);
+	free(k);
+}
+
+/* Parse the stream options; 0 and *pb on a bad one. */
+static int parse_options(srv_req *r, stream *k, int64_t *resume,
+			 api_problem *pb)
+{
+	const char *format = srv_query(r, "format");
+	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
+	if (format) {
+		if (strcmp(format, "ndjson") == 0)
+			k->ndjson = 1;
+		else if (strcmp(format, "sse") != 0) {
+			api_fail(pb, API_QUERY, "format",
+				 "format must be sse or ndjson");
+			return 0;
+		}
+	} else {
+		k->ndjson = accept && strstr(accept, "application/x-ndjson");
+	}
+	const char *fields = srv_query(r, "fields");
+	k->fields = fields ? api_parse_fields(fields, pb) : API_F_DEFAULT;
+	if (!k->fields)
+		return 0;
+	const char *v;
+	char *end;
+	if ((v = srv_query(r, "rate"))) {
+		k->rate = strtod(v, &end);
+		if (*end || !(k->rate > 0 && k->rate <= 100000)) {
+			api_fail(pb, API_QUERY, "rate",
+				 "rate must be a number of samples per "
+				 "simulated second in (0, 100000]");
+			return 0;
+		}
+	}
+	if ((v = srv_query(r, "limit"))) {
+		unsigned long long n = strtoull(v, &end, 10);
+		if (*end || n == 0 || *v == '-') {
+			api_fail(pb, API_QUERY, "limit",
+				 "limit must be a positive integer");
+			return 0;
+		}
+		k->limit = n;
+	}
+	v = srv_header(r, "Last-Event-ID");
+	if (!v)
+		v = srv_query(r, "since");
+	*resume = -1;
+	if (v) {
+		unsigned long long id = strtoull(v, &end, 10);
+		if (*end || !*v || *v == '-') {
+			api_fail(pb, API_QUERY, "Last-Event-ID",
+				 "Last-Event-ID (or since) must be a record "
+				 "id, a non-negative integer");
+			return 0;
+		}
+		*resume = (int64_t)(id > INT64_MAX - 1 ? INT64_MAX - 1 : id);
+	}
+	return 1;
+}
+
+enum MHD_Result srv_h_stream(srv_req *r)
+{
+	api_problem pb;
+	int64_t resume;
+	stream *k = calloc(1, sizeof *k);
+	if (!k)
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	if (!parse_options(r, k, &resume, &pb)) {
+		free(k);
+		return srv_reply_problem(r, &pb, NULL);
+	}
+	k->s = srv_session_get(r->arg[0]);
+	if (!k->s) {
+		free(k);
+		return srv_fail(r, API_NOTFOUND, NULL,
+				"no session with id \"%.40s\"", r->arg[0]);
+	}
+	if (atomic_fetch_add(&srv_stats.stream_clients, 1) >=
+	    srv_cfg.max_streams) {
+		atomic_fetch_sub(&srv_stats.stream_clients, 1);
+		srv_session_put(k->s);
+		free(k);
+		return srv_fail(r, API_LIMIT, NULL,
+				"%d stream clients are connected, the limit "
+				"(--max-streams)", srv_cfg.max_streams);
+	}
+	srv_session_stream_count(k->s, 1);
+	atomic_fetch_add(&srv_stats.streams_opened, 1);
+	int columns, layers;
+	srv_session_feed_size(k->s, &columns, &layers);
+	k->rec_max = api_record_max(columns, layers);
+	k->out_cap = 4 * k->rec_max + 65536;
+	k->out = malloc(k->out_cap);
+	if (!k->out || srv_sample_alloc(&k->rec, columns, layers)) {
+		stream_free(k);
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	}
+	pthread_mutex_lock(srv_session_lock(k->s));
+	srv_ring_view rv = srv_session_ring(k->s);
+	if (resume >= 0)
+		k->cursor = (uint64_t)resume + 1 < rv.head
+				    ? (uint64_t)resume + 1
+				    : rv.head;
+	else
+		k->cursor = rv.head > rv.oldest ? rv.head - 1 : rv.head;
+	pthread_mutex_unlock(srv_session_lock(k->s));
+	k->out_len = (size_t)snprintf(
+		k->out, k->out_cap,
+		k->ndjson ? "{\"type\":\"hello\",\"session\":\"%s\","
+			    "\"next_id\":%" PRIu64 "}\n"
+			  : "retry: 1000\nevent: hello\ndata: "
+			    "{\"session\":\"%s\",\"next_id\":%" PRIu64 "}\n\n",
+		srv_session_id(k->s), k->cursor);
+	k->last_write = srv_now();
+	struct MHD_Response *resp = MHD_create_response_from_callback(
+		MHD_SIZE_UNKNOWN, 32 * 1024, reader, k, stream_free);
+	if (!resp) {
+		stream_free(k);
+		return MHD_NO;
+	}
+	MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE,
+				k->ndjson ? "application/x-ndjson"
+					  : "text/event-stream");
+	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL,
+				"no-store");
+	MHD_add_response_header(resp, "X-Accel-Buffering", "no");
+	return srv_queue(r, 200, resp);
+}

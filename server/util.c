@@ -1,0 +1,70 @@
+/*
+ * util.c - small services of the daemon: levelled logging to stderr,
+ * clocks, timed-wait deadlines and random session ids.
+ */
+#include <fcntl.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/random.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "srv.h"
+
+void srv_log(int level, const char *fmt, ...)
+{
+	static const char *const names[] = {"error", "warn", "info", "debug"};
+	if (level > srv_cfg.log_level)
+		return;
+	char line[1024];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof line, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "convsimd %s: %s\n", names[level & 3], line);
+}
+
+double srv_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double srv_unix_time(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+struct timespec srv_deadline(double seconds)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	if (seconds < 0)
+		seconds = 0;
+	if (seconds > 3600)
+		seconds = 3600;
+	long long ns = (long long)ts.tv_nsec + (long long)(seconds * 1e9);
+	ts.tv_sec += (time_t)(ns / 1000000000LL);
+	ts.tv_nsec = (long)(ns % 1000000000LL);
+	return ts;
+}
+
+void srv_new_id(char *id)
+{
+	static atomic_uint counter;
+	unsigned char raw[8];
+	if (getrandom(raw, sizeof raw, 0) != (ssize_t)sizeof raw) {
+		unsigned long long x = (unsigned long long)(srv_unix_time() *
+							    1e6) ^
+				       ((unsigned long long)atomic_fetch_add(
+						&counter, 1)
+					<< 40);
+		memcpy(raw, &x, sizeof raw);
+	}
+	for (int i = 0; i < 8; i++)
+		snprintf(id + 2 * i, 3, "%02x", raw[i]);
+}
