@@ -1,0 +1,121 @@
+// Helpers for the HTTP tests: start the real daemon on an ephemeral port,
+// talk JSON to it, and read its SSE / NDJSON streams record by record.
+// CONVSIMD names the binary (build/convsimd or build-san/convsimd); the
+// sanitizer build is slower, so timeouts scale with SLOW.
+import { spawn } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
+
+export const BIN = process.env.CONVSIMD ||
+  fileURLToPath(new URL('../../build/convsimd', import.meta.url));
+export const SLOW = Number(process.env.CONVSIM_TEST_SLOW ||
+  (BIN.includes('build-san') ? 4 : 1));
+export const WEB_ROOT = fileURLToPath(new URL('../../web', import.meta.url));
+
+// A scene that is cheap to integrate but still transports feed.
+export const CHEAP = { scene: { drive: 'ideal', columns: 1, layers: 2 } };
+export const NO_FEED = { scene: { drive: 'ideal', feed: false } };
+
+export async function startDaemon(args = []) {
+  const proc = spawn(BIN, ['--port', '0', '--log-level', 'warn',
+    '--web-root', WEB_ROOT, ...args], { stdio: ['ignore', 'pipe', 'pipe'] });
+  let stderr = '';
+  proc.stderr.on('data', (d) => { stderr += d; });
+  const exited = new Promise((resolve) => proc.on('exit', (code, sig) => resolve({ code, sig })));
+  const port = await new Promise((resolve, reject) => {
+    let out = '';
+    const timer = setTimeout(() => reject(new Error(`no port line; stderr: ${stderr}`)), 10000 * SLOW);
+    proc.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/^listening on http:\/\/127\.0\.0\.1:(\d+)$/m);
+      if (m) { clearTimeout(timer); resolve(Number(m[1])); }
+    });
+    exited.then(({ code }) => { clearTimeout(timer); reject(new Error(`daemon exited ${code}: ${stderr}`)); });
+  });
+  const base = `http://127.0.0.1:${port}`;
+  return {
+    proc, port, base, exited,
+    stderr: () => stderr,
+    async stop(signal = 'SIGTERM') {
+      if (proc.exitCode === null && proc.signalCode === null) proc.kill(signal);
+      const timer = setTimeout(() => proc.kill('SIGKILL'), 20000 * SLOW);
+      const r = await exited;
+      clearTimeout(timer);
+      return r;
+    },
+  };
+}
+
+// fetch with a JSON body; returns {status, headers, body (parsed when JSON), text}.
+export async function req(base, method, path, body, headers = {}) {
+  const init = { method, headers: { ...headers } };
+  if (body !== undefined) {
+    init.body = typeof body === 'string' ? body : JSON.stringify(body);
+    if (!('Content-Type' in init.headers)) init.headers['Content-Type'] = 'application/json';
+  }
+  const res = await fetch(base + path, init);
+  const text = await res.text();
+  let parsed = null;
+  const ct = res.headers.get('content-type') || '';
+  if (ct.includes('json') && text) parsed = JSON.parse(text);
+  return { status: res.status, headers: res.headers, body: parsed, text };
+}
+
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// Poll fn until it returns a truthy value or the time runs out.
+export async function until(fn, ms, what = 'condition') {
+  const end = Date.now() + ms * SLOW;
+  for (;;) {
+    const v = await fn();
+    if (v) return v;
+    if (Date.now() > end) throw new Error(`timed out waiting for ${what}`);
+    await sleep(50);
+  }
+}
+
+// Parse SSE text blocks into {id, event, data} records; comments are
+// returned as {comment}.
+export function parseSse(block) {
+  const rec = { event: 'message' };
+  const data = [];
+  for (const line of block.split('\n')) {
+    if (line.startsWith(':')) return { comment: line.slice(1).trim() };
+    const i = line.indexOf(':');
+    const field = i < 0 ? line : line.slice(0, i);
+    const value = i < 0 ? '' : line.slice(i + 1).replace(/^ /, '');
+    if (field === 'data') data.push(value);
+    else if (field === 'id') rec.id = Number(value);
+    else if (field === 'event') rec.event = value;
+    else if (field === 'retry') rec.retry = Number(value);
+  }
+  if (data.length) rec.data = JSON.parse(data.join('\n'));
+  return rec;
+}
+
+// Open a stream and yield records: SSE blocks as {id, event, data}, NDJSON
+// lines as parsed objects. The caller breaks out to close it.
+export async function* openStream(base, path, headers = {}, signal) {
+  const res = await fetch(base + path, { headers, signal });
+  if (res.status !== 200) throw new Error(`stream ${path}: ${res.status} ${await res.text()}`);
+  const ndjson = (res.headers.get('content-type') || '').includes('ndjson');
+  const sep = ndjson ? '\n' : '\n\n';
+  const dec = new TextDecoder();
+  let buf = '';
+  for await (const chunk of res.body) {
+    buf += dec.decode(chunk, { stream: true });
+    let at;
+    while ((at = buf.indexOf(sep)) >= 0) {
+      const block = buf.slice(0, at);
+      buf = buf.slice(at + sep.length);
+      if (!block) continue;
+      yield ndjson ? JSON.parse(block) : parseSse(block);
+    }
+  }
+}
+
+// Value of one Prometheus sample, e.g. metric(text, 'convsim_sessions') or
+// metric(text, 'convsim_http_requests_total{status="201"}'); 0 if absent.
+export function metric(text, key) {
+  const line = text.split('\n').find((l) => l.startsWith(key + ' '));
+  return line ? Number(line.slice(key.length + 1)) : 0;
+}
