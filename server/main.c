@@ -265,7 +265,11 @@ int main(int argc, char **argv)
 	MHD_socket ls = MHD_quiesce_daemon(d);
 	if (ls != MHD_INVALID_SOCKET)
 		close(ls);
-	MHD_stop_daemon(d); /* streams end within half a second */
+	/* streams notice within half a second, send "end" and close */
+	for (int i = 0; i < 500 && atomic_load(&srv_stats.stream_clients) > 0;
+	     i++)
+		usleep(10000);
+	MHD_stop_daemon(d);
 	srv_pool_stop();
 	srv_sweeps_shutdown();
 	srv_sessions_shutdown();
