@@ -1,0 +1,110 @@
+// Experiments (a beta schedule with per-segment steady velocity and
+// reversal time) and sweeps (v(beta) for both rotations on the pool).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { startDaemon, req, until, CHEAP, NO_FEED, SLOW } from './lib.mjs';
+
+let d;
+before(async () => { d = await startDaemon(); });
+after(async () => { assert.equal((await d.stop()).code, 0, d.stderr()); });
+
+const scene = { ...CHEAP.scene, transient: 0.5 };
+
+test('experiment on a fresh session: 38 -> 128 deg reverses the feed', { timeout: 60000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/experiments', {
+    session: { scene },
+    schedule: [{ beta: 38, until: 3 }, { beta: 128, until: 6 }],
+    beta_rate: 180,
+  });
+  assert.equal(r.status, 201, r.text);
+  assert.equal(r.headers.get('location'), `/api/v1/experiments/${r.body.id}`);
+  assert.equal(r.body.segments.length, 2);
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`);
+    return g.body.state === 'done' && g.body;
+  }, 40000, 'the experiment');
+  assert.equal(done.progress, 1);
+  const [a, b] = done.segments;
+  assert.equal(a.t_command, 0);
+  assert.equal(b.t_command, 3);
+  assert.equal(b.t_end, 6);
+  assert.ok(a.steady_velocity > 0.05, `38 deg: ${a.steady_velocity}`);
+  assert.ok(b.steady_velocity < -0.05, `128 deg: ${b.steady_velocity}`);
+  // the reversal is quick: the ramp at 180 deg/s takes 0.5 s
+  assert.ok(b.reversal_time > 0.1 && b.reversal_time < 2.5, `reversal ${b.reversal_time}`);
+  const s = await req(d.base, 'GET', `/api/v1/sessions/${done.session}`);
+  assert.equal(s.body.state, 'finished');
+  assert.equal(s.body.experiment, null);
+  const list = await req(d.base, 'GET', '/api/v1/experiments');
+  assert.ok(list.body.experiments.some((e) => e.id === r.body.id));
+  await req(d.base, 'DELETE', `/api/v1/sessions/${done.session}`);
+});
+
+test('experiment on an existing session; a second one is 409', { timeout: 60000 * SLOW }, async () => {
+  const c = await req(d.base, 'POST', '/api/v1/sessions', { scene, pace: 'max', until: 1 });
+  const id = c.body.id;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished', 20000, 'finish');
+  const r = await req(d.base, 'POST', '/api/v1/experiments',
+    { session: id, schedule: [{ beta: 128, until: 2 }, { beta: 38, until: 4 }] });
+  assert.equal(r.status, 201, r.text);
+  assert.equal(r.body.session, id);
+  const again = await req(d.base, 'POST', '/api/v1/experiments', { session: id, schedule: [{ beta: 90, until: 1 }] });
+  if (again.status !== 201) assert.equal(again.status, 409);
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`);
+    return g.body.state === 'done' && g.body;
+  }, 40000, 'the experiment');
+  assert.equal(done.t_start, 1);
+  assert.equal(done.segments[0].t_command, 1);
+  assert.equal(done.segments[1].t_end, 5);
+  assert.ok(done.segments[0].steady_velocity < 0);
+  assert.ok(done.segments[1].steady_velocity > 0);
+  const nf = await req(d.base, 'POST', '/api/v1/experiments', { session: 'ffffffffffffffff', schedule: [{ beta: 90, until: 1 }] });
+  assert.equal(nf.status, 404);
+  assert.equal(nf.body.field, 'session');
+  const bad = await req(d.base, 'POST', '/api/v1/experiments', { schedule: [{ beta: 90, until: 2 }, { beta: 30, until: 1 }] });
+  assert.equal(bad.status, 422);
+  assert.equal(bad.body.field, 'schedule[1].until');
+  await req(d.base, 'DELETE', `/api/v1/sessions/${id}`);
+});
+
+test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/sweeps',
+    { scene: { ...CHEAP.scene, transient: 1 }, beta: { from: 38, to: 128, step: 90 }, rotations: ['cw', 'ccw'], t_end: 2.5 });
+  assert.equal(r.status, 202, r.text);
+  assert.equal(r.body.total, 4);
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}`);
+    return g.body.state === 'done' && g.body;
+  }, 50000, 'the sweep');
+  assert.equal(done.done, 4);
+  const v = (beta, rot) => done.points.find((p) => p.beta === beta && p.rotation === rot).velocity;
+  assert.ok(v(38, 'cw') > 0.05, `cw 38: ${v(38, 'cw')}`);
+  assert.ok(v(128, 'cw') < -0.05, `cw 128: ${v(128, 'cw')}`);
+  assert.equal(done.series.cw.length, 2);
+  const csv = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`);
+  assert.equal(csv.headers.get('content-type'), 'text/csv');
+  const lines = csv.text.trim().split('\n');
+  assert.equal(lines[0], 'beta,rotation,velocity,state');
+  assert.equal(lines.length, 5);
+  assert.equal(Number(lines[1].split(',')[2]), v(38, 'cw'));
+  const bad = await req(d.base, 'POST', '/api/v1/sweeps', { rotations: ['up'] });
+  assert.equal(bad.status, 422);
+  const bad2 = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [10, 'x'] });
+  assert.equal(bad2.status, 400);
+  assert.equal(bad2.body.field, 'beta[1]');
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${r.body.id}`)).status, 204);
+  assert.equal((await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}`)).status, 404);
+});
+
+test('a sweep can be cancelled while queued', { timeout: 60000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/sweeps',
+    { ...NO_FEED, beta: { from: 0, to: 180, step: 5 }, t_end: 0.2 });
+  assert.equal(r.status, 202);
+  assert.equal(r.body.total, 74);
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${r.body.id}`)).status, 204);
+  await until(async () => {
+    const h = await req(d.base, 'GET', '/api/v1/health');
+    return h.body.pool_queued === 0;
+  }, 20000, 'the pool to drain');
+});
