@@ -185,7 +185,7 @@ test('a sweep draws v(β) for both rotations', async () => {
 	await page.fill('#sweep-form input[name="from"]', '30');
 	await page.fill('#sweep-form input[name="to"]', '130');
 	await page.fill('#sweep-form input[name="step"]', '50');
-	await page.fill('#sweep-form input[name="t_end"]', '1.5');
+	await page.fill('#sweep-form input[name="t_end"]', '3'); /* past the preset's 2 s transient */
 	await page.click('#sweep-run');
 	await until(async () => await count('#plot-sweep') >= 6, 60000, 'six sweep points');
 	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));

@@ -430,10 +430,13 @@ export function experimentRequest(f) {
 	return body;
 }
 
-/* Query string of the stream: which fields, samples per simulated second. */
+/* Query string of the stream: which fields, and since=ID to start from
+ * that record (0: the oldest the daemon still holds, so the plots fill at
+ * once on attach). */
 export function streamQuery(opts = {}) {
 	const q = new URLSearchParams();
 	q.set('fields', (opts.fields ?? ['trough', 'orbit', 'rotor', 'eliminators', 'feed']).join(','));
+	if (Number.isInteger(opts.since) && opts.since >= 0) q.set('since', String(opts.since));
 	return q.toString();
 }
 
@@ -517,6 +520,21 @@ export async function patchSession(id, patch) {
 export async function deleteSession(id) {
 	await request('DELETE', `/sessions/${enc(id)}`);
 }
+/* The recorded history of a session as columns by field name,
+ * {t: [...], beta: [...], feed_velocity: [...], ...}; from/to in s. */
+export function trajectoryColumns(d) {
+	const fields = Array.isArray(d?.fields) ? d.fields.map(String) : [];
+	const rows = Array.isArray(d?.rows) ? d.rows : [];
+	const out = {};
+	fields.forEach((f, i) => { out[f] = rows.map(r => num(Array.isArray(r) ? r[i] : undefined)); });
+	return out;
+}
+export async function trajectory(id, { from, to } = {}) {
+	const q = new URLSearchParams({ format: 'json' });
+	if (Number.isFinite(from)) q.set('from', String(from));
+	if (Number.isFinite(to)) q.set('to', String(to));
+	return trajectoryColumns((await request('GET', `/sessions/${enc(id)}/trajectory?${q}`)).data);
+}
 export async function createSweep(form) {
 	return normalizeSweep((await request('POST', '/sweeps', sweepRequest(form))).data);
 }
@@ -546,6 +564,8 @@ export function openStream(id, opts, handlers) {
 		} else if (/drop|miss|lag/i.test(kind)) {
 			h.dropped?.(num(d.missed ?? d.dropped ?? d.count ?? d.n));
 		} else if (/end|close|stop|done|error/i.test(kind) && !/sample/i.test(kind)) {
+			/* the daemon closes the stream after "end": do not reconnect */
+			es.close();
 			h.end?.(d);
 		} else if (Array.isArray(d)) {
 			for (const s of d) h.sample?.(normalizeSample(s));

@@ -153,7 +153,9 @@ async function startSession(ev) {
 		const s = await api.createSession(form);
 		setOnline(true);
 		message('ok', `Session ${s.id} started (${form.preset}, β = ${fmt(form.beta, 1)}°, ${rotationLabel(form.rotation)}).`);
-		attach(s.id, s, form);
+		/* the POST answer's status is that of t = 0 before the first step:
+		 * let the first poll fill the tiles */
+		attach(s.id, null);
 		refreshSessionList();
 	} catch (err) {
 		report(err, 'Start session', $('#session-form'));
@@ -177,7 +179,7 @@ function detach() {
 	$('#session-select').value = '';
 }
 
-function attach(id, initial, form) {
+function attach(id, initial) {
 	detach();
 	app.id = id;
 	app.session = initial ?? null;
@@ -191,13 +193,15 @@ function attach(id, initial, form) {
 	$('#session-select').value = id;
 	setControlsEnabled(true);
 	resetTraces(initial?.columns);
-	const rate = form?.rate ?? numberOf($('#session-form').elements.rate);
-	app.stream = api.openStream(id, { rate: Number.isFinite(rate) && rate > 0 ? rate : undefined }, {
+	app.stream = api.openStream(id, { since: 0 }, {
 		open: () => { setOnline(true); $('#live-state').textContent = `stream: open (${id})`; },
 		sample: onSample,
 		control: onControl,
 		dropped: n => { if (n > 0) app.dropped += n; },
-		end: () => { $('#live-state').textContent = 'stream: ended'; },
+		end: d => {
+			$('#live-state').textContent = `stream: ended${d?.reason ? ` (${d.reason})` : ''}`;
+			pollStatus();
+		},
 		error: state => {
 			$('#live-state').textContent = state === 2 ? 'stream: closed' : 'stream: reconnecting…';
 		},
@@ -367,8 +371,9 @@ function showStatus(s) {
 	const state = s.error ? `error: ${s.error}` : s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
 	$('#state-now').textContent = state;
 	document.body.dataset.running = s.running === false ? 'false' : 'true';
-	$('#pause').disabled = !app.id || s.running === false;
-	$('#resume').disabled = !app.id || s.running !== false;
+	/* finished and failed sessions can be neither paused nor resumed */
+	$('#pause').disabled = !app.id || !/^running$/i.test(s.state || (s.running ? 'running' : ''));
+	$('#resume').disabled = !app.id || !/^paused$/i.test(s.state || (s.running === false ? 'paused' : ''));
 	$('#rotor-now').textContent = fmt(s.rotorSpeed, 2, 'rad/s');
 	$('#rotor-rpm').textContent = Number.isFinite(s.rotorSpeed) ? `${fmt(Math.abs(s.rotorSpeed) * RAD_S_TO_RPM, 0)} rpm` +
 		(Number.isFinite(s.omegaSs) ? ` · ω_ss ${fmt(s.omegaSs, 2)} rad/s` : '') : DASH;
@@ -433,7 +438,7 @@ function makePlots() {
 	});
 	app.plots.rotor = new TimePlot($('#plot-rotor'), {
 		series: [{ label: 'rotor speed / (rad/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
-		yLabel: 'rotor speed / (rad/s)', y2Label: 'β / °',
+		yLabel: 'rotor speed / (rad/s)', y2Label: 'β / °', y2Range: [0, 180],
 	});
 	app.plots.strokes = new TimePlot($('#plot-strokes'), {
 		series: [{ label: 's₁ / mm', color: PALETTE[4] }, { label: 's₂ / mm', color: PALETTE[5] }],
@@ -452,7 +457,7 @@ function makePlots() {
 	});
 	app.plots.experiment = new TimePlot($('#plot-experiment'), {
 		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
-		yLabel: 'v / (m/s)', y2Label: 'β / °', aspect: 0.42,
+		yLabel: 'v / (m/s)', y2Label: 'β / °', y2Range: [0, 180], aspect: 0.5,
 	});
 }
 
@@ -558,7 +563,10 @@ async function runSweep(ev) {
 			showSweep(u);
 			progress(box, u.progress, `${u.state || 'running'} · ${u.points.length} points`);
 		});
+		const missing = end.points.filter(p => !Number.isFinite(p.v)).length;
 		if (end.failed) message('error', `Sweep ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
+		else if (missing) message('warn', `Sweep ${end.id} finished, but ${missing} of ${end.points.length} points gave no transport velocity: ` +
+			'the run time per point must exceed the scene\'s transient (the transport velocity ignores t < transient).');
 		else message('ok', `Sweep ${end.id} finished: ${end.points.length} points.`);
 	} catch (err) {
 		report(err, 'Sweep', $('#sweep-form'));
@@ -612,6 +620,11 @@ async function runExperiment(ev) {
 		});
 		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
 		else message('ok', `Experiment ${end.id} finished.`);
+		if (end.sessionId) {
+			/* the recorded history gives the whole reversal, whatever the stream saw */
+			const traj = await api.trajectory(end.sessionId).catch(() => null);
+			showExperiment(end, form, traj);
+		}
 	} catch (err) {
 		report(err, 'Experiment', $('#experiment-form'));
 	} finally {
@@ -619,7 +632,7 @@ async function runExperiment(ev) {
 	}
 }
 
-function showExperiment(j, form) {
+function showExperiment(j, form, traj) {
 	const rev = j.segments.map(s => s.reversalTime).filter(Number.isFinite);
 	$('#reversal-time').textContent = rev.length ? fmt(rev[rev.length - 1], 3, 's') : DASH;
 	const table = $('#experiment-table');
@@ -642,7 +655,8 @@ function showExperiment(j, form) {
 	const betaAt = x => x < form.tSwitch ? form.beta1 : form.beta2;
 	let t = j.trace.t, v = j.trace.v, b = t.map(betaAt);
 	const live = app.expTrace?.data();
-	if (live && live[0].length > 1) [t, v, b] = live;
+	if (traj?.t?.length > 1 && traj.feed_velocity) [t, v, b] = [traj.t, traj.feed_velocity, traj.beta ?? traj.t.map(betaAt)];
+	else if (live && live[0].length > 1) [t, v, b] = live;
 	if (!t.length && j.segments.length) {
 		t = []; v = []; b = [];
 		j.segments.forEach((s, i) => {
@@ -654,7 +668,16 @@ function showExperiment(j, form) {
 			t.push(t0 + (i ? dt : 0), t1); v.push(s.v, s.v); b.push(beta, beta);
 		});
 	}
-	if (t.length) app.plots.experiment.setData([t, v, b]);
+	const gaps = a => a.map(x => Number.isFinite(x) ? x : null); /* uPlot wants null, not NaN */
+	if (t.length) app.plots.experiment.setData([t, gaps(v), gaps(b)]);
+	const marks = [];
+	j.segments.forEach((s, i) => {
+		if (i === 0 || !Number.isFinite(s.tStart)) return;
+		marks.push({ x: s.tStart, label: `β → ${fmt(s.beta, 0)}°`, color: '#d97706' });
+		if (Number.isFinite(s.reversalTime))
+			marks.push({ x: s.tStart + s.reversalTime, label: `90 % after ${fmt(s.reversalTime, 3)} s`, color: '#7c3aed', row: 1 });
+	});
+	app.plots.experiment.setMarkers(marks);
 }
 
 /* ---- wiring ------------------------------------------------------------------ */

@@ -45,15 +45,17 @@ function observe(el, plot, aspect, legendRoom) {
 export class TimePlot {
 	/* series: [{label, color, scale ('y' or 'y2'), width, dash}];
 	 * axes: {y: label, y2: label (optional)}; aspect = height / width. */
-	constructor(el, { series, yLabel, y2Label, aspect = 0.55, xLabel = 't / s', yRange, legend = true }) {
+	constructor(el, { series, yLabel, y2Label, aspect = 0.7, xLabel = 't / s', yRange, y2Range, legend = true }) {
 		this.el = el;
+		this.markers = [];
+		const self = this;
 		const s = sizeOf(el, aspect);
 		const legendRoom = legend ? 26 : 0;
 		const scales = { x: { time: false } };
 		if (yRange) scales.y = { range: yRange };
-		if (y2Label) scales.y2 = { auto: true };
-		const axes = [axis(xLabel), axis(yLabel, { size: 56 })];
-		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 56, grid: { show: false } }));
+		if (y2Label) scales.y2 = y2Range ? { range: y2Range } : { auto: true };
+		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })];
+		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 50, space: 24, grid: { show: false } }));
 		this.plot = new uPlot({
 			width: s.width,
 			height: s.height - legendRoom,
@@ -61,6 +63,7 @@ export class TimePlot {
 			axes,
 			legend: { show: legend, live: false },
 			cursor: { drag: { x: false, y: false }, points: { size: 5 } },
+			hooks: { draw: [u => drawMarkers(u, self.markers)] },
 			series: [{ label: 't / s', value: (u, v) => v == null ? '–' : v.toFixed(3) },
 				...series.map((d, i) => ({
 					label: d.label,
@@ -82,10 +85,38 @@ export class TimePlot {
 		this.el.dataset.points = String(cols[0].length);
 	}
 
+	/* Vertical marker lines [{x, label, color}] (x in s). */
+	setMarkers(list) {
+		this.markers = list.filter(m => Number.isFinite(m.x));
+		this.plot.redraw(false);
+	}
+
 	destroy() {
 		this.ro.disconnect();
 		this.plot.destroy();
 	}
+}
+
+function drawMarkers(u, markers) {
+	if (!markers.length) return;
+	const ctx = u.ctx;
+	const { left, top, width, height } = u.bbox;
+	ctx.save();
+	ctx.font = `${11 * uPlot.pxRatio}px system-ui, sans-serif`;
+	ctx.textBaseline = 'top';
+	for (const m of markers) {
+		const x = u.valToPos(m.x, 'x', true);
+		if (x < left || x > left + width) continue;
+		ctx.strokeStyle = ctx.fillStyle = m.color ?? '#475569';
+		ctx.lineWidth = uPlot.pxRatio;
+		ctx.setLineDash([4 * uPlot.pxRatio, 3 * uPlot.pxRatio]);
+		ctx.beginPath();
+		ctx.moveTo(x, top);
+		ctx.lineTo(x, top + height);
+		ctx.stroke();
+		if (m.label) ctx.fillText(m.label, x + 4 * uPlot.pxRatio, top + 4 * uPlot.pxRatio + (m.row ?? 0) * 14 * uPlot.pxRatio);
+	}
+	ctx.restore();
 }
 
 function fmtVal(v) {
@@ -201,7 +232,7 @@ export class XYPlot {
 			legend: { show: legend, live: false },
 			cursor: { show: false, drag: { x: false, y: false } },
 			scales: { x: { time: false, range: rangeFn('x') }, y: { range: rangeFn('y') } },
-			axes: [axis(xLabel), axis(yLabel, { size: 56 })],
+			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })],
 			hooks,
 			series: [{}, ...series.map((d, i) => ({
 				label: d.label,
@@ -221,7 +252,10 @@ export class XYPlot {
 		const data = [null, ...pairs];
 		this.ext = extent(data);
 		this.plot.setData(data);
-		this.el.dataset.points = String(pairs.reduce((n, p) => n + p[0].length, 0));
+		let n = 0;
+		for (const [xs, ys] of pairs)
+			for (let i = 0; i < xs.length; i++) if (Number.isFinite(xs[i]) && Number.isFinite(ys[i])) n++;
+		this.el.dataset.points = String(n);
 	}
 
 	destroy() {
