@@ -37,7 +37,7 @@ export function direction(v, still = 1e-3) {
 	return v > 0 ? 'right' : 'left';
 }
 
-export const ARROW = { right: '→', left: '←', still: '·', '': DASH };
+export const ARROW = { right: '→', left: '←', still: '·', '': '' };
 
 /* Velocity with explicit sign, m/s: "+0.123 m/s". */
 export function fmtVelocity(v, digits = 3) {

@@ -174,6 +174,7 @@ function detach() {
 	document.body.dataset.sessionId = '';
 	history.replaceState(null, '', location.pathname);
 	setControlsEnabled(false);
+	$('#beta-now-mark').hidden = true;
 	$('#session-label').textContent = 'no session';
 	$('#live-state').textContent = 'stream: idle';
 	$('#session-select').value = '';
@@ -356,6 +357,7 @@ function onControl(c) {
  * over the last half second of the stream (or ten periods, if longer),
  * else the daemon's running estimate. */
 function currentVelocity() {
+	if (app.session?.feed === false) return NaN;
 	const [ts, xs] = app.traces?.feedMean.data() ?? [[], []];
 	const omega = Math.abs(app.lastSample?.rotorSpeed ?? app.session?.rotorSpeed ?? NaN);
 	const span = omega > 1 ? Math.max(0.5, 10 * 2 * Math.PI / omega) : 0.5;
@@ -389,7 +391,9 @@ function showStatus(s) {
 		$('#beta-slider').value = String(target);
 		$('#beta-number').value = String(Math.round(target * 10) / 10);
 	}
-	if (Number.isFinite(s.beta)) $('#beta-now-mark').style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
+	const mark = $('#beta-now-mark');
+	mark.hidden = !Number.isFinite(s.beta);
+	if (Number.isFinite(s.beta)) mark.style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
 	$('#m-preset').textContent = s.preset ?? DASH;
 	const scene = [];
 	if (Number.isFinite(s.columns)) scene.push(`${s.columns} columns × ${s.layers} layers`);
@@ -399,6 +403,7 @@ function showStatus(s) {
 	$('#m-method').textContent = s.method ?? DASH;
 	$('#m-pace').textContent = fmtPace(s.pace);
 	showReductions(s.reductions);
+	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
 	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
 	app.dirty = true;
 }
@@ -465,7 +470,7 @@ function buildFeedPlot(K) {
 	const el = $('#plot-feed');
 	if (app.plots.feed && app.plots.feedK === K) return;
 	app.plots.feed?.destroy();
-	const series = K ? Array.from({ length: K }, (_, k) => ({ label: `column ${k + 1}` })) : [{ label: 'no feed', color: '#94a3b8' }];
+	const series = K ? Array.from({ length: K }, (_, k) => ({ label: `column ${k + 1}` })) : [{ label: 'columns', color: '#94a3b8' }];
 	app.plots.feed = new TimePlot(el, { series, yLabel: 'displacement / mm' });
 	app.plots.feedK = K;
 }
@@ -516,7 +521,7 @@ function draw() {
 		strokes: last?.strokes,
 		phase: last?.phi,
 		strokeRange: range,
-		columns: app.columns || (s?.feed === false ? 0 : s?.columns),
+		columns: app.columns || (s ? (s.feed === false ? 0 : s.columns) : ($('#session-form').elements.feed.checked ? numberOf($('#session-form').elements.columns) : 0)),
 		layers: s?.layers ?? numberOf($('#session-form').elements.layers),
 		direction: dir,
 	});

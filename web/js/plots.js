@@ -78,11 +78,13 @@ export class TimePlot {
 		}, [[], ...series.map(() => [])], el);
 		this.ro = observe(el, this.plot, aspect, legendRoom);
 		el.dataset.points = '0';
+		el.classList.add('empty');
 	}
 
 	setData(cols) {
 		this.plot.setData(cols);
 		this.el.dataset.points = String(cols[0].length);
+		this.el.classList.toggle('empty', cols[0].length === 0);
 	}
 
 	/* Vertical marker lines [{x, label, color}] (x in s). */
@@ -245,6 +247,7 @@ export class XYPlot {
 		}, [null, ...series.map(() => [[], []])], el);
 		this.ro = observe(el, this.plot, aspect, legendRoom);
 		el.dataset.points = '0';
+		el.classList.add('empty');
 	}
 
 	/* pairs: one [xs, ys] per series. */
@@ -256,6 +259,7 @@ export class XYPlot {
 		for (const [xs, ys] of pairs)
 			for (let i = 0; i < xs.length; i++) if (Number.isFinite(xs[i]) && Number.isFinite(ys[i])) n++;
 		this.el.dataset.points = String(n);
+		this.el.classList.toggle('empty', n === 0);
 	}
 
 	destroy() {
