@@ -37,7 +37,7 @@ struct srv_experiment {
 	srv_experiment *next;
 };
 
-#define EXP_RECORDS 200000
+#define EXP_RECORDS 50000
 
 static pthread_mutex_t exp_lock = PTHREAD_MUTEX_INITIALIZER;
 static srv_experiment *exp_head;
@@ -130,6 +130,15 @@ static void finish_segment(srv_experiment *e, const sim_status *st)
 	seg->state = 2;
 }
 
+/* The feed-velocity record is only needed while running (exp_lock held). */
+static void drop_record(srv_experiment *e)
+{
+	free(e->rec_t);
+	free(e->rec_v);
+	e->rec_t = e->rec_v = NULL;
+	e->rec_n = e->rec_cap = 0;
+}
+
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
 	static const char *const names[] = {"waiting", "running", "done",
@@ -205,6 +214,7 @@ int srv_exp_step(srv_experiment *e, sim *sm, const sim_status *st,
 		} else {
 			e->state = EXP_DONE;
 			e->attached = 0;
+			drop_record(e);
 			save_results(e);
 			over = 1;
 		}
@@ -221,6 +231,7 @@ void srv_exp_abort(srv_experiment *e, const char *why)
 		snprintf(e->error, sizeof e->error, "%s", why);
 	}
 	e->attached = 0;
+	drop_record(e);
 	pthread_mutex_unlock(&exp_lock);
 }
 
