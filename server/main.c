@@ -195,6 +195,14 @@ int main(int argc, char **argv)
 	if (parse_flags(argc, argv))
 		return 2;
 	pick_web_root(argv[0]);
+	struct stat dd;
+	if (srv_cfg.data_dir && (stat(srv_cfg.data_dir, &dd) != 0 ||
+				 !S_ISDIR(dd.st_mode) ||
+				 access(srv_cfg.data_dir, W_OK) != 0)) {
+		fprintf(stderr, "convsimd: --data-dir %s is not a writable "
+				"directory\n", srv_cfg.data_dir);
+		return 2;
+	}
 
 	sigset_t sigs;
 	sigemptyset(&sigs);

@@ -2,6 +2,9 @@
 // reversal time) and sweeps (v(beta) for both rotations on the pool).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { startDaemon, req, until, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 let d;
@@ -107,4 +110,24 @@ test('a sweep can be cancelled while queued', { timeout: 60000 * SLOW }, async (
     const h = await req(d.base, 'GET', '/api/v1/health');
     return h.body.pool_queued === 0;
   }, 20000, 'the pool to drain');
+});
+
+test('--data-dir keeps finished sweeps and experiments', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-'));
+  const dd = await startDaemon(['--data-dir', dir]);
+  try {
+    const sw = await req(dd.base, 'POST', '/api/v1/sweeps', { ...NO_FEED, beta: [20, 40], rotations: ['cw'], t_end: 0.1 });
+    const ex = await req(dd.base, 'POST', '/api/v1/experiments', { session: { ...NO_FEED }, schedule: [{ beta: 50, until: 0.2 }] });
+    await until(async () => (await req(dd.base, 'GET', `/api/v1/sweeps/${sw.body.id}`)).body.state === 'done', 20000, 'sweep');
+    await until(async () => (await req(dd.base, 'GET', `/api/v1/experiments/${ex.body.id}`)).body.state === 'done', 20000, 'experiment');
+    const csv = readFileSync(join(dir, `sweep-${sw.body.id}.csv`), 'utf8').trim().split('\n');
+    assert.equal(csv.length, 3);
+    assert.equal(csv[1].split(',')[0], '20');
+    const saved = JSON.parse(readFileSync(join(dir, `experiment-${ex.body.id}.json`), 'utf8'));
+    assert.equal(saved.state, 'done');
+    assert.equal(saved.segments[0].beta, 50);
+  } finally {
+    assert.equal((await dd.stop()).code, 0, dd.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
 });
