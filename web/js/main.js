@@ -379,7 +379,7 @@ function showStatus(s) {
 	$('#rotor-now').textContent = fmt(s.rotorSpeed, 2, 'rad/s');
 	$('#rotor-rpm').textContent = Number.isFinite(s.rotorSpeed) ? `${fmt(Math.abs(s.rotorSpeed) * RAD_S_TO_RPM, 0)} rpm` +
 		(Number.isFinite(s.omegaSs) ? ` · ω_ss ${fmt(s.omegaSs, 2)} rad/s` : '') : DASH;
-	$('#rtf-now').textContent = Number.isFinite(s.realTimeFactor) ? `${fmtSig(s.realTimeFactor, 3)}× real time` : DASH;
+	$('#rtf-now').textContent = Number.isFinite(s.realTimeFactor) ? `${fmtSig(s.realTimeFactor, 3)}×` : DASH;
 	$('#sps-now').textContent = `${fmtSig(s.stepsPerSecond, 3, 'steps/s')} · pace ${fmtPace(s.pace)}`;
 	$('#beta-now').textContent = fmt(s.beta, 1, '°');
 	$('#beta-target').textContent = fmt(Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta, 1, '°');
