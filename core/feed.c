@@ -1,0 +1,257 @@
+/*
+ * feed.c - the feed model (MODEL.md "Feed", paper eqs. 6-9).
+ *
+ * Column k has layers j = 1..L (stored 0..L-1, bottom first) with absolute
+ * coordinates xi (horizontal) and eta (vertical); layer 0 of the paper is
+ * the deck point D_k = G + R(alpha)(d_k, h_d). Between layer j-1 and j:
+ *   delta = eta_{j-1} - eta_j,  contact when delta > 0,
+ *   F = k delta^p (loading, delta' >= 0) or R^2 k delta^p (unloading),
+ *   T = -mu F sgn(xi'_j - xi'_{j-1})   (on layer j; -T on layer j-1).
+ * The loading/unloading switch is taken at delta' = 0 with delta' >= 0 as
+ * loading, so that a layer at rest carries its full load (the paper's
+ * formula with sgn(0) = 0 would halve it there).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "feed.h"
+
+static inline double friction_sign(const model *md, double v)
+{
+	if (md->sc.friction == SIM_FRICTION_REGULARISED)
+		return tanh(v / md->sc.friction_eps);
+	return (v > 0.0) - (v < 0.0);
+}
+
+/* Indices of the feed blocks in y. */
+#define XI(md, y) ((y) + (md)->nq)
+#define ETA(md, y) ((y) + (md)->nq + (md)->nf)
+#define XID(md, y) ((y) + (md)->npos + (md)->nq)
+#define ETAD(md, y) ((y) + (md)->npos + (md)->nq + (md)->nf)
+
+/* Column k: accelerations into dy, deck force into F (2). */
+static void column_rhs(const model *md, const double *y, int k, const double dpos[2],
+		       const double dvel[2], double *dy, double F[2], double *fric,
+		       double *contact)
+{
+	const int L = md->L, base = k * L;
+	const double *xi = XI(md, y), *eta = ETA(md, y);
+	const double *xid = XID(md, y), *etad = ETAD(md, y);
+	double *axi = XID(md, dy), *aeta = ETAD(md, dy);
+	const double mu = md->p.mu;
+	double prev_eta = dpos[1], prev_etad = dvel[1], prev_xid = dvel[0];
+	(void)xi;
+	F[0] = F[1] = 0.0;
+	for (int j = 0; j < L; j++) {
+		int e = base + j;
+		axi[e] = 0.0;
+		aeta[e] = 0.0;
+		double delta = prev_eta - eta[e];
+		if (delta > 0.0) {
+			double ddot = prev_etad - etad[e];
+			double Fn = model_contact_force(md, delta, ddot);
+			double vrel = xid[e] - prev_xid;
+			double T = -mu * Fn * friction_sign(md, vrel);
+			axi[e] += T;
+			aeta[e] += Fn;
+			if (j > 0) {
+				axi[e - 1] -= T;
+				aeta[e - 1] -= Fn;
+			} else {
+				F[0] = -T;
+				F[1] = -Fn;
+			}
+			*contact += Fn * ddot;
+			*fric -= T * vrel;
+		}
+		prev_eta = eta[e];
+		prev_etad = etad[e];
+		prev_xid = xid[e];
+	}
+	const double inv_m = 1.0 / md->p.m_n, g = md->p.g;
+	for (int j = 0; j < L; j++) {
+		axi[base + j] *= inv_m;
+		aeta[base + j] = aeta[base + j] * inv_m - g;
+	}
+}
+
+void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
+	      const double qd[NQ_FULL], double *dy, double Qfeed[NQ_FULL],
+	      double *fric_power, double *contact_power)
+{
+	const int nf = md->nf;
+	/* position rates are the velocities */
+	memcpy(XI(md, dy), XID(md, y), sizeof(double) * (size_t)nf);
+	memcpy(ETA(md, dy), ETAD(md, y), sizeof(double) * (size_t)nf);
+	double fric = 0.0, contact = 0.0;
+	/* Mirrored columns k and K-1-k are summed together first, so that the
+	 * moments of a symmetric motion cancel exactly despite round-off. */
+	for (int k = 0; k <= (md->K - 1) / 2; k++) {
+		int kk = md->K - 1 - k;
+		double Qpair[NQ_FULL] = {0}, Qm[NQ_FULL] = {0};
+		double pos[2], vel[2], F[2];
+		model_deck(md, k, q, qd, pos, vel);
+		column_rhs(md, y, k, pos, vel, dy, F, &fric, &contact);
+		model_deck_force(md, k, q, F, Qpair);
+		if (kk != k) {
+			model_deck(md, kk, q, qd, pos, vel);
+			column_rhs(md, y, kk, pos, vel, dy, F, &fric, &contact);
+			model_deck_force(md, kk, q, F, Qm);
+			for (int i = 0; i < NQ_FULL; i++)
+				Qpair[i] += Qm[i];
+		}
+		for (int i = 0; i < NQ_FULL; i++)
+			Qfeed[i] += md->col_weight * Qpair[i];
+	}
+	*fric_power = md->col_weight * fric;
+	*contact_power = md->col_weight * contact;
+}
+
+void feed_energy(const model *md, const double *y, double *kinetic, double *potential)
+{
+	const double *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
+	double T = 0.0, V = 0.0;
+	for (int e = 0; e < md->nf; e++) {
+		T += xid[e] * xid[e] + etad[e] * etad[e];
+		V += eta[e];
+	}
+	*kinetic = 0.5 * md->col_weight * md->p.m_n * T;
+	*potential = md->col_weight * md->p.m_n * md->p.g * V;
+}
+
+double feed_contact_energy(const model *md, const double *y, const double q[NQ_FULL],
+			   const double qd[NQ_FULL])
+{
+	const double *eta = ETA(md, y), *etad = ETAD(md, y);
+	double E = 0.0;
+	for (int k = 0; k < md->K; k++) {
+		double pos[2], vel[2];
+		model_deck(md, k, q, qd, pos, vel);
+		double prev = pos[1], prevd = vel[1];
+		for (int j = 0; j < md->L; j++) {
+			int e = k * md->L + j;
+			double delta = prev - eta[e];
+			if (delta > 0.0)
+				E += model_contact_force(md, delta, prevd - etad[e]) * delta /
+				     (md->p.p + 1.0);
+			prev = eta[e];
+			prevd = etad[e];
+		}
+	}
+	return md->col_weight * E;
+}
+
+void feed_settle(const model *md, double *y, const double q[NQ_FULL])
+{
+	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
+	double zero[NQ_FULL] = {0};
+	const double w = md->p.m_n * md->p.g;
+	for (int k = 0; k < md->K; k++) {
+		double pos[2], vel[2];
+		model_deck(md, k, q, zero, pos, vel);
+		double level = pos[1];
+		for (int j = 0; j < md->L; j++) {
+			int e = k * md->L + j;
+			/* layer j carries itself and every layer above it */
+			double load = w * (double)(md->L - j);
+			double delta = md->p.p == 1.0 ? load / md->p.k_c
+						     : pow(load / md->p.k_c, 1.0 / md->p.p);
+			level -= delta;
+			eta[e] = level;
+			xi[e] = pos[0];
+			xid[e] = 0.0;
+			etad[e] = 0.0;
+		}
+	}
+}
+
+double feed_mean_xi(const model *md, const double *y, int k)
+{
+	const double *xi = XI(md, y);
+	int from = k < 0 ? 0 : k * md->L, to = k < 0 ? md->nf : from + md->L;
+	double s = 0.0;
+	for (int e = from; e < to; e++)
+		s += xi[e];
+	return to > from ? s / (double)(to - from) : 0.0;
+}
+
+static inline double clamp(double v, double lo, double hi)
+{
+	return v < lo ? lo : v > hi ? hi : v;
+}
+
+void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
+		      const double deck_vel1[2], double h, double *Pn, double *Pt,
+		      double impulse[2], double *fric, double *contact)
+{
+	const int L = md->L, base = k * L;
+	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
+	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
+	const int coulomb = md->sc.friction == SIM_FRICTION_COULOMB;
+	double hi[64], lo[64], vy[64], vx[64];
+	/* impulse bounds from the compressions at the sub-step's start:
+	 * loading k delta^p h, unloading R^2 k delta^p h */
+	double prev_eta = deck_pos[1];
+	for (int j = 0; j < L; j++) {
+		int e = base + j;
+		double delta = prev_eta - eta[e];
+		hi[j] = delta > 0.0 ? h * model_contact_force(md, delta, 1.0) : 0.0;
+		lo[j] = R2 * hi[j];
+		Pn[j] = clamp(Pn[j], lo[j], hi[j]);
+		Pt[j] = coulomb ? clamp(Pt[j], -mu * Pn[j], mu * Pn[j]) : 0.0;
+		vy[j] = etad[e] - g * h;
+		vx[j] = xid[e];
+		prev_eta = eta[e];
+	}
+	/* velocities after the step: v_j+ = v_j + (P_j - P_{j+1}) / m; each
+	 * impulse is projected onto its law at the new relative velocity,
+	 * which is set-valued at zero (resting contact, sticking layers) */
+	const double tol = 1e-13 * m * (g * h + 1e-300) * L;
+	for (int sweep = 0; sweep < 60; sweep++) {
+		double change = 0.0;
+		for (int i = 0; i < L; i++) {
+			int j = (sweep & 1) ? L - 1 - i : i;
+			if (hi[j] == 0.0) {
+				Pn[j] = Pt[j] = 0.0;
+				continue;
+			}
+			double up_n = j + 1 < L ? Pn[j + 1] : 0.0, up_t = j + 1 < L ? Pt[j + 1] : 0.0;
+			double eff = j == 0 ? 1.0 / m : 2.0 / m;
+			/* normal: delta' = v_{j-1}+ - v_j+ */
+			double vj = vy[j] + (Pn[j] - up_n) / m;
+			double vb = j == 0 ? deck_vel1[1] : vy[j - 1] + (Pn[j - 1] - Pn[j]) / m;
+			double np = clamp(Pn[j] + (vb - vj) / eff, lo[j], hi[j]);
+			change = fmax(change, fabs(np - Pn[j]));
+			Pn[j] = np;
+			/* tangential: xi'_j+ - xi'_{j-1}+ */
+			double uj = vx[j] + (Pt[j] - up_t) / m;
+			double ub = j == 0 ? deck_vel1[0] : vx[j - 1] + (Pt[j - 1] - Pt[j]) / m;
+			double bound = mu * Pn[j], tp;
+			if (coulomb)
+				tp = clamp(Pt[j] - (uj - ub) / eff, -bound, bound);
+			else
+				tp = -bound * tanh((vx[j] - (j == 0 ? deck_vel1[0] : vx[j - 1])) /
+						   md->sc.friction_eps);
+			change = fmax(change, fabs(tp - Pt[j]));
+			Pt[j] = tp;
+		}
+		if (change <= tol)
+			break;
+	}
+	double prev_vy = deck_vel1[1], prev_vx = deck_vel1[0];
+	for (int j = 0; j < L; j++) {
+		int e = base + j;
+		double up_n = j + 1 < L ? Pn[j + 1] : 0.0, up_t = j + 1 < L ? Pt[j + 1] : 0.0;
+		etad[e] = vy[j] + (Pn[j] - up_n) / m;
+		xid[e] = vx[j] + (Pt[j] - up_t) / m;
+		/* work on the relative motion at the new velocities */
+		*contact += Pn[j] * (prev_vy - etad[e]);
+		*fric -= Pt[j] * (xid[e] - prev_vx);
+		prev_vy = etad[e];
+		prev_vx = xid[e];
+		xi[e] += h * xid[e];
+		eta[e] += h * etad[e];
+	}
+	impulse[0] -= Pt[0];
+	impulse[1] -= Pn[0];
+}

@@ -1,0 +1,46 @@
+/*
+ * feed.h - internal: the feed of MODEL.md (paper eqs. 6-9): columns of
+ * zero-thickness layers of point masses on the deck, normal contact with
+ * the loading/unloading switch and Coulomb (or, as an explicit option,
+ * regularised) friction between neighbouring layers and with the deck.
+ */
+#ifndef CONVSIM_FEED_H
+#define CONVSIM_FEED_H
+
+#include "model.h"
+
+/* Feed part of dy (positions' rates and accelerations), the generalized
+ * force of the feed on the machine (Qfeed, added to), and the friction and
+ * contact powers (written). q, qd: full machine coordinates. */
+void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
+	      const double qd[NQ_FULL], double *dy, double Qfeed[NQ_FULL],
+	      double *fric_power, double *contact_power);
+
+/* Kinetic and gravitational energy of the feed (written). */
+void feed_energy(const model *md, const double *y, double *kinetic, double *potential);
+
+/* Elastic energy held in the contacts now (in the current loading mode). */
+double feed_contact_energy(const model *md, const double *y, const double q[NQ_FULL],
+			   const double qd[NQ_FULL]);
+
+/* Place the feed settled on the deck for machine coordinates q (at rest). */
+void feed_settle(const model *md, double *y, const double q[NQ_FULL]);
+
+/* Mean horizontal position of column k's elements (all columns: k = -1). */
+double feed_mean_xi(const model *md, const double *y, int k);
+
+/* One sub-step of length h of column k for the split method "dem",
+ * semi-implicit: impulse bounds from the compressions at the start, then
+ * the normal and friction impulses of the whole column solved against the
+ * velocities at the end (projected Gauss-Seidel, warm-started from and
+ * written back to Pn[L], Pt[L]). At zero relative velocity the laws are
+ * set-valued (normal impulse in [R^2 k delta^p h, k delta^p h], friction in
+ * [-mu, mu] times it), so resting and sticking layers rest and stick
+ * exactly instead of chattering. The deck moves as prescribed: deck_pos at
+ * the start, deck_vel1 at the end. Adds the impulse on the deck to
+ * impulse[2] and the friction and contact work to *fric, *contact. */
+void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
+		      const double deck_vel1[2], double h, double *Pn, double *Pt,
+		      double impulse[2], double *fric, double *contact);
+
+#endif

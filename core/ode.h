@@ -1,0 +1,44 @@
+/*
+ * ode.h - internal: integrators as data. Each method is one file of static
+ * functions exporting one const descriptor; ode_registry.c lists them so
+ * that the API finds a method by name. The caller (sim.c) decides when to
+ * step; there are no callbacks into the caller.
+ */
+#ifndef CONVSIM_ODE_H
+#define CONVSIM_ODE_H
+
+#include "model.h"
+
+typedef struct ode_method {
+	const char *name;
+	int order;     /* classical order on smooth problems */
+	int adaptive;  /* step size from rtol/atol */
+	int dense;     /* steps past the target and interpolates */
+	const char *doc;
+	/* Workspace for model md (its size n fixed) and settings cfg; NULL on
+	 * allocation failure. Everything the steps need is allocated here. */
+	void *(*alloc)(const model *md, const sim_method *cfg);
+	/* One step from (*t, y), in place. Fixed-step methods do not pass
+	 * t_max (the last step is shortened); dense methods may. Returns
+	 * SIM_OK or SIM_ESTEP. */
+	int (*step)(void *ws, model *md, double *t, double *y, double t_max);
+	/* Dense methods: the state at t within the last step into out. */
+	void (*interpolate)(void *ws, double t, double *out);
+	/* Forget cached derivatives (after a control change). */
+	void (*reset)(void *ws);
+	void (*free)(void *ws);
+} ode_method;
+
+extern const ode_method ode_rk4, ode_dopri5, ode_euler, ode_dem;
+
+/* Method by name, NULL if unknown. */
+const ode_method *ode_find(const char *name);
+
+/* Length of the fixed step that lands on t_max without a sliver. */
+static inline double ode_fixed_step(double t, double dt, double t_max)
+{
+	double rest = t_max - t;
+	return rest <= dt * (1.0 + 1e-9) ? rest : dt;
+}
+
+#endif

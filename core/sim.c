@@ -1,0 +1,482 @@
+/*
+ * sim.c - one simulation instance: owns the model, the state, the chosen
+ * integrator's workspace and the observables (transport-velocity estimator,
+ * energy balance). The caller decides when to step (sim_advance); controls
+ * take effect at the integrator's current time.
+ *
+ * Transport velocity (MODEL.md "Observables"): the mean feed displacement
+ * is sampled at the excitation period boundaries, i.e. where the rotor's
+ * angle relative to the trough, phi - alpha, crosses a multiple of 2 pi
+ * (located within the step on cubic Hermite interpolants); the estimate is
+ * the slope between the first boundary after the transient and the latest
+ * one, so the periodic part of the motion cancels exactly.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "feed.h"
+#include "ode.h"
+
+struct sim {
+	model md;
+	sim_method cfg;
+	const ode_method *ode;
+	void *ws;
+	double t_int, t_obs;
+	double *y, *y_obs, *dy;
+	double e0;
+	uint64_t steps;
+	int failed;
+	char error[160];
+	/* period boundaries */
+	double psi_prev, X_prev, psid_prev, Xd_prev, tb_prev_step;
+	double est_start;
+	int est_pending, n_bound;
+	double tb_first, Xb_first, tb_last, Xb_last, tb_prev, Xb_prev;
+	double X0;
+	double *X0k;
+	sim_status st;
+};
+
+static double mean_xi_rate(const model *md, const double *y)
+{
+	const double *xid = y + md->npos + md->nq;
+	double s = 0.0;
+	for (int e = 0; e < md->nf; e++)
+		s += xid[e];
+	return md->nf > 0 ? s / md->nf : 0.0;
+}
+
+/* phi - alpha and its rate, and the mean feed position and its rate. */
+static void period_probe(const sim *s, double t, const double *y, double *psi, double *psid,
+			 double *X, double *Xd)
+{
+	double q[NQ_FULL], qd[NQ_FULL];
+	model_full_coords(&s->md, t, y, q, qd);
+	*psi = q[Q_PHI] - q[Q_ALPHA];
+	*psid = qd[Q_PHI] - qd[Q_ALPHA];
+	*X = s->md.nf > 0 ? feed_mean_xi(&s->md, y, -1) : 0.0;
+	*Xd = mean_xi_rate(&s->md, y);
+}
+
+static double hermite(double p0, double v0, double p1, double v1, double H, double u)
+{
+	double u2 = u * u, u3 = u2 * u;
+	return (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * H * v0 + (-2 * u3 + 3 * u2) * p1 +
+	       (u3 - u2) * H * v1;
+}
+
+static void on_boundary(sim *s, double tb, double Xb)
+{
+	if (s->est_pending) {
+		if (tb + 1e-12 < s->est_start)
+			return;
+		s->est_pending = 0;
+		s->n_bound = 0;
+		s->tb_first = s->tb_last = tb;
+		s->Xb_first = s->Xb_last = Xb;
+		return;
+	}
+	s->tb_prev = s->tb_last;
+	s->Xb_prev = s->Xb_last;
+	s->tb_last = tb;
+	s->Xb_last = Xb;
+	s->n_bound++;
+}
+
+/* After a step from t0 to t1: locate crossings of phi - alpha through
+ * multiples of 2 pi. */
+static void detect_periods(sim *s, double t0, double t1)
+{
+	double psi, psid, X, Xd;
+	period_probe(s, t1, s->y, &psi, &psid, &X, &Xd);
+	double H = t1 - t0;
+	double n0 = floor(s->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
+	if (n0 != n1 && H > 0.0) {
+		int up = n1 > n0;
+		for (double nb = up ? n0 + 1 : n0; up ? nb <= n1 : nb > n1; nb += up ? 1 : -1) {
+			double target = nb * 2 * M_PI, lo = 0.0, hi = 1.0;
+			for (int it = 0; it < 60; it++) {
+				double mid = 0.5 * (lo + hi);
+				double v = hermite(s->psi_prev, s->psid_prev, psi, psid, H, mid);
+				if ((v < target) == up)
+					lo = mid;
+				else
+					hi = mid;
+			}
+			double u = 0.5 * (lo + hi);
+			on_boundary(s, t0 + u * H, hermite(s->X_prev, s->Xd_prev, X, Xd, H, u));
+		}
+	}
+	s->psi_prev = psi;
+	s->psid_prev = psid;
+	s->X_prev = X;
+	s->Xd_prev = Xd;
+}
+
+/* Divergence guard: finite state, bounded machine motion and feed. */
+static int check_state(sim *s)
+{
+	const model *md = &s->md;
+	for (int i = 0; i < md->n; i++) {
+		if (!isfinite(s->y[i])) {
+			snprintf(s->error, sizeof s->error,
+				 "diverged at t = %.9g s: non-finite state (component %d); "
+				 "try a smaller step",
+				 s->t_int, i);
+			return SIM_EDIVERGED;
+		}
+	}
+	double q[NQ_FULL], qd[NQ_FULL];
+	model_full_coords(md, s->t_int, s->y, q, qd);
+	const char *cause = NULL;
+	if (fabs(q[Q_X]) > 1.0 || fabs(q[Q_Y]) > 1.0)
+		cause = "trough displacement beyond 1 m";
+	else if (fabs(q[Q_ALPHA]) > 0.5)
+		cause = "trough rotation beyond 0.5 rad";
+	else if (fabs(q[Q_S1]) > 1.0 || fabs(q[Q_S2]) > 1.0)
+		cause = "eliminator stroke beyond 1 m";
+	else if (fabs(qd[Q_PHI] - qd[Q_ALPHA]) > 100.0 * md->p.omega_ss + 1e3)
+		cause = "rotor speed beyond 100 omega_ss";
+	if (!cause && md->nf > 0) {
+		const double *eta = s->y + md->nq + md->nf;
+		for (int k = 0; k < md->K && !cause; k++) {
+			double pos[2], vel[2];
+			model_deck(md, k, q, qd, pos, vel);
+			for (int j = 0; j < md->L; j++) {
+				double rel = eta[k * md->L + j] - pos[1];
+				if (rel < -0.05) {
+					cause = "feed element sank 5 cm into the deck "
+						"(step too large for the contact stiffness)";
+					break;
+				}
+				if (rel > 100.0) {
+					cause = "feed element thrown beyond 100 m";
+					break;
+				}
+			}
+		}
+	}
+	if (cause) {
+		snprintf(s->error, sizeof s->error, "diverged at t = %.9g s: %s", s->t_int, cause);
+		return SIM_EDIVERGED;
+	}
+	return SIM_OK;
+}
+
+static void update_status(sim *s);
+
+sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
+	     size_t msglen)
+{
+	int e = sim_validate(p, sc, m, msg, msglen);
+	sim *s = NULL;
+	if (e != SIM_OK)
+		goto fail;
+	e = SIM_ENOMEM;
+	s = calloc(1, sizeof *s);
+	if (!s)
+		goto fail;
+	model_init(&s->md, p, sc);
+	s->cfg = *m;
+	s->ode = ode_find(m->name);
+	size_t n = (size_t)s->md.n;
+	s->y = calloc(3 * n, sizeof(double));
+	s->X0k = calloc((size_t)(s->md.K > 0 ? s->md.K : 1), sizeof(double));
+	if (!s->y || !s->X0k)
+		goto fail;
+	s->y_obs = s->y + n;
+	s->dy = s->y_obs + n;
+	s->ws = s->ode->alloc(&s->md, m);
+	if (!s->ws)
+		goto fail;
+	model_equilibrium(&s->md, s->y);
+	memcpy(s->y_obs, s->y, sizeof(double) * n);
+	double kin, pot;
+	s->e0 = model_energy_stored(&s->md, 0.0, s->y, &kin, &pot);
+	s->X0 = s->md.nf > 0 ? feed_mean_xi(&s->md, s->y, -1) : 0.0;
+	for (int k = 0; k < s->md.K; k++)
+		s->X0k[k] = feed_mean_xi(&s->md, s->y, k);
+	period_probe(s, 0.0, s->y, &s->psi_prev, &s->psid_prev, &s->X_prev, &s->Xd_prev);
+	s->est_start = sc->transient;
+	s->est_pending = 1;
+	update_status(s);
+	if (err)
+		*err = SIM_OK;
+	return s;
+fail:
+	if (e == SIM_ENOMEM && msg)
+		snprintf(msg, msglen, "out of memory for the simulation workspace");
+	if (err)
+		*err = e;
+	sim_free(s);
+	return NULL;
+}
+
+void sim_free(sim *s)
+{
+	if (!s)
+		return;
+	if (s->ode && s->ws)
+		s->ode->free(s->ws);
+	free(s->y);
+	free(s->X0k);
+	free(s);
+}
+
+const char *sim_last_error(const sim *s)
+{
+	return s->error;
+}
+
+double sim_effective_time(const sim *s)
+{
+	return s->t_int;
+}
+
+int sim_advance(sim *s, double t_end)
+{
+	if (s->failed)
+		return s->failed;
+	if (!isfinite(t_end) || t_end < s->t_obs - 1e-12)
+		return SIM_ETIME;
+	const double eps = 1e-12 * fmax(1.0, fabs(t_end));
+	while (s->t_int < t_end - eps) {
+		double t0 = s->t_int;
+		int e = s->ode->step(s->ws, &s->md, &s->t_int, s->y, t_end);
+		if (e == SIM_OK)
+			e = check_state(s);
+		else
+			snprintf(s->error, sizeof s->error,
+				 "step size underflow at t = %.9g s (tolerance too tight or a "
+				 "discontinuity the method cannot pass)",
+				 s->t_int);
+		if (e != SIM_OK) {
+			s->failed = e;
+			update_status(s);
+			return e;
+		}
+		s->steps++;
+		detect_periods(s, t0, s->t_int);
+	}
+	size_t n = (size_t)s->md.n;
+	if (s->ode->dense && s->t_int > t_end + eps) {
+		s->ode->interpolate(s->ws, t_end, s->y_obs);
+		s->t_obs = t_end;
+	} else {
+		memcpy(s->y_obs, s->y, sizeof(double) * n);
+		s->t_obs = s->t_int;
+	}
+	update_status(s);
+	return SIM_OK;
+}
+
+/* ---- controls ---- */
+
+static void control_changed(sim *s)
+{
+	s->ode->reset(s->ws);
+	update_status(s);
+}
+
+int sim_set_beta(sim *s, double target_deg, double rate_deg_s)
+{
+	if (!isfinite(target_deg) || target_deg < 0.0 || target_deg > 180.0)
+		return SIM_EPARAM;
+	if (isfinite(rate_deg_s) && rate_deg_s > 0.0) {
+		if (rate_deg_s < 0.1 || rate_deg_s > 3600.0)
+			return SIM_EPARAM;
+		s->md.p.beta_rate = rate_deg_s * M_PI / 180.0;
+	} else if (!isfinite(rate_deg_s)) {
+		return SIM_EPARAM;
+	}
+	ramp_to_position(&s->md.beta_ramp, s->t_int, target_deg * M_PI / 180.0,
+			 s->md.p.beta_rate, s->md.p.beta_accel);
+	control_changed(s);
+	return SIM_OK;
+}
+
+static void ideal_speed(sim *s)
+{
+	if (!s->md.phi_prescribed)
+		return;
+	double target = s->md.drive_on ? (double)s->md.rotation * s->md.omega_ss : 0.0;
+	ramp_to_rate(&s->md.psi_ramp, s->t_int, target, s->md.p.drive_accel);
+}
+
+int sim_set_rotation(sim *s, int rotation)
+{
+	if (rotation != SIM_CW && rotation != SIM_CCW)
+		return SIM_EPARAM;
+	s->md.rotation = rotation;
+	ideal_speed(s);
+	control_changed(s);
+	return SIM_OK;
+}
+
+int sim_set_omega_ss(sim *s, double omega_ss)
+{
+	if (!isfinite(omega_ss) || omega_ss < 1.0 || omega_ss > 1000.0)
+		return SIM_EPARAM;
+	s->md.omega_ss = omega_ss;
+	ideal_speed(s);
+	control_changed(s);
+	return SIM_OK;
+}
+
+int sim_set_drive_on(sim *s, int on)
+{
+	s->md.drive_on = on != 0;
+	ideal_speed(s);
+	control_changed(s);
+	return SIM_OK;
+}
+
+void sim_restart_transport(sim *s)
+{
+	s->est_pending = 1;
+	s->est_start = s->t_int;
+	update_status(s);
+}
+
+/* ---- observables ---- */
+
+static void update_status(sim *s)
+{
+	model *md = &s->md;
+	sim_status *st = &s->st;
+	model_eval ev;
+	uint64_t evals = md->rhs_evals;
+	model_rhs(md, s->t_obs, s->y_obs, s->dy, &ev);
+	md->rhs_evals = evals;
+	st->t = s->t_obs;
+	st->t_int = s->t_int;
+	st->beta = ev.beta;
+	st->beta_dot = ev.beta_dot;
+	st->beta_target = md->beta_ramp.b_end;
+	st->rotation = md->rotation;
+	st->drive_on = md->drive_on;
+	st->omega_ss = md->omega_ss;
+	memcpy(st->q, ev.q, sizeof st->q);
+	memcpy(st->qd, ev.qd, sizeof st->qd);
+	st->rotor_speed = ev.rotor_speed;
+	st->motor_torque = ev.torque;
+	st->power = ev.torque * ev.rotor_speed;
+	memcpy(st->deck, ev.deck, sizeof st->deck);
+	memcpy(st->deck_vel, ev.deck_vel, sizeof st->deck_vel);
+	st->feed_displacement = md->nf > 0 ? feed_mean_xi(md, s->y_obs, -1) - s->X0 : 0.0;
+	if (!s->est_pending && s->n_bound >= 1) {
+		st->transport_velocity =
+			(s->Xb_last - s->Xb_first) / (s->tb_last - s->tb_first);
+		st->transport_periods = s->n_bound;
+		st->feed_velocity = (s->Xb_last - s->Xb_prev) / (s->tb_last - s->tb_prev);
+		st->period = s->tb_last - s->tb_prev;
+	} else {
+		st->transport_velocity = NAN;
+		st->transport_periods = 0;
+		st->feed_velocity = NAN;
+		st->period = NAN;
+	}
+	double kin, pot;
+	model_energy_stored(md, s->t_obs, s->y_obs, &kin, &pot);
+	const double *acc = s->y_obs + 2 * md->npos;
+	double contact_elastic = 0.0;
+	if (md->nf > 0)
+		contact_elastic = feed_contact_energy(md, s->y_obs, ev.q, ev.qd);
+	st->e_input = acc[ACC_IN];
+	st->e_kinetic = kin;
+	st->e_potential = pot - s->e0 + contact_elastic;
+	st->e_dissipated =
+		acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - contact_elastic);
+	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
+			 acc[ACC_IN];
+	st->steps = s->steps;
+	st->rhs_evals = md->rhs_evals;
+	st->reductions = md->reductions;
+	st->n_dof = md->nq + 2 * md->nf;
+}
+
+void sim_get_status(const sim *s, sim_status *st)
+{
+	*st = s->st;
+}
+
+int sim_columns(const sim *s)
+{
+	return s->md.nf > 0 ? s->md.sc.columns : 0;
+}
+
+int sim_layers(const sim *s)
+{
+	return s->md.nf > 0 ? s->md.L : 0;
+}
+
+/* Physical column c maps to integrated column c, or 0 under symmetry. */
+static int integrated_column(const sim *s, int c)
+{
+	return s->md.K == 1 ? 0 : c;
+}
+
+void sim_column_displacement(const sim *s, double *out)
+{
+	int K = sim_columns(s);
+	for (int c = 0; c < K; c++) {
+		int k = integrated_column(s, c);
+		out[c] = feed_mean_xi(&s->md, s->y_obs, k) - s->X0k[k];
+	}
+}
+
+void sim_deck_points(const sim *s, double *out)
+{
+	int K = sim_columns(s);
+	double q[NQ_FULL], qd[NQ_FULL];
+	model_full_coords(&s->md, s->t_obs, s->y_obs, q, qd);
+	double zero[NQ_FULL] = {0};
+	for (int c = 0; c < K; c++) {
+		int k = integrated_column(s, c);
+		double pos[2], vel[2], rest[2];
+		model_deck(&s->md, k, q, qd, pos, vel);
+		model_deck(&s->md, k, zero, zero, rest, vel);
+		out[2 * c] = pos[0] - rest[0];
+		out[2 * c + 1] = pos[1] - rest[1];
+	}
+}
+
+void sim_feed_state(const sim *s, double *xi, double *eta)
+{
+	const model *md = &s->md;
+	int K = sim_columns(s), L = md->L;
+	for (int c = 0; c < K; c++) {
+		int k = integrated_column(s, c);
+		for (int j = 0; j < L; j++) {
+			if (xi)
+				xi[c * L + j] = s->y_obs[md->nq + k * L + j];
+			if (eta)
+				eta[c * L + j] = s->y_obs[md->nq + md->nf + k * L + j];
+		}
+	}
+}
+
+const char *sim_reduction_name(int bit)
+{
+	static const char *const names[] = {"no_feed", "symmetric_alpha", "ideal_drive",
+					    "one_way_coupling"};
+	return bit >= 0 && bit < 4 ? names[bit] : NULL;
+}
+
+int sim_measure_velocity(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			 double t_end, double *v, char *msg, size_t msglen)
+{
+	int err;
+	sim *s = sim_new(p, sc, m, &err, msg, msglen);
+	if (!s)
+		return err;
+	err = sim_advance(s, t_end);
+	if (err != SIM_OK && msg)
+		snprintf(msg, msglen, "%s", s->error);
+	*v = s->st.transport_velocity;
+	sim_free(s);
+	return err;
+}
