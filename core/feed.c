@@ -180,16 +180,87 @@ static inline double clamp(double v, double lo, double hi)
 	return v < lo ? lo : v > hi ? hi : v;
 }
 
+enum { BOND = 0, HI = 1, LO = 2 };
+
+/* Exact solve of one column's impulses over a sub-step (a convex problem:
+ * minimise sum m/2 (v_j - vs_j)^2 + sum max(lo_j s_j, hi_j s_j) with
+ * s_j = v_{j-1} - v_j and v_{-1} = v0, the deck's velocity). Contact j
+ * (between layer j-1, or the deck, and layer j) is BOND (s = 0, impulse in
+ * [lo, hi]), HI (impulse hi, s >= 0) or LO (impulse lo, s <= 0). Bonded
+ * runs of layers move as one cluster; the modes are switched until they
+ * are consistent (active-set method, warm-started from mode[]). Writes the
+ * impulses P (on layer j from below) and the new velocities v. */
+static void chain_solve(int L, double m, const double *vs, double v0, const double *lo,
+			const double *hi, double *P, double *v, signed char *mode)
+{
+	for (int iter = 0; iter < 4 * L + 8; iter++) {
+		for (int a = 0; a < L;) {
+			int b = a;
+			while (b + 1 < L && mode[b + 1] == BOND)
+				b++;
+			double Ptop = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
+			if (a == 0 && mode[0] == BOND) {
+				/* rides with the deck */
+				double Pj = Ptop;
+				for (int j = b; j >= 0; j--) {
+					Pj += m * (v0 - vs[j]);
+					P[j] = Pj;
+					v[j] = v0;
+				}
+			} else {
+				double Pbot = mode[a] == HI ? hi[a] : lo[a], sum = 0.0;
+				for (int j = a; j <= b; j++)
+					sum += vs[j];
+				double n = (double)(b - a + 1);
+				double vc = (m * sum + Pbot - Ptop) / (n * m);
+				P[a] = Pbot;
+				for (int j = a; j <= b; j++) {
+					v[j] = vc;
+					if (j < b)
+						P[j + 1] = P[j] - m * (vc - vs[j]);
+				}
+			}
+			a = b + 1;
+		}
+		/* consistency; after L rounds switch one contact at a time */
+		int changed = 0;
+		for (int j = 0; j < L && !(changed && iter >= L); j++) {
+			double sj = (j == 0 ? v0 : v[j - 1]) - v[j];
+			double tolP = 1e-12 * (fabs(hi[j]) + fabs(lo[j])) + 1e-300;
+			signed char nm = mode[j];
+			if (hi[j] == lo[j])
+				nm = HI; /* fixed impulse (or no contact) */
+			else if (mode[j] == BOND)
+				nm = P[j] > hi[j] + tolP ? HI : P[j] < lo[j] - tolP ? LO : BOND;
+			else if (mode[j] == HI && sj < -1e-13)
+				nm = BOND;
+			else if (mode[j] == LO && sj > 1e-13)
+				nm = BOND;
+			if (nm != mode[j]) {
+				mode[j] = nm;
+				changed = 1;
+			}
+		}
+		if (!changed)
+			break;
+	}
+	for (int j = 0; j < L; j++)
+		if (mode[j] != BOND)
+			P[j] = mode[j] == HI ? hi[j] : lo[j];
+}
+
 void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
-		      const double deck_vel1[2], double h, double *Pn, double *Pt,
-		      double impulse[2], double *fric, double *contact)
+		      const double deck_vel1[2], double h, signed char *modes, double impulse[2],
+		      double *fric, double *contact)
 {
 	const int L = md->L, base = k * L;
 	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
 	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
-	const int coulomb = md->sc.friction == SIM_FRICTION_COULOMB;
-	double hi[64], lo[64], vy[64], vx[64];
-	/* impulse bounds from the compressions at the sub-step's start:
+	double hi[64], lo[64], vs[64], Pn[64], Pt[64], vn[64], vt[64];
+	signed char *mn = modes + base, *mt = modes + md->nf + base;
+	if (L < 1 || L > 64)
+		return;
+	/* normal impulse bounds from the compressions at the sub-step's start:
 	 * loading k delta^p h, unloading R^2 k delta^p h */
 	double prev_eta = deck_pos[1];
 	for (int j = 0; j < L; j++) {
@@ -197,60 +268,39 @@ void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2
 		double delta = prev_eta - eta[e];
 		hi[j] = delta > 0.0 ? h * model_contact_force(md, delta, 1.0) : 0.0;
 		lo[j] = R2 * hi[j];
-		Pn[j] = clamp(Pn[j], lo[j], hi[j]);
-		Pt[j] = coulomb ? clamp(Pt[j], -mu * Pn[j], mu * Pn[j]) : 0.0;
-		vy[j] = etad[e] - g * h;
-		vx[j] = xid[e];
+		vs[j] = etad[e] - g * h;
 		prev_eta = eta[e];
 	}
-	/* velocities after the step: v_j+ = v_j + (P_j - P_{j+1}) / m; each
-	 * impulse is projected onto its law at the new relative velocity,
-	 * which is set-valued at zero (resting contact, sticking layers) */
-	const double tol = 1e-13 * m * (g * h + 1e-300) * L;
-	for (int sweep = 0; sweep < 60; sweep++) {
-		double change = 0.0;
-		for (int i = 0; i < L; i++) {
-			int j = (sweep & 1) ? L - 1 - i : i;
-			if (hi[j] == 0.0) {
-				Pn[j] = Pt[j] = 0.0;
-				continue;
-			}
-			double up_n = j + 1 < L ? Pn[j + 1] : 0.0, up_t = j + 1 < L ? Pt[j + 1] : 0.0;
-			double eff = j == 0 ? 1.0 / m : 2.0 / m;
-			/* normal: delta' = v_{j-1}+ - v_j+ */
-			double vj = vy[j] + (Pn[j] - up_n) / m;
-			double vb = j == 0 ? deck_vel1[1] : vy[j - 1] + (Pn[j - 1] - Pn[j]) / m;
-			double np = clamp(Pn[j] + (vb - vj) / eff, lo[j], hi[j]);
-			change = fmax(change, fabs(np - Pn[j]));
-			Pn[j] = np;
-			/* tangential: xi'_j+ - xi'_{j-1}+ */
-			double uj = vx[j] + (Pt[j] - up_t) / m;
-			double ub = j == 0 ? deck_vel1[0] : vx[j - 1] + (Pt[j - 1] - Pt[j]) / m;
-			double bound = mu * Pn[j], tp;
-			if (coulomb)
-				tp = clamp(Pt[j] - (uj - ub) / eff, -bound, bound);
-			else
-				tp = -bound * tanh((vx[j] - (j == 0 ? deck_vel1[0] : vx[j - 1])) /
-						   md->sc.friction_eps);
-			change = fmax(change, fabs(tp - Pt[j]));
-			Pt[j] = tp;
+	chain_solve(L, m, vs, deck_vel1[1], lo, hi, Pn, vn, mn);
+	/* friction impulses within [-mu, mu] times the normal ones */
+	for (int j = 0; j < L; j++) {
+		vs[j] = xid[base + j];
+		hi[j] = mu * Pn[j];
+		lo[j] = -hi[j];
+	}
+	if (md->sc.friction == SIM_FRICTION_COULOMB) {
+		chain_solve(L, m, vs, deck_vel1[0], lo, hi, Pt, vt, mt);
+	} else {
+		/* regularised: explicit in the velocities at the start */
+		for (int j = 0; j < L; j++) {
+			double below = j == 0 ? deck_vel1[0] : vs[j - 1];
+			Pt[j] = hi[j] * tanh((below - vs[j]) / md->sc.friction_eps);
 		}
-		if (change <= tol)
-			break;
+		for (int j = 0; j < L; j++)
+			vt[j] = vs[j] + (Pt[j] - (j + 1 < L ? Pt[j + 1] : 0.0)) / m;
 	}
 	double prev_vy = deck_vel1[1], prev_vx = deck_vel1[0];
 	for (int j = 0; j < L; j++) {
 		int e = base + j;
-		double up_n = j + 1 < L ? Pn[j + 1] : 0.0, up_t = j + 1 < L ? Pt[j + 1] : 0.0;
-		etad[e] = vy[j] + (Pn[j] - up_n) / m;
-		xid[e] = vx[j] + (Pt[j] - up_t) / m;
+		etad[e] = vn[j];
+		xid[e] = vt[j];
 		/* work on the relative motion at the new velocities */
-		*contact += Pn[j] * (prev_vy - etad[e]);
-		*fric -= Pt[j] * (xid[e] - prev_vx);
-		prev_vy = etad[e];
-		prev_vx = xid[e];
-		xi[e] += h * xid[e];
-		eta[e] += h * etad[e];
+		*contact += Pn[j] * (prev_vy - vn[j]);
+		*fric += Pt[j] * (prev_vx - vt[j]);
+		prev_vy = vn[j];
+		prev_vx = vt[j];
+		xi[e] += h * vt[j];
+		eta[e] += h * vn[j];
 	}
 	impulse[0] -= Pt[0];
 	impulse[1] -= Pn[0];

@@ -28,7 +28,8 @@ typedef struct dem {
 	int n, substeps, have_q;
 	double dt;
 	double Qfeed[NQ_FULL];
-	double *k1, *k2, *k3, *k4, *tmp, *Pn, *Pt;
+	double *k1, *k2, *k3, *k4, *tmp;
+	signed char *modes;
 } dem;
 
 static void dem_free(void *p)
@@ -37,6 +38,7 @@ static void dem_free(void *p)
 	if (!w)
 		return;
 	free(w->k1);
+	free(w->modes);
 	free(w);
 }
 
@@ -49,8 +51,9 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->dt = cfg->dt;
 	w->substeps = cfg->substeps > 0 ? cfg->substeps : 1;
 	size_t nf = (size_t)(md->nf > 0 ? md->nf : 1);
-	w->k1 = calloc(5 * (size_t)md->n + 2 * nf, sizeof(double));
-	if (!w->k1) {
+	w->k1 = calloc(5 * (size_t)md->n, sizeof(double));
+	w->modes = calloc(2 * nf, 1);
+	if (!w->k1 || !w->modes) {
 		dem_free(w);
 		return NULL;
 	}
@@ -58,8 +61,6 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->k3 = w->k2 + md->n;
 	w->k4 = w->k3 + md->n;
 	w->tmp = w->k4 + md->n;
-	w->Pn = w->tmp + md->n;
-	w->Pt = w->Pn + nf;
 	return w;
 }
 
@@ -107,10 +108,6 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 		feed_rhs(md, y, q, qd, w->tmp, w->Qfeed, &fr, &cp);
 		if (!md->sc.feed_coupling)
 			memset(w->Qfeed, 0, sizeof w->Qfeed);
-		/* warm start: every contact carries what rests on it */
-		for (int e = 0; e < md->nf; e++)
-			w->Pn[e] = md->p.m_n * md->p.g * (double)(md->L - e % md->L) * w->dt /
-				   (double)w->substeps;
 		w->have_q = 1;
 	}
 	memcpy(w->tmp, y, sizeof(double) * (size_t)n);
@@ -158,8 +155,8 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 				vel1[c] = i + 1 == ns ? v1[c]
 						      : hermite(v0[c], a0[c], v1[c], a1[c], H, s1);
 			}
-			feed_dem_substep(md, y, k, pos, vel1, h, w->Pn + k * md->L,
-					 w->Pt + k * md->L, impulse, &fric, &contact);
+			feed_dem_substep(md, y, k, pos, vel1, h, w->modes, impulse, &fric,
+					 &contact);
 		}
 		double F[2] = {impulse[0] / H, impulse[1] / H};
 		model_deck_force(md, k, ev1.q, F, Qnew);
