@@ -246,12 +246,13 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 	/* drive: torque on the rotor, reaction on the trough */
 	double omega = qd[Q_PHI] - qd[Q_ALPHA];
 	double drag = p->b_phi * omega * fabs(omega);
+	double load = -(double)md->rotation * p->M_load;
 	double torque = 0.0;
 	if (!md->phi_prescribed)
 		torque = motor_torque(md, omega);
-	rhs[Q_PHI] += torque - drag;
-	rhs[Q_ALPHA] -= torque - drag;
-	damp_power += drag * omega;
+	rhs[Q_PHI] += torque - drag + load;
+	rhs[Q_ALPHA] -= torque - drag + load;
+	damp_power += drag * omega - load * omega;
 
 	/* complete the symmetric M */
 	for (int i = 0; i < NQ_FULL; i++)
@@ -306,7 +307,7 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 	}
 	if (md->phi_prescribed) {
 		/* the drive's torque closes the rotor's equation */
-		double s = -rhs[Q_PHI] - drag;
+		double s = -rhs[Q_PHI] - drag + load;
 		for (int j = 0; j < NQ_FULL; j++)
 			s += M[Q_PHI][j] * qdd[j];
 		torque = s;

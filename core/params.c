@@ -35,6 +35,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, w_x, REAL, "m", -5, 5, NULL, 1, "vibrator axle, body x")                    \
 	X(G_PARAM, w_y, REAL, "m", -5, 5, NULL, 1, "vibrator axle, body y")                    \
 	X(G_PARAM, b_phi, REAL, "N m s^2", 0, 1, NULL, 1, "bearing drag b_phi w|w|")           \
+	X(G_PARAM, M_load, REAL, "N m", 0, 1e5, NULL, 1, "constant load torque against the rotation") \
 	X(G_PARAM, M_ut, REAL, "N m", 0.1, 1e5, NULL, 1, "motor breakdown torque")            \
 	X(G_PARAM, omega_ss, REAL, "rad/s", 1, 1000, NULL, 1, "motor synchronous speed")       \
 	X(G_PARAM, slip_ut, REAL, "rad/s", 0.1, 500, NULL, 1, "breakdown slip omega_ss - omega_ut") \
@@ -203,9 +204,9 @@ static int range_error(size_t i, char *msg, size_t len)
 		else if (t->kind == SIM_KIND_BOOL)
 			snprintf(msg, len, "%s must be true or false", t->name);
 		else
-			snprintf(msg, len, "%s must be a%s number in [%g, %g]%s%s", t->name,
-				 t->kind == SIM_KIND_INT ? "n integer" : " finite", t->min, t->max,
-				 *t->unit ? " " : "", t->unit);
+			snprintf(msg, len, "%s must be %s in [%g, %g]%s%s", t->name,
+				 t->kind == SIM_KIND_INT ? "an integer" : "a finite number", t->min,
+				 t->max, *t->unit ? " " : "", t->unit);
 	}
 	return SIM_EPARAM;
 }

@@ -341,6 +341,37 @@ void sim_restart_transport(sim *s)
 	update_status(s);
 }
 
+int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi_dot,
+		   const double *eta_dot)
+{
+	model *md = &s->md;
+	if (s->t_int != s->t_obs)
+		return SIM_ETIME;
+	const double *src[4] = {xi, eta, xi_dot, eta_dot};
+	int off[4] = {md->nq, md->nq + md->nf, md->npos + md->nq, md->npos + md->nq + md->nf};
+	for (int a = 0; a < 4; a++)
+		for (int e = 0; src[a] && e < md->nf; e++)
+			if (!isfinite(src[a][e]))
+				return SIM_EPARAM;
+	for (int a = 0; a < 4; a++)
+		if (src[a])
+			memcpy(s->y + off[a], src[a], sizeof(double) * (size_t)md->nf);
+	memcpy(s->y_obs, s->y, sizeof(double) * (size_t)md->n);
+	double kin, pot;
+	const double *acc = s->y + 2 * md->npos;
+	s->e0 = model_energy_stored(md, s->t_int, s->y, &kin, &pot) + acc[ACC_CONTACT] +
+		acc[ACC_DAMP] + acc[ACC_FRIC] - acc[ACC_IN];
+	/* a fresh workspace: split methods cache the feed's reaction */
+	void *ws = s->ode->alloc(md, &s->cfg);
+	if (!ws)
+		return SIM_ENOMEM;
+	s->ode->free(s->ws);
+	s->ws = ws;
+	period_probe(s, s->t_int, s->y, &s->psi_prev, &s->psid_prev, &s->X_prev, &s->Xd_prev);
+	update_status(s);
+	return SIM_OK;
+}
+
 /* ---- observables ---- */
 
 static void update_status(sim *s)

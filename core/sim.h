@@ -59,6 +59,8 @@ typedef struct sim_params {
 	double m, e, J_w;         /* kg, m, kg m^2 */
 	double w_x, w_y;          /* m: axle, body frame */
 	double b_phi;             /* N m s^2: bearing drag b_phi*w|w| */
+	double M_load;            /* N m: constant load torque on the rotor,
+				     against the commanded rotation */
 	/* motor (Kloss) */
 	double M_ut;              /* N m breakdown torque */
 	double omega_ss;          /* rad/s synchronous speed (>0) */
@@ -191,6 +193,14 @@ int sim_set_beta(sim *s, double target_deg, double rate_deg_s);
 int sim_set_rotation(sim *s, int rotation);    /* SIM_CW / SIM_CCW */
 int sim_set_omega_ss(sim *s, double omega_ss); /* rad/s */
 int sim_set_drive_on(sim *s, int on);
+
+/* Place the feed at the observed time (which must equal the integrator's:
+ * true after sim_new and for fixed-step methods): xi, eta, xi', eta' of
+ * integrated column k, layer j at [k*L + j] (any array may be NULL to keep
+ * it). The energy balance restarts from the new state. SIM_EPARAM if a
+ * value is not finite, SIM_ETIME if the integrator stands ahead. */
+int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi_dot,
+		   const double *eta_dot);
 
 /* ---- observables at the observed time -------------------------------- */
 

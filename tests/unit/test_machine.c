@@ -1,0 +1,310 @@
+/*
+ * test_machine.c - the machine against answers known without the code:
+ * static equilibrium, the Kloss steady speed under a constant load, the
+ * linear frequency-domain (Den Hartog) orbit with the Frahm antiresonance,
+ * energy balance, observed convergence order of the fixed-step methods,
+ * continuity of beta ramps, and mirror symmetry.
+ */
+#include <complex.h>
+
+#include "testutil.h"
+
+static setup machine_only(const char *method, const char *dt)
+{
+	setup u = preset();
+	set(&u, "feed", "false");
+	set(&u, "method", method);
+	set(&u, "dt", dt);
+	return u;
+}
+
+/* At rest with the motor off nothing moves, with and without feed. */
+static void rest_holds_to_round_off(void **state)
+{
+	(void)state;
+	const char *cases[][2] = {{"rk4", "false"}, {"dem", "true"}, {"euler", "false"}};
+	for (int c = 0; c < 3; c++) {
+		setup u = preset();
+		set(&u, "motor_on", "false");
+		set(&u, "method", cases[c][0]);
+		set(&u, "feed", cases[c][1]);
+		sim *s = make(&u);
+		sim_status a = status(s);
+		advance(s, 1.0);
+		sim_status b = status(s);
+		for (int i = 0; i < 6; i++)
+			assert_close(b.q[i], a.q[i], 1e-13);
+		assert_close(b.rotor_speed, 0.0, 1e-11);
+		assert_close(b.feed_displacement, 0.0, 1e-14);
+		assert_close(b.e_residual, 0.0, 1e-10);
+		/* the feed weighs on the suspension: y sinks by W_feed / (2 k_y) */
+		double sink = strcmp(cases[c][1], "true") == 0 ? 5 * 8 * 0.5 * 9.81 / 150000.0 : 0.0;
+		assert_close(a.q[1], -sink, 1e-12);
+		sim_free(s);
+	}
+}
+
+/* Kloss: under a constant load M_L < M_ut the steady speed solves
+ * M_el(w) = M_L; with no unbalance (e = 0) the rotor is decoupled. */
+static void kloss_steady_speed(void **state)
+{
+	(void)state;
+	for (int r = 0; r < 2; r++) {
+		setup u = machine_only("rk4", "1e-4");
+		set(&u, "e", "0");
+		set(&u, "J_w", "0.01"); /* J_w alone (1e-4) is stiff for dt = 1e-4 */
+		set(&u, "M_load", "5"); /* below the starting torque, 9.77 N m */
+		set(&u, "rotation", r ? "ccw" : "cw");
+		sim *s = make(&u);
+		advance(s, 5.0); /* the trough's rocking from the start decays in ~0.5 s */
+		sim_status st = status(s);
+		double Mut = 50.0, ML = 5.0, sut = 15.5;
+		double slip = sut * (Mut - sqrt(Mut * Mut - ML * ML)) / ML;
+		double expect = (r ? 1.0 : -1.0) * (157.08 - slip);
+		assert_close(st.rotor_speed, expect, 1e-6); /* 6e-9 relative */
+		assert_close(st.motor_torque, r ? ML : -ML, 1e-7);
+		sim_free(s);
+	}
+}
+
+/* Complex Gaussian elimination for the 4 x 4 linear response. */
+static void csolve(int n, double complex A[4][4], double complex *b)
+{
+	for (int c = 0; c < n; c++) {
+		for (int r = c + 1; r < n; r++) {
+			double complex f = A[r][c] / A[c][c];
+			for (int k = c; k < n; k++)
+				A[r][k] -= f * A[c][k];
+			b[r] -= f * b[c];
+		}
+	}
+	for (int c = n - 1; c >= 0; c--) {
+		for (int k = c + 1; k < n; k++)
+			b[c] -= A[c][k] * b[k];
+		b[c] /= A[c][c];
+	}
+}
+
+/* Steady complex amplitudes of z = (x, y, s1, s2) for the forcing
+ * m e W^2 (cos phi, sin phi), phi = phi0 + W t, with alpha = 0:
+ * M z'' + C z' + K z = F e^{i phi} (every mass moves with G; the
+ * eliminator masses also along u). */
+static void linear_response(double beta, double W, double b_s, double complex Z[4])
+{
+	double ux = -sin(beta), uy = cos(beta), mt = 120 + 10 + 18 + 18;
+	double M[4][4] = {{mt, 0, 18 * ux, 18 * ux},
+			  {0, mt, 18 * uy, 18 * uy},
+			  {18 * ux, 18 * uy, 18, 0},
+			  {18 * ux, 18 * uy, 0, 18}};
+	double C[4] = {6000, 6000, b_s, b_s}, K[4] = {150000, 150000, 444132, 444132};
+	double complex A[4][4];
+	double F = 10 * 0.0215 * W * W;
+	for (int i = 0; i < 4; i++) {
+		for (int j = 0; j < 4; j++)
+			A[i][j] = -W * W * M[i][j];
+		A[i][i] += K[i] + I * W * C[i];
+	}
+	Z[0] = F;
+	Z[1] = -I * F;
+	Z[2] = Z[3] = 0;
+	csolve(4, A, Z);
+}
+
+/* No feed, ideal drive at w: the steady orbit of (x, y, s1, s2) is the
+ * linear frequency-domain solution, and at w = sqrt(k_s/m_i) the trough
+ * hardly moves along the guides u(beta) (Den Hartog's absorber). */
+static void linear_orbit_and_frahm_antiresonance(void **state)
+{
+	(void)state;
+	setup u = machine_only("rk4", "1e-4");
+	set(&u, "drive", "ideal");
+	set(&u, "trough_rotation", "false"); /* alpha = 0: the (x, y, s) system */
+	set(&u, "b_x", "3000");              /* fast decay of the start */
+	set(&u, "b_y", "3000");
+	double beta = 38.0 * M_PI / 180.0, W = 157.08 * -1.0; /* cw */
+	sim *s = make(&u);
+	sim_status st0 = status(s);
+	advance(s, 8.0);
+	double ux = -sin(beta), uy = cos(beta);
+	double complex Z[4], Z0[4];
+	linear_response(beta, W, 60.0, Z);
+	linear_response(beta, -sqrt(444132.0 / 18.0), 0.0, Z0); /* tuned exactly */
+	double amp = cabs(Z[0]) + cabs(Z[1]), worst = 0.0, along_u = 0.0, along_n = 0.0;
+	for (int k = 0; k < 200; k++) {
+		advance(s, 8.0 + k * 2e-4);
+		sim_status st = status(s);
+		double complex ph = cexp(I * st.q[3]);
+		double xp = creal(Z[0] * ph), yp = creal(Z[1] * ph), sp = creal(Z[2] * ph);
+		worst = fmax(worst, fabs(st.q[0] - xp) + fabs(st.q[1] - st0.q[1] - yp));
+		worst = fmax(worst, fabs(st.q[4] - st0.q[4] - sp) * amp / cabs(Z[2]));
+		along_u = fmax(along_u, fabs(ux * st.q[0] + uy * (st.q[1] - st0.q[1])));
+		along_n = fmax(along_n, fabs(uy * st.q[0] - ux * (st.q[1] - st0.q[1])));
+	}
+	if (worst > 1e-6 * amp)
+		fail_msg("orbit differs from the linear solution by %.3g (amplitude %.3g)", worst, amp);
+	/* the antiresonance: along u only the eliminator damping's rest
+	 * remains (zero without it), as the simulation shows too */
+	double complex zu = ux * Z[0] + uy * Z[1], zn = uy * Z[0] - ux * Z[1];
+	double complex zu0 = ux * Z0[0] + uy * Z0[1], zn0 = uy * Z0[0] - ux * Z0[1];
+	assert_true(cabs(zu0) < 1e-10 * cabs(zn0));
+	assert_true(along_n > 1e-3);
+	assert_rel(along_u / along_n, cabs(zu) / cabs(zn), 1e-3);
+	assert_true(along_u < 0.1 * along_n);
+	sim_free(s);
+}
+
+/* Energy: kinetic + potential change = drive work - dissipated work, to
+ * the integrator's accuracy (fourth order for rk4). */
+static void energy_balance_converges(void **state)
+{
+	(void)state;
+	double res[2];
+	double input = 0.0;
+	for (int k = 0; k < 2; k++) {
+		setup u = machine_only("rk4", k ? "1e-4" : "2e-4");
+		sim *s = make(&u);
+		advance(s, 0.5);
+		sim_status st = status(s);
+		res[k] = fabs(st.e_residual);
+		input = st.e_input;
+		sim_free(s);
+	}
+	assert_true(input > 10.0);
+	if (!(res[1] < 1e-7 * input))
+		fail_msg("residual %.3g J of %.3g J input", res[1], input);
+	double order = log2(res[0] / res[1]);
+	if (!(order > 3.0))
+		fail_msg("energy residual order %.2f (%.3g, %.3g)", order, res[0], res[1]);
+}
+
+/* Error of (x, y, s1) sampled every ms over [0, T] against a reference. */
+static double trajectory_error(const setup *u, const double *ref, int n, double dt_sample)
+{
+	sim *s = make(u);
+	double err = 0.0;
+	for (int k = 1; k <= n; k++) {
+		advance(s, k * dt_sample);
+		sim_status st = status(s);
+		err = fmax(err, fabs(st.q[0] - ref[3 * k - 3]) + fabs(st.q[1] - ref[3 * k - 2]) +
+					fabs(st.q[4] - ref[3 * k - 1]));
+	}
+	sim_free(s);
+	return err;
+}
+
+/* Observed order of the fixed-step methods on the machine without feed
+ * (Kloss motor start: a smooth problem). */
+static void fixed_step_convergence_order(void **state)
+{
+	(void)state;
+	enum { N = 150 };
+	const double ds = 1e-3;
+	double *ref = calloc(3 * N, sizeof(double));
+	setup r = machine_only("dopri5", "1e-5");
+	set(&r, "rtol", "1e-12");
+	set(&r, "atol", "1e-15");
+	sim *s = make(&r);
+	for (int k = 1; k <= N; k++) {
+		advance(s, k * ds);
+		sim_status st = status(s);
+		ref[3 * k - 3] = st.q[0];
+		ref[3 * k - 2] = st.q[1];
+		ref[3 * k - 1] = st.q[4];
+	}
+	sim_free(s);
+	struct {
+		const char *method;
+		const char *dt[2];
+		double order;
+	} cases[] = {{"rk4", {"2e-4", "1e-4"}, 4}, {"dem", {"2e-4", "1e-4"}, 4},
+		     {"euler", {"2e-5", "1e-5"}, 1}};
+	for (int c = 0; c < 3; c++) {
+		double e[2];
+		for (int k = 0; k < 2; k++) {
+			setup u = machine_only(cases[c].method, cases[c].dt[k]);
+			e[k] = trajectory_error(&u, ref, N, ds);
+		}
+		double order = log2(e[0] / e[1]);
+		if (fabs(order - cases[c].order) > 0.3)
+			fail_msg("%s: observed order %.3f (errors %.3g, %.3g), expected %.0f",
+				 cases[c].method, order, e[0], e[1], cases[c].order);
+	}
+	free(ref);
+}
+
+/* beta ramps: beta and beta' continuous, |beta'| <= rate, |beta''| <=
+ * accel, also when a new target arrives in the middle of a ramp. */
+static void beta_ramps_are_continuous(void **state)
+{
+	(void)state;
+	setup u = machine_only("rk4", "1e-4");
+	sim *s = make(&u);
+	advance(s, 0.1);
+	double t_eff = sim_effective_time(s);
+	assert_close(t_eff, 0.1, 1e-12);
+	assert_int_equal(sim_set_beta(s, 128.0, 90.0), SIM_OK);
+	const double rate = M_PI / 2, accel = 900.0 * M_PI / 180.0, dt = 1e-3;
+	sim_status prev = status(s);
+	double peak = 0.0;
+	for (int k = 1; k <= 2500; k++) {
+		if (k == 500) /* retarget mid-ramp, back down */
+			assert_int_equal(sim_set_beta(s, 60.0, 0.0), SIM_OK);
+		advance(s, 0.1 + k * dt);
+		sim_status st = status(s);
+		assert_true(fabs(st.beta - prev.beta) <= rate * dt * (1 + 1e-9));
+		assert_true(fabs(st.beta_dot - prev.beta_dot) <= accel * dt * (1 + 1e-9));
+		peak = fmax(peak, fabs(st.beta_dot));
+		prev = st;
+	}
+	assert_close(prev.beta, 60.0 * M_PI / 180.0, 1e-12);
+	assert_close(prev.beta_dot, 0.0, 0.0);
+	assert_close(peak, rate, 1e-9);
+	assert_int_equal(sim_set_beta(s, 181.0, 0.0), SIM_EPARAM);
+	assert_int_equal(sim_set_beta(s, 90.0, -5.0), SIM_OK); /* keeps the rate */
+	assert_int_equal(sim_set_beta(s, 90.0, 1e5), SIM_EPARAM);
+	sim_free(s);
+}
+
+/* Mirror symmetry of the symmetric machine: (cw, beta) and (ccw, 180 -
+ * beta) give mirrored motions: x, alpha and the rotor speed change sign,
+ * y stays, and the eliminators swap with their strokes negated (the
+ * mirrored guide points the other way along the same line). */
+static void mirror_symmetry_machine(void **state)
+{
+	(void)state;
+	setup a = machine_only("rk4", "1e-4"), b = machine_only("rk4", "1e-4");
+	set(&a, "beta", "38");
+	set(&b, "beta", "142");
+	set(&b, "rotation", "ccw");
+	sim *sa = make(&a), *sb = make(&b);
+	double scale = 0.0, worst = 0.0;
+	for (int k = 1; k <= 500; k++) {
+		advance(sa, k * 1e-3);
+		advance(sb, k * 1e-3);
+		sim_status x = status(sa), y = status(sb);
+		double d[6] = {x.q[0] + y.q[0], x.q[1] - y.q[1], x.q[2] + y.q[2],
+			       x.q[4] + y.q[5], x.q[5] + y.q[4], x.rotor_speed + y.rotor_speed};
+		scale = fmax(scale, fabs(x.q[0]) + fabs(x.q[1]) + fabs(x.q[4]));
+		for (int i = 0; i < 5; i++)
+			worst = fmax(worst, fabs(d[i]));
+		assert_close(d[5], 0.0, 1e-9 * fabs(x.rotor_speed) + 1e-12);
+	}
+	if (worst > 1e-10 * scale)
+		fail_msg("mirror mismatch %.3g at scale %.3g", worst, scale);
+	sim_free(sa);
+	sim_free(sb);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(rest_holds_to_round_off),
+		cmocka_unit_test(kloss_steady_speed),
+		cmocka_unit_test(linear_orbit_and_frahm_antiresonance),
+		cmocka_unit_test(energy_balance_converges),
+		cmocka_unit_test(fixed_step_convergence_order),
+		cmocka_unit_test(beta_ramps_are_continuous),
+		cmocka_unit_test(mirror_symmetry_machine),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

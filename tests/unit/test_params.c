@@ -1,0 +1,130 @@
+/*
+ * test_params.c - parameter validation: every setting has a unit and a
+ * range; bad values (negative or zero masses, non-finite numbers, sizes
+ * that would allocate without bound, unknown names) are refused with a
+ * message naming the setting and its range, and change nothing.
+ */
+#include "testutil.h"
+
+static void refuses_out_of_range_with_range_in_message(void **state)
+{
+	(void)state;
+	setup u = preset();
+	char msg[200];
+	double before = u.p.m1;
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "m1", -1.0, msg, sizeof msg), SIM_EPARAM);
+	assert_string_equal(msg, "m1 must be a finite number in [0.001, 10000] kg");
+	assert_true(u.p.m1 == before);
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "M_r", 0.0, msg, sizeof msg), SIM_EPARAM);
+	assert_string_equal(msg, "M_r must be a finite number in [1, 100000] kg");
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "k_s1", NAN, msg, sizeof msg), SIM_EPARAM);
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "k_s1", INFINITY, msg, sizeof msg), SIM_EPARAM);
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "columns", 1e9, msg, sizeof msg), SIM_EPARAM);
+	assert_string_equal(msg, "columns must be an integer in [1, 64]");
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "layers", 2.5, msg, sizeof msg), SIM_EPARAM);
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "beta", 181, msg, sizeof msg), SIM_EPARAM);
+	assert_string_equal(msg, "beta must be a finite number in [0, 180] deg");
+	assert_int_equal(sim_set_str(&u.p, &u.sc, &u.m, "rotation", "left", msg, sizeof msg),
+			 SIM_EPARAM);
+	assert_string_equal(msg, "rotation must be one of cw|ccw");
+	assert_int_equal(sim_set_str(&u.p, &u.sc, &u.m, "method", "rk45", msg, sizeof msg),
+			 SIM_EPARAM);
+	assert_string_equal(msg, "method must be one of rk4|dopri5|euler|dem");
+	assert_int_equal(sim_set_str(&u.p, &u.sc, &u.m, "dt", "1e-3x", msg, sizeof msg),
+			 SIM_EPARAM);
+	assert_int_equal(sim_set(&u.p, &u.sc, &u.m, "k_s3", 1.0, msg, sizeof msg), SIM_EUNKNOWN);
+	assert_string_equal(msg, "unknown setting 'k_s3'");
+	/* nothing changed */
+	setup fresh = preset();
+	assert_memory_equal(&u.p, &fresh.p, sizeof u.p);
+	assert_memory_equal(&u.sc, &fresh.sc, sizeof u.sc);
+}
+
+static void converts_units_and_enums(void **state)
+{
+	(void)state;
+	setup u = preset();
+	set(&u, "beta", "128");
+	assert_close(u.p.beta, 128.0 * M_PI / 180.0, 1e-15);
+	set(&u, "rotation", "ccw");
+	assert_int_equal(u.p.rotation, SIM_CCW);
+	set(&u, "drive", "ideal");
+	assert_int_equal(u.sc.drive, SIM_DRIVE_IDEAL);
+	set(&u, "feed", "false");
+	assert_int_equal(u.sc.feed, 0);
+	set(&u, "method", "rk4");
+	assert_string_equal(u.m.name, "rk4");
+	double v;
+	assert_int_equal(sim_get(&u.p, &u.sc, &u.m, "beta", &v), SIM_OK);
+	assert_close(v, 128.0, 1e-12);
+	assert_int_equal(sim_get(&u.p, &u.sc, &u.m, "rotation", &v), SIM_OK);
+	assert_close(v, 1.0, 0.0);
+}
+
+static void sim_new_refuses_invalid_sets(void **state)
+{
+	(void)state;
+	setup u = preset();
+	u.p.m2 = -3.0; /* written past the checks */
+	char msg[200];
+	int err = -1;
+	assert_null(sim_new(&u.p, &u.sc, &u.m, &err, msg, sizeof msg));
+	assert_int_equal(err, SIM_EPARAM);
+	assert_string_equal(msg, "m2 must be a finite number in [0.001, 10000] kg");
+	u = preset();
+	snprintf(u.m.name, sizeof u.m.name, "%s", "magic");
+	assert_null(sim_new(&u.p, &u.sc, &u.m, &err, msg, sizeof msg));
+	assert_int_equal(err, SIM_EPARAM);
+	u = preset();
+	u.sc.layers = 100000;
+	assert_null(sim_new(&u.p, &u.sc, &u.m, &err, msg, sizeof msg));
+	assert_string_equal(msg, "layers must be an integer in [1, 64]");
+}
+
+static void every_setting_is_described(void **state)
+{
+	(void)state;
+	size_t n;
+	const sim_setting *t = sim_settings(&n);
+	assert_true(n > 50);
+	setup u = preset();
+	for (size_t i = 0; i < n; i++) {
+		double v;
+		assert_non_null(t[i].doc);
+		assert_true(t[i].min <= t[i].max);
+		assert_int_equal(sim_get(&u.p, &u.sc, &u.m, t[i].name, &v), SIM_OK);
+		/* the preset lies inside every range */
+		if (!(v >= t[i].min - 1e-9 && v <= t[i].max + 1e-9))
+			fail_msg("preset %s = %g outside [%g, %g]", t[i].name, v, t[i].min, t[i].max);
+		assert_true(strcmp(t[i].group, "params") == 0 || strcmp(t[i].group, "scene") == 0 ||
+			    strcmp(t[i].group, "integrator") == 0);
+	}
+	size_t nm;
+	const sim_method_info *mi = sim_methods(&nm);
+	assert_int_equal(nm, 4);
+	assert_string_equal(mi[0].name, "rk4");
+	assert_int_equal(mi[0].order, 4);
+	assert_string_equal(mi[1].name, "dopri5");
+	assert_int_equal(mi[1].adaptive, 1);
+}
+
+static void errors_have_text(void **state)
+{
+	(void)state;
+	assert_string_equal(sim_strerror(SIM_OK), "ok");
+	assert_string_equal(sim_strerror(SIM_EDIVERGED), "simulation diverged");
+	assert_string_equal(sim_strerror(999), "unknown error");
+	sim_free(NULL);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(refuses_out_of_range_with_range_in_message),
+		cmocka_unit_test(converts_units_and_enums),
+		cmocka_unit_test(sim_new_refuses_invalid_sets),
+		cmocka_unit_test(every_setting_is_described),
+		cmocka_unit_test(errors_have_text),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

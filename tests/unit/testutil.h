@@ -1,0 +1,78 @@
+/*
+ * testutil.h - shared set-up for the core's unit tests (cmocka): the
+ * czubak2016 preset with changes, running an instance to a time, and
+ * assertions on doubles with a message that shows both values.
+ */
+#ifndef CONVSIM_TESTUTIL_H
+#define CONVSIM_TESTUTIL_H
+
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "sim.h"
+
+typedef struct setup {
+	sim_params p;
+	sim_scene sc;
+	sim_method m;
+} setup;
+
+static inline setup preset(void)
+{
+	setup u;
+	sim_preset_czubak2016(&u.p, &u.sc, &u.m);
+	return u;
+}
+
+/* Set NAME=VALUE (user units) or fail the test. */
+static inline void set(setup *u, const char *name, const char *value)
+{
+	char msg[200];
+	int e = sim_set_str(&u->p, &u->sc, &u->m, name, value, msg, sizeof msg);
+	if (e != SIM_OK)
+		fail_msg("set %s=%s: %s", name, value, msg);
+}
+
+static inline sim *make(const setup *u)
+{
+	char msg[200];
+	int err;
+	sim *s = sim_new(&u->p, &u->sc, &u->m, &err, msg, sizeof msg);
+	if (!s)
+		fail_msg("sim_new: %s", msg);
+	return s;
+}
+
+static inline void advance(sim *s, double t)
+{
+	int e = sim_advance(s, t);
+	if (e != SIM_OK)
+		fail_msg("sim_advance(%g): %s", t, sim_last_error(s));
+}
+
+static inline sim_status status(const sim *s)
+{
+	sim_status st;
+	sim_get_status(s, &st);
+	return st;
+}
+
+#define assert_close(a, b, tol)                                                           \
+	do {                                                                              \
+		double a_ = (a), b_ = (b), t_ = (tol);                                    \
+		if (!(fabs(a_ - b_) <= t_))                                               \
+			fail_msg("%s = %.12g, %s = %.12g, |diff| %.3g > %.3g", #a, a_, #b, b_, \
+				 fabs(a_ - b_), t_);                                      \
+	} while (0)
+
+#define assert_rel(a, b, rel) assert_close(a, b, (rel) * fabs(b))
+
+#endif
