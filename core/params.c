@@ -28,7 +28,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, b_x, REAL, "N s/m", 0, 1e6, NULL, 1, "horizontal damping per spring set")   \
 	X(G_PARAM, b_y, REAL, "N s/m", 0, 1e6, NULL, 1, "vertical damping per spring set")     \
 	X(G_PARAM, M_r, REAL, "kg", 1, 1e5, NULL, 1, "trough mass")                            \
-	X(G_PARAM, J_r, REAL, "kg m^2", 0.01, 1e5, NULL, 1, "trough moment of inertia about G") \
+	X(G_PARAM, J_r, REAL, "kg m^2", 0.01, 1e12, NULL, 1, "trough moment of inertia about G (large values pin its rotation)") \
 	X(G_PARAM, m, REAL, "kg", 0.001, 1000, NULL, 1, "unbalanced mass")                     \
 	X(G_PARAM, e, REAL, "m", 0, 0.5, NULL, 1, "eccentricity of the unbalanced mass")       \
 	X(G_PARAM, J_w, REAL, "kg m^2", 1e-6, 10, NULL, 1, "rotor moment of inertia")          \

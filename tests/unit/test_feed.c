@@ -1,0 +1,252 @@
+/*
+ * test_feed.c - the feed against known answers: rebound at R times the
+ * impact speed, the hopping theory of VDI 2333 for a deck moving
+ * harmonically along a line, transport direction and its reversal by
+ * beta, mirror symmetry with opposite transport, agreement of the
+ * symmetric reduction with the full model, and the energy balance.
+ */
+#include "feed.h"
+#include "model.h"
+#include "testutil.h"
+
+/* One element dropped on a fixed deck (no gravity, so that the contact
+ * alone acts): it leaves at R times the impact speed (p = 1: loading
+ * stiffness k, unloading R^2 k). */
+static void rebound_speed_is_R_times_impact(void **state)
+{
+	(void)state;
+	const char *methods[][3] = {{"rk4", "1e-6", "1"}, {"dem", "1e-5", "1"}, {"dopri5", "1e-5", "1"}};
+	const char *Rs[] = {"0.05", "0.5", "0.9"};
+	for (int mi = 0; mi < 3; mi++)
+		for (int ri = 0; ri < 3; ri++) {
+			setup u = preset();
+			set(&u, "columns", "1");
+			set(&u, "layers", "1");
+			set(&u, "g", "0");
+			set(&u, "motor_on", "false");
+			set(&u, "feed_coupling", "false");
+			set(&u, "R", Rs[ri]);
+			set(&u, "method", methods[mi][0]);
+			set(&u, "dt", methods[mi][1]);
+			set(&u, "substeps", methods[mi][2]);
+			sim *s = make(&u);
+			double eta = 1e-3, etad = -0.5;
+			assert_int_equal(sim_place_feed(s, NULL, &eta, NULL, &etad), SIM_OK);
+			advance(s, 0.2);
+			double y0, v;
+			/* the velocity after separation, from two positions */
+			sim_feed_state(s, NULL, &y0);
+			advance(s, 0.25);
+			double y1;
+			sim_feed_state(s, NULL, &y1);
+			v = (y1 - y0) / 0.05;
+			double expect = atof(Rs[ri]) * 0.5;
+			double tol = mi == 1 ? 0.01 : mi == 2 ? 1e-3 : 2e-4;
+			if (fabs(v - expect) > tol * expect)
+				fail_msg("%s R=%s: rebound %.6g m/s, expected %.6g", methods[mi][0],
+					 Rs[ri], v, expect);
+			sim_free(s);
+		}
+}
+
+/* Flight fraction n of VDI 2333 hopping theory:
+ * sqrt(G^2 - 1) = (2 pi^2 n^2 + cos 2 pi n - 1) / (2 pi n - sin 2 pi n). */
+static double flight_fraction(double G)
+{
+	double lo = 1e-6, hi = 1.0, target = sqrt(G * G - 1.0);
+	for (int it = 0; it < 200; it++) {
+		double n = 0.5 * (lo + hi), a = 2 * M_PI * n;
+		double f = (2 * M_PI * M_PI * n * n + cos(a) - 1.0) / (a - sin(a));
+		if (f < target)
+			lo = n;
+		else
+			hi = n;
+	}
+	return 0.5 * (lo + hi);
+}
+
+/* One element on a deck moving harmonically along a line at angle psi
+ * (amplitude A, 1 < Gamma < 3.3, no slip, plastic impact): mean velocity
+ * v = g n^2 cot(psi) / (2 f). The deck motion is prescribed: the feed's
+ * sub-step of the split method is driven directly. */
+static void hopping_theory_vdi2333(void **state)
+{
+	(void)state;
+	const double psis[] = {20.0, 30.0, 45.0}, Gammas[] = {1.6, 2.2, 3.0};
+	for (int c = 0; c < 3; c++) {
+		setup u = preset();
+		set(&u, "columns", "1");
+		set(&u, "layers", "1");
+		set(&u, "R", "0.001");
+		set(&u, "mu", "2");
+		set(&u, "k_c", "1e7");
+		model md;
+		model_init(&md, &u.p, &u.sc);
+		md.p.mu = 100.0; /* the theory assumes no slip at all */
+		double *y = calloc((size_t)md.n, sizeof(double));
+		signed char modes[2] = {0, 0};
+		const double g = 9.81, f = 25.0, w = 2 * M_PI * f, psi = psis[c] * M_PI / 180.0;
+		const double A = Gammas[c] * g / (w * w * sin(psi)), h = 2e-6;
+		const int per = (int)lround(1.0 / (f * h));
+		double xi0 = 0.0;
+		int periods = 40, skip = 10;
+		for (int k = 0; k < periods * per; k++) {
+			double t = k * h, t1 = t + h;
+			double pos[2] = {A * cos(psi) * sin(w * t), A * sin(psi) * sin(w * t)};
+			double vel1[2] = {A * w * cos(psi) * cos(w * t1), A * w * sin(psi) * cos(w * t1)};
+			double imp[2] = {0, 0}, fr = 0, co = 0;
+			feed_dem_substep(&md, y, 0, pos, vel1, h, modes, imp, &fr, &co);
+			if (k + 1 == skip * per)
+				xi0 = y[md.nq];
+		}
+		double v = (y[md.nq] - xi0) / ((periods - skip) / f);
+		double n = flight_fraction(Gammas[c]);
+		double expect = g * n * n / tan(psi) / (2 * f);
+		/* measured within 0.25 % on the three cases */
+		if (fabs(v - expect) > 0.005 * expect)
+			fail_msg("psi %g Gamma %g: v %.5g m/s, theory %.5g (n = %.4f)", psis[c],
+				 Gammas[c], v, expect, n);
+		free(y);
+	}
+}
+
+static double run_velocity(setup *u, double t_end)
+{
+	sim *s = make(u);
+	advance(s, t_end);
+	double v = status(s).transport_velocity;
+	sim_free(s);
+	return v;
+}
+
+/* beta sets the direction: about 38 deg throws right, about 128 deg left
+ * (clockwise rotation), and a beta change in a running session reverses
+ * the feed without a change of rotation. */
+static void beta_sets_and_reverses_direction(void **state)
+{
+	(void)state;
+	setup u = preset();
+	set(&u, "trough_rotation", "false");
+	set(&u, "transient", "1.5");
+	set(&u, "beta", "38");
+	double right = run_velocity(&u, 3.0);
+	set(&u, "beta", "128");
+	double left = run_velocity(&u, 3.0);
+	if (!(right > 0.08 && left < -0.05))
+		fail_msg("v(38) = %.4g, v(128) = %.4g m/s", right, left);
+	set(&u, "beta", "38");
+	sim *s = make(&u);
+	advance(s, 2.5);
+	double before = status(s).feed_velocity;
+	assert_int_equal(sim_set_beta(s, 128.0, 180.0), SIM_OK);
+	sim_restart_transport(s);
+	advance(s, 5.0);
+	sim_status st = status(s);
+	assert_true(before > 0.08);
+	assert_true(st.feed_velocity < -0.05);
+	assert_close(st.beta * 180 / M_PI, 128.0, 1e-9);
+	assert_true(st.transport_velocity < -0.05);
+	sim_free(s);
+}
+
+/* (cw, beta) and (ccw, 180 - beta) mirror each other, feed included:
+ * opposite feed displacement at every instant, opposite velocity. */
+static void mirror_symmetry_with_feed(void **state)
+{
+	(void)state;
+	setup a = preset(), b = preset();
+	set(&a, "trough_rotation", "true");
+	set(&b, "beta", "142");
+	set(&b, "rotation", "ccw");
+	sim *sa = make(&a), *sb = make(&b);
+	double worst = 0.0, scale = 0.0;
+	for (int k = 1; k <= 30; k++) {
+		advance(sa, 0.1 * k);
+		advance(sb, 0.1 * k);
+		sim_status x = status(sa), y = status(sb);
+		worst = fmax(worst, fabs(x.feed_displacement + y.feed_displacement));
+		worst = fmax(worst, fabs(x.q[0] + y.q[0]) + fabs(x.q[1] - y.q[1]));
+		scale = fmax(scale, fabs(x.feed_displacement));
+	}
+	if (worst > 1e-9 * scale)
+		fail_msg("mirror mismatch %.3g (scale %.3g)", worst, scale);
+	double va = status(sa).transport_velocity, vb = status(sb).transport_velocity;
+	/* the period boundaries of the mirrored run fall half a period later */
+	assert_true(va > 0.1);
+	assert_rel(vb, -va, 2e-3);
+	sim_free(sa);
+	sim_free(sb);
+}
+
+/* The symmetric reduction (alpha = 0, one column standing for five) is the
+ * full model's motion when the trough cannot rotate: pinned by a huge J_r,
+ * the two agree to 1e-9 over the first second of the start. */
+static void reduction_agrees_with_full_model(void **state)
+{
+	(void)state;
+	setup full = preset(), red = preset();
+	set(&full, "J_r", "1e12");
+	set(&red, "J_r", "1e12");
+	set(&red, "trough_rotation", "false");
+	sim *a = make(&full), *b = make(&red);
+	assert_int_equal(status(a).reductions, 0);
+	assert_int_equal(status(b).reductions, SIM_RED_SYMMETRIC);
+	assert_int_equal(status(b).n_dof, 5 + 2 * 8);
+	double worst = 0.0;
+	const int idx[5] = {0, 1, 3, 4, 5};
+	double scale[5] = {0};
+	for (int k = 1; k <= 1000; k++) {
+		advance(a, k * 1e-3);
+		advance(b, k * 1e-3);
+		sim_status x = status(a), y = status(b);
+		for (int i = 0; i < 5; i++) {
+			scale[i] = fmax(scale[i], fabs(x.q[idx[i]]));
+			worst = fmax(worst, fabs(x.q[idx[i]] - y.q[idx[i]]) / scale[i]);
+		}
+	}
+	if (worst > 1e-9)
+		fail_msg("reduced vs full: %.3g relative", worst);
+	double cd[5];
+	sim_column_displacement(b, cd);
+	for (int k = 1; k < 5; k++)
+		assert_close(cd[k], cd[0], 0.0);
+	sim_free(a);
+	sim_free(b);
+}
+
+/* Energy: input = stored change + dissipated, to the method's accuracy;
+ * the split method's residual shrinks with its sub-step. */
+static void energy_balance_with_feed(void **state)
+{
+	(void)state;
+	double rel[2];
+	const char *dts[2] = {"1e-4", "2.5e-5"};
+	for (int k = 0; k < 2; k++) {
+		setup u = preset();
+		set(&u, "trough_rotation", "false");
+		set(&u, "dt", dts[k]);
+		set(&u, "substeps", "1");
+		sim *s = make(&u);
+		advance(s, 1.0);
+		sim_status st = status(s);
+		assert_true(st.e_input > 50.0);
+		assert_true(st.e_dissipated > 0.2 * st.e_input);
+		rel[k] = fabs(st.e_residual) / st.e_input;
+		sim_free(s);
+	}
+	if (!(rel[0] < 5e-3 && rel[1] < 0.6 * rel[0]))
+		fail_msg("energy residual %.3g, %.3g of the input", rel[0], rel[1]);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(rebound_speed_is_R_times_impact),
+		cmocka_unit_test(hopping_theory_vdi2333),
+		cmocka_unit_test(beta_sets_and_reverses_direction),
+		cmocka_unit_test(mirror_symmetry_with_feed),
+		cmocka_unit_test(reduction_agrees_with_full_model),
+		cmocka_unit_test(energy_balance_with_feed),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
