@@ -1,17 +1,30 @@
 #!/usr/bin/env bash
-# Runs every test group against the built binaries and prints one closing
-# line "N passed, M failed". Unit tests are cmocka binaries; HTTP and
-# browser tests are node:test files that start the real daemon on port 0.
+# Runs every test group against the built binaries and closes with one line
+# "tests: N passed, M failed" counting the individual tests of all groups.
+# Unit tests are cmocka binaries; HTTP and browser tests are node:test files
+# that start the real daemon on port 0.
 set -u
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 export BUILD CONVSIMD="$PWD/$BUILD/convsimd" CONVSIM="$PWD/$BUILD/convsim"
 mkdir -p tests/out
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
 pass=0; fail=0; failed=()
 run() { # name, command...
 	local name=$1; shift
 	echo "=== $name"
-	if timeout 900 "$@"; then pass=$((pass+1)); else fail=$((fail+1)); failed+=("$name"); fi
+	timeout 900 "$@" 2>&1 | tee "$log"
+	local rc=${PIPESTATUS[0]} p f
+	# cmocka: "[  PASSED  ] N test(s)." / "[  FAILED  ] N test(s), listed below:"
+	# node:test: "# pass N" / "# fail N"
+	p=$(sed -n -e 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' -e 's/^# pass \([0-9]*\)$/\1/p' "$log" | tail -1)
+	f=$(sed -n -e 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' -e 's/^# fail \([0-9]*\)$/\1/p' "$log" | tail -1)
+	p=${p:-0}; f=${f:-0}
+	# a group that crashed or timed out counts as one more failure
+	if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
+	pass=$((pass + p)); fail=$((fail + f))
+	[ "$rc" -eq 0 ] || failed+=("$name")
 }
 for t in "$BUILD"/tests/test_*; do
 	[ -x "$t" ] || continue
@@ -19,10 +32,9 @@ for t in "$BUILD"/tests/test_*; do
 done
 for f in tests/http/*.test.mjs tests/web/*.test.mjs; do
 	[ -e "$f" ] || continue
-	# shellcheck disable=SC2086
 	run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
 done
 echo
-[ ${#failed[@]} -eq 0 ] || printf 'failed: %s\n' "${failed[@]}"
-echo "test groups: $pass passed, $fail failed"
-[ "$fail" -eq 0 ]
+[ ${#failed[@]} -eq 0 ] || printf 'failed group: %s\n' "${failed[@]}"
+echo "tests: $pass passed, $fail failed"
+[ "$fail" -eq 0 ] && [ ${#failed[@]} -eq 0 ]
