@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Work-precision benchmark (`make bench`): builds tests/bench/workprec
+# against the core library, runs the scenes in two single-threaded
+# processes (the full scene alone in one, the others in turn in the other),
+# then writes the table and the plot. BENCH_QUICK=1: shorter horizons and
+# ladders, results into $BUILD/bench-quick instead of tests/bench/results.
+set -eu
+cd "$(dirname "$0")/../.."
+BUILD=${BUILD:-build}
+CC=${CC:-cc}
+if [ "${BENCH_QUICK:-0}" = 1 ]; then
+	out="$BUILD/bench-quick"; q=quick; cmd="BENCH_QUICK=1 make bench"
+else
+	out=tests/bench/results; q=; cmd="make bench"
+fi
+mkdir -p "$out" "$BUILD/bench"
+bin="$BUILD/bench/workprec"
+$CC -O2 -g -Wall -Wextra -Werror -std=c11 -D_POSIX_C_SOURCE=200809L -Icore \
+	-o "$bin" tests/bench/workprec.c "$BUILD/libcore.a" -lm
+pin() { # core, command...: one core per process where taskset exists
+	local c=$1; shift
+	if command -v taskset >/dev/null; then taskset -c "$c" "$@"; else "$@"; fi
+}
+start=$(date +%s)
+echo "bench: full scene on core 0; machine alone, reduced scene, reductions on core 1"
+pin 0 "$bin" scene full $q > "$out/full.tsv" &
+full_pid=$!
+{
+	pin 1 "$bin" scene nofeed $q > "$out/nofeed.tsv"
+	pin 1 "$bin" scene reduced $q > "$out/reduced.tsv"
+	pin 1 "$bin" scene reductions $q > "$out/reductions.tsv"
+} &
+rest_pid=$!
+wait "$full_pid"
+wait "$rest_pid"
+"$bin" report "$out" "$cmd"
+echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"
