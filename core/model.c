@@ -113,15 +113,13 @@ void model_full_coords(const model *md, double t, const double *y, double q[NQ_F
 		       double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
-	for (int i = 0; i < NQ_FULL; i++) {
-		double a = 0.0, b = 0.0;
-		for (int r = 0; r < md->nq; r++) {
-			a += md->T[i][r] * qr[r];
-			b += md->T[i][r] * qrd[r];
+	memset(q, 0, sizeof(double) * NQ_FULL);
+	memset(qd, 0, sizeof(double) * NQ_FULL);
+	for (int r = 0; r < md->nq; r++)
+		for (int a = 0; a < md->ncol[r]; a++) {
+			q[md->col[r][a]] += qr[r];
+			qd[md->col[r][a]] += qrd[r];
 		}
-		q[i] = a;
-		qd[i] = b;
-	}
 	if (md->phi_prescribed) {
 		double psi, psid, psidd;
 		ramp_eval(&md->psi_ramp, t, &psi, &psid, &psidd);
@@ -265,32 +263,26 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 		double psi, psid;
 		ramp_eval(&md->psi_ramp, t, &psi, &psid, &qpdd[Q_PHI]);
 	}
-	/* reduced system Tt M T qr'' = Tt (rhs - M qp'') */
+	/* reduced system Tt M T qr'' = Tt (rhs - M qp''); T only selects
+	 * coordinates or moves two together, so sums over index lists do */
 	int n = md->nq;
-	double Mr[NQ_FULL][NQ_FULL], br[NQ_FULL], MT[NQ_FULL][NQ_FULL];
-	for (int i = 0; i < NQ_FULL; i++)
-		for (int r = 0; r < n; r++) {
-			double s = 0.0;
-			for (int j = 0; j < NQ_FULL; j++)
-				s += M[i][j] * md->T[j][r];
-			MT[i][r] = s;
-		}
+	double Mr[NQ_FULL][NQ_FULL], br[NQ_FULL];
 	double res[NQ_FULL];
 	for (int i = 0; i < NQ_FULL; i++) {
 		double s = rhs[i];
-		for (int j = 0; j < NQ_FULL; j++)
-			s -= M[i][j] * qpdd[j];
+		if (md->phi_prescribed)
+			s -= M[i][Q_PHI] * qpdd[Q_PHI];
 		res[i] = s;
 	}
 	for (int r = 0; r < n; r++) {
-		double s = 0.0;
-		for (int i = 0; i < NQ_FULL; i++)
-			s += md->T[i][r] * res[i];
-		br[r] = s;
+		const int *ir = md->col[r];
+		br[r] = md->ncol[r] == 1 ? res[ir[0]] : res[ir[0]] + res[ir[1]];
 		for (int c = 0; c <= r; c++) {
+			const int *ic = md->col[c];
 			double m = 0.0;
-			for (int i = 0; i < NQ_FULL; i++)
-				m += md->T[i][r] * MT[i][c];
+			for (int a = 0; a < md->ncol[r]; a++)
+				for (int b = 0; b < md->ncol[c]; b++)
+					m += M[ir[a]][ic[b]];
 			Mr[r][c] = m;
 		}
 	}
@@ -299,12 +291,10 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 			br[r] = NAN;
 	}
 	double qdd[NQ_FULL];
-	for (int i = 0; i < NQ_FULL; i++) {
-		double s = qpdd[i];
-		for (int r = 0; r < n; r++)
-			s += md->T[i][r] * br[r];
-		qdd[i] = s;
-	}
+	memcpy(qdd, qpdd, sizeof qdd);
+	for (int r = 0; r < n; r++)
+		for (int a = 0; a < md->ncol[r]; a++)
+			qdd[md->col[r][a]] += br[r];
 	if (md->phi_prescribed) {
 		/* the drive's torque closes the rotor's equation */
 		double s = -rhs[Q_PHI] - drag + load;

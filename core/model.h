@@ -44,7 +44,9 @@ typedef struct model {
 	unsigned reductions;
 	/* reduced machine coordinates */
 	int nq;
-	double T[NQ_FULL][NQ_FULL];  /* T[i][r]: d q_i / d q_r */
+	double T[NQ_FULL][NQ_FULL];  /* T[i][r]: d q_i / d q_r (0 or 1) */
+	int ncol[NQ_FULL];            /* full coordinates that reduced r moves */
+	int col[NQ_FULL][2];          /* ... and which (at most two) */
 	int alpha_fixed, phi_prescribed;
 	/* feed */
 	int K, L, nf;                 /* integrated columns, layers, elements */

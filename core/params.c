@@ -164,10 +164,10 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 
 	memset(m, 0, sizeof *m);
 	snprintf(m->name, sizeof m->name, "%s", "dem");
-	m->dt = 1e-4;
+	m->dt = 2e-4;
 	m->rtol = 1e-6;
 	m->atol = 1e-9;
-	m->substeps = 4;
+	m->substeps = 1;
 }
 
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)

@@ -59,6 +59,10 @@ void model_init(model *md, const sim_params *p, const sim_scene *sc)
 	if (ideal && col_alpha >= 0)
 		md->T[Q_PHI][col_alpha] = 1.0;
 	md->nq = r;
+	for (int c = 0; c < r; c++)
+		for (int i = 0; i < NQ_FULL; i++)
+			if (md->T[i][c] != 0.0)
+				md->col[c][md->ncol[c]++] = i;
 	md->alpha_fixed = sym;
 	md->phi_prescribed = ideal;
 
@@ -93,8 +97,11 @@ static void static_residual(const model *md, const double q[NQ_FULL], double res
 {
 	model tmp = *md; /* machine only, every coordinate free */
 	memset(tmp.T, 0, sizeof tmp.T);
-	for (int i = 0; i < NQ_FULL; i++)
+	for (int i = 0; i < NQ_FULL; i++) {
 		tmp.T[i][i] = 1.0;
+		tmp.ncol[i] = 1;
+		tmp.col[i][0] = i;
+	}
 	tmp.nq = NQ_FULL;
 	tmp.nf = 0;
 	tmp.npos = NQ_FULL;

@@ -22,12 +22,16 @@ static setup machine_only(const char *method, const char *dt)
 static void rest_holds_to_round_off(void **state)
 {
 	(void)state;
-	const char *cases[][2] = {{"rk4", "false"}, {"dem", "true"}, {"euler", "false"}};
-	for (int c = 0; c < 3; c++) {
+	/* method, feed, trough_rotation */
+	const char *cases[][3] = {{"rk4", "false", "true"},  {"dem", "true", "true"},
+				  {"euler", "false", "true"}, {"dem", "true", "false"},
+				  {"rk4", "false", "false"}, {"dopri5", "false", "true"}};
+	for (int c = 0; c < 6; c++) {
 		setup u = preset();
 		set(&u, "motor_on", "false");
 		set(&u, "method", cases[c][0]);
 		set(&u, "feed", cases[c][1]);
+		set(&u, "trough_rotation", cases[c][2]);
 		sim *s = make(&u);
 		sim_status a = status(s);
 		advance(s, 1.0);
@@ -37,9 +41,11 @@ static void rest_holds_to_round_off(void **state)
 		assert_close(b.rotor_speed, 0.0, 1e-11);
 		assert_close(b.feed_displacement, 0.0, 1e-14);
 		assert_close(b.e_residual, 0.0, 1e-10);
-		/* the feed weighs on the suspension: y sinks by W_feed / (2 k_y) */
+		/* the feed weighs on the suspension: y sinks by W_feed / (2 k_y);
+		 * the eliminators hang at -m g cos(beta) / k_s */
 		double sink = strcmp(cases[c][1], "true") == 0 ? 5 * 8 * 0.5 * 9.81 / 150000.0 : 0.0;
 		assert_close(a.q[1], -sink, 1e-12);
+		assert_close(a.q[4], -18 * 9.81 * cos(38 * M_PI / 180) / 444132.0, 1e-12);
 		sim_free(s);
 	}
 }
