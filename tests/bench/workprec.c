@@ -242,7 +242,8 @@ static void scene_feed(const char *scene, const char *const *sets)
 	/* rk4 ladder; its three finest runs give the Richardson check */
 	run_spec rl[] = {{"rk4", 2e-5, 1, 0, H},   {"rk4", 1e-5, 1, 0, H},
 			 {"rk4", 5e-6, 1, 0, H},   {"rk4", 2.5e-6, 1, 0, H},
-			 {"rk4", 1.25e-6, 1, 0, H}, {"rk4", 6.25e-7, 1, 0, H}};
+			 {"rk4", 1.25e-6, 1, 0, H}, {"rk4", 6.25e-7, 1, 0, H},
+			 {"rk4", 3.125e-7, 1, 0, H}};
 	int nr = (int)(sizeof rl / sizeof rl[0]);
 	if (quick)
 		nr = 4;
