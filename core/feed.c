@@ -86,17 +86,18 @@ void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
 	double fric = 0.0, contact = 0.0;
 	/* Mirrored columns k and K-1-k are summed together first, so that the
 	 * moments of a symmetric motion cancel exactly despite round-off. */
+	model_rot R = model_rotation(q);
 	for (int k = 0; k <= (md->K - 1) / 2; k++) {
 		int kk = md->K - 1 - k;
 		double Qpair[NQ_FULL] = {0}, Qm[NQ_FULL] = {0};
 		double pos[2], vel[2], F[2];
-		model_deck(md, k, q, qd, pos, vel);
+		model_deck(md, k, &R, q, qd, pos, vel);
 		column_rhs(md, y, k, pos, vel, dy, F, &fric, &contact);
-		model_deck_force(md, k, q, F, Qpair);
+		model_deck_force(md, k, &R, F, Qpair);
 		if (kk != k) {
-			model_deck(md, kk, q, qd, pos, vel);
+			model_deck(md, kk, &R, q, qd, pos, vel);
 			column_rhs(md, y, kk, pos, vel, dy, F, &fric, &contact);
-			model_deck_force(md, kk, q, F, Qm);
+			model_deck_force(md, kk, &R, F, Qm);
 			for (int i = 0; i < NQ_FULL; i++)
 				Qpair[i] += Qm[i];
 		}
@@ -124,9 +125,10 @@ double feed_contact_energy(const model *md, const double *y, const double q[NQ_F
 {
 	const double *eta = ETA(md, y), *etad = ETAD(md, y);
 	double E = 0.0;
+	model_rot R = model_rotation(q);
 	for (int k = 0; k < md->K; k++) {
 		double pos[2], vel[2];
-		model_deck(md, k, q, qd, pos, vel);
+		model_deck(md, k, &R, q, qd, pos, vel);
 		double prev = pos[1], prevd = vel[1];
 		for (int j = 0; j < md->L; j++) {
 			int e = k * md->L + j;
@@ -146,9 +148,10 @@ void feed_settle(const model *md, double *y, const double q[NQ_FULL])
 	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
 	double zero[NQ_FULL] = {0};
 	const double w = md->p.m_n * md->p.g;
+	model_rot R = model_rotation(q);
 	for (int k = 0; k < md->K; k++) {
 		double pos[2], vel[2];
-		model_deck(md, k, q, zero, pos, vel);
+		model_deck(md, k, &R, q, zero, pos, vel);
 		double level = pos[1];
 		for (int j = 0; j < md->L; j++) {
 			int e = k * md->L + j;

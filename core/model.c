@@ -76,13 +76,12 @@ static void point_mass_vibrator(const model *md, double ca, double sa, const dou
  *         + R (2 s' beta' u' + (c + s)(beta'' u' - beta'^2 u)),
  * with b_rel' = s' u + (c + s) beta' u' the guide-frame rate. */
 static void point_mass_eliminator(const model *md, int i, double ca, double sa,
-				  const double *q, const double *qd, double beta,
+				  const double *q, const double *qd, double sb, double cb,
 				  double beta_d, double beta_dd, pm *k)
 {
 	int qs = i == 0 ? Q_S1 : Q_S2;
 	double px = i == 0 ? md->p.p1_x : md->p.p2_x;
 	double py = i == 0 ? md->p.p1_y : md->p.p2_y;
-	double sb = sin(beta), cb = cos(beta);
 	double u[2] = {-sb, cb}, up[2] = {-cb, -sb};
 	double cs = md->p.c + q[qs], sd = qd[qs], ad = qd[Q_ALPHA];
 	double b[2] = {px + cs * u[0], py + cs * u[1]}, Rb[2], Ru[2];
@@ -128,24 +127,22 @@ void model_full_coords(const model *md, double t, const double *y, double q[NQ_F
 	}
 }
 
-void model_deck(const model *md, int k, const double q[NQ_FULL], const double qd[NQ_FULL],
-		double pos[2], double vel[2])
+void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FULL],
+		const double qd[NQ_FULL], double pos[2], double vel[2])
 {
-	double ca = cos(q[Q_ALPHA]), sa = sin(q[Q_ALPHA]);
 	double dv[2] = {md->d[k], md->p.h_d}, Rd[2];
-	rot(ca, sa, dv, Rd);
+	rot(R->c, R->s, dv, Rd);
 	pos[0] = q[Q_X] + Rd[0];
 	pos[1] = q[Q_Y] + Rd[1];
 	vel[0] = qd[Q_X] - qd[Q_ALPHA] * Rd[1];
 	vel[1] = qd[Q_Y] + qd[Q_ALPHA] * Rd[0];
 }
 
-void model_deck_force(const model *md, int k, const double q[NQ_FULL], const double F[2],
+void model_deck_force(const model *md, int k, const model_rot *R, const double F[2],
 		      double Q[NQ_FULL])
 {
-	double ca = cos(q[Q_ALPHA]), sa = sin(q[Q_ALPHA]);
 	double dv[2] = {md->d[k], md->p.h_d}, Rd[2];
-	rot(ca, sa, dv, Rd);
+	rot(R->c, R->s, dv, Rd);
 	Q[Q_X] += F[0];
 	Q[Q_Y] += F[1];
 	Q[Q_ALPHA] += -Rd[1] * F[0] + Rd[0] * F[1];
@@ -195,12 +192,13 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 	model_full_coords(md, t, y, q, qd);
 	double beta, beta_d, beta_dd;
 	ramp_eval(&md->beta_ramp, t, &beta, &beta_d, &beta_dd);
-	double ca = cos(q[Q_ALPHA]), sa = sin(q[Q_ALPHA]);
+	model_rot Ra = model_rotation(q);
+	double ca = Ra.c, sa = Ra.s, sbeta = sin(beta), cbeta = cos(beta);
 
 	pm pms[3];
 	point_mass_vibrator(md, ca, sa, q, qd, &pms[0]);
-	point_mass_eliminator(md, 0, ca, sa, q, qd, beta, beta_d, beta_dd, &pms[1]);
-	point_mass_eliminator(md, 1, ca, sa, q, qd, beta, beta_d, beta_dd, &pms[2]);
+	point_mass_eliminator(md, 0, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[1]);
+	point_mass_eliminator(md, 1, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[2]);
 
 	double M[NQ_FULL][NQ_FULL] = {{0}};
 	double rhs[NQ_FULL];
@@ -319,7 +317,7 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 				acc[1] += P->jc[i][1] * qdd[i];
 			}
 			double cs = p->c + q[k == 1 ? Q_S1 : Q_S2];
-			double up[2] = {-cos(beta), -sin(beta)}, Rup[2];
+			double up[2] = {-cbeta, -sbeta}, Rup[2];
 			rot(ca, sa, up, Rup);
 			guide_power += P->m * cs * beta_d * (acc[0] * Rup[0] + acc[1] * Rup[1]);
 		}
@@ -381,15 +379,16 @@ double model_energy_stored(model *md, double t, const double *y, double *kinetic
 	model_full_coords(md, t, y, q, qd);
 	double beta, beta_d, beta_dd;
 	ramp_eval(&md->beta_ramp, t, &beta, &beta_d, &beta_dd);
-	double ca = cos(q[Q_ALPHA]), sa = sin(q[Q_ALPHA]);
+	model_rot Ra = model_rotation(q);
+	double ca = Ra.c, sa = Ra.s;
+	double sbeta = sin(beta), cbeta = cos(beta);
 	pm pms[3];
 	point_mass_vibrator(md, ca, sa, q, qd, &pms[0]);
-	point_mass_eliminator(md, 0, ca, sa, q, qd, beta, beta_d, beta_dd, &pms[1]);
-	point_mass_eliminator(md, 1, ca, sa, q, qd, beta, beta_d, beta_dd, &pms[2]);
+	point_mass_eliminator(md, 0, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[1]);
+	point_mass_eliminator(md, 1, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[2]);
 	double T = 0.5 * (p->M_r * (qd[Q_X] * qd[Q_X] + qd[Q_Y] * qd[Q_Y]) +
 			  p->J_r * qd[Q_ALPHA] * qd[Q_ALPHA] + p->J_w * qd[Q_PHI] * qd[Q_PHI]);
 	double V = p->M_r * p->g * q[Q_Y];
-	double sbeta = sin(beta), cbeta = cos(beta);
 	for (int k = 0; k < 3; k++) {
 		const pm *P = &pms[k];
 		double v[2] = {0.0, 0.0};

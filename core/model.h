@@ -16,6 +16,8 @@
 #ifndef CONVSIM_MODEL_H
 #define CONVSIM_MODEL_H
 
+#include <math.h>
+
 #include "sim.h"
 
 enum { Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2, NQ_FULL };
@@ -87,11 +89,25 @@ void model_rhs(model *md, double t, const double *y, double *dy, model_eval *ev)
  * ACC_IN/ACC_DAMP), with the feed replaced by the generalized force Qfeed. */
 void model_machine_rhs(model *md, double t, const double *y, const double Qfeed[NQ_FULL],
 		       double *dy, model_eval *ev);
+/* The trough's rotation R(alpha) of a machine state, computed once and
+ * passed to the deck-point functions. */
+typedef struct model_rot {
+	double c, s;
+} model_rot;
+static inline model_rot model_rotation(const double q[NQ_FULL])
+{
+	model_rot r = {1.0, 0.0};
+	if (q[2] != 0.0) {
+		r.c = cos(q[2]);
+		r.s = sin(q[2]);
+	}
+	return r;
+}
 /* Deck point kinematics of integrated column k for a machine state. */
-void model_deck(const model *md, int k, const double q[NQ_FULL], const double qd[NQ_FULL],
-		double pos[2], double vel[2]);
+void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FULL],
+		const double qd[NQ_FULL], double pos[2], double vel[2]);
 /* Generalized force of a force F applied at column k's deck point. */
-void model_deck_force(const model *md, int k, const double q[NQ_FULL], const double F[2],
+void model_deck_force(const model *md, int k, const model_rot *R, const double F[2],
 		      double Q[NQ_FULL]);
 /* Full coordinates from y at time t. */
 void model_full_coords(const model *md, double t, const double *y, double q[NQ_FULL],

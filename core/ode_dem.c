@@ -77,9 +77,10 @@ static void machine_axpy(const model *md, double *out, const double *y, double h
 		out[2 * md->npos + a] = y[2 * md->npos + a] + h * k[2 * md->npos + a];
 }
 
-static void deck_accel(const model *md, int k, const model_eval *ev, double acc[2])
+static void deck_accel(const model *md, int k, const model_rot *R, const model_eval *ev,
+		       double acc[2])
 {
-	double ca = cos(ev->q[Q_ALPHA]), sa = sin(ev->q[Q_ALPHA]);
+	double ca = R->c, sa = R->s;
 	double dx = md->d[k], dy = md->p.h_d;
 	double Rd[2] = {ca * dx - sa * dy, sa * dx + ca * dy};
 	double ad = ev->qd[Q_ALPHA], add = ev->qdd[Q_ALPHA];
@@ -140,12 +141,13 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 	const double h = H / ns;
 	double Qnew[NQ_FULL] = {0};
 	double fric = 0.0, contact = 0.0;
+	model_rot R0 = model_rotation(ev0.q), R1 = model_rotation(ev1.q);
 	for (int k = 0; k < md->K; k++) {
 		double p0[2], v0[2], p1[2], v1[2], a0[2], a1[2];
-		model_deck(md, k, ev0.q, ev0.qd, p0, v0);
-		model_deck(md, k, ev1.q, ev1.qd, p1, v1);
-		deck_accel(md, k, &ev0, a0);
-		deck_accel(md, k, &ev1, a1);
+		model_deck(md, k, &R0, ev0.q, ev0.qd, p0, v0);
+		model_deck(md, k, &R1, ev1.q, ev1.qd, p1, v1);
+		deck_accel(md, k, &R0, &ev0, a0);
+		deck_accel(md, k, &R1, &ev1, a1);
 		double impulse[2] = {0.0, 0.0};
 		for (int i = 0; i < ns; i++) {
 			double s0 = (double)i / ns, s1 = (double)(i + 1) / ns;
@@ -159,7 +161,7 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 					 &contact);
 		}
 		double F[2] = {impulse[0] / H, impulse[1] / H};
-		model_deck_force(md, k, ev1.q, F, Qnew);
+		model_deck_force(md, k, &R1, F, Qnew);
 	}
 	y[2 * md->npos + ACC_FRIC] += md->col_weight * fric;
 	y[2 * md->npos + ACC_CONTACT] += md->col_weight * contact;

@@ -111,9 +111,10 @@ static void static_residual(const model *md, const double q[NQ_FULL], double res
 	double y[2 * NQ_FULL + ACC_N] = {0}, dy[2 * NQ_FULL + ACC_N];
 	memcpy(y, q, sizeof(double) * NQ_FULL);
 	double Qfeed[NQ_FULL] = {0};
+	model_rot R = model_rotation(q);
 	for (int k = 0; k < md->K && md->nf > 0; k++) {
 		double F[2] = {0.0, -md->col_weight * md->L * md->p.m_n * md->p.g};
-		model_deck_force(md, k, q, F, Qfeed);
+		model_deck_force(md, k, &R, F, Qfeed);
 	}
 	model_eval ev;
 	model_machine_rhs(&tmp, 0.0, y, Qfeed, dy, &ev);

@@ -142,9 +142,10 @@ static int check_state(sim *s)
 		cause = "rotor speed beyond 100 omega_ss";
 	if (!cause && md->nf > 0) {
 		const double *eta = s->y + md->nq + md->nf;
+		model_rot R = model_rotation(q);
 		for (int k = 0; k < md->K && !cause; k++) {
 			double pos[2], vel[2];
-			model_deck(md, k, q, qd, pos, vel);
+			model_deck(md, k, &R, q, qd, pos, vel);
 			for (int j = 0; j < md->L; j++) {
 				double rel = eta[k * md->L + j] - pos[1];
 				if (rel < -0.05) {
@@ -465,11 +466,12 @@ void sim_deck_points(const sim *s, double *out)
 	double q[NQ_FULL], qd[NQ_FULL];
 	model_full_coords(&s->md, s->t_obs, s->y_obs, q, qd);
 	double zero[NQ_FULL] = {0};
+	model_rot R = model_rotation(q), R0 = model_rotation(zero);
 	for (int c = 0; c < K; c++) {
 		int k = integrated_column(s, c);
 		double pos[2], vel[2], rest[2];
-		model_deck(&s->md, k, q, qd, pos, vel);
-		model_deck(&s->md, k, zero, zero, rest, vel);
+		model_deck(&s->md, k, &R, q, qd, pos, vel);
+		model_deck(&s->md, k, &R0, zero, zero, rest, vel);
 		out[2 * c] = pos[0] - rest[0];
 		out[2 * c + 1] = pos[1] - rest[1];
 	}
