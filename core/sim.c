@@ -395,7 +395,7 @@ static void update_status(sim *s)
 	memcpy(st->qd, ev.qd, sizeof st->qd);
 	st->rotor_speed = ev.rotor_speed;
 	st->motor_torque = ev.torque;
-	st->power = ev.torque * ev.rotor_speed;
+	st->power = ev.torque * ev.rotor_speed + 0.0; /* no negative zero */
 	memcpy(st->deck, ev.deck, sizeof st->deck);
 	memcpy(st->deck_vel, ev.deck_vel, sizeof st->deck_vel);
 	st->feed_displacement = md->nf > 0 ? feed_mean_xi(md, s->y_obs, -1) - s->X0 : 0.0;

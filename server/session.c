@@ -157,6 +157,9 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 			 msg[0] ? msg : sim_strerror(err));
 		goto fail;
 	}
+	/* the worker has not run yet: publish the initial state ourselves so
+	 * that the 201 answer shows beta, rotation and the equilibrium */
+	sim_get_status(s->sim, &s->st);
 	if (spec->scene.feed) {
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
