@@ -303,6 +303,7 @@ static void scene_reductions(void)
 	static const char *const v_sym[] = {"trough_rotation", "false", NULL};
 	static const char *const v_ideal[] = {"drive", "ideal", NULL};
 	static const char *const v_l4[] = {"layers", "4", NULL};
+	static const char *const v_l4m[] = {"layers", "4", "m_n", "1", NULL};
 	static const char *const v_oneway[] = {"feed_coupling", "false", NULL};
 	static const char *const v_sym_ideal[] = {"trough_rotation", "false", "drive", "ideal",
 						  NULL};
@@ -318,6 +319,7 @@ static void scene_reductions(void)
 		{"symmetric", v_sym, 1},
 		{"ideal_drive", v_ideal, 0},
 		{"layers_4", v_l4, 1},
+		{"layers_4_same_mass", v_l4m, 1},
 		{"one_way", v_oneway, 1},
 		{"symmetric+ideal", v_sym_ideal, 0},
 		{"symmetric+layers_4", v_sym_l4, 1},
