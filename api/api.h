@@ -112,6 +112,7 @@ enum {
 	API_C_RUNNING = 1 << 4,
 	API_C_PACE = 1 << 5,
 	API_C_UNTIL = 1 << 6,
+	API_C_MOTOR = 1 << 7,
 };
 typedef struct api_control {
 	unsigned set;
@@ -120,6 +121,7 @@ typedef struct api_control {
 	int rotation;     /* SIM_CW / SIM_CCW */
 	double omega_ss;  /* rad/s */
 	int running;
+	int motor_on;     /* drive switched on (motor or ideal drive) */
 	double pace;      /* API_PACE_MAX for "max" */
 	double until;     /* s, 0 = none */
 } api_control;

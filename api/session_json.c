@@ -33,12 +33,27 @@ static api_err check_setting(const api_spec *spec, const char *name,
 	return API_OK;
 }
 
+/* A boolean member: sets *out and the bit, or fails with a type error. */
+static api_err parse_bool(const cJSON *root, const char *name, unsigned bit,
+			  int *out, api_control *c, api_problem *pb)
+{
+	const cJSON *it = cJSON_GetObjectItemCaseSensitive(root, name);
+	if (!it)
+		return API_OK;
+	if (!cJSON_IsBool(it))
+		return api_fail(pb, API_TYPE, name, "%s must be true or false",
+				name);
+	*out = cJSON_IsTrue(it);
+	c->set |= bit;
+	return API_OK;
+}
+
 api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			  api_control *c, api_problem *pb)
 {
-	static const char *const members[] = {"beta", "beta_rate", "rotation",
-					      "omega_ss", "running", "pace",
-					      "until", NULL};
+	static const char *const members[] = {"beta",     "beta_rate", "rotation",
+					      "omega_ss", "running",   "motor_on",
+					      "pace",     "until",     NULL};
 	memset(c, 0, sizeof *c);
 	cJSON *root = api_parse_object(body, len, 0, pb);
 	if (!root)
@@ -48,8 +63,8 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 	if (e == API_OK && !root->child)
 		e = api_fail(pb, API_INVALID, NULL,
 			     "no change given; expected any of beta, "
-			     "beta_rate, rotation, omega_ss, running, pace, "
-			     "until");
+			     "beta_rate, rotation, omega_ss, running, "
+			     "motor_on, pace, until");
 	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "beta")) &&
 	    (e = check_setting(spec, "beta", it, &c->beta, pb)) == API_OK)
 		c->set |= API_C_BETA;
@@ -80,16 +95,10 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			snprintf(pb->choices, sizeof pb->choices, "cw|ccw");
 		}
 	}
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "running"))) {
-		if (!cJSON_IsBool(it)) {
-			e = api_fail(pb, API_TYPE, "running",
-				     "running must be true or false");
-		} else {
-			c->running = cJSON_IsTrue(it);
-			c->set |= API_C_RUNNING;
-		}
-	}
+	if (e == API_OK)
+		e = parse_bool(root, "running", API_C_RUNNING, &c->running, c, pb);
+	if (e == API_OK)
+		e = parse_bool(root, "motor_on", API_C_MOTOR, &c->motor_on, c, pb);
 	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "pace")) &&
 	    (e = api_parse_pace(it, "pace", &c->pace, pb)) == API_OK)
 		c->set |= API_C_PACE;
@@ -124,6 +133,8 @@ static cJSON *control_object(const api_control *c)
 		api_add_number(o, "omega_ss", c->omega_ss);
 	if (c->set & API_C_RUNNING)
 		cJSON_AddBoolToObject(o, "running", c->running);
+	if (c->set & API_C_MOTOR)
+		cJSON_AddBoolToObject(o, "motor_on", c->motor_on);
 	if (c->set & API_C_PACE)
 		put_pace(o, "pace", c->pace);
 	if (c->set & API_C_UNTIL) {

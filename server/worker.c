@@ -112,6 +112,8 @@ static int apply_commands(srv_session *s)
 			rc = sim_set_rotation(s->sim, c->rotation);
 		if (rc == SIM_OK && (c->set & API_C_OMEGA_SS))
 			rc = sim_set_omega_ss(s->sim, c->omega_ss);
+		if (rc == SIM_OK && (c->set & API_C_MOTOR))
+			rc = sim_set_drive_on(s->sim, c->motor_on);
 		if (rc == SIM_OK && (c->set & API_C_PACE)) {
 			s->pace = c->pace;
 			reanchor = 1;

@@ -24,6 +24,10 @@ test('create answers 201 with Location and the full spec', { timeout: 20000 * SL
   assert.equal(r.body.spec.scene.feed, false);
   assert.equal(r.body.spec.scene.drive, 'ideal');
   assert.equal(r.body.pace, 'max');
+  // the answer shows the initial state, not an empty snapshot
+  assert.equal(r.body.status.beta, 38);
+  assert.equal(r.body.status.rotation, 'cw');
+  assert.equal(r.body.status.t, 0);
   const g = await until(async () => {
     const s = await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`);
     return s.body.state === 'finished' && s;
@@ -191,4 +195,29 @@ test('trajectory as JSON and CSV, doubles round-trip', { timeout: 30000 * SLOW }
   assert.equal(p.status, 200);
   assert.equal(p.body.applied.omega_ss, omega / 3);
   await req(d.base, 'DELETE', `/api/v1/sessions/${id}`);
+});
+
+test('PATCH motor_on switches the drive off and on; a wrong type changes nothing', { timeout: 30000 * SLOW }, async () => {
+  const c = await req(d.base, 'POST', '/api/v1/sessions',
+    { ...NO_FEED, pace: 'max', until: 0.5 });
+  assert.equal(c.status, 201);
+  const id = c.body.id;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished',
+    10000 * SLOW, 'the first half second');
+  const bad = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { motor_on: 'off' });
+  assert.equal(bad.status, 400);
+  assert.equal(bad.body.field, 'motor_on');
+  assert.equal(bad.body.detail, 'motor_on must be true or false');
+  const off = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { motor_on: false, until: 1 });
+  assert.equal(off.status, 200);
+  assert.equal(off.body.t_effective, 0.5);
+  assert.equal(off.body.applied.motor_on, false);
+  const g = await until(async () => {
+    const s = await req(d.base, 'GET', `/api/v1/sessions/${id}`);
+    return s.body.state === 'finished' && s;
+  }, 10000 * SLOW, 'the drive to stop');
+  assert.equal(g.body.status.drive_on, false);
+  // the ideal drive ramps 157 rad/s down at 2000 rad/s^2: at rest by 0.58 s
+  assert.ok(Math.abs(g.body.status.rotor_speed) < 1e-6, `rotor ${g.body.status.rotor_speed}`);
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
