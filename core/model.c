@@ -182,23 +182,41 @@ static int cholesky_solve(int n, double A[NQ_FULL][NQ_FULL], double *b)
 	return 0;
 }
 
+/* The machine's configuration at time t: full coordinates, beta and its
+ * rates, and the three point masses. */
+typedef struct config {
+	double q[NQ_FULL], qd[NQ_FULL];
+	double beta, beta_d, beta_dd, sbeta, cbeta;
+	double ca, sa;
+	pm pms[3];
+} config;
+
+static void configure(const model *md, double t, const double *y, config *c)
+{
+	model_full_coords(md, t, y, c->q, c->qd);
+	ramp_eval(&md->beta_ramp, t, &c->beta, &c->beta_d, &c->beta_dd);
+	model_rot Ra = model_rotation(c->q);
+	c->ca = Ra.c;
+	c->sa = Ra.s;
+	c->sbeta = sin(c->beta);
+	c->cbeta = cos(c->beta);
+	point_mass_vibrator(md, c->ca, c->sa, c->q, c->qd, &c->pms[0]);
+	for (int i = 0; i < 2; i++)
+		point_mass_eliminator(md, i, c->ca, c->sa, c->q, c->qd, c->sbeta, c->cbeta,
+				      c->beta_d, c->beta_dd, &c->pms[1 + i]);
+}
+
 /* Machine: mass matrix, forces without the feed (plus Qextra), reduced
  * solve. Writes machine accelerations into dy and the machine powers. */
 static void machine(model *md, double t, const double *y, const double Qextra[NQ_FULL],
 		    double *dy, model_eval *ev)
 {
 	const sim_params *p = &md->p;
-	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(md, t, y, q, qd);
-	double beta, beta_d, beta_dd;
-	ramp_eval(&md->beta_ramp, t, &beta, &beta_d, &beta_dd);
-	model_rot Ra = model_rotation(q);
-	double ca = Ra.c, sa = Ra.s, sbeta = sin(beta), cbeta = cos(beta);
-
-	pm pms[3];
-	point_mass_vibrator(md, ca, sa, q, qd, &pms[0]);
-	point_mass_eliminator(md, 0, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[1]);
-	point_mass_eliminator(md, 1, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[2]);
+	config cf;
+	configure(md, t, y, &cf);
+	const double *q = cf.q, *qd = cf.qd, ca = cf.ca, sa = cf.sa;
+	const double beta = cf.beta, beta_d = cf.beta_d, sbeta = cf.sbeta, cbeta = cf.cbeta;
+	const pm *pms = cf.pms;
 
 	double M[NQ_FULL][NQ_FULL] = {{0}};
 	double rhs[NQ_FULL];
@@ -325,8 +343,8 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 	dy[2 * md->npos + ACC_IN] = torque * omega + guide_power;
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev) {
-		memcpy(ev->q, q, sizeof q);
-		memcpy(ev->qd, qd, sizeof qd);
+		memcpy(ev->q, q, sizeof ev->q);
+		memcpy(ev->qd, qd, sizeof ev->qd);
 		memcpy(ev->qdd, qdd, sizeof qdd);
 		ev->beta = beta;
 		ev->beta_dot = beta_d;
@@ -375,17 +393,11 @@ double model_energy_stored(model *md, double t, const double *y, double *kinetic
 			   double *potential)
 {
 	const sim_params *p = &md->p;
-	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(md, t, y, q, qd);
-	double beta, beta_d, beta_dd;
-	ramp_eval(&md->beta_ramp, t, &beta, &beta_d, &beta_dd);
-	model_rot Ra = model_rotation(q);
-	double ca = Ra.c, sa = Ra.s;
-	double sbeta = sin(beta), cbeta = cos(beta);
-	pm pms[3];
-	point_mass_vibrator(md, ca, sa, q, qd, &pms[0]);
-	point_mass_eliminator(md, 0, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[1]);
-	point_mass_eliminator(md, 1, ca, sa, q, qd, sbeta, cbeta, beta_d, beta_dd, &pms[2]);
+	config cf;
+	configure(md, t, y, &cf);
+	const double *q = cf.q, *qd = cf.qd, ca = cf.ca, sa = cf.sa;
+	const double beta_d = cf.beta_d, sbeta = cf.sbeta, cbeta = cf.cbeta;
+	const pm *pms = cf.pms;
 	double T = 0.5 * (p->M_r * (qd[Q_X] * qd[Q_X] + qd[Q_Y] * qd[Q_Y]) +
 			  p->J_r * qd[Q_ALPHA] * qd[Q_ALPHA] + p->J_w * qd[Q_PHI] * qd[Q_PHI]);
 	double V = p->M_r * p->g * q[Q_Y];
