@@ -112,7 +112,8 @@ static void static_residual(const model *md, const double q[NQ_FULL], double res
 	memcpy(y, q, sizeof(double) * NQ_FULL);
 	double Qfeed[NQ_FULL] = {0};
 	model_rot R = model_rotation(q);
-	for (int k = 0; k < md->K && md->nf > 0; k++) {
+	/* one-way coupling: the feed's weight never reaches the trough */
+	for (int k = 0; k < md->K && md->nf > 0 && md->sc.feed_coupling; k++) {
 		double F[2] = {0.0, -md->col_weight * md->L * md->p.m_n * md->p.g};
 		model_deck_force(md, k, &R, F, Qfeed);
 	}

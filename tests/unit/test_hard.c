@@ -535,12 +535,8 @@ static void divergence_is_reported(void **state)
 	sim_free(s);
 }
 
-/* Motor off and one-way coupling: the feed does not act on the trough, so
- * the machine must stay exactly at rest. CORE BUG (reported, issue 2):
- * model_equilibrium() balances the suspension against the feed's weight at
- * the deck points even when the feed is not coupled, so the trough starts
- * 33 um below its one-way equilibrium and swings (preset machine, one
- * element). Skipped until the core is fixed; remove the skip then. */
+/* One-way coupling: the feed's weight never reaches the trough, so the
+ * machine rests at the empty machine's equilibrium and nothing moves. */
 static void one_way_machine_stays_still(void **state)
 {
 	(void)state;
@@ -554,12 +550,6 @@ static void one_way_machine_stays_still(void **state)
 	sim_status a = status(s);
 	advance(s, 0.1);
 	sim_status b = status(s);
-	if (fabs(b.q[1] - a.q[1]) > 1e-12) {
-		print_message("one-way coupling: trough y moved %.3g m in 0.1 s (core bug, skipped)\n",
-			      b.q[1] - a.q[1]);
-		sim_free(s);
-		skip();
-	}
 	for (int i = 0; i < 6; i++)
 		assert_close(b.q[i], a.q[i], 1e-12);
 	sim_free(s);
