@@ -225,7 +225,7 @@ static void layer_counts(void **state)
 	sim_free(s);
 	for (int L = 1; L <= 32; L += 31) {
 		setup w = u;
-		char buf[8];
+		char buf[16];
 		snprintf(buf, sizeof buf, "%d", L);
 		set(&w, "layers", buf);
 		double v;
