@@ -359,7 +359,9 @@ typedef struct rec {
 
 static int nrec;
 static rec recs[512];
-static char rich[4][8][64]; /* richardson rows: scene v3 order vrich vdiff trajdiff torder */
+/* richardson rows: [0] scene, [1] method, [2] v finest, [3] order, [4] v limit,
+ * [5] v difference, [6] trajectory difference, [7] trajectory order */
+static char rich[4][8][64];
 static int nrich;
 
 static void read_tsv(const char *path)
@@ -506,9 +508,9 @@ static void write_md(const char *dir, const char *cmd)
 					"extrapolation (observed order %s) lies %.2e (relative RMS) "
 					"from the reference. Errors below these are not resolved "
 					"(shaded in the plot).\n\n",
-					ref->method, ref->setting, ref->v, rich[k][1], rich[k][2],
-					rich[k][3], strtod(rich[k][4], NULL), rich[k][6],
-					strtod(rich[k][5], NULL));
+					ref->method, ref->setting, ref->v, rich[k][2], rich[k][3],
+					rich[k][4], strtod(rich[k][5], NULL), rich[k][7],
+					strtod(rich[k][6], NULL));
 			}
 		}
 		fprintf(f,
@@ -731,8 +733,8 @@ static void write_svg(const char *dir)
 		tfloor[0] = chk->trel;
 	for (int k = 0; k < nrich; k++) {
 		int s = strcmp(rich[k][0], "full") == 0 ? 1 : 2;
-		vfloor[s - 1] = strtod(rich[k][4], NULL);
-		tfloor[s] = strtod(rich[k][5], NULL);
+		vfloor[s - 1] = strtod(rich[k][5], NULL);
+		tfloor[s] = strtod(rich[k][6], NULL);
 	}
 	panel(f, 0, 0, W, H, sc[0], E_TRAJ, "(1) machine, no feed: trajectory", tfloor[0], 0);
 	panel(f, W, 0, W, H, sc[1], E_TRAJ, "(2) full scene: trajectory", tfloor[1], 0);

@@ -44,13 +44,15 @@ static setup one_element(void)
 	return u;
 }
 
+/* Column 0's deck point (sim_deck_points fills every physical column). */
 static double deck_top(const sim *s)
 {
-	double d[2];
+	double d[2 * 64];
 	sim_deck_points(s, d);
 	return d[1];
 }
 
+/* The single element of a one-column, one-layer scene. */
 static double element_eta(const sim *s)
 {
 	double xi, eta;
@@ -61,7 +63,7 @@ static double element_eta(const sim *s)
 /* Horizontal position of the element relative to the deck point. */
 static double element_xi(const sim *s)
 {
-	double xi, eta, d[2];
+	double xi, eta, d[2 * 64];
 	sim_feed_state(s, &xi, &eta);
 	sim_deck_points(s, d);
 	return xi - d[0];
