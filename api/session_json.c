@@ -184,10 +184,19 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(o, "rtf", v->rtf);
 	cJSON_AddNumberToObject(o, "n_dof", st->n_dof);
 	cJSON *red = cJSON_AddArrayToObject(o, "reductions");
-	for (int b = 0; sim_reduction_name(b); b++)
-		if (st->reductions & (1u << b))
-			cJSON_AddItemToArray(
-				red, cJSON_CreateString(sim_reduction_name(b)));
+	cJSON *fig = cJSON_AddArrayToObject(o, "reduction_figures");
+	for (int b = 0; sim_reduction(b); b++) {
+		if (!(st->reductions & (1u << b)))
+			continue;
+		const sim_reduction_info *r = sim_reduction(b);
+		cJSON_AddItemToArray(red, cJSON_CreateString(r->name));
+		cJSON *f = cJSON_CreateObject();
+		cJSON_AddStringToObject(f, "name", r->name);
+		cJSON_AddStringToObject(f, "drops", r->drops);
+		api_add_number(f, "speedup", r->speedup);
+		api_add_number(f, "error", r->v_error);
+		cJSON_AddItemToArray(fig, f);
+	}
 	cJSON *en = cJSON_AddObjectToObject(o, "energy");
 	api_add_number(en, "input", st->e_input);
 	api_add_number(en, "kinetic", st->e_kinetic);

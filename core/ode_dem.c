@@ -135,9 +135,15 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 		*t = t1;
 		return SIM_OK;
 	}
-	/* 2. the feed along the interpolated deck motion */
-	model_machine_rhs(md, t1, y, w->Qfeed, w->k4, &ev1);
+	/* 2. the feed along the interpolated deck motion; the machine's end
+	 * acceleration is needed only to interpolate between sub-steps */
 	const int ns = w->substeps;
+	if (ns > 1) {
+		model_machine_rhs(md, t1, y, w->Qfeed, w->k4, &ev1);
+	} else {
+		model_full_coords(md, t1, y, ev1.q, ev1.qd);
+		memset(ev1.qdd, 0, sizeof ev1.qdd);
+	}
 	const double h = H / ns;
 	double Qnew[NQ_FULL] = {0};
 	double fric = 0.0, contact = 0.0;

@@ -19,6 +19,12 @@
 #include "feed.h"
 #include "ode.h"
 
+/* speed-up, relative transport-velocity change: czubak2016, dem dt = 1e-4 */
+#define REDUCTION_NO_FEED 2.23, NAN
+#define REDUCTION_SYMMETRIC 1.69, 3.2e-5
+#define REDUCTION_IDEAL 1.03, 2.9e-2
+#define REDUCTION_ONE_WAY 1.00, 3.0e-2
+
 struct sim {
 	model md;
 	sim_method cfg;
@@ -492,11 +498,26 @@ void sim_feed_state(const sim *s, double *xi, double *eta)
 	}
 }
 
+/* Figures from `make bench` (tests/bench/results/reductions.tsv). */
+static const sim_reduction_info reductions[] = {
+	{"no_feed", "every feed coordinate (there is no transport velocity)", REDUCTION_NO_FEED},
+	{"symmetric_alpha", "alpha and all but one column, which counts K times",
+	 REDUCTION_SYMMETRIC},
+	{"ideal_drive", "the rotor's equation: phi - alpha turns at omega_ss, without slip",
+	 REDUCTION_IDEAL},
+	{"one_way_coupling", "the feed's reaction on the trough", REDUCTION_ONE_WAY},
+};
+
+const sim_reduction_info *sim_reduction(int bit)
+{
+	return bit >= 0 && bit < (int)(sizeof reductions / sizeof reductions[0]) ? &reductions[bit]
+										 : NULL;
+}
+
 const char *sim_reduction_name(int bit)
 {
-	static const char *const names[] = {"no_feed", "symmetric_alpha", "ideal_drive",
-					    "one_way_coupling"};
-	return bit >= 0 && bit < 4 ? names[bit] : NULL;
+	const sim_reduction_info *r = sim_reduction(bit);
+	return r ? r->name : NULL;
 }
 
 int sim_measure_velocity(const sim_params *p, const sim_scene *sc, const sim_method *m,

@@ -213,6 +213,19 @@ enum {
 /* Name of reduction bit i (0..3), NULL past the end. */
 const char *sim_reduction_name(int bit);
 
+/* What reduction bit i leaves out, with its speed-up and the relative
+ * change of the transport velocity against the full model, as measured by
+ * `make bench` on the czubak2016 start with the default method
+ * (tests/bench/results/reductions.tsv; NaN where it does not apply).
+ * NULL past the end. Static. */
+typedef struct sim_reduction_info {
+	const char *name;
+	const char *drops;
+	double speedup;
+	double v_error;
+} sim_reduction_info;
+const sim_reduction_info *sim_reduction(int bit);
+
 typedef struct sim_status {
 	double t;                 /* s observed time */
 	double t_int;             /* s integrator time */

@@ -37,7 +37,7 @@ export const FIELDS = {
 		realTimeFactor: ['status.real_time_factor', 'real_time_factor', 'status.rtf', 'rtf'],
 		stepsPerSecond: ['status.steps_per_s', 'steps_per_s', 'status.steps_per_second', 'steps_per_second'],
 		steps: ['status.steps', 'steps'],
-		reductions: ['status.reductions', 'reductions', 'model.reductions'],
+		reductions: ['status.reduction_figures', 'status.reductions', 'reductions', 'model.reductions'],
 		columns: ['columns', 'spec.scene.columns', 'scene.columns', 'status.columns'],
 		layers: ['layers', 'spec.scene.layers', 'scene.layers', 'status.layers'],
 		feed: ['spec.scene.feed', 'scene.feed'],
