@@ -188,6 +188,8 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 		goto fail;
 	model_init(&s->md, p, sc);
 	s->cfg = *m;
+	if (s->cfg.dt == 0.0)
+		s->cfg.dt = sim_default_dt(m, sc);
 	s->ode = ode_find(m->name);
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(3 * n, sizeof(double));
@@ -196,7 +198,7 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 		goto fail;
 	s->y_obs = s->y + n;
 	s->dy = s->y_obs + n;
-	s->ws = s->ode->alloc(&s->md, m);
+	s->ws = s->ode->alloc(&s->md, &s->cfg);
 	if (!s->ws)
 		goto fail;
 	model_equilibrium(&s->md, s->y);
@@ -432,6 +434,7 @@ static void update_status(sim *s)
 			 acc[ACC_IN];
 	st->steps = s->steps;
 	st->rhs_evals = md->rhs_evals;
+	st->dt = s->cfg.dt;
 	st->reductions = md->reductions;
 	st->n_dof = md->nq + 2 * md->nf;
 }

@@ -101,8 +101,9 @@ typedef struct sim_scene {
 	double transient;     /* s: transport velocity ignores t < transient */
 } sim_scene;
 
-/* Integrator choice. dt: fixed step (or macro step) in s; rtol/atol for
- * adaptive methods; substeps: feed sub-steps per macro step (method "dem"). */
+/* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
+ * default of the scene kind (sim_default_dt); rtol/atol for adaptive
+ * methods; substeps: feed sub-steps per macro step (method "dem"). */
 typedef struct sim_method {
 	char name[24];
 	double dt;
@@ -145,6 +146,10 @@ int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 /* Read one named setting in user units; SIM_EUNKNOWN if no such name. */
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
+
+/* The integrator step that dt = 0 stands for: the default of method m
+ * on the kind of scene s (with or without feed), s. */
+double sim_default_dt(const sim_method *m, const sim_scene *s);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
  * method). Same error convention as sim_set. */
@@ -252,6 +257,7 @@ typedef struct sim_status {
 	double e_input, e_kinetic, e_potential, e_dissipated; /* J */
 	double e_residual;        /* J: stored change + dissipated - input */
 	uint64_t steps, rhs_evals;
+	double dt;                /* s: the integrator's (first) step in use */
 	unsigned reductions;      /* SIM_RED_* bits */
 	int n_dof;                /* integrated machine + feed coordinates */
 } sim_status;
