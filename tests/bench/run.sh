@@ -34,4 +34,6 @@ rest_pid=$!
 wait "$full_pid"
 wait "$rest_pid"
 "$bin" report "$out" "$cmd"
+echo "bench: the default step over the beta range (both cores)"
+bash tests/bench/beta_range.sh "$out"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"
