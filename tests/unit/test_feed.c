@@ -19,12 +19,8 @@ static void rebound_speed_is_R_times_impact(void **state)
 	const char *Rs[] = {"0.05", "0.5", "0.9"};
 	for (int mi = 0; mi < 3; mi++)
 		for (int ri = 0; ri < 3; ri++) {
-			setup u = preset();
-			set(&u, "columns", "1");
-			set(&u, "layers", "1");
+			setup u = one_element();
 			set(&u, "g", "0");
-			set(&u, "motor_on", "false");
-			set(&u, "feed_coupling", "false");
 			set(&u, "R", Rs[ri]);
 			set(&u, "method", methods[mi][0]);
 			set(&u, "dt", methods[mi][1]);

@@ -21,17 +21,11 @@ static setup reduced_ideal(void)
 	return u;
 }
 
-/* One element (one column, one layer) on a deck held still: motor off and
- * one-way coupling, so the machine stays at rest whatever the feed does
- * (one_way_machine_stays_still checks that). */
-static setup one_element(void)
+/* One element on a still deck (testutil.h), stepped by dem with fine
+ * feed sub-steps. */
+static setup one_element_dem(void)
 {
-	setup u = preset();
-	set(&u, "trough_rotation", "false");
-	set(&u, "columns", "1");
-	set(&u, "layers", "1");
-	set(&u, "motor_on", "false");
-	set(&u, "feed_coupling", "false");
+	setup u = one_element();
 	set(&u, "method", "dem");
 	set(&u, "dt", "1e-4");
 	set(&u, "substeps", "10");
@@ -117,7 +111,7 @@ static double impact_compression(const setup *u, double h0)
 static void restitution_extremes(void **state)
 {
 	(void)state;
-	setup u = one_element();
+	setup u = one_element_dem();
 	const double h0 = 0.02;
 	set(&u, "R", "0.99");
 	double d = impact_compression(&u, h0), h1 = 0.9801 * (h0 + d) - d;
@@ -240,7 +234,7 @@ static void layer_counts(void **state)
 static void bouncing_element(void **state)
 {
 	(void)state;
-	setup u = one_element();
+	setup u = one_element_dem();
 	set(&u, "R", "0.5");
 	const double h0 = 0.01, T = 0.25;
 	sim *s;
@@ -284,7 +278,7 @@ static void bouncing_element(void **state)
 static void sliding_block_stops(void **state)
 {
 	(void)state;
-	setup u = one_element();
+	setup u = one_element_dem();
 	const double v0 = 0.5, mu = u.p.mu, g = u.p.g;
 	const double t_stop = v0 / (mu * g), dist = v0 * v0 / (2 * mu * g);
 	sim *s = make(&u);
@@ -536,12 +530,7 @@ static void divergence_is_reported(void **state)
 static void one_way_machine_stays_still(void **state)
 {
 	(void)state;
-	setup u = preset();
-	set(&u, "trough_rotation", "false");
-	set(&u, "columns", "1");
-	set(&u, "layers", "1");
-	set(&u, "motor_on", "false");
-	set(&u, "feed_coupling", "false");
+	setup u = one_element();
 	sim *s = make(&u);
 	sim_status a = status(s);
 	advance(s, 0.1);

@@ -41,6 +41,19 @@ static inline void set(setup *u, const char *name, const char *value)
 		fail_msg("set %s=%s: %s", name, value, msg);
 }
 
+/* One element (one column, one layer) on a deck held still: motor off and
+ * one-way coupling, so the machine stays at rest whatever the feed does. */
+static inline setup one_element(void)
+{
+	setup u = preset();
+	set(&u, "trough_rotation", "false");
+	set(&u, "columns", "1");
+	set(&u, "layers", "1");
+	set(&u, "motor_on", "false");
+	set(&u, "feed_coupling", "false");
+	return u;
+}
+
 static inline sim *make(const setup *u)
 {
 	char msg[200];
