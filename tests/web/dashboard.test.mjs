@@ -159,6 +159,27 @@ test('moving the β slider turns the session to 128° and reverses the shown dir
 	await until(async () => await page.$eval('#schematic', e => e.dataset.beta) === '128.00', 5000, 'the schematic at 128°');
 });
 
+test('the drive row changes omega_ss and switches the drive, checked through the API', async () => {
+	await page.locator('#omega-ss').fill('150');
+	await page.locator('#omega-ss').press('Enter');
+	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.omega_ss === 150,
+		5000, 'omega_ss = 150 in the API');
+	await page.locator('#motor').click();
+	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.drive_on === false,
+		5000, 'drive_on = false in the API');
+	await until(async () => await page.$eval('#drive-now', e => e.textContent) === 'off', 5000, 'drive shown off');
+	assert.equal(await page.$eval('#motor', e => e.textContent), 'Switch on');
+	await page.locator('#motor').click();
+	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.drive_on === true,
+		5000, 'drive_on = true again');
+	await page.locator('#pace-live').fill('abc');
+	await page.locator('#pace-live').press('Enter');
+	const refused = await page.waitForSelector('#messages .msg.error', { timeout: 5000 });
+	assert.match(await refused.textContent(), /400.*pace must be a number or "max"/);
+	await page.click('#messages .msg.error .msg-close');
+	assert.equal(await page.$$eval('#messages .msg.error', l => l.length), 0);
+});
+
 test('a refused input shows the daemon\'s problem detail', async () => {
 	const body = { preset: 'czubak2016', params: { beta: 38, rotation: 'cw' },
 		scene: { columns: 5, layers: 999, feed: true, drive: 'ideal' }, integrator: { method: 'rk4' }, pace: 1 };

@@ -27,6 +27,7 @@ export const FIELDS = {
 		rotation: ['status.rotation', 'rotation', 'spec.params.rotation', 'params.rotation'],
 		rotorSpeed: ['status.rotor_speed', 'rotor_speed', 'status.rotor.speed', 'rotor.speed'],
 		omegaSs: ['status.omega_ss', 'omega_ss', 'spec.params.omega_ss', 'params.omega_ss'],
+		driveOn: ['status.drive_on', 'drive_on'],
 		transportVelocity: ['status.transport_velocity', 'transport_velocity', 'status.transport.velocity', 'transport.velocity'],
 		feedVelocity: ['status.feed_velocity', 'feed_velocity'],
 		running: ['status.running', 'running'],
@@ -184,6 +185,7 @@ export function normalizeSession(raw) {
 		rotation: rotationName(pick(raw, F.rotation)),
 		rotorSpeed: scalar(raw, F.rotorSpeed),
 		omegaSs: scalar(raw, F.omegaSs),
+		driveOn: typeof pick(raw, F.driveOn) === 'boolean' ? pick(raw, F.driveOn) : undefined,
 		transportVelocity: scalar(raw, F.transportVelocity),
 		feedVelocity: scalar(raw, F.feedVelocity),
 		running,
@@ -512,7 +514,7 @@ export async function createSession(form) {
 export async function getSession(id) {
 	return normalizeSession((await request('GET', `/sessions/${enc(id)}`)).data);
 }
-/* patch: any of {beta, beta_rate, rotation, omega_ss, running, pace}. */
+/* patch: any of {beta, beta_rate, rotation, omega_ss, motor_on, running, pace}. */
 export async function patchSession(id, patch) {
 	const d = (await request('PATCH', `/sessions/${enc(id)}`, patch)).data;
 	return { raw: d, control: normalizeControl(d), session: normalizeSession(d) };

@@ -292,7 +292,8 @@ async function refreshSessionList() {
 }
 
 function setControlsEnabled(on) {
-	for (const e of ['#pause', '#resume', '#delete', '#flip', '#beta-slider', '#beta-number'])
+	for (const e of ['#pause', '#resume', '#delete', '#flip', '#beta-slider', '#beta-number',
+		'#motor', '#omega-ss', '#pace-live'])
 		$(e).disabled = !on;
 	for (const b of $$('.quick')) b.disabled = !on;
 }
@@ -384,6 +385,12 @@ function showStatus(s) {
 	$('#beta-now').textContent = fmt(s.beta, 1, '°');
 	$('#beta-target').textContent = fmt(Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta, 1, '°');
 	$('#rotation-now').textContent = rotationLabel(s.rotation);
+	$('#drive-now').textContent = s.driveOn === false ? 'off' : s.driveOn ? 'on' : DASH;
+	$('#motor').textContent = s.driveOn === false ? 'Switch on' : 'Switch off';
+	if (document.activeElement !== $('#omega-ss') && Number.isFinite(s.omegaSs))
+		$('#omega-ss').value = String(s.omegaSs);
+	if (document.activeElement !== $('#pace-live') && s.pace !== undefined)
+		$('#pace-live').value = s.pace === 'max' ? 'max' : Number.isFinite(s.pace) ? String(s.pace) : '';
 	$('#v-daemon').textContent = fmtVelocity(s.transportVelocity);
 	/* slider follows the target unless the user is moving it */
 	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
@@ -696,6 +703,19 @@ function wire() {
 		const now = app.session?.rotation ?? 'cw';
 		patch({ rotation: now === 'cw' ? 'ccw' : 'cw' }, 'Rotation change');
 	};
+	$('#motor').onclick = () => {
+		const on = app.session?.driveOn !== false;
+		patch({ motor_on: !on }, on ? 'Drive off' : 'Drive on');
+	};
+	$('#omega-ss').addEventListener('change', () => {
+		const w = numberOf($('#omega-ss'));
+		if (Number.isFinite(w)) patch({ omega_ss: w }, 'ω_ss change');
+	});
+	$('#pace-live').addEventListener('change', () => {
+		const text = $('#pace-live').value.trim();
+		const pace = text === 'max' ? 'max' : Number(text);
+		patch({ pace }, 'Pace change');
+	});
 	const slider = $('#beta-slider'), number = $('#beta-number');
 	slider.addEventListener('input', () => { app.betaEditing = true; number.value = slider.value; });
 	slider.addEventListener('change', async () => {
