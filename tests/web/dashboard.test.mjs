@@ -213,6 +213,12 @@ test('a sweep draws v(β) for both rotations', async () => {
 	assert.deepEqual(rows.map(r => r[0]), ['30.0', '80.0', '130.0']);
 	const v = rows.map(r => [Number(r[1]), Number(r[2])]);
 	assert.ok(v.flat().every(Number.isFinite), `sweep table ${JSON.stringify(rows)}`);
+	/* the CSV link serves the same six points */
+	const href = await page.$eval('#sweep-csv', a => a.hidden ? null : a.getAttribute('href'));
+	assert.match(href, /^\/api\/v1\/sweeps\/[^/?]+\?format=csv$/);
+	const csv = (await (await fetch(base + href)).text()).trim().split('\n');
+	assert.equal(csv.length, 7, csv.join('\n'));
+	assert.match(csv[0], /^beta,rotation,/);
 });
 
 test('a β-change experiment reports its reversal time', async () => {

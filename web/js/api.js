@@ -519,6 +519,10 @@ export async function patchSession(id, patch) {
 	const d = (await request('PATCH', `/sessions/${enc(id)}`, patch)).data;
 	return { raw: d, control: normalizeControl(d), session: normalizeSession(d) };
 }
+/* Where the daemon serves a sweep's results as CSV. */
+export function sweepCsvUrl(id) {
+	return `${BASE}/sweeps/${enc(id)}?format=csv`;
+}
 export async function deleteSession(id) {
 	await request('DELETE', `/sessions/${enc(id)}`);
 }

@@ -588,6 +588,12 @@ async function runSweep(ev) {
 }
 
 function showSweep(j) {
+	const csv = $('#sweep-csv');
+	csv.hidden = !j.id;
+	if (j.id) {
+		csv.href = api.sweepCsvUrl(j.id);
+		csv.download = `sweep-${j.id}.csv`;
+	}
 	const by = rot => j.points.filter(p => p.rotation === rot).sort((a, b) => a.beta - b.beta);
 	const cw = by('cw'), ccw = by('ccw');
 	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]]);
