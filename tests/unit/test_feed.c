@@ -74,7 +74,6 @@ static void hopping_theory_vdi2333(void **state)
 		set(&u, "columns", "1");
 		set(&u, "layers", "1");
 		set(&u, "R", "0.001");
-		set(&u, "mu", "2");
 		set(&u, "k_c", "1e7");
 		model md;
 		model_init(&md, &u.p, &u.sc);
