@@ -20,10 +20,10 @@
 #include "ode.h"
 
 /* speed-up, relative transport-velocity change: czubak2016, dem dt = 1e-4 */
-#define REDUCTION_NO_FEED 2.23, NAN
-#define REDUCTION_SYMMETRIC 1.69, 3.2e-5
+#define REDUCTION_NO_FEED 1.75, NAN
+#define REDUCTION_SYMMETRIC 1.73, 3.2e-5
 #define REDUCTION_IDEAL 1.03, 2.9e-2
-#define REDUCTION_ONE_WAY 1.00, 3.0e-2
+#define REDUCTION_ONE_WAY 0.99, 3.2e-2
 
 struct sim {
 	model md;
