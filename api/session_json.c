@@ -181,6 +181,7 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(o, "steps", (double)st->steps);
 	api_add_number(o, "rhs_evals", (double)st->rhs_evals);
 	api_add_number(o, "dt", st->dt);
+	cJSON_AddNumberToObject(o, "substeps", st->substeps);
 	api_add_number(o, "steps_per_s", v->steps_per_s);
 	api_add_number(o, "rtf", v->rtf);
 	cJSON_AddNumberToObject(o, "n_dof", st->n_dof);

@@ -76,6 +76,12 @@ typedef struct model_eval {
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
 } model_eval;
 
+/* The feed's mass over the machine's (trough, vibrator and eliminator
+ * masses): the added-mass ratio of the machine-feed coupling. */
+double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
+/* Largest ratio for which dem corrects its coupling (README "dem"). */
+#define MODEL_CORRECTOR_MAX_RATIO 0.2
+
 /* Build the reduced model from parameters and scene (validated already). */
 void model_init(model *md, const sim_params *p, const sim_scene *sc);
 /* Fill y (length md->n) with the static equilibrium with the feed settled. */

@@ -15,6 +15,15 @@
  *     treatment of dry friction; see Acary & Brogliato, Numerical Methods
  *     for Nonsmooth Dynamical Systems, 2008, ch. 10).
  *
+ *  3. with more than one sub-step, the machine's step is taken again with
+ *     the feed's mean reaction of this very step (a corrector; the feed is
+ *     not stepped again), which removes most of the one-step lag. Like
+ *     every partitioned coupling it suffers from added mass: with the feed
+ *     heavier than about 30 % of the machine a perturbation grows by ~1.5
+ *     per step (measured), so the corrector is used only up to 20 %
+ *     (MODEL_CORRECTOR_MAX_RATIO); heavier feeds keep the lagged coupling,
+ *     which is stable.
+ *
  * Without feed it is exactly RK4 on the machine.
  */
 #include <math.h>
@@ -26,9 +35,10 @@
 
 typedef struct dem {
 	int n, substeps, have_q;
+	int correct; /* corrector on: feed light enough (added mass) */
 	double dt;
 	double Qfeed[NQ_FULL];
-	double *k1, *k2, *k3, *k4, *tmp;
+	double *k1, *k2, *k3, *k4, *tmp, *save;
 	signed char *modes;
 } dem;
 
@@ -50,8 +60,10 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->n = md->n;
 	w->dt = cfg->dt;
 	w->substeps = cfg->substeps > 0 ? cfg->substeps : 1;
+	w->correct = w->substeps > 1 && md->sc.feed_coupling &&
+		     model_feed_mass_ratio(&md->p, &md->sc) <= MODEL_CORRECTOR_MAX_RATIO;
 	size_t nf = (size_t)(md->nf > 0 ? md->nf : 1);
-	w->k1 = calloc(5 * (size_t)md->n, sizeof(double));
+	w->k1 = calloc(6 * (size_t)md->n, sizeof(double));
 	w->modes = calloc(2 * nf, 1);
 	if (!w->k1 || !w->modes) {
 		dem_free(w);
@@ -61,6 +73,7 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->k3 = w->k2 + md->n;
 	w->k4 = w->k3 + md->n;
 	w->tmp = w->k4 + md->n;
+	w->save = w->tmp + md->n;
 	return w;
 }
 
@@ -75,6 +88,29 @@ static void machine_axpy(const model *md, double *out, const double *y, double h
 	}
 	for (int a = ACC_IN; a <= ACC_DAMP; a++)
 		out[2 * md->npos + a] = y[2 * md->npos + a] + h * k[2 * md->npos + a];
+}
+
+/* One classical RK4 step of the machine's entries of y over H, with the
+ * feed's reaction held at w->Qfeed; ev0 receives the start evaluation. */
+static void machine_rk4(dem *w, model *md, double t, double H, double *y, model_eval *ev0)
+{
+	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
+	model_machine_rhs(md, t, y, w->Qfeed, w->k1, ev0);
+	machine_axpy(md, w->tmp, y, 0.5 * H, w->k1);
+	model_machine_rhs(md, t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);
+	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
+	model_machine_rhs(md, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
+	machine_axpy(md, w->tmp, y, H, w->k3);
+	model_machine_rhs(md, t + H, w->tmp, w->Qfeed, w->k4, NULL);
+	for (int r = 0; r < md->nq; r++) {
+		int v = md->npos + r;
+		y[r] += H / 6.0 * (w->k1[r] + 2.0 * (w->k2[r] + w->k3[r]) + w->k4[r]);
+		y[v] += H / 6.0 * (w->k1[v] + 2.0 * (w->k2[v] + w->k3[v]) + w->k4[v]);
+	}
+	for (int a = ACC_IN; a <= ACC_DAMP; a++) {
+		int i = 2 * md->npos + a;
+		y[i] += H / 6.0 * (w->k1[i] + 2.0 * (w->k2[i] + w->k3[i]) + w->k4[i]);
+	}
 }
 
 static void deck_accel(const model *md, int k, const model_rot *R, const model_eval *ev,
@@ -111,25 +147,12 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 			memset(w->Qfeed, 0, sizeof w->Qfeed);
 		w->have_q = 1;
 	}
-	memcpy(w->tmp, y, sizeof(double) * (size_t)n);
+	const int ns = w->substeps;
+	if (w->correct)
+		memcpy(w->save, y, sizeof(double) * (size_t)n);
 	/* 1. machine RK4 with the feed force held */
 	model_eval ev0, ev1;
-	model_machine_rhs(md, *t, y, w->Qfeed, w->k1, &ev0);
-	machine_axpy(md, w->tmp, y, 0.5 * H, w->k1);
-	model_machine_rhs(md, *t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);
-	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
-	model_machine_rhs(md, *t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
-	machine_axpy(md, w->tmp, y, H, w->k3);
-	model_machine_rhs(md, *t + H, w->tmp, w->Qfeed, w->k4, NULL);
-	for (int r = 0; r < md->nq; r++) {
-		int v = md->npos + r;
-		y[r] += H / 6.0 * (w->k1[r] + 2.0 * (w->k2[r] + w->k3[r]) + w->k4[r]);
-		y[v] += H / 6.0 * (w->k1[v] + 2.0 * (w->k2[v] + w->k3[v]) + w->k4[v]);
-	}
-	for (int a = ACC_IN; a <= ACC_DAMP; a++) {
-		int i = 2 * md->npos + a;
-		y[i] += H / 6.0 * (w->k1[i] + 2.0 * (w->k2[i] + w->k3[i]) + w->k4[i]);
-	}
+	machine_rk4(w, md, *t, H, y, &ev0);
 	double t1 = (H == t_max - *t) ? t_max : *t + H;
 	if (md->nf == 0) {
 		*t = t1;
@@ -137,7 +160,6 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 	}
 	/* 2. the feed along the interpolated deck motion; the machine's end
 	 * acceleration is needed only to interpolate between sub-steps */
-	const int ns = w->substeps;
 	if (ns > 1) {
 		model_machine_rhs(md, t1, y, w->Qfeed, w->k4, &ev1);
 	} else {
@@ -173,6 +195,17 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 	y[2 * md->npos + ACC_CONTACT] += md->col_weight * contact;
 	for (int i = 0; i < NQ_FULL; i++)
 		w->Qfeed[i] = md->sc.feed_coupling ? md->col_weight * Qnew[i] : 0.0;
+	if (w->correct) {
+		/* 3. corrector: the machine's step again, now with the feed's
+		 * reaction of this very step (the feed is not stepped again) */
+		for (int r = 0; r < md->nq; r++) {
+			y[r] = w->save[r];
+			y[md->npos + r] = w->save[md->npos + r];
+		}
+		for (int a = ACC_IN; a <= ACC_DAMP; a++)
+			y[2 * md->npos + a] = w->save[2 * md->npos + a];
+		machine_rk4(w, md, *t, H, y, &ev0);
+	}
 	*t = t1;
 	return SIM_OK;
 }

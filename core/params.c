@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model.h"
 #include "ode.h"
 #include "sim.h"
 
@@ -76,7 +77,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
-	X(G_METHOD, substeps, INT, "", 1, 1000, NULL, 1, "feed sub-steps per macro step (dem)")
+	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 1.25e-4 s")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -167,15 +168,19 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	m->dt = 0.0; /* chosen by sim_method_defaults() for the scene */
 	m->rtol = 1e-6;
 	m->atol = 1e-9;
-	m->substeps = 1;
+	m->substeps = 0; /* as many as the feed step needs */
 }
 
-/* Defaults of the integrator step per scene kind, measured (README,
- * "Defaults"): with feed, dem at 1e-4 s keeps the transport velocity
- * within 0.3 % of the peak velocity over beta in [0, 180] deg, both
- * rotations (2e-4 s: 0.8 %, 1e-3 s: 5.7 %); without feed the machine is
- * smooth and 1e-3 s keeps the trajectory within 2e-4. */
-double sim_default_dt(const sim_method *m, const sim_scene *s)
+/* Defaults per scene kind, measured over beta in [0, 180] deg, both
+ * rotations (README "Defaults", tests/bench/beta_range.sh): with feed, dem
+ * takes machine steps of 1e-3 s and feed sub-steps of at most 1.25e-4 s
+ * with its corrected coupling (v within 0.71 % of the peak velocity
+ * everywhere); a feed too heavy for the corrector (added mass) takes
+ * steps of 1e-4 s (0.27 %); without feed the machine is smooth and RK4 at
+ * 1e-3 s keeps the trajectory within 2e-4. */
+#define FEED_STEP_MAX 1.25e-4
+
+double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
 	int feed = s->feed && s->columns > 0 && s->layers > 0;
 	if (strcmp(m->name, "euler") == 0)
@@ -184,7 +189,16 @@ double sim_default_dt(const sim_method *m, const sim_scene *s)
 		return feed ? 1e-5 : 1e-3;
 	if (strcmp(m->name, "dopri5") == 0)
 		return 1e-5; /* the first step */
-	return feed ? 1e-4 : 1e-3;
+	if (feed && (!s->feed_coupling ||
+		     model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO))
+		return 1e-4;
+	return 1e-3;
+}
+
+int sim_default_substeps(double dt)
+{
+	int n = (int)ceil(dt / FEED_STEP_MAX - 1e-9);
+	return n < 1 ? 1 : n;
 }
 
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)

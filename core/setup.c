@@ -23,6 +23,14 @@ static int machine_symmetric(const sim_params *p)
 	       p->p1_x == -p->p2_x && p->p1_y == p->p2_y;
 }
 
+double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc)
+{
+	if (!sc->feed)
+		return 0.0;
+	double feed = p->m_n * (double)sc->columns * (double)sc->layers;
+	return feed / (p->M_r + p->m + p->m1 + p->m2);
+}
+
 void model_init(model *md, const sim_params *p, const sim_scene *sc)
 {
 	memset(md, 0, sizeof *md);

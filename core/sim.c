@@ -189,7 +189,9 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	model_init(&s->md, p, sc);
 	s->cfg = *m;
 	if (s->cfg.dt == 0.0)
-		s->cfg.dt = sim_default_dt(m, sc);
+		s->cfg.dt = sim_default_dt(p, sc, m);
+	if (s->cfg.substeps == 0)
+		s->cfg.substeps = sim_default_substeps(s->cfg.dt);
 	s->ode = ode_find(m->name);
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(3 * n, sizeof(double));
@@ -435,6 +437,7 @@ static void update_status(sim *s)
 	st->steps = s->steps;
 	st->rhs_evals = md->rhs_evals;
 	st->dt = s->cfg.dt;
+	st->substeps = s->cfg.substeps;
 	st->reductions = md->reductions;
 	st->n_dof = md->nq + 2 * md->nf;
 }

@@ -103,7 +103,8 @@ typedef struct sim_scene {
 
 /* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
  * default of the scene kind (sim_default_dt); rtol/atol for adaptive
- * methods; substeps: feed sub-steps per macro step (method "dem"). */
+ * methods; substeps: feed sub-steps per macro step (method "dem"), 0 for
+ * sim_default_substeps(dt). */
 typedef struct sim_method {
 	char name[24];
 	double dt;
@@ -147,9 +148,13 @@ int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
 
-/* The integrator step that dt = 0 stands for: the default of method m
- * on the kind of scene s (with or without feed), s. */
-double sim_default_dt(const sim_method *m, const sim_scene *s);
+/* The integrator step (s) that dt = 0 stands for: the default of method m
+ * for the kind of scene: with or without feed, and, for dem, whether the
+ * feed is light enough for its corrected coupling. */
+double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
+/* The feed sub-steps that substeps = 0 stands for with macro step dt (s):
+ * as many as keep the feed's step at or below 1.25e-4 s. */
+int sim_default_substeps(double dt);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
  * method). Same error convention as sim_set. */
@@ -258,6 +263,7 @@ typedef struct sim_status {
 	double e_residual;        /* J: stored change + dissipated - input */
 	uint64_t steps, rhs_evals;
 	double dt;                /* s: the integrator's (first) step in use */
+	int substeps;             /* feed sub-steps per step in use (dem) */
 	unsigned reductions;      /* SIM_RED_* bits */
 	int n_dof;                /* integrated machine + feed coordinates */
 } sim_status;

@@ -236,7 +236,7 @@ static int cmd_run(int argc, char **argv)
 	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o.preset, st.t);
 	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
 	       "\"atol\": %.17g, \"substeps\": %d},\n",
-	       o.m.name, st.dt, o.m.rtol, o.m.atol, o.m.substeps);
+	       o.m.name, st.dt, o.m.rtol, o.m.atol, st.substeps);
 	printf("  \"reductions\": [");
 	for (int b = 0, first = 1; sim_reduction_name(b); b++)
 		if (st.reductions & (1u << b)) {

@@ -144,7 +144,8 @@ test('a client behind the ring is told how many records it missed', { timeout: 3
 });
 
 test('NDJSON with the real curl binary', { timeout: 30000 * SLOW }, async () => {
-  const c = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 5 });
+  // real time, so that the session cannot finish before curl has read its records
+  const c = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, until: 30 });
   const id = c.body.id;
   const run = (args) => new Promise((resolve, reject) => {
     const p = spawn('curl', ['-sS', '-N', '--max-time', String(20 * SLOW), ...args]);
