@@ -77,7 +77,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
-	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 1.25e-4 s")
+	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 1e-4 s")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -173,12 +173,12 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 
 /* Defaults per scene kind, measured over beta in [0, 180] deg, both
  * rotations (README "Defaults", tests/bench/beta_range.sh): with feed, dem
- * takes machine steps of 1e-3 s and feed sub-steps of at most 1.25e-4 s
- * with its corrected coupling (v within 0.71 % of the peak velocity
+ * takes machine steps of 1e-3 s and feed sub-steps of at most 1e-4 s
+ * with its corrected coupling (v within 0.62 % of the peak velocity
  * everywhere); a feed too heavy for the corrector (added mass) takes
  * steps of 1e-4 s (0.27 %); without feed the machine is smooth and RK4 at
  * 1e-3 s keeps the trajectory within 2e-4. */
-#define FEED_STEP_MAX 1.25e-4
+#define FEED_STEP_MAX 1e-4
 
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {

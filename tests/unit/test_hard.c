@@ -565,7 +565,7 @@ static void heavy_feed_coupling_stays_stable(void **state)
 	set(&heavy, "layers", "24");
 	s = make(&light);
 	assert_close(status(s).dt, 1e-3, 0.0);
-	assert_int_equal(status(s).substeps, 8);
+	assert_int_equal(status(s).substeps, 10);
 	sim_free(s);
 	s = make(&heavy);
 	assert_close(status(s).dt, 1e-4, 0.0);
