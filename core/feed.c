@@ -83,27 +83,14 @@ void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
 	/* position rates are the velocities */
 	memcpy(XI(md, dy), XID(md, y), sizeof(double) * (size_t)nf);
 	memcpy(ETA(md, dy), ETAD(md, y), sizeof(double) * (size_t)nf);
-	double fric = 0.0, contact = 0.0;
-	/* Mirrored columns k and K-1-k are summed together first, so that the
-	 * moments of a symmetric motion cancel exactly despite round-off. */
+	double fric = 0.0, contact = 0.0, F[64][2];
 	model_rot R = model_rotation(q);
-	for (int k = 0; k <= (md->K - 1) / 2; k++) {
-		int kk = md->K - 1 - k;
-		double Qpair[NQ_FULL] = {0}, Qm[NQ_FULL] = {0};
-		double pos[2], vel[2], F[2];
+	for (int k = 0; k < md->K; k++) {
+		double pos[2], vel[2];
 		model_deck(md, k, &R, q, qd, pos, vel);
-		column_rhs(md, y, k, pos, vel, dy, F, &fric, &contact);
-		model_deck_force(md, k, &R, F, Qpair);
-		if (kk != k) {
-			model_deck(md, kk, &R, q, qd, pos, vel);
-			column_rhs(md, y, kk, pos, vel, dy, F, &fric, &contact);
-			model_deck_force(md, kk, &R, F, Qm);
-			for (int i = 0; i < NQ_FULL; i++)
-				Qpair[i] += Qm[i];
-		}
-		for (int i = 0; i < NQ_FULL; i++)
-			Qfeed[i] += md->col_weight * Qpair[i];
+		column_rhs(md, y, k, pos, vel, dy, F[k], &fric, &contact);
 	}
+	model_deck_forces(md, &R, (const double(*)[2])F, md->col_weight, Qfeed);
 	*fric_power = md->col_weight * fric;
 	*contact_power = md->col_weight * contact;
 }

@@ -138,14 +138,32 @@ void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FU
 	vel[1] = qd[Q_Y] + qd[Q_ALPHA] * Rd[0];
 }
 
-void model_deck_force(const model *md, int k, const model_rot *R, const double F[2],
-		      double Q[NQ_FULL])
+/* Generalized force of a force F applied at column k's deck point. */
+static void deck_force(const model *md, int k, const model_rot *R, const double F[2],
+		       double Q[NQ_FULL])
 {
 	double dv[2] = {md->d[k], md->p.h_d}, Rd[2];
 	rot(R->c, R->s, dv, Rd);
 	Q[Q_X] += F[0];
 	Q[Q_Y] += F[1];
 	Q[Q_ALPHA] += -Rd[1] * F[0] + Rd[0] * F[1];
+}
+
+void model_deck_forces(const model *md, const model_rot *R, const double (*F)[2],
+		       double scale, double Q[NQ_FULL])
+{
+	for (int k = 0; k <= (md->K - 1) / 2; k++) {
+		int kk = md->K - 1 - k;
+		double Qpair[NQ_FULL] = {0}, Qm[NQ_FULL] = {0};
+		deck_force(md, k, R, F[k], Qpair);
+		if (kk != k) {
+			deck_force(md, kk, R, F[kk], Qm);
+			for (int i = 0; i < NQ_FULL; i++)
+				Qpair[i] += Qm[i];
+		}
+		for (int i = 0; i < NQ_FULL; i++)
+			Q[i] += scale * Qpair[i];
+	}
 }
 
 /* In-place Cholesky solve of the n x n SPD system A x = b (A overwritten).

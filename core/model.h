@@ -112,9 +112,12 @@ static inline model_rot model_rotation(const double q[NQ_FULL])
 /* Deck point kinematics of integrated column k for a machine state. */
 void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FULL],
 		const double qd[NQ_FULL], double pos[2], double vel[2]);
-/* Generalized force of a force F applied at column k's deck point. */
-void model_deck_force(const model *md, int k, const model_rot *R, const double F[2],
-		      double Q[NQ_FULL]);
+/* Add to Q the generalized force of the forces F[k] (N) at every integrated
+ * column's deck point, times scale. Mirrored columns k and K-1-k are
+ * summed together first, so that the moments of a symmetric motion cancel
+ * exactly despite round-off. */
+void model_deck_forces(const model *md, const model_rot *R, const double (*F)[2],
+		       double scale, double Q[NQ_FULL]);
 /* Full coordinates from y at time t. */
 void model_full_coords(const model *md, double t, const double *y, double q[NQ_FULL],
 		       double qd[NQ_FULL]);

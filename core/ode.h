@@ -41,4 +41,13 @@ static inline double ode_fixed_step(double t, double dt, double t_max)
 	return rest <= dt * (1.0 + 1e-9) ? rest : dt;
 }
 
+/* Cubic Hermite interpolant on a step of length H at u in [0, 1] from the
+ * values p0, p1 and rates v0, v1 at its ends. */
+static inline double ode_hermite(double p0, double v0, double p1, double v1, double H, double u)
+{
+	double u2 = u * u, u3 = u2 * u;
+	return (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * H * v0 + (-2 * u3 + 3 * u2) * p1 +
+	       (u3 - u2) * H * v1;
+}
+
 #endif

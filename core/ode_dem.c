@@ -124,14 +124,6 @@ static void deck_accel(const model *md, int k, const model_rot *R, const model_e
 	acc[1] = ev->qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
 }
 
-/* Cubic Hermite on [0, H] at s in [0, 1]: value from (p0, v0, p1, v1). */
-static inline double hermite(double p0, double v0, double p1, double v1, double H, double s)
-{
-	double s2 = s * s, s3 = s2 * s;
-	return (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * H * v0 + (-2 * s3 + 3 * s2) * p1 +
-	       (s3 - s2) * H * v1;
-}
-
 static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 {
 	dem *w = p;
@@ -167,7 +159,7 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 		memset(ev1.qdd, 0, sizeof ev1.qdd);
 	}
 	const double h = H / ns;
-	double Qnew[NQ_FULL] = {0};
+	double F[64][2];
 	double fric = 0.0, contact = 0.0;
 	model_rot R0 = model_rotation(ev0.q), R1 = model_rotation(ev1.q);
 	for (int k = 0; k < md->K; k++) {
@@ -181,20 +173,21 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 			double s0 = (double)i / ns, s1 = (double)(i + 1) / ns;
 			double pos[2], vel1[2];
 			for (int c = 0; c < 2; c++) {
-				pos[c] = hermite(p0[c], v0[c], p1[c], v1[c], H, s0);
+				pos[c] = ode_hermite(p0[c], v0[c], p1[c], v1[c], H, s0);
 				vel1[c] = i + 1 == ns ? v1[c]
-						      : hermite(v0[c], a0[c], v1[c], a1[c], H, s1);
+						      : ode_hermite(v0[c], a0[c], v1[c], a1[c], H, s1);
 			}
 			feed_dem_substep(md, y, k, pos, vel1, h, w->modes, impulse, &fric,
 					 &contact);
 		}
-		double F[2] = {impulse[0] / H, impulse[1] / H};
-		model_deck_force(md, k, &R1, F, Qnew);
+		F[k][0] = impulse[0] / H;
+		F[k][1] = impulse[1] / H;
 	}
 	y[2 * md->npos + ACC_FRIC] += md->col_weight * fric;
 	y[2 * md->npos + ACC_CONTACT] += md->col_weight * contact;
-	for (int i = 0; i < NQ_FULL; i++)
-		w->Qfeed[i] = md->sc.feed_coupling ? md->col_weight * Qnew[i] : 0.0;
+	memset(w->Qfeed, 0, sizeof w->Qfeed);
+	if (md->sc.feed_coupling)
+		model_deck_forces(md, &R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
 	if (w->correct) {
 		/* 3. corrector: the machine's step again, now with the feed's
 		 * reaction of this very step (the feed is not stepped again) */

@@ -118,12 +118,15 @@ static void static_residual(const model *md, const double q[NQ_FULL], double res
 	tmp.drive_on = 0;
 	double y[2 * NQ_FULL + ACC_N] = {0}, dy[2 * NQ_FULL + ACC_N];
 	memcpy(y, q, sizeof(double) * NQ_FULL);
-	double Qfeed[NQ_FULL] = {0};
+	double Qfeed[NQ_FULL] = {0}, F[64][2];
 	model_rot R = model_rotation(q);
 	/* one-way coupling: the feed's weight never reaches the trough */
-	for (int k = 0; k < md->K && md->nf > 0 && md->sc.feed_coupling; k++) {
-		double F[2] = {0.0, -md->col_weight * md->L * md->p.m_n * md->p.g};
-		model_deck_force(md, k, &R, F, Qfeed);
+	if (md->nf > 0 && md->sc.feed_coupling) {
+		for (int k = 0; k < md->K; k++) {
+			F[k][0] = 0.0;
+			F[k][1] = -md->L * md->p.m_n * md->p.g;
+		}
+		model_deck_forces(md, &R, (const double(*)[2])F, md->col_weight, Qfeed);
 	}
 	model_eval ev;
 	model_machine_rhs(&tmp, 0.0, y, Qfeed, dy, &ev);

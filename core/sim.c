@@ -67,13 +67,6 @@ static void period_probe(const sim *s, double t, const double *y, double *psi, d
 	*Xd = mean_xi_rate(&s->md, y);
 }
 
-static double hermite(double p0, double v0, double p1, double v1, double H, double u)
-{
-	double u2 = u * u, u3 = u2 * u;
-	return (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * H * v0 + (-2 * u3 + 3 * u2) * p1 +
-	       (u3 - u2) * H * v1;
-}
-
 static void on_boundary(sim *s, double tb, double Xb)
 {
 	if (s->est_pending) {
@@ -106,14 +99,14 @@ static void detect_periods(sim *s, double t0, double t1)
 			double target = nb * 2 * M_PI, lo = 0.0, hi = 1.0;
 			for (int it = 0; it < 60; it++) {
 				double mid = 0.5 * (lo + hi);
-				double v = hermite(s->psi_prev, s->psid_prev, psi, psid, H, mid);
+				double v = ode_hermite(s->psi_prev, s->psid_prev, psi, psid, H, mid);
 				if ((v < target) == up)
 					lo = mid;
 				else
 					hi = mid;
 			}
 			double u = 0.5 * (lo + hi);
-			on_boundary(s, t0 + u * H, hermite(s->X_prev, s->Xd_prev, X, Xd, H, u));
+			on_boundary(s, t0 + u * H, ode_hermite(s->X_prev, s->Xd_prev, X, Xd, H, u));
 		}
 	}
 	s->psi_prev = psi;
