@@ -88,4 +88,16 @@ static inline sim_status status(const sim *s)
 
 #define assert_rel(a, b, rel) assert_close(a, b, (rel) * fabs(b))
 
+/* Advance s to t_end and check that no machine coordinate moved by more
+ * than tol (m, rad); returns the status before and after. */
+static inline void assert_rests(sim *s, double t_end, double tol, sim_status *before,
+				sim_status *after)
+{
+	*before = status(s);
+	advance(s, t_end);
+	*after = status(s);
+	for (int i = 0; i < 6; i++)
+		assert_close(after->q[i], before->q[i], tol);
+}
+
 #endif
