@@ -7,7 +7,8 @@
  *           stays closed; optional equal scaling keeps its true shape and so
  *           its direction.
  * Each plot resizes with its container and records how many points it
- * drew in data-points on the container (the browser test reads it).
+ * drew in data-points, and a time plot the latest time it drew in data-t-end,
+ * on the container (the browser test reads both).
  */
 
 import uPlot from '../vendor/uplot/uPlot.esm.js';
@@ -83,8 +84,12 @@ export class TimePlot {
 
 	setData(cols) {
 		this.plot.setData(cols);
-		this.el.dataset.points = String(cols[0].length);
-		this.el.classList.toggle('empty', cols[0].length === 0);
+		const n = cols[0].length;
+		this.el.dataset.points = String(n);
+		/* the latest time drawn: it advances while samples arrive, even when
+		 * a "history" trace thins and the point count drops */
+		this.el.dataset.tEnd = n ? String(cols[0][n - 1]) : '';
+		this.el.classList.toggle('empty', n === 0);
 	}
 
 	/* Vertical marker lines [{x, label, color}] (x in s). */
