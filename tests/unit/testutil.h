@@ -54,6 +54,16 @@ static inline setup one_element(void)
 	return u;
 }
 
+/* The reduced scene (alpha dropped, one column) with the ideal drive. */
+static inline setup reduced_ideal(void)
+{
+	setup u = preset();
+	set(&u, "trough_rotation", "false");
+	set(&u, "drive", "ideal");
+	set(&u, "transient", "0.5");
+	return u;
+}
+
 static inline sim *make(const setup *u)
 {
 	char msg[200];
