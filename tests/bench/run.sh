@@ -16,7 +16,9 @@ fi
 mkdir -p "$out" "$BUILD/bench"
 bin="$BUILD/bench/workprec"
 $CC -O2 -g -Wall -Wextra -Werror -std=c11 -D_POSIX_C_SOURCE=200809L -Icore \
-	-o "$bin" tests/bench/workprec.c "$BUILD/libcore.a" -lm
+	-o "$bin" tests/bench/workprec.c tests/bench/workprec_run.c \
+	tests/bench/workprec_scenes.c tests/bench/workprec_report.c tests/bench/workprec_svg.c \
+	"$BUILD/libcore.a" -lm
 pin() { # core, command...: one core per process where taskset exists
 	local c=$1; shift
 	if command -v taskset >/dev/null; then taskset -c "$c" "$@"; else "$@"; fi
