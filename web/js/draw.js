@@ -1,0 +1,61 @@
+/*
+ * draw.js - redraws plots, the velocity tile and the schematic from the
+ * traces at most every animation frame (every 50 ms), and only when the
+ * page is dirty.
+ */
+
+import { fmtVelocity, direction, ARROW } from './format.js';
+import { app, $, numberOf } from './ui.js';
+import { currentVelocity, MM } from './live.js';
+
+let lastDraw = 0;
+export function frame(now) {
+	requestAnimationFrame(frame);
+	if (!app.dirty || now - lastDraw < 50) return;
+	lastDraw = now;
+	app.dirty = false;
+	draw();
+}
+
+function draw() {
+	const tr = app.traces;
+	if (tr) {
+		const o = tr.orbit.data();
+		app.plots.orbit.setData([[o[1], o[2]]]);
+		app.plots.strokes.setData(tr.strokes.data());
+		app.plots.trough.setData(tr.trough.data());
+		app.plots.rotor.setData(tr.rotor.data());
+		if (app.columns) app.plots.feed.setData(tr.feed.data());
+		$('#live-state').dataset.samples = String(app.samples);
+		$('#live-state').dataset.dropped = String(app.dropped);
+		if (app.stream && app.samples)
+			$('#live-state').textContent = `stream: ${app.samples} samples` + (app.dropped ? `, ${app.dropped} missed (slow client)` : '');
+	}
+	const v = currentVelocity();
+	const dir = direction(v);
+	app.lastVelocity = v;
+	$('#v-value').textContent = fmtVelocity(v);
+	const arrow = $('#v-arrow');
+	arrow.textContent = ARROW[dir];
+	arrow.dataset.direction = dir;
+	$('#tile-velocity').dataset.direction = dir;
+	$('#v-dir').textContent = dir === 'right' ? 'feed moves right (+x)' : dir === 'left' ? 'feed moves left (−x)' : dir === 'still' ? 'feed at rest' : 'no reading yet';
+	const s = app.session;
+	const last = app.lastSample;
+	const strokes = tr?.strokes.data();
+	const range = strokes && strokes[0].length ? [1, 2].map(c => {
+		const v = strokes[c].filter(Number.isFinite);
+		return v.length ? [Math.min(...v) / MM, Math.max(...v) / MM] : null;
+	}) : undefined;
+	app.schematic.update({
+		beta: Number.isFinite(last?.beta) ? last.beta : s?.beta ?? numberOf($('#session-form').elements.beta),
+		betaTarget: s?.betaTarget,
+		rotation: last?.rotation ?? s?.rotation ?? $('#session-form').elements.rotation.value,
+		strokes: last?.strokes,
+		phase: last?.phi,
+		strokeRange: range,
+		columns: app.columns || (s ? (s.feed === false ? 0 : s.columns) : ($('#session-form').elements.feed.checked ? numberOf($('#session-form').elements.columns) : 0)),
+		layers: s?.layers ?? numberOf($('#session-form').elements.layers),
+		direction: dir,
+	});
+}

@@ -1,0 +1,49 @@
+/*
+ * figures.js - the page's plots: which plot shows what, with its series,
+ * labels and axes (plots.js draws them), and the schematic. The feed plot
+ * is rebuilt when the number of columns changes.
+ */
+
+import { TimePlot, XYPlot, PALETTE } from './plots.js';
+import { Schematic } from './schematic.js';
+import { app, $, numberOf } from './ui.js';
+
+export function makePlots() {
+	app.plots.orbit = new XYPlot($('#plot-orbit'), {
+		series: [{ label: 'deck point', color: PALETTE[0], width: 1.75 }],
+		xLabel: 'horizontal displacement x / mm', yLabel: 'vertical displacement y / mm',
+		equal: true, aspect: 0.78,
+	});
+	app.plots.rotor = new TimePlot($('#plot-rotor'), {
+		series: [{ label: 'rotor speed / (rad/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
+		yLabel: 'rotor speed / (rad/s)', y2Label: 'β / °', y2Range: [0, 180],
+	});
+	app.plots.strokes = new TimePlot($('#plot-strokes'), {
+		series: [{ label: 's₁ / mm', color: PALETTE[4] }, { label: 's₂ / mm', color: PALETTE[5] }],
+		yLabel: 'stroke / mm',
+	});
+	app.plots.trough = new TimePlot($('#plot-trough'), {
+		series: [{ label: 'x / mm', color: PALETTE[0] }, { label: 'y / mm', color: PALETTE[1] }],
+		yLabel: 'displacement / mm',
+	});
+	buildFeedPlot(0);
+	app.schematic = new Schematic($('#schematic'));
+	app.schematic.update({ beta: numberOf($('#session-form').elements.beta), rotation: 'cw', columns: 5, layers: 8 });
+	app.plots.sweep = new XYPlot($('#plot-sweep'), {
+		series: [{ label: 'clockwise', color: PALETTE[0] }, { label: 'counter-clockwise', color: PALETTE[1] }],
+		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
+	});
+	app.plots.experiment = new TimePlot($('#plot-experiment'), {
+		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
+		yLabel: 'v / (m/s)', y2Label: 'β / °', y2Range: [0, 180], aspect: 0.5,
+	});
+}
+
+export function buildFeedPlot(K) {
+	const el = $('#plot-feed');
+	if (app.plots.feed && app.plots.feedK === K) return;
+	app.plots.feed?.destroy();
+	const series = K ? Array.from({ length: K }, (_, k) => ({ label: `column ${k + 1}` })) : [{ label: 'columns', color: '#94a3b8' }];
+	app.plots.feed = new TimePlot(el, { series, yLabel: 'displacement / mm' });
+	app.plots.feedK = K;
+}

@@ -1,0 +1,191 @@
+/*
+ * session.js - the attached session: the new-session form, attaching to a
+ * session (its stream feeds live.js, its status is polled every STATUS_MS
+ * for the tiles, its id is kept in the URL hash #session=ID so that a
+ * reload re-attaches), detaching, PATCH requests of the live controls,
+ * deleting, and the session list in the header.
+ */
+
+import * as api from './api.js';
+import { fmt, fmtTime, rotationLabel, parsePace } from './format.js';
+import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
+import { resetTraces, onSample, onControl } from './live.js';
+import { showStatus } from './status.js';
+
+const STATUS_MS = 500;
+
+/* Values of the new-session form. Numbers are passed on as typed, so the
+ * daemon (not the browser) judges their ranges and names the field. */
+export function readSessionForm() {
+	const f = $('#session-form').elements;
+	const paceText = f.pace.value;
+	const pace = parsePace(paceText);
+	return {
+		preset: f.preset.value,
+		beta: numberOf(f.beta),
+		rotation: f.rotation.value,
+		columns: numberOf(f.columns),
+		layers: numberOf(f.layers),
+		feed: f.feed.checked,
+		drive: f.drive.value,
+		method: f.method.value.trim(),
+		dt: numberOf(f.dt),
+		pace: pace ?? (Number.isFinite(Number(paceText)) ? Number(paceText) : paceText),
+		rate: numberOf(f.rate),
+		betaRate: numberOf($('#beta-rate')),
+	};
+}
+
+export async function startSession(ev) {
+	ev.preventDefault();
+	const form = readSessionForm();
+	const btn = $('#start');
+	busy(btn, true);
+	try {
+		const s = await api.createSession(form);
+		setOnline(true);
+		message('ok', `Session ${s.id} started (${form.preset}, β = ${fmt(form.beta, 1)}°, ${rotationLabel(form.rotation)}).`);
+		/* the POST answer's status is that of t = 0 before the first step:
+		 * let the first poll fill the tiles */
+		attach(s.id, null);
+		refreshSessionList();
+	} catch (err) {
+		report(err, 'Start session', $('#session-form'));
+	} finally {
+		busy(btn, false);
+	}
+}
+
+export function detach() {
+	app.stream?.close();
+	app.stream = null;
+	clearInterval(app.statusTimer);
+	app.statusTimer = 0;
+	app.id = null;
+	app.session = null;
+	document.body.dataset.sessionId = '';
+	history.replaceState(null, '', location.pathname);
+	setControlsEnabled(false);
+	$('#beta-now-mark').hidden = true;
+	$('#session-label').textContent = 'no session';
+	$('#live-state').textContent = 'stream: idle';
+	$('#session-select').value = '';
+}
+
+export function attach(id, initial) {
+	detach();
+	app.id = id;
+	app.session = initial ?? null;
+	app.samples = 0;
+	app.dropped = 0;
+	app.controls = [];
+	app.lastVelocity = NaN;
+	document.body.dataset.sessionId = id;
+	history.replaceState(null, '', `#session=${encodeURIComponent(id)}`);
+	$('#session-label').textContent = `session ${id}`;
+	$('#session-select').value = id;
+	setControlsEnabled(true);
+	resetTraces(initial?.columns);
+	app.stream = api.openStream(id, { since: 0 }, {
+		open: () => { setOnline(true); $('#live-state').textContent = `stream: open (${id})`; },
+		sample: onSample,
+		control: onControl,
+		dropped: n => { if (n > 0) app.dropped += n; },
+		end: d => {
+			$('#live-state').textContent = `stream: ended${d?.reason ? ` (${d.reason})` : ''}`;
+			pollStatus();
+		},
+		error: state => {
+			$('#live-state').textContent = state === 2 ? 'stream: closed' : 'stream: reconnecting…';
+		},
+	});
+	pollStatus();
+	app.statusTimer = setInterval(pollStatus, STATUS_MS);
+	if (initial) showStatus(initial);
+}
+
+let polls = 0;
+export async function pollStatus() {
+	const id = app.id;
+	if (!id) return;
+	if (++polls % 10 === 0) refreshSessionList();
+	try {
+		const s = await api.getSession(id);
+		if (id !== app.id) return;
+		setOnline(true);
+		showStatus(s);
+	} catch (err) {
+		if (id !== app.id) return;
+		if (err instanceof api.ApiError && err.status === 404) {
+			message('warn', `Session ${id} no longer exists on the daemon.`);
+			detach();
+			refreshSessionList();
+		} else if (err instanceof api.NetworkError) {
+			setOnline(false);
+		}
+	}
+}
+
+export async function patch(body, what) {
+	if (!app.id) return null;
+	try {
+		const r = await api.patchSession(app.id, body);
+		setOnline(true);
+		pollStatus();
+		return r;
+	} catch (err) {
+		report(err, what);
+		pollStatus();
+		return null;
+	}
+}
+
+export async function setBeta(beta) {
+	const body = { beta };
+	const rate = numberOf($('#beta-rate'));
+	if (Number.isFinite(rate) && rate > 0) body.beta_rate = rate;
+	const r = await patch(body, 'β change');
+	if (r) {
+		const t = r.control.t;
+		message('ok', `β → ${fmt(beta, 1)}°` + (Number.isFinite(t) ? ` from t = ${fmtTime(t)}` : '') + '.');
+	}
+	return r;
+}
+
+export async function removeSession() {
+	const id = app.id;
+	if (!id) return;
+	try {
+		await api.deleteSession(id);
+		message('ok', `Session ${id} deleted.`);
+	} catch (err) {
+		if (!(err instanceof api.ApiError && err.status === 404)) { report(err, 'Delete'); return; }
+	}
+	detach();
+	refreshSessionList();
+}
+
+export async function refreshSessionList() {
+	try {
+		const list = await api.listSessions();
+		setOnline(true);
+		const sel = $('#session-select');
+		const keep = app.id ?? '';
+		sel.replaceChildren(new Option('none', ''));
+		for (const s of list) {
+			const label = `${s.id} · β ${fmt(s.beta, 0)}° · ${s.rotation ?? ''} · t ${fmt(s.t, 1)} s`;
+			sel.append(new Option(label, s.id));
+		}
+		if (keep && !list.some(s => s.id === keep)) sel.append(new Option(keep, keep));
+		sel.value = keep;
+	} catch (err) {
+		if (err instanceof api.NetworkError) setOnline(false);
+	}
+}
+
+function setControlsEnabled(on) {
+	for (const e of ['#pause', '#resume', '#delete', '#flip', '#beta-slider', '#beta-number',
+		'#motor', '#omega-ss', '#pace-live'])
+		$(e).disabled = !on;
+	for (const b of $$('.quick')) b.disabled = !on;
+}

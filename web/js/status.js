@@ -1,0 +1,83 @@
+/*
+ * status.js - the attached session's polled status on the page: the tiles
+ * (simulated time, rotor speed, real-time factor), the live-control card
+ * (buttons, beta slider and readout, rotation, drive row) and the model
+ * card with its reductions.
+ */
+
+import { fmt, fmtSig, fmtTime, fmtVelocity, fmtPace, RAD_S_TO_RPM, rotationLabel, wrapBeta,
+	DASH } from './format.js';
+import { app, $ } from './ui.js';
+import { resetTraces } from './live.js';
+
+export function showStatus(s) {
+	app.session = s;
+	$('#t-now').textContent = fmtTime(s.t);
+	const state = s.error ? `error: ${s.error}` : s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
+	$('#state-now').textContent = state;
+	document.body.dataset.running = s.running === false ? 'false' : 'true';
+	/* finished and failed sessions can be neither paused nor resumed */
+	$('#pause').disabled = !app.id || !/^running$/i.test(s.state || (s.running ? 'running' : ''));
+	$('#resume').disabled = !app.id || !/^paused$/i.test(s.state || (s.running === false ? 'paused' : ''));
+	$('#rotor-now').textContent = fmt(s.rotorSpeed, 2, 'rad/s');
+	$('#rotor-rpm').textContent = Number.isFinite(s.rotorSpeed) ? `${fmt(Math.abs(s.rotorSpeed) * RAD_S_TO_RPM, 0)} rpm` +
+		(Number.isFinite(s.omegaSs) ? ` · ω_ss ${fmt(s.omegaSs, 2)} rad/s` : '') : DASH;
+	$('#rtf-now').textContent = Number.isFinite(s.realTimeFactor) ? `${fmtSig(s.realTimeFactor, 3)}×` : DASH;
+	$('#sps-now').textContent = `${fmtSig(s.stepsPerSecond, 3, 'steps/s')} · pace ${fmtPace(s.pace)}`;
+	$('#beta-now').textContent = fmt(s.beta, 1, '°');
+	$('#beta-target').textContent = fmt(Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta, 1, '°');
+	$('#rotation-now').textContent = rotationLabel(s.rotation);
+	$('#drive-now').textContent = s.driveOn === false ? 'off' : s.driveOn ? 'on' : DASH;
+	$('#motor').textContent = s.driveOn === false ? 'Switch on' : 'Switch off';
+	if (document.activeElement !== $('#omega-ss') && Number.isFinite(s.omegaSs))
+		$('#omega-ss').value = String(s.omegaSs);
+	if (document.activeElement !== $('#pace-live') && s.pace !== undefined)
+		$('#pace-live').value = s.pace === 'max' ? 'max' : Number.isFinite(s.pace) ? String(s.pace) : '';
+	$('#v-daemon').textContent = fmtVelocity(s.transportVelocity);
+	/* slider follows the target unless the user is moving it */
+	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
+	if (!app.betaEditing && Number.isFinite(target) && document.activeElement !== $('#beta-number')) {
+		$('#beta-slider').value = String(target);
+		$('#beta-number').value = String(Math.round(target * 10) / 10);
+	}
+	const mark = $('#beta-now-mark');
+	mark.hidden = !Number.isFinite(s.beta);
+	if (Number.isFinite(s.beta)) mark.style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
+	$('#m-preset').textContent = s.preset ?? DASH;
+	const scene = [];
+	if (Number.isFinite(s.columns)) scene.push(`${s.columns} columns × ${s.layers} layers`);
+	if (s.feed === false) scene.push('no feed');
+	if (s.drive) scene.push(`${s.drive} drive`);
+	$('#m-scene').textContent = scene.join(', ') || DASH;
+	$('#m-method').textContent = s.method ?? DASH;
+	$('#m-pace').textContent = fmtPace(s.pace);
+	showReductions(s.reductions);
+	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
+	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
+	app.dirty = true;
+}
+
+function showReductions(list) {
+	const box = $('#reductions');
+	const key = JSON.stringify(list);
+	if (box.dataset.key === key) return;
+	box.dataset.key = key;
+	box.replaceChildren();
+	if (!list.length) {
+		const m = document.createElement('span');
+		m.className = 'muted';
+		m.textContent = 'full model (no reductions applied)';
+		box.append(m);
+		return;
+	}
+	for (const r of list) {
+		const c = document.createElement('span');
+		c.className = 'chip';
+		c.textContent = r.name.replace(/_/g, ' ');
+		const extra = [];
+		if (Number.isFinite(r.speedup)) extra.push(`speed-up ${fmtSig(r.speedup, 3)}×`);
+		if (Number.isFinite(r.error)) extra.push(`error ${fmtSig(r.error, 2)}`);
+		if (extra.length) c.title = extra.join(', ');
+		box.append(c);
+	}
+}

@@ -1,0 +1,133 @@
+/*
+ * ui.js - what every part of the dashboard page shares: the page state
+ * (app, also window.convsim for the console and the browser test), the
+ * element lookups, the message bar, the daemon's connection state, reading
+ * a number from an input, busy buttons, and the progress bar and polling
+ * loop of a sweep or an experiment.
+ */
+
+import * as api from './api.js';
+import { problemText } from './format.js';
+
+const JOB_POLL_MS = 500;
+
+export const $ = sel => document.querySelector(sel);
+export const $$ = sel => Array.from(document.querySelectorAll(sel));
+
+export const app = {
+	session: null,        /* normalized status of the attached session */
+	id: null,
+	stream: null,
+	statusTimer: 0,
+	samples: 0,
+	dropped: 0,
+	columns: 0,
+	traces: null,
+	plots: {},
+	dirty: false,
+	online: undefined,
+	betaEditing: false,   /* the user is dragging the slider */
+	lastVelocity: NaN,
+	controls: [],         /* control events seen on the stream */
+	pending: new Set(),   /* requests in flight, for button states */
+};
+window.convsim = app;     /* for the console and the browser test */
+
+/* ---- messages ------------------------------------------------------------ */
+
+export function message(kind, text, { key, sticky = false } = {}) {
+	const box = $('#messages');
+	if (key) box.querySelector(`[data-key="${key}"]`)?.remove();
+	const m = document.createElement('div');
+	m.className = `msg ${kind}`;
+	m.setAttribute('role', kind === 'error' ? 'alert' : 'status');
+	if (key) m.dataset.key = key;
+	const span = document.createElement('span');
+	span.className = 'msg-text';
+	span.textContent = text;
+	const close = document.createElement('button');
+	close.className = 'msg-close';
+	close.type = 'button';
+	close.setAttribute('aria-label', 'Dismiss');
+	close.textContent = '×';
+	close.onclick = () => m.remove();
+	m.append(span, close);
+	box.prepend(m);
+	while (box.children.length > 5) box.lastChild.remove();
+	if (!sticky) setTimeout(() => m.remove(), kind === 'error' ? 20000 : 5000);
+	return m;
+}
+
+function clearMessage(key) {
+	$(`#messages [data-key="${key}"]`)?.remove();
+}
+
+/* Report a failed request: a refused input shows the daemon's problem
+ * detail and marks the field it names; an unreachable daemon says so. */
+export function report(err, what, form) {
+	if (err instanceof api.NetworkError) {
+		setOnline(false);
+		message('error', `${what}: ${err.message}`, { key: 'network', sticky: true });
+		return;
+	}
+	if (err instanceof api.ApiError) {
+		message('error', `${what} refused: ${problemText(err)}`, { key: `refused-${what}` });
+		if (form && err.field) {
+			const name = String(err.field).split(/[./]/).pop();
+			const input = form.elements[name];
+			if (input) {
+				input.setAttribute('aria-invalid', 'true');
+				input.title = err.detail;
+				input.addEventListener('input', () => input.removeAttribute('aria-invalid'), { once: true });
+			}
+		}
+		return;
+	}
+	message('error', `${what}: ${err?.message ?? err}`);
+	console.error(err);
+}
+
+export function setOnline(on) {
+	if (on === app.online) return;
+	app.online = on;
+	const c = $('#conn');
+	c.dataset.state = on ? 'online' : 'offline';
+	c.textContent = on ? 'daemon: connected' : 'daemon: unreachable';
+	if (on) clearMessage('network');
+	else message('error', 'The convsim daemon does not answer. Start it with build/convsimd (make run) and reload; the page retries by itself.', { key: 'network', sticky: true });
+}
+
+export function numberOf(input) {
+	const s = String(input?.value ?? '').trim();
+	return s === '' ? NaN : Number(s);
+}
+
+export function busy(button, on) {
+	if (!button) return;
+	button.classList.toggle('busy', on);
+	button.disabled = on;
+}
+
+/* ---- sweeps and experiments ------------------------------------------------ */
+
+export function progress(box, frac, text) {
+	box.hidden = false;
+	box.querySelector('.bar').style.width = `${Math.round((Number.isFinite(frac) ? frac : 0) * 100)}%`;
+	box.querySelector('.ptext').textContent = text;
+}
+
+export async function poll(get, id, onUpdate) {
+	for (;;) {
+		await new Promise(r => setTimeout(r, JOB_POLL_MS));
+		let j;
+		try {
+			j = await get(id);
+			setOnline(true);
+		} catch (err) {
+			if (err instanceof api.NetworkError) { setOnline(false); continue; }
+			throw err;
+		}
+		onUpdate(j);
+		if (j.done) return j;
+	}
+}
