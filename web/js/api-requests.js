@@ -1,0 +1,65 @@
+/*
+ * api-requests.js - what the dashboard sends the daemon: the base URL, the
+ * request bodies of POST /sessions, /sweeps and /experiments built from
+ * the forms' values, and the stream's query string. No DOM, no network;
+ * node:test covers it (through api.js, which re-exports it).
+ */
+
+export const BASE = '/api/v1';
+
+/* The POST /sessions body from the form's values (see session.js readSessionForm):
+ * {preset, params: {beta, rotation[, beta_rate]}, scene: {columns, layers,
+ * feed, drive}, integrator: {method[, dt]}, pace[, sample_rate]}. */
+export function sessionRequest(f) {
+	const body = {
+		preset: f.preset,
+		params: { beta: f.beta, rotation: f.rotation },
+		scene: { columns: f.columns, layers: f.layers, feed: f.feed, drive: f.drive },
+		integrator: { method: f.method },
+		pace: f.pace,
+	};
+	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.params.beta_rate = f.betaRate;
+	if (Number.isFinite(f.dt) && f.dt > 0) body.integrator.dt = f.dt;
+	if (Number.isFinite(f.rate) && f.rate > 0) body.sample_rate = f.rate;
+	return body;
+}
+
+/* POST /sweeps: the session form's model, a beta grid, both rotations. */
+export function sweepRequest(f) {
+	const body = sessionRequest(f);
+	delete body.pace;
+	delete body.sample_rate;
+	delete body.params.beta;
+	delete body.params.rotation;
+	body.scene.feed = true;
+	body.beta = { from: f.from, to: f.to, step: f.step };
+	body.rotations = ['cw', 'ccw'];
+	body.t_end = f.tEnd;
+	return body;
+}
+
+/* POST /experiments: a fresh session from the form's model (the daemon
+ * runs it at pace "max" unless told otherwise) and the schedule beta1
+ * until tSwitch, then beta2 until tEnd. */
+export function experimentRequest(f) {
+	const session = sessionRequest({ ...f, beta: f.beta1 });
+	session.scene.feed = true;
+	if (f.experimentPace !== undefined) session.pace = f.experimentPace;
+	else delete session.pace;
+	const body = {
+		session,
+		schedule: [{ beta: f.beta1, until: f.tSwitch }, { beta: f.beta2, until: f.tEnd }],
+	};
+	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.beta_rate = f.betaRate;
+	return body;
+}
+
+/* Query string of the stream: which fields, and since=ID to start from
+ * that record (0: the oldest the daemon still holds, so the plots fill at
+ * once on attach). */
+export function streamQuery(opts = {}) {
+	const q = new URLSearchParams();
+	q.set('fields', (opts.fields ?? ['trough', 'orbit', 'rotor', 'eliminators', 'feed']).join(','));
+	if (Number.isInteger(opts.since) && opts.since >= 0) q.set('since', String(opts.since));
+	return q.toString();
+}
