@@ -8,6 +8,8 @@
 #ifndef CONVSIM_WORKPREC_H
 #define CONVSIM_WORKPREC_H
 
+#include <stdio.h>
+
 #define SAMPLE_DT 2e-3
 enum { NSAMP = 400 }; /* 0.8 s = 20 periods of omega_ss = 157.08 rad/s */
 
@@ -76,6 +78,10 @@ void wp_report(const char *dir, const char *cmd);
 
 /* The first row of a scene of the given kind ("ref", "refcheck"), or NULL. */
 const wp_rec *wp_find_ref(const wp_records *t, const char *scene, const char *kind);
+
+/* Opens DIR/NAME for writing (the caller closes it); exits with a message
+ * when it cannot. */
+FILE *wp_create(const char *dir, const char *name);
 
 /* Writes DIR/workprec.svg from the rows t (borrowed). Exits on a file it
  * cannot write. */

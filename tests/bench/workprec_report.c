@@ -210,15 +210,21 @@ static void md_reductions(FILE *f, const wp_records *t)
 	fprintf(f, "\n");
 }
 
-static void write_md(const char *dir, const char *cmd, const wp_records *t)
+FILE *wp_create(const char *dir, const char *name)
 {
 	char path[512];
-	snprintf(path, sizeof path, "%s/workprec.md", dir);
+	snprintf(path, sizeof path, "%s/%s", dir, name);
 	FILE *f = fopen(path, "w");
 	if (!f) {
 		perror(path);
 		exit(1);
 	}
+	return f;
+}
+
+static void write_md(const char *dir, const char *cmd, const wp_records *t)
+{
+	FILE *f = wp_create(dir, "workprec.md");
 	fprintf(f, "# Work-precision benchmark\n\nMade by `%s`\n\n", cmd);
 	fprintf(f,
 		"One process per scene, one thread each (at most two in parallel). CPU s/sim s: "

@@ -199,13 +199,7 @@ static void panel(FILE *f, const wp_records *t, double ox, double oy, double w, 
 
 void wp_write_svg(const char *dir, const wp_records *t)
 {
-	char path[512];
-	snprintf(path, sizeof path, "%s/workprec.svg", dir);
-	FILE *f = fopen(path, "w");
-	if (!f) {
-		perror(path);
-		exit(1);
-	}
+	FILE *f = wp_create(dir, "workprec.svg");
 	const double W = 420, H = 320;
 	fprintf(f,
 		"<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' "
