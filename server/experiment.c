@@ -12,7 +12,8 @@
  * feed velocity over the segment's second half and its reversal time runs
  * from the command until the feed velocity first reaches 90 % of that
  * steady value. Fields are guarded by the experiment's lock, taken inside
- * the session lock by the worker's hooks and alone by the handlers.
+ * the session lock by the worker's hooks and alone by the handlers (lock
+ * order: registry.h).
  */
 #include <math.h>
 #include <pthread.h>

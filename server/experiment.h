@@ -2,8 +2,8 @@
  * experiment.h - the beta-schedule experiment as the worker runs it.
  *
  * An experiment rides on one session's worker, which calls the hooks below
- * with the session lock held (the experiment's own lock is taken inside
- * them: session lock > experiment lock). The experiment never touches the
+ * with the session lock held; they take the experiment's own lock inside
+ * it, as the lock order (registry.h) allows. The experiment never touches the
  * simulation: each segment's beta is a command (srv_cmd, worker.h) it hands
  * back to the worker, which queues and applies it like a PATCH and reports
  * the outcome with srv_exp_commanded. The handlers and the registry of
