@@ -64,49 +64,57 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 	return API_OK;
 }
 
+/* "session": the id of an existing session, or a create body for a fresh
+ * one (none: a fresh czubak2016 session), which runs at pace "max" unless
+ * the body sets a pace. */
+static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
+				    api_problem *pb)
+{
+	static const char *const session_members[] = {
+		"preset", "params", "scene", "integrator", "pace",
+		"sample_rate", NULL};
+	if (sess && cJSON_IsString(sess)) {
+		snprintf(req->session_id, sizeof req->session_id, "%s",
+			 sess->valuestring);
+		if (sim_preset("czubak2016", &req->spec.params,
+			       &req->spec.scene, &req->spec.method) != SIM_OK)
+			return api_fail(pb, API_UNAVAILABLE, NULL,
+					"the default preset is missing");
+		return API_OK;
+	}
+	if (sess && !cJSON_IsObject(sess))
+		return api_fail(pb, API_TYPE, "session",
+				"session must be a session id or a session "
+				"body object");
+	req->fresh = 1;
+	cJSON *empty = sess ? NULL : cJSON_CreateObject();
+	const cJSON *src = sess ? sess : empty;
+	api_err e = api_check_members(src, session_members, "session.", pb);
+	if (e == API_OK)
+		e = api_apply_model(src, &req->spec, pb);
+	if (e == API_OK)
+		e = api_apply_session_extras(src, &req->spec, pb);
+	if (e == API_OK && !cJSON_GetObjectItemCaseSensitive(src, "pace"))
+		req->spec.pace = API_PACE_MAX;
+	if (e == API_OK)
+		e = api_validate_spec(&req->spec, pb);
+	cJSON_Delete(empty);
+	return e;
+}
+
 api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb)
 {
 	static const char *const members[] = {"session", "schedule",
 					      "beta_rate", NULL};
-	static const char *const session_members[] = {
-		"preset", "params", "scene", "integrator", "pace",
-		"sample_rate", NULL};
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_object(body, len, 0, pb);
+	cJSON *root = api_parse_body(body, len, 0, members, pb);
 	if (!root)
 		return pb->code;
-	api_err e = api_check_members(root, members, "", pb);
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
 	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
 	const cJSON *rate = cJSON_GetObjectItemCaseSensitive(root, "beta_rate");
-	const cJSON *empty = NULL;
-	if (e == API_OK && sess && cJSON_IsString(sess)) {
-		snprintf(req->session_id, sizeof req->session_id, "%s",
-			 sess->valuestring);
-		if (sim_preset("czubak2016", &req->spec.params,
-			       &req->spec.scene, &req->spec.method) != SIM_OK)
-			e = api_fail(pb, API_UNAVAILABLE, NULL,
-				     "the default preset is missing");
-	} else if (e == API_OK && (!sess || cJSON_IsObject(sess))) {
-		req->fresh = 1;
-		cJSON *obj = sess ? NULL : (cJSON *)(empty = cJSON_CreateObject());
-		const cJSON *src = sess ? sess : obj;
-		e = api_check_members(src, session_members, "session.", pb);
-		if (e == API_OK)
-			e = api_apply_model(src, &req->spec, pb);
-		if (e == API_OK)
-			e = api_apply_session_extras(src, &req->spec, pb);
-		if (e == API_OK &&
-		    !cJSON_GetObjectItemCaseSensitive(src, "pace"))
-			req->spec.pace = API_PACE_MAX;
-		if (e == API_OK)
-			e = api_validate_spec(&req->spec, pb);
-	} else if (e == API_OK) {
-		e = api_fail(pb, API_TYPE, "session",
-			     "session must be a session id or a session "
-			     "body object");
-	}
+	api_err e = parse_session_member(sess, req, pb);
 	if (e == API_OK && rate && !cJSON_IsNull(rate)) {
 		char msg[256] = "";
 		sim_params p = req->spec.params;
@@ -144,7 +152,6 @@ api_err api_parse_experiment(const char *body, size_t len,
 				req->spec.until = prev;
 		}
 	}
-	cJSON_Delete((cJSON *)empty);
 	cJSON_Delete(root);
 	return e;
 }

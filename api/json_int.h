@@ -34,10 +34,12 @@ char *api_print(const cJSON *item);
 /* Print and free the tree; NULL when tree is NULL or out of memory. */
 char *api_print_free(cJSON *item);
 
-/* Parse len bytes as one JSON object (empty or blank text gives {} when
- * empty_ok). Returns the tree or NULL with *pb set (400). */
-cJSON *api_parse_object(const char *body, size_t len, int empty_ok,
-			api_problem *pb);
+/* The prologue of every body parser (body.c): parse len bytes as one JSON
+ * object (empty or blank text gives {} when empty_ok) whose members are all
+ * among the NULL-terminated names. Returns the tree (caller deletes it) or
+ * NULL with *pb set: 400 malformed or not an object, 422 unknown member. */
+cJSON *api_parse_body(const char *body, size_t len, int empty_ok,
+		      const char *const *members, api_problem *pb);
 
 /* The settings-table entry of name in group, or NULL. */
 const sim_setting *api_setting(const char *group, const char *name);
@@ -63,7 +65,7 @@ api_err api_parse_real(const cJSON *it, const char *field, double lo,
 api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
 				 api_problem *pb);
 /* Every member of obj must be one of the NULL-terminated names (422
- * naming prefix + member otherwise). */
+ * naming prefix + member otherwise). body.c. */
 api_err api_check_members(const cJSON *obj, const char *const *names,
 			  const char *prefix, api_problem *pb);
 /* sim_validate on the spec, as a 422 problem. */

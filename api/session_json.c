@@ -55,12 +55,12 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 					      "omega_ss", "running",   "motor_on",
 					      "pace",     "until",     NULL};
 	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_object(body, len, 0, pb);
+	cJSON *root = api_parse_body(body, len, 0, members, pb);
 	if (!root)
 		return pb->code;
-	api_err e = api_check_members(root, members, "", pb);
+	api_err e = API_OK;
 	const cJSON *it;
-	if (e == API_OK && !root->child)
+	if (!root->child)
 		e = api_fail(pb, API_INVALID, NULL,
 			     "no change given; expected any of beta, "
 			     "beta_rate, rotation, omega_ss, running, "

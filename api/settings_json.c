@@ -254,31 +254,6 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
 	return API_OK;
 }
 
-/* Every member of obj must be one of the NULL-terminated names. */
-api_err api_check_members(const cJSON *obj, const char *const *names,
-			  const char *prefix, api_problem *pb)
-{
-	for (const cJSON *it = obj->child; it; it = it->next) {
-		int known = 0;
-		for (size_t i = 0; names[i] && !known; i++)
-			known = strcmp(it->string, names[i]) == 0;
-		if (!known) {
-			char field[64], list[256] = "";
-			snprintf(field, sizeof field, "%s%s", prefix,
-				 it->string);
-			size_t at = 0;
-			for (size_t i = 0; names[i] && at < sizeof list; i++)
-				at += (size_t)snprintf(list + at,
-						       sizeof list - at, "%s%s",
-						       i ? ", " : "", names[i]);
-			return api_fail(pb, API_UNKNOWN, field,
-					"unknown member \"%.40s\"; expected "
-					"any of: %s", it->string, list);
-		}
-	}
-	return API_OK;
-}
-
 api_err api_validate_spec(api_spec *spec, api_problem *pb)
 {
 	char msg[256] = "";
@@ -297,12 +272,10 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 		"preset", "params", "scene", "integrator", "pace", "until",
 		"sample_rate", NULL};
 	memset(spec, 0, sizeof *spec);
-	cJSON *root = api_parse_object(body, len, 1, pb);
+	cJSON *root = api_parse_body(body, len, 1, members, pb);
 	if (!root)
 		return pb->code;
-	api_err e = api_check_members(root, members, "", pb);
-	if (e == API_OK)
-		e = api_apply_model(root, spec, pb);
+	api_err e = api_apply_model(root, spec, pb);
 	if (e == API_OK)
 		e = api_apply_session_extras(root, spec, pb);
 	if (e == API_OK)

@@ -148,12 +148,10 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 					      "integrator", "beta", "rotations",
 					      "t_end", NULL};
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_object(body, len, 1, pb);
+	cJSON *root = api_parse_body(body, len, 1, members, pb);
 	if (!root)
 		return pb->code;
-	api_err e = api_check_members(root, members, "", pb);
-	if (e == API_OK)
-		e = api_apply_model(root, &req->spec, pb);
+	api_err e = api_apply_model(root, &req->spec, pb);
 	if (e == API_OK)
 		e = api_validate_spec(&req->spec, pb);
 	req->t_end = 5.0;

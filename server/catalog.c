@@ -1,16 +1,24 @@
 /*
  * catalog.c - the daemon's read-only resources: presets and the settings
- * table, health, and the OpenAPI document (built once, on first use).
+ * table, health, /metrics (the gauges gathered here, the text by
+ * metrics.c) and the OpenAPI document (built once, on first use).
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "srv.h"
+#include <pthread.h>
+
+#include "catalog.h"
+#include "metrics.h"
+#include "pool.h"
+#include "session.h"
+#include "util.h"
 
 static pthread_once_t openapi_once = PTHREAD_ONCE_INIT;
 static char *openapi_text;
 static double started;
+static const srv_config *cfg;
 
 static void build_openapi(void)
 {
@@ -37,23 +45,35 @@ enum MHD_Result srv_h_presets(srv_req *r)
 	return srv_reply_json(r, 200, api_presets_json());
 }
 
-void srv_catalog_init(void)
+void srv_catalog_init(const srv_config *config)
 {
+	cfg = config;
 	started = srv_now();
 }
 
 enum MHD_Result srv_h_health(srv_req *r)
 {
 	api_health h = {
-		.status = atomic_load(&srv_stopping) ? "stopping" : "ok",
+		.status = srv_stopping() ? "stopping" : "ok",
 		.uptime = srv_now() - started,
 		.sessions = (int)srv_session_count(),
-		.max_sessions = srv_cfg.max_sessions,
+		.max_sessions = cfg->max_sessions,
 		.stream_clients = atomic_load(&srv_stats.stream_clients),
-		.max_streams = srv_cfg.max_streams,
-		.pool_threads = srv_cfg.pool_threads,
+		.max_streams = cfg->max_streams,
+		.pool_threads = cfg->pool_threads,
 		.pool_queued = srv_pool_queued(),
 	};
-	return srv_reply_json(r, atomic_load(&srv_stopping) ? 503 : 200,
+	return srv_reply_json(r, srv_stopping() ? 503 : 200,
 			      api_health_json(&h));
+}
+
+enum MHD_Result srv_h_metrics(srv_req *r)
+{
+	srv_gauges g = {
+		.sessions = (double)srv_session_count(),
+		.steps_per_s = srv_sessions_steps_per_s(),
+		.pool_queued = (double)srv_pool_queued(),
+	};
+	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
+			 srv_metrics_text(&g), NULL, NULL);
 }

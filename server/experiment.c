@@ -1,30 +1,37 @@
 /*
- * experiment.c - the beta-schedule experiment (POST /api/v1/experiments).
+ * experiment.c - the beta-schedule experiment (POST /api/v1/experiments)
+ * as its session's worker runs it.
  *
- * An experiment rides on one session's worker: at each segment start the
- * worker commands the segment's beta, restarts the core's transport
- * estimator (sim_restart_transport) and notes sim_effective_time() as the
- * command time; after every advance it records the per-period feed
- * velocity (sim_status.feed_velocity). When a segment ends, its steady
- * velocity is the mean feed velocity over the segment's second half and
- * its reversal time runs from the command until the feed velocity first
- * reaches 90 % of that steady value. Fields the worker writes are guarded
- * by exp_lock, taken after the session lock; handlers read under
- * exp_lock only. Experiments are kept until shutdown (the oldest finished
- * ones are evicted beyond --max-experiments).
+ * At each segment start the experiment hands the worker a command: the
+ * segment's beta, then a restart of the core's transport estimator
+ * (sim_restart_transport); the worker applies it between steps like any
+ * PATCH and reports sim_effective_time() as the command time, or the
+ * core's refusal, which aborts the experiment with that error. After every
+ * advance it records the per-period feed velocity (sim_status.
+ * feed_velocity). When a segment ends, its steady velocity is the mean
+ * feed velocity over the segment's second half and its reversal time runs
+ * from the command until the feed velocity first reaches 90 % of that
+ * steady value. Fields are guarded by the experiment's lock, taken inside
+ * the session lock by the worker's hooks and alone by the handlers (lock
+ * order: registry.h).
  */
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "srv.h"
+#include "experiment.h"
+#include "util.h"
 
 enum { EXP_WAITING, EXP_RUNNING, EXP_DONE, EXP_ABORTED };
 
 struct srv_experiment {
-	char id[24];
-	char session_id[24];
+	srv_entry entry;         /* id and references: experiment_http.c */
+	const char *data_dir;    /* borrowed; NULL: results are not saved */
+	pthread_mutex_t lock;
+	/* guarded by lock */
+	char session_id[SRV_ID_LEN];
 	api_experiment_req req;  /* schedule and per-segment results */
 	int state;
 	int attached;            /* a session worker still refers to it */
@@ -34,71 +41,100 @@ struct srv_experiment {
 	double *rec_t, *rec_v;   /* feed velocity record */
 	size_t rec_n, rec_cap, seg_first;
 	double rec_spacing;      /* s between records, at least */
-	srv_experiment *next;
+	srv_cmd cmd;             /* the running segment's command */
 };
 
 #define EXP_RECORDS 50000
-
-static pthread_mutex_t exp_lock = PTHREAD_MUTEX_INITIALIZER;
-static srv_experiment *exp_head;
-static int exp_count;
-
-void srv_experiments_init(void)
-{
-	exp_head = NULL;
-	exp_count = 0;
-}
-
-static void exp_free(srv_experiment *e)
-{
-	if (!e)
-		return;
-	free(e->rec_t);
-	free(e->rec_v);
-	free(e);
-}
-
-void srv_experiments_shutdown(void)
-{
-	pthread_mutex_lock(&exp_lock);
-	while (exp_head) {
-		srv_experiment *e = exp_head;
-		exp_head = e->next;
-		exp_free(e);
-	}
-	exp_count = 0;
-	pthread_mutex_unlock(&exp_lock);
-}
-
-const char *srv_exp_id(const srv_experiment *e)
-{
-	return e->id;
-}
 
 static double exp_end(const srv_experiment *e)
 {
 	return e->req.seg[e->req.nseg - 1].until;
 }
 
-static void start_segment(srv_experiment *e, int i, sim *sm,
-			  const sim_status *st, srv_session *s)
+srv_experiment *srv_exp_new(const api_experiment_req *req,
+			    const char *data_dir, api_problem *pb)
+{
+	srv_experiment *e = calloc(1, sizeof *e);
+	if (!e) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
+	e->req = *req;
+	e->data_dir = data_dir;
+	e->attached = 1;
+	pthread_mutex_init(&e->lock, NULL);
+	double dur = exp_end(e);
+	e->rec_cap = EXP_RECORDS;
+	e->rec_spacing = dur / EXP_RECORDS;
+	e->rec_t = malloc(e->rec_cap * sizeof(double));
+	e->rec_v = malloc(e->rec_cap * sizeof(double));
+	if (!e->rec_t || !e->rec_v) {
+		srv_exp_free(e);
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
+	return e;
+}
+
+void srv_exp_free(srv_experiment *e)
+{
+	if (!e)
+		return;
+	free(e->rec_t);
+	free(e->rec_v);
+	pthread_mutex_destroy(&e->lock);
+	free(e);
+}
+
+srv_entry *srv_exp_entry(srv_experiment *e)
+{
+	return &e->entry;
+}
+
+srv_experiment *srv_exp_from_entry(srv_entry *en)
+{
+	return SRV_CONTAINER(en, srv_experiment, entry);
+}
+
+const char *srv_exp_id(const srv_experiment *e)
+{
+	return e->entry.id;
+}
+
+void srv_exp_set_session(srv_experiment *e, const char *session_id)
+{
+	pthread_mutex_lock(&e->lock);
+	snprintf(e->session_id, sizeof e->session_id, "%s", session_id);
+	pthread_mutex_unlock(&e->lock);
+}
+
+int srv_exp_finished(srv_experiment *e)
+{
+	pthread_mutex_lock(&e->lock);
+	int over = !e->attached && e->state >= EXP_DONE;
+	pthread_mutex_unlock(&e->lock);
+	return over;
+}
+
+/* Start segment i at status st (lock held): its command for the worker. */
+static srv_cmd *start_segment(srv_experiment *e, int i, const sim_status *st)
 {
 	api_segment *seg = &e->req.seg[i];
-	api_control c = {.set = API_C_BETA, .beta = seg->beta};
+	srv_cmd *cmd = &e->cmd;
+	memset(cmd, 0, sizeof *cmd);
+	cmd->c.set = API_C_BETA;
+	cmd->c.beta = seg->beta;
 	if (e->req.beta_rate > 0) {
-		c.set |= API_C_BETA_RATE;
-		c.beta_rate = e->req.beta_rate;
+		cmd->c.set |= API_C_BETA_RATE;
+		cmd->c.beta_rate = e->req.beta_rate;
 	}
-	seg->t_command = sim_effective_time(sm);
-	sim_set_beta(sm, seg->beta, e->req.beta_rate);
-	sim_restart_transport(sm);
+	cmd->restart_transport = 1;
+	cmd->from_experiment = 1;
 	seg->start_velocity = st->feed_velocity;
 	seg->state = 1;
 	e->cur = i;
 	e->seg_first = e->rec_n;
-	char json[API_EVENT_MAX];
-	api_control_event(json, sizeof json, &c, seg->t_command);
-	srv_session_push_event(s, "control", json);
+	return cmd;
 }
 
 static void finish_segment(srv_experiment *e, const sim_status *st)
@@ -130,7 +166,7 @@ static void finish_segment(srv_experiment *e, const sim_status *st)
 	seg->state = 2;
 }
 
-/* The feed-velocity record is only needed while running (exp_lock held). */
+/* The feed-velocity record is only needed while running (lock held). */
 static void drop_record(srv_experiment *e)
 {
 	free(e->rec_t);
@@ -139,12 +175,13 @@ static void drop_record(srv_experiment *e)
 	e->rec_n = e->rec_cap = 0;
 }
 
+/* The view of e (lock held); v->seg borrows e's segments. */
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
 	static const char *const names[] = {"waiting", "running", "done",
 					    "aborted"};
 	memset(v, 0, sizeof *v);
-	snprintf(v->id, sizeof v->id, "%s", e->id);
+	snprintf(v->id, sizeof v->id, "%s", e->entry.id);
 	snprintf(v->session_id, sizeof v->session_id, "%s", e->session_id);
 	v->state = names[e->state];
 	snprintf(v->error, sizeof v->error, "%s", e->error);
@@ -158,34 +195,37 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 
 static void save_results(const srv_experiment *e)
 {
-	if (!srv_cfg.data_dir)
+	if (!e->data_dir)
 		return;
 	api_experiment_view v;
 	fill_view(e, &v);
 	char *text = api_experiment_json(&v);
-	char path[4096];
-	snprintf(path, sizeof path, "%s/experiment-%s.json", srv_cfg.data_dir,
-		 e->id);
-	FILE *f = text ? fopen(path, "w") : NULL;
-	if (f) {
-		fputs(text, f);
-		fputc('\n', f);
-		fclose(f);
-	} else {
-		srv_log(SRV_LOG_WARN, "cannot write %s", path);
-	}
+	char name[64];
+	snprintf(name, sizeof name, "experiment-%s.json", e->entry.id);
+	srv_write_file(e->data_dir, name, text, 1);
 	free(text);
 }
 
-void srv_exp_begin(srv_experiment *e, sim *sm, const sim_status *st,
-		   srv_session *s)
+void srv_exp_view(srv_experiment *e, api_experiment_view *v,
+		  api_segment *seg)
 {
-	pthread_mutex_lock(&exp_lock);
+	pthread_mutex_lock(&e->lock);
+	fill_view(e, v);
+	memcpy(seg, e->req.seg, (size_t)e->req.nseg * sizeof *seg);
+	pthread_mutex_unlock(&e->lock);
+	v->seg = seg;
+}
+
+srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
+		       double *t_end)
+{
+	pthread_mutex_lock(&e->lock);
 	e->t0 = e->t_now = st->t;
 	e->state = EXP_RUNNING;
-	srv_session_extend(s, e->t0 + exp_end(e));
-	start_segment(e, 0, sm, st, s);
-	pthread_mutex_unlock(&exp_lock);
+	*t_end = e->t0 + exp_end(e);
+	srv_cmd *cmd = start_segment(e, 0, st);
+	pthread_mutex_unlock(&e->lock);
+	return cmd;
 }
 
 double srv_exp_boundary(const srv_experiment *e)
@@ -195,11 +235,11 @@ double srv_exp_boundary(const srv_experiment *e)
 	return e->t0 + e->req.seg[e->cur].until;
 }
 
-int srv_exp_step(srv_experiment *e, sim *sm, const sim_status *st,
-		 srv_session *s)
+srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 {
-	int over = 0;
-	pthread_mutex_lock(&exp_lock);
+	srv_cmd *cmd = NULL;
+	*over = 0;
+	pthread_mutex_lock(&e->lock);
 	e->t_now = st->t;
 	if (isfinite(st->feed_velocity) && e->rec_n < e->rec_cap &&
 	    (e->rec_n == 0 ||
@@ -210,155 +250,52 @@ int srv_exp_step(srv_experiment *e, sim *sm, const sim_status *st,
 	if (st->t >= srv_exp_boundary(e) - 1e-9) {
 		finish_segment(e, st);
 		if (e->cur + 1 < e->req.nseg) {
-			start_segment(e, e->cur + 1, sm, st, s);
+			cmd = start_segment(e, e->cur + 1, st);
 		} else {
 			e->state = EXP_DONE;
 			e->attached = 0;
 			drop_record(e);
 			save_results(e);
-			over = 1;
+			*over = 1;
 		}
 	}
-	pthread_mutex_unlock(&exp_lock);
-	return over;
+	pthread_mutex_unlock(&e->lock);
+	return cmd;
 }
 
-void srv_exp_abort(srv_experiment *e, const char *why)
+/* Abort (lock held): the state and the error, the record dropped. */
+static void abort_locked(srv_experiment *e, const char *why)
 {
-	pthread_mutex_lock(&exp_lock);
 	if (e->state == EXP_WAITING || e->state == EXP_RUNNING) {
 		e->state = EXP_ABORTED;
 		snprintf(e->error, sizeof e->error, "%s", why);
 	}
 	e->attached = 0;
 	drop_record(e);
-	pthread_mutex_unlock(&exp_lock);
 }
 
-/* Make room for one more (exp_lock held): evict the oldest finished. */
-static int make_room(void)
+int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 {
-	if (exp_count < srv_cfg.max_experiments)
-		return 1;
-	srv_experiment **pp = &exp_head, **victim = NULL;
-	for (; *pp; pp = &(*pp)->next)
-		if (!(*pp)->attached && (*pp)->state >= EXP_DONE)
-			victim = pp; /* list is newest first: last is oldest */
-	if (!victim)
-		return 0;
-	srv_experiment *v = *victim;
-	*victim = v->next;
-	exp_free(v);
-	exp_count--;
-	return 1;
-}
-
-enum MHD_Result srv_h_experiments_create(srv_req *r)
-{
-	enum MHD_Result res;
-	api_problem pb;
-	if (!srv_need_json(r, 0, &res))
-		return res;
-	srv_experiment *e = calloc(1, sizeof *e);
-	if (!e)
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	if (api_parse_experiment(r->body, r->body_len, &e->req, &pb) !=
-	    API_OK) {
-		exp_free(e);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	double dur = exp_end(e);
-	e->rec_cap = EXP_RECORDS;
-	e->rec_spacing = dur / EXP_RECORDS;
-	e->rec_t = malloc(e->rec_cap * sizeof(double));
-	e->rec_v = malloc(e->rec_cap * sizeof(double));
-	pthread_mutex_lock(&exp_lock);
-	int room = make_room();
-	if (room)
-		exp_count++; /* reserve */
-	pthread_mutex_unlock(&exp_lock);
-	if (!room) {
-		exp_free(e);
-		return srv_fail(r, API_LIMIT, NULL,
-				"%d experiments are running or kept "
-				"(--max-experiments)", srv_cfg.max_experiments);
-	}
-	if (!e->rec_t || !e->rec_v) {
-		api_fail(&pb, API_UNAVAILABLE, NULL, "out of memory");
-		goto fail;
-	}
-	srv_new_id(e->id);
-	e->attached = 1;
-	srv_session *s;
-	if (e->req.fresh) {
-		s = srv_session_create(&e->req.spec, e, &pb);
-		if (!s)
-			goto fail;
+	pthread_mutex_lock(&e->lock);
+	api_segment *seg = &e->req.seg[e->cur];
+	int refused = cmd->rc != SIM_OK;
+	if (refused) {
+		char why[200];
+		snprintf(why, sizeof why,
+			 "segment %d: the session refused beta = %g deg: %s",
+			 e->cur, seg->beta, sim_strerror(cmd->rc));
+		srv_log(SRV_LOG_WARN, "experiment %s: %s", e->entry.id, why);
+		abort_locked(e, why);
 	} else {
-		s = srv_session_get(e->req.session_id);
-		if (!s) {
-			api_fail(&pb, API_NOTFOUND, "session",
-				 "no session with id \"%.40s\"",
-				 e->req.session_id);
-			goto fail;
-		}
-		if (srv_session_attach(s, e, &pb) != API_OK) {
-			srv_session_put(s);
-			goto fail;
-		}
+		seg->t_command = cmd->t_eff;
 	}
-	snprintf(e->session_id, sizeof e->session_id, "%s",
-		 srv_session_id(s));
-	srv_session_put(s);
-	atomic_fetch_add(&srv_stats.experiments, 1);
-	api_experiment_view v;
-	char location[96];
-	pthread_mutex_lock(&exp_lock);
-	e->next = exp_head;
-	exp_head = e;
-	fill_view(e, &v);
-	char *text = api_experiment_json(&v);
-	pthread_mutex_unlock(&exp_lock);
-	snprintf(location, sizeof location, "/api/v1/experiments/%s", e->id);
-	return srv_reply(r, 201, "application/json", text,
-			 MHD_HTTP_HEADER_LOCATION, location);
-fail:
-	pthread_mutex_lock(&exp_lock);
-	exp_count--;
-	pthread_mutex_unlock(&exp_lock);
-	exp_free(e);
-	return srv_reply_problem(r, &pb, NULL);
+	pthread_mutex_unlock(&e->lock);
+	return refused;
 }
 
-enum MHD_Result srv_h_experiment_get(srv_req *r)
+void srv_exp_abort(srv_experiment *e, const char *why)
 {
-	char *text = NULL;
-	int found = 0;
-	pthread_mutex_lock(&exp_lock);
-	for (srv_experiment *e = exp_head; e; e = e->next)
-		if (strcmp(e->id, r->arg[0]) == 0) {
-			api_experiment_view v;
-			fill_view(e, &v);
-			text = api_experiment_json(&v);
-			found = 1;
-			break;
-		}
-	pthread_mutex_unlock(&exp_lock);
-	if (!found)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no experiment with id \"%.40s\"", r->arg[0]);
-	return srv_reply_json(r, 200, text);
-}
-
-enum MHD_Result srv_h_experiments_list(srv_req *r)
-{
-	pthread_mutex_lock(&exp_lock);
-	api_experiment_view *v = calloc((size_t)exp_count + 1, sizeof *v);
-	size_t n = 0;
-	for (srv_experiment *e = exp_head; v && e; e = e->next)
-		fill_view(e, &v[n++]);
-	char *text = v ? api_experiment_list_json(v, n) : NULL;
-	pthread_mutex_unlock(&exp_lock);
-	free(v);
-	return srv_reply_json(r, 200, text);
+	pthread_mutex_lock(&e->lock);
+	abort_locked(e, why);
+	pthread_mutex_unlock(&e->lock);
 }

@@ -3,12 +3,13 @@
  *
  * Counters are atomics bumped where things happen (requests by status,
  * steps, stream records, dropped samples); gauges (sessions, stream
- * clients, steps per second) are read when scraped.
+ * clients, steps per second) are read when scraped: the caller hands in
+ * the ones other modules own, so this file calls nothing of server/.
  */
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "srv.h"
+#include "metrics.h"
 
 srv_metrics srv_stats;
 static atomic_ullong by_status[600];
@@ -28,7 +29,7 @@ static void metric(FILE *f, const char *name, const char *type,
 		type, name, value);
 }
 
-char *srv_metrics_text(void)
+char *srv_metrics_text(const srv_gauges *g)
 {
 	char *text = NULL;
 	size_t len = 0;
@@ -36,7 +37,7 @@ char *srv_metrics_text(void)
 	if (!f)
 		return NULL;
 	metric(f, "convsim_sessions", "gauge", "Live simulation sessions.",
-	       (double)srv_session_count());
+	       g->sessions);
 	metric(f, "convsim_sessions_created_total", "counter",
 	       "Sessions created.", (double)srv_stats.sessions_created);
 	metric(f, "convsim_sessions_deleted_total", "counter",
@@ -46,7 +47,7 @@ char *srv_metrics_text(void)
 	       (double)srv_stats.steps);
 	metric(f, "convsim_steps_per_second", "gauge",
 	       "Integrator steps per wall second, summed over sessions.",
-	       srv_sessions_steps_per_s());
+	       g->steps_per_s);
 	metric(f, "convsim_stream_clients", "gauge",
 	       "Open stream connections.",
 	       (double)atomic_load(&srv_stats.stream_clients));
@@ -64,7 +65,7 @@ char *srv_metrics_text(void)
 	       "Sweep points measured.", (double)srv_stats.sweep_points);
 	metric(f, "convsim_pool_queued", "gauge",
 	       "Sweep jobs waiting for a pool thread.",
-	       (double)srv_pool_queued());
+	       g->pool_queued);
 	fprintf(f, "# HELP convsim_http_requests_total HTTP responses by "
 		   "status.\n# TYPE convsim_http_requests_total counter\n");
 	for (int s = 100; s < 600; s++) {
@@ -76,10 +77,4 @@ char *srv_metrics_text(void)
 	}
 	fclose(f);
 	return text;
-}
-
-enum MHD_Result srv_h_metrics(srv_req *r)
-{
-	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
-			 srv_metrics_text(), NULL, NULL);
 }

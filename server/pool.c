@@ -2,12 +2,13 @@
  * pool.c - a fixed pool of worker threads for sweep points.
  *
  * Jobs are fn(arg) pairs on a FIFO list. Stopping lets the threads drain
- * what is queued (jobs check srv_stopping and return at once), then joins
+ * what is queued (jobs check srv_stopping() and return at once), then joins
  * them, so every job runs exactly once and owners can count on it.
  */
+#include <pthread.h>
 #include <stdlib.h>
 
-#include "srv.h"
+#include "pool.h"
 
 typedef struct job {
 	void (*fn)(void *);

@@ -12,7 +12,9 @@
 #include <string.h>
 #include <strings.h>
 
-#include "srv.h"
+#include "metrics.h"
+#include "reply.h"
+#include "util.h"
 
 enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp)
 {
@@ -49,6 +51,22 @@ enum MHD_Result srv_reply(srv_req *r, int status, const char *ctype,
 enum MHD_Result srv_reply_json(srv_req *r, int status, char *text)
 {
 	return srv_reply(r, status, "application/json", text, NULL, NULL);
+}
+
+enum MHD_Result srv_reply_created(srv_req *r, int status, char *text,
+				  const char *prefix, const char *id)
+{
+	char location[96];
+	snprintf(location, sizeof location, "%s/%s", prefix, id);
+	return srv_reply(r, status, "application/json", text,
+			 MHD_HTTP_HEADER_LOCATION, location);
+}
+
+enum MHD_Result srv_reply_empty(srv_req *r)
+{
+	struct MHD_Response *resp =
+		MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT);
+	return srv_queue(r, 204, resp);
 }
 
 enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
@@ -120,4 +138,20 @@ int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result)
 			   "application/json (got \"%.60s\")",
 			   ct ? ct : "none");
 	return 0;
+}
+
+int srv_table_format(srv_req *r, api_problem *pb)
+{
+	const char *f = srv_query(r, "format");
+	if (f) {
+		if (strcmp(f, "json") == 0)
+			return 0;
+		if (strcmp(f, "csv") == 0)
+			return 1;
+		api_fail(pb, API_QUERY, "format",
+			 "format must be json or csv (got \"%.40s\")", f);
+		return -1;
+	}
+	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
+	return accept && strstr(accept, "text/csv") ? 1 : 0;
 }

@@ -15,7 +15,14 @@
 #include <string.h>
 #include <strings.h>
 
-#include "srv.h"
+#include "catalog.h"
+#include "experiment_http.h"
+#include "routes.h"
+#include "session_http.h"
+#include "static.h"
+#include "stream.h"
+#include "sweep.h"
+#include "util.h"
 
 typedef struct route {
 	const char *method;
@@ -43,6 +50,13 @@ static const route routes[] = {
 	{"GET", "/api/v1/openapi.json", srv_h_openapi},
 	{"GET", "/metrics", srv_h_metrics},
 };
+
+static const srv_config *cfg;
+
+void srv_routes_init(const srv_config *config)
+{
+	cfg = config;
+}
 
 typedef struct req_state {
 	srv_req r;
@@ -156,20 +170,20 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->r.json_body = ct && json_type(ct);
 		const char *cl = MHD_lookup_connection_value(
 			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-		if (cl && strtoull(cl, NULL, 10) > srv_cfg.max_body) {
+		if (cl && strtoull(cl, NULL, 10) > cfg->max_body) {
 			/* refuse before reading the body */
 			st->r.body = "";
 			return srv_fail(&st->r, API_TOOLARGE, NULL,
 					"the body has %s bytes; the limit is "
 					"%zu (--max-body)", cl,
-					srv_cfg.max_body);
+					cfg->max_body);
 		}
 		return MHD_YES;
 	}
 	if (*upload_data_size) {
 		size_t n = *upload_data_size;
 		*upload_data_size = 0;
-		if (st->too_large || st->len + n > srv_cfg.max_body) {
+		if (st->too_large || st->len + n > cfg->max_body) {
 			st->too_large = 1;
 			return MHD_YES;
 		}
@@ -193,8 +207,8 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 	if (st->too_large)
 		return srv_fail(&st->r, API_TOOLARGE, NULL,
 				"the body exceeds the limit of %zu bytes "
-				"(--max-body)", srv_cfg.max_body);
-	if (atomic_load(&srv_stopping) && strncmp(url, "/api/", 5) == 0)
+				"(--max-body)", cfg->max_body);
+	if (srv_stopping() && strncmp(url, "/api/", 5) == 0)
 		return srv_fail(&st->r, API_UNAVAILABLE, NULL,
 				"the daemon is shutting down");
 	return route_request(&st->r);

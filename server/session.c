@@ -1,13 +1,13 @@
 /*
- * session.c - sessions: registry, lifetime, views, the control queue
- * entry point and read access to the record ring and history.
+ * session.c - sessions: registry, lifetime, views, the control entry point
+ * and the snapshot readers of the record ring and history.
  *
- * Sessions live in a registry (a list under reg_lock) and are reference
- * counted: the registry, each handler while it works and each stream
- * hold one. Handlers never call the core: controls go through the
- * worker's command queue (worker.c) and wait for its acknowledgement;
- * everything else is read from what the worker publishes under the
- * session lock. Lock order: registry lock before any session lock.
+ * Sessions live in a registry (registry.c) and are reference counted: the
+ * registry, each handler while it works and each stream hold one. Handlers
+ * never call the core: controls go through the worker's command queue
+ * (worker.c) and wait for its acknowledgement; everything else is read
+ * from what the worker publishes under the session lock, which never
+ * leaves this file and worker.c. Lock order: see registry.h.
  */
 #include <errno.h>
 #include <math.h>
@@ -15,16 +15,19 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "experiment.h"
+#include "metrics.h"
 #include "session_int.h"
+#include "util.h"
 
-static pthread_mutex_t reg_lock = PTHREAD_MUTEX_INITIALIZER;
-static srv_session *reg_head;
-static size_t reg_count; /* sessions in the registry or being created */
+static void destroy(srv_entry *en);
+static srv_registry sessions = SRV_REGISTRY_INIT(destroy);
+static const srv_config *cfg;
 
-void srv_sessions_init(void)
+void srv_sessions_init(const srv_config *config)
 {
-	reg_head = NULL;
-	reg_count = 0;
+	cfg = config;
+	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
 }
 
 int srv_sample_alloc(api_sample *rec, int columns, int layers)
@@ -82,27 +85,40 @@ static void session_free(srv_session *s)
 	free(s);
 }
 
-static void stop_worker(srv_session *s)
+/* Tell the worker to stop and every waiter to look again. */
+static void signal_stop(srv_session *s)
 {
 	pthread_mutex_lock(&s->lock);
 	s->stop = 1;
 	pthread_cond_broadcast(&s->wake);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
+}
+
+static void stop_worker(srv_session *s)
+{
+	signal_stop(s);
 	if (s->worker_started) {
 		pthread_join(s->worker, NULL);
 		s->worker_started = 0;
 	}
 }
 
+static void destroy(srv_entry *en)
+{
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	stop_worker(s);
+	session_free(s);
+}
+
 static int alloc_buffers(srv_session *s)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	s->ring_cap = srv_cfg.ring > 16 ? (size_t)srv_cfg.ring : 16;
+	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
 	s->ring = calloc(s->ring_cap, sizeof *s->ring);
 	s->ring_store = calloc(per ? s->ring_cap * per : 1, sizeof(double));
-	s->hist_cap = srv_cfg.history > 16 ? (size_t)srv_cfg.history : 16;
+	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
 	s->hist = calloc(s->hist_cap * API_HISTORY_COLS, sizeof(double));
 	if (!s->ring || !s->ring_store || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
@@ -121,41 +137,23 @@ static int alloc_buffers(srv_session *s)
 	return 0;
 }
 
-srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
-				api_problem *pb)
+/* Build s for spec: its sim instance, the initial status and the buffers
+ * (lock and conditions are initialised). 0, or -1 with *pb. */
+static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 {
-	pthread_mutex_lock(&reg_lock);
-	if (reg_count >= (size_t)srv_cfg.max_sessions) {
-		pthread_mutex_unlock(&reg_lock);
-		api_fail(pb, API_LIMIT, NULL,
-			 "%d sessions exist, the limit (--max-sessions); "
-			 "delete one first", srv_cfg.max_sessions);
-		return NULL;
-	}
-	reg_count++;
-	pthread_mutex_unlock(&reg_lock);
-
 	char msg[256] = "";
 	int err = SIM_OK;
-	srv_session *s = calloc(1, sizeof *s);
-	if (!s) {
-		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
-		goto fail_count;
-	}
 	s->spec = *spec;
 	s->created = srv_unix_time();
 	s->pace = spec->pace;
 	s->until = spec->until;
 	s->state = SRV_RUNNING;
-	pthread_mutex_init(&s->lock, NULL);
-	pthread_cond_init(&s->wake, NULL);
-	pthread_cond_init(&s->data, NULL);
 	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
 			 sizeof msg);
 	if (!s->sim) {
 		api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
 			 msg[0] ? msg : sim_strerror(err));
-		goto fail;
+		return -1;
 	}
 	/* the worker has not run yet: publish the initial state ourselves so
 	 * that the 201 answer shows beta, rotation and the equilibrium */
@@ -166,126 +164,82 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 	}
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
-		goto fail;
+		return -1;
 	}
-	s->exp = exp;
-	s->refs = 2; /* the registry's and the caller's */
+	return 0;
+}
 
-	pthread_mutex_lock(&reg_lock);
-	for (;;) { /* an id no live session has */
-		srv_new_id(s->id);
-		srv_session *o = reg_head;
-		while (o && strcmp(o->id, s->id) != 0)
-			o = o->next;
-		if (!o)
-			break;
-	}
-	s->next = reg_head;
-	reg_head = s;
-	pthread_mutex_unlock(&reg_lock);
-
-	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
-		pthread_mutex_lock(&reg_lock);
-		srv_session **pp = &reg_head;
-		while (*pp != s)
-			pp = &(*pp)->next;
-		*pp = s->next;
-		reg_count--;
-		pthread_mutex_unlock(&reg_lock);
-		api_fail(pb, API_UNAVAILABLE, NULL,
-			 "cannot start the session's worker thread");
-		session_free(s);
+srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
+				api_problem *pb)
+{
+	srv_session *s = calloc(1, sizeof *s);
+	if (!s) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
+	pthread_mutex_init(&s->lock, NULL);
+	pthread_cond_init(&s->wake, NULL);
+	pthread_cond_init(&s->data, NULL);
+	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
+		session_free(s);
+		api_fail(pb, API_LIMIT, NULL,
+			 "%d sessions exist, the limit (--max-sessions); "
+			 "delete one first", cfg->max_sessions);
+		return NULL;
+	}
+	if (session_init(s, spec, pb))
+		goto fail;
+	s->exp = exp;
+	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
+		api_fail(pb, API_UNAVAILABLE, NULL,
+			 "cannot start the session's worker thread");
+		goto fail;
+	}
 	s->worker_started = 1;
+	srv_registry_publish(&sessions, &s->entry);
 	atomic_fetch_add(&srv_stats.sessions_created, 1);
-	srv_log(SRV_LOG_INFO, "session %s created", s->id);
+	srv_log(SRV_LOG_INFO, "session %s created", s->entry.id);
 	return s;
 fail:
+	srv_registry_cancel(&sessions, &s->entry);
 	session_free(s);
-fail_count:
-	pthread_mutex_lock(&reg_lock);
-	reg_count--;
-	pthread_mutex_unlock(&reg_lock);
 	return NULL;
 }
 
 srv_session *srv_session_get(const char *id)
 {
-	pthread_mutex_lock(&reg_lock);
-	srv_session *s = reg_head;
-	while (s && strcmp(s->id, id) != 0)
-		s = s->next;
-	if (s)
-		s->refs++;
-	pthread_mutex_unlock(&reg_lock);
-	return s;
+	srv_entry *en = srv_registry_get(&sessions, id);
+	return en ? SRV_CONTAINER(en, srv_session, entry) : NULL;
 }
 
 void srv_session_put(srv_session *s)
 {
-	if (!s)
-		return;
-	pthread_mutex_lock(&reg_lock);
-	int last = --s->refs == 0;
-	pthread_mutex_unlock(&reg_lock);
-	if (last) {
-		stop_worker(s);
-		session_free(s);
-	}
-}
-
-/* Unlink from the registry; 0 if someone already did. */
-static int unlink_session(srv_session *s)
-{
-	pthread_mutex_lock(&reg_lock);
-	if (s->removed) {
-		pthread_mutex_unlock(&reg_lock);
-		return 0;
-	}
-	s->removed = 1;
-	srv_session **pp = &reg_head;
-	while (*pp && *pp != s)
-		pp = &(*pp)->next;
-	if (*pp)
-		*pp = s->next;
-	reg_count--;
-	pthread_mutex_unlock(&reg_lock);
-	return 1;
+	if (s)
+		srv_registry_put(&sessions, &s->entry);
 }
 
 void srv_session_delete(srv_session *s)
 {
-	if (!unlink_session(s))
+	if (!srv_registry_remove(&sessions, &s->entry))
 		return;
 	stop_worker(s);
 	atomic_fetch_add(&srv_stats.sessions_deleted, 1);
-	srv_log(SRV_LOG_INFO, "session %s deleted", s->id);
-	srv_session_put(s); /* the registry's reference */
+	srv_log(SRV_LOG_INFO, "session %s deleted", s->entry.id);
 }
 
 void srv_sessions_shutdown(void)
 {
-	/* stop all workers first (in parallel), then drop the references */
-	pthread_mutex_lock(&reg_lock);
-	for (srv_session *s = reg_head; s; s = s->next) {
-		pthread_mutex_lock(&s->lock);
-		s->stop = 1;
-		pthread_cond_broadcast(&s->wake);
-		pthread_cond_broadcast(&s->data);
-		pthread_mutex_unlock(&s->lock);
-	}
-	pthread_mutex_unlock(&reg_lock);
+	/* stop all workers first (in parallel), then delete each */
 	for (;;) {
-		pthread_mutex_lock(&reg_lock);
-		srv_session *s = reg_head;
-		if (s)
-			s->refs++;
-		pthread_mutex_unlock(&reg_lock);
-		if (!s)
+		srv_session **all = NULL;
+		size_t n = srv_sessions_all(&all);
+		for (size_t i = 0; i < n; i++)
+			signal_stop(all[i]);
+		for (size_t i = 0; i < n; i++)
+			srv_session_delete(all[i]);
+		srv_sessions_release(all, n);
+		if (n == 0)
 			break;
-		srv_session_delete(s);
-		srv_session_put(s);
 	}
 }
 
@@ -293,7 +247,7 @@ void srv_sessions_shutdown(void)
 
 const char *srv_session_id(const srv_session *s)
 {
-	return s->id;
+	return s->entry.id;
 }
 
 static const char *state_name(int state)
@@ -306,7 +260,7 @@ static const char *state_name(int state)
 void srv_session_view(srv_session *s, api_view *v)
 {
 	memset(v, 0, sizeof *v);
-	snprintf(v->id, sizeof v->id, "%s", s->id);
+	snprintf(v->id, sizeof v->id, "%s", s->entry.id);
 	v->spec = &s->spec;
 	v->created = s->created;
 	v->columns = s->columns;
@@ -330,42 +284,45 @@ void srv_session_view(srv_session *s, api_view *v)
 
 size_t srv_session_count(void)
 {
-	pthread_mutex_lock(&reg_lock);
-	size_t n = 0;
-	for (srv_session *s = reg_head; s; s = s->next)
-		n++;
-	pthread_mutex_unlock(&reg_lock);
+	return srv_registry_count(&sessions);
+}
+
+size_t srv_sessions_all(srv_session ***out)
+{
+	srv_entry **all = NULL;
+	size_t n = srv_registry_snapshot(&sessions, &all);
+	srv_session **arr = calloc(n ? n : 1, sizeof *arr);
+	if (!arr) {
+		srv_registry_release(&sessions, all, n);
+		n = 0;
+	}
+	for (size_t i = 0; i < n; i++)
+		arr[i] = SRV_CONTAINER(all[i], srv_session, entry);
+	if (arr)
+		free(all);
+	*out = arr;
 	return n;
+}
+
+void srv_sessions_release(srv_session **all, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		srv_session_put(all[i]);
+	free(all);
 }
 
 double srv_sessions_steps_per_s(void)
 {
 	double sum = 0;
-	pthread_mutex_lock(&reg_lock);
-	for (srv_session *s = reg_head; s; s = s->next) {
-		pthread_mutex_lock(&s->lock);
-		sum += s->steps_per_s;
-		pthread_mutex_unlock(&s->lock);
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all);
+	for (size_t i = 0; i < n; i++) {
+		pthread_mutex_lock(&all[i]->lock);
+		sum += all[i]->steps_per_s;
+		pthread_mutex_unlock(&all[i]->lock);
 	}
-	pthread_mutex_unlock(&reg_lock);
+	srv_sessions_release(all, n);
 	return sum;
-}
-
-size_t srv_sessions_all(srv_session ***out)
-{
-	pthread_mutex_lock(&reg_lock);
-	size_t n = 0;
-	for (srv_session *s = reg_head; s; s = s->next)
-		n++;
-	srv_session **arr = calloc(n ? n : 1, sizeof *arr);
-	size_t k = 0;
-	for (srv_session *s = reg_head; arr && s; s = s->next) {
-		s->refs++;
-		arr[k++] = s;
-	}
-	pthread_mutex_unlock(&reg_lock);
-	*out = arr;
-	return arr ? k : 0;
 }
 
 api_err srv_session_control(srv_session *s, const api_control *c,
@@ -394,27 +351,14 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 		pthread_mutex_unlock(&s->lock);
 		return e;
 	}
-	if (s->cmd_tail)
-		s->cmd_tail->next = &cmd;
-	else
-		s->cmd_head = &cmd;
-	s->cmd_tail = &cmd;
-	pthread_cond_broadcast(&s->wake);
+	srv_worker_queue(s, &cmd);
 	struct timespec until = srv_deadline(timeout_s);
 	while (!cmd.done && !s->stop)
 		if (pthread_cond_timedwait(&s->data, &s->lock, &until) ==
 		    ETIMEDOUT)
 			break;
 	if (!cmd.done) { /* take it back: nothing changes */
-		srv_cmd **pp = &s->cmd_head, *prev = NULL;
-		while (*pp && *pp != &cmd) {
-			prev = *pp;
-			pp = &(*pp)->next;
-		}
-		if (*pp)
-			*pp = cmd.next;
-		if (s->cmd_tail == &cmd)
-			s->cmd_tail = prev;
+		srv_worker_unqueue(s, &cmd);
 		pthread_mutex_unlock(&s->lock);
 		return api_fail(pb, API_UNAVAILABLE, NULL,
 				"the session's worker did not take the change "
@@ -452,47 +396,47 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	return rc;
 }
 
-void srv_session_extend(srv_session *s, double t_end)
+/* ---- snapshot readers ----------------------------------------------------- */
+
+/* The ring's bounds and the run state (lock held). */
+static void look(srv_session *s, srv_ring_read *rd)
 {
-	if (s->until > 0 && s->until < t_end)
-		s->until = t_end;
-	if (s->state == SRV_FINISHED && s->st.t < t_end)
-		s->state = SRV_RUNNING;
+	rd->head = s->head;
+	rd->oldest = s->head > s->ring_cap ? s->head - s->ring_cap : 0;
+	rd->state = s->state;
+	rd->removed = s->stop;
+	rd->t = s->st.t;
 }
 
-/* ---- stream access -------------------------------------------------------- */
-
-pthread_mutex_t *srv_session_lock(srv_session *s)
+srv_ring_read srv_session_ring(srv_session *s)
 {
-	return &s->lock;
+	srv_ring_read rd;
+	pthread_mutex_lock(&s->lock);
+	look(s, &rd);
+	pthread_mutex_unlock(&s->lock);
+	return rd;
 }
 
-pthread_cond_t *srv_session_data_cond(srv_session *s)
+void srv_session_read(srv_session *s, uint64_t cursor, api_sample *dst,
+		      srv_ring_read *rd)
 {
-	return &s->data;
+	pthread_mutex_lock(&s->lock);
+	look(s, rd);
+	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
+	if (idx < rd->head)
+		copy_record(dst, &s->ring[idx % s->ring_cap]);
+	pthread_mutex_unlock(&s->lock);
 }
 
-srv_ring_view srv_session_ring(srv_session *s)
+void srv_session_wait(srv_session *s, const srv_ring_read *rd,
+		      double seconds)
 {
-	srv_ring_view v = {s->head,
-			   s->head > s->ring_cap ? s->head - s->ring_cap : 0};
-	return v;
-}
-
-void srv_session_copy(srv_session *s, uint64_t idx, api_sample *dst)
-{
-	copy_record(dst, &s->ring[idx % s->ring_cap]);
-}
-
-int srv_session_state(srv_session *s, int *removed)
-{
-	*removed = s->stop;
-	return s->state;
-}
-
-double srv_session_time(srv_session *s)
-{
-	return s->st.t;
+	pthread_mutex_lock(&s->lock);
+	if (s->head == rd->head && s->state == rd->state && !s->stop) {
+		struct timespec ts = srv_deadline(seconds);
+		pthread_cond_timedwait(&s->data, &s->lock, &ts);
+	}
+	pthread_mutex_unlock(&s->lock);
 }
 
 void srv_session_stream_count(srv_session *s, int delta)

@@ -11,7 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "srv.h"
+#include "session.h"
+#include "session_http.h"
 
 #define CONTROL_TIMEOUT_S 5.0
 
@@ -34,11 +35,9 @@ enum MHD_Result srv_h_sessions_create(srv_req *r)
 	if (!s)
 		return srv_reply_problem(r, &pb, NULL);
 	api_view v;
-	char location[96];
 	srv_session_view(s, &v);
-	snprintf(location, sizeof location, "/api/v1/sessions/%s", v.id);
-	res = srv_reply(r, 201, "application/json", api_session_json(&v, 1),
-			MHD_HTTP_HEADER_LOCATION, location);
+	res = srv_reply_created(r, 201, api_session_json(&v, 1),
+				"/api/v1/sessions", v.id);
 	srv_session_put(s);
 	return res;
 }
@@ -54,9 +53,7 @@ enum MHD_Result srv_h_sessions_list(srv_req *r)
 			srv_session_view(all[i], &views[i]);
 		text = api_session_list_json(views, n);
 	}
-	for (size_t i = 0; i < n; i++)
-		srv_session_put(all[i]);
-	free(all);
+	srv_sessions_release(all, n);
 	free(views);
 	return srv_reply_json(r, 200, text);
 }
@@ -107,9 +104,7 @@ enum MHD_Result srv_h_session_delete(srv_req *r)
 		return not_found(r, r->arg[0]);
 	srv_session_delete(s);
 	srv_session_put(s);
-	struct MHD_Response *resp =
-		MHD_create_response_from_buffer(0, NULL, MHD_RESPMEM_PERSISTENT);
-	return srv_queue(r, 204, resp);
+	return srv_reply_empty(r);
 }
 
 /* A finite number from a query argument; 0 and *pb if malformed. */
@@ -129,22 +124,6 @@ static int query_number(srv_req *r, const char *key, double *out,
 	}
 	*out = x;
 	return 1;
-}
-
-int srv_table_format(srv_req *r, api_problem *pb)
-{
-	const char *f = srv_query(r, "format");
-	if (f) {
-		if (strcmp(f, "json") == 0)
-			return 0;
-		if (strcmp(f, "csv") == 0)
-			return 1;
-		api_fail(pb, API_QUERY, "format",
-			 "format must be json or csv (got \"%.40s\")", f);
-		return -1;
-	}
-	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
-	return accept && strstr(accept, "text/csv") ? 1 : 0;
 }
 
 enum MHD_Result srv_h_trajectory(srv_req *r)

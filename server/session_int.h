@@ -5,22 +5,17 @@
 #ifndef CONVSIM_SESSION_INT_H
 #define CONVSIM_SESSION_INT_H
 
-#include "srv.h"
+#include <math.h>
+#include <pthread.h>
+
+#include "registry.h"
+#include "session.h"
+#include "worker.h"
 
 #define DEG (180.0 / M_PI)
 
-typedef struct srv_cmd {
-	api_control c;
-	int done, rc;
-	double t_eff;
-	struct srv_cmd *next;
-} srv_cmd;
-
 struct srv_session {
-	char id[24];
-	int refs;                 /* registry lock */
-	int removed;              /* registry lock */
-	srv_session *next;        /* registry list */
+	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
 	double created;
 	int columns, layers;      /* feed size, 0 without feed */
@@ -49,10 +44,8 @@ struct srv_session {
 	double hist_stride, hist_next;
 	int streams;
 	srv_experiment *exp;
+	srv_cmd *exp_cmd;         /* the experiment's command while queued */
 	int exp_started;
 };
-
-/* The worker thread's body; arg is the srv_session. */
-void *srv_worker_main(void *arg);
 
 #endif

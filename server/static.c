@@ -13,7 +13,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "srv.h"
+#include "static.h"
+
+static const srv_config *cfg;
+
+void srv_static_init(const srv_config *config)
+{
+	cfg = config;
+}
 
 static const struct {
 	const char *ext, *type;
@@ -64,7 +71,7 @@ enum MHD_Result srv_h_static(srv_req *r)
 	char path[PATH_MAX], root[PATH_MAX], real[PATH_MAX];
 	if (!safe_path(url))
 		return missing(r);
-	if (!realpath(srv_cfg.web_root, root))
+	if (!realpath(cfg->web_root, root))
 		return missing(r);
 	int n = snprintf(path, sizeof path, "%s%s", root, url);
 	if (n < 0 || (size_t)n >= sizeof path || !realpath(path, real))

@@ -3,9 +3,10 @@
  * NDJSON.
  *
  * Each client has a cursor into its session's record ring. The
- * connection's own thread (libmicrohttpd runs one per connection) waits on
- * the session's condition variable for new records, copies them out
- * under the lock one at a time and formats them outside it, so a client
+ * connection's own thread (libmicrohttpd runs one per connection) waits
+ * for new records and copies them out one at a time through session.c's
+ * snapshot readers (srv_session_read, srv_session_wait; it never takes the
+ * session lock itself) and formats them outside the lock, so a client
  * only ever slows itself: the worker overwrites the ring regardless, and
  * a client that fell behind the oldest record gets a "dropped" notice with
  * the number of records it missed, then continues from the oldest one.
@@ -21,7 +22,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "srv.h"
+#include "metrics.h"
+#include "session.h"
+#include "stream.h"
+#include "util.h"
+
+static const srv_config *cfg;
+
+void srv_streams_init(const srv_config *config)
+{
+	cfg = config;
+}
 
 typedef struct stream {
 	srv_session *s;
@@ -36,6 +47,7 @@ typedef struct stream {
 	char *out;
 	size_t out_len, out_pos, out_cap;
 	double last_write;
+	double heartbeat;  /* s */
 	int ended;
 } stream;
 
@@ -47,76 +59,70 @@ static void end_stream(stream *k, const char *reason)
 	k->ended = 1;
 }
 
+/* Format the record just copied into k->rec unless ?rate thins it out. */
+static void put_record(stream *k)
+{
+	if (k->rec.kind == API_REC_SAMPLE && k->rate > 0) {
+		double t = k->rec.st.t;
+		if (t < k->next_t - 1e-9)
+			return;
+		k->next_t = (floor(t * k->rate + 1e-6) + 1) / k->rate;
+	}
+	k->out_len += api_format_record(k->out + k->out_len,
+					k->out_cap - k->out_len, &k->rec,
+					k->fields, k->ndjson);
+	k->sent++;
+	atomic_fetch_add(&srv_stats.stream_records, 1);
+	if (k->limit && k->sent >= k->limit)
+		end_stream(k, "limit");
+}
+
 /* Wait for and format the next batch of records into k->out. */
 static void fill(stream *k)
 {
-	pthread_mutex_t *lock = srv_session_lock(k->s);
-	pthread_cond_t *cond = srv_session_data_cond(k->s);
-	pthread_mutex_lock(lock);
 	while (!k->ended) {
-		int removed, state = srv_session_state(k->s, &removed);
-		srv_ring_view rv = srv_session_ring(k->s);
-		if (atomic_load(&srv_stopping)) {
+		srv_ring_read rd;
+		srv_session_read(k->s, k->cursor, &k->rec, &rd);
+		if (srv_stopping()) {
 			end_stream(k, "shutdown");
 			break;
 		}
-		if (removed) {
+		if (rd.removed) {
 			end_stream(k, "deleted");
 			break;
 		}
-		if (k->cursor < rv.oldest) {
-			uint64_t missed = rv.oldest - k->cursor;
+		if (k->cursor < rd.oldest) {
+			uint64_t missed = rd.oldest - k->cursor;
 			atomic_fetch_add(&srv_stats.dropped_samples, missed);
 			k->out_len += api_format_dropped(
 				k->out + k->out_len, k->out_cap - k->out_len,
-				missed, rv.oldest, k->ndjson);
-			k->cursor = rv.oldest;
+				missed, rd.oldest, k->ndjson);
+			k->cursor = rd.oldest;
 		}
-		if (k->cursor < rv.head) {
-			srv_session_copy(k->s, k->cursor++, &k->rec);
-			pthread_mutex_unlock(lock);
-			int skip = 0;
-			if (k->rec.kind == API_REC_SAMPLE && k->rate > 0) {
-				double t = k->rec.st.t;
-				skip = t < k->next_t - 1e-9;
-				if (!skip)
-					k->next_t = (floor(t * k->rate + 1e-6) +
-						     1) / k->rate;
-			}
-			if (!skip) {
-				k->out_len += api_format_record(
-					k->out + k->out_len,
-					k->out_cap - k->out_len, &k->rec,
-					k->fields, k->ndjson);
-				k->sent++;
-				atomic_fetch_add(&srv_stats.stream_records, 1);
-				if (k->limit && k->sent >= k->limit)
-					end_stream(k, "limit");
-			}
-			pthread_mutex_lock(lock);
+		if (k->cursor < rd.head) { /* srv_session_read copied it */
+			k->cursor++;
+			put_record(k);
 			if (k->out_len + k->rec_max > k->out_cap)
 				break;
 			continue;
 		}
 		if (k->out_len)
 			break;
-		if (state == SRV_FINISHED || state == SRV_FAILED) {
-			end_stream(k, state == SRV_FINISHED ? "finished"
-							    : "failed");
+		if (rd.state == SRV_FINISHED || rd.state == SRV_FAILED) {
+			end_stream(k, rd.state == SRV_FINISHED ? "finished"
+							       : "failed");
 			break;
 		}
 		double idle = srv_now() - k->last_write;
-		if (idle >= srv_cfg.heartbeat) {
+		if (idle >= k->heartbeat) {
 			k->out_len += api_format_heartbeat(
 				k->out + k->out_len, k->out_cap - k->out_len,
-				srv_session_time(k->s), k->ndjson);
+				rd.t, k->ndjson);
 			break;
 		}
-		double wait = srv_cfg.heartbeat - idle;
-		struct timespec ts = srv_deadline(wait < 0.5 ? wait : 0.5);
-		pthread_cond_timedwait(cond, lock, &ts);
+		double wait = k->heartbeat - idle;
+		srv_session_wait(k->s, &rd, wait < 0.5 ? wait : 0.5);
 	}
-	pthread_mutex_unlock(lock);
 	k->last_write = srv_now();
 }
 
@@ -220,6 +226,7 @@ enum MHD_Result srv_h_stream(srv_req *r)
 		free(k);
 		return srv_reply_problem(r, &pb, NULL);
 	}
+	k->heartbeat = cfg->heartbeat;
 	k->s = srv_session_get(r->arg[0]);
 	if (!k->s) {
 		free(k);
@@ -227,13 +234,13 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				"no session with id \"%.40s\"", r->arg[0]);
 	}
 	if (atomic_fetch_add(&srv_stats.stream_clients, 1) >=
-	    srv_cfg.max_streams) {
+	    cfg->max_streams) {
 		atomic_fetch_sub(&srv_stats.stream_clients, 1);
 		srv_session_put(k->s);
 		free(k);
 		return srv_fail(r, API_LIMIT, NULL,
 				"%d stream clients are connected, the limit "
-				"(--max-streams)", srv_cfg.max_streams);
+				"(--max-streams)", cfg->max_streams);
 	}
 	srv_session_stream_count(k->s, 1);
 	atomic_fetch_add(&srv_stats.streams_opened, 1);
@@ -246,15 +253,13 @@ enum MHD_Result srv_h_stream(srv_req *r)
 		stream_free(k);
 		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
 	}
-	pthread_mutex_lock(srv_session_lock(k->s));
-	srv_ring_view rv = srv_session_ring(k->s);
+	srv_ring_read rv = srv_session_ring(k->s);
 	if (resume >= 0)
 		k->cursor = (uint64_t)resume + 1 < rv.head
 				    ? (uint64_t)resume + 1
 				    : rv.head;
 	else
 		k->cursor = rv.head > rv.oldest ? rv.head - 1 : rv.head;
-	pthread_mutex_unlock(srv_session_lock(k->s));
 	k->out_len = (size_t)snprintf(
 		k->out, k->out_cap,
 		k->ndjson ? "{\"type\":\"hello\",\"session\":\"%s\","

@@ -1,21 +1,31 @@
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
- * clocks, timed-wait deadlines and random session ids.
+ * clocks, timed-wait deadlines, random ids, the stopping flag and result
+ * files.
  */
 #include <fcntl.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/random.h>
 #include <time.h>
 #include <unistd.h>
 
-#include "srv.h"
+#include "util.h"
+
+static atomic_int log_level = SRV_LOG_INFO;
+static atomic_int stopping;
+
+void srv_log_init(int level)
+{
+	atomic_store(&log_level, level);
+}
 
 void srv_log(int level, const char *fmt, ...)
 {
 	static const char *const names[] = {"error", "warn", "info", "debug"};
-	if (level > srv_cfg.log_level)
+	if (level > atomic_load(&log_level))
 		return;
 	char line[1024];
 	va_list ap;
@@ -67,4 +77,30 @@ void srv_new_id(char *id)
 	}
 	for (int i = 0; i < 8; i++)
 		snprintf(id + 2 * i, 3, "%02x", raw[i]);
+}
+
+int srv_stopping(void)
+{
+	return atomic_load(&stopping);
+}
+
+void srv_stop(void)
+{
+	atomic_store(&stopping, 1);
+}
+
+void srv_write_file(const char *dir, const char *name, const char *text,
+		    int newline)
+{
+	char path[4096];
+	snprintf(path, sizeof path, "%s/%s", dir, name);
+	FILE *f = text ? fopen(path, "w") : NULL;
+	if (f) {
+		fputs(text, f);
+		if (newline)
+			fputc('\n', f);
+		fclose(f);
+	} else {
+		srv_log(SRV_LOG_WARN, "cannot write %s", path);
+	}
 }

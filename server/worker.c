@@ -2,22 +2,82 @@
  * worker.c - a session's worker thread: the only thread that touches the
  * session's sim instance.
  *
- * The worker applies queued controls between steps (reading
- * sim_effective_time() for the acknowledgement), advances the core one
- * sample interval (1/sample_rate simulated seconds) at a time with
- * sim_advance, and publishes under the session lock: the status
- * snapshot, a record in the bounded ring (samples and control events,
- * indexed by a sequence number that never repeats) and, every stride, a
- * trajectory row (the stride doubles whenever the history fills). Pacing
- * holds simulated time to pace x wall time without catching up after a
- * stall, or runs flat out for pace "max" up to "until". Achieved steps/s
- * and real-time factor are measured over half-second windows.
+ * The loop runs a few named phases per turn, with the session lock held
+ * except while the core advances (libuv's uv_run is the model):
+ *
+ *   job start   an experiment attached since the last turn begins: its first
+ *               segment's command joins the queue
+ *   commands    queued controls (PATCH, experiment segments) are applied in
+ *               order and acknowledged, reading sim_effective_time()
+ *   until       a running session that reached "until" finishes
+ *   idle        a session that is not running sleeps until woken
+ *   pacing      simulated time is held to pace x wall time (no catching up
+ *               after a stall; pace "max" runs flat out up to "until")
+ *   step        sim_advance by one sample interval (1/sample_rate simulated
+ *               seconds, cut at "until" and at experiment boundaries), then
+ *               publish the status snapshot and a record in the bounded ring
+ *               (samples and control events, indexed by a sequence number
+ *               that never repeats) and, every stride, a trajectory row (the
+ *               stride doubles whenever the history fills)
+ *   job step    the experiment records the step and, at a segment boundary,
+ *               hands over the next segment's command
+ *   failure     a core error fails the session and aborts its experiment
+ *   meter       achieved steps/s and real-time factor over half-second
+ *               windows
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "experiment.h"
+#include "metrics.h"
 #include "session_int.h"
+#include "util.h"
+
+/* Wall-clock anchors of pacing and metering. */
+typedef struct clocks {
+	double anchor_wall, anchor_t; /* pacing: wall time at simulated t */
+	double rate_wall, rate_t;     /* metering window start */
+	uint64_t rate_steps;
+} clocks;
+
+/* Restart pacing and metering from now (after a pause or a pace change). */
+static void restart_clocks(clocks *c, const srv_session *s)
+{
+	c->anchor_wall = c->rate_wall = srv_now();
+	c->anchor_t = c->rate_t = s->st.t;
+	c->rate_steps = s->st.steps;
+}
+
+/* ---- the command queue ------------------------------------------------------ */
+
+void srv_worker_queue(srv_session *s, srv_cmd *cmd)
+{
+	cmd->next = NULL;
+	if (s->cmd_tail)
+		s->cmd_tail->next = cmd;
+	else
+		s->cmd_head = cmd;
+	s->cmd_tail = cmd;
+	pthread_cond_broadcast(&s->wake);
+}
+
+int srv_worker_unqueue(srv_session *s, srv_cmd *cmd)
+{
+	srv_cmd **pp = &s->cmd_head, *prev = NULL;
+	while (*pp && *pp != cmd) {
+		prev = *pp;
+		pp = &(*pp)->next;
+	}
+	if (!*pp)
+		return 0;
+	*pp = cmd->next;
+	if (s->cmd_tail == cmd)
+		s->cmd_tail = prev;
+	return 1;
+}
+
+/* ---- records ------------------------------------------------------------------ */
 
 static api_sample *push_slot(srv_session *s)
 {
@@ -26,8 +86,7 @@ static api_sample *push_slot(srv_session *s)
 	return slot;
 }
 
-void srv_session_push_event(srv_session *s, const char *type,
-			    const char *json)
+static void push_event(srv_session *s, const char *type, const char *json)
 {
 	api_sample *slot = push_slot(s);
 	slot->kind = API_REC_EVENT;
@@ -43,7 +102,7 @@ static void push_event_reason(srv_session *s, const char *type,
 	api_fmt_double(t, sizeof t, s->st.t);
 	snprintf(json, sizeof json, "{\"t\":%s%s%s}", t, detail ? "," : "",
 		 detail ? detail : "");
-	srv_session_push_event(s, type, json);
+	push_event(s, type, json);
 }
 
 static void record_history(srv_session *s)
@@ -88,7 +147,56 @@ static void gather_feed(srv_session *s)
 	sim_feed_state(s->sim, s->scratch.xi, s->scratch.eta);
 }
 
-/* Apply queued controls (lock held). Returns 1 if pacing must restart. */
+/* ---- the attached experiment ---------------------------------------------- */
+
+/* Queue the experiment's command, if it handed one over (lock held). */
+static void queue_experiment_command(srv_session *s, srv_cmd *cmd)
+{
+	if (!cmd)
+		return;
+	if (s->exp_cmd)
+		srv_worker_unqueue(s, s->exp_cmd);
+	s->exp_cmd = cmd;
+	srv_worker_queue(s, cmd);
+}
+
+/* Let go of the experiment, aborting it with why unless why is NULL; its
+ * command is taken back if still queued (lock held). */
+static void detach_experiment(srv_session *s, const char *why)
+{
+	if (!s->exp)
+		return;
+	if (s->exp_cmd)
+		srv_worker_unqueue(s, s->exp_cmd);
+	s->exp_cmd = NULL;
+	if (why)
+		srv_exp_abort(s->exp, why);
+	s->exp = NULL;
+	s->exp_started = 0;
+}
+
+/* The experiment's command was applied or refused (lock held). */
+static void experiment_commanded(srv_session *s, const srv_cmd *cmd)
+{
+	if (cmd != s->exp_cmd)
+		return;
+	s->exp_cmd = NULL;
+	if (srv_exp_commanded(s->exp, cmd))
+		detach_experiment(s, NULL);
+}
+
+/* Let the session run at least up to t_end (s): raise until, resume a
+ * finished session (lock held). */
+static void extend_until(srv_session *s, double t_end)
+{
+	if (s->until > 0 && s->until < t_end)
+		s->until = t_end;
+	if (s->state == SRV_FINISHED && s->st.t < t_end)
+		s->state = SRV_RUNNING;
+}
+
+/* Apply queued controls in order and acknowledge each (lock held).
+ * Returns 1 if pacing must restart. */
 static int apply_commands(srv_session *s)
 {
 	int reanchor = 0;
@@ -114,6 +222,8 @@ static int apply_commands(srv_session *s)
 			rc = sim_set_omega_ss(s->sim, c->omega_ss);
 		if (rc == SIM_OK && (c->set & API_C_MOTOR))
 			rc = sim_set_drive_on(s->sim, c->motor_on);
+		if (rc == SIM_OK && cmd->restart_transport)
+			sim_restart_transport(s->sim);
 		if (rc == SIM_OK && (c->set & API_C_PACE)) {
 			s->pace = c->pace;
 			reanchor = 1;
@@ -136,11 +246,13 @@ static int apply_commands(srv_session *s)
 		if (rc == SIM_OK) {
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
-			srv_session_push_event(s, "control", json);
+			push_event(s, "control", json);
 		}
 		cmd->rc = rc;
 		cmd->t_eff = t_eff;
 		cmd->done = 1;
+		if (cmd->from_experiment)
+			experiment_commanded(s, cmd);
 	}
 	pthread_cond_broadcast(&s->data);
 	return reanchor;
@@ -162,106 +274,153 @@ static double next_time(srv_session *s)
 	return t_next;
 }
 
+/* ---- the phases --------------------------------------------------------------- */
+
+/* job start: an experiment attached since the last turn begins. */
+static void start_job(srv_session *s)
+{
+	if (!s->exp || s->exp_started || s->state == SRV_FAILED || s->stop)
+		return;
+	double t_end;
+	srv_cmd *cmd = srv_exp_begin(s->exp, &s->st, &t_end);
+	extend_until(s, t_end);
+	queue_experiment_command(s, cmd);
+	s->exp_started = 1;
+	pthread_cond_broadcast(&s->data);
+}
+
+/* commands: apply what is queued; pacing restarts after pace or pause. */
+static void run_commands(srv_session *s, clocks *c)
+{
+	if (s->cmd_head && apply_commands(s))
+		restart_clocks(c, s);
+}
+
+/* until: a running session that reached until finishes there. */
+static void check_until(srv_session *s)
+{
+	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
+		s->state = SRV_FINISHED;
+		push_event_reason(s, "finished", NULL);
+		pthread_cond_broadcast(&s->data);
+	}
+}
+
+/* idle: a session that is not running sleeps until woken; 1 if it slept. */
+static int idle(srv_session *s, clocks *c)
+{
+	if (s->state == SRV_RUNNING)
+		return 0;
+	s->steps_per_s = s->rtf = 0;
+	pthread_cond_wait(&s->wake, &s->lock);
+	restart_clocks(c, s);
+	return 1;
+}
+
+/* pacing: wait until t_next is due in wall time; 1 if it waited (the loop
+ * then starts over, so that commands are seen at once). */
+static int pace(srv_session *s, clocks *c, double t_next)
+{
+	if (s->pace == API_PACE_MAX)
+		return 0;
+	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
+	double now = srv_now();
+	if (now < due - 1e-4) {
+		struct timespec ts = srv_deadline(due - now);
+		pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+		return 1;
+	}
+	if (now - due > 0.25) { /* behind: do not catch up */
+		c->anchor_wall = now;
+		c->anchor_t = s->st.t;
+	}
+	return 0;
+}
+
+/* step: advance to t_next with the lock released, then publish the status
+ * and a sample. Returns the core's code. */
+static int step_and_publish(srv_session *s, double t_next)
+{
+	sim_status st;
+	pthread_mutex_unlock(&s->lock);
+	int rc = sim_advance(s->sim, t_next);
+	sim_get_status(s->sim, &st);
+	gather_feed(s);
+	pthread_mutex_lock(&s->lock);
+	if (st.steps > s->st.steps)
+		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
+	s->st = st;
+	record_sample(s);
+	return rc;
+}
+
+/* job step: the experiment sees the step; it may end or hand over the
+ * next segment's command. */
+static void run_job(srv_session *s)
+{
+	if (!s->exp || !s->exp_started)
+		return;
+	int over = 0;
+	queue_experiment_command(s, srv_exp_step(s->exp, &s->st, &over));
+	if (over)
+		detach_experiment(s, NULL);
+}
+
+/* failure: the core refused to go on; the session fails for good. */
+static void fail(srv_session *s, int rc)
+{
+	s->state = SRV_FAILED;
+	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
+		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
+	push_event_reason(s, "failed", NULL);
+	detach_experiment(s, s->error);
+	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
+}
+
+/* meter: steps/s and real-time factor over the last half second. */
+static void meter(srv_session *s, clocks *c)
+{
+	double now = srv_now();
+	if (now - c->rate_wall < 0.5)
+		return;
+	s->steps_per_s = (double)(s->st.steps - c->rate_steps) /
+			 (now - c->rate_wall);
+	s->rtf = (s->st.t - c->rate_t) / (now - c->rate_wall);
+	c->rate_wall = now;
+	c->rate_t = s->st.t;
+	c->rate_steps = s->st.steps;
+}
+
 void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
-	double anchor_wall = srv_now(), anchor_t = 0;
-	double rate_wall = anchor_wall, rate_t = 0;
-	uint64_t rate_steps = 0;
-	sim_status st;
-
+	clocks clk;
 	gather_feed(s);
 	pthread_mutex_lock(&s->lock);
 	sim_get_status(s->sim, &s->st);
 	record_sample(s);
+	restart_clocks(&clk, s);
 	pthread_cond_broadcast(&s->data);
 	for (;;) {
-		if (s->cmd_head && apply_commands(s)) {
-			anchor_wall = rate_wall = srv_now();
-			anchor_t = rate_t = s->st.t;
-			rate_steps = s->st.steps;
-		}
+		start_job(s);
+		run_commands(s, &clk);
 		if (s->stop)
 			break;
-		if (s->exp && !s->exp_started && s->state != SRV_FAILED) {
-			srv_exp_begin(s->exp, s->sim, &s->st, s);
-			s->exp_started = 1;
-			pthread_cond_broadcast(&s->data);
-		}
-		if (s->state == SRV_RUNNING && s->until > 0 &&
-		    s->st.t >= s->until) {
-			s->state = SRV_FINISHED;
-			push_event_reason(s, "finished", NULL);
-			pthread_cond_broadcast(&s->data);
-		}
-		if (s->state != SRV_RUNNING) {
-			s->steps_per_s = s->rtf = 0;
-			pthread_cond_wait(&s->wake, &s->lock);
-			anchor_wall = rate_wall = srv_now();
-			anchor_t = rate_t = s->st.t;
-			rate_steps = s->st.steps;
+		check_until(s);
+		if (idle(s, &clk))
 			continue;
-		}
 		double t_next = next_time(s);
-		if (s->pace != API_PACE_MAX) {
-			double due = anchor_wall + (t_next - anchor_t) / s->pace;
-			double now = srv_now();
-			if (now < due - 1e-4) {
-				struct timespec ts = srv_deadline(due - now);
-				pthread_cond_timedwait(&s->wake, &s->lock, &ts);
-				continue;
-			}
-			if (now - due > 0.25) { /* behind: do not catch up */
-				anchor_wall = now;
-				anchor_t = s->st.t;
-			}
-		}
-		pthread_mutex_unlock(&s->lock);
-		int rc = sim_advance(s->sim, t_next);
-		sim_get_status(s->sim, &st);
-		gather_feed(s);
-		pthread_mutex_lock(&s->lock);
-		if (st.steps > s->st.steps)
-			atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
-		s->st = st;
-		record_sample(s);
-		if (s->exp && s->exp_started &&
-		    srv_exp_step(s->exp, s->sim, &s->st, s)) {
-			s->exp = NULL;
-			s->exp_started = 0;
-		}
-		if (rc != SIM_OK) {
-			s->state = SRV_FAILED;
-			snprintf(s->error, sizeof s->error, "%s: %s",
-				 sim_strerror(rc),
-				 sim_last_error(s->sim) ? sim_last_error(s->sim)
-							: "");
-			push_event_reason(s, "failed", NULL);
-			if (s->exp) {
-				srv_exp_abort(s->exp, s->error);
-				s->exp = NULL;
-			}
-			srv_log(SRV_LOG_WARN, "session %s failed: %s", s->id,
-				s->error);
-		}
-		double now = srv_now();
-		if (now - rate_wall >= 0.5) {
-			s->steps_per_s = (double)(st.steps - rate_steps) /
-					 (now - rate_wall);
-			s->rtf = (st.t - rate_t) / (now - rate_wall);
-			rate_wall = now;
-			rate_t = st.t;
-			rate_steps = st.steps;
-		}
+		if (pace(s, &clk, t_next))
+			continue;
+		int rc = step_and_publish(s, t_next);
+		run_job(s);
+		if (rc != SIM_OK)
+			fail(s, rc);
+		meter(s, &clk);
 		pthread_cond_broadcast(&s->data);
 	}
-	if (s->exp) {
-		srv_exp_abort(s->exp, "the session was deleted or the daemon "
-				      "stopped");
-		s->exp = NULL;
-	}
+	detach_experiment(s, "the session was deleted or the daemon stopped");
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;
 }
-

@@ -1,0 +1,193 @@
+/*
+ * config.c - the daemon's options: defaults, the command line and the
+ * checks of what it names (web root guess, writable data directory).
+ *
+ * Options are a table {flag, kind, range, field}: one loop parses them all
+ * and each kind checks its range with one message.
+ */
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "config.h"
+#include "util.h"
+
+static const srv_config defaults = {
+	.listen = "127.0.0.1",
+	.port = 8080,
+	.max_sessions = 64,
+	.max_streams = 256,
+	.max_body = 1 << 20,
+	.data_dir = NULL,
+	.web_root = NULL,
+	.log_level = SRV_LOG_INFO,
+	.ring = 4096,
+	.history = 20000,
+	.pool_threads = 2,
+	.heartbeat = 15.0,
+	.max_experiments = 256,
+	.max_sweeps = 64,
+};
+
+enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL };
+
+typedef struct opt {
+	const char *name;
+	int kind;
+	long lo, hi;
+	size_t field; /* offsetof(srv_config, ...) */
+} opt;
+
+#define F(member) offsetof(srv_config, member)
+static const opt opts[] = {
+	{"listen", OPT_STRING, 0, 0, F(listen)},
+	{"port", OPT_INT, 0, 65535, F(port)},
+	{"max-sessions", OPT_INT, 1, 100000, F(max_sessions)},
+	{"max-streams", OPT_INT, 1, 100000, F(max_streams)},
+	{"max-body", OPT_SIZE, 64, 1L << 30, F(max_body)},
+	{"data-dir", OPT_STRING, 0, 0, F(data_dir)},
+	{"web-root", OPT_STRING, 0, 0, F(web_root)},
+	{"log-level", OPT_LEVEL, 0, 0, F(log_level)},
+	{"ring", OPT_INT, 16, 1 << 22, F(ring)},
+	{"history", OPT_INT, 16, 1 << 24, F(history)},
+	{"pool-threads", OPT_INT, 1, 256, F(pool_threads)},
+	{"heartbeat", OPT_SECONDS, 0, 0, F(heartbeat)},
+};
+#undef F
+#define NOPTS (sizeof opts / sizeof *opts)
+
+static void usage(FILE *f)
+{
+	fprintf(f,
+		"usage: convsimd [options]\n"
+		"  --listen ADDR        address to bind (default 127.0.0.1)\n"
+		"  --port N             TCP port, 0 = ephemeral (default 8080)\n"
+		"  --max-sessions N     live sessions (default 64)\n"
+		"  --max-streams N      open stream clients (default 256)\n"
+		"  --max-body BYTES     request body limit (default 1048576)\n"
+		"  --data-dir DIR       save experiment and sweep results here\n"
+		"  --web-root DIR       static files served at / (default web)\n"
+		"  --log-level L        error|warn|info|debug (default info)\n"
+		"  --ring N             stream records kept per session "
+		"(default 4096)\n"
+		"  --history N          trajectory rows kept per session "
+		"(default 20000)\n"
+		"  --pool-threads N     sweep worker threads (default 2)\n"
+		"  --heartbeat S        seconds between stream heartbeats "
+		"(default 15)\n");
+}
+
+static int parse_int(const char *arg, const char *name, long lo, long hi,
+		     long *out)
+{
+	char *end;
+	long v = strtol(arg, &end, 10);
+	if (*end || end == arg || v < lo || v > hi) {
+		fprintf(stderr, "convsimd: %s must be an integer in [%ld, %ld]\n",
+			name, lo, hi);
+		return -1;
+	}
+	*out = v;
+	return 0;
+}
+
+/* Set one option of cfg from its argument; -1 with a message if bad. */
+static int set_option(srv_config *cfg, const opt *o, const char *arg)
+{
+	static const char *const levels[] = {"error", "warn", "info", "debug"};
+	char *at = (char *)cfg + o->field, flag[40], *end;
+	long v;
+	snprintf(flag, sizeof flag, "--%s", o->name);
+	switch (o->kind) {
+	case OPT_STRING: *(const char **)(void *)at = arg; return 0;
+	case OPT_INT:
+	case OPT_SIZE:
+		if (parse_int(arg, flag, o->lo, o->hi, &v))
+			return -1;
+		if (o->kind == OPT_INT)
+			*(int *)(void *)at = (int)v;
+		else
+			*(size_t *)(void *)at = (size_t)v;
+		return 0;
+	case OPT_SECONDS: {
+		double s = strtod(arg, &end);
+		if (*end || !(s >= 0.05 && s <= 3600)) {
+			fprintf(stderr, "convsimd: --heartbeat must be "
+					"seconds in [0.05, 3600]\n");
+			return -1;
+		}
+		*(double *)(void *)at = s;
+		return 0;
+	}
+	default:
+		for (int i = 0; i < 4; i++)
+			if (strcmp(arg, levels[i]) == 0) {
+				*(int *)(void *)at = i;
+				return 0;
+			}
+		fprintf(stderr, "convsimd: --log-level must be "
+				"error, warn, info or debug\n");
+		return -1;
+	}
+}
+
+/* web/ next to the working directory, else next to the binary's parent. */
+static void pick_web_root(srv_config *cfg, const char *argv0)
+{
+	static char web_guess[4096];
+	struct stat sb;
+	if (cfg->web_root)
+		return;
+	cfg->web_root = "web";
+	if (stat("web", &sb) == 0 && S_ISDIR(sb.st_mode))
+		return;
+	const char *slash = strrchr(argv0, '/');
+	if (!slash)
+		return;
+	snprintf(web_guess, sizeof web_guess, "%.*s/../web",
+		 (int)(slash - argv0), argv0);
+	if (stat(web_guess, &sb) == 0 && S_ISDIR(sb.st_mode))
+		cfg->web_root = web_guess;
+}
+
+int srv_config_parse(srv_config *cfg, int argc, char **argv)
+{
+	struct option longopts[NOPTS + 2];
+	for (size_t i = 0; i < NOPTS; i++)
+		longopts[i] = (struct option){opts[i].name, required_argument,
+					      0, (int)i};
+	longopts[NOPTS] = (struct option){"help", no_argument, 0, 'h'};
+	longopts[NOPTS + 1] = (struct option){0, 0, 0, 0};
+	*cfg = defaults;
+	int c;
+	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+		if (c == 'h') {
+			usage(stdout);
+			return 1;
+		}
+		if (c < 0 || (size_t)c >= NOPTS) {
+			usage(stderr);
+			return -1;
+		}
+		if (set_option(cfg, &opts[c], optarg))
+			return -1;
+	}
+	if (optind < argc) {
+		fprintf(stderr, "convsimd: unexpected argument %s\n",
+			argv[optind]);
+		return -1;
+	}
+	pick_web_root(cfg, argv[0]);
+	struct stat dd;
+	if (cfg->data_dir && (stat(cfg->data_dir, &dd) != 0 ||
+			      !S_ISDIR(dd.st_mode) ||
+			      access(cfg->data_dir, W_OK) != 0)) {
+		fprintf(stderr, "convsimd: --data-dir %s is not a writable "
+				"directory\n", cfg->data_dir);
+		return -1;
+	}
+	return 0;
+}

@@ -1,0 +1,34 @@
+/*
+ * config.h - the daemon's options: their defaults and the command line.
+ *
+ * main.c owns the one srv_config and hands it (borrowed, read-only while
+ * the daemon runs) to each module's init, which keeps what it needs: no
+ * module reads another's globals for its settings.
+ */
+#ifndef CONVSIM_CONFIG_H
+#define CONVSIM_CONFIG_H
+
+#include <stddef.h>
+
+typedef struct srv_config {
+	const char *listen;    /* address to bind, "127.0.0.1" */
+	int port;              /* 0: ephemeral */
+	int max_sessions;
+	int max_streams;       /* open stream clients, all sessions */
+	size_t max_body;       /* bytes */
+	const char *data_dir;  /* NULL: results are not saved */
+	const char *web_root;  /* static files served at / */
+	int log_level;         /* SRV_LOG_* */
+	int ring;              /* stream records kept per session */
+	int history;           /* trajectory rows kept per session */
+	int pool_threads;      /* sweep workers */
+	double heartbeat;      /* s between stream heartbeats */
+	int max_experiments, max_sweeps;
+} srv_config;
+
+/* Fill *cfg from the defaults and the command line (argv is borrowed: the
+ * strings stay argv's). Returns 0; 1 after --help (usage printed); -1 on a
+ * bad option (message on stderr). */
+int srv_config_parse(srv_config *cfg, int argc, char **argv);
+
+#endif

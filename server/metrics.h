@@ -1,0 +1,37 @@
+/*
+ * metrics.h - the daemon's counters and their Prometheus text.
+ *
+ * Counters are atomics that the modules bump where things happen; gauges
+ * (live sessions, steps per second, queued pool jobs) belong to other
+ * modules and are handed in when /metrics is scraped. A leaf: it calls
+ * nothing else of server/.
+ */
+#ifndef CONVSIM_METRICS_H
+#define CONVSIM_METRICS_H
+
+#include <stdatomic.h>
+
+typedef struct srv_metrics {
+	atomic_ullong sessions_created, sessions_deleted;
+	atomic_ullong steps;             /* all sessions */
+	atomic_int stream_clients;
+	atomic_ullong streams_opened, dropped_samples, stream_records;
+	atomic_ullong sweep_points, experiments;
+	atomic_ullong requests[6];       /* by status class 1xx..5xx (index 1..5) */
+} srv_metrics;
+extern srv_metrics srv_stats;
+
+/* Gauges read by the caller at scrape time. */
+typedef struct srv_gauges {
+	double sessions;
+	double steps_per_s;   /* summed over running sessions */
+	double pool_queued;
+} srv_gauges;
+
+/* Count one response with this HTTP status. */
+void srv_metrics_count(int status);
+/* The Prometheus text exposition (malloc'd, caller frees; NULL when out of
+ * memory). */
+char *srv_metrics_text(const srv_gauges *g);
+
+#endif

@@ -1,0 +1,62 @@
+/*
+ * reply.h - one HTTP request as the handlers see it, and the ways to
+ * answer it (libmicrohttpd stays behind these, in server/ only).
+ *
+ * Every response goes through srv_queue, which counts its status for
+ * /metrics. Handlers return what these return.
+ */
+#ifndef CONVSIM_REPLY_H
+#define CONVSIM_REPLY_H
+
+#include <microhttpd.h>
+#include <stddef.h>
+
+#include "api.h"
+
+typedef struct srv_req {
+	struct MHD_Connection *conn;
+	const char *method;
+	const char *url;
+	char arg[2][64];       /* path parameters ("*" segments) */
+	const char *body;      /* NUL-terminated, body_len bytes */
+	size_t body_len;
+	int has_content_type;
+	int json_body;         /* Content-Type is application/json */
+} srv_req;
+
+typedef enum MHD_Result (*srv_handler)(srv_req *r);
+
+/* Queue a reply. text is malloc'd and taken (freed here); NULL text gives
+ * a 503 problem. extra_name/extra_value add one header (may be NULL). */
+enum MHD_Result srv_reply(srv_req *r, int status, const char *ctype,
+			  char *text, const char *extra_name,
+			  const char *extra_value);
+enum MHD_Result srv_reply_json(srv_req *r, int status, char *text);
+/* 201 or 202 with a JSON body (taken) and Location: prefix/id. */
+enum MHD_Result srv_reply_created(srv_req *r, int status, char *text,
+				  const char *prefix, const char *id);
+/* 204 without a body. */
+enum MHD_Result srv_reply_empty(srv_req *r);
+/* Queue a static, borrowed buffer (not freed). */
+enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
+				 const void *data, size_t len);
+/* RFC 9457 problem reply for *pb (405 adds Allow from allow if given). */
+enum MHD_Result srv_reply_problem(srv_req *r, const api_problem *pb,
+				  const char *allow);
+enum MHD_Result srv_fail(srv_req *r, api_err code, const char *field,
+			 const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+/* Queue a response (taken) and count its status for /metrics. */
+enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp);
+/* Query argument or NULL; header value or NULL (borrowed from the
+ * connection). */
+const char *srv_query(srv_req *r, const char *key);
+const char *srv_header(srv_req *r, const char *name);
+/* 1 if the request carries a JSON body (or none, when empty_ok); else
+ * queues 415 and returns 0 (the handler then returns *result). */
+int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result);
+/* Table format from ?format=json|csv or Accept: text/csv: 0 json, 1 csv,
+ * -1 with *pb (400) when ?format= names something else. */
+int srv_table_format(srv_req *r, api_problem *pb);
+
+#endif

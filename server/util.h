@@ -1,0 +1,38 @@
+/*
+ * util.h - small services every part of the daemon uses: levelled logging
+ * to stderr, clocks, timed-wait deadlines, random ids, the daemon's
+ * "stopping" flag and writing a result file. A leaf: it uses nothing else
+ * of server/.
+ */
+#ifndef CONVSIM_UTIL_H
+#define CONVSIM_UTIL_H
+
+#include <time.h>
+
+enum { SRV_LOG_ERROR, SRV_LOG_WARN, SRV_LOG_INFO, SRV_LOG_DEBUG };
+
+/* Messages above level are dropped (default SRV_LOG_INFO). */
+void srv_log_init(int level);
+/* One line "convsimd LEVEL: message" on stderr. */
+void srv_log(int level, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+/* Wall-clock seconds: monotonic (for pacing) and unix time. */
+double srv_now(void);
+double srv_unix_time(void);
+/* A fresh random id of 16 hex digits into id (>= 17 bytes). */
+void srv_new_id(char *id);
+/* Absolute deadline for pthread_cond_timedwait, seconds from now
+ * (clamped to [0, 3600]). */
+struct timespec srv_deadline(double seconds);
+
+/* The daemon is shutting down (set once, on SIGTERM/SIGINT): streams end,
+ * pool jobs return at once, the API answers 503. */
+int srv_stopping(void);
+void srv_stop(void);
+
+/* Write text (borrowed; NULL counts as a failure) to dir/name, with a final
+ * newline when newline is set; a warning is logged when that fails. */
+void srv_write_file(const char *dir, const char *name, const char *text,
+		    int newline);
+
+#endif
