@@ -10,11 +10,10 @@
 #include "model.h"
 
 typedef struct ode_method {
-	const char *name;
-	int order;     /* classical order on smooth problems */
-	int adaptive;  /* step size from rtol/atol */
+	/* name, order, adaptive, doc: the public description. First member,
+	 * so that the registry lists descriptors through it. */
+	sim_method_info info;
 	int dense;     /* steps past the target and interpolates */
-	const char *doc;
 	/* Workspace for model md (its size n fixed) and settings cfg; NULL on
 	 * allocation failure. Everything the steps need is allocated here. */
 	void *(*alloc)(const model *md, const sim_method *cfg);

@@ -209,11 +209,11 @@ static void dem_reset(void *p)
 }
 
 const ode_method ode_dem = {
-	.name = "dem",
-	.order = 1,
-	.adaptive = 0,
+	.info = {.name = "dem",
+		 .order = 1,
+		 .adaptive = 0,
+		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction"},
 	.dense = 0,
-	.doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction",
 	.alloc = dem_alloc,
 	.step = dem_step,
 	.interpolate = NULL,

@@ -184,11 +184,11 @@ static void dp_reset(void *p)
 }
 
 const ode_method ode_dopri5 = {
-	.name = "dopri5",
-	.order = 5,
-	.adaptive = 1,
+	.info = {.name = "dopri5",
+		 .order = 5,
+		 .adaptive = 1,
+		 .doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step"},
 	.dense = 1,
-	.doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step",
 	.alloc = dp_alloc,
 	.step = dp_step,
 	.interpolate = dp_interpolate,

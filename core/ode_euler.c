@@ -58,11 +58,11 @@ static void euler_reset(void *p)
 }
 
 const ode_method ode_euler = {
-	.name = "euler",
-	.order = 1,
-	.adaptive = 0,
+	.info = {.name = "euler",
+		 .order = 1,
+		 .adaptive = 0,
+		 .doc = "semi-implicit (symplectic) Euler, fixed step dt"},
 	.dense = 0,
-	.doc = "semi-implicit (symplectic) Euler, fixed step dt",
 	.alloc = euler_alloc,
 	.step = euler_step,
 	.interpolate = NULL,

@@ -68,11 +68,11 @@ static void rk4_reset(void *p)
 }
 
 const ode_method ode_rk4 = {
-	.name = "rk4",
-	.order = 4,
-	.adaptive = 0,
+	.info = {.name = "rk4",
+		 .order = 4,
+		 .adaptive = 0,
+		 .doc = "classical Runge-Kutta, fixed step dt, whole state"},
 	.dense = 0,
-	.doc = "classical Runge-Kutta, fixed step dt, whole state",
 	.alloc = rk4_alloc,
 	.step = rk4_step,
 	.interpolate = NULL,

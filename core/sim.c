@@ -18,6 +18,7 @@
 
 #include "feed.h"
 #include "ode.h"
+#include "units.h"
 
 /* speed-up, relative transport-velocity change: czubak2016, dem dt = 1e-4 */
 #define REDUCTION_NO_FEED 1.75, NAN
@@ -285,19 +286,19 @@ static void control_changed(sim *s)
 	update_status(s);
 }
 
-int sim_set_beta(sim *s, double target_deg, double rate_deg_s)
+int sim_set_beta(sim *s, double beta, double rate)
 {
-	if (!isfinite(target_deg) || target_deg < 0.0 || target_deg > 180.0)
+	if (!sim_setting_check(sim_setting_find("beta"), beta))
 		return SIM_EPARAM;
-	if (isfinite(rate_deg_s) && rate_deg_s > 0.0) {
-		if (rate_deg_s < 0.1 || rate_deg_s > 3600.0)
+	if (isfinite(rate) && rate > 0.0) {
+		if (!sim_setting_check(sim_setting_find("beta_rate"), rate))
 			return SIM_EPARAM;
-		s->md.p.beta_rate = rate_deg_s * M_PI / 180.0;
-	} else if (!isfinite(rate_deg_s)) {
+		s->md.p.beta_rate = rate;
+	} else if (!isfinite(rate)) {
 		return SIM_EPARAM;
 	}
-	ramp_to_position(&s->md.beta_ramp, s->t_int, target_deg * M_PI / 180.0,
-			 s->md.p.beta_rate, s->md.p.beta_accel);
+	ramp_to_position(&s->md.beta_ramp, s->t_int, beta, s->md.p.beta_rate,
+			 s->md.p.beta_accel);
 	control_changed(s);
 	return SIM_OK;
 }
@@ -322,7 +323,7 @@ int sim_set_rotation(sim *s, int rotation)
 
 int sim_set_omega_ss(sim *s, double omega_ss)
 {
-	if (!isfinite(omega_ss) || omega_ss < 1.0 || omega_ss > 1000.0)
+	if (!sim_setting_check(sim_setting_find("omega_ss"), omega_ss))
 		return SIM_EPARAM;
 	s->md.omega_ss = omega_ss;
 	ideal_speed(s);

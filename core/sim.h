@@ -9,9 +9,10 @@
  * calls back into its caller and never aborts: any number of instances may
  * run in parallel threads, one thread per instance.
  *
- * Units are SI throughout except where a name says otherwise: angles that a
- * user types (beta, beta_rate) are in degrees, everything internal and every
- * observable angle is in radians.
+ * Units are SI throughout this interface: angles in rad, rates in rad/s,
+ * times in s. Degrees and other friendly units exist only in the settings
+ * table (its unit and scale columns) and at the edges (CLI, API), which
+ * convert once with the helpers of units.h.
  */
 #ifndef CONVSIM_SIM_H
 #define CONVSIM_SIM_H
@@ -42,12 +43,15 @@ const char *sim_strerror(int err);
 
 /* ---- parameters ------------------------------------------------------ */
 
+/* Largest feed: columns K and layers L (settings table and array sizes). */
+#define SIM_MAX_COLUMNS 64
+#define SIM_MAX_LAYERS 64
+
 enum { SIM_CW = -1, SIM_CCW = 1 };
 enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
 enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
 
-/* Physical parameters, MODEL.md names. Angles in radians here; the name
- * table below converts beta from degrees. */
+/* Physical parameters, MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
 	/* suspension */
 	double l1, l2, h;         /* m: spring sets at (l1,-h), (-l2,-h) */
@@ -119,6 +123,7 @@ typedef struct sim_setting {
 	const char *group;    /* "params", "scene" or "integrator" */
 	sim_kind kind;
 	const char *unit;     /* as the user writes it: "deg", "N/m", ... */
+	double scale;         /* SI value of one user unit (RAD_PER_DEG, else 1) */
 	double min, max;      /* allowed closed range in user units */
 	const char *choices;  /* SIM_KIND_ENUM: "cw|ccw" (index = value) */
 	const char *doc;
@@ -134,17 +139,19 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
 extern const char *const sim_preset_names[];
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m);
 
-/* Set one named setting from a number in user units (beta in degrees; enum
- * and bool settings take their index 0/1/...). Checks range and finiteness.
- * On error returns SIM_EPARAM or SIM_EUNKNOWN and, if msg != NULL, writes a
- * sentence naming the setting and its range into msg (msglen bytes). */
+/* Set one named setting from a number in SI units (beta in rad; enum and
+ * bool settings take their index 0/1/...). Checks the table's range (scaled
+ * to SI) and finiteness. On error returns SIM_EPARAM or SIM_EUNKNOWN and,
+ * if msg != NULL, writes a sentence naming the setting and its range (in
+ * user units) into msg (msglen bytes); nothing is changed then. For user
+ * units see sim_set_user() in units.h. */
 int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 	    double value, char *msg, size_t msglen);
 /* The same for a string value: enum choices ("cw", "ideal", "rk4" for
- * the integrator "method") or a number. */
+ * the integrator "method"), true/false, or a number in SI units. */
 int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 		const char *value, char *msg, size_t msglen);
-/* Read one named setting in user units; SIM_EUNKNOWN if no such name. */
+/* Read one named setting in SI units; SIM_EUNKNOWN if no such name. */
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
 
@@ -169,8 +176,9 @@ typedef struct sim_method_info {
 	int adaptive;     /* 1 if rtol/atol drive the step */
 	const char *doc;
 } sim_method_info;
-/* Registry of integrators; *n receives the count. Static. */
-const sim_method_info *sim_methods(size_t *n);
+/* Registry of integrators, built from each method's own descriptor: an
+ * array of *n pointers, all static. */
+const sim_method_info *const *sim_methods(size_t *n);
 
 /* ---- instances ------------------------------------------------------- */
 
@@ -197,11 +205,13 @@ const char *sim_last_error(const sim *s);
 
 /* Time (s) at which a control set now takes effect: the integrator's time. */
 double sim_effective_time(const sim *s);
-/* Ramp beta to target_deg (deg, within the beta range) at rate_deg_s
- * (deg/s, > 0; <= 0 keeps the current rate). Returns SIM_OK or SIM_EPARAM. */
-int sim_set_beta(sim *s, double target_deg, double rate_deg_s);
+/* Ramp beta to beta (rad) at rate (rad/s; <= 0 keeps the current rate),
+ * both within the settings table's ranges of "beta" and "beta_rate".
+ * Returns SIM_OK or SIM_EPARAM (nothing changed). */
+int sim_set_beta(sim *s, double beta, double rate);
 int sim_set_rotation(sim *s, int rotation);    /* SIM_CW / SIM_CCW */
-int sim_set_omega_ss(sim *s, double omega_ss); /* rad/s */
+/* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
+int sim_set_omega_ss(sim *s, double omega_ss);
 int sim_set_drive_on(sim *s, int on);
 
 /* Place the feed at the observed time (which must equal the integrator's:

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "srv.h"
+#include "units.h"
 
 enum { EXP_WAITING, EXP_RUNNING, EXP_DONE, EXP_ABORTED };
 
@@ -90,7 +91,8 @@ static void start_segment(srv_experiment *e, int i, sim *sm,
 		c.beta_rate = e->req.beta_rate;
 	}
 	seg->t_command = sim_effective_time(sm);
-	sim_set_beta(sm, seg->beta, e->req.beta_rate);
+	sim_set_beta(sm, sim_rad_from_deg(seg->beta),
+		     sim_rad_from_deg(e->req.beta_rate));
 	sim_restart_transport(sm);
 	seg->start_velocity = st->feed_velocity;
 	seg->state = 1;

@@ -7,8 +7,6 @@
 
 #include "srv.h"
 
-#define DEG (180.0 / M_PI)
-
 typedef struct srv_cmd {
 	api_control c;
 	int done, rc;

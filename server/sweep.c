@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "srv.h"
+#include "units.h"
 
 typedef struct srv_sweep {
 	char id[24];
@@ -110,7 +111,7 @@ static void run_point(void *arg)
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
 		double v = 0;
-		int rc = sim_set(&spec.params, &spec.scene, &spec.method,
+		int rc = sim_set_user(&spec.params, &spec.scene, &spec.method,
 				 "beta", p->beta, msg, sizeof msg);
 		spec.params.rotation = p->rotation;
 		if (rc == SIM_OK)
