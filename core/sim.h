@@ -20,19 +20,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Return codes: one list, expanded into the enum, sim_strerror() and (in
- * api/) the HTTP status. X(name, http_status, message). */
+/* Return codes: one list, expanded into the enum and sim_strerror().
+ * X(name, message); no transport meaning (api/errors.c maps them). */
 #define SIM_ERRNO_MAP(X)                                                      \
-	X(OK, 200, "ok")                                                      \
-	X(EPARAM, 422, "parameter out of range")                              \
-	X(EUNKNOWN, 422, "unknown name")                                      \
-	X(ENOMEM, 503, "out of memory")                                       \
-	X(EDIVERGED, 422, "simulation diverged")                              \
-	X(ESTEP, 422, "step size underflow")                                  \
-	X(ETIME, 422, "requested time lies in the past")
+	X(OK, "ok")                                                           \
+	X(EPARAM, "parameter out of range")                                   \
+	X(EUNKNOWN, "unknown name")                                           \
+	X(ENOMEM, "out of memory")                                            \
+	X(EDIVERGED, "simulation diverged")                                   \
+	X(ESTEP, "step size underflow")                                       \
+	X(ETIME, "requested time lies in the past")
 
 typedef enum {
-#define SIM_ERR_ENUM(name, status, msg) SIM_##name,
+#define SIM_ERR_ENUM(name, msg) SIM_##name,
 	SIM_ERRNO_MAP(SIM_ERR_ENUM)
 #undef SIM_ERR_ENUM
 	SIM_NERR
