@@ -2,12 +2,14 @@
  * ode.h - internal: integrators as data. Each method is one file of static
  * functions exporting one const descriptor; ode_registry.c lists them so
  * that the API finds a method by name. The caller (sim.c) decides when to
- * step; there are no callbacks into the caller.
+ * step; there are no callbacks into the caller. A step reads the const
+ * model and the controls through its dyn and changes only the state, its
+ * workspace and the dyn's evaluation counter.
  */
 #ifndef CONVSIM_ODE_H
 #define CONVSIM_ODE_H
 
-#include "model.h"
+#include "dynamics.h"
 
 typedef struct ode_method {
 	/* name, order, adaptive, doc: the public description. First member,
@@ -20,7 +22,7 @@ typedef struct ode_method {
 	/* One step from (*t, y), in place. Fixed-step methods do not pass
 	 * t_max (the last step is shortened); dense methods may. Returns
 	 * SIM_OK or SIM_ESTEP. */
-	int (*step)(void *ws, model *md, double *t, double *y, double t_max);
+	int (*step)(void *ws, dyn *sys, double *t, double *y, double t_max);
 	/* Dense methods: the state at t within the last step into out. */
 	void (*interpolate)(void *ws, double t, double *out);
 	/* Forget cached derivatives (after a control change). */

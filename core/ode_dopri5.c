@@ -85,14 +85,14 @@ static void *dp_alloc(const model *md, const sim_method *cfg)
 	return w;
 }
 
-static int dp_step(void *p, model *md, double *t, double *y, double t_max)
+static int dp_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	dopri5 *w = p;
 	const int n = w->n;
 	double **k = w->k;
 	(void)t_max;
 	if (!w->have_k1) {
-		model_rhs(md, *t, y, k[0], NULL);
+		dyn_rhs(sys, *t, y, k[0]);
 		w->have_k1 = 1;
 	}
 	for (;;) {
@@ -105,25 +105,25 @@ static int dp_step(void *p, model *md, double *t, double *y, double t_max)
 			h = w->hmin;
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * a21 * k[0][i];
-		model_rhs(md, *t + c2 * h, w->ytmp, k[1], NULL);
+		dyn_rhs(sys, *t + c2 * h, w->ytmp, k[1]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a31 * k[0][i] + a32 * k[1][i]);
-		model_rhs(md, *t + c3 * h, w->ytmp, k[2], NULL);
+		dyn_rhs(sys, *t + c3 * h, w->ytmp, k[2]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a41 * k[0][i] + a42 * k[1][i] + a43 * k[2][i]);
-		model_rhs(md, *t + c4 * h, w->ytmp, k[3], NULL);
+		dyn_rhs(sys, *t + c4 * h, w->ytmp, k[3]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a51 * k[0][i] + a52 * k[1][i] + a53 * k[2][i] +
 						 a54 * k[3][i]);
-		model_rhs(md, *t + c5 * h, w->ytmp, k[4], NULL);
+		dyn_rhs(sys, *t + c5 * h, w->ytmp, k[4]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a61 * k[0][i] + a62 * k[1][i] + a63 * k[2][i] +
 						 a64 * k[3][i] + a65 * k[4][i]);
-		model_rhs(md, *t + h, w->ytmp, k[5], NULL);
+		dyn_rhs(sys, *t + h, w->ytmp, k[5]);
 		for (int i = 0; i < n; i++)
 			w->ynew[i] = y[i] + h * (a71 * k[0][i] + a73 * k[2][i] + a74 * k[3][i] +
 						 a75 * k[4][i] + a76 * k[5][i]);
-		model_rhs(md, *t + h, w->ynew, k[6], NULL);
+		dyn_rhs(sys, *t + h, w->ynew, k[6]);
 		double err = 0.0;
 		for (int i = 0; i < w->nerr; i++) {
 			double ei = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] +

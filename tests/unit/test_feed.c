@@ -76,7 +76,8 @@ static void hopping_theory_vdi2333(void **state)
 		set(&u, "R", "0.001");
 		set(&u, "k_c", "1e7");
 		model md;
-		model_init(&md, &u.p, &u.sc);
+		model_ctl ctl;
+		model_init(&md, &ctl, &u.p, &u.sc);
 		md.p.mu = 100.0; /* the theory assumes no slip at all */
 		double *y = calloc((size_t)md.n, sizeof(double));
 		signed char modes[2] = {0, 0};
