@@ -107,6 +107,38 @@ static void static_residual(const model *md, const model_ctl *ctl, const double 
 	memcpy(res, ev.qdd, sizeof ev.qdd);
 }
 
+/* Gaussian elimination with partial pivoting: J x = b for n <= 5, x into b
+ * (J overwritten). */
+static void gauss_solve(int n, double J[5][5], double b[5])
+{
+	for (int c = 0; c < n; c++) {
+		int piv = c;
+		for (int r = c + 1; r < n; r++)
+			if (fabs(J[r][c]) > fabs(J[piv][c]))
+				piv = r;
+		for (int k = 0; k < n; k++) {
+			double t = J[c][k];
+			J[c][k] = J[piv][k];
+			J[piv][k] = t;
+		}
+		double t = b[c];
+		b[c] = b[piv];
+		b[piv] = t;
+		for (int r = c + 1; r < n; r++) {
+			double f = J[r][c] / J[c][c];
+			for (int k = c; k < n; k++)
+				J[r][k] -= f * J[c][k];
+			b[r] -= f * b[c];
+		}
+	}
+	for (int c = n - 1; c >= 0; c--) {
+		double s = b[c];
+		for (int k = c + 1; k < n; k++)
+			s -= J[c][k] * b[k];
+		b[c] = s / J[c][c];
+	}
+}
+
 /* Newton's iteration on the static accelerations of (x, y, alpha, s1, s2)
  * from the preload's strokes: q (written) at rest in equilibrium. */
 static void static_equilibrium(const model *md, const model_ctl *ctl, double q[NQ_FULL])
@@ -144,33 +176,7 @@ static void static_equilibrium(const model *md, const model_ctl *ctl, double q[N
 			for (int a = 0; a < n; a++)
 				J[a][b] = (r1[idx[a]] - r0[idx[a]]) / hq;
 		}
-		/* Gaussian elimination with partial pivoting */
-		for (int c = 0; c < n; c++) {
-			int piv = c;
-			for (int r = c + 1; r < n; r++)
-				if (fabs(J[r][c]) > fabs(J[piv][c]))
-					piv = r;
-			for (int k = 0; k < n; k++) {
-				double t = J[c][k];
-				J[c][k] = J[piv][k];
-				J[piv][k] = t;
-			}
-			double t = rhs[c];
-			rhs[c] = rhs[piv];
-			rhs[piv] = t;
-			for (int r = c + 1; r < n; r++) {
-				double f = J[r][c] / J[c][c];
-				for (int k = c; k < n; k++)
-					J[r][k] -= f * J[c][k];
-				rhs[r] -= f * rhs[c];
-			}
-		}
-		for (int c = n - 1; c >= 0; c--) {
-			double s = rhs[c];
-			for (int k = c + 1; k < n; k++)
-				s -= J[c][k] * rhs[k];
-			rhs[c] = s / J[c][c];
-		}
+		gauss_solve(n, J, rhs);
 		for (int a = 0; a < n; a++)
 			q[idx[a]] += rhs[a];
 	}

@@ -182,6 +182,41 @@ static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int
 	fputc('\n', f);
 }
 
+/* The run's JSON summary on stdout: final status, cost (cpu, wall in s)
+ * and the error, if any. */
+static void print_summary(const opts *o, const sim *s, const sim_status *st, int err, double cpu,
+			  double wall)
+{
+	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o->preset, st->t);
+	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
+	       "\"atol\": %.17g, \"substeps\": %d},\n",
+	       o->m.name, st->dt, o->m.rtol, o->m.atol, st->substeps);
+	printf("  \"reductions\": [");
+	for (int b = 0, first = 1; sim_reduction_name(b); b++)
+		if (st->reductions & (1u << b)) {
+			printf("%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
+			first = 0;
+		}
+	printf("],\n  \"transport_velocity\": ");
+	print_num(stdout, st->transport_velocity);
+	printf(",\n  \"transport_periods\": %.0f,\n  \"rotor_speed\": ", st->transport_periods);
+	print_num(stdout, st->rotor_speed);
+	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", sim_deg_from_rad(st->beta));
+	print_num(stdout, st->feed_displacement);
+	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
+	       (unsigned long long)st->steps, (unsigned long long)st->rhs_evals, st->n_dof);
+	printf("  \"cpu_seconds\": %.6g,\n  \"wall_seconds\": %.6g,\n", cpu, wall);
+	printf("  \"real_time_factor\": %.6g,\n", cpu > 0 ? st->t / cpu : 0.0);
+	printf("  \"energy\": {\"input\": %.10g, \"kinetic\": %.10g, \"potential\": %.10g, "
+	       "\"dissipated\": %.10g, \"residual\": %.6g},\n",
+	       st->e_input, st->e_kinetic, st->e_potential, st->e_dissipated, st->e_residual);
+	printf("  \"error\": ");
+	if (err != SIM_OK)
+		printf("\"%s\"\n}\n", sim_last_error(s));
+	else
+		printf("null\n}\n");
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	opts o = {0};
@@ -200,7 +235,7 @@ static int cmd_run(int argc, char **argv)
 		return 2;
 	}
 	FILE *f = NULL;
-	double *colbuf = calloc(64, sizeof(double));
+	double *colbuf = calloc(SIM_MAX_COLUMNS, sizeof(double));
 	if (o.out) {
 		f = fopen(o.out, "w");
 		if (!f) {
@@ -234,34 +269,7 @@ static int cmd_run(int argc, char **argv)
 		fclose(f);
 	}
 	sim_get_status(s, &st);
-	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o.preset, st.t);
-	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
-	       "\"atol\": %.17g, \"substeps\": %d},\n",
-	       o.m.name, st.dt, o.m.rtol, o.m.atol, st.substeps);
-	printf("  \"reductions\": [");
-	for (int b = 0, first = 1; sim_reduction_name(b); b++)
-		if (st.reductions & (1u << b)) {
-			printf("%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
-			first = 0;
-		}
-	printf("],\n  \"transport_velocity\": ");
-	print_num(stdout, st.transport_velocity);
-	printf(",\n  \"transport_periods\": %.0f,\n  \"rotor_speed\": ", st.transport_periods);
-	print_num(stdout, st.rotor_speed);
-	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", sim_deg_from_rad(st.beta));
-	print_num(stdout, st.feed_displacement);
-	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
-	       (unsigned long long)st.steps, (unsigned long long)st.rhs_evals, st.n_dof);
-	printf("  \"cpu_seconds\": %.6g,\n  \"wall_seconds\": %.6g,\n", cpu, wall);
-	printf("  \"real_time_factor\": %.6g,\n", cpu > 0 ? st.t / cpu : 0.0);
-	printf("  \"energy\": {\"input\": %.10g, \"kinetic\": %.10g, \"potential\": %.10g, "
-	       "\"dissipated\": %.10g, \"residual\": %.6g},\n",
-	       st.e_input, st.e_kinetic, st.e_potential, st.e_dissipated, st.e_residual);
-	printf("  \"error\": ");
-	if (err != SIM_OK)
-		printf("\"%s\"\n}\n", sim_last_error(s));
-	else
-		printf("null\n}\n");
+	print_summary(&o, s, &st, err, cpu, wall);
 	sim_free(s);
 	free(colbuf);
 	return err == SIM_OK ? 0 : 1;
