@@ -199,6 +199,7 @@ void sim_free(sim *s);
  * observed time. Returns SIM_OK, SIM_ETIME, or SIM_EDIVERGED / SIM_ESTEP
  * (the instance is then frozen; sim_last_error() tells time and cause). */
 int sim_advance(sim *s, double t_end);
+/* Why the instance froze (time and cause), "" while it runs; owned by s. */
 const char *sim_last_error(const sim *s);
 
 /* ---- controls (take effect at sim_effective_time()) ------------------ */
@@ -209,9 +210,11 @@ double sim_effective_time(const sim *s);
  * both within the settings table's ranges of "beta" and "beta_rate".
  * Returns SIM_OK or SIM_EPARAM (nothing changed). */
 int sim_set_beta(sim *s, double beta, double rate);
-int sim_set_rotation(sim *s, int rotation);    /* SIM_CW / SIM_CCW */
+/* Sense of the unbalanced mass, SIM_CW or SIM_CCW; else SIM_EPARAM. */
+int sim_set_rotation(sim *s, int rotation);
 /* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
 int sim_set_omega_ss(sim *s, double omega_ss);
+/* Switch the drive on (on != 0) or off; always SIM_OK. */
 int sim_set_drive_on(sim *s, int on);
 
 /* Place the feed at the observed time (which must equal the integrator's:
@@ -278,6 +281,8 @@ typedef struct sim_status {
 	int n_dof;                /* integrated machine + feed coordinates */
 } sim_status;
 
+/* Copy the status at the observed time into *st (SI units). Reading never
+ * changes the instance, its counters included. */
 void sim_get_status(const sim *s, sim_status *st);
 
 /* Restart the transport-velocity estimator at the next period boundary
@@ -291,6 +296,7 @@ int sim_measure_velocity(const sim_params *p, const sim_scene *s,
 			 char *msg, size_t msglen);
 
 /* Feed geometry of the instance. */
+/* Physical columns K and layers L; 0 without feed. */
 int sim_columns(const sim *s);
 int sim_layers(const sim *s);
 /* Per column k: mean feed displacement xi_bar_k(t) - xi_bar_k(0), m.
