@@ -11,9 +11,11 @@
 
 #include "sim.h"
 
-/* The scale of "deg" and its inverse. */
-#define RAD_PER_DEG (M_PI / 180.0)
-#define DEG_PER_RAD (180.0 / M_PI)
+/* pi spelt as glibc's M_PI (the same double), which strict feature-test
+ * settings leave undefined; the scale of "deg" and its inverse. */
+#define SIM_PI 3.14159265358979323846
+#define RAD_PER_DEG (SIM_PI / 180.0)
+#define DEG_PER_RAD (180.0 / SIM_PI)
 
 /* The setting named name, or NULL. Static. */
 const sim_setting *sim_setting_find(const char *name);
@@ -47,11 +49,11 @@ int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, c
  * their results bit-identical. Settings go through the table instead. */
 static inline double sim_rad_from_deg(double deg)
 {
-	return deg * M_PI / 180.0;
+	return deg * SIM_PI / 180.0;
 }
 static inline double sim_deg_from_rad(double rad)
 {
-	return rad * 180.0 / M_PI;
+	return rad * 180.0 / SIM_PI;
 }
 
 #endif
