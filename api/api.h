@@ -61,7 +61,8 @@ typedef struct api_problem {
 
 /* HTTP status of an api_err (500 for an unknown code). */
 int api_status(api_err code);
-/* HTTP status of a core return code, from SIM_ERRNO_MAP. */
+/* HTTP status of a core return code (500 for an unknown code), through
+ * the one table in errors.c. */
 int api_sim_status(int sim_err);
 /* The api_err a core return code maps to. */
 api_err api_from_sim(int sim_err);

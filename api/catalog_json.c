@@ -75,13 +75,13 @@ char *api_presets_json(void)
 	cJSON_AddItemToObject(o, "settings", api_settings_array());
 	cJSON *methods = cJSON_AddArrayToObject(o, "methods");
 	size_t nm = 0;
-	const sim_method_info *mi = sim_methods(&nm);
+	const sim_method_info *const *mi = sim_methods(&nm);
 	for (size_t i = 0; mi && i < nm; i++) {
 		cJSON *mo = cJSON_CreateObject();
-		cJSON_AddStringToObject(mo, "name", mi[i].name);
-		cJSON_AddNumberToObject(mo, "order", mi[i].order);
-		cJSON_AddBoolToObject(mo, "adaptive", mi[i].adaptive);
-		cJSON_AddStringToObject(mo, "doc", mi[i].doc ? mi[i].doc : "");
+		cJSON_AddStringToObject(mo, "name", mi[i]->name);
+		cJSON_AddNumberToObject(mo, "order", mi[i]->order);
+		cJSON_AddBoolToObject(mo, "adaptive", mi[i]->adaptive);
+		cJSON_AddStringToObject(mo, "doc", mi[i]->doc ? mi[i]->doc : "");
 		cJSON_AddItemToArray(methods, mo);
 	}
 	return api_print_free(o);

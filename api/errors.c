@@ -1,9 +1,10 @@
 /*
  * errors.c - error codes to HTTP statuses and RFC 9457 problem details.
  *
- * Two X-macro lists meet here: the core's SIM_ERRNO_MAP (which already
- * carries an HTTP status per core error) and api.h's API_ERRNO_MAP for the
- * errors of the HTTP layer. A problem names the offending field by its
+ * api.h's API_ERRNO_MAP lists the errors of the HTTP layer with their
+ * statuses and problem types; SIM_TO_API below is the one table that maps
+ * the core's return codes (SIM_ERRNO_MAP, names and messages only) onto
+ * them, and so to HTTP statuses. A problem names the offending field by its
  * JSON path and, when the field is a setting of the core's table, adds the
  * allowed range or choices so that a client can correct itself.
  */
@@ -30,27 +31,38 @@ int api_status(api_err code)
 	return api_errors[code].status;
 }
 
+/* X(core code, api code): every SIM_ERRNO_MAP entry once. */
+#define SIM_TO_API(X)                                                         \
+	X(OK, OK)                                                             \
+	X(EPARAM, RANGE)                                                      \
+	X(EUNKNOWN, UNKNOWN)                                                  \
+	X(ENOMEM, UNAVAILABLE)                                                \
+	X(EDIVERGED, INVALID)                                                 \
+	X(ESTEP, INVALID)                                                     \
+	X(ETIME, INVALID)
+
+static const api_err sim_to_api[SIM_NERR] = {
+#define SIM_TO_API_ROW(sim, api) [SIM_##sim] = API_##api,
+	SIM_TO_API(SIM_TO_API_ROW)
+#undef SIM_TO_API_ROW
+};
+#define SIM_TO_API_COUNT(sim, api) +1
+_Static_assert(0 SIM_TO_API(SIM_TO_API_COUNT) == SIM_NERR,
+	       "SIM_TO_API maps every core return code");
+#undef SIM_TO_API_COUNT
+
 int api_sim_status(int sim_err)
 {
-	switch (sim_err) {
-#define SIM_ERR_CASE(name, status, msg) case SIM_##name: return status;
-	SIM_ERRNO_MAP(SIM_ERR_CASE)
-#undef SIM_ERR_CASE
-	default: return 500;
-	}
+	if (sim_err < 0 || sim_err >= SIM_NERR)
+		return 500;
+	return api_status(sim_to_api[sim_err]);
 }
 
 api_err api_from_sim(int sim_err)
 {
-	switch (sim_err) {
-	case SIM_OK: return API_OK;
-	case SIM_EPARAM: return API_RANGE;
-	case SIM_EUNKNOWN: return API_UNKNOWN;
-	case SIM_ENOMEM: return API_UNAVAILABLE;
-	default:
-		return api_sim_status(sim_err) == 503 ? API_UNAVAILABLE
-						      : API_INVALID;
-	}
+	if (sim_err < 0 || sim_err >= SIM_NERR)
+		return API_INVALID;
+	return sim_to_api[sim_err];
 }
 
 const sim_setting *api_setting(const char *group, const char *name)

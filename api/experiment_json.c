@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
 static api_err parse_segment(const cJSON *it, int i, double prev,
 			     const api_spec *spec, api_segment *seg,
@@ -36,7 +37,7 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 	sim_params p = spec->params;
 	sim_scene s = spec->scene;
 	sim_method m = spec->method;
-	int rc = sim_set(&p, &s, &m, "beta", beta->valuedouble, msg,
+	int rc = sim_set_user(&p, &s, &m, "beta", beta->valuedouble, msg,
 			 sizeof msg);
 	if (rc != SIM_OK) {
 		api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);
@@ -121,7 +122,7 @@ api_err api_parse_experiment(const char *body, size_t len,
 		if (!cJSON_IsNumber(rate))
 			e = api_fail(pb, API_TYPE, "beta_rate",
 				     "beta_rate must be a number (deg/s)");
-		else if (sim_set(&p, &req->spec.scene, &req->spec.method,
+		else if (sim_set_user(&p, &req->spec.scene, &req->spec.method,
 				 "beta_rate", rate->valuedouble, msg,
 				 sizeof msg) != SIM_OK)
 			e = api_fail(pb, API_RANGE, "beta_rate", "%s", msg);

@@ -239,11 +239,11 @@ static cJSON *group_schema(const char *group)
 	if (strcmp(group, "integrator") == 0 &&
 	    !cJSON_GetObjectItemCaseSensitive(props, "method")) {
 		size_t nm = 0;
-		const sim_method_info *mi = sim_methods(&nm);
+		const sim_method_info *const *mi = sim_methods(&nm);
 		cJSON *p = cJSON_CreateObject();
 		cJSON *e = cJSON_AddArrayToObject(p, "enum");
 		for (size_t i = 0; mi && i < nm; i++)
-			cJSON_AddItemToArray(e, cJSON_CreateString(mi[i].name));
+			cJSON_AddItemToArray(e, cJSON_CreateString(mi[i]->name));
 		cJSON_AddItemToObject(props, "method", p);
 	}
 	return schema;

@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
-#define DEG (180.0 / M_PI)
 
 static api_err check_setting(const api_spec *spec, const char *name,
 			     const cJSON *it, double *value, api_problem *pb)
@@ -25,7 +25,7 @@ static api_err check_setting(const api_spec *spec, const char *name,
 	if (!cJSON_IsNumber(it))
 		return api_fail(pb, API_TYPE, name, "%s must be a number",
 				name);
-	int rc = sim_set(&p, &s, &m, name, it->valuedouble, msg, sizeof msg);
+	int rc = sim_set_user(&p, &s, &m, name, it->valuedouble, msg, sizeof msg);
 	if (rc != SIM_OK)
 		return api_fail(pb, api_from_sim(rc), name, "%s",
 				msg[0] ? msg : sim_strerror(rc));
@@ -163,9 +163,9 @@ static cJSON *status_object(const api_view *v)
 	cJSON *o = cJSON_CreateObject();
 	api_add_number(o, "t", st->t);
 	api_add_number(o, "t_integrator", st->t_int);
-	api_add_number(o, "beta", st->beta * DEG);
-	api_add_number(o, "beta_target", st->beta_target * DEG);
-	api_add_number(o, "beta_dot", st->beta_dot * DEG);
+	api_add_number(o, "beta", st->beta * DEG_PER_RAD);
+	api_add_number(o, "beta_target", st->beta_target * DEG_PER_RAD);
+	api_add_number(o, "beta_dot", st->beta_dot * DEG_PER_RAD);
 	cJSON_AddStringToObject(o, "rotation",
 				st->rotation == SIM_CW ? "cw" : "ccw");
 	cJSON_AddBoolToObject(o, "drive_on", st->drive_on);

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
 /* The name of choice idx in "a|b|c" into out; 0 if there is none. */
 static int choice_name(const char *choices, int idx, char *out, size_t len)
@@ -75,7 +76,7 @@ api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
 			return api_fail(pb, API_RANGE, field,
 					"%s must be an integer in [%g, %g]",
 					field, set->min, set->max);
-		rc = sim_set(p, s, m, name, item->valuedouble, msg, sizeof msg);
+		rc = sim_set_user(p, s, m, name, item->valuedouble, msg, sizeof msg);
 		break;
 	case SIM_KIND_BOOL:
 		if (cJSON_IsBool(item))
@@ -159,7 +160,7 @@ cJSON *api_settings_object(const sim_params *p, const sim_scene *s,
 		if (strcmp(tab[i].group, group) != 0)
 			continue;
 		double v = NAN;
-		if (sim_get(p, s, m, tab[i].name, &v) != SIM_OK)
+		if (sim_get_user(p, s, m, tab[i].name, &v) != SIM_OK)
 			continue;
 		if (strcmp(tab[i].name, "method") == 0)
 			has_method = 1;

@@ -14,8 +14,8 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
-#define DEG (180.0 / M_PI)
 
 /* Bounded writer into a fixed buffer. */
 typedef struct writer {
@@ -107,8 +107,8 @@ size_t api_record_max(int columns, int layers)
 static void sample_body(writer *w, const api_sample *s, unsigned f)
 {
 	const sim_status *st = &s->st;
-	w_num(w, "beta", st->beta * DEG);
-	w_num(w, "beta_target", st->beta_target * DEG);
+	w_num(w, "beta", st->beta * DEG_PER_RAD);
+	w_num(w, "beta_target", st->beta_target * DEG_PER_RAD);
 	if (f & API_F_TROUGH) {
 		w_num(w, "x", st->q[0]);
 		w_num(w, "y", st->q[1]);
@@ -248,7 +248,7 @@ const char *const api_history_names[API_HISTORY_COLS] = {
 void api_history_row(const sim_status *st, double *row)
 {
 	const double v[API_HISTORY_COLS] = {
-		st->t,           st->beta * DEG,    st->beta_target * DEG,
+		st->t,           st->beta * DEG_PER_RAD,    st->beta_target * DEG_PER_RAD,
 		st->q[0],        st->q[1],          st->q[2],
 		st->deck[0],     st->deck[1],       st->rotor_speed,
 		st->motor_torque, st->q[4],         st->q[5],

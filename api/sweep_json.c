@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
 static api_err check_beta(const api_spec *spec, const char *field, double v,
 			  api_problem *pb)
@@ -21,7 +22,7 @@ static api_err check_beta(const api_spec *spec, const char *field, double v,
 	sim_scene s = spec->scene;
 	sim_method m = spec->method;
 	char msg[256] = "";
-	int rc = sim_set(&p, &s, &m, "beta", v, msg, sizeof msg);
+	int rc = sim_set_user(&p, &s, &m, "beta", v, msg, sizeof msg);
 	if (rc == SIM_OK)
 		return API_OK;
 	api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);

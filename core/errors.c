@@ -1,13 +1,13 @@
 /*
  * errors.c - text of the core's return codes, generated from SIM_ERRNO_MAP
- * so that the enum, the messages and the API's HTTP statuses share one list.
+ * so that the enum and the messages share one list.
  */
 #include "sim.h"
 
 const char *sim_strerror(int err)
 {
 	switch (err) {
-#define SIM_ERR_TEXT(name, status, msg) \
+#define SIM_ERR_TEXT(name, msg)         \
 	case SIM_##name:                \
 		return msg;
 		SIM_ERRNO_MAP(SIM_ERR_TEXT)

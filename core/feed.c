@@ -10,11 +10,23 @@
  * The loading/unloading switch is taken at delta' = 0 with delta' >= 0 as
  * loading, so that a layer at rest carries its full load (the paper's
  * formula with sgn(0) = 0 would halve it there).
+ *
+ * The deck's motion comes in (deck_motion, or the deck point of one
+ * sub-step); the feed's forces on the deck go out. No machine function is
+ * called here: dynamics.c and ode_dem.c couple the two.
  */
 #include <math.h>
 #include <string.h>
 
 #include "feed.h"
+
+/* Normal contact force of the paper's law (eq. 7) for compression delta > 0
+ * and its rate: loading k delta^p for rate >= 0, unloading R^2 k delta^p. */
+static double contact_force(const model *md, double delta, double delta_dot)
+{
+	double f = md->p.p == 1.0 ? md->p.k_c * delta : md->p.k_c * pow(delta, md->p.p);
+	return delta_dot >= 0.0 ? f : f * md->p.R * md->p.R;
+}
 
 static inline double friction_sign(const model *md, double v)
 {
@@ -49,7 +61,7 @@ static void column_rhs(const model *md, const double *y, int k, const double dpo
 		double delta = prev_eta - eta[e];
 		if (delta > 0.0) {
 			double ddot = prev_etad - etad[e];
-			double Fn = model_contact_force(md, delta, ddot);
+			double Fn = contact_force(md, delta, ddot);
 			double vrel = xid[e] - prev_xid;
 			double T = -mu * Fn * friction_sign(md, vrel);
 			axi[e] += T;
@@ -75,22 +87,16 @@ static void column_rhs(const model *md, const double *y, int k, const double dpo
 	}
 }
 
-void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
-	      const double qd[NQ_FULL], double *dy, double Qfeed[NQ_FULL],
-	      double *fric_power, double *contact_power)
+void feed_rhs(const model *md, const double *y, const deck_motion *dm, double *dy,
+	      double (*F)[2], double *fric_power, double *contact_power)
 {
 	const int nf = md->nf;
 	/* position rates are the velocities */
 	memcpy(XI(md, dy), XID(md, y), sizeof(double) * (size_t)nf);
 	memcpy(ETA(md, dy), ETAD(md, y), sizeof(double) * (size_t)nf);
-	double fric = 0.0, contact = 0.0, F[64][2];
-	model_rot R = model_rotation(q);
-	for (int k = 0; k < md->K; k++) {
-		double pos[2], vel[2];
-		model_deck(md, k, &R, q, qd, pos, vel);
-		column_rhs(md, y, k, pos, vel, dy, F[k], &fric, &contact);
-	}
-	model_deck_forces(md, &R, (const double(*)[2])F, md->col_weight, Qfeed);
+	double fric = 0.0, contact = 0.0;
+	for (int k = 0; k < md->dk.K; k++)
+		column_rhs(md, y, k, dm->pos[k], dm->vel[k], dy, F[k], &fric, &contact);
 	*fric_power = md->col_weight * fric;
 	*contact_power = md->col_weight * contact;
 }
@@ -107,21 +113,17 @@ void feed_energy(const model *md, const double *y, double *kinetic, double *pote
 	*potential = md->col_weight * md->p.m_n * md->p.g * V;
 }
 
-double feed_contact_energy(const model *md, const double *y, const double q[NQ_FULL],
-			   const double qd[NQ_FULL])
+double feed_contact_energy(const model *md, const double *y, const deck_motion *dm)
 {
 	const double *eta = ETA(md, y), *etad = ETAD(md, y);
 	double E = 0.0;
-	model_rot R = model_rotation(q);
-	for (int k = 0; k < md->K; k++) {
-		double pos[2], vel[2];
-		model_deck(md, k, &R, q, qd, pos, vel);
-		double prev = pos[1], prevd = vel[1];
+	for (int k = 0; k < md->dk.K; k++) {
+		double prev = dm->pos[k][1], prevd = dm->vel[k][1];
 		for (int j = 0; j < md->L; j++) {
 			int e = k * md->L + j;
 			double delta = prev - eta[e];
 			if (delta > 0.0)
-				E += model_contact_force(md, delta, prevd - etad[e]) * delta /
+				E += contact_force(md, delta, prevd - etad[e]) * delta /
 				     (md->p.p + 1.0);
 			prev = eta[e];
 			prevd = etad[e];
@@ -130,15 +132,12 @@ double feed_contact_energy(const model *md, const double *y, const double q[NQ_F
 	return md->col_weight * E;
 }
 
-void feed_settle(const model *md, double *y, const double q[NQ_FULL])
+void feed_settle(const model *md, double *y, const deck_motion *dm)
 {
 	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
-	double zero[NQ_FULL] = {0};
 	const double w = md->p.m_n * md->p.g;
-	model_rot R = model_rotation(q);
-	for (int k = 0; k < md->K; k++) {
-		double pos[2], vel[2];
-		model_deck(md, k, &R, q, zero, pos, vel);
+	for (int k = 0; k < md->dk.K; k++) {
+		const double *pos = dm->pos[k];
 		double level = pos[1];
 		for (int j = 0; j < md->L; j++) {
 			int e = k * md->L + j;
@@ -163,6 +162,15 @@ double feed_mean_xi(const model *md, const double *y, int k)
 	for (int e = from; e < to; e++)
 		s += xi[e];
 	return to > from ? s / (double)(to - from) : 0.0;
+}
+
+double feed_mean_xi_rate(const model *md, const double *y)
+{
+	const double *xid = XID(md, y);
+	double s = 0.0;
+	for (int e = 0; e < md->nf; e++)
+		s += xid[e];
+	return md->nf > 0 ? s / md->nf : 0.0;
 }
 
 static inline double clamp(double v, double lo, double hi)
@@ -246,9 +254,10 @@ void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2
 	const int L = md->L, base = k * L;
 	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
 	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
-	double hi[64], lo[64], vs[64], Pn[64], Pt[64], vn[64], vt[64];
+	double hi[SIM_MAX_LAYERS], lo[SIM_MAX_LAYERS], vs[SIM_MAX_LAYERS], Pn[SIM_MAX_LAYERS],
+		Pt[SIM_MAX_LAYERS], vn[SIM_MAX_LAYERS], vt[SIM_MAX_LAYERS];
 	signed char *mn = modes + base, *mt = modes + md->nf + base;
-	if (L < 1 || L > 64)
+	if (L < 1 || L > SIM_MAX_LAYERS)
 		return;
 	/* normal impulse bounds from the compressions at the sub-step's start:
 	 * loading k delta^p h, unloading R^2 k delta^p h */
@@ -256,7 +265,7 @@ void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2
 	for (int j = 0; j < L; j++) {
 		int e = base + j;
 		double delta = prev_eta - eta[e];
-		hi[j] = delta > 0.0 ? h * model_contact_force(md, delta, 1.0) : 0.0;
+		hi[j] = delta > 0.0 ? h * contact_force(md, delta, 1.0) : 0.0;
 		lo[j] = R2 * hi[j];
 		vs[j] = etad[e] - g * h;
 		prev_eta = eta[e];

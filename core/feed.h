@@ -3,31 +3,36 @@
  * zero-thickness layers of point masses on the deck, normal contact with
  * the loading/unloading switch and Coulomb (or, as an explicit option,
  * regularised) friction between neighbouring layers and with the deck.
+ *
+ * The feed is a function of the deck's motion: every entry point takes the
+ * deck points' positions and velocities (deck.h) and returns the forces or
+ * impulses on the deck; it calls no machine function. It reads the layout
+ * and parameters from the const model. SI units throughout.
  */
 #ifndef CONVSIM_FEED_H
 #define CONVSIM_FEED_H
 
 #include "model.h"
 
-/* Feed part of dy (positions' rates and accelerations), the generalized
- * force of the feed on the machine (Qfeed, added to), and the friction and
- * contact powers (written). q, qd: full machine coordinates. */
-void feed_rhs(const model *md, const double *y, const double q[NQ_FULL],
-	      const double qd[NQ_FULL], double *dy, double Qfeed[NQ_FULL],
-	      double *fric_power, double *contact_power);
+/* Feed part of dy (positions' rates and accelerations) for the deck motion
+ * dm; F[k] receives the force (N) of column k on its deck point, and the
+ * friction and contact powers (W, all columns counted) are written. */
+void feed_rhs(const model *md, const double *y, const deck_motion *dm, double *dy,
+	      double (*F)[2], double *fric_power, double *contact_power);
 
-/* Kinetic and gravitational energy of the feed (written). */
+/* Kinetic and gravitational energy of the feed (written, J). */
 void feed_energy(const model *md, const double *y, double *kinetic, double *potential);
 
-/* Elastic energy held in the contacts now (in the current loading mode). */
-double feed_contact_energy(const model *md, const double *y, const double q[NQ_FULL],
-			   const double qd[NQ_FULL]);
+/* Elastic energy (J) held in the contacts now (in the current loading mode). */
+double feed_contact_energy(const model *md, const double *y, const deck_motion *dm);
 
-/* Place the feed settled on the deck for machine coordinates q (at rest). */
-void feed_settle(const model *md, double *y, const double q[NQ_FULL]);
+/* Place the feed settled at rest on the deck points dm->pos. */
+void feed_settle(const model *md, double *y, const deck_motion *dm);
 
-/* Mean horizontal position of column k's elements (all columns: k = -1). */
+/* Mean horizontal position (m) of column k's elements (all columns: k = -1). */
 double feed_mean_xi(const model *md, const double *y, int k);
+/* Mean horizontal velocity (m/s) of all elements; 0 without feed. */
+double feed_mean_xi_rate(const model *md, const double *y);
 
 /* One sub-step of length h of column k for the split method "dem",
  * semi-implicit: impulse bounds from the compressions at the start, then

@@ -4,7 +4,20 @@
  * point masses (unbalanced mass, two eliminator masses on guides turned to
  * beta(t)), mass matrix M = diag(M_r, M_r, J_r, J_w, 0, 0) + sum m_k J_k^T J_k
  * solved by Cholesky at every evaluation, suspension with preload, Kloss or
- * ideal drive, and the feed's reaction at the deck points.
+ * ideal drive, and the feed's reaction as a given generalized force.
+ *
+ * The right-hand side is a pipeline of stages (in the manner of MuJoCo's
+ * mj_fwdPosition, mj_fwdVelocity, mj_fwdActuation, ...), each with a
+ * one-line contract; model_machine_rhs runs them in this order:
+ *   configure             q, q', beta(t), R(alpha), the three point masses
+ *   mass_matrix_and_bias  M (lower half) and Q_feed - gravity - sum m J^T a
+ *   suspension            spring sets with preload, their damping power
+ *   eliminators           guide springs and dampers, their damping power
+ *   drive                 motor torque, bearing drag and load, rotor speed
+ *   solve                 reduced Cholesky solve for q'' (and the ideal
+ *                         drive's torque that closes the rotor equation)
+ *   power                 drive and guide-actuator input, damping power
+ * Floating-point operations keep the order of the former single function.
  *
  * Velocity-product and beta-rate terms enter through a_k in
  * r_k'' = J_k q'' + a_k; see the derivation next to point_mass_* below.
@@ -13,28 +26,21 @@
 #include <string.h>
 
 #include "model.h"
-#include "feed.h"
-
-static inline void rot(double ca, double sa, const double b[2], double out[2])
-{
-	out[0] = ca * b[0] - sa * b[1];
-	out[1] = sa * b[0] + ca * b[1];
-}
 
 /* Kloss static characteristic (paper eq. 10), counter-clockwise sense. */
-static double kloss(const model *md, double omega)
+static double kloss(const model *md, const model_ctl *ctl, double omega)
 {
-	double slip = md->omega_ss - omega;
+	double slip = ctl->omega_ss - omega;
 	double s_ut = md->p.slip_ut;
 	return 2.0 * md->p.M_ut * slip * s_ut / (s_ut * s_ut + slip * slip);
 }
 
 /* Motor torque on the rotor for relative speed omega, both senses. */
-static double motor_torque(const model *md, double omega)
+static double motor_torque(const model *md, const model_ctl *ctl, double omega)
 {
-	if (!md->drive_on)
+	if (!ctl->drive_on)
 		return 0.0;
-	return md->rotation == SIM_CCW ? kloss(md, omega) : -kloss(md, -omega);
+	return ctl->rotation == SIM_CCW ? kloss(md, ctl, omega) : -kloss(md, ctl, -omega);
 }
 
 /* One point mass: Jacobian columns (2 x 6, column-major jc[i][0..1]) and
@@ -48,11 +54,11 @@ typedef struct pm {
 
 /* Unbalanced mass at G + R w + e (cos phi, sin phi):
  *   r'' = [I, perp(Rw), e(-sin phi, cos phi)] q'' - alpha'^2 Rw - e phi'^2 (cos, sin). */
-static void point_mass_vibrator(const model *md, double ca, double sa, const double *q,
+static void point_mass_vibrator(const model *md, const deck_rot *R, const double *q,
 				const double *qd, pm *k)
 {
 	double w[2] = {md->p.w_x, md->p.w_y}, Rw[2];
-	rot(ca, sa, w, Rw);
+	deck_rotate(R, w, Rw);
 	double cf = cos(q[Q_PHI]), sf = sin(q[Q_PHI]), e = md->p.e;
 	memset(k->jc, 0, sizeof k->jc);
 	k->m = md->p.m;
@@ -75,7 +81,7 @@ static void point_mass_vibrator(const model *md, double ca, double sa, const dou
  *         - alpha'^2 R b + 2 alpha' perp(R b_rel')
  *         + R (2 s' beta' u' + (c + s)(beta'' u' - beta'^2 u)),
  * with b_rel' = s' u + (c + s) beta' u' the guide-frame rate. */
-static void point_mass_eliminator(const model *md, int i, double ca, double sa,
+static void point_mass_eliminator(const model *md, int i, const deck_rot *R,
 				  const double *q, const double *qd, double sb, double cb,
 				  double beta_d, double beta_dd, pm *k)
 {
@@ -85,15 +91,15 @@ static void point_mass_eliminator(const model *md, int i, double ca, double sa,
 	double u[2] = {-sb, cb}, up[2] = {-cb, -sb};
 	double cs = md->p.c + q[qs], sd = qd[qs], ad = qd[Q_ALPHA];
 	double b[2] = {px + cs * u[0], py + cs * u[1]}, Rb[2], Ru[2];
-	rot(ca, sa, b, Rb);
-	rot(ca, sa, u, Ru);
+	deck_rotate(R, b, Rb);
+	deck_rotate(R, u, Ru);
 	double brel[2] = {sd * u[0] + cs * beta_d * up[0], sd * u[1] + cs * beta_d * up[1]};
 	double Rbrel[2];
-	rot(ca, sa, brel, Rbrel);
+	deck_rotate(R, brel, Rbrel);
 	double g2 = 2.0 * sd * beta_d, h1 = cs * beta_dd, h2 = cs * beta_d * beta_d;
 	double gl[2] = {g2 * up[0] + h1 * up[0] - h2 * u[0], g2 * up[1] + h1 * up[1] - h2 * u[1]};
 	double Rgl[2];
-	rot(ca, sa, gl, Rgl);
+	deck_rotate(R, gl, Rgl);
 	memset(k->jc, 0, sizeof k->jc);
 	k->m = i == 0 ? md->p.m1 : md->p.m2;
 	k->jc[Q_X][0] = 1.0;
@@ -108,8 +114,8 @@ static void point_mass_eliminator(const model *md, int i, double ca, double sa,
 	k->r[1] = Rb[1];
 }
 
-void model_full_coords(const model *md, double t, const double *y, double q[NQ_FULL],
-		       double qd[NQ_FULL])
+void model_full_coords(const model *md, const model_ctl *ctl, double t, const double *y,
+		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
 	memset(q, 0, sizeof(double) * NQ_FULL);
@@ -121,49 +127,130 @@ void model_full_coords(const model *md, double t, const double *y, double q[NQ_F
 		}
 	if (md->phi_prescribed) {
 		double psi, psid, psidd;
-		ramp_eval(&md->psi_ramp, t, &psi, &psid, &psidd);
+		ramp_eval(&ctl->psi_ramp, t, &psi, &psid, &psidd);
 		q[Q_PHI] += psi;
 		qd[Q_PHI] += psid;
 	}
 }
 
-void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FULL],
-		const double qd[NQ_FULL], double pos[2], double vel[2])
+/* The machine's configuration at time t: full coordinates, beta and its
+ * rates, and the three point masses. */
+typedef struct config {
+	double q[NQ_FULL], qd[NQ_FULL];
+	double beta, beta_d, beta_dd, sbeta, cbeta;
+	deck_rot R;
+	pm pms[3];
+} config;
+
+/* Stage configure: q, q', beta(t) and its rates, R(alpha), point masses. */
+static void configure(const model *md, const model_ctl *ctl, double t, const double *y,
+		      config *c)
 {
-	double dv[2] = {md->d[k], md->p.h_d}, Rd[2];
-	rot(R->c, R->s, dv, Rd);
-	pos[0] = q[Q_X] + Rd[0];
-	pos[1] = q[Q_Y] + Rd[1];
-	vel[0] = qd[Q_X] - qd[Q_ALPHA] * Rd[1];
-	vel[1] = qd[Q_Y] + qd[Q_ALPHA] * Rd[0];
+	model_full_coords(md, ctl, t, y, c->q, c->qd);
+	ramp_eval(&ctl->beta_ramp, t, &c->beta, &c->beta_d, &c->beta_dd);
+	c->R = deck_rotation(c->q);
+	c->sbeta = sin(c->beta);
+	c->cbeta = cos(c->beta);
+	point_mass_vibrator(md, &c->R, c->q, c->qd, &c->pms[0]);
+	for (int i = 0; i < 2; i++)
+		point_mass_eliminator(md, i, &c->R, c->q, c->qd, c->sbeta, c->cbeta, c->beta_d,
+				      c->beta_dd, &c->pms[1 + i]);
 }
 
-/* Generalized force of a force F applied at column k's deck point. */
-static void deck_force(const model *md, int k, const model_rot *R, const double F[2],
-		       double Q[NQ_FULL])
+/* Stage mass_matrix_and_bias: lower half of M, and rhs = Qfeed - gravity -
+ * sum m_k J_k^T a_k (the velocity-product and beta-rate terms). */
+static void mass_matrix_and_bias(const model *md, const config *cf, const double Qfeed[NQ_FULL],
+				 double M[NQ_FULL][NQ_FULL], double rhs[NQ_FULL])
 {
-	double dv[2] = {md->d[k], md->p.h_d}, Rd[2];
-	rot(R->c, R->s, dv, Rd);
-	Q[Q_X] += F[0];
-	Q[Q_Y] += F[1];
-	Q[Q_ALPHA] += -Rd[1] * F[0] + Rd[0] * F[1];
-}
-
-void model_deck_forces(const model *md, const model_rot *R, const double (*F)[2],
-		       double scale, double Q[NQ_FULL])
-{
-	for (int k = 0; k <= (md->K - 1) / 2; k++) {
-		int kk = md->K - 1 - k;
-		double Qpair[NQ_FULL] = {0}, Qm[NQ_FULL] = {0};
-		deck_force(md, k, R, F[k], Qpair);
-		if (kk != k) {
-			deck_force(md, kk, R, F[kk], Qm);
-			for (int i = 0; i < NQ_FULL; i++)
-				Qpair[i] += Qm[i];
+	const sim_params *p = &md->p;
+	memset(M, 0, sizeof(double) * NQ_FULL * NQ_FULL);
+	M[Q_X][Q_X] = p->M_r;
+	M[Q_Y][Q_Y] = p->M_r;
+	M[Q_ALPHA][Q_ALPHA] = p->J_r;
+	M[Q_PHI][Q_PHI] = p->J_w;
+	for (int i = 0; i < NQ_FULL; i++)
+		rhs[i] = Qfeed ? Qfeed[i] : 0.0;
+	rhs[Q_Y] -= p->M_r * p->g;
+	for (int k = 0; k < 3; k++) {
+		const pm *P = &cf->pms[k];
+		for (int i = 0; i < NQ_FULL; i++) {
+			double ji0 = P->jc[i][0], ji1 = P->jc[i][1];
+			if (ji0 == 0.0 && ji1 == 0.0)
+				continue;
+			for (int j = 0; j <= i; j++)
+				M[i][j] += P->m * (ji0 * P->jc[j][0] + ji1 * P->jc[j][1]);
+			/* gravity and the velocity-product terms */
+			rhs[i] += P->m * (-ji1 * p->g - ji0 * P->a[0] - ji1 * P->a[1]);
 		}
-		for (int i = 0; i < NQ_FULL; i++)
-			Q[i] += scale * Qpair[i];
 	}
+}
+
+/* Spring set i's attachment turned by R(alpha) (RP) and its displacement
+ * from rest (u). */
+static void suspension_point(const sim_params *p, const config *cf, int i, double RP[2],
+			     double u[2])
+{
+	double Pb[2] = {i == 0 ? p->l1 : -p->l2, -p->h};
+	deck_rotate(&cf->R, Pb, RP);
+	u[0] = cf->q[Q_X] + RP[0] - Pb[0];
+	u[1] = cf->q[Q_Y] + RP[1] - Pb[1];
+}
+
+/* Stage suspension: the two spring sets with preload into rhs; their
+ * damping power is added to *damp_power. */
+static void suspension(const model *md, const config *cf, double rhs[NQ_FULL],
+		       double *damp_power)
+{
+	const sim_params *p = &md->p;
+	const double *qd = cf->qd;
+	for (int i = 0; i < 2; i++) {
+		double RP[2], u[2];
+		suspension_point(p, cf, i, RP, u);
+		double vx = qd[Q_X] - qd[Q_ALPHA] * RP[1], vy = qd[Q_Y] + qd[Q_ALPHA] * RP[0];
+		double Fx = -p->k_x * u[0] - p->b_x * vx;
+		double Fy = -p->k_y * u[1] - p->b_y * vy + md->F0[i];
+		rhs[Q_X] += Fx;
+		rhs[Q_Y] += Fy;
+		rhs[Q_ALPHA] += -RP[1] * Fx + RP[0] * Fy;
+		*damp_power += p->b_x * vx * vx + p->b_y * vy * vy;
+	}
+}
+
+/* Stage eliminators: springs and dampers along the guides into rhs; their
+ * damping power is added to *damp_power. */
+static void eliminators(const sim_params *p, const config *cf, double rhs[NQ_FULL],
+			double *damp_power)
+{
+	const double *q = cf->q, *qd = cf->qd;
+	rhs[Q_S1] += -p->k_s1 * q[Q_S1] - p->b_s1 * qd[Q_S1];
+	rhs[Q_S2] += -p->k_s2 * q[Q_S2] - p->b_s2 * qd[Q_S2];
+	*damp_power += p->b_s1 * qd[Q_S1] * qd[Q_S1] + p->b_s2 * qd[Q_S2] * qd[Q_S2];
+}
+
+/* The drive's terms at one evaluation. */
+typedef struct drive_terms {
+	double omega;   /* rad/s rotor speed relative to the trough */
+	double drag;    /* N m bearing drag */
+	double load;    /* N m load torque */
+	double torque;  /* N m motor torque (ideal drive: set by solve) */
+} drive_terms;
+
+/* Stage drive: motor torque (Kloss; none for the ideal drive), drag and
+ * load on phi and their reaction on alpha; drag and load power added to
+ * *damp_power. */
+static void drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FULL],
+		  double *damp_power, drive_terms *dt)
+{
+	const sim_params *p = &md->p;
+	dt->omega = cf->qd[Q_PHI] - cf->qd[Q_ALPHA];
+	dt->drag = p->b_phi * dt->omega * fabs(dt->omega);
+	dt->load = -(double)ctl->rotation * p->M_load;
+	dt->torque = 0.0;
+	if (!md->phi_prescribed)
+		dt->torque = motor_torque(md, ctl, dt->omega);
+	rhs[Q_PHI] += dt->torque - dt->drag + dt->load;
+	rhs[Q_ALPHA] -= dt->torque - dt->drag + dt->load;
+	*damp_power += dt->drag * dt->omega - dt->load * dt->omega;
 }
 
 /* In-place Cholesky solve of the n x n SPD system A x = b (A overwritten).
@@ -200,107 +287,14 @@ static int cholesky_solve(int n, double A[NQ_FULL][NQ_FULL], double *b)
 	return 0;
 }
 
-/* The machine's configuration at time t: full coordinates, beta and its
- * rates, and the three point masses. */
-typedef struct config {
-	double q[NQ_FULL], qd[NQ_FULL];
-	double beta, beta_d, beta_dd, sbeta, cbeta;
-	double ca, sa;
-	pm pms[3];
-} config;
-
-static void configure(const model *md, double t, const double *y, config *c)
+/* Reduced system Tt M T qr'' = Tt (rhs - M qp'') (T only selects
+ * coordinates or moves two together, so sums over index lists do), solved
+ * in place: br receives qr'' (NaN if M is not positive definite). */
+static void reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
 {
-	model_full_coords(md, t, y, c->q, c->qd);
-	ramp_eval(&md->beta_ramp, t, &c->beta, &c->beta_d, &c->beta_dd);
-	model_rot Ra = model_rotation(c->q);
-	c->ca = Ra.c;
-	c->sa = Ra.s;
-	c->sbeta = sin(c->beta);
-	c->cbeta = cos(c->beta);
-	point_mass_vibrator(md, c->ca, c->sa, c->q, c->qd, &c->pms[0]);
-	for (int i = 0; i < 2; i++)
-		point_mass_eliminator(md, i, c->ca, c->sa, c->q, c->qd, c->sbeta, c->cbeta,
-				      c->beta_d, c->beta_dd, &c->pms[1 + i]);
-}
-
-/* Machine: mass matrix, forces without the feed (plus Qextra), reduced
- * solve. Writes machine accelerations into dy and the machine powers. */
-static void machine(model *md, double t, const double *y, const double Qextra[NQ_FULL],
-		    double *dy, model_eval *ev)
-{
-	const sim_params *p = &md->p;
-	config cf;
-	configure(md, t, y, &cf);
-	const double *q = cf.q, *qd = cf.qd, ca = cf.ca, sa = cf.sa;
-	const double beta = cf.beta, beta_d = cf.beta_d, sbeta = cf.sbeta, cbeta = cf.cbeta;
-	const pm *pms = cf.pms;
-
-	double M[NQ_FULL][NQ_FULL] = {{0}};
-	double rhs[NQ_FULL];
-	M[Q_X][Q_X] = p->M_r;
-	M[Q_Y][Q_Y] = p->M_r;
-	M[Q_ALPHA][Q_ALPHA] = p->J_r;
-	M[Q_PHI][Q_PHI] = p->J_w;
-	for (int i = 0; i < NQ_FULL; i++)
-		rhs[i] = Qextra ? Qextra[i] : 0.0;
-	rhs[Q_Y] -= p->M_r * p->g;
-	for (int k = 0; k < 3; k++) {
-		const pm *P = &pms[k];
-		for (int i = 0; i < NQ_FULL; i++) {
-			double ji0 = P->jc[i][0], ji1 = P->jc[i][1];
-			if (ji0 == 0.0 && ji1 == 0.0)
-				continue;
-			for (int j = 0; j <= i; j++)
-				M[i][j] += P->m * (ji0 * P->jc[j][0] + ji1 * P->jc[j][1]);
-			/* gravity and the velocity-product terms */
-			rhs[i] += P->m * (-ji1 * p->g - ji0 * P->a[0] - ji1 * P->a[1]);
-		}
-	}
-	double damp_power = 0.0;
-	/* suspension spring sets with preload */
-	for (int i = 0; i < 2; i++) {
-		double Pb[2] = {i == 0 ? p->l1 : -p->l2, -p->h}, RP[2];
-		rot(ca, sa, Pb, RP);
-		double ux = q[Q_X] + RP[0] - Pb[0], uy = q[Q_Y] + RP[1] - Pb[1];
-		double vx = qd[Q_X] - qd[Q_ALPHA] * RP[1], vy = qd[Q_Y] + qd[Q_ALPHA] * RP[0];
-		double Fx = -p->k_x * ux - p->b_x * vx;
-		double Fy = -p->k_y * uy - p->b_y * vy + md->F0[i];
-		rhs[Q_X] += Fx;
-		rhs[Q_Y] += Fy;
-		rhs[Q_ALPHA] += -RP[1] * Fx + RP[0] * Fy;
-		damp_power += p->b_x * vx * vx + p->b_y * vy * vy;
-	}
-	/* eliminator springs and dampers along the guides */
-	rhs[Q_S1] += -p->k_s1 * q[Q_S1] - p->b_s1 * qd[Q_S1];
-	rhs[Q_S2] += -p->k_s2 * q[Q_S2] - p->b_s2 * qd[Q_S2];
-	damp_power += p->b_s1 * qd[Q_S1] * qd[Q_S1] + p->b_s2 * qd[Q_S2] * qd[Q_S2];
-	/* drive: torque on the rotor, reaction on the trough */
-	double omega = qd[Q_PHI] - qd[Q_ALPHA];
-	double drag = p->b_phi * omega * fabs(omega);
-	double load = -(double)md->rotation * p->M_load;
-	double torque = 0.0;
-	if (!md->phi_prescribed)
-		torque = motor_torque(md, omega);
-	rhs[Q_PHI] += torque - drag + load;
-	rhs[Q_ALPHA] -= torque - drag + load;
-	damp_power += drag * omega - load * omega;
-
-	/* complete the symmetric M */
-	for (int i = 0; i < NQ_FULL; i++)
-		for (int j = i + 1; j < NQ_FULL; j++)
-			M[i][j] = M[j][i];
-
-	/* prescribed accelerations q_p'' */
-	double qpdd[NQ_FULL] = {0};
-	if (md->phi_prescribed) {
-		double psi, psid;
-		ramp_eval(&md->psi_ramp, t, &psi, &psid, &qpdd[Q_PHI]);
-	}
-	/* reduced system Tt M T qr'' = Tt (rhs - M qp''); T only selects
-	 * coordinates or moves two together, so sums over index lists do */
 	int n = md->nq;
-	double Mr[NQ_FULL][NQ_FULL], br[NQ_FULL];
+	double Mr[NQ_FULL][NQ_FULL];
 	double res[NQ_FULL];
 	for (int i = 0; i < NQ_FULL; i++) {
 		double s = rhs[i];
@@ -324,129 +318,138 @@ static void machine(model *md, double t, const double *y, const double Qextra[NQ
 		for (int r = 0; r < n; r++)
 			br[r] = NAN;
 	}
-	double qdd[NQ_FULL];
-	memcpy(qdd, qpdd, sizeof qdd);
-	for (int r = 0; r < n; r++)
+}
+
+/* Stage solve: complete M, solve for qr'' (br) and the full q'' (qdd); under
+ * the ideal drive the drive's torque is what closes the rotor's equation. */
+static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_FULL][NQ_FULL],
+		  const double rhs[NQ_FULL], drive_terms *dt, double br[NQ_FULL],
+		  double qdd[NQ_FULL])
+{
+	for (int i = 0; i < NQ_FULL; i++)
+		for (int j = i + 1; j < NQ_FULL; j++)
+			M[i][j] = M[j][i];
+	/* prescribed accelerations q_p'' */
+	double qpdd[NQ_FULL] = {0};
+	if (md->phi_prescribed) {
+		double psi, psid;
+		ramp_eval(&ctl->psi_ramp, t, &psi, &psid, &qpdd[Q_PHI]);
+	}
+	reduced_solve(md, (const double(*)[NQ_FULL])M, rhs, qpdd, br);
+	memcpy(qdd, qpdd, sizeof(double) * NQ_FULL);
+	for (int r = 0; r < md->nq; r++)
 		for (int a = 0; a < md->ncol[r]; a++)
 			qdd[md->col[r][a]] += br[r];
 	if (md->phi_prescribed) {
-		/* the drive's torque closes the rotor's equation */
-		double s = -rhs[Q_PHI] - drag + load;
+		double s = -rhs[Q_PHI] - dt->drag + dt->load;
 		for (int j = 0; j < NQ_FULL; j++)
 			s += M[Q_PHI][j] * qdd[j];
-		torque = s;
+		dt->torque = s;
 	}
-	for (int r = 0; r < n; r++) {
+}
+
+/* Eliminator mass k (1, 2) moves along dr/dbeta = (c + s) R u' when the
+ * guide turns: returns c + s and writes R u'. */
+static double guide_turn(const sim_params *p, const config *cf, int k, double Rup[2])
+{
+	double up[2] = {-cf->cbeta, -cf->sbeta};
+	deck_rotate(&cf->R, up, Rup);
+	return p->c + cf->q[k == 1 ? Q_S1 : Q_S2];
+}
+
+/* Stage power: work rate of the actuator that turns the guides (it carries
+ * each eliminator mass along dr/dbeta against its inertia and weight, the
+ * guide's normal force; zero while beta is held). */
+static double guide_power(const sim_params *p, const config *cf, const double qdd[NQ_FULL])
+{
+	double power = 0.0;
+	if (cf->beta_d == 0.0)
+		return power;
+	for (int k = 1; k < 3; k++) {
+		const pm *P = &cf->pms[k];
+		double acc[2] = {P->a[0], P->a[1] + p->g};
+		for (int i = 0; i < NQ_FULL; i++) {
+			acc[0] += P->jc[i][0] * qdd[i];
+			acc[1] += P->jc[i][1] * qdd[i];
+		}
+		double Rup[2];
+		double cs = guide_turn(p, cf, k, Rup);
+		power += P->m * cs * cf->beta_d * (acc[0] * Rup[0] + acc[1] * Rup[1]);
+	}
+	return power;
+}
+
+/* What an evaluation shows the observer. */
+static void observe(const model *md, const config *cf, const double qdd[NQ_FULL],
+		    const drive_terms *dt, model_eval *ev)
+{
+	memcpy(ev->q, cf->q, sizeof ev->q);
+	memcpy(ev->qd, cf->qd, sizeof ev->qd);
+	memcpy(ev->qdd, qdd, sizeof ev->qdd);
+	ev->beta = cf->beta;
+	ev->beta_dot = cf->beta_d;
+	ev->torque = dt->torque;
+	ev->rotor_speed = dt->omega;
+	/* the centre deck point, from its rest position */
+	deck_point(&md->dk, 0.0, &cf->R, cf->q, cf->qd, ev->deck, ev->deck_vel);
+	ev->deck[1] -= md->dk.h_d;
+}
+
+void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
+		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev)
+{
+	config cf;
+	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], br[NQ_FULL], qdd[NQ_FULL];
+	double damp_power = 0.0;
+	drive_terms dt;
+	configure(md, ctl, t, y, &cf);
+	mass_matrix_and_bias(md, &cf, Qfeed, M, rhs);
+	suspension(md, &cf, rhs, &damp_power);
+	eliminators(&md->p, &cf, rhs, &damp_power);
+	drive(md, ctl, &cf, rhs, &damp_power, &dt);
+	solve(md, ctl, t, M, rhs, &dt, br, qdd);
+	for (int r = 0; r < md->nq; r++) {
 		dy[r] = y[md->npos + r];
 		dy[md->npos + r] = br[r];
 	}
-	/* work of the actuator that turns the guides: it carries each
-	 * eliminator mass along dr/dbeta = (c + s) R u' against its inertia
-	 * and weight (the guide's normal force); zero while beta is held */
-	double guide_power = 0.0;
-	if (beta_d != 0.0) {
-		for (int k = 1; k < 3; k++) {
-			const pm *P = &pms[k];
-			double acc[2] = {P->a[0], P->a[1] + p->g};
-			for (int i = 0; i < NQ_FULL; i++) {
-				acc[0] += P->jc[i][0] * qdd[i];
-				acc[1] += P->jc[i][1] * qdd[i];
-			}
-			double cs = p->c + q[k == 1 ? Q_S1 : Q_S2];
-			double up[2] = {-cbeta, -sbeta}, Rup[2];
-			rot(ca, sa, up, Rup);
-			guide_power += P->m * cs * beta_d * (acc[0] * Rup[0] + acc[1] * Rup[1]);
-		}
-	}
-	dy[2 * md->npos + ACC_IN] = torque * omega + guide_power;
+	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd);
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
-	if (ev) {
-		memcpy(ev->q, q, sizeof ev->q);
-		memcpy(ev->qd, qd, sizeof ev->qd);
-		memcpy(ev->qdd, qdd, sizeof qdd);
-		ev->beta = beta;
-		ev->beta_dot = beta_d;
-		ev->torque = torque;
-		ev->rotor_speed = omega;
-		double dv[2] = {0.0, p->h_d}, Rd[2];
-		rot(ca, sa, dv, Rd);
-		ev->deck[0] = q[Q_X] + Rd[0] - dv[0];
-		ev->deck[1] = q[Q_Y] + Rd[1] - dv[1];
-		ev->deck_vel[0] = qd[Q_X] - qd[Q_ALPHA] * Rd[1];
-		ev->deck_vel[1] = qd[Q_Y] + qd[Q_ALPHA] * Rd[0];
-	}
+	if (ev)
+		observe(md, &cf, qdd, &dt, ev);
 }
 
-void model_machine_rhs(model *md, double t, const double *y, const double Qfeed[NQ_FULL],
-		       double *dy, model_eval *ev)
-{
-	md->rhs_evals++;
-	machine(md, t, y, Qfeed, dy, ev);
-}
-
-void model_rhs(model *md, double t, const double *y, double *dy, model_eval *ev)
-{
-	md->rhs_evals++;
-	double Qfeed[NQ_FULL] = {0};
-	double *acc = dy + 2 * md->npos;
-	acc[ACC_FRIC] = 0.0;
-	acc[ACC_CONTACT] = 0.0;
-	if (md->nf > 0) {
-		double q[NQ_FULL], qd[NQ_FULL];
-		model_full_coords(md, t, y, q, qd);
-		feed_rhs(md, y, q, qd, dy, Qfeed, &acc[ACC_FRIC], &acc[ACC_CONTACT]);
-		if (!md->sc.feed_coupling)
-			memset(Qfeed, 0, sizeof Qfeed);
-	}
-	machine(md, t, y, Qfeed, dy, ev);
-}
-
-double model_contact_force(const model *md, double delta, double delta_dot)
-{
-	double f = md->p.p == 1.0 ? md->p.k_c * delta : md->p.k_c * pow(delta, md->p.p);
-	return delta_dot >= 0.0 ? f : f * md->p.R * md->p.R;
-}
-
-double model_energy_stored(model *md, double t, const double *y, double *kinetic,
-			   double *potential)
+void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,
+			  double *kinetic, double *potential)
 {
 	const sim_params *p = &md->p;
 	config cf;
-	configure(md, t, y, &cf);
-	const double *q = cf.q, *qd = cf.qd, ca = cf.ca, sa = cf.sa;
-	const double beta_d = cf.beta_d, sbeta = cf.sbeta, cbeta = cf.cbeta;
-	const pm *pms = cf.pms;
+	configure(md, ctl, t, y, &cf);
+	const double *q = cf.q, *qd = cf.qd;
 	double T = 0.5 * (p->M_r * (qd[Q_X] * qd[Q_X] + qd[Q_Y] * qd[Q_Y]) +
 			  p->J_r * qd[Q_ALPHA] * qd[Q_ALPHA] + p->J_w * qd[Q_PHI] * qd[Q_PHI]);
 	double V = p->M_r * p->g * q[Q_Y];
 	for (int k = 0; k < 3; k++) {
-		const pm *P = &pms[k];
+		const pm *P = &cf.pms[k];
 		double v[2] = {0.0, 0.0};
 		for (int i = 0; i < NQ_FULL; i++) {
 			v[0] += P->jc[i][0] * qd[i];
 			v[1] += P->jc[i][1] * qd[i];
 		}
 		if (k > 0) { /* guide rotation: (c + s) beta' u' in the body frame */
-			double cs = p->c + q[k == 1 ? Q_S1 : Q_S2];
-			double up[2] = {-cbeta, -sbeta}, Rup[2];
-			rot(ca, sa, up, Rup);
-			v[0] += cs * beta_d * Rup[0];
-			v[1] += cs * beta_d * Rup[1];
+			double Rup[2];
+			double cs = guide_turn(p, &cf, k, Rup);
+			v[0] += cs * cf.beta_d * Rup[0];
+			v[1] += cs * cf.beta_d * Rup[1];
 		}
 		T += 0.5 * P->m * (v[0] * v[0] + v[1] * v[1]);
 		V += P->m * p->g * (q[Q_Y] + P->r[1]);
 	}
 	for (int i = 0; i < 2; i++) {
-		double Pb[2] = {i == 0 ? p->l1 : -p->l2, -p->h}, RP[2];
-		rot(ca, sa, Pb, RP);
-		double ux = q[Q_X] + RP[0] - Pb[0], uy = q[Q_Y] + RP[1] - Pb[1];
-		V += 0.5 * (p->k_x * ux * ux + p->k_y * uy * uy) - md->F0[i] * uy;
+		double RP[2], u[2];
+		suspension_point(p, &cf, i, RP, u);
+		V += 0.5 * (p->k_x * u[0] * u[0] + p->k_y * u[1] * u[1]) - md->F0[i] * u[1];
 	}
 	V += 0.5 * (p->k_s1 * q[Q_S1] * q[Q_S1] + p->k_s2 * q[Q_S2] * q[Q_S2]);
-	double Tf = 0.0, Vf = 0.0;
-	if (md->nf > 0)
-		feed_energy(md, y, &Tf, &Vf);
-	*kinetic = T + Tf;
-	*potential = V + Vf;
-	return *kinetic + *potential;
+	*kinetic = T;
+	*potential = V;
 }

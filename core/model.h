@@ -1,8 +1,7 @@
 /*
- * model.h - internal: the equations of motion of the conveyor (MODEL.md).
- *
- * The model owns the parameters, the scene after reduction, the control
- * ramps and the layout of the state vector y that the integrators advance:
+ * model.h - internal: the machine of MODEL.md (trough, vibrator, two
+ * eliminators on guides at beta(t), suspension, drive) and the layout of
+ * the state vector y that the integrators advance:
  *
  *   y = [ q_r (nq) | xi (nf) | eta (nf) |  q_r' (nq) | xi' (nf) | eta' (nf) | acc (ACC_N) ]
  *        \______________ npos _______/     \_______________ npos ______/
@@ -11,35 +10,25 @@
  * phi, s1, s2) is q = T q_r + q_p(t) (T selects/combines, q_p holds the
  * prescribed motions: alpha = 0 in the symmetric reduction, phi = alpha +
  * psi(t) for the ideal drive). acc are energy accumulators integrated with
- * the state. Not part of the public interface.
+ * the state.
+ *
+ * Like MuJoCo's const mjModel beside mjData, what never changes during a
+ * run (parameters, scene, geometry, reduced layout, preload: `model`,
+ * const after model_init) is apart from what does (the controls:
+ * `model_ctl`). The machine knows nothing of the feed: its reaction comes
+ * in as a generalized force (dynamics.c couples the two). Not part of the
+ * public interface.
  */
 #ifndef CONVSIM_MODEL_H
 #define CONVSIM_MODEL_H
 
-#include <math.h>
-
+#include "deck.h"
+#include "ramp.h"
 #include "sim.h"
 
-enum { Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2, NQ_FULL };
 enum { ACC_IN, ACC_DAMP, ACC_FRIC, ACC_CONTACT, ACC_N };
 
-/* A C1 motion with piecewise-constant second derivative: segments that
- * start at ts[i] with value b[i], rate v[i], and constant acceleration a[i];
- * after the last segment the motion continues at rate v_end from b_end. */
-typedef struct ramp {
-	int n;
-	double ts[4], b[4], v[4], a[4];
-	double t_end, b_end, v_end;
-} ramp;
-
-void ramp_hold(ramp *r, double t, double value, double rate);
-void ramp_eval(const ramp *r, double t, double *b, double *bd, double *bdd);
-/* Time-optimal move from the state at t to rest at target, |rate| <= vmax,
- * |accel| <= amax. */
-void ramp_to_position(ramp *r, double t, double target, double vmax, double amax);
-/* Change the rate to v_target at |accel| = amax, then keep it. */
-void ramp_to_rate(ramp *r, double t, double v_target, double amax);
-
+/* Constant during a run. */
 typedef struct model {
 	sim_params p;
 	sim_scene sc;
@@ -51,23 +40,26 @@ typedef struct model {
 	int col[NQ_FULL][2];          /* ... and which (at most two) */
 	int alpha_fixed, phi_prescribed;
 	/* feed */
-	int K, L, nf;                 /* integrated columns, layers, elements */
+	int L, nf;                    /* layers, integrated elements */
 	double col_weight;            /* how many physical columns one stands for */
-	double d[64];                 /* body x of each integrated column */
+	deck dk;                      /* integrated columns (dk.K) and their deck points */
 	/* layout */
 	int npos, n;
 	/* preload of the suspension (vertical, N) at P1 and P2 */
 	double F0[2];
-	/* controls */
-	ramp beta_ramp;               /* beta, rad */
-	ramp psi_ramp;                /* ideal drive: phi - alpha, rad */
-	int rotation;                 /* SIM_CW / SIM_CCW */
-	double omega_ss;
-	int drive_on;
-	uint64_t rhs_evals;
 } model;
 
-/* Everything a full evaluation yields besides dy. */
+/* The controls: changed between steps by sim_set_* (SI units). */
+typedef struct model_ctl {
+	ramp beta_ramp;               /* beta, rad */
+	ramp psi_ramp;                /* ideal drive: phi - alpha, rad */
+	double beta_rate;             /* rad/s, slew rate of the next beta ramp */
+	int rotation;                 /* SIM_CW / SIM_CCW */
+	double omega_ss;              /* rad/s */
+	int drive_on;
+} model_ctl;
+
+/* Everything an evaluation yields besides dy. */
 typedef struct model_eval {
 	double q[NQ_FULL], qd[NQ_FULL], qdd[NQ_FULL];
 	double beta, beta_dot;
@@ -82,53 +74,27 @@ double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
 /* Largest ratio for which dem corrects its coupling (README "dem"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 
-/* Build the reduced model from parameters and scene (validated already). */
-void model_init(model *md, const sim_params *p, const sim_scene *sc);
-/* Fill y (length md->n) with the static equilibrium with the feed settled. */
-void model_equilibrium(model *md, double *y);
+/* Build the reduced model (with its suspension preload) and the initial
+ * controls from parameters and scene (validated already). setup.c */
+void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene *sc);
 
-/* dy = f(t, y). ev may be NULL. Never allocates. */
-void model_rhs(model *md, double t, const double *y, double *dy, model_eval *ev);
+/* Static strokes s1, s2 (m) of the eliminators at rest at the initial
+ * beta (written). setup.c */
+void model_static_strokes(const sim_params *p, double s[2]);
 
-/* Pieces for split (multirate) methods.
- * model_machine_rhs: machine part of dy only (positions, velocities and
- * ACC_IN/ACC_DAMP), with the feed replaced by the generalized force Qfeed. */
-void model_machine_rhs(model *md, double t, const double *y, const double Qfeed[NQ_FULL],
-		       double *dy, model_eval *ev);
-/* The trough's rotation R(alpha) of a machine state, computed once and
- * passed to the deck-point functions. */
-typedef struct model_rot {
-	double c, s;
-} model_rot;
-static inline model_rot model_rotation(const double q[NQ_FULL])
-{
-	model_rot r = {1.0, 0.0};
-	if (q[2] != 0.0) {
-		r.c = cos(q[2]);
-		r.s = sin(q[2]);
-	}
-	return r;
-}
-/* Deck point kinematics of integrated column k for a machine state. */
-void model_deck(const model *md, int k, const model_rot *R, const double q[NQ_FULL],
-		const double qd[NQ_FULL], double pos[2], double vel[2]);
-/* Add to Q the generalized force of the forces F[k] (N) at every integrated
- * column's deck point, times scale. Mirrored columns k and K-1-k are
- * summed together first, so that the moments of a symmetric motion cancel
- * exactly despite round-off. */
-void model_deck_forces(const model *md, const model_rot *R, const double (*F)[2],
-		       double scale, double Q[NQ_FULL]);
 /* Full coordinates from y at time t. */
-void model_full_coords(const model *md, double t, const double *y, double q[NQ_FULL],
-		       double qd[NQ_FULL]);
+void model_full_coords(const model *md, const model_ctl *ctl, double t, const double *y,
+		       double q[NQ_FULL], double qd[NQ_FULL]);
 
-/* Normal contact force of the paper's law (eq. 7) for compression delta > 0
- * and its rate: loading k delta^p for rate >= 0, unloading R^2 k delta^p. */
-double model_contact_force(const model *md, double delta, double delta_dot);
+/* Machine part of dy = f(t, y) (positions' rates, accelerations and the
+ * ACC_IN/ACC_DAMP powers) with the feed's reaction given as the generalized
+ * force Qfeed (NULL: none). ev may be NULL. Never allocates, counts nothing. */
+void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
+		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev);
 
-/* Stored energy (kinetic + potential) of the state; contact work and the
- * other accumulators are in y. */
-double model_energy_stored(model *md, double t, const double *y, double *kinetic,
-			   double *potential);
+/* Kinetic and potential energy (J) of the machine alone in state y at t
+ * (written); the potential includes gravity, springs and preload. */
+void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,
+			  double *kinetic, double *potential);
 
 #endif

@@ -2,26 +2,27 @@
  * ode.h - internal: integrators as data. Each method is one file of static
  * functions exporting one const descriptor; ode_registry.c lists them so
  * that the API finds a method by name. The caller (sim.c) decides when to
- * step; there are no callbacks into the caller.
+ * step; there are no callbacks into the caller. A step reads the const
+ * model and the controls through its dyn and changes only the state, its
+ * workspace and the dyn's evaluation counter.
  */
 #ifndef CONVSIM_ODE_H
 #define CONVSIM_ODE_H
 
-#include "model.h"
+#include "dynamics.h"
 
 typedef struct ode_method {
-	const char *name;
-	int order;     /* classical order on smooth problems */
-	int adaptive;  /* step size from rtol/atol */
+	/* name, order, adaptive, doc: the public description. First member,
+	 * so that the registry lists descriptors through it. */
+	sim_method_info info;
 	int dense;     /* steps past the target and interpolates */
-	const char *doc;
 	/* Workspace for model md (its size n fixed) and settings cfg; NULL on
 	 * allocation failure. Everything the steps need is allocated here. */
 	void *(*alloc)(const model *md, const sim_method *cfg);
 	/* One step from (*t, y), in place. Fixed-step methods do not pass
 	 * t_max (the last step is shortened); dense methods may. Returns
 	 * SIM_OK or SIM_ESTEP. */
-	int (*step)(void *ws, model *md, double *t, double *y, double t_max);
+	int (*step)(void *ws, dyn *sys, double *t, double *y, double t_max);
 	/* Dense methods: the state at t within the last step into out. */
 	void (*interpolate)(void *ws, double t, double *out);
 	/* Forget cached derivatives (after a control change). */

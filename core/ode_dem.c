@@ -92,16 +92,17 @@ static void machine_axpy(const model *md, double *out, const double *y, double h
 
 /* One classical RK4 step of the machine's entries of y over H, with the
  * feed's reaction held at w->Qfeed; ev0 receives the start evaluation. */
-static void machine_rk4(dem *w, model *md, double t, double H, double *y, model_eval *ev0)
+static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0)
 {
+	const model *md = sys->md;
 	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
-	model_machine_rhs(md, t, y, w->Qfeed, w->k1, ev0);
+	dyn_machine_rhs(sys, t, y, w->Qfeed, w->k1, ev0);
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k1);
-	model_machine_rhs(md, t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);
+	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
-	model_machine_rhs(md, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
+	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
 	machine_axpy(md, w->tmp, y, H, w->k3);
-	model_machine_rhs(md, t + H, w->tmp, w->Qfeed, w->k4, NULL);
+	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, NULL);
 	for (int r = 0; r < md->nq; r++) {
 		int v = md->npos + r;
 		y[r] += H / 6.0 * (w->k1[r] + 2.0 * (w->k2[r] + w->k3[r]) + w->k4[r]);
@@ -113,30 +114,16 @@ static void machine_rk4(dem *w, model *md, double t, double H, double *y, model_
 	}
 }
 
-static void deck_accel(const model *md, int k, const model_rot *R, const model_eval *ev,
-		       double acc[2])
-{
-	double ca = R->c, sa = R->s;
-	double dx = md->d[k], dy = md->p.h_d;
-	double Rd[2] = {ca * dx - sa * dy, sa * dx + ca * dy};
-	double ad = ev->qd[Q_ALPHA], add = ev->qdd[Q_ALPHA];
-	acc[0] = ev->qdd[Q_X] - add * Rd[1] - ad * ad * Rd[0];
-	acc[1] = ev->qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
-}
-
-static int dem_step(void *p, model *md, double *t, double *y, double t_max)
+static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	dem *w = p;
+	const model *md = sys->md;
 	const int n = w->n;
 	double H = ode_fixed_step(*t, w->dt, t_max);
 	if (md->nf > 0 && !w->have_q) {
 		/* first step: the feed's reaction from the smooth law now */
-		double q[NQ_FULL], qd[NQ_FULL], fr, cp;
-		model_full_coords(md, *t, y, q, qd);
 		memset(w->Qfeed, 0, sizeof w->Qfeed);
-		feed_rhs(md, y, q, qd, w->tmp, w->Qfeed, &fr, &cp);
-		if (!md->sc.feed_coupling)
-			memset(w->Qfeed, 0, sizeof w->Qfeed);
+		dynamics_feed_reaction(md, sys->ctl, *t, y, w->tmp, w->Qfeed);
 		w->have_q = 1;
 	}
 	const int ns = w->substeps;
@@ -144,7 +131,7 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 		memcpy(w->save, y, sizeof(double) * (size_t)n);
 	/* 1. machine RK4 with the feed force held */
 	model_eval ev0, ev1;
-	machine_rk4(w, md, *t, H, y, &ev0);
+	machine_rk4(w, sys, *t, H, y, &ev0);
 	double t1 = (H == t_max - *t) ? t_max : *t + H;
 	if (md->nf == 0) {
 		*t = t1;
@@ -153,21 +140,22 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 	/* 2. the feed along the interpolated deck motion; the machine's end
 	 * acceleration is needed only to interpolate between sub-steps */
 	if (ns > 1) {
-		model_machine_rhs(md, t1, y, w->Qfeed, w->k4, &ev1);
+		dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
 	} else {
-		model_full_coords(md, t1, y, ev1.q, ev1.qd);
+		model_full_coords(md, sys->ctl, t1, y, ev1.q, ev1.qd);
 		memset(ev1.qdd, 0, sizeof ev1.qdd);
 	}
 	const double h = H / ns;
-	double F[64][2];
+	double F[SIM_MAX_COLUMNS][2];
 	double fric = 0.0, contact = 0.0;
-	model_rot R0 = model_rotation(ev0.q), R1 = model_rotation(ev1.q);
-	for (int k = 0; k < md->K; k++) {
+	const deck *dk = &md->dk;
+	deck_rot R0 = deck_rotation(ev0.q), R1 = deck_rotation(ev1.q);
+	for (int k = 0; k < dk->K; k++) {
 		double p0[2], v0[2], p1[2], v1[2], a0[2], a1[2];
-		model_deck(md, k, &R0, ev0.q, ev0.qd, p0, v0);
-		model_deck(md, k, &R1, ev1.q, ev1.qd, p1, v1);
-		deck_accel(md, k, &R0, &ev0, a0);
-		deck_accel(md, k, &R1, &ev1, a1);
+		deck_point(dk, dk->d[k], &R0, ev0.q, ev0.qd, p0, v0);
+		deck_point(dk, dk->d[k], &R1, ev1.q, ev1.qd, p1, v1);
+		deck_accel(dk, k, &R0, ev0.qd, ev0.qdd, a0);
+		deck_accel(dk, k, &R1, ev1.qd, ev1.qdd, a1);
 		double impulse[2] = {0.0, 0.0};
 		for (int i = 0; i < ns; i++) {
 			double s0 = (double)i / ns, s1 = (double)(i + 1) / ns;
@@ -187,7 +175,7 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 	y[2 * md->npos + ACC_CONTACT] += md->col_weight * contact;
 	memset(w->Qfeed, 0, sizeof w->Qfeed);
 	if (md->sc.feed_coupling)
-		model_deck_forces(md, &R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
+		deck_forces(dk, &R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
 	if (w->correct) {
 		/* 3. corrector: the machine's step again, now with the feed's
 		 * reaction of this very step (the feed is not stepped again) */
@@ -197,7 +185,7 @@ static int dem_step(void *p, model *md, double *t, double *y, double t_max)
 		}
 		for (int a = ACC_IN; a <= ACC_DAMP; a++)
 			y[2 * md->npos + a] = w->save[2 * md->npos + a];
-		machine_rk4(w, md, *t, H, y, &ev0);
+		machine_rk4(w, sys, *t, H, y, &ev0);
 	}
 	*t = t1;
 	return SIM_OK;
@@ -209,11 +197,11 @@ static void dem_reset(void *p)
 }
 
 const ode_method ode_dem = {
-	.name = "dem",
-	.order = 1,
-	.adaptive = 0,
+	.info = {.name = "dem",
+		 .order = 1,
+		 .adaptive = 0,
+		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction"},
 	.dense = 0,
-	.doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction",
 	.alloc = dem_alloc,
 	.step = dem_step,
 	.interpolate = NULL,

@@ -85,14 +85,47 @@ static void *dp_alloc(const model *md, const sim_method *cfg)
 	return w;
 }
 
-static int dp_step(void *p, model *md, double *t, double *y, double t_max)
+/* Scaled RMS norm of the embedded error estimate of a step of length h
+ * from y to w->ynew (the energy accumulators excluded); 1e10 if not finite. */
+static double error_norm(const dopri5 *w, const double *y, double h)
+{
+	double *const *k = w->k;
+	double err = 0.0;
+	for (int i = 0; i < w->nerr; i++) {
+		double ei = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] +
+				 e6 * k[5][i] + e7 * k[6][i]);
+		double sc = w->atol + w->rtol * fmax(fabs(y[i]), fabs(w->ynew[i]));
+		err += (ei / sc) * (ei / sc);
+	}
+	err = sqrt(err / (double)w->nerr);
+	return isfinite(err) ? err : 1e10;
+}
+
+/* Dense output coefficients r1..r5 of an accepted step of length h from y
+ * to w->ynew. */
+static void dense_coefficients(dopri5 *w, const double *y, double h)
+{
+	double *const *k = w->k;
+	for (int i = 0; i < w->n; i++) {
+		double dy = w->ynew[i] - y[i];
+		double bspl = h * k[0][i] - dy;
+		w->r1[i] = y[i];
+		w->r2[i] = dy;
+		w->r3[i] = bspl;
+		w->r4[i] = dy - h * k[6][i] - bspl;
+		w->r5[i] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] +
+				d6 * k[5][i] + d7 * k[6][i]);
+	}
+}
+
+static int dp_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	dopri5 *w = p;
 	const int n = w->n;
 	double **k = w->k;
 	(void)t_max;
 	if (!w->have_k1) {
-		model_rhs(md, *t, y, k[0], NULL);
+		dyn_rhs(sys, *t, y, k[0]);
 		w->have_k1 = 1;
 	}
 	for (;;) {
@@ -105,35 +138,26 @@ static int dp_step(void *p, model *md, double *t, double *y, double t_max)
 			h = w->hmin;
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * a21 * k[0][i];
-		model_rhs(md, *t + c2 * h, w->ytmp, k[1], NULL);
+		dyn_rhs(sys, *t + c2 * h, w->ytmp, k[1]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a31 * k[0][i] + a32 * k[1][i]);
-		model_rhs(md, *t + c3 * h, w->ytmp, k[2], NULL);
+		dyn_rhs(sys, *t + c3 * h, w->ytmp, k[2]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a41 * k[0][i] + a42 * k[1][i] + a43 * k[2][i]);
-		model_rhs(md, *t + c4 * h, w->ytmp, k[3], NULL);
+		dyn_rhs(sys, *t + c4 * h, w->ytmp, k[3]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a51 * k[0][i] + a52 * k[1][i] + a53 * k[2][i] +
 						 a54 * k[3][i]);
-		model_rhs(md, *t + c5 * h, w->ytmp, k[4], NULL);
+		dyn_rhs(sys, *t + c5 * h, w->ytmp, k[4]);
 		for (int i = 0; i < n; i++)
 			w->ytmp[i] = y[i] + h * (a61 * k[0][i] + a62 * k[1][i] + a63 * k[2][i] +
 						 a64 * k[3][i] + a65 * k[4][i]);
-		model_rhs(md, *t + h, w->ytmp, k[5], NULL);
+		dyn_rhs(sys, *t + h, w->ytmp, k[5]);
 		for (int i = 0; i < n; i++)
 			w->ynew[i] = y[i] + h * (a71 * k[0][i] + a73 * k[2][i] + a74 * k[3][i] +
 						 a75 * k[4][i] + a76 * k[5][i]);
-		model_rhs(md, *t + h, w->ynew, k[6], NULL);
-		double err = 0.0;
-		for (int i = 0; i < w->nerr; i++) {
-			double ei = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] +
-					 e5 * k[4][i] + e6 * k[5][i] + e7 * k[6][i]);
-			double sc = w->atol + w->rtol * fmax(fabs(y[i]), fabs(w->ynew[i]));
-			err += (ei / sc) * (ei / sc);
-		}
-		err = sqrt(err / (double)w->nerr);
-		if (!isfinite(err))
-			err = 1e10;
+		dyn_rhs(sys, *t + h, w->ynew, k[6]);
+		double err = error_norm(w, y, h);
 		/* PI controller */
 		const double beta = 0.04, expo1 = 0.2 - beta * 0.75, safe = 0.9;
 		double fac11 = pow(err, expo1);
@@ -142,17 +166,7 @@ static int dp_step(void *p, model *md, double *t, double *y, double t_max)
 			double fac = fac11 / pow(w->facold, beta);
 			fac = fmax(0.1, fmin(5.0, fac / safe));
 			w->facold = fmax(err, 1e-4);
-			/* dense output coefficients of this step */
-			for (int i = 0; i < n; i++) {
-				double dy = w->ynew[i] - y[i];
-				double bspl = h * k[0][i] - dy;
-				w->r1[i] = y[i];
-				w->r2[i] = dy;
-				w->r3[i] = bspl;
-				w->r4[i] = dy - h * k[6][i] - bspl;
-				w->r5[i] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] +
-						d5 * k[4][i] + d6 * k[5][i] + d7 * k[6][i]);
-			}
+			dense_coefficients(w, y, h);
 			w->t_old = *t;
 			w->h_old = h;
 			memcpy(y, w->ynew, sizeof(double) * (size_t)n);
@@ -184,11 +198,11 @@ static void dp_reset(void *p)
 }
 
 const ode_method ode_dopri5 = {
-	.name = "dopri5",
-	.order = 5,
-	.adaptive = 1,
+	.info = {.name = "dopri5",
+		 .order = 5,
+		 .adaptive = 1,
+		 .doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step"},
 	.dense = 1,
-	.doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step",
 	.alloc = dp_alloc,
 	.step = dp_step,
 	.interpolate = dp_interpolate,

@@ -36,12 +36,13 @@ static void *euler_alloc(const model *md, const sim_method *cfg)
 	return w;
 }
 
-static int euler_step(void *p, model *md, double *t, double *y, double t_max)
+static int euler_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	euler *w = p;
+	const model *md = sys->md;
 	const int np = md->npos;
 	double h = ode_fixed_step(*t, w->dt, t_max);
-	model_rhs(md, *t, y, w->f, NULL);
+	dyn_rhs(sys, *t, y, w->f);
 	for (int i = 0; i < np; i++) {
 		y[np + i] += h * w->f[np + i];
 		y[i] += h * y[np + i];
@@ -58,11 +59,11 @@ static void euler_reset(void *p)
 }
 
 const ode_method ode_euler = {
-	.name = "euler",
-	.order = 1,
-	.adaptive = 0,
+	.info = {.name = "euler",
+		 .order = 1,
+		 .adaptive = 0,
+		 .doc = "semi-implicit (symplectic) Euler, fixed step dt"},
 	.dense = 0,
-	.doc = "semi-implicit (symplectic) Euler, fixed step dt",
 	.alloc = euler_alloc,
 	.step = euler_step,
 	.interpolate = NULL,

@@ -41,21 +41,21 @@ static void *rk4_alloc(const model *md, const sim_method *cfg)
 	return w;
 }
 
-static int rk4_step(void *p, model *md, double *t, double *y, double t_max)
+static int rk4_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	rk4 *w = p;
 	const int n = w->n;
 	double h = ode_fixed_step(*t, w->dt, t_max);
-	model_rhs(md, *t, y, w->k1, NULL);
+	dyn_rhs(sys, *t, y, w->k1);
 	for (int i = 0; i < n; i++)
 		w->tmp[i] = y[i] + 0.5 * h * w->k1[i];
-	model_rhs(md, *t + 0.5 * h, w->tmp, w->k2, NULL);
+	dyn_rhs(sys, *t + 0.5 * h, w->tmp, w->k2);
 	for (int i = 0; i < n; i++)
 		w->tmp[i] = y[i] + 0.5 * h * w->k2[i];
-	model_rhs(md, *t + 0.5 * h, w->tmp, w->k3, NULL);
+	dyn_rhs(sys, *t + 0.5 * h, w->tmp, w->k3);
 	for (int i = 0; i < n; i++)
 		w->tmp[i] = y[i] + h * w->k3[i];
-	model_rhs(md, *t + h, w->tmp, w->k4, NULL);
+	dyn_rhs(sys, *t + h, w->tmp, w->k4);
 	for (int i = 0; i < n; i++)
 		y[i] += h / 6.0 * (w->k1[i] + 2.0 * (w->k2[i] + w->k3[i]) + w->k4[i]);
 	*t = (h == t_max - *t) ? t_max : *t + h;
@@ -68,11 +68,11 @@ static void rk4_reset(void *p)
 }
 
 const ode_method ode_rk4 = {
-	.name = "rk4",
-	.order = 4,
-	.adaptive = 0,
+	.info = {.name = "rk4",
+		 .order = 4,
+		 .adaptive = 0,
+		 .doc = "classical Runge-Kutta, fixed step dt, whole state"},
 	.dense = 0,
-	.doc = "classical Runge-Kutta, fixed step dt, whole state",
 	.alloc = rk4_alloc,
 	.step = rk4_step,
 	.interpolate = NULL,

@@ -13,13 +13,12 @@
 #include "model.h"
 #include "ode.h"
 #include "sim.h"
+#include "units.h"
 
 enum { G_PARAM, G_SCENE, G_METHOD };
 
-#define DEG (M_PI / 180.0)
-
 /* X(group, field, kind, unit, min, max, choices, scale, doc)
- * scale converts user units to stored units (degrees to radians). */
+ * scale: the SI value of one user unit (RAD_PER_DEG for degrees). */
 #define SETTINGS(X)                                                                        \
 	X(G_PARAM, l1, REAL, "m", 0.05, 10, NULL, 1, "x of spring set 1 (body point (l1, -h))") \
 	X(G_PARAM, l2, REAL, "m", 0.05, 10, NULL, 1, "x of spring set 2 is -l2")               \
@@ -52,9 +51,9 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, p2_x, REAL, "m", -5, 5, NULL, 1, "guide 2 point, body x")                   \
 	X(G_PARAM, p2_y, REAL, "m", -5, 5, NULL, 1, "guide 2 point, body y")                   \
 	X(G_PARAM, c, REAL, "m", -1, 1, NULL, 1, "eliminator mass offset along its guide")     \
-	X(G_PARAM, beta, REAL, "deg", 0, 180, NULL, DEG, "guide angle = vibration direction")  \
-	X(G_PARAM, beta_rate, REAL, "deg/s", 0.1, 3600, NULL, DEG, "slew rate of beta ramps")  \
-	X(G_PARAM, beta_accel, REAL, "deg/s^2", 1, 1e6, NULL, DEG, "acceleration bound of beta ramps") \
+	X(G_PARAM, beta, REAL, "deg", 0, 180, NULL, RAD_PER_DEG, "guide angle = vibration direction")  \
+	X(G_PARAM, beta_rate, REAL, "deg/s", 0.1, 3600, NULL, RAD_PER_DEG, "slew rate of beta ramps")  \
+	X(G_PARAM, beta_accel, REAL, "deg/s^2", 1, 1e6, NULL, RAD_PER_DEG, "acceleration bound of beta ramps") \
 	X(G_PARAM, m_n, REAL, "kg", 1e-4, 100, NULL, 1, "feed element mass")                   \
 	X(G_PARAM, k_c, REAL, "N/m^p", 100, 1e10, NULL, 1, "contact stiffness k")              \
 	X(G_PARAM, p, REAL, "", 1, 2, NULL, 1, "contact exponent")                             \
@@ -65,8 +64,8 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, g, REAL, "m/s^2", 0, 100, NULL, 1, "gravity")                               \
 	X(G_PARAM, drive_accel, REAL, "rad/s^2", 1, 1e6, NULL, 1, "speed ramp of the ideal drive") \
 	X(G_SCENE, feed, BOOL, "", 0, 1, NULL, 1, "simulate the feed")                         \
-	X(G_SCENE, columns, INT, "", 1, 64, NULL, 1, "feed columns K")                         \
-	X(G_SCENE, layers, INT, "", 1, 64, NULL, 1, "feed layers L")                           \
+	X(G_SCENE, columns, INT, "", 1, SIM_MAX_COLUMNS, NULL, 1, "feed columns K")                         \
+	X(G_SCENE, layers, INT, "", 1, SIM_MAX_LAYERS, NULL, 1, "feed layers L")                           \
 	X(G_SCENE, drive, ENUM, "", 0, 1, "motor|ideal", 1, "Kloss motor or constant speed")   \
 	X(G_SCENE, trough_rotation, BOOL, "", 0, 1, NULL, 1, "false allows alpha = 0 on a symmetric machine") \
 	X(G_SCENE, feed_coupling, BOOL, "", 0, 1, NULL, 1, "false: the feed does not act on the trough") \
@@ -83,22 +82,21 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 #define GNAME_G_SCENE "scene"
 #define GNAME_G_METHOD "integrator"
 #define ROW_PUB(grp, f, k, u, lo, hi, ch, sc, d) \
-	{#f, GNAME_##grp, SIM_KIND_##k, u, lo, hi, ch, d},
-static const sim_setting table[] = {SETTINGS(ROW_PUB){"method", "integrator", SIM_KIND_ENUM, "", 0,
-						 3, "rk4|dopri5|euler|dem",
+	{#f, GNAME_##grp, SIM_KIND_##k, u, sc, lo, hi, ch, d},
+static const sim_setting table[] = {SETTINGS(ROW_PUB){"method", "integrator", SIM_KIND_ENUM, "", 1,
+						 0, 3, "rk4|dopri5|euler|dem",
 						 "integrator by name"}};
 #undef ROW_PUB
 
 typedef struct loc {
 	int group;
 	size_t off;
-	double scale;
 } loc;
 #define OFF_G_PARAM(f) offsetof(sim_params, f)
 #define OFF_G_SCENE(f) offsetof(sim_scene, f)
 #define OFF_G_METHOD(f) offsetof(sim_method, f)
-#define ROW_LOC(grp, f, k, u, lo, hi, ch, sc, d) {grp, OFF_##grp(f), sc},
-static const loc locs[] = {SETTINGS(ROW_LOC){G_METHOD, 0, 1}};
+#define ROW_LOC(grp, f, k, u, lo, hi, ch, sc, d) {grp, OFF_##grp(f)},
+static const loc locs[] = {SETTINGS(ROW_LOC){G_METHOD, 0}};
 #undef ROW_LOC
 
 #define N_SETTINGS (sizeof table / sizeof table[0])
@@ -146,9 +144,9 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	p->k_c = 1e6;
 	p->b_phi = 0.0;
 	p->g = 9.81;
-	p->beta = 38.0 * DEG;
-	p->beta_rate = 90.0 * DEG;
-	p->beta_accel = 900.0 * DEG;
+	p->beta = 38.0 * RAD_PER_DEG;
+	p->beta_rate = 90.0 * RAD_PER_DEG;
+	p->beta_accel = 900.0 * RAD_PER_DEG;
 	p->drive_accel = 2000.0;
 
 	memset(s, 0, sizeof *s);
@@ -220,10 +218,21 @@ static void *field(sim_params *p, sim_scene *s, sim_method *m, size_t i)
 
 static int find(const char *name)
 {
-	for (size_t i = 0; i < N_SETTINGS; i++)
+	for (size_t i = 0; name && i < N_SETTINGS; i++)
 		if (strcmp(table[i].name, name) == 0)
 			return (int)i;
 	return -1;
+}
+
+const sim_setting *sim_setting_find(const char *name)
+{
+	int i = find(name);
+	return i < 0 ? NULL : &table[i];
+}
+
+int sim_setting_check(const sim_setting *t, double value)
+{
+	return isfinite(value) && value >= t->min * t->scale && value <= t->max * t->scale;
 }
 
 static int range_error(size_t i, char *msg, size_t len)
@@ -242,79 +251,121 @@ static int range_error(size_t i, char *msg, size_t len)
 	return SIM_EPARAM;
 }
 
+static int unknown_error(const char *name, char *msg, size_t msglen)
+{
+	if (msg)
+		snprintf(msg, msglen, "unknown setting '%s'", name ? name : "");
+	return SIM_EUNKNOWN;
+}
+
 int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name, double value,
 	    char *msg, size_t msglen)
 {
-	int i = name ? find(name) : -1;
-	if (i < 0) {
-		if (msg)
-			snprintf(msg, msglen, "unknown setting '%s'", name ? name : "");
-		return SIM_EUNKNOWN;
-	}
+	int i = find(name);
+	if (i < 0)
+		return unknown_error(name, msg, msglen);
 	const sim_setting *t = &table[i];
-	if (!isfinite(value) || value < t->min || value > t->max)
+	if (!sim_setting_check(t, value))
 		return range_error((size_t)i, msg, msglen);
 	if (t->kind != SIM_KIND_REAL && value != floor(value))
 		return range_error((size_t)i, msg, msglen);
 	if (strcmp(t->name, "method") == 0) {
 		size_t n;
-		const sim_method_info *mi = sim_methods(&n);
-		snprintf(m->name, sizeof m->name, "%s", mi[(size_t)value].name);
+		const sim_method_info *const *mi = sim_methods(&n);
+		snprintf(m->name, sizeof m->name, "%s", mi[(size_t)value]->name);
 		return SIM_OK;
 	}
 	void *f = field(p, s, m, (size_t)i);
 	if (strcmp(t->name, "rotation") == 0)
 		*(int *)f = value == 0 ? SIM_CW : SIM_CCW;
 	else if (t->kind == SIM_KIND_REAL)
-		*(double *)f = value * locs[i].scale;
+		*(double *)f = value;
 	else
 		*(int *)f = (int)value;
 	return SIM_OK;
 }
 
-int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
-		const char *value, char *msg, size_t msglen)
+int sim_set_user(sim_params *p, sim_scene *s, sim_method *m, const char *name, double value,
+		 char *msg, size_t msglen)
 {
-	int i = name ? find(name) : -1;
-	if (i < 0 || !value)
-		return sim_set(p, s, m, name, NAN, msg, msglen);
+	const sim_setting *t = sim_setting_find(name);
+	if (!t)
+		return unknown_error(name, msg, msglen);
+	return sim_set(p, s, m, name, sim_setting_to_si(t, value), msg, msglen);
+}
+
+/* A string as setting i's number: the index of an enum choice, 0/1 for a
+ * bool ("true", "false", "1", "0"), else a decimal number. */
+static int parse_value(size_t i, const char *value, double *out, char *msg, size_t msglen)
+{
 	const sim_setting *t = &table[i];
 	if (t->kind == SIM_KIND_ENUM) {
 		const char *c = t->choices;
 		for (int idx = 0; c && *c; idx++) {
 			size_t len = strcspn(c, "|");
-			if (strlen(value) == len && strncmp(c, value, len) == 0)
-				return sim_set(p, s, m, name, idx, msg, msglen);
+			if (strlen(value) == len && strncmp(c, value, len) == 0) {
+				*out = idx;
+				return SIM_OK;
+			}
 			c += len + (c[len] == '|');
 		}
-		return range_error((size_t)i, msg, msglen);
+		return range_error(i, msg, msglen);
 	}
 	if (t->kind == SIM_KIND_BOOL) {
 		if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0)
-			return sim_set(p, s, m, name, 1, msg, msglen);
-		if (strcmp(value, "false") == 0 || strcmp(value, "0") == 0)
-			return sim_set(p, s, m, name, 0, msg, msglen);
-		return range_error((size_t)i, msg, msglen);
+			*out = 1;
+		else if (strcmp(value, "false") == 0 || strcmp(value, "0") == 0)
+			*out = 0;
+		else
+			return range_error(i, msg, msglen);
+		return SIM_OK;
 	}
 	char *end;
-	double v = strtod(value, &end);
+	*out = strtod(value, &end);
 	if (end == value || *end != '\0')
-		return range_error((size_t)i, msg, msglen);
-	return sim_set(p, s, m, name, v, msg, msglen);
+		return range_error(i, msg, msglen);
+	return SIM_OK;
+}
+
+/* sim_set_str (user = 0, SI) and sim_set_user_str (user = 1). */
+static int set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
+		   const char *value, int user, char *msg, size_t msglen)
+{
+	int i = find(name);
+	if (i < 0 || !value)
+		return sim_set(p, s, m, name, NAN, msg, msglen);
+	double v;
+	int e = parse_value((size_t)i, value, &v, msg, msglen);
+	if (e != SIM_OK)
+		return e;
+	return user ? sim_set_user(p, s, m, name, v, msg, msglen)
+		    : sim_set(p, s, m, name, v, msg, msglen);
+}
+
+int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
+		const char *value, char *msg, size_t msglen)
+{
+	return set_str(p, s, m, name, value, 0, msg, msglen);
+}
+
+int sim_set_user_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
+		     const char *value, char *msg, size_t msglen)
+{
+	return set_str(p, s, m, name, value, 1, msg, msglen);
 }
 
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
 	    double *value)
 {
-	int i = name ? find(name) : -1;
+	int i = find(name);
 	if (i < 0)
 		return SIM_EUNKNOWN;
 	const sim_setting *t = &table[i];
 	if (strcmp(t->name, "method") == 0) {
 		size_t n;
-		const sim_method_info *mi = sim_methods(&n);
+		const sim_method_info *const *mi = sim_methods(&n);
 		for (size_t k = 0; k < n; k++)
-			if (strcmp(mi[k].name, m->name) == 0)
+			if (strcmp(mi[k]->name, m->name) == 0)
 				*value = (double)k;
 		return SIM_OK;
 	}
@@ -322,10 +373,20 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const 
 	if (strcmp(t->name, "rotation") == 0)
 		*value = *(const int *)f == SIM_CW ? 0 : 1;
 	else if (t->kind == SIM_KIND_REAL)
-		*value = *(const double *)f / locs[i].scale;
+		*value = *(const double *)f;
 	else
 		*value = *(const int *)f;
 	return SIM_OK;
+}
+
+int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
+		 double *value)
+{
+	double si;
+	int e = sim_get(p, s, m, name, &si);
+	if (e == SIM_OK)
+		*value = sim_setting_from_si(&table[find(name)], si);
+	return e;
 }
 
 int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, char *msg,
@@ -338,7 +399,7 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 	}
 	for (size_t i = 0; i + 1 < N_SETTINGS; i++) {
 		double v;
-		sim_get(p, s, m, table[i].name, &v);
+		sim_get_user(p, s, m, table[i].name, &v);
 		/* a stored value converted back may differ in the last bit */
 		double tol = 1e-12 * fmax(fabs(table[i].min), fabs(table[i].max));
 		if (!isfinite(v) || v < table[i].min - tol || v > table[i].max + tol)

@@ -7,7 +7,7 @@
  */
 #include <math.h>
 
-#include "model.h"
+#include "ramp.h"
 
 void ramp_hold(ramp *r, double t, double value, double rate)
 {

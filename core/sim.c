@@ -1,23 +1,21 @@
 /*
- * sim.c - one simulation instance: owns the model, the state, the chosen
- * integrator's workspace and the observables (transport-velocity estimator,
- * energy balance). The caller decides when to step (sim_advance); controls
- * take effect at the integrator's current time.
- *
- * Transport velocity (MODEL.md "Observables"): the mean feed displacement
- * is sampled at the excitation period boundaries, i.e. where the rotor's
- * angle relative to the trough, phi - alpha, crosses a multiple of 2 pi
- * (located within the step on cubic Hermite interpolants); the estimate is
- * the slope between the first boundary after the transient and the latest
- * one, so the periodic part of the motion cancels exactly.
+ * sim.c - one simulation instance: owns the const model, the controls, the
+ * state, the chosen integrator's workspace and the observables (the
+ * transport-velocity estimator of estimator.c, the energy balance). The
+ * caller decides when to step (sim_advance); controls take effect at the
+ * integrator's current time. Reading the status never changes the
+ * instance: it is computed after each change with an evaluation that
+ * counts nothing.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "estimator.h"
 #include "feed.h"
 #include "ode.h"
+#include "units.h"
 
 /* speed-up, relative transport-velocity change: czubak2016, dem dt = 1e-4 */
 #define REDUCTION_NO_FEED 1.75, NAN
@@ -26,7 +24,9 @@
 #define REDUCTION_ONE_WAY 0.99, 3.2e-2
 
 struct sim {
-	model md;
+	model md;            /* const after sim_new */
+	model_ctl ctl;       /* changed by the sim_set_* controls */
+	dyn sys;             /* what the integrator steps: &md, &ctl, rhs_evals */
 	sim_method cfg;
 	const ode_method *ode;
 	void *ws;
@@ -36,83 +36,48 @@ struct sim {
 	uint64_t steps;
 	int failed;
 	char error[160];
-	/* period boundaries */
-	double psi_prev, X_prev, psid_prev, Xd_prev, tb_prev_step;
-	double est_start;
-	int est_pending, n_bound;
-	double tb_first, Xb_first, tb_last, Xb_last, tb_prev, Xb_prev;
+	estimator est;
 	double X0;
 	double *X0k;
 	sim_status st;
 };
 
-static double mean_xi_rate(const model *md, const double *y)
+/* Divergence guard, machine: bounded displacements, rotation, strokes and
+ * rotor speed; NULL or the cause. */
+static const char *machine_runaway(const model *md, const double q[NQ_FULL],
+				   const double qd[NQ_FULL])
 {
-	const double *xid = y + md->npos + md->nq;
-	double s = 0.0;
-	for (int e = 0; e < md->nf; e++)
-		s += xid[e];
-	return md->nf > 0 ? s / md->nf : 0.0;
+	if (fabs(q[Q_X]) > 1.0 || fabs(q[Q_Y]) > 1.0)
+		return "trough displacement beyond 1 m";
+	if (fabs(q[Q_ALPHA]) > 0.5)
+		return "trough rotation beyond 0.5 rad";
+	if (fabs(q[Q_S1]) > 1.0 || fabs(q[Q_S2]) > 1.0)
+		return "eliminator stroke beyond 1 m";
+	if (fabs(qd[Q_PHI] - qd[Q_ALPHA]) > 100.0 * md->p.omega_ss + 1e3)
+		return "rotor speed beyond 100 omega_ss";
+	return NULL;
 }
 
-/* phi - alpha and its rate, and the mean feed position and its rate. */
-static void period_probe(const sim *s, double t, const double *y, double *psi, double *psid,
-			 double *X, double *Xd)
+/* Divergence guard, feed: no element sunk into or thrown far from its
+ * deck point; NULL or the cause. */
+static const char *feed_runaway(const model *md, const double *y, const double q[NQ_FULL],
+				const double qd[NQ_FULL])
 {
-	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(&s->md, t, y, q, qd);
-	*psi = q[Q_PHI] - q[Q_ALPHA];
-	*psid = qd[Q_PHI] - qd[Q_ALPHA];
-	*X = s->md.nf > 0 ? feed_mean_xi(&s->md, y, -1) : 0.0;
-	*Xd = mean_xi_rate(&s->md, y);
-}
-
-static void on_boundary(sim *s, double tb, double Xb)
-{
-	if (s->est_pending) {
-		if (tb + 1e-12 < s->est_start)
-			return;
-		s->est_pending = 0;
-		s->n_bound = 0;
-		s->tb_first = s->tb_last = tb;
-		s->Xb_first = s->Xb_last = Xb;
-		return;
-	}
-	s->tb_prev = s->tb_last;
-	s->Xb_prev = s->Xb_last;
-	s->tb_last = tb;
-	s->Xb_last = Xb;
-	s->n_bound++;
-}
-
-/* After a step from t0 to t1: locate crossings of phi - alpha through
- * multiples of 2 pi. */
-static void detect_periods(sim *s, double t0, double t1)
-{
-	double psi, psid, X, Xd;
-	period_probe(s, t1, s->y, &psi, &psid, &X, &Xd);
-	double H = t1 - t0;
-	double n0 = floor(s->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
-	if (n0 != n1 && H > 0.0) {
-		int up = n1 > n0;
-		for (double nb = up ? n0 + 1 : n0; up ? nb <= n1 : nb > n1; nb += up ? 1 : -1) {
-			double target = nb * 2 * M_PI, lo = 0.0, hi = 1.0;
-			for (int it = 0; it < 60; it++) {
-				double mid = 0.5 * (lo + hi);
-				double v = ode_hermite(s->psi_prev, s->psid_prev, psi, psid, H, mid);
-				if ((v < target) == up)
-					lo = mid;
-				else
-					hi = mid;
-			}
-			double u = 0.5 * (lo + hi);
-			on_boundary(s, t0 + u * H, ode_hermite(s->X_prev, s->Xd_prev, X, Xd, H, u));
+	const double *eta = y + md->nq + md->nf;
+	deck_rot R = deck_rotation(q);
+	for (int k = 0; k < md->dk.K; k++) {
+		double pos[2], vel[2];
+		deck_point(&md->dk, md->dk.d[k], &R, q, qd, pos, vel);
+		for (int j = 0; j < md->L; j++) {
+			double rel = eta[k * md->L + j] - pos[1];
+			if (rel < -0.05)
+				return "feed element sank 5 cm into the deck "
+				       "(step too large for the contact stiffness)";
+			if (rel > 100.0)
+				return "feed element thrown beyond 100 m";
 		}
 	}
-	s->psi_prev = psi;
-	s->psid_prev = psid;
-	s->X_prev = X;
-	s->Xd_prev = Xd;
+	return NULL;
 }
 
 /* Divergence guard: finite state, bounded machine motion and feed. */
@@ -129,36 +94,10 @@ static int check_state(sim *s)
 		}
 	}
 	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(md, s->t_int, s->y, q, qd);
-	const char *cause = NULL;
-	if (fabs(q[Q_X]) > 1.0 || fabs(q[Q_Y]) > 1.0)
-		cause = "trough displacement beyond 1 m";
-	else if (fabs(q[Q_ALPHA]) > 0.5)
-		cause = "trough rotation beyond 0.5 rad";
-	else if (fabs(q[Q_S1]) > 1.0 || fabs(q[Q_S2]) > 1.0)
-		cause = "eliminator stroke beyond 1 m";
-	else if (fabs(qd[Q_PHI] - qd[Q_ALPHA]) > 100.0 * md->p.omega_ss + 1e3)
-		cause = "rotor speed beyond 100 omega_ss";
-	if (!cause && md->nf > 0) {
-		const double *eta = s->y + md->nq + md->nf;
-		model_rot R = model_rotation(q);
-		for (int k = 0; k < md->K && !cause; k++) {
-			double pos[2], vel[2];
-			model_deck(md, k, &R, q, qd, pos, vel);
-			for (int j = 0; j < md->L; j++) {
-				double rel = eta[k * md->L + j] - pos[1];
-				if (rel < -0.05) {
-					cause = "feed element sank 5 cm into the deck "
-						"(step too large for the contact stiffness)";
-					break;
-				}
-				if (rel > 100.0) {
-					cause = "feed element thrown beyond 100 m";
-					break;
-				}
-			}
-		}
-	}
+	model_full_coords(md, &s->ctl, s->t_int, s->y, q, qd);
+	const char *cause = machine_runaway(md, q, qd);
+	if (!cause && md->nf > 0)
+		cause = feed_runaway(md, s->y, q, qd);
 	if (cause) {
 		snprintf(s->error, sizeof s->error, "diverged at t = %.9g s: %s", s->t_int, cause);
 		return SIM_EDIVERGED;
@@ -179,7 +118,8 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	s = calloc(1, sizeof *s);
 	if (!s)
 		goto fail;
-	model_init(&s->md, p, sc);
+	model_init(&s->md, &s->ctl, p, sc);
+	s->sys = (dyn){.md = &s->md, .ctl = &s->ctl, .rhs_evals = 0};
 	s->cfg = *m;
 	if (s->cfg.dt == 0.0)
 		s->cfg.dt = sim_default_dt(p, sc, m);
@@ -188,7 +128,7 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	s->ode = ode_find(m->name);
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(3 * n, sizeof(double));
-	s->X0k = calloc((size_t)(s->md.K > 0 ? s->md.K : 1), sizeof(double));
+	s->X0k = calloc((size_t)(s->md.dk.K > 0 ? s->md.dk.K : 1), sizeof(double));
 	if (!s->y || !s->X0k)
 		goto fail;
 	s->y_obs = s->y + n;
@@ -196,16 +136,14 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	s->ws = s->ode->alloc(&s->md, &s->cfg);
 	if (!s->ws)
 		goto fail;
-	model_equilibrium(&s->md, s->y);
+	dynamics_equilibrium(&s->md, &s->ctl, s->y);
 	memcpy(s->y_obs, s->y, sizeof(double) * n);
 	double kin, pot;
-	s->e0 = model_energy_stored(&s->md, 0.0, s->y, &kin, &pot);
+	s->e0 = dynamics_energy_stored(&s->md, &s->ctl, 0.0, s->y, &kin, &pot);
 	s->X0 = s->md.nf > 0 ? feed_mean_xi(&s->md, s->y, -1) : 0.0;
-	for (int k = 0; k < s->md.K; k++)
+	for (int k = 0; k < s->md.dk.K; k++)
 		s->X0k[k] = feed_mean_xi(&s->md, s->y, k);
-	period_probe(s, 0.0, s->y, &s->psi_prev, &s->psid_prev, &s->X_prev, &s->Xd_prev);
-	s->est_start = sc->transient;
-	s->est_pending = 1;
+	estimator_init(&s->est, &s->md, &s->ctl, 0.0, s->y, sc->transient);
 	update_status(s);
 	if (err)
 		*err = SIM_OK;
@@ -249,7 +187,7 @@ int sim_advance(sim *s, double t_end)
 	const double eps = 1e-12 * fmax(1.0, fabs(t_end));
 	while (s->t_int < t_end - eps) {
 		double t0 = s->t_int;
-		int e = s->ode->step(s->ws, &s->md, &s->t_int, s->y, t_end);
+		int e = s->ode->step(s->ws, &s->sys, &s->t_int, s->y, t_end);
 		if (e == SIM_OK)
 			e = check_state(s);
 		else
@@ -263,7 +201,7 @@ int sim_advance(sim *s, double t_end)
 			return e;
 		}
 		s->steps++;
-		detect_periods(s, t0, s->t_int);
+		estimator_step(&s->est, &s->md, &s->ctl, t0, s->t_int, s->y);
 	}
 	size_t n = (size_t)s->md.n;
 	if (s->ode->dense && s->t_int > t_end + eps) {
@@ -285,19 +223,19 @@ static void control_changed(sim *s)
 	update_status(s);
 }
 
-int sim_set_beta(sim *s, double target_deg, double rate_deg_s)
+int sim_set_beta(sim *s, double beta, double rate)
 {
-	if (!isfinite(target_deg) || target_deg < 0.0 || target_deg > 180.0)
+	if (!sim_setting_check(sim_setting_find("beta"), beta))
 		return SIM_EPARAM;
-	if (isfinite(rate_deg_s) && rate_deg_s > 0.0) {
-		if (rate_deg_s < 0.1 || rate_deg_s > 3600.0)
+	if (isfinite(rate) && rate > 0.0) {
+		if (!sim_setting_check(sim_setting_find("beta_rate"), rate))
 			return SIM_EPARAM;
-		s->md.p.beta_rate = rate_deg_s * M_PI / 180.0;
-	} else if (!isfinite(rate_deg_s)) {
+		s->ctl.beta_rate = rate;
+	} else if (!isfinite(rate)) {
 		return SIM_EPARAM;
 	}
-	ramp_to_position(&s->md.beta_ramp, s->t_int, target_deg * M_PI / 180.0,
-			 s->md.p.beta_rate, s->md.p.beta_accel);
+	ramp_to_position(&s->ctl.beta_ramp, s->t_int, beta, s->ctl.beta_rate,
+			 s->md.p.beta_accel);
 	control_changed(s);
 	return SIM_OK;
 }
@@ -306,15 +244,15 @@ static void ideal_speed(sim *s)
 {
 	if (!s->md.phi_prescribed)
 		return;
-	double target = s->md.drive_on ? (double)s->md.rotation * s->md.omega_ss : 0.0;
-	ramp_to_rate(&s->md.psi_ramp, s->t_int, target, s->md.p.drive_accel);
+	double target = s->ctl.drive_on ? (double)s->ctl.rotation * s->ctl.omega_ss : 0.0;
+	ramp_to_rate(&s->ctl.psi_ramp, s->t_int, target, s->md.p.drive_accel);
 }
 
 int sim_set_rotation(sim *s, int rotation)
 {
 	if (rotation != SIM_CW && rotation != SIM_CCW)
 		return SIM_EPARAM;
-	s->md.rotation = rotation;
+	s->ctl.rotation = rotation;
 	ideal_speed(s);
 	control_changed(s);
 	return SIM_OK;
@@ -322,9 +260,9 @@ int sim_set_rotation(sim *s, int rotation)
 
 int sim_set_omega_ss(sim *s, double omega_ss)
 {
-	if (!isfinite(omega_ss) || omega_ss < 1.0 || omega_ss > 1000.0)
+	if (!sim_setting_check(sim_setting_find("omega_ss"), omega_ss))
 		return SIM_EPARAM;
-	s->md.omega_ss = omega_ss;
+	s->ctl.omega_ss = omega_ss;
 	ideal_speed(s);
 	control_changed(s);
 	return SIM_OK;
@@ -332,7 +270,7 @@ int sim_set_omega_ss(sim *s, double omega_ss)
 
 int sim_set_drive_on(sim *s, int on)
 {
-	s->md.drive_on = on != 0;
+	s->ctl.drive_on = on != 0;
 	ideal_speed(s);
 	control_changed(s);
 	return SIM_OK;
@@ -340,15 +278,14 @@ int sim_set_drive_on(sim *s, int on)
 
 void sim_restart_transport(sim *s)
 {
-	s->est_pending = 1;
-	s->est_start = s->t_int;
+	estimator_restart(&s->est, s->t_int);
 	update_status(s);
 }
 
 int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi_dot,
 		   const double *eta_dot)
 {
-	model *md = &s->md;
+	const model *md = &s->md;
 	if (s->t_int != s->t_obs)
 		return SIM_ETIME;
 	const double *src[4] = {xi, eta, xi_dot, eta_dot};
@@ -363,7 +300,7 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 	memcpy(s->y_obs, s->y, sizeof(double) * (size_t)md->n);
 	double kin, pot;
 	const double *acc = s->y + 2 * md->npos;
-	s->e0 = model_energy_stored(md, s->t_int, s->y, &kin, &pot) + acc[ACC_CONTACT] +
+	s->e0 = dynamics_energy_stored(md, &s->ctl, s->t_int, s->y, &kin, &pot) + acc[ACC_CONTACT] +
 		acc[ACC_DAMP] + acc[ACC_FRIC] - acc[ACC_IN];
 	/* a fresh workspace: split methods cache the feed's reaction */
 	void *ws = s->ode->alloc(md, &s->cfg);
@@ -371,29 +308,50 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 		return SIM_ENOMEM;
 	s->ode->free(s->ws);
 	s->ws = ws;
-	period_probe(s, s->t_int, s->y, &s->psi_prev, &s->psid_prev, &s->X_prev, &s->Xd_prev);
+	estimator_probe(&s->est, md, &s->ctl, s->t_int, s->y);
 	update_status(s);
 	return SIM_OK;
 }
 
 /* ---- observables ---- */
 
+/* Energies of the status: stored (kinetic, potential with the contacts'
+ * elastic energy), input, dissipated and the balance's residual. */
+static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
+{
+	const model *md = &s->md;
+	double kin, pot;
+	dynamics_energy_stored(md, &s->ctl, s->t_obs, s->y_obs, &kin, &pot);
+	const double *acc = s->y_obs + 2 * md->npos;
+	double contact_elastic = 0.0;
+	if (md->nf > 0)
+		contact_elastic = dynamics_contact_energy(md, s->y_obs, ev->q, ev->qd);
+	st->e_input = acc[ACC_IN];
+	st->e_kinetic = kin;
+	st->e_potential = pot - s->e0 + contact_elastic;
+	st->e_dissipated =
+		acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - contact_elastic);
+	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
+			 acc[ACC_IN];
+}
+
+/* Recompute the status at the observed time after any change. Evaluates
+ * the right-hand side for observation only: no counter moves. */
 static void update_status(sim *s)
 {
-	model *md = &s->md;
+	const model *md = &s->md;
+	const model_ctl *ctl = &s->ctl;
 	sim_status *st = &s->st;
 	model_eval ev;
-	uint64_t evals = md->rhs_evals;
-	model_rhs(md, s->t_obs, s->y_obs, s->dy, &ev);
-	md->rhs_evals = evals;
+	dynamics_eval(md, ctl, s->t_obs, s->y_obs, s->dy, &ev);
 	st->t = s->t_obs;
 	st->t_int = s->t_int;
 	st->beta = ev.beta;
 	st->beta_dot = ev.beta_dot;
-	st->beta_target = md->beta_ramp.b_end;
-	st->rotation = md->rotation;
-	st->drive_on = md->drive_on;
-	st->omega_ss = md->omega_ss;
+	st->beta_target = ctl->beta_ramp.b_end;
+	st->rotation = ctl->rotation;
+	st->drive_on = ctl->drive_on;
+	st->omega_ss = ctl->omega_ss;
 	memcpy(st->q, ev.q, sizeof st->q);
 	memcpy(st->qd, ev.qd, sizeof st->qd);
 	st->rotor_speed = ev.rotor_speed;
@@ -402,33 +360,15 @@ static void update_status(sim *s)
 	memcpy(st->deck, ev.deck, sizeof st->deck);
 	memcpy(st->deck_vel, ev.deck_vel, sizeof st->deck_vel);
 	st->feed_displacement = md->nf > 0 ? feed_mean_xi(md, s->y_obs, -1) - s->X0 : 0.0;
-	if (!s->est_pending && s->n_bound >= 1) {
-		st->transport_velocity =
-			(s->Xb_last - s->Xb_first) / (s->tb_last - s->tb_first);
-		st->transport_periods = s->n_bound;
-		st->feed_velocity = (s->Xb_last - s->Xb_prev) / (s->tb_last - s->tb_prev);
-		st->period = s->tb_last - s->tb_prev;
-	} else {
-		st->transport_velocity = NAN;
-		st->transport_periods = 0;
-		st->feed_velocity = NAN;
-		st->period = NAN;
-	}
-	double kin, pot;
-	model_energy_stored(md, s->t_obs, s->y_obs, &kin, &pot);
-	const double *acc = s->y_obs + 2 * md->npos;
-	double contact_elastic = 0.0;
-	if (md->nf > 0)
-		contact_elastic = feed_contact_energy(md, s->y_obs, ev.q, ev.qd);
-	st->e_input = acc[ACC_IN];
-	st->e_kinetic = kin;
-	st->e_potential = pot - s->e0 + contact_elastic;
-	st->e_dissipated =
-		acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - contact_elastic);
-	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
-			 acc[ACC_IN];
+	estimate est;
+	estimator_read(&s->est, &est);
+	st->transport_velocity = est.transport_velocity;
+	st->transport_periods = est.transport_periods;
+	st->feed_velocity = est.feed_velocity;
+	st->period = est.period;
+	status_energy(s, &ev, st);
 	st->steps = s->steps;
-	st->rhs_evals = md->rhs_evals;
+	st->rhs_evals = s->sys.rhs_evals;
 	st->dt = s->cfg.dt;
 	st->substeps = s->cfg.substeps;
 	st->reductions = md->reductions;
@@ -453,7 +393,7 @@ int sim_layers(const sim *s)
 /* Physical column c maps to integrated column c, or 0 under symmetry. */
 static int integrated_column(const sim *s, int c)
 {
-	return s->md.K == 1 ? 0 : c;
+	return s->md.dk.K == 1 ? 0 : c;
 }
 
 void sim_column_displacement(const sim *s, double *out)
@@ -468,15 +408,16 @@ void sim_column_displacement(const sim *s, double *out)
 void sim_deck_points(const sim *s, double *out)
 {
 	int K = sim_columns(s);
+	const deck *dk = &s->md.dk;
 	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(&s->md, s->t_obs, s->y_obs, q, qd);
+	model_full_coords(&s->md, &s->ctl, s->t_obs, s->y_obs, q, qd);
 	double zero[NQ_FULL] = {0};
-	model_rot R = model_rotation(q), R0 = model_rotation(zero);
+	deck_rot R = deck_rotation(q), R0 = deck_rotation(zero);
 	for (int c = 0; c < K; c++) {
 		int k = integrated_column(s, c);
 		double pos[2], vel[2], rest[2];
-		model_deck(&s->md, k, &R, q, qd, pos, vel);
-		model_deck(&s->md, k, &R0, zero, zero, rest, vel);
+		deck_point(dk, dk->d[k], &R, q, qd, pos, vel);
+		deck_point(dk, dk->d[k], &R0, zero, zero, rest, vel);
 		out[2 * c] = pos[0] - rest[0];
 		out[2 * c + 1] = pos[1] - rest[1];
 	}

@@ -9,9 +9,10 @@
  * calls back into its caller and never aborts: any number of instances may
  * run in parallel threads, one thread per instance.
  *
- * Units are SI throughout except where a name says otherwise: angles that a
- * user types (beta, beta_rate) are in degrees, everything internal and every
- * observable angle is in radians.
+ * Units are SI throughout this interface: angles in rad, rates in rad/s,
+ * times in s. Degrees and other friendly units exist only in the settings
+ * table (its unit and scale columns) and at the edges (CLI, API), which
+ * convert once with the helpers of units.h.
  */
 #ifndef CONVSIM_SIM_H
 #define CONVSIM_SIM_H
@@ -19,19 +20,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Return codes: one list, expanded into the enum, sim_strerror() and (in
- * api/) the HTTP status. X(name, http_status, message). */
+/* Return codes: one list, expanded into the enum and sim_strerror().
+ * X(name, message); no transport meaning (api/errors.c maps them). */
 #define SIM_ERRNO_MAP(X)                                                      \
-	X(OK, 200, "ok")                                                      \
-	X(EPARAM, 422, "parameter out of range")                              \
-	X(EUNKNOWN, 422, "unknown name")                                      \
-	X(ENOMEM, 503, "out of memory")                                       \
-	X(EDIVERGED, 422, "simulation diverged")                              \
-	X(ESTEP, 422, "step size underflow")                                  \
-	X(ETIME, 422, "requested time lies in the past")
+	X(OK, "ok")                                                           \
+	X(EPARAM, "parameter out of range")                                   \
+	X(EUNKNOWN, "unknown name")                                           \
+	X(ENOMEM, "out of memory")                                            \
+	X(EDIVERGED, "simulation diverged")                                   \
+	X(ESTEP, "step size underflow")                                       \
+	X(ETIME, "requested time lies in the past")
 
 typedef enum {
-#define SIM_ERR_ENUM(name, status, msg) SIM_##name,
+#define SIM_ERR_ENUM(name, msg) SIM_##name,
 	SIM_ERRNO_MAP(SIM_ERR_ENUM)
 #undef SIM_ERR_ENUM
 	SIM_NERR
@@ -42,12 +43,15 @@ const char *sim_strerror(int err);
 
 /* ---- parameters ------------------------------------------------------ */
 
+/* Largest feed: columns K and layers L (settings table and array sizes). */
+#define SIM_MAX_COLUMNS 64
+#define SIM_MAX_LAYERS 64
+
 enum { SIM_CW = -1, SIM_CCW = 1 };
 enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
 enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
 
-/* Physical parameters, MODEL.md names. Angles in radians here; the name
- * table below converts beta from degrees. */
+/* Physical parameters, MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
 	/* suspension */
 	double l1, l2, h;         /* m: spring sets at (l1,-h), (-l2,-h) */
@@ -119,6 +123,7 @@ typedef struct sim_setting {
 	const char *group;    /* "params", "scene" or "integrator" */
 	sim_kind kind;
 	const char *unit;     /* as the user writes it: "deg", "N/m", ... */
+	double scale;         /* SI value of one user unit (RAD_PER_DEG, else 1) */
 	double min, max;      /* allowed closed range in user units */
 	const char *choices;  /* SIM_KIND_ENUM: "cw|ccw" (index = value) */
 	const char *doc;
@@ -134,17 +139,19 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
 extern const char *const sim_preset_names[];
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m);
 
-/* Set one named setting from a number in user units (beta in degrees; enum
- * and bool settings take their index 0/1/...). Checks range and finiteness.
- * On error returns SIM_EPARAM or SIM_EUNKNOWN and, if msg != NULL, writes a
- * sentence naming the setting and its range into msg (msglen bytes). */
+/* Set one named setting from a number in SI units (beta in rad; enum and
+ * bool settings take their index 0/1/...). Checks the table's range (scaled
+ * to SI) and finiteness. On error returns SIM_EPARAM or SIM_EUNKNOWN and,
+ * if msg != NULL, writes a sentence naming the setting and its range (in
+ * user units) into msg (msglen bytes); nothing is changed then. For user
+ * units see sim_set_user() in units.h. */
 int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 	    double value, char *msg, size_t msglen);
 /* The same for a string value: enum choices ("cw", "ideal", "rk4" for
- * the integrator "method") or a number. */
+ * the integrator "method"), true/false, or a number in SI units. */
 int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 		const char *value, char *msg, size_t msglen);
-/* Read one named setting in user units; SIM_EUNKNOWN if no such name. */
+/* Read one named setting in SI units; SIM_EUNKNOWN if no such name. */
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
 
@@ -169,8 +176,9 @@ typedef struct sim_method_info {
 	int adaptive;     /* 1 if rtol/atol drive the step */
 	const char *doc;
 } sim_method_info;
-/* Registry of integrators; *n receives the count. Static. */
-const sim_method_info *sim_methods(size_t *n);
+/* Registry of integrators, built from each method's own descriptor: an
+ * array of *n pointers, all static. */
+const sim_method_info *const *sim_methods(size_t *n);
 
 /* ---- instances ------------------------------------------------------- */
 
@@ -191,17 +199,22 @@ void sim_free(sim *s);
  * observed time. Returns SIM_OK, SIM_ETIME, or SIM_EDIVERGED / SIM_ESTEP
  * (the instance is then frozen; sim_last_error() tells time and cause). */
 int sim_advance(sim *s, double t_end);
+/* Why the instance froze (time and cause), "" while it runs; owned by s. */
 const char *sim_last_error(const sim *s);
 
 /* ---- controls (take effect at sim_effective_time()) ------------------ */
 
 /* Time (s) at which a control set now takes effect: the integrator's time. */
 double sim_effective_time(const sim *s);
-/* Ramp beta to target_deg (deg, within the beta range) at rate_deg_s
- * (deg/s, > 0; <= 0 keeps the current rate). Returns SIM_OK or SIM_EPARAM. */
-int sim_set_beta(sim *s, double target_deg, double rate_deg_s);
-int sim_set_rotation(sim *s, int rotation);    /* SIM_CW / SIM_CCW */
-int sim_set_omega_ss(sim *s, double omega_ss); /* rad/s */
+/* Ramp beta to beta (rad) at rate (rad/s; <= 0 keeps the current rate),
+ * both within the settings table's ranges of "beta" and "beta_rate".
+ * Returns SIM_OK or SIM_EPARAM (nothing changed). */
+int sim_set_beta(sim *s, double beta, double rate);
+/* Sense of the unbalanced mass, SIM_CW or SIM_CCW; else SIM_EPARAM. */
+int sim_set_rotation(sim *s, int rotation);
+/* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
+int sim_set_omega_ss(sim *s, double omega_ss);
+/* Switch the drive on (on != 0) or off; always SIM_OK. */
 int sim_set_drive_on(sim *s, int on);
 
 /* Place the feed at the observed time (which must equal the integrator's:
@@ -268,6 +281,8 @@ typedef struct sim_status {
 	int n_dof;                /* integrated machine + feed coordinates */
 } sim_status;
 
+/* Copy the status at the observed time into *st (SI units). Reading never
+ * changes the instance, its counters included. */
 void sim_get_status(const sim *s, sim_status *st);
 
 /* Restart the transport-velocity estimator at the next period boundary
@@ -281,6 +296,7 @@ int sim_measure_velocity(const sim_params *p, const sim_scene *s,
 			 char *msg, size_t msglen);
 
 /* Feed geometry of the instance. */
+/* Physical columns K and layers L; 0 without feed. */
 int sim_columns(const sim *s);
 int sim_layers(const sim *s);
 /* Per column k: mean feed displacement xi_bar_k(t) - xi_bar_k(0), m.

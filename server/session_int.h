@@ -12,8 +12,6 @@
 #include "session.h"
 #include "worker.h"
 
-#define DEG (180.0 / M_PI)
-
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */

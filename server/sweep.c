@@ -19,6 +19,7 @@
 #include "pool.h"
 #include "registry.h"
 #include "sweep.h"
+#include "units.h"
 #include "util.h"
 
 typedef struct srv_sweep {
@@ -115,7 +116,7 @@ static void run_point(void *arg)
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
 		double v = 0;
-		int rc = sim_set(&spec.params, &spec.scene, &spec.method,
+		int rc = sim_set_user(&spec.params, &spec.scene, &spec.method,
 				 "beta", p->beta, msg, sizeof msg);
 		spec.params.rotation = p->rotation;
 		if (rc == SIM_OK)

@@ -32,6 +32,7 @@
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
+#include "units.h"
 #include "util.h"
 
 /* Wall-clock anchors of pacing and metering. */
@@ -211,10 +212,11 @@ static int apply_commands(srv_session *s)
 		if (c->set & (API_C_BETA | API_C_BETA_RATE)) {
 			double target = (c->set & API_C_BETA)
 						? c->beta
-						: s->st.beta_target * DEG;
+						: s->st.beta_target * DEG_PER_RAD;
 			double rate =
 				(c->set & API_C_BETA_RATE) ? c->beta_rate : 0;
-			rc = sim_set_beta(s->sim, target, rate);
+			rc = sim_set_beta(s->sim, sim_rad_from_deg(target),
+					  sim_rad_from_deg(rate));
 		}
 		if (rc == SIM_OK && (c->set & API_C_ROTATION))
 			rc = sim_set_rotation(s->sim, c->rotation);

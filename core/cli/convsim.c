@@ -19,6 +19,7 @@
 #include <time.h>
 
 #include "sim.h"
+#include "units.h"
 
 static double now(void)
 {
@@ -89,7 +90,7 @@ static int parse(int argc, char **argv, opts *o)
 			}
 			char name[64];
 			snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-			if (sim_set_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) !=
+			if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) !=
 			    SIM_OK) {
 				fprintf(stderr, "convsim: %s\n", msg);
 				return 2;
@@ -138,7 +139,7 @@ static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int
 	int K = sim_columns(s);
 	double vals[16] = {st->t,           st->q[0],          st->q[1],
 			   st->q[2],        st->q[4],          st->q[5],
-			   st->rotor_speed, st->motor_torque,  st->beta * 180.0 / M_PI,
+			   st->rotor_speed, st->motor_torque,  sim_deg_from_rad(st->beta),
 			   st->deck[0],     st->deck[1],       st->feed_displacement,
 			   st->e_input,     st->e_dissipated,  st->e_residual,
 			   st->transport_velocity};
@@ -181,6 +182,41 @@ static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int
 	fputc('\n', f);
 }
 
+/* The run's JSON summary on stdout: final status, cost (cpu, wall in s)
+ * and the error, if any. */
+static void print_summary(const opts *o, const sim *s, const sim_status *st, int err, double cpu,
+			  double wall)
+{
+	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o->preset, st->t);
+	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
+	       "\"atol\": %.17g, \"substeps\": %d},\n",
+	       o->m.name, st->dt, o->m.rtol, o->m.atol, st->substeps);
+	printf("  \"reductions\": [");
+	for (int b = 0, first = 1; sim_reduction_name(b); b++)
+		if (st->reductions & (1u << b)) {
+			printf("%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
+			first = 0;
+		}
+	printf("],\n  \"transport_velocity\": ");
+	print_num(stdout, st->transport_velocity);
+	printf(",\n  \"transport_periods\": %.0f,\n  \"rotor_speed\": ", st->transport_periods);
+	print_num(stdout, st->rotor_speed);
+	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", sim_deg_from_rad(st->beta));
+	print_num(stdout, st->feed_displacement);
+	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
+	       (unsigned long long)st->steps, (unsigned long long)st->rhs_evals, st->n_dof);
+	printf("  \"cpu_seconds\": %.6g,\n  \"wall_seconds\": %.6g,\n", cpu, wall);
+	printf("  \"real_time_factor\": %.6g,\n", cpu > 0 ? st->t / cpu : 0.0);
+	printf("  \"energy\": {\"input\": %.10g, \"kinetic\": %.10g, \"potential\": %.10g, "
+	       "\"dissipated\": %.10g, \"residual\": %.6g},\n",
+	       st->e_input, st->e_kinetic, st->e_potential, st->e_dissipated, st->e_residual);
+	printf("  \"error\": ");
+	if (err != SIM_OK)
+		printf("\"%s\"\n}\n", sim_last_error(s));
+	else
+		printf("null\n}\n");
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	opts o = {0};
@@ -199,7 +235,7 @@ static int cmd_run(int argc, char **argv)
 		return 2;
 	}
 	FILE *f = NULL;
-	double *colbuf = calloc(64, sizeof(double));
+	double *colbuf = calloc(SIM_MAX_COLUMNS, sizeof(double));
 	if (o.out) {
 		f = fopen(o.out, "w");
 		if (!f) {
@@ -233,34 +269,7 @@ static int cmd_run(int argc, char **argv)
 		fclose(f);
 	}
 	sim_get_status(s, &st);
-	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o.preset, st.t);
-	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
-	       "\"atol\": %.17g, \"substeps\": %d},\n",
-	       o.m.name, st.dt, o.m.rtol, o.m.atol, st.substeps);
-	printf("  \"reductions\": [");
-	for (int b = 0, first = 1; sim_reduction_name(b); b++)
-		if (st.reductions & (1u << b)) {
-			printf("%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
-			first = 0;
-		}
-	printf("],\n  \"transport_velocity\": ");
-	print_num(stdout, st.transport_velocity);
-	printf(",\n  \"transport_periods\": %.0f,\n  \"rotor_speed\": ", st.transport_periods);
-	print_num(stdout, st.rotor_speed);
-	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", st.beta * 180.0 / M_PI);
-	print_num(stdout, st.feed_displacement);
-	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
-	       (unsigned long long)st.steps, (unsigned long long)st.rhs_evals, st.n_dof);
-	printf("  \"cpu_seconds\": %.6g,\n  \"wall_seconds\": %.6g,\n", cpu, wall);
-	printf("  \"real_time_factor\": %.6g,\n", cpu > 0 ? st.t / cpu : 0.0);
-	printf("  \"energy\": {\"input\": %.10g, \"kinetic\": %.10g, \"potential\": %.10g, "
-	       "\"dissipated\": %.10g, \"residual\": %.6g},\n",
-	       st.e_input, st.e_kinetic, st.e_potential, st.e_dissipated, st.e_residual);
-	printf("  \"error\": ");
-	if (err != SIM_OK)
-		printf("\"%s\"\n}\n", sim_last_error(s));
-	else
-		printf("null\n}\n");
+	print_summary(&o, s, &st, err, cpu, wall);
 	sim_free(s);
 	free(colbuf);
 	return err == SIM_OK ? 0 : 1;
@@ -294,7 +303,7 @@ static void *worker(void *arg)
 			return NULL;
 		task *t = &pl->tasks[i];
 		sim_params p = pl->o->p;
-		p.beta = t->beta * M_PI / 180.0;
+		p.beta = sim_rad_from_deg(t->beta);
 		p.rotation = t->rotation;
 		t->err = sim_measure_velocity(&p, &pl->o->sc, &pl->o->m, pl->o->duration, &t->v,
 					      t->msg, sizeof t->msg);
@@ -398,11 +407,11 @@ static int cmd_list(void)
 		printf("%-16s %-11s %-9s %-24s %s\n", t[i].name, t[i].group, t[i].unit, range,
 		       t[i].doc);
 	}
-	const sim_method_info *mi = sim_methods(&n);
+	const sim_method_info *const *mi = sim_methods(&n);
 	printf("\nintegrators:\n");
 	for (size_t i = 0; i < n; i++)
-		printf("  %-8s order %d%s: %s\n", mi[i].name, mi[i].order,
-		       mi[i].adaptive ? ", adaptive" : "", mi[i].doc);
+		printf("  %-8s order %d%s: %s\n", mi[i]->name, mi[i]->order,
+		       mi[i]->adaptive ? ", adaptive" : "", mi[i]->doc);
 	return 0;
 }
 

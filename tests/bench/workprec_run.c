@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "sim.h"
+#include "units.h"
 #include "workprec.h"
 
 static double cpu_now(void)
@@ -24,7 +25,7 @@ static void apply(sim_params *p, sim_scene *sc, sim_method *m, const char *const
 {
 	char msg[200];
 	for (int i = 0; sets && sets[i]; i += 2)
-		if (sim_set_str(p, sc, m, sets[i], sets[i + 1], msg, sizeof msg) != SIM_OK) {
+		if (sim_set_user_str(p, sc, m, sets[i], sets[i + 1], msg, sizeof msg) != SIM_OK) {
 			fprintf(stderr, "workprec: %s=%s: %s\n", sets[i], sets[i + 1], msg);
 			exit(2);
 		}

@@ -76,7 +76,8 @@ static void hopping_theory_vdi2333(void **state)
 		set(&u, "R", "0.001");
 		set(&u, "k_c", "1e7");
 		model md;
-		model_init(&md, &u.p, &u.sc);
+		model_ctl ctl;
+		model_init(&md, &ctl, &u.p, &u.sc);
 		md.p.mu = 100.0; /* the theory assumes no slip at all */
 		double *y = calloc((size_t)md.n, sizeof(double));
 		signed char modes[2] = {0, 0};
@@ -133,7 +134,7 @@ static void beta_sets_and_reverses_direction(void **state)
 	sim *s = make(&u);
 	advance(s, 2.5);
 	double before = status(s).feed_velocity;
-	assert_int_equal(sim_set_beta(s, 128.0, 180.0), SIM_OK);
+	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(128.0), sim_rad_from_deg(180.0)), SIM_OK);
 	sim_restart_transport(s);
 	advance(s, 5.0);
 	sim_status st = status(s);

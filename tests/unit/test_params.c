@@ -55,7 +55,7 @@ static void converts_units_and_enums(void **state)
 	set(&u, "method", "rk4");
 	assert_string_equal(u.m.name, "rk4");
 	double v;
-	assert_int_equal(sim_get(&u.p, &u.sc, &u.m, "beta", &v), SIM_OK);
+	assert_int_equal(sim_get_user(&u.p, &u.sc, &u.m, "beta", &v), SIM_OK);
 	assert_close(v, 128.0, 1e-12);
 	assert_int_equal(sim_get(&u.p, &u.sc, &u.m, "rotation", &v), SIM_OK);
 	assert_close(v, 1.0, 0.0);
@@ -92,7 +92,7 @@ static void every_setting_is_described(void **state)
 		double v;
 		assert_non_null(t[i].doc);
 		assert_true(t[i].min <= t[i].max);
-		assert_int_equal(sim_get(&u.p, &u.sc, &u.m, t[i].name, &v), SIM_OK);
+		assert_int_equal(sim_get_user(&u.p, &u.sc, &u.m, t[i].name, &v), SIM_OK);
 		/* the preset lies inside every range */
 		if (!(v >= t[i].min - 1e-9 && v <= t[i].max + 1e-9))
 			fail_msg("preset %s = %g outside [%g, %g]", t[i].name, v, t[i].min, t[i].max);
@@ -100,12 +100,12 @@ static void every_setting_is_described(void **state)
 			    strcmp(t[i].group, "integrator") == 0);
 	}
 	size_t nm;
-	const sim_method_info *mi = sim_methods(&nm);
+	const sim_method_info *const *mi = sim_methods(&nm);
 	assert_int_equal(nm, 4);
-	assert_string_equal(mi[0].name, "rk4");
-	assert_int_equal(mi[0].order, 4);
-	assert_string_equal(mi[1].name, "dopri5");
-	assert_int_equal(mi[1].adaptive, 1);
+	assert_string_equal(mi[0]->name, "rk4");
+	assert_int_equal(mi[0]->order, 4);
+	assert_string_equal(mi[1]->name, "dopri5");
+	assert_int_equal(mi[1]->adaptive, 1);
 }
 
 static void errors_have_text(void **state)

@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "sim.h"
+#include "units.h"
 
 typedef struct setup {
 	sim_params p;
@@ -36,7 +37,7 @@ static inline setup preset(void)
 static inline void set(setup *u, const char *name, const char *value)
 {
 	char msg[200];
-	int e = sim_set_str(&u->p, &u->sc, &u->m, name, value, msg, sizeof msg);
+	int e = sim_set_user_str(&u->p, &u->sc, &u->m, name, value, msg, sizeof msg);
 	if (e != SIM_OK)
 		fail_msg("set %s=%s: %s", name, value, msg);
 }
