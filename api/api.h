@@ -291,6 +291,8 @@ typedef struct api_sweep_point {
 	int rotation;    /* SIM_CW / SIM_CCW */
 	int state;       /* 0 pending, 1 running, 2 done, 3 failed */
 	double velocity; /* m/s */
+	double uncertainty; /* m/s, the estimate's error bar */
+	int steady;      /* the estimate showed no drift */
 	char error[160];
 } api_sweep_point;
 typedef struct api_sweep_view {

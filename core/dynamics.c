@@ -70,6 +70,20 @@ double dynamics_contact_energy(const model *md, const double *y, const double q[
 	return feed_contact_energy(md, y, &dm);
 }
 
+void dynamics_feed_weight(const model *md, const double q[NQ_FULL], double Qfeed[NQ_FULL])
+{
+	/* one-way coupling: the feed's weight never reaches the trough */
+	if (md->nf == 0 || !md->sc.feed_coupling)
+		return;
+	double F[SIM_MAX_COLUMNS][2];
+	deck_rot R = deck_rotation(q);
+	for (int k = 0; k < md->dk.K; k++) {
+		F[k][0] = 0.0;
+		F[k][1] = -md->L * md->p.m_n * md->p.g;
+	}
+	deck_forces(&md->dk, &R, (const double(*)[2])F, md->col_weight, Qfeed);
+}
+
 /* Static accelerations (zero exactly where gravity, springs with preload
  * and the feed weight at the deck points balance) at rest for full
  * coordinates q, motor off. */
@@ -92,50 +106,40 @@ static void static_residual(const model *md, const model_ctl *ctl, const double 
 	off.drive_on = 0;
 	double y[2 * NQ_FULL + ACC_N] = {0}, dy[2 * NQ_FULL + ACC_N];
 	memcpy(y, q, sizeof(double) * NQ_FULL);
-	double Qfeed[NQ_FULL] = {0}, F[SIM_MAX_COLUMNS][2];
-	deck_rot R = deck_rotation(q);
-	/* one-way coupling: the feed's weight never reaches the trough */
-	if (md->nf > 0 && md->sc.feed_coupling) {
-		for (int k = 0; k < md->dk.K; k++) {
-			F[k][0] = 0.0;
-			F[k][1] = -md->L * md->p.m_n * md->p.g;
-		}
-		deck_forces(&md->dk, &R, (const double(*)[2])F, md->col_weight, Qfeed);
-	}
+	double Qfeed[NQ_FULL] = {0};
+	dynamics_feed_weight(md, q, Qfeed);
 	model_eval ev;
 	model_machine_rhs(&tmp, &off, 0.0, y, Qfeed, dy, &ev);
 	memcpy(res, ev.qdd, sizeof ev.qdd);
 }
 
-/* Gaussian elimination with partial pivoting: J x = b for n <= 5, x into b
- * (J overwritten). */
-static void gauss_solve(int n, double J[5][5], double b[5])
+void dynamics_dense_solve(int n, int lda, double *A, double *b)
 {
 	for (int c = 0; c < n; c++) {
 		int piv = c;
 		for (int r = c + 1; r < n; r++)
-			if (fabs(J[r][c]) > fabs(J[piv][c]))
+			if (fabs(A[r * lda + c]) > fabs(A[piv * lda + c]))
 				piv = r;
 		for (int k = 0; k < n; k++) {
-			double t = J[c][k];
-			J[c][k] = J[piv][k];
-			J[piv][k] = t;
+			double t = A[c * lda + k];
+			A[c * lda + k] = A[piv * lda + k];
+			A[piv * lda + k] = t;
 		}
 		double t = b[c];
 		b[c] = b[piv];
 		b[piv] = t;
 		for (int r = c + 1; r < n; r++) {
-			double f = J[r][c] / J[c][c];
+			double f = A[r * lda + c] / A[c * lda + c];
 			for (int k = c; k < n; k++)
-				J[r][k] -= f * J[c][k];
+				A[r * lda + k] -= f * A[c * lda + k];
 			b[r] -= f * b[c];
 		}
 	}
 	for (int c = n - 1; c >= 0; c--) {
 		double s = b[c];
 		for (int k = c + 1; k < n; k++)
-			s -= J[c][k] * b[k];
-		b[c] = s / J[c][c];
+			s -= A[c * lda + k] * b[k];
+		b[c] = s / A[c * lda + c];
 	}
 }
 
@@ -176,7 +180,7 @@ static void static_equilibrium(const model *md, const model_ctl *ctl, double q[N
 			for (int a = 0; a < n; a++)
 				J[a][b] = (r1[idx[a]] - r0[idx[a]]) / hq;
 		}
-		gauss_solve(n, J, rhs);
+		dynamics_dense_solve(n, 5, &J[0][0], rhs);
 		for (int a = 0; a < n; a++)
 			q[idx[a]] += rhs[a];
 	}

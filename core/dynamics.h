@@ -60,6 +60,21 @@ double dynamics_energy_stored(const model *md, const model_ctl *ctl, double t, c
 double dynamics_contact_energy(const model *md, const double *y, const double q[NQ_FULL],
 			       const double qd[NQ_FULL]);
 
+/* Add to Qfeed the generalized force of the feed's weight resting on the
+ * deck points for the machine configuration q (nothing without a feed or
+ * under one-way coupling). */
+void dynamics_feed_weight(const model *md, const double q[NQ_FULL], double Qfeed[NQ_FULL]);
+
+/* Solve A x = b (A: n x n, row stride lda, overwritten) by Gaussian
+ * elimination with partial pivoting; x into b. */
+void dynamics_dense_solve(int n, int lda, double *A, double *b);
+
+/* The `steady` start (steady.c): replace the machine part of the
+ * equilibrium state y by the periodic forced response at the loaded motor
+ * speed (shooting), and move the settled feed with its deck points. The
+ * motor off: y is kept. */
+void dynamics_steady_start(const model *md, model_ctl *ctl, double *y);
+
 /* Fill y (length md->n) with the static equilibrium with the feed settled;
  * the ideal drive's psi ramp is re-anchored to it. */
 void dynamics_equilibrium(const model *md, model_ctl *ctl, double *y);

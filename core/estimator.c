@@ -7,14 +7,16 @@
  * the latest one, so the periodic part of the motion cancels exactly.
  */
 #include <math.h>
+#include <string.h>
 
 #include "estimator.h"
 #include "feed.h"
 #include "ode.h"
 
-/* phi - alpha and its rate, and the mean feed position and its rate. */
+/* phi - alpha and its rate, the mean feed position and its rate, and the
+ * drive's input energy. */
 static void period_probe(const model *md, const model_ctl *ctl, double t, const double *y,
-			 double *psi, double *psid, double *X, double *Xd)
+			 double *psi, double *psid, double *X, double *Xd, double *E)
 {
 	double q[NQ_FULL], qd[NQ_FULL];
 	model_full_coords(md, ctl, t, y, q, qd);
@@ -22,12 +24,14 @@ static void period_probe(const model *md, const model_ctl *ctl, double t, const 
 	*psid = qd[Q_PHI] - qd[Q_ALPHA];
 	*X = md->nf > 0 ? feed_mean_xi(md, y, -1) : 0.0;
 	*Xd = feed_mean_xi_rate(md, y);
+	*E = y[2 * md->npos + ACC_IN];
 }
 
 void estimator_probe(estimator *e, const model *md, const model_ctl *ctl, double t,
 		     const double *y)
 {
-	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev);
+	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
+		     &e->E_prev);
 }
 
 void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double t,
@@ -44,7 +48,26 @@ void estimator_restart(estimator *e, double start)
 	e->start = start;
 }
 
-static void on_boundary(estimator *e, double tb, double Xb)
+/* Keep boundary (tb, Xb) as a batch edge if it is a stride-th one. */
+static void record(estimator *e, double tb, double Xb)
+{
+	if (e->n_bound % e->stride != 0)
+		return;
+	if (e->n_rec == EST_RECORDS) {
+		for (int i = 0; i < EST_RECORDS / 2; i++) {
+			e->rec_t[i] = e->rec_t[2 * i];
+			e->rec_X[i] = e->rec_X[2 * i];
+		}
+		e->n_rec = EST_RECORDS / 2;
+		e->stride *= 2;
+		if (e->n_bound % e->stride != 0)
+			return;
+	}
+	e->rec_t[e->n_rec] = tb;
+	e->rec_X[e->n_rec++] = Xb;
+}
+
+static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 {
 	if (e->pending) {
 		if (tb + 1e-12 < e->start)
@@ -53,20 +76,26 @@ static void on_boundary(estimator *e, double tb, double Xb)
 		e->n_bound = 0;
 		e->tb_first = e->tb_last = tb;
 		e->Xb_first = e->Xb_last = Xb;
+		e->Eb_first = e->Eb_last = Eb;
+		e->n_rec = 0;
+		e->stride = 1;
+		record(e, tb, Xb);
 		return;
 	}
 	e->tb_prev = e->tb_last;
 	e->Xb_prev = e->Xb_last;
 	e->tb_last = tb;
 	e->Xb_last = Xb;
+	e->Eb_last = Eb;
 	e->n_bound++;
+	record(e, tb, Xb);
 }
 
 void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
 		    const double *y)
 {
-	double psi, psid, X, Xd;
-	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd);
+	double psi, psid, X, Xd, E;
+	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E);
 	double H = t1 - t0;
 	double n0 = floor(e->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
 	if (n0 != n1 && H > 0.0) {
@@ -82,26 +111,75 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
 					hi = mid;
 			}
 			double u = 0.5 * (lo + hi);
-			on_boundary(e, t0 + u * H, ode_hermite(e->X_prev, e->Xd_prev, X, Xd, H, u));
+			on_boundary(e, t0 + u * H, ode_hermite(e->X_prev, e->Xd_prev, X, Xd, H, u),
+				    e->E_prev + u * (E - e->E_prev));
 		}
 	}
 	e->psi_prev = psi;
 	e->psid_prev = psid;
 	e->X_prev = X;
 	e->Xd_prev = Xd;
+	e->E_prev = E;
+}
+
+/* Slope of X over t between points a and b of the batch edges. */
+static double edge_slope(const double *t, const double *X, int a, int b)
+{
+	return (X[b] - X[a]) / (t[b] - t[a]);
+}
+
+/* The error bar and the steady flag from the batch edges (the records and
+ * the latest boundary); see estimate. */
+static void error_bar(const estimator *e, double v, estimate *out)
+{
+	double t[EST_RECORDS + 1], X[EST_RECORDS + 1];
+	int n = e->n_rec;
+	memcpy(t, e->rec_t, sizeof(double) * (size_t)n);
+	memcpy(X, e->rec_X, sizeof(double) * (size_t)n);
+	if (e->tb_last > t[n - 1]) {
+		t[n] = e->tb_last;
+		X[n++] = e->Xb_last;
+	}
+	int nb = n - 1;
+	out->uncertainty = NAN;
+	out->steady = 0;
+	if (nb < 4)
+		return;
+	double sw = 0.0, sw2 = 0.0, var = 0.0;
+	for (int i = 0; i < nb; i++) {
+		double w = t[i + 1] - t[i], d = edge_slope(t, X, i, i + 1) - v;
+		sw += w;
+		sw2 += w * w;
+		var += w * d * d;
+	}
+	double neff = sw * sw / sw2;
+	double se = sqrt(var / sw / (neff - 1.0));
+	int mid = n / 2;
+	double drift = edge_slope(t, X, mid, n - 1) - edge_slope(t, X, 0, mid);
+	out->uncertainty = sqrt(se * se + 0.25 * drift * drift);
+	out->steady = e->n_bound >= 8 && fabs(drift) <= fmax(6.0 * se, 0.005 * fabs(v));
 }
 
 void estimator_read(const estimator *e, estimate *out)
 {
 	if (!e->pending && e->n_bound >= 1) {
-		out->transport_velocity = (e->Xb_last - e->Xb_first) / (e->tb_last - e->tb_first);
+		double span = e->tb_last - e->tb_first;
+		out->transport_velocity = (e->Xb_last - e->Xb_first) / span;
 		out->transport_periods = e->n_bound;
 		out->feed_velocity = (e->Xb_last - e->Xb_prev) / (e->tb_last - e->tb_prev);
 		out->period = e->tb_last - e->tb_prev;
+		double sense = e->psid_prev < 0.0 ? -1.0 : 1.0;
+		out->rotor_speed_mean = sense * 2.0 * M_PI * e->n_bound / span;
+		out->power_mean = (e->Eb_last - e->Eb_first) / span + 0.0;
+		out->torque_mean = out->power_mean / out->rotor_speed_mean + 0.0;
+		error_bar(e, out->transport_velocity, out);
 	} else {
 		out->transport_velocity = NAN;
 		out->transport_periods = 0;
 		out->feed_velocity = NAN;
 		out->period = NAN;
+		out->uncertainty = NAN;
+		out->steady = 0;
+		out->rotor_speed_mean = out->torque_mean = out->power_mean = NAN;
 	}
 }

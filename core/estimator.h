@@ -8,13 +8,20 @@
 
 #include "model.h"
 
+enum { EST_RECORDS = 64 };
+
 typedef struct estimator {
-	/* phi - alpha and the mean feed position, with rates, after the last step */
-	double psi_prev, psid_prev, X_prev, Xd_prev;
+	/* phi - alpha, the mean feed position and the drive's input energy,
+	 * with rates, after the last step */
+	double psi_prev, psid_prev, X_prev, Xd_prev, E_prev;
 	double start;         /* s: the estimate starts at the first boundary after */
 	int pending;          /* waiting for that boundary */
 	int n_bound;          /* whole periods since the first boundary */
-	double tb_first, Xb_first, tb_last, Xb_last, tb_prev, Xb_prev;
+	double tb_first, Xb_first, Eb_first, tb_last, Xb_last, Eb_last, tb_prev, Xb_prev;
+	/* every stride-th boundary from the first (t, X): batch edges for the
+	 * error bar; when full, every second is dropped and stride doubles */
+	double rec_t[EST_RECORDS], rec_X[EST_RECORDS];
+	int n_rec, stride;
 } estimator;
 
 /* Start over: probe the state y at t, wait for the first period boundary
@@ -31,9 +38,19 @@ void estimator_restart(estimator *e, double start);
 void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
 		    const double *y);
 
-/* The estimate (NaN before one whole period; see sim_status). */
+/* The estimate (NaN before one whole period; see sim_status).
+ * uncertainty: the scatter of the batch velocities between records (their
+ * standard error) and half the drift between the window's halves, added in
+ * quadrature; NaN with fewer than 4 batches. steady: at least 8 periods and
+ * 4 batches, and a drift within 6 standard errors or 0.5 % of |v|.
+ * rotor_speed_mean: 2 pi n over the window's time (signed like phi');
+ * power_mean: the drive's input over it; torque_mean: their ratio (the
+ * torque averaged over the angle turned). */
 typedef struct estimate {
 	double transport_velocity, transport_periods, feed_velocity, period;
+	double uncertainty;
+	int steady;
+	double rotor_speed_mean, torque_mean, power_mean;
 } estimate;
 void estimator_read(const estimator *e, estimate *out);
 

@@ -27,7 +27,7 @@
 
 #include "model.h"
 
-/* Kloss static characteristic (paper eq. 10), counter-clockwise sense. */
+/* Kloss static characteristic (paper eq. 10), for phi' > 0. */
 static double kloss(const model *md, const model_ctl *ctl, double omega)
 {
 	double slip = ctl->omega_ss - omega;
@@ -35,12 +35,13 @@ static double kloss(const model *md, const model_ctl *ctl, double omega)
 	return 2.0 * md->p.M_ut * slip * s_ut / (s_ut * s_ut + slip * slip);
 }
 
-/* Motor torque on the rotor for relative speed omega, both senses. */
+/* Motor torque on the rotor for relative speed omega, both senses: the
+ * Kloss characteristic for phi' > 0 (clockwise), mirrored for phi' < 0. */
 static double motor_torque(const model *md, const model_ctl *ctl, double omega)
 {
 	if (!ctl->drive_on)
 		return 0.0;
-	return ctl->rotation == SIM_CCW ? kloss(md, ctl, omega) : -kloss(md, ctl, -omega);
+	return ctl->rotation == SIM_CW ? kloss(md, ctl, omega) : -kloss(md, ctl, -omega);
 }
 
 /* One point mass: Jacobian columns (2 x 6, column-major jc[i][0..1]) and
@@ -196,23 +197,35 @@ static void suspension_point(const sim_params *p, const config *cf, int i, doubl
 	u[1] = cf->q[Q_Y] + RP[1] - Pb[1];
 }
 
+/* The settling damping the `steady` start adds at time t < 0 (N s/m): full
+ * until settle_t0, then faded out by a half cosine to none at t = 0. */
+static double settle_damping(const model_ctl *ctl, double t)
+{
+	if (!(t < 0.0 && ctl->settle_b > 0.0))
+		return 0.0;
+	if (t <= ctl->settle_t0)
+		return ctl->settle_b;
+	return 0.5 * ctl->settle_b * (1.0 + cos(M_PI * (t - ctl->settle_t0) / -ctl->settle_t0));
+}
+
 /* Stage suspension: the two spring sets with preload into rhs; their
  * damping power is added to *damp_power. */
-static void suspension(const model *md, const config *cf, double rhs[NQ_FULL],
-		       double *damp_power)
+static void suspension(const model *md, const model_ctl *ctl, double t, const config *cf,
+		       double rhs[NQ_FULL], double *damp_power)
 {
 	const sim_params *p = &md->p;
 	const double *qd = cf->qd;
+	double extra = settle_damping(ctl, t), b_x = p->b_x + extra, b_y = p->b_y + extra;
 	for (int i = 0; i < 2; i++) {
 		double RP[2], u[2];
 		suspension_point(p, cf, i, RP, u);
 		double vx = qd[Q_X] - qd[Q_ALPHA] * RP[1], vy = qd[Q_Y] + qd[Q_ALPHA] * RP[0];
-		double Fx = -p->k_x * u[0] - p->b_x * vx;
-		double Fy = -p->k_y * u[1] - p->b_y * vy + md->F0[i];
+		double Fx = -p->k_x * u[0] - b_x * vx;
+		double Fy = -p->k_y * u[1] - b_y * vy + md->F0[i];
 		rhs[Q_X] += Fx;
 		rhs[Q_Y] += Fy;
 		rhs[Q_ALPHA] += -RP[1] * Fx + RP[0] * Fy;
-		*damp_power += p->b_x * vx * vx + p->b_y * vy * vy;
+		*damp_power += b_x * vx * vx + b_y * vy * vy;
 	}
 }
 
@@ -404,7 +417,7 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	drive_terms dt;
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, Qfeed, M, rhs);
-	suspension(md, &cf, rhs, &damp_power);
+	suspension(md, ctl, t, &cf, rhs, &damp_power);
 	eliminators(&md->p, &cf, rhs, &damp_power);
 	drive(md, ctl, &cf, rhs, &damp_power, &dt);
 	solve(md, ctl, t, M, rhs, &dt, br, qdd);

@@ -57,6 +57,10 @@ typedef struct model_ctl {
 	int rotation;                 /* SIM_CW / SIM_CCW */
 	double omega_ss;              /* rad/s */
 	int drive_on;
+	/* the `steady` start's settling (steady.c): before t = 0 the
+	 * suspension carries settle_b (N s/m per spring set and direction)
+	 * more damping, faded out to none over [settle_t0, 0] */
+	double settle_b, settle_t0;
 } model_ctl;
 
 /* Everything an evaluation yields besides dy. */

@@ -67,16 +67,17 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_SCENE, columns, INT, "", 1, SIM_MAX_COLUMNS, NULL, 1, "feed columns K")                         \
 	X(G_SCENE, layers, INT, "", 1, SIM_MAX_LAYERS, NULL, 1, "feed layers L")                           \
 	X(G_SCENE, drive, ENUM, "", 0, 1, "motor|ideal", 1, "Kloss motor or constant speed")   \
-	X(G_SCENE, trough_rotation, BOOL, "", 0, 1, NULL, 1, "false allows alpha = 0 on a symmetric machine") \
+	X(G_SCENE, trough_rotation, BOOL, "", 0, 1, NULL, 1, "true: integrate alpha even on a symmetric machine; false: the engine drops it there") \
 	X(G_SCENE, feed_coupling, BOOL, "", 0, 1, NULL, 1, "false: the feed does not act on the trough") \
 	X(G_SCENE, friction, ENUM, "", 0, 1, "coulomb|regularised", 1, "friction law")          \
 	X(G_SCENE, friction_eps, REAL, "m/s", 1e-6, 1, NULL, 1, "regularised friction width")  \
 	X(G_SCENE, motor_on, BOOL, "", 0, 1, NULL, 1, "drive switched on at t = 0")            \
 	X(G_SCENE, transient, REAL, "s", 0, 1e4, NULL, 1, "transport velocity ignores t < transient") \
+	X(G_SCENE, start, ENUM, "", 0, 1, "rest|steady", 1, "rest: run-up from static equilibrium (the paper's scene); steady: on the forced response at the loaded speed") \
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
-	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 1e-4 s")
+	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 2.5e-5 s")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -154,12 +155,13 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	s->columns = 5;
 	s->layers = 8;
 	s->drive = SIM_DRIVE_MOTOR;
-	s->trough_rotation = 1;
+	s->trough_rotation = 0; /* the engine drops alpha on the symmetric machine */
 	s->feed_coupling = 1;
 	s->friction = SIM_FRICTION_COULOMB;
 	s->friction_eps = 1e-3;
 	s->motor_on = 1;
-	s->transient = 2.0;
+	s->start = SIM_START_STEADY;
+	s->transient = 0.0;
 
 	memset(m, 0, sizeof *m);
 	snprintf(m->name, sizeof m->name, "%s", "dem");
@@ -169,14 +171,15 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	m->substeps = 0; /* as many as the feed step needs */
 }
 
-/* Defaults per scene kind, measured over beta in [0, 180] deg, both
- * rotations (README "Defaults", tests/bench/beta_range.sh): with feed, dem
- * takes machine steps of 1e-3 s and feed sub-steps of at most 1e-4 s
- * with its corrected coupling (v within 0.62 % of the peak velocity
- * everywhere); a feed too heavy for the corrector (added mass) takes
- * steps of 1e-4 s (0.27 %); without feed the machine is smooth and RK4 at
+/* Defaults per scene kind, measured against the converged reference at
+ * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
+ * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
+ * of 5e-4 s and feed sub-steps of at most 2.5e-5 s with its corrected
+ * coupling (worst 0.70 % by MODEL.md's convention after a `steady` start
+ * and a 4-s window); a feed too heavy for the corrector (added mass) takes
+ * single steps of 2.5e-5 s; without feed the machine is smooth and RK4 at
  * 1e-3 s keeps the trajectory within 2e-4. */
-#define FEED_STEP_MAX 1e-4
+#define FEED_STEP_MAX 2.5e-5
 
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
@@ -187,10 +190,11 @@ double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method 
 		return feed ? 1e-5 : 1e-3;
 	if (strcmp(m->name, "dopri5") == 0)
 		return 1e-5; /* the first step */
-	if (feed && (!s->feed_coupling ||
-		     model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO))
-		return 1e-4;
-	return 1e-3;
+	if (!feed)
+		return 1e-3;
+	if (s->feed_coupling && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO)
+		return FEED_STEP_MAX;
+	return 5e-4;
 }
 
 int sim_default_substeps(double dt)

@@ -47,9 +47,18 @@ const char *sim_strerror(int err);
 #define SIM_MAX_COLUMNS 64
 #define SIM_MAX_LAYERS 64
 
-enum { SIM_CW = -1, SIM_CCW = 1 };
+/* Rotation sense of the unbalanced mass in the paper's words (MODEL.md
+ * "Rotation sense"): its clockwise is phi' > 0 in the model's axes
+ * (clockwise seen from behind the drawing), its counter-clockwise phi' < 0.
+ * The value is the sign of phi'. */
+enum { SIM_CW = 1, SIM_CCW = -1 };
 enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
 enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
+/* How an instance starts (MODEL.md "Start"): `rest`, the paper's run-up
+ * from static equilibrium with the motor switched on at t = 0; `steady`,
+ * the machine on its periodic forced response at the loaded motor speed
+ * with the feed settled on the moving deck. */
+enum { SIM_START_REST = 0, SIM_START_STEADY = 1 };
 
 /* Physical parameters, MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
@@ -97,12 +106,14 @@ typedef struct sim_scene {
 	int feed;             /* 0: no feed degrees of freedom */
 	int columns, layers;  /* K, L */
 	int drive;            /* SIM_DRIVE_MOTOR (Kloss) or SIM_DRIVE_IDEAL */
-	int trough_rotation;  /* 0: alpha may be dropped if the machine is symmetric */
+	int trough_rotation;  /* 1: integrate alpha even on a symmetric machine;
+				 0: the engine drops it there by itself */
 	int feed_coupling;    /* 0: one-way (feed does not act on the trough) */
 	int friction;         /* SIM_FRICTION_* */
 	double friction_eps;  /* m/s, regularised friction width */
 	int motor_on;         /* drive on at t = 0 */
 	double transient;     /* s: transport velocity ignores t < transient */
+	int start;            /* SIM_START_REST or SIM_START_STEADY */
 } sim_scene;
 
 /* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
@@ -269,6 +280,18 @@ typedef struct sim_status {
 				     last sim_restart_transport); NaN before
 				     one whole period */
 	double transport_periods; /* whole periods the estimate spans */
+	double transport_velocity_uncertainty; /* m/s: the estimate's error bar
+				     (scatter over the window, the drift
+				     between its halves, and for dem the
+				     step's calibrated error); NaN with
+				     fewer than 4 batches of periods */
+	int steady;               /* 1 when the estimate spans at least 8
+				     periods and shows no drift beyond its
+				     scatter */
+	double rotor_speed_mean;  /* rad/s, motor_torque_mean N m, power_mean W:
+				     means over the same whole periods as
+				     transport_velocity; NaN before one */
+	double motor_torque_mean, power_mean;
 	double feed_velocity;     /* m/s: mean over the last whole period (NaN
 				     before one); for reversal detection */
 	double period;            /* s: length of the last whole period */
@@ -289,11 +312,21 @@ void sim_get_status(const sim *s, sim_status *st);
  * (for example after a beta change, to measure the new steady state). */
 void sim_restart_transport(sim *s);
 
-/* Create a fresh instance, run it to t_end (s) and return its transport
- * velocity (m/s) in *v; msg as sim_new. For sweeps (thread-safe). */
-int sim_measure_velocity(const sim_params *p, const sim_scene *s,
-			 const sim_method *m, double t_end, double *v,
-			 char *msg, size_t msglen);
+/* A measurement of the transport velocity: the status fields of the same
+ * names at the end of a run. */
+typedef struct sim_measurement {
+	double transport_velocity, uncertainty; /* m/s */
+	int steady;
+	double periods;                         /* whole periods spanned */
+	double rotor_speed_mean;                /* rad/s */
+	double cpu_seconds;                     /* of this thread */
+} sim_measurement;
+
+/* Create a fresh instance, run it to t_end (s) and fill *out (NaN fields
+ * where undefined); msg as sim_new, or the failure's cause. Returns
+ * sim_new's or sim_advance's code. For sweeps (thread-safe). */
+int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
+		sim_measurement *out, char *msg, size_t msglen);
 
 /* Feed geometry of the instance. */
 /* Physical columns K and layers L; 0 without feed. */

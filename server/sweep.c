@@ -2,7 +2,7 @@
  * sweep.c - v(beta) sweeps on the worker pool (POST /api/v1/sweeps).
  *
  * A sweep is a grid of (beta, rotation) points; each point is one pool
- * job that builds a fresh instance with sim_measure_velocity (thread-safe,
+ * job that builds a fresh instance with sim_measure (thread-safe,
  * no session involved) and stores the steady transport velocity. Sweeps
  * live in a registry (registry.c) that holds one reference, and every
  * queued job holds one, so DELETE (cancel) can unlink a sweep while its
@@ -115,19 +115,20 @@ static void run_point(void *arg)
 	if (!skip) {
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
-		double v = 0;
+		sim_measurement r;
 		int rc = sim_set_user(&spec.params, &spec.scene, &spec.method,
 				 "beta", p->beta, msg, sizeof msg);
 		spec.params.rotation = p->rotation;
 		if (rc == SIM_OK)
-			rc = sim_measure_velocity(&spec.params, &spec.scene,
-						  &spec.method, sw->req.t_end,
-						  &v, msg, sizeof msg);
+			rc = sim_measure(&spec.params, &spec.scene, &spec.method,
+					 sw->req.t_end, &r, msg, sizeof msg);
 		pthread_mutex_lock(&sw->lock);
 		sw->running--;
 		if (rc == SIM_OK) {
 			p->state = 2;
-			p->velocity = v;
+			p->velocity = r.transport_velocity;
+			p->uncertainty = r.uncertainty;
+			p->steady = r.steady;
 		} else {
 			p->state = 3;
 			snprintf(p->error, sizeof p->error, "%s",

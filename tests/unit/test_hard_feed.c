@@ -134,7 +134,7 @@ static void very_stiff_contact(void **state)
 	sim_status st = status(s);
 	double v_soft;
 	char msg[200];
-	assert_int_equal(sim_measure_velocity(&soft.p, &soft.sc, &soft.m, 1.5, &v_soft, msg,
+	assert_int_equal(measure_v(&soft, 1.5, &v_soft, msg,
 					      sizeof msg),
 			 SIM_OK);
 	print_message("k = 1e8: v = %.5f m/s (k = 1e6: %.5f)\n", st.transport_velocity, v_soft);
@@ -160,7 +160,7 @@ static void friction_extremes(void **state)
 		setup w = u;
 		set(&w, "mu", mus[i]);
 		char msg[200];
-		assert_int_equal(sim_measure_velocity(&w.p, &w.sc, &w.m, 2.0, &v[i], msg, sizeof msg),
+		assert_int_equal(measure_v(&w, 2.0, &v[i], msg, sizeof msg),
 				 SIM_OK);
 	}
 	print_message("v(mu = 0, 0.4, 1) = %.3g %.5f %.5f m/s\n", v[0], v[1], v[2]);
@@ -198,7 +198,7 @@ static void layer_counts(void **state)
 		set(&w, "layers", buf);
 		double v;
 		char msg[200];
-		assert_int_equal(sim_measure_velocity(&w.p, &w.sc, &w.m, 1.5, &v, msg, sizeof msg),
+		assert_int_equal(measure_v(&w, 1.5, &v, msg, sizeof msg),
 				 SIM_OK);
 		print_message("layers %d: v = %.5f m/s\n", L, v);
 		assert_true(v > 0.05 && v < 0.5);

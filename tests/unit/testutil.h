@@ -26,10 +26,23 @@ typedef struct setup {
 	sim_method m;
 } setup;
 
-static inline setup preset(void)
+/* The czubak2016 preset as the paper's scene, which most known-answer
+ * tests are written for: the run-up from rest (start = rest), the full
+ * model (trough_rotation = true) and v measured after 2 s. Tests of the
+ * defaults themselves use preset_defaults(). */
+static inline setup preset_defaults(void)
 {
 	setup u;
 	sim_preset_czubak2016(&u.p, &u.sc, &u.m);
+	return u;
+}
+
+static inline setup preset(void)
+{
+	setup u = preset_defaults();
+	u.sc.start = SIM_START_REST;
+	u.sc.trough_rotation = 1;
+	u.sc.transient = 2.0;
 	return u;
 }
 
@@ -63,6 +76,15 @@ static inline setup reduced_ideal(void)
 	set(&u, "drive", "ideal");
 	set(&u, "transient", "0.5");
 	return u;
+}
+
+/* sim_measure's transport velocity (m/s) into *v; its return code. */
+static inline int measure_v(const setup *u, double t_end, double *v, char *msg, size_t msglen)
+{
+	sim_measurement r;
+	int e = sim_measure(&u->p, &u->sc, &u->m, t_end, &r, msg, msglen);
+	*v = r.transport_velocity;
+	return e;
 }
 
 static inline sim *make(const setup *u)

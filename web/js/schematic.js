@@ -70,16 +70,20 @@ function zigzag(x, yTop, yBot, n = 6, amp = 0.035) {
 	return pts(p);
 }
 
-/* Arc arrow around c (model m) of radius r, for the rotor's sense. */
+/* Arc arrow around c (model m) of radius r, for the rotor's sense as it
+ * turns in this drawing. The drawing shows the machine in the model's axes
+ * (X right, Y up) from the front; the paper's "clockwise" is phi' > 0 in
+ * these axes (MODEL.md), i.e. clockwise seen from behind the drawing, so
+ * on screen it turns counter-clockwise. */
 function rotorArc(c, r, rotation) {
 	const [cx, cy] = toSvg(c[0], c[1]);
 	const R = r * VIEW.scale;
 	const a0 = 200 * DEG, a1 = -60 * DEG; /* screen angles */
-	const cw = rotation !== 'ccw';
-	const [s, e] = cw ? [a0, a1] : [a1, a0];
+	const screenCw = rotation === 'ccw';
+	const [s, e] = screenCw ? [a0, a1] : [a1, a0];
 	const p = a => [cx + R * Math.cos(a), cy - R * Math.sin(a)];
 	const [sx, sy] = p(s), [ex, ey] = p(e);
-	const sweep = cw ? 1 : 0;
+	const sweep = screenCw ? 1 : 0;
 	return `M${sx.toFixed(1)},${sy.toFixed(1)} A${R},${R} 0 1 ${sweep} ${ex.toFixed(1)},${ey.toFixed(1)}`;
 }
 
@@ -184,9 +188,11 @@ export class Schematic {
 		const ex = cx + ra * Math.cos(beta * DEG), ey = cy - ra * Math.sin(beta * DEG);
 		this.betaArc.setAttribute('d', `M${cx + ra},${cy} A${ra},${ra} 0 0 0 ${ex.toFixed(1)},${ey.toFixed(1)}`);
 		this.betaText.textContent = `β = ${beta.toFixed(1)}°` + (Math.abs(target - beta) > 0.05 ? `  → ${target.toFixed(1)}°` : '');
-		this.rotText.textContent = st.rotation === 'ccw' ? 'rotor: counter-clockwise' : st.rotation === 'cw' ? 'rotor: clockwise' : '';
+		this.rotText.textContent = st.rotation === 'ccw' ? 'rotor: counter-clockwise (φ̇ < 0; seen from behind)'
+			: st.rotation === 'cw' ? 'rotor: clockwise (φ̇ > 0; seen from behind)' : '';
+		this.rotorArrow.dataset.screenSense = st.rotation === 'ccw' ? 'clockwise' : st.rotation === 'cw' ? 'counter-clockwise' : '';
 		this.rotorArrow.setAttribute('d', rotorArc([0, 0], 0.085, st.rotation));
-		const ph = Number.isFinite(st.phase) ? st.phase : (st.rotation === 'ccw' ? 1 : -1) * 0.8;
+		const ph = Number.isFinite(st.phase) ? st.phase : (st.rotation === 'ccw' ? -1 : 1) * 0.8;
 		this.unbalance.setAttribute('cx', (cx + 0.035 * VIEW.scale * Math.cos(ph)).toFixed(1));
 		this.unbalance.setAttribute('cy', (cy - 0.035 * VIEW.scale * Math.sin(ph)).toFixed(1));
 		/* feed columns */

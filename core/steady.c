@@ -1,0 +1,189 @@
+/*
+ * steady.c - the machine part of the `steady` start (MODEL.md "Start
+ * steady"): the machine on its periodic forced response at the loaded
+ * motor speed, the feed settled on the moving deck.
+ *
+ * The forced response is found by shooting (Nayfeh & Balachandran, Applied
+ * Nonlinear Dynamics, 1995, ch. 7): the machine alone, the feed's weight
+ * resting on the deck points as constant forces, the rotor turning at a
+ * constant relative speed Omega, is periodic with T = 2 pi / |Omega|;
+ * Newton's method on z -> Phi_T(z) - z (Phi_T: one period of classical
+ * RK4 with 256 steps, its Jacobian by finite differences) finds the
+ * periodic state z. The machine is nearly linear, so this is the linear
+ * frequency-domain solution plus its small nonlinear corrections, and two
+ * or three Newton steps converge. With the Kloss motor, Omega is where the
+ * motor's torque balances the mean torque that the periodic motion draws
+ * (dampers, bearing drag, load): a fixed-point iteration on the motor's
+ * stable branch. The feed's own dissipation is not known before it moves;
+ * sim.c's settling phase takes care of what remains.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "dynamics.h"
+#include "feed.h"
+
+enum { STEPS_PER_PERIOD = 256, NEWTON_MAX = 6, OMEGA_ITER = 4, NZ = 2 * NQ_FULL };
+
+typedef struct shooter {
+	model mm;           /* the machine alone, phi - alpha prescribed */
+	model_ctl ctl;      /* its controls: beta held, psi at Omega */
+	const model *md;    /* the scene's model: deck points, feed weight */
+	double T;           /* s, the period */
+	double mean_torque; /* N m, of the last period integrated */
+} shooter;
+
+static void shoot_rhs(const shooter *sh, double t, const double *y, double *dy, model_eval *ev)
+{
+	double q[NQ_FULL], qd[NQ_FULL], Qfeed[NQ_FULL] = {0};
+	model_full_coords(&sh->mm, &sh->ctl, t, y, q, qd);
+	dynamics_feed_weight(sh->md, q, Qfeed);
+	model_machine_rhs(&sh->mm, &sh->ctl, t, y, Qfeed, dy, ev);
+}
+
+/* One period of classical RK4 from z (positions then rates, 2 nq values):
+ * the end state into out, the drive's mean torque into sh->mean_torque. */
+static void one_period(shooter *sh, const double *z, double *out)
+{
+	const model *mm = &sh->mm;
+	int nq = mm->nq, n = mm->n;
+	double y[NZ + ACC_N] = {0}, k1[NZ + ACC_N], k2[NZ + ACC_N], k3[NZ + ACC_N],
+	       k4[NZ + ACC_N], tmp[NZ + ACC_N];
+	memcpy(y, z, sizeof(double) * (size_t)nq);
+	memcpy(y + mm->npos, z + nq, sizeof(double) * (size_t)nq);
+	double h = sh->T / STEPS_PER_PERIOD, t = 0.0, torque = 0.0;
+	model_eval ev;
+	for (int s = 0; s < STEPS_PER_PERIOD; s++) {
+		shoot_rhs(sh, t, y, k1, &ev);
+		torque += ev.torque;
+		for (int i = 0; i < n; i++)
+			tmp[i] = y[i] + 0.5 * h * k1[i];
+		shoot_rhs(sh, t + 0.5 * h, tmp, k2, NULL);
+		for (int i = 0; i < n; i++)
+			tmp[i] = y[i] + 0.5 * h * k2[i];
+		shoot_rhs(sh, t + 0.5 * h, tmp, k3, NULL);
+		for (int i = 0; i < n; i++)
+			tmp[i] = y[i] + h * k3[i];
+		shoot_rhs(sh, t + h, tmp, k4, NULL);
+		for (int i = 0; i < n; i++)
+			y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+		t += h;
+	}
+	sh->mean_torque = torque / STEPS_PER_PERIOD;
+	memcpy(out, y, sizeof(double) * (size_t)nq);
+	memcpy(out + nq, y + mm->npos, sizeof(double) * (size_t)nq);
+}
+
+/* Newton on Phi_T(z) - z = 0 from the guess in z (updated). */
+static void shoot(shooter *sh, double *z)
+{
+	int m = 2 * sh->mm.nq;
+	double end[NZ], pert[NZ], endp[NZ], J[NZ][NZ], r[NZ];
+	for (int it = 0; it < NEWTON_MAX; it++) {
+		one_period(sh, z, end);
+		double norm = 0.0, scale = 0.0;
+		for (int i = 0; i < m; i++) {
+			r[i] = z[i] - end[i];
+			norm = fmax(norm, fabs(r[i]));
+			scale = fmax(scale, fabs(z[i]));
+		}
+		if (norm <= 1e-13 * fmax(scale, 1e-3))
+			break;
+		double torque = sh->mean_torque;
+		for (int b = 0; b < m; b++) {
+			memcpy(pert, z, sizeof(double) * (size_t)m);
+			double hz = 1e-7 * fmax(fabs(z[b]), b < m / 2 ? 1e-3 : 1e-1);
+			pert[b] += hz;
+			one_period(sh, pert, endp);
+			for (int a = 0; a < m; a++)
+				J[a][b] = (endp[a] - end[a]) / hz - (a == b ? 1.0 : 0.0);
+		}
+		sh->mean_torque = torque;
+		dynamics_dense_solve(m, NZ, &J[0][0], r);
+		for (int i = 0; i < m; i++)
+			if (!isfinite(r[i]))
+				return;
+		for (int i = 0; i < m; i++)
+			z[i] += r[i];
+	}
+}
+
+/* The signed relative rotor speed at which the Kloss motor delivers the
+ * torque `need` (N m, signed like the rotation) on its stable branch, slip
+ * below the breakdown slip: the small root of M_el(slip) = |need|. NaN at
+ * or past the breakdown torque. */
+static double motor_speed_for(const model *md, const model_ctl *ctl, double need)
+{
+	double s_ut = md->p.slip_ut, M_ut = md->p.M_ut, tau = (double)ctl->rotation * need;
+	if (!(fabs(tau) < M_ut))
+		return NAN;
+	double slip = tau == 0.0 ? 0.0 : s_ut * (M_ut - sqrt(M_ut * M_ut - tau * tau)) / tau;
+	return (double)ctl->rotation * (ctl->omega_ss - slip);
+}
+
+/* The settled feed moves with its deck point: shifted by the deck point's
+ * displacement from q0 to q, at the deck point's velocity. */
+static void move_feed(const model *md, const double q0[NQ_FULL], const double qd0[NQ_FULL],
+		      const double q[NQ_FULL], const double qd[NQ_FULL], double *y)
+{
+	deck_rot R0 = deck_rotation(q0), R = deck_rotation(q);
+	double *xi = y + md->nq, *eta = xi + md->nf;
+	double *xid = y + md->npos + md->nq, *etad = xid + md->nf;
+	for (int k = 0; k < md->dk.K; k++) {
+		double p0[2], v0[2], p1[2], v1[2];
+		deck_point(&md->dk, md->dk.d[k], &R0, q0, qd0, p0, v0);
+		deck_point(&md->dk, md->dk.d[k], &R, q, qd, p1, v1);
+		for (int j = 0; j < md->L; j++) {
+			int e = k * md->L + j;
+			xi[e] += p1[0] - p0[0];
+			eta[e] += p1[1] - p0[1];
+			xid[e] = v1[0];
+			etad[e] = v1[1];
+		}
+	}
+}
+
+void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
+{
+	if (!ctl->drive_on)
+		return;
+	double q0[NQ_FULL], qd0[NQ_FULL];
+	model_full_coords(md, ctl, 0.0, y, q0, qd0);
+	sim_scene sc = md->sc;
+	sc.feed = 0;
+	sc.drive = SIM_DRIVE_IDEAL;
+	sc.motor_on = 1;
+	shooter sh = {.md = md};
+	model_init(&sh.mm, &sh.ctl, &md->p, &sc);
+	sh.mm.F0[0] = md->F0[0];
+	sh.mm.F0[1] = md->F0[1];
+	sh.ctl.beta_ramp = ctl->beta_ramp;
+	sh.ctl.rotation = ctl->rotation;
+	sh.ctl.omega_ss = ctl->omega_ss;
+	double psi0 = q0[Q_PHI] - q0[Q_ALPHA];
+	double Omega = (double)ctl->rotation * ctl->omega_ss;
+	double z[NZ] = {0};
+	int nq = sh.mm.nq;
+	for (int r = 0; r < nq; r++)
+		z[r] = q0[sh.mm.col[r][0]]; /* the guess: the static equilibrium */
+	for (int it = 0; it < (md->phi_prescribed ? 1 : OMEGA_ITER); it++) {
+		sh.T = 2.0 * M_PI / fabs(Omega);
+		ramp_hold(&sh.ctl.psi_ramp, 0.0, psi0, Omega);
+		shoot(&sh, z);
+		double next = motor_speed_for(md, ctl, sh.mean_torque);
+		if (md->phi_prescribed || !isfinite(next))
+			break;
+		Omega = next;
+	}
+	double yy[NZ + ACC_N] = {0}, q[NQ_FULL], qd[NQ_FULL];
+	memcpy(yy, z, sizeof(double) * (size_t)nq);
+	memcpy(yy + sh.mm.npos, z + nq, sizeof(double) * (size_t)nq);
+	model_full_coords(&sh.mm, &sh.ctl, 0.0, yy, q, qd);
+	for (int r = 0; r < md->nq; r++) {
+		int i = md->col[r][0];
+		y[r] = q[i];
+		y[md->npos + r] = qd[i];
+	}
+	if (md->nf > 0)
+		move_feed(md, q0, qd0, q, qd, y);
+}
