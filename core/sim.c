@@ -34,7 +34,7 @@ struct sim {
 	double t_int, t_obs, t_prev;
 	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
 					    start of the last step */
-	double e0, kin0, elastic0;       /* energies at t = 0 */
+	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
 	uint64_t steps;
 	int failed;
 	char error[160];
@@ -161,8 +161,7 @@ static void zero_observers(sim *s)
 	memcpy(s->y_obs, s->y, sizeof(double) * (size_t)md->n);
 	memcpy(s->y_prev, s->y, sizeof(double) * (size_t)md->n);
 	s->t_obs = s->t_prev = s->t_int;
-	double pot;
-	s->e0 = dynamics_energy_stored(md, &s->ctl, s->t_int, s->y, &s->kin0, &pot);
+	s->e0 = dynamics_energy_stored(md, &s->ctl, s->t_int, s->y, &s->kin0, &s->pot0);
 	s->elastic0 = 0.0;
 	if (md->nf > 0) {
 		double q[NQ_FULL], qd[NQ_FULL];
@@ -426,7 +425,7 @@ static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 		elastic = dynamics_contact_energy(md, s->y_obs, ev->q, ev->qd);
 	st->e_input = acc[ACC_IN];
 	st->e_kinetic = kin - s->kin0;
-	st->e_potential = pot - (s->e0 - s->kin0) + (elastic - s->elastic0);
+	st->e_potential = (pot - s->pot0) + (elastic - s->elastic0);
 	st->e_dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - (elastic - s->elastic0));
 	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
 			 acc[ACC_IN];

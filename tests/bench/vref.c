@@ -23,6 +23,7 @@
 #include <time.h>
 
 #include "sim.h"
+#include "units.h"
 
 enum { MAX_WIN = 16, MAX_SET = 32, MAX_PTS = 1024 };
 
@@ -59,15 +60,15 @@ static void run_point(point *pt)
 	sim_method m;
 	sim_preset("czubak2016", &p, &sc, &m);
 	for (int i = 0; i < g.nset; i++)
-		if (sim_set_str(&p, &sc, &m, g.set_name[i], g.set_value[i], pt->msg,
+		if (sim_set_user_str(&p, &sc, &m, g.set_name[i], g.set_value[i], pt->msg,
 				sizeof pt->msg) != SIM_OK) {
 			pt->err = 1;
 			return;
 		}
 	char num[32];
 	snprintf(num, sizeof num, "%.17g", pt->beta);
-	sim_set_str(&p, &sc, &m, "beta", num, NULL, 0);
-	sim_set_str(&p, &sc, &m, "rotation", pt->rotation == SIM_CW ? "cw" : "ccw", NULL, 0);
+	sim_set_user_str(&p, &sc, &m, "beta", num, NULL, 0);
+	sim_set_user_str(&p, &sc, &m, "rotation", pt->rotation == SIM_CW ? "cw" : "ccw", NULL, 0);
 	sc.transient = g.win[0];
 	double c0 = cpu_now();
 	int err;

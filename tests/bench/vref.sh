@@ -5,17 +5,17 @@
 # Independent of what it checks: the full model (trough_rotation=true), the
 # paper's `rest` start and a late window, [16, 32] s (the run-up's bounce
 # decays with tau ~ 3.7 s), with a step far finer than any default: dem
-# with a 2.5e-4 s machine step and 80 feed sub-steps (h = 3.125e-6 s).
+# with a 1.25e-4 s machine step and 40 feed sub-steps (h = 3.125e-6 s).
 # Shown converged at every point by two more runs, each changing one thing:
-#   h/2 run   -> 40 sub-steps (h = 6.25e-6 s): the feed step doubled;
-#   H/2 run   -> 1.25e-4 s machine step with 20 sub-steps (h = 6.25e-6 s):
+#   h/2 run   -> 20 sub-steps (h = 6.25e-6 s): the feed step doubled;
+#   H/2 run   -> 6.25e-5 s machine step with 10 sub-steps (h = 6.25e-6 s):
 #                against the h/2 run, the machine step halved;
 #   windows   -> v over [16, 24] s against [24, 32] s: a later window.
 # dem converges with order 1 in h here, so the change on doubling h bounds
 # the reference's own step error. Writes tests/bench/results/vref.tsv:
 #   beta_deg rotation v_ref d_h d_H d_window u_ref
 # (m/s; d_* are the changes above, u_ref the largest of them) and prints a
-# summary. Takes about 25 min of CPU (both cores: ~13 min).
+# summary. Takes about 30 min of CPU (both cores: ~15 min).
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
@@ -32,9 +32,9 @@ run() { # name dt substeps
 		--set start=rest --set trough_rotation=true --set dt="$2" --set substeps="$3" \
 		> "$tmp/$1.tsv"
 }
-run ref 2.5e-4 80
-run h2 2.5e-4 40
-run H2 1.25e-4 20
+run ref 1.25e-4 40
+run h2 1.25e-4 20
+run H2 6.25e-5 10
 paste "$tmp/ref.tsv" "$tmp/h2.tsv" "$tmp/H2.tsv" | awk -F'\t' '
 	function abs(x) { return x < 0 ? -x : x }
 	BEGIN { OFS = "\t"; print "beta_deg", "rotation", "v_ref", "d_h", "d_H", "d_window", "u_ref" }

@@ -73,7 +73,10 @@ static void beta_reversal_max_slew(void **state)
 	double in1, in2;
 	double r1 = reversal_residual("1e-4", &in1), r2 = reversal_residual("2.5e-5", &in2);
 	assert_true(fabs(r1) < 1e-3 * in1);
-	assert_true(fabs(r2) < 0.25 * fabs(r1));
+	/* first order across the jumps in beta'': a 4x smaller step leaves at
+	 * most 0.3 of the residual (0.25 measured; whole steps since the
+	 * observation no longer cuts them, so no step lands on a jump) */
+	assert_true(fabs(r2) < 0.3 * fabs(r1));
 }
 
 /* beta oscillating between 38 and 128 deg (cw): the feed's velocity
@@ -123,7 +126,7 @@ static void motor_start_through_resonance(void **state)
 	for (double t = 2e-3; t <= 2.0 + 1e-12; t += 2e-3) {
 		advance(s, t);
 		sim_status st = status(s);
-		double w = -st.rotor_speed, a = hypot(st.q[0], st.q[1]);
+		double w = st.rotor_speed, a = hypot(st.q[0], st.q[1]); /* cw: phi' > 0 */
 		if (isnan(t30) && w > 30.0)
 			t30 = t;
 		if (isnan(t90) && w > 0.9 * u.p.omega_ss)

@@ -63,9 +63,9 @@ static void kloss_steady_speed(void **state)
 		sim_status st = status(s);
 		double Mut = 50.0, ML = 5.0, sut = 15.5;
 		double slip = sut * (Mut - sqrt(Mut * Mut - ML * ML)) / ML;
-		double expect = (r ? 1.0 : -1.0) * (157.08 - slip);
+		double expect = (r ? -1.0 : 1.0) * (157.08 - slip); /* cw: phi' > 0 */
 		assert_close(st.rotor_speed, expect, 1e-6); /* 6e-9 relative */
-		assert_close(st.motor_torque, r ? ML : -ML, 1e-5);
+		assert_close(st.motor_torque, r ? -ML : ML, 1e-5);
 		sim_free(s);
 	}
 }
@@ -124,14 +124,14 @@ static void linear_orbit_and_frahm_antiresonance(void **state)
 	set(&u, "trough_rotation", "false"); /* alpha = 0: the (x, y, s) system */
 	set(&u, "b_x", "3000");              /* fast decay of the start */
 	set(&u, "b_y", "3000");
-	double beta = 38.0 * M_PI / 180.0, W = 157.08 * -1.0; /* cw */
+	double beta = 38.0 * M_PI / 180.0, W = 157.08 * 1.0; /* cw: phi' > 0 */
 	sim *s = make(&u);
 	sim_status st0 = status(s);
 	advance(s, 8.0);
 	double ux = -sin(beta), uy = cos(beta);
 	double complex Z[4], Z0[4];
 	linear_response(beta, W, 60.0, Z);
-	linear_response(beta, -sqrt(444132.0 / 18.0), 0.0, Z0); /* tuned exactly */
+	linear_response(beta, sqrt(444132.0 / 18.0), 0.0, Z0); /* tuned exactly */
 	double amp = cabs(Z[0]) + cabs(Z[1]), worst = 0.0, along_u = 0.0, along_n = 0.0;
 	for (int k = 0; k < 200; k++) {
 		advance(s, 8.0 + k * 2e-4);
