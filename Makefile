@@ -32,11 +32,12 @@ DEB_NEEDS := /usr/include/microhttpd.h:libmicrohttpd-dev \
              /usr/include/cjson/cJSON.h:libcjson-dev \
              /usr/include/cmocka.h:libcmocka-dev \
              /usr/bin/curl:curl \
+             /usr/bin/python3:python3 \
              /usr/bin/node:nodejs \
              /usr/bin/npm:npm \
              /usr/bin/chromium:chromium
 
-.PHONY: all deps run test check bench clean
+.PHONY: all deps run test check bench mutate clean
 all: deps $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing (Debian packages, npm test tools). Idempotent.
@@ -96,6 +97,10 @@ check:
 
 bench: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
+
+# Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
+mutate: all
+	$(Q)bash tests/mutate.sh
 
 clean:
 	rm -rf build build-san

@@ -32,6 +32,8 @@ struct sim {
 	const ode_method *ode;
 	void *ws;
 	double t_int, t_obs, t_prev;
+	uint64_t k_fixed;    /* fixed-step methods: t_int = k_fixed * dt, so
+				that time carries no round-off of summed steps */
 	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
 					    start of the last step */
 	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
@@ -192,7 +194,7 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	if (s->cfg.dt == 0.0)
 		s->cfg.dt = sim_default_dt(p, sc, m);
 	if (s->cfg.substeps == 0)
-		s->cfg.substeps = sim_default_substeps(s->cfg.dt);
+		s->cfg.substeps = s->md.nf > 0 ? sim_default_substeps(s->cfg.dt) : 1;
 	s->ode = ode_find(m->name);
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(4 * n, sizeof(double));
@@ -246,7 +248,9 @@ const char *sim_last_error(const sim *s)
 
 double sim_effective_time(const sim *s)
 {
-	return s->t_int;
+	/* the integrator's time, never before the observed one (they differ
+	 * by the round-off of summed steps when the integrator stands on it) */
+	return fmax(s->t_int, s->t_obs);
 }
 
 /* The state at t within the last step [t_prev, t_int] into y_obs, for the
@@ -292,6 +296,8 @@ int sim_advance(sim *s, double t_end)
 			update_status(s);
 			return e;
 		}
+		if (!s->ode->dense)
+			s->t_int = (double)++s->k_fixed * s->cfg.dt;
 		s->t_prev = t0;
 		s->steps++;
 		estimator_step(&s->est, &s->md, &s->ctl, t0, s->t_int, s->y);

