@@ -16,15 +16,31 @@ ref=tests/bench/results/vref.tsv
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 TIMEFORMAT=%U
+key() { printf '%s' "$1" | tr ' /+' '___'; }
 sweep() { # name, extra arguments...: one core, CPU seconds into $tmp/name.cpu
-	local name=$1; shift
+	local f; f="$tmp/$(key "$1")"; shift
 	{ time "$BUILD/convsim" sweep --beta 0:180:5 --rotation cw,ccw --threads 1 --format csv "$@" \
-		> "$tmp/$name.csv" 2>/dev/null; } 2> "$tmp/$name.cpu"
+		> "$f.csv" 2>/dev/null; } 2> "$f.cpu"
 }
-sweep default
-sweep full --set trough_rotation=true
-gate() { # name: the summary row of one sweep against the reference
-	awk -F'[,\t]' -v name="$1" -v cpu="$(cat "$tmp/$1.cpu")" '
+# name | sweep arguments | what the row shows
+runs=(
+	"default||the defaults (steady start, 4-s window, dem 5e-4 s / 20 sub-steps, symmetric reduction)"
+	"full|--set trough_rotation=true|the same on the full model: the reduction's own error"
+	"rest 2+2 s|--set start=rest --set transient=2 --duration 4|the former measurement: run-up from rest, window [2, 4] s"
+	"rest 8+4 s|--set start=rest --set transient=8 --duration 12|run-up from rest, window [8, 12] s"
+	"1e-3 / 10|--set dt=1e-3 --set substeps=10|the former default step, steady start"
+	"1e-3 / 40|--set dt=1e-3 --set substeps=40|the feed step of the default, machine step doubled"
+	"5e-4 / 10|--set dt=5e-4 --set substeps=10|the machine step of the default, feed step doubled"
+	"2.5e-4 / 10|--set dt=2.5e-4 --set substeps=10|machine step halved"
+)
+for r in "${runs[@]}"; do
+	IFS='|' read -r name args _ <<<"$r"
+	# shellcheck disable=SC2086
+	sweep "$name" $args
+done
+gate() { # name, what: the summary row of one sweep against the reference
+	local f; f="$tmp/$(key "$1")"
+	awk -F'[,\t]' -v name="$1" -v what="$2" -v cpu="$(cat "$f.cpu")" '
 		function abs(x) { return x < 0 ? -x : x }
 		FNR == 1 { next }
 		NR == FNR { k = $1 " " $2; vref[k] = $3; a = abs($3); if (a > peak) peak = a; next }
@@ -38,9 +54,9 @@ gate() { # name: the summary row of one sweep against the reference
 			if ($5 != "true") unsteady++
 		}
 		END {
-			printf "| %s | %d | %.2f %% (%s) | %d | %d | %d | %s |\n", name, n, 100 * worst, at,
+			printf "| %s | %s | %.2f %% (%s) | %d | %d | %d | %s |\n", name, what, 100 * worst, at,
 				bad, outside, unsteady, cpu
-		}' "$ref" "$tmp/$1.csv"
+		}' "$ref" "$f.csv"
 }
 {
 	echo "# The v(beta) curve against the converged reference"
@@ -51,10 +67,12 @@ gate() { # name: the summary row of one sweep against the reference
 	echo "MODEL.md's convention; \"outside u\": points whose |v - v_ref| exceeds the reported"
 	echo "uncertainty; CPU: seconds on one core for the whole curve."
 	echo
-	echo "| run | points | worst error | beyond 1 % | outside u | not steady | CPU s |"
+	echo "| run | what | worst error | beyond 1 % | outside u | not steady | CPU s |"
 	echo "|---|---|---|---|---|---|---|"
-	gate default
-	gate full
+	for r in "${runs[@]}"; do
+		IFS='|' read -r name _ what <<<"$r"
+		gate "$name" "$what"
+	done
 	echo
 	echo "Per point (default run): beta, rotation, v, uncertainty, v_ref, error (convention, %)."
 	echo

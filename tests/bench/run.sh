@@ -36,6 +36,6 @@ rest_pid=$!
 wait "$full_pid"
 wait "$rest_pid"
 "$bin" report "$out" "$cmd"
-echo "bench: the default step over the beta range (both cores)"
-bash tests/bench/beta_range.sh "$out"
+echo "bench: the 74-point v(beta) curve against the converged reference (one core per sweep)"
+bash tests/bench/accuracy.sh "$out"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

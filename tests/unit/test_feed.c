@@ -1,12 +1,10 @@
 /*
  * test_feed.c - the feed against known answers: rebound at R times the
- * impact speed, the hopping theory of VDI 2333 for a deck moving
- * harmonically along a line, transport direction and its reversal by
- * beta, mirror symmetry with opposite transport, agreement of the
- * symmetric reduction with the full model, and the energy balance.
+ * impact speed, transport direction and its reversal by beta, mirror
+ * symmetry with opposite transport, agreement of the symmetric reduction
+ * with the full model, and the energy balance (the hopping theory of VDI
+ * 2333 runs through the engine in test_accuracy.c).
  */
-#include "feed.h"
-#include "model.h"
 #include "testutil.h"
 
 /* One element dropped on a fixed deck (no gravity, so that the contact
@@ -43,67 +41,6 @@ static void rebound_speed_is_R_times_impact(void **state)
 					 Rs[ri], v, expect);
 			sim_free(s);
 		}
-}
-
-/* Flight fraction n of VDI 2333 hopping theory:
- * sqrt(G^2 - 1) = (2 pi^2 n^2 + cos 2 pi n - 1) / (2 pi n - sin 2 pi n). */
-static double flight_fraction(double G)
-{
-	double lo = 1e-6, hi = 1.0, target = sqrt(G * G - 1.0);
-	for (int it = 0; it < 200; it++) {
-		double n = 0.5 * (lo + hi), a = 2 * M_PI * n;
-		double f = (2 * M_PI * M_PI * n * n + cos(a) - 1.0) / (a - sin(a));
-		if (f < target)
-			lo = n;
-		else
-			hi = n;
-	}
-	return 0.5 * (lo + hi);
-}
-
-/* One element on a deck moving harmonically along a line at angle psi
- * (amplitude A, 1 < Gamma < 3.3, no slip, plastic impact): mean velocity
- * v = g n^2 cot(psi) / (2 f). The deck motion is prescribed: the feed's
- * sub-step of the split method is driven directly. */
-static void hopping_theory_vdi2333(void **state)
-{
-	(void)state;
-	const double psis[] = {20.0, 30.0, 45.0}, Gammas[] = {1.6, 2.2, 3.0};
-	for (int c = 0; c < 3; c++) {
-		setup u = preset();
-		set(&u, "columns", "1");
-		set(&u, "layers", "1");
-		set(&u, "R", "0.001");
-		set(&u, "k_c", "1e7");
-		model md;
-		model_ctl ctl;
-		model_init(&md, &ctl, &u.p, &u.sc);
-		md.p.mu = 100.0; /* the theory assumes no slip at all */
-		double *y = calloc((size_t)md.n, sizeof(double));
-		signed char modes[2] = {0, 0};
-		const double g = 9.81, f = 25.0, w = 2 * M_PI * f, psi = psis[c] * M_PI / 180.0;
-		const double A = Gammas[c] * g / (w * w * sin(psi)), h = 2e-6;
-		const int per = (int)lround(1.0 / (f * h));
-		double xi0 = 0.0;
-		int periods = 40, skip = 10;
-		for (int k = 0; k < periods * per; k++) {
-			double t = k * h, t1 = t + h;
-			double pos[2] = {A * cos(psi) * sin(w * t), A * sin(psi) * sin(w * t)};
-			double vel1[2] = {A * w * cos(psi) * cos(w * t1), A * w * sin(psi) * cos(w * t1)};
-			double imp[2] = {0, 0}, fr = 0, co = 0;
-			feed_dem_substep(&md, y, 0, pos, vel1, h, modes, imp, &fr, &co);
-			if (k + 1 == skip * per)
-				xi0 = y[md.nq];
-		}
-		double v = (y[md.nq] - xi0) / ((periods - skip) / f);
-		double n = flight_fraction(Gammas[c]);
-		double expect = g * n * n / tan(psi) / (2 * f);
-		/* measured within 0.25 % on the three cases */
-		if (fabs(v - expect) > 0.005 * expect)
-			fail_msg("psi %g Gamma %g: v %.5g m/s, theory %.5g (n = %.4f)", psis[c],
-				 Gammas[c], v, expect, n);
-		free(y);
-	}
 }
 
 static double run_velocity(setup *u, double t_end)
@@ -239,7 +176,6 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(rebound_speed_is_R_times_impact),
-		cmocka_unit_test(hopping_theory_vdi2333),
 		cmocka_unit_test(beta_sets_and_reverses_direction),
 		cmocka_unit_test(mirror_symmetry_with_feed),
 		cmocka_unit_test(reduction_agrees_with_full_model),

@@ -129,9 +129,8 @@ static void linear_orbit_and_frahm_antiresonance(void **state)
 	sim_status st0 = status(s);
 	advance(s, 8.0);
 	double ux = -sin(beta), uy = cos(beta);
-	double complex Z[4], Z0[4];
+	double complex Z[4];
 	linear_response(beta, W, 60.0, Z);
-	linear_response(beta, sqrt(444132.0 / 18.0), 0.0, Z0); /* tuned exactly */
 	double amp = cabs(Z[0]) + cabs(Z[1]), worst = 0.0, along_u = 0.0, along_n = 0.0;
 	for (int k = 0; k < 200; k++) {
 		advance(s, 8.0 + k * 2e-4);
@@ -148,8 +147,6 @@ static void linear_orbit_and_frahm_antiresonance(void **state)
 	/* the antiresonance: along u only the eliminator damping's rest
 	 * remains (zero without it), as the simulation shows too */
 	double complex zu = ux * Z[0] + uy * Z[1], zn = uy * Z[0] - ux * Z[1];
-	double complex zu0 = ux * Z0[0] + uy * Z0[1], zn0 = uy * Z0[0] - ux * Z0[1];
-	assert_true(cabs(zu0) < 1e-10 * cabs(zn0));
 	assert_true(along_n > 1e-3);
 	assert_rel(along_u / along_n, cabs(zu) / cabs(zn), 1e-3);
 	assert_true(along_u < 0.1 * along_n);
