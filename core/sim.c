@@ -1,11 +1,12 @@
 /*
  * sim.c - one simulation instance: owns the const model, the controls, the
- * state, the chosen integrator's workspace and the observables (the
- * transport-velocity estimator of estimator.c, the energy balance). The
- * caller decides when to step (sim_advance); controls take effect at the
- * integrator's current time. Reading the status never changes the
- * instance: it is computed after each change with an evaluation that
- * counts nothing.
+ * state, the chosen integrator's workspace and the observers (the
+ * transport-velocity estimator of estimator.c, the energy baselines); the
+ * `steady` start's settling; stepping with observation on the step's
+ * interpolant; the controls; sim_measure. The caller decides when to step
+ * (sim_advance); controls take effect at the integrator's current time.
+ * What the instance shows is computed in sim_status.c after each change,
+ * with an evaluation that counts nothing.
  */
 #include <math.h>
 #include <stdio.h>
@@ -13,38 +14,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "estimator.h"
 #include "feed.h"
-#include "ode.h"
+#include "sim_int.h"
 #include "units.h"
-
-/* speed-up, relative transport-velocity change: czubak2016, dem dt = 1e-4 */
-#define REDUCTION_NO_FEED 1.75, NAN
-#define REDUCTION_SYMMETRIC 1.73, 3.2e-5
-#define REDUCTION_IDEAL 1.03, 2.9e-2
-#define REDUCTION_ONE_WAY 0.99, 3.2e-2
-
-struct sim {
-	model md;            /* const after sim_new */
-	model_ctl ctl;       /* changed by the sim_set_* controls */
-	dyn sys;             /* what the integrator steps: &md, &ctl, rhs_evals */
-	sim_method cfg;
-	const ode_method *ode;
-	void *ws;
-	double t_int, t_obs, t_prev;
-	uint64_t k_fixed;    /* fixed-step methods: t_int = k_fixed * dt, so
-				that time carries no round-off of summed steps */
-	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
-					    start of the last step */
-	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
-	uint64_t steps;
-	int failed;
-	char error[160];
-	estimator est;
-	double X0;
-	double *X0k;
-	sim_status st;
-};
 
 /* Divergence guard, machine: bounded displacements, rotation, strokes and
  * rotor speed; NULL or the cause. */
@@ -109,7 +81,6 @@ static int check_state(sim *s)
 	return SIM_OK;
 }
 
-static void update_status(sim *s);
 
 /* Settling of the `steady` start, in simulated seconds before t = 0, and
  * the suspension damping it adds (N s/m per spring set and direction),
@@ -174,7 +145,7 @@ static void zero_observers(sim *s)
 	for (int k = 0; k < md->dk.K; k++)
 		s->X0k[k] = feed_mean_xi(md, s->y, k);
 	estimator_init(&s->est, md, &s->ctl, s->t_int, s->y, md->sc.transient);
-	update_status(s);
+	sim_update_status(s);
 }
 
 sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
@@ -293,7 +264,7 @@ int sim_advance(sim *s, double t_end)
 				 s->t_int);
 		if (e != SIM_OK) {
 			s->failed = e;
-			update_status(s);
+			sim_update_status(s);
 			return e;
 		}
 		if (!s->ode->dense)
@@ -314,7 +285,7 @@ int sim_advance(sim *s, double t_end)
 		memcpy(s->y_obs, s->y, sizeof(double) * n);
 		s->t_obs = t_end;
 	}
-	update_status(s);
+	sim_update_status(s);
 	return SIM_OK;
 }
 
@@ -323,7 +294,7 @@ int sim_advance(sim *s, double t_end)
 static void control_changed(sim *s)
 {
 	s->ode->reset(s->ws);
-	update_status(s);
+	sim_update_status(s);
 }
 
 int sim_set_beta(sim *s, double beta, double rate)
@@ -382,7 +353,7 @@ int sim_set_drive_on(sim *s, int on)
 void sim_restart_transport(sim *s)
 {
 	estimator_restart(&s->est, s->t_int);
-	update_status(s);
+	sim_update_status(s);
 }
 
 int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi_dot,
@@ -411,190 +382,9 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 	zero_observers(s);
 	s->X0 = X0; /* displacements still count from the start */
 	memcpy(s->X0k, X0k, sizeof(double) * (size_t)md->dk.K);
-	update_status(s);
+	sim_update_status(s);
 	return SIM_OK;
 }
-
-/* ---- observables ---- */
-
-/* Energies of the status, each a change since t = 0 (all exactly zero
- * then): kinetic, potential (with the contacts' elastic energy), input,
- * dissipated, and the balance's residual. */
-static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
-{
-	const model *md = &s->md;
-	double kin, pot;
-	dynamics_energy_stored(md, &s->ctl, s->t_obs, s->y_obs, &kin, &pot);
-	const double *acc = s->y_obs + 2 * md->npos;
-	double elastic = 0.0;
-	if (md->nf > 0)
-		elastic = dynamics_contact_energy(md, s->y_obs, ev->q, ev->qd);
-	st->e_input = acc[ACC_IN];
-	st->e_kinetic = kin - s->kin0;
-	st->e_potential = (pot - s->pot0) + (elastic - s->elastic0);
-	st->e_dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - (elastic - s->elastic0));
-	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
-			 acc[ACC_IN];
-}
-
-/* The discretisation error of dem's transport velocity, as a fraction of
- * |v|, at its default step for a light feed (sim_default_dt and
- * sim_default_substeps: machine step 5e-4 s, feed step 2.5e-5 s): the
- * largest |v - v_ref| / |v_ref| over the 74 points of czubak2016
- * (tests/bench/accuracy.sh: 1.19 %, at v = 0.008 m/s), rounded up. For
- * other dem steps it scales with the larger of the two step ratios (dem is
- * first order in v); for the other methods the step's error is not
- * calibrated and the bar holds only the scatter and drift. */
-#define DEM_V_ERROR 0.0125
-#define DEM_V_ERROR_DT 5e-4
-#define DEM_V_ERROR_H 2.5e-5
-
-static double step_error(const sim *s, double v)
-{
-	if (s->ode != &ode_dem || s->md.nf == 0)
-		return 0.0;
-	double h = s->cfg.dt / s->cfg.substeps;
-	double ratio = fmax(s->cfg.dt / DEM_V_ERROR_DT, h / DEM_V_ERROR_H);
-	return DEM_V_ERROR * ratio * fabs(v);
-}
-
-/* The transport-velocity estimate into the status. */
-static void status_estimate(const sim *s, sim_status *st)
-{
-	estimate est;
-	estimator_read(&s->est, &est);
-	st->transport_velocity = est.transport_velocity;
-	st->transport_periods = est.transport_periods;
-	st->feed_velocity = est.feed_velocity;
-	st->period = est.period;
-	st->transport_velocity_uncertainty =
-		est.uncertainty + step_error(s, est.transport_velocity);
-	st->steady = est.steady;
-	st->rotor_speed_mean = est.rotor_speed_mean;
-	st->motor_torque_mean = est.torque_mean;
-	st->power_mean = est.power_mean;
-}
-
-/* Recompute the status at the observed time after any change. Evaluates
- * the right-hand side for observation only: no counter moves. */
-static void update_status(sim *s)
-{
-	const model *md = &s->md;
-	const model_ctl *ctl = &s->ctl;
-	sim_status *st = &s->st;
-	model_eval ev;
-	dynamics_eval(md, ctl, s->t_obs, s->y_obs, s->dy, &ev);
-	st->t = s->t_obs;
-	st->t_int = s->t_int;
-	st->beta = ev.beta;
-	st->beta_dot = ev.beta_dot;
-	st->beta_target = ctl->beta_ramp.b_end;
-	st->rotation = ctl->rotation;
-	st->drive_on = ctl->drive_on;
-	st->omega_ss = ctl->omega_ss;
-	memcpy(st->q, ev.q, sizeof st->q);
-	memcpy(st->qd, ev.qd, sizeof st->qd);
-	st->rotor_speed = ev.rotor_speed;
-	st->motor_torque = ev.torque;
-	st->power = ev.torque * ev.rotor_speed + 0.0; /* no negative zero */
-	memcpy(st->deck, ev.deck, sizeof st->deck);
-	memcpy(st->deck_vel, ev.deck_vel, sizeof st->deck_vel);
-	st->feed_displacement = md->nf > 0 ? feed_mean_xi(md, s->y_obs, -1) - s->X0 : 0.0;
-	status_estimate(s, st);
-	status_energy(s, &ev, st);
-	st->steps = s->steps;
-	st->rhs_evals = s->sys.rhs_evals;
-	st->dt = s->cfg.dt;
-	st->substeps = s->cfg.substeps;
-	st->reductions = md->reductions;
-	st->n_dof = md->nq + 2 * md->nf;
-}
-
-void sim_get_status(const sim *s, sim_status *st)
-{
-	*st = s->st;
-}
-
-int sim_columns(const sim *s)
-{
-	return s->md.nf > 0 ? s->md.sc.columns : 0;
-}
-
-int sim_layers(const sim *s)
-{
-	return s->md.nf > 0 ? s->md.L : 0;
-}
-
-/* Physical column c maps to integrated column c, or 0 under symmetry. */
-static int integrated_column(const sim *s, int c)
-{
-	return s->md.dk.K == 1 ? 0 : c;
-}
-
-void sim_column_displacement(const sim *s, double *out)
-{
-	int K = sim_columns(s);
-	for (int c = 0; c < K; c++) {
-		int k = integrated_column(s, c);
-		out[c] = feed_mean_xi(&s->md, s->y_obs, k) - s->X0k[k];
-	}
-}
-
-void sim_deck_points(const sim *s, double *out)
-{
-	int K = sim_columns(s);
-	const deck *dk = &s->md.dk;
-	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(&s->md, &s->ctl, s->t_obs, s->y_obs, q, qd);
-	double zero[NQ_FULL] = {0};
-	deck_rot R = deck_rotation(q), R0 = deck_rotation(zero);
-	for (int c = 0; c < K; c++) {
-		int k = integrated_column(s, c);
-		double pos[2], vel[2], rest[2];
-		deck_point(dk, dk->d[k], &R, q, qd, pos, vel);
-		deck_point(dk, dk->d[k], &R0, zero, zero, rest, vel);
-		out[2 * c] = pos[0] - rest[0];
-		out[2 * c + 1] = pos[1] - rest[1];
-	}
-}
-
-void sim_feed_state(const sim *s, double *xi, double *eta)
-{
-	const model *md = &s->md;
-	int K = sim_columns(s), L = md->L;
-	for (int c = 0; c < K; c++) {
-		int k = integrated_column(s, c);
-		for (int j = 0; j < L; j++) {
-			if (xi)
-				xi[c * L + j] = s->y_obs[md->nq + k * L + j];
-			if (eta)
-				eta[c * L + j] = s->y_obs[md->nq + md->nf + k * L + j];
-		}
-	}
-}
-
-/* Figures from `make bench` (tests/bench/results/reductions.tsv). */
-static const sim_reduction_info reductions[] = {
-	{"no_feed", "every feed coordinate (there is no transport velocity)", REDUCTION_NO_FEED},
-	{"symmetric_alpha", "alpha and all but one column, which counts K times",
-	 REDUCTION_SYMMETRIC},
-	{"ideal_drive", "the rotor's equation: phi - alpha turns at omega_ss, without slip",
-	 REDUCTION_IDEAL},
-	{"one_way_coupling", "the feed's reaction on the trough", REDUCTION_ONE_WAY},
-};
-
-const sim_reduction_info *sim_reduction(int bit)
-{
-	return bit >= 0 && bit < (int)(sizeof reductions / sizeof reductions[0]) ? &reductions[bit]
-										 : NULL;
-}
-
-const char *sim_reduction_name(int bit)
-{
-	const sim_reduction_info *r = sim_reduction(bit);
-	return r ? r->name : NULL;
-}
-
 int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen)
 {

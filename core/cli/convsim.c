@@ -326,6 +326,46 @@ static void *worker(void *arg)
 	}
 }
 
+/* The sweep's table on stdout (CSV or JSON), failures on stderr; returns
+ * the number of failed points. */
+static int print_sweep(const opts *o, const pool *pl)
+{
+	int json = o->format && strcmp(o->format, "json") == 0, failed = 0;
+	if (json)
+		printf("{\"duration\": %.17g, \"transient\": %.17g, \"method\": \"%s\", \"points\": [\n",
+		       o->duration, o->sc.transient, o->m.name);
+	else
+		printf("beta_deg,rotation,transport_velocity_m_s,uncertainty_m_s,steady\n");
+	for (int i = 0; i < pl->n; i++) {
+		task *t = &pl->tasks[i];
+		const char *rot = t->rotation == SIM_CW ? "cw" : "ccw";
+		const char *steady = t->r.steady ? "true" : "false";
+		if (t->err != SIM_OK) {
+			failed++;
+			fprintf(stderr, "convsim: beta %g %s: %s\n", t->beta, rot, t->msg);
+		}
+		if (json) {
+			printf("  {\"beta\": %.17g, \"rotation\": \"%s\", \"transport_velocity\": ",
+			       t->beta, rot);
+			print_num(stdout, t->r.transport_velocity);
+			printf(", \"uncertainty\": ");
+			print_num(stdout, t->r.uncertainty);
+			printf(", \"steady\": %s}%s\n", steady, i + 1 < pl->n ? "," : "");
+		} else {
+			printf("%g,%s,", t->beta, rot);
+			if (isfinite(t->r.transport_velocity))
+				printf("%.9g", t->r.transport_velocity);
+			printf(",");
+			if (isfinite(t->r.uncertainty))
+				printf("%.3g", t->r.uncertainty);
+			printf(",%s\n", steady);
+		}
+	}
+	if (json)
+		printf("]}\n");
+	return failed;
+}
+
 static int cmd_sweep(int argc, char **argv)
 {
 	opts o = {0};
@@ -377,39 +417,7 @@ static int cmd_sweep(int argc, char **argv)
 	for (int i = 0; i < o.threads; i++)
 		pthread_join(th[i], NULL);
 	fprintf(stderr, "\rsweep: %d/%d done in %.1f s\n", pl.done, pl.n, now() - w0);
-	int json = o.format && strcmp(o.format, "json") == 0, failed = 0;
-	if (json)
-		printf("{\"duration\": %.17g, \"transient\": %.17g, \"method\": \"%s\", \"points\": [\n",
-		       o.duration, o.sc.transient, o.m.name);
-	else
-		printf("beta_deg,rotation,transport_velocity_m_s,uncertainty_m_s,steady\n");
-	for (int i = 0; i < pl.n; i++) {
-		task *t = &pl.tasks[i];
-		const char *rot = t->rotation == SIM_CW ? "cw" : "ccw";
-		const char *steady = t->r.steady ? "true" : "false";
-		if (t->err != SIM_OK) {
-			failed++;
-			fprintf(stderr, "convsim: beta %g %s: %s\n", t->beta, rot, t->msg);
-		}
-		if (json) {
-			printf("  {\"beta\": %.17g, \"rotation\": \"%s\", \"transport_velocity\": ",
-			       t->beta, rot);
-			print_num(stdout, t->r.transport_velocity);
-			printf(", \"uncertainty\": ");
-			print_num(stdout, t->r.uncertainty);
-			printf(", \"steady\": %s}%s\n", steady, i + 1 < pl.n ? "," : "");
-		} else {
-			printf("%g,%s,", t->beta, rot);
-			if (isfinite(t->r.transport_velocity))
-				printf("%.9g", t->r.transport_velocity);
-			printf(",");
-			if (isfinite(t->r.uncertainty))
-				printf("%.3g", t->r.uncertainty);
-			printf(",%s\n", steady);
-		}
-	}
-	if (json)
-		printf("]}\n");
+	int failed = print_sweep(&o, &pl);
 	pthread_mutex_destroy(&pl.lock);
 	free(pl.tasks);
 	return failed ? 1 : 0;

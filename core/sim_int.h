@@ -1,0 +1,40 @@
+/*
+ * sim_int.h - internal: the inside of a sim, shared by sim.c (the
+ * instance, its controls and stepping) and sim_status.c (what it shows:
+ * the status at the observed time, feed and deck observables). Not part of
+ * the public interface (sim.h), as SQLite's btreeInt.h beside btree.h.
+ */
+#ifndef CONVSIM_SIM_INT_H
+#define CONVSIM_SIM_INT_H
+
+#include "estimator.h"
+#include "ode.h"
+
+struct sim {
+	model md;            /* const after sim_new */
+	model_ctl ctl;       /* changed by the sim_set_* controls */
+	dyn sys;             /* what the integrator steps: &md, &ctl, rhs_evals */
+	sim_method cfg;
+	const ode_method *ode;
+	void *ws;
+	double t_int, t_obs, t_prev;
+	uint64_t k_fixed;    /* fixed-step methods: t_int = k_fixed * dt, so
+				that time carries no round-off of summed steps */
+	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
+					    start of the last step */
+	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
+	uint64_t steps;
+	int failed;
+	char error[160];
+	estimator est;
+	double X0;
+	double *X0k;
+	sim_status st;
+};
+
+/* Recompute s->st at the observed time after any change; reads the state
+ * and evaluates the right-hand side for observation only (no counter
+ * moves). sim_status.c */
+void sim_update_status(sim *s);
+
+#endif
