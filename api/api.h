@@ -80,6 +80,16 @@ char *api_problem_json(const api_problem *pb, const char *instance);
  * the length written (buf of at least 32 bytes). */
 int api_fmt_double(char *buf, size_t len, double v);
 
+/* ---- values in user units ------------------------------------------------ */
+
+/* A setting's value as a request gave it in the settings table's user unit
+ * (beta in deg, beta_rate in deg/s), converted to SI once, where api/
+ * parsed it: si goes to the core, user is what answers echo. */
+typedef struct api_value {
+	double si;
+	double user;
+} api_value;
+
 /* ---- sessions ----------------------------------------------------------- */
 
 #define API_PACE_MAX 0.0         /* pace value meaning "as fast as possible" */
@@ -117,8 +127,8 @@ enum {
 };
 typedef struct api_control {
 	unsigned set;
-	double beta;      /* deg */
-	double beta_rate; /* deg/s */
+	api_value beta;      /* rad (deg as sent) */
+	api_value beta_rate; /* rad/s (deg/s as sent) */
 	int rotation;     /* SIM_CW / SIM_CCW */
 	double omega_ss;  /* rad/s */
 	int running;
@@ -227,7 +237,7 @@ char *api_trajectory_csv(const double *rows, size_t n);
 
 #define API_EXP_MAX_SEGMENTS 32
 typedef struct api_segment {
-	double beta;            /* deg commanded at the segment start */
+	api_value beta;         /* rad (deg as sent) commanded at the start */
 	double until;           /* s after the experiment start */
 	/* results, filled by the server */
 	int state;              /* 0 pending, 1 running, 2 done */
@@ -235,6 +245,8 @@ typedef struct api_segment {
 	double t_end;           /* s */
 	double steady_velocity; /* m/s mean feed velocity, last half */
 	double mean_velocity;   /* m/s transport estimate over the segment */
+	double uncertainty;     /* m/s error bar of mean_velocity; NaN if none */
+	int steady;             /* the estimate showed no drift at the end */
 	double reversal_time;   /* s command -> 90 % of steady; NaN if never */
 	double start_velocity;  /* m/s feed velocity at the command */
 } api_segment;
@@ -243,7 +255,7 @@ typedef struct api_experiment_req {
 	int fresh;              /* 1: create a session from spec */
 	api_spec spec;
 	char session_id[24];    /* fresh == 0 */
-	double beta_rate;       /* deg/s, 0 = keep */
+	api_value beta_rate;    /* rad/s (deg/s as sent), 0 = keep */
 	int nseg;
 	api_segment seg[API_EXP_MAX_SEGMENTS];
 } api_experiment_req;
@@ -275,24 +287,30 @@ char *api_experiment_list_json(const api_experiment_view *v, size_t n);
 typedef struct api_sweep_req {
 	api_spec spec;
 	int nbeta;
-	double *betas;         /* deg, malloc'd by the parser (caller frees) */
+	api_value *betas;      /* rad (deg as sent), malloc'd by the parser
+				  (caller frees) */
 	int nrot;
 	int rotations[2];      /* SIM_CW / SIM_CCW */
 	double t_end;          /* s simulated per point */
 } api_sweep_req;
+/* Default simulated time per point after scene.transient, s: after a steady
+ * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
+ * 1 % (MODEL.md's convention). */
+#define API_SWEEP_WINDOW 4.0
 /* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
  * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],
- * "t_end". */
+ * "t_end" (default scene.transient + API_SWEEP_WINDOW; it must exceed
+ * scene.transient). */
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb);
 
 typedef struct api_sweep_point {
-	double beta;     /* deg */
+	api_value beta;  /* rad (deg as sent) */
 	int rotation;    /* SIM_CW / SIM_CCW */
 	int state;       /* 0 pending, 1 running, 2 done, 3 failed */
-	double velocity; /* m/s */
-	double uncertainty; /* m/s, the estimate's error bar */
-	int steady;      /* the estimate showed no drift */
+	double velocity;    /* m/s */
+	double uncertainty; /* m/s, the estimate's error bar; NaN if none */
+	int steady;         /* the estimate showed no drift */
 	char error[160];
 } api_sweep_point;
 typedef struct api_sweep_view {

@@ -12,14 +12,13 @@
 #include <string.h>
 
 #include "json_int.h"
-#include "units.h"
 
 static api_err parse_segment(const cJSON *it, int i, double prev,
 			     const api_spec *spec, api_segment *seg,
 			     api_problem *pb)
 {
 	static const char *const members[] = {"beta", "until", NULL};
-	char prefix[40], field[48], msg[256] = "";
+	char prefix[40], field[48];
 	snprintf(prefix, sizeof prefix, "schedule[%d].", i);
 	if (!cJSON_IsObject(it))
 		return api_fail(pb, API_TYPE, prefix,
@@ -31,19 +30,10 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 	const cJSON *beta = cJSON_GetObjectItemCaseSensitive(it, "beta");
 	const cJSON *until = cJSON_GetObjectItemCaseSensitive(it, "until");
 	snprintf(field, sizeof field, "%sbeta", prefix);
-	if (!cJSON_IsNumber(beta))
-		return api_fail(pb, API_TYPE, field, "%s must be a number (deg)",
-				field);
-	sim_params p = spec->params;
-	sim_scene s = spec->scene;
-	sim_method m = spec->method;
-	int rc = sim_set_user(&p, &s, &m, "beta", beta->valuedouble, msg,
-			 sizeof msg);
-	if (rc != SIM_OK) {
-		api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);
-		snprintf(pb->field, sizeof pb->field, "%s", field);
-		return pb->code;
-	}
+	api_value beta_si;
+	e = api_parse_user_value(spec, "beta", beta, field, &beta_si, pb);
+	if (e != API_OK)
+		return e;
 	snprintf(field, sizeof field, "%suntil", prefix);
 	if (!cJSON_IsNumber(until))
 		return api_fail(pb, API_TYPE, field,
@@ -57,9 +47,9 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 		return API_RANGE;
 	}
 	memset(seg, 0, sizeof *seg);
-	seg->beta = beta->valuedouble;
+	seg->beta = beta_si;
 	seg->until = until->valuedouble;
-	seg->steady_velocity = seg->mean_velocity = NAN;
+	seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
 	seg->reversal_time = seg->start_velocity = NAN;
 	seg->t_command = seg->t_end = NAN;
 	return API_OK;
@@ -116,19 +106,9 @@ api_err api_parse_experiment(const char *body, size_t len,
 	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
 	const cJSON *rate = cJSON_GetObjectItemCaseSensitive(root, "beta_rate");
 	api_err e = parse_session_member(sess, req, pb);
-	if (e == API_OK && rate && !cJSON_IsNull(rate)) {
-		char msg[256] = "";
-		sim_params p = req->spec.params;
-		if (!cJSON_IsNumber(rate))
-			e = api_fail(pb, API_TYPE, "beta_rate",
-				     "beta_rate must be a number (deg/s)");
-		else if (sim_set_user(&p, &req->spec.scene, &req->spec.method,
-				 "beta_rate", rate->valuedouble, msg,
-				 sizeof msg) != SIM_OK)
-			e = api_fail(pb, API_RANGE, "beta_rate", "%s", msg);
-		else
-			req->beta_rate = rate->valuedouble;
-	}
+	if (e == API_OK && rate && !cJSON_IsNull(rate))
+		e = api_parse_user_value(&req->spec, "beta_rate", rate,
+					 "beta_rate", &req->beta_rate, pb);
 	if (e == API_OK && !cJSON_IsArray(sched))
 		e = api_fail(pb, sched ? API_TYPE : API_INVALID, "schedule",
 			     "schedule must be an array of {\"beta\": DEG, "
@@ -174,7 +154,7 @@ static cJSON *experiment_object(const api_experiment_view *v)
 	for (int i = 0; i < v->nseg; i++) {
 		const api_segment *s = &v->seg[i];
 		cJSON *so = cJSON_CreateObject();
-		api_add_number(so, "beta", s->beta);
+		api_add_number(so, "beta", s->beta.user);
 		api_add_number(so, "until", s->until);
 		cJSON_AddStringToObject(so, "state",
 					seg_state[s->state < 0 || s->state > 2
@@ -185,6 +165,11 @@ static cJSON *experiment_object(const api_experiment_view *v)
 		api_add_number(so, "start_velocity", s->start_velocity);
 		api_add_number(so, "steady_velocity", s->steady_velocity);
 		api_add_number(so, "mean_velocity", s->mean_velocity);
+		api_add_number(so, "uncertainty", s->uncertainty);
+		if (s->state == 2)
+			cJSON_AddBoolToObject(so, "steady", s->steady);
+		else
+			cJSON_AddNullToObject(so, "steady");
 		api_add_number(so, "reversal_time", s->reversal_time);
 		cJSON_AddItemToArray(arr, so);
 	}

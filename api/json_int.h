@@ -49,6 +49,20 @@ const sim_setting *api_setting(const char *group, const char *name);
 api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
 			  const char *group, const cJSON *item,
 			  api_problem *pb);
+/* A value of setting name given in its user unit (the settings table's
+ * unit: beta in deg), checked against spec's settings with sim_set on a
+ * scratch copy (so range and message are the core's) and converted to SI
+ * once, here: *out gets both. field is the member's JSON path for the
+ * problem (the detail is prefixed with it when it differs from name). */
+api_err api_user_value(const api_spec *spec, const char *name, double user,
+		       const char *field, api_value *out, api_problem *pb);
+/* The same for a JSON member, which must be a number (400 otherwise). */
+api_err api_parse_user_value(const api_spec *spec, const char *name,
+			     const cJSON *it, const char *field,
+			     api_value *out, api_problem *pb);
+/* An SI value of setting name in its user unit, for answers (the table's
+ * scale; unchanged for an unknown name). */
+double api_user_of(const char *name, double si);
 /* Apply preset/params/scene/integrator members of obj (others ignored)
  * to *spec, starting from the preset (default czubak2016). */
 api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb);

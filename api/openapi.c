@@ -20,6 +20,8 @@
 	"\"requestBody\":{\"required\":true,\"content\":{\"application/"     \
 	"json\":{\"schema\":" schema "}}}"
 #define REF(name) "{\"$ref\":\"#/components/schemas/" name "\"}"
+#define NUM_OR_NULL(desc)                                                     \
+	"{\"type\":[\"number\",\"null\"],\"description\":\"" desc "\"}"
 
 static const char doc_text[] =
 	"{\"openapi\":\"3.1.0\","
@@ -157,9 +159,44 @@ static const char doc_text[] =
 	"\"Session\":{\"type\":\"object\",\"properties\":{"
 	"\"id\":{\"type\":\"string\"},\"state\":{\"enum\":[\"running\","
 	"\"paused\",\"finished\",\"failed\"]},\"pace\":" REF("Pace") ","
-	"\"until\":{\"type\":[\"number\",\"null\"]},\"status\":{\"type\":"
-	"\"object\"},\"spec\":{\"type\":\"object\"},\"t_effective\":{\"type\":"
-	"[\"number\",\"null\"]},\"applied\":" REF("Control") "}},"
+	"\"until\":{\"type\":[\"number\",\"null\"]},\"status\":"
+	REF("Status") ",\"spec\":{\"type\":\"object\"},\"t_effective\":{"
+	"\"type\":[\"number\",\"null\"]},\"applied\":" REF("Control") "}},"
+	"\"Status\":{\"type\":\"object\",\"description\":\"Live state at the "
+	"simulated time t; SI units but beta, beta_target (deg) and beta_dot "
+	"(deg/s); null where not defined yet\",\"properties\":{"
+	"\"t\":{\"type\":\"number\"},\"t_integrator\":{\"type\":\"number\"},"
+	"\"beta\":{\"type\":\"number\"},\"beta_target\":{\"type\":\"number\"},"
+	"\"beta_dot\":{\"type\":\"number\"},"
+	"\"rotation\":{\"enum\":[\"cw\",\"ccw\"]},\"drive_on\":{\"type\":"
+	"\"boolean\"},\"omega_ss\":{\"type\":\"number\"},"
+	"\"rotor_speed\":{\"type\":\"number\",\"description\":\"rad/s, "
+	"positive for clockwise (the paper's sense)\"},"
+	"\"motor_torque\":{\"type\":\"number\"},\"power\":{\"type\":"
+	"\"number\"},"
+	"\"rotor_speed_mean\":" NUM_OR_NULL("rad/s, mean over the transport "
+	"estimate's whole periods") ","
+	"\"motor_torque_mean\":" NUM_OR_NULL("N m, the same mean") ","
+	"\"power_mean\":" NUM_OR_NULL("W, the same mean") ","
+	"\"transport_velocity\":" NUM_OR_NULL("m/s, slope of the mean feed "
+	"displacement over the whole periods since scene.transient (or the "
+	"last estimator restart)") ","
+	"\"transport_velocity_uncertainty\":" NUM_OR_NULL("m/s, the "
+	"estimate's error bar; null before 4 batches of periods") ","
+	"\"steady\":{\"type\":\"boolean\",\"description\":\"the estimate "
+	"spans at least 8 periods and shows no drift beyond its scatter\"},"
+	"\"transport_periods\":{\"type\":\"number\"},"
+	"\"feed_velocity\":" NUM_OR_NULL("m/s, last whole period") ","
+	"\"feed_displacement\":{\"type\":\"number\"},"
+	"\"period\":" NUM_OR_NULL("s") ","
+	"\"steps\":{\"type\":\"number\"},\"rhs_evals\":{\"type\":\"number\"},"
+	"\"dt\":{\"type\":\"number\"},\"substeps\":{\"type\":\"integer\"},"
+	"\"steps_per_s\":{\"type\":\"number\"},\"rtf\":{\"type\":\"number\"},"
+	"\"n_dof\":{\"type\":\"integer\"},\"reductions\":{\"type\":\"array\","
+	"\"items\":{\"type\":\"string\"}},\"reduction_figures\":{\"type\":"
+	"\"array\"},\"energy\":{\"type\":\"object\",\"description\":\"J, "
+	"changes since t = 0: input, kinetic, potential, dissipated, "
+	"residual\"}}},"
 	"\"ExperimentCreate\":{\"type\":\"object\",\"required\":[\"schedule\"],"
 	"\"properties\":{\"session\":{\"oneOf\":[{\"type\":\"string\"},"
 	REF("SessionCreate") "]},\"beta_rate\":{\"type\":\"number\"},"
@@ -174,6 +211,11 @@ static const char doc_text[] =
 	"\"object\",\"properties\":{\"beta\":{\"type\":\"number\"},\"until\":{"
 	"\"type\":\"number\"},\"t_command\":{\"type\":[\"number\",\"null\"]},"
 	"\"steady_velocity\":{\"type\":[\"number\",\"null\"]},"
+	"\"mean_velocity\":" NUM_OR_NULL("m/s, transport estimate over the "
+	"segment") ","
+	"\"uncertainty\":" NUM_OR_NULL("m/s, error bar of mean_velocity") ","
+	"\"steady\":{\"type\":[\"boolean\",\"null\"],\"description\":"
+	"\"mean_velocity showed no drift (null until the segment is done)\"},"
 	"\"reversal_time\":{\"type\":[\"number\",\"null\"]}}}}}},"
 	"\"SweepCreate\":{\"type\":\"object\",\"properties\":{\"preset\":{"
 	"\"type\":\"string\"},\"params\":" REF("Params") ",\"scene\":"
@@ -182,20 +224,36 @@ static const char doc_text[] =
 	"\"number\"}},{\"type\":\"object\",\"properties\":{\"from\":{\"type\":"
 	"\"number\"},\"to\":{\"type\":\"number\"},\"step\":{\"type\":"
 	"\"number\"}}}]},\"rotations\":{\"type\":\"array\",\"items\":{\"enum\":"
-	"[\"cw\",\"ccw\"]}},\"t_end\":{\"type\":\"number\",\"minimum\":0.01,"
-	"\"maximum\":600}}},"
+	"[\"cw\",\"ccw\"]}},\"t_end\":{\"type\":\"number\",\"maximum\":600,"
+	"\"description\":\"simulated s per point; must exceed scene.transient; "
+	"default scene.transient + 4\"}}},"
 	"\"Sweep\":{\"type\":\"object\",\"properties\":{\"id\":{\"type\":"
 	"\"string\"},\"state\":{\"enum\":[\"queued\",\"running\",\"done\","
 	"\"cancelled\"]},\"total\":{\"type\":\"integer\"},\"done\":{\"type\":"
-	"\"integer\"},\"points\":{\"type\":\"array\"},\"series\":{\"type\":"
+	"\"integer\"},\"t_end\":{\"type\":\"number\"},\"points\":{\"type\":"
+	"\"array\",\"items\":{\"type\":\"object\",\"properties\":{"
+	"\"beta\":{\"type\":\"number\",\"description\":\"deg\"},"
+	"\"rotation\":{\"enum\":[\"cw\",\"ccw\"]},\"state\":{\"enum\":["
+	"\"pending\",\"running\",\"done\",\"failed\"]},"
+	"\"velocity\":" NUM_OR_NULL("m/s") ","
+	"\"uncertainty\":" NUM_OR_NULL("m/s, error bar of velocity") ","
+	"\"steady\":{\"type\":[\"boolean\",\"null\"]},"
+	"\"error\":{\"type\":\"string\"}}}},\"series\":{\"type\":"
 	"\"object\"}}}"
 	"}}}";
 
-/* A JSON Schema object for one group of the settings table. */
+/* A JSON Schema object for one group of the settings table, with the
+ * czubak2016 preset's values as defaults. */
 static cJSON *group_schema(const char *group)
 {
 	size_t n = 0;
 	const sim_setting *tab = sim_settings(&n);
+	sim_params pp;
+	sim_scene ps;
+	sim_method pm;
+	cJSON *defaults = sim_preset("czubak2016", &pp, &ps, &pm) == SIM_OK
+				  ? api_settings_object(&pp, &ps, &pm, group)
+				  : NULL;
 	cJSON *schema = cJSON_CreateObject();
 	cJSON_AddStringToObject(schema, "type", "object");
 	cJSON_AddBoolToObject(schema, "additionalProperties", 0);
@@ -234,8 +292,14 @@ static cJSON *group_schema(const char *group)
 			 tab[i].unit ? tab[i].unit : "",
 			 tab[i].unit && tab[i].unit[0] ? "]" : "");
 		cJSON_AddStringToObject(p, "description", desc);
+		const cJSON *dv = cJSON_GetObjectItemCaseSensitive(defaults,
+								   tab[i].name);
+		if (dv && !cJSON_IsNull(dv))
+			cJSON_AddItemToObject(p, "default",
+					      cJSON_Duplicate(dv, 1));
 		cJSON_AddItemToObject(props, tab[i].name, p);
 	}
+	cJSON_Delete(defaults);
 	if (strcmp(group, "integrator") == 0 &&
 	    !cJSON_GetObjectItemCaseSensitive(props, "method")) {
 		size_t nm = 0;

@@ -4,7 +4,9 @@
  *
  * Controls are validated against the session's own settings with sim_set
  * on a scratch copy, so the messages and ranges are the core's; a control
- * is all or nothing. Angles leave here in degrees, as users type them.
+ * is all or nothing. Angles are converted to SI once, where they are
+ * parsed (api_parse_user_value), and leave here in degrees, as users type
+ * them: the "applied" echo shows what was sent.
  */
 #include <math.h>
 #include <stdio.h>
@@ -12,25 +14,21 @@
 #include <string.h>
 
 #include "json_int.h"
-#include "units.h"
 
 
-static api_err check_setting(const api_spec *spec, const char *name,
-			     const cJSON *it, double *value, api_problem *pb)
+/* A number member for a setting in its user unit (beta in deg), converted
+ * once to SI; sets the bit. */
+static api_err parse_value(const cJSON *root, const api_spec *spec,
+			   const char *name, unsigned bit, api_value *out,
+			   api_control *c, api_problem *pb)
 {
-	sim_params p = spec->params;
-	sim_scene s = spec->scene;
-	sim_method m = spec->method;
-	char msg[256] = "";
-	if (!cJSON_IsNumber(it))
-		return api_fail(pb, API_TYPE, name, "%s must be a number",
-				name);
-	int rc = sim_set_user(&p, &s, &m, name, it->valuedouble, msg, sizeof msg);
-	if (rc != SIM_OK)
-		return api_fail(pb, api_from_sim(rc), name, "%s",
-				msg[0] ? msg : sim_strerror(rc));
-	*value = it->valuedouble;
-	return API_OK;
+	const cJSON *it = cJSON_GetObjectItemCaseSensitive(root, name);
+	if (!it)
+		return API_OK;
+	api_err e = api_parse_user_value(spec, name, it, name, out, pb);
+	if (e == API_OK)
+		c->set |= bit;
+	return e;
 }
 
 /* A boolean member: sets *out and the bit, or fails with a type error. */
@@ -65,19 +63,16 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			     "no change given; expected any of beta, "
 			     "beta_rate, rotation, omega_ss, running, "
 			     "motor_on, pace, until");
-	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "beta")) &&
-	    (e = check_setting(spec, "beta", it, &c->beta, pb)) == API_OK)
-		c->set |= API_C_BETA;
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "beta_rate")) &&
-	    (e = check_setting(spec, "beta_rate", it, &c->beta_rate, pb)) ==
-		    API_OK)
-		c->set |= API_C_BETA_RATE;
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "omega_ss")) &&
-	    (e = check_setting(spec, "omega_ss", it, &c->omega_ss, pb)) ==
-		    API_OK)
-		c->set |= API_C_OMEGA_SS;
+	api_value omega_ss = {0, 0};
+	if (e == API_OK)
+		e = parse_value(root, spec, "beta", API_C_BETA, &c->beta, c, pb);
+	if (e == API_OK)
+		e = parse_value(root, spec, "beta_rate", API_C_BETA_RATE,
+				&c->beta_rate, c, pb);
+	if (e == API_OK)
+		e = parse_value(root, spec, "omega_ss", API_C_OMEGA_SS,
+				&omega_ss, c, pb);
+	c->omega_ss = omega_ss.si;
 	if (e == API_OK &&
 	    (it = cJSON_GetObjectItemCaseSensitive(root, "rotation"))) {
 		if (!cJSON_IsString(it)) {
@@ -122,10 +117,11 @@ static void put_pace(cJSON *o, const char *name, double pace)
 static cJSON *control_object(const api_control *c)
 {
 	cJSON *o = cJSON_CreateObject();
+	/* angles as the user sent them */
 	if (c->set & API_C_BETA)
-		api_add_number(o, "beta", c->beta);
+		api_add_number(o, "beta", c->beta.user);
 	if (c->set & API_C_BETA_RATE)
-		api_add_number(o, "beta_rate", c->beta_rate);
+		api_add_number(o, "beta_rate", c->beta_rate.user);
 	if (c->set & API_C_ROTATION)
 		cJSON_AddStringToObject(o, "rotation",
 					c->rotation == SIM_CW ? "cw" : "ccw");
@@ -163,9 +159,9 @@ static cJSON *status_object(const api_view *v)
 	cJSON *o = cJSON_CreateObject();
 	api_add_number(o, "t", st->t);
 	api_add_number(o, "t_integrator", st->t_int);
-	api_add_number(o, "beta", st->beta * DEG_PER_RAD);
-	api_add_number(o, "beta_target", st->beta_target * DEG_PER_RAD);
-	api_add_number(o, "beta_dot", st->beta_dot * DEG_PER_RAD);
+	api_add_number(o, "beta", api_user_of("beta", st->beta));
+	api_add_number(o, "beta_target", api_user_of("beta", st->beta_target));
+	api_add_number(o, "beta_dot", api_user_of("beta_rate", st->beta_dot));
 	cJSON_AddStringToObject(o, "rotation",
 				st->rotation == SIM_CW ? "cw" : "ccw");
 	cJSON_AddBoolToObject(o, "drive_on", st->drive_on);
@@ -173,7 +169,14 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(o, "rotor_speed", st->rotor_speed);
 	api_add_number(o, "motor_torque", st->motor_torque);
 	api_add_number(o, "power", st->power);
+	/* means over the transport estimate's whole periods (null before one) */
+	api_add_number(o, "rotor_speed_mean", st->rotor_speed_mean);
+	api_add_number(o, "motor_torque_mean", st->motor_torque_mean);
+	api_add_number(o, "power_mean", st->power_mean);
 	api_add_number(o, "transport_velocity", st->transport_velocity);
+	api_add_number(o, "transport_velocity_uncertainty",
+		       st->transport_velocity_uncertainty);
+	cJSON_AddBoolToObject(o, "steady", st->steady);
 	api_add_number(o, "transport_periods", st->transport_periods);
 	api_add_number(o, "feed_velocity", st->feed_velocity);
 	api_add_number(o, "feed_displacement", st->feed_displacement);

@@ -102,6 +102,54 @@ api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
 	return from_sim_set(rc, field, msg, pb);
 }
 
+api_err api_user_value(const api_spec *spec, const char *name, double user,
+		       const char *field, api_value *out, api_problem *pb)
+{
+	const sim_setting *set = sim_setting_find(name);
+	if (!set)
+		return api_fail(pb, API_UNKNOWN, field, "unknown setting \"%s\"",
+				name);
+	double si = sim_setting_to_si(set, user);
+	sim_params p = spec->params;
+	sim_scene s = spec->scene;
+	sim_method m = spec->method;
+	char msg[256] = "";
+	int rc = sim_set(&p, &s, &m, name, si, msg, sizeof msg);
+	if (rc != SIM_OK) {
+		/* the range comes with the setting's name; the field is the
+		 * member's path */
+		if (!msg[0])
+			snprintf(msg, sizeof msg, "%s", sim_strerror(rc));
+		if (strcmp(field, name) == 0)
+			api_fail(pb, api_from_sim(rc), name, "%s", msg);
+		else
+			api_fail(pb, api_from_sim(rc), name, "%s: %s", field, msg);
+		snprintf(pb->field, sizeof pb->field, "%s", field);
+		return pb->code;
+	}
+	out->si = si;
+	out->user = user;
+	return API_OK;
+}
+
+api_err api_parse_user_value(const api_spec *spec, const char *name,
+			     const cJSON *it, const char *field,
+			     api_value *out, api_problem *pb)
+{
+	if (!cJSON_IsNumber(it)) {
+		const sim_setting *set = sim_setting_find(name);
+		return api_fail(pb, API_TYPE, field, "%s must be a number (%s)",
+				field, set && set->unit ? set->unit : "");
+	}
+	return api_user_value(spec, name, it->valuedouble, field, out, pb);
+}
+
+double api_user_of(const char *name, double si)
+{
+	const sim_setting *set = sim_setting_find(name);
+	return set ? sim_setting_from_si(set, si) : si;
+}
+
 api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)
 {
 	static const char *const groups[] = {"params", "scene", "integrator"};

@@ -14,7 +14,6 @@
 #include <string.h>
 
 #include "json_int.h"
-#include "units.h"
 
 
 /* Bounded writer into a fixed buffer. */
@@ -107,8 +106,8 @@ size_t api_record_max(int columns, int layers)
 static void sample_body(writer *w, const api_sample *s, unsigned f)
 {
 	const sim_status *st = &s->st;
-	w_num(w, "beta", st->beta * DEG_PER_RAD);
-	w_num(w, "beta_target", st->beta_target * DEG_PER_RAD);
+	w_num(w, "beta", api_user_of("beta", st->beta));
+	w_num(w, "beta_target", api_user_of("beta", st->beta_target));
 	if (f & API_F_TROUGH) {
 		w_num(w, "x", st->q[0]);
 		w_num(w, "y", st->q[1]);
@@ -144,6 +143,9 @@ static void sample_body(writer *w, const api_sample *s, unsigned f)
 		w_num(w, "feed_displacement", st->feed_displacement);
 		w_num(w, "feed_velocity", st->feed_velocity);
 		w_num(w, "transport_velocity", st->transport_velocity);
+		w_num(w, "transport_velocity_uncertainty",
+		      st->transport_velocity_uncertainty);
+		w_str(w, st->steady ? ",\"steady\":true" : ",\"steady\":false");
 		w_array(w, "columns", s->column_disp, s->columns);
 	}
 	if (f & API_F_ENERGY) {
@@ -248,7 +250,8 @@ const char *const api_history_names[API_HISTORY_COLS] = {
 void api_history_row(const sim_status *st, double *row)
 {
 	const double v[API_HISTORY_COLS] = {
-		st->t,           st->beta * DEG_PER_RAD,    st->beta_target * DEG_PER_RAD,
+		st->t,           api_user_of("beta", st->beta),
+		api_user_of("beta", st->beta_target),
 		st->q[0],        st->q[1],          st->q[2],
 		st->deck[0],     st->deck[1],       st->rotor_speed,
 		st->motor_torque, st->q[4],         st->q[5],

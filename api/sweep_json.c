@@ -13,22 +13,8 @@
 #include <string.h>
 
 #include "json_int.h"
-#include "units.h"
 
-static api_err check_beta(const api_spec *spec, const char *field, double v,
-			  api_problem *pb)
-{
-	sim_params p = spec->params;
-	sim_scene s = spec->scene;
-	sim_method m = spec->method;
-	char msg[256] = "";
-	int rc = sim_set_user(&p, &s, &m, "beta", v, msg, sizeof msg);
-	if (rc == SIM_OK)
-		return API_OK;
-	api_fail(pb, api_from_sim(rc), "beta", "%s: %s", field, msg);
-	snprintf(pb->field, sizeof pb->field, "%s", field);
-	return pb->code;
-}
+#define T_END_MAX 600.0 /* s simulated per point, at most */
 
 static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 			  api_problem *pb)
@@ -41,8 +27,12 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 		if (!req->betas)
 			return api_fail(pb, API_UNAVAILABLE, NULL,
 					"out of memory");
-		for (int i = 0; i < 19; i++)
-			req->betas[i] = 10.0 * i;
+		for (int i = 0; i < 19; i++) {
+			api_err e = api_user_value(&req->spec, "beta", 10.0 * i,
+						   "beta", &req->betas[i], pb);
+			if (e != API_OK)
+				return e;
+		}
 		return API_OK;
 	}
 	if (cJSON_IsArray(it)) {
@@ -58,15 +48,11 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 		int i = 0;
 		for (const cJSON *b = it->child; b; b = b->next, i++) {
 			snprintf(field, sizeof field, "beta[%d]", i);
-			if (!cJSON_IsNumber(b))
-				return api_fail(pb, API_TYPE, field,
-						"%s must be a number (deg)",
-						field);
-			api_err e = check_beta(&req->spec, field,
-					       b->valuedouble, pb);
+			api_err e = api_parse_user_value(&req->spec, "beta", b,
+							 field, &req->betas[i],
+							 pb);
 			if (e != API_OK)
 				return e;
-			req->betas[i] = b->valuedouble;
 		}
 		req->nbeta = n;
 		return API_OK;
@@ -86,8 +72,10 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 			return api_fail(pb, API_TYPE, field,
 					"%s must be a number (deg)", field);
 		g[k] = v->valuedouble;
+		api_value checked;
 		if (k < 2)
-			e = check_beta(&req->spec, field, g[k], pb);
+			e = api_user_value(&req->spec, "beta", g[k], field,
+					   &checked, pb);
 	}
 	if (e != API_OK)
 		return e;
@@ -104,9 +92,10 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 	req->betas = malloc((size_t)req->nbeta * sizeof *req->betas);
 	if (!req->betas)
 		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
-	for (int i = 0; i < req->nbeta; i++)
-		req->betas[i] = g[0] + i * g[2];
-	return API_OK;
+	for (int i = 0; i < req->nbeta && e == API_OK; i++)
+		e = api_user_value(&req->spec, "beta", g[0] + i * g[2], "beta",
+				   &req->betas[i], pb);
+	return e;
 }
 
 static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
@@ -142,6 +131,37 @@ static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
 	return API_OK;
 }
 
+/* t_end: simulated seconds per point, past scene.transient (the estimate
+ * starts there), default API_SWEEP_WINDOW after it. */
+static api_err parse_t_end(const cJSON *te, const sim_scene *scene,
+			   double *t_end, api_problem *pb)
+{
+	const double lo = scene->transient, hi = T_END_MAX;
+	*t_end = fmin(scene->transient + API_SWEEP_WINDOW, hi);
+	if (!(lo < hi)) {
+		api_fail(pb, API_RANGE, "scene.transient",
+			 "scene.transient = %g s leaves no time to measure: a "
+			 "sweep runs at most %g s per point", lo, hi);
+		pb->has_range = 1, pb->min = 0, pb->max = hi;
+		return API_RANGE;
+	}
+	if (!te)
+		return API_OK;
+	if (!cJSON_IsNumber(te))
+		return api_fail(pb, API_TYPE, "t_end",
+				"t_end must be a number (s)");
+	if (!(te->valuedouble > lo && te->valuedouble <= hi)) {
+		api_fail(pb, API_RANGE, "t_end",
+			 "t_end must exceed scene.transient = %g s (the "
+			 "transport velocity is measured after it) and be at "
+			 "most %g s", lo, hi);
+		pb->has_range = 1, pb->min = lo, pb->max = hi;
+		return API_RANGE;
+	}
+	*t_end = te->valuedouble;
+	return API_OK;
+}
+
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
@@ -155,10 +175,9 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 	api_err e = api_apply_model(root, &req->spec, pb);
 	if (e == API_OK)
 		e = api_validate_spec(&req->spec, pb);
-	req->t_end = 5.0;
 	const cJSON *te = cJSON_GetObjectItemCaseSensitive(root, "t_end");
-	if (e == API_OK && te)
-		e = api_parse_real(te, "t_end", 0.01, 600, 0, &req->t_end, pb);
+	if (e == API_OK)
+		e = parse_t_end(te, &req->spec.scene, &req->t_end, pb);
 	if (e == API_OK)
 		e = parse_grid(cJSON_GetObjectItemCaseSensitive(root, "beta"),
 			       req, pb);
@@ -199,21 +218,26 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	for (size_t i = 0; points && i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		cJSON *po = cJSON_CreateObject();
-		api_add_number(po, "beta", p->beta);
+		api_add_number(po, "beta", p->beta.user);
 		cJSON_AddStringToObject(po, "rotation",
 					p->rotation == SIM_CW ? "cw" : "ccw");
 		cJSON_AddStringToObject(po, "state", point_state(p->state));
-		if (p->state == 2)
+		if (p->state == 2) {
 			api_add_number(po, "velocity", p->velocity);
-		else
+			api_add_number(po, "uncertainty", p->uncertainty);
+			cJSON_AddBoolToObject(po, "steady", p->steady);
+		} else {
 			cJSON_AddNullToObject(po, "velocity");
+			cJSON_AddNullToObject(po, "uncertainty");
+			cJSON_AddNullToObject(po, "steady");
+		}
 		if (p->error[0])
 			cJSON_AddStringToObject(po, "error", p->error);
 		cJSON_AddItemToArray(pts, po);
 		if (p->state == 2) {
 			cJSON *pair = cJSON_CreateArray();
 			cJSON_AddItemToArray(pair,
-					     cJSON_CreateNumber(p->beta));
+					     cJSON_CreateNumber(p->beta.user));
 			cJSON_AddItemToArray(
 				pair, isfinite(p->velocity)
 					      ? cJSON_CreateNumber(p->velocity)
@@ -247,13 +271,18 @@ char *api_sweep_list_json(const api_sweep_view *v, size_t n)
 char *api_sweep_csv(const api_sweep_view *v)
 {
 	api_buf b = {0};
-	api_buf_puts(&b, "beta,rotation,velocity,state\n");
+	api_buf_puts(&b, "beta,rotation,velocity,uncertainty,steady,state\n");
 	for (size_t i = 0; i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
-		api_buf_double(&b, p->beta);
+		int done = p->state == 2;
+		api_buf_double(&b, p->beta.user);
 		api_buf_puts(&b, p->rotation == SIM_CW ? ",cw," : ",ccw,");
-		if (p->state == 2 && isfinite(p->velocity))
+		if (done && isfinite(p->velocity))
 			api_buf_double(&b, p->velocity);
+		api_buf_put(&b, ",", 1);
+		if (done && isfinite(p->uncertainty))
+			api_buf_double(&b, p->uncertainty);
+		api_buf_puts(&b, !done ? "," : p->steady ? ",true" : ",false");
 		api_buf_printf(&b, ",%s\n", point_state(p->state));
 	}
 	return api_buf_take(&b);

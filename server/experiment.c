@@ -124,7 +124,7 @@ static srv_cmd *start_segment(srv_experiment *e, int i, const sim_status *st)
 	memset(cmd, 0, sizeof *cmd);
 	cmd->c.set = API_C_BETA;
 	cmd->c.beta = seg->beta;
-	if (e->req.beta_rate > 0) {
+	if (e->req.beta_rate.si > 0) {
 		cmd->c.set |= API_C_BETA_RATE;
 		cmd->c.beta_rate = e->req.beta_rate;
 	}
@@ -141,7 +141,10 @@ static void finish_segment(srv_experiment *e, const sim_status *st)
 {
 	api_segment *seg = &e->req.seg[e->cur];
 	seg->t_end = st->t;
+	/* the estimator restarted at the segment's command */
 	seg->mean_velocity = st->transport_velocity;
+	seg->uncertainty = st->transport_velocity_uncertainty;
+	seg->steady = st->steady;
 	double half = seg->t_command + 0.5 * (seg->t_end - seg->t_command);
 	double sum = 0;
 	size_t n = 0;
@@ -283,7 +286,7 @@ int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 		char why[200];
 		snprintf(why, sizeof why,
 			 "segment %d: the session refused beta = %g deg: %s",
-			 e->cur, seg->beta, sim_strerror(cmd->rc));
+			 e->cur, seg->beta.user, sim_strerror(cmd->rc));
 		srv_log(SRV_LOG_WARN, "experiment %s: %s", e->entry.id, why);
 		abort_locked(e, why);
 	} else {

@@ -19,7 +19,6 @@
 #include "pool.h"
 #include "registry.h"
 #include "sweep.h"
-#include "units.h"
 #include "util.h"
 
 typedef struct srv_sweep {
@@ -116,12 +115,11 @@ static void run_point(void *arg)
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
 		sim_measurement r;
-		int rc = sim_set_user(&spec.params, &spec.scene, &spec.method,
-				 "beta", p->beta, msg, sizeof msg);
+		/* beta was checked and converted to SI by api/ */
+		spec.params.beta = p->beta.si;
 		spec.params.rotation = p->rotation;
-		if (rc == SIM_OK)
-			rc = sim_measure(&spec.params, &spec.scene, &spec.method,
-					 sw->req.t_end, &r, msg, sizeof msg);
+		int rc = sim_measure(&spec.params, &spec.scene, &spec.method,
+				     sw->req.t_end, &r, msg, sizeof msg);
 		pthread_mutex_lock(&sw->lock);
 		sw->running--;
 		if (rc == SIM_OK) {

@@ -32,7 +32,6 @@
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
-#include "units.h"
 #include "util.h"
 
 /* Wall-clock anchors of pacing and metering. */
@@ -210,13 +209,12 @@ static int apply_commands(srv_session *s)
 		double t_eff = sim_effective_time(s->sim);
 		int rc = SIM_OK;
 		if (c->set & (API_C_BETA | API_C_BETA_RATE)) {
-			double target = (c->set & API_C_BETA)
-						? c->beta
-						: s->st.beta_target * DEG_PER_RAD;
+			/* SI from api/; a rate alone keeps the target */
+			double target = (c->set & API_C_BETA) ? c->beta.si
+							      : s->st.beta_target;
 			double rate =
-				(c->set & API_C_BETA_RATE) ? c->beta_rate : 0;
-			rc = sim_set_beta(s->sim, sim_rad_from_deg(target),
-					  sim_rad_from_deg(rate));
+				(c->set & API_C_BETA_RATE) ? c->beta_rate.si : 0;
+			rc = sim_set_beta(s->sim, target, rate);
 		}
 		if (rc == SIM_OK && (c->set & API_C_ROTATION))
 			rc = sim_set_rotation(s->sim, c->rotation);

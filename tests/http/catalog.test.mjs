@@ -48,6 +48,31 @@ test('OpenAPI 3.1 document', { timeout: 10000 * SLOW }, async () => {
   const params = r.body.components.schemas.Params.properties;
   assert.equal(params.k_s1.type, 'number');
   assert.deepEqual(params.rotation.enum, ['cw', 'ccw']);
+  // every $ref names a schema, response or parameter the document has
+  const refs = [];
+  const walk = (v) => {
+    if (!v || typeof v !== 'object') return;
+    if (typeof v.$ref === 'string') refs.push(v.$ref);
+    for (const x of Object.values(v)) walk(x);
+  };
+  walk(r.body);
+  assert.ok(refs.length > 10);
+  for (const ref of refs) {
+    const m = ref.match(/^#\/components\/(schemas|responses|parameters)\/(\w+)$/);
+    assert.ok(m && r.body.components[m[1]][m[2]], `unresolved ${ref}`);
+  }
+  const { schemas } = r.body.components;
+  assert.deepEqual(schemas.Scene.properties.start.enum, ['rest', 'steady']);
+  assert.equal(schemas.Scene.properties.start.default, 'steady');
+  assert.equal(schemas.Scene.properties.transient.default, 0);
+  const status = schemas.Status.properties;
+  for (const k of ['transport_velocity', 'transport_velocity_uncertainty', 'rotor_speed_mean',
+    'motor_torque_mean', 'power_mean']) assert.deepEqual(status[k].type, ['number', 'null'], k);
+  assert.equal(status.steady.type, 'boolean');
+  const point = schemas.Sweep.properties.points.items.properties;
+  assert.ok(point.uncertainty && point.steady);
+  const segment = schemas.Experiment.properties.segments.items.properties;
+  assert.ok(segment.uncertainty && segment.steady && segment.mean_velocity);
 });
 
 test('static files: index at /, types by extension, no traversal', { timeout: 10000 * SLOW }, async () => {

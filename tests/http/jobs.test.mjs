@@ -1,11 +1,13 @@
 // Experiments (a beta schedule with per-segment steady velocity and
 // reversal time) and sweeps (v(beta) for both rotations on the pool).
+// Where a job runs the czubak2016 defaults at a clockwise peak, its
+// velocity is checked against the converged reference (sessions.test.mjs).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, CHEAP, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, until, near, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 let d;
 before(async () => { d = await startDaemon(); });
@@ -29,12 +31,21 @@ test('experiment on a fresh session: 38 -> 128 deg reverses the feed', { timeout
   assert.equal(done.progress, 1);
   const [a, b] = done.segments;
   assert.equal(a.t_command, 0);
-  assert.equal(b.t_command, 3);
+  // the integrator's time (a sum of whole steps): 3 s up to round-off
+  near(b.t_command, 3, 1e-9, 'second command');
   assert.equal(b.t_end, 6);
   assert.ok(a.steady_velocity > 0.05, `38 deg: ${a.steady_velocity}`);
   assert.ok(b.steady_velocity < -0.05, `128 deg: ${b.steady_velocity}`);
   // the reversal is quick: the ramp at 180 deg/s takes 0.5 s
   assert.ok(b.reversal_time > 0.1 && b.reversal_time < 2.5, `reversal ${b.reversal_time}`);
+  for (const seg of done.segments) {
+    assert.equal(typeof seg.uncertainty, 'number');
+    assert.equal(typeof seg.steady, 'boolean');
+  }
+  // the mean over the second segment spans the reversal, far from its
+  // steady value: its error bar says so
+  assert.ok(b.uncertainty > 0.01, `uncertainty over the reversal ${b.uncertainty}`);
+  assert.ok(a.uncertainty < 0.005, `uncertainty without a reversal ${a.uncertainty}`);
   const s = await req(d.base, 'GET', `/api/v1/sessions/${done.session}`);
   assert.equal(s.body.state, 'finished');
   assert.equal(s.body.experiment, null);
@@ -58,7 +69,7 @@ test('experiment on an existing session; a second one is 409', { timeout: 60000 
     return g.body.state === 'done' && g.body;
   }, 40000, 'the experiment');
   assert.equal(done.t_start, 1);
-  assert.equal(done.segments[0].t_command, 1);
+  near(done.segments[0].t_command, 1, 1e-9, 'first command'); // integrator time, as above
   assert.equal(done.segments[1].t_end, 5);
   assert.ok(done.segments[0].steady_velocity < 0);
   assert.ok(done.segments[1].steady_velocity > 0);
@@ -85,12 +96,19 @@ test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, as
   assert.ok(v(38, 'cw') > 0.05, `cw 38: ${v(38, 'cw')}`);
   assert.ok(v(128, 'cw') < -0.05, `cw 128: ${v(128, 'cw')}`);
   assert.equal(done.series.cw.length, 2);
+  for (const p of done.points) {
+    assert.ok(Number.isFinite(p.uncertainty) && p.uncertainty > 0, `uncertainty ${p.uncertainty}`);
+    assert.equal(typeof p.steady, 'boolean');
+  }
   const csv = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`);
   assert.equal(csv.headers.get('content-type'), 'text/csv');
   const lines = csv.text.trim().split('\n');
-  assert.equal(lines[0], 'beta,rotation,velocity,state');
+  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state');
   assert.equal(lines.length, 5);
-  assert.equal(Number(lines[1].split(',')[2]), v(38, 'cw'));
+  const first = lines[1].split(',');
+  const p0 = done.points[0];
+  assert.deepEqual(first, [String(p0.beta), p0.rotation, String(p0.velocity), String(p0.uncertainty),
+    String(p0.steady), 'done']);
   const bad = await req(d.base, 'POST', '/api/v1/sweeps', { rotations: ['up'] });
   assert.equal(bad.status, 422);
   const bad2 = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [10, 'x'] });
@@ -98,6 +116,76 @@ test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, as
   assert.equal(bad2.body.field, 'beta[1]');
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${r.body.id}`)).status, 204);
   assert.equal((await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}`)).status, 404);
+});
+
+test('sweep of the defaults at the clockwise peaks: t_end = transient + 4 s, v within 1 % and its error bar', { timeout: 60000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [30, 135], rotations: ['cw'] });
+  assert.equal(r.status, 202, r.text);
+  assert.equal(r.body.t_end, 4); // the preset's transient is 0
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}`);
+    return g.body.state === 'done' && g.body;
+  }, 50000, 'the sweep');
+  for (const [beta, vRef] of [[30, 0.152557], [135, -0.147252]]) {
+    const p = done.points.find((q) => q.beta === beta);
+    assert.equal(p.state, 'done', p.error);
+    near(p.velocity, vRef, 0.01 * Math.abs(vRef), `sweep at ${beta} deg against 1 % of v_ref`);
+    near(p.velocity, vRef, p.uncertainty, `sweep at ${beta} deg against its error bar`);
+    assert.equal(p.steady, true);
+  }
+  // a transient moves the default window with it
+  const later = await req(d.base, 'POST', '/api/v1/sweeps', { scene: { transient: 1.5 }, beta: [90], rotations: ['cw'] });
+  assert.equal(later.status, 202, later.text);
+  assert.equal(later.body.t_end, 5.5);
+  await req(d.base, 'DELETE', `/api/v1/sweeps/${later.body.id}`);
+  await req(d.base, 'DELETE', `/api/v1/sweeps/${r.body.id}`);
+});
+
+test('a sweep whose t_end does not pass the transient is refused whole', { timeout: 20000 * SLOW }, async () => {
+  const before = (await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps.length;
+  for (const [body, transient] of [[{ t_end: 0 }, 0], [{ scene: { transient: 2 }, t_end: 2 }, 2],
+    [{ scene: { transient: 2 }, t_end: 1, beta: [30] }, 2]]) {
+    const r = await req(d.base, 'POST', '/api/v1/sweeps', body);
+    assert.equal(r.status, 422, r.text);
+    assert.match(r.headers.get('content-type'), /^application\/problem\+json/);
+    assert.deepEqual(r.body, {
+      type: '/api/v1/problems/out-of-range',
+      title: 'Value out of range',
+      status: 422,
+      detail: `t_end must exceed scene.transient = ${transient} s (the transport velocity is measured after it) and be at most 600 s`,
+      instance: '/api/v1/sweeps',
+      field: 't_end',
+      min: transient,
+      max: 600,
+    });
+  }
+  const wrong = await req(d.base, 'POST', '/api/v1/sweeps', { t_end: '5' });
+  assert.equal(wrong.status, 400);
+  assert.equal(wrong.body.field, 't_end');
+  assert.equal((await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps.length, before, 'nothing was started');
+});
+
+test('experiment at a clockwise peak: the segment\'s mean velocity, its error bar and steady flag', { timeout: 60000 * SLOW }, async () => {
+  // the session starts at 30 deg and the segment commands 30 deg: no ramp,
+  // the estimator restarts at the command
+  const r = await req(d.base, 'POST', '/api/v1/experiments', {
+    session: { params: { beta: 30 } },
+    schedule: [{ beta: 30, until: 4 }],
+  });
+  assert.equal(r.status, 201, r.text);
+  assert.equal(r.body.segments[0].uncertainty, null);
+  assert.equal(r.body.segments[0].steady, null);
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`);
+    return ['done', 'aborted'].includes(g.body.state) && g.body;
+  }, 50000, 'the experiment');
+  assert.equal(done.state, 'done', done.error);
+  const [seg] = done.segments;
+  const vRef = 0.152557;
+  near(seg.mean_velocity, vRef, 0.01 * vRef, 'mean_velocity against 1 % of v_ref');
+  near(seg.mean_velocity, vRef, seg.uncertainty, 'mean_velocity against its error bar');
+  assert.equal(seg.steady, true);
+  await req(d.base, 'DELETE', `/api/v1/sessions/${done.session}`);
 });
 
 test('a sweep can be cancelled while queued', { timeout: 60000 * SLOW }, async () => {

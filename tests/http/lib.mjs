@@ -60,6 +60,13 @@ export async function req(base, method, path, body, headers = {}) {
   return { status: res.status, headers: res.headers, body: parsed, text };
 }
 
+// |actual - expected| <= tol, with both in the message.
+export function near(actual, expected, tol, what = 'value') {
+  if (!(Math.abs(actual - expected) <= tol)) {
+    throw new Error(`${what}: ${actual} is not within ${tol} of ${expected}`);
+  }
+}
+
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // Poll fn until it returns a truthy value or the time runs out.

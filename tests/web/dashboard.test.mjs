@@ -111,6 +111,10 @@ test('a session starts from the form', async () => {
 	await page.fill('input[name="columns"]', '5');
 	await page.fill('input[name="beta"]', '38');
 	await page.selectOption('select[name="rotation"]', 'cw');
+	/* start: steady (on the forced response, the default) or rest (the paper's run-up) */
+	assert.deepEqual(await page.$$eval('select[name="scene_start"] option', o => o.map(x => x.value)), ['steady', 'rest']);
+	assert.equal(await page.$eval('select[name="scene_start"]', e => e.value), 'steady');
+	await page.selectOption('select[name="scene_start"]', 'steady');
 	await page.fill('input[name="pace"]', PACE);
 	await page.fill('input[name="rate"]', '500');
 	await page.click('#start');
@@ -119,6 +123,7 @@ test('a session starts from the form', async () => {
 	assert.equal(s.id, sessionId);
 	assert.equal(s.columns, 5);
 	assert.equal(s.layers, 2);
+	assert.equal(s.spec.scene.start, 'steady');
 	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
 });
 
@@ -143,6 +148,18 @@ test('β = 38°, clockwise: the page shows transport to the right', async () => 
 	const text = await page.$eval('#v-value', e => e.textContent);
 	assert.match(text, /^\+\d\.\d{3} m\/s$/);
 	assert.equal(await page.$eval('#schematic', e => e.dataset.direction), 'right');
+	/* the daemon's estimate with its error bar, and "steady" once it has
+	 * settled (the steady start needs no transient) */
+	const shown = await until(async () => {
+		const d = await page.$eval('#v-daemon', e => e.textContent);
+		const mark = await page.$eval('#v-steady', e => e.dataset.steady);
+		return /^\+0\.\d{3} ± 0\.\d{3} m\/s$/.test(d) && mark === 'steady' ? { d, mark } : null;
+	}, 30000, 'the daemon estimate ± its error bar, steady');
+	assert.equal(await page.$eval('#v-steady', e => e.textContent), 'steady');
+	const st = (await apiGet(`/api/v1/sessions/${sessionId}`)).status;
+	assert.equal(typeof st.transport_velocity_uncertainty, 'number');
+	const [v, u] = shown.d.split(' ± ').map(Number.parseFloat);
+	assert.ok(Math.abs(v - st.transport_velocity) < 0.01 && u > 0, `shown ${shown.d}, API ${st.transport_velocity}`);
 });
 
 test('moving the β slider turns the session to 128° and reverses the shown direction', async () => {
@@ -210,19 +227,24 @@ test('a sweep draws v(β) for both rotations', async () => {
 	await page.fill('#sweep-form input[name="from"]', '30');
 	await page.fill('#sweep-form input[name="to"]', '130');
 	await page.fill('#sweep-form input[name="step"]', '50');
-	await page.fill('#sweep-form input[name="t_end"]', '3'); /* past the preset's 2 s transient */
+	await page.fill('#sweep-form input[name="t_end"]', '3'); /* past the preset's transient (0 s) */
 	await page.click('#sweep-run');
 	await until(async () => await count('#plot-sweep') >= 6, 60000, 'six sweep points');
+	/* columns: beta, then v, u and steady/settling for each rotation */
 	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));
 	assert.deepEqual(rows.map(r => r[0]), ['30.0', '80.0', '130.0']);
-	const v = rows.map(r => [Number(r[1]), Number(r[2])]);
+	const v = rows.map(r => [Number(r[1]), Number(r[4])]);
 	assert.ok(v.flat().every(Number.isFinite), `sweep table ${JSON.stringify(rows)}`);
+	const u = rows.map(r => [Number(r[2]), Number(r[5])]);
+	assert.ok(u.flat().every(x => x > 0), `sweep table ${JSON.stringify(rows)}`);
+	assert.ok(rows.every(r => ['steady', 'settling'].includes(r[3]) && ['steady', 'settling'].includes(r[6])),
+		`sweep table ${JSON.stringify(rows)}`);
 	/* the CSV link serves the same six points */
 	const href = await page.$eval('#sweep-csv', a => a.hidden ? null : a.getAttribute('href'));
 	assert.match(href, /^\/api\/v1\/sweeps\/[^/?]+\?format=csv$/);
 	const csv = (await (await fetch(base + href)).text()).trim().split('\n');
 	assert.equal(csv.length, 7, csv.join('\n'));
-	assert.match(csv[0], /^beta,rotation,/);
+	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state');
 });
 
 test('a β-change experiment reports its reversal time', async () => {
@@ -231,6 +253,8 @@ test('a β-change experiment reports its reversal time', async () => {
 	await page.fill('#experiment-form input[name="t_switch"]', '1.5');
 	await page.fill('#experiment-form input[name="t_end"]', '4');
 	await page.uncheck('#experiment-form input[name="watch"]');
+	/* the experiment's fresh session takes the form's start: the run-up */
+	await page.selectOption('select[name="scene_start"]', 'rest');
 	await page.click('#experiment-run');
 	const shown = await until(async () => {
 		const t = await page.$eval('#reversal-time', e => e.textContent);
@@ -238,6 +262,11 @@ test('a β-change experiment reports its reversal time', async () => {
 	}, 60000, 'a reversal time');
 	assert.ok(Number.parseFloat(shown) > 0);
 	assert.ok(await count('#plot-experiment') > 0);
+	const [exp] = (await apiGet('/api/v1/experiments')).experiments;
+	assert.equal((await apiGet(`/api/v1/sessions/${exp.session}`)).spec.scene.start, 'rest');
+	const table = await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[4].textContent));
+	assert.ok(table.every(t => /^[+-]?\d\.\d{3} ± \d\.\d{3}/.test(t)), `mean v ± u: ${table}`);
+	await page.selectOption('select[name="scene_start"]', 'steady');
 });
 
 test('screenshot of the dashboard', async () => {

@@ -5,7 +5,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import * as api from '../../web/js/api.js';
 import { Trace, slope, recentVelocity } from '../../web/js/series.js';
-import { fmt, fmtVelocity, direction, wrapBeta, parsePace, problemText } from '../../web/js/format.js';
+import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText } from '../../web/js/format.js';
 import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
 
 const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
@@ -13,16 +13,22 @@ const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != 
 test('session document maps to the page model', () => {
 	const s = api.normalizeSession({
 		id: 'a7', state: 'paused', preset: 'czubak2016', pace: 'max', columns: 5, layers: 8,
-		status: { t: 2.5, beta: 38, beta_target: 128, rotation: 'cw', rotor_speed: -157.08,
-			transport_velocity: 0.12, rtf: 4.5, steps_per_s: 2e5, reductions: ['symmetric', 'ideal_drive'] },
+		spec: { scene: { start: 'steady' } },
+		status: { t: 2.5, beta: 38, beta_target: 128, rotation: 'cw', rotor_speed: 157.08,
+			transport_velocity: 0.12, transport_velocity_uncertainty: 0.002, steady: true,
+			rotor_speed_mean: 156.9, rtf: 4.5, steps_per_s: 2e5, reductions: ['symmetric', 'ideal_drive'] },
 	});
 	assert.equal(s.id, 'a7');
 	assert.equal(s.t, 2.5);
 	assert.equal(s.beta, 38);
 	assert.equal(s.betaTarget, 128);
 	assert.equal(s.rotation, 'cw');
-	assert.equal(s.rotorSpeed, -157.08);
+	assert.equal(s.rotorSpeed, 157.08);
 	assert.equal(s.transportVelocity, 0.12);
+	assert.equal(s.transportUncertainty, 0.002);
+	assert.equal(s.steady, true);
+	assert.equal(s.rotorSpeedMean, 156.9);
+	assert.equal(s.start, 'steady');
 	assert.equal(s.running, false);
 	assert.equal(s.pace, 'max');
 	assert.equal(s.realTimeFactor, 4.5);
@@ -34,12 +40,15 @@ test('a session without status yet gives NaN, not zeros', () => {
 	const s = api.normalizeSession({ id: 'b', state: 'running', status: null });
 	assert.ok(Number.isNaN(s.t));
 	assert.ok(Number.isNaN(s.beta));
+	assert.ok(Number.isNaN(s.transportUncertainty));
+	assert.equal(s.steady, undefined);
 	assert.equal(s.running, true);
 });
 
 test('stream sample maps flat members to vectors; null becomes NaN', () => {
 	const s = api.normalizeSample({ t: 1.25, beta: 40, x: 1e-3, y: -2e-3, alpha: 0, deck_x: 3e-3, deck_y: 4e-3,
-		rotor_speed: -150, s1: 0.004, s2: null, columns: [0.1, 0.2, 0.3], feed_velocity: 0.2 }, '17');
+		rotor_speed: 150, s1: 0.004, s2: null, columns: [0.1, 0.2, 0.3], feed_velocity: 0.2,
+		transport_velocity_uncertainty: null, steady: false }, '17');
 	assert.equal(s.index, 17);
 	assert.deepEqual(s.deck, [3e-3, 4e-3]);
 	assert.deepEqual(s.trough, [1e-3, -2e-3, 0]);
@@ -47,6 +56,8 @@ test('stream sample maps flat members to vectors; null becomes NaN', () => {
 	assert.ok(Number.isNaN(s.strokes[1]));
 	close(s.feedMean, 0.2, 1e-15);   /* mean of the columns when feed_displacement is absent */
 	assert.equal(s.feedVelocity, 0.2);
+	assert.ok(Number.isNaN(s.transportUncertainty));
+	assert.equal(s.steady, false);
 	const bare = api.normalizeSample({ t: 0 });
 	assert.deepEqual(bare.deck, []);
 	assert.deepEqual(bare.columns, []);
@@ -63,13 +74,16 @@ test('control event and PATCH answer give beta and effective time', () => {
 
 test('sweep points from a list, and from per-rotation columns', () => {
 	const j = api.normalizeSweep({ id: 'w1', state: 'running', total: 4, done: 2, progress: 0.5, points: [
-		{ beta: 30, rotation: 'cw', state: 'done', velocity: 0.1 },
+		{ beta: 30, rotation: 'cw', state: 'done', velocity: 0.1, uncertainty: 0.002, steady: true },
 		{ beta: 30, rotation: 'ccw', state: 'done', velocity: -0.02 },
 		{ beta: 60, rotation: 'cw', state: 'pending', velocity: null }] });
 	assert.equal(j.progress, 0.5);
 	assert.equal(j.done, false);
 	assert.equal(j.points.length, 3);
 	assert.ok(Number.isNaN(j.points[2].v));
+	assert.equal(j.points[0].u, 0.002);
+	assert.equal(j.points[0].steady, true);
+	assert.equal(j.points[1].u, undefined);
 	const k = api.sweepPoints({ cw: { beta: [0, 10], v: [0.01, 0.05] } });
 	assert.deepEqual(k, [{ beta: 0, rotation: 'cw', v: 0.01 }, { beta: 10, rotation: 'cw', v: 0.05 }]);
 	assert.equal(api.normalizeSweep({ state: 'done' }).done, true);
@@ -79,13 +93,18 @@ test('sweep points from a list, and from per-rotation columns', () => {
 test('experiment segments carry steady velocity and reversal time', () => {
 	const e = api.normalizeExperiment({ id: 'e1', session: 's9', state: 'done', progress: 1, t: 6, segments: [
 		{ beta: 38, until: 3, state: 'done', t_command: 0, t_end: 3, steady_velocity: 0.15, reversal_time: null },
-		{ beta: 128, until: 6, state: 'done', t_command: 3, t_end: 6, steady_velocity: -0.14, reversal_time: 0.42 }] });
+		{ beta: 128, until: 6, state: 'done', t_command: 3, t_end: 6, steady_velocity: -0.14, reversal_time: 0.42,
+			mean_velocity: -0.11, uncertainty: 0.03, steady: false }] });
 	assert.equal(e.sessionId, 's9');
 	assert.equal(e.done, true);
 	assert.equal(e.segments[1].v, -0.14);
 	assert.equal(e.segments[1].reversalTime, 0.42);
 	assert.equal(e.segments[1].tStart, 3);
 	assert.ok(Number.isNaN(e.segments[0].reversalTime));
+	assert.equal(e.segments[1].meanVelocity, -0.11);
+	assert.equal(e.segments[1].uncertainty, 0.03);
+	assert.equal(e.segments[1].steady, false);
+	assert.equal(e.segments[0].steady, undefined);
 });
 
 test('request bodies follow the API request shapes', () => {
@@ -95,6 +114,9 @@ test('request bodies follow the API request shapes', () => {
 		preset: 'czubak2016', params: { beta: 38, rotation: 'cw' },
 		scene: { columns: 5, layers: 8, feed: true, drive: 'ideal' },
 		integrator: { method: 'rk4' }, pace: 'max', sample_rate: 500 });
+	assert.deepEqual(api.sessionRequest({ ...form, start: 'rest' }).scene,
+		{ columns: 5, layers: 8, feed: true, drive: 'ideal', start: 'rest' });
+	assert.equal(api.experimentRequest({ ...form, start: 'rest', beta1: 38, beta2: 128, tSwitch: 3, tEnd: 6 }).session.scene.start, 'rest');
 	const sw = api.sweepRequest({ ...form, from: 0, to: 180, step: 10, tEnd: 3 });
 	assert.deepEqual(sw.beta, { from: 0, to: 180, step: 10 });
 	assert.deepEqual(sw.rotations, ['cw', 'ccw']);
@@ -121,7 +143,9 @@ test('pick, num and rotation spellings', () => {
 	assert.equal(api.pick(null, ['a']), undefined);
 	assert.ok(Number.isNaN(api.num(null)));
 	assert.equal(api.num('1.5'), 1.5);
-	assert.equal(api.rotationName(-1), 'cw');
+	/* the core's sign of phi': the paper's clockwise is +1 (MODEL.md) */
+	assert.equal(api.rotationName(1), 'cw');
+	assert.equal(api.rotationName(-1), 'ccw');
 	assert.equal(api.rotationName('ccw'), 'ccw');
 	assert.equal(api.rotationName('up'), undefined);
 	assert.deepEqual(api.methodEnum({ a: { properties: { method: { enum: ['rk4', 'dopri5'] } } } }), ['rk4', 'dopri5']);
@@ -169,6 +193,11 @@ test('formatting: units, signs, directions', () => {
 	assert.equal(fmt(1.5, 1, 's'), '1.5 s');
 	assert.equal(fmtVelocity(0.1234), '+0.123 m/s');
 	assert.equal(fmtVelocity(-0.05), '-0.050 m/s');
+	assert.equal(fmtVelocityPm(0.15258, 0.00191), '+0.153 ± 0.002 m/s');
+	assert.equal(fmtVelocityPm(-0.147, NaN), '-0.147 m/s');
+	assert.equal(steadyLabel(true), 'steady');
+	assert.equal(steadyLabel(false), 'settling');
+	assert.equal(steadyLabel(undefined), '');
 	assert.equal(direction(0.2), 'right');
 	assert.equal(direction(-0.2), 'left');
 	assert.equal(direction(5e-4), 'still');

@@ -23,6 +23,9 @@ export const FIELDS = {
 		omegaSs: ['status.omega_ss', 'omega_ss', 'spec.params.omega_ss', 'params.omega_ss'],
 		driveOn: ['status.drive_on', 'drive_on'],
 		transportVelocity: ['status.transport_velocity', 'transport_velocity', 'status.transport.velocity', 'transport.velocity'],
+		transportUncertainty: ['status.transport_velocity_uncertainty', 'transport_velocity_uncertainty'],
+		steady: ['status.steady', 'steady'],
+		rotorSpeedMean: ['status.rotor_speed_mean', 'rotor_speed_mean'],
 		feedVelocity: ['status.feed_velocity', 'feed_velocity'],
 		running: ['status.running', 'running'],
 		state: ['state', 'status.state'],
@@ -38,6 +41,7 @@ export const FIELDS = {
 		feed: ['spec.scene.feed', 'scene.feed'],
 		drive: ['spec.scene.drive', 'scene.drive'],
 		method: ['spec.integrator.method', 'integrator.method'],
+		start: ['spec.scene.start', 'scene.start'],
 		preset: ['preset', 'spec.preset'],
 		error: ['error', 'status.error'],
 	},
@@ -61,6 +65,8 @@ export const FIELDS = {
 		feedMean: ['feed_displacement', 'feed.mean'],
 		feedVelocity: ['feed_velocity', 'feed.velocity'],
 		transportVelocity: ['transport_velocity', 'feed.transport_velocity'],
+		transportUncertainty: ['transport_velocity_uncertainty'],
+		steady: ['steady'],
 	},
 	control: {
 		t: ['t_effective', 'effective_t', 't', 'time'],
@@ -123,10 +129,11 @@ export function num(v) {
 	return NaN;
 }
 
-/* "cw"/"ccw" from the API's spellings (strings, or the core's -1/+1). */
+/* "cw"/"ccw" from the API's spellings (strings, or the core's +1/-1: the
+ * paper's clockwise is phi' > 0, MODEL.md). */
 export function rotationName(v) {
-	if (v === -1 || v === 'cw' || v === 'CW' || v === 'clockwise') return 'cw';
-	if (v === 1 || v === 'ccw' || v === 'CCW' || v === 'counterclockwise' || v === 'counter-clockwise') return 'ccw';
+	if (v === 1 || v === 'cw' || v === 'CW' || v === 'clockwise') return 'cw';
+	if (v === -1 || v === 'ccw' || v === 'CCW' || v === 'counterclockwise' || v === 'counter-clockwise') return 'ccw';
 	return undefined;
 }
 
@@ -143,6 +150,11 @@ export function numList(v, keys) {
 }
 
 /* ---- normalizers ------------------------------------------------------- */
+
+/* true/false, or undefined when the member is absent or null. */
+function flag(v) {
+	return typeof v === 'boolean' ? v : undefined;
+}
 
 function scalar(raw, paths) {
 	const v = pick(raw, paths);
@@ -181,6 +193,9 @@ export function normalizeSession(raw) {
 		omegaSs: scalar(raw, F.omegaSs),
 		driveOn: typeof pick(raw, F.driveOn) === 'boolean' ? pick(raw, F.driveOn) : undefined,
 		transportVelocity: scalar(raw, F.transportVelocity),
+		transportUncertainty: scalar(raw, F.transportUncertainty),
+		steady: flag(pick(raw, F.steady)),
+		rotorSpeedMean: scalar(raw, F.rotorSpeedMean),
 		feedVelocity: scalar(raw, F.feedVelocity),
 		running,
 		state: typeof state === 'string' ? state : (running === false ? 'paused' : running ? 'running' : ''),
@@ -194,6 +209,7 @@ export function normalizeSession(raw) {
 		feed: pick(raw, F.feed),
 		drive: pick(raw, F.drive),
 		method: pick(raw, F.method),
+		start: pick(raw, F.start),
 		preset: pick(raw, F.preset),
 		error: pick(raw, F.error),
 		experiment: pick(raw, F.experiment) ?? null,
@@ -236,6 +252,8 @@ export function normalizeSample(raw, eventId) {
 		feedMean,
 		feedVelocity: v('feedVelocity'),
 		transportVelocity: v('transportVelocity'),
+		transportUncertainty: v('transportUncertainty'),
+		steady: flag(pick(raw, F.steady)),
 	};
 }
 
@@ -272,21 +290,26 @@ function stateOf(raw, F) {
 	return typeof s === 'string' ? s : (s && typeof s.state === 'string' ? s.state : '');
 }
 
-/* v(beta) points of a sweep, flattened to [{beta, rotation, v}]. Accepts a
+/* v(beta) points of a sweep, flattened to [{beta, rotation, v}], with u
+ * (the error bar, m/s) and steady where the daemon gives them. Accepts a
  * list of points or an object keyed by rotation holding lists or columns. */
 export function sweepPoints(results) {
 	const out = [];
-	const push = (beta, rotation, v) => {
+	const push = (beta, rotation, v, p) => {
 		const b = num(beta);
-		if (Number.isFinite(b)) out.push({ beta: b, rotation: rotationName(rotation), v: num(v) });
+		if (!Number.isFinite(b)) return;
+		const point = { beta: b, rotation: rotationName(rotation), v: num(v) };
+		if (p && 'uncertainty' in p) point.u = num(p.uncertainty);
+		if (p && typeof p.steady === 'boolean') point.steady = p.steady;
+		out.push(point);
 	};
 	const vOf = p => p.transport_velocity ?? p.v ?? p.velocity;
 	if (Array.isArray(results)) {
-		for (const p of results) if (p && typeof p === 'object') push(p.beta, p.rotation, vOf(p));
+		for (const p of results) if (p && typeof p === 'object') push(p.beta, p.rotation, vOf(p), p);
 	} else if (results && typeof results === 'object') {
 		for (const [rot, list] of Object.entries(results)) {
 			if (Array.isArray(list)) {
-				for (const p of list) if (p && typeof p === 'object') push(p.beta, p.rotation ?? rot, vOf(p));
+				for (const p of list) if (p && typeof p === 'object') push(p.beta, p.rotation ?? rot, vOf(p), p);
 			} else if (list && Array.isArray(list.beta)) {
 				const vs = list.transport_velocity ?? list.v ?? [];
 				list.beta.forEach((b, i) => push(b, rot, vs[i]));
@@ -323,6 +346,8 @@ export function normalizeExperiment(raw) {
 		tEnd: num(s.t_end ?? s.to),
 		v: num(s.steady_velocity ?? s.transport_velocity ?? s.v),
 		meanVelocity: num(s.mean_velocity),
+		uncertainty: num(s.uncertainty),
+		steady: flag(s.steady),
 		startVelocity: num(s.start_velocity),
 		reversalTime: num(s.reversal_time ?? s.t_reversal),
 	}));

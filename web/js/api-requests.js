@@ -9,7 +9,7 @@ export const BASE = '/api/v1';
 
 /* The POST /sessions body from the form's values (see session.js readSessionForm):
  * {preset, params: {beta, rotation[, beta_rate]}, scene: {columns, layers,
- * feed, drive}, integrator: {method[, dt]}, pace[, sample_rate]}. */
+ * feed, drive[, start]}, integrator: {method[, dt]}, pace[, sample_rate]}. */
 export function sessionRequest(f) {
 	const body = {
 		preset: f.preset,
@@ -18,6 +18,7 @@ export function sessionRequest(f) {
 		integrator: { method: f.method },
 		pace: f.pace,
 	};
+	if (f.start) body.scene.start = f.start;
 	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.params.beta_rate = f.betaRate;
 	if (Number.isFinite(f.dt) && f.dt > 0) body.integrator.dt = f.dt;
 	if (Number.isFinite(f.rate) && f.rate > 0) body.sample_rate = f.rate;

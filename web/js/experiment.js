@@ -7,7 +7,7 @@
 
 import * as api from './api.js';
 import { Trace } from './series.js';
-import { fmt, fmtTime, fmtVelocity, direction, ARROW, DASH } from './format.js';
+import { fmt, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direction, ARROW, DASH } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm, attach } from './session.js';
 
@@ -56,7 +56,7 @@ function showExperiment(j, form, traj) {
 	const table = $('#experiment-table');
 	table.replaceChildren();
 	const head = table.createTHead().insertRow();
-	for (const h of ['segment', 'β / °', 'from / s', 'steady v / (m/s)', 'reversal / s']) head.append(Object.assign(document.createElement('th'), { textContent: h }));
+	for (const h of ['segment', 'β / °', 'from / s', 'steady v / (m/s)', 'mean v ± u / (m/s)', 'reversal / s']) head.append(Object.assign(document.createElement('th'), { textContent: h }));
 	const body = table.createTBody();
 	j.segments.forEach((s, i) => {
 		const row = body.insertRow();
@@ -65,6 +65,16 @@ function showExperiment(j, form, traj) {
 		row.insertCell().textContent = fmt(s.tStart, 2);
 		const vc = row.insertCell();
 		vc.textContent = `${fmtVelocity(s.v).replace(' m/s', '')} ${ARROW[direction(s.v)]}`;
+		/* the daemon's estimate over the segment, its error bar, and whether
+		 * it had settled by the segment's end */
+		const mc = row.insertCell();
+		mc.textContent = fmtVelocityPm(s.meanVelocity, s.uncertainty).replace(' m/s', '');
+		const mark = steadyLabel(Number.isFinite(s.meanVelocity) ? s.steady : undefined);
+		if (mark) {
+			const m = Object.assign(document.createElement('span'), { className: 'steady-mark', textContent: mark });
+			m.dataset.steady = mark;
+			mc.append(' ', m);
+		}
 		row.insertCell().textContent = fmt(s.reversalTime, 3);
 	});
 	/* the feed velocity as streamed (when the plots follow the experiment's

@@ -46,6 +46,19 @@ export function fmtVelocity(v, digits = 3) {
 	return (v > 0 && Number(s) !== 0 ? '+' : '') + s + ' m/s';
 }
 
+/* A velocity with its error bar, m/s: "+0.153 ± 0.002 m/s"; without a
+ * finite error bar the velocity alone. */
+export function fmtVelocityPm(v, u, digits = 3) {
+	if (!Number.isFinite(v) || !Number.isFinite(u)) return fmtVelocity(v, digits);
+	return `${fmtVelocity(v, digits).replace(' m/s', '')} ± ${fmt(u, digits)} m/s`;
+}
+
+/* The estimate's state: "steady" (no drift beyond its scatter), "settling"
+ * (not yet, or drifting), or "" when the daemon gives none. */
+export function steadyLabel(steady) {
+	return steady === true ? 'steady' : steady === false ? 'settling' : '';
+}
+
 /* beta reduced to [0, 180) degrees: beta is periodic with 180 degrees. */
 export function wrapBeta(deg) {
 	if (!Number.isFinite(deg)) return NaN;

@@ -133,8 +133,9 @@ function fmtVal(v) {
 }
 
 /* A polyline through the finite points of series sidx (data order), with
- * optional round markers. Returns uPlot's path object. */
-function polylinePaths(markers) {
+ * optional round markers and vertical error bars y ± errs(sidx)[i] (errs
+ * returns an array or nothing). Returns uPlot's path object. */
+function polylinePaths(markers, errs) {
 	return (u, sidx) => {
 		const [xs, ys] = u.data[sidx];
 		const s = u.series[sidx];
@@ -159,20 +160,37 @@ function polylinePaths(markers) {
 				line.moveTo(X, Y);
 			}
 		}
+		const es = errs?.(sidx);
+		for (let i = 0; es && i < xs.length; i++) {
+			const x = xs[i], y = ys[i], e = es[i];
+			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y) || !(e > 0)) continue;
+			const X = u.valToPos(x, xk, true);
+			const Y0 = u.valToPos(y - e, yk, true), Y1 = u.valToPos(y + e, yk, true);
+			line.moveTo(X, Y0);
+			line.lineTo(X, Y1);
+			line.moveTo(X - r, Y0);
+			line.lineTo(X + r, Y0);
+			line.moveTo(X - r, Y1);
+			line.lineTo(X + r, Y1);
+			line.moveTo(X, Y1);
+		}
 		return { stroke: line, fill: null, clip: null, band: null, gaps: null, flags: 0 };
 	};
 }
 
-/* Axis ranges over every finite x and y of the data. */
-export function extent(data) {
+/* Axis ranges over every finite x and y of the data (y ± its error bar
+ * where errs[i - 1] gives one). */
+export function extent(data, errs = []) {
 	let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
 	for (let i = 1; i < data.length; i++) {
 		const [xs, ys] = data[i];
+		const es = errs[i - 1];
 		for (let j = 0; j < xs.length; j++) {
 			const x = xs[j], y = ys[j];
 			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) continue;
+			const e = es && es[j] > 0 ? es[j] : 0;
 			if (x < x0) x0 = x; if (x > x1) x1 = x;
-			if (y < y0) y0 = y; if (y > y1) y1 = y;
+			if (y - e < y0) y0 = y - e; if (y + e > y1) y1 = y + e;
 		}
 	}
 	return { x0, x1, y0, y1 };
@@ -202,6 +220,7 @@ export class XYPlot {
 		this.el = el;
 		this.equal = equal;
 		this.xRange = xRange;
+		this.errs = [];
 		const s = sizeOf(el, aspect);
 		const legend = series.length > 1;
 		const legendRoom = legend ? 26 : 0;
@@ -246,7 +265,7 @@ export class XYPlot {
 				stroke: d.color ?? PALETTE[i % PALETTE.length],
 				width: d.width ?? 1.5,
 				facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }],
-				paths: polylinePaths(markers),
+				paths: polylinePaths(markers, sidx => self.errs[sidx - 1]),
 				points: { show: false },
 			}))],
 		}, [null, ...series.map(() => [[], []])], el);
@@ -255,10 +274,12 @@ export class XYPlot {
 		el.classList.add('empty');
 	}
 
-	/* pairs: one [xs, ys] per series. */
-	setData(pairs) {
+	/* pairs: one [xs, ys] per series; errs (optional): one array of error
+	 * bars per series, drawn as y ± err. */
+	setData(pairs, errs = []) {
 		const data = [null, ...pairs];
-		this.ext = extent(data);
+		this.errs = errs;
+		this.ext = extent(data, errs);
 		this.plot.setData(data);
 		let n = 0;
 		for (const [xs, ys] of pairs)

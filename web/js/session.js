@@ -28,6 +28,7 @@ export function readSessionForm() {
 		layers: numberOf(f.layers),
 		feed: f.feed.checked,
 		drive: f.drive.value,
+		start: f.scene_start.value, /* not f.start: the submit button is #start */
 		method: f.method.value.trim(),
 		dt: numberOf(f.dt),
 		pace: pace ?? (Number.isFinite(Number(paceText)) ? Number(paceText) : paceText),

@@ -1,12 +1,13 @@
 /*
  * status.js - the attached session's polled status on the page: the tiles
- * (simulated time, rotor speed, real-time factor), the live-control card
+ * (the daemon's transport velocity with its error bar and steady mark,
+ * simulated time, rotor speed, real-time factor), the live-control card
  * (buttons, beta slider and readout, rotation, drive row) and the model
  * card with its reductions.
  */
 
-import { fmt, fmtSig, fmtTime, fmtVelocity, fmtPace, RAD_S_TO_RPM, rotationLabel, wrapBeta,
-	DASH } from './format.js';
+import { fmt, fmtSig, fmtTime, fmtVelocityPm, steadyLabel, fmtPace, RAD_S_TO_RPM, rotationLabel,
+	wrapBeta, DASH } from './format.js';
 import { app, $ } from './ui.js';
 import { resetTraces } from './live.js';
 
@@ -33,21 +34,25 @@ export function showStatus(s) {
 		$('#omega-ss').value = String(s.omegaSs);
 	if (document.activeElement !== $('#pace-live') && s.pace !== undefined)
 		$('#pace-live').value = s.pace === 'max' ? 'max' : Number.isFinite(s.pace) ? String(s.pace) : '';
-	$('#v-daemon').textContent = fmtVelocity(s.transportVelocity);
+	$('#v-daemon').textContent = fmtVelocityPm(s.transportVelocity, s.transportUncertainty);
+	const mark = steadyLabel(Number.isFinite(s.transportVelocity) ? s.steady : undefined);
+	$('#v-steady').textContent = mark;
+	$('#v-steady').dataset.steady = mark;
 	/* slider follows the target unless the user is moving it */
 	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
 	if (!app.betaEditing && Number.isFinite(target) && document.activeElement !== $('#beta-number')) {
 		$('#beta-slider').value = String(target);
 		$('#beta-number').value = String(Math.round(target * 10) / 10);
 	}
-	const mark = $('#beta-now-mark');
-	mark.hidden = !Number.isFinite(s.beta);
-	if (Number.isFinite(s.beta)) mark.style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
+	const now = $('#beta-now-mark');
+	now.hidden = !Number.isFinite(s.beta);
+	if (Number.isFinite(s.beta)) now.style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
 	$('#m-preset').textContent = s.preset ?? DASH;
 	const scene = [];
 	if (Number.isFinite(s.columns)) scene.push(`${s.columns} columns × ${s.layers} layers`);
 	if (s.feed === false) scene.push('no feed');
 	if (s.drive) scene.push(`${s.drive} drive`);
+	if (s.start) scene.push(`${s.start} start`);
 	$('#m-scene').textContent = scene.join(', ') || DASH;
 	$('#m-method').textContent = s.method ?? DASH;
 	$('#m-pace').textContent = fmtPace(s.pace);

@@ -1,11 +1,12 @@
 /*
  * sweep.js - the sweep panel: runs v(beta) for both rotations on the
- * new-session form's model, follows its progress, and shows the plot, the
- * table and the CSV link.
+ * new-session form's model, follows its progress, and shows the plot (with
+ * each point's error bar), the table (v, its error bar u, steady or
+ * settling) and the CSV link.
  */
 
 import * as api from './api.js';
-import { fmt } from './format.js';
+import { fmt, steadyLabel } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm } from './session.js';
 
@@ -29,8 +30,12 @@ export async function runSweep(ev) {
 		const missing = end.points.filter(p => !Number.isFinite(p.v)).length;
 		if (end.failed) message('error', `Sweep ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
 		else if (missing) message('warn', `Sweep ${end.id} finished, but ${missing} of ${end.points.length} points gave no transport velocity: ` +
-			'the run time per point must exceed the scene\'s transient (the transport velocity ignores t < transient).');
-		else message('ok', `Sweep ${end.id} finished: ${end.points.length} points.`);
+			'the run time per point must exceed the scene\'s transient by at least one excitation period (the transport velocity ignores t < transient).');
+		else {
+			const settling = end.points.filter(p => p.steady === false).length;
+			message(settling ? 'warn' : 'ok', `Sweep ${end.id} finished: ${end.points.length} points` +
+				(settling ? `, ${settling} still settling at the end (a longer run time per point helps).` : ', all steady.'));
+		}
 	} catch (err) {
 		report(err, 'Sweep', $('#sweep-form'));
 	} finally {
@@ -47,17 +52,25 @@ function showSweep(j) {
 	}
 	const by = rot => j.points.filter(p => p.rotation === rot).sort((a, b) => a.beta - b.beta);
 	const cw = by('cw'), ccw = by('ccw');
-	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]]);
+	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]],
+		[cw.map(p => p.u), ccw.map(p => p.u)]);
 	const table = $('#sweep-table');
 	table.replaceChildren();
 	const head = table.createTHead().insertRow();
-	for (const h of ['β / °', 'v clockwise / (m/s)', 'v counter-clockwise / (m/s)']) head.append(Object.assign(document.createElement('th'), { textContent: h }));
+	for (const h of ['β / °', 'v clockwise / (m/s)', '± u', '', 'v counter-clockwise / (m/s)', '± u', ''])
+		head.append(Object.assign(document.createElement('th'), { textContent: h }));
 	const betas = [...new Set(j.points.map(p => p.beta))].sort((a, b) => a - b);
 	const body = table.createTBody();
 	for (const b of betas) {
 		const row = body.insertRow();
 		row.insertCell().textContent = fmt(b, 1);
-		row.insertCell().textContent = fmt(cw.find(p => p.beta === b)?.v, 4);
-		row.insertCell().textContent = fmt(ccw.find(p => p.beta === b)?.v, 4);
+		for (const p of [cw.find(q => q.beta === b), ccw.find(q => q.beta === b)]) {
+			row.insertCell().textContent = fmt(p?.v, 4);
+			row.insertCell().textContent = fmt(p?.u, 4);
+			const mark = row.insertCell();
+			mark.textContent = steadyLabel(Number.isFinite(p?.v) ? p.steady : undefined);
+			mark.className = 'steady-mark';
+			mark.dataset.steady = mark.textContent;
+		}
 	}
 }
