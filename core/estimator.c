@@ -122,14 +122,11 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
 	e->E_prev = E;
 }
 
-/* Slope of X over t between points a and b of the batch edges. */
-static double edge_slope(const double *t, const double *X, int a, int b)
-{
-	return (X[b] - X[a]) / (t[b] - t[a]);
-}
-
 /* The error bar and the steady flag from the batch edges (the records and
- * the latest boundary); see estimate. */
+ * the latest boundary): the batch velocities v_i at their mid-times c_i are
+ * fitted by a straight line (least squares); its slope times the window's
+ * length is the drift D, the scatter s of the residuals gives the standard
+ * error of the mean s / sqrt(n) and of the slope. See estimate. */
 static void error_bar(const estimator *e, double v, estimate *out)
 {
 	double t[EST_RECORDS + 1], X[EST_RECORDS + 1];
@@ -145,19 +142,29 @@ static void error_bar(const estimator *e, double v, estimate *out)
 	out->steady = 0;
 	if (nb < 4)
 		return;
-	double sw = 0.0, sw2 = 0.0, var = 0.0;
+	double cm = 0.0, vm = 0.0, vi[EST_RECORDS], ci[EST_RECORDS];
 	for (int i = 0; i < nb; i++) {
-		double w = t[i + 1] - t[i], d = edge_slope(t, X, i, i + 1) - v;
-		sw += w;
-		sw2 += w * w;
-		var += w * d * d;
+		vi[i] = (X[i + 1] - X[i]) / (t[i + 1] - t[i]);
+		ci[i] = 0.5 * (t[i] + t[i + 1]);
+		cm += ci[i] / nb;
+		vm += vi[i] / nb;
 	}
-	double neff = sw * sw / sw2;
-	double se = sqrt(var / sw / (neff - 1.0));
-	int mid = n / 2;
-	double drift = edge_slope(t, X, mid, n - 1) - edge_slope(t, X, 0, mid);
+	double scc = 0.0, scv = 0.0;
+	for (int i = 0; i < nb; i++) {
+		scc += (ci[i] - cm) * (ci[i] - cm);
+		scv += (ci[i] - cm) * (vi[i] - vm);
+	}
+	double slope = scv / scc, ss = 0.0;
+	for (int i = 0; i < nb; i++) {
+		double r = vi[i] - vm - slope * (ci[i] - cm);
+		ss += r * r;
+	}
+	double s = sqrt(ss / (nb - 2)), window = t[n - 1] - t[0];
+	double se = s / sqrt((double)nb), se_drift = s / sqrt(scc) * window;
+	double drift = slope * window;
 	out->uncertainty = sqrt(se * se + 0.25 * drift * drift);
-	out->steady = e->n_bound >= 8 && fabs(drift) <= fmax(6.0 * se, 0.005 * fabs(v));
+	out->steady = e->n_bound >= 8 &&
+		      (fabs(drift) <= 3.0 * se_drift || fabs(drift) <= 0.005 * fabs(v));
 }
 
 void estimator_read(const estimator *e, estimate *out)

@@ -39,13 +39,14 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
 		    const double *y);
 
 /* The estimate (NaN before one whole period; see sim_status).
- * uncertainty: the scatter of the batch velocities between records (their
- * standard error) and half the drift between the window's halves, added in
- * quadrature; NaN with fewer than 4 batches. steady: at least 8 periods and
- * 4 batches, and a drift within 6 standard errors or 0.5 % of |v|.
- * rotor_speed_mean: 2 pi n over the window's time (signed like phi');
- * power_mean: the drive's input over it; torque_mean: their ratio (the
- * torque averaged over the angle turned). */
+ * uncertainty: the batch velocities (between records) fitted by a straight
+ * line over time; the standard error of their mean and half the drift (the
+ * line's change over the window), added in quadrature; NaN with fewer than
+ * 4 batches. steady: at least 8 periods and 4 batches, and a drift within
+ * 3 of its standard errors (no trend the scatter cannot explain) or below
+ * 0.5 % of |v|. rotor_speed_mean: 2 pi n over the window's time (signed like
+ * phi'); power_mean: the drive's input over it; torque_mean: their ratio
+ * (the torque averaged over the angle turned). */
 typedef struct estimate {
 	double transport_velocity, transport_periods, feed_velocity, period;
 	double uncertainty;

@@ -20,7 +20,8 @@ typedef struct ode_method {
 	 * allocation failure. Everything the steps need is allocated here. */
 	void *(*alloc)(const model *md, const sim_method *cfg);
 	/* One step from (*t, y), in place. Fixed-step methods do not pass
-	 * t_max (the last step is shortened); dense methods may. Returns
+	 * t_max (the last step is shortened; sim.c passes INFINITY except to
+	 * land the steady start's settling on t = 0); dense methods may. Returns
 	 * SIM_OK or SIM_ESTEP. */
 	int (*step)(void *ws, dyn *sys, double *t, double *y, double t_max);
 	/* Dense methods: the state at t within the last step into out. */

@@ -171,7 +171,7 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * feed is light enough for its corrected coupling. */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 /* The feed sub-steps that substeps = 0 stands for with macro step dt (s):
- * as many as keep the feed's step at or below 1e-4 s. */
+ * as many as keep the feed's step at or below 2.5e-5 s. */
 int sim_default_substeps(double dt);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
@@ -204,11 +204,13 @@ sim *sim_new(const sim_params *p, const sim_scene *s, const sim_method *m,
 /* Free an instance; NULL is accepted. */
 void sim_free(sim *s);
 
-/* Advance the observed time to t_end (s, >= current). Fixed-step methods
- * shorten the last step to land on t_end; adaptive methods step past and
- * interpolate (dense output), so the integrator may stand ahead of the
- * observed time. Returns SIM_OK, SIM_ETIME, or SIM_EDIVERGED / SIM_ESTEP
- * (the instance is then frozen; sim_last_error() tells time and cause). */
+/* Advance the observed time to t_end (s, >= current). The integrator takes
+ * whole steps (fixed-step methods never shorten one to land on t_end) and
+ * may stand up to one step ahead; the observed state at t_end comes from
+ * the last step's interpolant (dense output for dopri5), so when and how
+ * often a caller observes changes nothing. Returns SIM_OK, SIM_ETIME, or
+ * SIM_EDIVERGED / SIM_ESTEP (the instance is then frozen; sim_last_error()
+ * tells time and cause). */
 int sim_advance(sim *s, double t_end);
 /* Why the instance froze (time and cause), "" while it runs; owned by s. */
 const char *sim_last_error(const sim *s);

@@ -39,6 +39,11 @@ void wp_run(const char *const *sets, const run_spec *rs, run_out *o)
 	sim_scene sc;
 	sim_method m;
 	sim_preset_czubak2016(&p, &sc, &m);
+	/* the paper's scene, the same for every method: the run-up from rest,
+	 * the full model unless a scene drops alpha, v over [2, 6] s */
+	sc.start = SIM_START_REST;
+	sc.trough_rotation = 1;
+	sc.transient = 2.0;
 	apply(&p, &sc, &m, sets);
 	snprintf(m.name, sizeof m.name, "%s", rs->method);
 	m.dt = rs->dt;

@@ -101,12 +101,7 @@ test('the status at t = 0: new fields typed, undefined ones null, energy changes
     assert.equal(c.body.spec.scene.start, start);
     const st = c.body.status;
     assert.equal(st.t, 0);
-    const { potential, ...exact } = st.energy;
-    assert.deepEqual(exact, { input: 0, kinetic: 0, dissipated: 0, residual: 0 });
-    // core/sim.c forms it as pot - (e0 - kin0), which leaves round-off
-    // (up to 7e-15 J) where pot - pot0 would give 0: reported; make this
-    // exact once the core keeps pot0
-    near(potential, 0, 1e-12, `${start}: energy.potential at t = 0`);
+    assert.deepEqual(st.energy, { input: 0, kinetic: 0, potential: 0, dissipated: 0, residual: 0 });
     for (const k of ['transport_velocity', 'transport_velocity_uncertainty', 'rotor_speed_mean',
       'motor_torque_mean', 'power_mean', 'feed_velocity']) {
       assert.ok(k in st, k);
