@@ -42,18 +42,4 @@ int sim_set_user_str(sim_params *p, sim_scene *s, sim_method *m, const char *nam
 int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
 		 double *value);
 
-/* Degrees <-> radians rounded as x * pi / 180 and x * 180 / pi, which
- * differ in the last bit from x * RAD_PER_DEG and x * DEG_PER_RAD for about
- * a third of all values (38 deg among them). The beta controls and the
- * CLI's beta_deg column and sweep have always rounded this way; these keep
- * their results bit-identical. Settings go through the table instead. */
-static inline double sim_rad_from_deg(double deg)
-{
-	return deg * SIM_PI / 180.0;
-}
-static inline double sim_deg_from_rad(double rad)
-{
-	return rad * 180.0 / SIM_PI;
-}
-
 #endif

@@ -139,7 +139,7 @@ static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int
 	int K = sim_columns(s);
 	double vals[16] = {st->t,           st->q[0],          st->q[1],
 			   st->q[2],        st->q[4],          st->q[5],
-			   st->rotor_speed, st->motor_torque,  sim_deg_from_rad(st->beta),
+			   st->rotor_speed, st->motor_torque,  st->beta * DEG_PER_RAD,
 			   st->deck[0],     st->deck[1],       st->feed_displacement,
 			   st->e_input,     st->e_dissipated,  st->e_residual,
 			   st->transport_velocity};
@@ -208,7 +208,7 @@ static void print_summary(const opts *o, const sim *s, const sim_status *st, int
 	print_num(stdout, st->motor_torque_mean);
 	printf(",\n  \"power\": ");
 	print_num(stdout, st->power_mean);
-	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", sim_deg_from_rad(st->beta));
+	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", st->beta * DEG_PER_RAD);
 	print_num(stdout, st->feed_displacement);
 	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
 	       (unsigned long long)st->steps, (unsigned long long)st->rhs_evals, st->n_dof);
@@ -315,7 +315,7 @@ static void *worker(void *arg)
 			return NULL;
 		task *t = &pl->tasks[i];
 		sim_params p = pl->o->p;
-		p.beta = sim_rad_from_deg(t->beta);
+		p.beta = t->beta * RAD_PER_DEG;
 		p.rotation = t->rotation;
 		t->err = sim_measure(&p, &pl->o->sc, &pl->o->m, pl->o->duration, &t->r, t->msg,
 				     sizeof t->msg);

@@ -71,7 +71,7 @@ static void beta_sets_and_reverses_direction(void **state)
 	sim *s = make(&u);
 	advance(s, 2.5);
 	double before = status(s).feed_velocity;
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(128.0), sim_rad_from_deg(180.0)), SIM_OK);
+	assert_int_equal(sim_set_beta(s, 128.0 * RAD_PER_DEG, 180.0 * RAD_PER_DEG), SIM_OK);
 	sim_restart_transport(s);
 	advance(s, 5.0);
 	sim_status st = status(s);

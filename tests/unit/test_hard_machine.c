@@ -34,7 +34,7 @@ static double reversal_residual(const char *dt, double *e_input)
 	sim *s = make(&u);
 	advance(s, 0.5);
 	double res0 = status(s).e_residual;
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(180.0), sim_rad_from_deg(3600.0)), SIM_OK);
+	assert_int_equal(sim_set_beta(s, 180.0 * RAD_PER_DEG, 3600.0 * RAD_PER_DEG), SIM_OK);
 	double t0 = 0.5, prev = 0.0, t_done = NAN, max_rate = 0.0;
 	for (double t = t0 + 1e-3; t <= t0 + 0.2 + 1e-12; t += 1e-3) {
 		advance(s, t);
@@ -96,7 +96,7 @@ static void beta_oscillating(void **state)
 	double t = 0.6;
 	for (int half = 0; half < 4; half++) {
 		double target = half % 2 == 0 ? 128.0 : 38.0;
-		assert_int_equal(sim_set_beta(s, sim_rad_from_deg(target), sim_rad_from_deg(-1)), SIM_OK);
+		assert_int_equal(sim_set_beta(s, target * RAD_PER_DEG, -1 * RAD_PER_DEG), SIM_OK);
 		t += 0.6;
 		advance(s, t);
 		sim_status st = status(s);

@@ -242,13 +242,13 @@ static void beta_ramps_are_continuous(void **state)
 	advance(s, 0.1);
 	double t_eff = sim_effective_time(s);
 	assert_close(t_eff, 0.1, 1e-12);
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(128.0), sim_rad_from_deg(90.0)), SIM_OK);
+	assert_int_equal(sim_set_beta(s, 128.0 * RAD_PER_DEG, 90.0 * RAD_PER_DEG), SIM_OK);
 	const double rate = M_PI / 2, accel = 900.0 * M_PI / 180.0, dt = 1e-3;
 	sim_status prev = status(s);
 	double peak = 0.0;
 	for (int k = 1; k <= 2500; k++) {
 		if (k == 500) /* retarget mid-ramp, back down */
-			assert_int_equal(sim_set_beta(s, sim_rad_from_deg(60.0), sim_rad_from_deg(0.0)), SIM_OK);
+			assert_int_equal(sim_set_beta(s, 60.0 * RAD_PER_DEG, 0.0 * RAD_PER_DEG), SIM_OK);
 		advance(s, 0.1 + k * dt);
 		sim_status st = status(s);
 		assert_true(fabs(st.beta - prev.beta) <= rate * dt * (1 + 1e-9));
@@ -259,9 +259,9 @@ static void beta_ramps_are_continuous(void **state)
 	assert_close(prev.beta, 60.0 * M_PI / 180.0, 1e-12);
 	assert_close(prev.beta_dot, 0.0, 0.0);
 	assert_close(peak, rate, 1e-9);
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(181.0), sim_rad_from_deg(0.0)), SIM_EPARAM);
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(90.0), sim_rad_from_deg(-5.0)), SIM_OK); /* keeps the rate */
-	assert_int_equal(sim_set_beta(s, sim_rad_from_deg(90.0), sim_rad_from_deg(1e5)), SIM_EPARAM);
+	assert_int_equal(sim_set_beta(s, 181.0 * RAD_PER_DEG, 0.0 * RAD_PER_DEG), SIM_EPARAM);
+	assert_int_equal(sim_set_beta(s, 90.0 * RAD_PER_DEG, -5.0 * RAD_PER_DEG), SIM_OK); /* keeps the rate */
+	assert_int_equal(sim_set_beta(s, 90.0 * RAD_PER_DEG, 1e5 * RAD_PER_DEG), SIM_EPARAM);
 	sim_free(s);
 }
 
