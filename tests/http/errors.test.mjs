@@ -55,6 +55,10 @@ test('bad session bodies: 400/413/415/422 and nothing is created', { timeout: 20
   assert.equal(b.max, setting('beta').max);
   b = problem(await post({ params: { rotation: 'sideways' } }), 422, 'out-of-range');
   assert.deepEqual(b.choices, ['cw', 'ccw']);
+  b = problem(await post({ scene: { start: 'warm' } }), 422, 'out-of-range');
+  assert.equal(b.field, 'scene.start');
+  assert.deepEqual(b.choices, ['rest', 'steady']);
+  assert.equal(b.detail, 'start must be one of rest|steady');
   b = problem(await post({ pace: 0 }), 422, 'out-of-range');
   assert.equal(b.field, 'pace');
   b = problem(await post({ preset: 'nosuch' }), 422, 'out-of-range');
