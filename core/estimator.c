@@ -13,10 +13,10 @@
 #include "feed.h"
 #include "ode.h"
 
-/* phi - alpha and its rate, the mean feed position and its rate, and the
- * drive's input energy. */
+/* phi - alpha and its rate, the mean feed position and its rate, the
+ * drive's input energy, and the speed of the trough's centre of mass. */
 static void period_probe(const model *md, const model_ctl *ctl, double t, const double *y,
-			 double *psi, double *psid, double *X, double *Xd, double *E)
+			 double *psi, double *psid, double *X, double *Xd, double *E, double *V)
 {
 	double q[NQ_FULL], qd[NQ_FULL];
 	model_full_coords(md, ctl, t, y, q, qd);
@@ -25,13 +25,15 @@ static void period_probe(const model *md, const model_ctl *ctl, double t, const 
 	*X = md->nf > 0 ? feed_mean_xi(md, y, -1) : 0.0;
 	*Xd = feed_mean_xi_rate(md, y);
 	*E = y[2 * md->npos + ACC_IN];
+	*V = hypot(qd[Q_X], qd[Q_Y]);
 }
 
 void estimator_probe(estimator *e, const model *md, const model_ctl *ctl, double t,
 		     const double *y)
 {
+	double V;
 	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
-		     &e->E_prev);
+		     &e->E_prev, &V);
 }
 
 void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double t,
@@ -79,6 +81,7 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 		e->Eb_first = e->Eb_last = Eb;
 		e->n_rec = 0;
 		e->stride = 1;
+		e->speed_max = 0.0;
 		record(e, tb, Xb);
 		return;
 	}
@@ -94,8 +97,10 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
 		    const double *y)
 {
-	double psi, psid, X, Xd, E;
-	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E);
+	double psi, psid, X, Xd, E, V;
+	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E, &V);
+	if (!e->pending)
+		e->speed_max = fmax(e->speed_max, V);
 	double H = t1 - t0;
 	double n0 = floor(e->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
 	if (n0 != n1 && H > 0.0) {
@@ -164,7 +169,8 @@ static void error_bar(const estimator *e, double v, estimate *out)
 	double drift = slope * window;
 	out->uncertainty = sqrt(se * se + 0.25 * drift * drift);
 	out->steady = e->n_bound >= 8 &&
-		      (fabs(drift) <= 3.0 * se_drift || fabs(drift) <= 0.005 * fabs(v));
+		      (fabs(drift) <= 3.0 * se_drift || fabs(drift) <= 0.005 * fabs(v)) &&
+		      out->uncertainty <= 0.005 * e->speed_max + 0.01 * fabs(v);
 }
 
 void estimator_read(const estimator *e, estimate *out)

@@ -22,6 +22,7 @@ typedef struct estimator {
 	 * error bar; when full, every second is dropped and stride doubles */
 	double rec_t[EST_RECORDS], rec_X[EST_RECORDS];
 	int n_rec, stride;
+	double speed_max;     /* m/s: the trough's largest speed in the window */
 } estimator;
 
 /* Start over: probe the state y at t, wait for the first period boundary
@@ -42,9 +43,11 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
  * uncertainty: the batch velocities (between records) fitted by a straight
  * line over time; the standard error of their mean and half the drift (the
  * line's change over the window), added in quadrature; NaN with fewer than
- * 4 batches. steady: at least 8 periods and 4 batches, and a drift within
- * 3 of its standard errors (no trend the scatter cannot explain) or below
- * 0.5 % of |v|. rotor_speed_mean: 2 pi n over the window's time (signed like
+ * 4 batches. steady: at least 8 periods and 4 batches, a drift within 3
+ * of its standard errors (no trend the scatter cannot explain) or below
+ * 0.5 % of |v|, and an error bar (scatter and drift) within 1 % of |v| plus
+ * 0.5 % of the trough's vibration speed (its largest over the window), the
+ * scale of v where v itself is near zero. rotor_speed_mean: 2 pi n over the window's time (signed like
  * phi'); power_mean: the drive's input over it; torque_mean: their ratio
  * (the torque averaged over the angle turned). */
 typedef struct estimate {

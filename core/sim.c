@@ -123,9 +123,10 @@ static int settle(sim *s)
 	return e;
 }
 
-/* Time zero of every observer: energy accumulators and baselines, feed
- * displacement origins, the estimator, the observed state. */
-static void zero_observers(sim *s)
+/* Time zero of every observer: energy accumulators and baselines, the
+ * estimator, the observed state, and with origins the feed displacements'
+ * origins too; then the status. */
+static void zero_observers(sim *s, int origins)
 {
 	const model *md = &s->md;
 	double *acc = s->y + 2 * md->npos;
@@ -141,9 +142,11 @@ static void zero_observers(sim *s)
 		model_full_coords(md, &s->ctl, s->t_int, s->y, q, qd);
 		s->elastic0 = dynamics_contact_energy(md, s->y, q, qd);
 	}
-	s->X0 = md->nf > 0 ? feed_mean_xi(md, s->y, -1) : 0.0;
-	for (int k = 0; k < md->dk.K; k++)
-		s->X0k[k] = feed_mean_xi(md, s->y, k);
+	if (origins) {
+		s->X0 = md->nf > 0 ? feed_mean_xi(md, s->y, -1) : 0.0;
+		for (int k = 0; k < md->dk.K; k++)
+			s->X0k[k] = feed_mean_xi(md, s->y, k);
+	}
 	estimator_init(&s->est, md, &s->ctl, s->t_int, s->y, md->sc.transient);
 	sim_update_status(s);
 }
@@ -188,7 +191,7 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 			goto fail;
 		}
 	}
-	zero_observers(s);
+	zero_observers(s, 1);
 	if (err)
 		*err = SIM_OK;
 	return s;
@@ -368,23 +371,19 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 		for (int e = 0; src[a] && e < md->nf; e++)
 			if (!isfinite(src[a][e]))
 				return SIM_EPARAM;
-	for (int a = 0; a < 4; a++)
-		if (src[a])
-			memcpy(s->y + off[a], src[a], sizeof(double) * (size_t)md->nf);
 	/* a fresh workspace: split methods cache the feed's reaction */
 	void *ws = s->ode->alloc(md, &s->cfg);
 	if (!ws)
 		return SIM_ENOMEM;
 	s->ode->free(s->ws);
 	s->ws = ws;
-	double X0 = s->X0, X0k[SIM_MAX_COLUMNS];
-	memcpy(X0k, s->X0k, sizeof(double) * (size_t)md->dk.K);
-	zero_observers(s);
-	s->X0 = X0; /* displacements still count from the start */
-	memcpy(s->X0k, X0k, sizeof(double) * (size_t)md->dk.K);
-	sim_update_status(s);
+	for (int a = 0; a < 4; a++)
+		if (src[a])
+			memcpy(s->y + off[a], src[a], sizeof(double) * (size_t)md->nf);
+	zero_observers(s, 0); /* displacements still count from the start */
 	return SIM_OK;
 }
+
 int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen)
 {

@@ -231,10 +231,12 @@ int sim_set_omega_ss(sim *s, double omega_ss);
 int sim_set_drive_on(sim *s, int on);
 
 /* Place the feed at the observed time (which must equal the integrator's:
- * true after sim_new and for fixed-step methods): xi, eta, xi', eta' of
- * integrated column k, layer j at [k*L + j] (any array may be NULL to keep
- * it). The energy balance restarts from the new state. SIM_EPARAM if a
- * value is not finite, SIM_ETIME if the integrator stands ahead. */
+ * true after sim_new, and wherever a step ended exactly there): xi, eta,
+ * xi', eta' of integrated column k, layer j at [k*L + j] (any array may be
+ * NULL to keep it). The energy terms restart from zero and the transport
+ * estimator from the new state; feed displacements still count from the
+ * start. SIM_EPARAM if a value is not finite, SIM_ETIME if the integrator
+ * stands ahead, SIM_ENOMEM; on error nothing changed. */
 int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi_dot,
 		   const double *eta_dot);
 
