@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "sim.h"
+#include "table.h"
 
 /* ---- errors ----------------------------------------------------------- */
 
@@ -223,15 +224,19 @@ size_t api_format_end(char *buf, size_t len, const char *reason, int ndjson);
 
 /* ---- trajectory --------------------------------------------------------- */
 
-#define API_HISTORY_COLS 17
-extern const char *const api_history_names[API_HISTORY_COLS];
-/* One trajectory row (API_HISTORY_COLS doubles, column 0 is t) from a
- * status. */
-void api_history_row(const sim_status *st, double *row);
-/* n rows of API_HISTORY_COLS (borrowed) as JSON {"fields","rows"} or as
- * CSV with a header line. malloc'd text. */
-char *api_trajectory_json(const double *rows, size_t n, double stride);
-char *api_trajectory_csv(const double *rows, size_t n);
+/* A trajectory row: the named columns of core/table.h (SIM_TRAJECTORY_COLUMNS,
+ * column 0 is t) then column_1 ... column_K, the per-column feed
+ * displacement; API_HISTORY_WIDTH(K) doubles. The CLI writes the same. */
+#define API_HISTORY_WIDTH(columns) ((size_t)SIM_TRAJECTORY_NAMED + (size_t)(columns))
+/* One trajectory row from a status and the K per-column displacements
+ * (borrowed; may be NULL when columns is 0). */
+void api_history_row(const sim_status *st, const double *column_disp, int columns,
+		     double *row);
+/* n rows of API_HISTORY_WIDTH(columns) (borrowed) as JSON
+ * {"fields","units","count","stride","rows"} or as CSV with a header line.
+ * stride: the rows' spacing, s. malloc'd text. */
+char *api_trajectory_json(const double *rows, size_t n, int columns, double stride);
+char *api_trajectory_csv(const double *rows, size_t n, int columns);
 
 /* ---- experiments --------------------------------------------------------- */
 

@@ -141,11 +141,13 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	int columns, layers;
+	srv_session_feed_size(s, &columns, &layers);
 	size_t n = srv_session_history(s, from, to, &rows, &stride);
 	srv_session_put(s);
 	char *text = !rows  ? NULL
-		     : csv ? api_trajectory_csv(rows, n)
-			   : api_trajectory_json(rows, n, stride);
+		     : csv ? api_trajectory_csv(rows, n, columns)
+			   : api_trajectory_json(rows, n, columns, stride);
 	free(rows);
 	return srv_reply(r, 200, csv ? "text/csv" : "application/json", text,
 			 NULL, NULL);
