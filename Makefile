@@ -29,27 +29,35 @@ API_OBJ    := $(API_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
-# Debian packages the project needs, by the file each provides.
-DEB_NEEDS := /usr/include/microhttpd.h:libmicrohttpd-dev \
-             /usr/include/cjson/cJSON.h:libcjson-dev \
-             /usr/include/cmocka.h:libcmocka-dev \
+# Debian packages the project needs, by the file each provides: to build
+# and run (`make`, `make run`), and in addition to test (`make test`,
+# `make install`'s unit check).
+DEB_BUILD := /usr/include/microhttpd.h:libmicrohttpd-dev \
+             /usr/include/cjson/cJSON.h:libcjson-dev
+DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
              /usr/bin/curl:curl \
              /usr/bin/python3:python3 \
              /usr/bin/node:nodejs \
              /usr/bin/npm:npm \
-             /usr/bin/chromium:chromium
+             /usr/bin/chromium:chromium \
+             /usr/bin/systemd-analyze:systemd
 
-.PHONY: all deps run test check bench mutate clean
-all: deps $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
+.PHONY: all deps deps-build run test check bench mutate clean install uninstall
+all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
-# Install what is missing (Debian packages, npm test tools). Idempotent.
-deps: $(BUILD)/.deps
-$(BUILD)/.deps: Makefile tests/package.json
-	$(Q)missing=""; for pair in $(DEB_NEEDS); do f=$${pair%%:*}; p=$${pair##*:}; \
-	  [ -e "$$f" ] || missing="$$missing $$p"; done; \
-	if [ -n "$$missing" ]; then echo "apt-get install$$missing"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; fi
-	$(Q)if [ ! -d tests/node_modules/playwright-core ]; then echo "npm ci (tests)"; \
+# Install what is missing: Debian packages (with apt-get, which needs root:
+# run as root or have sudo) and the npm test tools (tests/node_modules, no
+# root). Says what it installs and why; idempotent. deps-build is the part
+# that building and running need.
+deps: deps-build $(BUILD)/.deps
+deps-build: $(BUILD)/.deps-build
+$(BUILD)/.deps-build: Makefile
+	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
+	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze)" sh tests/apt-deps.sh
+	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ]; then \
+	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@
 
@@ -87,10 +95,12 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  CC      $<")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(LDLIBS)
 
-run: all
-	$(BUILD)/convsimd --listen $(HOST) --port $(PORT)
+# Builds only the daemon it runs. PORT, HOST and DAEMON_FLAGS (any of
+# `build/convsimd --help`) are the knobs.
+run: deps-build $(BUILD)/convsimd
+	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) $(DAEMON_FLAGS)
 
-test: all
+test: deps all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
 
 check:
