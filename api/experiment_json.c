@@ -194,3 +194,37 @@ char *api_experiment_list_json(const api_experiment_view *v, size_t n)
 		cJSON_AddItemToArray(arr, experiment_object(&v[i]));
 	return api_print_free(o);
 }
+
+/* A CSV cell: the number, or nothing when not finite. */
+static void csv_num(api_buf *b, double v)
+{
+	api_buf_put(b, ",", 1);
+	if (isfinite(v))
+		api_buf_double(b, v);
+}
+
+char *api_experiment_csv(const api_experiment_view *v, size_t n)
+{
+	static const char *const seg_state[] = {"pending", "running", "done"};
+	api_buf b = {0};
+	api_buf_puts(&b, API_EXPERIMENT_CSV "\n");
+	for (size_t i = 0; i < n; i++)
+		for (int k = 0; k < v[i].nseg; k++) {
+			const api_segment *g = &v[i].seg[k];
+			int done = g->state == 2;
+			api_buf_printf(&b, "%s,%s,%d", v[i].id, v[i].session_id, k + 1);
+			csv_num(&b, g->beta.user);
+			csv_num(&b, g->until);
+			api_buf_printf(&b, ",%s", seg_state[g->state >= 0 && g->state <= 2 ? g->state : 0]);
+			csv_num(&b, g->state ? g->t_command : NAN);
+			csv_num(&b, done ? g->t_end : NAN);
+			csv_num(&b, g->state ? g->start_velocity : NAN);
+			csv_num(&b, done ? g->steady_velocity : NAN);
+			csv_num(&b, done ? g->mean_velocity : NAN);
+			csv_num(&b, done ? g->uncertainty : NAN);
+			api_buf_puts(&b, !done ? "," : g->steady ? ",true" : ",false");
+			csv_num(&b, done ? g->reversal_time : NAN);
+			api_buf_put(&b, "\n", 1);
+		}
+	return api_buf_take(&b);
+}

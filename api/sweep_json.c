@@ -271,7 +271,7 @@ char *api_sweep_list_json(const api_sweep_view *v, size_t n)
 char *api_sweep_csv(const api_sweep_view *v)
 {
 	api_buf b = {0};
-	api_buf_puts(&b, "beta,rotation,velocity,uncertainty,steady,state\n");
+	api_buf_puts(&b, SIM_SWEEP_CSV_HEADER "\n");
 	for (size_t i = 0; i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		int done = p->state == 2;
@@ -284,6 +284,18 @@ char *api_sweep_csv(const api_sweep_view *v)
 			api_buf_double(&b, p->uncertainty);
 		api_buf_puts(&b, !done ? "," : p->steady ? ",true" : ",false");
 		api_buf_printf(&b, ",%s\n", point_state(p->state));
+	}
+	return api_buf_take(&b);
+}
+
+char *api_sweep_list_csv(const api_sweep_view *v, size_t n)
+{
+	api_buf b = {0};
+	api_buf_puts(&b, "sweep,state,done,total,t_end\n");
+	for (size_t i = 0; i < n; i++) {
+		api_buf_printf(&b, "%s,%s,%zu,%zu,", v[i].id, v[i].state, v[i].done, v[i].total);
+		api_buf_double(&b, v[i].t_end);
+		api_buf_put(&b, "\n", 1);
 	}
 	return api_buf_take(&b);
 }

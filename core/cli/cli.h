@@ -46,9 +46,6 @@ int cli_operand_index(void);
 /* Parse the same argv again from its start. */
 void cli_restart_options(void);
 
-/* The candidate of names[0 .. n-1] (stride bytes apart, a pointer to the
- * name first) nearest to word by edit distance, or NULL if none is near. */
-const char *cli_suggest(const char *word, const void *names, size_t n, size_t stride);
 /* " (did you mean 'X'?)" for a near miss, else "": into buf. */
 const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion);
 

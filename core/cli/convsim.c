@@ -23,6 +23,7 @@
 
 #include "cli.h"
 #include "sim.h"
+#include "suggest.h"
 #include "table.h"
 #include "units.h"
 
@@ -64,7 +65,7 @@ static void setting_error(const opts *o, const char *arg, const char *name, cons
 	const sim_setting *t = sim_settings(&n);
 	char hint[96] = "";
 	if (!sim_setting_find(name))
-		cli_did_you_mean(hint, sizeof hint, cli_suggest(name, &t->name, n, sizeof *t));
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, n, sizeof *t));
 	fprintf(stderr, "convsim %s: --set %s: %s%s; 'convsim list' shows every setting\n", o->cmd,
 		arg, msg, hint);
 }
@@ -123,7 +124,7 @@ static int parse(int argc, char **argv, unsigned cmd, opts *o)
 		fprintf(stderr, "convsim %s: --preset: unknown preset '%s'%s; known: czubak2016\n",
 			o->cmd, o->preset,
 			cli_did_you_mean(hint, sizeof hint,
-					 cli_suggest(o->preset, sim_preset_names, n,
+					 sim_suggest(o->preset, sim_preset_names, n,
 						     sizeof *sim_preset_names)));
 		return 2;
 	}
@@ -487,7 +488,7 @@ static int parse_rotation(const char *text, int rots[2])
 					"one%s\n",
 				tok,
 				cli_did_you_mean(hint, sizeof hint,
-						 !known ? cli_suggest(tok, senses, 2, sizeof *senses)
+						 !known ? sim_suggest(tok, senses, 2, sizeof *senses)
 						       : NULL));
 			return -1;
 		}
@@ -605,7 +606,7 @@ static int unknown_command(const char *name)
 	static const char *const names[] = {"run", "sweep", "list", "help"};
 	char hint[96];
 	fprintf(stderr, "convsim: unknown command '%s'%s; 'convsim help' lists the commands\n", name,
-		cli_did_you_mean(hint, sizeof hint, cli_suggest(name, names, 4, sizeof *names)));
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, names, 4, sizeof *names)));
 	return 2;
 }
 

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "suggest.h"
 
 #define RS (CMD_RUN | CMD_SWEEP)
 #define ALL (CMD_RUN | CMD_SWEEP | CMD_LIST)
@@ -122,50 +123,6 @@ void cli_help(FILE *f, unsigned cmd)
 			   "trough_rotation=true).\n");
 }
 
-/* Edit distance (Levenshtein) of two short strings. */
-static size_t distance(const char *a, const char *b)
-{
-	size_t n = strlen(b), row[64];
-	if (n >= 64 || strlen(a) >= 64)
-		return 64;
-	for (size_t j = 0; j <= n; j++)
-		row[j] = j;
-	for (size_t i = 1; a[i - 1]; i++) {
-		size_t diag = row[0];
-		row[0] = i;
-		for (size_t j = 1; j <= n; j++) {
-			size_t up = row[j];
-			size_t best = diag + (a[i - 1] != b[j - 1]);
-			if (row[j] + 1 < best)
-				best = row[j] + 1;
-			if (row[j - 1] + 1 < best)
-				best = row[j - 1] + 1;
-			row[j] = best;
-			diag = up;
-		}
-	}
-	return row[n];
-}
-
-const char *cli_suggest(const char *word, const void *names, size_t n, size_t stride)
-{
-	const char *best = NULL;
-	size_t best_d = (size_t)-1, len = strlen(word);
-	for (size_t i = 0; i < n; i++) {
-		const char *name = *(const char *const *)((const char *)names + i * stride);
-		size_t d = distance(word, name);
-		/* a prefix counts as near too */
-		if (len >= 2 && strncmp(name, word, len) == 0)
-			d = 1;
-		if (d < best_d) {
-			best_d = d;
-			best = name;
-		}
-	}
-	size_t limit = len < 4 ? 1 : len < 9 ? 2 : 3;
-	return best && best_d <= limit ? best : NULL;
-}
-
 const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion)
 {
 	if (suggestion)
@@ -221,7 +178,7 @@ int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
 		const char *plain = word;
 		while (*plain == '-')
 			plain++;
-		const char *s = strlen(plain) > 1 ? cli_suggest(plain, names, n, sizeof *names) : NULL;
+		const char *s = strlen(plain) > 1 ? sim_suggest(plain, names, n, sizeof *names) : NULL;
 		char full[80];
 		if (s)
 			snprintf(full, sizeof full, "--%s", s);
