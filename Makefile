@@ -72,7 +72,15 @@ INC_tests  := -Icore
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
-	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(firstword $(subst /, ,$*))) -c $< -o $@
+	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(firstword $(subst /, ,$*))) $(INC_EXTRA) -c $< -o $@
+
+# The OpenAPI document's response and stream schemas, api/schemas.json,
+# become one C string literal (api/openapi.c includes it).
+$(BUILD)/api/schemas.inc: api/schemas.json
+	@mkdir -p $(dir $@)
+	$(Q)sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$$/\\n"/' $< > $@
+$(BUILD)/api/openapi.o: $(BUILD)/api/schemas.inc
+$(BUILD)/api/openapi.o: INC_EXTRA := -I$(BUILD)/api
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")

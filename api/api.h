@@ -131,6 +131,11 @@ typedef struct api_route {
 	unsigned query;  /* API_Q_* bits it takes */
 	int tables;      /* a result route: JSON or CSV by Accept or ?format= */
 	const char *summary;
+	const char *request;  /* body schema (components/schemas), or NULL */
+	int status;           /* the success status */
+	const char *response; /* its JSON schema, or "" (no body), or a media
+				 type ("text/html", ...) for other bodies */
+	const char *problems; /* the problem statuses it may answer, "400,404" */
 } api_route;
 /* The route table and the query parameters (static). */
 const api_route *api_routes(size_t *n);

@@ -15,6 +15,9 @@
 
 #include "json_int.h"
 
+const char *const api_members_control[] = {"beta", "beta_rate", "rotation", "omega_ss",
+					    "running", "motor_on", "pace", "until", NULL};
+
 
 /* A number member for a setting in its user unit (beta in deg), converted
  * once to SI; sets the bit. */
@@ -49,11 +52,8 @@ static api_err parse_bool(const cJSON *root, const char *name, unsigned bit,
 api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			  api_control *c, api_problem *pb)
 {
-	static const char *const members[] = {"beta",     "beta_rate", "rotation",
-					      "omega_ss", "running",   "motor_on",
-					      "pace",     "until",     NULL};
 	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_body(body, len, 0, members, pb);
+	cJSON *root = api_parse_body(body, len, 0, api_members_control, pb);
 	if (!root)
 		return pb->code;
 	api_err e = API_OK;

@@ -14,6 +14,10 @@
 
 #include "json_int.h"
 
+const char *const api_members_beta_range[] = {"from", "to", "step", NULL};
+const char *const api_members_sweep[] = {"preset", "params", "scene", "integrator",
+					  "beta", "rotations", "t_end", NULL};
+
 #define T_END_MAX 600.0 /* s simulated per point, at most */
 
 static api_err parse_grid(const cJSON *it, api_sweep_req *req,
@@ -61,7 +65,7 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 		return api_fail(pb, API_TYPE, "beta",
 				"beta must be {\"from\",\"to\",\"step\"} or an "
 				"array of angles");
-	static const char *const members[] = {"from", "to", "step", NULL};
+	const char *const *members = api_members_beta_range;
 	api_err e = api_check_members(it, members, "beta.", pb);
 	double g[3];
 	for (int k = 0; k < 3 && e == API_OK; k++) {
@@ -165,11 +169,8 @@ static api_err parse_t_end(const cJSON *te, const sim_scene *scene,
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
-	static const char *const members[] = {"preset", "params", "scene",
-					      "integrator", "beta", "rotations",
-					      "t_end", NULL};
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 1, members, pb);
+	cJSON *root = api_parse_body(body, len, 1, api_members_sweep, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, &req->spec, pb);
