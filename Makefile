@@ -10,6 +10,12 @@ LDLIBS  := -lm -lpthread
 BUILD   ?= build
 PORT    ?= 8080
 HOST    ?= 127.0.0.1
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BINDIR  ?= $(PREFIX)/bin
+DATADIR ?= $(PREFIX)/share/convsim
+DOCDIR  ?= $(PREFIX)/share/doc/convsim
+UNITDIR ?= $(PREFIX)/lib/systemd/system
 
 ifeq ($(V),1)
 Q :=
@@ -121,6 +127,28 @@ bench: all
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
 mutate: all
 	$(Q)bash tests/mutate.sh
+
+# The binaries, the dashboard, the docs and a hardened systemd unit under
+# $(DESTDIR)$(PREFIX); the unit is checked with systemd-analyze verify when
+# that exists and DESTDIR is empty (the unit names the installed paths).
+install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR) $(DESTDIR)$(UNITDIR)
+	install -m 755 $(BUILD)/convsim $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
+	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
+	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
+	install -m 644 README.md docs/MODEL.md $(DESTDIR)$(DOCDIR)/
+	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
+	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service
+	chmod 644 $(DESTDIR)$(UNITDIR)/convsimd.service
+	$(Q)if [ -z "$(DESTDIR)" ] && command -v systemd-analyze >/dev/null 2>&1; then \
+	  echo "systemd-analyze verify $(UNITDIR)/convsimd.service"; \
+	  systemd-analyze verify $(UNITDIR)/convsimd.service || exit 1; \
+	else echo "(systemd-analyze not run: DESTDIR set or systemd-analyze missing)"; fi
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/convsim $(DESTDIR)$(BINDIR)/convsimd \
+	  $(DESTDIR)$(UNITDIR)/convsimd.service
+	rm -rf $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR)
 
 clean:
 	rm -rf build build-san
