@@ -86,6 +86,31 @@ static int apply_set(opts *o, const char *v)
 	return 0;
 }
 
+/* The first pass over command cmd's options: help (shown, -1), a wrong
+ * option or an operand (reported, 2), else 0 with --preset in *preset
+ * (may be NULL for commands without one). */
+static int first_pass(int argc, char **argv, unsigned cmd, const char **preset)
+{
+	const char *arg;
+	int id;
+	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
+		if (id == 0)
+			return 2;
+		if (id == OPT_HELP) {
+			cli_help(stdout, cmd);
+			return -1;
+		}
+		if (id == OPT_PRESET && preset)
+			*preset = arg;
+	}
+	if (cli_operand_index() < argc) {
+		fprintf(stderr, "convsim %s: unexpected argument '%s' (options start with --)\n",
+			argv[0], argv[cli_operand_index()]);
+		return 2;
+	}
+	return 0;
+}
+
 /* Parse command cmd's options into *o. Returns 0, 2 (usage error) or -1
  * (help shown: exit 0). */
 static int parse(int argc, char **argv, unsigned cmd, opts *o)
@@ -99,23 +124,11 @@ static int parse(int argc, char **argv, unsigned cmd, opts *o)
 	o->beta = "0:180:10";
 	/* the preset first, so that --set applies on top of it wherever it
 	 * stands; a first pass finds it */
+	int rc = first_pass(argc, argv, cmd, &o->preset);
+	if (rc)
+		return rc;
 	const char *arg;
 	int id;
-	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
-		if (id == 0)
-			return 2;
-		if (id == OPT_HELP) {
-			cli_help(stdout, cmd);
-			return -1;
-		}
-		if (id == OPT_PRESET)
-			o->preset = arg;
-	}
-	if (cli_operand_index() < argc) {
-		fprintf(stderr, "convsim %s: unexpected argument '%s' (options start with --)\n",
-			o->cmd, argv[cli_operand_index()]);
-		return 2;
-	}
 	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
 		char hint[96];
 		size_t n = 0;
@@ -561,21 +574,9 @@ static int cmd_sweep(int argc, char **argv)
 
 static int cmd_list(int argc, char **argv)
 {
-	const char *arg;
-	int id;
-	while ((id = cli_next_option(argc, argv, CMD_LIST, &arg)) != -1) {
-		if (id == 0)
-			return 2;
-		if (id == OPT_HELP) {
-			cli_help(stdout, CMD_LIST);
-			return 0;
-		}
-	}
-	if (cli_operand_index() < argc) {
-		fprintf(stderr, "convsim list: unexpected argument '%s'\n",
-			argv[cli_operand_index()]);
-		return 2;
-	}
+	int rc = first_pass(argc, argv, CMD_LIST, NULL);
+	if (rc)
+		return rc < 0 ? 0 : rc;
 	size_t n;
 	const sim_setting *t = sim_settings(&n);
 	printf("%-16s %-11s %-9s %-24s %s\n", "name", "group", "unit", "range", "meaning");
