@@ -1,6 +1,7 @@
 # Conveyor simulator: one Makefile for the core library, the CLI, the daemon,
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
+# `make deps` installs what is missing, `make install` installs,
 # `make bench` writes the work-precision tables. V=1 shows the commands.
 
 CC      ?= cc
