@@ -1,6 +1,7 @@
 # Conveyor simulator: one Makefile for the core library, the CLI, the daemon,
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
+# `make deps` installs what is missing, `make install` installs,
 # `make bench` writes the work-precision tables. V=1 shows the commands.
 
 CC      ?= cc
@@ -10,6 +11,12 @@ LDLIBS  := -lm -lpthread
 BUILD   ?= build
 PORT    ?= 8080
 HOST    ?= 127.0.0.1
+PREFIX  ?= /usr/local
+DESTDIR ?=
+BINDIR  ?= $(PREFIX)/bin
+DATADIR ?= $(PREFIX)/share/convsim
+DOCDIR  ?= $(PREFIX)/share/doc/convsim
+UNITDIR ?= $(PREFIX)/lib/systemd/system
 
 ifeq ($(V),1)
 Q :=
@@ -18,36 +25,46 @@ Q := @
 endif
 
 CORE_SRC   := $(wildcard core/*.c)
+CLI_SRC    := $(wildcard core/cli/*.c)
 API_SRC    := $(wildcard api/*.c)
 SERVER_SRC := $(wildcard server/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 
 CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/%.o)
+CLI_OBJ    := $(CLI_SRC:%.c=$(BUILD)/%.o)
 API_OBJ    := $(API_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
-# Debian packages the project needs, by the file each provides.
-DEB_NEEDS := /usr/include/microhttpd.h:libmicrohttpd-dev \
-             /usr/include/cjson/cJSON.h:libcjson-dev \
-             /usr/include/cmocka.h:libcmocka-dev \
+# Debian packages the project needs, by the file each provides: to build
+# and run (`make`, `make run`), and in addition to test (`make test`,
+# `make install`'s unit check).
+DEB_BUILD := /usr/include/microhttpd.h:libmicrohttpd-dev \
+             /usr/include/cjson/cJSON.h:libcjson-dev
+DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
              /usr/bin/curl:curl \
              /usr/bin/python3:python3 \
              /usr/bin/node:nodejs \
              /usr/bin/npm:npm \
-             /usr/bin/chromium:chromium
+             /usr/bin/chromium:chromium \
+             /usr/bin/systemd-analyze:systemd
 
-.PHONY: all deps run test check bench mutate clean
-all: deps $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
+.PHONY: all deps deps-build run test check bench mutate clean install uninstall
+all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
-# Install what is missing (Debian packages, npm test tools). Idempotent.
-deps: $(BUILD)/.deps
-$(BUILD)/.deps: Makefile tests/package.json
-	$(Q)missing=""; for pair in $(DEB_NEEDS); do f=$${pair%%:*}; p=$${pair##*:}; \
-	  [ -e "$$f" ] || missing="$$missing $$p"; done; \
-	if [ -n "$$missing" ]; then echo "apt-get install$$missing"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; fi
-	$(Q)if [ ! -d tests/node_modules/playwright-core ]; then echo "npm ci (tests)"; \
+# Install what is missing: Debian packages (with apt-get, which needs root:
+# run as root or have sudo) and the npm test tools (tests/node_modules, no
+# root). Says what it installs and why; idempotent. deps-build is the part
+# that building and running need.
+deps: deps-build $(BUILD)/.deps
+deps-build: $(BUILD)/.deps-build
+$(BUILD)/.deps-build: Makefile
+	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
+	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze)" sh tests/apt-deps.sh
+	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ]; then \
+	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@
 
@@ -62,7 +79,15 @@ INC_tests  := -Icore
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
-	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(firstword $(subst /, ,$*))) -c $< -o $@
+	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(firstword $(subst /, ,$*))) $(INC_EXTRA) -c $< -o $@
+
+# The OpenAPI document's response and stream schemas, api/schemas.json,
+# become one C string literal (api/openapi.c includes it).
+$(BUILD)/api/schemas.inc: api/schemas.json
+	@mkdir -p $(dir $@)
+	$(Q)sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$$/\\n"/' $< > $@
+$(BUILD)/api/openapi.o: $(BUILD)/api/schemas.inc
+$(BUILD)/api/openapi.o: INC_EXTRA := -I$(BUILD)/api
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
@@ -72,7 +97,7 @@ $(BUILD)/libapi.a: $(API_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim: $(BUILD)/core/cli/convsim.o $(BUILD)/libcore.a
+$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
@@ -85,10 +110,12 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  CC      $<")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(LDLIBS)
 
-run: all
-	$(BUILD)/convsimd --listen $(HOST) --port $(PORT)
+# Builds only the daemon it runs. PORT, HOST and DAEMON_FLAGS (any of
+# `build/convsimd --help`) are the knobs.
+run: deps-build $(BUILD)/convsimd
+	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) $(DAEMON_FLAGS)
 
-test: all
+test: deps all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
 
 check:
@@ -102,7 +129,29 @@ bench: all
 mutate: all
 	$(Q)bash tests/mutate.sh
 
+# The binaries, the dashboard, the docs and a hardened systemd unit under
+# $(DESTDIR)$(PREFIX); the unit is checked with systemd-analyze verify when
+# that exists and DESTDIR is empty (the unit names the installed paths).
+install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR) $(DESTDIR)$(UNITDIR)
+	install -m 755 $(BUILD)/convsim $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
+	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
+	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
+	install -m 644 README.md docs/MODEL.md $(DESTDIR)$(DOCDIR)/
+	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
+	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service
+	chmod 644 $(DESTDIR)$(UNITDIR)/convsimd.service
+	$(Q)if [ -z "$(DESTDIR)" ] && command -v systemd-analyze >/dev/null 2>&1; then \
+	  echo "systemd-analyze verify $(UNITDIR)/convsimd.service"; \
+	  systemd-analyze verify $(UNITDIR)/convsimd.service || exit 1; \
+	else echo "(systemd-analyze not run: DESTDIR set or systemd-analyze missing)"; fi
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/convsim $(DESTDIR)$(BINDIR)/convsimd \
+	  $(DESTDIR)$(UNITDIR)/convsimd.service
+	rm -rf $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR)
+
 clean:
 	rm -rf build build-san
 
--include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(BUILD)/core/cli/convsim.d
+-include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d)

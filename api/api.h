@@ -18,30 +18,61 @@
 #include <stdint.h>
 
 #include "sim.h"
+#include "table.h"
 
 /* ---- errors ----------------------------------------------------------- */
 
-/* X(name, http_status, type slug, title). 400: the body is not JSON or a
- * value has the wrong JSON type; 422: well-formed but unacceptable (out of
- * range, unknown name, inconsistent set). */
+/* X(name, http_status, type slug, title, explanation). 400: the body is not
+ * JSON, a value has the wrong JSON type or the query is wrong; 422:
+ * well-formed but unacceptable (out of range, unknown name, inconsistent
+ * set). The explanation is the page each problem type URI serves. */
 #define API_ERRNO_MAP(X)                                                      \
-	X(OK, 200, "ok", "OK")                                                \
-	X(MALFORMED, 400, "malformed-json", "Malformed JSON")                 \
-	X(TYPE, 400, "wrong-type", "Wrong type")                              \
-	X(QUERY, 400, "bad-query", "Bad query parameter")                     \
-	X(NOTFOUND, 404, "not-found", "Not found")                            \
-	X(METHOD, 405, "method-not-allowed", "Method not allowed")            \
-	X(CONFLICT, 409, "conflict", "Conflict")                              \
-	X(TOOLARGE, 413, "body-too-large", "Request body too large")          \
-	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type") \
-	X(RANGE, 422, "out-of-range", "Value out of range")                   \
-	X(UNKNOWN, 422, "unknown-field", "Unknown field")                     \
-	X(INVALID, 422, "invalid-value", "Invalid value")                     \
-	X(LIMIT, 429, "limit-reached", "Limit reached")                       \
-	X(UNAVAILABLE, 503, "unavailable", "Service unavailable")
+	X(OK, 200, "ok", "OK", "The request succeeded.")                       \
+	X(MALFORMED, 400, "malformed-json", "Malformed JSON",                 \
+	  "The request body is not one JSON value: a syntax error, or text after it. Send one "   \
+	  "JSON object with Content-Type: application/json.")                \
+	X(TYPE, 400, "wrong-type", "Wrong type",                              \
+	  "A member has the wrong JSON type (a string where a number belongs, true for pace), " \
+	  "or the body is not an object. `field` names the member; GET /api/v1/presets lists " \
+	  "every setting with its kind.")                                     \
+	X(QUERY, 400, "bad-query", "Bad query parameter",                     \
+	  "A query parameter is unknown to this route or malformed, or Last-Event-ID is not a " \
+	  "record id. `field` names it; the route's parameters are in /api/v1/openapi.json.") \
+	X(NOTFOUND, 404, "not-found", "Not found",                            \
+	  "No session, experiment, sweep, path or file has this name. Sessions are gone once " \
+	  "deleted; experiments and sweeps once deleted or pushed out by newer ones.")          \
+	X(METHOD, 405, "method-not-allowed", "Method not allowed",            \
+	  "The path exists but not with this method; the Allow header lists the methods it " \
+	  "takes.")                                                           \
+	X(NOTACCEPTABLE, 406, "not-acceptable", "Not acceptable",             \
+	  "The Accept header names no representation the route has. Result routes answer " \
+	  "application/json or text/csv (also chosen with ?format=json|csv); the others " \
+	  "application/json.")                                                \
+	X(CONFLICT, 409, "conflict", "Conflict",                              \
+	  "The session cannot do this now: it failed (diverged), finished (raise until to " \
+	  "resume), until lies in the past, or it already runs an experiment.") \
+	X(TOOLARGE, 413, "body-too-large", "Request body too large",          \
+	  "The body is larger than the daemon's --max-body; it was not read.") \
+	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type", \
+	  "Request bodies must be sent with Content-Type: application/json.") \
+	X(RANGE, 422, "out-of-range", "Value out of range",                   \
+	  "A value lies outside its range or choices (or names an unknown preset). `field` " \
+	  "names it and `min`/`max` or `choices` say what is allowed. Nothing was changed.") \
+	X(UNKNOWN, 422, "unknown-field", "Unknown field",                     \
+	  "A member or setting name is not known here; unknown members are refused, never " \
+	  "ignored. `field` names it. Nothing was changed.")                 \
+	X(INVALID, 422, "invalid-value", "Invalid value",                     \
+	  "The values are each in range but do not fit together (the core's sim_validate), " \
+	  "the simulation failed on them, or a PATCH changed nothing.")     \
+	X(LIMIT, 429, "limit-reached", "Limit reached",                       \
+	  "A limit of the daemon is reached (--max-sessions, --max-streams, kept experiments " \
+	  "or sweeps). Delete something or retry later (Retry-After).")     \
+	X(UNAVAILABLE, 503, "unavailable", "Service unavailable",             \
+	  "The daemon is shutting down, out of memory, or its worker did not take a control " \
+	  "within 5 s; nothing was changed. Retry later (Retry-After).")
 
 typedef enum {
-#define API_ERR_ENUM(name, status, slug, title) API_##name,
+#define API_ERR_ENUM(name, status, slug, title, explanation) API_##name,
 	API_ERRNO_MAP(API_ERR_ENUM)
 #undef API_ERR_ENUM
 	API_NERR
@@ -79,6 +110,49 @@ char *api_problem_json(const api_problem *pb, const char *instance);
 /* Shortest text of v that parses back to v; "null" if not finite. Returns
  * the length written (buf of at least 32 bytes). */
 int api_fmt_double(char *buf, size_t len, double v);
+
+/* ---- routes ---------------------------------------------------------------- */
+
+/* Query parameters, by bit; two share the name "format" (tables, streams). */
+enum {
+	API_Q_FORMAT = 1 << 0, API_Q_FROM = 1 << 1, API_Q_TO = 1 << 2, API_Q_STRIDE = 1 << 3,
+	API_Q_STREAM_FORMAT = 1 << 4, API_Q_FIELDS = 1 << 5, API_Q_RATE = 1 << 6,
+	API_Q_LIMIT = 1 << 7, API_Q_SINCE = 1 << 8,
+};
+typedef struct api_query {
+	unsigned bit;
+	const char *name;
+	const char *schema; /* JSON Schema text */
+	const char *doc;
+} api_query;
+/* One route: "*" in the pattern is one path segment ({id}). */
+typedef struct api_route {
+	const char *method, *pattern;
+	unsigned query;  /* API_Q_* bits it takes */
+	int tables;      /* a result route: JSON or CSV by Accept or ?format= */
+	const char *summary;
+	const char *request;  /* body schema (components/schemas), or NULL */
+	int status;           /* the success status */
+	const char *response; /* its JSON schema, or "" (no body), or a media
+				 type ("text/html", ...) for other bodies */
+	const char *problems; /* the problem statuses it may answer, "400,404" */
+} api_route;
+/* The route table and the query parameters (static). */
+const api_route *api_routes(size_t *n);
+const api_query *api_queries(size_t *n);
+/* The route of method and pattern, or NULL. */
+const api_route *api_route_find(const char *method, const char *pattern);
+/* API_OK if route rt takes query parameter name, else a 400 bad-query
+ * problem naming the parameters it takes (and the nearest one). */
+api_err api_check_query(const api_route *rt, const char *name, api_problem *pb);
+/* The representation of a result route from ?format= (may be NULL) and
+ * Accept (may be NULL): *csv 0 (JSON) or 1 (CSV); 400 for another format,
+ * 406 when Accept names neither. Other routes: JSON, API_OK. */
+api_err api_negotiate(const api_route *rt, const char *format, const char *accept, int *csv,
+		      api_problem *pb);
+/* The page a problem type URI serves (/api/v1/problems/SLUG): malloc'd
+ * HTML, or NULL for an unknown slug. */
+char *api_problem_page(const char *slug);
 
 /* ---- values in user units ------------------------------------------------ */
 
@@ -169,6 +243,10 @@ typedef struct api_view {
 char *api_session_json(const api_view *v, int with_spec);
 /* {"sessions": [...]} of n views (no spec). malloc'd text. */
 char *api_session_list_json(const api_view *v, size_t n);
+/* n sessions' summaries as CSV, one row each: id, state, the trajectory's
+ * named columns at the session's time, then steady, transport_periods and
+ * the means over whole periods. malloc'd text. */
+char *api_session_csv(const api_view *v, size_t n);
 /* PATCH answer: the session plus "applied" (the changes), "t_effective"
  * (s, null if the worker did not acknowledge in time). malloc'd text. */
 char *api_control_result_json(const api_view *v, const api_control *c,
@@ -223,15 +301,19 @@ size_t api_format_end(char *buf, size_t len, const char *reason, int ndjson);
 
 /* ---- trajectory --------------------------------------------------------- */
 
-#define API_HISTORY_COLS 17
-extern const char *const api_history_names[API_HISTORY_COLS];
-/* One trajectory row (API_HISTORY_COLS doubles, column 0 is t) from a
- * status. */
-void api_history_row(const sim_status *st, double *row);
-/* n rows of API_HISTORY_COLS (borrowed) as JSON {"fields","rows"} or as
- * CSV with a header line. malloc'd text. */
-char *api_trajectory_json(const double *rows, size_t n, double stride);
-char *api_trajectory_csv(const double *rows, size_t n);
+/* A trajectory row: the named columns of core/table.h (SIM_TRAJECTORY_COLUMNS,
+ * column 0 is t) then column_1 ... column_K, the per-column feed
+ * displacement; API_HISTORY_WIDTH(K) doubles. The CLI writes the same. */
+#define API_HISTORY_WIDTH(columns) ((size_t)SIM_TRAJECTORY_NAMED + (size_t)(columns))
+/* One trajectory row from a status and the K per-column displacements
+ * (borrowed; may be NULL when columns is 0). */
+void api_history_row(const sim_status *st, const double *column_disp, int columns,
+		     double *row);
+/* n rows of API_HISTORY_WIDTH(columns) (borrowed) as JSON
+ * {"fields","units","count","stride","rows"} or as CSV with a header line.
+ * stride: the rows' spacing, s. malloc'd text. */
+char *api_trajectory_json(const double *rows, size_t n, int columns, double stride);
+char *api_trajectory_csv(const double *rows, size_t n, int columns);
 
 /* ---- experiments --------------------------------------------------------- */
 
@@ -280,6 +362,12 @@ typedef struct api_experiment_view {
 char *api_experiment_json(const api_experiment_view *v);
 /* {"experiments": [...]} of n views. malloc'd text. */
 char *api_experiment_list_json(const api_experiment_view *v, size_t n);
+/* The segments of n experiments as CSV, one row each (API_EXPERIMENT_CSV
+ * columns). malloc'd text. */
+#define API_EXPERIMENT_CSV                                                            \
+	"experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,"   \
+	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time"
+char *api_experiment_csv(const api_experiment_view *v, size_t n);
 
 /* ---- sweeps --------------------------------------------------------------- */
 
@@ -322,6 +410,8 @@ typedef struct api_sweep_view {
 } api_sweep_view;
 char *api_sweep_json(const api_sweep_view *v);
 char *api_sweep_csv(const api_sweep_view *v);
+/* n sweeps as CSV, one row each: sweep, state, done, total, t_end. */
+char *api_sweep_list_csv(const api_sweep_view *v, size_t n);
 /* {"sweeps": [...]} of n views without their points. malloc'd text. */
 char *api_sweep_list_json(const api_sweep_view *v, size_t n);
 

@@ -17,9 +17,9 @@
 
 static const struct {
 	int status;
-	const char *slug, *title;
+	const char *slug, *title, *explanation;
 } api_errors[] = {
-#define API_ERR_ROW(name, status, slug, title) {status, slug, title},
+#define API_ERR_ROW(name, status, slug, title, explanation) {status, slug, title, explanation},
 	API_ERRNO_MAP(API_ERR_ROW)
 #undef API_ERR_ROW
 };
@@ -145,4 +145,36 @@ char *api_problem_json(const api_problem *pb, const char *instance)
 			cJSON_AddItemToArray(arr, cJSON_CreateString(tok));
 	}
 	return api_print_free(o);
+}
+
+char *api_problem_page(const char *slug)
+{
+	int at = -1;
+	for (int i = 1; i < API_NERR; i++)
+		if (strcmp(api_errors[i].slug, slug) == 0)
+			at = i;
+	if (at < 0)
+		return NULL;
+	api_buf b = {0};
+	api_buf_printf(&b,
+		       "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+		       "<title>%d %s - convsim problem</title>"
+		       "<style>body{font:16px/1.5 system-ui,sans-serif;max-width:46em;margin:2em "
+		       "auto;padding:0 1em}code{background:#eee;padding:0 .2em}td,th{padding:.2em "
+		       ".6em;text-align:left;vertical-align:top}</style></head><body>\n"
+		       "<h1>%s</h1>\n<p><code>/api/v1/problems/%s</code> &middot; HTTP %d</p>\n"
+		       "<p>%s</p>\n"
+		       "<p>The problem's <code>detail</code> says what exactly was wrong; "
+		       "<code>instance</code> is the request's path. A refused request changed "
+		       "nothing.</p>\n<h2>Every problem type of this API</h2>\n<table>"
+		       "<tr><th>status</th><th>type</th><th>title</th></tr>\n",
+		       api_errors[at].status, api_errors[at].title, api_errors[at].title,
+		       api_errors[at].slug, api_errors[at].status, api_errors[at].explanation);
+	for (int i = 1; i < API_NERR; i++)
+		api_buf_printf(&b, "<tr><td>%d</td><td><a href=\"%s\">%s</a></td><td>%s</td></tr>\n",
+			       api_errors[i].status, api_errors[i].slug, api_errors[i].slug,
+			       api_errors[i].title);
+	api_buf_puts(&b, "</table>\n<p>The API: <a href=\"../openapi.json\">openapi.json</a>.</p>"
+			 "\n</body></html>\n");
+	return api_buf_take(&b);
 }

@@ -13,18 +13,22 @@
 
 #include "json_int.h"
 
+const char *const api_members_segment[] = {"beta", "until", NULL};
+const char *const api_members_experiment_session[] = {"preset", "params", "scene", "integrator",
+						       "pace", "sample_rate", NULL};
+const char *const api_members_experiment[] = {"session", "schedule", "beta_rate", NULL};
+
 static api_err parse_segment(const cJSON *it, int i, double prev,
 			     const api_spec *spec, api_segment *seg,
 			     api_problem *pb)
 {
-	static const char *const members[] = {"beta", "until", NULL};
 	char prefix[40], field[48];
 	snprintf(prefix, sizeof prefix, "schedule[%d].", i);
 	if (!cJSON_IsObject(it))
 		return api_fail(pb, API_TYPE, prefix,
 				"schedule[%d] must be an object {\"beta\": "
 				"DEG, \"until\": S}", i);
-	api_err e = api_check_members(it, members, prefix, pb);
+	api_err e = api_check_members(it, api_members_segment, prefix, pb);
 	if (e != API_OK)
 		return e;
 	const cJSON *beta = cJSON_GetObjectItemCaseSensitive(it, "beta");
@@ -61,9 +65,6 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 				    api_problem *pb)
 {
-	static const char *const session_members[] = {
-		"preset", "params", "scene", "integrator", "pace",
-		"sample_rate", NULL};
 	if (sess && cJSON_IsString(sess)) {
 		snprintf(req->session_id, sizeof req->session_id, "%s",
 			 sess->valuestring);
@@ -80,7 +81,7 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 	req->fresh = 1;
 	cJSON *empty = sess ? NULL : cJSON_CreateObject();
 	const cJSON *src = sess ? sess : empty;
-	api_err e = api_check_members(src, session_members, "session.", pb);
+	api_err e = api_check_members(src, api_members_experiment_session, "session.", pb);
 	if (e == API_OK)
 		e = api_apply_model(src, &req->spec, pb);
 	if (e == API_OK)
@@ -96,10 +97,8 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb)
 {
-	static const char *const members[] = {"session", "schedule",
-					      "beta_rate", NULL};
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 0, members, pb);
+	cJSON *root = api_parse_body(body, len, 0, api_members_experiment, pb);
 	if (!root)
 		return pb->code;
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
@@ -193,4 +192,38 @@ char *api_experiment_list_json(const api_experiment_view *v, size_t n)
 	for (size_t i = 0; i < n; i++)
 		cJSON_AddItemToArray(arr, experiment_object(&v[i]));
 	return api_print_free(o);
+}
+
+/* A CSV cell: the number, or nothing when not finite. */
+static void csv_num(api_buf *b, double v)
+{
+	api_buf_put(b, ",", 1);
+	if (isfinite(v))
+		api_buf_double(b, v);
+}
+
+char *api_experiment_csv(const api_experiment_view *v, size_t n)
+{
+	static const char *const seg_state[] = {"pending", "running", "done"};
+	api_buf b = {0};
+	api_buf_puts(&b, API_EXPERIMENT_CSV "\n");
+	for (size_t i = 0; i < n; i++)
+		for (int k = 0; k < v[i].nseg; k++) {
+			const api_segment *g = &v[i].seg[k];
+			int done = g->state == 2;
+			api_buf_printf(&b, "%s,%s,%d", v[i].id, v[i].session_id, k + 1);
+			csv_num(&b, g->beta.user);
+			csv_num(&b, g->until);
+			api_buf_printf(&b, ",%s", seg_state[g->state >= 0 && g->state <= 2 ? g->state : 0]);
+			csv_num(&b, g->state ? g->t_command : NAN);
+			csv_num(&b, done ? g->t_end : NAN);
+			csv_num(&b, g->state ? g->start_velocity : NAN);
+			csv_num(&b, done ? g->steady_velocity : NAN);
+			csv_num(&b, done ? g->mean_velocity : NAN);
+			csv_num(&b, done ? g->uncertainty : NAN);
+			api_buf_puts(&b, !done ? "," : g->steady ? ",true" : ",false");
+			csv_num(&b, done ? g->reversal_time : NAN);
+			api_buf_put(&b, "\n", 1);
+		}
+	return api_buf_take(&b);
 }

@@ -90,4 +90,15 @@ cJSON *api_settings_array(void);
 /* Add a number member; non-finite values become null. */
 void api_add_number(cJSON *obj, const char *name, double v);
 
+/* The members each request body may have (NULL-terminated): the parsers
+ * refuse any other, and openapi.c builds the request schemas from these
+ * very lists. */
+extern const char *const api_members_session_create[];
+extern const char *const api_members_control[];
+extern const char *const api_members_experiment[];
+extern const char *const api_members_experiment_session[];
+extern const char *const api_members_segment[];
+extern const char *const api_members_sweep[];
+extern const char *const api_members_beta_range[];
+
 #endif

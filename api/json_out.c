@@ -4,7 +4,8 @@
  * cJSON's own printer picks %1.15g and falls back to %1.17g only when a
  * tolerance test fails, so some doubles do not round-trip, and it follows
  * the C locale's decimal point. Here every number is written as the
- * shortest of %.15g, %.16g and %.17g that strtod reads back bit for bit;
+ * shortest of %.15g, %.16g and %.17g that strtod reads back bit for bit
+ * (sim_fmt_double of core/table.h, which the CLI prints with too);
  * non-finite numbers become null. The same growable buffer serves the
  * CSV writers.
  */
@@ -18,16 +19,7 @@
 
 int api_fmt_double(char *buf, size_t len, double v)
 {
-	if (!isfinite(v))
-		return snprintf(buf, len, "null");
-	if (v == 0.0)
-		return snprintf(buf, len, signbit(v) ? "-0" : "0");
-	for (int prec = 15; prec <= 17; prec++) {
-		int n = snprintf(buf, len, "%.*g", prec, v);
-		if (prec == 17 || strtod(buf, NULL) == v)
-			return n;
-	}
-	return 0;
+	return sim_fmt_double(buf, len, v, "null");
 }
 
 void api_buf_put(api_buf *b, const char *s, size_t n)

@@ -1,246 +1,27 @@
 /*
  * openapi.c - the OpenAPI 3.1 description of the HTTP API, served at
- * /api/v1/openapi.json. The paths are written out here as JSON text; the
- * schemas of the "params", "scene" and "integrator" objects are generated
- * from the core's settings table, so names, units and ranges never drift
- * from what the daemon accepts.
+ * /api/v1/openapi.json, generated from the tables the daemon validates
+ * with:
+ *   - paths, their query parameters, request bodies, success and problem
+ *     responses from the route table (api/routes.c), which the server
+ *     checks every request against;
+ *   - the "params", "scene" and "integrator" schemas from the core's
+ *     settings table (names, kinds, units, ranges, defaults);
+ *   - each request body's members from the very lists its parser accepts
+ *     (closed: additionalProperties false);
+ *   - the response and stream-record schemas from api/schemas.json
+ *     (embedded at build time), which tests/http/openapi.test.mjs checks
+ *     against live responses and stream records.
  */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "json_int.h"
 
-/* Shorthands used in the text below. */
-#define PROBLEM_REF "{\"$ref\":\"#/components/responses/Problem\"}"
-#define JSON_OF(schema)                                                       \
-	"{\"description\":\"OK\",\"content\":{\"application/json\":{"        \
-	"\"schema\":" schema "}}}"
-#define ID_PARAM "{\"$ref\":\"#/components/parameters/Id\"}"
-#define BODY(schema)                                                          \
-	"\"requestBody\":{\"required\":true,\"content\":{\"application/"     \
-	"json\":{\"schema\":" schema "}}}"
-#define REF(name) "{\"$ref\":\"#/components/schemas/" name "\"}"
-#define NUM_OR_NULL(desc)                                                     \
-	"{\"type\":[\"number\",\"null\"],\"description\":\"" desc "\"}"
-
-static const char doc_text[] =
-	"{\"openapi\":\"3.1.0\","
-	"\"info\":{\"title\":\"convsim daemon API\",\"version\":\"1\","
-	"\"description\":\"Simulation sessions of a reversible vibratory "
-	"conveyor (Czubak 2016): beta on the fly, streams, experiments, "
-	"sweeps. Errors are RFC 9457 problem details.\"},"
-	"\"paths\":{"
-	"\"/api/v1/sessions\":{"
-	"\"post\":{\"summary\":\"Create a session and start its worker\","
-	BODY(REF("SessionCreate")) ","
-	"\"responses\":{\"201\":" JSON_OF(REF("Session")) ","
-	"\"400\":" PROBLEM_REF ",\"413\":" PROBLEM_REF ",\"415\":" PROBLEM_REF
-	",\"422\":" PROBLEM_REF ",\"429\":" PROBLEM_REF ",\"503\":" PROBLEM_REF
-	"}},"
-	"\"get\":{\"summary\":\"List sessions with live status\","
-	"\"responses\":{\"200\":" JSON_OF(
-		"{\"type\":\"object\",\"properties\":{\"sessions\":{\"type\":"
-		"\"array\",\"items\":" REF("Session") "}}}") "}}},"
-	"\"/api/v1/sessions/{id}\":{\"parameters\":[" ID_PARAM "],"
-	"\"get\":{\"summary\":\"Spec and live status\",\"responses\":{"
-	"\"200\":" JSON_OF(REF("Session")) ",\"404\":" PROBLEM_REF "}},"
-	"\"patch\":{\"summary\":\"Change beta, rotation, omega_ss, motor_on, running, "
-	"pace or until while it runs; answers the simulated time the change "
-	"takes effect\"," BODY(REF("Control")) ","
-	"\"responses\":{\"200\":" JSON_OF(REF("Session")) ","
-	"\"400\":" PROBLEM_REF ",\"404\":" PROBLEM_REF ",\"409\":" PROBLEM_REF
-	",\"415\":" PROBLEM_REF ",\"422\":" PROBLEM_REF ",\"503\":" PROBLEM_REF
-	"}},"
-	"\"delete\":{\"summary\":\"Stop and remove the session\","
-	"\"responses\":{\"204\":{\"description\":\"deleted\"},\"404\":"
-	PROBLEM_REF "}}},"
-	"\"/api/v1/sessions/{id}/stream\":{\"parameters\":[" ID_PARAM ","
-	"{\"name\":\"format\",\"in\":\"query\",\"schema\":{\"enum\":[\"sse\","
-	"\"ndjson\"]}},"
-	"{\"name\":\"fields\",\"in\":\"query\",\"description\":\"comma list "
-	"of trough, orbit, rotor, eliminators, feed, energy, elements, all\","
-	"\"schema\":{\"type\":\"string\"}},"
-	"{\"name\":\"rate\",\"in\":\"query\",\"description\":\"samples per "
-	"simulated second\",\"schema\":{\"type\":\"number\"}},"
-	"{\"name\":\"limit\",\"in\":\"query\",\"schema\":{\"type\":"
-	"\"integer\",\"minimum\":1}},"
-	"{\"name\":\"since\",\"in\":\"query\",\"description\":\"resume after "
-	"this record id (as Last-Event-ID)\",\"schema\":{\"type\":"
-	"\"integer\",\"minimum\":0}},"
-	"{\"name\":\"Last-Event-ID\",\"in\":\"header\",\"schema\":{\"type\":"
-	"\"integer\",\"minimum\":0}}],"
-	"\"get\":{\"summary\":\"Server-Sent Events or NDJSON of samples and "
-	"control events\",\"responses\":{\"200\":{\"description\":\"stream\","
-	"\"content\":{\"text/event-stream\":{},\"application/x-ndjson\":{}}},"
-	"\"400\":" PROBLEM_REF ",\"404\":" PROBLEM_REF ",\"429\":" PROBLEM_REF
-	"}}},"
-	"\"/api/v1/sessions/{id}/trajectory\":{\"parameters\":[" ID_PARAM ","
-	"{\"name\":\"from\",\"in\":\"query\",\"schema\":{\"type\":\"number\"}},"
-	"{\"name\":\"to\",\"in\":\"query\",\"schema\":{\"type\":\"number\"}},"
-	"{\"name\":\"format\",\"in\":\"query\",\"schema\":{\"enum\":[\"json\","
-	"\"csv\"]}}],"
-	"\"get\":{\"summary\":\"Recorded, downsampled history\","
-	"\"responses\":{\"200\":{\"description\":\"rows\",\"content\":{"
-	"\"application/json\":{},\"text/csv\":{}}},\"400\":" PROBLEM_REF
-	",\"404\":" PROBLEM_REF "}}},"
-	"\"/api/v1/experiments\":{"
-	"\"post\":{\"summary\":\"Run a beta schedule; per segment the steady "
-	"transport velocity and the reversal time\","
-	BODY(REF("ExperimentCreate")) ","
-	"\"responses\":{\"201\":" JSON_OF(REF("Experiment")) ",\"400\":"
-	PROBLEM_REF ",\"404\":" PROBLEM_REF ",\"409\":" PROBLEM_REF ",\"422\":"
-	PROBLEM_REF ",\"429\":" PROBLEM_REF "}},"
-	"\"get\":{\"summary\":\"List experiments\",\"responses\":{\"200\":"
-	JSON_OF("{\"type\":\"object\"}") "}}},"
-	"\"/api/v1/experiments/{id}\":{\"parameters\":[" ID_PARAM "],"
-	"\"get\":{\"summary\":\"Progress and results\",\"responses\":{\"200\":"
-	JSON_OF(REF("Experiment")) ",\"404\":" PROBLEM_REF "}}},"
-	"\"/api/v1/sweeps\":{"
-	"\"post\":{\"summary\":\"Measure v(beta) for both rotations on the "
-	"worker pool\"," BODY(REF("SweepCreate")) ","
-	"\"responses\":{\"202\":" JSON_OF(REF("Sweep")) ",\"400\":" PROBLEM_REF
-	",\"422\":" PROBLEM_REF ",\"429\":" PROBLEM_REF "}},"
-	"\"get\":{\"summary\":\"List sweeps\",\"responses\":{\"200\":"
-	JSON_OF("{\"type\":\"object\"}") "}}},"
-	"\"/api/v1/sweeps/{id}\":{\"parameters\":[" ID_PARAM ","
-	"{\"name\":\"format\",\"in\":\"query\",\"schema\":{\"enum\":[\"json\","
-	"\"csv\"]}}],"
-	"\"get\":{\"summary\":\"Progress and results\",\"responses\":{\"200\":"
-	"{\"description\":\"results\",\"content\":{\"application/json\":{"
-	"\"schema\":" REF("Sweep") "},\"text/csv\":{}}},\"404\":" PROBLEM_REF
-	"}},"
-	"\"delete\":{\"summary\":\"Cancel and forget\",\"responses\":{\"204\":"
-	"{\"description\":\"deleted\"},\"404\":" PROBLEM_REF "}}},"
-	"\"/api/v1/presets\":{\"get\":{\"summary\":\"Presets, the settings "
-	"table, integrators\",\"responses\":{\"200\":" JSON_OF(
-		"{\"type\":\"object\"}") "}}},"
-	"\"/api/v1/health\":{\"get\":{\"summary\":\"Liveness\",\"responses\":"
-	"{\"200\":" JSON_OF("{\"type\":\"object\"}") ",\"503\":{\"description\":"
-	"\"shutting down\"}}}},"
-	"\"/api/v1/openapi.json\":{\"get\":{\"summary\":\"This document\","
-	"\"responses\":{\"200\":" JSON_OF("{\"type\":\"object\"}") "}}},"
-	"\"/metrics\":{\"get\":{\"summary\":\"Prometheus text format\","
-	"\"responses\":{\"200\":{\"description\":\"metrics\",\"content\":{"
-	"\"text/plain\":{}}}}}}"
-	"},"
-	"\"components\":{"
-	"\"parameters\":{\"Id\":{\"name\":\"id\",\"in\":\"path\",\"required\":"
-	"true,\"schema\":{\"type\":\"string\"}}},"
-	"\"responses\":{\"Problem\":{\"description\":\"RFC 9457 problem\","
-	"\"content\":{\"application/problem+json\":{\"schema\":"
-	REF("Problem") "}}}},"
-	"\"schemas\":{"
-	"\"Problem\":{\"type\":\"object\",\"properties\":{"
-	"\"type\":{\"type\":\"string\"},\"title\":{\"type\":\"string\"},"
-	"\"status\":{\"type\":\"integer\"},\"detail\":{\"type\":\"string\"},"
-	"\"instance\":{\"type\":\"string\"},\"field\":{\"type\":\"string\"},"
-	"\"min\":{\"type\":\"number\"},\"max\":{\"type\":\"number\"},"
-	"\"choices\":{\"type\":\"array\",\"items\":{\"type\":\"string\"}}}},"
-	"\"Pace\":{\"oneOf\":[{\"type\":\"number\",\"minimum\":0.001,"
-	"\"maximum\":1000},{\"const\":\"max\"}]},"
-	"\"SessionCreate\":{\"type\":\"object\",\"additionalProperties\":false,"
-	"\"properties\":{\"preset\":{\"type\":\"string\"},"
-	"\"params\":" REF("Params") ",\"scene\":" REF("Scene") ","
-	"\"integrator\":" REF("Integrator") ",\"pace\":" REF("Pace") ","
-	"\"until\":{\"type\":[\"number\",\"null\"],\"description\":\"simulated "
-	"end time, s (pace max defaults to 60)\"},"
-	"\"sample_rate\":{\"type\":\"number\",\"minimum\":1,\"maximum\":10000}"
-	"}},"
-	"\"Control\":{\"type\":\"object\",\"additionalProperties\":false,"
-	"\"minProperties\":1,\"properties\":{"
-	"\"beta\":{\"type\":\"number\",\"description\":\"deg\"},"
-	"\"beta_rate\":{\"type\":\"number\",\"description\":\"deg/s\"},"
-	"\"rotation\":{\"enum\":[\"cw\",\"ccw\"]},"
-	"\"omega_ss\":{\"type\":\"number\",\"description\":\"rad/s\"},"
-	"\"running\":{\"type\":\"boolean\"},"
-	"\"motor_on\":{\"type\":\"boolean\",\"description\":\"drive on/off\"},"
-	"\"pace\":" REF("Pace") ","
-	"\"until\":{\"type\":[\"number\",\"null\"]}}},"
-	"\"Session\":{\"type\":\"object\",\"properties\":{"
-	"\"id\":{\"type\":\"string\"},\"state\":{\"enum\":[\"running\","
-	"\"paused\",\"finished\",\"failed\"]},\"pace\":" REF("Pace") ","
-	"\"until\":{\"type\":[\"number\",\"null\"]},\"status\":"
-	REF("Status") ",\"spec\":{\"type\":\"object\"},\"t_effective\":{"
-	"\"type\":[\"number\",\"null\"]},\"applied\":" REF("Control") "}},"
-	"\"Status\":{\"type\":\"object\",\"description\":\"Live state at the "
-	"simulated time t; SI units but beta, beta_target (deg) and beta_dot "
-	"(deg/s); null where not defined yet\",\"properties\":{"
-	"\"t\":{\"type\":\"number\"},\"t_integrator\":{\"type\":\"number\"},"
-	"\"beta\":{\"type\":\"number\"},\"beta_target\":{\"type\":\"number\"},"
-	"\"beta_dot\":{\"type\":\"number\"},"
-	"\"rotation\":{\"enum\":[\"cw\",\"ccw\"]},\"drive_on\":{\"type\":"
-	"\"boolean\"},\"omega_ss\":{\"type\":\"number\"},"
-	"\"rotor_speed\":{\"type\":\"number\",\"description\":\"rad/s, "
-	"positive for clockwise (the paper's sense)\"},"
-	"\"motor_torque\":{\"type\":\"number\"},\"power\":{\"type\":"
-	"\"number\"},"
-	"\"rotor_speed_mean\":" NUM_OR_NULL("rad/s, mean over the transport "
-	"estimate's whole periods") ","
-	"\"motor_torque_mean\":" NUM_OR_NULL("N m, the same mean") ","
-	"\"power_mean\":" NUM_OR_NULL("W, the same mean") ","
-	"\"transport_velocity\":" NUM_OR_NULL("m/s, slope of the mean feed "
-	"displacement over the whole periods since scene.transient (or the "
-	"last estimator restart)") ","
-	"\"transport_velocity_uncertainty\":" NUM_OR_NULL("m/s, the "
-	"estimate's error bar; null before 4 batches of periods") ","
-	"\"steady\":{\"type\":\"boolean\",\"description\":\"the estimate "
-	"spans at least 8 periods and shows no drift beyond its scatter\"},"
-	"\"transport_periods\":{\"type\":\"number\"},"
-	"\"feed_velocity\":" NUM_OR_NULL("m/s, last whole period") ","
-	"\"feed_displacement\":{\"type\":\"number\"},"
-	"\"period\":" NUM_OR_NULL("s") ","
-	"\"steps\":{\"type\":\"number\"},\"rhs_evals\":{\"type\":\"number\"},"
-	"\"dt\":{\"type\":\"number\"},\"substeps\":{\"type\":\"integer\"},"
-	"\"steps_per_s\":{\"type\":\"number\"},\"rtf\":{\"type\":\"number\"},"
-	"\"n_dof\":{\"type\":\"integer\"},\"reductions\":{\"type\":\"array\","
-	"\"items\":{\"type\":\"string\"}},\"reduction_figures\":{\"type\":"
-	"\"array\"},\"energy\":{\"type\":\"object\",\"description\":\"J, "
-	"changes since t = 0: input, kinetic, potential, dissipated, "
-	"residual\"}}},"
-	"\"ExperimentCreate\":{\"type\":\"object\",\"required\":[\"schedule\"],"
-	"\"properties\":{\"session\":{\"oneOf\":[{\"type\":\"string\"},"
-	REF("SessionCreate") "]},\"beta_rate\":{\"type\":\"number\"},"
-	"\"schedule\":{\"type\":\"array\",\"minItems\":1,\"maxItems\":32,"
-	"\"items\":{\"type\":\"object\",\"required\":[\"beta\",\"until\"],"
-	"\"properties\":{\"beta\":{\"type\":\"number\"},\"until\":{\"type\":"
-	"\"number\"}}}}}},"
-	"\"Experiment\":{\"type\":\"object\",\"properties\":{\"id\":{\"type\":"
-	"\"string\"},\"session\":{\"type\":\"string\"},\"state\":{\"enum\":["
-	"\"waiting\",\"running\",\"done\",\"aborted\"]},\"progress\":{\"type\":"
-	"\"number\"},\"segments\":{\"type\":\"array\",\"items\":{\"type\":"
-	"\"object\",\"properties\":{\"beta\":{\"type\":\"number\"},\"until\":{"
-	"\"type\":\"number\"},\"t_command\":{\"type\":[\"number\",\"null\"]},"
-	"\"steady_velocity\":{\"type\":[\"number\",\"null\"]},"
-	"\"mean_velocity\":" NUM_OR_NULL("m/s, transport estimate over the "
-	"segment") ","
-	"\"uncertainty\":" NUM_OR_NULL("m/s, error bar of mean_velocity") ","
-	"\"steady\":{\"type\":[\"boolean\",\"null\"],\"description\":"
-	"\"mean_velocity showed no drift (null until the segment is done)\"},"
-	"\"reversal_time\":{\"type\":[\"number\",\"null\"]}}}}}},"
-	"\"SweepCreate\":{\"type\":\"object\",\"properties\":{\"preset\":{"
-	"\"type\":\"string\"},\"params\":" REF("Params") ",\"scene\":"
-	REF("Scene") ",\"integrator\":" REF("Integrator") ","
-	"\"beta\":{\"oneOf\":[{\"type\":\"array\",\"items\":{\"type\":"
-	"\"number\"}},{\"type\":\"object\",\"properties\":{\"from\":{\"type\":"
-	"\"number\"},\"to\":{\"type\":\"number\"},\"step\":{\"type\":"
-	"\"number\"}}}]},\"rotations\":{\"type\":\"array\",\"items\":{\"enum\":"
-	"[\"cw\",\"ccw\"]}},\"t_end\":{\"type\":\"number\",\"maximum\":600,"
-	"\"description\":\"simulated s per point; must exceed scene.transient; "
-	"default scene.transient + 4\"}}},"
-	"\"Sweep\":{\"type\":\"object\",\"properties\":{\"id\":{\"type\":"
-	"\"string\"},\"state\":{\"enum\":[\"queued\",\"running\",\"done\","
-	"\"cancelled\"]},\"total\":{\"type\":\"integer\"},\"done\":{\"type\":"
-	"\"integer\"},\"t_end\":{\"type\":\"number\"},\"points\":{\"type\":"
-	"\"array\",\"items\":{\"type\":\"object\",\"properties\":{"
-	"\"beta\":{\"type\":\"number\",\"description\":\"deg\"},"
-	"\"rotation\":{\"enum\":[\"cw\",\"ccw\"]},\"state\":{\"enum\":["
-	"\"pending\",\"running\",\"done\",\"failed\"]},"
-	"\"velocity\":" NUM_OR_NULL("m/s") ","
-	"\"uncertainty\":" NUM_OR_NULL("m/s, error bar of velocity") ","
-	"\"steady\":{\"type\":[\"boolean\",\"null\"]},"
-	"\"error\":{\"type\":\"string\"}}}},\"series\":{\"type\":"
-	"\"object\"}}}"
-	"}}}";
+static const char schemas_text[] =
+#include "schemas.inc"
+	;
 
 /* A JSON Schema object for one group of the settings table, with the
  * czubak2016 preset's values as defaults. */
@@ -313,20 +94,203 @@ static cJSON *group_schema(const char *group)
 	return schema;
 }
 
+/* A request schema: exactly the parser's members, each typed by
+ * schemas.json's x-request-members; NULL if the two lists differ. */
+static cJSON *request_schema(const cJSON *types, const cJSON *required, const char *name,
+			     const char *const *members)
+{
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(types, name);
+	int n = 0;
+	while (members[n])
+		n++;
+	if (!t || cJSON_GetArraySize(t) != n)
+		return NULL;
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "type", "object");
+	cJSON *props = cJSON_AddObjectToObject(o, "properties");
+	for (int i = 0; i < n; i++) {
+		const cJSON *p = cJSON_GetObjectItemCaseSensitive(t, members[i]);
+		if (!p) {
+			cJSON_Delete(o);
+			return NULL;
+		}
+		cJSON_AddItemToObject(props, members[i], cJSON_Duplicate(p, 1));
+	}
+	const cJSON *req = cJSON_GetObjectItemCaseSensitive(required, name);
+	if (req)
+		cJSON_AddItemToObject(o, "required", cJSON_Duplicate(req, 1));
+	if (strcmp(name, "Control") == 0)
+		cJSON_AddNumberToObject(o, "minProperties", 1);
+	cJSON_AddBoolToObject(o, "additionalProperties", 0);
+	return o;
+}
+
+static cJSON *ref(const char *kind, const char *name)
+{
+	char r[96];
+	snprintf(r, sizeof r, "#/components/%s/%s", kind, name);
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "$ref", r);
+	return o;
+}
+
+/* content: {media: {schema}} for each media type given (schema may be
+ * NULL: none). */
+static cJSON *content(const char *media, cJSON *schema)
+{
+	cJSON *c = cJSON_CreateObject();
+	cJSON *m = cJSON_AddObjectToObject(c, media);
+	if (schema)
+		cJSON_AddItemToObject(m, "schema", schema);
+	return c;
+}
+
+/* The operation object of route rt. */
+static cJSON *operation(const api_route *rt)
+{
+	size_t nq;
+	const api_query *q = api_queries(&nq);
+	cJSON *op = cJSON_CreateObject();
+	cJSON_AddStringToObject(op, "summary", rt->summary);
+	cJSON *params = cJSON_AddArrayToObject(op, "parameters");
+	if (strchr(rt->pattern, '*'))
+		cJSON_AddItemToArray(params, ref("parameters", "Id"));
+	for (size_t i = 0; i < nq; i++) {
+		if (!(rt->query & q[i].bit))
+			continue;
+		cJSON *p = cJSON_CreateObject();
+		cJSON_AddStringToObject(p, "name", q[i].name);
+		cJSON_AddStringToObject(p, "in", "query");
+		cJSON_AddStringToObject(p, "description", q[i].doc);
+		cJSON_AddItemToObject(p, "schema", cJSON_Parse(q[i].schema));
+		cJSON_AddItemToArray(params, p);
+	}
+	if (rt->query & API_Q_SINCE) {
+		cJSON *p = cJSON_CreateObject();
+		cJSON_AddStringToObject(p, "name", "Last-Event-ID");
+		cJSON_AddStringToObject(p, "in", "header");
+		cJSON_AddItemToObject(p, "schema", cJSON_Parse("{\"type\":\"integer\",\"minimum\":0}"));
+		cJSON_AddItemToArray(params, p);
+	}
+	if (rt->request) {
+		cJSON *body = cJSON_AddObjectToObject(op, "requestBody");
+		cJSON_AddBoolToObject(body, "required", 1);
+		cJSON_AddItemToObject(body, "content",
+				      content("application/json", ref("schemas", rt->request)));
+	}
+	cJSON *responses = cJSON_AddObjectToObject(op, "responses");
+	char status[8];
+	snprintf(status, sizeof status, "%d", rt->status);
+	cJSON *ok = cJSON_AddObjectToObject(responses, status);
+	cJSON_AddStringToObject(ok, "description", rt->status == 204 ? "done, no body" : "OK");
+	if (strcmp(rt->response, "StreamRecord") == 0) {
+		cJSON *c = content("text/event-stream", NULL);
+		cJSON_AddItemToObject(c, "application/x-ndjson",
+				      cJSON_Parse("{\"itemSchema\":{\"$ref\":"
+						  "\"#/components/schemas/StreamRecord\"},"
+						  "\"schema\":{\"$ref\":"
+						  "\"#/components/schemas/StreamRecord\"}}"));
+		cJSON_AddItemToObject(ok, "content", c);
+	} else if (strchr(rt->response, '/')) {
+		cJSON_AddItemToObject(ok, "content", content(rt->response, NULL));
+	} else if (rt->response[0]) {
+		cJSON *c = content("application/json", ref("schemas", rt->response));
+		if (rt->tables)
+			cJSON_AddItemToObject(c, "text/csv",
+					      cJSON_Parse("{\"schema\":{\"type\":\"string\","
+							  "\"description\":\"CSV with a header line\"}}"));
+		cJSON_AddItemToObject(ok, "content", c);
+	}
+	if (strcmp(rt->response, "Health") == 0) {
+		cJSON *down = cJSON_AddObjectToObject(responses, "503");
+		cJSON_AddStringToObject(down, "description", "shutting down");
+		cJSON_AddItemToObject(down, "content", content("application/json", ref("schemas", "Health")));
+	}
+	char list[64];
+	snprintf(list, sizeof list, "%s", rt->problems);
+	char *save = NULL;
+	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save))
+		cJSON_AddItemToObject(responses, t, ref("responses", "Problem"));
+	return op;
+}
+
+/* The paths object from the route table ("*" becomes {id}). */
+static cJSON *paths(void)
+{
+	size_t n;
+	const api_route *rt = api_routes(&n);
+	cJSON *paths = cJSON_CreateObject();
+	for (size_t i = 0; i < n; i++) {
+		char path[96], method[8];
+		size_t at = 0;
+		for (const char *p = rt[i].pattern; *p && at + 5 < sizeof path; p++)
+			at += (size_t)snprintf(path + at, sizeof path - at, "%s",
+					       *p == '*' ? "{id}" : (char[]){*p, 0});
+		snprintf(method, sizeof method, "%s", rt[i].method);
+		for (char *m = method; *m; m++)
+			*m = (char)(*m - 'A' + 'a');
+		cJSON *item = cJSON_GetObjectItemCaseSensitive(paths, path);
+		if (!item)
+			item = cJSON_AddObjectToObject(paths, path);
+		cJSON_AddItemToObject(item, method, operation(&rt[i]));
+	}
+	return paths;
+}
+
 char *api_openapi_json(void)
 {
-	cJSON *doc = cJSON_Parse(doc_text);
-	cJSON *schemas = doc ? cJSON_GetObjectItemCaseSensitive(
-				       cJSON_GetObjectItemCaseSensitive(
-					       doc, "components"),
-				       "schemas")
-			     : NULL;
-	if (!schemas) {
-		cJSON_Delete(doc);
-		return NULL;
+	static const struct {
+		const char *name;
+		const char *const *members;
+	} bodies[] = {
+		{"SessionCreate", api_members_session_create},
+		{"Control", api_members_control},
+		{"ExperimentCreate", api_members_experiment},
+		{"ExperimentSession", api_members_experiment_session},
+		{"ScheduleSegment", api_members_segment},
+		{"SweepCreate", api_members_sweep},
+		{"BetaRange", api_members_beta_range},
+	};
+	cJSON *src = cJSON_Parse(schemas_text);
+	cJSON *comps = cJSON_DetachItemFromObjectCaseSensitive(src, "components");
+	cJSON *schemas = cJSON_GetObjectItemCaseSensitive(comps, "schemas");
+	const cJSON *types = cJSON_GetObjectItemCaseSensitive(src, "x-request-members");
+	const cJSON *required = cJSON_GetObjectItemCaseSensitive(src, "x-required");
+	cJSON *doc = NULL;
+	if (!schemas || !types)
+		goto fail;
+	for (size_t i = 0; i < sizeof bodies / sizeof *bodies; i++) {
+		cJSON *b = request_schema(types, required, bodies[i].name, bodies[i].members);
+		if (!b)
+			goto fail; /* schemas.json and a parser disagree */
+		cJSON_AddItemToObject(schemas, bodies[i].name, b);
 	}
 	cJSON_AddItemToObject(schemas, "Params", group_schema("params"));
 	cJSON_AddItemToObject(schemas, "Scene", group_schema("scene"));
 	cJSON_AddItemToObject(schemas, "Integrator", group_schema("integrator"));
+	cJSON_AddItemToObject(comps, "parameters",
+			      cJSON_Parse("{\"Id\":{\"name\":\"id\",\"in\":\"path\",\"required\":"
+					  "true,\"schema\":{\"type\":\"string\"}}}"));
+	cJSON_AddItemToObject(comps, "responses",
+			      cJSON_Parse("{\"Problem\":{\"description\":\"RFC 9457 problem; its "
+					  "type URI serves a page that explains it\",\"content\":{"
+					  "\"application/problem+json\":{\"schema\":{\"$ref\":"
+					  "\"#/components/schemas/Problem\"}}}}}"));
+	doc = cJSON_CreateObject();
+	cJSON_AddStringToObject(doc, "openapi", "3.1.0");
+	cJSON *info = cJSON_AddObjectToObject(doc, "info");
+	cJSON_AddStringToObject(info, "title", "convsim daemon API");
+	cJSON_AddStringToObject(info, "version", "1");
+	cJSON_AddStringToObject(info, "description",
+				"Simulation sessions of a reversible vibratory conveyor (Czubak 2016): "
+				"beta on the fly, streams, experiments, sweeps. Results as JSON or CSV "
+				"(Accept or ?format=). Errors are RFC 9457 problem details.");
+	cJSON_AddItemToObject(doc, "paths", paths());
+	cJSON_AddItemToObject(doc, "components", comps);
+	cJSON_Delete(src);
 	return api_print_free(doc);
+fail:
+	cJSON_Delete(comps);
+	cJSON_Delete(src);
+	return NULL;
 }

@@ -15,6 +15,9 @@
 
 #include "json_int.h"
 
+const char *const api_members_control[] = {"beta", "beta_rate", "rotation", "omega_ss",
+					    "running", "motor_on", "pace", "until", NULL};
+
 
 /* A number member for a setting in its user unit (beta in deg), converted
  * once to SI; sets the bit. */
@@ -49,11 +52,8 @@ static api_err parse_bool(const cJSON *root, const char *name, unsigned bit,
 api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			  api_control *c, api_problem *pb)
 {
-	static const char *const members[] = {"beta",     "beta_rate", "rotation",
-					      "omega_ss", "running",   "motor_on",
-					      "pace",     "until",     NULL};
 	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_body(body, len, 0, members, pb);
+	cJSON *root = api_parse_body(body, len, 0, api_members_control, pb);
 	if (!root)
 		return pb->code;
 	api_err e = API_OK;
@@ -293,4 +293,35 @@ char *api_control_result_json(const api_view *v, const api_control *c,
 	else
 		cJSON_AddNullToObject(o, "t_effective");
 	return api_print_free(o);
+}
+
+char *api_session_csv(const api_view *v, size_t n)
+{
+	api_buf b = {0};
+	api_buf_puts(&b, "id,state");
+	for (int c = 0; c < SIM_TRAJECTORY_NAMED; c++)
+		api_buf_printf(&b, ",%s", sim_trajectory_name(c));
+	api_buf_puts(&b, ",steady,transport_periods,rotor_speed_mean,motor_torque_mean,"
+			 "power_mean\n");
+	for (size_t i = 0; i < n; i++) {
+		const sim_status *st = &v[i].st;
+		double row[SIM_TRAJECTORY_NAMED];
+		api_buf_printf(&b, "%s,%s", v[i].id, v[i].state);
+		sim_trajectory_row(st, row);
+		const double means[] = {st->transport_periods, st->rotor_speed_mean,
+					st->motor_torque_mean, st->power_mean};
+		for (int c = 0; c < SIM_TRAJECTORY_NAMED; c++) {
+			api_buf_put(&b, ",", 1);
+			if (v[i].has_status && isfinite(row[c]))
+				api_buf_double(&b, row[c]);
+		}
+		api_buf_puts(&b, !v[i].has_status ? "," : st->steady ? ",true" : ",false");
+		for (int c = 0; c < 4; c++) {
+			api_buf_put(&b, ",", 1);
+			if (v[i].has_status && isfinite(means[c]))
+				api_buf_double(&b, means[c]);
+		}
+		api_buf_put(&b, "\n", 1);
+	}
+	return api_buf_take(&b);
 }

@@ -12,6 +12,9 @@
 #include <string.h>
 
 #include "json_int.h"
+
+const char *const api_members_session_create[] = {"preset", "params", "scene", "integrator",
+						   "pace", "until", "sample_rate", NULL};
 #include "units.h"
 
 /* The name of choice idx in "a|b|c" into out; 0 if there is none. */
@@ -317,11 +320,8 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb)
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb)
 {
-	static const char *const members[] = {
-		"preset", "params", "scene", "integrator", "pace", "until",
-		"sample_rate", NULL};
 	memset(spec, 0, sizeof *spec);
-	cJSON *root = api_parse_body(body, len, 1, members, pb);
+	cJSON *root = api_parse_body(body, len, 1, api_members_session_create, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, spec, pb);

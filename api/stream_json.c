@@ -6,7 +6,7 @@
  * record is either Server-Sent Events (id, event, data lines) or one
  * NDJSON line carrying "type" and "id". Doubles round-trip
  * (api_fmt_double). The trajectory is a downsampled table of
- * API_HISTORY_COLS columns, written as JSON or CSV.
+ * the trajectory columns of core/table.h, written as JSON or CSV.
  */
 #include <math.h>
 #include <stdio.h>
@@ -239,46 +239,53 @@ size_t api_format_end(char *buf, size_t len, const char *reason, int ndjson)
 
 /* ---- trajectory ------------------------------------------------------ */
 
-const char *const api_history_names[API_HISTORY_COLS] = {
-	"t",           "beta",         "beta_target",      "x",
-	"y",           "alpha",        "deck_x",           "deck_y",
-	"rotor_speed", "motor_torque", "s1",               "s2",
-	"feed_displacement", "feed_velocity", "transport_velocity",
-	"power",       "e_residual",
-};
-
-void api_history_row(const sim_status *st, double *row)
+void api_history_row(const sim_status *st, const double *column_disp, int columns,
+		     double *row)
 {
-	const double v[API_HISTORY_COLS] = {
-		st->t,           api_user_of("beta", st->beta),
-		api_user_of("beta", st->beta_target),
-		st->q[0],        st->q[1],          st->q[2],
-		st->deck[0],     st->deck[1],       st->rotor_speed,
-		st->motor_torque, st->q[4],         st->q[5],
-		st->feed_displacement, st->feed_velocity,
-		st->transport_velocity, st->power, st->e_residual,
-	};
-	memcpy(row, v, sizeof v);
+	sim_trajectory_row(st, row);
+	for (int k = 0; k < columns; k++)
+		row[SIM_TRAJECTORY_NAMED + k] = column_disp[k];
 }
 
-char *api_trajectory_json(const double *rows, size_t n, double stride)
+/* Column c's name (column_1 ... past the named ones). */
+static void put_column_name(api_buf *b, int c, int quoted)
+{
+	char name[32];
+	if (c < SIM_TRAJECTORY_NAMED)
+		snprintf(name, sizeof name, "%s", sim_trajectory_name(c));
+	else
+		snprintf(name, sizeof name, "column_%d", c - SIM_TRAJECTORY_NAMED + 1);
+	if (quoted)
+		api_buf_jstr(b, name);
+	else
+		api_buf_puts(b, name);
+}
+
+char *api_trajectory_json(const double *rows, size_t n, int columns, double stride)
 {
 	api_buf b = {0};
+	int width = (int)API_HISTORY_WIDTH(columns);
 	api_buf_puts(&b, "{\"fields\":[");
-	for (int c = 0; c < API_HISTORY_COLS; c++) {
+	for (int c = 0; c < width; c++) {
 		if (c)
 			api_buf_put(&b, ",", 1);
-		api_buf_jstr(&b, api_history_names[c]);
+		put_column_name(&b, c, 1);
+	}
+	api_buf_puts(&b, "],\"units\":[");
+	for (int c = 0; c < width; c++) {
+		if (c)
+			api_buf_put(&b, ",", 1);
+		api_buf_jstr(&b, c < SIM_TRAJECTORY_NAMED ? sim_trajectory_unit(c) : "m");
 	}
 	api_buf_printf(&b, "],\"count\":%zu,\"stride\":", n);
 	api_buf_double(&b, stride);
 	api_buf_puts(&b, ",\"rows\":[");
 	for (size_t i = 0; i < n; i++) {
 		api_buf_puts(&b, i ? ",[" : "[");
-		for (int c = 0; c < API_HISTORY_COLS; c++) {
+		for (int c = 0; c < width; c++) {
 			if (c)
 				api_buf_put(&b, ",", 1);
-			api_buf_double(&b, rows[i * API_HISTORY_COLS + c]);
+			api_buf_double(&b, rows[i * (size_t)width + (size_t)c]);
 		}
 		api_buf_put(&b, "]", 1);
 	}
@@ -286,19 +293,20 @@ char *api_trajectory_json(const double *rows, size_t n, double stride)
 	return api_buf_take(&b);
 }
 
-char *api_trajectory_csv(const double *rows, size_t n)
+char *api_trajectory_csv(const double *rows, size_t n, int columns)
 {
 	api_buf b = {0};
-	for (int c = 0; c < API_HISTORY_COLS; c++) {
+	int width = (int)API_HISTORY_WIDTH(columns);
+	for (int c = 0; c < width; c++) {
 		api_buf_puts(&b, c ? "," : "");
-		api_buf_puts(&b, api_history_names[c]);
+		put_column_name(&b, c, 0);
 	}
 	api_buf_put(&b, "\n", 1);
 	for (size_t i = 0; i < n; i++) {
-		for (int c = 0; c < API_HISTORY_COLS; c++) {
+		for (int c = 0; c < width; c++) {
 			if (c)
 				api_buf_put(&b, ",", 1);
-			double v = rows[i * API_HISTORY_COLS + c];
+			double v = rows[i * (size_t)width + (size_t)c];
 			if (isfinite(v))
 				api_buf_double(&b, v);
 		}

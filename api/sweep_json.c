@@ -14,6 +14,10 @@
 
 #include "json_int.h"
 
+const char *const api_members_beta_range[] = {"from", "to", "step", NULL};
+const char *const api_members_sweep[] = {"preset", "params", "scene", "integrator",
+					  "beta", "rotations", "t_end", NULL};
+
 #define T_END_MAX 600.0 /* s simulated per point, at most */
 
 static api_err parse_grid(const cJSON *it, api_sweep_req *req,
@@ -61,7 +65,7 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 		return api_fail(pb, API_TYPE, "beta",
 				"beta must be {\"from\",\"to\",\"step\"} or an "
 				"array of angles");
-	static const char *const members[] = {"from", "to", "step", NULL};
+	const char *const *members = api_members_beta_range;
 	api_err e = api_check_members(it, members, "beta.", pb);
 	double g[3];
 	for (int k = 0; k < 3 && e == API_OK; k++) {
@@ -165,11 +169,8 @@ static api_err parse_t_end(const cJSON *te, const sim_scene *scene,
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
-	static const char *const members[] = {"preset", "params", "scene",
-					      "integrator", "beta", "rotations",
-					      "t_end", NULL};
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 1, members, pb);
+	cJSON *root = api_parse_body(body, len, 1, api_members_sweep, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, &req->spec, pb);
@@ -271,7 +272,7 @@ char *api_sweep_list_json(const api_sweep_view *v, size_t n)
 char *api_sweep_csv(const api_sweep_view *v)
 {
 	api_buf b = {0};
-	api_buf_puts(&b, "beta,rotation,velocity,uncertainty,steady,state\n");
+	api_buf_puts(&b, SIM_SWEEP_CSV_HEADER "\n");
 	for (size_t i = 0; i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		int done = p->state == 2;
@@ -284,6 +285,18 @@ char *api_sweep_csv(const api_sweep_view *v)
 			api_buf_double(&b, p->uncertainty);
 		api_buf_puts(&b, !done ? "," : p->steady ? ",true" : ",false");
 		api_buf_printf(&b, ",%s\n", point_state(p->state));
+	}
+	return api_buf_take(&b);
+}
+
+char *api_sweep_list_csv(const api_sweep_view *v, size_t n)
+{
+	api_buf b = {0};
+	api_buf_puts(&b, "sweep,state,done,total,t_end\n");
+	for (size_t i = 0; i < n; i++) {
+		api_buf_printf(&b, "%s,%s,%zu,%zu,", v[i].id, v[i].state, v[i].done, v[i].total);
+		api_buf_double(&b, v[i].t_end);
+		api_buf_put(&b, "\n", 1);
 	}
 	return api_buf_take(&b);
 }

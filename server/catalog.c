@@ -40,6 +40,15 @@ enum MHD_Result srv_h_openapi(srv_req *r)
 				strlen(openapi_text));
 }
 
+enum MHD_Result srv_h_problem(srv_req *r)
+{
+	char *page = api_problem_page(r->arg[0]);
+	if (!page)
+		return srv_fail(r, API_NOTFOUND, NULL, "no problem type \"%.40s\"; "
+				"/api/v1/problems/not-found lists them all", r->arg[0]);
+	return srv_reply(r, 200, "text/html; charset=utf-8", page, NULL, NULL);
+}
+
 enum MHD_Result srv_h_presets(srv_req *r)
 {
 	return srv_reply_json(r, 200, api_presets_json());

@@ -17,5 +17,7 @@ enum MHD_Result srv_h_presets(srv_req *r);
 enum MHD_Result srv_h_health(srv_req *r);
 enum MHD_Result srv_h_metrics(srv_req *r);
 enum MHD_Result srv_h_openapi(srv_req *r);
+/* GET /api/v1/problems/SLUG: the HTML page that explains a problem type. */
+enum MHD_Result srv_h_problem(srv_req *r);
 
 #endif

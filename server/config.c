@@ -147,10 +147,16 @@ static void pick_web_root(srv_config *cfg, const char *argv0)
 	const char *slash = strrchr(argv0, '/');
 	if (!slash)
 		return;
-	snprintf(web_guess, sizeof web_guess, "%.*s/../web",
-		 (int)(slash - argv0), argv0);
-	if (stat(web_guess, &sb) == 0 && S_ISDIR(sb.st_mode))
-		cfg->web_root = web_guess;
+	/* beside the build directory, or where `make install` puts it */
+	static const char *const guesses[] = {"../web", "../share/convsim/web"};
+	for (size_t i = 0; i < sizeof guesses / sizeof *guesses; i++) {
+		snprintf(web_guess, sizeof web_guess, "%.*s/%s", (int)(slash - argv0), argv0,
+			 guesses[i]);
+		if (stat(web_guess, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+			cfg->web_root = web_guess;
+			return;
+		}
+	}
 }
 
 int srv_config_parse(srv_config *cfg, int argc, char **argv)

@@ -66,12 +66,12 @@ static api_err start_on_session(srv_experiment *e,
 }
 
 /* The experiment as JSON, from a consistent copy of its state. */
-static char *experiment_json(srv_experiment *e)
+static char *experiment_json(srv_experiment *e, int csv)
 {
 	api_experiment_view v;
 	api_segment seg[API_EXP_MAX_SEGMENTS];
 	srv_exp_view(e, &v, seg);
-	return api_experiment_json(&v);
+	return csv ? api_experiment_csv(&v, 1) : api_experiment_json(&v);
 }
 
 enum MHD_Result srv_h_experiments_create(srv_req *r)
@@ -108,7 +108,7 @@ enum MHD_Result srv_h_experiments_create(srv_req *r)
 	free(req);
 	srv_registry_publish(&experiments, srv_exp_entry(e));
 	atomic_fetch_add(&srv_stats.experiments, 1);
-	res = srv_reply_created(r, 201, experiment_json(e),
+	res = srv_reply_created(r, 201, experiment_json(e, 0),
 				"/api/v1/experiments", srv_exp_id(e));
 	srv_registry_put(&experiments, srv_exp_entry(e));
 	return res;
@@ -120,9 +120,9 @@ enum MHD_Result srv_h_experiment_get(srv_req *r)
 	if (!en)
 		return srv_fail(r, API_NOTFOUND, NULL,
 				"no experiment with id \"%.40s\"", r->arg[0]);
-	char *text = experiment_json(srv_exp_from_entry(en));
+	char *text = experiment_json(srv_exp_from_entry(en), r->csv);
 	srv_registry_put(&experiments, en);
-	return srv_reply_json(r, 200, text);
+	return srv_reply_result(r, text);
 }
 
 enum MHD_Result srv_h_experiments_list(srv_req *r)
@@ -136,10 +136,10 @@ enum MHD_Result srv_h_experiments_list(srv_req *r)
 		for (size_t i = 0; i < n; i++)
 			srv_exp_view(srv_exp_from_entry(all[i]), &v[i],
 				     seg + i * API_EXP_MAX_SEGMENTS);
-		text = api_experiment_list_json(v, n);
+		text = r->csv ? api_experiment_csv(v, n) : api_experiment_list_json(v, n);
 	}
 	srv_registry_release(&experiments, all, n);
 	free(v);
 	free(seg);
-	return srv_reply_json(r, 200, text);
+	return srv_reply_result(r, text);
 }

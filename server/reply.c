@@ -140,18 +140,8 @@ int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result)
 	return 0;
 }
 
-int srv_table_format(srv_req *r, api_problem *pb)
+enum MHD_Result srv_reply_result(srv_req *r, char *text)
 {
-	const char *f = srv_query(r, "format");
-	if (f) {
-		if (strcmp(f, "json") == 0)
-			return 0;
-		if (strcmp(f, "csv") == 0)
-			return 1;
-		api_fail(pb, API_QUERY, "format",
-			 "format must be json or csv (got \"%.40s\")", f);
-		return -1;
-	}
-	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
-	return accept && strstr(accept, "text/csv") ? 1 : 0;
+	return srv_reply(r, 200, r->csv ? "text/csv" : "application/json", text,
+			 MHD_HTTP_HEADER_VARY, "Accept");
 }

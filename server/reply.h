@@ -22,6 +22,7 @@ typedef struct srv_req {
 	size_t body_len;
 	int has_content_type;
 	int json_body;         /* Content-Type is application/json */
+	int csv;               /* a result route answers CSV (negotiated) */
 } srv_req;
 
 typedef enum MHD_Result (*srv_handler)(srv_req *r);
@@ -55,8 +56,8 @@ const char *srv_header(srv_req *r, const char *name);
 /* 1 if the request carries a JSON body (or none, when empty_ok); else
  * queues 415 and returns 0 (the handler then returns *result). */
 int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result);
-/* Table format from ?format=json|csv or Accept: text/csv: 0 json, 1 csv,
- * -1 with *pb (400) when ?format= names something else. */
-int srv_table_format(srv_req *r, api_problem *pb);
+/* 200 with a result in the negotiated representation (r->csv): text is
+ * JSON or CSV accordingly (taken). */
+enum MHD_Result srv_reply_result(srv_req *r, char *text);
 
 #endif

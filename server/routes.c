@@ -7,7 +7,9 @@
  * read when Content-Length exceeds --max-body, and while it is read for
  * chunked bodies), checks its media type, then calls the one handler. A
  * path that exists with another method gets 405 with Allow; unknown paths
- * under /api/ get 404; everything else is a static file of web/.
+ * under /api/ get 404; everything else is a static file of web/. Query
+ * parameters and the representation are checked against the API's route
+ * table (api/routes.c) before the handler runs.
  * Per-request state is freed in the completion callback.
  */
 #include <stdio.h>
@@ -48,6 +50,7 @@ static const route routes[] = {
 	{"GET", "/api/v1/presets", srv_h_presets},
 	{"GET", "/api/v1/health", srv_h_health},
 	{"GET", "/api/v1/openapi.json", srv_h_openapi},
+	{"GET", "/api/v1/problems/*", srv_h_problem},
 	{"GET", "/metrics", srv_h_metrics},
 };
 
@@ -103,6 +106,42 @@ static int json_type(const char *ct)
 	return 0;
 }
 
+typedef struct query_check {
+	const api_route *rt;
+	api_problem *pb;
+	int bad;
+} query_check;
+
+static enum MHD_Result check_one_query(void *cls, enum MHD_ValueKind kind, const char *key,
+				       const char *value)
+{
+	(void)kind;
+	(void)value;
+	query_check *qc = cls;
+	if (qc->bad || api_check_query(qc->rt, key, qc->pb) == API_OK)
+		return MHD_YES;
+	qc->bad = 1;
+	return MHD_NO;
+}
+
+/* The checks the API's route table asks for before a handler runs: every
+ * query parameter known to the route, the representation (r->csv) of a
+ * result route. */
+static enum MHD_Result call_route(srv_req *r, const route *ro)
+{
+	const api_route *rt = api_route_find(ro->method, ro->pattern);
+	api_problem pb;
+	if (rt) {
+		query_check qc = {rt, &pb, 0};
+		MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, check_one_query, &qc);
+		if (qc.bad ||
+		    api_negotiate(rt, rt->tables ? srv_query(r, "format") : NULL,
+				  srv_header(r, MHD_HTTP_HEADER_ACCEPT), &r->csv, &pb) != API_OK)
+			return srv_reply_problem(r, &pb, NULL);
+	}
+	return ro->handler(r);
+}
+
 static enum MHD_Result route_request(srv_req *r)
 {
 	char allow[96] = "";
@@ -115,7 +154,7 @@ static enum MHD_Result route_request(srv_req *r)
 		path_known = 1;
 		if (strcmp(routes[i].method, method) == 0) {
 			memcpy(r->arg, arg, sizeof arg);
-			return routes[i].handler(r);
+			return call_route(r, &routes[i]);
 		}
 		if (!strstr(allow, routes[i].method)) {
 			size_t at = strlen(allow);

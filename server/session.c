@@ -119,7 +119,7 @@ static int alloc_buffers(srv_session *s)
 	s->ring = calloc(s->ring_cap, sizeof *s->ring);
 	s->ring_store = calloc(per ? s->ring_cap * per : 1, sizeof(double));
 	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
-	s->hist = calloc(s->hist_cap * API_HISTORY_COLS, sizeof(double));
+	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
 	if (!s->ring || !s->ring_store || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
@@ -131,9 +131,10 @@ static int alloc_buffers(srv_session *s)
 		r->xi = r->column_disp + s->columns;
 		r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
 	}
-	s->hist_stride = 1.0 / s->spec.sample_rate;
-	if (s->hist_stride < 0.01)
-		s->hist_stride = 0.01;
+	/* trajectory rows every whole number of sample intervals, at least
+	 * 0.01 s apart */
+	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
+	s->hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
 	return 0;
 }
 
@@ -456,16 +457,16 @@ size_t srv_session_history(srv_session *s, double from, double to,
 			   double **rows, double *stride)
 {
 	pthread_mutex_lock(&s->lock);
+	size_t width = API_HISTORY_WIDTH(s->columns);
 	size_t first = 0, last = s->hist_n;
-	while (first < s->hist_n && s->hist[first * API_HISTORY_COLS] < from)
+	while (first < s->hist_n && s->hist[first * width] < from)
 		first++;
-	while (last > first && s->hist[(last - 1) * API_HISTORY_COLS] > to)
+	while (last > first && s->hist[(last - 1) * width] > to)
 		last--;
 	size_t n = last - first;
-	*rows = malloc((n ? n : 1) * API_HISTORY_COLS * sizeof(double));
+	*rows = malloc((n ? n : 1) * width * sizeof(double));
 	if (*rows && n)
-		memcpy(*rows, s->hist + first * API_HISTORY_COLS,
-		       n * API_HISTORY_COLS * sizeof(double));
+		memcpy(*rows, s->hist + first * width, n * width * sizeof(double));
 	*stride = s->hist_stride;
 	pthread_mutex_unlock(&s->lock);
 	return *rows ? n : 0;

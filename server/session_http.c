@@ -51,11 +51,11 @@ enum MHD_Result srv_h_sessions_list(srv_req *r)
 	if (views) {
 		for (size_t i = 0; i < n; i++)
 			srv_session_view(all[i], &views[i]);
-		text = api_session_list_json(views, n);
+		text = r->csv ? api_session_csv(views, n) : api_session_list_json(views, n);
 	}
 	srv_sessions_release(all, n);
 	free(views);
-	return srv_reply_json(r, 200, text);
+	return srv_reply_result(r, text);
 }
 
 enum MHD_Result srv_h_session_get(srv_req *r)
@@ -65,7 +65,8 @@ enum MHD_Result srv_h_session_get(srv_req *r)
 		return not_found(r, r->arg[0]);
 	api_view v;
 	srv_session_view(s, &v);
-	enum MHD_Result res = srv_reply_json(r, 200, api_session_json(&v, 1));
+	enum MHD_Result res =
+		srv_reply_result(r, r->csv ? api_session_csv(&v, 1) : api_session_json(&v, 1));
 	srv_session_put(s);
 	return res;
 }
@@ -129,24 +130,48 @@ static int query_number(srv_req *r, const char *key, double *out,
 enum MHD_Result srv_h_trajectory(srv_req *r)
 {
 	api_problem pb;
-	double from = -INFINITY, to = INFINITY, stride = 0, *rows = NULL;
-	int csv;
+	double from = -INFINITY, to = INFINITY, every = 0, stride = 0, *rows = NULL;
 	if (!query_number(r, "from", &from, &pb) ||
 	    !query_number(r, "to", &to, &pb) ||
-	    (csv = srv_table_format(r, &pb)) < 0)
+	    !query_number(r, "stride", &every, &pb))
 		return srv_reply_problem(r, &pb, NULL);
 	if (from > to)
 		return srv_fail(r, API_QUERY, "from",
 				"from (%g) must not exceed to (%g)", from, to);
+	if (every < 0)
+		return srv_fail(r, API_QUERY, "stride", "stride must be positive (s)");
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	int columns, layers;
+	srv_session_feed_size(s, &columns, &layers);
 	size_t n = srv_session_history(s, from, to, &rows, &stride);
 	srv_session_put(s);
+	if (rows && every > 0) {
+		/* rows on the grid of multiples of the asked stride, which must
+		 * be a whole number of the recorded spacing */
+		double k = every / stride;
+		if (fabs(k - floor(k + 0.5)) > 1e-6 || k < 0.5) {
+			free(rows);
+			char rec[40];
+			api_fmt_double(rec, sizeof rec, stride);
+			return srv_fail(r, API_QUERY, "stride",
+					"stride must be a whole multiple of the recorded spacing, "
+					"now %s s (got %g)", rec, every);
+		}
+		size_t width = API_HISTORY_WIDTH(columns), kept = 0;
+		for (size_t i = 0; i < n; i++) {
+			double m = rows[i * width] / every;
+			if (fabs(m - floor(m + 0.5)) < 1e-6)
+				memmove(rows + kept++ * width, rows + i * width,
+					width * sizeof *rows);
+		}
+		n = kept;
+		stride = every;
+	}
 	char *text = !rows  ? NULL
-		     : csv ? api_trajectory_csv(rows, n)
-			   : api_trajectory_json(rows, n, stride);
+		     : r->csv ? api_trajectory_csv(rows, n, columns)
+			   : api_trajectory_json(rows, n, columns, stride);
 	free(rows);
-	return srv_reply(r, 200, csv ? "text/csv" : "application/json", text,
-			 NULL, NULL);
+	return srv_reply_result(r, text);
 }

@@ -244,10 +244,6 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 
 enum MHD_Result srv_h_sweep_get(srv_req *r)
 {
-	api_problem pb;
-	int csv = srv_table_format(r, &pb);
-	if (csv < 0)
-		return srv_reply_problem(r, &pb, NULL);
 	srv_entry *en = srv_registry_get(&sweeps, r->arg[0]);
 	if (!en)
 		return srv_fail(r, API_NOTFOUND, NULL,
@@ -256,11 +252,10 @@ enum MHD_Result srv_h_sweep_get(srv_req *r)
 	api_sweep_view v;
 	pthread_mutex_lock(&sw->lock);
 	fill_view(sw, &v);
-	char *text = csv ? api_sweep_csv(&v) : api_sweep_json(&v);
+	char *text = r->csv ? api_sweep_csv(&v) : api_sweep_json(&v);
 	pthread_mutex_unlock(&sw->lock);
 	srv_registry_put(&sweeps, en);
-	return srv_reply(r, 200, csv ? "text/csv" : "application/json", text,
-			 NULL, NULL);
+	return srv_reply_result(r, text);
 }
 
 enum MHD_Result srv_h_sweeps_list(srv_req *r)
@@ -276,11 +271,11 @@ enum MHD_Result srv_h_sweeps_list(srv_req *r)
 			fill_view(sw, &v[i]);
 			pthread_mutex_unlock(&sw->lock);
 		}
-		text = api_sweep_list_json(v, n);
+		text = r->csv ? api_sweep_list_csv(v, n) : api_sweep_list_json(v, n);
 	}
 	srv_registry_release(&sweeps, all, n);
 	free(v);
-	return srv_reply_json(r, 200, text);
+	return srv_reply_result(r, text);
 }
 
 enum MHD_Result srv_h_sweep_delete(srv_req *r)

@@ -105,23 +105,40 @@ static void push_event_reason(srv_session *s, const char *type,
 	push_event(s, type, json);
 }
 
+/* 1 if t lies on the grid of multiples of step (to rounding). */
+static int on_grid(double t, double step)
+{
+	double m = t / step;
+	return fabs(m - floor(m + 0.5)) < 1e-6;
+}
+
+/* A trajectory row at every multiple of the stride, exactly: rows are
+ * taken at sample times on that grid (the stride is a whole number of
+ * sample intervals), so the rows lie `stride` apart as reported. */
 static void record_history(srv_session *s)
 {
-	if (s->st.t < s->hist_next - 1e-12 || !s->hist_cap)
+	if (!s->hist_cap || s->st.t < s->hist_next - 1e-9 * s->hist_stride ||
+	    !on_grid(s->st.t, s->hist_stride))
 		return;
+	size_t width = API_HISTORY_WIDTH(s->columns);
 	if (s->hist_n == s->hist_cap) {
-		/* full: keep every other row, double the stride */
+		/* full: keep the rows on the doubled grid, double the stride */
 		size_t k = 0;
-		for (size_t i = 0; i < s->hist_n; i += 2, k++)
-			memmove(s->hist + k * API_HISTORY_COLS,
-				s->hist + i * API_HISTORY_COLS,
-				API_HISTORY_COLS * sizeof(double));
+		for (size_t i = 0; i < s->hist_n; i++)
+			if (on_grid(s->hist[i * width], 2 * s->hist_stride))
+				memmove(s->hist + k++ * width, s->hist + i * width,
+					width * sizeof(double));
 		s->hist_n = k;
 		s->hist_stride *= 2;
+		if (!on_grid(s->st.t, s->hist_stride)) {
+			s->hist_next = (floor(s->st.t / s->hist_stride + 1e-6) + 1) * s->hist_stride;
+			return;
+		}
 	}
-	api_history_row(&s->st, s->hist + s->hist_n * API_HISTORY_COLS);
+	api_history_row(&s->st, s->scratch.column_disp, s->columns,
+			s->hist + s->hist_n * width);
 	s->hist_n++;
-	s->hist_next = s->st.t + s->hist_stride;
+	s->hist_next = (floor(s->st.t / s->hist_stride + 0.5) + 1) * s->hist_stride;
 }
 
 static void record_sample(srv_session *s)

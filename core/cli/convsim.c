@@ -1,16 +1,19 @@
 /*
  * convsim.c - command-line runner of the simulation core.
  *
- *   convsim run   --preset czubak2016 [--set NAME=VALUE ...] --duration S
+ *   convsim run   [--preset NAME] [--set NAME=VALUE ...] [--duration S]
  *                 [--out FILE] [--format csv|json] [--sample-rate HZ]
- *   convsim sweep --preset czubak2016 --beta FROM:TO:STEP --rotation cw,ccw
+ *   convsim sweep [--preset NAME] [--beta FROM:TO:STEP] [--rotation cw,ccw]
  *                 [--set NAME=VALUE ...] [--duration S] [--threads N]
- *                 [--format csv|json]
- *   convsim list  (settings with units and ranges, integrators)
+ *                 [--out FILE] [--format csv|json]
+ *   convsim list | help [COMMAND] | --version
  *
  * `run` prints a JSON summary on stdout; `sweep` prints v(beta) per
- * rotation direction and reports progress on stderr. Uses the core only.
+ * rotation sense. Options come from one table (options.c); numbers are
+ * printed as the daemon prints them, and the trajectory and sweep tables
+ * have the daemon's columns (core/table.h). Uses the core only.
  */
+#include <errno.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -18,15 +21,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "cli.h"
 #include "sim.h"
+#include "suggest.h"
+#include "table.h"
 #include "units.h"
-
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double cpu_now(void)
 {
@@ -35,151 +34,208 @@ static double cpu_now(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int usage(void)
-{
-	fprintf(stderr,
-		"usage: convsim run --preset NAME [--set NAME=VALUE ...] --duration S\n"
-		"                   [--out FILE] [--format csv|json] [--sample-rate HZ]\n"
-		"       convsim sweep --preset NAME --beta FROM:TO:STEP [--rotation cw,ccw]\n"
-		"                   [--set NAME=VALUE ...] [--duration S] [--threads N]\n"
-		"                   [--format csv|json]\n"
-		"       convsim list\n");
-	return 2;
-}
+/* The default measuring window (s after the transient) of run and sweep:
+ * with the `steady` start, 4 s keep all 74 points of czubak2016 within
+ * 1 % of the converged reference (README "Accuracy"). */
+#define MEASURE_WINDOW 4.0
 
 typedef struct opts {
+	const char *cmd;
 	sim_params p;
 	sim_scene sc;
 	sim_method m;
 	const char *preset, *out, *format, *beta, *rotation;
 	double duration, rate;
-	int threads;
+	int threads, quiet;
 } opts;
 
-/* Parse the options shared by run and sweep. Returns 0 or an exit code. */
-static int parse(int argc, char **argv, opts *o)
+/* Print a number as the daemon does (shortest round trip); non-finite as
+ * `nonfinite`. */
+static void put_num(FILE *f, double v, const char *nonfinite)
 {
-	o->preset = "czubak2016";
-	o->format = NULL;
-	o->duration = -1.0;
-	o->rate = 1000.0;
-	o->threads = 2;
-	o->rotation = "cw,ccw";
-	sim_preset(o->preset, &o->p, &o->sc, &o->m);
-	/* the preset first, so that --set applies on top of it */
-	for (int i = 2; i < argc - 1; i++)
-		if (strcmp(argv[i], "--preset") == 0)
-			o->preset = argv[i + 1];
-	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
-		fprintf(stderr, "convsim: unknown preset '%s' (known: czubak2016)\n", o->preset);
-		return 2;
+	char num[40];
+	sim_fmt_double(num, sizeof num, v, nonfinite);
+	fputs(num, f);
+}
+
+/* "unknown setting 'x'" gets the nearest setting's name. */
+static void setting_error(const opts *o, const char *arg, const char *name, const char *msg)
+{
+	size_t n;
+	const sim_setting *t = sim_settings(&n);
+	char hint[96] = "";
+	if (!sim_setting_find(name))
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, n, sizeof *t));
+	fprintf(stderr, "convsim %s: --set %s: %s%s; 'convsim list' shows every setting\n", o->cmd,
+		arg, msg, hint);
+}
+
+static int apply_set(opts *o, const char *v)
+{
+	const char *eq = strchr(v, '=');
+	if (!eq || eq == v) {
+		fprintf(stderr, "convsim %s: --set needs NAME=VALUE, got '%s'\n", o->cmd, v);
+		return -1;
 	}
-	for (int i = 2; i < argc; i++) {
-		const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!v)
-			return usage();
-		i++;
-		char msg[200];
-		if (strcmp(a, "--preset") == 0) {
-			continue;
-		} else if (strcmp(a, "--set") == 0) {
-			const char *eq = strchr(v, '=');
-			if (!eq) {
-				fprintf(stderr, "convsim: --set needs NAME=VALUE, got '%s'\n", v);
-				return 2;
-			}
-			char name[64];
-			snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-			if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) !=
-			    SIM_OK) {
-				fprintf(stderr, "convsim: %s\n", msg);
-				return 2;
-			}
-		} else if (strcmp(a, "--duration") == 0) {
-			o->duration = atof(v);
-		} else if (strcmp(a, "--out") == 0) {
-			o->out = v;
-		} else if (strcmp(a, "--format") == 0) {
-			o->format = v;
-		} else if (strcmp(a, "--sample-rate") == 0) {
-			o->rate = atof(v);
-		} else if (strcmp(a, "--beta") == 0) {
-			o->beta = v;
-		} else if (strcmp(a, "--rotation") == 0) {
-			o->rotation = v;
-		} else if (strcmp(a, "--threads") == 0) {
-			o->threads = atoi(v);
-		} else {
-			fprintf(stderr, "convsim: unknown option '%s'\n", a);
-			return usage();
+	char name[64], msg[200];
+	snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
+	if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) != SIM_OK) {
+		setting_error(o, v, name, msg);
+		return -1;
+	}
+	return 0;
+}
+
+/* The first pass over command cmd's options: help (shown, -1), a wrong
+ * option or an operand (reported, 2), else 0 with --preset in *preset
+ * (may be NULL for commands without one). */
+static int first_pass(int argc, char **argv, unsigned cmd, const char **preset)
+{
+	const char *arg;
+	int id;
+	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
+		if (id == 0)
+			return 2;
+		if (id == OPT_HELP) {
+			cli_help(stdout, cmd);
+			return -1;
 		}
+		if (id == OPT_PRESET && preset)
+			*preset = arg;
 	}
-	if (o->format && strcmp(o->format, "csv") != 0 && strcmp(o->format, "json") != 0) {
-		fprintf(stderr, "convsim: --format must be csv or json\n");
-		return 2;
-	}
-	if (!(o->rate > 0.0 && o->rate <= 1e6)) {
-		fprintf(stderr, "convsim: --sample-rate must be in (0, 1e6] Hz\n");
+	if (cli_operand_index() < argc) {
+		fprintf(stderr, "convsim %s: unexpected argument '%s' (options start with --)\n",
+			argv[0], argv[cli_operand_index()]);
 		return 2;
 	}
 	return 0;
 }
 
-static void print_num(FILE *f, double v)
+/* Parse command cmd's options into *o. Returns 0, 2 (usage error) or -1
+ * (help shown: exit 0). */
+static int parse(int argc, char **argv, unsigned cmd, opts *o)
 {
-	if (isfinite(v))
-		fprintf(f, "%.17g", v);
-	else
-		fputs("null", f);
+	o->cmd = argv[0];
+	o->preset = "czubak2016";
+	o->duration = NAN;
+	o->rate = 1000.0;
+	o->threads = 2;
+	o->rotation = "cw,ccw";
+	o->beta = "0:180:10";
+	/* the preset first, so that --set applies on top of it wherever it
+	 * stands; a first pass finds it */
+	int rc = first_pass(argc, argv, cmd, &o->preset);
+	if (rc)
+		return rc;
+	const char *arg;
+	int id;
+	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
+		char hint[96];
+		size_t n = 0;
+		while (sim_preset_names[n])
+			n++;
+		fprintf(stderr, "convsim %s: --preset: unknown preset '%s'%s; known: czubak2016\n",
+			o->cmd, o->preset,
+			cli_did_you_mean(hint, sizeof hint,
+					 sim_suggest(o->preset, sim_preset_names, n,
+						     sizeof *sim_preset_names)));
+		return 2;
+	}
+	cli_restart_options();
+	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
+		int bad = 0;
+		switch (id) {
+		case OPT_SET: bad = apply_set(o, arg); break;
+		case OPT_DURATION:
+			bad = cli_number(o->cmd, "duration", "seconds", arg, 0, 1e5, 1, &o->duration);
+			break;
+		case OPT_RATE:
+			bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
+			break;
+		case OPT_THREADS: {
+			double th;
+			bad = cli_number(o->cmd, "threads", NULL, arg, 1, 64, 0, &th);
+			if (!bad && th != floor(th)) {
+				fprintf(stderr, "convsim %s: --threads must be a whole number, got '%s'\n",
+					o->cmd, arg);
+				bad = 1;
+			}
+			o->threads = (int)th;
+			break;
+		}
+		case OPT_OUT: o->out = arg; break;
+		case OPT_FORMAT: o->format = arg; break;
+		case OPT_BETA: o->beta = arg; break;
+		case OPT_ROTATION: o->rotation = arg; break;
+		case OPT_QUIET: o->quiet = 1; break;
+		default: break;
+		}
+		if (bad)
+			return 2;
+	}
+	if (o->format && strcmp(o->format, "csv") != 0 && strcmp(o->format, "json") != 0) {
+		fprintf(stderr, "convsim %s: --format must be csv or json, got '%s'\n", o->cmd,
+			o->format);
+		return 2;
+	}
+	if (isnan(o->duration))
+		o->duration = o->sc.transient + MEASURE_WINDOW;
+	return 0;
 }
 
-static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int first,
-		      double *colbuf)
+/* ---- run ---- */
+
+/* The trajectory file: the daemon's columns (core/table.h), as CSV with a
+ * header line or as the daemon's JSON {"fields","units","stride","rows",
+ * "count"}. */
+typedef struct traj_file {
+	FILE *f;
+	int json, columns;
+	long rows;
+	double *colbuf;
+} traj_file;
+
+static void traj_begin(traj_file *tf, double stride)
 {
-	int K = sim_columns(s);
-	double vals[16] = {st->t,           st->q[0],          st->q[1],
-			   st->q[2],        st->q[4],          st->q[5],
-			   st->rotor_speed, st->motor_torque,  st->beta * DEG_PER_RAD,
-			   st->deck[0],     st->deck[1],       st->feed_displacement,
-			   st->e_input,     st->e_dissipated,  st->e_residual,
-			   st->transport_velocity};
-	static const char *const names[16] = {
-		"t",     "x",     "y",           "alpha", "s1",          "s2",
-		"rotor_speed", "motor_torque", "beta_deg", "deck_x", "deck_y",
-		"feed_displacement", "e_input", "e_dissipated", "e_residual",
-		"transport_velocity"};
-	sim_column_displacement(s, colbuf);
-	if (json) {
-		fputs(first ? "[\n{" : ",\n{", f);
-		for (int i = 0; i < 16; i++) {
-			fprintf(f, "%s\"%s\":", i ? "," : "", names[i]);
-			print_num(f, vals[i]);
-		}
-		fputs(",\"columns\":[", f);
-		for (int k = 0; k < K; k++) {
-			if (k)
-				fputc(',', f);
-			print_num(f, colbuf[k]);
-		}
-		fputs("]}", f);
+	FILE *f = tf->f;
+	int width = SIM_TRAJECTORY_NAMED + tf->columns;
+	fputs(tf->json ? "{\"fields\":[" : "", f);
+	for (int c = 0; c < width; c++) {
+		const char *q = tf->json ? "\"" : "";
+		fputs(c ? "," : "", f);
+		if (c < SIM_TRAJECTORY_NAMED)
+			fprintf(f, "%s%s%s", q, sim_trajectory_name(c), q);
+		else
+			fprintf(f, "%scolumn_%d%s", q, c - SIM_TRAJECTORY_NAMED + 1, q);
+	}
+	if (!tf->json) {
+		fputc('\n', f);
 		return;
 	}
-	if (first) {
-		for (int i = 0; i < 16; i++)
-			fprintf(f, "%s%s", i ? "," : "", names[i]);
-		for (int k = 0; k < K; k++)
-			fprintf(f, ",column_%d", k + 1);
-		fputc('\n', f);
+	fputs("],\"units\":[", f);
+	for (int c = 0; c < width; c++)
+		fprintf(f, "%s\"%s\"", c ? "," : "",
+			c < SIM_TRAJECTORY_NAMED ? sim_trajectory_unit(c) : "m");
+	fputs("],\"stride\":", f);
+	put_num(f, stride, "null");
+	fputs(",\"rows\":[", f);
+}
+
+static void traj_row(traj_file *tf, const sim *s, const sim_status *st)
+{
+	double row[SIM_TRAJECTORY_NAMED];
+	sim_trajectory_row(st, row);
+	sim_column_displacement(s, tf->colbuf);
+	const char *nonfinite = tf->json ? "null" : "";
+	if (tf->json)
+		fputs(tf->rows ? ",\n[" : "\n[", tf->f);
+	for (int c = 0; c < SIM_TRAJECTORY_NAMED + tf->columns; c++) {
+		fputs(c ? "," : "", tf->f);
+		put_num(tf->f, c < SIM_TRAJECTORY_NAMED ? row[c] : tf->colbuf[c - SIM_TRAJECTORY_NAMED],
+			nonfinite);
 	}
-	for (int i = 0; i < 16; i++) {
-		if (i)
-			fputc(',', f);
-		if (isfinite(vals[i]))
-			fprintf(f, "%.10g", vals[i]);
-	}
-	for (int k = 0; k < K; k++)
-		fprintf(f, ",%.10g", colbuf[k]);
-	fputc('\n', f);
+	fputs(tf->json ? "]" : "\n", tf->f);
+	tf->rows++;
 }
 
 /* The run's JSON summary on stdout: final status, cost (cpu, wall in s)
@@ -187,107 +243,145 @@ static void write_row(FILE *f, const sim *s, const sim_status *st, int json, int
 static void print_summary(const opts *o, const sim *s, const sim_status *st, int err, double cpu,
 			  double wall)
 {
-	printf("{\n  \"preset\": \"%s\",\n  \"duration\": %.17g,\n", o->preset, st->t);
-	printf("  \"integrator\": {\"method\": \"%s\", \"dt\": %.17g, \"rtol\": %.17g, "
-	       "\"atol\": %.17g, \"substeps\": %d},\n",
-	       o->m.name, st->dt, o->m.rtol, o->m.atol, st->substeps);
-	printf("  \"reductions\": [");
+	FILE *f = stdout;
+#define NUM(name, v)                                   \
+	do {                                           \
+		fputs(",\n  \"" name "\": ", f);       \
+		put_num(f, (v), "null");               \
+	} while (0)
+	fprintf(f, "{\n  \"preset\": \"%s\"", o->preset);
+	NUM("duration", st->t);
+	fprintf(f, ",\n  \"integrator\": {\"method\": \"%s\", \"dt\": ", o->m.name);
+	put_num(f, st->dt, "null");
+	fputs(", \"rtol\": ", f);
+	put_num(f, o->m.rtol, "null");
+	fputs(", \"atol\": ", f);
+	put_num(f, o->m.atol, "null");
+	fprintf(f, ", \"substeps\": %d},\n  \"reductions\": [", st->substeps);
 	for (int b = 0, first = 1; sim_reduction_name(b); b++)
 		if (st->reductions & (1u << b)) {
-			printf("%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
+			fprintf(f, "%s\"%s\"", first ? "" : ", ", sim_reduction_name(b));
 			first = 0;
 		}
-	printf("],\n  \"transport_velocity\": ");
-	print_num(stdout, st->transport_velocity);
-	printf(",\n  \"transport_velocity_uncertainty\": ");
-	print_num(stdout, st->transport_velocity_uncertainty);
-	printf(",\n  \"steady\": %s", st->steady ? "true" : "false");
-	printf(",\n  \"transport_periods\": %.0f,\n  \"rotor_speed\": ", st->transport_periods);
-	print_num(stdout, st->rotor_speed_mean);
-	printf(",\n  \"motor_torque\": ");
-	print_num(stdout, st->motor_torque_mean);
-	printf(",\n  \"power\": ");
-	print_num(stdout, st->power_mean);
-	printf(",\n  \"beta_deg\": %.17g,\n  \"feed_displacement\": ", st->beta * DEG_PER_RAD);
-	print_num(stdout, st->feed_displacement);
-	printf(",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d,\n",
-	       (unsigned long long)st->steps, (unsigned long long)st->rhs_evals, st->n_dof);
-	printf("  \"cpu_seconds\": %.6g,\n  \"wall_seconds\": %.6g,\n", cpu, wall);
-	printf("  \"real_time_factor\": %.6g,\n", cpu > 0 ? st->t / cpu : 0.0);
-	printf("  \"energy\": {\"input\": %.10g, \"kinetic\": %.10g, \"potential\": %.10g, "
-	       "\"dissipated\": %.10g, \"residual\": %.6g},\n",
-	       st->e_input, st->e_kinetic, st->e_potential, st->e_dissipated, st->e_residual);
-	printf("  \"error\": ");
+	fputc(']', f);
+	NUM("transport_velocity", st->transport_velocity);
+	NUM("transport_velocity_uncertainty", st->transport_velocity_uncertainty);
+	fprintf(f, ",\n  \"steady\": %s", st->steady ? "true" : "false");
+	NUM("transport_periods", st->transport_periods);
+	NUM("rotor_speed", st->rotor_speed_mean);
+	NUM("motor_torque", st->motor_torque_mean);
+	NUM("power", st->power_mean);
+	NUM("beta", sim_table_user("beta", st->beta));
+	NUM("feed_displacement", st->feed_displacement);
+	fprintf(f, ",\n  \"steps\": %llu,\n  \"rhs_evals\": %llu,\n  \"n_dof\": %d",
+		(unsigned long long)st->steps, (unsigned long long)st->rhs_evals, st->n_dof);
+	NUM("cpu_seconds", cpu);
+	NUM("wall_seconds", wall);
+	NUM("real_time_factor", cpu > 0 ? st->t / cpu : NAN);
+	fputs(",\n  \"energy\": {\"input\": ", f);
+	put_num(f, st->e_input, "null");
+	fputs(", \"kinetic\": ", f);
+	put_num(f, st->e_kinetic, "null");
+	fputs(", \"potential\": ", f);
+	put_num(f, st->e_potential, "null");
+	fputs(", \"dissipated\": ", f);
+	put_num(f, st->e_dissipated, "null");
+	fputs(", \"residual\": ", f);
+	put_num(f, st->e_residual, "null");
+	fputs("},\n  \"error\": ", f);
 	if (err != SIM_OK)
-		printf("\"%s\"\n}\n", sim_last_error(s));
+		fprintf(f, "\"%s\"\n}\n", sim_last_error(s));
 	else
-		printf("null\n}\n");
+		fputs("null\n}\n", f);
+#undef NUM
+}
+
+/* The file's format: --format, else by the name's extension. */
+static int wants_json(const char *format, const char *file)
+{
+	if (format)
+		return strcmp(format, "json") == 0;
+	size_t n = file ? strlen(file) : 0;
+	return n > 5 && strcmp(file + n - 5, ".json") == 0;
+}
+
+static FILE *open_out(const opts *o)
+{
+	FILE *f = fopen(o->out, "w");
+	if (!f) {
+		fprintf(stderr, "convsim %s: --out: cannot write '%s': %s\n", o->cmd, o->out,
+			strerror(errno));
+	}
+	return f;
 }
 
 static int cmd_run(int argc, char **argv)
 {
 	opts o = {0};
-	int rc = parse(argc, argv, &o);
+	int rc = parse(argc, argv, CMD_RUN, &o);
 	if (rc)
-		return rc;
-	if (!(o.duration > 0.0 && o.duration <= 1e5)) {
-		fprintf(stderr, "convsim: --duration must be in (0, 1e5] s\n");
-		return 2;
-	}
+		return rc < 0 ? 0 : rc;
 	char msg[200];
 	int err;
-	double w0 = now(), c0 = cpu_now(); /* the steady start's settling included */
+	double w0 = cli_now(), c0 = cpu_now(); /* the steady start's settling included */
 	sim *s = sim_new(&o.p, &o.sc, &o.m, &err, msg, sizeof msg);
 	if (!s) {
-		fprintf(stderr, "convsim: %s\n", msg);
+		fprintf(stderr, "convsim run: %s\n", msg);
 		return 2;
 	}
-	FILE *f = NULL;
-	double *colbuf = calloc(SIM_MAX_COLUMNS, sizeof(double));
+	traj_file tf = {.json = wants_json(o.format, o.out), .columns = sim_columns(s)};
 	if (o.out) {
-		f = fopen(o.out, "w");
-		if (!f) {
-			perror(o.out);
+		tf.f = open_out(&o);
+		tf.colbuf = calloc(SIM_MAX_COLUMNS, sizeof(double));
+		if (!tf.f || !tf.colbuf) {
+			if (tf.f)
+				fclose(tf.f);
+			free(tf.colbuf);
 			sim_free(s);
-			free(colbuf);
 			return 1;
 		}
 	}
-	int json_traj = o.format && strcmp(o.format, "json") == 0;
 	sim_status st;
 	long nsamples = (long)ceil(o.duration * o.rate - 1e-9);
-	if (f) {
+	if (tf.f) {
 		sim_get_status(s, &st);
-		write_row(f, s, &st, json_traj, 1, colbuf);
+		traj_begin(&tf, 1.0 / o.rate);
+		traj_row(&tf, s, &st);
 	}
+	cli_progress pr;
+	cli_progress_start(&pr, "run", o.quiet, 1.0);
 	err = SIM_OK;
 	for (long i = 1; i <= nsamples && err == SIM_OK; i++) {
 		double t = i == nsamples ? o.duration : (double)i / o.rate;
 		err = sim_advance(s, t);
-		if (f && err == SIM_OK) {
+		if (tf.f && err == SIM_OK) {
 			sim_get_status(s, &st);
-			write_row(f, s, &st, json_traj, 0, colbuf);
+			traj_row(&tf, s, &st);
 		}
+		cli_progress_update(&pr, t, o.duration, "s simulated", "");
 	}
-	double wall = now() - w0, cpu = cpu_now() - c0;
-	if (f) {
-		if (json_traj)
-			fputs("\n]\n", f);
-		fclose(f);
+	double wall = cli_now() - w0, cpu = cpu_now() - c0;
+	char done[96];
+	snprintf(done, sizeof done, "%g s simulated in %.1f s", o.duration, wall);
+	cli_progress_end(&pr, done, 0);
+	int write_failed = 0;
+	if (tf.f) {
+		if (tf.json)
+			fprintf(tf.f, "],\"count\":%ld}\n", tf.rows);
+		write_failed = ferror(tf.f) | (fclose(tf.f) != 0);
+		free(tf.colbuf);
+		if (write_failed)
+			fprintf(stderr, "convsim run: --out: writing '%s' failed\n", o.out);
 	}
 	sim_get_status(s, &st);
 	print_summary(&o, s, &st, err, cpu, wall);
+	if (err != SIM_OK)
+		fprintf(stderr, "convsim run: %s\n", sim_last_error(s));
 	sim_free(s);
-	free(colbuf);
-	return err == SIM_OK ? 0 : 1;
+	return err == SIM_OK && !write_failed ? 0 : 1;
 }
 
 /* ---- sweep ---- */
-
-/* The default measuring window of a sweep point (s after the transient):
- * with the `steady` start, 4 s keep all 74 points of czubak2016 within
- * 1 % of the converged reference (README "Accuracy"). */
-#define SWEEP_WINDOW 4.0
 
 typedef struct task {
 	double beta;
@@ -301,6 +395,7 @@ typedef struct pool {
 	const opts *o;
 	task *tasks;
 	int n, next, done;
+	cli_progress progress;
 	pthread_mutex_t lock;
 } pool;
 
@@ -321,85 +416,127 @@ static void *worker(void *arg)
 				     sizeof t->msg);
 		pthread_mutex_lock(&pl->lock);
 		pl->done++;
-		fprintf(stderr, "\rsweep: %d/%d done", pl->done, pl->n);
+		char detail[48];
+		snprintf(detail, sizeof detail, " (last: %g deg %s)", t->beta,
+			 t->rotation == SIM_CW ? "cw" : "ccw");
+		cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
 		pthread_mutex_unlock(&pl->lock);
 	}
 }
 
-/* The sweep's table on stdout (CSV or JSON), failures on stderr; returns
- * the number of failed points. */
-static int print_sweep(const opts *o, const pool *pl)
+/* The sweep's table (CSV with the daemon's header, or JSON with the
+ * daemon's point members) on f; failures on stderr. Returns the number of
+ * failed points. */
+static int print_sweep(FILE *f, const opts *o, const pool *pl)
 {
 	int json = o->format && strcmp(o->format, "json") == 0, failed = 0;
-	if (json)
-		printf("{\"duration\": %.17g, \"transient\": %.17g, \"method\": \"%s\", \"points\": [\n",
-		       o->duration, o->sc.transient, o->m.name);
-	else
-		printf("beta_deg,rotation,transport_velocity_m_s,uncertainty_m_s,steady\n");
+	if (json) {
+		fputs("{\"duration\":", f);
+		put_num(f, o->duration, "null");
+		fputs(",\"transient\":", f);
+		put_num(f, o->sc.transient, "null");
+		fprintf(f, ",\"method\":\"%s\",\"points\":[\n", o->m.name);
+	} else {
+		fputs(SIM_SWEEP_CSV_HEADER "\n", f);
+	}
 	for (int i = 0; i < pl->n; i++) {
-		task *t = &pl->tasks[i];
+		const task *t = &pl->tasks[i];
 		const char *rot = t->rotation == SIM_CW ? "cw" : "ccw";
+		const char *state = t->err == SIM_OK ? "done" : "failed";
 		const char *steady = t->r.steady ? "true" : "false";
 		if (t->err != SIM_OK) {
 			failed++;
-			fprintf(stderr, "convsim: beta %g %s: %s\n", t->beta, rot, t->msg);
+			fprintf(stderr, "convsim sweep: beta %g %s: %s\n", t->beta, rot, t->msg);
 		}
-		if (json) {
-			printf("  {\"beta\": %.17g, \"rotation\": \"%s\", \"transport_velocity\": ",
-			       t->beta, rot);
-			print_num(stdout, t->r.transport_velocity);
-			printf(", \"uncertainty\": ");
-			print_num(stdout, t->r.uncertainty);
-			printf(", \"steady\": %s}%s\n", steady, i + 1 < pl->n ? "," : "");
-		} else {
-			printf("%g,%s,", t->beta, rot);
-			if (isfinite(t->r.transport_velocity))
-				printf("%.9g", t->r.transport_velocity);
-			printf(",");
-			if (isfinite(t->r.uncertainty))
-				printf("%.3g", t->r.uncertainty);
-			printf(",%s\n", steady);
-		}
+		const char *nf = json ? "null" : "";
+		fputs(json ? "{\"beta\":" : "", f);
+		put_num(f, t->beta, nf);
+		fprintf(f, json ? ",\"rotation\":\"%s\",\"velocity\":" : ",%s,", rot);
+		put_num(f, t->r.transport_velocity, nf);
+		fputs(json ? ",\"uncertainty\":" : ",", f);
+		put_num(f, t->r.uncertainty, nf);
+		if (json)
+			fprintf(f, ",\"steady\":%s,\"state\":\"%s\"}%s\n", steady, state,
+				i + 1 < pl->n ? "," : "");
+		else
+			fprintf(f, ",%s,%s\n", steady, state);
 	}
 	if (json)
-		printf("]}\n");
+		fputs("]}\n", f);
 	return failed;
+}
+
+/* --beta FROM:TO:STEP or one angle into *from, *to, *step. */
+static int parse_beta(const char *text, double *from, double *to, double *step)
+{
+	char tail;
+	int n = sscanf(text, "%lf:%lf:%lf%c", from, to, step, &tail);
+	if (n == 1 && sscanf(text, "%lf%c", from, &tail) == 1) {
+		*to = *from;
+		*step = 1;
+		n = 3;
+	}
+	if (n != 3 || !(*step > 0) || !(*from >= 0) || !(*to <= 180) || !(*to >= *from)) {
+		fprintf(stderr, "convsim sweep: --beta must be FROM:TO:STEP in degrees with 0 <= FROM "
+				"<= TO <= 180 and STEP > 0 (or one angle), got '%s'\n",
+			text);
+		return -1;
+	}
+	return 0;
+}
+
+/* --rotation cw, ccw, cw,ccw (or ccw,cw) into rots; the count or -1. */
+static int parse_rotation(const char *text, int rots[2])
+{
+	static const char *const senses[] = {"cw", "ccw"};
+	int n = 0;
+	char buf[64];
+	snprintf(buf, sizeof buf, "%s", text);
+	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+		int known = strcmp(tok, "cw") == 0 || strcmp(tok, "ccw") == 0;
+		int r = strcmp(tok, "cw") == 0 ? SIM_CW : SIM_CCW;
+		if (!known || n == 2 || (n == 1 && rots[0] == r)) {
+			char hint[96];
+			fprintf(stderr, "convsim sweep: --rotation takes cw, ccw or cw,ccw; '%s' is not "
+					"one%s\n",
+				tok,
+				cli_did_you_mean(hint, sizeof hint,
+						 !known ? sim_suggest(tok, senses, 2, sizeof *senses)
+						       : NULL));
+			return -1;
+		}
+		rots[n++] = r;
+	}
+	if (!n)
+		fprintf(stderr, "convsim sweep: --rotation takes cw, ccw or cw,ccw\n");
+	return n ? n : -1;
 }
 
 static int cmd_sweep(int argc, char **argv)
 {
 	opts o = {0};
-	int rc = parse(argc, argv, &o);
+	int rc = parse(argc, argv, CMD_SWEEP, &o);
 	if (rc)
-		return rc;
-	if (o.duration <= 0.0)
-		o.duration = o.sc.transient + SWEEP_WINDOW;
+		return rc < 0 ? 0 : rc;
 	if (!(o.duration > o.sc.transient)) {
-		fprintf(stderr, "convsim: --duration (%g s) must exceed the scene's transient (%g s): "
-				"v is measured over [transient, duration]\n",
+		fprintf(stderr, "convsim sweep: --duration (%g s) must exceed the scene's transient "
+				"(%g s): v is measured over [transient, duration]\n",
 			o.duration, o.sc.transient);
 		return 2;
 	}
 	double from, to, step;
-	if (!o.beta || sscanf(o.beta, "%lf:%lf:%lf", &from, &to, &step) != 3 || !(step > 0) ||
-	    from < 0 || to > 180 || to < from) {
-		fprintf(stderr, "convsim: --beta FROM:TO:STEP with 0 <= FROM <= TO <= 180, STEP > 0\n");
+	int rots[2], nrot;
+	if (parse_beta(o.beta, &from, &to, &step) || (nrot = parse_rotation(o.rotation, rots)) < 0)
 		return 2;
-	}
-	int rots[2], nrot = 0;
-	if (strstr(o.rotation, "cw") == o.rotation || strstr(o.rotation, ",cw"))
-		rots[nrot++] = SIM_CW;
-	if (strstr(o.rotation, "ccw"))
-		rots[nrot++] = SIM_CCW;
-	if (nrot == 0) {
-		fprintf(stderr, "convsim: --rotation takes cw, ccw or cw,ccw\n");
-		return 2;
-	}
 	int nb = (int)floor((to - from) / step + 1e-9) + 1;
-	if (nb > 10000 || o.threads < 1 || o.threads > 64) {
-		fprintf(stderr, "convsim: at most 10000 beta values and 1..64 threads\n");
+	if (nb > 10000) {
+		fprintf(stderr, "convsim sweep: --beta %s gives %d angles; at most 10000\n", o.beta,
+			nb);
 		return 2;
 	}
+	FILE *out = stdout;
+	if (o.out && !(out = open_out(&o)))
+		return 1;
 	pool pl = {.o = &o, .n = nb * nrot};
 	pl.tasks = calloc((size_t)pl.n, sizeof(task));
 	if (!pl.tasks)
@@ -410,32 +547,50 @@ static int cmd_sweep(int argc, char **argv)
 			pl.tasks[r * nb + i].rotation = rots[r];
 		}
 	pthread_mutex_init(&pl.lock, NULL);
+	cli_progress_start(&pl.progress, "sweep", o.quiet, 0);
 	pthread_t th[64];
-	double w0 = now();
-	for (int i = 0; i < o.threads; i++)
+	int nth = o.threads < pl.n ? o.threads : pl.n;
+	for (int i = 0; i < nth; i++)
 		pthread_create(&th[i], NULL, worker, &pl);
-	for (int i = 0; i < o.threads; i++)
+	for (int i = 0; i < nth; i++)
 		pthread_join(th[i], NULL);
-	fprintf(stderr, "\rsweep: %d/%d done in %.1f s\n", pl.done, pl.n, now() - w0);
-	int failed = print_sweep(&o, &pl);
+	char done[96];
+	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl.done, pl.n,
+		 cli_now() - pl.progress.t0);
+	cli_progress_end(&pl.progress, done, 1);
+	int failed = print_sweep(out, &o, &pl);
+	int write_failed = 0;
+	if (out != stdout) {
+		write_failed = ferror(out) | (fclose(out) != 0);
+		if (write_failed)
+			fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
+	}
 	pthread_mutex_destroy(&pl.lock);
 	free(pl.tasks);
-	return failed ? 1 : 0;
+	return failed || write_failed ? 1 : 0;
 }
 
-static int cmd_list(void)
+/* ---- list ---- */
+
+static int cmd_list(int argc, char **argv)
 {
+	int rc = first_pass(argc, argv, CMD_LIST, NULL);
+	if (rc)
+		return rc < 0 ? 0 : rc;
 	size_t n;
 	const sim_setting *t = sim_settings(&n);
 	printf("%-16s %-11s %-9s %-24s %s\n", "name", "group", "unit", "range", "meaning");
 	for (size_t i = 0; i < n; i++) {
-		char range[64];
-		if (t[i].kind == SIM_KIND_ENUM)
+		char range[96], lo[40], hi[40];
+		if (t[i].kind == SIM_KIND_ENUM) {
 			snprintf(range, sizeof range, "%s", t[i].choices);
-		else if (t[i].kind == SIM_KIND_BOOL)
+		} else if (t[i].kind == SIM_KIND_BOOL) {
 			snprintf(range, sizeof range, "true|false");
-		else
-			snprintf(range, sizeof range, "[%g, %g]", t[i].min, t[i].max);
+		} else {
+			sim_fmt_double(lo, sizeof lo, t[i].min, "");
+			sim_fmt_double(hi, sizeof hi, t[i].max, "");
+			snprintf(range, sizeof range, "[%s, %s]", lo, hi);
+		}
 		printf("%-16s %-11s %-9s %-24s %s\n", t[i].name, t[i].group, t[i].unit, range,
 		       t[i].doc);
 	}
@@ -447,15 +602,41 @@ static int cmd_list(void)
 	return 0;
 }
 
+static int unknown_command(const char *name)
+{
+	static const char *const names[] = {"run", "sweep", "list", "help"};
+	char hint[96];
+	fprintf(stderr, "convsim: unknown command '%s'%s; 'convsim help' lists the commands\n", name,
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, names, 4, sizeof *names)));
+	return 2;
+}
+
 int main(int argc, char **argv)
 {
-	if (argc < 2)
-		return usage();
-	if (strcmp(argv[1], "run") == 0)
-		return cmd_run(argc, argv);
-	if (strcmp(argv[1], "sweep") == 0)
-		return cmd_sweep(argc, argv);
-	if (strcmp(argv[1], "list") == 0)
-		return cmd_list();
-	return usage();
+	if (argc < 2) {
+		cli_help(stderr, 0);
+		return 2;
+	}
+	const char *c = argv[1];
+	if (strcmp(c, "--version") == 0 || strcmp(c, "-V") == 0 || strcmp(c, "version") == 0) {
+		printf("convsim %s\n", CONVSIM_VERSION);
+		return 0;
+	}
+	if (strcmp(c, "--help") == 0 || strcmp(c, "-h") == 0 || strcmp(c, "help") == 0) {
+		if (argc > 2 && strcmp(c, "help") == 0) {
+			unsigned cmd = cli_command(argv[2]);
+			if (!cmd)
+				return unknown_command(argv[2]);
+			cli_help(stdout, cmd);
+			return 0;
+		}
+		cli_help(stdout, 0);
+		return 0;
+	}
+	switch (cli_command(c)) {
+	case CMD_RUN: return cmd_run(argc - 1, argv + 1);
+	case CMD_SWEEP: return cmd_sweep(argc - 1, argv + 1);
+	case CMD_LIST: return cmd_list(argc - 1, argv + 1);
+	default: return unknown_command(c);
+	}
 }

@@ -69,9 +69,10 @@ test('OpenAPI 3.1 document', { timeout: 10000 * SLOW }, async () => {
   for (const k of ['transport_velocity', 'transport_velocity_uncertainty', 'rotor_speed_mean',
     'motor_torque_mean', 'power_mean']) assert.deepEqual(status[k].type, ['number', 'null'], k);
   assert.equal(status.steady.type, 'boolean');
-  const point = schemas.Sweep.properties.points.items.properties;
+  const item = (o) => (o.$ref ? schemas[o.$ref.split('/').pop()] : o);
+  const point = item(schemas.Sweep.properties.points.items).properties;
   assert.ok(point.uncertainty && point.steady);
-  const segment = schemas.Experiment.properties.segments.items.properties;
+  const segment = item(schemas.Experiment.properties.segments.items).properties;
   assert.ok(segment.uncertainty && segment.steady && segment.mean_velocity);
 });
 

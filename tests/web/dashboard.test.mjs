@@ -8,7 +8,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
-import { mkdirSync } from 'node:fs';
+import { mkdirSync, readFileSync } from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from '../node_modules/playwright-core/index.mjs';
@@ -71,6 +71,16 @@ const count = async sel => Number(await attr(sel, 'points'));
 const tEnd = async sel => Number(await attr(sel, 'tEnd'));
 const samples = async () => Number(await attr('#live-state', 'samples'));
 const shownDirection = () => attr('#v-arrow', 'direction');
+const visible = sel => page.isVisible(sel);
+
+/* Click sel, wait for the download it starts; its name and bytes. */
+async function download(sel) {
+	const [dl] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.click(sel)]);
+	return { name: dl.suggestedFilename(), bytes: readFileSync(await dl.path()) };
+}
+const csvLines = d => d.bytes.toString('utf8').trim().split('\n');
+const TRAJ_HEAD = 't,beta,beta_target,x,y,alpha,s1,s2,deck_x,deck_y,rotor_speed,motor_torque,power,' +
+	'feed_displacement,feed_velocity,transport_velocity,transport_velocity_uncertainty,e_input,e_dissipated,e_residual';
 
 before(async () => {
 	mkdirSync(OUT, { recursive: true });
@@ -102,6 +112,9 @@ test('the page loads from the daemon and finds it online', async () => {
 	await page.waitForSelector('#conn[data-state="online"]', { timeout: 10000 });
 	const presets = await page.$$eval('#f-preset option', o => o.map(x => x.value));
 	assert.ok(presets.includes('czubak2016'), `presets offered: ${presets}`);
+	/* nothing to download yet: no links, no plot exports */
+	for (const sel of ['#sweep-csv', '#session-downloads', '#experiment-downloads', '.plot-export'])
+		assert.equal(await visible(sel), false, `${sel} hidden before there is anything to download`);
 	assert.deepEqual(pageErrors, []);
 });
 
@@ -141,6 +154,37 @@ test('stream samples arrive and the plots grow', async () => {
 	assert.ok(await count('#plot-rotor') > 1 && await count('#plot-feed') > 1, 'rotor and feed plots draw points');
 	const t = await page.$eval('#t-now', e => e.textContent);
 	assert.match(t, /^\d+\.\d{3} s$/);
+});
+
+test('every live plot exports PNG and CSV; the trajectory downloads as CSV and JSON', async () => {
+	for (const name of ['orbit', 'feed', 'rotor', 'strokes', 'trough']) {
+		const png = await download(`#plot-${name} + .plot-export button[data-export="png"]`);
+		assert.equal(png.name, `${name}.png`);
+		assert.deepEqual([...png.bytes.subarray(0, 4)], [0x89, 0x50, 0x4e, 0x47], `${name}.png is a PNG`);
+		const csv = await download(`#plot-${name} + .plot-export button[data-export="csv"]`);
+		assert.equal(csv.name, `${name}.csv`);
+		const lines = csvLines(csv);
+		assert.ok(lines.length > 5, `${name}.csv has rows`);
+		const width = lines[0].split(',').length;
+		assert.ok(lines.every(l => l.split(',').length === width), `${name}.csv is rectangular`);
+		assert.ok(lines.slice(1).every(l => l.split(',').every(c => c === '' || Number.isFinite(Number(c))) || name === 'orbit'), `${name}.csv numbers`);
+	}
+	assert.equal(csvLines(await download('#plot-rotor + .plot-export button[data-export="csv"]'))[0], 't / s,rotor speed / (rad/s),β / °');
+	assert.equal(csvLines(await download('#plot-orbit + .plot-export button[data-export="csv"]'))[0],
+		'series,horizontal displacement x / mm,vertical displacement y / mm');
+	/* five identical columns (the symmetric machine): one line, said so */
+	assert.ok(await visible('#feed-note'));
+	assert.match(await page.$eval('#feed-note', e => e.textContent), /All 5 columns move identically/);
+	assert.equal(csvLines(await download('#plot-feed + .plot-export button[data-export="csv"]'))[0], 't / s,columns 1–5 (identical)');
+	/* the recorded trajectory, with the CLI's columns */
+	assert.ok(await visible('#session-downloads'));
+	const traj = await download('#traj-csv');
+	assert.equal(traj.name, `trajectory-${sessionId}.csv`);
+	const tl = csvLines(traj);
+	assert.equal(tl[0], `${TRAJ_HEAD},column_1,column_2,column_3,column_4,column_5`);
+	assert.ok(tl.length > 10);
+	const tj = JSON.parse((await download('#traj-json')).bytes.toString('utf8'));
+	assert.equal(tj.fields.join(','), tl[0]);
 });
 
 test('β = 38°, clockwise: the page shows transport to the right', async () => {
@@ -224,6 +268,7 @@ test('a refused input shows the daemon\'s problem detail', async () => {
 });
 
 test('a sweep draws v(β) for both rotations', async () => {
+	assert.equal(await visible('#sweep-csv'), false, 'no sweep CSV link before a sweep');
 	await page.fill('#sweep-form input[name="from"]', '30');
 	await page.fill('#sweep-form input[name="to"]', '130');
 	await page.fill('#sweep-form input[name="step"]', '50');
@@ -245,6 +290,11 @@ test('a sweep draws v(β) for both rotations', async () => {
 	const csv = (await (await fetch(base + href)).text()).trim().split('\n');
 	assert.equal(csv.length, 7, csv.join('\n'));
 	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state');
+	const got = csvLines(await download('#sweep-csv'));
+	assert.deepEqual(got, csv);
+	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
+	assert.equal(plot[0], 'series,β / °,transport velocity v / (m/s),error');
+	assert.equal(plot.length, 7);
 });
 
 test('a β-change experiment reports its reversal time', async () => {
@@ -266,6 +316,18 @@ test('a β-change experiment reports its reversal time', async () => {
 	assert.equal((await apiGet(`/api/v1/sessions/${exp.session}`)).spec.scene.start, 'rest');
 	const table = await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[4].textContent));
 	assert.ok(table.every(t => /^[+-]?\d\.\d{3} ± \d\.\d{3}/.test(t)), `mean v ± u: ${table}`);
+	/* its downloads: the segments and the session's trajectory */
+	await until(() => visible('#experiment-downloads'), 10000, 'the experiment downloads');
+	const seg = csvLines(await download('#experiment-csv'));
+	assert.equal(seg[0], 'experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,' +
+		'steady_velocity,mean_velocity,uncertainty,steady,reversal_time');
+	assert.equal(seg.length, 3);
+	assert.deepEqual(seg.slice(1).map(l => l.split(',')[3]), ['38', '128']);
+	const et = csvLines(await download('#experiment-traj'));
+	assert.ok(et[0].startsWith(TRAJ_HEAD));
+	assert.ok(Number(et[et.length - 1].split(',')[0]) >= 3.9, 'the trajectory covers the experiment');
+	const ep = csvLines(await download('#plot-experiment + .plot-export button[data-export="csv"]'));
+	assert.equal(ep[0], 't / s,feed velocity / (m/s),β / °');
 	await page.selectOption('select[name="scene_start"]', 'steady');
 });
 

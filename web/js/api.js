@@ -105,6 +105,14 @@ export async function patchSession(id, patch) {
 export function sweepCsvUrl(id) {
 	return `${BASE}/sweeps/${enc(id)}?format=csv`;
 }
+/* Where the daemon serves a session's recorded trajectory (format csv or
+ * json) and an experiment's segments as CSV. */
+export function trajectoryUrl(id, format) {
+	return `${BASE}/sessions/${enc(id)}/trajectory?format=${format}`;
+}
+export function experimentCsvUrl(id) {
+	return `${BASE}/experiments/${enc(id)}?format=csv`;
+}
 export async function deleteSession(id) {
 	await request('DELETE', `/sessions/${enc(id)}`);
 }

@@ -7,6 +7,7 @@
 import { fmtVelocity, direction, ARROW } from './format.js';
 import { app, $, numberOf } from './ui.js';
 import { currentVelocity, MM } from './live.js';
+import { buildFeedPlot } from './figures.js';
 
 let lastDraw = 0;
 export function frame(now) {
@@ -25,7 +26,12 @@ function draw() {
 		app.plots.strokes.setData(tr.strokes.data());
 		app.plots.trough.setData(tr.trough.data());
 		app.plots.rotor.setData(tr.rotor.data());
-		if (app.columns) app.plots.feed.setData(tr.feed.data());
+		if (app.columns) {
+			const d = tr.feed.data();
+			const alike = columnsAlike(d);
+			buildFeedPlot(app.columns, alike);
+			app.plots.feed.setData(alike ? d.slice(0, 2) : d);
+		}
 		$('#live-state').dataset.samples = String(app.samples);
 		$('#live-state').dataset.dropped = String(app.dropped);
 		if (app.stream && app.samples)
@@ -58,4 +64,15 @@ function draw() {
 		layers: s?.layers ?? numberOf($('#session-form').elements.layers),
 		direction: dir,
 	});
+}
+
+/* 1 if every column's trace equals the first's (to 1e-12 of its size). */
+function columnsAlike(d) {
+	if (d.length < 3 || !d[0].length) return false;
+	let size = 1e-12;
+	for (const v of d[1]) if (Number.isFinite(v)) size = Math.max(size, Math.abs(v));
+	for (let k = 2; k < d.length; k++)
+		for (let i = 0; i < d[k].length; i++)
+			if (!(Math.abs(d[k][i] - d[1][i]) <= 1e-12 * size)) return false;
+	return true;
 }

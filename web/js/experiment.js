@@ -20,6 +20,7 @@ export async function runExperiment(ev) {
 	const box = $('#experiment-progress');
 	busy(btn, true);
 	app.experiment = null;
+	$('#experiment-downloads').hidden = true;
 	app.expTrace = new Trace(2, { policy: 'history', capacity: 4000 });
 	try {
 		const j = await api.createExperiment(form);
@@ -38,6 +39,15 @@ export async function runExperiment(ev) {
 		});
 		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
 		else message('ok', `Experiment ${end.id} finished.`);
+		const csv = $('#experiment-csv'), traj = $('#experiment-traj');
+		csv.href = api.experimentCsvUrl(end.id);
+		csv.download = `experiment-${end.id}.csv`;
+		if (end.sessionId) {
+			traj.href = api.trajectoryUrl(end.sessionId, 'csv');
+			traj.download = `experiment-${end.id}-trajectory.csv`;
+		}
+		traj.hidden = !end.sessionId;
+		$('#experiment-downloads').hidden = false;
 		if (end.sessionId) {
 			/* the recorded history gives the whole reversal, whatever the stream saw */
 			const traj = await api.trajectory(end.sessionId).catch(() => null);

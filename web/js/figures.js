@@ -39,11 +39,20 @@ export function makePlots() {
 	});
 }
 
-export function buildFeedPlot(K) {
+/* The feed plot for K columns; alike: every column moves the same (the
+ * symmetric machine's columns), drawn as one line with a note saying so. */
+export function buildFeedPlot(K, alike = false) {
 	const el = $('#plot-feed');
-	if (app.plots.feed && app.plots.feedK === K) return;
+	alike = alike && K > 1;
+	if (app.plots.feed && app.plots.feedK === K && app.plots.feedAlike === alike) return;
 	app.plots.feed?.destroy();
-	const series = K ? Array.from({ length: K }, (_, k) => ({ label: `column ${k + 1}` })) : [{ label: 'columns', color: '#94a3b8' }];
+	const series = !K ? [{ label: 'columns', color: '#94a3b8' }]
+		: alike ? [{ label: `columns 1–${K} (identical)` }]
+			: Array.from({ length: K }, (_, k) => ({ label: `column ${k + 1}` }));
 	app.plots.feed = new TimePlot(el, { series, yLabel: 'displacement / mm' });
 	app.plots.feedK = K;
+	app.plots.feedAlike = alike;
+	const note = $('#feed-note');
+	note.hidden = !alike;
+	note.textContent = alike ? `All ${K} columns move identically (a symmetric machine: the engine computes one representative column), so one line stands for all ${K}.` : '';
 }

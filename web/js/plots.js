@@ -8,7 +8,8 @@
  *           its direction.
  * Each plot resizes with its container and records how many points it
  * drew in data-points, and a time plot the latest time it drew in data-t-end,
- * on the container (the browser test reads both).
+ * on the container (the browser test reads both). Each has a PNG and a CSV
+ * export under it, shown once it has something to export.
  */
 
 import uPlot from '../vendor/uplot/uPlot.esm.js';
@@ -26,6 +27,60 @@ const AXIS = {
 
 function axis(label, extra = {}) {
 	return { ...AXIS, label, labelSize: 18, ...extra };
+}
+
+/* Auto range with a fallback, so that an empty plot still draws its axes. */
+function autoRange(u, min, max) {
+	if (min == null || max == null || !Number.isFinite(min) || !Number.isFinite(max)) return [0, 1];
+	return uPlot.rangeNum(min, max, 0.1, true);
+}
+
+/* Save blob under name through a temporary download link. */
+function save(blob, name) {
+	const a = document.createElement('a');
+	a.href = URL.createObjectURL(blob);
+	a.download = name;
+	document.body.append(a);
+	a.click();
+	a.remove();
+	setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+}
+
+const cell = v => (typeof v === 'number' ? (Number.isFinite(v) ? String(v) : '')
+	: /[",\n]/.test(String(v)) ? `"${String(v).replace(/"/g, '""')}"` : String(v ?? ''));
+export const csvText = rows => rows.map(r => r.map(cell).join(',')).join('\n') + '\n';
+
+/* PNG and CSV buttons under a plot's container; the plot object gives
+ * csvRows() and its uPlot; named after the container (plot-rotor: rotor). */
+function addExport(owner, el) {
+	const bar = document.createElement('div');
+	bar.className = 'plot-export';
+	bar.hidden = true;
+	const name = (el.id || 'plot').replace(/^plot-/, '');
+	for (const kind of ['png', 'csv']) {
+		const b = document.createElement('button');
+		b.type = 'button';
+		b.className = 'link';
+		b.dataset.export = kind;
+		b.textContent = kind === 'png' ? 'PNG' : 'CSV';
+		b.title = kind === 'png' ? 'this plot as an image' : 'the data of this plot';
+		b.addEventListener('click', () => {
+			if (kind === 'csv') return save(new Blob([csvText(owner.csvRows())], { type: 'text/csv' }), `${name}.csv`);
+			const src = owner.plot.ctx.canvas;
+			const c = document.createElement('canvas');
+			c.width = src.width;
+			c.height = src.height;
+			const ctx = c.getContext('2d');
+			ctx.fillStyle = '#fff';
+			ctx.fillRect(0, 0, c.width, c.height);
+			ctx.drawImage(src, 0, 0);
+			c.toBlob(blob => save(blob, `${name}.png`), 'image/png');
+		});
+		bar.append(b);
+	}
+	bar.prepend(Object.assign(document.createElement('span'), { textContent: 'Export: ' }));
+	el.after(bar);
+	return bar;
 }
 
 function sizeOf(el, aspect) {
@@ -53,8 +108,9 @@ export class TimePlot {
 		const s = sizeOf(el, aspect);
 		const legendRoom = legend ? 26 : 0;
 		const scales = { x: { time: false } };
-		if (yRange) scales.y = { range: yRange };
-		if (y2Label) scales.y2 = y2Range ? { range: y2Range } : { auto: true };
+		scales.y = { range: yRange ?? autoRange };
+		if (y2Label) scales.y2 = { range: y2Range ?? autoRange };
+		this.labels = [xLabel, ...series.map(d => d.label)];
 		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })];
 		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 50, space: 24, grid: { show: false } }));
 		this.plot = new uPlot({
@@ -70,7 +126,7 @@ export class TimePlot {
 					label: d.label,
 					stroke: d.color ?? PALETTE[i % PALETTE.length],
 					width: d.width ?? 1.5,
-					dash: d.dash,
+					dash: d.dash ?? DASHES[Math.floor(i / PALETTE.length) % DASHES.length],
 					scale: d.scale ?? 'y',
 					spanGaps: true,
 					points: { show: false },
@@ -80,6 +136,13 @@ export class TimePlot {
 		this.ro = observe(el, this.plot, aspect, legendRoom);
 		el.dataset.points = '0';
 		el.classList.add('empty');
+		this.bar = addExport(this, el);
+	}
+
+	/* The plotted data as rows, the labels first. */
+	csvRows() {
+		const d = this.plot.data;
+		return [this.labels, ...d[0].map((t, i) => d.map(c => c[i]))];
 	}
 
 	setData(cols) {
@@ -90,6 +153,7 @@ export class TimePlot {
 		 * a "history" trace thins and the point count drops */
 		this.el.dataset.tEnd = n ? String(cols[0][n - 1]) : '';
 		this.el.classList.toggle('empty', n === 0);
+		this.bar.hidden = n === 0;
 	}
 
 	/* Vertical marker lines [{x, label, color}] (x in s). */
@@ -101,8 +165,13 @@ export class TimePlot {
 	destroy() {
 		this.ro.disconnect();
 		this.plot.destroy();
+		this.bar.remove();
 	}
 }
+
+/* Line styles after the palette's colours run out: distinct columns stay
+ * distinguishable. */
+const DASHES = [undefined, [6, 3], [2, 2], [8, 3, 2, 3]];
 
 function drawMarkers(u, markers) {
 	if (!markers.length) return;
@@ -221,6 +290,7 @@ export class XYPlot {
 		this.equal = equal;
 		this.xRange = xRange;
 		this.errs = [];
+		this.labels = [xLabel, yLabel, series.map(d => d.label)];
 		const s = sizeOf(el, aspect);
 		const legend = series.length > 1;
 		const legendRoom = legend ? 26 : 0;
@@ -272,6 +342,19 @@ export class XYPlot {
 		this.ro = observe(el, this.plot, aspect, legendRoom);
 		el.dataset.points = '0';
 		el.classList.add('empty');
+		this.bar = addExport(this, el);
+	}
+
+	/* The plotted points as rows: series, x, y (and its error bar). */
+	csvRows() {
+		const [xLabel, yLabel, names] = this.labels;
+		const withErr = this.errs.some(e => e && e.length);
+		const rows = [['series', xLabel, yLabel, ...(withErr ? ['error'] : [])]];
+		this.plot.data.slice(1).forEach(([xs, ys], k) => xs.forEach((x, i) => {
+			if (Number.isFinite(x) && Number.isFinite(ys[i]))
+				rows.push([names[k], x, ys[i], ...(withErr ? [this.errs[k]?.[i] ?? NaN] : [])]);
+		}));
+		return rows;
 	}
 
 	/* pairs: one [xs, ys] per series; errs (optional): one array of error
@@ -286,10 +369,12 @@ export class XYPlot {
 			for (let i = 0; i < xs.length; i++) if (Number.isFinite(xs[i]) && Number.isFinite(ys[i])) n++;
 		this.el.dataset.points = String(n);
 		this.el.classList.toggle('empty', n === 0);
+		this.bar.hidden = n === 0;
 	}
 
 	destroy() {
 		this.ro.disconnect();
 		this.plot.destroy();
+		this.bar.remove();
 	}
 }

@@ -67,6 +67,7 @@ export function detach() {
 	document.body.dataset.sessionId = '';
 	history.replaceState(null, '', location.pathname);
 	setControlsEnabled(false);
+	$('#session-downloads').hidden = true;
 	$('#beta-now-mark').hidden = true;
 	$('#session-label').textContent = 'no session';
 	$('#live-state').textContent = 'stream: idle';
@@ -86,6 +87,12 @@ export function attach(id, initial) {
 	$('#session-label').textContent = `session ${id}`;
 	$('#session-select').value = id;
 	setControlsEnabled(true);
+	for (const format of ['csv', 'json']) {
+		const a = $(`#traj-${format}`);
+		a.href = api.trajectoryUrl(id, format);
+		a.download = `trajectory-${id}.${format}`;
+	}
+	$('#session-downloads').hidden = false;
 	resetTraces(initial?.columns);
 	app.stream = api.openStream(id, { since: 0 }, {
 		open: () => { setOnline(true); $('#live-state').textContent = `stream: open (${id})`; },

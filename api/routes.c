@@ -1,0 +1,184 @@
+/*
+ * routes.c - the API's routes as data: method, path, the query parameters
+ * each takes and whether it answers results (JSON or CSV). The server
+ * checks every request against this table (unknown query parameters are a
+ * 400, an Accept it cannot serve a 406) and openapi.c describes the same
+ * table, so the document and the checks cannot drift.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "json_int.h"
+#include "suggest.h"
+
+static const api_query queries[] = {
+	{API_Q_FORMAT, "format", "{\"type\":\"string\",\"enum\":[\"json\",\"csv\"]}",
+	 "representation; overrides Accept (application/json or text/csv)"},
+	{API_Q_FROM, "from", "{\"type\":\"number\"}", "first row's time, s"},
+	{API_Q_TO, "to", "{\"type\":\"number\"}", "last row's time, s"},
+	{API_Q_STRIDE, "stride", "{\"type\":\"number\",\"exclusiveMinimum\":0}",
+	 "rows this far apart, s: a multiple of the recorded spacing (the answer's stride)"},
+	{API_Q_STREAM_FORMAT, "format", "{\"type\":\"string\",\"enum\":[\"sse\",\"ndjson\"]}",
+	 "Server-Sent Events (default) or NDJSON (also Accept: application/x-ndjson)"},
+	{API_Q_FIELDS, "fields", "{\"type\":\"string\"}",
+	 "comma list of trough, orbit, rotor, eliminators, feed, energy, elements, all, default"},
+	{API_Q_RATE, "rate", "{\"type\":\"number\",\"exclusiveMinimum\":0}",
+	 "samples per simulated second (thins the session's sample_rate)"},
+	{API_Q_LIMIT, "limit", "{\"type\":\"integer\",\"minimum\":1}", "end after this many records"},
+	{API_Q_SINCE, "since", "{\"type\":\"integer\",\"minimum\":0}",
+	 "resume after this record id (as Last-Event-ID)"},
+};
+
+#define TRAJ (API_Q_FORMAT | API_Q_FROM | API_Q_TO | API_Q_STRIDE)
+#define STREAM (API_Q_STREAM_FORMAT | API_Q_FIELDS | API_Q_RATE | API_Q_LIMIT | API_Q_SINCE)
+static const api_route routes[] = {
+	{"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
+	 "SessionCreate", 201, "Session", "400,413,415,422,429,503"},
+	{"GET", "/api/v1/sessions", API_Q_FORMAT, 1,
+	 "All sessions with live status (CSV: one summary row each)", NULL, 200, "SessionList",
+	 "400,406"},
+	{"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
+	 "One session: spec and live status (CSV: its summary row)", NULL, 200, "Session",
+	 "400,404,406"},
+	{"PATCH", "/api/v1/sessions/*", 0, 0,
+	 "Change beta, beta_rate, rotation, omega_ss, motor_on, running, pace or until while it "
+	 "runs; answers the simulated time the change takes effect",
+	 "Control", 200, "ControlResult", "400,404,409,413,415,422,503"},
+	{"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
+	 "400,404"},
+	{"GET", "/api/v1/sessions/*/stream", STREAM, 0,
+	 "Server-Sent Events or NDJSON of samples and events", NULL, 200, "StreamRecord",
+	 "400,404,429"},
+	{"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
+	 "The recorded, downsampled history (the CLI's trajectory columns)", NULL, 200,
+	 "Trajectory", "400,404,406"},
+	{"POST", "/api/v1/experiments", 0, 0,
+	 "Run a beta schedule; per segment the transport velocity and the reversal time",
+	 "ExperimentCreate", 201, "Experiment", "400,404,409,413,415,422,429,503"},
+	{"GET", "/api/v1/experiments", API_Q_FORMAT, 1,
+	 "All kept experiments (CSV: one row per segment)", NULL, 200, "ExperimentList", "400,406"},
+	{"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
+	 "Progress and results (CSV: one row per segment)", NULL, 200, "Experiment",
+	 "400,404,406"},
+	{"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
+	 "SweepCreate", 202, "Sweep", "400,413,415,422,429,503"},
+	{"GET", "/api/v1/sweeps", API_Q_FORMAT, 1, "All kept sweeps (CSV: one row per sweep)", NULL,
+	 200, "SweepList", "400,406"},
+	{"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
+	 "Progress and results (CSV: one row per point, the CLI's sweep columns)", NULL, 200,
+	 "Sweep", "400,404,406"},
+	{"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404"},
+	{"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
+	 "Presets", "400"},
+	{"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",
+	 NULL, 200, "Health", "400"},
+	{"GET", "/api/v1/openapi.json", 0, 0, "This document", NULL, 200, "application/json",
+	 "400"},
+	{"GET", "/api/v1/problems/*", 0, 0, "What a problem type means", NULL, 200, "text/html",
+	 "400,404"},
+	{"GET", "/metrics", 0, 0, "Prometheus text format", NULL, 200, "text/plain", "400"},
+};
+
+const api_route *api_routes(size_t *n)
+{
+	*n = sizeof routes / sizeof *routes;
+	return routes;
+}
+
+const api_query *api_queries(size_t *n)
+{
+	*n = sizeof queries / sizeof *queries;
+	return queries;
+}
+
+const api_route *api_route_find(const char *method, const char *pattern)
+{
+	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++)
+		if (strcmp(routes[i].method, method) == 0 && strcmp(routes[i].pattern, pattern) == 0)
+			return &routes[i];
+	return NULL;
+}
+
+api_err api_check_query(const api_route *rt, const char *name, api_problem *pb)
+{
+	const char *allowed[sizeof queries / sizeof *queries];
+	size_t n = 0;
+	char list[160] = "";
+	for (size_t i = 0; i < sizeof queries / sizeof *queries; i++) {
+		if (!(rt->query & queries[i].bit))
+			continue;
+		if (strcmp(queries[i].name, name) == 0)
+			return API_OK;
+		allowed[n++] = queries[i].name;
+		size_t at = strlen(list);
+		snprintf(list + at, sizeof list - at, "%s%s", at ? ", " : "", queries[i].name);
+	}
+	const char *near = sim_suggest(name, allowed, n, sizeof *allowed);
+	char hint[96] = "";
+	if (near)
+		snprintf(hint, sizeof hint, " (did you mean \"%s\"?)", near);
+	return api_fail(pb, API_QUERY, name, "unknown query parameter \"%.40s\"%s; this route takes %s",
+			name, hint, n ? list : "none");
+}
+
+/* The q value Accept gives to type ("text/csv"), 0..1; -1 if not named. */
+static double accept_q(const char *accept, const char *type)
+{
+	double best = -1;
+	const char *slash = strchr(type, '/');
+	const char *p = accept;
+	while (p && *p) {
+		while (*p == ' ' || *p == ',')
+			p++;
+		size_t n = strcspn(p, ";,");
+		while (n && p[n - 1] == ' ')
+			n--;
+		int match = (n == strlen(type) && strncasecmp(p, type, n) == 0) ||
+			    (n == 3 && strncmp(p, "*/*", 3) == 0) ||
+			    (n == (size_t)(slash - type) + 2 &&
+			     strncasecmp(p, type, (size_t)(slash - type) + 1) == 0 && p[n - 1] == '*');
+		double q = 1;
+		const char *end = strchr(p, ',');
+		const char *qs = strstr(p, ";q=");
+		if (!qs)
+			qs = strstr(p, "; q=");
+		if (qs && (!end || qs < end))
+			q = atof(strchr(qs, '=') + 1);
+		/* an exact type outranks a wildcard of the same q */
+		if (match && q > 0) {
+			double rank = q + (n == strlen(type) ? 1e-3 : 0);
+			if (rank > best)
+				best = rank;
+		}
+		p = end;
+	}
+	return best;
+}
+
+api_err api_negotiate(const api_route *rt, const char *format, const char *accept, int *csv,
+		      api_problem *pb)
+{
+	*csv = 0;
+	if (!rt->tables)
+		return API_OK;
+	if (format) {
+		if (strcmp(format, "json") == 0 || strcmp(format, "csv") == 0) {
+			*csv = format[0] == 'c';
+			return API_OK;
+		}
+		return api_fail(pb, API_QUERY, "format", "format must be json or csv (got \"%.40s\")",
+				format);
+	}
+	if (!accept || !*accept)
+		return API_OK;
+	double qj = accept_q(accept, "application/json"), qc = accept_q(accept, "text/csv");
+	if (qj < 0 && qc < 0)
+		return api_fail(pb, API_NOTACCEPTABLE, NULL,
+				"Accept: %.80s names neither application/json nor text/csv "
+				"(or use ?format=json|csv)",
+				accept);
+	*csv = qc > qj;
+	return API_OK;
+}

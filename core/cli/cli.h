@@ -1,0 +1,74 @@
+/*
+ * cli.h - what the files of the command-line runner share: the option
+ * table (one entry per option: its names, argument, unit, default and
+ * meaning, from which both getopt_long's table and the help are made),
+ * near-miss suggestions, number parsing with specific messages, and the
+ * progress reporter. Every message starts with "convsim" and the command.
+ */
+#ifndef CONVSIM_CLI_H
+#define CONVSIM_CLI_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#define CONVSIM_VERSION "1.0.0"
+
+/* Commands, as bits (an option belongs to one or more). */
+enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4 };
+
+enum {
+	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
+	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP
+};
+
+typedef struct cli_opt {
+	unsigned cmds;    /* CMD_* bits: the commands that take it */
+	int id;           /* OPT_* */
+	const char *name; /* long name, without "--" */
+	char key;         /* short letter, or 0 */
+	const char *arg;  /* metavariable, NULL for a flag */
+	const char *unit; /* of the argument, or NULL */
+	const char *def;  /* the default as the help shows it, or NULL */
+	const char *doc;
+} cli_opt;
+
+/* The command bit for a command name, 0 if unknown. */
+unsigned cli_command(const char *name);
+/* Print command cmd's help (usage, every option with unit and default)
+ * on f; cmd 0 prints the overview. */
+void cli_help(FILE *f, unsigned cmd);
+/* The next option of argv for command cmd (getopt_long over the table):
+ * OPT_* with *arg set, -1 at the end, or 0 after printing a specific
+ * error (unknown option with a suggestion, missing argument). */
+int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg);
+/* Index of the first operand after the options (getopt's optind). */
+int cli_operand_index(void);
+/* Parse the same argv again from its start. */
+void cli_restart_options(void);
+
+/* " (did you mean 'X'?)" for a near miss, else "": into buf. */
+const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion);
+
+/* Parse text as a finite number in [lo, hi] (lo excluded if lo_open).
+ * On error prints "convsim CMD: --NAME must be ..., got 'text'" and
+ * returns -1. */
+int cli_number(const char *cmd, const char *opt, const char *unit, const char *text,
+	       double lo, double hi, int lo_open, double *out);
+
+/* Progress on stderr: a bar redrawn in place on a terminal, plain lines
+ * (every tenth of the work) otherwise. Reports start after min_wall
+ * seconds of wall time (0: at once). */
+typedef struct cli_progress {
+	const char *label;
+	int tty, quiet, shown, decile;
+	double t0, last, min_wall;
+} cli_progress;
+void cli_progress_start(cli_progress *p, const char *label, int quiet, double min_wall);
+/* done of total units; detail is shown after the count (may be ""). */
+void cli_progress_update(cli_progress *p, double done, double total, const char *unit,
+			 const char *detail);
+/* The closing line (always for force, else only if something was shown). */
+void cli_progress_end(cli_progress *p, const char *summary, int force);
+double cli_now(void);
+
+#endif

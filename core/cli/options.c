@@ -1,0 +1,276 @@
+/*
+ * options.c - the command line's options as one table: getopt_long's
+ * table and the help are both made from it, so they cannot drift. Also
+ * the near-miss suggestions ("did you mean"), number parsing with
+ * specific messages, and the progress reporter (a bar on a terminal,
+ * plain lines into a file or pipe).
+ */
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "suggest.h"
+
+#define RS (CMD_RUN | CMD_SWEEP)
+#define ALL (CMD_RUN | CMD_SWEEP | CMD_LIST)
+
+static const cli_opt options[] = {
+	{RS, OPT_PRESET, "preset", 'p', "NAME", NULL, "czubak2016",
+	 "starting values for every setting (known: czubak2016)"},
+	{RS, OPT_SET, "set", 's', "NAME=VALUE", NULL, NULL,
+	 "set one setting, in the unit `convsim list` shows; repeatable"},
+	{CMD_RUN, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
+	 "simulated time to run (4 s for czubak2016, whose transient is 0)"},
+	{CMD_SWEEP, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
+	 "simulated time per point; v is measured after the transient"},
+	{CMD_RUN, OPT_OUT, "out", 'o', "FILE", NULL, "none",
+	 "also write the trajectory (the daemon's columns) to FILE"},
+	{CMD_SWEEP, OPT_OUT, "out", 'o', "FILE", NULL, "stdout", "write the v(beta) table to FILE"},
+	{CMD_RUN, OPT_FORMAT, "format", 'f', "csv|json", NULL, "by FILE's extension, else csv",
+	 "format of the trajectory file"},
+	{CMD_SWEEP, OPT_FORMAT, "format", 'f', "csv|json", NULL, "csv", "format of the v(beta) table"},
+	{CMD_RUN, OPT_RATE, "sample-rate", 'r', "HZ", "Hz", "1000",
+	 "trajectory rows per simulated second, in (0, 1e6]"},
+	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
+	 "guide angles in [0, 180], or one angle"},
+	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",
+	 "cw (the paper's clockwise, rotor speed > 0), ccw, or both"},
+	{CMD_SWEEP, OPT_THREADS, "threads", 'j', "N", NULL, "2",
+	 "simulations run in parallel, 1..64"},
+	{RS, OPT_QUIET, "quiet", 'q', NULL, NULL, NULL, "no progress on stderr"},
+	{ALL, OPT_HELP, "help", 'h', NULL, NULL, NULL, "show this help on stdout and exit"},
+};
+#define NOPTIONS (sizeof options / sizeof *options)
+
+static const struct {
+	const char *name;
+	unsigned cmd;
+	const char *synopsis, *about;
+} commands[] = {
+	{"run", CMD_RUN, "convsim run [OPTIONS]",
+	 "Run one simulation and print its JSON summary on stdout (transport velocity with its\n"
+	 "error bar, means over whole periods, cost, energy balance); with --out also the\n"
+	 "trajectory. Progress goes to stderr on runs longer than a second."},
+	{"sweep", CMD_SWEEP, "convsim sweep [OPTIONS]",
+	 "Measure the steady transport velocity v(beta): one fresh simulation per angle and\n"
+	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
+	 "stderr: a bar on a terminal, plain lines otherwise."},
+	{"list", CMD_LIST, "convsim list",
+	 "Print every setting (name, group, unit, range, meaning) and the integrators."},
+};
+#define NCOMMANDS (sizeof commands / sizeof *commands)
+
+unsigned cli_command(const char *name)
+{
+	for (size_t i = 0; i < NCOMMANDS; i++)
+		if (strcmp(commands[i].name, name) == 0)
+			return commands[i].cmd;
+	return 0;
+}
+
+static const char *command_name(unsigned cmd)
+{
+	for (size_t i = 0; i < NCOMMANDS; i++)
+		if (commands[i].cmd == cmd)
+			return commands[i].name;
+	return "";
+}
+
+void cli_help(FILE *f, unsigned cmd)
+{
+	if (!cmd) {
+		fprintf(f, "convsim %s - the reversible vibratory conveyor simulator's command line\n\n"
+			   "usage: convsim COMMAND [OPTIONS]\n"
+			   "       convsim help [COMMAND]     this text, or COMMAND's options\n"
+			   "       convsim --version\n\ncommands:\n",
+			CONVSIM_VERSION);
+		for (size_t i = 0; i < NCOMMANDS; i++)
+			fprintf(f, "  %-6s %s\n", commands[i].name,
+				i == 0   ? "one simulation: JSON summary, optional trajectory"
+				: i == 1 ? "v(beta) for both rotation senses, as CSV or JSON"
+					 : "every setting with its unit and range; the integrators");
+		fprintf(f, "\n'convsim help COMMAND' or 'convsim COMMAND --help' lists the options "
+			   "with their\ndefaults and units. Exit status: 0 done, 1 the simulation "
+			   "failed, 2 a usage error.\n");
+		return;
+	}
+	size_t c = 0;
+	while (c < NCOMMANDS && commands[c].cmd != cmd)
+		c++;
+	fprintf(f, "usage: %s\n\n%s\n\noptions:\n", commands[c].synopsis, commands[c].about);
+	for (size_t i = 0; i < NOPTIONS; i++) {
+		const cli_opt *o = &options[i];
+		if (!(o->cmds & cmd))
+			continue;
+		char flag[64];
+		snprintf(flag, sizeof flag, "%c%c%s--%s%s%s", o->key ? '-' : ' ',
+			 o->key ? o->key : ' ', o->key ? ", " : "  ", o->name, o->arg ? " " : "",
+			 o->arg ? o->arg : "");
+		fprintf(f, "  %-26s %s\n", flag, o->doc);
+		if (o->unit || o->def)
+			fprintf(f, "  %-26s %s%s%s%s%s\n", "", o->unit ? "unit: " : "",
+				o->unit ? o->unit : "", o->unit && o->def ? "; " : "",
+				o->def ? "default: " : "", o->def ? o->def : "");
+	}
+	if (cmd & (CMD_RUN | CMD_SWEEP))
+		fprintf(f, "\nsettings for --set: 'convsim list' (for example --set beta=30 "
+			   "--set rotation=ccw\n--set method=rk4 --set dt=1e-5 --set "
+			   "trough_rotation=true).\n");
+}
+
+const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion)
+{
+	if (suggestion)
+		snprintf(buf, len, " (did you mean '%.60s'?)", suggestion);
+	else
+		snprintf(buf, len, "%s", "");
+	return buf;
+}
+
+int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
+{
+	struct option longopts[NOPTIONS + 1];
+	char shortopts[2 * NOPTIONS + 2] = ":";
+	const char *names[NOPTIONS];
+	size_t n = 0, at = 1;
+	for (size_t i = 0; i < NOPTIONS; i++) {
+		const cli_opt *o = &options[i];
+		if (!(o->cmds & cmd))
+			continue;
+		longopts[n] = (struct option){o->name, o->arg ? required_argument : no_argument,
+					      NULL, o->id};
+		names[n++] = o->name;
+		if (o->key) {
+			shortopts[at++] = o->key;
+			if (o->arg)
+				shortopts[at++] = ':';
+		}
+	}
+	longopts[n] = (struct option){NULL, 0, NULL, 0};
+	shortopts[at] = '\0';
+	opterr = 0;
+	int c = getopt_long(argc, argv, shortopts, longopts, NULL);
+	*arg = optarg;
+	if (c == -1)
+		return -1;
+	const char *cname = command_name(cmd);
+	if (c == ':' || c == '?') {
+		const char *bad = argv[optind - 1];
+		char word[64], hint[96];
+		if (optopt && optopt < 256) {
+			snprintf(word, sizeof word, "-%c", optopt);
+		} else {
+			snprintf(word, sizeof word, "%s", bad);
+			char *eq = strchr(word, '=');
+			if (eq)
+				*eq = '\0';
+		}
+		if (c == ':') {
+			fprintf(stderr, "convsim %s: option %s needs an argument (see 'convsim help %s')\n",
+				cname, word, cname);
+			return 0;
+		}
+		const char *plain = word;
+		while (*plain == '-')
+			plain++;
+		const char *s = strlen(plain) > 1 ? sim_suggest(plain, names, n, sizeof *names) : NULL;
+		char full[80];
+		if (s)
+			snprintf(full, sizeof full, "--%s", s);
+		fprintf(stderr, "convsim %s: unknown or ambiguous option '%s'%s; 'convsim help %s' "
+				"lists them\n",
+			cname, word, cli_did_you_mean(hint, sizeof hint, s ? full : NULL), cname);
+		return 0;
+	}
+	/* a short letter maps to its entry's id */
+	for (size_t i = 0; i < NOPTIONS; i++)
+		if (options[i].key == c && (options[i].cmds & cmd))
+			return options[i].id;
+	return c;
+}
+
+int cli_operand_index(void)
+{
+	return optind;
+}
+
+void cli_restart_options(void)
+{
+	optind = 0; /* glibc: 0 starts getopt afresh */
+}
+
+int cli_number(const char *cmd, const char *opt, const char *unit, const char *text,
+	       double lo, double hi, int lo_open, double *out)
+{
+	char *end;
+	double v = strtod(text, &end);
+	int ok = end != text && *end == '\0' && isfinite(v) && (lo_open ? v > lo : v >= lo) &&
+		 v <= hi;
+	if (ok) {
+		*out = v;
+		return 0;
+	}
+	fprintf(stderr, "convsim %s: --%s must be a number%s%s in %c%g, %g], got '%s'\n", cmd, opt,
+		unit ? " of " : "", unit ? unit : "", lo_open ? '(' : '[', lo, hi, text);
+	return -1;
+}
+
+/* ---- progress ------------------------------------------------------------ */
+
+double cli_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void cli_progress_start(cli_progress *p, const char *label, int quiet, double min_wall)
+{
+	*p = (cli_progress){.label = label, .quiet = quiet, .tty = isatty(STDERR_FILENO),
+			    .t0 = cli_now(), .decile = -1, .min_wall = min_wall};
+}
+
+void cli_progress_update(cli_progress *p, double done, double total, const char *unit,
+			 const char *detail)
+{
+	if (p->quiet || !(total > 0))
+		return;
+	double now = cli_now(), wall = now - p->t0, frac = done / total;
+	if (wall < p->min_wall)
+		return;
+	if (p->tty) {
+		if (p->shown && now - p->last < 0.1 && done < total)
+			return;
+		char bar[31];
+		int full = (int)(30 * frac);
+		for (int i = 0; i < 30; i++)
+			bar[i] = i < full ? '#' : '.';
+		bar[30] = '\0';
+		fprintf(stderr, "\r%s [%s] %3.0f%%  %g/%g %s%s  %.1f s ", p->label, bar, 100 * frac,
+			done, total, unit, detail, wall);
+	} else {
+		int decile = (int)floor(10 * frac + 1e-9);
+		if (decile <= p->decile || done >= total) /* the end has its own line */
+			return;
+		p->decile = decile;
+		fprintf(stderr, "%s: %g/%g %s (%.0f %%)%s, %.1f s\n", p->label, done, total, unit,
+			100 * frac, detail, wall);
+	}
+	fflush(stderr);
+	p->shown = 1;
+	p->last = now;
+}
+
+void cli_progress_end(cli_progress *p, const char *summary, int force)
+{
+	if (p->quiet || !(force || p->shown))
+		return;
+	if (p->tty && p->shown)
+		fputs("\r\033[K", stderr);
+	fprintf(stderr, "%s: %s\n", p->label, summary);
+}

@@ -1,0 +1,112 @@
+/*
+ * table.h - the tables a user takes away, as the CLI and the daemon write
+ * them: one column list for trajectories, one header for v(beta) sweeps,
+ * and one way to print a number. Header only (static inline, libc and
+ * libm), so that core/cli (which sees only core/) and api/ share it
+ * without a dependency between the two.
+ *
+ * Numbers are the shortest of %.15g, %.16g and %.17g that strtod reads
+ * back bit for bit: a value printed by `convsim` and by `convsimd` is the
+ * same text (1e-06, never 9.9999999999999995e-07).
+ */
+#ifndef CONVSIM_TABLE_H
+#define CONVSIM_TABLE_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "sim.h"
+#include "units.h"
+
+/* Write v into buf (len bytes) as the shortest text that reads back as v
+ * ("-0" and "0" kept apart); non-finite values as `nonfinite` ("null" in
+ * JSON, "" in CSV). Returns the length written, as snprintf. */
+static inline int sim_fmt_double(char *buf, size_t len, double v, const char *nonfinite)
+{
+	if (!isfinite(v))
+		return snprintf(buf, len, "%s", nonfinite);
+	if (v == 0.0)
+		return snprintf(buf, len, signbit(v) ? "-0" : "0");
+	int n = 0;
+	for (int prec = 15; prec <= 17; prec++) {
+		n = snprintf(buf, len, "%.*g", prec, v);
+		if (strtod(buf, NULL) == v)
+			break;
+	}
+	return n;
+}
+
+/* A user-unit value of a setting from SI (beta: rad to deg), by the
+ * settings table's scale, as the API converts it. */
+static inline double sim_table_user(const char *setting, double si)
+{
+	const sim_setting *t = sim_setting_find(setting);
+	return t ? sim_setting_from_si(t, si) : si;
+}
+
+/*
+ * The trajectory's columns: X(name, unit, value from `const sim_status
+ * *st`). After them come `column_1` ... `column_K` (m), the mean
+ * displacement of each feed column since t = 0. The daemon's
+ * GET /sessions/ID/trajectory and `convsim run --out` write exactly these.
+ */
+#define SIM_TRAJECTORY_COLUMNS(X)                                               \
+	X(t, "s", st->t)                                                        \
+	X(beta, "deg", sim_table_user("beta", st->beta))                        \
+	X(beta_target, "deg", sim_table_user("beta", st->beta_target))          \
+	X(x, "m", st->q[0])                                                     \
+	X(y, "m", st->q[1])                                                     \
+	X(alpha, "rad", st->q[2])                                               \
+	X(s1, "m", st->q[4])                                                    \
+	X(s2, "m", st->q[5])                                                    \
+	X(deck_x, "m", st->deck[0])                                             \
+	X(deck_y, "m", st->deck[1])                                             \
+	X(rotor_speed, "rad/s", st->rotor_speed)                                \
+	X(motor_torque, "N m", st->motor_torque)                                \
+	X(power, "W", st->power)                                                \
+	X(feed_displacement, "m", st->feed_displacement)                        \
+	X(feed_velocity, "m/s", st->feed_velocity)                              \
+	X(transport_velocity, "m/s", st->transport_velocity)                    \
+	X(transport_velocity_uncertainty, "m/s", st->transport_velocity_uncertainty) \
+	X(e_input, "J", st->e_input)                                            \
+	X(e_dissipated, "J", st->e_dissipated)                                  \
+	X(e_residual, "J", st->e_residual)
+
+#define SIM_TABLE_COUNT_(name, unit, value) +1
+/* Number of named trajectory columns (before column_1 ... column_K). */
+#define SIM_TRAJECTORY_NAMED (0 SIM_TRAJECTORY_COLUMNS(SIM_TABLE_COUNT_))
+
+/* Name and unit of named column i (0 <= i < SIM_TRAJECTORY_NAMED). */
+static inline const char *sim_trajectory_name(int i)
+{
+#define SIM_TABLE_NAME_(name, unit, value) #name,
+	static const char *const names[] = {SIM_TRAJECTORY_COLUMNS(SIM_TABLE_NAME_)};
+#undef SIM_TABLE_NAME_
+	return names[i];
+}
+static inline const char *sim_trajectory_unit(int i)
+{
+#define SIM_TABLE_UNIT_(name, unit, value) unit,
+	static const char *const units[] = {SIM_TRAJECTORY_COLUMNS(SIM_TABLE_UNIT_)};
+#undef SIM_TABLE_UNIT_
+	return units[i];
+}
+
+/* The named columns of one row from a status into row[0 ..
+ * SIM_TRAJECTORY_NAMED - 1]. */
+static inline void sim_trajectory_row(const sim_status *st, double *row)
+{
+#define SIM_TABLE_VALUE_(name, unit, value) value,
+	const double v[] = {SIM_TRAJECTORY_COLUMNS(SIM_TABLE_VALUE_)};
+#undef SIM_TABLE_VALUE_
+	for (int i = 0; i < SIM_TRAJECTORY_NAMED; i++)
+		row[i] = v[i];
+}
+
+/* The v(beta) sweep's CSV header: beta in deg, rotation cw|ccw, velocity
+ * and uncertainty in m/s (empty when not measured), steady true|false,
+ * state queued|running|done|failed|cancelled. */
+#define SIM_SWEEP_CSV_HEADER "beta,rotation,velocity,uncertainty,steady,state"
+
+#endif

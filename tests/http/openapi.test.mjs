@@ -1,0 +1,143 @@
+// The OpenAPI document against the live daemon, with ajv's JSON Schema
+// 2020-12 validator: every operation it lists is exercised and its answer
+// validated against the schema the document gives for that status; every
+// stream record kind seen (SSE and NDJSON) against StreamRecord; the
+// request bodies sent against their (closed) request schemas, and a body
+// with an unknown member is refused by both the schema and the daemon.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import Ajv2020 from 'ajv/dist/2020.js';
+import { startDaemon, req, until, openStream, SLOW, CHEAP } from './lib.mjs';
+
+const ID = 'https://convsim.invalid/openapi.json';
+let d, doc, ajv;
+const seen = new Set();
+
+before(async () => {
+  d = await startDaemon(['--heartbeat', '0.2']);
+  doc = (await req(d.base, 'GET', '/api/v1/openapi.json')).body;
+  ajv = new Ajv2020({ strict: false, allErrors: true });
+  ajv.addSchema({ ...doc, $id: ID });
+});
+after(async () => { await d?.stop(); });
+
+const schema = (name) => {
+  const v = ajv.getSchema(`${ID}#/components/schemas/${name}`);
+  assert.ok(v, `schema ${name}`);
+  return v;
+};
+function valid(name, value, what) {
+  const v = schema(name);
+  assert.ok(v(value), `${what} against ${name}: ${ajv.errorsText(v.errors)}\n${JSON.stringify(value).slice(0, 400)}`);
+}
+const deref = (o) => (o && o.$ref ? o.$ref.split('/').slice(1).reduce((a, k) => a[k], doc) : o);
+
+// call an operation as the document describes it and validate the answer
+async function call(method, template, path, body, headers, checkBody = true) {
+  const op = doc.paths[template]?.[method.toLowerCase()];
+  assert.ok(op, `${method} ${template} is in the document`);
+  if (body !== undefined && op.requestBody && checkBody) {
+    const ref = op.requestBody.content['application/json'].schema.$ref.split('/').pop();
+    valid(ref, body, `${method} ${template} request`);
+  }
+  const r = await req(d.base, method, path, body, headers);
+  const resp = deref(op.responses[String(r.status)]);
+  assert.ok(resp, `${method} ${path}: status ${r.status} is documented (${r.text.slice(0, 200)})`);
+  const ct = (r.headers.get('content-type') || '').split(';')[0];
+  if (resp.content) {
+    assert.ok(resp.content[ct], `${method} ${path}: ${ct} is documented for ${r.status}`);
+    const s = resp.content[ct].schema;
+    if (s && ct.includes('json')) {
+      const name = (s.$ref || '').split('/').pop();
+      if (name) valid(name, r.body, `${method} ${path} -> ${r.status}`);
+    }
+  } else {
+    assert.equal(r.text, '', `${method} ${path}: no body documented`);
+  }
+  seen.add(`${method.toLowerCase()} ${template}`);
+  return r;
+}
+
+test('every operation answers what the document says', { timeout: 120000 * SLOW }, async () => {
+  const create = { ...CHEAP, params: { beta: 38, rotation: 'cw' }, pace: 'max', until: 0.5, sample_rate: 250 };
+  const s = (await call('POST', '/api/v1/sessions', '/api/v1/sessions', create)).body;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${s.id}`)).body.state === 'finished', 30000 * SLOW, 'finished');
+  await call('GET', '/api/v1/sessions', '/api/v1/sessions');
+  await call('GET', '/api/v1/sessions', '/api/v1/sessions?format=csv');
+  await call('GET', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`);
+  await call('PATCH', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`,
+    { beta: 128, beta_rate: 90, rotation: 'ccw', omega_ss: 150, running: true, motor_on: true, pace: 'max', until: 0.8 });
+  await call('GET', '/api/v1/sessions/{id}/trajectory', `/api/v1/sessions/${s.id}/trajectory?from=0&to=0.4`);
+  await call('GET', '/api/v1/sessions/{id}/trajectory', `/api/v1/sessions/${s.id}/trajectory?format=csv`);
+  const e = (await call('POST', '/api/v1/experiments', '/api/v1/experiments',
+    { session: { ...CHEAP, pace: 'max' }, schedule: [{ beta: 38, until: 0.3 }, { beta: 128, until: 0.6 }], beta_rate: 90 })).body;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${e.id}`)).body.state === 'done', 30000 * SLOW, 'experiment');
+  await call('GET', '/api/v1/experiments/{id}', `/api/v1/experiments/${e.id}`);
+  await call('GET', '/api/v1/experiments', '/api/v1/experiments');
+  const w = (await call('POST', '/api/v1/sweeps', '/api/v1/sweeps',
+    { ...CHEAP, beta: { from: 30, to: 60, step: 30 }, rotations: ['cw', 'ccw'], t_end: 0.3 })).body;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${w.id}`)).body.state === 'done', 30000 * SLOW, 'sweep');
+  await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`);
+  await call('GET', '/api/v1/sweeps', '/api/v1/sweeps');
+  await call('GET', '/api/v1/presets', '/api/v1/presets');
+  await call('GET', '/api/v1/health', '/api/v1/health');
+  await call('GET', '/api/v1/openapi.json', '/api/v1/openapi.json');
+  await call('GET', '/api/v1/problems/{id}', '/api/v1/problems/out-of-range');
+  await call('GET', '/metrics', '/metrics');
+  // problems, each validated as the documented Problem
+  await call('GET', '/api/v1/sessions/{id}', '/api/v1/sessions/none');
+  await call('GET', '/api/v1/sessions/{id}/trajectory', `/api/v1/sessions/${s.id}/trajectory?fromm=1`);
+  await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`, undefined, { Accept: 'image/png' });
+  await call('POST', '/api/v1/sessions', '/api/v1/sessions', { params: { k_s1: -1 } }, {}, false);
+  await call('DELETE', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`);
+  await call('DELETE', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`);
+  // the stream: SSE and NDJSON records of every kind it produced
+  const s2 = (await call('POST', '/api/v1/sessions', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${s2.id}`)).body.state === 'finished', 30000 * SLOW, 'finished');
+  await req(d.base, 'PATCH', `/api/v1/sessions/${s2.id}`, { until: 0.3 });
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${s2.id}`)).body.status.t >= 0.3, 30000 * SLOW, 'resumed');
+  const slow = (await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 0.001 })).body;
+  const kinds = new Set();
+  for (const [path, ndjson] of [[`/api/v1/sessions/${s2.id}/stream?since=0&fields=all&limit=200`, false],
+    [`/api/v1/sessions/${s2.id}/stream?format=ndjson&since=0&fields=all&limit=200`, true],
+    [`/api/v1/sessions/${slow.id}/stream?format=ndjson&fields=feed`, true]]) {
+    let n = 0;
+    for await (const r of openStream(d.base, path)) {
+      if (r.comment) continue;
+      if (!ndjson && !r.data) continue; /* the retry: line */
+      const rec = ndjson ? r : { type: r.event, ...(r.id !== undefined ? { id: r.id } : {}), ...r.data };
+      valid('StreamRecord', rec, `${path} record ${n}`);
+      kinds.add(rec.type);
+      n++;
+      if (rec.type === 'end' || (rec.type === 'heartbeat' && !path.includes('since'))) break;
+    }
+  }
+  seen.add('get /api/v1/sessions/{id}/stream');
+  for (const k of ['hello', 'sample', 'control', 'finished', 'end', 'heartbeat']) assert.ok(kinds.has(k), `a ${k} record was seen and validated`);
+  const ops = Object.entries(doc.paths).flatMap(([p, o]) => Object.keys(o).map((m) => `${m} ${p}`));
+  assert.deepEqual(ops.filter((o) => !seen.has(o)), [], 'every documented operation was exercised');
+});
+
+test('request schemas are closed like the parsers: an unknown member fails both', async () => {
+  for (const [name, path, body] of [
+    ['SessionCreate', '/api/v1/sessions', { pace: 1, bogus: 1 }],
+    ['ExperimentCreate', '/api/v1/experiments', { schedule: [{ beta: 38, until: 1 }], bogus: 1 }],
+    ['SweepCreate', '/api/v1/sweeps', { beta: [30], bogus: 1 }],
+  ]) {
+    assert.equal(schema(name)(body), false, `${name} refuses an unknown member`);
+    const r = await req(d.base, 'POST', path, body);
+    assert.equal(r.status, 422, path);
+    assert.equal(r.body.type, '/api/v1/problems/unknown-field');
+  }
+  for (const name of ['Status', 'Session', 'Experiment', 'Sweep', 'SweepPoint', 'Segment', 'Trajectory', 'Problem']) {
+    const s = doc.components.schemas[name];
+    assert.ok(s.additionalProperties === false || s.unevaluatedProperties === false, `${name} is closed`);
+    assert.ok(Array.isArray(s.required) || s.allOf, `${name} says what is required`);
+  }
+  // query parameters: what the document lists, the daemon takes
+  for (const [p, o] of Object.entries(doc.paths)) {
+    const ps = (o.get?.parameters || []).filter((x) => x.in === 'query');
+    if (!p.includes('trajectory')) continue;
+    assert.deepEqual(ps.map((x) => x.name).sort(), ['format', 'from', 'stride', 'to']);
+  }
+});
