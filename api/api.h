@@ -383,7 +383,7 @@ typedef struct api_sweep_req {
 } api_sweep_req;
 /* Default simulated time per point after scene.transient, s: after a steady
  * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
- * 1 % (MODEL.md's convention). */
+ * 1 % (docs/MODEL.md's convention). */
 #define API_SWEEP_WINDOW 4.0
 /* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
  * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],

@@ -1,6 +1,6 @@
 /*
  * deck.h - internal: the trough as a rigid body seen from its body points
- * (MODEL.md "Frames and coordinates"): the rotation R(alpha), body vectors
+ * (docs/MODEL.md "Frames and coordinates"): the rotation R(alpha), body vectors
  * turned into the world frame, the deck points D_k = G + R(alpha)(d_k, h_d)
  * with their velocities and accelerations, and the generalized force of
  * forces applied there. The machine (model.c), the feed coupling
@@ -14,7 +14,7 @@
 
 #include "sim.h"
 
-/* Machine coordinates q = (x, y, alpha, phi, s1, s2) (MODEL.md). */
+/* Machine coordinates q = (x, y, alpha, phi, s1, s2) (docs/MODEL.md). */
 enum { Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2, NQ_FULL };
 
 /* R(alpha) of a machine state, computed once per evaluation. */

@@ -1,5 +1,5 @@
 /*
- * estimator.c - transport velocity (MODEL.md "Observables"): the mean feed
+ * estimator.c - transport velocity (docs/MODEL.md "Observables"): the mean feed
  * displacement is sampled at the excitation period boundaries, i.e. where
  * the rotor's angle relative to the trough, phi - alpha, crosses a multiple
  * of 2 pi (located within the step on cubic Hermite interpolants); the

@@ -1,6 +1,6 @@
 /*
  * estimator.h - internal: the transport-velocity estimator of a sim
- * (MODEL.md "Observables"). It samples the mean feed displacement at the
+ * (docs/MODEL.md "Observables"). It samples the mean feed displacement at the
  * excitation period boundaries and reports the slope over whole periods.
  */
 #ifndef CONVSIM_ESTIMATOR_H

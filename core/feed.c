@@ -1,5 +1,5 @@
 /*
- * feed.c - the feed model (MODEL.md "Feed", paper eqs. 6-9).
+ * feed.c - the feed model (docs/MODEL.md "Feed", paper eqs. 6-9).
  *
  * Column k has layers j = 1..L (stored 0..L-1, bottom first) with absolute
  * coordinates xi (horizontal) and eta (vertical); layer 0 of the paper is

@@ -1,5 +1,5 @@
 /*
- * feed.h - internal: the feed of MODEL.md (paper eqs. 6-9): columns of
+ * feed.h - internal: the feed of docs/MODEL.md (paper eqs. 6-9): columns of
  * zero-thickness layers of point masses on the deck, normal contact with
  * the loading/unloading switch and Coulomb (or, as an explicit option,
  * regularised) friction between neighbouring layers and with the deck.

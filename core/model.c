@@ -1,5 +1,5 @@
 /*
- * model.c - equations of motion of the machine (MODEL.md "Equations of
+ * model.c - equations of motion of the machine (docs/MODEL.md "Equations of
  * motion"): exact planar rigid-body kinematics of the trough with three
  * point masses (unbalanced mass, two eliminator masses on guides turned to
  * beta(t)), mass matrix M = diag(M_r, M_r, J_r, J_w, 0, 0) + sum m_k J_k^T J_k

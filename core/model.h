@@ -1,5 +1,5 @@
 /*
- * model.h - internal: the machine of MODEL.md (trough, vibrator, two
+ * model.h - internal: the machine of docs/MODEL.md (trough, vibrator, two
  * eliminators on guides at beta(t), suspension, drive) and the layout of
  * the state vector y that the integrators advance:
  *

@@ -1,6 +1,6 @@
 /*
  * params.c - every named setting with its unit and allowed range, the
- * czubak2016 preset (MODEL.md "Parameters"), and checked assignment by name.
+ * czubak2016 preset (docs/MODEL.md "Parameters"), and checked assignment by name.
  * One table drives validation, error messages, the CLI, the API and its
  * OpenAPI document.
  */
@@ -128,7 +128,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	p->mu = 0.4;
 	p->p = 1.0;
 	p->M_ut = 50.0;
-	/* corrected (MODEL.md): e printed 0.215 m, omega_ss printed 42.5 rad/s */
+	/* corrected (docs/MODEL.md): e printed 0.215 m, omega_ss printed 42.5 rad/s */
 	p->e = 0.0215;
 	p->omega_ss = 157.08;
 	p->slip_ut = 15.5;
@@ -175,7 +175,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
  * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
  * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
  * of 5e-4 s and feed sub-steps of at most 2.5e-5 s with its corrected
- * coupling (worst 0.70 % by MODEL.md's convention after a `steady` start
+ * coupling (worst 0.70 % by docs/MODEL.md's convention after a `steady` start
  * and a 4-s window); a feed too heavy for the corrector (added mass) takes
  * single steps of 2.5e-5 s; without feed the machine is smooth and RK4 at
  * 1e-3 s keeps the trajectory within 2e-4. */

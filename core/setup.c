@@ -1,5 +1,5 @@
 /*
- * setup.c - builds the cheapest model a scene needs (MODEL.md "Model only
+ * setup.c - builds the cheapest model a scene needs (docs/MODEL.md "Model only
  * what a scene needs"): the reduced layout, the deck geometry, the
  * suspension preload, and the initial controls. (The initial state, the
  * static equilibrium with the feed settled, is dynamics_equilibrium.)

@@ -1,7 +1,7 @@
 /*
  * sim.h - public interface of the conveyor simulation core.
  *
- * A `sim` is one simulation instance (one session): the machine of MODEL.md
+ * A `sim` is one simulation instance (one session): the machine of docs/MODEL.md
  * (trough, vibrator, two Frahm eliminators on guides at angle beta), the
  * optional feed (columns x layers of point masses with the paper's contact
  * law), the chosen integrator and the model reductions the scene allows.
@@ -47,20 +47,20 @@ const char *sim_strerror(int err);
 #define SIM_MAX_COLUMNS 64
 #define SIM_MAX_LAYERS 64
 
-/* Rotation sense of the unbalanced mass in the paper's words (MODEL.md
+/* Rotation sense of the unbalanced mass in the paper's words (docs/MODEL.md
  * "Rotation sense"): its clockwise is phi' > 0 in the model's axes
  * (clockwise seen from behind the drawing), its counter-clockwise phi' < 0.
  * The value is the sign of phi'. */
 enum { SIM_CW = 1, SIM_CCW = -1 };
 enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
 enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
-/* How an instance starts (MODEL.md "Start"): `rest`, the paper's run-up
+/* How an instance starts (docs/MODEL.md "Start"): `rest`, the paper's run-up
  * from static equilibrium with the motor switched on at t = 0; `steady`,
  * the machine on its periodic forced response at the loaded motor speed
  * with the feed settled on the moving deck. */
 enum { SIM_START_REST = 0, SIM_START_STEADY = 1 };
 
-/* Physical parameters, MODEL.md names, SI (angles in radians). */
+/* Physical parameters, docs/MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
 	/* suspension */
 	double l1, l2, h;         /* m: spring sets at (l1,-h), (-l2,-h) */
@@ -130,7 +130,7 @@ typedef struct sim_method {
 /* Description of one named setting, for validation, docs and OpenAPI. */
 typedef enum { SIM_KIND_REAL, SIM_KIND_INT, SIM_KIND_BOOL, SIM_KIND_ENUM } sim_kind;
 typedef struct sim_setting {
-	const char *name;     /* MODEL.md name, e.g. "beta", "k_s1" */
+	const char *name;     /* docs/MODEL.md name, e.g. "beta", "k_s1" */
 	const char *group;    /* "params", "scene" or "integrator" */
 	sim_kind kind;
 	const char *unit;     /* as the user writes it: "deg", "N/m", ... */
@@ -143,7 +143,7 @@ typedef struct sim_setting {
 /* The table of every named setting; *n receives its length. Static. */
 const sim_setting *sim_settings(size_t *n);
 
-/* The czubak2016 preset (MODEL.md), default scene and default method. */
+/* The czubak2016 preset (docs/MODEL.md), default scene and default method. */
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
 
 /* Names of known presets, NULL-terminated, static. Fill by name. */

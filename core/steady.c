@@ -1,5 +1,5 @@
 /*
- * steady.c - the machine part of the `steady` start (MODEL.md "Start
+ * steady.c - the machine part of the `steady` start (docs/MODEL.md "Start
  * steady"): the machine on its periodic forced response at the loaded
  * motor speed, the feed settled on the moving deck.
  *

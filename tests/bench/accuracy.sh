@@ -4,7 +4,7 @@
 # `convsim sweep` (what daemon sweeps use too), against the converged
 # reference tests/bench/results/vref.tsv (tests/bench/vref.sh). Also the
 # full model (trough_rotation=true) at the same defaults, so the automatic
-# symmetric reduction's own error shows. Accuracy convention (MODEL.md):
+# symmetric reduction's own error shows. Accuracy convention (docs/MODEL.md):
 # a point is within 1 % when |v - v_ref| <= 0.01 |v_ref| where
 # |v_ref| >= 0.3 peak, else <= 0.01 peak. Each point's error bar u (the
 # sweep's `uncertainty`) must contain v_ref. Writes $1/accuracy.md.
@@ -64,7 +64,7 @@ gate() { # name, what: the summary row of one sweep against the reference
 	echo "Command: \`bash tests/bench/accuracy.sh\` (part of \`make bench\`). 74 points (beta = 0..180 deg"
 	echo "every 5 deg, cw and ccw), \`build/convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1\`"
 	echo "with its defaults, against \`tests/bench/results/vref.tsv\` (\`tests/bench/vref.sh\`). Error by"
-	echo "MODEL.md's convention; \"outside u\": points whose |v - v_ref| exceeds the reported"
+	echo "docs/MODEL.md's convention; \"outside u\": points whose |v - v_ref| exceeds the reported"
 	echo "uncertainty; CPU: seconds on one core for the whole curve."
 	echo
 	echo "| run | what | worst error | beyond 1 % | outside u | not steady | CPU s |"
@@ -74,12 +74,13 @@ gate() { # name, what: the summary row of one sweep against the reference
 		gate "$name" "$what"
 	done
 	echo
-	# the automatic reduction against the full model, point by point
+	# the automatic reduction against the full model, point by point (the
+	# sweep's CSV: beta,rotation,velocity,uncertainty,steady,state)
 	paste -d, "$tmp/default.csv" "$tmp/full.csv" | awk -F, -v cd="$(cat "$tmp/default.cpu")" \
 		-v cf="$(cat "$tmp/full.cpu")" '
 		function abs(x) { return x < 0 ? -x : x }
 		NR == 1 { next }
-		{ a = abs($8); if (a > peak) peak = a; d = abs($3 - $8); if (d > worst) { worst = d; at = $1 "° " $2 } }
+		{ a = abs($9); if (a > peak) peak = a; d = abs($3 - $9); if (d > worst) { worst = d; at = $1 "° " $2 } }
 		END {
 			printf "The symmetric reduction (applied by the defaults) against the full model at the same\n"
 			printf "step and start, all 74 points: largest |v - v_full| = %.2g m/s (%.3f %% of the peak, at %s);\n", worst, 100 * worst / peak, at

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The converged reference v_ref(beta, rotation) at the 74 points beta =
-# 0..180 deg every 5 deg, both senses (MODEL.md "Accuracy convention").
+# 0..180 deg every 5 deg, both senses (docs/MODEL.md "Accuracy convention").
 #
 # Independent of what it checks: the full model (trough_rotation=true), the
 # paper's `rest` start and a late window, [16, 32] s (the run-up's bounce
@@ -48,5 +48,5 @@ paste "$tmp/ref.tsv" "$tmp/h2.tsv" "$tmp/H2.tsv" | awk -F'\t' '
 awk -F'\t' 'NR > 1 { a = $3 < 0 ? -$3 : $3; if (a > peak) peak = a; v[NR] = a; u[NR] = $7 }
 	END {
 		for (i in v) { d = v[i] >= 0.3 * peak ? v[i] : peak; r = u[i] / d; if (r > w) w = r }
-		printf "vref: peak %.5f m/s; largest reference uncertainty %.3f %% (MODEL.md convention)\n", peak, 100 * w
+		printf "vref: peak %.5f m/s; largest reference uncertainty %.3f %% (docs/MODEL.md convention)\n", peak, 100 * w
 	}' "$out/vref.tsv"

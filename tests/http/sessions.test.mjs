@@ -45,7 +45,7 @@ test('create answers 201 with Location and the full spec', { timeout: 20000 * SL
 
 // v of the czubak2016 defaults (steady start, transient 0, Kloss motor,
 // 5 x 8 feed, dem) over [0, 4] s, against converged references (finer step
-// and later window, MODEL.md's accuracy convention): the clockwise peaks
+// and later window, docs/MODEL.md's accuracy convention): the clockwise peaks
 // near 30 deg (right) and 137 deg (left), and the mirror image of the
 // first, counter-clockwise at 150 deg. A beta taken as radians, or a
 // rotation sense flipped anywhere on the API path, misses them by far.

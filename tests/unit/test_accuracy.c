@@ -5,7 +5,7 @@
  * line, the feed's reaction at the deck points (an off-centre load tilts
  * the trough by the amount statics gives), the converged reference
  * v_ref(beta) at the defaults (tests/bench/results/vref.tsv), the
- * rotation convention of MODEL.md, the error bars, the `steady` start, the
+ * rotation convention of docs/MODEL.md, the error bars, the `steady` start, the
  * automatic symmetric reduction, and observation that never changes the
  * integration.
  */
@@ -153,7 +153,7 @@ static sim_status run_point(double beta_deg, const char *rotation, const char *t
 
 /* The defaults (steady start, dem default step, symmetric reduction where
  * it applies) against the converged reference after 4 s: within 1 % by
- * MODEL.md's convention, steady, and the error bar holds v_ref. */
+ * docs/MODEL.md's convention, steady, and the error bar holds v_ref. */
 static void defaults_meet_the_reference(void **state)
 {
 	(void)state;
@@ -173,7 +173,7 @@ static void defaults_meet_the_reference(void **state)
 	}
 }
 
-/* MODEL.md: the paper's clockwise is phi' > 0 in the model's axes, faster
+/* docs/MODEL.md: the paper's clockwise is phi' > 0 in the model's axes, faster
  * to the right with its peak near 30 deg; mirror symmetry maps (cw, beta)
  * to (ccw, 180 - beta) with the opposite velocity. */
 static void rotation_convention_and_mirror(void **state)

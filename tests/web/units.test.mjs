@@ -143,7 +143,7 @@ test('pick, num and rotation spellings', () => {
 	assert.equal(api.pick(null, ['a']), undefined);
 	assert.ok(Number.isNaN(api.num(null)));
 	assert.equal(api.num('1.5'), 1.5);
-	/* the core's sign of phi': the paper's clockwise is +1 (MODEL.md) */
+	/* the core's sign of phi': the paper's clockwise is +1 (docs/MODEL.md) */
 	assert.equal(api.rotationName(1), 'cw');
 	assert.equal(api.rotationName(-1), 'ccw');
 	assert.equal(api.rotationName('ccw'), 'ccw');

@@ -130,7 +130,7 @@ export function num(v) {
 }
 
 /* "cw"/"ccw" from the API's spellings (strings, or the core's +1/-1: the
- * paper's clockwise is phi' > 0, MODEL.md). */
+ * paper's clockwise is phi' > 0, docs/MODEL.md). */
 export function rotationName(v) {
 	if (v === 1 || v === 'cw' || v === 'CW' || v === 'clockwise') return 'cw';
 	if (v === -1 || v === 'ccw' || v === 'CCW' || v === 'counterclockwise' || v === 'counter-clockwise') return 'ccw';

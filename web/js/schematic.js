@@ -18,7 +18,7 @@ export function toSvg(x, y) {
 	return [VIEW.x0 + VIEW.scale * x, VIEW.y0 - VIEW.scale * y];
 }
 
-/* Unit vectors of MODEL.md, beta in degrees. */
+/* Unit vectors of docs/MODEL.md, beta in degrees. */
 export function vibrationDirection(betaDeg) {
 	return [Math.cos(betaDeg * DEG), Math.sin(betaDeg * DEG)];
 }
@@ -32,7 +32,7 @@ export function guideEnds(p, betaDeg, half) {
 	return [[p[0] - half * u[0], p[1] - half * u[1]], [p[0] + half * u[0], p[1] + half * u[1]]];
 }
 
-/* Body-frame layout of the czubak2016 machine (MODEL.md), metres. */
+/* Body-frame layout of the czubak2016 machine (docs/MODEL.md), metres. */
 export const LAYOUT = {
 	guides: [[-0.3, 0], [0.3, 0]],  /* p_1, p_2 */
 	guideHalf: 0.2,
@@ -73,7 +73,7 @@ function zigzag(x, yTop, yBot, n = 6, amp = 0.035) {
 /* Arc arrow around c (model m) of radius r, for the rotor's sense as it
  * turns in this drawing. The drawing shows the machine in the model's axes
  * (X right, Y up) from the front; the paper's "clockwise" is phi' > 0 in
- * these axes (MODEL.md), i.e. clockwise seen from behind the drawing, so
+ * these axes (docs/MODEL.md), i.e. clockwise seen from behind the drawing, so
  * on screen it turns counter-clockwise. */
 function rotorArc(c, r, rotation) {
 	const [cx, cy] = toSvg(c[0], c[1]);
