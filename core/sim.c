@@ -294,9 +294,14 @@ int sim_advance(sim *s, double t_end)
 
 /* ---- controls ---- */
 
-static void control_changed(sim *s)
+/* After a control: the integrator forgets cached derivatives, and the
+ * transport estimate starts over at the first period boundary after
+ * `settled` (the control's ramp, if any, has ended then), so that it and
+ * its error bar and steady flag speak of the new regime only. */
+static void control_changed(sim *s, double settled)
 {
 	s->ode->reset(s->ws);
+	estimator_restart(&s->est, fmax(s->t_int, settled));
 	sim_update_status(s);
 }
 
@@ -313,7 +318,7 @@ int sim_set_beta(sim *s, double beta, double rate)
 	}
 	ramp_to_position(&s->ctl.beta_ramp, s->t_int, beta, s->ctl.beta_rate,
 			 s->md.p.beta_accel);
-	control_changed(s);
+	control_changed(s, s->ctl.beta_ramp.t_end);
 	return SIM_OK;
 }
 
@@ -331,7 +336,7 @@ int sim_set_rotation(sim *s, int rotation)
 		return SIM_EPARAM;
 	s->ctl.rotation = rotation;
 	ideal_speed(s);
-	control_changed(s);
+	control_changed(s, s->md.phi_prescribed ? s->ctl.psi_ramp.t_end : s->t_int);
 	return SIM_OK;
 }
 
@@ -341,7 +346,7 @@ int sim_set_omega_ss(sim *s, double omega_ss)
 		return SIM_EPARAM;
 	s->ctl.omega_ss = omega_ss;
 	ideal_speed(s);
-	control_changed(s);
+	control_changed(s, s->md.phi_prescribed ? s->ctl.psi_ramp.t_end : s->t_int);
 	return SIM_OK;
 }
 
@@ -349,7 +354,7 @@ int sim_set_drive_on(sim *s, int on)
 {
 	s->ctl.drive_on = on != 0;
 	ideal_speed(s);
-	control_changed(s);
+	control_changed(s, s->md.phi_prescribed ? s->ctl.psi_ramp.t_end : s->t_int);
 	return SIM_OK;
 }
 

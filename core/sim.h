@@ -281,7 +281,7 @@ typedef struct sim_status {
 	double transport_velocity;/* m/s: slope of feed_displacement over the
 				     whole excitation periods since the
 				     estimator start (scene.transient or the
-				     last sim_restart_transport); NaN before
+				     last sim_restart_transport or control); NaN before
 				     one whole period */
 	double transport_periods; /* whole periods the estimate spans */
 	double transport_velocity_uncertainty; /* m/s: the estimate's error bar

@@ -267,6 +267,31 @@ static void short_window_is_not_steady(void **state)
 	sim_free(s);
 }
 
+/* A control restarts the transport estimate once its ramp has ended: after
+ * beta 30 -> 135 deg at t = 2 s (a 1.2-s ramp at 90 deg/s) the estimate
+ * speaks of the new regime only and meets v_ref(135 deg, cw) by t = 6 s,
+ * inside its error bar (with the old regime in it, v over [0, 6] s would
+ * be about -0.04 m/s). */
+static void a_control_restarts_the_estimate(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	set(&u, "beta", "30");
+	sim *s = make(&u);
+	advance(s, 2.0);
+	assert_true(status(s).transport_velocity > 0.14);
+	assert_int_equal(sim_set_beta(s, 135.0 * RAD_PER_DEG, 0.0), SIM_OK);
+	advance(s, 3.0); /* still ramping: no estimate yet */
+	assert_true(isnan(status(s).transport_velocity));
+	advance(s, 6.0);
+	sim_status st = status(s);
+	double v_ref = REF[1].v_ref;
+	assert_close(st.transport_velocity, v_ref, 0.01 * fabs(v_ref));
+	assert_true(fabs(st.transport_velocity - v_ref) <= st.transport_velocity_uncertainty);
+	assert_int_equal(st.steady, 1);
+	sim_free(s);
+}
+
 /* Sampling, streaming and status reads change nothing: the state after
  * 1 s is bitwise the same whether it is observed at 10, 250, 1000 or
  * 2000 Hz or not at all. */
@@ -321,6 +346,7 @@ int main(void)
 		cmocka_unit_test(symmetric_reduction_by_itself),
 		cmocka_unit_test(steady_start),
 		cmocka_unit_test(short_window_is_not_steady),
+		cmocka_unit_test(a_control_restarts_the_estimate),
 		cmocka_unit_test(observation_never_changes_integration),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
