@@ -91,7 +91,10 @@ static void dem_continues(void **state)
 {
 	(void)state;
 	setup u = small("dem");
-	continues_bit_for_bit(&u, 0.3137, 0.7);
+	/* at several moments: the feed in flight (no reaction held) and in
+	 * contact */
+	for (double t1 = 0.3037; t1 < 0.33; t1 += 0.0051)
+		continues_bit_for_bit(&u, t1, 0.6);
 	u = preset_defaults(); /* the defaults themselves, full feed */
 	continues_bit_for_bit(&u, 0.3137, 0.6);
 }
