@@ -85,8 +85,11 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  CC      $<")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(LDLIBS)
 
+# the daemon's state (sessions, checkpoints, results) survives a restart
+DATA    ?= var/data
 run: all
-	$(BUILD)/convsimd --listen $(HOST) --port $(PORT)
+	$(Q)mkdir -p $(DATA)
+	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) --data-dir $(DATA)
 
 test: all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh

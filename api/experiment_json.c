@@ -97,7 +97,8 @@ api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb)
 {
 	static const char *const members[] = {"session", "schedule",
-					      "beta_rate", NULL};
+					      "beta_rate", "keep_session",
+					      NULL};
 	memset(req, 0, sizeof *req);
 	cJSON *root = api_parse_body(body, len, 0, members, pb);
 	if (!root)
@@ -105,7 +106,13 @@ api_err api_parse_experiment(const char *body, size_t len,
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
 	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
 	const cJSON *rate = cJSON_GetObjectItemCaseSensitive(root, "beta_rate");
+	const cJSON *keep =
+		cJSON_GetObjectItemCaseSensitive(root, "keep_session");
 	api_err e = parse_session_member(sess, req, pb);
+	if (e == API_OK && keep && !cJSON_IsBool(keep))
+		e = api_fail(pb, API_TYPE, "keep_session",
+			     "keep_session must be true or false");
+	req->keep_session = cJSON_IsTrue(keep);
 	if (e == API_OK && rate && !cJSON_IsNull(rate))
 		e = api_parse_user_value(&req->spec, "beta_rate", rate,
 					 "beta_rate", &req->beta_rate, pb);

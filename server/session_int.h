@@ -44,6 +44,39 @@ struct srv_session {
 	srv_experiment *exp;
 	srv_cmd *exp_cmd;         /* the experiment's command while queued */
 	int exp_started;
+	/* lifetime and persistence (session_store.c) */
+	int damaged;              /* restored without a usable spec or
+				     checkpoint: listed, failed, no worker */
+	int owned;                /* created by an experiment that does not
+				     keep it: removed when it ends */
+	int expire;               /* remove at the next reap */
+	double last_access;       /* srv_now() of the last request */
+	char *controls;           /* every acknowledged control, one JSON
+				     line each (controls.ndjson) */
+	size_t controls_len, controls_cap;
+	double ckpt_wall;         /* srv_now() of the last checkpoint */
+	int ckpt_dirty;           /* a control or state change since */
+	char store_error[256];    /* the last failed write, "" */
 };
+
+/* ---- session_store.c: the session's files (store.h) ------------------ */
+
+/* Queue the spec file (at creation). */
+void srv_persist_spec(srv_session *s);
+/* Append an acknowledged control's event line and queue the controls
+ * file (worker, lock held). */
+void srv_persist_control(srv_session *s, const char *json);
+/* Queue a checkpoint now if one is due: the interval has passed, or the
+ * session stopped running with changes since the last one (worker, lock
+ * held, after the commands phase). */
+void srv_persist_checkpoint(srv_session *s, int force);
+/* Queue the removal of the session's files. */
+void srv_persist_remove(const srv_session *s);
+
+/* session.c: publish a session built by session_store.c: s has its
+ * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
+ * buffers are allocated and the worker started here. 0 or -1 (s freed). */
+int srv_session_adopt(srv_session *s);
+
 
 #endif

@@ -8,7 +8,12 @@
  *   job start   an experiment attached since the last turn begins: its first
  *               segment's command joins the queue
  *   commands    queued controls (PATCH, experiment segments) are applied in
- *               order and acknowledged, reading sim_effective_time()
+ *               order and acknowledged, reading sim_effective_time(); each
+ *               is appended to the session's control log
+ *   checkpoint  with --data-dir, every --checkpoint-interval of wall time
+ *               (and before going idle after a change) the session's
+ *               state is serialised and handed to the store's writer
+ *               (session_store.c); no file is touched here
  *   until       a running session that reached "until" finishes
  *   idle        a session that is not running sleeps until woken
  *   pacing      simulated time is held to pace x wall time (no catching up
@@ -247,6 +252,8 @@ static int apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
 			push_event(s, "control", json);
+			srv_persist_control(s, json);
+			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
 		cmd->t_eff = t_eff;
@@ -301,6 +308,7 @@ static void check_until(srv_session *s)
 {
 	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
 		s->state = SRV_FINISHED;
+		s->ckpt_dirty = 1;
 		push_event_reason(s, "finished", NULL);
 		pthread_cond_broadcast(&s->data);
 	}
@@ -312,6 +320,7 @@ static int idle(srv_session *s, clocks *c)
 	if (s->state == SRV_RUNNING)
 		return 0;
 	s->steps_per_s = s->rtf = 0;
+	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	pthread_cond_wait(&s->wake, &s->lock);
 	restart_clocks(c, s);
 	return 1;
@@ -362,14 +371,21 @@ static void run_job(srv_session *s)
 		return;
 	int over = 0;
 	queue_experiment_command(s, srv_exp_step(s->exp, &s->st, &over));
-	if (over)
+	if (over) {
 		detach_experiment(s, NULL);
+		s->ckpt_dirty = 1;
+		if (s->owned) /* created by it and not kept */
+			s->expire = 1;
+	}
 }
 
 /* failure: the core refused to go on; the session fails for good. */
 static void fail(srv_session *s, int rc)
 {
 	s->state = SRV_FAILED;
+	s->ckpt_dirty = 1;
+	if (s->owned)
+		s->expire = 1;
 	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
 		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
 	push_event_reason(s, "failed", NULL);
@@ -406,6 +422,7 @@ void *srv_worker_main(void *arg)
 		run_commands(s, &clk);
 		if (s->stop)
 			break;
+		srv_persist_checkpoint(s, 0);
 		check_until(s);
 		if (idle(s, &clk))
 			continue;
@@ -418,6 +435,10 @@ void *srv_worker_main(void *arg)
 			fail(s, rc);
 		meter(s, &clk);
 		pthread_cond_broadcast(&s->data);
+	}
+	if (srv_stopping()) { /* the next start continues from here */
+		s->ckpt_dirty = 1;
+		srv_persist_checkpoint(s, 1);
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
 	pthread_cond_broadcast(&s->data);
