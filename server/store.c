@@ -26,6 +26,7 @@
 
 typedef struct store_job {
 	char path[256];
+	int notify;           /* only call done (a superseded write) */
 	void *buf;            /* NULL: remove path */
 	size_t len;
 	int keep_prev;
@@ -179,7 +180,9 @@ static void run_job(store_job *j)
 {
 	char msg[4400] = "";
 	int err = 0;
-	if (j->buf) {
+	if (j->notify) {
+		/* superseded: nothing to write, done says so */
+	} else if (j->buf) {
 		err = write_atomic(j, msg, sizeof msg);
 		if (err) {
 			atomic_fetch_add(&srv_stats.store_errors, 1);
@@ -279,17 +282,9 @@ static void enqueue(store_job *j)
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg)
 {
-	if (!st.started) {
+	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
+	if (!j) { /* off (callers check first) or out of memory */
 		free(buf);
-		if (done)
-			done(arg, 0, "");
-		return;
-	}
-	store_job *j = calloc(1, sizeof *j);
-	if (!j) {
-		free(buf);
-		if (done)
-			done(arg, ENOMEM, "out of memory for a write");
 		return;
 	}
 	snprintf(j->path, sizeof j->path, "%s", path);
@@ -316,11 +311,13 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		}
 	pthread_mutex_unlock(&st.lock);
 	if (old) {
+		/* the caller may hold a lock the callback takes: the writer
+		 * calls it */
 		free(j);
 		free(old->buf);
-		if (old->done)
-			old->done(old->arg, 0, "");
-		free(old);
+		old->buf = NULL;
+		old->notify = 1;
+		enqueue(old);
 		return;
 	}
 	enqueue(j);

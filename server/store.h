@@ -55,8 +55,10 @@ double srv_store_interval(void);
 /* Queue a write of buf (len bytes; ownership taken, freed after the
  * write) to path (relative to the data directory, parent directories
  * created). keep_prev: the file it replaces is kept as path.prev. done
- * (may be NULL) is called once with the outcome, also when superseded
- * (err 0) or when the store is off (err 0, nothing written). */
+ * (may be NULL) is called once, always on the writer thread (the caller
+ * may hold locks it takes), with the outcome, also when superseded (err
+ * 0, what ""). Callers check srv_store_enabled() first: with the store
+ * off, or out of memory, buf is freed and done is never called. */
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg);
 /* Queue the removal of path (a file, or a directory and what it holds),

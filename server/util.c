@@ -1,7 +1,6 @@
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
- * clocks, timed-wait deadlines, random ids, the stopping flag and result
- * files.
+ * clocks, timed-wait deadlines, random ids and the stopping flag.
  */
 #include <fcntl.h>
 #include <stdarg.h>

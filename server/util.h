@@ -1,8 +1,7 @@
 /*
  * util.h - small services every part of the daemon uses: levelled logging
  * to stderr, clocks, timed-wait deadlines, random ids, the daemon's
- * "stopping" flag. A leaf: it uses nothing else
- * of server/.
+ * "stopping" flag. A leaf: it uses nothing else of server/.
  */
 #ifndef CONVSIM_UTIL_H
 #define CONVSIM_UTIL_H
