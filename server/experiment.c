@@ -22,7 +22,6 @@
 #include <string.h>
 
 #include "experiment.h"
-#include "experiment_http.h"
 #include "store.h"
 #include "util.h"
 
@@ -52,6 +51,8 @@ struct srv_experiment {
 	size_t rec_n, rec_cap, seg_first;
 	double rec_spacing;      /* s between records, at least */
 	srv_cmd cmd;             /* the running segment's command */
+	int writes;              /* queued store writes (they refer to e) */
+	int freed;               /* srv_exp_free came while writes > 0 */
 };
 
 #define EXP_RECORDS 50000
@@ -86,14 +87,24 @@ srv_experiment *srv_exp_new(const api_experiment_req *req,
 	return e;
 }
 
-void srv_exp_free(srv_experiment *e)
+static void exp_release(srv_experiment *e)
 {
-	if (!e)
-		return;
 	free(e->rec_t);
 	free(e->rec_v);
 	pthread_mutex_destroy(&e->lock);
 	free(e);
+}
+
+void srv_exp_free(srv_experiment *e)
+{
+	if (!e)
+		return;
+	pthread_mutex_lock(&e->lock);
+	int later = e->writes > 0; /* the last write's callback frees it */
+	e->freed = 1;
+	pthread_mutex_unlock(&e->lock);
+	if (!later)
+		exp_release(e);
 }
 
 srv_entry *srv_exp_entry(srv_experiment *e)
@@ -244,18 +255,30 @@ static void record_of(const srv_experiment *e, exp_record *r)
 	r->rec_spacing = e->rec_spacing;
 }
 
-/* A write's outcome for experiment id (malloc'd, freed here). */
+/* A write's outcome for e (its writes count keeps it alive). */
 static void written(void *arg, int err, const char *what)
 {
-	char *id = arg;
+	srv_experiment *e = arg;
 	if (err)
-		srv_experiment_write_failed(id, what);
-	free(id);
+		srv_exp_write_failed(e, what);
+	pthread_mutex_lock(&e->lock);
+	int gone = --e->writes == 0 && e->freed;
+	pthread_mutex_unlock(&e->lock);
+	if (gone)
+		exp_release(e);
+}
+
+/* Queue a write for e (lock held). */
+static void queue_write(srv_experiment *e, const char *path, void *buf,
+			size_t len)
+{
+	e->writes++;
+	srv_store_write(path, buf, len, 0, written, e);
 }
 
 /* Queue experiments/ID.bin (lock held). Not while the daemon stops: an
  * experiment its session's worker lets go then is resumed next time. */
-static void persist_locked(const srv_experiment *e)
+static void persist_locked(srv_experiment *e)
 {
 	if (!e->data_dir || srv_stopping())
 		return;
@@ -266,8 +289,7 @@ static void persist_locked(const srv_experiment *e)
 	char path[64];
 	snprintf(path, sizeof path, "experiments/%s.bin", e->entry.id);
 	if (buf)
-		srv_store_write(path, buf, len, 0, written,
-				strdup(e->entry.id));
+		queue_write(e, path, buf, len);
 }
 
 void srv_exp_persist(srv_experiment *e)
@@ -280,6 +302,10 @@ void srv_exp_persist(srv_experiment *e)
 void srv_exp_write_failed(srv_experiment *e, const char *what)
 {
 	pthread_mutex_lock(&e->lock);
+	if (e->freed) {
+		pthread_mutex_unlock(&e->lock);
+		return;
+	}
 	if (e->state != EXP_RUNNING && e->state != EXP_WAITING) {
 		e->state = EXP_ERROR;
 		snprintf(e->error, sizeof e->error, "%s", what);
@@ -399,7 +425,7 @@ int srv_exp_interrupt(srv_experiment *e)
 }
 
 /* The results file DIR/experiment-ID.json and the record (lock held). */
-static void save_results(const srv_experiment *e)
+static void save_results(srv_experiment *e)
 {
 	if (!e->data_dir)
 		return;
@@ -414,8 +440,7 @@ static void save_results(const srv_experiment *e)
 	if (file) {
 		memcpy(file, text, n);
 		file[n] = '\n';
-		srv_store_write(name, file, n + 1, 0, written,
-				strdup(e->entry.id));
+		queue_write(e, name, file, n + 1);
 	}
 	free(text);
 }

@@ -54,15 +54,6 @@ void srv_experiment_put(srv_experiment *e)
 		srv_registry_put(&experiments, srv_exp_entry(e));
 }
 
-void srv_experiment_write_failed(const char *id, const char *what)
-{
-	srv_experiment *e = srv_experiment_get(id);
-	if (!e)
-		return;
-	srv_exp_write_failed(e, what);
-	srv_experiment_put(e);
-}
-
 size_t srv_experiments_restore(void)
 {
 	char **names = NULL;

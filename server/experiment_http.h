@@ -25,8 +25,6 @@ size_t srv_experiments_interrupt_orphans(void);
  * (NULL accepted). */
 srv_experiment *srv_experiment_get(const char *id);
 void srv_experiment_put(srv_experiment *e);
-/* The store could not write experiment id's files (writer thread). */
-void srv_experiment_write_failed(const char *id, const char *what);
 
 /* POST /api/v1/experiments, GET /api/v1/experiments[/{id}]. */
 enum MHD_Result srv_h_experiments_create(srv_req *r);

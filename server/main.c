@@ -91,7 +91,7 @@ static void restore_state(void)
 		return;
 	double t0 = srv_now();
 	size_t ne = srv_experiments_restore();
-	size_t ns = srv_sessions_restore();
+	size_t ns = srv_sessions_restore(srv_experiment_get, srv_experiment_put);
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_sweeps_restore();
 	if (ne + ns + nw)

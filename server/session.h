@@ -48,8 +48,12 @@ void srv_session_delete(srv_session *s);
  * experiment and no request for that long. Returns how many. */
 size_t srv_sessions_reap(double idle_timeout);
 /* Rebuild the sessions of the data directory (session_store.c); the
- * experiments must be restored first. Returns how many. */
-size_t srv_sessions_restore(void);
+ * experiments must be restored first: find (a new reference by id, or
+ * NULL) and put give the running ones back to their sessions (passed in,
+ * so that sessions do not depend on the experiments' registry). Returns
+ * how many. */
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e));
 const char *srv_session_id(const srv_session *s);
 /* Fill a view (spec borrowed from s: keep the reference while using it). */
 void srv_session_view(srv_session *s, api_view *v);

@@ -23,7 +23,6 @@
 #include <string.h>
 
 #include "experiment.h"
-#include "experiment_http.h"
 #include "metrics.h"
 #include "session_int.h"
 #include "store.h"
@@ -178,6 +177,10 @@ void srv_persist_remove(const srv_session *s)
 
 /* The checkpoint of s from file (relative): restores s->sim, run state and
  * the experiment; 0, or -1 with why. */
+/* The experiments' registry, for the restore (srv_sessions_restore). */
+static srv_experiment *(*exp_find)(const char *id);
+static void (*exp_put)(srv_experiment *e);
+
 static int load_checkpoint(srv_session *s, const char *file, char *why,
 			   size_t whylen)
 {
@@ -215,12 +218,13 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 	snprintf(s->error, sizeof s->error, "%s", r.error);
 	if (r.exp_started && r.exp_len) {
 		r.exp_id[SRV_ID_LEN - 1] = '\0';
-		srv_experiment *e = srv_experiment_get(r.exp_id);
+		srv_experiment *e = exp_find(r.exp_id);
 		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
 			s->exp = e;
 			s->exp_started = 1;
 		}
-		srv_experiment_put(e); /* the registry keeps it */
+		if (e)
+			exp_put(e); /* the registry keeps it */
 	}
 	rc = 0;
 done:
@@ -280,10 +284,13 @@ static void restore_one(srv_session *s, const char *id)
 	snprintf(s->error, sizeof s->error, "damaged: %s; %s", why, why2);
 }
 
-size_t srv_sessions_restore(void)
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e))
 {
 	if (!srv_store_enabled())
 		return 0;
+	exp_find = find;
+	exp_put = put;
 	char **names = NULL;
 	size_t n = srv_store_list("sessions", &names), count = 0;
 	for (size_t i = 0; i < n; i++) {

@@ -15,7 +15,7 @@ import { join } from 'node:path';
 import { startDaemon, req, until, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
 
 const INTERVAL = 0.5;            // --checkpoint-interval, s
-const MARGIN = 0.4 * SLOW;       // s: scheduling slack on top of it
+const MARGIN = 0.8 * SLOW;       // s: scheduling slack on top of it (shared CI cores)
 const ROUNDS = 5;
 
 // seeded, so that a failure can be replayed (CONVSIM_CRASH_SEED)
@@ -40,7 +40,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
     });
     assert.equal(ex.status, 201, ex.text);
     const sw = await req(d.base, 'POST', '/api/v1/sweeps', {
-      beta: { from: 0, to: 180, step: 5 }, rotations: ['cw', 'ccw'], t_end: 2,
+      ...CHEAP, beta: { from: 0, to: 180, step: 5 }, rotations: ['cw', 'ccw'], t_end: 2,
     });
     assert.equal(sw.status, 202, sw.text);
     let finished = null; // a finished result, served again byte for byte
