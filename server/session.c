@@ -129,14 +129,8 @@ static int alloc_buffers(srv_session *s)
 	if (!s->ring || !s->ring_store || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
-	for (size_t i = 0; i < s->ring_cap; i++) {
-		api_sample *r = &s->ring[i];
-		r->columns = s->columns;
-		r->layers = s->layers;
-		r->column_disp = s->ring_store + i * per;
-		r->xi = r->column_disp + s->columns;
-		r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
-	}
+	/* the slots' array pointers are set when a slot is first written
+	 * (srv_ring_slot): megabytes of ring are not touched up front */
 	s->hist_stride = 1.0 / s->spec.sample_rate;
 	if (s->hist_stride < 0.01)
 		s->hist_stride = 0.01;
@@ -249,13 +243,6 @@ int srv_session_adopt(srv_session *s)
 		srv_registry_cancel(&sessions, &s->entry);
 		goto fail;
 	}
-	if (!s->damaged) {
-		if (pthread_create(&s->worker, NULL, srv_worker_main, s)) {
-			srv_registry_cancel(&sessions, &s->entry);
-			goto fail;
-		}
-		s->worker_started = 1;
-	}
 	srv_registry_publish(&sessions, &s->entry);
 	srv_registry_put(&sessions, &s->entry); /* the registry's stays */
 	return 0;
@@ -304,6 +291,29 @@ void srv_sessions_shutdown(void)
 		if (n == 0)
 			break;
 	}
+}
+
+size_t srv_sessions_start_restored(void)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), started = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (s->damaged || s->worker_started)
+			continue;
+		if (pthread_create(&s->worker, NULL, srv_worker_main, s) == 0) {
+			s->worker_started = 1;
+			started++;
+		} else {
+			pthread_mutex_lock(&s->lock);
+			s->state = SRV_FAILED;
+			snprintf(s->error, sizeof s->error,
+				 "cannot start the session's worker thread");
+			pthread_mutex_unlock(&s->lock);
+		}
+	}
+	srv_sessions_release(all, n);
+	return started;
 }
 
 size_t srv_sessions_reap(double idle_timeout)

@@ -59,6 +59,21 @@ struct srv_session {
 	char store_error[256];    /* the last failed write, "" */
 };
 
+/* Slot i of the ring with its arrays pointed into ring_store (set on
+ * every use, so that untouched slots cost no page). */
+static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
+{
+	size_t per = (size_t)s->columns +
+		     2 * (size_t)s->columns * (size_t)s->layers;
+	api_sample *r = &s->ring[i];
+	r->columns = s->columns;
+	r->layers = s->layers;
+	r->column_disp = s->ring_store + i * per;
+	r->xi = r->column_disp + s->columns;
+	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
+	return r;
+}
+
 /* ---- session_store.c: the session's files (store.h) ------------------ */
 
 /* Queue the spec file (at creation). */
@@ -75,8 +90,11 @@ void srv_persist_remove(const srv_session *s);
 
 /* session.c: publish a session built by session_store.c: s has its
  * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
- * buffers are allocated and the worker started here. 0 or -1 (s freed). */
+ * buffers are allocated here. 0 or -1 (s freed). Its worker starts with
+ * srv_sessions_start_restored, once every session is in. */
 int srv_session_adopt(srv_session *s);
+/* Start the workers of the adopted sessions. Returns how many. */
+size_t srv_sessions_start_restored(void);
 
 
 #endif

@@ -309,5 +309,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 		free(names[i]);
 	}
 	free(names);
+	/* all in first: the restore does not compete with running workers */
+	srv_sessions_start_restored();
 	return count;
 }

@@ -10,6 +10,7 @@
  * replaced stays as it was. So a reader finds the old file or the new
  * one, whole, never a mixture, whatever moment the daemon dies.
  */
+#define _GNU_SOURCE /* pthread_setname_np: the writer shows as "store" */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -202,6 +203,7 @@ static void run_job(store_job *j)
 static void *writer_main(void *arg)
 {
 	(void)arg;
+	pthread_setname_np(pthread_self(), "store");
 	pthread_mutex_lock(&st.lock);
 	for (;;) {
 		while (!st.head && !st.stop)

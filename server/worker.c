@@ -86,7 +86,7 @@ int srv_worker_unqueue(srv_session *s, srv_cmd *cmd)
 
 static api_sample *push_slot(srv_session *s)
 {
-	api_sample *slot = &s->ring[s->head % s->ring_cap];
+	api_sample *slot = srv_ring_slot(s, s->head % s->ring_cap);
 	slot->index = s->head++;
 	return slot;
 }
