@@ -50,7 +50,7 @@ typedef struct ckpt_scalars {
 
 /* FNV-1a, 64 bits (Fowler, Noll, Vo): enough to tell a torn or flipped
  * buffer from a whole one; not a defence against a forger. */
-static uint64_t fnv1a(const void *buf, size_t len)
+uint64_t sim_checksum(const void *buf, size_t len)
 {
 	const unsigned char *b = buf;
 	uint64_t h = 1469598103934665603ULL;
@@ -142,7 +142,7 @@ int sim_checkpoint(const sim *s, void *buf, size_t len)
 	put(&at, s->X0k, sizeof(double) * columns_of(s));
 	if (h.ws_size)
 		s->ode->save(s->ws, at);
-	h.checksum = fnv1a(payload, h.payload);
+	h.checksum = sim_checksum(payload, h.payload);
 	memcpy(buf, &h, sizeof h);
 	return SIM_OK;
 }
@@ -172,7 +172,7 @@ static int check_frame(const sim *s, const void *buf, size_t len, char *msg, siz
 		return refuse(msg, msglen, "layout differs from this session's model or build");
 	if (len - sizeof h < h.payload)
 		return refuse(msg, msglen, "cut off");
-	if (fnv1a((const char *)buf + sizeof h, h.payload) != h.checksum)
+	if (sim_checksum((const char *)buf + sizeof h, h.payload) != h.checksum)
 		return refuse(msg, msglen, "checksum mismatch");
 	return SIM_OK;
 }

@@ -222,6 +222,10 @@ const char *sim_last_error(const sim *s);
  * another version is refused. */
 #define SIM_CHECKPOINT_VERSION 1
 
+/* FNV-1a 64 of len bytes: the checkpoints' checksum, for callers that
+ * frame their own files the same way. */
+uint64_t sim_checksum(const void *buf, size_t len);
+
 /* Bytes sim_checkpoint writes for this instance (fixed for its life). */
 size_t sim_checkpoint_size(const sim *s);
 /* Write everything that determines the instance's future (state, the

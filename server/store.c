@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "metrics.h"
+#include "sim.h"
 #include "store.h"
 #include "util.h"
 
@@ -51,17 +52,6 @@ typedef struct frame_header {
 	uint32_t version, kind, pad;
 	uint64_t len, checksum;
 } frame_header;
-
-uint64_t srv_store_checksum(const void *buf, size_t len)
-{
-	const unsigned char *b = buf;
-	uint64_t h = 1469598103934665603ULL;
-	for (size_t i = 0; i < len; i++) {
-		h ^= b[i];
-		h *= 1099511628211ULL;
-	}
-	return h;
-}
 
 static void full_path(char *out, size_t len, const char *rel)
 {
@@ -340,7 +330,7 @@ void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
 		      size_t *len)
 {
 	frame_header h = {{'C', 'V', 'S', 'F'}, SRV_STORE_VERSION, kind, 0,
-			  plen, srv_store_checksum(payload, plen)};
+			  plen, sim_checksum(payload, plen)};
 	char *buf = malloc(sizeof h + plen);
 	if (!buf)
 		return NULL;
@@ -404,7 +394,7 @@ void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
 			bad = "cut off";
 		else if (h.len < n - sizeof h)
 			bad = "longer than its header says";
-		else if (srv_store_checksum(buf + sizeof h, h.len) != h.checksum)
+		else if (sim_checksum(buf + sizeof h, h.len) != h.checksum)
 			bad = "checksum mismatch";
 	}
 	if (bad) {

@@ -14,7 +14,7 @@
  * (convsim_store_errors_total).
  *
  * Framed files: a header (magic "CVSF", format version, kind, payload
- * length, FNV-1a 64 checksum of the payload) and the payload. Reading one
+ * length, FNV-1a 64 checksum of the payload, sim_checksum) and the payload. Reading one
  * checks all of it and says what is wrong.
  *
  * Lock order: the store's queue lock is a leaf (registry.h): callbacks run
@@ -80,8 +80,5 @@ char *srv_store_read_text(const char *path, size_t *len);
 /* Entries of a directory (relative path), malloc'd array of malloc'd
  * names (free each and the array); the count, 0 if none. */
 size_t srv_store_list(const char *path, char ***names);
-
-/* FNV-1a 64 of len bytes. */
-uint64_t srv_store_checksum(const void *buf, size_t len);
 
 #endif
