@@ -250,7 +250,7 @@ static void restore_one(srv_session *s, const char *id)
 	}
 	if (!r) {
 		s->damaged = 1;
-		snprintf(s->error, sizeof s->error, "damaged: %s", why);
+		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
 		return;
 	}
 	s->spec = r->spec;
@@ -281,7 +281,7 @@ static void restore_one(srv_session *s, const char *id)
 		snprintf(why, sizeof why, "its spec is refused: %s", msg);
 	}
 	s->damaged = 1;
-	snprintf(s->error, sizeof s->error, "damaged: %s; %s", why, why2);
+	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
 size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),

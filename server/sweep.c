@@ -278,7 +278,7 @@ size_t srv_sweeps_restore(void)
 				sw = NULL;
 			}
 		} else if (!ok && p) {
-			snprintf(why, sizeof why, "%s: inconsistent", path);
+			snprintf(why, sizeof why, "%.200s: inconsistent", path);
 		}
 		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0)
 			srv_log(SRV_LOG_WARN, "sweep not restored: %s", why);
