@@ -111,9 +111,12 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
 	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(LDLIBS)
 
 # Builds only the daemon it runs. PORT, HOST and DAEMON_FLAGS (any of
-# `build/convsimd --help`) are the knobs.
+# `build/convsimd --help`) are the knobs; the daemon's state (sessions,
+# checkpoints, results) lives in DATA and survives a restart.
+DATA    ?= var/data
 run: deps-build $(BUILD)/convsimd
-	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) $(DAEMON_FLAGS)
+	$(Q)mkdir -p $(DATA)
+	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) --data-dir $(DATA) $(DAEMON_FLAGS)
 
 test: deps all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh

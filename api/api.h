@@ -338,6 +338,7 @@ typedef struct api_experiment_req {
 	api_spec spec;
 	char session_id[24];    /* fresh == 0 */
 	api_value beta_rate;    /* rad/s (deg/s as sent), 0 = keep */
+	int keep_session;       /* a fresh session stays after the end */
 	int nseg;
 	api_segment seg[API_EXP_MAX_SEGMENTS];
 } api_experiment_req;
@@ -345,14 +346,16 @@ typedef struct api_experiment_req {
 /* Parse POST /experiments: {"session": ID} or {"session": {create body}}
  * (or none: a fresh czubak2016 session at pace "max"), "schedule":
  * [{"beta": DEG, "until": S}, ...] with increasing until, optional
- * "beta_rate". Returns API_OK or the error in *pb. */
+ * "beta_rate" and "keep_session" (a fresh session is removed when the
+ * experiment ends unless true). Returns API_OK or the error in *pb. */
 api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb);
 
 typedef struct api_experiment_view {
 	char id[24];
 	char session_id[24];
-	const char *state;      /* running, done, aborted, failed */
+	const char *state;      /* waiting, running, done, aborted,
+				   interrupted, error */
 	char error[256];
 	double t_start, t_now;  /* s simulated */
 	double progress;        /* 0..1 */
@@ -403,7 +406,8 @@ typedef struct api_sweep_point {
 } api_sweep_point;
 typedef struct api_sweep_view {
 	char id[24];
-	const char *state;  /* queued, running, done, cancelled */
+	const char *state;  /* queued, running, done, cancelled, error */
+	const char *error;  /* why "error" (a write failed); NULL or "" */
 	size_t total, done;
 	double t_end;
 	const api_sweep_point *pt; /* borrowed, total entries */

@@ -39,7 +39,8 @@ int api_status(api_err code)
 	X(ENOMEM, UNAVAILABLE)                                                \
 	X(EDIVERGED, INVALID)                                                 \
 	X(ESTEP, INVALID)                                                     \
-	X(ETIME, INVALID)
+	X(ETIME, INVALID)                                                     \
+	X(ECHECKPOINT, INVALID)
 
 static const api_err sim_to_api[SIM_NERR] = {
 #define SIM_TO_API_ROW(sim, api) [SIM_##sim] = API_##api,

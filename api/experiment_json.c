@@ -16,7 +16,8 @@
 const char *const api_members_segment[] = {"beta", "until", NULL};
 const char *const api_members_experiment_session[] = {"preset", "params", "scene", "integrator",
 						       "pace", "sample_rate", NULL};
-const char *const api_members_experiment[] = {"session", "schedule", "beta_rate", NULL};
+const char *const api_members_experiment[] = {"session", "schedule", "beta_rate", "keep_session",
+					       NULL};
 
 static api_err parse_segment(const cJSON *it, int i, double prev,
 			     const api_spec *spec, api_segment *seg,
@@ -104,7 +105,13 @@ api_err api_parse_experiment(const char *body, size_t len,
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
 	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
 	const cJSON *rate = cJSON_GetObjectItemCaseSensitive(root, "beta_rate");
+	const cJSON *keep =
+		cJSON_GetObjectItemCaseSensitive(root, "keep_session");
 	api_err e = parse_session_member(sess, req, pb);
+	if (e == API_OK && keep && !cJSON_IsBool(keep))
+		e = api_fail(pb, API_TYPE, "keep_session",
+			     "keep_session must be true or false");
+	req->keep_session = cJSON_IsTrue(keep);
 	if (e == API_OK && rate && !cJSON_IsNull(rate))
 		e = api_parse_user_value(&req->spec, "beta_rate", rate,
 					 "beta_rate", &req->beta_rate, pb);

@@ -207,6 +207,8 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "id", v->id);
 	cJSON_AddStringToObject(o, "state", v->state);
+	if (v->error && v->error[0])
+		cJSON_AddStringToObject(o, "error", v->error);
 	api_add_number(o, "total", (double)v->total);
 	api_add_number(o, "done", (double)v->done);
 	api_add_number(o, "progress",

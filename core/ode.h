@@ -29,6 +29,14 @@ typedef struct ode_method {
 	/* Forget cached derivatives (after a control change). */
 	void (*reset)(void *ws);
 	void (*free)(void *ws);
+	/* What the workspace carries from one step to the next (cached
+	 * derivatives, step size, contact modes, dense output), for a
+	 * checkpoint (checkpoint.c): its size in bytes, then saved into /
+	 * loaded from a buffer of that size. NULL when the workspace caches
+	 * nothing (size 0). load trusts its buffer: the caller checked it. */
+	size_t (*state_size)(const void *ws);
+	void (*save)(const void *ws, void *buf);
+	void (*load)(void *ws, const void *buf);
 } ode_method;
 
 extern const ode_method ode_rk4, ode_dopri5, ode_euler, ode_dem;

@@ -35,6 +35,7 @@
 
 typedef struct dem {
 	int n, substeps, have_q;
+	int nmodes; /* feed elements with a normal and a tangential mode each */
 	int correct; /* corrector on: feed light enough (added mass) */
 	double dt;
 	double Qfeed[NQ_FULL];
@@ -63,6 +64,7 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->correct = w->substeps > 1 && md->sc.feed_coupling &&
 		     model_feed_mass_ratio(&md->p, &md->sc) <= MODEL_CORRECTOR_MAX_RATIO;
 	size_t nf = (size_t)(md->nf > 0 ? md->nf : 1);
+	w->nmodes = (int)nf;
 	w->k1 = calloc(6 * (size_t)md->n, sizeof(double));
 	w->modes = calloc(2 * nf, 1);
 	if (!w->k1 || !w->modes) {
@@ -196,6 +198,31 @@ static void dem_reset(void *p)
 	(void)p;
 }
 
+/* Carried between steps: the held reaction and the contacts' modes. */
+static size_t dem_state_size(const void *p)
+{
+	const dem *w = p;
+	return sizeof w->have_q + sizeof w->Qfeed + 2 * (size_t)w->nmodes;
+}
+
+static void dem_save(const void *p, void *buf)
+{
+	const dem *w = p;
+	char *b = buf;
+	memcpy(b, &w->have_q, sizeof w->have_q);
+	memcpy(b + sizeof w->have_q, w->Qfeed, sizeof w->Qfeed);
+	memcpy(b + sizeof w->have_q + sizeof w->Qfeed, w->modes, 2 * (size_t)w->nmodes);
+}
+
+static void dem_load(void *p, const void *buf)
+{
+	dem *w = p;
+	const char *b = buf;
+	memcpy(&w->have_q, b, sizeof w->have_q);
+	memcpy(w->Qfeed, b + sizeof w->have_q, sizeof w->Qfeed);
+	memcpy(w->modes, b + sizeof w->have_q + sizeof w->Qfeed, 2 * (size_t)w->nmodes);
+}
+
 const ode_method ode_dem = {
 	.info = {.name = "dem",
 		 .order = 1,
@@ -207,4 +234,7 @@ const ode_method ode_dem = {
 	.interpolate = NULL,
 	.reset = dem_reset,
 	.free = dem_free,
+	.state_size = dem_state_size,
+	.save = dem_save,
+	.load = dem_load,
 };

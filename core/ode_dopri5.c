@@ -197,6 +197,51 @@ static void dp_reset(void *p)
 	w->have_k1 = 0;
 }
 
+/* Carried between steps: the controller's step and memory, the FSAL
+ * stage k[0] and the last step's dense output (r1..r5 over t_old, h_old).
+ * The other stages are scratch. */
+typedef struct dp_scalars {
+	double h, facold, t_old, h_old;
+	uint64_t forced;
+	int have_k1;
+} dp_scalars;
+
+static size_t dp_state_size(const void *p)
+{
+	const dopri5 *w = p;
+	return sizeof(dp_scalars) + 6 * sizeof(double) * (size_t)w->n;
+}
+
+static void dp_save(const void *p, void *buf)
+{
+	const dopri5 *w = p;
+	dp_scalars sc = {w->h, w->facold, w->t_old, w->h_old, w->forced, w->have_k1};
+	const double *vec[6] = {w->k[0], w->r1, w->r2, w->r3, w->r4, w->r5};
+	size_t len = sizeof(double) * (size_t)w->n;
+	char *b = buf;
+	memcpy(b, &sc, sizeof sc);
+	for (int i = 0; i < 6; i++)
+		memcpy(b + sizeof sc + (size_t)i * len, vec[i], len);
+}
+
+static void dp_load(void *p, const void *buf)
+{
+	dopri5 *w = p;
+	dp_scalars sc;
+	double *vec[6] = {w->k[0], w->r1, w->r2, w->r3, w->r4, w->r5};
+	size_t len = sizeof(double) * (size_t)w->n;
+	const char *b = buf;
+	memcpy(&sc, b, sizeof sc);
+	for (int i = 0; i < 6; i++)
+		memcpy(vec[i], b + sizeof sc + (size_t)i * len, len);
+	w->h = sc.h;
+	w->facold = sc.facold;
+	w->t_old = sc.t_old;
+	w->h_old = sc.h_old;
+	w->forced = sc.forced;
+	w->have_k1 = sc.have_k1;
+}
+
 const ode_method ode_dopri5 = {
 	.info = {.name = "dopri5",
 		 .order = 5,
@@ -208,4 +253,7 @@ const ode_method ode_dopri5 = {
 	.interpolate = dp_interpolate,
 	.reset = dp_reset,
 	.free = dp_free,
+	.state_size = dp_state_size,
+	.save = dp_save,
+	.load = dp_load,
 };

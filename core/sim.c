@@ -151,8 +151,8 @@ static void zero_observers(sim *s, int origins)
 	sim_update_status(s);
 }
 
-sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
-	     size_t msglen)
+sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
+	       char *msg, size_t msglen)
 {
 	int e = sim_validate(p, sc, m, msg, msglen);
 	sim *s = NULL;
@@ -181,17 +181,6 @@ sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int 
 	s->ws = s->ode->alloc(&s->md, &s->cfg);
 	if (!s->ws)
 		goto fail;
-	dynamics_equilibrium(&s->md, &s->ctl, s->y);
-	if (sc->start == SIM_START_STEADY && s->ctl.drive_on) {
-		dynamics_steady_start(&s->md, &s->ctl, s->y);
-		e = settle(s);
-		if (e != SIM_OK) {
-			if (msg)
-				snprintf(msg, msglen, "%s", s->error);
-			goto fail;
-		}
-	}
-	zero_observers(s, 1);
 	if (err)
 		*err = SIM_OK;
 	return s;
@@ -202,6 +191,29 @@ fail:
 		*err = e;
 	sim_free(s);
 	return NULL;
+}
+
+sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
+	     size_t msglen)
+{
+	sim *s = sim_alloc(p, sc, m, err, msg, msglen);
+	if (!s)
+		return NULL;
+	dynamics_equilibrium(&s->md, &s->ctl, s->y);
+	if (sc->start == SIM_START_STEADY && s->ctl.drive_on) {
+		dynamics_steady_start(&s->md, &s->ctl, s->y);
+		int e = settle(s);
+		if (e != SIM_OK) {
+			if (msg)
+				snprintf(msg, msglen, "%s", s->error);
+			if (err)
+				*err = e;
+			sim_free(s);
+			return NULL;
+		}
+	}
+	zero_observers(s, 1);
+	return s;
 }
 
 void sim_free(sim *s)

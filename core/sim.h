@@ -29,7 +29,8 @@
 	X(ENOMEM, "out of memory")                                            \
 	X(EDIVERGED, "simulation diverged")                                   \
 	X(ESTEP, "step size underflow")                                       \
-	X(ETIME, "requested time lies in the past")
+	X(ETIME, "requested time lies in the past")                           \
+	X(ECHECKPOINT, "checkpoint damaged, cut off or of another version")
 
 typedef enum {
 #define SIM_ERR_ENUM(name, msg) SIM_##name,
@@ -214,6 +215,35 @@ void sim_free(sim *s);
 int sim_advance(sim *s, double t_end);
 /* Why the instance froze (time and cause), "" while it runs; owned by s. */
 const char *sim_last_error(const sim *s);
+
+/* ---- checkpoints ------------------------------------------------------- */
+
+/* Version of the checkpoint format (checkpoint.c); a checkpoint of
+ * another version is refused. */
+#define SIM_CHECKPOINT_VERSION 1
+
+/* FNV-1a 64 of len bytes: the checkpoints' checksum, for callers that
+ * frame their own files the same way. */
+uint64_t sim_checksum(const void *buf, size_t len);
+
+/* Bytes sim_checkpoint writes for this instance (fixed for its life). */
+size_t sim_checkpoint_size(const sim *s);
+/* Write everything that determines the instance's future (state, the
+ * last step's start for the interpolant, times and step count, controls
+ * with their ramps, the estimator with its records, energy baselines,
+ * the integrator workspace's cached values, counters, a failure) into buf
+ * (len >= sim_checkpoint_size), framed by a magic, the version, the
+ * instance's layout and a checksum. Reads only. SIM_OK or SIM_EPARAM
+ * (buffer too small). */
+int sim_checkpoint(const sim *s, void *buf, size_t len);
+/* An instance for p, sc, m (the set the checkpoint was taken of) in the
+ * checkpoint's state: it continues bit for bit as the checkpointed one
+ * would have (no equilibrium, no settling). buf is borrowed. NULL on
+ * error with *err: sim_new's codes, or SIM_ECHECKPOINT when buf is cut
+ * off, fails its checksum, has another version or another layout (msg
+ * says which); never reads past len. */
+sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, const void *buf,
+		 size_t len, int *err, char *msg, size_t msglen);
 
 /* ---- controls (take effect at sim_effective_time()) ------------------ */
 

@@ -32,6 +32,13 @@ struct sim {
 	sim_status st;
 };
 
+/* An instance for a validated set with its workspace allocated and the
+ * controls initialised, but no state yet (all zero): sim_new fills it with
+ * the start, sim_restore (checkpoint.c) with a checkpoint. Errors as
+ * sim_new. sim.c */
+sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
+	       char *msg, size_t msglen);
+
 /* Recompute s->st at the observed time after any change; reads the state
  * and evaluates the right-hand side for observation only (no counter
  * moves). sim_status.c */

@@ -30,6 +30,8 @@ static const srv_config defaults = {
 	.heartbeat = 15.0,
 	.max_experiments = 256,
 	.max_sweeps = 64,
+	.checkpoint_interval = 10.0,
+	.idle_timeout = 0.0,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL };
@@ -54,7 +56,10 @@ static const opt opts[] = {
 	{"ring", OPT_INT, 16, 1 << 22, F(ring)},
 	{"history", OPT_INT, 16, 1 << 24, F(history)},
 	{"pool-threads", OPT_INT, 1, 256, F(pool_threads)},
-	{"heartbeat", OPT_SECONDS, 0, 0, F(heartbeat)},
+	{"heartbeat", OPT_SECONDS, 50, 3600000, F(heartbeat)},
+	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
+	 F(checkpoint_interval)},
+	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -77,7 +82,11 @@ static void usage(FILE *f)
 		"(default 20000)\n"
 		"  --pool-threads N     sweep worker threads (default 2)\n"
 		"  --heartbeat S        seconds between stream heartbeats "
-		"(default 15)\n");
+		"(default 15)\n"
+		"  --checkpoint-interval S  wall seconds between session "
+		"checkpoints (default 10)\n"
+		"  --idle-timeout S     remove sessions with no client and no "
+		"request for S seconds (default 0: never)\n");
 }
 
 static int parse_int(const char *arg, const char *name, long lo, long hi,
@@ -113,10 +122,13 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 			*(size_t *)(void *)at = (size_t)v;
 		return 0;
 	case OPT_SECONDS: {
+		/* lo, hi: the range in milliseconds */
 		double s = strtod(arg, &end);
-		if (*end || !(s >= 0.05 && s <= 3600)) {
-			fprintf(stderr, "convsimd: --heartbeat must be "
-					"seconds in [0.05, 3600]\n");
+		if (*end || end == arg || !(s >= 1e-3 * (double)o->lo &&
+					    s <= 1e-3 * (double)o->hi)) {
+			fprintf(stderr, "convsimd: %s must be seconds in "
+					"[%g, %g]\n", flag, 1e-3 * (double)o->lo,
+				1e-3 * (double)o->hi);
 			return -1;
 		}
 		*(double *)(void *)at = s;

@@ -24,6 +24,8 @@ typedef struct srv_config {
 	int pool_threads;      /* sweep workers */
 	double heartbeat;      /* s between stream heartbeats */
 	int max_experiments, max_sweeps;
+	double checkpoint_interval; /* s of wall time between checkpoints */
+	double idle_timeout;   /* s without client or request; 0: never */
 } srv_config;
 
 /* Fill *cfg from the defaults and the command line (argv is borrowed: the

@@ -22,9 +22,18 @@
 #include <string.h>
 
 #include "experiment.h"
+#include "store.h"
 #include "util.h"
 
-enum { EXP_WAITING, EXP_RUNNING, EXP_DONE, EXP_ABORTED };
+enum {
+	EXP_WAITING,
+	EXP_RUNNING,
+	EXP_DONE,
+	EXP_ABORTED,
+	EXP_INTERRUPTED, /* running when the daemon died, not resumed */
+	EXP_ERROR,       /* its result could not be written */
+	EXP_NSTATES
+};
 
 struct srv_experiment {
 	srv_entry entry;         /* id and references: experiment_http.c */
@@ -42,6 +51,8 @@ struct srv_experiment {
 	size_t rec_n, rec_cap, seg_first;
 	double rec_spacing;      /* s between records, at least */
 	srv_cmd cmd;             /* the running segment's command */
+	int writes;              /* queued store writes (they refer to e) */
+	int freed;               /* srv_exp_free came while writes > 0 */
 };
 
 #define EXP_RECORDS 50000
@@ -60,7 +71,7 @@ srv_experiment *srv_exp_new(const api_experiment_req *req,
 		return NULL;
 	}
 	e->req = *req;
-	e->data_dir = data_dir;
+	e->data_dir = data_dir && srv_store_enabled() ? data_dir : NULL;
 	e->attached = 1;
 	pthread_mutex_init(&e->lock, NULL);
 	double dur = exp_end(e);
@@ -76,14 +87,24 @@ srv_experiment *srv_exp_new(const api_experiment_req *req,
 	return e;
 }
 
-void srv_exp_free(srv_experiment *e)
+static void exp_release(srv_experiment *e)
 {
-	if (!e)
-		return;
 	free(e->rec_t);
 	free(e->rec_v);
 	pthread_mutex_destroy(&e->lock);
 	free(e);
+}
+
+void srv_exp_free(srv_experiment *e)
+{
+	if (!e)
+		return;
+	pthread_mutex_lock(&e->lock);
+	int later = e->writes > 0; /* the last write's callback frees it */
+	e->freed = 1;
+	pthread_mutex_unlock(&e->lock);
+	if (!later)
+		exp_release(e);
 }
 
 srv_entry *srv_exp_entry(srv_experiment *e)
@@ -99,6 +120,11 @@ srv_experiment *srv_exp_from_entry(srv_entry *en)
 const char *srv_exp_id(const srv_experiment *e)
 {
 	return e->entry.id;
+}
+
+int srv_exp_keeps_session(const srv_experiment *e)
+{
+	return e->req.keep_session || !e->req.fresh;
 }
 
 void srv_exp_set_session(srv_experiment *e, const char *session_id)
@@ -181,8 +207,8 @@ static void drop_record(srv_experiment *e)
 /* The view of e (lock held); v->seg borrows e's segments. */
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
-	static const char *const names[] = {"waiting", "running", "done",
-					    "aborted"};
+	static const char *const names[EXP_NSTATES] = {
+		"waiting", "running", "done", "aborted", "interrupted", "error"};
 	memset(v, 0, sizeof *v);
 	snprintf(v->id, sizeof v->id, "%s", e->entry.id);
 	snprintf(v->session_id, sizeof v->session_id, "%s", e->session_id);
@@ -196,16 +222,226 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 	v->seg = e->req.seg;
 }
 
-static void save_results(const srv_experiment *e)
+/* ---- persistence (store.h) ---------------------------------------------
+ *
+ * experiments/ID.bin holds the record below: written at creation and when
+ * the experiment ends, enough to serve it again. While it runs, its
+ * progress (the record and the feed-velocity record) rides in its
+ * session's checkpoint (srv_exp_save), so that both continue from the same
+ * moment. */
+typedef struct exp_record {
+	char id[SRV_ID_LEN], session_id[SRV_ID_LEN];
+	api_experiment_req req;
+	int32_t state, cur;
+	char error[256];
+	double t0, t_now;
+	uint64_t seg_first, rec_n;
+	double rec_spacing;
+} exp_record;
+
+static void record_of(const srv_experiment *e, exp_record *r)
+{
+	memset(r, 0, sizeof *r);
+	snprintf(r->id, sizeof r->id, "%s", e->entry.id);
+	snprintf(r->session_id, sizeof r->session_id, "%s", e->session_id);
+	r->req = e->req;
+	r->state = e->state;
+	r->cur = e->cur;
+	snprintf(r->error, sizeof r->error, "%s", e->error);
+	r->t0 = e->t0;
+	r->t_now = e->t_now;
+	r->seg_first = e->seg_first;
+	r->rec_n = e->rec_n;
+	r->rec_spacing = e->rec_spacing;
+}
+
+/* A write's outcome for e (its writes count keeps it alive). */
+static void written(void *arg, int err, const char *what)
+{
+	srv_experiment *e = arg;
+	if (err)
+		srv_exp_write_failed(e, what);
+	pthread_mutex_lock(&e->lock);
+	int gone = --e->writes == 0 && e->freed;
+	pthread_mutex_unlock(&e->lock);
+	if (gone)
+		exp_release(e);
+}
+
+/* Queue a write for e (lock held). */
+static void queue_write(srv_experiment *e, const char *path, void *buf,
+			size_t len)
+{
+	e->writes++;
+	srv_store_write(path, buf, len, 0, written, e);
+}
+
+/* Queue experiments/ID.bin (lock held). Not while the daemon stops: an
+ * experiment its session's worker lets go then is resumed next time. */
+static void persist_locked(srv_experiment *e)
+{
+	if (!e->data_dir || srv_stopping())
+		return;
+	exp_record r;
+	record_of(e, &r);
+	size_t len;
+	void *buf = srv_store_frame(SRV_STORE_EXPERIMENT, &r, sizeof r, &len);
+	char path[64];
+	snprintf(path, sizeof path, "experiments/%s.bin", e->entry.id);
+	if (buf)
+		queue_write(e, path, buf, len);
+}
+
+void srv_exp_persist(srv_experiment *e)
+{
+	pthread_mutex_lock(&e->lock);
+	persist_locked(e);
+	pthread_mutex_unlock(&e->lock);
+}
+
+void srv_exp_write_failed(srv_experiment *e, const char *what)
+{
+	pthread_mutex_lock(&e->lock);
+	if (e->freed) {
+		pthread_mutex_unlock(&e->lock);
+		return;
+	}
+	if (e->state != EXP_RUNNING && e->state != EXP_WAITING) {
+		e->state = EXP_ERROR;
+		snprintf(e->error, sizeof e->error, "%s", what);
+	}
+	pthread_mutex_unlock(&e->lock);
+}
+
+void *srv_exp_save(srv_experiment *e, size_t *len)
+{
+	pthread_mutex_lock(&e->lock);
+	exp_record r;
+	record_of(e, &r);
+	size_t vec = e->rec_n * sizeof(double);
+	char *buf = malloc(sizeof r + 2 * vec);
+	if (buf) {
+		memcpy(buf, &r, sizeof r);
+		if (vec) {
+			memcpy(buf + sizeof r, e->rec_t, vec);
+			memcpy(buf + sizeof r + vec, e->rec_v, vec);
+		}
+		*len = sizeof r + 2 * vec;
+	}
+	pthread_mutex_unlock(&e->lock);
+	return buf;
+}
+
+int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
+{
+	exp_record r;
+	if (len < sizeof r)
+		return -1;
+	memcpy(&r, buf, sizeof r);
+	if (r.rec_n > EXP_RECORDS || len != sizeof r + 2 * r.rec_n * sizeof(double) ||
+	    r.state != EXP_RUNNING || r.cur < 0 || r.cur >= r.req.nseg ||
+	    r.req.nseg < 1 || r.req.nseg > API_EXP_MAX_SEGMENTS ||
+	    r.seg_first > r.rec_n)
+		return -1;
+	int rc = -1;
+	pthread_mutex_lock(&e->lock);
+	if (!e->rec_t) {
+		e->rec_t = malloc(EXP_RECORDS * sizeof(double));
+		e->rec_v = malloc(EXP_RECORDS * sizeof(double));
+	}
+	if (e->rec_t && e->rec_v) {
+		size_t vec = r.rec_n * sizeof(double);
+		const char *b = (const char *)buf + sizeof r;
+		memcpy(e->rec_t, b, vec);
+		memcpy(e->rec_v, b + vec, vec);
+		e->rec_cap = EXP_RECORDS;
+		e->rec_n = r.rec_n;
+		e->seg_first = r.seg_first;
+		e->rec_spacing = r.rec_spacing;
+		e->req = r.req;
+		e->state = EXP_RUNNING;
+		e->cur = r.cur;
+		e->t0 = r.t0;
+		e->t_now = r.t_now;
+		e->attached = 1;
+		e->error[0] = '\0';
+		rc = 0;
+	}
+	pthread_mutex_unlock(&e->lock);
+	return rc;
+}
+
+srv_experiment *srv_exp_load(const char *id, api_problem *pb)
+{
+	char path[64], why[256];
+	snprintf(path, sizeof path, "experiments/%s", id);
+	size_t len;
+	exp_record *r = srv_store_read(path, SRV_STORE_EXPERIMENT, &len, why,
+				       sizeof why);
+	if (r && (len != sizeof *r || r->state < 0 ||
+		  r->state >= EXP_NSTATES || r->req.nseg < 1 ||
+		  r->req.nseg > API_EXP_MAX_SEGMENTS)) {
+		free(r);
+		r = NULL;
+		snprintf(why, sizeof why, "%s: inconsistent", path);
+	}
+	if (!r) {
+		api_fail(pb, API_INVALID, NULL, "%s", why);
+		return NULL;
+	}
+	r->id[SRV_ID_LEN - 1] = r->session_id[SRV_ID_LEN - 1] = '\0';
+	r->error[sizeof r->error - 1] = '\0';
+	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, pb);
+	if (e) {
+		snprintf(e->entry.id, sizeof e->entry.id, "%s", r->id);
+		snprintf(e->session_id, sizeof e->session_id, "%s",
+			 r->session_id);
+		e->state = r->state;
+		e->cur = r->cur;
+		snprintf(e->error, sizeof e->error, "%s", r->error);
+		e->t0 = r->t0;
+		e->t_now = r->t_now;
+		e->attached = 0;
+		drop_record(e);
+	}
+	free(r);
+	return e;
+}
+
+int srv_exp_interrupt(srv_experiment *e)
+{
+	pthread_mutex_lock(&e->lock);
+	int hit = !e->attached &&
+		  (e->state == EXP_RUNNING || e->state == EXP_WAITING);
+	if (hit) {
+		e->state = EXP_INTERRUPTED;
+		snprintf(e->error, sizeof e->error,
+			 "the daemon stopped before it ended and its session "
+			 "could not resume it; the segments done are kept");
+		persist_locked(e);
+	}
+	pthread_mutex_unlock(&e->lock);
+	return hit;
+}
+
+/* The results file DIR/experiment-ID.json and the record (lock held). */
+static void save_results(srv_experiment *e)
 {
 	if (!e->data_dir)
 		return;
+	persist_locked(e);
 	api_experiment_view v;
 	fill_view(e, &v);
 	char *text = api_experiment_json(&v);
+	size_t n = text ? strlen(text) : 0;
+	char *file = text ? malloc(n + 1) : NULL;
 	char name[64];
 	snprintf(name, sizeof name, "experiment-%s.json", e->entry.id);
-	srv_write_file(e->data_dir, name, text, 1);
+	if (file) {
+		memcpy(file, text, n);
+		file[n] = '\n';
+		queue_write(e, name, file, n + 1);
+	}
 	free(text);
 }
 
@@ -275,6 +511,7 @@ static void abort_locked(srv_experiment *e, const char *why)
 	}
 	e->attached = 0;
 	drop_record(e);
+	persist_locked(e);
 }
 
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)

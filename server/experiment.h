@@ -28,6 +28,9 @@ void srv_exp_free(srv_experiment *e);
 srv_entry *srv_exp_entry(srv_experiment *e);
 srv_experiment *srv_exp_from_entry(srv_entry *en);
 const char *srv_exp_id(const srv_experiment *e);
+/* 1 when its session stays after the end (it was not created by the
+ * experiment, or keep_session was asked). */
+int srv_exp_keeps_session(const srv_experiment *e);
 /* Note the session it runs on. */
 void srv_exp_set_session(srv_experiment *e, const char *session_id);
 /* 1 when it is over and no worker refers to it (it may be evicted). */
@@ -55,5 +58,25 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over);
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd);
 /* The session ended before the experiment (deleted, failed, shutdown). */
 void srv_exp_abort(srv_experiment *e, const char *why);
+
+/* ---- persistence (store.h) ---------------------------------------------- */
+
+/* Queue experiments/ID.bin (at creation; the end writes it by itself). */
+void srv_exp_persist(srv_experiment *e);
+/* The running state (record and feed-velocity record) for the session's
+ * checkpoint: malloc'd, its length in *len; NULL when out of memory.
+ * Session lock held (the experiment's is taken inside). */
+void *srv_exp_save(srv_experiment *e, size_t *len);
+/* Continue from a running state srv_exp_save wrote: attached again. 0, or
+ * -1 when buf does not pass its checks (nothing changed). */
+int srv_exp_resume(srv_experiment *e, const void *buf, size_t len);
+/* An experiment from experiments/ID (a file name) as it was last written,
+ * not attached; NULL with *pb when the file does not pass its checks. */
+srv_experiment *srv_exp_load(const char *file, api_problem *pb);
+/* Still running but no session resumed it: "interrupted", its finished
+ * segments kept. Returns 1 if it was. */
+int srv_exp_interrupt(srv_experiment *e);
+/* A result or record could not be written: state "error" with what. */
+void srv_exp_write_failed(srv_experiment *e, const char *what);
 
 #endif

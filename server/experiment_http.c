@@ -9,11 +9,14 @@
  * session; the session's worker then runs it (experiment.c).
  */
 #include <stdlib.h>
+#include <string.h>
 
 #include "experiment.h"
 #include "experiment_http.h"
 #include "metrics.h"
 #include "session.h"
+#include "store.h"
+#include "util.h"
 
 static void destroy(srv_entry *en)
 {
@@ -37,6 +40,57 @@ void srv_experiments_shutdown(void)
 static int evictable(srv_entry *en)
 {
 	return srv_exp_finished(srv_exp_from_entry(en));
+}
+
+srv_experiment *srv_experiment_get(const char *id)
+{
+	srv_entry *en = srv_registry_get(&experiments, id);
+	return en ? srv_exp_from_entry(en) : NULL;
+}
+
+void srv_experiment_put(srv_experiment *e)
+{
+	if (e)
+		srv_registry_put(&experiments, srv_exp_entry(e));
+}
+
+size_t srv_experiments_restore(void)
+{
+	char **names = NULL;
+	size_t n = srv_store_enabled() ? srv_store_list("experiments", &names)
+				       : 0,
+	       count = 0;
+	for (size_t i = 0; i < n; i++) {
+		size_t l = strlen(names[i]);
+		api_problem pb;
+		srv_experiment *e = NULL;
+		if (l > 4 && strcmp(names[i] + l - 4, ".bin") == 0)
+			e = srv_exp_load(names[i], &pb);
+		if (e && srv_registry_reserve(&experiments, srv_exp_entry(e),
+					      evictable) == 0) {
+			srv_registry_publish(&experiments, srv_exp_entry(e));
+			srv_registry_put(&experiments, srv_exp_entry(e));
+			count++;
+		} else if (e) {
+			srv_exp_free(e);
+		} else if (l > 4 && strcmp(names[i] + l - 4, ".bin") == 0) {
+			srv_log(SRV_LOG_WARN, "experiment not restored: %s",
+				pb.detail);
+		}
+		free(names[i]);
+	}
+	free(names);
+	return count;
+}
+
+size_t srv_experiments_interrupt_orphans(void)
+{
+	srv_entry **all = NULL;
+	size_t n = srv_registry_snapshot(&experiments, &all), count = 0;
+	for (size_t i = 0; i < n; i++)
+		count += (size_t)srv_exp_interrupt(srv_exp_from_entry(all[i]));
+	srv_registry_release(&experiments, all, n);
+	return count;
 }
 
 /* Run e on a fresh session or attach it to the one it names; the session's
@@ -107,6 +161,7 @@ enum MHD_Result srv_h_experiments_create(srv_req *r)
 	}
 	free(req);
 	srv_registry_publish(&experiments, srv_exp_entry(e));
+	srv_exp_persist(e);
 	atomic_fetch_add(&srv_stats.experiments, 1);
 	res = srv_reply_created(r, 201, experiment_json(e, 0),
 				"/api/v1/experiments", srv_exp_id(e));

@@ -26,6 +26,7 @@
 #include "routes.h"
 #include "session.h"
 #include "static.h"
+#include "store.h"
 #include "stream.h"
 #include "sweep.h"
 #include "util.h"
@@ -79,6 +80,25 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_sessions_shutdown();
 	srv_experiments_shutdown();
 	srv_catalog_shutdown();
+	srv_store_close(); /* every queued write is on disk */
+}
+
+/* Rebuild what the data directory holds: experiments first (the sessions
+ * resume theirs), then sessions, then sweeps (on the pool). */
+static void restore_state(void)
+{
+	if (!srv_store_enabled())
+		return;
+	double t0 = srv_now();
+	size_t ne = srv_experiments_restore();
+	size_t ns = srv_sessions_restore(srv_experiment_get, srv_experiment_put);
+	size_t ni = srv_experiments_interrupt_orphans();
+	size_t nw = srv_sweeps_restore();
+	if (ne + ns + nw)
+		srv_log(SRV_LOG_INFO,
+			"restored %zu sessions, %zu experiments (%zu "
+			"interrupted), %zu sweeps in %.3f s",
+			ns, ne, ni, nw, srv_now() - t0);
 }
 
 int main(int argc, char **argv)
@@ -107,10 +127,13 @@ int main(int argc, char **argv)
 	srv_streams_init(&cfg);
 	srv_static_init(&cfg);
 	srv_routes_init(&cfg);
+	if (srv_store_open(&cfg))
+		return 1;
 	if (srv_pool_start(cfg.pool_threads)) {
 		fprintf(stderr, "convsimd: cannot start the worker pool\n");
 		return 1;
 	}
+	restore_state();
 	struct MHD_Daemon *d = MHD_start_daemon(
 		la.flags, (uint16_t)cfg.port, NULL, NULL, srv_dispatch, NULL,
 		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
@@ -134,8 +157,12 @@ int main(int argc, char **argv)
 	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max",
 		cfg.web_root, cfg.max_sessions, cfg.max_streams);
 
+	/* once a second: remove the sessions whose experiment ended and
+	 * those idle beyond --idle-timeout */
 	int sig = 0;
-	sigwait(&sigs, &sig);
+	struct timespec tick = {1, 0};
+	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0)
+		srv_sessions_reap(cfg.idle_timeout);
 	srv_log(SRV_LOG_INFO, "%s: shutting down",
 		sig == SIGINT ? "SIGINT" : "SIGTERM");
 	shut_down(d);

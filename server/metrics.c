@@ -63,6 +63,12 @@ char *srv_metrics_text(const srv_gauges *g)
 	       "Experiments started.", (double)srv_stats.experiments);
 	metric(f, "convsim_sweep_points_total", "counter",
 	       "Sweep points measured.", (double)srv_stats.sweep_points);
+	metric(f, "convsim_store_writes_total", "counter",
+	       "Files written to the data directory.",
+	       (double)srv_stats.store_writes);
+	metric(f, "convsim_store_errors_total", "counter",
+	       "Writes to the data directory that failed (ENOSPC, EIO, ...).",
+	       (double)srv_stats.store_errors);
 	metric(f, "convsim_pool_queued", "gauge",
 	       "Sweep jobs waiting for a pool thread.",
 	       g->pool_queued);

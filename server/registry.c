@@ -73,10 +73,11 @@ int srv_registry_reserve(srv_registry *reg, srv_entry *e,
 	pthread_mutex_lock(&reg->lock);
 	if (reg->count >= reg->cap)
 		dead = evict(reg, evictable, &room);
+	if (room && e->id[0] && find(reg, e->id))
+		room = 0; /* a restored id that is taken already */
 	if (room) {
-		do
+		while (!e->id[0] || find(reg, e->id))
 			srv_new_id(e->id);
-		while (find(reg, e->id));
 		e->refs = 0;
 		e->published = 0;
 		e->next = reg->head;

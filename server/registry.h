@@ -20,8 +20,9 @@
  *
  * A registry's lock is only held inside these functions: it is taken
  * before an object's lock only by the evictable test, and nothing takes it
- * while holding an object's lock. The pool's lock and the metrics are
- * leaves: nothing is taken under them.
+ * while holding an object's lock. The pool's lock, the store's queue lock
+ * (store.c) and the metrics are leaves: nothing is taken under them; the
+ * store's callbacks run with no store lock held and may take any.
  */
 #ifndef CONVSIM_REGISTRY_H
 #define CONVSIM_REGISTRY_H
@@ -56,8 +57,9 @@ typedef struct srv_registry {
 /* Start empty with room for cap entries. */
 void srv_registry_open(srv_registry *reg, size_t cap);
 
-/* Take a place for e (borrowed until published or cancelled): give it an
- * id no other entry has and count it against the cap. When the registry is
+/* Take a place for e (borrowed until published or cancelled): keep the
+ * id it has (an object restored from the data directory; -1 if another
+ * entry has it) or, when e->id is empty, give it an id no other entry has and count it against the cap. When the registry is
  * full, the oldest published entry that evictable accepts (called under
  * the registry lock; it may take the object's lock) is removed first;
  * evictable NULL never evicts. Returns 0, or -1 when full. */

@@ -10,6 +10,7 @@
  * leaves this file and worker.c. Lock order: see registry.h.
  */
 #include <errno.h>
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +19,7 @@
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
+#include "store.h"
 #include "util.h"
 
 static void destroy(srv_entry *en);
@@ -79,10 +81,14 @@ static void session_free(srv_session *s)
 	free(s->ring);
 	free(s->ring_store);
 	free(s->hist);
+	free(s->controls);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);
 	free(s);
+	/* a session's buffers are megabytes: give the pages back to the
+	 * system rather than keep them in the allocator (glibc) */
+	malloc_trim(0);
 }
 
 /* Tell the worker to stop and every waiter to look again. */
@@ -123,14 +129,8 @@ static int alloc_buffers(srv_session *s)
 	if (!s->ring || !s->ring_store || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
-	for (size_t i = 0; i < s->ring_cap; i++) {
-		api_sample *r = &s->ring[i];
-		r->columns = s->columns;
-		r->layers = s->layers;
-		r->column_disp = s->ring_store + i * per;
-		r->xi = r->column_disp + s->columns;
-		r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
-	}
+	/* the slots' array pointers are set when a slot is first written
+	 * (srv_ring_slot): megabytes of ring are not touched up front */
 	/* trajectory rows every whole number of sample intervals, at least
 	 * 0.01 s apart */
 	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
@@ -191,6 +191,9 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 	if (session_init(s, spec, pb))
 		goto fail;
 	s->exp = exp;
+	s->owned = exp && !srv_exp_keeps_session(exp);
+	s->last_access = s->ckpt_wall = srv_now();
+	s->ckpt_dirty = 1;
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
 		api_fail(pb, API_UNAVAILABLE, NULL,
 			 "cannot start the session's worker thread");
@@ -198,6 +201,7 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 	}
 	s->worker_started = 1;
 	srv_registry_publish(&sessions, &s->entry);
+	srv_persist_spec(s);
 	atomic_fetch_add(&srv_stats.sessions_created, 1);
 	srv_log(SRV_LOG_INFO, "session %s created", s->entry.id);
 	return s;
@@ -210,7 +214,44 @@ fail:
 srv_session *srv_session_get(const char *id)
 {
 	srv_entry *en = srv_registry_get(&sessions, id);
-	return en ? SRV_CONTAINER(en, srv_session, entry) : NULL;
+	if (!en)
+		return NULL;
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	pthread_mutex_lock(&s->lock);
+	s->last_access = srv_now();
+	pthread_mutex_unlock(&s->lock);
+	return s;
+}
+
+int srv_session_adopt(srv_session *s)
+{
+	s->last_access = s->ckpt_wall = srv_now();
+	if (s->damaged) {
+		s->state = SRV_FAILED;
+	} else {
+		sim_get_status(s->sim, &s->st);
+		if (s->spec.scene.feed) {
+			s->columns = sim_columns(s->sim);
+			s->layers = sim_layers(s->sim);
+		}
+	}
+	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
+		srv_log(SRV_LOG_WARN, "session %s not restored: --max-sessions "
+				      "reached or id taken", s->entry.id);
+		goto fail;
+	}
+	if (alloc_buffers(s)) {
+		srv_registry_cancel(&sessions, &s->entry);
+		goto fail;
+	}
+	srv_registry_publish(&sessions, &s->entry);
+	srv_registry_put(&sessions, &s->entry); /* the registry's stays */
+	return 0;
+fail:
+	if (s->exp)
+		srv_exp_abort(s->exp, "its session could not be restored");
+	session_free(s);
+	return -1;
 }
 
 void srv_session_put(srv_session *s)
@@ -219,29 +260,85 @@ void srv_session_put(srv_session *s)
 		srv_registry_put(&sessions, &s->entry);
 }
 
-void srv_session_delete(srv_session *s)
+/* Unlink s and stop its worker; its files go too unless the daemon
+ * stops (then they are what the next start restores). */
+static void remove_session(srv_session *s, int files)
 {
 	if (!srv_registry_remove(&sessions, &s->entry))
 		return;
 	stop_worker(s);
+	if (files)
+		srv_persist_remove(s); /* after the worker's last write */
 	atomic_fetch_add(&srv_stats.sessions_deleted, 1);
 	srv_log(SRV_LOG_INFO, "session %s deleted", s->entry.id);
 }
 
+void srv_session_delete(srv_session *s)
+{
+	remove_session(s, 1);
+}
+
 void srv_sessions_shutdown(void)
 {
-	/* stop all workers first (in parallel), then delete each */
+	/* stop all workers first (in parallel), then remove each */
 	for (;;) {
 		srv_session **all = NULL;
 		size_t n = srv_sessions_all(&all);
 		for (size_t i = 0; i < n; i++)
 			signal_stop(all[i]);
 		for (size_t i = 0; i < n; i++)
-			srv_session_delete(all[i]);
+			remove_session(all[i], 0);
 		srv_sessions_release(all, n);
 		if (n == 0)
 			break;
 	}
+}
+
+size_t srv_sessions_start_restored(void)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), started = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (s->damaged || s->worker_started)
+			continue;
+		if (pthread_create(&s->worker, NULL, srv_worker_main, s) == 0) {
+			s->worker_started = 1;
+			started++;
+		} else {
+			pthread_mutex_lock(&s->lock);
+			s->state = SRV_FAILED;
+			snprintf(s->error, sizeof s->error,
+				 "cannot start the session's worker thread");
+			pthread_mutex_unlock(&s->lock);
+		}
+	}
+	srv_sessions_release(all, n);
+	return started;
+}
+
+size_t srv_sessions_reap(double idle_timeout)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), reaped = 0;
+	double now = srv_now();
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		pthread_mutex_lock(&s->lock);
+		int idle = idle_timeout > 0 && s->streams == 0 && !s->exp &&
+			   now - s->last_access > idle_timeout;
+		int go = s->expire || idle;
+		pthread_mutex_unlock(&s->lock);
+		if (!go)
+			continue;
+		srv_log(SRV_LOG_INFO, "session %s %s", s->entry.id,
+			idle ? "expired (--idle-timeout)"
+			     : "removed: its experiment ended");
+		srv_session_delete(s);
+		reaped++;
+	}
+	srv_sessions_release(all, n);
+	return reaped;
 }
 
 /* ---- queries --------------------------------------------------------------- */
@@ -267,8 +364,12 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->columns = s->columns;
 	v->layers = s->layers;
 	pthread_mutex_lock(&s->lock);
-	v->state = state_name(s->state);
-	snprintf(v->error, sizeof v->error, "%s", s->error);
+	v->state = s->damaged ? "damaged"
+		   : s->store_error[0] && s->state != SRV_FAILED
+			   ? "error"
+			   : state_name(s->state);
+	snprintf(v->error, sizeof v->error, "%s",
+		 s->store_error[0] && !s->damaged ? s->store_error : s->error);
 	v->pace = s->pace;
 	v->until = s->until;
 	v->has_status = 1;

@@ -40,9 +40,20 @@ srv_session *srv_session_get(const char *id);
 /* Drop a reference; the last one stops the worker and frees the session.
  * NULL is accepted. */
 void srv_session_put(srv_session *s);
-/* Remove from the registry, stop the worker, end the streams. The caller
- * holds a reference (and still puts it). */
+/* Remove from the registry, stop the worker, end the streams, remove its
+ * files. The caller holds a reference (and still puts it). */
 void srv_session_delete(srv_session *s);
+/* Delete the sessions whose experiment ended (created by it, not kept)
+ * and, with idle_timeout > 0 (s), those with no stream client, no
+ * experiment and no request for that long. Returns how many. */
+size_t srv_sessions_reap(double idle_timeout);
+/* Rebuild the sessions of the data directory (session_store.c); the
+ * experiments must be restored first: find (a new reference by id, or
+ * NULL) and put give the running ones back to their sessions (passed in,
+ * so that sessions do not depend on the experiments' registry). Returns
+ * how many. */
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e));
 const char *srv_session_id(const srv_session *s);
 /* Fill a view (spec borrowed from s: keep the reference while using it). */
 void srv_session_view(srv_session *s, api_view *v);

@@ -44,6 +44,57 @@ struct srv_session {
 	srv_experiment *exp;
 	srv_cmd *exp_cmd;         /* the experiment's command while queued */
 	int exp_started;
+	/* lifetime and persistence (session_store.c) */
+	int damaged;              /* restored without a usable spec or
+				     checkpoint: listed, failed, no worker */
+	int owned;                /* created by an experiment that does not
+				     keep it: removed when it ends */
+	int expire;               /* remove at the next reap */
+	double last_access;       /* srv_now() of the last request */
+	char *controls;           /* every acknowledged control, one JSON
+				     line each (controls.ndjson) */
+	size_t controls_len, controls_cap;
+	double ckpt_wall;         /* srv_now() of the last checkpoint */
+	int ckpt_dirty;           /* a control or state change since */
+	char store_error[256];    /* the last failed write, "" */
 };
+
+/* Slot i of the ring with its arrays pointed into ring_store (set on
+ * every use, so that untouched slots cost no page). */
+static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
+{
+	size_t per = (size_t)s->columns +
+		     2 * (size_t)s->columns * (size_t)s->layers;
+	api_sample *r = &s->ring[i];
+	r->columns = s->columns;
+	r->layers = s->layers;
+	r->column_disp = s->ring_store + i * per;
+	r->xi = r->column_disp + s->columns;
+	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
+	return r;
+}
+
+/* ---- session_store.c: the session's files (store.h) ------------------ */
+
+/* Queue the spec file (at creation). */
+void srv_persist_spec(srv_session *s);
+/* Append an acknowledged control's event line and queue the controls
+ * file (worker, lock held). */
+void srv_persist_control(srv_session *s, const char *json);
+/* Queue a checkpoint now if one is due: the interval has passed, or the
+ * session stopped running with changes since the last one (worker, lock
+ * held, after the commands phase). */
+void srv_persist_checkpoint(srv_session *s, int force);
+/* Queue the removal of the session's files. */
+void srv_persist_remove(const srv_session *s);
+
+/* session.c: publish a session built by session_store.c: s has its
+ * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
+ * buffers are allocated here. 0 or -1 (s freed). Its worker starts with
+ * srv_sessions_start_restored, once every session is in. */
+int srv_session_adopt(srv_session *s);
+/* Start the workers of the adopted sessions. Returns how many. */
+size_t srv_sessions_start_restored(void);
+
 
 #endif

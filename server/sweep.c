@@ -18,6 +18,7 @@
 #include "metrics.h"
 #include "pool.h"
 #include "registry.h"
+#include "store.h"
 #include "sweep.h"
 #include "util.h"
 
@@ -29,6 +30,7 @@ typedef struct srv_sweep {
 	api_sweep_point *pt;
 	size_t total, done;
 	int running, cancelled;
+	char store_error[256];  /* a write failed: state "error" */
 } srv_sweep;
 
 typedef struct sweep_job {
@@ -68,6 +70,8 @@ static void destroy(srv_entry *en)
 
 static const char *sweep_state(const srv_sweep *sw)
 {
+	if (sw->store_error[0])
+		return "error";
 	if (sw->cancelled)
 		return "cancelled";
 	if (sw->done == sw->total)
@@ -79,23 +83,84 @@ static void fill_view(const srv_sweep *sw, api_sweep_view *v)
 {
 	snprintf(v->id, sizeof v->id, "%s", sw->entry.id);
 	v->state = sweep_state(sw);
+	v->error = sw->store_error;
 	v->total = sw->total;
 	v->done = sw->done;
 	v->t_end = sw->req.t_end;
 	v->pt = sw->pt;
 }
 
+/* ---- persistence (store.h) ---------------------------------------------
+ *
+ * sweeps/ID.bin: the record below, the betas and every point, written at
+ * creation, after each point and at a cancel (a pending write is replaced
+ * by the newer one); at the end, sweep-ID.csv. A restart serves finished
+ * sweeps again and queues the points that were pending or running. */
+typedef struct sweep_record {
+	char id[SRV_ID_LEN];
+	api_sweep_req req;     /* betas: NULL here, they follow */
+	uint64_t total, done;
+	int32_t cancelled, pad;
+} sweep_record;
+
+/* A write's outcome for sweep id (malloc'd, freed here). */
+static void written(void *arg, int err, const char *what)
+{
+	char *id = arg;
+	srv_entry *en = err ? srv_registry_get(&sweeps, id) : NULL;
+	free(id);
+	if (!en)
+		return;
+	srv_sweep *sw = sweep_of(en);
+	pthread_mutex_lock(&sw->lock);
+	snprintf(sw->store_error, sizeof sw->store_error, "%s", what);
+	pthread_mutex_unlock(&sw->lock);
+	srv_registry_put(&sweeps, en);
+}
+
+/* Queue sweeps/ID.bin (lock held). */
+static void persist_locked(const srv_sweep *sw)
+{
+	if (!srv_store_enabled())
+		return;
+	sweep_record r;
+	memset(&r, 0, sizeof r);
+	snprintf(r.id, sizeof r.id, "%s", sw->entry.id);
+	r.req = sw->req;
+	r.req.betas = NULL;
+	r.total = sw->total;
+	r.done = sw->done;
+	r.cancelled = sw->cancelled;
+	size_t nb = (size_t)sw->req.nbeta * sizeof *sw->req.betas,
+	       np = sw->total * sizeof *sw->pt;
+	char *p = malloc(sizeof r + nb + np);
+	if (!p)
+		return;
+	memcpy(p, &r, sizeof r);
+	memcpy(p + sizeof r, sw->req.betas, nb);
+	memcpy(p + sizeof r + nb, sw->pt, np);
+	size_t len;
+	void *buf = srv_store_frame(SRV_STORE_SWEEP, p, sizeof r + nb + np, &len);
+	free(p);
+	char path[64];
+	snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
+	if (buf)
+		srv_store_write(path, buf, len, 0, written, strdup(sw->entry.id));
+}
+
+/* The CSV result (lock held). */
 static void save_results(const srv_sweep *sw)
 {
-	if (!cfg->data_dir)
+	if (!srv_store_enabled())
 		return;
 	api_sweep_view v;
 	fill_view(sw, &v);
 	char *text = api_sweep_csv(&v);
 	char name[64];
 	snprintf(name, sizeof name, "sweep-%s.csv", sw->entry.id);
-	srv_write_file(cfg->data_dir, name, text, 0);
-	free(text);
+	if (text)
+		srv_store_write(name, text, strlen(text), 0, written,
+				strdup(sw->entry.id));
 }
 
 static void run_point(void *arg)
@@ -134,11 +199,94 @@ static void run_point(void *arg)
 		}
 		sw->done++;
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
+		persist_locked(sw);
 		if (sw->done == sw->total)
 			save_results(sw);
 		pthread_mutex_unlock(&sw->lock);
 	}
 	srv_registry_put(&sweeps, &sw->entry);
+}
+
+size_t srv_sweeps_restore(void)
+{
+	char **names = NULL;
+	size_t n = srv_store_enabled() ? srv_store_list("sweeps", &names) : 0,
+	       count = 0;
+	for (size_t i = 0; i < n; i++) {
+		char path[300], why[300];
+		snprintf(path, sizeof path, "sweeps/%s", names[i]);
+		free(names[i]);
+		size_t l = strlen(path), len = 0;
+		char *p = l > 4 && strcmp(path + l - 4, ".bin") == 0
+				  ? srv_store_read(path, SRV_STORE_SWEEP, &len,
+						   why, sizeof why)
+				  : NULL;
+		sweep_record r;
+		size_t nb = 0, np = 0;
+		int ok = p && len >= sizeof r;
+		if (ok) {
+			memcpy(&r, p, sizeof r);
+			nb = (size_t)r.req.nbeta * sizeof(api_value);
+			np = r.total * sizeof(api_sweep_point);
+			ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
+			     r.total <= API_SWEEP_MAX_POINTS &&
+			     len == sizeof r + nb + np;
+		}
+		srv_sweep *sw = ok ? calloc(1, sizeof *sw) : NULL;
+		if (sw) {
+			pthread_mutex_init(&sw->lock, NULL);
+			sw->req = r.req;
+			sw->req.betas = malloc(nb ? nb : 1);
+			sw->pt = malloc(np ? np : 1);
+			r.id[SRV_ID_LEN - 1] = '\0';
+			snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
+		}
+		if (sw && sw->req.betas && sw->pt) {
+			memcpy(sw->req.betas, p + sizeof r, nb);
+			memcpy(sw->pt, p + sizeof r + nb, np);
+			sw->total = r.total;
+			sw->cancelled = r.cancelled;
+			sw->done = 0;
+			for (size_t k = 0; k < sw->total; k++) {
+				if (sw->pt[k].state == 1) /* was running */
+					sw->pt[k].state = 0;
+				sw->done += sw->pt[k].state >= 2;
+			}
+			if (srv_registry_reserve(&sweeps, &sw->entry, NULL) == 0) {
+				srv_registry_publish(&sweeps, &sw->entry);
+				pthread_mutex_lock(&sw->lock);
+				size_t refs = 0;
+				for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
+					if (sw->pt[k].state != 0)
+						continue;
+					sweep_job *job = malloc(sizeof *job);
+					if (!job)
+						continue;
+					job->sw = sw;
+					job->i = k;
+					srv_registry_hold(&sweeps, &sw->entry);
+					if (srv_pool_submit(run_point, job) != 0) {
+						free(job);
+						refs++;
+					}
+				}
+				pthread_mutex_unlock(&sw->lock);
+				for (size_t k = 0; k < refs; k++)
+					srv_registry_put(&sweeps, &sw->entry);
+				srv_registry_put(&sweeps, &sw->entry);
+				count++;
+				sw = NULL;
+			}
+		} else if (!ok && p) {
+			snprintf(why, sizeof why, "%.200s: inconsistent", path);
+		}
+		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0)
+			srv_log(SRV_LOG_WARN, "sweep not restored: %s", why);
+		sweep_free(sw);
+		free(p);
+	}
+	free(names);
+	return count;
 }
 
 void srv_sweeps_shutdown(void)
@@ -230,6 +378,7 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */
 	/* jobs wait for the lock: the answer shows the sweep as queued */
 	pthread_mutex_lock(&sw->lock);
+	persist_locked(sw);
 	size_t unused = submit_points(sw);
 	api_sweep_view v;
 	fill_view(sw, &v);
@@ -289,7 +438,14 @@ enum MHD_Result srv_h_sweep_delete(srv_req *r)
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
 	pthread_mutex_unlock(&sw->lock);
-	srv_registry_remove(&sweeps, en);
+	if (srv_registry_remove(&sweeps, en) && srv_store_enabled()) {
+		/* the record and the result go with it */
+		char path[64];
+		snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
+		srv_store_remove(path);
+		snprintf(path, sizeof path, "sweep-%s.csv", sw->entry.id);
+		srv_store_remove(path);
+	}
 	srv_registry_put(&sweeps, en);
 	return srv_reply_empty(r);
 }

@@ -10,6 +10,9 @@
 /* Start with an empty registry; cfg (borrowed for the daemon's life) gives
  * --max-sweeps and --data-dir. */
 void srv_sweeps_init(const srv_config *cfg);
+/* Rebuild the sweeps of the data directory (after the pool started):
+ * finished ones are served again, pending points are queued. How many. */
+size_t srv_sweeps_restore(void);
 /* Free every sweep (after the pool has stopped). */
 void srv_sweeps_shutdown(void);
 

@@ -1,7 +1,6 @@
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
- * clocks, timed-wait deadlines, random ids, the stopping flag and result
- * files.
+ * clocks, timed-wait deadlines, random ids and the stopping flag.
  */
 #include <fcntl.h>
 #include <stdarg.h>
@@ -87,20 +86,4 @@ int srv_stopping(void)
 void srv_stop(void)
 {
 	atomic_store(&stopping, 1);
-}
-
-void srv_write_file(const char *dir, const char *name, const char *text,
-		    int newline)
-{
-	char path[4096];
-	snprintf(path, sizeof path, "%s/%s", dir, name);
-	FILE *f = text ? fopen(path, "w") : NULL;
-	if (f) {
-		fputs(text, f);
-		if (newline)
-			fputc('\n', f);
-		fclose(f);
-	} else {
-		srv_log(SRV_LOG_WARN, "cannot write %s", path);
-	}
 }

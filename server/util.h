@@ -1,8 +1,7 @@
 /*
  * util.h - small services every part of the daemon uses: levelled logging
  * to stderr, clocks, timed-wait deadlines, random ids, the daemon's
- * "stopping" flag and writing a result file. A leaf: it uses nothing else
- * of server/.
+ * "stopping" flag. A leaf: it uses nothing else of server/.
  */
 #ifndef CONVSIM_UTIL_H
 #define CONVSIM_UTIL_H
@@ -29,10 +28,5 @@ struct timespec srv_deadline(double seconds);
  * pool jobs return at once, the API answers 503. */
 int srv_stopping(void);
 void srv_stop(void);
-
-/* Write text (borrowed; NULL counts as a failure) to dir/name, with a final
- * newline when newline is set; a warning is logged when that fails. */
-void srv_write_file(const char *dir, const char *name, const char *text,
-		    int newline);
 
 #endif

@@ -8,7 +8,12 @@
  *   job start   an experiment attached since the last turn begins: its first
  *               segment's command joins the queue
  *   commands    queued controls (PATCH, experiment segments) are applied in
- *               order and acknowledged, reading sim_effective_time()
+ *               order and acknowledged, reading sim_effective_time(); each
+ *               is appended to the session's control log
+ *   checkpoint  with --data-dir, every --checkpoint-interval of wall time
+ *               (and before going idle after a change) the session's
+ *               state is serialised and handed to the store's writer
+ *               (session_store.c); no file is touched here
  *   until       a running session that reached "until" finishes
  *   idle        a session that is not running sleeps until woken
  *   pacing      simulated time is held to pace x wall time (no catching up
@@ -81,7 +86,7 @@ int srv_worker_unqueue(srv_session *s, srv_cmd *cmd)
 
 static api_sample *push_slot(srv_session *s)
 {
-	api_sample *slot = &s->ring[s->head % s->ring_cap];
+	api_sample *slot = srv_ring_slot(s, s->head % s->ring_cap);
 	slot->index = s->head++;
 	return slot;
 }
@@ -264,6 +269,8 @@ static int apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
 			push_event(s, "control", json);
+			srv_persist_control(s, json);
+			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
 		cmd->t_eff = t_eff;
@@ -318,6 +325,7 @@ static void check_until(srv_session *s)
 {
 	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
 		s->state = SRV_FINISHED;
+		s->ckpt_dirty = 1;
 		push_event_reason(s, "finished", NULL);
 		pthread_cond_broadcast(&s->data);
 	}
@@ -329,6 +337,7 @@ static int idle(srv_session *s, clocks *c)
 	if (s->state == SRV_RUNNING)
 		return 0;
 	s->steps_per_s = s->rtf = 0;
+	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	pthread_cond_wait(&s->wake, &s->lock);
 	restart_clocks(c, s);
 	return 1;
@@ -379,14 +388,21 @@ static void run_job(srv_session *s)
 		return;
 	int over = 0;
 	queue_experiment_command(s, srv_exp_step(s->exp, &s->st, &over));
-	if (over)
+	if (over) {
 		detach_experiment(s, NULL);
+		s->ckpt_dirty = 1;
+		if (s->owned) /* created by it and not kept */
+			s->expire = 1;
+	}
 }
 
 /* failure: the core refused to go on; the session fails for good. */
 static void fail(srv_session *s, int rc)
 {
 	s->state = SRV_FAILED;
+	s->ckpt_dirty = 1;
+	if (s->owned)
+		s->expire = 1;
 	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
 		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
 	push_event_reason(s, "failed", NULL);
@@ -423,6 +439,7 @@ void *srv_worker_main(void *arg)
 		run_commands(s, &clk);
 		if (s->stop)
 			break;
+		srv_persist_checkpoint(s, 0);
 		check_until(s);
 		if (idle(s, &clk))
 			continue;
@@ -435,6 +452,10 @@ void *srv_worker_main(void *arg)
 			fail(s, rc);
 		meter(s, &clk);
 		pthread_cond_broadcast(&s->data);
+	}
+	if (srv_stopping()) { /* the next start continues from here */
+		s->ckpt_dirty = 1;
+		srv_persist_checkpoint(s, 1);
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
 	pthread_cond_broadcast(&s->data);

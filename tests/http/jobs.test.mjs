@@ -4,7 +4,7 @@
 // velocity is checked against the converged reference (sessions.test.mjs).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startDaemon, req, until, near, CHEAP, NO_FEED, SLOW } from './lib.mjs';
@@ -51,7 +51,9 @@ test('experiment on a fresh session: 38 -> 128 deg reverses the feed', { timeout
   assert.equal(s.body.experiment, null);
   const list = await req(d.base, 'GET', '/api/v1/experiments');
   assert.ok(list.body.experiments.some((e) => e.id === r.body.id));
-  await req(d.base, 'DELETE', `/api/v1/sessions/${done.session}`);
+  // the session it created goes within a second of the end (no keep_session)
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${done.session}`)).status === 404,
+    3000, 'the experiment\'s session to be removed');
 });
 
 test('experiment on an existing session; a second one is 409', { timeout: 60000 * SLOW }, async () => {
@@ -171,6 +173,7 @@ test('experiment at a clockwise peak: the segment\'s mean velocity, its error ba
   const r = await req(d.base, 'POST', '/api/v1/experiments', {
     session: { params: { beta: 30 } },
     schedule: [{ beta: 30, until: 4 }],
+    keep_session: true,
   });
   assert.equal(r.status, 201, r.text);
   assert.equal(r.body.segments[0].uncertainty, null);
@@ -185,6 +188,9 @@ test('experiment at a clockwise peak: the segment\'s mean velocity, its error ba
   near(seg.mean_velocity, vRef, 0.01 * vRef, 'mean_velocity against 1 % of v_ref');
   near(seg.mean_velocity, vRef, seg.uncertainty, 'mean_velocity against its error bar');
   assert.equal(seg.steady, true);
+  // keep_session: the session stays after the end
+  await new Promise((res) => setTimeout(res, 1500));
+  assert.equal((await req(d.base, 'GET', `/api/v1/sessions/${done.session}`)).status, 200);
   await req(d.base, 'DELETE', `/api/v1/sessions/${done.session}`);
 });
 
@@ -208,6 +214,9 @@ test('--data-dir keeps finished sweeps and experiments', { timeout: 60000 * SLOW
     const ex = await req(dd.base, 'POST', '/api/v1/experiments', { session: { ...NO_FEED }, schedule: [{ beta: 50, until: 0.2 }] });
     await until(async () => (await req(dd.base, 'GET', `/api/v1/sweeps/${sw.body.id}`)).body.state === 'done', 20000, 'sweep');
     await until(async () => (await req(dd.base, 'GET', `/api/v1/experiments/${ex.body.id}`)).body.state === 'done', 20000, 'experiment');
+    // results are written by the store's writer, just after the state says done
+    await until(() => existsSync(join(dir, `sweep-${sw.body.id}.csv`)) &&
+      existsSync(join(dir, `experiment-${ex.body.id}.json`)), 5000, 'the result files');
     const csv = readFileSync(join(dir, `sweep-${sw.body.id}.csv`), 'utf8').trim().split('\n');
     assert.equal(csv.length, 3);
     assert.equal(csv[1].split(',')[0], '20');

@@ -15,9 +15,13 @@ export const WEB_ROOT = fileURLToPath(new URL('../../web', import.meta.url));
 export const CHEAP = { scene: { drive: 'ideal', columns: 1, layers: 2 } };
 export const NO_FEED = { scene: { drive: 'ideal', feed: false } };
 
-export async function startDaemon(args = []) {
-  const proc = spawn(BIN, ['--port', '0', '--log-level', 'warn',
-    '--web-root', WEB_ROOT, ...args], { stdio: ['ignore', 'pipe', 'pipe'] });
+// opts.wrap: a command the daemon is started under (its arguments follow),
+// opts.tail: arguments after the usual ones (persistence.test.mjs).
+export async function startDaemon(args = [], opts = {}) {
+  const daemonArgs = ['--port', '0', '--log-level', 'warn', '--web-root', WEB_ROOT,
+    ...args, ...(opts.tail || [])];
+  const [cmd, ...pre] = opts.wrap ? opts.wrap : [BIN];
+  const proc = spawn(cmd, [...pre, ...daemonArgs], { stdio: ['ignore', 'pipe', 'pipe'] });
   let stderr = '';
   proc.stderr.on('data', (d) => { stderr += d; });
   const exited = new Promise((resolve) => proc.on('exit', (code, sig) => resolve({ code, sig })));

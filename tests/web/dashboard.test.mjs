@@ -305,15 +305,19 @@ test('a β-change experiment reports its reversal time', async () => {
 	await page.uncheck('#experiment-form input[name="watch"]');
 	/* the experiment's fresh session takes the form's start: the run-up */
 	await page.selectOption('select[name="scene_start"]', 'rest');
+	/* the start is checked in the request the dashboard sends (which also
+	 * keeps the experiment's session for its plot and trajectory) */
+	const posted = page.waitForRequest(r => r.url().endsWith('/api/v1/experiments') && r.method() === 'POST');
 	await page.click('#experiment-run');
+	const sent = JSON.parse((await posted).postData());
+	assert.equal(sent.session.scene.start, 'rest');
+	assert.equal(sent.keep_session, true);
 	const shown = await until(async () => {
 		const t = await page.$eval('#reversal-time', e => e.textContent);
 		return /^\d+\.\d{3} s$/.test(t) ? t : null;
 	}, 60000, 'a reversal time');
 	assert.ok(Number.parseFloat(shown) > 0);
 	assert.ok(await count('#plot-experiment') > 0);
-	const [exp] = (await apiGet('/api/v1/experiments')).experiments;
-	assert.equal((await apiGet(`/api/v1/sessions/${exp.session}`)).spec.scene.start, 'rest');
 	const table = await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[4].textContent));
 	assert.ok(table.every(t => /^[+-]?\d\.\d{3} ± \d\.\d{3}/.test(t)), `mean v ± u: ${table}`);
 	/* its downloads: the segments and the session's trajectory */

@@ -125,6 +125,7 @@ test('request bodies follow the API request shapes', () => {
 	assert.deepEqual(ex.schedule, [{ beta: 38, until: 3 }, { beta: 128, until: 6 }]);
 	assert.equal(ex.session.params.beta, 38);
 	assert.equal(ex.session.pace, undefined);
+	assert.equal(ex.keep_session, true, 'the page plots the session after the end');
 	assert.equal(api.streamQuery(), 'fields=trough%2Corbit%2Crotor%2Celiminators%2Cfeed');
 });
 

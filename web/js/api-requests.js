@@ -41,7 +41,8 @@ export function sweepRequest(f) {
 
 /* POST /experiments: a fresh session from the form's model (the daemon
  * runs it at pace "max" unless told otherwise) and the schedule beta1
- * until tSwitch, then beta2 until tEnd. */
+ * until tSwitch, then beta2 until tEnd. The session is kept after the
+ * end (keep_session): the page plots and offers its trajectory. */
 export function experimentRequest(f) {
 	const session = sessionRequest({ ...f, beta: f.beta1 });
 	session.scene.feed = true;
@@ -50,6 +51,7 @@ export function experimentRequest(f) {
 	const body = {
 		session,
 		schedule: [{ beta: f.beta1, until: f.tSwitch }, { beta: f.beta2, until: f.tEnd }],
+		keep_session: true,
 	};
 	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.beta_rate = f.betaRate;
 	return body;

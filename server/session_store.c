@@ -1,0 +1,315 @@
+/*
+ * session_store.c - a session's files in the data directory and the
+ * sessions rebuilt from them at start-up (README "Persistence").
+ *
+ *   sessions/ID/spec.bin         the spec as created (framed, store.h)
+ *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
+ *                                object a line with t_effective (s)
+ *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
+ *                                until, the attached experiment's state
+ *                                and the core's checkpoint (sim.h); the
+ *                                one before it as checkpoint.bin.prev
+ *
+ * Everything is written by the store's writer (store.c); the worker only
+ * serialises, between steps, with the session lock held. A restore never
+ * fails the daemon: a checkpoint that does not pass its checks falls back
+ * to the previous one; a session whose spec or both checkpoints are
+ * unusable is listed as "damaged" with the reason; a session with a spec
+ * and no checkpoint yet starts again from its spec.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "experiment.h"
+#include "metrics.h"
+#include "session_int.h"
+#include "store.h"
+#include "util.h"
+
+/* sessions/ID/spec.bin */
+typedef struct spec_record {
+	char id[SRV_ID_LEN];
+	api_spec spec;
+	double created;
+	int32_t owned, pad;
+} spec_record;
+
+/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
+ * the core's checkpoint (sim_len bytes) follow. */
+typedef struct ckpt_record {
+	int32_t state, exp_started;
+	double pace, until;
+	char error[256];
+	char exp_id[SRV_ID_LEN];
+	uint64_t exp_len, sim_len;
+} ckpt_record;
+
+static void session_dir(char *out, size_t len, const char *id,
+			const char *file)
+{
+	snprintf(out, len, "sessions/%s%s%s", id, file ? "/" : "",
+		 file ? file : "");
+}
+
+/* A write's outcome for session id (malloc'd, freed here): a failure puts
+ * the session in state "error" with the reason; a later success clears
+ * it. */
+static void written(void *arg, int err, const char *what)
+{
+	char *id = arg;
+	srv_session *s = srv_session_get(id);
+	free(id);
+	if (!s)
+		return;
+	pthread_mutex_lock(&s->lock);
+	if (err)
+		snprintf(s->store_error, sizeof s->store_error, "%s", what);
+	else if (what && what[0] == '\0' && s->store_error[0])
+		s->store_error[0] = '\0';
+	pthread_mutex_unlock(&s->lock);
+	srv_session_put(s);
+}
+
+static void queue(const srv_session *s, const char *file, void *buf,
+		  size_t len, int keep_prev)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, file);
+	srv_store_write(path, buf, len, keep_prev, written,
+			strdup(s->entry.id));
+}
+
+void srv_persist_spec(srv_session *s)
+{
+	if (!srv_store_enabled() || s->damaged)
+		return;
+	spec_record r;
+	memset(&r, 0, sizeof r);
+	snprintf(r.id, sizeof r.id, "%s", s->entry.id);
+	r.spec = s->spec;
+	r.created = s->created;
+	r.owned = s->owned;
+	size_t len;
+	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
+	if (buf)
+		queue(s, "spec.bin", buf, len, 0);
+}
+
+void srv_persist_control(srv_session *s, const char *json)
+{
+	if (!srv_store_enabled())
+		return;
+	size_t add = strlen(json) + 1;
+	if (s->controls_len + add + 1 > s->controls_cap) {
+		size_t cap = s->controls_cap ? 2 * s->controls_cap : 4096;
+		while (cap < s->controls_len + add + 1)
+			cap *= 2;
+		char *nc = realloc(s->controls, cap);
+		if (!nc)
+			return;
+		s->controls = nc;
+		s->controls_cap = cap;
+	}
+	memcpy(s->controls + s->controls_len, json, add - 1);
+	s->controls_len += add;
+	s->controls[s->controls_len - 1] = '\n';
+	char *copy = malloc(s->controls_len ? s->controls_len : 1);
+	if (!copy)
+		return;
+	memcpy(copy, s->controls, s->controls_len);
+	queue(s, "controls.ndjson", copy, s->controls_len, 0);
+}
+
+void srv_persist_checkpoint(srv_session *s, int force)
+{
+	if (!srv_store_enabled() || !s->sim)
+		return;
+	double now = srv_now();
+	int due = now - s->ckpt_wall >= srv_store_interval() &&
+		  (s->state == SRV_RUNNING || s->ckpt_dirty);
+	if (!due && !(force && s->ckpt_dirty))
+		return;
+	ckpt_record r;
+	memset(&r, 0, sizeof r);
+	r.state = s->state;
+	r.pace = s->pace;
+	r.until = s->until;
+	snprintf(r.error, sizeof r.error, "%s", s->error);
+	void *exp = NULL;
+	if (s->exp && s->exp_started) {
+		size_t n = 0;
+		exp = srv_exp_save(s->exp, &n);
+		r.exp_len = exp ? n : 0;
+		r.exp_started = 1;
+		snprintf(r.exp_id, sizeof r.exp_id, "%s", srv_exp_id(s->exp));
+	}
+	r.sim_len = sim_checkpoint_size(s->sim);
+	size_t plen = sizeof r + r.exp_len + r.sim_len;
+	char *payload = malloc(plen);
+	if (payload) {
+		memcpy(payload, &r, sizeof r);
+		if (r.exp_len)
+			memcpy(payload + sizeof r, exp, r.exp_len);
+		sim_checkpoint(s->sim, payload + sizeof r + r.exp_len,
+			       r.sim_len);
+		size_t len;
+		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
+					    &len);
+		if (buf)
+			queue(s, "checkpoint.bin", buf, len, 1);
+	}
+	free(payload);
+	free(exp);
+	s->ckpt_wall = now;
+	s->ckpt_dirty = 0;
+}
+
+void srv_persist_remove(const srv_session *s)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, NULL);
+	srv_store_remove(path);
+}
+
+/* ---- restore ------------------------------------------------------------ */
+
+/* The checkpoint of s from file (relative): restores s->sim, run state and
+ * the experiment; 0, or -1 with why. */
+/* The experiments' registry, for the restore (srv_sessions_restore). */
+static srv_experiment *(*exp_find)(const char *id);
+static void (*exp_put)(srv_experiment *e);
+
+static int load_checkpoint(srv_session *s, const char *file, char *why,
+			   size_t whylen)
+{
+	size_t len;
+	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
+	if (!p)
+		return -1;
+	ckpt_record r;
+	int rc = -1;
+	if (len < sizeof r) {
+		snprintf(why, whylen, "%s: cut off", file);
+		goto done;
+	}
+	memcpy(&r, p, sizeof r);
+	if (r.exp_len > len || r.sim_len != len - sizeof r - r.exp_len ||
+	    r.state < SRV_RUNNING || r.state > SRV_FAILED) {
+		snprintf(why, whylen, "%s: inconsistent lengths or state", file);
+		goto done;
+	}
+	char msg[256] = "";
+	int err;
+	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
+			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
+			      sizeof msg);
+	if (!sm) {
+		snprintf(why, whylen, "%s: %s", file, msg);
+		goto done;
+	}
+	sim_free(s->sim);
+	s->sim = sm;
+	s->state = r.state;
+	s->pace = r.pace;
+	s->until = r.until;
+	r.error[sizeof r.error - 1] = '\0';
+	snprintf(s->error, sizeof s->error, "%s", r.error);
+	if (r.exp_started && r.exp_len) {
+		r.exp_id[SRV_ID_LEN - 1] = '\0';
+		srv_experiment *e = exp_find(r.exp_id);
+		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
+			s->exp = e;
+			s->exp_started = 1;
+		}
+		if (e)
+			exp_put(e); /* the registry keeps it */
+	}
+	rc = 0;
+done:
+	free(p);
+	return rc;
+}
+
+/* Build session id from its files into s (calloc'd, lock initialised). */
+static void restore_one(srv_session *s, const char *id)
+{
+	char path[128], why[512] = "", why2[512] = "";
+	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
+	s->created = srv_unix_time();
+	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
+	session_dir(path, sizeof path, id, "spec.bin");
+	size_t len;
+	spec_record *r = srv_store_read(path, SRV_STORE_SESSION, &len, why,
+					sizeof why);
+	if (r && len != sizeof *r) {
+		snprintf(why, sizeof why, "%s: of another size", path);
+		free(r);
+		r = NULL;
+	}
+	if (!r) {
+		s->damaged = 1;
+		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
+		return;
+	}
+	s->spec = r->spec;
+	s->created = r->created;
+	s->owned = r->owned;
+	free(r);
+	s->pace = s->spec.pace;
+	s->until = s->spec.until;
+	s->state = SRV_RUNNING;
+	session_dir(path, sizeof path, id, "checkpoint.bin");
+	if (load_checkpoint(s, path, why, sizeof why) == 0)
+		return;
+	char prev[160];
+	snprintf(prev, sizeof prev, "%s.prev", path);
+	if (load_checkpoint(s, prev, why2, sizeof why2) == 0) {
+		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
+				      "previous checkpoint", id, why);
+		return;
+	}
+	int none = strstr(why, "missing") && strstr(why2, "missing");
+	if (none) { /* created less than one interval before the crash */
+		char msg[256] = "";
+		int err;
+		s->sim = sim_new(&s->spec.params, &s->spec.scene,
+				 &s->spec.method, &err, msg, sizeof msg);
+		if (s->sim)
+			return;
+		snprintf(why, sizeof why, "its spec is refused: %s", msg);
+	}
+	s->damaged = 1;
+	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
+}
+
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e))
+{
+	if (!srv_store_enabled())
+		return 0;
+	exp_find = find;
+	exp_put = put;
+	char **names = NULL;
+	size_t n = srv_store_list("sessions", &names), count = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = calloc(1, sizeof *s);
+		if (s) {
+			pthread_mutex_init(&s->lock, NULL);
+			pthread_cond_init(&s->wake, NULL);
+			pthread_cond_init(&s->data, NULL);
+			restore_one(s, names[i]);
+			if (s->damaged)
+				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
+					s->error);
+			if (srv_session_adopt(s) == 0)
+				count++;
+		}
+		free(names[i]);
+	}
+	free(names);
+	/* all in first: the restore does not compete with running workers */
+	srv_sessions_start_restored();
+	return count;
+}

@@ -1,0 +1,84 @@
+/*
+ * store.h - the daemon's state on disk (--data-dir): one writer thread
+ * that writes every file as temporary file -> fsync -> rename -> fsync of
+ * the directory, and the framed binary files it reads back at start-up.
+ *
+ * Nothing else writes under the data directory. Callers hand a finished
+ * buffer to the writer (srv_store_write) and go on: no caller waits for a
+ * disk, none writes on a worker's step path or under a registry lock. A
+ * pending write to the same path is replaced by a newer one (a checkpoint
+ * that could not be written in time is superseded, never queued twice).
+ * The outcome of each write comes back through its callback, on the
+ * writer thread with no lock held: 0, or the errno (ENOSPC, EIO, EACCES,
+ * ...) with a sentence naming the file; failures are logged and counted
+ * (convsim_store_errors_total).
+ *
+ * Framed files: a header (magic "CVSF", format version, kind, payload
+ * length, FNV-1a 64 checksum of the payload, sim_checksum) and the payload. Reading one
+ * checks all of it and says what is wrong.
+ *
+ * Lock order: the store's queue lock is a leaf (registry.h): callbacks run
+ * after it is released.
+ */
+#ifndef CONVSIM_STORE_H
+#define CONVSIM_STORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "config.h"
+
+#define SRV_STORE_VERSION 1
+
+/* Kinds of framed files. */
+enum {
+	SRV_STORE_SESSION = 1,    /* sessions/ID/spec.bin */
+	SRV_STORE_CHECKPOINT = 2, /* sessions/ID/checkpoint.bin (+ .prev) */
+	SRV_STORE_EXPERIMENT = 3, /* experiments/ID.bin */
+	SRV_STORE_SWEEP = 4,      /* sweeps/ID.bin */
+};
+
+/* Called on the writer thread after a write: err 0 or an errno, what a
+ * sentence naming the file and the failed step. */
+typedef void (*srv_store_done)(void *arg, int err, const char *what);
+
+/* Start the writer on cfg->data_dir (nothing when it is NULL) and create
+ * its sub-directories. 0, or -1 with a message on stderr. */
+int srv_store_open(const srv_config *cfg);
+/* Finish every queued write and stop the writer. */
+void srv_store_close(void);
+/* 1 when a data directory is in use. */
+int srv_store_enabled(void);
+/* --checkpoint-interval, s of wall time. */
+double srv_store_interval(void);
+
+/* Queue a write of buf (len bytes; ownership taken, freed after the
+ * write) to path (relative to the data directory, parent directories
+ * created). keep_prev: the file it replaces is kept as path.prev. done
+ * (may be NULL) is called once, always on the writer thread (the caller
+ * may hold locks it takes), with the outcome, also when superseded (err
+ * 0, what ""). Callers check srv_store_enabled() first: with the store
+ * off, or out of memory, buf is freed and done is never called. */
+void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
+		     srv_store_done done, void *arg);
+/* Queue the removal of path (a file, or a directory and what it holds),
+ * after every write queued before it. */
+void srv_store_remove(const char *path);
+
+/* A framed file of kind around payload (borrowed): malloc'd, its length
+ * in *len; NULL when out of memory. */
+void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
+		      size_t *len);
+/* Read path (relative) as a framed file of kind: the payload (malloc'd,
+ * caller frees) and its length, or NULL with the reason in why (missing,
+ * cut off, checksum, unknown version, ...). */
+void *srv_store_read(const char *path, uint32_t kind, size_t *len, char *why,
+		     size_t whylen);
+/* Read a whole plain file (relative path); malloc'd with a final NUL,
+ * NULL if missing. */
+char *srv_store_read_text(const char *path, size_t *len);
+/* Entries of a directory (relative path), malloc'd array of malloc'd
+ * names (free each and the array); the count, 0 if none. */
+size_t srv_store_list(const char *path, char ***names);
+
+#endif

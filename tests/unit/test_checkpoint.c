@@ -1,0 +1,209 @@
+/*
+ * test_checkpoint.c - checkpoints of an instance (core/checkpoint.c):
+ * a restored instance continues bit for bit as the uninterrupted one, for
+ * every integrator, across a beta ramp in progress, a rotation change and
+ * an estimator restart; a damaged buffer (cut off anywhere, any bit
+ * flipped, another version, another model) is refused with
+ * SIM_ECHECKPOINT and never crashes.
+ */
+#include "testutil.h"
+
+/* Status and feed of an instance, compared bytewise. */
+static void assert_same(const sim *a, const sim *b)
+{
+	sim_status sa = status(a), sb = status(b);
+	if (memcmp(&sa, &sb, sizeof sa) != 0)
+		fail_msg("status differs: t %.17g / %.17g, x %.17g / %.17g, v %.17g / %.17g", sa.t,
+			 sb.t, sa.q[0], sb.q[0], sa.transport_velocity, sb.transport_velocity);
+	int n = sim_columns(a) * sim_layers(a);
+	assert_int_equal(n, sim_columns(b) * sim_layers(b));
+	double xa[SIM_MAX_COLUMNS * 4], ea[SIM_MAX_COLUMNS * 4], xb[SIM_MAX_COLUMNS * 4],
+		eb[SIM_MAX_COLUMNS * 4];
+	assert_true(n <= SIM_MAX_COLUMNS * 4);
+	sim_feed_state(a, xa, ea);
+	sim_feed_state(b, xb, eb);
+	assert_memory_equal(xa, xb, sizeof(double) * (size_t)n);
+	assert_memory_equal(ea, eb, sizeof(double) * (size_t)n);
+}
+
+static void *checkpoint_of(const sim *s, size_t *len)
+{
+	*len = sim_checkpoint_size(s);
+	void *buf = malloc(*len);
+	assert_non_null(buf);
+	assert_int_equal(sim_checkpoint(s, buf, *len), SIM_OK);
+	return buf;
+}
+
+static sim *restore(const setup *u, const void *buf, size_t len)
+{
+	char msg[200] = "";
+	int err = -1;
+	sim *s = sim_restore(&u->p, &u->sc, &u->m, buf, len, &err, msg, sizeof msg);
+	if (!s)
+		fail_msg("sim_restore: %s", msg);
+	assert_int_equal(err, SIM_OK);
+	return s;
+}
+
+/* Run a to t1 with controls on the way, checkpoint at an observed time
+ * between steps (0.3137 s is no step boundary), restore into b, then run
+ * both to t2 observed at different rates: they must agree bitwise. */
+static void continues_bit_for_bit(const setup *u, double t1, double t2)
+{
+	sim *a = make(u);
+	advance(a, 0.1);
+	assert_int_equal(sim_set_beta(a, 80.0 * RAD_PER_DEG, 0.0), SIM_OK);
+	advance(a, 0.2);
+	sim_restart_transport(a);
+	advance(a, t1);
+	size_t len;
+	void *buf = checkpoint_of(a, &len);
+	sim *b = restore(u, buf, len);
+	assert_same(a, b); /* at once, at the observed time */
+	/* a ramp still running; a rotation change after the restore */
+	for (double t = t1; t < t2;) {
+		t = fmin(t2, t + 0.05);
+		advance(a, t);
+		advance(b, t);
+		if (fabs(t - 0.5) < 1e-9) {
+			assert_int_equal(sim_set_omega_ss(a, 150.0), SIM_OK);
+			assert_int_equal(sim_set_omega_ss(b, 150.0), SIM_OK);
+		}
+	}
+	assert_same(a, b);
+	free(buf);
+	sim_free(a);
+	sim_free(b);
+}
+
+/* The reduced scene with the motor (the default steady start) and a small
+ * feed keeps every integrator quick. */
+static setup small(const char *method)
+{
+	setup u = preset_defaults();
+	set(&u, "layers", "2");
+	set(&u, "method", method);
+	return u;
+}
+
+static void dem_continues(void **state)
+{
+	(void)state;
+	setup u = small("dem");
+	/* at several moments: the feed in flight (no reaction held) and in
+	 * contact */
+	for (double t1 = 0.3037; t1 < 0.33; t1 += 0.0051)
+		continues_bit_for_bit(&u, t1, 0.6);
+	u = preset_defaults(); /* the defaults themselves, full feed */
+	continues_bit_for_bit(&u, 0.3137, 0.6);
+}
+
+static void rk4_continues(void **state)
+{
+	(void)state;
+	setup u = small("rk4");
+	continues_bit_for_bit(&u, 0.3137, 0.6);
+}
+
+static void euler_continues(void **state)
+{
+	(void)state;
+	setup u = small("euler");
+	continues_bit_for_bit(&u, 0.3137, 0.6);
+}
+
+static void dopri5_continues(void **state)
+{
+	(void)state;
+	setup u = small("dopri5");
+	set(&u, "feed", "false");
+	set(&u, "drive", "ideal");
+	continues_bit_for_bit(&u, 0.3137, 0.6);
+	u = small("dopri5"); /* with feed: sliding modes at the step floor */
+	set(&u, "layers", "1");
+	set(&u, "start", "rest");
+	continues_bit_for_bit(&u, 0.3137, 0.45);
+}
+
+/* A restore does not settle again: it takes no time at all beyond the
+ * allocation, and the restored t is the checkpoint's. */
+static void restore_does_not_settle(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	sim *a = make(&u);
+	advance(a, 0.25);
+	size_t len;
+	void *buf = checkpoint_of(a, &len);
+	sim *b = restore(&u, buf, len);
+	assert_true(status(b).t == 0.25);
+	assert_true(status(b).rhs_evals == status(a).rhs_evals);
+	free(buf);
+	sim_free(a);
+	sim_free(b);
+}
+
+/* Every cut, every bit flipped in the header and payload (sampled), and a
+ * checkpoint of another model: SIM_ECHECKPOINT, never a crash (run under
+ * ASan by make check). */
+static void damage_is_refused(void **state)
+{
+	(void)state;
+	setup u = small("dem");
+	sim *a = make(&u);
+	advance(a, 0.05);
+	size_t len;
+	unsigned char *buf = checkpoint_of(a, &len);
+	unsigned char *copy = malloc(len);
+	assert_non_null(copy);
+	char msg[200];
+	int err;
+	for (size_t cut = 0; cut < len; cut += 1 + cut / 16) {
+		memcpy(copy, buf, cut);
+		sim *b = sim_restore(&u.p, &u.sc, &u.m, copy, cut, &err, msg, sizeof msg);
+		assert_null(b);
+		assert_int_equal(err, SIM_ECHECKPOINT);
+	}
+	uint64_t x = 88172645463325252ULL; /* xorshift64 */
+	for (int round = 0; round < 400; round++) {
+		x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+		size_t bit = round < 64 * 8 ? (size_t)round % (len * 8) : (size_t)(x % (len * 8));
+		memcpy(copy, buf, len);
+		copy[bit / 8] ^= (unsigned char)(1u << (bit % 8));
+		sim *b = sim_restore(&u.p, &u.sc, &u.m, copy, len, &err, msg, sizeof msg);
+		assert_null(b);
+		assert_int_equal(err, SIM_ECHECKPOINT);
+	}
+	/* the version field: refused by name */
+	memcpy(copy, buf, len);
+	copy[8] ^= 2;
+	assert_null(sim_restore(&u.p, &u.sc, &u.m, copy, len, &err, msg, sizeof msg));
+	assert_non_null(strstr(msg, "version"));
+	/* another model (more layers): another layout */
+	setup v = small("dem");
+	set(&v, "layers", "3");
+	assert_null(sim_restore(&v.p, &v.sc, &v.m, buf, len, &err, msg, sizeof msg));
+	assert_int_equal(err, SIM_ECHECKPOINT);
+	assert_non_null(strstr(msg, "layout"));
+	/* and the whole buffer still restores */
+	sim *b = restore(&u, buf, len);
+	assert_same(a, b);
+	sim_free(b);
+	free(copy);
+	free(buf);
+	sim_free(a);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(dem_continues),
+		cmocka_unit_test(rk4_continues),
+		cmocka_unit_test(euler_continues),
+		cmocka_unit_test(dopri5_continues),
+		cmocka_unit_test(restore_does_not_settle),
+		cmocka_unit_test(damage_is_refused),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
