@@ -269,8 +269,12 @@ static void remove_session(srv_session *s, int files)
 	stop_worker(s);
 	if (files)
 		srv_persist_remove(s); /* after the worker's last write */
-	atomic_fetch_add(&srv_stats.sessions_deleted, 1);
-	srv_log(SRV_LOG_INFO, "session %s deleted", s->entry.id);
+	if (files) {
+		atomic_fetch_add(&srv_stats.sessions_deleted, 1);
+		srv_log(SRV_LOG_INFO, "session %s deleted", s->entry.id);
+	} else {
+		srv_log(SRV_LOG_INFO, "session %s closed", s->entry.id);
+	}
 }
 
 void srv_session_delete(srv_session *s)
