@@ -1,0 +1,34 @@
+// How many default sessions one daemon holds in real time on this machine
+// (`node tests/bench/realtime.mjs [N ...]`, not part of `make bench`: about
+// 1 minute per N, loopback only, bounded). For each N it starts N sessions of
+// the czubak2016 defaults at pace 1 on a fresh daemon, lets them run 10 s of
+// wall time, then reads every session's achieved real-time factor (`rtf`,
+// over the last half second) and counts those at 0.95 or better; then it
+// deletes them. Prints a markdown table.
+import { startDaemon, req, sleep } from '../http/lib.mjs';
+
+const counts = process.argv.slice(2).map(Number).filter((n) => n > 0);
+const Ns = counts.length ? counts : [50, 100, 150, 200];
+const rows = [];
+for (const N of Ns) {
+  const d = await startDaemon(['--max-sessions', String(Math.max(64, N))]);
+  const ids = [];
+  for (let i = 0; i < N; i++) {
+    const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 120 });
+    if (r.status !== 201) throw new Error(`session ${i}: ${r.status} ${r.text}`);
+    ids.push(r.body.id);
+  }
+  await sleep(10000);
+  const list = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
+  const rtf = list.map((s) => s.status.rtf ?? s.rtf).filter((x) => Number.isFinite(x));
+  rtf.sort((a, b) => a - b);
+  const ok = rtf.filter((x) => x >= 0.95).length;
+  const p = (q) => rtf[Math.min(rtf.length - 1, Math.floor(q * rtf.length))];
+  rows.push(`| ${N} | ${ok} | ${p(0).toFixed(2)} | ${p(0.5).toFixed(2)} |`);
+  for (const id of ids) await req(d.base, 'DELETE', `/api/v1/sessions/${id}`);
+  await d.stop();
+}
+console.log('Command: `node tests/bench/realtime.mjs` (czubak2016 defaults, pace 1, 10 s of wall time, 2 cores)\n');
+console.log('| sessions | at >= 0.95 of real time | slowest rtf | median rtf |');
+console.log('|---|---|---|---|');
+for (const r of rows) console.log(r);
