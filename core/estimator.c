@@ -28,19 +28,13 @@ static void period_probe(const model *md, const model_ctl *ctl, double t, const 
 	*V = hypot(qd[Q_X], qd[Q_Y]);
 }
 
-void estimator_probe(estimator *e, const model *md, const model_ctl *ctl, double t,
-		     const double *y)
-{
-	double V;
-	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
-		     &e->E_prev, &V);
-}
-
 void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double t,
 		    const double *y, double start)
 {
 	*e = (estimator){0};
-	estimator_probe(e, md, ctl, t, y);
+	double V;
+	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
+		     &e->E_prev, &V);
 	estimator_restart(e, start);
 }
 
@@ -69,6 +63,50 @@ static void record(estimator *e, double tb, double Xb)
 	e->rec_X[e->n_rec++] = Xb;
 }
 
+/* The error bar's parts from the batch edges (the records and the latest
+ * boundary), kept in e->bar: they change only at a boundary. The batch
+ * velocities v_i at their mid-times c_i are fitted by a straight line
+ * (least squares); its slope times the window's length is the drift D,
+ * the scatter s of the residuals gives the standard error of the mean
+ * s / sqrt(n) and of the drift. See estimate. */
+static void error_bar(estimator *e)
+{
+	double t[EST_RECORDS + 1], X[EST_RECORDS + 1];
+	int n = e->n_rec;
+	memcpy(t, e->rec_t, sizeof(double) * (size_t)n);
+	memcpy(X, e->rec_X, sizeof(double) * (size_t)n);
+	if (e->tb_last > t[n - 1]) {
+		t[n] = e->tb_last;
+		X[n++] = e->Xb_last;
+	}
+	int nb = n - 1;
+	e->bar.uncertainty = NAN;
+	if (nb < 4)
+		return;
+	double cm = 0.0, vm = 0.0, vi[EST_RECORDS], ci[EST_RECORDS];
+	for (int i = 0; i < nb; i++) {
+		vi[i] = (X[i + 1] - X[i]) / (t[i + 1] - t[i]);
+		ci[i] = 0.5 * (t[i] + t[i + 1]);
+		cm += ci[i] / nb;
+		vm += vi[i] / nb;
+	}
+	double scc = 0.0, scv = 0.0;
+	for (int i = 0; i < nb; i++) {
+		scc += (ci[i] - cm) * (ci[i] - cm);
+		scv += (ci[i] - cm) * (vi[i] - vm);
+	}
+	double slope = scv / scc, ss = 0.0;
+	for (int i = 0; i < nb; i++) {
+		double r = vi[i] - vm - slope * (ci[i] - cm);
+		ss += r * r;
+	}
+	double s = sqrt(ss / (nb - 2)), window = t[n - 1] - t[0];
+	double se = s / sqrt((double)nb);
+	e->bar.se_drift = s / sqrt(scc) * window;
+	e->bar.drift = slope * window;
+	e->bar.uncertainty = sqrt(se * se + 0.25 * e->bar.drift * e->bar.drift);
+}
+
 static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 {
 	if (e->pending) {
@@ -83,6 +121,7 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 		e->stride = 1;
 		e->speed_max = 0.0;
 		record(e, tb, Xb);
+		e->bar.uncertainty = NAN;
 		return;
 	}
 	e->tb_prev = e->tb_last;
@@ -92,6 +131,7 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 	e->Eb_last = Eb;
 	e->n_bound++;
 	record(e, tb, Xb);
+	error_bar(e);
 }
 
 void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
@@ -127,52 +167,6 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
 	e->E_prev = E;
 }
 
-/* The error bar and the steady flag from the batch edges (the records and
- * the latest boundary): the batch velocities v_i at their mid-times c_i are
- * fitted by a straight line (least squares); its slope times the window's
- * length is the drift D, the scatter s of the residuals gives the standard
- * error of the mean s / sqrt(n) and of the slope. See estimate. */
-static void error_bar(const estimator *e, double v, estimate *out)
-{
-	double t[EST_RECORDS + 1], X[EST_RECORDS + 1];
-	int n = e->n_rec;
-	memcpy(t, e->rec_t, sizeof(double) * (size_t)n);
-	memcpy(X, e->rec_X, sizeof(double) * (size_t)n);
-	if (e->tb_last > t[n - 1]) {
-		t[n] = e->tb_last;
-		X[n++] = e->Xb_last;
-	}
-	int nb = n - 1;
-	out->uncertainty = NAN;
-	out->steady = 0;
-	if (nb < 4)
-		return;
-	double cm = 0.0, vm = 0.0, vi[EST_RECORDS], ci[EST_RECORDS];
-	for (int i = 0; i < nb; i++) {
-		vi[i] = (X[i + 1] - X[i]) / (t[i + 1] - t[i]);
-		ci[i] = 0.5 * (t[i] + t[i + 1]);
-		cm += ci[i] / nb;
-		vm += vi[i] / nb;
-	}
-	double scc = 0.0, scv = 0.0;
-	for (int i = 0; i < nb; i++) {
-		scc += (ci[i] - cm) * (ci[i] - cm);
-		scv += (ci[i] - cm) * (vi[i] - vm);
-	}
-	double slope = scv / scc, ss = 0.0;
-	for (int i = 0; i < nb; i++) {
-		double r = vi[i] - vm - slope * (ci[i] - cm);
-		ss += r * r;
-	}
-	double s = sqrt(ss / (nb - 2)), window = t[n - 1] - t[0];
-	double se = s / sqrt((double)nb), se_drift = s / sqrt(scc) * window;
-	double drift = slope * window;
-	out->uncertainty = sqrt(se * se + 0.25 * drift * drift);
-	out->steady = e->n_bound >= 8 &&
-		      (fabs(drift) <= 3.0 * se_drift || fabs(drift) <= 0.005 * fabs(v)) &&
-		      out->uncertainty <= 0.005 * e->speed_max + 0.01 * fabs(v);
-}
-
 void estimator_read(const estimator *e, estimate *out)
 {
 	if (!e->pending && e->n_bound >= 1) {
@@ -185,7 +179,13 @@ void estimator_read(const estimator *e, estimate *out)
 		out->rotor_speed_mean = sense * 2.0 * M_PI * e->n_bound / span;
 		out->power_mean = (e->Eb_last - e->Eb_first) / span + 0.0;
 		out->torque_mean = out->power_mean / out->rotor_speed_mean + 0.0;
-		error_bar(e, out->transport_velocity, out);
+		/* steady: see estimate; the trough's speed grows within a period */
+		double v = fabs(out->transport_velocity);
+		out->uncertainty = e->bar.uncertainty;
+		out->steady = !isnan(e->bar.uncertainty) && e->n_bound >= 8 &&
+			      (fabs(e->bar.drift) <= 3.0 * e->bar.se_drift ||
+			       fabs(e->bar.drift) <= 0.005 * v) &&
+			      e->bar.uncertainty <= 0.005 * e->speed_max + 0.01 * v;
 	} else {
 		out->transport_velocity = NAN;
 		out->transport_periods = 0;

@@ -23,15 +23,15 @@ typedef struct estimator {
 	double rec_t[EST_RECORDS], rec_X[EST_RECORDS];
 	int n_rec, stride;
 	double speed_max;     /* m/s: the trough's largest speed in the window */
+	struct {              /* the error bar's parts as of the latest boundary */
+		double uncertainty, drift, se_drift;
+	} bar;
 } estimator;
 
 /* Start over: probe the state y at t, wait for the first period boundary
  * at or after start (s). */
 void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double t,
 		    const double *y, double start);
-/* Re-probe after the state was replaced at t (the boundaries so far stay). */
-void estimator_probe(estimator *e, const model *md, const model_ctl *ctl, double t,
-		     const double *y);
 /* Restart the estimate at the next boundary at or after start (s). */
 void estimator_restart(estimator *e, double start);
 /* After a step from t0 to t1 that ended in state y: locate the period

@@ -154,9 +154,7 @@ void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
 	sc.drive = SIM_DRIVE_IDEAL;
 	sc.motor_on = 1;
 	shooter sh = {.md = md};
-	model_init(&sh.mm, &sh.ctl, &md->p, &sc);
-	sh.mm.F0[0] = md->F0[0];
-	sh.mm.F0[1] = md->F0[1];
+	model_init(&sh.mm, &sh.ctl, &md->p, &sc); /* the same preload as md's */
 	sh.ctl.beta_ramp = ctl->beta_ramp;
 	sh.ctl.rotation = ctl->rotation;
 	sh.ctl.omega_ss = ctl->omega_ss;
@@ -166,7 +164,7 @@ void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
 	int nq = sh.mm.nq;
 	for (int r = 0; r < nq; r++)
 		z[r] = q0[sh.mm.col[r][0]]; /* the guess: the static equilibrium */
-	for (int it = 0; it < (md->phi_prescribed ? 1 : OMEGA_ITER); it++) {
+	for (int it = 0; it < OMEGA_ITER; it++) {
 		sh.T = 2.0 * M_PI / fabs(Omega);
 		ramp_hold(&sh.ctl.psi_ramp, 0.0, psi0, Omega);
 		shoot(&sh, z);
