@@ -40,14 +40,20 @@ UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 # and run (`make`, `make run`), and in addition to test (`make test`,
 # `make install`'s unit check).
 DEB_BUILD := /usr/include/microhttpd.h:libmicrohttpd-dev \
-             /usr/include/cjson/cJSON.h:libcjson-dev
+             /usr/include/cjson/cJSON.h:libcjson-dev \
+             /usr/include/gsl/gsl_multifit_nlinear.h:libgsl-dev
 DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
              /usr/bin/curl:curl \
              /usr/bin/python3:python3 \
              /usr/bin/node:nodejs \
              /usr/bin/npm:npm \
              /usr/bin/chromium:chromium \
-             /usr/bin/systemd-analyze:systemd
+             /usr/bin/systemd-analyze:systemd \
+             /usr/sbin/haproxy:haproxy \
+             /usr/bin/clang:clang \
+             /usr/bin/valgrind:valgrind
+# and in addition to benchmark (`make bench`: the ODE peers).
+DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
 
 .PHONY: all deps deps-build run test check bench mutate clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
@@ -62,10 +68,13 @@ $(BUILD)/.deps-build: Makefile
 	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
-	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze)" sh tests/apt-deps.sh
+	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze, haproxy, clang for libFuzzer, valgrind)" sh tests/apt-deps.sh
 	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps-bench: Makefile
+	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (SUNDIALS)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 
 # Include floors, by the top directory of the source: core/ (and its CLI)
@@ -125,7 +134,7 @@ check:
 	$(Q)$(MAKE) --no-print-directory BUILD=build-san \
 	  CFLAGS="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" test
 
-bench: all
+bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
 
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
