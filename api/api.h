@@ -38,6 +38,15 @@
 	X(QUERY, 400, "bad-query", "Bad query parameter",                     \
 	  "A query parameter is unknown to this route or malformed, or Last-Event-ID is not a " \
 	  "record id. `field` names it; the route's parameters are in /api/v1/openapi.json.") \
+	X(BADREQUEST, 400, "bad-request", "Bad request",                      \
+	  "The request itself is malformed: no Host header, or a header the daemon cannot " \
+	  "read. `field` names the header.")                                  \
+	X(UNAUTHORIZED, 401, "unauthorized", "Unauthorized",                  \
+	  "The daemon runs with --token-file: send Authorization: Bearer TOKEN (the token in " \
+	  "that file). Only the dashboard's files and /api/v1/health are open without it.") \
+	X(FORBIDDEN, 403, "forbidden-origin", "Origin not allowed",           \
+	  "The request came from a web page of another origin. The daemon answers its own " \
+	  "origin and those given with --allow-origin; nothing was changed.") \
 	X(NOTFOUND, 404, "not-found", "Not found",                            \
 	  "No session, experiment, sweep, path or file has this name. Sessions are gone once " \
 	  "deleted; experiments and sweeps once deleted or pushed out by newer ones.")          \
@@ -51,10 +60,14 @@
 	X(CONFLICT, 409, "conflict", "Conflict",                              \
 	  "The session cannot do this now: it failed (diverged), finished (raise until to " \
 	  "resume), until lies in the past, or it already runs an experiment.") \
+	X(MISDIRECTED, 421, "misdirected-request", "Misdirected request",    \
+	  "The Host header names neither the address the daemon listens on nor a " \
+	  "--server-name (a defence against DNS rebinding); nothing was changed.") \
 	X(TOOLARGE, 413, "body-too-large", "Request body too large",          \
 	  "The body is larger than the daemon's --max-body; it was not read.") \
 	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type", \
-	  "Request bodies must be sent with Content-Type: application/json.") \
+	  "POST, PATCH, PUT and DELETE must carry Content-Type: application/json, even with " \
+	  "an empty body (a web page of another origin cannot send that type unasked).") \
 	X(RANGE, 422, "out-of-range", "Value out of range",                   \
 	  "A value lies outside its range or choices (or names an unknown preset). `field` " \
 	  "names it and `min`/`max` or `choices` say what is allowed. Nothing was changed.") \

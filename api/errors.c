@@ -117,6 +117,69 @@ api_err api_fail(api_problem *pb, api_err code, const char *field,
 	return code;
 }
 
+/* Length of the valid UTF-8 sequence at s (RFC 3629: no overlong forms,
+ * no surrogates, nothing above U+10FFFF), 0 if the bytes there are not
+ * one. */
+static size_t utf8_seq(const unsigned char *s)
+{
+	if (s[0] < 0x80)
+		return 1;
+	size_t n = s[0] >= 0xc2 && s[0] <= 0xdf   ? 2
+		   : s[0] >= 0xe0 && s[0] <= 0xef ? 3
+		   : s[0] >= 0xf0 && s[0] <= 0xf4 ? 4
+						  : 0;
+	unsigned lo = 0x80, hi = 0xbf; /* the second byte's range */
+	if (s[0] == 0xe0)
+		lo = 0xa0;
+	else if (s[0] == 0xed)
+		hi = 0x9f;
+	else if (s[0] == 0xf0)
+		lo = 0x90;
+	else if (s[0] == 0xf4)
+		hi = 0x8f;
+	if (n == 0 || s[1] < lo || s[1] > hi)
+		return 0;
+	for (size_t i = 2; i < n; i++)
+		if (s[i] < 0x80 || s[i] > 0xbf)
+			return 0;
+	return n;
+}
+
+/* A copy of text in valid UTF-8: each byte that does not start a valid
+ * sequence becomes U+FFFD. Requests may hold any bytes (a path, a
+ * member's name, a header echoed in a detail, a detail cut mid-character),
+ * and a problem must still parse as JSON. NULL when out of memory. */
+static char *utf8_valid(const char *text)
+{
+	const unsigned char *s = (const unsigned char *)text;
+	size_t len = strlen(text);
+	char *out = malloc(3 * len + 1), *o = out;
+	if (!out)
+		return NULL;
+	while (*s) {
+		size_t n = utf8_seq(s);
+		if (n == 0) {
+			memcpy(o, "\xef\xbf\xbd", 3);
+			o += 3;
+			s++;
+			continue;
+		}
+		memcpy(o, s, n);
+		o += n;
+		s += n;
+	}
+	*o = '\0';
+	return out;
+}
+
+static void add_valid_string(cJSON *o, const char *name, const char *text)
+{
+	char *valid = utf8_valid(text);
+	if (valid)
+		cJSON_AddStringToObject(o, name, valid);
+	free(valid);
+}
+
 char *api_problem_json(const api_problem *pb, const char *instance)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -127,11 +190,11 @@ char *api_problem_json(const api_problem *pb, const char *instance)
 	cJSON_AddStringToObject(o, "type", type);
 	cJSON_AddStringToObject(o, "title", api_errors[code].title);
 	cJSON_AddNumberToObject(o, "status", api_errors[code].status);
-	cJSON_AddStringToObject(o, "detail", pb->detail);
+	add_valid_string(o, "detail", pb->detail);
 	if (instance)
-		cJSON_AddStringToObject(o, "instance", instance);
+		add_valid_string(o, "instance", instance);
 	if (pb->field[0])
-		cJSON_AddStringToObject(o, "field", pb->field);
+		add_valid_string(o, "field", pb->field);
 	if (pb->has_range) {
 		api_add_number(o, "min", pb->min);
 		api_add_number(o, "max", pb->max);

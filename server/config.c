@@ -34,7 +34,8 @@ static const srv_config defaults = {
 	.idle_timeout = 0.0,
 };
 
-enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL };
+enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL, OPT_FLAG,
+       OPT_LIST };
 
 typedef struct opt {
 	const char *name;
@@ -60,6 +61,10 @@ static const opt opts[] = {
 	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
 	 F(checkpoint_interval)},
 	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout)},
+	{"token-file", OPT_STRING, 0, 0, F(token_file)},
+	{"insecure", OPT_FLAG, 0, 0, F(insecure)},
+	{"allow-origin", OPT_LIST, 0, 0, F(allow_origins)},
+	{"server-name", OPT_LIST, 0, 0, F(server_names)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -86,7 +91,17 @@ static void usage(FILE *f)
 		"  --checkpoint-interval S  wall seconds between session "
 		"checkpoints (default 10)\n"
 		"  --idle-timeout S     remove sessions with no client and no "
-		"request for S seconds (default 0: never)\n");
+		"request for S seconds (default 0: never)\n"
+		"  --token-file FILE    require Authorization: Bearer with the "
+		"token in FILE\n"
+		"                       (mode 0600 or stricter) on every route "
+		"but / files and /health\n"
+		"  --insecure           allow a non-loopback --listen without "
+		"--token-file\n"
+		"  --allow-origin ORIG  one more browser origin allowed to call "
+		"(repeatable, max 16)\n"
+		"  --server-name NAME   one more Host name the daemon answers to "
+		"(repeatable, max 16)\n");
 }
 
 static int parse_int(const char *arg, const char *name, long lo, long hi,
@@ -112,6 +127,17 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	snprintf(flag, sizeof flag, "--%s", o->name);
 	switch (o->kind) {
 	case OPT_STRING: *(const char **)(void *)at = arg; return 0;
+	case OPT_FLAG: *(int *)(void *)at = 1; return 0;
+	case OPT_LIST: {
+		srv_list *l = (srv_list *)(void *)at;
+		if (l->n >= SRV_LIST_MAX || !*arg) {
+			fprintf(stderr, "convsimd: %s takes a non-empty value, at "
+					"most %d times\n", flag, SRV_LIST_MAX);
+			return -1;
+		}
+		l->v[l->n++] = arg;
+		return 0;
+	}
 	case OPT_INT:
 	case OPT_SIZE:
 		if (parse_int(arg, flag, o->lo, o->hi, &v))
@@ -175,8 +201,10 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 {
 	struct option longopts[NOPTS + 2];
 	for (size_t i = 0; i < NOPTS; i++)
-		longopts[i] = (struct option){opts[i].name, required_argument,
-					      0, (int)i};
+		longopts[i] = (struct option){
+			opts[i].name,
+			opts[i].kind == OPT_FLAG ? no_argument : required_argument,
+			0, (int)i};
 	longopts[NOPTS] = (struct option){"help", no_argument, 0, 'h'};
 	longopts[NOPTS + 1] = (struct option){0, 0, 0, 0};
 	*cfg = defaults;

@@ -10,6 +10,13 @@
 
 #include <stddef.h>
 
+/* A repeatable option's values (argv's strings, borrowed). */
+#define SRV_LIST_MAX 16
+typedef struct srv_list {
+	const char *v[SRV_LIST_MAX];
+	int n;
+} srv_list;
+
 typedef struct srv_config {
 	const char *listen;    /* address to bind, "127.0.0.1" */
 	int port;              /* 0: ephemeral */
@@ -26,6 +33,10 @@ typedef struct srv_config {
 	int max_experiments, max_sweeps;
 	double checkpoint_interval; /* s of wall time between checkpoints */
 	double idle_timeout;   /* s without client or request; 0: never */
+	const char *token_file; /* NULL: no token asked (loopback only) */
+	int insecure;          /* serve beyond loopback without a token */
+	srv_list allow_origins; /* --allow-origin: more origins than ours */
+	srv_list server_names; /* --server-name: more Host names */
 } srv_config;
 
 /* Fill *cfg from the defaults and the command line (argv is borrowed: the

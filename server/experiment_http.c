@@ -132,8 +132,6 @@ enum MHD_Result srv_h_experiments_create(srv_req *r)
 {
 	enum MHD_Result res;
 	api_problem pb;
-	if (!srv_need_json(r, 0, &res))
-		return res;
 	api_experiment_req *req = malloc(sizeof *req);
 	if (!req)
 		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");

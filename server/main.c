@@ -21,6 +21,7 @@
 #include "catalog.h"
 #include "config.h"
 #include "experiment_http.h"
+#include "gate.h"
 #include "metrics.h"
 #include "pool.h"
 #include "routes.h"
@@ -81,6 +82,7 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_experiments_shutdown();
 	srv_catalog_shutdown();
 	srv_store_close(); /* every queued write is on disk */
+	srv_gate_shutdown();
 }
 
 /* Rebuild what the data directory holds: experiments first (the sessions
@@ -117,7 +119,7 @@ int main(int argc, char **argv)
 	signal(SIGPIPE, SIG_IGN);
 
 	listen_addr la;
-	if (resolve_listen(&cfg, &la))
+	if (resolve_listen(&cfg, &la) || srv_gate_init(&cfg))
 		return 2;
 
 	srv_catalog_init(&cfg);
@@ -149,6 +151,7 @@ int main(int argc, char **argv)
 	const union MHD_DaemonInfo *info =
 		MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
 	int port = info ? info->port : cfg.port;
+	srv_gate_set_port(port);
 	if (strchr(cfg.listen, ':'))
 		printf("listening on http://[%s]:%d\n", cfg.listen, port);
 	else

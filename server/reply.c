@@ -20,6 +20,14 @@ enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp)
 {
 	if (!resp)
 		return MHD_NO;
+	if (r->cors_origin) {
+		MHD_add_response_header(resp, "Access-Control-Allow-Origin",
+					r->cors_origin);
+		MHD_add_response_header(resp, "Access-Control-Expose-Headers",
+					"Location, Retry-After, "
+					"WWW-Authenticate");
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Origin");
+	}
 	srv_metrics_count(status);
 	enum MHD_Result rc = MHD_queue_response(r->conn, (unsigned)status,
 						resp);
@@ -83,6 +91,12 @@ enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
 enum MHD_Result srv_reply_problem(srv_req *r, const api_problem *pb,
 				  const char *allow)
 {
+	return srv_reply_problem_with(r, pb, MHD_HTTP_HEADER_ALLOW, allow);
+}
+
+enum MHD_Result srv_reply_problem_with(srv_req *r, const api_problem *pb,
+				       const char *name, const char *value)
+{
 	char *text = api_problem_json(pb, r->url);
 	int status = api_status(pb->code);
 	if (!text)
@@ -97,8 +111,8 @@ enum MHD_Result srv_reply_problem(srv_req *r, const api_problem *pb,
 				"application/problem+json");
 	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL,
 				"no-store");
-	if (allow)
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);
+	if (name && value)
+		MHD_add_response_header(resp, name, value);
 	if (status == 429 || status == 503)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, "1");
 	return srv_queue(r, status, resp);
@@ -125,19 +139,6 @@ const char *srv_query(srv_req *r, const char *key)
 const char *srv_header(srv_req *r, const char *name)
 {
 	return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);
-}
-
-int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result)
-{
-	if (r->json_body || (empty_ok && r->body_len == 0 &&
-			     !r->has_content_type))
-		return 1;
-	const char *ct = srv_header(r, MHD_HTTP_HEADER_CONTENT_TYPE);
-	*result = srv_fail(r, API_MEDIATYPE, NULL,
-			   "the body must be sent as Content-Type: "
-			   "application/json (got \"%.60s\")",
-			   ct ? ct : "none");
-	return 0;
 }
 
 enum MHD_Result srv_reply_result(srv_req *r, char *text)

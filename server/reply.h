@@ -20,8 +20,7 @@ typedef struct srv_req {
 	char arg[2][64];       /* path parameters ("*" segments) */
 	const char *body;      /* NUL-terminated, body_len bytes */
 	size_t body_len;
-	int has_content_type;
-	int json_body;         /* Content-Type is application/json */
+	const char *cors_origin; /* an allowed Origin (gate.c), or NULL */
 	int csv;               /* a result route answers CSV (negotiated) */
 } srv_req;
 
@@ -44,18 +43,19 @@ enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
 /* RFC 9457 problem reply for *pb (405 adds Allow from allow if given). */
 enum MHD_Result srv_reply_problem(srv_req *r, const api_problem *pb,
 				  const char *allow);
+/* The same with one more header name: value (either may be NULL). */
+enum MHD_Result srv_reply_problem_with(srv_req *r, const api_problem *pb,
+				       const char *name, const char *value);
 enum MHD_Result srv_fail(srv_req *r, api_err code, const char *field,
 			 const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
-/* Queue a response (taken) and count its status for /metrics. */
+/* Queue a response (taken) and count its status for /metrics; a request
+ * from an allowed origin gets Access-Control-Allow-Origin and Vary. */
 enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp);
 /* Query argument or NULL; header value or NULL (borrowed from the
  * connection). */
 const char *srv_query(srv_req *r, const char *key);
 const char *srv_header(srv_req *r, const char *name);
-/* 1 if the request carries a JSON body (or none, when empty_ok); else
- * queues 415 and returns 0 (the handler then returns *result). */
-int srv_need_json(srv_req *r, int empty_ok, enum MHD_Result *result);
 /* 200 with a result in the negotiated representation (r->csv): text is
  * JSON or CSV accordingly (taken). */
 enum MHD_Result srv_reply_result(srv_req *r, char *text);

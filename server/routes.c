@@ -3,9 +3,11 @@
  *
  * Routes are a static table {method, pattern, handler}; "*" in a pattern
  * matches one path segment and becomes a path argument. The access
- * handler collects the request body (refusing it with 413 before it is
- * read when Content-Length exceeds --max-body, and while it is read for
- * chunked bodies), checks its media type, then calls the one handler. A
+ * handler first passes the request's headers through the gate (gate.c:
+ * Host, Origin, token, the JSON media type of mutating requests), then
+ * collects the body (refusing it with 413 before it is read when
+ * Content-Length exceeds --max-body, and while it is read for chunked
+ * bodies), then calls the one handler. A
  * path that exists with another method gets 405 with Allow; unknown paths
  * under /api/ get 404; everything else is a static file of web/. Query
  * parameters and the representation are checked against the API's route
@@ -19,6 +21,7 @@
 
 #include "catalog.h"
 #include "experiment_http.h"
+#include "gate.h"
 #include "routes.h"
 #include "session_http.h"
 #include "static.h"
@@ -88,22 +91,6 @@ static int match(const char *pattern, const char *url, char arg[2][64])
 		}
 	}
 	return *p == '\0' && *u == '\0';
-}
-
-static int json_type(const char *ct)
-{
-	static const char *const types[] = {"application/json",
-					    "application/merge-patch+json",
-					    "application/problem+json"};
-	while (*ct == ' ')
-		ct++;
-	for (size_t i = 0; i < sizeof types / sizeof *types; i++) {
-		size_t n = strlen(types[i]);
-		if (strncasecmp(ct, types[i], n) == 0 &&
-		    (ct[n] == '\0' || ct[n] == ';' || ct[n] == ' '))
-			return 1;
-	}
-	return 0;
 }
 
 typedef struct query_check {
@@ -187,6 +174,21 @@ static enum MHD_Result route_request(srv_req *r)
 	return srv_h_static(r);
 }
 
+/* The request as first seen, headers only: the gate, then the declared
+ * body size (refused before the body is read). */
+static enum MHD_Result first_look(srv_req *r)
+{
+	enum MHD_Result result;
+	if (!srv_gate_check(r, &result))
+		return result;
+	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
+	if (cl && strtoull(cl, NULL, 10) > cfg->max_body)
+		return srv_fail(r, API_TOOLARGE, NULL,
+				"the body has %.30s bytes; the limit is %zu "
+				"(--max-body)", cl, cfg->max_body);
+	return MHD_YES;
+}
+
 enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 			     const char *url, const char *method,
 			     const char *version, const char *upload_data,
@@ -203,21 +205,8 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->r.conn = conn;
 		st->r.method = method;
 		st->r.url = url;
-		const char *ct = MHD_lookup_connection_value(
-			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-		st->r.has_content_type = ct != NULL;
-		st->r.json_body = ct && json_type(ct);
-		const char *cl = MHD_lookup_connection_value(
-			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-		if (cl && strtoull(cl, NULL, 10) > cfg->max_body) {
-			/* refuse before reading the body */
-			st->r.body = "";
-			return srv_fail(&st->r, API_TOOLARGE, NULL,
-					"the body has %s bytes; the limit is "
-					"%zu (--max-body)", cl,
-					cfg->max_body);
-		}
-		return MHD_YES;
+		st->r.body = "";
+		return first_look(&st->r);
 	}
 	if (*upload_data_size) {
 		size_t n = *upload_data_size;

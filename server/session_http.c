@@ -27,8 +27,6 @@ enum MHD_Result srv_h_sessions_create(srv_req *r)
 	enum MHD_Result res;
 	api_spec spec;
 	api_problem pb;
-	if (!srv_need_json(r, 1, &res))
-		return res;
 	if (api_parse_session(r->body, r->body_len, &spec, &pb) != API_OK)
 		return srv_reply_problem(r, &pb, NULL);
 	srv_session *s = srv_session_create(&spec, NULL, &pb);
@@ -81,8 +79,6 @@ enum MHD_Result srv_h_session_patch(srv_req *r)
 	api_problem pb;
 	double t_eff = NAN;
 	api_view v;
-	if (!srv_need_json(r, 0, &res))
-		goto out;
 	srv_session_view(s, &v);
 	if (api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
 		    API_OK ||

@@ -2,8 +2,10 @@
  * static.c - the dashboard's files: GET / serves web/index.html, other
  * paths the file of that name under --web-root, with a Content-Type by
  * extension. Paths with "..", "//", backslashes or hidden segments are
- * refused, and the resolved path must stay inside the web root, so no
- * request reaches a file outside it.
+ * refused, and the resolved path (links followed) must stay inside the
+ * web root, so no request reaches a file outside it. Only regular files
+ * are served: a FIFO, a device, a socket or a directory is "not found",
+ * and opening one never blocks (O_NONBLOCK, then fstat).
  */
 #include <fcntl.h>
 #include <limits.h>
@@ -79,7 +81,10 @@ enum MHD_Result srv_h_static(srv_req *r)
 	size_t rl = strlen(root);
 	if (strncmp(real, root, rl) != 0 || real[rl] != '/')
 		return missing(r);
-	int fd = open(real, O_RDONLY | O_CLOEXEC);
+	/* the resolved path is opened without following a link put there
+	 * since, and without waiting for a FIFO's writer: only a regular
+	 * file is served */
+	int fd = open(real, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
 	struct stat sb;
 	if (fd < 0)
 		return missing(r);

@@ -362,8 +362,6 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 {
 	enum MHD_Result res;
 	api_problem pb;
-	if (!srv_need_json(r, 1, &res))
-		return res;
 	srv_sweep *sw = sweep_new(r, &pb);
 	if (!sw)
 		return srv_reply_problem(r, &pb, NULL);

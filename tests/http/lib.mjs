@@ -3,6 +3,9 @@
 // CONVSIMD names the binary (build/convsimd or build-san/convsimd); the
 // sanitizer build is slower, so timeouts scale with SLOW.
 import { spawn } from 'node:child_process';
+import { mkdtempSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 export const BIN = process.env.CONVSIMD ||
@@ -30,7 +33,7 @@ export async function startDaemon(args = [], opts = {}) {
     const timer = setTimeout(() => reject(new Error(`no port line; stderr: ${stderr}`)), 10000 * SLOW);
     proc.stdout.on('data', (d) => {
       out += d;
-      const m = out.match(/^listening on http:\/\/127\.0\.0\.1:(\d+)$/m);
+      const m = out.match(/^listening on http:\/\/\S+:(\d+)$/m);
       if (m) { clearTimeout(timer); resolve(Number(m[1])); }
     });
     exited.then(({ code }) => { clearTimeout(timer); reject(new Error(`daemon exited ${code}: ${stderr}`)); });
@@ -49,13 +52,22 @@ export async function startDaemon(args = [], opts = {}) {
   };
 }
 
+// A token file (mode 0600 unless told) in a fresh temporary directory.
+export function tokenFile(token, mode = 0o600) {
+  const file = join(mkdtempSync(join(tmpdir(), 'convsim-token-')), 'token');
+  writeFileSync(file, token + '\n', { mode });
+  return file;
+}
+
 // fetch with a JSON body; returns {status, headers, body (parsed when JSON), text}.
+// POST, PATCH, PUT and DELETE carry Content-Type: application/json (the
+// daemon refuses them without it) unless headers name another or null.
 export async function req(base, method, path, body, headers = {}) {
   const init = { method, headers: { ...headers } };
-  if (body !== undefined) {
-    init.body = typeof body === 'string' ? body : JSON.stringify(body);
-    if (!('Content-Type' in init.headers)) init.headers['Content-Type'] = 'application/json';
-  }
+  if (body !== undefined) init.body = typeof body === 'string' ? body : JSON.stringify(body);
+  if ((body !== undefined || /^(POST|PATCH|PUT|DELETE)$/.test(method)) &&
+      !('Content-Type' in init.headers)) init.headers['Content-Type'] = 'application/json';
+  if (init.headers['Content-Type'] === null) delete init.headers['Content-Type'];
   const res = await fetch(base + path, init);
   const text = await res.text();
   let parsed = null;
