@@ -142,3 +142,33 @@ export function metric(text, key) {
   const line = text.split('\n').find((l) => l.startsWith(key + ' '));
   return line ? Number(line.slice(key.length + 1)) : 0;
 }
+
+// One request written byte for byte on a fresh socket (any Host, Origin or
+// invalid UTF-8 a browser or fetch would not send); the answer is read until
+// the daemon closes. head: the request line and headers as a string or
+// Buffer, without the blank line; "Connection: close" is added. Returns
+// {status, headers (lower-case names; repeated ones joined by ", "), body
+// (Buffer), raw (Buffer)}.
+export async function rawRequest(port, head, body = '') {
+  const { connect } = await import('node:net');
+  const raw = await new Promise((resolve, reject) => {
+    const sock = connect(port, '127.0.0.1');
+    const parts = [];
+    sock.setTimeout(15000 * SLOW, () => { sock.destroy(); reject(new Error('raw request timed out')); });
+    sock.on('data', (b) => parts.push(b));
+    sock.on('end', () => resolve(Buffer.concat(parts)));
+    sock.on('error', reject);
+    sock.write(Buffer.concat([Buffer.from(head), Buffer.from('\r\nConnection: close\r\n\r\n'),
+      Buffer.from(body)]));
+  });
+  const at = raw.indexOf('\r\n\r\n');
+  const lines = raw.subarray(0, at).toString('latin1').split('\r\n');
+  const headers = {};
+  for (const l of lines.slice(1)) {
+    const i = l.indexOf(':');
+    const k = l.slice(0, i).toLowerCase();
+    const v = l.slice(i + 1).trim();
+    headers[k] = k in headers ? `${headers[k]}, ${v}` : v;
+  }
+  return { status: Number(lines[0].split(' ')[1]), headers, body: raw.subarray(at + 4), raw };
+}
