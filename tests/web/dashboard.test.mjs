@@ -4,11 +4,16 @@
 // what the API says. Saves tests/out/dashboard.png.
 //
 // Scene: ideal drive, 5 columns x 2 layers, pace 2 (cheap to simulate; the
-// point here is the UI, not the physics).
+// point here is the UI, not the physics). The daemon runs with a token
+// (--token-file) and the page is opened as `make run` prints it, with
+// #token=... in the fragment: every request, the stream and the downloads
+// below carry it.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
-import { mkdirSync, readFileSync } from 'node:fs';
+import { randomBytes } from 'node:crypto';
+import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from '../node_modules/playwright-core/index.mjs';
@@ -21,10 +26,14 @@ const PACE = process.env.DASHBOARD_PACE || '2';
 
 let daemon, base, browser, page;
 const pageErrors = [];
+const TOKEN = randomBytes(20).toString('hex');
+const AUTH = { Authorization: `Bearer ${TOKEN}` };
+const TOKEN_FILE = path.join(mkdtempSync(path.join(tmpdir(), 'convsim-dash-')), 'token');
+writeFileSync(TOKEN_FILE, TOKEN + '\n', { mode: 0o600 });
 
 function startDaemon() {
 	return new Promise((resolve, reject) => {
-		const p = spawn(DAEMON, ['--port', '0'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
+		const p = spawn(DAEMON, ['--port', '0', '--token-file', TOKEN_FILE], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
 		let out = '';
 		const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`no "listening on" line from ${DAEMON} in 15 s:\n${out}`)); }, 15000);
 		const scan = chunk => {
@@ -49,7 +58,7 @@ async function stopDaemon() {
 }
 
 async function apiGet(p) {
-	const res = await fetch(base + p);
+	const res = await fetch(base + p, { headers: AUTH });
 	assert.equal(res.status, 200, `GET ${p}`);
 	return res.json();
 }
@@ -105,9 +114,12 @@ after(async () => {
 let sessionId;
 
 test('the page loads from the daemon and finds it online', async () => {
-	const res = await page.goto(base + '/');
+	const res = await page.goto(`${base}/#token=${TOKEN}`);
 	assert.equal(res.status(), 200);
 	await page.waitForSelector('body[data-ready="true"]', { timeout: 15000 });
+	/* the token left the address bar for this tab's sessionStorage */
+	assert.ok(!page.url().includes(TOKEN), page.url());
+	assert.equal(await page.evaluate(() => sessionStorage.getItem('convsim.token')), TOKEN);
 	assert.match(await page.title(), /convsim/);
 	await page.waitForSelector('#conn[data-state="online"]', { timeout: 10000 });
 	const presets = await page.$$eval('#f-preset option', o => o.map(x => x.value));
@@ -248,7 +260,7 @@ test('the drive row changes omega_ss and switches the drive, checked through the
 test('a refused input shows the daemon\'s problem detail', async () => {
 	const body = { preset: 'czubak2016', params: { beta: 38, rotation: 'cw' },
 		scene: { columns: 5, layers: 999, feed: true, drive: 'ideal' }, integrator: { method: 'rk4' }, pace: 1 };
-	const res = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
+	const res = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json', ...AUTH }, body: JSON.stringify(body) });
 	assert.equal(res.status, 422);
 	assert.match(res.headers.get('content-type'), /application\/problem\+json/);
 	const problem = await res.json();
@@ -287,7 +299,8 @@ test('a sweep draws v(β) for both rotations', async () => {
 	/* the CSV link serves the same six points */
 	const href = await page.$eval('#sweep-csv', a => a.hidden ? null : a.getAttribute('href'));
 	assert.match(href, /^\/api\/v1\/sweeps\/[^/?]+\?format=csv$/);
-	const csv = (await (await fetch(base + href)).text()).trim().split('\n');
+	assert.equal((await fetch(base + href)).status, 401, 'the link alone is not enough');
+	const csv = (await (await fetch(base + href, { headers: AUTH })).text()).trim().split('\n');
 	assert.equal(csv.length, 7, csv.join('\n'));
 	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state');
 	const got = csvLines(await download('#sweep-csv'));
@@ -333,6 +346,24 @@ test('a β-change experiment reports its reversal time', async () => {
 	const ep = csvLines(await download('#plot-experiment + .plot-export button[data-export="csv"]'));
 	assert.equal(ep[0], 't / s,feed velocity / (m/s),β / °');
 	await page.selectOption('select[name="scene_start"]', 'steady');
+});
+
+test('the token stays with the tab: a reload works; a tab without it is told', async () => {
+	const attached = await page.$eval('body', b => b.dataset.sessionId);
+	await page.reload();
+	await page.waitForSelector('body[data-ready="true"]', { timeout: 15000 });
+	await page.waitForSelector('#conn[data-state="online"]', { timeout: 10000 });
+	assert.equal(await page.$eval('body', b => b.dataset.sessionId), attached);
+	await until(async () => await samples() > 0, 10000, 'stream samples after the reload');
+	assert.equal(await page.$$eval('#messages .msg.error', l => l.length), 0);
+	const other = await browser.newPage(); /* a new context: no sessionStorage */
+	try {
+		await other.goto(base + '/');
+		const msg = await other.waitForSelector('#messages .msg.error', { timeout: 10000 });
+		assert.match(await msg.textContent(), /asks for its token.*#token=/);
+	} finally {
+		await other.close();
+	}
 });
 
 test('screenshot of the dashboard', async () => {

@@ -228,3 +228,13 @@ test('schematic geometry: n(beta) and u(beta) are orthonormal, guides at beta', 
 	assert.equal(x, VIEW.x0);
 	assert.ok(y < VIEW.y0, 'model up is screen up');
 });
+
+test('the token header: set for the tab, none without a token', () => {
+	assert.deepEqual(api.authHeaders(), {});
+	assert.equal(api.hasToken(), false);
+	api.setToken(' 0123456789abcdef0123\n');
+	assert.deepEqual(api.authHeaders(), { Authorization: 'Bearer 0123456789abcdef0123' });
+	assert.equal(api.hasToken(), true);
+	api.setToken(null);
+	assert.deepEqual(api.authHeaders(), {});
+});

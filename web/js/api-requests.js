@@ -1,11 +1,26 @@
 /*
  * api-requests.js - what the dashboard sends the daemon: the base URL, the
- * request bodies of POST /sessions, /sweeps and /experiments built from
- * the forms' values, and the stream's query string. No DOM, no network;
- * node:test covers it (through api.js, which re-exports it).
+ * bearer token's header, the request bodies of POST /sessions, /sweeps
+ * and /experiments built from the forms' values, and the stream's query
+ * string. No DOM, no network; node:test covers it (through api.js, which
+ * re-exports it).
  */
 
 export const BASE = '/api/v1';
+
+/* The daemon's token for this tab (auth.js sets it from the URL fragment
+ * or sessionStorage); '' when the daemon runs without one. */
+let token = '';
+export function setToken(t) {
+	token = typeof t === 'string' ? t.trim() : '';
+}
+export function hasToken() {
+	return token !== '';
+}
+/* The Authorization header every API request carries (none without a token). */
+export function authHeaders() {
+	return token ? { Authorization: `Bearer ${token}` } : {};
+}
 
 /* The POST /sessions body from the form's values (see session.js readSessionForm):
  * {preset, params: {beta, rotation[, beta_rate]}, scene: {columns, layers,

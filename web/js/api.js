@@ -10,13 +10,16 @@
  * plain objects the normalize* functions return (units: SI, beta in
  * degrees, rotation "cw"/"ccw").
  *
+ * Every request carries the daemon's bearer token when the tab has one
+ * (setToken, api-requests.js).
+ *
  * Errors: a refused request throws ApiError carrying the problem+json body
  * (RFC 9457: type, title, status, detail and any extension members such as
  * the offending field and its range); an unreachable daemon throws
  * NetworkError. This module touches no DOM and runs under node:test.
  */
 
-import { BASE, sessionRequest, sweepRequest, experimentRequest } from './api-requests.js';
+import { BASE, authHeaders, sessionRequest, sweepRequest, experimentRequest } from './api-requests.js';
 import { normalizeSession, normalizeControl, normalizeSweep, normalizeExperiment,
 	normalizePresets, normalizeMethods, trajectoryColumns, methodEnum } from './api-normalize.js';
 
@@ -50,18 +53,22 @@ export class NetworkError extends Error {
 
 /* ---- HTTP -------------------------------------------------------------- */
 
-async function request(method, path, body) {
-	const init = { method, headers: { Accept: 'application/json, application/problem+json' } };
-	if (body !== undefined) {
-		init.headers['Content-Type'] = 'application/json';
-		init.body = JSON.stringify(body);
-	}
-	let res;
+/* fetch with the token; an unreachable daemon throws NetworkError. */
+async function send(url, init) {
 	try {
-		res = await fetch(BASE + path, init);
+		return await fetch(url, { ...init, headers: { ...init.headers, ...authHeaders() } });
 	} catch (e) {
 		throw new NetworkError(e);
 	}
+}
+
+/* Every mutating request says Content-Type: application/json, even
+ * without a body: the daemon refuses it otherwise (415). */
+async function request(method, path, body) {
+	const init = { method, headers: { Accept: 'application/json, application/problem+json' } };
+	if (method !== 'GET') init.headers['Content-Type'] = 'application/json';
+	if (body !== undefined) init.body = JSON.stringify(body);
+	const res = await send(BASE + path, init);
 	const text = await res.text().catch(() => '');
 	let data = null;
 	if (text) {
@@ -112,6 +119,18 @@ export function trajectoryUrl(id, format) {
 }
 export function experimentCsvUrl(id) {
 	return `${BASE}/experiments/${enc(id)}?format=csv`;
+}
+/* GET url (one of the *Url functions) with the token, as a Blob: what a
+ * download link fetches when a plain link could not carry the header. */
+export async function fetchBlob(url) {
+	const res = await send(url, { method: 'GET', headers: {} });
+	if (!res.ok) {
+		const text = await res.text().catch(() => '');
+		let data = text;
+		try { data = JSON.parse(text); } catch { /* keep the text */ }
+		throw new ApiError(res.status, data);
+	}
+	return res.blob();
 }
 export async function deleteSession(id) {
 	await request('DELETE', `/sessions/${enc(id)}`);

@@ -10,11 +10,13 @@
  * they share; figures.js says which plot shows what; controls.js wires the
  * live-control card; sweep.js and experiment.js are the two job panels.
  * api.js (with api-normalize.js, api-requests.js, api-stream.js) is the
- * one link to the daemon.
+ * one link to the daemon; auth.js gives it the token from the URL's
+ * fragment (#token=...).
  */
 
 import * as api from './api.js';
-import { app, $, report, setOnline } from './ui.js';
+import { initAuth } from './auth.js';
+import { app, $, message, report, setOnline } from './ui.js';
 import { startSession, attach, detach, refreshSessionList } from './session.js';
 import { makePlots } from './figures.js';
 import { frame } from './draw.js';
@@ -82,6 +84,10 @@ async function loadPresets() {
 		}
 	} catch (err) {
 		if (err instanceof api.NetworkError) setOnline(false);
+		/* a daemon with a token and a page without it */
+		else if (err.status === 401)
+			message('error', 'The daemon asks for its token: open the address that `make run` printed ' +
+				'(it ends in #token=…), or add #token=TOKEN to this page\'s address.', { key: 'token', sticky: true });
 	}
 	if (!methods.length) methods = (await api.integratorNames().catch(() => [])).map(name => ({ name, doc: '' }));
 	if (methods.length) {
@@ -109,6 +115,7 @@ async function healthLoop() {
 }
 
 async function init() {
+	initAuth();
 	makePlots();
 	wire();
 	requestAnimationFrame(frame);

@@ -35,8 +35,9 @@ function autoRange(u, min, max) {
 	return uPlot.rangeNum(min, max, 0.1, true);
 }
 
-/* Save blob under name through a temporary download link. */
-function save(blob, name) {
+/* Save blob under name through a temporary download link (also auth.js's
+ * downloads of the API's files). */
+export function saveBlob(blob, name) {
 	const a = document.createElement('a');
 	a.href = URL.createObjectURL(blob);
 	a.download = name;
@@ -65,7 +66,7 @@ function addExport(owner, el) {
 		b.textContent = kind === 'png' ? 'PNG' : 'CSV';
 		b.title = kind === 'png' ? 'this plot as an image' : 'the data of this plot';
 		b.addEventListener('click', () => {
-			if (kind === 'csv') return save(new Blob([csvText(owner.csvRows())], { type: 'text/csv' }), `${name}.csv`);
+			if (kind === 'csv') return saveBlob(new Blob([csvText(owner.csvRows())], { type: 'text/csv' }), `${name}.csv`);
 			const src = owner.plot.ctx.canvas;
 			const c = document.createElement('canvas');
 			c.width = src.width;
@@ -74,7 +75,7 @@ function addExport(owner, el) {
 			ctx.fillStyle = '#fff';
 			ctx.fillRect(0, 0, c.width, c.height);
 			ctx.drawImage(src, 0, 0);
-			c.toBlob(blob => save(blob, `${name}.png`), 'image/png');
+			c.toBlob(blob => saveBlob(blob, `${name}.png`), 'image/png');
 		});
 		bar.append(b);
 	}
