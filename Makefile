@@ -121,11 +121,23 @@ $(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
 
 # Builds only the daemon it runs. PORT, HOST and DAEMON_FLAGS (any of
 # `build/convsimd --help`) are the knobs; the daemon's state (sessions,
-# checkpoints, results) lives in DATA and survives a restart.
+# checkpoints, results) lives in DATA and survives a restart. The daemon
+# always runs with a token: TOKEN (a file) is made once, mode 0600, from
+# 32 bytes of /dev/urandom, and the dashboard's address is printed with
+# the token in its fragment (#token=..., never sent to a server).
 DATA    ?= var/data
+TOKEN   ?= var/token
 run: deps-build $(BUILD)/convsimd
-	$(Q)mkdir -p $(DATA)
-	$(BUILD)/convsimd --listen $(HOST) --port $(PORT) --data-dir $(DATA) $(DAEMON_FLAGS)
+	$(Q)mkdir -p $(DATA) $(dir $(TOKEN))
+	$(Q)[ -s $(TOKEN) ] || (umask 077 && head -c 32 /dev/urandom | od -An -tx1 | \
+	  tr -d ' \n' > $(TOKEN) && echo "made a token in $(TOKEN) (mode 0600)")
+	$(Q)$(BUILD)/convsimd --listen $(HOST) --port $(PORT) --data-dir $(DATA) \
+	  --token-file $(TOKEN) $(DAEMON_FLAGS) | while IFS= read -r line; do \
+	  echo "$$line"; case $$line in "listening on "*) url=$${line#listening on }; \
+	  url=$$(echo "$$url" | sed -e 's,//0\.0\.0\.0:,//127.0.0.1:,' -e 's,//\[::\]:,//[::1]:,'); \
+	  echo "dashboard: $$url/#token=$$(cat $(TOKEN))"; \
+	  echo "curl:      curl -H \"Authorization: Bearer \$$(cat $(TOKEN))\" $$url/api/v1/sessions";; \
+	  esac; done
 
 test: deps all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
