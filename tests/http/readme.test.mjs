@@ -1,6 +1,7 @@
 // README's Python example, taken from README.md itself (the block after
 // <!-- test:python-example -->, so the two cannot drift), run with the
-// system python3 (standard library only) against the real daemon.
+// system python3 (standard library only) against the real daemon, which
+// runs with a token as `make run` starts it.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFile } from 'node:child_process';
@@ -8,11 +9,12 @@ import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { promisify } from 'node:util';
-import { startDaemon, SLOW } from './lib.mjs';
+import { startDaemon, tokenFile, SLOW } from './lib.mjs';
 
 const README = new URL('../../README.md', import.meta.url);
+const TOKEN = 'readme-example-token-0123456789';
 let d;
-before(async () => { d = await startDaemon(); });
+before(async () => { d = await startDaemon(['--token-file', tokenFile(TOKEN)]); });
 after(async () => { await d?.stop(); });
 
 export function pythonExample(text) {
@@ -27,7 +29,7 @@ test('README\'s Python example runs against the daemon and prints v and the swee
   const file = join(mkdtempSync(join(tmpdir(), 'convsim-py-')), 'example.py');
   writeFileSync(file, code);
   const { stdout } = await promisify(execFile)('python3', [file], {
-    env: { ...process.env, CONVSIM_URL: d.base }, timeout: 110000 * SLOW });
+    env: { ...process.env, CONVSIM_URL: d.base, CONVSIM_TOKEN: TOKEN }, timeout: 110000 * SLOW });
   const lines = stdout.trim().split('\n');
   const m = lines[0].match(/^v = (\S+) \+- (\S+) m\/s, steady: (True|False)$/);
   assert.ok(m, lines[0]);
