@@ -211,6 +211,15 @@ static cJSON *operation(const api_route *rt)
 	char *save = NULL;
 	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save))
 		cJSON_AddItemToObject(responses, t, ref("responses", "Problem"));
+	/* the request gate's answers, the same for every route (README
+	 * "Security"): the token (not on health), Origin, Host */
+	int open_route = strcmp(rt->pattern, "/api/v1/health") == 0;
+	if (open_route)
+		cJSON_AddArrayToObject(op, "security");
+	else
+		cJSON_AddItemToObject(responses, "401", ref("responses", "Problem"));
+	cJSON_AddItemToObject(responses, "403", ref("responses", "Problem"));
+	cJSON_AddItemToObject(responses, "421", ref("responses", "Problem"));
 	return op;
 }
 
@@ -276,8 +285,14 @@ char *api_openapi_json(void)
 					  "type URI serves a page that explains it\",\"content\":{"
 					  "\"application/problem+json\":{\"schema\":{\"$ref\":"
 					  "\"#/components/schemas/Problem\"}}}}}"));
+	cJSON_AddItemToObject(comps, "securitySchemes",
+			      cJSON_Parse("{\"bearer\":{\"type\":\"http\",\"scheme\":\"bearer\","
+					  "\"description\":\"the token of the daemon's --token-file; "
+					  "none when it runs without one\"}}"));
 	doc = cJSON_CreateObject();
 	cJSON_AddStringToObject(doc, "openapi", "3.1.0");
+	cJSON_AddItemToObject(doc, "security",
+			      cJSON_Parse("[{\"bearer\":[]},{}]"));
 	cJSON *info = cJSON_AddObjectToObject(doc, "info");
 	cJSON_AddStringToObject(info, "title", "convsim daemon API");
 	cJSON_AddStringToObject(info, "version", "1");
