@@ -57,7 +57,7 @@ r0=$(rss)
 make_sessions 100
 r1=$(rss)
 for id in $(curl -sf "$base/sessions" | grep -o '"id":"[0-9a-f]*"' | cut -d'"' -f4); do
-	curl -sf -XDELETE "$base/sessions/$id" -o /dev/null
+	curl -sf -XDELETE -H 'Content-Type: application/json' "$base/sessions/$id" -o /dev/null
 done
 sleep 1
 r2=$(rss)
