@@ -295,15 +295,21 @@ static void drive(const model *md, const model_ctl *ctl, const config *cf, doubl
 	*damp_power += dt->drag * dt->omega - dt->load * dt->omega;
 }
 
+/* The upper half of M from its lower half. */
+static void symmetrize(double M[NQ_FULL][NQ_FULL])
+{
+	for (int i = 0; i < NQ_FULL; i++)
+		for (int j = i + 1; j < NQ_FULL; j++)
+			M[i][j] = M[j][i];
+}
+
 /* Stage solve: complete M, solve for qr'' (br) and the full q'' (qdd); under
  * the ideal drive the drive's torque is what closes the rotor's equation. */
 static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_FULL][NQ_FULL],
 		  const double rhs[NQ_FULL], drive_terms *dt, double br[NQ_FULL],
 		  double qdd[NQ_FULL])
 {
-	for (int i = 0; i < NQ_FULL; i++)
-		for (int j = i + 1; j < NQ_FULL; j++)
-			M[i][j] = M[j][i];
+	symmetrize(M);
 	/* prescribed accelerations q_p'' */
 	double qpdd[NQ_FULL] = {0};
 	if (md->phi_prescribed) {
@@ -390,6 +396,17 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev)
 		observe(md, &cf, qdd, &dt, ev);
+}
+
+void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
+			  const double Q[NQ_FULL], double *qrdd)
+{
+	config cf;
+	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], none[NQ_FULL] = {0};
+	configure(md, ctl, t, y, &cf);
+	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
+	symmetrize(M);
+	model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q, none, qrdd);
 }
 
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,

@@ -113,6 +113,11 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
 		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev);
 
+/* The reduced accelerations (qrdd, nq values) that the generalized force Q
+ * alone gives the machine in state y at t: (T^t M T)^-1 T^t Q. */
+void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
+			  const double Q[NQ_FULL], double *qrdd);
+
 /* Kinetic and potential energy (J) of the machine alone in state y at t
  * (written); the potential includes gravity, springs and preload. */
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,
