@@ -8,8 +8,8 @@
  * resting on the deck points as constant forces, the rotor turning at a
  * constant relative speed Omega, is periodic with T = 2 pi / |Omega|;
  * Newton's method on z -> Phi_T(z) - z (Phi_T: one period of classical
- * RK4 with 256 steps, its Jacobian by finite differences) finds the
- * periodic state z. The machine is nearly linear, so this is the linear
+ * RK4 with 128 steps, its Jacobian by finite differences and kept while
+ * the residual falls tenfold per step) finds the periodic state z. The machine is nearly linear, so this is the linear
  * frequency-domain solution plus its small nonlinear corrections, and two
  * or three Newton steps converge. With the Kloss motor, Omega is where the
  * motor's torque balances the mean torque that the periodic motion draws
