@@ -103,6 +103,7 @@ static void static_residual(const model *md, const model_ctl *ctl, const double 
 	tmp.npos = NQ_FULL;
 	tmp.n = 2 * NQ_FULL + ACC_N;
 	tmp.phi_prescribed = 0;
+	model_solve_layout(&tmp);
 	off.drive_on = 0;
 	double y[2 * NQ_FULL + ACC_N] = {0}, dy[2 * NQ_FULL + ACC_N];
 	memcpy(y, q, sizeof(double) * NQ_FULL);

@@ -248,7 +248,7 @@ static void chain_solve(int L, double m, const double *vs, double v0, const doub
 }
 
 void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
-		      const double deck_vel1[2], double h, signed char *modes, double impulse[2],
+		      const double deck_vel[2], double h, signed char *modes, double impulse[2],
 		      double *fric, double *contact)
 {
 	const int L = md->L, base = k * L;
@@ -270,7 +270,7 @@ void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2
 		vs[j] = etad[e] - g * h;
 		prev_eta = eta[e];
 	}
-	chain_solve(L, m, vs, deck_vel1[1], lo, hi, Pn, vn, mn);
+	chain_solve(L, m, vs, deck_vel[1], lo, hi, Pn, vn, mn);
 	/* friction impulses within [-mu, mu] times the normal ones */
 	for (int j = 0; j < L; j++) {
 		vs[j] = xid[base + j];
@@ -278,17 +278,17 @@ void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2
 		lo[j] = -hi[j];
 	}
 	if (md->sc.friction == SIM_FRICTION_COULOMB) {
-		chain_solve(L, m, vs, deck_vel1[0], lo, hi, Pt, vt, mt);
+		chain_solve(L, m, vs, deck_vel[0], lo, hi, Pt, vt, mt);
 	} else {
 		/* regularised: explicit in the velocities at the start */
 		for (int j = 0; j < L; j++) {
-			double below = j == 0 ? deck_vel1[0] : vs[j - 1];
+			double below = j == 0 ? deck_vel[0] : vs[j - 1];
 			Pt[j] = hi[j] * tanh((below - vs[j]) / md->sc.friction_eps);
 		}
 		for (int j = 0; j < L; j++)
 			vt[j] = vs[j] + (Pt[j] - (j + 1 < L ? Pt[j + 1] : 0.0)) / m;
 	}
-	double prev_vy = deck_vel1[1], prev_vx = deck_vel1[0];
+	double prev_vy = deck_vel[1], prev_vx = deck_vel[0];
 	for (int j = 0; j < L; j++) {
 		int e = base + j;
 		etad[e] = vn[j];

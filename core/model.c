@@ -3,8 +3,9 @@
  * motion"): exact planar rigid-body kinematics of the trough with three
  * point masses (unbalanced mass, two eliminator masses on guides turned to
  * beta(t)), mass matrix M = diag(M_r, M_r, J_r, J_w, 0, 0) + sum m_k J_k^T J_k
- * solved by Cholesky at every evaluation, suspension with preload, Kloss or
- * ideal drive, and the feed's reaction as a given generalized force.
+ * solved at every evaluation (model_solve.c), suspension with preload,
+ * Kloss or ideal drive, and the feed's reaction as a given generalized
+ * force.
  *
  * The right-hand side is a pipeline of stages (in the manner of MuJoCo's
  * mj_fwdPosition, mj_fwdVelocity, mj_fwdActuation, ...), each with a
@@ -14,10 +15,10 @@
  *   suspension            spring sets with preload, their damping power
  *   eliminators           guide springs and dampers, their damping power
  *   drive                 motor torque, bearing drag and load, rotor speed
- *   solve                 reduced Cholesky solve for q'' (and the ideal
- *                         drive's torque that closes the rotor equation)
+ *   solve                 reduced solve for q'' (model_solve.c; and the
+ *                         ideal drive's torque that closes the rotor
+ *                         equation)
  *   power                 drive and guide-actuator input, damping power
- * Floating-point operations keep the order of the former single function.
  *
  * Velocity-product and beta-rate terms enter through a_k in
  * r_k'' = J_k q'' + a_k; see the derivation next to point_mass_* below.
@@ -44,14 +45,24 @@ static double motor_torque(const model *md, const model_ctl *ctl, double omega)
 	return ctl->rotation == SIM_CW ? kloss(md, ctl, omega) : -kloss(md, ctl, -omega);
 }
 
-/* One point mass: Jacobian columns (2 x 6, column-major jc[i][0..1]) and
+/* One point mass: its Jacobian, which has the same shape for all three
+ * (the unit columns of x and y, a column ja on alpha and a column jo on its
+ * own coordinate `own`: phi for the vibrator, s_i for eliminator i), and
  * the bias acceleration a. */
 typedef struct pm {
 	double m;
-	double jc[NQ_FULL][2];
+	int own;
+	double ja[2], jo[2];
 	double a[2];
 	double r[2];  /* position relative to G */
 } pm;
+
+/* r' = J q' (+ the guide's turn, added by the caller). */
+static void pm_velocity(const pm *P, const double *qd, double v[2])
+{
+	v[0] = qd[Q_X] + P->ja[0] * qd[Q_ALPHA] + P->jo[0] * qd[P->own];
+	v[1] = qd[Q_Y] + P->ja[1] * qd[Q_ALPHA] + P->jo[1] * qd[P->own];
+}
 
 /* Unbalanced mass at G + R w + e (cos phi, sin phi):
  *   r'' = [I, perp(Rw), e(-sin phi, cos phi)] q'' - alpha'^2 Rw - e phi'^2 (cos, sin). */
@@ -61,14 +72,12 @@ static void point_mass_vibrator(const model *md, const deck_rot *R, const double
 	double w[2] = {md->p.w_x, md->p.w_y}, Rw[2];
 	deck_rotate(R, w, Rw);
 	double cf = cos(q[Q_PHI]), sf = sin(q[Q_PHI]), e = md->p.e;
-	memset(k->jc, 0, sizeof k->jc);
 	k->m = md->p.m;
-	k->jc[Q_X][0] = 1.0;
-	k->jc[Q_Y][1] = 1.0;
-	k->jc[Q_ALPHA][0] = -Rw[1];
-	k->jc[Q_ALPHA][1] = Rw[0];
-	k->jc[Q_PHI][0] = -e * sf;
-	k->jc[Q_PHI][1] = e * cf;
+	k->own = Q_PHI;
+	k->ja[0] = -Rw[1];
+	k->ja[1] = Rw[0];
+	k->jo[0] = -e * sf;
+	k->jo[1] = e * cf;
 	double ad2 = qd[Q_ALPHA] * qd[Q_ALPHA], pd2 = qd[Q_PHI] * qd[Q_PHI];
 	k->a[0] = -ad2 * Rw[0] - e * pd2 * cf;
 	k->a[1] = -ad2 * Rw[1] - e * pd2 * sf;
@@ -101,14 +110,12 @@ static void point_mass_eliminator(const model *md, int i, const deck_rot *R,
 	double gl[2] = {g2 * up[0] + h1 * up[0] - h2 * u[0], g2 * up[1] + h1 * up[1] - h2 * u[1]};
 	double Rgl[2];
 	deck_rotate(R, gl, Rgl);
-	memset(k->jc, 0, sizeof k->jc);
 	k->m = i == 0 ? md->p.m1 : md->p.m2;
-	k->jc[Q_X][0] = 1.0;
-	k->jc[Q_Y][1] = 1.0;
-	k->jc[Q_ALPHA][0] = -Rb[1];
-	k->jc[Q_ALPHA][1] = Rb[0];
-	k->jc[qs][0] = Ru[0];
-	k->jc[qs][1] = Ru[1];
+	k->own = qs;
+	k->ja[0] = -Rb[1];
+	k->ja[1] = Rb[0];
+	k->jo[0] = Ru[0];
+	k->jo[1] = Ru[1];
 	k->a[0] = -ad * ad * Rb[0] - 2.0 * ad * Rbrel[1] + Rgl[0];
 	k->a[1] = -ad * ad * Rb[1] + 2.0 * ad * Rbrel[0] + Rgl[1];
 	k->r[0] = Rb[0];
@@ -143,6 +150,21 @@ typedef struct config {
 	pm pms[3];
 } config;
 
+/* sin and cos of beta, remembered for the last beta this thread asked
+ * for: beta is held for most of a run, and the memo is keyed by the exact
+ * value, so the results are those of sin and cos themselves. */
+static void beta_sincos(double beta, double *sb, double *cb)
+{
+	static _Thread_local double memo[3] = {NAN, NAN, NAN};
+	if (beta != memo[0]) {
+		memo[0] = beta;
+		memo[1] = sin(beta);
+		memo[2] = cos(beta);
+	}
+	*sb = memo[1];
+	*cb = memo[2];
+}
+
 /* Stage configure: q, q', beta(t) and its rates, R(alpha), point masses. */
 static void configure(const model *md, const model_ctl *ctl, double t, const double *y,
 		      config *c)
@@ -150,8 +172,7 @@ static void configure(const model *md, const model_ctl *ctl, double t, const dou
 	model_full_coords(md, ctl, t, y, c->q, c->qd);
 	ramp_eval(&ctl->beta_ramp, t, &c->beta, &c->beta_d, &c->beta_dd);
 	c->R = deck_rotation(c->q);
-	c->sbeta = sin(c->beta);
-	c->cbeta = cos(c->beta);
+	beta_sincos(c->beta, &c->sbeta, &c->cbeta);
 	point_mass_vibrator(md, &c->R, c->q, c->qd, &c->pms[0]);
 	for (int i = 0; i < 2; i++)
 		point_mass_eliminator(md, i, &c->R, c->q, c->qd, c->sbeta, c->cbeta, c->beta_d,
@@ -159,30 +180,38 @@ static void configure(const model *md, const model_ctl *ctl, double t, const dou
 }
 
 /* Stage mass_matrix_and_bias: lower half of M, and rhs = Qfeed - gravity -
- * sum m_k J_k^T a_k (the velocity-product and beta-rate terms). */
+ * sum m_k J_k^T a_k (the velocity-product and beta-rate terms). Each point
+ * mass fills the (x, y, alpha) block, its own coordinate's row there and
+ * its own (constant) diagonal; the own coordinates never couple. */
 static void mass_matrix_and_bias(const model *md, const config *cf, const double Qfeed[NQ_FULL],
 				 double M[NQ_FULL][NQ_FULL], double rhs[NQ_FULL])
 {
 	const sim_params *p = &md->p;
 	memset(M, 0, sizeof(double) * NQ_FULL * NQ_FULL);
-	M[Q_X][Q_X] = p->M_r;
-	M[Q_Y][Q_Y] = p->M_r;
+	M[Q_X][Q_X] = M[Q_Y][Q_Y] = p->M_r;
 	M[Q_ALPHA][Q_ALPHA] = p->J_r;
-	M[Q_PHI][Q_PHI] = p->J_w;
 	for (int i = 0; i < NQ_FULL; i++)
 		rhs[i] = Qfeed ? Qfeed[i] : 0.0;
 	rhs[Q_Y] -= p->M_r * p->g;
 	for (int k = 0; k < 3; k++) {
 		const pm *P = &cf->pms[k];
-		for (int i = 0; i < NQ_FULL; i++) {
-			double ji0 = P->jc[i][0], ji1 = P->jc[i][1];
-			if (ji0 == 0.0 && ji1 == 0.0)
-				continue;
-			for (int j = 0; j <= i; j++)
-				M[i][j] += P->m * (ji0 * P->jc[j][0] + ji1 * P->jc[j][1]);
-			/* gravity and the velocity-product terms */
-			rhs[i] += P->m * (-ji1 * p->g - ji0 * P->a[0] - ji1 * P->a[1]);
-		}
+		const double m = P->m, *ja = P->ja, *jo = P->jo;
+		const int o = P->own;
+		M[Q_X][Q_X] += m;
+		M[Q_Y][Q_Y] += m;
+		M[Q_ALPHA][Q_X] += m * ja[0];
+		M[Q_ALPHA][Q_Y] += m * ja[1];
+		M[Q_ALPHA][Q_ALPHA] += m * (ja[0] * ja[0] + ja[1] * ja[1]);
+		M[o][Q_X] = m * jo[0];
+		M[o][Q_Y] = m * jo[1];
+		M[o][Q_ALPHA] = m * (jo[0] * ja[0] + jo[1] * ja[1]);
+		M[o][o] = md->own_m[o];
+		/* gravity and the velocity-product terms, -m J^T (a + g e_y) */
+		double f0 = -m * P->a[0], f1 = -m * (P->a[1] + p->g);
+		rhs[Q_X] += f0;
+		rhs[Q_Y] += f1;
+		rhs[Q_ALPHA] += ja[0] * f0 + ja[1] * f1;
+		rhs[o] += jo[0] * f0 + jo[1] * f1;
 	}
 }
 
@@ -266,71 +295,12 @@ static void drive(const model *md, const model_ctl *ctl, const config *cf, doubl
 	*damp_power += dt->drag * dt->omega - dt->load * dt->omega;
 }
 
-/* In-place Cholesky solve of the n x n SPD system A x = b (A overwritten).
- * Returns 0, or -1 if A is not positive definite. */
-static int cholesky_solve(int n, double A[NQ_FULL][NQ_FULL], double *b)
+/* The upper half of M from its lower half. */
+static void symmetrize(double M[NQ_FULL][NQ_FULL])
 {
-	for (int j = 0; j < n; j++) {
-		double d = A[j][j];
-		for (int k = 0; k < j; k++)
-			d -= A[j][k] * A[j][k];
-		if (!(d > 0.0))
-			return -1;
-		d = sqrt(d);
-		A[j][j] = d;
-		for (int i = j + 1; i < n; i++) {
-			double s = A[i][j];
-			for (int k = 0; k < j; k++)
-				s -= A[i][k] * A[j][k];
-			A[i][j] = s / d;
-		}
-	}
-	for (int i = 0; i < n; i++) {
-		double s = b[i];
-		for (int k = 0; k < i; k++)
-			s -= A[i][k] * b[k];
-		b[i] = s / A[i][i];
-	}
-	for (int i = n - 1; i >= 0; i--) {
-		double s = b[i];
-		for (int k = i + 1; k < n; k++)
-			s -= A[k][i] * b[k];
-		b[i] = s / A[i][i];
-	}
-	return 0;
-}
-
-/* Reduced system Tt M T qr'' = Tt (rhs - M qp'') (T only selects
- * coordinates or moves two together, so sums over index lists do), solved
- * in place: br receives qr'' (NaN if M is not positive definite). */
-static void reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
-			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
-{
-	int n = md->nq;
-	double Mr[NQ_FULL][NQ_FULL];
-	double res[NQ_FULL];
-	for (int i = 0; i < NQ_FULL; i++) {
-		double s = rhs[i];
-		if (md->phi_prescribed)
-			s -= M[i][Q_PHI] * qpdd[Q_PHI];
-		res[i] = s;
-	}
-	for (int r = 0; r < n; r++) {
-		const int *ir = md->col[r];
-		br[r] = md->ncol[r] == 1 ? res[ir[0]] : res[ir[0]] + res[ir[1]];
-		for (int c = 0; c <= r; c++) {
-			const int *ic = md->col[c];
-			double m = 0.0;
-			for (int a = 0; a < md->ncol[r]; a++)
-				for (int b = 0; b < md->ncol[c]; b++)
-					m += M[ir[a]][ic[b]];
-			Mr[r][c] = m;
-		}
-	}
-	if (cholesky_solve(n, Mr, br) != 0) {
-		for (int r = 0; r < n; r++)
-			br[r] = NAN;
-	}
+	for (int i = 0; i < NQ_FULL; i++)
+		for (int j = i + 1; j < NQ_FULL; j++)
+			M[i][j] = M[j][i];
 }
 
 /* Stage solve: complete M, solve for qr'' (br) and the full q'' (qdd); under
@@ -339,16 +309,14 @@ static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_F
 		  const double rhs[NQ_FULL], drive_terms *dt, double br[NQ_FULL],
 		  double qdd[NQ_FULL])
 {
-	for (int i = 0; i < NQ_FULL; i++)
-		for (int j = i + 1; j < NQ_FULL; j++)
-			M[i][j] = M[j][i];
+	symmetrize(M);
 	/* prescribed accelerations q_p'' */
 	double qpdd[NQ_FULL] = {0};
 	if (md->phi_prescribed) {
 		double psi, psid;
 		ramp_eval(&ctl->psi_ramp, t, &psi, &psid, &qpdd[Q_PHI]);
 	}
-	reduced_solve(md, (const double(*)[NQ_FULL])M, rhs, qpdd, br);
+	model_reduced_solve(md, (const double(*)[NQ_FULL])M, rhs, qpdd, br);
 	memcpy(qdd, qpdd, sizeof(double) * NQ_FULL);
 	for (int r = 0; r < md->nq; r++)
 		for (int a = 0; a < md->ncol[r]; a++)
@@ -380,11 +348,10 @@ static double guide_power(const sim_params *p, const config *cf, const double qd
 		return power;
 	for (int k = 1; k < 3; k++) {
 		const pm *P = &cf->pms[k];
-		double acc[2] = {P->a[0], P->a[1] + p->g};
-		for (int i = 0; i < NQ_FULL; i++) {
-			acc[0] += P->jc[i][0] * qdd[i];
-			acc[1] += P->jc[i][1] * qdd[i];
-		}
+		double acc[2];
+		pm_velocity(P, qdd, acc);
+		acc[0] += P->a[0];
+		acc[1] += P->a[1] + p->g;
 		double Rup[2];
 		double cs = guide_turn(p, cf, k, Rup);
 		power += P->m * cs * cf->beta_d * (acc[0] * Rup[0] + acc[1] * Rup[1]);
@@ -431,6 +398,17 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 		observe(md, &cf, qdd, &dt, ev);
 }
 
+void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
+			  const double Q[NQ_FULL], double *qrdd)
+{
+	config cf;
+	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], none[NQ_FULL] = {0};
+	configure(md, ctl, t, y, &cf);
+	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
+	symmetrize(M);
+	model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q, none, qrdd);
+}
+
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,
 			  double *kinetic, double *potential)
 {
@@ -443,11 +421,8 @@ void model_machine_energy(const model *md, const model_ctl *ctl, double t, const
 	double V = p->M_r * p->g * q[Q_Y];
 	for (int k = 0; k < 3; k++) {
 		const pm *P = &cf.pms[k];
-		double v[2] = {0.0, 0.0};
-		for (int i = 0; i < NQ_FULL; i++) {
-			v[0] += P->jc[i][0] * qd[i];
-			v[1] += P->jc[i][1] * qd[i];
-		}
+		double v[2];
+		pm_velocity(P, qd, v);
 		if (k > 0) { /* guide rotation: (c + s) beta' u' in the body frame */
 			double Rup[2];
 			double cs = guide_turn(p, &cf, k, Rup);

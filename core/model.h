@@ -39,6 +39,12 @@ typedef struct model {
 	int ncol[NQ_FULL];            /* full coordinates that reduced r moves */
 	int col[NQ_FULL][2];          /* ... and which (at most two) */
 	int alpha_fixed, phi_prescribed;
+	/* the solve's layout (model_solve_layout): the reduced coordinates of
+	 * the trough (x, y, alpha), and the inverse constant inertia of each
+	 * point mass's own coordinate (phi, s1, s2; 0 for the trough's) */
+	int n_body, body[3];
+	double own_inv[NQ_FULL];
+	double own_m[NQ_FULL];        /* ... and that inertia, by full coordinate */
 	/* feed */
 	int L, nf;                    /* layers, integrated elements */
 	double col_weight;            /* how many physical columns one stands for */
@@ -82,6 +88,17 @@ double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
  * controls from parameters and scene (validated already). setup.c */
 void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene *sc);
 
+/* Fill the solve's layout (n_body, body, own_inv, own_m) from nq, ncol,
+ * col and the parameters; model_init calls it, and so must whoever changes
+ * those. model_solve.c */
+void model_solve_layout(model *md);
+
+/* Solve the reduced system T^t M T qr'' = T^t (rhs - M qp'') (M: symmetric,
+ * both halves filled; qp'': the prescribed accelerations) for qr'' into
+ * br (NaN if M is not positive definite). model_solve.c */
+void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			 const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL]);
+
 /* Static strokes s1, s2 (m) of the eliminators at rest at the initial
  * beta (written). setup.c */
 void model_static_strokes(const sim_params *p, double s[2]);
@@ -95,6 +112,11 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
  * force Qfeed (NULL: none). ev may be NULL. Never allocates, counts nothing. */
 void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
 		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev);
+
+/* The reduced accelerations (qrdd, nq values) that the generalized force Q
+ * alone gives the machine in state y at t: (T^t M T)^-1 T^t Q. */
+void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
+			  const double Q[NQ_FULL], double *qrdd);
 
 /* Kinetic and potential energy (J) of the machine alone in state y at t
  * (written); the potential includes gravity, springs and preload. */

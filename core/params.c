@@ -77,7 +77,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
-	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 2.5e-5 s")
+	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 6.25e-5 s")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -174,12 +174,14 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 /* Defaults per scene kind, measured against the converged reference at
  * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
  * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
- * of 5e-4 s and feed sub-steps of at most 2.5e-5 s with its corrected
- * coupling (worst 0.70 % by docs/MODEL.md's convention after a `steady` start
- * and a 4-s window); a feed too heavy for the corrector (added mass) takes
- * single steps of 2.5e-5 s; without feed the machine is smooth and RK4 at
- * 1e-3 s keeps the trajectory within 2e-4. */
-#define FEED_STEP_MAX 2.5e-5
+ * of 1e-3 s and feed sub-steps of at most 6.25e-5 s (16) with its
+ * corrected coupling (worst 0.69 % by docs/MODEL.md's convention after a
+ * `steady` start and a 4-s window; 8e-5 s sub-steps are 1.07 % off); a
+ * feed too heavy for the corrector (added mass) takes single steps of
+ * 2.5e-5 s; without feed the machine is smooth and RK4 at 1e-3 s keeps the
+ * trajectory within 2e-4. */
+#define FEED_STEP_MAX 6.25e-5
+#define HEAVY_FEED_STEP 2.5e-5
 
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
@@ -190,11 +192,9 @@ double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method 
 		return feed ? 1e-5 : 1e-3;
 	if (strcmp(m->name, "dopri5") == 0)
 		return 1e-5; /* the first step */
-	if (!feed)
-		return 1e-3;
-	if (s->feed_coupling && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO)
-		return FEED_STEP_MAX;
-	return 5e-4;
+	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO)
+		return HEAVY_FEED_STEP;
+	return 1e-3;
 }
 
 int sim_default_substeps(double dt)

@@ -98,6 +98,7 @@ void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene 
 				md->col[c][md->ncol[c]++] = i;
 	md->alpha_fixed = sym;
 	md->phi_prescribed = ideal;
+	model_solve_layout(md);
 
 	md->dk.h_d = p->h_d;
 	if (feed) {

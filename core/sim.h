@@ -172,7 +172,7 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * feed is light enough for its corrected coupling. */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 /* The feed sub-steps that substeps = 0 stands for with macro step dt (s):
- * as many as keep the feed's step at or below 2.5e-5 s. */
+ * as many as keep the feed's step at or below 6.25e-5 s. */
 int sim_default_substeps(double dt);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt vs

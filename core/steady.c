@@ -8,8 +8,8 @@
  * resting on the deck points as constant forces, the rotor turning at a
  * constant relative speed Omega, is periodic with T = 2 pi / |Omega|;
  * Newton's method on z -> Phi_T(z) - z (Phi_T: one period of classical
- * RK4 with 256 steps, its Jacobian by finite differences) finds the
- * periodic state z. The machine is nearly linear, so this is the linear
+ * RK4 with 128 steps, its Jacobian by finite differences and kept while
+ * the residual falls tenfold per step) finds the periodic state z. The machine is nearly linear, so this is the linear
  * frequency-domain solution plus its small nonlinear corrections, and two
  * or three Newton steps converge. With the Kloss motor, Omega is where the
  * motor's torque balances the mean torque that the periodic motion draws
@@ -23,7 +23,7 @@
 #include "dynamics.h"
 #include "feed.h"
 
-enum { STEPS_PER_PERIOD = 256, NEWTON_MAX = 6, OMEGA_ITER = 4, NZ = 2 * NQ_FULL };
+enum { STEPS_PER_PERIOD = 128, NEWTON_MAX = 6, OMEGA_ITER = 4, NZ = 2 * NQ_FULL };
 
 typedef struct shooter {
 	model mm;           /* the machine alone, phi - alpha prescribed */
@@ -74,11 +74,31 @@ static void one_period(shooter *sh, const double *z, double *out)
 	memcpy(out + nq, y + mm->npos, sizeof(double) * (size_t)nq);
 }
 
-/* Newton on Phi_T(z) - z = 0 from the guess in z (updated). */
-static void shoot(shooter *sh, double *z)
+/* Jacobian of z -> Phi_T(z) - z at z by forward differences (end =
+ * Phi_T(z) given; sh->mean_torque is kept, that of z). */
+static void shoot_jacobian(shooter *sh, const double *z, const double *end, double J[NZ][NZ])
 {
 	int m = 2 * sh->mm.nq;
-	double end[NZ], pert[NZ], endp[NZ], J[NZ][NZ], r[NZ];
+	double pert[NZ], endp[NZ], torque = sh->mean_torque;
+	for (int b = 0; b < m; b++) {
+		memcpy(pert, z, sizeof(double) * (size_t)m);
+		double hz = 1e-7 * fmax(fabs(z[b]), b < m / 2 ? 1e-3 : 1e-1);
+		pert[b] += hz;
+		one_period(sh, pert, endp);
+		for (int a = 0; a < m; a++)
+			J[a][b] = (endp[a] - end[a]) / hz - (a == b ? 1.0 : 0.0);
+	}
+	sh->mean_torque = torque;
+}
+
+/* Newton on Phi_T(z) - z = 0 from the guess in z (updated). The machine is
+ * nearly linear, so the Jacobian in *J (valid when *have_J) is kept while
+ * each step shrinks the residual at least tenfold (the chord method; the
+ * motor-speed rounds reuse it as well), and computed afresh otherwise. */
+static void shoot(shooter *sh, double *z, double J[NZ][NZ], int *have_J)
+{
+	int m = 2 * sh->mm.nq;
+	double end[NZ], A[NZ][NZ], r[NZ], last = INFINITY;
 	for (int it = 0; it < NEWTON_MAX; it++) {
 		one_period(sh, z, end);
 		double norm = 0.0, scale = 0.0;
@@ -89,17 +109,13 @@ static void shoot(shooter *sh, double *z)
 		}
 		if (norm <= 1e-13 * fmax(scale, 1e-3))
 			break;
-		double torque = sh->mean_torque;
-		for (int b = 0; b < m; b++) {
-			memcpy(pert, z, sizeof(double) * (size_t)m);
-			double hz = 1e-7 * fmax(fabs(z[b]), b < m / 2 ? 1e-3 : 1e-1);
-			pert[b] += hz;
-			one_period(sh, pert, endp);
-			for (int a = 0; a < m; a++)
-				J[a][b] = (endp[a] - end[a]) / hz - (a == b ? 1.0 : 0.0);
+		if (!*have_J || !(norm <= 0.1 * last)) {
+			shoot_jacobian(sh, z, end, J);
+			*have_J = 1;
 		}
-		sh->mean_torque = torque;
-		dynamics_dense_solve(m, NZ, &J[0][0], r);
+		last = norm;
+		memcpy(A, J, sizeof A);
+		dynamics_dense_solve(m, NZ, &A[0][0], r);
 		for (int i = 0; i < m; i++)
 			if (!isfinite(r[i]))
 				return;
@@ -160,14 +176,14 @@ void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
 	sh.ctl.omega_ss = ctl->omega_ss;
 	double psi0 = q0[Q_PHI] - q0[Q_ALPHA];
 	double Omega = (double)ctl->rotation * ctl->omega_ss;
-	double z[NZ] = {0};
-	int nq = sh.mm.nq;
+	double z[NZ] = {0}, J[NZ][NZ];
+	int nq = sh.mm.nq, have_J = 0;
 	for (int r = 0; r < nq; r++)
 		z[r] = q0[sh.mm.col[r][0]]; /* the guess: the static equilibrium */
 	for (int it = 0; it < OMEGA_ITER; it++) {
 		sh.T = 2.0 * M_PI / fabs(Omega);
 		ramp_hold(&sh.ctl.psi_ramp, 0.0, psi0, Omega);
-		shoot(&sh, z);
+		shoot(&sh, z, J, &have_J);
 		double next = motor_speed_for(md, ctl, sh.mean_torque);
 		if (md->phi_prescribed || !isfinite(next))
 			break;

@@ -340,8 +340,8 @@ static void heavy_feed_coupling_stays_stable(void **state)
 	setup light = preset(), heavy = preset();
 	set(&heavy, "layers", "24");
 	s = make(&light);
-	assert_close(status(s).dt, 5e-4, 0.0);
-	assert_int_equal(status(s).substeps, 20);
+	assert_close(status(s).dt, 1e-3, 0.0);
+	assert_int_equal(status(s).substeps, 16);
 	sim_free(s);
 	s = make(&heavy);
 	assert_close(status(s).dt, 2.5e-5, 0.0);

@@ -1,0 +1,120 @@
+/*
+ * model_solve.c - the machine's mass matrix solve (model.h): the reduced
+ * system T^t M T qr'' = T^t (rhs - M qp'') for the accelerations. Each
+ * point mass moves one coordinate of its own (phi for the vibrator, s_i
+ * for eliminator i) with a constant inertia, and no two of those couple,
+ * so M is a 3 x 3 block on the trough's (x, y, alpha) bordered by a
+ * constant diagonal: the own coordinates are eliminated with the inverses
+ * model_solve_layout computes once, and only the Schur complement on the
+ * trough's coordinates is factored (LDL^T, no square roots) at each
+ * evaluation, instead of a Cholesky factorisation of the whole matrix.
+ */
+#include <math.h>
+
+#include "model.h"
+
+void model_solve_layout(model *md)
+{
+	const sim_params *p = &md->p;
+	/* M's diagonal on a point mass's own coordinate, constant: J_w + m e^2
+	 * on phi (|jo| = e), m_i on s_i (|jo| = |u| = 1) */
+	md->own_m[Q_PHI] = p->J_w + p->m * p->e * p->e;
+	md->own_m[Q_S1] = p->m1;
+	md->own_m[Q_S2] = p->m2;
+	md->n_body = 0;
+	for (int r = 0; r < md->nq; r++) {
+		int i = md->col[r][0];
+		md->own_inv[r] = 0.0;
+		if (md->ncol[r] == 1 && (i == Q_PHI || i == Q_S1 || i == Q_S2))
+			md->own_inv[r] = 1.0 / md->own_m[i];
+		else
+			md->body[md->n_body++] = r;
+	}
+}
+
+/* In-place LDL^T solve of the n x n (n <= 3) SPD system A x = b (lower
+ * half of A used and overwritten). Returns 0, or -1 if A is not positive
+ * definite. */
+static int ldlt_solve(int n, double A[3][3], double *b)
+{
+	for (int j = 0; j < n; j++) {
+		double d = A[j][j];
+		for (int k = 0; k < j; k++)
+			d -= A[j][k] * A[j][k] * A[k][k];
+		if (!(d > 0.0))
+			return -1;
+		A[j][j] = d;
+		double inv = 1.0 / d;
+		for (int i = j + 1; i < n; i++) {
+			double s = A[i][j];
+			for (int k = 0; k < j; k++)
+				s -= A[i][k] * A[j][k] * A[k][k];
+			A[i][j] = s * inv;
+		}
+	}
+	for (int i = 0; i < n; i++)
+		for (int k = 0; k < i; k++)
+			b[i] -= A[i][k] * b[k];
+	for (int i = n - 1; i >= 0; i--) {
+		b[i] /= A[i][i];
+		for (int k = i + 1; k < n; k++)
+			b[i] -= A[k][i] * b[k];
+	}
+	return 0;
+}
+
+/* The point masses' own coordinates (phi, s1, s2 where integrated alone)
+ * have constant, mutually uncoupled diagonals (md->own_inv holds their
+ * inverses), so they are eliminated first and only the Schur complement
+ * on the trough's coordinates (x, y and alpha, at most 3) is factored. */
+void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
+{
+	int n = md->nq, nb = md->n_body;
+	double Mr[NQ_FULL][NQ_FULL], res[NQ_FULL], S[3][3], x[3];
+	for (int i = 0; i < NQ_FULL; i++)
+		res[i] = md->phi_prescribed ? rhs[i] - M[i][Q_PHI] * qpdd[Q_PHI] : rhs[i];
+	for (int r = 0; r < n; r++) {
+		const int *ir = md->col[r];
+		br[r] = md->ncol[r] == 1 ? res[ir[0]] : res[ir[0]] + res[ir[1]];
+		for (int c = 0; c < nb; c++) {
+			const int *ic = md->col[md->body[c]];
+			double m = 0.0;
+			for (int a = 0; a < md->ncol[r]; a++)
+				for (int b = 0; b < md->ncol[md->body[c]]; b++)
+					m += M[ir[a]][ic[b]];
+			Mr[r][c] = m;
+		}
+	}
+	/* Mr[r][c]: row r against body coordinate c; S = B - C D^-1 C^T */
+	for (int a = 0; a < nb; a++) {
+		int ra = md->body[a];
+		x[a] = br[ra];
+		for (int c = 0; c <= a; c++)
+			S[a][c] = Mr[ra][c];
+		for (int d = 0; d < n; d++) {
+			double inv = md->own_inv[d];
+			if (inv == 0.0)
+				continue;
+			x[a] -= Mr[d][a] * inv * br[d];
+			for (int c = 0; c <= a; c++)
+				S[a][c] -= Mr[d][a] * inv * Mr[d][c];
+		}
+	}
+	if (ldlt_solve(nb, S, x) != 0) {
+		for (int r = 0; r < n; r++)
+			br[r] = NAN;
+		return;
+	}
+	for (int d = 0; d < n; d++) {
+		double inv = md->own_inv[d];
+		if (inv == 0.0)
+			continue;
+		double s = br[d];
+		for (int c = 0; c < nb; c++)
+			s -= Mr[d][c] * x[c];
+		br[d] = s * inv;
+	}
+	for (int a = 0; a < nb; a++)
+		br[md->body[a]] = x[a];
+}
