@@ -60,6 +60,8 @@ static const opt opts[] = {
 	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
 	 F(checkpoint_interval)},
 	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout)},
+	{"node-id", OPT_STRING, 0, 0, F(node_id)},
+	{"peers", OPT_STRING, 0, 0, F(peers)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -86,7 +88,11 @@ static void usage(FILE *f)
 		"  --checkpoint-interval S  wall seconds between session "
 		"checkpoints (default 10)\n"
 		"  --idle-timeout S     remove sessions with no client and no "
-		"request for S seconds (default 0: never)\n");
+		"request for S seconds (default 0: never)\n"
+		"  --node-id NAME       this replica's name (1-10 of a-z 0-9 -): "
+		"every id it makes starts NAME-\n"
+		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
+		"gather theirs\n");
 }
 
 static int parse_int(const char *arg, const char *name, long lo, long hi,
@@ -146,6 +152,19 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	}
 }
 
+/* 1..SRV_NODE_ID_MAX of [a-z0-9-], not starting with '-'. */
+static int valid_node_id(const char *id)
+{
+	size_t n = strlen(id);
+	if (n < 1 || n > SRV_NODE_ID_MAX || id[0] == '-')
+		return 0;
+	for (size_t i = 0; i < n; i++)
+		if (!((id[i] >= 'a' && id[i] <= 'z') ||
+		      (id[i] >= '0' && id[i] <= '9') || id[i] == '-'))
+			return 0;
+	return 1;
+}
+
 /* web/ next to the working directory, else next to the binary's parent. */
 static void pick_web_root(srv_config *cfg, const char *argv0)
 {
@@ -196,6 +215,12 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 	if (optind < argc) {
 		fprintf(stderr, "convsimd: unexpected argument %s\n",
 			argv[optind]);
+		return -1;
+	}
+	if (cfg->node_id && !valid_node_id(cfg->node_id)) {
+		fprintf(stderr, "convsimd: --node-id must be 1 to %d characters "
+				"of a-z, 0-9 and '-', starting with a letter "
+				"or digit\n", SRV_NODE_ID_MAX);
 		return -1;
 	}
 	pick_web_root(cfg, argv[0]);

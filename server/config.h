@@ -26,7 +26,12 @@ typedef struct srv_config {
 	int max_experiments, max_sweeps;
 	double checkpoint_interval; /* s of wall time between checkpoints */
 	double idle_timeout;   /* s without client or request; 0: never */
+	const char *node_id;   /* --node-id: ids start "NODE-"; NULL: none */
+	const char *peers;     /* --peers: comma list of http://HOST:PORT */
 } srv_config;
+
+/* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */
+#define SRV_NODE_ID_MAX 10
 
 /* Fill *cfg from the defaults and the command line (argv is borrowed: the
  * strings stay argv's). Returns 0; 1 after --help (usage printed); -1 on a
