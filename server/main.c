@@ -22,6 +22,7 @@
 #include "config.h"
 #include "experiment_http.h"
 #include "metrics.h"
+#include "peers.h"
 #include "pool.h"
 #include "routes.h"
 #include "session.h"
@@ -118,7 +119,7 @@ int main(int argc, char **argv)
 	signal(SIGPIPE, SIG_IGN);
 
 	listen_addr la;
-	if (resolve_listen(&cfg, &la))
+	if (resolve_listen(&cfg, &la) || srv_peers_init(&cfg))
 		return 2;
 
 	srv_catalog_init(&cfg);
