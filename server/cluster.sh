@@ -79,6 +79,8 @@ write_config() {
 		echo "    timeout client $((4 * HEARTBEAT))s"
 		echo "    timeout server $((4 * HEARTBEAT))s"
 		echo "    timeout tunnel 1h"
+		echo "    # a stream's records leave at once (else each waits for the next, MSG_MORE)"
+		echo "    option http-no-delay"
 		echo "    retries 2"
 		echo "frontend convsim"
 		echo "    bind $PROXY_HOST:$PROXY_PORT"

@@ -9,58 +9,31 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
-import net from 'node:net';
 import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { BIN, SLOW, WEB_ROOT, CHEAP, req, openStream, until } from './lib.mjs';
+import { SLOW, WEB_ROOT, CHEAP, CLUSTER_SCRIPT, req, openStream, until, startCluster } from './lib.mjs';
 
-const SCRIPT = fileURLToPath(new URL('../../server/cluster.sh', import.meta.url));
 const HEARTBEAT = 1; // s; the proxy's idle timeouts are four of them
 const ID = /^(n[123])-[0-9a-f]{12}$/;
 
-// n distinct free loopback ports (held open together, then released).
-async function freePorts(n) {
-  const servers = await Promise.all(Array.from({ length: n }, () => new Promise((resolve) => {
-    const s = net.createServer();
-    s.listen(0, '127.0.0.1', () => resolve(s));
-  })));
-  const ports = servers.map((s) => s.address().port);
-  await Promise.all(servers.map((s) => new Promise((r) => s.close(r))));
-  return ports;
-}
-
 const alive = (pid) => { try { process.kill(pid, 0); return true; } catch { return false; } };
 
-let dir, env, runner, base, restarted = null, output = '';
+let dir, cluster, env, base, restarted = null;
 const started = []; // every pid this file may have to stop
 
 before(async () => {
   dir = fs.mkdtempSync(path.join(os.tmpdir(), 'convsim-cluster-'));
-  const [proxy, ...ports] = await freePorts(4);
-  env = {
-    ...process.env, N: '3', PROXY_PORT: String(proxy), PORTS: ports.join(' '), DIR: dir,
-    CONVSIMD: BIN, HEARTBEAT: String(HEARTBEAT),
+  cluster = await startCluster(3, dir, {
+    HEARTBEAT: String(HEARTBEAT),
     DAEMON_FLAGS: `--log-level warn --web-root ${WEB_ROOT} --checkpoint-interval 0.5`,
-  };
-  runner = spawn('bash', [SCRIPT, 'run'], { env, detached: true, stdio: ['ignore', 'pipe', 'pipe'] });
-  started.push(runner.pid);
-  runner.stderr.on('data', (d) => { output += d; });
-  base = await new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`no cluster line: ${output}`)), 20000 * SLOW);
-    runner.stdout.on('data', (d) => {
-      output += d;
-      const m = output.match(/^cluster: (http:\/\/127\.0\.0\.1:\d+)\//m);
-      if (m) { clearTimeout(timer); resolve(m[1]); }
-    });
-    runner.on('exit', (code) => { clearTimeout(timer); reject(new Error(`cluster.sh exited ${code}: ${output}`)); });
   });
-  for (const f of ['n1', 'n2', 'n3', 'haproxy']) started.push(Number(fs.readFileSync(path.join(dir, `${f}.pid`), 'utf8')));
+  ({ base, env } = cluster);
+  started.push(cluster.runner.pid, ...Object.values(cluster.pids));
 });
 
 after(async () => {
   if (restarted && alive(restarted.pid)) restarted.kill('SIGTERM');
-  if (runner && alive(runner.pid)) process.kill(runner.pid, 'SIGTERM');
+  if (cluster) cluster.stop();
   await until(() => started.every((pid) => !alive(pid)) && (!restarted || restarted.exitCode !== null), 20000,
     'every process of the cluster to stop').catch(() => {
     for (const pid of started) if (alive(pid)) process.kill(pid, 'SIGKILL');
@@ -146,7 +119,7 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
     const before3 = new Map();
     for (const id of per.n3) before3.set(id, (await req(base, 'GET', `/api/v1/sessions/${id}`)).body.status.t);
     await new Promise((r) => setTimeout(r, 1000)); // a checkpoint after these reads (0.5 s)
-    const pid3 = Number(fs.readFileSync(path.join(dir, 'n3.pid'), 'utf8'));
+    const pid3 = cluster.pids.n3;
     process.kill(pid3, 'SIGKILL');
     await until(() => !alive(pid3), 5000, 'n3 to die');
     for (const id of per.n3) {
@@ -162,7 +135,7 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
     assert.equal(partial.status, 200);
     assert.equal(partial.body.sessions.length, 20);
     assert.equal(partial.body.unreachable.length, 1);
-    assert.equal(partial.body.unreachable[0].peer, `http://127.0.0.1:${env.PORTS.split(' ')[2]}`);
+    assert.equal(partial.body.unreachable[0].peer, `http://127.0.0.1:${cluster.ports[2]}`);
     assert.equal(partial.headers.get('convsim-unreachable'), partial.body.unreachable[0].peer);
     // once HAProxy's health check has marked n3 down, creations go to the others only
     await new Promise((r) => setTimeout(r, 2500)); // fall 2 x inter 1 s
@@ -174,7 +147,7 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
     }
 
     // restarted on its data directory, n3's sessions come back through the proxy
-    restarted = spawn('bash', [SCRIPT, 'replica', 'n3'], { env, stdio: 'ignore' });
+    restarted = spawn('bash', [CLUSTER_SCRIPT, 'replica', 'n3'], { env, stdio: 'ignore' });
     await until(async () => (await req(base, 'GET', `/api/v1/sessions/${per.n3[0]}`)).status === 200,
       15000, 'n3 back behind the proxy');
     for (const id of per.n3) {
@@ -191,7 +164,7 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
 test('cluster.sh stops every process it started', { timeout: 30000 * SLOW }, async () => {
   const pids = started.slice(1);
   assert.ok(pids.slice(0, 2).every(alive), 'n1 and n2 run');
-  process.kill(runner.pid, 'SIGTERM');
-  await until(() => pids.every((pid) => !alive(pid)) && !alive(runner.pid), 20000, 'the cluster to stop');
+  assert.equal(await cluster.stop(), 0);
+  await until(() => pids.every((pid) => !alive(pid)), 20000, 'the cluster to stop');
   assert.equal(fs.existsSync(path.join(dir, 'n1.pid')), false, 'pid files removed');
 });
