@@ -209,27 +209,6 @@ static const char *fetch_body(fetch *f, size_t *len)
 	return head_end + 4;
 }
 
-/* Queue the merged answer with the Convsim-Unreachable header if any. */
-static enum MHD_Result reply_merged(srv_req *r, char *text,
-				    const char *unreachable)
-{
-	if (!text)
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	struct MHD_Response *resp = MHD_create_response_from_buffer(
-		strlen(text), text, MHD_RESPMEM_MUST_FREE);
-	if (!resp) {
-		free(text);
-		return MHD_NO;
-	}
-	MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE,
-				r->csv ? "text/csv" : "application/json");
-	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-	MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Accept");
-	if (unreachable[0])
-		MHD_add_response_header(resp, "Convsim-Unreachable", unreachable);
-	return srv_queue(r, 200, resp);
-}
-
 enum MHD_Result srv_peers_reply(srv_req *r, char *local, const char *member)
 {
 	const char *scope = srv_query(r, "scope");
@@ -269,5 +248,6 @@ enum MHD_Result srv_peers_reply(srv_req *r, char *local, const char *member)
 			close(f[i].fd);
 		free(f[i].buf);
 	}
-	return reply_merged(r, api_list_finish(l), unreachable);
+	return srv_reply_result_with(r, api_list_finish(l), "Convsim-Unreachable",
+				     unreachable[0] ? unreachable : NULL);
 }

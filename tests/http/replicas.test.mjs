@@ -7,7 +7,8 @@ import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
-import { BIN, CHEAP, startDaemon, req, until } from './lib.mjs';
+import Ajv2020 from 'ajv/dist/2020.js';
+import { BIN, CHEAP, startDaemon, req } from './lib.mjs';
 
 // Run the daemon to its exit (bad flags end it at once).
 const refused = (args) => spawnSync(BIN, ['--port', '0', ...args], { encoding: 'utf8', timeout: 10000 });
@@ -86,6 +87,13 @@ test('--peers: lists gather every peer, ?scope=local does not, a dead or wrong p
     assert.equal(list.status, 200);
     assert.deepEqual(list.body.sessions.map((s) => s.id).sort(), [...ids].sort());
     assert.deepEqual(list.body.unreachable, [{ peer: oddUrl, reason: 'its answer is not a sessions list' }]);
+    // the merged, partial list is what the OpenAPI document says
+    const doc = (await req(a.base, 'GET', '/api/v1/openapi.json')).body;
+    const ajv = new Ajv2020({ strict: false, allErrors: true });
+    ajv.addSchema({ ...doc, $id: 'https://convsim.invalid/openapi.json' });
+    const SessionList = ajv.getSchema('https://convsim.invalid/openapi.json#/components/schemas/SessionList');
+    assert.ok(SessionList(list.body), ajv.errorsText(SessionList.errors));
+    assert.ok(doc.paths['/api/v1/sessions'].get.parameters.some((q) => q.name === 'scope'));
     assert.equal(list.headers.get('convsim-unreachable'), oddUrl);
     const local = await req(a.base, 'GET', '/api/v1/sessions?scope=local');
     assert.deepEqual(local.body.sessions.map((s) => s.id), [ids[0]]);
