@@ -15,7 +15,12 @@
 //     for 1, 2 and 3 replicas on this machine: N default sessions at pace 1
 //     created through the proxy (spread by leastconn), 10 s of wall time,
 //     how many keep a real-time factor >= 0.95 (heldInRealTime of
-//     realtime.mjs); CPU seconds of the replicas and of HAProxy over the run.
+//     realtime.mjs); CPU of the replicas and of HAProxy over the run, and
+//     the replicas' CPU per simulated second (sessions' t summed), which the
+//     other loads on a shared machine do not change much.
+//   node tests/bench/cluster.mjs idle
+//     3 idle replicas and HAProxy (health checks every second) for 10 s:
+//     each one's CPU and resident memory.
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -116,26 +121,46 @@ async function capacity(counts) {
       const replicas = Object.entries(c.pids).filter(([k]) => k !== 'haproxy').map(([, v]) => v);
       for (const N of counts) {
         const w0 = performance.now(), r0 = cpuOf(replicas), h0 = cpuSeconds(c.pids.haproxy);
-        const { ok, min, median } = await heldInRealTime(c.base, N);
+        const load = os.loadavg()[0];
+        const { ok, min, median, simulated } = await heldInRealTime(c.base, N);
         const wall = (performance.now() - w0) / 1000;
         const rc = cpuOf(replicas) - r0, hc = cpuSeconds(c.pids.haproxy) - h0;
         rows.push(`| ${n} | ${N} | ${ok} | ${min.toFixed(2)} | ${median.toFixed(2)} | `
-          + `${(rc / wall).toFixed(2)} | ${(100 * hc / wall).toFixed(2)} % |`);
+          + `${(rc / wall).toFixed(2)} | ${(1000 * rc / simulated).toFixed(1)} | ${(100 * hc / wall).toFixed(2)} % | ${load.toFixed(1)} |`);
         console.error(rows[rows.length - 1]);
       }
     });
   }
   console.log(`Command: \`node tests/bench/cluster.mjs capacity ${counts.join(' ')}\` (czubak2016 defaults, pace 1, `
     + '10 s of wall time, created through HAProxy; 2 cores shared with other builds)\n');
-  console.log('| replicas | sessions | at >= 0.95 of real time | slowest rtf | median rtf | replicas\' CPU / cores | HAProxy CPU |');
-  console.log('|---|---|---|---|---|---|---|');
+  console.log('| replicas | sessions | at >= 0.95 of real time | slowest rtf | median rtf | replicas\' CPU / cores '
+    + '| replicas\' CPU ms per simulated s | HAProxy CPU | load average |');
+  console.log('|---|---|---|---|---|---|---|---|---|');
   for (const r of rows) console.log(r);
+}
+
+const rssMB = (pid) => Number(fs.readFileSync(`/proc/${pid}/status`, 'utf8').match(/VmRSS:\s+(\d+)/)[1]) / 1024;
+
+async function idle() {
+  await withCluster(3, async (c) => {
+    await sleep(1000);
+    const pids = Object.entries(c.pids);
+    const before = pids.map(([, p]) => cpuSeconds(p));
+    await sleep(10000);
+    console.log('Command: `node tests/bench/cluster.mjs idle` (3 replicas, no session, 10 s)\n');
+    console.log('| process | CPU (% of one core) | resident memory / MB |');
+    console.log('|---|---|---|');
+    pids.forEach(([name, p], i) => {
+      console.log(`| ${name} | ${(10 * (cpuSeconds(p) - before[i])).toFixed(2)} | ${rssMB(p).toFixed(1)} |`);
+    });
+  });
 }
 
 const [what, ...rest] = process.argv.slice(2);
 if (what === 'latency') await latency(Number(rest[0]) || 300);
+else if (what === 'idle') await idle();
 else if (what === 'capacity') await capacity(rest.length ? rest.map(Number) : [100, 125, 150]);
 else {
-  console.error('usage: node tests/bench/cluster.mjs latency [PATCHES] | capacity [N ...]');
+  console.error('usage: node tests/bench/cluster.mjs latency [PATCHES] | capacity [N ...] | idle');
   process.exit(2);
 }
