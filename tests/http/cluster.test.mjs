@@ -143,7 +143,7 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
       const r = await req(base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, sample_rate: 50 });
       assert.equal(r.status, 201, r.text);
       assert.notEqual(node(r.body.id), 'n3');
-      assert.equal((await req(base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
+      assert.equal((await req(base, 'DELETE', `/api/v1/sessions/${r.body.id}`, '')).status, 204);
     }
 
     // restarted on its data directory, n3's sessions come back through the proxy
