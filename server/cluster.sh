@@ -122,9 +122,9 @@ replica() {
 	[ -n "$addr" ] || die "no replica named $name in: $REPLICAS"
 	mkdir -p "$DIR/$name"
 	[ -z "${TOKEN_FILE:-}" ] || extra+=(--token-file "$TOKEN_FILE")
-	if "$CONVSIMD" --help | grep -q -- '--server-name'; then
-		extra+=(--server-name "$SERVER_NAME")
-	fi
+	case $("$CONVSIMD" --help) in
+	*--server-name*) extra+=(--server-name "$SERVER_NAME") ;;
+	esac
 	# shellcheck disable=SC2086 # DAEMON_FLAGS is a list of flags
 	exec "$CONVSIMD" --node-id "$name" --listen "${addr%:*}" --port "${addr##*:}" \
 		--data-dir "$DIR/$name" --heartbeat "$HEARTBEAT" --peers "${peers%,}" \
