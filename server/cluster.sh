@@ -20,8 +20,10 @@
 #   TOKEN_FILE          adds --token-file FILE to every replica
 #   SERVER_NAME [PROXY_HOST:PORT]  given to replicas as --server-name when the
 #                       daemon has that flag (the Host clients send the proxy)
-#   HEARTBEAT [15]      the replicas' --heartbeat; the proxy's idle timeouts
+#   HEARTBEAT [15]      whole seconds: the replicas' --heartbeat; the proxy's idle timeouts
 #                       are four of them, so streams stay open
+#   REQUEST_TIMEOUT [30] s the proxy waits for a replica's answer at least (a
+#                       creation computes the steady start; a busy machine)
 set -euo pipefail
 
 N=${N:-3}
@@ -33,6 +35,7 @@ DIR=${DIR:-var/cluster}
 CONVSIMD=${CONVSIMD:-build/convsimd}
 HAPROXY=${HAPROXY:-/usr/sbin/haproxy}
 HEARTBEAT=${HEARTBEAT:-15}
+REQUEST_TIMEOUT=${REQUEST_TIMEOUT:-30}
 SERVER_NAME=${SERVER_NAME:-$PROXY_HOST:$PROXY_PORT}
 if [ -z "${PORTS:-}" ]; then
 	PORTS=$(seq -s ' ' $((PROXY_PORT + 1)) $((PROXY_PORT + ${#NODE_NAMES[@]})))
@@ -60,7 +63,9 @@ errorfile() {
 # DIR/haproxy.cfg: creations and everything without an id to any replica
 # (leastconn); /sessions|experiments|sweeps|fits/NAME-<12 hex> to replica NAME.
 write_config() {
-	local abs name addr cfg r
+	local abs name addr cfg r idle
+	# the idle timeouts: four heartbeats, and at least one answer's time
+	idle=$((4 * HEARTBEAT > REQUEST_TIMEOUT ? 4 * HEARTBEAT : REQUEST_TIMEOUT))
 	mkdir -p "$DIR/errors"
 	abs=$(cd "$DIR" && pwd)
 	cfg="$DIR/haproxy.cfg"
@@ -76,9 +81,10 @@ write_config() {
 		    timeout http-request 10s
 		    timeout http-keep-alive 10s
 		    timeout queue 5s
-		    # streams (SSE, NDJSON) send a heartbeat every ${HEARTBEAT} s of silence
-		    timeout client $((4 * HEARTBEAT))s
-		    timeout server $((4 * HEARTBEAT))s
+		    # streams (SSE, NDJSON) send a heartbeat every ${HEARTBEAT} s of silence;
+		    # an answer may take ${REQUEST_TIMEOUT} s (a creation on a busy replica)
+		    timeout client ${idle}s
+		    timeout server ${idle}s
 		    timeout tunnel 1h
 		    # a stream's records leave at once (else each waits for the next, MSG_MORE)
 		    option http-no-delay

@@ -13,7 +13,10 @@ import os from 'node:os';
 import path from 'node:path';
 import { SLOW, WEB_ROOT, CHEAP, CLUSTER_SCRIPT, req, openStream, until, startCluster } from './lib.mjs';
 
-const HEARTBEAT = 1; // s; the proxy's idle timeouts are four of them
+// s; the proxy's idle timeouts are four of them (REQUEST_TIMEOUT the same:
+// the idle stream below outlives them; a creation on this busy machine
+// may take seconds); slower under the sanitizers
+const HEARTBEAT = 2 * Math.ceil(SLOW);
 const ID = /^(n[123])-[0-9a-f]{12}$/;
 
 const alive = (pid) => { try { process.kill(pid, 0); return true; } catch { return false; } };
@@ -25,6 +28,7 @@ before(async () => {
   dir = fs.mkdtempSync(path.join(os.tmpdir(), 'convsim-cluster-'));
   cluster = await startCluster(3, dir, {
     HEARTBEAT: String(HEARTBEAT),
+    REQUEST_TIMEOUT: String(4 * HEARTBEAT),
     DAEMON_FLAGS: `--log-level warn --web-root ${WEB_ROOT} --checkpoint-interval 0.5`,
   });
   ({ base, env } = cluster);
@@ -48,7 +52,8 @@ test('three replicas behind HAProxy: routing, streams, a replica killed and rest
     // 30 creations through the proxy land on all three replicas
     const ids = [];
     for (let i = 0; i < 30; i++) {
-      const r = await req(base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, sample_rate: 50 });
+      const r = await req(base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, sample_rate: 50 })
+        .catch((e) => { throw new Error(`POST through ${base}: ${e.cause?.message || e.message}\n${cluster.output()}`); });
       assert.equal(r.status, 201, r.text);
       assert.match(r.body.id, ID);
       assert.equal(r.headers.get('location'), `/api/v1/sessions/${r.body.id}`);
