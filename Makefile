@@ -55,7 +55,7 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
 
-.PHONY: all deps deps-build run test check bench mutate clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench mutate clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -138,6 +138,14 @@ run: deps-build $(BUILD)/convsimd
 	  echo "dashboard: $$url/#token=$$(cat $(TOKEN))"; \
 	  echo "curl:      curl -H \"Authorization: Bearer \$$(cat $(TOKEN))\" $$url/api/v1/sessions";; \
 	  esac; done
+
+# N replicas (--node-id n1..nN, --data-dir var/cluster/nK) behind one HAProxy
+# on PROXY_PORT (18700): server/cluster.sh, whose header lists the knobs
+# (PROXY_PORT, PORTS, DIR, DAEMON_FLAGS, TOKEN_FILE, SERVER_NAME, HEARTBEAT,
+# given here or in the environment). Ctrl-C stops everything.
+N       ?= 3
+cluster: deps-build $(BUILD)/convsimd
+	$(Q)N=$(N) CONVSIMD=$(BUILD)/convsimd bash server/cluster.sh run
 
 test: deps all
 	$(Q)BUILD=$(BUILD) bash tests/run.sh

@@ -130,7 +130,7 @@ int api_fmt_double(char *buf, size_t len, double v);
 enum {
 	API_Q_FORMAT = 1 << 0, API_Q_FROM = 1 << 1, API_Q_TO = 1 << 2, API_Q_STRIDE = 1 << 3,
 	API_Q_STREAM_FORMAT = 1 << 4, API_Q_FIELDS = 1 << 5, API_Q_RATE = 1 << 6,
-	API_Q_LIMIT = 1 << 7, API_Q_SINCE = 1 << 8,
+	API_Q_LIMIT = 1 << 7, API_Q_SINCE = 1 << 8, API_Q_SCOPE = 1 << 9,
 };
 typedef struct api_query {
 	unsigned bit;
@@ -431,6 +431,24 @@ char *api_sweep_csv(const api_sweep_view *v);
 char *api_sweep_list_csv(const api_sweep_view *v, size_t n);
 /* {"sweeps": [...]} of n views without their points. malloc'd text. */
 char *api_sweep_list_json(const api_sweep_view *v, size_t n);
+
+/* ---- listings across replicas (--peers) ------------------------------------ */
+
+/* One listing gathered from several replicas (list_json.c). */
+typedef struct api_list api_list;
+/* Start from the receiving replica's own listing (borrowed text): JSON
+ * with the array member `member` ("sessions", "experiments", "sweeps"),
+ * or CSV. NULL when that text is not such a listing or out of memory. */
+api_list *api_list_new(const char *member, int csv, const char *local);
+/* Append a peer's listing of the same kind (len bytes). Returns 0, or -1
+ * if it is not one (nothing appended): report the peer unreachable. */
+int api_list_add(api_list *l, const char *body, size_t len);
+/* Name a peer whose entries are missing (JSON: the "unreachable" member;
+ * CSV carries no such member: the server says it in a header). */
+void api_list_unreachable(api_list *l, const char *peer, const char *reason);
+/* The merged text (malloc'd; NULL if out of memory); frees l (NULL is
+ * accepted). */
+char *api_list_finish(api_list *l);
 
 /* ---- catalogue ------------------------------------------------------------- */
 

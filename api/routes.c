@@ -29,6 +29,9 @@ static const api_query queries[] = {
 	{API_Q_LIMIT, "limit", "{\"type\":\"integer\",\"minimum\":1}", "end after this many records"},
 	{API_Q_SINCE, "since", "{\"type\":\"integer\",\"minimum\":0}",
 	 "resume after this record id (as Last-Event-ID)"},
+	{API_Q_SCOPE, "scope", "{\"type\":\"string\",\"enum\":[\"all\",\"local\"]}",
+	 "all (default): this replica's entries and those of its --peers; local: this replica's "
+	 "only"},
 };
 
 #define TRAJ (API_Q_FORMAT | API_Q_FROM | API_Q_TO | API_Q_STRIDE)
@@ -36,7 +39,7 @@ static const api_query queries[] = {
 static const api_route routes[] = {
 	{"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
 	 "SessionCreate", 201, "Session", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sessions", API_Q_FORMAT, 1,
+	{"GET", "/api/v1/sessions", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All sessions with live status (CSV: one summary row each)", NULL, 200, "SessionList",
 	 "400,406"},
 	{"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
@@ -57,15 +60,15 @@ static const api_route routes[] = {
 	{"POST", "/api/v1/experiments", 0, 0,
 	 "Run a beta schedule; per segment the transport velocity and the reversal time",
 	 "ExperimentCreate", 201, "Experiment", "400,404,409,413,415,422,429,503"},
-	{"GET", "/api/v1/experiments", API_Q_FORMAT, 1,
+	{"GET", "/api/v1/experiments", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All kept experiments (CSV: one row per segment)", NULL, 200, "ExperimentList", "400,406"},
 	{"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per segment)", NULL, 200, "Experiment",
 	 "400,404,406"},
 	{"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
 	 "SweepCreate", 202, "Sweep", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sweeps", API_Q_FORMAT, 1, "All kept sweeps (CSV: one row per sweep)", NULL,
-	 200, "SweepList", "400,406"},
+	{"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
+	 "All kept sweeps (CSV: one row per sweep)", NULL, 200, "SweepList", "400,406"},
 	{"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per point, the CLI's sweep columns)", NULL, 200,
 	 "Sweep", "400,404,406"},

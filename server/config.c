@@ -65,6 +65,8 @@ static const opt opts[] = {
 	{"insecure", OPT_FLAG, 0, 0, F(insecure)},
 	{"allow-origin", OPT_LIST, 0, 0, F(allow_origins)},
 	{"server-name", OPT_LIST, 0, 0, F(server_names)},
+	{"node-id", OPT_STRING, 0, 0, F(node_id)},
+	{"peers", OPT_STRING, 0, 0, F(peers)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -101,7 +103,11 @@ static void usage(FILE *f)
 		"  --allow-origin ORIG  one more browser origin allowed to call "
 		"(repeatable, max 16)\n"
 		"  --server-name NAME   one more Host name the daemon answers to "
-		"(repeatable, max 16)\n");
+		"(repeatable, max 16)\n"
+		"  --node-id NAME       this replica's name (1-10 of a-z 0-9 -): "
+		"every id it makes starts NAME-\n"
+		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
+		"gather theirs\n");
 }
 
 static int parse_int(const char *arg, const char *name, long lo, long hi,
@@ -172,6 +178,19 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	}
 }
 
+/* 1..SRV_NODE_ID_MAX of [a-z0-9-], not starting with '-'. */
+static int valid_node_id(const char *id)
+{
+	size_t n = strlen(id);
+	if (n < 1 || n > SRV_NODE_ID_MAX || id[0] == '-')
+		return 0;
+	for (size_t i = 0; i < n; i++)
+		if (!((id[i] >= 'a' && id[i] <= 'z') ||
+		      (id[i] >= '0' && id[i] <= '9') || id[i] == '-'))
+			return 0;
+	return 1;
+}
+
 /* web/ next to the working directory, else next to the binary's parent. */
 static void pick_web_root(srv_config *cfg, const char *argv0)
 {
@@ -224,6 +243,12 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 	if (optind < argc) {
 		fprintf(stderr, "convsimd: unexpected argument %s\n",
 			argv[optind]);
+		return -1;
+	}
+	if (cfg->node_id && !valid_node_id(cfg->node_id)) {
+		fprintf(stderr, "convsimd: --node-id must be 1 to %d characters "
+				"of a-z, 0-9 and '-', starting with a letter "
+				"or digit\n", SRV_NODE_ID_MAX);
 		return -1;
 	}
 	pick_web_root(cfg, argv[0]);

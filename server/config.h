@@ -37,7 +37,12 @@ typedef struct srv_config {
 	int insecure;          /* serve beyond loopback without a token */
 	srv_list allow_origins; /* --allow-origin: more origins than ours */
 	srv_list server_names; /* --server-name: more Host names */
+	const char *node_id;   /* --node-id: ids start "NODE-"; NULL: none */
+	const char *peers;     /* --peers: comma list of http://HOST:PORT */
 } srv_config;
+
+/* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */
+#define SRV_NODE_ID_MAX 10
 
 /* Fill *cfg from the defaults and the command line (argv is borrowed: the
  * strings stay argv's). Returns 0; 1 after --help (usage printed); -1 on a

@@ -14,6 +14,7 @@
 #include "experiment.h"
 #include "experiment_http.h"
 #include "metrics.h"
+#include "peers.h"
 #include "session.h"
 #include "store.h"
 #include "util.h"
@@ -194,5 +195,5 @@ enum MHD_Result srv_h_experiments_list(srv_req *r)
 	srv_registry_release(&experiments, all, n);
 	free(v);
 	free(seg);
-	return srv_reply_result(r, text);
+	return srv_peers_reply(r, text, "experiments");
 }

@@ -23,6 +23,7 @@
 #include "experiment_http.h"
 #include "gate.h"
 #include "metrics.h"
+#include "peers.h"
 #include "pool.h"
 #include "routes.h"
 #include "session.h"
@@ -110,6 +111,7 @@ int main(int argc, char **argv)
 	if (parsed)
 		return parsed > 0 ? 0 : 2;
 	srv_log_init(cfg.log_level);
+	srv_ids_init(cfg.node_id);
 
 	sigset_t sigs;
 	sigemptyset(&sigs);
@@ -119,7 +121,8 @@ int main(int argc, char **argv)
 	signal(SIGPIPE, SIG_IGN);
 
 	listen_addr la;
-	if (resolve_listen(&cfg, &la) || srv_gate_init(&cfg))
+	if (resolve_listen(&cfg, &la) || srv_gate_init(&cfg) ||
+	    srv_peers_init(&cfg))
 		return 2;
 
 	srv_catalog_init(&cfg);

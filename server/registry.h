@@ -33,7 +33,7 @@
 #define SRV_ID_LEN 24
 
 typedef struct srv_entry {
-	char id[SRV_ID_LEN];     /* 16 hex digits, set by reserve */
+	char id[SRV_ID_LEN];     /* srv_new_id's, set by reserve */
 	int refs;                /* registry lock */
 	int published;           /* registry lock */
 	struct srv_entry *next;  /* registry lock; newest first */

@@ -36,9 +36,10 @@ enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp)
 	return rc;
 }
 
-enum MHD_Result srv_reply(srv_req *r, int status, const char *ctype,
-			  char *text, const char *extra_name,
-			  const char *extra_value)
+/* Queue text (taken) with its type, no-store and up to two more headers
+ * (name/value pairs; a NULL name or value skips one). */
+static enum MHD_Result reply_text(srv_req *r, int status, const char *ctype,
+				  char *text, const char *const extra[4])
 {
 	if (!text)
 		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
@@ -51,9 +52,18 @@ enum MHD_Result srv_reply(srv_req *r, int status, const char *ctype,
 	MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
 	MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL,
 				"no-store");
-	if (extra_name && extra_value)
-		MHD_add_response_header(resp, extra_name, extra_value);
+	for (int i = 0; i < 4; i += 2)
+		if (extra[i] && extra[i + 1])
+			MHD_add_response_header(resp, extra[i], extra[i + 1]);
 	return srv_queue(r, status, resp);
+}
+
+enum MHD_Result srv_reply(srv_req *r, int status, const char *ctype,
+			  char *text, const char *extra_name,
+			  const char *extra_value)
+{
+	const char *const extra[4] = {extra_name, extra_value, NULL, NULL};
+	return reply_text(r, status, ctype, text, extra);
 }
 
 enum MHD_Result srv_reply_json(srv_req *r, int status, char *text)
@@ -143,6 +153,14 @@ const char *srv_header(srv_req *r, const char *name)
 
 enum MHD_Result srv_reply_result(srv_req *r, char *text)
 {
-	return srv_reply(r, 200, r->csv ? "text/csv" : "application/json", text,
-			 MHD_HTTP_HEADER_VARY, "Accept");
+	return srv_reply_result_with(r, text, NULL, NULL);
+}
+
+enum MHD_Result srv_reply_result_with(srv_req *r, char *text,
+				      const char *name, const char *value)
+{
+	const char *const extra[4] = {MHD_HTTP_HEADER_VARY, "Accept", name,
+				      value};
+	return reply_text(r, 200, r->csv ? "text/csv" : "application/json",
+			  text, extra);
 }

@@ -59,5 +59,8 @@ const char *srv_header(srv_req *r, const char *name);
 /* 200 with a result in the negotiated representation (r->csv): text is
  * JSON or CSV accordingly (taken). */
 enum MHD_Result srv_reply_result(srv_req *r, char *text);
+/* The same with one more header (name or value NULL: none). */
+enum MHD_Result srv_reply_result_with(srv_req *r, char *text,
+				      const char *name, const char *value);
 
 #endif

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "peers.h"
 #include "session.h"
 #include "session_http.h"
 
@@ -53,7 +54,7 @@ enum MHD_Result srv_h_sessions_list(srv_req *r)
 	}
 	srv_sessions_release(all, n);
 	free(views);
-	return srv_reply_result(r, text);
+	return srv_peers_reply(r, text, "sessions");
 }
 
 enum MHD_Result srv_h_session_get(srv_req *r)

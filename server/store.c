@@ -212,6 +212,38 @@ static void *writer_main(void *arg)
 	return NULL;
 }
 
+/* DIR/node-id names the replica whose ids the directory holds: a start
+ * with another --node-id (or none) would serve ids a proxy routes
+ * elsewhere, so it is refused. Written (here, before the writer starts)
+ * at the first start with a node id. */
+static int check_node_id(const char *node_id)
+{
+	char p[4096], held[64] = "";
+	full_path(p, sizeof p, "node-id");
+	FILE *f = fopen(p, "r");
+	if (f) {
+		if (!fgets(held, sizeof held, f))
+			held[0] = '\0';
+		fclose(f);
+		held[strcspn(held, "\n")] = '\0';
+		if (strcmp(held, node_id ? node_id : "") == 0)
+			return 0;
+		fprintf(stderr, "convsimd: --data-dir %s belongs to --node-id "
+				"%s (its file node-id); start it with that "
+				"node id\n", st.dir, held[0] ? held : "(none)");
+		return -1;
+	}
+	if (!node_id)
+		return 0;
+	f = fopen(p, "w");
+	int bad = !f || fprintf(f, "%s\n", node_id) < 0;
+	if (f && fclose(f) != 0)
+		bad = 1;
+	if (bad)
+		fprintf(stderr, "convsimd: cannot write %s\n", p);
+	return bad ? -1 : 0;
+}
+
 int srv_store_open(const srv_config *cfg)
 {
 	st.dir = cfg->data_dir;
@@ -228,6 +260,8 @@ int srv_store_open(const srv_config *cfg)
 			return -1;
 		}
 	}
+	if (check_node_id(cfg->node_id))
+		return -1;
 	if (pthread_create(&st.thread, NULL, writer_main, NULL) != 0) {
 		fprintf(stderr, "convsimd: cannot start the store's writer\n");
 		return -1;

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "metrics.h"
+#include "peers.h"
 #include "pool.h"
 #include "registry.h"
 #include "store.h"
@@ -422,7 +423,7 @@ enum MHD_Result srv_h_sweeps_list(srv_req *r)
 	}
 	srv_registry_release(&sweeps, all, n);
 	free(v);
-	return srv_reply_result(r, text);
+	return srv_peers_reply(r, text, "sweeps");
 }
 
 enum MHD_Result srv_h_sweep_delete(srv_req *r)

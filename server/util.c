@@ -1,6 +1,7 @@
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
- * clocks, timed-wait deadlines, random ids and the stopping flag.
+ * clocks, timed-wait deadlines, random ids (with the replica's node id)
+ * and the stopping flag.
  */
 #include <fcntl.h>
 #include <stdarg.h>
@@ -62,10 +63,18 @@ struct timespec srv_deadline(double seconds)
 	return ts;
 }
 
+static const char *node_prefix; /* set once, before any thread starts */
+
+void srv_ids_init(const char *node_id)
+{
+	node_prefix = node_id && *node_id ? node_id : NULL;
+}
+
 void srv_new_id(char *id)
 {
 	static atomic_uint counter;
 	unsigned char raw[8];
+	int nraw = 8;
 	if (getrandom(raw, sizeof raw, 0) != (ssize_t)sizeof raw) {
 		unsigned long long x = (unsigned long long)(srv_unix_time() *
 							    1e6) ^
@@ -74,7 +83,11 @@ void srv_new_id(char *id)
 					<< 40);
 		memcpy(raw, &x, sizeof raw);
 	}
-	for (int i = 0; i < 8; i++)
+	if (node_prefix) {
+		id += sprintf(id, "%s-", node_prefix);
+		nraw = 6;
+	}
+	for (int i = 0; i < nraw; i++)
 		snprintf(id + 2 * i, 3, "%02x", raw[i]);
 }
 

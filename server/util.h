@@ -18,7 +18,11 @@ void srv_log(int level, const char *fmt, ...)
 /* Wall-clock seconds: monotonic (for pacing) and unix time. */
 double srv_now(void);
 double srv_unix_time(void);
-/* A fresh random id of 16 hex digits into id (>= 17 bytes). */
+/* Ids made from now on start "node_id-" (borrowed, kept; NULL or "": no
+ * prefix). Call once at start-up, before any id is made. */
+void srv_ids_init(const char *node_id);
+/* A fresh random id into id (>= 24 bytes): 16 hex digits, or with a node
+ * id "NODE-" and 12 hex digits (a proxy routes by the prefix). */
 void srv_new_id(char *id);
 /* Absolute deadline for pthread_cond_timedwait, seconds from now
  * (clamped to [0, 3600]). */

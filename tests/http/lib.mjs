@@ -172,3 +172,54 @@ export async function rawRequest(port, head, body = '') {
   }
   return { status: Number(lines[0].split(' ')[1]), headers, body: raw.subarray(at + 4), raw };
 }
+
+// n distinct free loopback ports (held open together, then released).
+export async function freePorts(n) {
+  const net = await import('node:net');
+  const servers = await Promise.all(Array.from({ length: n }, () => new Promise((resolve) => {
+    const s = net.createServer();
+    s.listen(0, '127.0.0.1', () => resolve(s));
+  })));
+  const ports = servers.map((s) => s.address().port);
+  await Promise.all(servers.map((s) => new Promise((r) => s.close(r))));
+  return ports;
+}
+
+export const CLUSTER_SCRIPT = fileURLToPath(new URL('../../server/cluster.sh', import.meta.url));
+
+// Replicas behind HAProxy, as `make cluster N=n` starts them
+// (server/cluster.sh run), on free ports in the directory dir; env adds to
+// the script's environment. Returns {base, env, pids: {n1.., haproxy},
+// runner, output(), stop()}: stop() sends SIGTERM to the script, which
+// stops everything it started.
+export async function startCluster(n, dir, env = {}) {
+  const [proxy, ...ports] = await freePorts(n + 1);
+  const fullEnv = {
+    ...process.env, N: String(n), PROXY_PORT: String(proxy), PORTS: ports.join(' '), DIR: dir,
+    CONVSIMD: BIN, DAEMON_FLAGS: `--log-level warn --web-root ${WEB_ROOT}`, ...env,
+  };
+  const runner = spawn('bash', [CLUSTER_SCRIPT, 'run'], { env: fullEnv, stdio: ['ignore', 'pipe', 'pipe'] });
+  let output = '';
+  runner.stderr.on('data', (d) => { output += d; });
+  const exited = new Promise((resolve) => runner.on('exit', (code) => resolve(code)));
+  const base = await new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`no cluster line: ${output}`)), 20000 * SLOW);
+    runner.stdout.on('data', (d) => {
+      output += d;
+      const m = output.match(/^cluster: (http:\/\/127\.0\.0\.1:\d+)\//m);
+      if (m) { clearTimeout(timer); resolve(m[1]); }
+    });
+    exited.then((code) => { clearTimeout(timer); reject(new Error(`cluster.sh exited ${code}: ${output}`)); });
+  });
+  const { readFileSync } = await import('node:fs');
+  const pids = {};
+  for (let k = 1; k <= n; k++) pids[`n${k}`] = Number(readFileSync(`${dir}/n${k}.pid`, 'utf8'));
+  pids.haproxy = Number(readFileSync(`${dir}/haproxy.pid`, 'utf8'));
+  return {
+    base, env: fullEnv, pids, runner, ports, output: () => output,
+    async stop() {
+      if (runner.exitCode === null) runner.kill('SIGTERM');
+      return exited;
+    },
+  };
+}
