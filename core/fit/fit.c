@@ -1,0 +1,550 @@
+/*
+ * fit.c - the least-squares driver of a calibration: Levenberg-Marquardt in
+ * a trust region (GSL's gsl_multifit_nlinear, trs_lm, More scaling) on the
+ * residuals r_i = (model_i - data_i) / sigma_i (sigma_i = 1 when the data
+ * give none).
+ *
+ * Bounds by a smooth transform: each free parameter x in [lo, hi] is
+ * x = lo + (hi - lo) (1 + sin z) / 2 over an unbounded z (on log x when
+ * lo > 0 and hi / lo >= 1000, so that a stiffness spanning decades moves
+ * in proportion); the solver works in z and never leaves the bounds.
+ *
+ * Jacobian by forward differences in x, all columns in one parallel batch:
+ * step h_j = fd_rel * max(|x_j|, 1e-3 (hi_j - lo_j)) (5 % by default),
+ * backwards when x_j + h_j passes hi_j. The steady-state measure is not
+ * smooth at the 0.3 % level (its 4-s window sees whole periods only, and
+ * the feed's contact pattern shifts), so the step must move v well beyond
+ * that: 5 % of e moves v by about 12 %, 40 times the jitter (README
+ * "Calibration"). Then J_z = J_x dx/dz.
+ *
+ * Standard errors from the Jacobian in x at the optimum: cov = (J^T J)^-1
+ * when every datum has its sigma, else s2 (J^T J)^-1 with the residual
+ * variance s2 = chi2 / (n - p). Computed by SVD of J with its columns
+ * scaled to unit length; the scaled condition number flags combinations of
+ * parameters the data cannot fix.
+ */
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fit_int.h"
+#include "units.h"
+
+/* the scaled condition number above which a combination counts as not
+ * identifiable: a correlation of 0.9998 between two parameters */
+#define COND_WARN 100.0
+#define BOUND_NEAR 1e-3
+
+typedef struct ctx {
+	const fit_request *req;
+	fit_eval ev;
+	fit_result *res;
+	int p;
+	size_t n;
+	double *w;            /* per datum: sigma or 1 */
+	double *data;         /* per datum: v or peak beta */
+	/* the last f evaluation at an x, and the last Jacobian */
+	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
+	int fvalid;
+	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
+	int jvalid;
+	int iteration;
+} ctx;
+
+static int log_scale(const fit_free *f)
+{
+	return f->lo > 0 && f->hi / f->lo >= 1000;
+}
+
+static double x_of_z(const fit_free *f, double z)
+{
+	double u = 0.5 * (1 + sin(z));
+	if (log_scale(f))
+		return exp(log(f->lo) + u * (log(f->hi) - log(f->lo)));
+	return f->lo + u * (f->hi - f->lo);
+}
+
+static double dx_dz(const fit_free *f, double z)
+{
+	double du = 0.5 * cos(z);
+	if (log_scale(f))
+		return x_of_z(f, z) * (log(f->hi) - log(f->lo)) * du;
+	return (f->hi - f->lo) * du;
+}
+
+/* z of x; a start on a bound moves BOUND_NEAR of the width inside, where
+ * dx/dz is not zero. */
+static double z_of_x(const fit_free *f, double x)
+{
+	double u = log_scale(f) ? (log(x) - log(f->lo)) / (log(f->hi) - log(f->lo))
+				: (x - f->lo) / (f->hi - f->lo);
+	u = fmin(fmax(u, BOUND_NEAR), 1 - BOUND_NEAR);
+	return asin(2 * u - 1);
+}
+
+static void xs_of(const ctx *c, const gsl_vector *z, double *x)
+{
+	for (int j = 0; j < c->p; j++)
+		x[j] = x_of_z(&c->req->free[j], gsl_vector_get(z, (size_t)j));
+}
+
+static void report(ctx *c, const char *phase, const double *x, double cost)
+{
+	if (!c->req->progress)
+		return;
+	fit_progress pr = {phase, c->iteration, 0, cost, {0}};
+	pthread_mutex_lock(&c->ev.lock);
+	pr.evaluations = c->ev.evaluations;
+	pthread_mutex_unlock(&c->ev.lock);
+	for (int j = 0; x && j < c->p; j++)
+		pr.x[j] = x[j];
+	c->req->progress(c->req->ctx, &pr);
+}
+
+static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
+{
+	ctx *c = arg;
+	double x[FIT_MAX_FREE];
+	xs_of(c, z, x);
+	if (fit_eval_data(&c->ev, 1, x, c->fmodel, c->fmodel_u) != 0)
+		return GSL_EBADFUNC;
+	memcpy(c->fx, x, sizeof x);
+	c->fvalid = 1;
+	double cost = 0;
+	for (size_t i = 0; i < c->n; i++) {
+		double r = (c->fmodel[i] - c->data[i]) / c->w[i];
+		gsl_vector_set(f, i, r);
+		cost += r * r;
+	}
+	report(c, "fitting", x, cost);
+	return GSL_SUCCESS;
+}
+
+static int same_x(const double *a, const double *b, int p)
+{
+	return memcmp(a, b, sizeof *a * (size_t)p) == 0;
+}
+
+/* The forward-difference step of parameter j at x (signed). */
+static double fd_step(const ctx *c, int j, double x)
+{
+	const fit_free *f = &c->req->free[j];
+	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
+	h = fmin(h, 0.25 * (f->hi - f->lo));
+	return x + h <= f->hi ? h : -h;
+}
+
+/* J_x (weighted) at x into c->jac_x: the base set (unless f has it) and
+ * one perturbed set per parameter, in one batch. */
+static int jacobian_x(ctx *c, const double *x)
+{
+	int p = c->p, base = !(c->fvalid && same_x(c->fx, x, p));
+	size_t sets = (size_t)p + (size_t)base, n = c->n;
+	double *xs = malloc(sizeof *xs * sets * (size_t)p), *out = malloc(sizeof *out * sets * n);
+	double h[FIT_MAX_FREE];
+	int rc = xs && out ? 0 : -1;
+	for (size_t s = 0; rc == 0 && s < sets; s++)
+		for (int j = 0; j < p; j++) {
+			int pert = (int)s - base;
+			if (pert == j)
+				h[j] = fd_step(c, j, x[j]);
+			xs[s * (size_t)p + (size_t)j] = x[j] + (pert == j ? h[j] : 0);
+		}
+	if (rc == 0)
+		rc = fit_eval_data(&c->ev, sets, xs, out, NULL);
+	const double *f0 = base ? out : c->fmodel;
+	for (size_t i = 0; rc == 0 && i < n; i++)
+		for (int j = 0; j < p; j++)
+			c->jac_x[i * (size_t)p + (size_t)j] =
+				(out[((size_t)j + (size_t)base) * n + i] - f0[i]) / h[j] / c->w[i];
+	if (rc == 0) {
+		memcpy(c->jx, x, sizeof *x * (size_t)p);
+		c->jvalid = 1;
+	}
+	free(xs);
+	free(out);
+	return rc;
+}
+
+static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
+{
+	ctx *c = arg;
+	double x[FIT_MAX_FREE];
+	xs_of(c, z, x);
+	if (jacobian_x(c, x) != 0)
+		return GSL_EBADFUNC;
+	for (size_t i = 0; i < c->n; i++)
+		for (int j = 0; j < c->p; j++)
+			gsl_matrix_set(J, i, (size_t)j,
+				       c->jac_x[i * (size_t)c->p + (size_t)j] *
+					       dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
+	return GSL_SUCCESS;
+}
+
+static void warn(fit_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void warn(fit_result *res, const char *fmt, ...)
+{
+	if (res->nwarn >= FIT_MAX_WARNINGS)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(res->warnings[res->nwarn++], FIT_MSG, fmt, ap);
+	va_end(ap);
+}
+
+/* The parameter combination the data fix least (the right singular vector
+ * of the smallest singular value, as relative changes) into buf. */
+static void weak_combination(const ctx *c, const gsl_matrix *V, const double *scale,
+			     char *buf, size_t len)
+{
+	const fit_result *res = c->res;
+	size_t last = (size_t)c->p - 1, at = 0;
+	double d[FIT_MAX_FREE], norm = 0;
+	for (int j = 0; j < c->p; j++) {
+		/* direction in x: D^-1 v; as a relative change of x_j */
+		d[j] = gsl_matrix_get(V, (size_t)j, last) / scale[j] /
+		       fmax(fabs(res->x[j]), 1e-300);
+		norm = fmax(norm, fabs(d[j]));
+	}
+	for (int j = 0; j < c->p && at < len; j++)
+		if (fabs(d[j]) > 0.05 * norm)
+			at += (size_t)snprintf(buf + at, len - at, "%s%+.2f %s", at ? " " : "",
+					       d[j] / norm, c->req->free[j].name);
+}
+
+/* Standard errors, correlations, the condition number and the
+ * identifiability warnings from J_x (weighted) at the optimum. */
+static void covariance(ctx *c)
+{
+	fit_result *res = c->res;
+	int p = c->p;
+	size_t n = c->n;
+	gsl_matrix *A = gsl_matrix_alloc(n, (size_t)p), *V = gsl_matrix_alloc((size_t)p, (size_t)p);
+	gsl_vector *S = gsl_vector_alloc((size_t)p), *work = gsl_vector_alloc((size_t)p);
+	double scale[FIT_MAX_FREE];
+	for (int j = 0; j < p * p; j++)
+		res->corr[j] = NAN;
+	for (int j = 0; j < p; j++)
+		res->se[j] = NAN;
+	if (!A || !V || !S || !work)
+		goto done;
+	for (int j = 0; j < p; j++) {
+		double s2 = 0;
+		for (size_t i = 0; i < n; i++)
+			s2 += pow(c->jac_x[i * (size_t)p + (size_t)j], 2);
+		scale[j] = sqrt(s2);
+		if (!(scale[j] > 0)) {
+			warn(res, "'%s' is not identifiable: the data do not change with it",
+			     c->req->free[j].name);
+			scale[j] = 1;
+		}
+		for (size_t i = 0; i < n; i++)
+			gsl_matrix_set(A, i, (size_t)j, c->jac_x[i * (size_t)p + (size_t)j] / scale[j]);
+	}
+	gsl_linalg_SV_decomp(A, V, S, work);
+	double smax = gsl_vector_get(S, 0), smin = gsl_vector_get(S, (size_t)p - 1);
+	res->cond = smin > 0 ? smax / smin : INFINITY;
+	if (res->cond > COND_WARN && p > 1) {
+		char comb[160] = "";
+		weak_combination(c, V, scale, comb, sizeof comb);
+		warn(res, "not identifiable from these data: the condition number of the scaled "
+			  "Jacobian is %.3g (above %g); the data fix little of the combination %s "
+			  "(relative changes)", res->cond, COND_WARN, comb);
+	}
+	double factor = res->sigma_given ? 1 : res->dof > 0 ? res->s2 : NAN;
+	if (!(smin > 1e-12 * smax))
+		goto done; /* singular: no standard errors */
+	double cov[FIT_MAX_FREE * FIT_MAX_FREE];
+	for (int a = 0; a < p; a++)
+		for (int b = 0; b < p; b++) {
+			double s = 0;
+			for (int k = 0; k < p; k++)
+				s += gsl_matrix_get(V, (size_t)a, (size_t)k) *
+				     gsl_matrix_get(V, (size_t)b, (size_t)k) /
+				     pow(gsl_vector_get(S, (size_t)k), 2);
+			cov[a * p + b] = factor * s / (scale[a] * scale[b]);
+		}
+	for (int a = 0; a < p; a++)
+		res->se[a] = sqrt(cov[a * p + a]);
+	for (int a = 0; a < p; a++)
+		for (int b = 0; b < p; b++)
+			res->corr[a * p + b] = cov[a * p + b] / (res->se[a] * res->se[b]);
+done:
+	gsl_matrix_free(A);
+	gsl_matrix_free(V);
+	gsl_vector_free(S);
+	gsl_vector_free(work);
+}
+
+/* Bounds reached, standard errors as large as the value. */
+static void bound_warnings(ctx *c)
+{
+	fit_result *res = c->res;
+	for (int j = 0; j < c->p; j++) {
+		const fit_free *f = &c->req->free[j];
+		const sim_setting *t = sim_setting_find(f->name);
+		double w = f->hi - f->lo;
+		res->at_bound[j] = res->x[j] <= f->lo + 2 * BOUND_NEAR * w   ? -1
+				   : res->x[j] >= f->hi - 2 * BOUND_NEAR * w ? 1
+									     : 0;
+		if (res->at_bound[j])
+			warn(res, "'%s' ends at its %s bound %g %s: the data want it beyond; widen "
+				  "the bound or question the model", f->name,
+			     res->at_bound[j] < 0 ? "lower" : "upper",
+			     sim_setting_from_si(t, res->at_bound[j] < 0 ? f->lo : f->hi), t->unit);
+		else if (res->se[j] >= fabs(res->x[j]))
+			warn(res, "'%s' is not identifiable: its standard error (%g) is as large as "
+				  "its value (%g)", f->name, sim_setting_from_si(t, res->se[j]),
+			     sim_setting_from_si(t, res->x[j]));
+	}
+	if (!res->sigma_given && res->dof == 0)
+		warn(res, "as many data as free parameters: no residual variance, so no standard "
+			  "errors; give sigma with the data or more data");
+}
+
+/* The curves at the fit and at the start on the grid, per rotation of
+ * the data. */
+static int curves(ctx *c)
+{
+	const fit_request *r = c->req;
+	fit_result *res = c->res;
+	int p = c->p;
+	size_t n = (size_t)floor(SIM_PI / r->curve_step + 1e-9) + 1, total = 0;
+	for (size_t d = 0; d < c->n; d++) {
+		int rot = r->npoints ? r->points[d].rotation : r->peaks[d].rotation;
+		if (!(res->nrot > 0 && res->rotations[0] == rot) &&
+		    !(res->nrot > 1 && res->rotations[1] == rot))
+			res->rotations[res->nrot++] = rot;
+	}
+	total = n * (size_t)res->nrot;
+	res->ncurve = n;
+	res->curve_beta = malloc(sizeof(double) * n);
+	double *beta = malloc(sizeof(double) * total), *v = malloc(sizeof(double) * 2 * total),
+	       *u = malloc(sizeof(double) * 2 * total), xs[2 * FIT_MAX_FREE];
+	int *rot = malloc(sizeof(int) * total), rc = -1;
+	res->curve_fit = malloc(sizeof(double) * total);
+	res->curve_fit_u = malloc(sizeof(double) * total);
+	res->curve_start = malloc(sizeof(double) * total);
+	if (beta && v && u && rot && res->curve_beta && res->curve_fit && res->curve_fit_u &&
+	    res->curve_start) {
+		for (size_t k = 0; k < total; k++) {
+			beta[k] = fmin((double)(k % n) * r->curve_step, SIM_PI);
+			rot[k] = res->rotations[k / n];
+		}
+		memcpy(res->curve_beta, beta, sizeof(double) * n);
+		memcpy(xs, res->x, sizeof(double) * (size_t)p);
+		memcpy(xs + p, res->x0, sizeof(double) * (size_t)p);
+		rc = fit_eval_curve(&c->ev, 2, xs, total, beta, rot, v, u);
+		for (size_t k = 0; rc == 0 && k < total; k++) {
+			res->curve_fit[k] = v[k];
+			res->curve_fit_u[k] = u[k];
+			res->curve_start[k] = v[total + k];
+		}
+	}
+	free(beta);
+	free(v);
+	free(u);
+	free(rot);
+	return rc;
+}
+
+static double wall_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The data, weights and result arrays of c; -1 when out of memory. */
+static int prepare(ctx *c, const fit_request *r, fit_result *res)
+{
+	c->req = r;
+	c->res = res;
+	c->p = r->nfree;
+	if (fit_eval_init(&c->ev, r) != 0)
+		return -1;
+	c->n = c->ev.ndata;
+	size_t n = c->n;
+	c->w = malloc(sizeof(double) * n);
+	c->data = malloc(sizeof(double) * n);
+	c->fmodel = malloc(sizeof(double) * n);
+	c->fmodel_u = malloc(sizeof(double) * n);
+	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
+	res->ndata = n;
+	res->model = malloc(sizeof(double) * n);
+	res->model_u = malloc(sizeof(double) * n);
+	res->model_start = malloc(sizeof(double) * n);
+	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !res->model ||
+	    !res->model_u || !res->model_start)
+		return -1;
+	res->sigma_given = 1;
+	for (size_t i = 0; i < n; i++) {
+		double s = r->npoints ? r->points[i].sigma : r->peaks[i].sigma;
+		c->data[i] = r->npoints ? r->points[i].v : r->peaks[i].beta;
+		c->w[i] = isnan(s) ? 1 : s;
+		res->sigma_given &= !isnan(s);
+		res->model_start[i] = NAN;
+	}
+	res->nfree = c->p;
+	for (int j = 0; j < c->p; j++)
+		res->x0[j] = res->x[j] = r->free[j].start;
+	return 0;
+}
+
+/* The iterations; the status. */
+static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
+{
+	const fit_request *r = c->req;
+	double prev[FIT_MAX_FREE];
+	xs_of(c, gsl_multifit_nlinear_position(w), prev);
+	for (c->iteration = 1; c->iteration <= r->max_iter; c->iteration++) {
+		int rc = gsl_multifit_nlinear_iterate(w);
+		if (c->ev.failed)
+			return c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
+		double x[FIT_MAX_FREE], step = 0;
+		xs_of(c, gsl_multifit_nlinear_position(w), x);
+		for (int j = 0; j < c->p; j++) {
+			const fit_free *f = &r->free[j];
+			step = fmax(step, fabs(x[j] - prev[j]) /
+						  fmax(fabs(x[j]), 1e-3 * (f->hi - f->lo)));
+		}
+		memcpy(prev, x, sizeof x);
+		if (rc == GSL_ENOPROG) {
+			warn(c->res, "stopped after %d iterations: no step lowers the cost further "
+				     "(the steady-state measure's jitter limits the fit here)",
+			     c->iteration);
+			return FIT_CONVERGED;
+		}
+		if (rc != GSL_SUCCESS) {
+			snprintf(c->res->error, FIT_MSG, "the solver stopped: %s", gsl_strerror(rc));
+			return FIT_FAILED;
+		}
+		int info;
+		if (step < r->xtol ||
+		    gsl_multifit_nlinear_test(r->xtol, 1e-8, 0, &info, w) == GSL_SUCCESS)
+			return FIT_CONVERGED;
+	}
+	c->iteration = r->max_iter;
+	warn(c->res, "no convergence in %d iterations: the values are the last iterate",
+	     r->max_iter);
+	return FIT_MAXITER;
+}
+
+/* Levenberg-Marquardt from the start; fills res->x, iterations, status. */
+static int solve(ctx *c)
+{
+	int p = c->p;
+	gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
+	par.trs = gsl_multifit_nlinear_trs_lm;
+	par.scale = gsl_multifit_nlinear_scale_more;
+	gsl_multifit_nlinear_fdf fdf = {cb_f, cb_df, NULL, c->n, (size_t)p, c, 0, 0, 0};
+	gsl_multifit_nlinear_workspace *w =
+		gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, c->n, (size_t)p);
+	gsl_vector *z0 = gsl_vector_alloc((size_t)p);
+	int status = FIT_FAILED;
+	if (!w || !z0) {
+		snprintf(c->res->error, FIT_MSG, "out of memory");
+		goto done;
+	}
+	for (int j = 0; j < p; j++)
+		gsl_vector_set(z0, (size_t)j, z_of_x(&c->req->free[j], c->req->free[j].start));
+	int rc = gsl_multifit_nlinear_init(z0, &fdf, w);
+	if (rc == GSL_SUCCESS)
+		memcpy(c->res->model_start, c->fmodel, sizeof(double) * c->n);
+	status = rc != GSL_SUCCESS ? (c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED) : iterate(c, w);
+	if (status == FIT_FAILED && !c->res->error[0])
+		snprintf(c->res->error, FIT_MSG, "%s", c->ev.error);
+	if (status != FIT_FAILED)
+		xs_of(c, gsl_multifit_nlinear_position(w), c->res->x);
+	c->res->iterations = c->iteration;
+done:
+	gsl_multifit_nlinear_free(w);
+	gsl_vector_free(z0);
+	return status;
+}
+
+/* Model, residual statistics, Jacobian and covariance at res->x. */
+static int at_optimum(ctx *c)
+{
+	fit_result *res = c->res;
+	if (!(c->fvalid && same_x(c->fx, res->x, c->p)) &&
+	    fit_eval_data(&c->ev, 1, res->x, c->fmodel, c->fmodel_u) != 0)
+		return -1;
+	c->fvalid = 1;
+	memcpy(c->fx, res->x, sizeof(double) * (size_t)c->p);
+	memcpy(res->model, c->fmodel, sizeof(double) * c->n);
+	memcpy(res->model_u, c->fmodel_u, sizeof(double) * c->n);
+	res->chi2 = 0;
+	for (size_t i = 0; i < c->n; i++)
+		res->chi2 += pow((res->model[i] - c->data[i]) / c->w[i], 2);
+	res->dof = (int)c->n - c->p;
+	res->s2 = res->dof > 0 ? res->chi2 / res->dof : NAN;
+	report(c, "covariance", res->x, res->chi2);
+	if (!(c->jvalid && same_x(c->jx, res->x, c->p)) && jacobian_x(c, res->x) != 0)
+		return -1;
+	covariance(c);
+	bound_warnings(c);
+	return 0;
+}
+
+int fit_run(const fit_request *req, fit_result *res)
+{
+	memset(res, 0, sizeof *res);
+	gsl_set_error_handler_off();
+	double w0 = wall_now();
+	ctx c;
+	memset(&c, 0, sizeof c);
+	if (prepare(&c, req, res) != 0) {
+		res->status = FIT_FAILED;
+		snprintf(res->error, FIT_MSG, "out of memory");
+		goto done;
+	}
+	res->status = solve(&c);
+	if (res->status != FIT_FAILED && res->status != FIT_CANCELLED && at_optimum(&c) != 0)
+		res->status = c.ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
+	if (res->status == FIT_FAILED && !res->error[0])
+		snprintf(res->error, FIT_MSG, "%s", c.ev.error);
+	if ((res->status == FIT_CONVERGED || res->status == FIT_MAXITER) && req->curve_step > 0) {
+		report(&c, "curve", res->x, res->chi2);
+		if (curves(&c) != 0) {
+			if (c.ev.failed == 2)
+				res->status = FIT_CANCELLED;
+			else
+				warn(res, "no curve: %s", c.ev.error);
+			res->ncurve = 0;
+		}
+	}
+done:
+	res->evaluations = c.ev.evaluations;
+	res->cpu_seconds = c.ev.cpu_seconds;
+	res->wall_seconds = wall_now() - w0;
+	report(&c, "done", res->x, res->chi2);
+	fit_eval_free(&c.ev);
+	free(c.w);
+	free(c.data);
+	free(c.fmodel);
+	free(c.fmodel_u);
+	free(c.jac_x);
+	return res->status;
+}
+
+void fit_result_free(fit_result *res)
+{
+	if (!res)
+		return;
+	free(res->model);
+	free(res->model_u);
+	free(res->model_start);
+	free(res->curve_beta);
+	free(res->curve_fit);
+	free(res->curve_fit_u);
+	free(res->curve_start);
+	memset(res, 0, sizeof *res);
+}
