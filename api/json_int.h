@@ -100,5 +100,9 @@ extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];
 extern const char *const api_members_sweep[];
 extern const char *const api_members_beta_range[];
+extern const char *const api_members_fit[];
+extern const char *const api_members_fit_free[];
+extern const char *const api_members_fit_point[];
+extern const char *const api_members_fit_peak[];
 
 #endif
