@@ -66,3 +66,23 @@ export function streamQuery(opts = {}) {
 	if (Number.isInteger(opts.since) && opts.since >= 0) q.set('since', String(opts.since));
 	return q.toString();
 }
+
+/* POST /fits: the session form's model, the free names (NAME or
+ * NAME:MIN:MAX), the points as CSV text, the time per evaluation and the
+ * curve's grid. */
+export function fitRequest(f) {
+	const body = sessionRequest(f);
+	delete body.pace;
+	delete body.sample_rate;
+	delete body.params.beta;
+	delete body.params.rotation;
+	body.scene.feed = true;
+	body.free = String(f.free).split(',').map(s => s.trim()).filter(Boolean).map(s => {
+		const [name, min, max] = s.split(':');
+		return min === undefined ? name : { name, min: Number(min), max: Number(max) };
+	});
+	body.csv = f.csv;
+	if (Number.isFinite(f.tEnd)) body.t_end = f.tEnd;
+	if (Number.isFinite(f.curveStep)) body.curve_step = f.curveStep;
+	return body;
+}
