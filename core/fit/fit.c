@@ -54,9 +54,15 @@ typedef struct ctx {
 	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
 	int fvalid;
 	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
+	double *jmodel, *jmodel_u;       /* the model at jx */
 	int jvalid;
 	int iteration;
+	int trials, stalled;  /* f evaluations in this iteration; gave up */
 } ctx;
+
+/* trial steps per iteration: past this many rejections the cost is at the
+ * measure's jitter and the iterate stands */
+#define MAX_TRIALS 8
 
 static int log_scale(const fit_free *f)
 {
@@ -113,6 +119,10 @@ static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
 	ctx *c = arg;
 	double x[FIT_MAX_FREE];
 	xs_of(c, z, x);
+	if (c->iteration > 0 && ++c->trials > MAX_TRIALS) {
+		c->stalled = 1;
+		return GSL_EBADFUNC;
+	}
 	if (fit_eval_data(&c->ev, 1, x, c->fmodel, c->fmodel_u) != 0)
 		return GSL_EBADFUNC;
 	memcpy(c->fx, x, sizeof x);
@@ -147,9 +157,10 @@ static int jacobian_x(ctx *c, const double *x)
 {
 	int p = c->p, base = !(c->fvalid && same_x(c->fx, x, p));
 	size_t sets = (size_t)p + (size_t)base, n = c->n;
-	double *xs = malloc(sizeof *xs * sets * (size_t)p), *out = malloc(sizeof *out * sets * n);
+	double *xs = malloc(sizeof *xs * sets * (size_t)p), *out = malloc(sizeof *out * sets * n),
+	       *out_u = malloc(sizeof *out_u * sets * n);
 	double h[FIT_MAX_FREE];
-	int rc = xs && out ? 0 : -1;
+	int rc = xs && out && out_u ? 0 : -1;
 	for (size_t s = 0; rc == 0 && s < sets; s++)
 		for (int j = 0; j < p; j++) {
 			int pert = (int)s - base;
@@ -158,7 +169,7 @@ static int jacobian_x(ctx *c, const double *x)
 			xs[s * (size_t)p + (size_t)j] = x[j] + (pert == j ? h[j] : 0);
 		}
 	if (rc == 0)
-		rc = fit_eval_data(&c->ev, sets, xs, out, NULL);
+		rc = fit_eval_data(&c->ev, sets, xs, out, out_u);
 	const double *f0 = base ? out : c->fmodel;
 	for (size_t i = 0; rc == 0 && i < n; i++)
 		for (int j = 0; j < p; j++)
@@ -166,10 +177,13 @@ static int jacobian_x(ctx *c, const double *x)
 				(out[((size_t)j + (size_t)base) * n + i] - f0[i]) / h[j] / c->w[i];
 	if (rc == 0) {
 		memcpy(c->jx, x, sizeof *x * (size_t)p);
+		memcpy(c->jmodel, f0, sizeof(double) * n);
+		memcpy(c->jmodel_u, base ? out_u : c->fmodel_u, sizeof(double) * n);
 		c->jvalid = 1;
 	}
 	free(xs);
 	free(out);
+	free(out_u);
 	return rc;
 }
 
@@ -377,11 +391,14 @@ static int prepare(ctx *c, const fit_request *r, fit_result *res)
 	c->fmodel = malloc(sizeof(double) * n);
 	c->fmodel_u = malloc(sizeof(double) * n);
 	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
+	c->jmodel = malloc(sizeof(double) * n);
+	c->jmodel_u = malloc(sizeof(double) * n);
 	res->ndata = n;
 	res->model = malloc(sizeof(double) * n);
 	res->model_u = malloc(sizeof(double) * n);
 	res->model_start = malloc(sizeof(double) * n);
-	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !res->model ||
+	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !c->jmodel ||
+	    !c->jmodel_u || !res->model ||
 	    !res->model_u || !res->model_start)
 		return -1;
 	res->sigma_given = 1;
@@ -398,22 +415,59 @@ static int prepare(ctx *c, const fit_request *r, fit_result *res)
 	return 0;
 }
 
-/* The iterations; the status. */
+/* Rough standard errors (SI) from the last Jacobian and the cost at the
+ * current iterate, for the stopping test: 0, or -1 when J^T J is singular. */
+static int rough_se(const ctx *c, double cost, double *se)
+{
+	int p = c->p, rc = -1;
+	gsl_matrix *A = gsl_matrix_calloc((size_t)p, (size_t)p);
+	for (size_t i = 0; A && i < c->n; i++)
+		for (int a = 0; a < p; a++)
+			for (int b = 0; b < p; b++)
+				*gsl_matrix_ptr(A, (size_t)a, (size_t)b) +=
+					c->jac_x[i * (size_t)p + (size_t)a] *
+					c->jac_x[i * (size_t)p + (size_t)b];
+	double s2 = c->res->sigma_given ? 1 : cost / fmax((double)c->n - p, 1);
+	if (A && gsl_linalg_cholesky_decomp1(A) == GSL_SUCCESS &&
+	    gsl_linalg_cholesky_invert(A) == GSL_SUCCESS) {
+		for (int j = 0; j < p; j++)
+			se[j] = sqrt(s2 * gsl_matrix_get(A, (size_t)j, (size_t)j));
+		rc = 0;
+	}
+	gsl_matrix_free(A);
+	return rc;
+}
+
+/* The iterations; the status. Converged when the last step moved every
+ * parameter by less than xtol of its scale, or by less than a tenth of its
+ * (rough) standard error: the data cannot tell such steps apart. */
 static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
 {
 	const fit_request *r = c->req;
 	double prev[FIT_MAX_FREE];
 	xs_of(c, gsl_multifit_nlinear_position(w), prev);
 	for (c->iteration = 1; c->iteration <= r->max_iter; c->iteration++) {
+		c->trials = 0;
 		int rc = gsl_multifit_nlinear_iterate(w);
 		if (c->ev.failed)
 			return c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
-		double x[FIT_MAX_FREE], step = 0;
+		if (c->stalled) {
+			warn(c->res, "stopped in iteration %d: %d trial steps in a row did not lower "
+				     "the cost (the steady-state measure's jitter limits the fit here)",
+			     c->iteration, MAX_TRIALS);
+			c->iteration--;
+			return FIT_CONVERGED;
+		}
+		double x[FIT_MAX_FREE], se[FIT_MAX_FREE], step = 0, step_se = 0;
 		xs_of(c, gsl_multifit_nlinear_position(w), x);
+		double cost;
+		gsl_blas_ddot(gsl_multifit_nlinear_residual(w), gsl_multifit_nlinear_residual(w), &cost);
+		int have_se = c->jvalid && rough_se(c, cost, se) == 0;
 		for (int j = 0; j < c->p; j++) {
 			const fit_free *f = &r->free[j];
 			step = fmax(step, fabs(x[j] - prev[j]) /
 						  fmax(fabs(x[j]), 1e-3 * (f->hi - f->lo)));
+			step_se = fmax(step_se, have_se ? fabs(x[j] - prev[j]) / se[j] : INFINITY);
 		}
 		memcpy(prev, x, sizeof x);
 		if (rc == GSL_ENOPROG) {
@@ -427,7 +481,7 @@ static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
 			return FIT_FAILED;
 		}
 		int info;
-		if (step < r->xtol ||
+		if (step < r->xtol || step_se < 0.1 ||
 		    gsl_multifit_nlinear_test(r->xtol, 1e-8, 0, &info, w) == GSL_SUCCESS)
 			return FIT_CONVERGED;
 	}
@@ -474,9 +528,14 @@ done:
 static int at_optimum(ctx *c)
 {
 	fit_result *res = c->res;
-	if (!(c->fvalid && same_x(c->fx, res->x, c->p)) &&
-	    fit_eval_data(&c->ev, 1, res->x, c->fmodel, c->fmodel_u) != 0)
+	if (c->jvalid && same_x(c->jx, res->x, c->p)) {
+		/* the Jacobian's base: the model at the optimum */
+		memcpy(c->fmodel, c->jmodel, sizeof(double) * c->n);
+		memcpy(c->fmodel_u, c->jmodel_u, sizeof(double) * c->n);
+	} else if (!(c->fvalid && same_x(c->fx, res->x, c->p)) &&
+		   fit_eval_data(&c->ev, 1, res->x, c->fmodel, c->fmodel_u) != 0) {
 		return -1;
+	}
 	c->fvalid = 1;
 	memcpy(c->fx, res->x, sizeof(double) * (size_t)c->p);
 	memcpy(res->model, c->fmodel, sizeof(double) * c->n);
@@ -532,6 +591,8 @@ done:
 	free(c.fmodel);
 	free(c.fmodel_u);
 	free(c.jac_x);
+	free(c.jmodel);
+	free(c.jmodel_u);
 	return res->status;
 }
 

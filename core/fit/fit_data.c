@@ -122,6 +122,8 @@ static int parse_header(const char *line, size_t len, int col[NCOLS], char *msg,
 		int c = 0;
 		while (c < NCOLS && !(strlen(col_names[c]) == n && strncmp(p, col_names[c], n) == 0))
 			c++;
+		if (n == 8 && strncmp(p, "velocity", 8) == 0)
+			c = COL_V; /* the sweep table's name for v */
 		if (c == NCOLS) {
 			snprintf(msg, mlen, "CSV line 1: unknown column '%.*s'; the header is "
 					    "beta,rotation,v[,sigma]", (int)(n > 40 ? 40 : n), p);
