@@ -236,7 +236,6 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 
 static cJSON *fit_object(const api_fit_view *v, int with_result)
 {
-	char link[96];
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "id", v->id);
 	cJSON_AddStringToObject(o, "state", v->state);
@@ -256,11 +255,7 @@ static cJSON *fit_object(const api_fit_view *v, int with_result)
 		cJSON_AddItemToObject(o, "result", res);
 	else
 		cJSON_AddNullToObject(o, "result");
-	cJSON *links = cJSON_AddObjectToObject(o, "links");
-	snprintf(link, sizeof link, "/api/v1/fits/%s", v->id);
-	cJSON_AddStringToObject(links, "self", link);
-	snprintf(link, sizeof link, "/api/v1/fits/%s?format=csv", v->id);
-	cJSON_AddStringToObject(links, "csv", link);
+	api_add_result_links(o, "fits", v->id);
 	return o;
 }
 

@@ -89,6 +89,9 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb);
 cJSON *api_settings_array(void);
 /* Add a number member; non-finite values become null. */
 void api_add_number(cJSON *obj, const char *name, double v);
+/* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
+ * ?format=csv} (a job's result, as JSON and as CSV). */
+void api_add_result_links(cJSON *obj, const char *collection, const char *id);
 
 /* The members each request body may have (NULL-terminated): the parsers
  * refuse any other, and openapi.c builds the request schemas from these

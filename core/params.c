@@ -205,9 +205,9 @@ int sim_default_substeps(double dt)
 
 /* czubak2016 with the eccentricity fitted to the paper's clockwise peaks
  * at 38 and 128 deg (README "Calibration": `convsim fit --peaks
- * cw:38,cw:128 --free e:0.005:0.04`, e = 0.01539 +- 0.0076 m, rounded to
+ * cw:38,cw:128 --free e:0.005:0.04`, e = 0.01551 +- 0.0049 m, rounded to
  * three digits); everything else as czubak2016. */
-#define CZUBAK2016_FIT_E 0.0154
+#define CZUBAK2016_FIT_E 0.0155
 
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)
 {

@@ -69,6 +69,20 @@ int cli_first_pass(int argc, char **argv, unsigned cmd, const char **preset)
 
 /* Parse command cmd's options into *o. Returns 0, 2 (usage error) or -1
  * (help shown: exit 0). */
+/* --opt as a whole number in [1, hi] into *out: 0, or 1 after a message. */
+static int whole(const char *cmd, const char *opt, const char *arg, double hi, int *out)
+{
+	double v;
+	if (cli_number(cmd, opt, NULL, arg, 1, hi, 0, &v))
+		return 1;
+	if (v != floor(v)) {
+		fprintf(stderr, "convsim %s: --%s must be a whole number, got '%s'\n", cmd, opt, arg);
+		return 1;
+	}
+	*out = (int)v;
+	return 0;
+}
+
 int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 {
 	o->cmd = argv[0];
@@ -114,17 +128,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 		case OPT_RATE:
 			bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
 			break;
-		case OPT_THREADS: {
-			double th;
-			bad = cli_number(o->cmd, "threads", NULL, arg, 1, 64, 0, &th);
-			if (!bad && th != floor(th)) {
-				fprintf(stderr, "convsim %s: --threads must be a whole number, got '%s'\n",
-					o->cmd, arg);
-				bad = 1;
-			}
-			o->threads = (int)th;
-			break;
-		}
+		case OPT_THREADS: bad = whole(o->cmd, "threads", arg, 64, &o->threads); break;
 		case OPT_OUT: o->out = arg; break;
 		case OPT_FORMAT: o->format = arg; break;
 		case OPT_BETA: o->beta = arg; break;
@@ -139,17 +143,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 		case OPT_FD_STEP:
 			bad = cli_number(o->cmd, "fd-step", NULL, arg, 0, 0.5, 1, &o->fd_step);
 			break;
-		case OPT_MAX_ITER: {
-			double it;
-			bad = cli_number(o->cmd, "max-iter", NULL, arg, 1, 1000, 0, &it);
-			if (!bad && it != floor(it)) {
-				fprintf(stderr, "convsim %s: --max-iter must be a whole number, got '%s'\n",
-					o->cmd, arg);
-				bad = 1;
-			}
-			o->max_iter = (int)it;
-			break;
-		}
+		case OPT_MAX_ITER: bad = whole(o->cmd, "max-iter", arg, 1000, &o->max_iter); break;
 		default: break;
 		}
 		if (bad)
