@@ -17,11 +17,7 @@
  * that: 5 % of e moves v by about 12 %, 40 times the jitter (README
  * "Calibration"). Then J_z = J_x dx/dz.
  *
- * Standard errors from the Jacobian in x at the optimum: cov = (J^T J)^-1
- * when every datum has its sigma, else s2 (J^T J)^-1 with the residual
- * variance s2 = chi2 / (n - p). Computed by SVD of J with its columns
- * scaled to unit length; the scaled condition number flags combinations of
- * parameters the data cannot fix.
+ * Standard errors, correlations and warnings at the optimum: fit_cov.c.
  */
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
@@ -37,28 +33,7 @@
 #include "fit_int.h"
 #include "units.h"
 
-/* the scaled condition number above which a combination counts as not
- * identifiable: a correlation of 0.9998 between two parameters */
-#define COND_WARN 100.0
-#define BOUND_NEAR 1e-3
 
-typedef struct ctx {
-	const fit_request *req;
-	fit_eval ev;
-	fit_result *res;
-	int p;
-	size_t n;
-	double *w;            /* per datum: sigma or 1 */
-	double *data;         /* per datum: v or peak beta */
-	/* the last f evaluation at an x, and the last Jacobian */
-	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
-	int fvalid;
-	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
-	double *jmodel, *jmodel_u;       /* the model at jx */
-	int jvalid;
-	int iteration;
-	int trials, stalled;  /* f evaluations in this iteration; gave up */
-} ctx;
 
 /* trial steps per iteration: past this many rejections the cost is at the
  * measure's jitter and the iterate stands */
@@ -95,13 +70,13 @@ static double z_of_x(const fit_free *f, double x)
 	return asin(2 * u - 1);
 }
 
-static void xs_of(const ctx *c, const gsl_vector *z, double *x)
+static void xs_of(const fit_ctx *c, const gsl_vector *z, double *x)
 {
 	for (int j = 0; j < c->p; j++)
 		x[j] = x_of_z(&c->req->free[j], gsl_vector_get(z, (size_t)j));
 }
 
-static void report(ctx *c, const char *phase, const double *x, double cost)
+static void report(fit_ctx *c, const char *phase, const double *x, double cost)
 {
 	if (!c->req->progress)
 		return;
@@ -116,7 +91,7 @@ static void report(ctx *c, const char *phase, const double *x, double cost)
 
 static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
 {
-	ctx *c = arg;
+	fit_ctx *c = arg;
 	double x[FIT_MAX_FREE];
 	xs_of(c, z, x);
 	if (c->iteration > 0 && ++c->trials > MAX_TRIALS) {
@@ -143,7 +118,7 @@ static int same_x(const double *a, const double *b, int p)
 }
 
 /* The forward-difference step of parameter j at x (signed). */
-static double fd_step(const ctx *c, int j, double x)
+static double fd_step(const fit_ctx *c, int j, double x)
 {
 	const fit_free *f = &c->req->free[j];
 	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
@@ -153,7 +128,7 @@ static double fd_step(const ctx *c, int j, double x)
 
 /* J_x (weighted) at x into c->jac_x: the base set (unless f has it) and
  * one perturbed set per parameter, in one batch. */
-static int jacobian_x(ctx *c, const double *x)
+static int jacobian_x(fit_ctx *c, const double *x)
 {
 	int p = c->p, base = !(c->fvalid && same_x(c->fx, x, p));
 	size_t sets = (size_t)p + (size_t)base, n = c->n;
@@ -189,7 +164,7 @@ static int jacobian_x(ctx *c, const double *x)
 
 static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 {
-	ctx *c = arg;
+	fit_ctx *c = arg;
 	double x[FIT_MAX_FREE];
 	xs_of(c, z, x);
 	if (jacobian_x(c, x) != 0)
@@ -202,130 +177,9 @@ static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 	return GSL_SUCCESS;
 }
 
-static void warn(fit_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void warn(fit_result *res, const char *fmt, ...)
-{
-	if (res->nwarn >= FIT_MAX_WARNINGS)
-		return;
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(res->warnings[res->nwarn++], FIT_MSG, fmt, ap);
-	va_end(ap);
-}
-
-/* The parameter combination the data fix least (the right singular vector
- * of the smallest singular value, as relative changes) into buf. */
-static void weak_combination(const ctx *c, const gsl_matrix *V, const double *scale,
-			     char *buf, size_t len)
-{
-	const fit_result *res = c->res;
-	size_t last = (size_t)c->p - 1, at = 0;
-	double d[FIT_MAX_FREE], norm = 0;
-	for (int j = 0; j < c->p; j++) {
-		/* direction in x: D^-1 v; as a relative change of x_j */
-		d[j] = gsl_matrix_get(V, (size_t)j, last) / scale[j] /
-		       fmax(fabs(res->x[j]), 1e-300);
-		norm = fmax(norm, fabs(d[j]));
-	}
-	for (int j = 0; j < c->p && at < len; j++)
-		if (fabs(d[j]) > 0.05 * norm)
-			at += (size_t)snprintf(buf + at, len - at, "%s%+.2f %s", at ? " " : "",
-					       d[j] / norm, c->req->free[j].name);
-}
-
-/* Standard errors, correlations, the condition number and the
- * identifiability warnings from J_x (weighted) at the optimum. */
-static void covariance(ctx *c)
-{
-	fit_result *res = c->res;
-	int p = c->p;
-	size_t n = c->n;
-	gsl_matrix *A = gsl_matrix_alloc(n, (size_t)p), *V = gsl_matrix_alloc((size_t)p, (size_t)p);
-	gsl_vector *S = gsl_vector_alloc((size_t)p), *work = gsl_vector_alloc((size_t)p);
-	double scale[FIT_MAX_FREE];
-	for (int j = 0; j < p * p; j++)
-		res->corr[j] = NAN;
-	for (int j = 0; j < p; j++)
-		res->se[j] = NAN;
-	if (!A || !V || !S || !work)
-		goto done;
-	for (int j = 0; j < p; j++) {
-		double s2 = 0;
-		for (size_t i = 0; i < n; i++)
-			s2 += pow(c->jac_x[i * (size_t)p + (size_t)j], 2);
-		scale[j] = sqrt(s2);
-		if (!(scale[j] > 0)) {
-			warn(res, "'%s' is not identifiable: the data do not change with it",
-			     c->req->free[j].name);
-			scale[j] = 1;
-		}
-		for (size_t i = 0; i < n; i++)
-			gsl_matrix_set(A, i, (size_t)j, c->jac_x[i * (size_t)p + (size_t)j] / scale[j]);
-	}
-	gsl_linalg_SV_decomp(A, V, S, work);
-	double smax = gsl_vector_get(S, 0), smin = gsl_vector_get(S, (size_t)p - 1);
-	res->cond = smin > 0 ? smax / smin : INFINITY;
-	if (res->cond > COND_WARN && p > 1) {
-		char comb[160] = "";
-		weak_combination(c, V, scale, comb, sizeof comb);
-		warn(res, "not identifiable from these data: the condition number of the scaled "
-			  "Jacobian is %.3g (above %g); the data fix little of the combination %s "
-			  "(relative changes)", res->cond, COND_WARN, comb);
-	}
-	double factor = res->sigma_given ? 1 : res->dof > 0 ? res->s2 : NAN;
-	if (!(smin > 1e-12 * smax))
-		goto done; /* singular: no standard errors */
-	double cov[FIT_MAX_FREE * FIT_MAX_FREE];
-	for (int a = 0; a < p; a++)
-		for (int b = 0; b < p; b++) {
-			double s = 0;
-			for (int k = 0; k < p; k++)
-				s += gsl_matrix_get(V, (size_t)a, (size_t)k) *
-				     gsl_matrix_get(V, (size_t)b, (size_t)k) /
-				     pow(gsl_vector_get(S, (size_t)k), 2);
-			cov[a * p + b] = factor * s / (scale[a] * scale[b]);
-		}
-	for (int a = 0; a < p; a++)
-		res->se[a] = sqrt(cov[a * p + a]);
-	for (int a = 0; a < p; a++)
-		for (int b = 0; b < p; b++)
-			res->corr[a * p + b] = cov[a * p + b] / (res->se[a] * res->se[b]);
-done:
-	gsl_matrix_free(A);
-	gsl_matrix_free(V);
-	gsl_vector_free(S);
-	gsl_vector_free(work);
-}
-
-/* Bounds reached, standard errors as large as the value. */
-static void bound_warnings(ctx *c)
-{
-	fit_result *res = c->res;
-	for (int j = 0; j < c->p; j++) {
-		const fit_free *f = &c->req->free[j];
-		const sim_setting *t = sim_setting_find(f->name);
-		double w = f->hi - f->lo;
-		res->at_bound[j] = res->x[j] <= f->lo + 2 * BOUND_NEAR * w   ? -1
-				   : res->x[j] >= f->hi - 2 * BOUND_NEAR * w ? 1
-									     : 0;
-		if (res->at_bound[j])
-			warn(res, "'%s' ends at its %s bound %g %s: the data want it beyond; widen "
-				  "the bound or question the model", f->name,
-			     res->at_bound[j] < 0 ? "lower" : "upper",
-			     sim_setting_from_si(t, res->at_bound[j] < 0 ? f->lo : f->hi), t->unit);
-		else if (res->se[j] >= fabs(res->x[j]))
-			warn(res, "'%s' is not identifiable: its standard error (%g) is as large as "
-				  "its value (%g)", f->name, sim_setting_from_si(t, res->se[j]),
-			     sim_setting_from_si(t, res->x[j]));
-	}
-	if (!res->sigma_given && res->dof == 0)
-		warn(res, "as many data as free parameters: no residual variance, so no standard "
-			  "errors; give sigma with the data or more data");
-}
-
 /* The curves at the fit and at the start on the grid, per rotation of
  * the data. */
-static int curves(ctx *c)
+static int curves(fit_ctx *c)
 {
 	const fit_request *r = c->req;
 	fit_result *res = c->res;
@@ -377,7 +231,7 @@ static double wall_now(void)
 }
 
 /* The data, weights and result arrays of c; -1 when out of memory. */
-static int prepare(ctx *c, const fit_request *r, fit_result *res)
+static int prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 {
 	c->req = r;
 	c->res = res;
@@ -417,7 +271,7 @@ static int prepare(ctx *c, const fit_request *r, fit_result *res)
 
 /* Rough standard errors (SI) from the last Jacobian and the cost at the
  * current iterate, for the stopping test: 0, or -1 when J^T J is singular. */
-static int rough_se(const ctx *c, double cost, double *se)
+static int rough_se(const fit_ctx *c, double cost, double *se)
 {
 	int p = c->p, rc = -1;
 	gsl_matrix *A = gsl_matrix_calloc((size_t)p, (size_t)p);
@@ -441,7 +295,7 @@ static int rough_se(const ctx *c, double cost, double *se)
 /* The iterations; the status. Converged when the last step moved every
  * parameter by less than xtol of its scale, or by less than a tenth of its
  * (rough) standard error: the data cannot tell such steps apart. */
-static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
+static int iterate(fit_ctx *c, gsl_multifit_nlinear_workspace *w)
 {
 	const fit_request *r = c->req;
 	double prev[FIT_MAX_FREE];
@@ -452,7 +306,7 @@ static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
 		if (c->ev.failed)
 			return c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
 		if (c->stalled) {
-			warn(c->res, "stopped in iteration %d: %d trial steps in a row did not lower "
+			fit_warn(c->res, "stopped in iteration %d: %d trial steps in a row did not lower "
 				     "the cost (the steady-state measure's jitter limits the fit here)",
 			     c->iteration, MAX_TRIALS);
 			c->iteration--;
@@ -471,7 +325,7 @@ static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
 		}
 		memcpy(prev, x, sizeof x);
 		if (rc == GSL_ENOPROG) {
-			warn(c->res, "stopped after %d iterations: no step lowers the cost further "
+			fit_warn(c->res, "stopped after %d iterations: no step lowers the cost further "
 				     "(the steady-state measure's jitter limits the fit here)",
 			     c->iteration);
 			return FIT_CONVERGED;
@@ -486,13 +340,13 @@ static int iterate(ctx *c, gsl_multifit_nlinear_workspace *w)
 			return FIT_CONVERGED;
 	}
 	c->iteration = r->max_iter;
-	warn(c->res, "no convergence in %d iterations: the values are the last iterate",
+	fit_warn(c->res, "no convergence in %d iterations: the values are the last iterate",
 	     r->max_iter);
 	return FIT_MAXITER;
 }
 
 /* Levenberg-Marquardt from the start; fills res->x, iterations, status. */
-static int solve(ctx *c)
+static int solve(fit_ctx *c)
 {
 	int p = c->p;
 	gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
@@ -525,7 +379,7 @@ done:
 }
 
 /* Model, residual statistics, Jacobian and covariance at res->x. */
-static int at_optimum(ctx *c)
+static int at_optimum(fit_ctx *c)
 {
 	fit_result *res = c->res;
 	if (c->jvalid && same_x(c->jx, res->x, c->p)) {
@@ -548,8 +402,8 @@ static int at_optimum(ctx *c)
 	report(c, "covariance", res->x, res->chi2);
 	if (!(c->jvalid && same_x(c->jx, res->x, c->p)) && jacobian_x(c, res->x) != 0)
 		return -1;
-	covariance(c);
-	bound_warnings(c);
+	fit_covariance(c);
+	fit_bound_warnings(c);
 	return 0;
 }
 
@@ -558,7 +412,7 @@ int fit_run(const fit_request *req, fit_result *res)
 	memset(res, 0, sizeof *res);
 	gsl_set_error_handler_off();
 	double w0 = wall_now();
-	ctx c;
+	fit_ctx c;
 	memset(&c, 0, sizeof c);
 	if (prepare(&c, req, res) != 0) {
 		res->status = FIT_FAILED;
@@ -576,7 +430,7 @@ int fit_run(const fit_request *req, fit_result *res)
 			if (c.ev.failed == 2)
 				res->status = FIT_CANCELLED;
 			else
-				warn(res, "no curve: %s", c.ev.error);
+				fit_warn(res, "no curve: %s", c.ev.error);
 			res->ncurve = 0;
 		}
 	}

@@ -41,4 +41,37 @@ int fit_eval_data(fit_eval *ev, size_t nsets, const double *xs, double *out, dou
 int fit_eval_curve(fit_eval *ev, size_t nsets, const double *xs, size_t n, const double *beta,
 		   const int *rotation, double *v, double *u);
 
+/* ---- the solver's state (fit.c), its statistics (fit_cov.c) ---------- */
+
+/* A start on a bound moves this fraction of the width inside; a fit
+ * within twice it of a bound "ends at the bound". */
+#define BOUND_NEAR 1e-3
+
+typedef struct fit_ctx {
+	const fit_request *req;
+	fit_eval ev;
+	fit_result *res;
+	int p;
+	size_t n;
+	double *w;            /* per datum: sigma or 1 */
+	double *data;         /* per datum: v or peak beta */
+	/* the last f evaluation at an x, and the last Jacobian */
+	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
+	int fvalid;
+	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
+	double *jmodel, *jmodel_u;       /* the model at jx */
+	int jvalid;
+	int iteration;
+	int trials, stalled;  /* f evaluations in this iteration; gave up */
+} fit_ctx;
+
+/* One more warning into res (at most FIT_MAX_WARNINGS). */
+void fit_warn(fit_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Standard errors, correlation, condition number and identifiability
+ * warnings of res from c->jac_x (the weighted J in x at res->x). */
+void fit_covariance(fit_ctx *c);
+/* Warnings for bounds reached, standard errors as large as the value, and
+ * no residual variance. */
+void fit_bound_warnings(fit_ctx *c);
+
 #endif
