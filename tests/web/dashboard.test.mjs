@@ -302,7 +302,7 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	/* a refused CSV: the daemon's detail, nothing started */
 	await page.fill('#fit-form textarea[name="csv"]', 'beta,v\n30,0.1\n60,0.05\n');
 	await page.click('#fit-run');
-	const msg = await page.waitForSelector('#messages .msg.error >> text=/column \'rotation\' is missing/', { timeout: 5000 });
+	const msg = await page.waitForSelector('#messages .msg.error >> text=/column \'rotation\' is missing/', { timeout: 20000 });
 	assert.match(await msg.textContent(), /422/);
 	assert.deepEqual((await apiGet('/api/v1/fits')).fits, []);
 	await page.fill('#fit-form textarea[name="csv"]', 'beta,rotation,v,sigma\n20,cw,0.05,0.005\n60,cw,0.05,0.005\n' +
