@@ -8,6 +8,7 @@ CC      ?= cc
 CFLAGS  ?= -O2 -g
 WARN    := -Wall -Wextra -Werror -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 LDLIBS  := -lm -lpthread
+GSL_LIBS := -lgsl -lgslcblas
 BUILD   ?= build
 PORT    ?= 8080
 HOST    ?= 127.0.0.1
@@ -26,12 +27,14 @@ endif
 
 CORE_SRC   := $(wildcard core/*.c)
 CLI_SRC    := $(wildcard core/cli/*.c)
+FIT_SRC    := $(wildcard core/fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 SERVER_SRC := $(wildcard server/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 
 CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/%.o)
 CLI_OBJ    := $(CLI_SRC:%.c=$(BUILD)/%.o)
+FIT_OBJ    := $(FIT_SRC:%.c=$(BUILD)/%.o)
 API_OBJ    := $(API_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
@@ -77,13 +80,16 @@ $(BUILD)/.deps-bench: Makefile
 	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (SUNDIALS)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 
-# Include floors, by the top directory of the source: core/ (and its CLI)
-# sees only core/, api/ sees core/ and api/, server/ all three; the unit
-# tests see core/. A header included across a floor fails the build.
+# Include floors, by the top directory of the source: core/ sees only
+# core/; the fitting module core/fit/ sees core/ and GSL; the CLI core/cli/
+# sees core/ and core/fit/; api/ sees core/, core/fit/ and api/, server/
+# all of them; the unit tests see core/ and core/fit/. A header included
+# across a floor fails the build.
 INC_core   := -Icore
-INC_api    := -Icore -Iapi
-INC_server := -Icore -Iapi -Iserver
-INC_tests  := -Icore
+INC_api    := -Icore -Icore/fit -Iapi
+INC_server := -Icore -Icore/fit -Iapi -Iserver
+INC_tests  := -Icore -Icore/fit
+$(CLI_OBJ): INC_EXTRA := -Icore/fit
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
@@ -102,22 +108,26 @@ $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
+$(BUILD)/libfit.a: $(FIT_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
+
 $(BUILD)/libapi.a: $(API_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libcore.a
+$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(LDLIBS)
 
-$(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libcore.a
+$(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lmicrohttpd -lcjson $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libcore.a
+$(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
-	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(GSL_LIBS) $(LDLIBS)
 
 # Builds only the daemon it runs. PORT, HOST and DAEMON_FLAGS (any of
 # `build/convsimd --help`) are the knobs; the daemon's state (sessions,
@@ -186,4 +196,4 @@ uninstall:
 clean:
 	rm -rf build build-san
 
--include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d)
+-include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)

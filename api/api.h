@@ -17,6 +17,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fit.h"
 #include "sim.h"
 #include "table.h"
 
@@ -449,6 +450,32 @@ void api_list_unreachable(api_list *l, const char *peer, const char *reason);
 /* The merged text (malloc'd; NULL if out of memory); frees l (NULL is
  * accepted). */
 char *api_list_finish(api_list *l);
+
+/* ---- fits ------------------------------------------------------------------ */
+
+/* Parse POST /fits: preset/params/scene/integrator as for sessions, "free"
+ * (names, or {name, min, max, start} in the setting's unit), the data as
+ * "points" [{beta, rotation, v, sigma}], "csv" (text with the header
+ * beta,rotation,v[,sigma]) or "peaks" [{rotation, beta, sigma}], and
+ * "t_end", "curve_step" (deg), "max_iter", "fd_step". Checked whole with
+ * fit_check: a 422 naming the field, nothing started. *points (malloc'd,
+ * the caller frees; req->points points into it) holds the points. */
+api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point **points,
+		      api_problem *pb);
+
+typedef struct api_fit_view {
+	char id[24];
+	const char *state;        /* queued, running, done, failed, cancelled */
+	const fit_request *req;   /* borrowed */
+	fit_progress pr;          /* the last report (phase NULL before one) */
+	const char *result;       /* fit_result_json's text when over, or NULL */
+} api_fit_view;
+/* One fit: progress, current values and the result (null until over). */
+char *api_fit_json(const api_fit_view *v);
+/* {"fits": [...]} without results; CSV: fit,state,phase,iteration,
+ * evaluations,cost. malloc'd text. */
+char *api_fit_list_json(const api_fit_view *v, size_t n);
+char *api_fit_list_csv(const api_fit_view *v, size_t n);
 
 /* ---- catalogue ------------------------------------------------------------- */
 

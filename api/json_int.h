@@ -89,6 +89,9 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb);
 cJSON *api_settings_array(void);
 /* Add a number member; non-finite values become null. */
 void api_add_number(cJSON *obj, const char *name, double v);
+/* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
+ * ?format=csv} (a job's result, as JSON and as CSV). */
+void api_add_result_links(cJSON *obj, const char *collection, const char *id);
 
 /* The members each request body may have (NULL-terminated): the parsers
  * refuse any other, and openapi.c builds the request schemas from these
@@ -100,5 +103,9 @@ extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];
 extern const char *const api_members_sweep[];
 extern const char *const api_members_beta_range[];
+extern const char *const api_members_fit[];
+extern const char *const api_members_fit_free[];
+extern const char *const api_members_fit_point[];
+extern const char *const api_members_fit_peak[];
 
 #endif

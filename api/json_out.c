@@ -182,3 +182,12 @@ void api_add_number(cJSON *obj, const char *name, double v)
 		cJSON_AddNullToObject(obj, name);
 }
 
+void api_add_result_links(cJSON *obj, const char *collection, const char *id)
+{
+	char link[96];
+	cJSON *links = cJSON_AddObjectToObject(obj, "links");
+	snprintf(link, sizeof link, "/api/v1/%s/%s", collection, id);
+	cJSON_AddStringToObject(links, "self", link);
+	snprintf(link, sizeof link, "/api/v1/%s/%s?format=csv", collection, id);
+	cJSON_AddStringToObject(links, "csv", link);
+}

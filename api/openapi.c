@@ -259,6 +259,10 @@ char *api_openapi_json(void)
 		{"ScheduleSegment", api_members_segment},
 		{"SweepCreate", api_members_sweep},
 		{"BetaRange", api_members_beta_range},
+		{"FitCreate", api_members_fit},
+		{"FitFree", api_members_fit_free},
+		{"FitPoint", api_members_fit_point},
+		{"FitPeak", api_members_fit_peak},
 	};
 	cJSON *src = cJSON_Parse(schemas_text);
 	cJSON *comps = cJSON_DetachItemFromObjectCaseSensitive(src, "components");
@@ -298,7 +302,7 @@ char *api_openapi_json(void)
 	cJSON_AddStringToObject(info, "version", "1");
 	cJSON_AddStringToObject(info, "description",
 				"Simulation sessions of a reversible vibratory conveyor (Czubak 2016): "
-				"beta on the fly, streams, experiments, sweeps. Results as JSON or CSV "
+				"beta on the fly, streams, experiments, sweeps, fits. Results as JSON or CSV "
 				"(Accept or ?format=). Errors are RFC 9457 problem details.");
 	cJSON_AddItemToObject(doc, "paths", paths());
 	cJSON_AddItemToObject(doc, "components", comps);

@@ -203,7 +203,6 @@ static const char *point_state(int s)
 
 static cJSON *sweep_object(const api_sweep_view *v, int points)
 {
-	char link[96];
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "id", v->id);
 	cJSON_AddStringToObject(o, "state", v->state);
@@ -249,11 +248,7 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 					     pair);
 		}
 	}
-	cJSON *links = cJSON_AddObjectToObject(o, "links");
-	snprintf(link, sizeof link, "/api/v1/sweeps/%s", v->id);
-	cJSON_AddStringToObject(links, "self", link);
-	snprintf(link, sizeof link, "/api/v1/sweeps/%s?format=csv", v->id);
-	cJSON_AddStringToObject(links, "csv", link);
+	api_add_result_links(o, "sweeps", v->id);
 	return o;
 }
 

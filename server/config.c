@@ -30,6 +30,7 @@ static const srv_config defaults = {
 	.heartbeat = 15.0,
 	.max_experiments = 256,
 	.max_sweeps = 64,
+	.max_fits = 16,
 	.checkpoint_interval = 10.0,
 	.idle_timeout = 0.0,
 };

@@ -31,6 +31,7 @@ typedef struct srv_config {
 	int pool_threads;      /* sweep workers */
 	double heartbeat;      /* s between stream heartbeats */
 	int max_experiments, max_sweeps;
+	int max_fits;          /* fits kept (running or over) */
 	double checkpoint_interval; /* s of wall time between checkpoints */
 	double idle_timeout;   /* s without client or request; 0: never */
 	const char *token_file; /* NULL: no token asked (loopback only) */

@@ -30,6 +30,7 @@
 #include "static.h"
 #include "store.h"
 #include "stream.h"
+#include "fitjob.h"
 #include "sweep.h"
 #include "util.h"
 
@@ -77,6 +78,7 @@ static void shut_down(struct MHD_Daemon *d)
 	     i++)
 		usleep(10000);
 	MHD_stop_daemon(d);
+	srv_fits_shutdown(); /* their evaluations need the pool */
 	srv_pool_stop();
 	srv_sweeps_shutdown();
 	srv_sessions_shutdown();
@@ -129,6 +131,7 @@ int main(int argc, char **argv)
 	srv_sessions_init(&cfg);
 	srv_experiments_init(&cfg);
 	srv_sweeps_init(&cfg);
+	srv_fits_init(&cfg);
 	srv_streams_init(&cfg);
 	srv_static_init(&cfg);
 	srv_routes_init(&cfg);

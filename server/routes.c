@@ -22,6 +22,7 @@
 #include "catalog.h"
 #include "experiment_http.h"
 #include "gate.h"
+#include "fitjob.h"
 #include "routes.h"
 #include "session_http.h"
 #include "static.h"
@@ -50,6 +51,10 @@ static const route routes[] = {
 	{"GET", "/api/v1/sweeps", srv_h_sweeps_list},
 	{"GET", "/api/v1/sweeps/*", srv_h_sweep_get},
 	{"DELETE", "/api/v1/sweeps/*", srv_h_sweep_delete},
+	{"POST", "/api/v1/fits", srv_h_fits_create},
+	{"GET", "/api/v1/fits", srv_h_fits_list},
+	{"GET", "/api/v1/fits/*", srv_h_fit_get},
+	{"DELETE", "/api/v1/fits/*", srv_h_fit_delete},
 	{"GET", "/api/v1/presets", srv_h_presets},
 	{"GET", "/api/v1/health", srv_h_health},
 	{"GET", "/api/v1/openapi.json", srv_h_openapi},

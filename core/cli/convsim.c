@@ -6,6 +6,7 @@
  *   convsim sweep [--preset NAME] [--beta FROM:TO:STEP] [--rotation cw,ccw]
  *                 [--set NAME=VALUE ...] [--duration S] [--threads N]
  *                 [--out FILE] [--format csv|json]
+ *   convsim fit   (--data FILE | --peaks ROT:DEG,...) --free NAME,... (fit_cmd.c)
  *   convsim list | help [COMMAND] | --version
  *
  * `run` prints a JSON summary on stdout; `sweep` prints v(beta) per
@@ -34,21 +35,6 @@ static double cpu_now(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* The default measuring window (s after the transient) of run and sweep:
- * with the `steady` start, 4 s keep all 74 points of czubak2016 within
- * 1 % of the converged reference (README "Accuracy"). */
-#define MEASURE_WINDOW 4.0
-
-typedef struct opts {
-	const char *cmd;
-	sim_params p;
-	sim_scene sc;
-	sim_method m;
-	const char *preset, *out, *format, *beta, *rotation;
-	double duration, rate;
-	int threads, quiet;
-} opts;
-
 /* Print a number as the daemon does (shortest round trip); non-finite as
  * `nonfinite`. */
 static void put_num(FILE *f, double v, const char *nonfinite)
@@ -56,131 +42,6 @@ static void put_num(FILE *f, double v, const char *nonfinite)
 	char num[40];
 	sim_fmt_double(num, sizeof num, v, nonfinite);
 	fputs(num, f);
-}
-
-/* "unknown setting 'x'" gets the nearest setting's name. */
-static void setting_error(const opts *o, const char *arg, const char *name, const char *msg)
-{
-	size_t n;
-	const sim_setting *t = sim_settings(&n);
-	char hint[96] = "";
-	if (!sim_setting_find(name))
-		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, n, sizeof *t));
-	fprintf(stderr, "convsim %s: --set %s: %s%s; 'convsim list' shows every setting\n", o->cmd,
-		arg, msg, hint);
-}
-
-static int apply_set(opts *o, const char *v)
-{
-	const char *eq = strchr(v, '=');
-	if (!eq || eq == v) {
-		fprintf(stderr, "convsim %s: --set needs NAME=VALUE, got '%s'\n", o->cmd, v);
-		return -1;
-	}
-	char name[64], msg[200];
-	snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-	if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) != SIM_OK) {
-		setting_error(o, v, name, msg);
-		return -1;
-	}
-	return 0;
-}
-
-/* The first pass over command cmd's options: help (shown, -1), a wrong
- * option or an operand (reported, 2), else 0 with --preset in *preset
- * (may be NULL for commands without one). */
-static int first_pass(int argc, char **argv, unsigned cmd, const char **preset)
-{
-	const char *arg;
-	int id;
-	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
-		if (id == 0)
-			return 2;
-		if (id == OPT_HELP) {
-			cli_help(stdout, cmd);
-			return -1;
-		}
-		if (id == OPT_PRESET && preset)
-			*preset = arg;
-	}
-	if (cli_operand_index() < argc) {
-		fprintf(stderr, "convsim %s: unexpected argument '%s' (options start with --)\n",
-			argv[0], argv[cli_operand_index()]);
-		return 2;
-	}
-	return 0;
-}
-
-/* Parse command cmd's options into *o. Returns 0, 2 (usage error) or -1
- * (help shown: exit 0). */
-static int parse(int argc, char **argv, unsigned cmd, opts *o)
-{
-	o->cmd = argv[0];
-	o->preset = "czubak2016";
-	o->duration = NAN;
-	o->rate = 1000.0;
-	o->threads = 2;
-	o->rotation = "cw,ccw";
-	o->beta = "0:180:10";
-	/* the preset first, so that --set applies on top of it wherever it
-	 * stands; a first pass finds it */
-	int rc = first_pass(argc, argv, cmd, &o->preset);
-	if (rc)
-		return rc;
-	const char *arg;
-	int id;
-	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
-		char hint[96];
-		size_t n = 0;
-		while (sim_preset_names[n])
-			n++;
-		fprintf(stderr, "convsim %s: --preset: unknown preset '%s'%s; known: czubak2016\n",
-			o->cmd, o->preset,
-			cli_did_you_mean(hint, sizeof hint,
-					 sim_suggest(o->preset, sim_preset_names, n,
-						     sizeof *sim_preset_names)));
-		return 2;
-	}
-	cli_restart_options();
-	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
-		int bad = 0;
-		switch (id) {
-		case OPT_SET: bad = apply_set(o, arg); break;
-		case OPT_DURATION:
-			bad = cli_number(o->cmd, "duration", "seconds", arg, 0, 1e5, 1, &o->duration);
-			break;
-		case OPT_RATE:
-			bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
-			break;
-		case OPT_THREADS: {
-			double th;
-			bad = cli_number(o->cmd, "threads", NULL, arg, 1, 64, 0, &th);
-			if (!bad && th != floor(th)) {
-				fprintf(stderr, "convsim %s: --threads must be a whole number, got '%s'\n",
-					o->cmd, arg);
-				bad = 1;
-			}
-			o->threads = (int)th;
-			break;
-		}
-		case OPT_OUT: o->out = arg; break;
-		case OPT_FORMAT: o->format = arg; break;
-		case OPT_BETA: o->beta = arg; break;
-		case OPT_ROTATION: o->rotation = arg; break;
-		case OPT_QUIET: o->quiet = 1; break;
-		default: break;
-		}
-		if (bad)
-			return 2;
-	}
-	if (o->format && strcmp(o->format, "csv") != 0 && strcmp(o->format, "json") != 0) {
-		fprintf(stderr, "convsim %s: --format must be csv or json, got '%s'\n", o->cmd,
-			o->format);
-		return 2;
-	}
-	if (isnan(o->duration))
-		o->duration = o->sc.transient + MEASURE_WINDOW;
-	return 0;
 }
 
 /* ---- run ---- */
@@ -240,7 +101,7 @@ static void traj_row(traj_file *tf, const sim *s, const sim_status *st)
 
 /* The run's JSON summary on stdout: final status, cost (cpu, wall in s)
  * and the error, if any. */
-static void print_summary(const opts *o, const sim *s, const sim_status *st, int err, double cpu,
+static void print_summary(const cli_opts *o, const sim *s, const sim_status *st, int err, double cpu,
 			  double wall)
 {
 	FILE *f = stdout;
@@ -305,7 +166,7 @@ static int wants_json(const char *format, const char *file)
 	return n > 5 && strcmp(file + n - 5, ".json") == 0;
 }
 
-static FILE *open_out(const opts *o)
+static FILE *open_out(const cli_opts *o)
 {
 	FILE *f = fopen(o->out, "w");
 	if (!f) {
@@ -317,8 +178,8 @@ static FILE *open_out(const opts *o)
 
 static int cmd_run(int argc, char **argv)
 {
-	opts o = {0};
-	int rc = parse(argc, argv, CMD_RUN, &o);
+	cli_opts o = {0};
+	int rc = cli_parse(argc, argv, CMD_RUN, &o);
 	if (rc)
 		return rc < 0 ? 0 : rc;
 	char msg[200];
@@ -392,7 +253,7 @@ typedef struct task {
 } task;
 
 typedef struct pool {
-	const opts *o;
+	const cli_opts *o;
 	task *tasks;
 	int n, next, done;
 	cli_progress progress;
@@ -427,7 +288,7 @@ static void *worker(void *arg)
 /* The sweep's table (CSV with the daemon's header, or JSON with the
  * daemon's point members) on f; failures on stderr. Returns the number of
  * failed points. */
-static int print_sweep(FILE *f, const opts *o, const pool *pl)
+static int print_sweep(FILE *f, const cli_opts *o, const pool *pl)
 {
 	int json = o->format && strcmp(o->format, "json") == 0, failed = 0;
 	if (json) {
@@ -514,8 +375,8 @@ static int parse_rotation(const char *text, int rots[2])
 
 static int cmd_sweep(int argc, char **argv)
 {
-	opts o = {0};
-	int rc = parse(argc, argv, CMD_SWEEP, &o);
+	cli_opts o = {0};
+	int rc = cli_parse(argc, argv, CMD_SWEEP, &o);
 	if (rc)
 		return rc < 0 ? 0 : rc;
 	if (!(o.duration > o.sc.transient)) {
@@ -574,7 +435,7 @@ static int cmd_sweep(int argc, char **argv)
 
 static int cmd_list(int argc, char **argv)
 {
-	int rc = first_pass(argc, argv, CMD_LIST, NULL);
+	int rc = cli_first_pass(argc, argv, CMD_LIST, NULL);
 	if (rc)
 		return rc < 0 ? 0 : rc;
 	size_t n;
@@ -604,10 +465,10 @@ static int cmd_list(int argc, char **argv)
 
 static int unknown_command(const char *name)
 {
-	static const char *const names[] = {"run", "sweep", "list", "help"};
+	static const char *const names[] = {"run", "sweep", "fit", "list", "help"};
 	char hint[96];
 	fprintf(stderr, "convsim: unknown command '%s'%s; 'convsim help' lists the commands\n", name,
-		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, names, 4, sizeof *names)));
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, names, 5, sizeof *names)));
 	return 2;
 }
 
@@ -636,6 +497,7 @@ int main(int argc, char **argv)
 	switch (cli_command(c)) {
 	case CMD_RUN: return cmd_run(argc - 1, argv + 1);
 	case CMD_SWEEP: return cmd_sweep(argc - 1, argv + 1);
+	case CMD_FIT: return cli_cmd_fit(argc - 1, argv + 1);
 	case CMD_LIST: return cmd_list(argc - 1, argv + 1);
 	default: return unknown_command(c);
 	}

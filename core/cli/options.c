@@ -16,12 +16,12 @@
 #include "cli.h"
 #include "suggest.h"
 
-#define RS (CMD_RUN | CMD_SWEEP)
-#define ALL (CMD_RUN | CMD_SWEEP | CMD_LIST)
+#define RS (CMD_RUN | CMD_SWEEP | CMD_FIT)
+#define ALL (CMD_RUN | CMD_SWEEP | CMD_LIST | CMD_FIT)
 
 static const cli_opt options[] = {
 	{RS, OPT_PRESET, "preset", 'p', "NAME", NULL, "czubak2016",
-	 "starting values for every setting (known: czubak2016)"},
+	 "starting values for every setting (known: czubak2016, czubak2016-fit)"},
 	{RS, OPT_SET, "set", 's', "NAME=VALUE", NULL, NULL,
 	 "set one setting, in the unit `convsim list` shows; repeatable"},
 	{CMD_RUN, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
@@ -40,8 +40,25 @@ static const cli_opt options[] = {
 	 "guide angles in [0, 180], or one angle"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",
 	 "cw (the paper's clockwise, rotor speed > 0), ccw, or both"},
-	{CMD_SWEEP, OPT_THREADS, "threads", 'j', "N", NULL, "2",
+	{CMD_SWEEP | CMD_FIT, OPT_THREADS, "threads", 'j', "N", NULL, "2",
 	 "simulations run in parallel, 1..64"},
+	{CMD_FIT, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
+	 "simulated time per model evaluation; v is measured after the transient"},
+	{CMD_FIT, OPT_DATA, "data", 0, "FILE", NULL, NULL,
+	 "measured points as CSV with the header beta,rotation,v[,sigma] (deg, cw|ccw, m/s, m/s); "
+	 "- reads stdin"},
+	{CMD_FIT, OPT_PEAKS, "peaks", 0, "ROT:DEG[:SIGMA],...", "deg", NULL,
+	 "measured peak positions of v(beta) instead of points, e.g. cw:38,cw:128"},
+	{CMD_FIT, OPT_FREE, "free", 0, "NAME[:MIN:MAX],...", NULL, NULL,
+	 "free parameters by setting name, bounds in the setting's unit (default its range); "
+	 "they start at the model's values (--preset, --set)"},
+	{CMD_FIT, OPT_CURVE_STEP, "curve-step", 0, "DEG", "deg", "5",
+	 "grid of the fitted and the original curve over [0, 180]; 0: none"},
+	{CMD_FIT, OPT_FD_STEP, "fd-step", 0, "REL", NULL, "0.05",
+	 "finite-difference step relative to each parameter's value"},
+	{CMD_FIT, OPT_MAX_ITER, "max-iter", 0, "N", NULL, "30", "Levenberg-Marquardt iterations, at most"},
+	{CMD_FIT, OPT_OUT, "out", 'o', "FILE", NULL, "stdout", "write the result to FILE"},
+	{CMD_FIT, OPT_FORMAT, "format", 'f', "json|csv", NULL, "json", "format of the result"},
 	{RS, OPT_QUIET, "quiet", 'q', NULL, NULL, NULL, "no progress on stderr"},
 	{ALL, OPT_HELP, "help", 'h', NULL, NULL, NULL, "show this help on stdout and exit"},
 };
@@ -60,6 +77,12 @@ static const struct {
 	 "Measure the steady transport velocity v(beta): one fresh simulation per angle and\n"
 	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
 	 "stderr: a bar on a terminal, plain lines otherwise."},
+	{"fit", CMD_FIT, "convsim fit (--data FILE | --peaks ROT:DEG,...) --free NAME,... [OPTIONS]",
+	 "Fit free model parameters to measured v(beta) points or peak positions by\n"
+	 "Levenberg-Marquardt (GSL), each model value a steady-state measurement, the\n"
+	 "Jacobian's evaluations in parallel. Prints the result (values, standard errors,\n"
+	 "correlation, residuals, the fitted and the original curve, warnings) as JSON or\n"
+	 "CSV; a summary and progress go to stderr."},
 	{"list", CMD_LIST, "convsim list",
 	 "Print every setting (name, group, unit, range, meaning) and the integrators."},
 };
@@ -93,6 +116,7 @@ void cli_help(FILE *f, unsigned cmd)
 			fprintf(f, "  %-6s %s\n", commands[i].name,
 				i == 0   ? "one simulation: JSON summary, optional trajectory"
 				: i == 1 ? "v(beta) for both rotation senses, as CSV or JSON"
+				: i == 2 ? "fit parameters to measured v(beta) or its peaks"
 					 : "every setting with its unit and range; the integrators");
 		fprintf(f, "\n'convsim help COMMAND' or 'convsim COMMAND --help' lists the options "
 			   "with their\ndefaults and units. Exit status: 0 done, 1 the simulation "
@@ -117,7 +141,7 @@ void cli_help(FILE *f, unsigned cmd)
 				o->unit ? o->unit : "", o->unit && o->def ? "; " : "",
 				o->def ? "default: " : "", o->def ? o->def : "");
 	}
-	if (cmd & (CMD_RUN | CMD_SWEEP))
+	if (cmd & (CMD_RUN | CMD_SWEEP | CMD_FIT))
 		fprintf(f, "\nsettings for --set: 'convsim list' (for example --set beta=30 "
 			   "--set rotation=ccw\n--set method=rk4 --set dt=1e-5 --set "
 			   "trough_rotation=true).\n");

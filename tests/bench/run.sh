@@ -40,4 +40,6 @@ echo "bench: the 74-point v(beta) curve against the converged reference (one cor
 bash tests/bench/accuracy.sh "$out"
 echo "bench: cost against the feed's size (one core)"
 bash tests/bench/scaling.sh "$out"
+echo "bench: a 2-parameter fit on 20 points (two threads)"
+bash tests/bench/fit.sh "$out"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

@@ -79,6 +79,14 @@ test('every operation answers what the document says', { timeout: 120000 * SLOW 
   await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${w.id}`)).body.state === 'done', 30000 * SLOW, 'sweep');
   await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`);
   await call('GET', '/api/v1/sweeps', '/api/v1/sweeps');
+  const f = (await call('POST', '/api/v1/fits', '/api/v1/fits',
+    { ...CHEAP, free: [{ name: 'e', min: 0.01, max: 0.03 }], t_end: 0.5, curve_step: 90, max_iter: 2,
+      points: [{ beta: 30, rotation: 'cw', v: 0.1, sigma: 0.01 }, { beta: 130, rotation: 'cw', v: -0.1, sigma: 0.01 }] })).body;
+  await until(async () => (await req(d.base, 'GET', `/api/v1/fits/${f.id}`)).body.state === 'done', 60000 * SLOW, 'fit');
+  await call('GET', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}`);
+  await call('GET', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}?format=csv`);
+  await call('GET', '/api/v1/fits', '/api/v1/fits');
+  await call('DELETE', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}`, undefined, { 'Content-Type': 'application/json' });
   await call('GET', '/api/v1/presets', '/api/v1/presets');
   await call('GET', '/api/v1/health', '/api/v1/health');
   await call('GET', '/api/v1/openapi.json', '/api/v1/openapi.json');
@@ -123,13 +131,14 @@ test('request schemas are closed like the parsers: an unknown member fails both'
     ['SessionCreate', '/api/v1/sessions', { pace: 1, bogus: 1 }],
     ['ExperimentCreate', '/api/v1/experiments', { schedule: [{ beta: 38, until: 1 }], bogus: 1 }],
     ['SweepCreate', '/api/v1/sweeps', { beta: [30], bogus: 1 }],
+    ['FitCreate', '/api/v1/fits', { free: ['e'], bogus: 1 }],
   ]) {
     assert.equal(schema(name)(body), false, `${name} refuses an unknown member`);
     const r = await req(d.base, 'POST', path, body);
     assert.equal(r.status, 422, path);
     assert.equal(r.body.type, '/api/v1/problems/unknown-field');
   }
-  for (const name of ['Status', 'Session', 'Experiment', 'Sweep', 'SweepPoint', 'Segment', 'Trajectory', 'Problem']) {
+  for (const name of ['Status', 'Session', 'Experiment', 'Sweep', 'SweepPoint', 'Segment', 'Trajectory', 'Problem', 'Fit', 'FitResult']) {
     const s = doc.components.schemas[name];
     assert.ok(s.additionalProperties === false || s.unevaluatedProperties === false, `${name} is closed`);
     assert.ok(Array.isArray(s.required) || s.allOf, `${name} says what is required`);

@@ -40,14 +40,21 @@ export function sessionRequest(f) {
 	return body;
 }
 
-/* POST /sweeps: the session form's model, a beta grid, both rotations. */
-export function sweepRequest(f) {
+/* The session form's model for a job that sets beta and rotation per
+ * point (sweeps, fits): no pace, no sample rate, the feed on. */
+function jobModel(f) {
 	const body = sessionRequest(f);
 	delete body.pace;
 	delete body.sample_rate;
 	delete body.params.beta;
 	delete body.params.rotation;
 	body.scene.feed = true;
+	return body;
+}
+
+/* POST /sweeps: the session form's model, a beta grid, both rotations. */
+export function sweepRequest(f) {
+	const body = jobModel(f);
 	body.beta = { from: f.from, to: f.to, step: f.step };
 	body.rotations = ['cw', 'ccw'];
 	body.t_end = f.tEnd;
@@ -80,4 +87,19 @@ export function streamQuery(opts = {}) {
 	q.set('fields', (opts.fields ?? ['trough', 'orbit', 'rotor', 'eliminators', 'feed']).join(','));
 	if (Number.isInteger(opts.since) && opts.since >= 0) q.set('since', String(opts.since));
 	return q.toString();
+}
+
+/* POST /fits: the session form's model, the free names (NAME or
+ * NAME:MIN:MAX), the points as CSV text, the time per evaluation and the
+ * curve's grid. */
+export function fitRequest(f) {
+	const body = jobModel(f);
+	body.free = String(f.free).split(',').map(s => s.trim()).filter(Boolean).map(s => {
+		const [name, min, max] = s.split(':');
+		return min === undefined ? name : { name, min: Number(min), max: Number(max) };
+	});
+	body.csv = f.csv;
+	if (Number.isFinite(f.tEnd)) body.t_end = f.tEnd;
+	if (Number.isFinite(f.curveStep)) body.curve_step = f.curveStep;
+	return body;
 }

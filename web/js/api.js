@@ -19,7 +19,7 @@
  * NetworkError. This module touches no DOM and runs under node:test.
  */
 
-import { BASE, authHeaders, sessionRequest, sweepRequest, experimentRequest } from './api-requests.js';
+import { BASE, authHeaders, sessionRequest, sweepRequest, experimentRequest, fitRequest } from './api-requests.js';
 import { normalizeSession, normalizeControl, normalizeSweep, normalizeExperiment,
 	normalizePresets, normalizeMethods, trajectoryColumns, methodEnum } from './api-normalize.js';
 
@@ -157,4 +157,34 @@ export async function getExperiment(id) {
 
 export async function integratorNames() {
 	return methodEnum((await request('GET', '/openapi.json')).data);
+}
+
+/* ---- fits ---------------------------------------------------------------- */
+
+/* A fit job as the page uses it: progress, and the daemon's result object
+ * (fields as README "Calibration" lists them) once over. */
+export function normalizeFit(raw) {
+	const r = raw || {};
+	return {
+		id: r.id, state: r.state, phase: r.phase, iteration: r.iteration ?? 0,
+		maxIter: r.max_iter ?? 1, evaluations: r.evaluations ?? 0, values: r.values || {},
+		result: r.result || null,
+		done: ['done', 'failed', 'cancelled'].includes(r.state),
+		failed: r.state === 'failed' || r.state === 'cancelled',
+		progress: r.state === 'done' ? 1 : Math.min(1, (r.iteration ?? 0) / (r.max_iter || 1)),
+	};
+}
+export async function createFit(form) {
+	return normalizeFit((await request('POST', '/fits', fitRequest(form))).data);
+}
+export async function getFit(id) {
+	return normalizeFit((await request('GET', `/fits/${enc(id)}`)).data);
+}
+/* DELETE cancels a running fit; the body is empty JSON, as every mutating
+ * request carries Content-Type: application/json. */
+export async function deleteFit(id) {
+	await request('DELETE', `/fits/${enc(id)}`, {});
+}
+export function fitCsvUrl(id) {
+	return `${BASE}/fits/${enc(id)}?format=csv`;
 }

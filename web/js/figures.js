@@ -33,6 +33,12 @@ export function makePlots() {
 		series: [{ label: 'clockwise', color: PALETTE[0] }, { label: 'counter-clockwise', color: PALETTE[1] }],
 		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
 	});
+	app.plots.fit = new XYPlot($('#plot-fit'), {
+		series: [{ label: 'data cw', color: PALETTE[0] }, { label: 'fitted cw', color: PALETTE[2] },
+			{ label: 'original cw', color: '#94a3b8' }, { label: 'data ccw', color: PALETTE[1] },
+			{ label: 'fitted ccw', color: PALETTE[4] }, { label: 'original ccw', color: '#cbd5e1' }],
+		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
+	});
 	app.plots.experiment = new TimePlot($('#plot-experiment'), {
 		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
 		yLabel: 'v / (m/s)', y2Label: 'β / °', y2Range: [0, 180], aspect: 0.5,

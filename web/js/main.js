@@ -8,7 +8,7 @@
  * traces (live.js), its polled status the tiles and controls (status.js),
  * and draw.js redraws at most every animation frame. ui.js holds the state
  * they share; figures.js says which plot shows what; controls.js wires the
- * live-control card; sweep.js and experiment.js are the two job panels.
+ * live-control card; sweep.js, experiment.js and fit.js are the job panels.
  * api.js (with api-normalize.js, api-requests.js, api-stream.js) is the
  * one link to the daemon; auth.js gives it the token from the URL's
  * fragment (#token=...).
@@ -22,6 +22,7 @@ import { makePlots } from './figures.js';
 import { frame } from './draw.js';
 import { wireControls } from './controls.js';
 import { runSweep } from './sweep.js';
+import { wireFit } from './fit.js';
 import { runExperiment } from './experiment.js';
 
 const HEALTH_MS = 3000;
@@ -44,6 +45,7 @@ function wire() {
 	});
 	f.preset.addEventListener('change', () => applyPreset(f.preset.value));
 	$('#sweep-form').addEventListener('submit', runSweep);
+	wireFit();
 	$('#experiment-form').addEventListener('submit', runExperiment);
 }
 

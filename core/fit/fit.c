@@ -1,0 +1,465 @@
+/*
+ * fit.c - the least-squares driver of a calibration: Levenberg-Marquardt in
+ * a trust region (GSL's gsl_multifit_nlinear, trs_lm, More scaling) on the
+ * residuals r_i = (model_i - data_i) / sigma_i (sigma_i = 1 when the data
+ * give none).
+ *
+ * Bounds by a smooth transform: each free parameter x in [lo, hi] is
+ * x = lo + (hi - lo) (1 + sin z) / 2 over an unbounded z (on log x when
+ * lo > 0 and hi / lo >= 1000, so that a stiffness spanning decades moves
+ * in proportion); the solver works in z and never leaves the bounds.
+ *
+ * Jacobian by forward differences in x, all columns in one parallel batch:
+ * step h_j = fd_rel * max(|x_j|, 1e-3 (hi_j - lo_j)) (5 % by default),
+ * backwards when x_j + h_j passes hi_j. The steady-state measure is not
+ * smooth at the 0.3 % level (its 4-s window sees whole periods only, and
+ * the feed's contact pattern shifts), so the step must move v well beyond
+ * that: 5 % of e moves v by about 12 %, 40 times the jitter (README
+ * "Calibration"). Then J_z = J_x dx/dz.
+ *
+ * Standard errors, correlations and warnings at the optimum: fit_cov.c.
+ */
+#include <gsl/gsl_blas.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_multifit_nlinear.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fit_int.h"
+#include "units.h"
+
+
+
+/* trial steps per iteration: past this many rejections the cost is at the
+ * measure's jitter and the iterate stands */
+#define MAX_TRIALS 8
+
+static int log_scale(const fit_free *f)
+{
+	return f->lo > 0 && f->hi / f->lo >= 1000;
+}
+
+static double x_of_z(const fit_free *f, double z)
+{
+	double u = 0.5 * (1 + sin(z));
+	if (log_scale(f))
+		return exp(log(f->lo) + u * (log(f->hi) - log(f->lo)));
+	return f->lo + u * (f->hi - f->lo);
+}
+
+static double dx_dz(const fit_free *f, double z)
+{
+	double du = 0.5 * cos(z);
+	if (log_scale(f))
+		return x_of_z(f, z) * (log(f->hi) - log(f->lo)) * du;
+	return (f->hi - f->lo) * du;
+}
+
+/* z of x; a start on a bound moves BOUND_NEAR of the width inside, where
+ * dx/dz is not zero. */
+static double z_of_x(const fit_free *f, double x)
+{
+	double u = log_scale(f) ? (log(x) - log(f->lo)) / (log(f->hi) - log(f->lo))
+				: (x - f->lo) / (f->hi - f->lo);
+	u = fmin(fmax(u, BOUND_NEAR), 1 - BOUND_NEAR);
+	return asin(2 * u - 1);
+}
+
+static void xs_of(const fit_ctx *c, const gsl_vector *z, double *x)
+{
+	for (int j = 0; j < c->p; j++)
+		x[j] = x_of_z(&c->req->free[j], gsl_vector_get(z, (size_t)j));
+}
+
+static void report(fit_ctx *c, const char *phase, const double *x, double cost)
+{
+	if (!c->req->progress)
+		return;
+	fit_progress pr = {phase, c->iteration, 0, cost, {0}};
+	pthread_mutex_lock(&c->ev.lock);
+	pr.evaluations = c->ev.evaluations;
+	pthread_mutex_unlock(&c->ev.lock);
+	for (int j = 0; x && j < c->p; j++)
+		pr.x[j] = x[j];
+	c->req->progress(c->req->ctx, &pr);
+}
+
+static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
+{
+	fit_ctx *c = arg;
+	double x[FIT_MAX_FREE];
+	xs_of(c, z, x);
+	if (c->iteration > 0 && ++c->trials > MAX_TRIALS) {
+		c->stalled = 1;
+		return GSL_EBADFUNC;
+	}
+	if (fit_eval_data(&c->ev, 1, x, c->fmodel, c->fmodel_u) != 0)
+		return GSL_EBADFUNC;
+	memcpy(c->fx, x, sizeof x);
+	c->fvalid = 1;
+	double cost = 0;
+	for (size_t i = 0; i < c->n; i++) {
+		double r = (c->fmodel[i] - c->data[i]) / c->w[i];
+		gsl_vector_set(f, i, r);
+		cost += r * r;
+	}
+	report(c, "fitting", x, cost);
+	return GSL_SUCCESS;
+}
+
+static int same_x(const double *a, const double *b, int p)
+{
+	return memcmp(a, b, sizeof *a * (size_t)p) == 0;
+}
+
+/* The forward-difference step of parameter j at x (signed). */
+static double fd_step(const fit_ctx *c, int j, double x)
+{
+	const fit_free *f = &c->req->free[j];
+	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
+	h = fmin(h, 0.25 * (f->hi - f->lo));
+	return x + h <= f->hi ? h : -h;
+}
+
+/* J_x (weighted) at x into c->jac_x: the base set (unless f has it) and
+ * one perturbed set per parameter, in one batch. */
+static int jacobian_x(fit_ctx *c, const double *x)
+{
+	int p = c->p, base = !(c->fvalid && same_x(c->fx, x, p));
+	size_t sets = (size_t)p + (size_t)base, n = c->n;
+	double *xs = malloc(sizeof *xs * sets * (size_t)p), *out = malloc(sizeof *out * sets * n),
+	       *out_u = malloc(sizeof *out_u * sets * n);
+	double h[FIT_MAX_FREE];
+	int rc = xs && out && out_u ? 0 : -1;
+	for (size_t s = 0; rc == 0 && s < sets; s++)
+		for (int j = 0; j < p; j++) {
+			int pert = (int)s - base;
+			if (pert == j)
+				h[j] = fd_step(c, j, x[j]);
+			xs[s * (size_t)p + (size_t)j] = x[j] + (pert == j ? h[j] : 0);
+		}
+	if (rc == 0)
+		rc = fit_eval_data(&c->ev, sets, xs, out, out_u);
+	const double *f0 = base ? out : c->fmodel;
+	for (size_t i = 0; rc == 0 && i < n; i++)
+		for (int j = 0; j < p; j++)
+			c->jac_x[i * (size_t)p + (size_t)j] =
+				(out[((size_t)j + (size_t)base) * n + i] - f0[i]) / h[j] / c->w[i];
+	if (rc == 0) {
+		memcpy(c->jx, x, sizeof *x * (size_t)p);
+		memcpy(c->jmodel, f0, sizeof(double) * n);
+		memcpy(c->jmodel_u, base ? out_u : c->fmodel_u, sizeof(double) * n);
+		c->jvalid = 1;
+	}
+	free(xs);
+	free(out);
+	free(out_u);
+	return rc;
+}
+
+static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
+{
+	fit_ctx *c = arg;
+	double x[FIT_MAX_FREE];
+	xs_of(c, z, x);
+	if (jacobian_x(c, x) != 0)
+		return GSL_EBADFUNC;
+	for (size_t i = 0; i < c->n; i++)
+		for (int j = 0; j < c->p; j++)
+			gsl_matrix_set(J, i, (size_t)j,
+				       c->jac_x[i * (size_t)c->p + (size_t)j] *
+					       dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
+	return GSL_SUCCESS;
+}
+
+/* The curves at the fit and at the start on the grid, per rotation of
+ * the data. */
+static int curves(fit_ctx *c)
+{
+	const fit_request *r = c->req;
+	fit_result *res = c->res;
+	int p = c->p;
+	size_t n = (size_t)floor(SIM_PI / r->curve_step + 1e-9) + 1, total = 0;
+	for (size_t d = 0; d < c->n; d++) {
+		int rot = r->npoints ? r->points[d].rotation : r->peaks[d].rotation;
+		if (!(res->nrot > 0 && res->rotations[0] == rot) &&
+		    !(res->nrot > 1 && res->rotations[1] == rot))
+			res->rotations[res->nrot++] = rot;
+	}
+	total = n * (size_t)res->nrot;
+	res->ncurve = n;
+	res->curve_beta = malloc(sizeof(double) * n);
+	double *beta = malloc(sizeof(double) * total), *v = malloc(sizeof(double) * 2 * total),
+	       *u = malloc(sizeof(double) * 2 * total), xs[2 * FIT_MAX_FREE];
+	int *rot = malloc(sizeof(int) * total), rc = -1;
+	res->curve_fit = malloc(sizeof(double) * total);
+	res->curve_fit_u = malloc(sizeof(double) * total);
+	res->curve_start = malloc(sizeof(double) * total);
+	if (beta && v && u && rot && res->curve_beta && res->curve_fit && res->curve_fit_u &&
+	    res->curve_start) {
+		for (size_t k = 0; k < total; k++) {
+			beta[k] = fmin((double)(k % n) * r->curve_step, SIM_PI);
+			rot[k] = res->rotations[k / n];
+		}
+		memcpy(res->curve_beta, beta, sizeof(double) * n);
+		memcpy(xs, res->x, sizeof(double) * (size_t)p);
+		memcpy(xs + p, res->x0, sizeof(double) * (size_t)p);
+		rc = fit_eval_curve(&c->ev, 2, xs, total, beta, rot, v, u);
+		for (size_t k = 0; rc == 0 && k < total; k++) {
+			res->curve_fit[k] = v[k];
+			res->curve_fit_u[k] = u[k];
+			res->curve_start[k] = v[total + k];
+		}
+	}
+	free(beta);
+	free(v);
+	free(u);
+	free(rot);
+	return rc;
+}
+
+static double wall_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The data, weights and result arrays of c; -1 when out of memory. */
+static int prepare(fit_ctx *c, const fit_request *r, fit_result *res)
+{
+	c->req = r;
+	c->res = res;
+	c->p = r->nfree;
+	if (fit_eval_init(&c->ev, r) != 0)
+		return -1;
+	c->n = c->ev.ndata;
+	size_t n = c->n;
+	c->w = malloc(sizeof(double) * n);
+	c->data = malloc(sizeof(double) * n);
+	c->fmodel = malloc(sizeof(double) * n);
+	c->fmodel_u = malloc(sizeof(double) * n);
+	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
+	c->jmodel = malloc(sizeof(double) * n);
+	c->jmodel_u = malloc(sizeof(double) * n);
+	res->ndata = n;
+	res->model = malloc(sizeof(double) * n);
+	res->model_u = malloc(sizeof(double) * n);
+	res->model_start = malloc(sizeof(double) * n);
+	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !c->jmodel ||
+	    !c->jmodel_u || !res->model ||
+	    !res->model_u || !res->model_start)
+		return -1;
+	res->sigma_given = 1;
+	for (size_t i = 0; i < n; i++) {
+		double s = r->npoints ? r->points[i].sigma : r->peaks[i].sigma;
+		c->data[i] = r->npoints ? r->points[i].v : r->peaks[i].beta;
+		c->w[i] = isnan(s) ? 1 : s;
+		res->sigma_given &= !isnan(s);
+		res->model_start[i] = NAN;
+	}
+	res->nfree = c->p;
+	for (int j = 0; j < c->p; j++)
+		res->x0[j] = res->x[j] = r->free[j].start;
+	return 0;
+}
+
+/* Rough standard errors (SI) from the last Jacobian and the cost at the
+ * current iterate, for the stopping test: 0, or -1 when J^T J is singular. */
+static int rough_se(const fit_ctx *c, double cost, double *se)
+{
+	int p = c->p, rc = -1;
+	gsl_matrix *A = gsl_matrix_calloc((size_t)p, (size_t)p);
+	for (size_t i = 0; A && i < c->n; i++)
+		for (int a = 0; a < p; a++)
+			for (int b = 0; b < p; b++)
+				*gsl_matrix_ptr(A, (size_t)a, (size_t)b) +=
+					c->jac_x[i * (size_t)p + (size_t)a] *
+					c->jac_x[i * (size_t)p + (size_t)b];
+	double s2 = c->res->sigma_given ? 1 : cost / fmax((double)c->n - p, 1);
+	if (A && gsl_linalg_cholesky_decomp1(A) == GSL_SUCCESS &&
+	    gsl_linalg_cholesky_invert(A) == GSL_SUCCESS) {
+		for (int j = 0; j < p; j++)
+			se[j] = sqrt(s2 * gsl_matrix_get(A, (size_t)j, (size_t)j));
+		rc = 0;
+	}
+	gsl_matrix_free(A);
+	return rc;
+}
+
+/* The iterations; the status. Converged when the last step moved every
+ * parameter by less than xtol of its scale, or by less than a tenth of its
+ * (rough) standard error: the data cannot tell such steps apart. */
+static int iterate(fit_ctx *c, gsl_multifit_nlinear_workspace *w)
+{
+	const fit_request *r = c->req;
+	double prev[FIT_MAX_FREE];
+	xs_of(c, gsl_multifit_nlinear_position(w), prev);
+	for (c->iteration = 1; c->iteration <= r->max_iter; c->iteration++) {
+		c->trials = 0;
+		int rc = gsl_multifit_nlinear_iterate(w);
+		if (c->ev.failed)
+			return c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
+		if (c->stalled) {
+			fit_warn(c->res, "stopped in iteration %d: %d trial steps in a row did not lower "
+				     "the cost (the steady-state measure's jitter limits the fit here)",
+			     c->iteration, MAX_TRIALS);
+			c->iteration--;
+			return FIT_CONVERGED;
+		}
+		double x[FIT_MAX_FREE], se[FIT_MAX_FREE], step = 0, step_se = 0;
+		xs_of(c, gsl_multifit_nlinear_position(w), x);
+		double cost;
+		gsl_blas_ddot(gsl_multifit_nlinear_residual(w), gsl_multifit_nlinear_residual(w), &cost);
+		int have_se = c->jvalid && rough_se(c, cost, se) == 0;
+		for (int j = 0; j < c->p; j++) {
+			const fit_free *f = &r->free[j];
+			step = fmax(step, fabs(x[j] - prev[j]) /
+						  fmax(fabs(x[j]), 1e-3 * (f->hi - f->lo)));
+			step_se = fmax(step_se, have_se ? fabs(x[j] - prev[j]) / se[j] : INFINITY);
+		}
+		memcpy(prev, x, sizeof x);
+		if (rc == GSL_ENOPROG) {
+			fit_warn(c->res, "stopped after %d iterations: no step lowers the cost further "
+				     "(the steady-state measure's jitter limits the fit here)",
+			     c->iteration);
+			return FIT_CONVERGED;
+		}
+		if (rc != GSL_SUCCESS) {
+			snprintf(c->res->error, FIT_MSG, "the solver stopped: %s", gsl_strerror(rc));
+			return FIT_FAILED;
+		}
+		int info;
+		if (step < r->xtol || step_se < 0.1 ||
+		    gsl_multifit_nlinear_test(r->xtol, 1e-8, 0, &info, w) == GSL_SUCCESS)
+			return FIT_CONVERGED;
+	}
+	c->iteration = r->max_iter;
+	fit_warn(c->res, "no convergence in %d iterations: the values are the last iterate",
+	     r->max_iter);
+	return FIT_MAXITER;
+}
+
+/* Levenberg-Marquardt from the start; fills res->x, iterations, status. */
+static int solve(fit_ctx *c)
+{
+	int p = c->p;
+	gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
+	par.trs = gsl_multifit_nlinear_trs_lm;
+	par.scale = gsl_multifit_nlinear_scale_more;
+	gsl_multifit_nlinear_fdf fdf = {cb_f, cb_df, NULL, c->n, (size_t)p, c, 0, 0, 0};
+	gsl_multifit_nlinear_workspace *w =
+		gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, c->n, (size_t)p);
+	gsl_vector *z0 = gsl_vector_alloc((size_t)p);
+	int status = FIT_FAILED;
+	if (!w || !z0) {
+		snprintf(c->res->error, FIT_MSG, "out of memory");
+		goto done;
+	}
+	for (int j = 0; j < p; j++)
+		gsl_vector_set(z0, (size_t)j, z_of_x(&c->req->free[j], c->req->free[j].start));
+	int rc = gsl_multifit_nlinear_init(z0, &fdf, w);
+	if (rc == GSL_SUCCESS)
+		memcpy(c->res->model_start, c->fmodel, sizeof(double) * c->n);
+	status = rc != GSL_SUCCESS ? (c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED) : iterate(c, w);
+	if (status == FIT_FAILED && !c->res->error[0])
+		snprintf(c->res->error, FIT_MSG, "%s", c->ev.error);
+	if (status != FIT_FAILED)
+		xs_of(c, gsl_multifit_nlinear_position(w), c->res->x);
+	c->res->iterations = c->iteration;
+done:
+	gsl_multifit_nlinear_free(w);
+	gsl_vector_free(z0);
+	return status;
+}
+
+/* Model, residual statistics, Jacobian and covariance at res->x. */
+static int at_optimum(fit_ctx *c)
+{
+	fit_result *res = c->res;
+	if (c->jvalid && same_x(c->jx, res->x, c->p)) {
+		/* the Jacobian's base: the model at the optimum */
+		memcpy(c->fmodel, c->jmodel, sizeof(double) * c->n);
+		memcpy(c->fmodel_u, c->jmodel_u, sizeof(double) * c->n);
+	} else if (!(c->fvalid && same_x(c->fx, res->x, c->p)) &&
+		   fit_eval_data(&c->ev, 1, res->x, c->fmodel, c->fmodel_u) != 0) {
+		return -1;
+	}
+	c->fvalid = 1;
+	memcpy(c->fx, res->x, sizeof(double) * (size_t)c->p);
+	memcpy(res->model, c->fmodel, sizeof(double) * c->n);
+	memcpy(res->model_u, c->fmodel_u, sizeof(double) * c->n);
+	res->chi2 = 0;
+	for (size_t i = 0; i < c->n; i++)
+		res->chi2 += pow((res->model[i] - c->data[i]) / c->w[i], 2);
+	res->dof = (int)c->n - c->p;
+	res->s2 = res->dof > 0 ? res->chi2 / res->dof : NAN;
+	report(c, "covariance", res->x, res->chi2);
+	if (!(c->jvalid && same_x(c->jx, res->x, c->p)) && jacobian_x(c, res->x) != 0)
+		return -1;
+	fit_covariance(c);
+	fit_bound_warnings(c);
+	return 0;
+}
+
+int fit_run(const fit_request *req, fit_result *res)
+{
+	memset(res, 0, sizeof *res);
+	gsl_set_error_handler_off();
+	double w0 = wall_now();
+	fit_ctx c;
+	memset(&c, 0, sizeof c);
+	if (prepare(&c, req, res) != 0) {
+		res->status = FIT_FAILED;
+		snprintf(res->error, FIT_MSG, "out of memory");
+		goto done;
+	}
+	res->status = solve(&c);
+	if (res->status != FIT_FAILED && res->status != FIT_CANCELLED && at_optimum(&c) != 0)
+		res->status = c.ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
+	if (res->status == FIT_FAILED && !res->error[0])
+		snprintf(res->error, FIT_MSG, "%s", c.ev.error);
+	if ((res->status == FIT_CONVERGED || res->status == FIT_MAXITER) && req->curve_step > 0) {
+		report(&c, "curve", res->x, res->chi2);
+		if (curves(&c) != 0) {
+			if (c.ev.failed == 2)
+				res->status = FIT_CANCELLED;
+			else
+				fit_warn(res, "no curve: %s", c.ev.error);
+			res->ncurve = 0;
+		}
+	}
+done:
+	res->evaluations = c.ev.evaluations;
+	res->cpu_seconds = c.ev.cpu_seconds;
+	res->wall_seconds = wall_now() - w0;
+	report(&c, "done", res->x, res->chi2);
+	fit_eval_free(&c.ev);
+	free(c.w);
+	free(c.data);
+	free(c.fmodel);
+	free(c.fmodel_u);
+	free(c.jac_x);
+	free(c.jmodel);
+	free(c.jmodel_u);
+	return res->status;
+}
+
+void fit_result_free(fit_result *res)
+{
+	if (!res)
+		return;
+	free(res->model);
+	free(res->model_u);
+	free(res->model_start);
+	free(res->curve_beta);
+	free(res->curve_fit);
+	free(res->curve_fit_u);
+	free(res->curve_start);
+	memset(res, 0, sizeof *res);
+}

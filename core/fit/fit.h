@@ -1,0 +1,186 @@
+/*
+ * fit.h - calibration: least-squares fits of model parameters to measured
+ * transport velocities v(beta), or to the positions of the v(beta) peaks.
+ *
+ * Its own floor beside the engine: it calls the core (sim_measure, the
+ * settings table) and GSL (gsl_multifit_nlinear, Levenberg-Marquardt in a
+ * trust region), never cJSON or libmicrohttpd, and this header shows no GSL
+ * type, so the CLI and api/ see plain structs. Every model evaluation is a
+ * fresh sim_measure (a steady start and a window of t_end seconds); the
+ * evaluations of one Jacobian (or one residual vector) run in parallel
+ * through a caller's map function, or on the library's own threads.
+ *
+ * Units: SI inside (beta in rad, free parameters in their SI value);
+ * fit_check and the parsers take and report user units as the settings
+ * table gives them (beta in deg), converting once.
+ */
+#ifndef CONVSIM_FIT_H
+#define CONVSIM_FIT_H
+
+#include <stddef.h>
+
+#include "sim.h"
+
+#define FIT_MAX_FREE 8
+#define FIT_MAX_POINTS 1000
+#define FIT_MAX_PEAKS 8
+#define FIT_MAX_WARNINGS 8
+#define FIT_MSG 240
+
+/* One measured point: beta (rad), rotation SIM_CW / SIM_CCW, v (m/s) and
+ * its standard deviation sigma (m/s; NaN when not given). */
+typedef struct fit_point {
+	double beta;
+	int rotation;
+	double v, sigma;
+} fit_point;
+
+/* One measured peak of v(beta) (the fastest transport in one direction):
+ * its beta (rad) for a rotation, sigma (rad; NaN when not given). The
+ * model's peak is located by a scan of v(beta) over a fixed grid around
+ * the measured beta and a least-squares parabola through the scan's
+ * largest |v| and two neighbours each side. */
+typedef struct fit_peak {
+	double beta;
+	int rotation;
+	double sigma;
+} fit_peak;
+
+/* A free parameter: a real setting of group "params" (fit_free_param), its
+ * bounds and start (SI). */
+typedef struct fit_free {
+	char name[24];
+	double lo, hi;
+	double start;
+} fit_free;
+
+/* Progress reports (from the thread that runs fit_run). */
+typedef struct fit_progress {
+	const char *phase;   /* "fitting", "covariance", "curve", "done" */
+	int iteration;
+	long evaluations;    /* model evaluations (sim_measure runs) so far */
+	double cost;         /* sum of squared (weighted) residuals; NaN before one */
+	double x[FIT_MAX_FREE];
+} fit_progress;
+
+/* Runs job(arg, i) for i = 0..n-1, in parallel or not, and returns when
+ * all are done; the jobs are independent and thread-safe. */
+typedef void (*fit_job)(void *arg, size_t i);
+typedef void (*fit_map_fn)(void *ctx, size_t n, fit_job job, void *arg);
+
+typedef struct fit_request {
+	sim_params p;          /* the model; the free parameters' values are */
+	sim_scene sc;          /* replaced, beta and rotation set per point */
+	sim_method m;
+	double t_end;          /* s simulated per evaluation (> sc.transient) */
+	int nfree;
+	fit_free free[FIT_MAX_FREE];
+	size_t npoints;        /* points or peaks, not both */
+	fit_point *points;     /* borrowed */
+	int npeaks;
+	fit_peak peaks[FIT_MAX_PEAKS];
+	double peak_halfwidth; /* rad: the scan covers beta_peak +- this */
+	double peak_step;      /* rad: its spacing */
+	double curve_step;     /* rad: the fitted curve's grid on [0, 180] deg; 0: none */
+	int max_iter;
+	double fd_rel;         /* finite-difference step relative to the scale */
+	double xtol;           /* convergence: relative step in the parameters */
+	int threads;           /* own threads when map is NULL */
+	fit_map_fn map;        /* NULL: the library's threads */
+	void *map_ctx;
+	void (*progress)(void *ctx, const fit_progress *pr); /* may be NULL */
+	int (*cancelled)(void *ctx); /* may be NULL; nonzero stops the fit */
+	void *ctx;
+} fit_request;
+
+/* Defaults: model of the czubak2016 preset, t_end = transient + 4 s,
+ * peaks scanned over +-10 deg every 2 deg, curve every 5 deg, 30
+ * iterations, fd_rel 0.05, xtol 1e-3, 2 threads, no data. */
+void fit_request_init(fit_request *r);
+
+enum { FIT_CONVERGED = 0, FIT_MAXITER, FIT_CANCELLED, FIT_FAILED };
+/* "converged", "max-iterations", "cancelled", "failed". */
+const char *fit_status_name(int status);
+
+typedef struct fit_result {
+	int status;                 /* FIT_* */
+	char error[FIT_MSG];        /* FIT_FAILED: why */
+	int nfree;
+	double x[FIT_MAX_FREE];     /* SI; fitted values */
+	double x0[FIT_MAX_FREE];    /* the start */
+	double se[FIT_MAX_FREE];    /* standard errors, SI; NaN: not determined */
+	double corr[FIT_MAX_FREE * FIT_MAX_FREE]; /* row-major, NaN where undefined */
+	int at_bound[FIT_MAX_FREE]; /* -1 lower, +1 upper, 0 inside */
+	int sigma_given;            /* 1: se from (J^T W J)^-1; 0: times s2 */
+	double chi2;                /* sum of squared weighted residuals */
+	double s2;                  /* chi2 / dof (the residual variance) */
+	int dof;                    /* data - free parameters */
+	double cond;                /* condition number of J (columns scaled) */
+	int iterations;
+	long evaluations;
+	double cpu_seconds;         /* of the threads that evaluated */
+	double wall_seconds;
+	/* per datum (npoints or npeaks): the model at the fit */
+	size_t ndata;
+	double *model;              /* v (m/s) or the peak's beta (rad) */
+	double *model_u;            /* its uncertainty (same unit) */
+	double *model_start;        /* at the start */
+	/* the curves on the grid, per rotation: v at the fit and at the start */
+	size_t ncurve;              /* grid points per rotation */
+	int nrot, rotations[2];
+	double *curve_beta;         /* rad, ncurve */
+	double *curve_fit, *curve_fit_u, *curve_start; /* [rot * ncurve + k] */
+	int nwarn;
+	char warnings[FIT_MAX_WARNINGS][FIT_MSG];
+} fit_result;
+
+/* Run the fit (blocking; thread-safe, no global state but GSL's error
+ * handler, which is switched off). The request must have passed
+ * fit_check. Fills *res (free it with fit_result_free). Returns
+ * res->status. */
+int fit_run(const fit_request *req, fit_result *res);
+void fit_result_free(fit_result *res);
+
+/* ---- checks and parsers (user units in messages) ---------------------- */
+
+/* The setting for a free-parameter name: a real setting of group "params"
+ * that the steady state depends on (not beta, which each point sets, nor
+ * the ramp limits beta_rate, beta_accel, drive_accel). NULL with a
+ * message (and *err SIM_EUNKNOWN or SIM_EPARAM) otherwise. */
+const sim_setting *fit_free_param(const char *name, int *err, char *msg, size_t len);
+
+/* Set free parameter i of req by name with the bounds of its setting's
+ * range (or lo/hi in user units when finite) and the model's current
+ * value as its start; the problem into field/msg. SIM_OK or an error. */
+int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_user,
+		 char *field, size_t flen, char *msg, size_t mlen);
+
+/* Parse CSV text (header beta,rotation,v[,sigma], any column order, beta
+ * in deg) into a malloc'd array (*out, *n; caller frees). Returns SIM_OK,
+ * or SIM_EPARAM with a message naming the line and column. */
+int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len);
+
+/* Whole-request checks: data present (points or peaks, not both), beta
+ * finite in [0, 180] deg, rotation known, v and sigma finite (sigma > 0,
+ * given for every point or none), no duplicate (beta, rotation), at least
+ * as many data as free parameters, starts within bounds, t_end after the
+ * transient, the model valid. On error returns SIM_EPARAM with the field
+ * ("points[3].beta", "free", "t_end", ...) and the message. */
+int fit_check(const fit_request *req, char *field, size_t flen, char *msg, size_t mlen);
+
+/* ---- results as text (user units: beta in deg, parameters in their
+ * setting's unit; numbers round-trip, core/table.h's printer) ---------- */
+
+/* The CSV columns of a result: one row per free parameter (kind
+ * "parameter": model = fitted value, uncertainty = standard error, start),
+ * per point or peak (measured, sigma, model, uncertainty, residual = model
+ * - measured, start = the model at the start) and per curve point (model,
+ * uncertainty and start = v at the fit and at the start). */
+#define FIT_CSV_HEADER "kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start"
+
+/* The result as JSON (an object) or CSV: malloc'd text, NULL when out of
+ * memory. req is the request the result answers. */
+char *fit_result_json(const fit_request *req, const fit_result *res);
+char *fit_result_csv(const fit_request *req, const fit_result *res);
+
+#endif

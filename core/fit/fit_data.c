@@ -1,0 +1,344 @@
+/*
+ * fit_data.c - what a fit is given, checked before anything runs: the
+ * free parameters (by name from the settings table, bounds from their
+ * ranges), the measured points as CSV (header beta,rotation,v[,sigma]) and
+ * the whole request (fit_check). Messages speak in user units (deg) and
+ * name the field, so the CLI and the API report alike.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit.h"
+#include "suggest.h"
+#include "units.h"
+
+void fit_request_init(fit_request *r)
+{
+	memset(r, 0, sizeof *r);
+	sim_preset_czubak2016(&r->p, &r->sc, &r->m);
+	r->t_end = r->sc.transient + 4.0;
+	r->peak_halfwidth = 10.0 * RAD_PER_DEG;
+	r->peak_step = 2.0 * RAD_PER_DEG;
+	r->curve_step = 5.0 * RAD_PER_DEG;
+	r->max_iter = 30;
+	r->fd_rel = 0.05;
+	r->xtol = 1e-3;
+	r->threads = 2;
+}
+
+const char *fit_status_name(int status)
+{
+	static const char *const names[] = {"converged", "max-iterations", "cancelled", "failed"};
+	return status >= 0 && status <= FIT_FAILED ? names[status] : "failed";
+}
+
+/* Settings of group params that no steady state depends on, or that each
+ * point sets itself. */
+static int fixed_only(const char *name)
+{
+	static const char *const fixed[] = {"beta", "beta_rate", "beta_accel", "drive_accel"};
+	for (size_t i = 0; i < sizeof fixed / sizeof *fixed; i++)
+		if (strcmp(fixed[i], name) == 0)
+			return 1;
+	return 0;
+}
+
+const sim_setting *fit_free_param(const char *name, int *err, char *msg, size_t len)
+{
+	const sim_setting *t = sim_setting_find(name);
+	if (!t) {
+		size_t n;
+		const sim_setting *all = sim_settings(&n);
+		const char *near = sim_suggest(name, &all->name, n, sizeof *all);
+		snprintf(msg, len, "unknown parameter '%s'%s%s%s; 'convsim list' shows every setting",
+			 name, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
+		*err = SIM_EUNKNOWN;
+		return NULL;
+	}
+	if (t->kind != SIM_KIND_REAL || strcmp(t->group, "params") != 0 || fixed_only(name)) {
+		snprintf(msg, len,
+			 "'%s' cannot be fitted: free parameters are the real model parameters "
+			 "(group params) but beta (set by each point), beta_rate, beta_accel and "
+			 "drive_accel; integer, true/false, choice, scene and integrator settings "
+			 "stay fixed",
+			 name);
+		*err = SIM_EPARAM;
+		return NULL;
+	}
+	return t;
+}
+
+int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_user,
+		 char *field, size_t flen, char *msg, size_t mlen)
+{
+	int err;
+	snprintf(field, flen, "free");
+	const sim_setting *t = fit_free_param(name, &err, msg, mlen);
+	if (!t)
+		return err;
+	for (int i = 0; i < req->nfree; i++)
+		if (strcmp(req->free[i].name, name) == 0) {
+			snprintf(msg, mlen, "free parameter '%s' is named twice", name);
+			return SIM_EPARAM;
+		}
+	if (req->nfree >= FIT_MAX_FREE) {
+		snprintf(msg, mlen, "at most %d free parameters", FIT_MAX_FREE);
+		return SIM_EPARAM;
+	}
+	double lo = isnan(lo_user) ? t->min : lo_user, hi = isnan(hi_user) ? t->max : hi_user;
+	if (!(lo >= t->min && hi <= t->max && lo < hi)) {
+		snprintf(msg, mlen, "the bounds of '%s' must satisfy %g <= min < max <= %g %s", name,
+			 t->min, t->max, t->unit);
+		return SIM_EPARAM;
+	}
+	fit_free *f = &req->free[req->nfree++];
+	snprintf(f->name, sizeof f->name, "%s", name);
+	f->lo = sim_setting_to_si(t, lo);
+	f->hi = sim_setting_to_si(t, hi);
+	sim_get(&req->p, &req->sc, &req->m, name, &f->start);
+	return SIM_OK;
+}
+
+/* ---- CSV ---------------------------------------------------------------- */
+
+enum { COL_BETA, COL_ROTATION, COL_V, COL_SIGMA, NCOLS };
+static const char *const col_names[NCOLS] = {"beta", "rotation", "v", "sigma"};
+
+/* The header's columns into col[] (index of each name, -1 if absent). */
+static int parse_header(const char *line, size_t len, int col[NCOLS], char *msg, size_t mlen)
+{
+	for (int c = 0; c < NCOLS; c++)
+		col[c] = -1;
+	int k = 0;
+	for (const char *p = line, *end = line + len; p <= end; k++) {
+		const char *q = memchr(p, ',', (size_t)(end - p));
+		size_t n = (size_t)((q ? q : end) - p);
+		while (n && (p[n - 1] == ' ' || p[n - 1] == '\r'))
+			n--;
+		while (n && *p == ' ')
+			p++, n--;
+		int c = 0;
+		while (c < NCOLS && !(strlen(col_names[c]) == n && strncmp(p, col_names[c], n) == 0))
+			c++;
+		if (n == 8 && strncmp(p, "velocity", 8) == 0)
+			c = COL_V; /* the sweep table's name for v */
+		if (c == NCOLS) {
+			snprintf(msg, mlen, "CSV line 1: unknown column '%.*s'; the header is "
+					    "beta,rotation,v[,sigma]", (int)(n > 40 ? 40 : n), p);
+			return -1;
+		}
+		col[c] = k;
+		p = q ? q + 1 : end + 1;
+	}
+	for (int c = 0; c < COL_SIGMA; c++)
+		if (col[c] < 0) {
+			snprintf(msg, mlen, "CSV line 1: column '%s' is missing; the header is "
+					    "beta,rotation,v[,sigma]", col_names[c]);
+			return -1;
+		}
+	return k;
+}
+
+/* One data line of ncol cells into *pt. */
+static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit_point *pt,
+		     char *msg, size_t mlen)
+{
+	char *cell[16] = {0};
+	int k = 0;
+	for (char *save, *tok = strtok_r(line, ",", &save); tok && k < 16;
+	     tok = strtok_r(NULL, ",", &save))
+		cell[k++] = tok;
+	if (k != ncol) {
+		snprintf(msg, mlen, "CSV line %d: %d cells where the header has %d", lineno, k,
+			 ncol);
+		return -1;
+	}
+	double num[NCOLS] = {0, 0, 0, NAN};
+	for (int c = 0; c < NCOLS; c++) {
+		if (col[c] < 0 || c == COL_ROTATION)
+			continue;
+		char *s = cell[col[c]], *end;
+		num[c] = strtod(s, &end);
+		while (*end == ' ' || *end == '\r')
+			end++;
+		if (end == s || *end) {
+			snprintf(msg, mlen, "CSV line %d: %s must be a number, got '%.40s'", lineno,
+				 col_names[c], s);
+			return -1;
+		}
+	}
+	char *r = cell[col[COL_ROTATION]];
+	r += strspn(r, " ");
+	r[strcspn(r, " \r")] = '\0';
+	if (strcmp(r, "cw") != 0 && strcmp(r, "ccw") != 0) {
+		snprintf(msg, mlen, "CSV line %d: rotation must be cw or ccw, got '%.40s'", lineno, r);
+		return -1;
+	}
+	pt->beta = num[COL_BETA] * RAD_PER_DEG;
+	pt->rotation = r[1] == 'w' ? SIM_CW : SIM_CCW;
+	pt->v = num[COL_V];
+	pt->sigma = num[COL_SIGMA];
+	return 0;
+}
+
+int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t mlen)
+{
+	*out = NULL;
+	*n = 0;
+	size_t len = strlen(text);
+	char *buf = malloc(len + 1);
+	fit_point *pts = malloc(sizeof *pts * FIT_MAX_POINTS);
+	if (!buf || !pts) {
+		free(buf);
+		free(pts);
+		snprintf(msg, mlen, "out of memory");
+		return SIM_ENOMEM;
+	}
+	memcpy(buf, text, len + 1);
+	int col[NCOLS], ncol = -1, lineno = 0, rc = SIM_OK;
+	for (char *save, *line = strtok_r(buf, "\n", &save); line && rc == SIM_OK;
+	     line = strtok_r(NULL, "\n", &save)) {
+		lineno++;
+		if (line[strspn(line, " \r\t")] == '\0' || line[0] == '#')
+			continue;
+		if (ncol < 0) {
+			ncol = parse_header(line, strlen(line), col, msg, mlen);
+			rc = ncol < 0 ? SIM_EPARAM : SIM_OK;
+		} else if (*n >= FIT_MAX_POINTS) {
+			snprintf(msg, mlen, "CSV: more than %d points", FIT_MAX_POINTS);
+			rc = SIM_EPARAM;
+		} else if (parse_row(line, lineno, col, ncol, &pts[*n], msg, mlen) == 0) {
+			(*n)++;
+		} else {
+			rc = SIM_EPARAM;
+		}
+	}
+	free(buf);
+	if (rc == SIM_OK && ncol < 0) {
+		snprintf(msg, mlen, "CSV: no header line (beta,rotation,v[,sigma])");
+		rc = SIM_EPARAM;
+	}
+	if (rc != SIM_OK) {
+		free(pts);
+		*n = 0;
+		return rc;
+	}
+	*out = pts;
+	return SIM_OK;
+}
+
+/* ---- the whole request -------------------------------------------------- */
+
+#define FAIL(f, ...)                                         \
+	do {                                                 \
+		snprintf(field, flen, "%s", f);              \
+		snprintf(msg, mlen, __VA_ARGS__);            \
+		return SIM_EPARAM;                           \
+	} while (0)
+
+static int check_beta(double beta, int rotation, const char *name, char *field, size_t flen,
+		      char *msg, size_t mlen)
+{
+	char f[48];
+	snprintf(f, sizeof f, "%s.beta", name);
+	if (!(isfinite(beta) && beta >= 0 && beta <= SIM_PI * (1 + 1e-12)))
+		FAIL(f, "%s: beta must be a finite number in [0, 180] deg", name);
+	if (rotation != SIM_CW && rotation != SIM_CCW) {
+		snprintf(f, sizeof f, "%s.rotation", name);
+		FAIL(f, "%s: rotation must be cw or ccw", name);
+	}
+	return SIM_OK;
+}
+
+static int check_points(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
+{
+	char name[32], f[48];
+	int with_sigma = r->npoints && !isnan(r->points[0].sigma);
+	for (size_t i = 0; i < r->npoints; i++) {
+		const fit_point *p = &r->points[i];
+		snprintf(name, sizeof name, "points[%zu]", i);
+		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen))
+			return SIM_EPARAM;
+		snprintf(f, sizeof f, "%s.v", name);
+		if (!isfinite(p->v) || fabs(p->v) > 100)
+			FAIL(f, "%s: v must be a finite number in [-100, 100] m/s", name);
+		snprintf(f, sizeof f, "%s.sigma", name);
+		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0 && p->sigma <= 100))
+			FAIL(f, "%s: sigma must be a number in (0, 100] m/s", name);
+		if (isnan(p->sigma) == with_sigma)
+			FAIL(f, "%s: sigma must be given for every point or for none", name);
+		for (size_t k = 0; k < i; k++)
+			if (fabs(r->points[k].beta - p->beta) < 1e-9 &&
+			    r->points[k].rotation == p->rotation)
+				FAIL(name, "%s duplicates points[%zu] (beta %g deg, %s)", name, k,
+				     p->beta * DEG_PER_RAD, p->rotation == SIM_CW ? "cw" : "ccw");
+	}
+	return SIM_OK;
+}
+
+static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
+{
+	char name[32], f[48];
+	if (r->npeaks > FIT_MAX_PEAKS)
+		FAIL("peaks", "at most %d peaks", FIT_MAX_PEAKS);
+	for (int i = 0; i < r->npeaks; i++) {
+		const fit_peak *p = &r->peaks[i];
+		snprintf(name, sizeof name, "peaks[%d]", i);
+		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen))
+			return SIM_EPARAM;
+		snprintf(f, sizeof f, "%s.sigma", name);
+		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0))
+			FAIL(f, "%s: sigma must be a positive number of deg", name);
+		if (isnan(p->sigma) != isnan(r->peaks[0].sigma))
+			FAIL(f, "%s: sigma must be given for every peak or for none", name);
+		for (int k = 0; k < i; k++)
+			if (r->peaks[k].rotation == p->rotation &&
+			    fabs(r->peaks[k].beta - p->beta) < 2 * r->peak_halfwidth)
+				FAIL(name, "%s is within %g deg of peaks[%d] (%s): their scans "
+					   "would overlap", name, 2 * r->peak_halfwidth * DEG_PER_RAD,
+				     k, p->rotation == SIM_CW ? "cw" : "ccw");
+	}
+	return SIM_OK;
+}
+
+int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
+{
+	if (sim_validate(&r->p, &r->sc, &r->m, msg, mlen) != SIM_OK) {
+		snprintf(field, flen, "params");
+		return SIM_EPARAM;
+	}
+	if (!(r->t_end > r->sc.transient && r->t_end <= 600))
+		FAIL("t_end", "t_end must exceed the scene's transient (%g s) and be at most 600 s",
+		     r->sc.transient);
+	if (r->nfree < 1)
+		FAIL("free", "name at least one free parameter (e.g. e)");
+	if (r->npoints && r->npeaks)
+		FAIL("peaks", "give points or peaks, not both");
+	if (!r->npoints && !r->npeaks)
+		FAIL("points", "no data: give points (beta, rotation, v[, sigma]) or peaks");
+	if (r->npoints > FIT_MAX_POINTS)
+		FAIL("points", "at most %d points", FIT_MAX_POINTS);
+	if (check_points(r, field, flen, msg, mlen) || check_peaks(r, field, flen, msg, mlen))
+		return SIM_EPARAM;
+	size_t ndata = r->npoints ? r->npoints : (size_t)r->npeaks;
+	if (ndata < (size_t)r->nfree)
+		FAIL(r->npoints ? "points" : "peaks",
+		     "%zu data for %d free parameters: a fit needs at least as many data as free "
+		     "parameters", ndata, r->nfree);
+	for (int i = 0; i < r->nfree; i++) {
+		const fit_free *f = &r->free[i];
+		if (!(f->start >= f->lo && f->start <= f->hi))
+			FAIL("free", "the start of '%s' (%g) lies outside its bounds [%g, %g]",
+			     f->name, f->start, f->lo, f->hi);
+	}
+	if (!(r->fd_rel > 0 && r->fd_rel <= 0.5))
+		FAIL("fd_step", "fd_step must be in (0, 0.5]");
+	if (!(r->max_iter >= 1 && r->max_iter <= 1000))
+		FAIL("max_iter", "max_iter must be in [1, 1000]");
+	if (!(r->curve_step == 0 || (r->curve_step >= 0.5 * RAD_PER_DEG &&
+				     r->curve_step <= 90 * RAD_PER_DEG)))
+		FAIL("curve_step", "curve_step must be 0 (no curve) or in [0.5, 90] deg");
+	return SIM_OK;
+}

@@ -1,0 +1,77 @@
+/*
+ * fit_int.h - inside the fit module: the batch evaluator that fit.c's
+ * least-squares driver calls (fit_eval.c). Not for callers of fit.h.
+ */
+#ifndef CONVSIM_FIT_INT_H
+#define CONVSIM_FIT_INT_H
+
+#include <pthread.h>
+
+#include "fit.h"
+
+/* Evaluates the model's data (v at the points, or the peaks' beta) for
+ * sets of free-parameter values. One sim_measure per unit: a point, or
+ * one beta of a peak's scan grid. */
+typedef struct fit_eval {
+	const fit_request *req;
+	size_t ndata;            /* points or peaks */
+	size_t nunits;           /* units per parameter set */
+	int ngrid;               /* peaks: grid points per scan */
+	double *ubeta;           /* rad, nunits */
+	int *urot;
+	pthread_mutex_t lock;
+	long evaluations;        /* lock */
+	double cpu_seconds;      /* lock */
+	int failed;              /* lock: 1 failed (error), 2 cancelled */
+	char error[FIT_MSG];     /* lock */
+} fit_eval;
+
+/* Prepare the units of req (borrowed for ev's life). 0, or -1 when out of
+ * memory. */
+int fit_eval_init(fit_eval *ev, const fit_request *req);
+void fit_eval_free(fit_eval *ev);
+
+/* The data for nsets parameter sets xs[s * nfree + j] (SI), in one
+ * parallel batch: out[s * ndata + d] (m/s, or rad for peaks) and its
+ * uncertainty out_u (may be NULL). 0, or -1: ev->failed says why. */
+int fit_eval_data(fit_eval *ev, size_t nsets, const double *xs, double *out, double *out_u);
+
+/* v and its error bar at n (beta, rotation) for nsets parameter sets, in
+ * one batch: v[s * n + i]. 0 or -1 as fit_eval_data. */
+int fit_eval_curve(fit_eval *ev, size_t nsets, const double *xs, size_t n, const double *beta,
+		   const int *rotation, double *v, double *u);
+
+/* ---- the solver's state (fit.c), its statistics (fit_cov.c) ---------- */
+
+/* A start on a bound moves this fraction of the width inside; a fit
+ * within twice it of a bound "ends at the bound". */
+#define BOUND_NEAR 1e-3
+
+typedef struct fit_ctx {
+	const fit_request *req;
+	fit_eval ev;
+	fit_result *res;
+	int p;
+	size_t n;
+	double *w;            /* per datum: sigma or 1 */
+	double *data;         /* per datum: v or peak beta */
+	/* the last f evaluation at an x, and the last Jacobian */
+	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
+	int fvalid;
+	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
+	double *jmodel, *jmodel_u;       /* the model at jx */
+	int jvalid;
+	int iteration;
+	int trials, stalled;  /* f evaluations in this iteration; gave up */
+} fit_ctx;
+
+/* One more warning into res (at most FIT_MAX_WARNINGS). */
+void fit_warn(fit_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Standard errors, correlation, condition number and identifiability
+ * warnings of res from c->jac_x (the weighted J in x at res->x). */
+void fit_covariance(fit_ctx *c);
+/* Warnings for bounds reached, standard errors as large as the value, and
+ * no residual variance. */
+void fit_bound_warnings(fit_ctx *c);
+
+#endif

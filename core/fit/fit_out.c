@@ -1,0 +1,266 @@
+/*
+ * fit_out.c - a fit's result as text, the same for the CLI and the daemon:
+ * JSON (parameters with standard errors, correlation, per-datum model and
+ * residual, the curves, the solver's figures, warnings) and CSV (one table,
+ * FIT_CSV_HEADER). User units: beta in deg, parameters in their setting's
+ * unit; numbers by core/table.h's shortest round-trip printer.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit.h"
+#include "table.h"
+
+typedef struct text {
+	char *s;
+	size_t len, cap;
+	int failed;
+} text;
+
+static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void put(text *t, const char *fmt, ...)
+{
+	va_list ap;
+	for (int pass = 0; pass < 2 && !t->failed; pass++) {
+		va_start(ap, fmt);
+		int n = vsnprintf(t->s ? t->s + t->len : NULL, t->s ? t->cap - t->len : 0, fmt, ap);
+		va_end(ap);
+		if (n < 0) {
+			t->failed = 1;
+		} else if (t->s && t->len + (size_t)n < t->cap) {
+			t->len += (size_t)n;
+			return;
+		} else {
+			size_t cap = (t->cap + (size_t)n + 1) * 2;
+			char *s = realloc(t->s, cap);
+			if (!s)
+				t->failed = 1;
+			else
+				t->s = s, t->cap = cap;
+		}
+	}
+}
+
+static void num(text *t, double v, const char *nonfinite)
+{
+	char b[40];
+	sim_fmt_double(b, sizeof b, v, nonfinite);
+	put(t, "%s", b);
+}
+
+static void jstr(text *t, const char *s)
+{
+	put(t, "\"");
+	for (; *s; s++) {
+		unsigned char c = (unsigned char)*s;
+		if (c == '"' || c == '\\')
+			put(t, "\\%c", c);
+		else if (c < 0x20)
+			put(t, "\\u%04x", c);
+		else
+			put(t, "%c", c);
+	}
+	put(t, "\"");
+}
+
+static char *take(text *t)
+{
+	if (t->failed || !t->s) {
+		free(t->s);
+		return NULL;
+	}
+	return t->s;
+}
+
+static const char *rot_name(int r)
+{
+	return r == SIM_CW ? "cw" : "ccw";
+}
+
+/* An angle in deg as a user wrote it: rad back to deg, rounded to 1e-9
+ * deg (60 deg, not 59.99999999999999). */
+static double deg(double rad)
+{
+	return round(rad * DEG_PER_RAD * 1e9) / 1e9;
+}
+
+/* A parameter's value in its user unit. */
+static double user(const fit_free *f, double si)
+{
+	return sim_table_user(f->name, si);
+}
+
+static void json_parameters(text *t, const fit_request *q, const fit_result *r)
+{
+	put(t, "\"parameters\":[");
+	for (int j = 0; j < r->nfree; j++) {
+		const fit_free *f = &q->free[j];
+		const sim_setting *s = sim_setting_find(f->name);
+		put(t, "%s{\"name\":", j ? "," : "");
+		jstr(t, f->name);
+		put(t, ",\"unit\":");
+		jstr(t, s ? s->unit : "");
+		const char *keys[] = {"value", "standard_error", "start", "min", "max"};
+		double vals[] = {r->x[j], r->se[j], r->x0[j], f->lo, f->hi};
+		for (int k = 0; k < 5; k++) {
+			put(t, ",\"%s\":", keys[k]);
+			num(t, user(f, vals[k]), "null");
+		}
+		put(t, ",\"at_bound\":%s}", r->at_bound[j] < 0   ? "\"lower\""
+					    : r->at_bound[j] > 0 ? "\"upper\""
+								 : "null");
+	}
+	put(t, "],\"correlation\":[");
+	for (int a = 0; a < r->nfree; a++) {
+		put(t, "%s[", a ? "," : "");
+		for (int b = 0; b < r->nfree; b++) {
+			put(t, "%s", b ? "," : "");
+			num(t, r->corr[a * r->nfree + b], "null");
+		}
+		put(t, "]");
+	}
+	put(t, "]");
+}
+
+/* Datum i: measured, sigma, model, its uncertainty, start (user units). */
+static void datum(const fit_request *q, const fit_result *r, size_t i, double v[5])
+{
+	double k = q->npoints ? 1 : DEG_PER_RAD;
+	v[0] = q->npoints ? q->points[i].v : deg(q->peaks[i].beta);
+	v[1] = (q->npoints ? q->points[i].sigma : q->peaks[i].sigma) * k;
+	v[2] = r->model ? r->model[i] * k : NAN;
+	v[3] = r->model_u ? r->model_u[i] * k : NAN;
+	v[4] = r->model_start ? r->model_start[i] * k : NAN;
+}
+
+static void json_data(text *t, const fit_request *q, const fit_result *r)
+{
+	put(t, ",\"data\":\"%s\",\"%s\":[", q->npoints ? "points" : "peaks",
+	    q->npoints ? "points" : "peaks");
+	size_t n = q->npoints ? q->npoints : (size_t)q->npeaks;
+	for (size_t i = 0; i < n; i++) {
+		double v[5];
+		datum(q, r, i, v);
+		put(t, "%s{\"beta\":", i ? "," : "");
+		num(t, deg(q->npoints ? q->points[i].beta : q->peaks[i].beta), "null");
+		put(t, ",\"rotation\":\"%s\",\"%s\":",
+		    rot_name(q->npoints ? q->points[i].rotation : q->peaks[i].rotation),
+		    q->npoints ? "v" : "measured");
+		num(t, v[0], "null");
+		const char *keys[] = {"sigma", "model", "model_uncertainty", "residual",
+				      "model_start"};
+		double vals[] = {v[1], v[2], v[3], v[2] - v[0], v[4]};
+		for (int k = 0; k < 5; k++) {
+			put(t, ",\"%s\":", keys[k]);
+			num(t, vals[k], "null");
+		}
+		put(t, "}");
+	}
+	put(t, "]");
+}
+
+static void json_curve(text *t, const fit_result *r)
+{
+	put(t, ",\"curve\":");
+	if (!r->ncurve) {
+		put(t, "null");
+		return;
+	}
+	put(t, "{\"beta\":[");
+	for (size_t k = 0; k < r->ncurve; k++) {
+		put(t, "%s", k ? "," : "");
+		num(t, deg(r->curve_beta[k]), "null");
+	}
+	put(t, "]");
+	for (int ro = 0; ro < r->nrot; ro++) {
+		const double *arr[] = {r->curve_fit, r->curve_fit_u, r->curve_start};
+		const char *keys[] = {"fit", "fit_uncertainty", "start"};
+		put(t, ",\"%s\":{", rot_name(r->rotations[ro]));
+		for (int a = 0; a < 3; a++) {
+			put(t, "%s\"%s\":[", a ? "," : "", keys[a]);
+			for (size_t k = 0; k < r->ncurve; k++) {
+				put(t, "%s", k ? "," : "");
+				num(t, arr[a][(size_t)ro * r->ncurve + k], "null");
+			}
+			put(t, "]");
+		}
+		put(t, "}");
+	}
+	put(t, "}");
+}
+
+char *fit_result_json(const fit_request *q, const fit_result *r)
+{
+	text t = {0};
+	put(&t, "{\"status\":\"%s\",\"error\":", fit_status_name(r->status));
+	if (r->error[0])
+		jstr(&t, r->error);
+	else
+		put(&t, "null");
+	put(&t, ",");
+	json_parameters(&t, q, r);
+	const char *keys[] = {"chi2", "residual_variance", "condition_number", "cpu_seconds",
+			      "wall_seconds"};
+	double vals[] = {r->chi2, r->s2, r->cond, r->cpu_seconds, r->wall_seconds};
+	for (int k = 0; k < 5; k++) {
+		put(&t, ",\"%s\":", keys[k]);
+		num(&t, vals[k], "null");
+	}
+	put(&t, ",\"dof\":%d,\"standard_errors_from\":\"%s\",\"iterations\":%d,"
+		"\"evaluations\":%ld",
+	    r->dof, r->sigma_given ? "sigma" : "residual variance", r->iterations, r->evaluations);
+	json_data(&t, q, r);
+	json_curve(&t, r);
+	put(&t, ",\"warnings\":[");
+	for (int w = 0; w < r->nwarn; w++) {
+		put(&t, "%s", w ? "," : "");
+		jstr(&t, r->warnings[w]);
+	}
+	put(&t, "]}");
+	return take(&t);
+}
+
+static void csv_row(text *t, const char *kind, const char *name, double beta, const char *rot,
+		    const double v[6])
+{
+	put(t, "%s,%s,", kind, name);
+	num(t, beta, "");
+	put(t, ",%s", rot);
+	for (int k = 0; k < 6; k++) {
+		put(t, ",");
+		num(t, v[k], "");
+	}
+	put(t, "\n");
+}
+
+char *fit_result_csv(const fit_request *q, const fit_result *r)
+{
+	text t = {0};
+	put(&t, "%s\n", FIT_CSV_HEADER);
+	for (int j = 0; j < r->nfree; j++) {
+		const fit_free *f = &q->free[j];
+		double v[6] = {NAN, NAN, user(f, r->x[j]), user(f, r->se[j]), NAN, user(f, r->x0[j])};
+		csv_row(&t, "parameter", f->name, NAN, "", v);
+	}
+	size_t n = q->npoints ? q->npoints : (size_t)q->npeaks;
+	for (size_t i = 0; i < n; i++) {
+		double d[5];
+		datum(q, r, i, d);
+		double v[6] = {d[0], d[1], d[2], d[3], d[2] - d[0], d[4]};
+		double beta = q->npoints ? q->points[i].beta : q->peaks[i].beta;
+		int rot = q->npoints ? q->points[i].rotation : q->peaks[i].rotation;
+		csv_row(&t, q->npoints ? "point" : "peak", "", deg(beta), rot_name(rot), v);
+	}
+	for (int ro = 0; ro < r->nrot && r->ncurve; ro++)
+		for (size_t k = 0; k < r->ncurve; k++) {
+			size_t i = (size_t)ro * r->ncurve + k;
+			double v[6] = {NAN, NAN, r->curve_fit[i], r->curve_fit_u[i], NAN,
+				       r->curve_start[i]};
+			csv_row(&t, "curve", "", deg(r->curve_beta[k]),
+				rot_name(r->rotations[ro]), v);
+		}
+	return take(&t);
+}

@@ -1,0 +1,89 @@
+// `convsim fit` as a user meets it: bad input refused before anything runs
+// (exit 2, a message naming the option and the problem, nothing on stdout),
+// and a small fit on a cheap scene whose result carries the values, their
+// standard errors, the residuals and the curves in JSON and CSV, the same
+// for the same data. CONVSIM names the binary.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { mkdtempSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+
+const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
+const SLOW = Number(process.env.CONVSIM_TEST_SLOW || (process.env.BUILD === 'build-san' ? 4 : 1));
+const run = (...args) => {
+  const r = spawnSync(CLI, args, { encoding: 'utf8', timeout: 200000 * SLOW });
+  return { code: r.status, out: r.stdout, err: r.stderr };
+};
+const dir = mkdtempSync(join(tmpdir(), 'convsim-fit-'));
+const file = (name, text) => { const p = join(dir, name); writeFileSync(p, text); return p; };
+const CHEAP = ['--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2', '--duration', '2'];
+
+test('bad input: exit 2 with a message naming the problem, nothing on stdout', () => {
+  const good = file('good.csv', 'beta,rotation,v\n30,cw,0.1\n60,cw,0.05\n120,cw,-0.07\n');
+  const cases = [
+    [['--data', file('nan.csv', 'beta,rotation,v\nnan,cw,0.1\n60,cw,0.05\n'), '--free', 'e'],
+     /--data: points\[0\]: beta must be a finite number in \[0, 180\] deg/],
+    [['--data', file('far.csv', 'beta,rotation,v\n30,cw,0.1\n190,cw,0.05\n'), '--free', 'e'],
+     /points\[1\]: beta must be a finite number in \[0, 180\] deg/],
+    [['--data', good, '--free', 'ee'], /--free: unknown parameter 'ee' \(did you mean 'e'\?\)/],
+    [['--data', good, '--free', 'rotation'], /--free: 'rotation' cannot be fitted/],
+    [['--data', good, '--free', 'beta'], /--free: 'beta' cannot be fitted/],
+    [['--data', good, '--free', 'layers'], /--free: 'layers' cannot be fitted/],
+    [['--data', file('one.csv', 'beta,rotation,v\n30,cw,0.1\n'), '--free', 'e,mu'],
+     /1 data for 2 free parameters/],
+    [['--data', file('dup.csv', 'beta,rotation,v\n30,cw,0.1\n30,cw,0.11\n'), '--free', 'e'],
+     /points\[1\] duplicates points\[0\] \(beta 30 deg, cw\)/],
+    [['--data', file('col.csv', 'beta,v\n30,0.1\n60,0.05\n'), '--free', 'e'],
+     /CSV line 1: column 'rotation' is missing/],
+    [['--data', join(dir, 'absent.csv'), '--free', 'e'], /cannot read .*absent\.csv/],
+    [['--data', good], /--free is required/],
+    [['--free', 'e'], /give --data FILE \(points\) or --peaks/],
+    [['--peaks', 'cw:38,up:128', '--free', 'e'], /--peaks takes .* got 'up:128'/],
+    [['--data', good, '--free', 'e:0.1:0.01'], /bounds of 'e' must satisfy/],
+  ];
+  for (const [args, re] of cases) {
+    const r = run('fit', ...args, '-q');
+    assert.equal(r.code, 2, `${args.join(' ')}: ${r.err}`);
+    assert.equal(r.out, '', args.join(' '));
+    assert.match(r.err, /^convsim fit: /);
+    assert.match(r.err, re);
+  }
+});
+
+test('a one-parameter fit: values, errors, residuals and curves in JSON and CSV', { timeout: 300000 * SLOW }, () => {
+  // data from the model itself at e = 0.018: the fit from e = 0.0215 goes back there
+  const made = run('sweep', ...CHEAP, '--set', 'e=0.018', '--beta', '20:140:40', '--rotation', 'cw', '-q');
+  assert.equal(made.code, 0, made.err);
+  const rows = made.out.trim().split('\n').slice(1).map((l) => l.split(','));
+  const csv = 'beta,rotation,v\n' + rows.map((c) => `${c[0]},${c[1]},${c[2]}`).join('\n') + '\n';
+  const data = file('made.csv', csv);
+  const r = run('fit', ...CHEAP, '--data', data, '--free', 'e', '--curve-step', '60', '-q');
+  assert.equal(r.code, 0, r.err);
+  const res = JSON.parse(r.out);
+  assert.equal(res.status, 'converged');
+  assert.equal(res.standard_errors_from, 'residual variance');
+  const e = res.parameters[0];
+  assert.equal(e.name, 'e');
+  assert.equal(e.start, 0.0215);
+  assert.ok(Math.abs(e.value - 0.018) < 3e-4, `e = ${e.value}`);
+  assert.ok(e.standard_error > 0 && e.standard_error < 3e-4, `se = ${e.standard_error}`);
+  assert.equal(res.points.length, 4);
+  for (const p of res.points) assert.ok(Math.abs(p.residual) < 0.003, JSON.stringify(p));
+  assert.deepEqual(res.curve.beta, [0, 60, 120, 180]);
+  assert.equal(res.curve.cw.fit.length, 4);
+  // the original curve is the faster one (v grows with e)
+  assert.ok(res.curve.cw.start[1] > res.curve.cw.fit[1]);
+  const c = run('fit', ...CHEAP, '--data', data, '--free', 'e', '--curve-step', '60', '-q', '--format', 'csv');
+  assert.equal(c.code, 0, c.err);
+  const lines = c.out.trim().split('\n');
+  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+  const par = lines[1].split(',');
+  assert.deepEqual(par.slice(0, 6), ['parameter', 'e', '', '', '', '']);
+  assert.equal(Number(par[6]), e.value);
+  assert.equal(Number(par[7]), e.standard_error);
+  assert.equal(Number(par[9]), 0.0215);
+  assert.equal(lines.filter((l) => l.startsWith('point,')).length, 4);
+  assert.equal(lines.filter((l) => l.startsWith('curve,')).length, 4);
+});

@@ -1,0 +1,103 @@
+// Calibration fits as jobs (POST /api/v1/fits): bad input refused whole with
+// a 422 naming the field and nothing started; a fit's life (queued or
+// running with progress, done with its result as JSON and CSV, listed,
+// deleted); DELETE cancels a running fit, whose driver then stops.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
+
+let d;
+before(async () => { d = await startDaemon(['--log-level', 'info']); });
+after(async () => { assert.equal((await d.stop()).code, 0, d.stderr()); });
+
+const JSON_CT = { 'Content-Type': 'application/json' };
+const POINTS = [
+  { beta: 20, rotation: 'cw', v: 0.07 },
+  { beta: 60, rotation: 'cw', v: 0.06 },
+  { beta: 100, rotation: 'cw', v: -0.03 },
+  { beta: 140, rotation: 'cw', v: -0.09 },
+];
+const body = (extra = {}) => ({ ...CHEAP, t_end: 2, free: ['e'], points: POINTS, curve_step: 45, ...extra });
+
+test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW }, async () => {
+  const before = (await req(d.base, 'GET', '/api/v1/fits')).text;
+  const cases = [
+    [{ points: [{ beta: 200, rotation: 'cw', v: 0.1 }, ...POINTS] }, 'points[0].beta', /beta must be a finite number in \[0, 180\] deg/],
+    [{ free: ['ee'] }, 'free[0]', /unknown parameter 'ee' \(did you mean 'e'\?\)/],
+    [{ free: ['rotation'] }, 'free[0]', /'rotation' cannot be fitted/],
+    [{ free: ['beta'] }, 'free[0]', /'beta' cannot be fitted/],
+    [{ free: ['e', 'mu'], points: POINTS.slice(0, 1) }, 'points', /1 data for 2 free parameters/],
+    [{ points: [POINTS[0], { ...POINTS[0], v: 0.08 }] }, 'points[1]', /duplicates points\[0\]/],
+    [{ points: undefined, csv: 'beta,v\n30,0.1\n60,0.05\n' }, 'csv', /column 'rotation' is missing/],
+    [{ points: undefined, csv: 'beta,rotation,v\nnan,cw,0.1\n60,cw,0.05\n' }, 'points[0].beta', /finite number/],
+    [{ points: undefined }, 'points', /no data/],
+    [{ peaks: [{ rotation: 'cw', beta: 38 }] }, 'peaks', /points or peaks, not both/],
+    [{ t_end: 0 }, 't_end', /t_end must exceed/],
+    [{ free: [{ name: 'e', min: 0.1, max: 0.01 }] }, 'free[0]', /bounds of 'e'/],
+  ];
+  for (const [extra, field, re] of cases) {
+    const r = await req(d.base, 'POST', '/api/v1/fits', body(extra));
+    assert.equal(r.status, 422, `${JSON.stringify(extra)}: ${r.text}`);
+    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    assert.equal(r.body.field, field, r.text);
+    assert.match(r.body.detail, re);
+  }
+  // NaN cannot be JSON: a string where a number belongs is a 400
+  const t = await req(d.base, 'POST', '/api/v1/fits', body({ points: [{ beta: 'NaN', rotation: 'cw', v: 0.1 }] }));
+  assert.equal(t.status, 400, t.text);
+  assert.equal(t.body.field, 'points[0].beta');
+  assert.equal((await req(d.base, 'GET', '/api/v1/fits')).text, before);
+});
+
+test('a fit job: progress, JSON and CSV result, list, delete', { timeout: 240000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/fits', body());
+  assert.equal(r.status, 202, r.text);
+  assert.equal(r.headers.get('location'), `/api/v1/fits/${r.body.id}`);
+  assert.ok(['queued', 'running'].includes(r.body.state));
+  assert.deepEqual(r.body.values, { e: 0.0215 });
+  assert.equal(r.body.result, null);
+  const path = `/api/v1/fits/${r.body.id}`;
+  let seen = 0;
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', path);
+    assert.ok(g.body.evaluations >= seen, 'evaluations never go back');
+    seen = g.body.evaluations;
+    return g.body.state === 'done' && g.body;
+  }, 200000 * SLOW, 'the fit');
+  assert.ok(done.evaluations > 4);
+  const res = done.result;
+  assert.equal(res.status, 'converged');
+  assert.equal(res.parameters[0].name, 'e');
+  assert.ok(res.parameters[0].standard_error > 0);
+  assert.equal(res.points.length, 4);
+  for (const p of res.points) assert.ok(Math.abs(p.residual - (p.model - p.v)) < 1e-12);
+  assert.deepEqual(res.curve.beta, [0, 45, 90, 135, 180]);
+  assert.equal(res.evaluations, done.evaluations);
+  const csv = await req(d.base, 'GET', `${path}?format=csv`);
+  assert.equal(csv.status, 200);
+  const lines = csv.text.trim().split('\n');
+  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+  assert.equal(Number(lines[1].split(',')[6]), res.parameters[0].value);
+  assert.equal(lines.length, 1 + 1 + 4 + 5);
+  const list = await req(d.base, 'GET', '/api/v1/fits');
+  assert.ok(list.body.fits.some((f) => f.id === r.body.id && f.state === 'done' && f.result === null));
+  const lc = await req(d.base, 'GET', '/api/v1/fits?format=csv');
+  assert.match(lc.text, new RegExp(`^fit,state,phase,iteration,evaluations,cost\\n[\\s\\S]*${r.body.id},done,done,`));
+  assert.equal((await req(d.base, 'DELETE', path, undefined, JSON_CT)).status, 204);
+  assert.equal((await req(d.base, 'GET', path)).status, 404);
+});
+
+test('DELETE cancels a running fit', { timeout: 120000 * SLOW }, async () => {
+  // the default scene and many points: far longer than the test waits
+  const pts = [];
+  for (let b = 5; b < 180; b += 10) pts.push({ beta: b, rotation: 'cw', v: 0.05 }, { beta: b, rotation: 'ccw', v: -0.05 });
+  const r = await req(d.base, 'POST', '/api/v1/fits', { free: ['e', 'mu'], points: pts });
+  assert.equal(r.status, 202, r.text);
+  const path = `/api/v1/fits/${r.body.id}`;
+  await until(async () => (await req(d.base, 'GET', path)).body.evaluations > 0, 60000 * SLOW, 'first evaluations');
+  assert.equal((await req(d.base, 'DELETE', path, undefined, JSON_CT)).status, 204);
+  assert.equal((await req(d.base, 'GET', path)).status, 404);
+  assert.ok(!(await req(d.base, 'GET', '/api/v1/fits')).body.fits.some((f) => f.id === r.body.id));
+  // the driver stops after the evaluations already running
+  await until(async () => d.stderr().includes(`fit ${r.body.id}: cancelled`), 30000 * SLOW, 'the driver to stop');
+});

@@ -1,0 +1,101 @@
+/*
+ * fit.js - the calibration panel: measured points pasted or loaded as CSV,
+ * free parameters by name, POST /api/v1/fits on the new-session form's
+ * model; follows the fit's progress (iteration, evaluations, current
+ * values), can cancel it, and shows the data with their sigma, the fitted
+ * and the original curve, the values with standard errors and the
+ * warnings, and the result's CSV link.
+ */
+
+import * as api from './api.js';
+import { fmt } from './format.js';
+import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
+import { readSessionForm } from './session.js';
+
+let running = null;
+
+export function wireFit() {
+	$('#fit-form').addEventListener('submit', runFit);
+	$('#fit-form').elements.file.addEventListener('change', async ev => {
+		const file = ev.target.files[0];
+		if (file) $('#fit-form').elements.csv.value = await file.text();
+	});
+	$('#fit-cancel').addEventListener('click', async () => {
+		if (!running) return;
+		try {
+			await api.deleteFit(running);
+			message('warn', `Fit ${running} cancelled`);
+		} catch (err) { report(err, 'Cancel'); }
+	});
+}
+
+async function runFit(ev) {
+	ev.preventDefault();
+	const f = $('#fit-form').elements;
+	const form = { ...readSessionForm(), csv: f.csv.value, free: f.free.value,
+		tEnd: numberOf(f.t_end), curveStep: numberOf(f.curve_step) };
+	const btn = $('#fit-run'), cancel = $('#fit-cancel'), box = $('#fit-progress');
+	for (const el of f) el.removeAttribute?.('aria-invalid');
+	busy(btn, true);
+	try {
+		const j = await api.createFit(form);
+		setOnline(true);
+		running = j.id;
+		cancel.hidden = false;
+		const csv = $('#fit-csv');
+		csv.href = api.fitCsvUrl(j.id);
+		csv.download = `fit-${j.id}.csv`;
+		progress(box, 0, 'started');
+		const end = await poll(api.getFit, j.id, u => progress(box, u.progress,
+			`${u.state} · ${u.phase} · iteration ${u.iteration} · ${u.evaluations} evaluations · ` +
+			Object.entries(u.values).map(([k, v]) => `${k} = ${fmt(v, 5)}`).join(', ')));
+		if (end.result) showFit(end.result);
+		csv.hidden = !end.result;
+		const r = end.result;
+		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${r?.error ? ': ' + r.error : ''}`);
+		else message(r.warnings.length ? 'warn' : 'ok', `Fit ${end.id} ${r.status} after ${r.iterations} iterations, ` +
+			`${r.evaluations} evaluations` + (r.warnings.length ? `: ${r.warnings.length} warning(s) below` : ''));
+	} catch (err) {
+		if (err instanceof api.ApiError && err.status === 404 && running) message('warn', 'The fit was cancelled');
+		else report(err, 'Fit', $('#fit-form'));
+	} finally {
+		busy(btn, false);
+		cancel.hidden = true;
+		running = null;
+	}
+}
+
+/* The plot (data with sigma, fitted and original curves per rotation),
+ * the parameters' table and the warnings. */
+function showFit(r) {
+	const pairs = [], errs = [];
+	for (const rot of ['cw', 'ccw']) {
+		const pts = (r.points || []).filter(p => p.rotation === rot);
+		pairs.push([pts.map(p => p.beta), pts.map(p => p.v)]);
+		errs.push(pts.map(p => p.sigma ?? NaN));
+		const c = r.curve?.[rot];
+		for (const key of ['fit', 'start']) {
+			pairs.push(c ? [r.curve.beta, c[key]] : [[], []]);
+			errs.push(key === 'fit' && c ? c.fit_uncertainty : []);
+		}
+	}
+	app.plots.fit.setData(pairs, errs);
+	const table = $('#fit-table');
+	table.replaceChildren();
+	const head = table.createTHead().insertRow();
+	for (const h of ['parameter', 'fitted', '± standard error', 'start', 'unit', 'bound'])
+		head.append(Object.assign(document.createElement('th'), { textContent: h }));
+	const body = table.createTBody();
+	const sig = (v, n) => (Number.isFinite(v) ? Number(v.toPrecision(n)).toString() : '–');
+	for (const p of r.parameters) {
+		const row = body.insertRow();
+		row.dataset.name = p.name;
+		for (const v of [p.name, sig(p.value, 5), sig(p.standard_error, 2), sig(p.start, 5), p.unit, p.at_bound ?? ''])
+			row.insertCell().textContent = v;
+	}
+	const note = body.insertRow().insertCell();
+	note.colSpan = 6;
+	note.textContent = `standard errors from ${r.standard_errors_from}; χ² = ${fmt(r.chi2, 3)} with ${r.dof} degrees of freedom`;
+	const list = $('#fit-warnings');
+	list.replaceChildren(...r.warnings.map(w => Object.assign(document.createElement('li'), { textContent: w })));
+}
