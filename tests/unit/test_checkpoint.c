@@ -4,9 +4,14 @@
  * every integrator, across a beta ramp in progress, a rotation change and
  * an estimator restart; a damaged buffer (cut off anywhere, any bit
  * flipped, another version, another model) is refused with
- * SIM_ECHECKPOINT and never crashes.
+ * SIM_ECHECKPOINT and never crashes; a phase that jumped (what a checkpoint
+ * with a right checksum and a wrong estimator gives: found by the fuzz
+ * harness tests/fuzz/fuzz_store.c) restarts the estimate instead of
+ * counting every period in between.
  */
 #include "testutil.h"
+
+#include "sim_int.h" /* the estimator's phase, set as a damaged checkpoint would */
 
 /* Status and feed of an instance, compared bytewise. */
 static void assert_same(const sim *a, const sim *b)
@@ -147,6 +152,29 @@ static void restore_does_not_settle(void **state)
 /* Every cut, every bit flipped in the header and payload (sampled), and a
  * checkpoint of another model: SIM_ECHECKPOINT, never a crash (run under
  * ASan by make check). */
+/* The estimator's phase 1000 periods behind the state's, as a checkpoint
+ * with a right checksum and a wrong estimator restores it: the next step
+ * must not count 1000 periods (nor walk 1.6e17 of them for a phase of
+ * -1e18, which hung the restored session) but start the estimate over. */
+static void phase_jump_restarts(void **state)
+{
+	(void)state;
+	setup u = small("rk4");
+	sim *a = make(&u);
+	advance(a, 0.3);
+	sim_status before = status(a);
+	assert_true(before.transport_periods >= 1);
+	for (int k = 0; k < 2; k++) {
+		a->est.psi_prev -= k == 0 ? 1000 * 2 * M_PI : 1e18;
+		double t = status(a).t + 0.01;
+		advance(a, t);
+		sim_status st = status(a);
+		assert_true(st.transport_periods < before.transport_periods + 5);
+		assert_true(isnan(st.transport_velocity));
+	}
+	sim_free(a);
+}
+
 static void damage_is_refused(void **state)
 {
 	(void)state;
@@ -204,6 +232,7 @@ int main(void)
 		cmocka_unit_test(dopri5_continues),
 		cmocka_unit_test(restore_does_not_settle),
 		cmocka_unit_test(damage_is_refused),
+		cmocka_unit_test(phase_jump_restarts),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
