@@ -36,7 +36,6 @@ typedef struct spec_record {
 	int32_t owned, pad;
 } spec_record;
 
-
 static void session_dir(char *out, size_t len, const char *id,
 			const char *file)
 {
@@ -180,7 +179,9 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 		return -1;
 	}
 	memcpy(r, p, sizeof *r);
-	if (r->exp_len > len || r->sim_len != len - sizeof *r - r->exp_len ||
+	/* exp_len first: a length between len - sizeof *r and len wrapped
+	 * the difference below and let sim_len point past the buffer */
+	if (r->exp_len > len - sizeof *r || r->sim_len != len - sizeof *r - r->exp_len ||
 	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
 		snprintf(why, whylen, "inconsistent lengths or state");
 		return -1;
