@@ -175,6 +175,41 @@ static void phase_jump_restarts(void **state)
 	sim_free(a);
 }
 
+/* A checkpoint (right checksum) of an instance failed with a code no step
+ * gives (found by the checkpoint fuzz harness: sim_advance then answered
+ * SIM_EUNKNOWN) is refused; one failed by divergence restores failed. */
+static void failure_code_checked(void **state)
+{
+	(void)state;
+	setup u = small("rk4");
+	sim *a = make(&u);
+	advance(a, 0.05);
+	size_t len;
+	unsigned char *buf = checkpoint_of(a, &len);
+	/* the header (48 bytes), y, y_obs, y_prev, then t_int, t_obs, t_prev
+	 * and three counters before the failure code */
+	size_t at = 48 + 3 * sizeof(double) * (size_t)a->md.n + 48;
+	const int32_t codes[] = {SIM_EUNKNOWN, SIM_EDIVERGED};
+	for (int k = 0; k < 2; k++) {
+		memcpy(buf + at, &codes[k], sizeof codes[k]);
+		uint64_t sum = sim_checksum(buf + 48, len - 48);
+		memcpy(buf + 40, &sum, sizeof sum);
+		char msg[200];
+		int err;
+		sim *b = sim_restore(&u.p, &u.sc, &u.m, buf, len, &err, msg, sizeof msg);
+		if (k == 0) {
+			assert_null(b);
+			assert_int_equal(err, SIM_ECHECKPOINT);
+		} else {
+			assert_non_null(b);
+			assert_int_equal(sim_advance(b, 0.1), SIM_EDIVERGED);
+			sim_free(b);
+		}
+	}
+	free(buf);
+	sim_free(a);
+}
+
 static void damage_is_refused(void **state)
 {
 	(void)state;
@@ -233,6 +268,7 @@ int main(void)
 		cmocka_unit_test(restore_does_not_settle),
 		cmocka_unit_test(damage_is_refused),
 		cmocka_unit_test(phase_jump_restarts),
+		cmocka_unit_test(failure_code_checked),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
