@@ -214,8 +214,8 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
- * sample_rate within the ranges the parser allows, and the settings pass
- * sim_validate. API_OK or the problem (nothing is changed). */
+ * sample_rate within the ranges the parser allows, every setting within
+ * its range, and the set passes sim_validate. API_OK or the problem (nothing is changed). */
 api_err api_check_spec(const api_spec *spec, api_problem *pb);
 
 /* Control changes of PATCH /sessions/{id}; set has API_C_* bits. */

@@ -361,6 +361,19 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb)
 	if (!(spec->sample_rate >= RATE_MIN && spec->sample_rate <= RATE_MAX))
 		return api_fail(pb, API_RANGE, "sample_rate", "sample_rate %g lies outside [%g, %g]",
 				spec->sample_rate, RATE_MIN, RATE_MAX);
+	/* every setting in its range (sim_validate leaves some unused ones,
+	 * such as atol for a fixed step, unchecked; a request cannot set them
+	 * out of range either) */
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n);
 	api_spec copy = *spec;
+	for (size_t i = 0; i < n; i++) {
+		double v;
+		char msg[256] = "";
+		if (sim_get(&spec->params, &spec->scene, &spec->method, tab[i].name, &v) == SIM_OK &&
+		    sim_set(&copy.params, &copy.scene, &copy.method, tab[i].name, v, msg,
+			    sizeof msg) != SIM_OK)
+			return api_fail(pb, API_RANGE, tab[i].name, "%s", msg);
+	}
 	return api_validate_spec(&copy, pb);
 }
