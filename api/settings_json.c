@@ -358,6 +358,9 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb)
 	if (!(spec->until == 0 || (spec->until >= UNTIL_MIN && spec->until <= UNTIL_MAX)))
 		return api_fail(pb, API_RANGE, "until", "until %g lies outside [%g, %g] s",
 				spec->until, UNTIL_MIN, UNTIL_MAX);
+	if (spec->pace == API_PACE_MAX && spec->until == 0)
+		return api_fail(pb, API_INVALID, "until", "pace \"max\" without until (the parser "
+				"gives it %g s)", API_DEFAULT_MAX_UNTIL);
 	if (!(spec->sample_rate >= RATE_MIN && spec->sample_rate <= RATE_MAX))
 		return api_fail(pb, API_RANGE, "sample_rate", "sample_rate %g lies outside [%g, %g]",
 				spec->sample_rate, RATE_MIN, RATE_MAX);
