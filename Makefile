@@ -2,7 +2,8 @@
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
 # `make deps` installs what is missing, `make install` installs,
-# `make bench` writes the work-precision tables. V=1 shows the commands.
+# `make bench` writes the work-precision tables, `make fuzz` runs the
+# libFuzzer harnesses. V=1 shows the commands.
 
 CC      ?= cc
 CFLAGS  ?= -O2 -g
@@ -58,7 +59,7 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
 
-.PHONY: all deps deps-build run cluster test check bench mutate clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -167,6 +168,43 @@ check:
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
 
+# libFuzzer harnesses (tests/fuzz/, README "Fuzzing"): clang builds core/,
+# api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
+# harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
+# build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
+# executions, coverage and crashes is printed. A JSON body is one more
+# word in FUZZ_BODIES (and one row of tests/fuzz/fuzz_body.c's table).
+# (-Wno-unused-function: clang, unlike gcc, warns of an unused static
+# inline function in a .c file.)
+FUZZ_SECONDS ?= 60
+FUZZ_BUILD   := build-fuzz
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_BODIES  := session control experiment sweep
+FUZZ_NAMES   := $(FUZZ_BODIES:%=body_%) query route checkpoint store
+FUZZ_BINS    := $(FUZZ_NAMES:%=$(BUILD)/fuzz/%)
+FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))
+FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libcore.a
+
+fuzz: deps-build
+	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
+	  CFLAGS="-O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link" WARN="$(WARN) -Wno-unused-function" fuzz-build
+	$(Q)FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_NAMES="$(FUZZ_NAMES)" \
+	  bash tests/fuzz/run.sh
+
+fuzz-build: $(FUZZ_BINS)
+
+$(BUILD)/fuzz/body_%: tests/fuzz/fuzz_body.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
+	@mkdir -p $(dir $@)
+	@$(if $(Q),echo "  FUZZ    $@")
+	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer -DFUZZ_BODY='"$*"' $(INC_server) -o $@ \
+	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(LDLIBS)
+
+$(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
+	@mkdir -p $(dir $@)
+	@$(if $(Q),echo "  FUZZ    $@")
+	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer $(INC_server) -o $@ \
+	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(LDLIBS)
+
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
 mutate: all
 	$(Q)bash tests/mutate.sh
@@ -194,6 +232,6 @@ uninstall:
 	rm -rf $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR)
 
 clean:
-	rm -rf build build-san
+	rm -rf build build-san build-fuzz
 
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)

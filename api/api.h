@@ -164,6 +164,30 @@ api_err api_check_query(const api_route *rt, const char *name, api_problem *pb);
  * 406 when Accept names neither. Other routes: JSON, API_OK. */
 api_err api_negotiate(const api_route *rt, const char *format, const char *accept, int *csv,
 		      api_problem *pb);
+/* The options of GET /sessions/{id}/stream from its query parameters and
+ * headers (each NULL when absent): ?format= sse or ndjson (without it,
+ * an Accept naming application/x-ndjson), ?fields= (api_parse_fields),
+ * ?rate= in (0, 100000], ?limit= a positive integer, and the record to
+ * resume after, Last-Event-ID or else ?since=, a non-negative integer.
+ * API_OK or a 400 bad-query problem naming the parameter. */
+typedef struct api_stream_query {
+	int ndjson;
+	unsigned fields;   /* API_F_* */
+	double rate;       /* samples per simulated second, 0: all */
+	uint64_t limit;    /* records, 0: no limit */
+	int64_t resume;    /* record id to resume after, -1: from now */
+} api_stream_query;
+api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
+			       const char *rate, const char *limit, const char *last_event_id,
+			       const char *since, api_stream_query *q, api_problem *pb);
+/* ?from=, ?to=, ?stride= of GET /sessions/{id}/trajectory (NULL or empty
+ * when absent): finite numbers of seconds, from <= to, stride >= 0 (0:
+ * as recorded). Defaults -inf, +inf, 0. API_OK or a 400 bad-query. */
+typedef struct api_trajectory_query {
+	double from, to, stride;
+} api_trajectory_query;
+api_err api_parse_trajectory_query(const char *from, const char *to, const char *stride,
+				   api_trajectory_query *q, api_problem *pb);
 /* The page a problem type URI serves (/api/v1/problems/SLUG): malloc'd
  * HTML, or NULL for an unknown slug. */
 char *api_problem_page(const char *slug);
@@ -201,6 +225,12 @@ typedef struct api_spec {
  * *pb; *spec is then unspecified. */
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb);
+
+/* Check a spec that did not come from api_parse_session (a file read
+ * back): its strings are terminated, the preset known, pace, until and
+ * sample_rate within the ranges the parser allows, every setting within
+ * its range, and the set passes sim_validate. API_OK or the problem (nothing is changed). */
+api_err api_check_spec(const api_spec *spec, api_problem *pb);
 
 /* Control changes of PATCH /sessions/{id}; set has API_C_* bits. */
 enum {

@@ -3,8 +3,10 @@
  * each takes and whether it answers results (JSON or CSV). The server
  * checks every request against this table (unknown query parameters are a
  * 400, an Accept it cannot serve a 406) and openapi.c describes the same
- * table, so the document and the checks cannot drift.
+ * table, so the document and the checks cannot drift. The values of the
+ * stream's and the trajectory's parameters are parsed here too.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,5 +195,84 @@ api_err api_negotiate(const api_route *rt, const char *format, const char *accep
 				"(or use ?format=json|csv)",
 				accept);
 	*csv = qc > qj;
+	return API_OK;
+}
+
+api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
+			       const char *rate, const char *limit, const char *last_event_id,
+			       const char *since, api_stream_query *q, api_problem *pb)
+{
+	memset(q, 0, sizeof *q);
+	q->resume = -1;
+	if (format) {
+		if (strcmp(format, "ndjson") == 0)
+			q->ndjson = 1;
+		else if (strcmp(format, "sse") != 0)
+			return api_fail(pb, API_QUERY, "format", "format must be sse or ndjson");
+	} else {
+		q->ndjson = accept && strstr(accept, "application/x-ndjson");
+	}
+	q->fields = fields ? api_parse_fields(fields, pb) : API_F_DEFAULT;
+	if (!q->fields)
+		return pb->code;
+	char *end;
+	if (rate) {
+		q->rate = strtod(rate, &end);
+		if (*end || !(q->rate > 0 && q->rate <= 100000))
+			return api_fail(pb, API_QUERY, "rate",
+					"rate must be a number of samples per "
+					"simulated second in (0, 100000]");
+	}
+	if (limit) {
+		unsigned long long n = strtoull(limit, &end, 10);
+		if (*end || n == 0 || *limit == '-')
+			return api_fail(pb, API_QUERY, "limit", "limit must be a positive integer");
+		q->limit = n;
+	}
+	const char *v = last_event_id ? last_event_id : since;
+	if (v) {
+		unsigned long long id = strtoull(v, &end, 10);
+		if (*end || !*v || *v == '-')
+			return api_fail(pb, API_QUERY, "Last-Event-ID",
+					"Last-Event-ID (or since) must be a record "
+					"id, a non-negative integer");
+		q->resume = (int64_t)(id > INT64_MAX - 1 ? INT64_MAX - 1 : id);
+	}
+	return API_OK;
+}
+
+/* A finite number of seconds from a query value (absent or empty: *out
+ * stays). */
+static api_err query_seconds(const char *key, const char *v, double *out, api_problem *pb)
+{
+	if (!v || !*v)
+		return API_OK;
+	char *end;
+	double x = strtod(v, &end);
+	if (*end || !isfinite(x))
+		return api_fail(pb, API_QUERY, key, "%s must be a number of seconds (got \"%.40s\")",
+				key, v);
+	*out = x;
+	return API_OK;
+}
+
+api_err api_parse_trajectory_query(const char *from, const char *to, const char *stride,
+				   api_trajectory_query *q, api_problem *pb)
+{
+	q->from = -INFINITY;
+	q->to = INFINITY;
+	q->stride = 0;
+	api_err e = query_seconds("from", from, &q->from, pb);
+	if (e == API_OK)
+		e = query_seconds("to", to, &q->to, pb);
+	if (e == API_OK)
+		e = query_seconds("stride", stride, &q->stride, pb);
+	if (e != API_OK)
+		return e;
+	if (q->from > q->to)
+		return api_fail(pb, API_QUERY, "from", "from (%g) must not exceed to (%g)", q->from,
+				q->to);
+	if (q->stride < 0)
+		return api_fail(pb, API_QUERY, "stride", "stride must be positive (s)");
 	return API_OK;
 }

@@ -17,6 +17,15 @@ const char *const api_members_session_create[] = {"preset", "params", "scene", "
 						   "pace", "until", "sample_rate", NULL};
 #include "units.h"
 
+/* The ranges of a session's pace (a real-time factor; or "max"), until
+ * (s; or none) and sample_rate (1/s): the parsers and api_check_spec. */
+#define PACE_MIN 0.001
+#define PACE_MAX 1000.0
+#define UNTIL_MIN 1e-6
+#define UNTIL_MAX 1e6
+#define RATE_MIN 1.0
+#define RATE_MAX 10000.0
+
 /* The name of choice idx in "a|b|c" into out; 0 if there is none. */
 static int choice_name(const char *choices, int idx, char *out, size_t len)
 {
@@ -248,7 +257,7 @@ api_err api_parse_pace(const cJSON *it, const char *field, double *pace,
 		return api_fail(pb, API_TYPE, field,
 				"%s must be a number or \"max\"", field);
 	double v = it->valuedouble;
-	if (!(v >= 0.001 && v <= 1000)) {
+	if (!(v >= PACE_MIN && v <= PACE_MAX)) {
 		api_fail(pb, API_RANGE, field,
 			 "%s must be a real-time factor in [0.001, 1000] or "
 			 "\"max\"", field);
@@ -294,11 +303,11 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
 	    (e = api_parse_pace(it, "pace", &spec->pace, pb)) != API_OK)
 		return e;
 	if ((it = cJSON_GetObjectItemCaseSensitive(root, "until")) &&
-	    (e = api_parse_real(it, "until", 1e-6, 1e6, 1, &spec->until, pb)) !=
+	    (e = api_parse_real(it, "until", UNTIL_MIN, UNTIL_MAX, 1, &spec->until, pb)) !=
 		    API_OK)
 		return e;
 	if ((it = cJSON_GetObjectItemCaseSensitive(root, "sample_rate")) &&
-	    (e = api_parse_real(it, "sample_rate", 1, 10000, 0,
+	    (e = api_parse_real(it, "sample_rate", RATE_MIN, RATE_MAX, 0,
 			    &spec->sample_rate, pb)) != API_OK)
 		return e;
 	if (spec->pace == API_PACE_MAX && spec->until == 0)
@@ -331,4 +340,44 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 		e = api_validate_spec(spec, pb);
 	cJSON_Delete(root);
 	return e;
+}
+
+api_err api_check_spec(const api_spec *spec, api_problem *pb)
+{
+	if (!memchr(spec->preset, '\0', sizeof spec->preset) ||
+	    !memchr(spec->method.name, '\0', sizeof spec->method.name))
+		return api_fail(pb, API_INVALID, NULL, "the preset or method name is not a string");
+	sim_params p;
+	sim_scene sc;
+	sim_method m;
+	if (sim_preset(spec->preset, &p, &sc, &m) != SIM_OK)
+		return api_fail(pb, API_RANGE, "preset", "unknown preset \"%.31s\"", spec->preset);
+	if (!(spec->pace == API_PACE_MAX || (spec->pace >= PACE_MIN && spec->pace <= PACE_MAX)))
+		return api_fail(pb, API_RANGE, "pace", "pace %g is no real-time factor in [%g, %g]",
+				spec->pace, PACE_MIN, PACE_MAX);
+	if (!(spec->until == 0 || (spec->until >= UNTIL_MIN && spec->until <= UNTIL_MAX)))
+		return api_fail(pb, API_RANGE, "until", "until %g lies outside [%g, %g] s",
+				spec->until, UNTIL_MIN, UNTIL_MAX);
+	if (spec->pace == API_PACE_MAX && spec->until == 0)
+		return api_fail(pb, API_INVALID, "until", "pace \"max\" without until (the parser "
+				"gives it %g s)", API_DEFAULT_MAX_UNTIL);
+	if (!(spec->sample_rate >= RATE_MIN && spec->sample_rate <= RATE_MAX))
+		return api_fail(pb, API_RANGE, "sample_rate", "sample_rate %g lies outside [%g, %g]",
+				spec->sample_rate, RATE_MIN, RATE_MAX);
+	/* every setting in its range (sim_validate leaves some unused ones,
+	 * such as atol for a fixed step, unchecked; a request cannot set them
+	 * out of range either) */
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n);
+	api_spec scratch = *spec, copy = *spec;
+	for (size_t i = 0; i < n; i++) {
+		double v = NAN;
+		char msg[256] = "";
+		if (strcmp(tab[i].name, "method") != 0 && /* a name: sim_validate checks it */
+		    sim_get(&spec->params, &spec->scene, &spec->method, tab[i].name, &v) == SIM_OK &&
+		    sim_set(&scratch.params, &scratch.scene, &scratch.method, tab[i].name, v, msg,
+			    sizeof msg) != SIM_OK)
+			return api_fail(pb, API_RANGE, tab[i].name, "%s", msg);
+	}
+	return api_validate_spec(&copy, pb);
 }

@@ -215,7 +215,8 @@ sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, 
 	/* a matching checksum on nonsense is not expected, but a state that
 	 * is not finite or times out of order would poison everything */
 	int bad = !isfinite(s->t_int) || !isfinite(s->t_obs) || s->t_obs > s->t_int + 1e-9 ||
-		  s->failed < 0 || s->failed >= SIM_NERR || s->est.n_rec < 0 ||
+		  (s->failed != SIM_OK && s->failed != SIM_EDIVERGED && s->failed != SIM_ESTEP) ||
+		  s->est.n_rec < 0 || (!s->est.pending && s->est.n_rec < 1) ||
 		  s->est.n_rec > EST_RECORDS || s->ctl.beta_ramp.n < 0 || s->ctl.beta_ramp.n > 4 ||
 		  s->ctl.psi_ramp.n < 0 || s->ctl.psi_ramp.n > 4 || s->est.stride < 1;
 	for (int i = 0; !bad && i < s->md.n; i++)

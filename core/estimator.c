@@ -143,6 +143,13 @@ void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double 
 		e->speed_max = fmax(e->speed_max, V);
 	double H = t1 - t0;
 	double n0 = floor(e->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
+	/* a step passes a few periods at most; a phase that jumped by more
+	 * (a state read from a damaged checkpoint) starts the estimate over
+	 * rather than walking every boundary in between */
+	if (fabs(n1 - n0) > EST_STEP_PERIODS) {
+		estimator_restart(e, t1);
+		n0 = n1;
+	}
 	if (n0 != n1 && H > 0.0) {
 		int up = n1 > n0;
 		for (double nb = up ? n0 + 1 : n0; up ? nb <= n1 : nb > n1; nb += up ? 1 : -1) {

@@ -9,6 +9,9 @@
 #include "model.h"
 
 enum { EST_RECORDS = 64 };
+/* Most period boundaries one step can pass; a phase jump beyond it
+ * restarts the estimate (estimator_step). */
+enum { EST_STEP_PERIODS = 64 };
 
 typedef struct estimator {
 	/* phi - alpha, the mean feed position and the drive's input energy,

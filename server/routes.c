@@ -134,49 +134,72 @@ static enum MHD_Result call_route(srv_req *r, const route *ro)
 	return ro->handler(r);
 }
 
-static enum MHD_Result route_request(srv_req *r)
+void srv_route_resolve(const char *method, const char *url, srv_route_match *m)
 {
-	char allow[96] = "";
-	const char *method = strcmp(r->method, "HEAD") == 0 ? "GET" : r->method;
+	memset(m, 0, sizeof *m);
+	if (strcmp(method, "HEAD") == 0)
+		method = "GET";
 	int path_known = 0;
 	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
 		char arg[2][64];
-		if (!match(routes[i].pattern, r->url, arg))
+		if (!match(routes[i].pattern, url, arg))
 			continue;
 		path_known = 1;
 		if (strcmp(routes[i].method, method) == 0) {
-			memcpy(r->arg, arg, sizeof arg);
-			return call_route(r, &routes[i]);
+			m->kind = SRV_ROUTE_FOUND;
+			m->index = i;
+			m->method = routes[i].method;
+			m->pattern = routes[i].pattern;
+			memcpy(m->arg, arg, sizeof arg);
+			return;
 		}
+		char *allow = m->allow;
 		if (!strstr(allow, routes[i].method)) {
 			size_t at = strlen(allow);
-			snprintf(allow + at, sizeof allow - at, "%s%s",
+			snprintf(allow + at, sizeof m->allow - at, "%s%s",
 				 at ? ", " : "", routes[i].method);
 			if (strcmp(routes[i].method, "GET") == 0) {
 				at = strlen(allow);
-				snprintf(allow + at, sizeof allow - at,
+				snprintf(allow + at, sizeof m->allow - at,
 					 ", HEAD");
 			}
 		}
 	}
+	if (path_known)
+		m->kind = SRV_ROUTE_METHOD;
+	else if (strncmp(url, "/api/", 5) == 0 || strcmp(url, "/api") == 0)
+		m->kind = SRV_ROUTE_NOT_FOUND;
+	else if (strcmp(method, "GET") != 0)
+		m->kind = SRV_ROUTE_STATIC_METHOD;
+	else
+		m->kind = SRV_ROUTE_STATIC;
+}
+
+static enum MHD_Result route_request(srv_req *r)
+{
+	srv_route_match m;
+	srv_route_resolve(r->method, r->url, &m);
 	api_problem pb;
-	if (path_known) {
+	switch (m.kind) {
+	case SRV_ROUTE_FOUND:
+		memcpy(r->arg, m.arg, sizeof m.arg);
+		return call_route(r, &routes[m.index]);
+	case SRV_ROUTE_METHOD:
 		api_fail(&pb, API_METHOD, NULL,
 			 "%s is not allowed on %s; allowed: %s", r->method,
-			 r->url, allow);
-		return srv_reply_problem(r, &pb, allow);
-	}
-	if (strncmp(r->url, "/api/", 5) == 0 || strcmp(r->url, "/api") == 0) {
+			 r->url, m.allow);
+		return srv_reply_problem(r, &pb, m.allow);
+	case SRV_ROUTE_NOT_FOUND:
 		api_fail(&pb, API_NOTFOUND, NULL, "no such resource: %s",
 			 r->url);
 		return srv_reply_problem(r, &pb, NULL);
-	}
-	if (strcmp(method, "GET") != 0) {
+	case SRV_ROUTE_STATIC_METHOD:
 		api_fail(&pb, API_METHOD, NULL,
 			 "static files allow GET and HEAD only");
 		return srv_reply_problem(r, &pb, "GET, HEAD");
+	default:
+		return srv_h_static(r);
 	}
-	return srv_h_static(r);
 }
 
 /* The request as first seen, headers only: the gate, then the declared

@@ -17,4 +17,23 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 void srv_request_done(void *cls, struct MHD_Connection *conn,
 		      void **con_cls, enum MHD_RequestTerminationCode toe);
 
+/* What a request's method and path come to, decided by the route table
+ * alone (no libmicrohttpd, no state: the access handler acts on it, the
+ * fuzz harness tests/fuzz/fuzz_route.c checks it). HEAD is GET. */
+typedef enum {
+	SRV_ROUTE_FOUND,         /* routes' entry index, with its path arguments */
+	SRV_ROUTE_METHOD,        /* 405: the path exists with the methods in allow */
+	SRV_ROUTE_NOT_FOUND,     /* 404: an unknown path under /api */
+	SRV_ROUTE_STATIC_METHOD, /* 405: a static file asked for with another method */
+	SRV_ROUTE_STATIC,        /* a static file of --web-root */
+} srv_route_kind;
+typedef struct srv_route_match {
+	srv_route_kind kind;
+	size_t index;                /* FOUND: the entry of the table */
+	const char *method, *pattern; /* FOUND: the entry's (static) */
+	char arg[2][64];             /* FOUND: the "*" segments */
+	char allow[96];              /* METHOD: the Allow header */
+} srv_route_match;
+void srv_route_resolve(const char *method, const char *url, srv_route_match *m);
+
 #endif

@@ -105,38 +105,15 @@ enum MHD_Result srv_h_session_delete(srv_req *r)
 	return srv_reply_empty(r);
 }
 
-/* A finite number from a query argument; 0 and *pb if malformed. */
-static int query_number(srv_req *r, const char *key, double *out,
-			api_problem *pb)
-{
-	const char *v = srv_query(r, key);
-	if (!v || !*v)
-		return 1;
-	char *end;
-	double x = strtod(v, &end);
-	if (*end || !isfinite(x)) {
-		api_fail(pb, API_QUERY, key,
-			 "%s must be a number of seconds (got \"%.40s\")", key,
-			 v);
-		return 0;
-	}
-	*out = x;
-	return 1;
-}
-
 enum MHD_Result srv_h_trajectory(srv_req *r)
 {
 	api_problem pb;
-	double from = -INFINITY, to = INFINITY, every = 0, stride = 0, *rows = NULL;
-	if (!query_number(r, "from", &from, &pb) ||
-	    !query_number(r, "to", &to, &pb) ||
-	    !query_number(r, "stride", &every, &pb))
+	api_trajectory_query q;
+	double stride = 0, *rows = NULL;
+	if (api_parse_trajectory_query(srv_query(r, "from"), srv_query(r, "to"),
+				       srv_query(r, "stride"), &q, &pb) != API_OK)
 		return srv_reply_problem(r, &pb, NULL);
-	if (from > to)
-		return srv_fail(r, API_QUERY, "from",
-				"from (%g) must not exceed to (%g)", from, to);
-	if (every < 0)
-		return srv_fail(r, API_QUERY, "stride", "stride must be positive (s)");
+	double from = q.from, to = q.to, every = q.stride;
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);

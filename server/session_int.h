@@ -88,6 +88,28 @@ void srv_persist_checkpoint(srv_session *s, int force);
 /* Queue the removal of the session's files. */
 void srv_persist_remove(const srv_session *s);
 
+/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
+ * the core's checkpoint (sim_len bytes) follow. */
+typedef struct srv_ckpt_record {
+	int32_t state, exp_started;
+	double pace, until;
+	char error[256];
+	char exp_id[SRV_ID_LEN];
+	uint64_t exp_len, sim_len;
+} srv_ckpt_record;
+/* The files read back, checked without touching a session (the restore
+ * uses these; so does the fuzz harness tests/fuzz/fuzz_store.c). A spec
+ * file's payload (len bytes, borrowed): 0 with the spec, its creation
+ * time and whether an experiment owns it, or -1 with why (another size, a
+ * spec the API would refuse: api_check_spec). A checkpoint file's payload:
+ * 0 with its head in *r (strings terminated; the experiment's state and
+ * the core's checkpoint follow it in p), or -1 with why (cut off,
+ * inconsistent lengths, an unknown run state). */
+int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
+		    int *owned, char *why, size_t whylen);
+int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
+		    size_t whylen);
+
 /* session.c: publish a session built by session_store.c: s has its
  * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
  * buffers are allocated here. 0 or -1 (s freed). Its worker starts with

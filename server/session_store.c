@@ -36,16 +36,6 @@ typedef struct spec_record {
 	int32_t owned, pad;
 } spec_record;
 
-/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
- * the core's checkpoint (sim_len bytes) follow. */
-typedef struct ckpt_record {
-	int32_t state, exp_started;
-	double pace, until;
-	char error[256];
-	char exp_id[SRV_ID_LEN];
-	uint64_t exp_len, sim_len;
-} ckpt_record;
-
 static void session_dir(char *out, size_t len, const char *id,
 			const char *file)
 {
@@ -131,7 +121,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		  (s->state == SRV_RUNNING || s->ckpt_dirty);
 	if (!due && !(force && s->ckpt_dirty))
 		return;
-	ckpt_record r;
+	srv_ckpt_record r;
 	memset(&r, 0, sizeof r);
 	r.state = s->state;
 	r.pace = s->pace;
@@ -181,6 +171,26 @@ void srv_persist_remove(const srv_session *s)
 static srv_experiment *(*exp_find)(const char *id);
 static void (*exp_put)(srv_experiment *e);
 
+int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
+		    size_t whylen)
+{
+	if (len < sizeof *r) {
+		snprintf(why, whylen, "cut off");
+		return -1;
+	}
+	memcpy(r, p, sizeof *r);
+	/* exp_len first: a length between len - sizeof *r and len wrapped
+	 * the difference below and let sim_len point past the buffer */
+	if (r->exp_len > len - sizeof *r || r->sim_len != len - sizeof *r - r->exp_len ||
+	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
+		snprintf(why, whylen, "inconsistent lengths or state");
+		return -1;
+	}
+	r->error[sizeof r->error - 1] = '\0';
+	r->exp_id[SRV_ID_LEN - 1] = '\0';
+	return 0;
+}
+
 static int load_checkpoint(srv_session *s, const char *file, char *why,
 			   size_t whylen)
 {
@@ -188,19 +198,13 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
 	if (!p)
 		return -1;
-	ckpt_record r;
+	srv_ckpt_record r;
 	int rc = -1;
-	if (len < sizeof r) {
-		snprintf(why, whylen, "%s: cut off", file);
-		goto done;
-	}
-	memcpy(&r, p, sizeof r);
-	if (r.exp_len > len || r.sim_len != len - sizeof r - r.exp_len ||
-	    r.state < SRV_RUNNING || r.state > SRV_FAILED) {
-		snprintf(why, whylen, "%s: inconsistent lengths or state", file);
-		goto done;
-	}
 	char msg[256] = "";
+	if (srv_ckpt_decode(p, len, &r, msg, sizeof msg) != 0) {
+		snprintf(why, whylen, "%s: %s", file, msg);
+		goto done;
+	}
 	int err;
 	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
 			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
@@ -214,10 +218,8 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 	s->state = r.state;
 	s->pace = r.pace;
 	s->until = r.until;
-	r.error[sizeof r.error - 1] = '\0';
 	snprintf(s->error, sizeof s->error, "%s", r.error);
 	if (r.exp_started && r.exp_len) {
-		r.exp_id[SRV_ID_LEN - 1] = '\0';
 		srv_experiment *e = exp_find(r.exp_id);
 		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
 			s->exp = e;
@@ -232,6 +234,26 @@ done:
 	return rc;
 }
 
+int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
+		    int *owned, char *why, size_t whylen)
+{
+	spec_record r;
+	if (len != sizeof r) {
+		snprintf(why, whylen, "of another size");
+		return -1;
+	}
+	memcpy(&r, p, sizeof r);
+	api_problem pb;
+	if (api_check_spec(&r.spec, &pb) != API_OK) {
+		snprintf(why, whylen, "%s", pb.detail);
+		return -1;
+	}
+	*spec = r.spec;
+	*created = r.created;
+	*owned = r.owned != 0;
+	return 0;
+}
+
 /* Build session id from its files into s (calloc'd, lock initialised). */
 static void restore_one(srv_session *s, const char *id)
 {
@@ -241,10 +263,11 @@ static void restore_one(srv_session *s, const char *id)
 	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
 	session_dir(path, sizeof path, id, "spec.bin");
 	size_t len;
-	spec_record *r = srv_store_read(path, SRV_STORE_SESSION, &len, why,
-					sizeof why);
-	if (r && len != sizeof *r) {
-		snprintf(why, sizeof why, "%s: of another size", path);
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, sizeof why);
+	char msg[256];
+	if (r && srv_spec_decode(r, len, &s->spec, &s->created, &s->owned, msg,
+				 sizeof msg) != 0) {
+		snprintf(why, sizeof why, "%s: %s", path, msg);
 		free(r);
 		r = NULL;
 	}
@@ -253,9 +276,6 @@ static void restore_one(srv_session *s, const char *id)
 		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
 		return;
 	}
-	s->spec = r->spec;
-	s->created = r->created;
-	s->owned = r->owned;
 	free(r);
 	s->pace = s->spec.pace;
 	s->until = s->spec.until;

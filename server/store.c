@@ -405,40 +405,47 @@ char *srv_store_read_text(const char *rel, size_t *len)
 	return buf;
 }
 
-void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
-		     size_t whylen)
+void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
+			const char **bad)
 {
-	size_t n = 0;
-	char *buf = srv_store_read_text(rel, &n);
 	frame_header h;
-	const char *bad = NULL;
-	if (!buf)
-		bad = "missing or unreadable";
-	else if (n < sizeof h)
-		bad = "cut off (shorter than its header)";
-	if (!bad) {
+	*bad = NULL;
+	if (n < sizeof h)
+		*bad = "cut off (shorter than its header)";
+	if (!*bad) {
 		memcpy(&h, buf, sizeof h);
 		if (memcmp(h.magic, "CVSF", 4) != 0)
-			bad = "not a convsim file (bad magic)";
+			*bad = "not a convsim file (bad magic)";
 		else if (h.version != SRV_STORE_VERSION)
-			bad = "unknown version";
+			*bad = "unknown version";
 		else if (h.kind != kind)
-			bad = "a file of another kind";
+			*bad = "a file of another kind";
 		else if (h.len > n - sizeof h)
-			bad = "cut off";
+			*bad = "cut off";
 		else if (h.len < n - sizeof h)
-			bad = "longer than its header says";
+			*bad = "longer than its header says";
 		else if (sim_checksum(buf + sizeof h, h.len) != h.checksum)
-			bad = "checksum mismatch";
+			*bad = "checksum mismatch";
 	}
-	if (bad) {
-		snprintf(why, whylen, "%s: %s", rel, bad);
+	if (*bad) {
 		free(buf);
 		return NULL;
 	}
 	memmove(buf, buf + sizeof h, h.len);
 	*len = h.len;
 	return buf;
+}
+
+void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
+		     size_t whylen)
+{
+	size_t n = 0;
+	char *buf = srv_store_read_text(rel, &n);
+	const char *bad = "missing or unreadable";
+	void *payload = buf ? srv_store_unframe(buf, n, kind, len, &bad) : NULL;
+	if (!payload)
+		snprintf(why, whylen, "%s: %s", rel, bad);
+	return payload;
 }
 
 size_t srv_store_list(const char *rel, char ***names)

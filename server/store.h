@@ -74,6 +74,13 @@ void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
  * cut off, checksum, unknown version, ...). */
 void *srv_store_read(const char *path, uint32_t kind, size_t *len, char *why,
 		     size_t whylen);
+/* The payload of a framed file of kind held in buf (n bytes, malloc'd,
+ * taken): buf again with the payload moved to its start and its length in
+ * *len, or NULL (buf freed) with the reason in *bad (static text). No file
+ * system: srv_store_read reads, this checks (and the fuzz harness
+ * tests/fuzz/fuzz_store.c calls it). */
+void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
+			const char **bad);
 /* Read a whole plain file (relative path); malloc'd with a final NUL,
  * NULL if missing. */
 char *srv_store_read_text(const char *path, size_t *len);

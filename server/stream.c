@@ -161,57 +161,19 @@ static void stream_free(void *cls)
 static int parse_options(srv_req *r, stream *k, int64_t *resume,
 			 api_problem *pb)
 {
-	const char *format = srv_query(r, "format");
-	const char *accept = srv_header(r, MHD_HTTP_HEADER_ACCEPT);
-	if (format) {
-		if (strcmp(format, "ndjson") == 0)
-			k->ndjson = 1;
-		else if (strcmp(format, "sse") != 0) {
-			api_fail(pb, API_QUERY, "format",
-				 "format must be sse or ndjson");
-			return 0;
-		}
-	} else {
-		k->ndjson = accept && strstr(accept, "application/x-ndjson");
-	}
-	const char *fields = srv_query(r, "fields");
-	k->fields = fields ? api_parse_fields(fields, pb) : API_F_DEFAULT;
-	if (!k->fields)
+	api_stream_query q;
+	if (api_parse_stream_query(srv_query(r, "format"),
+				   srv_header(r, MHD_HTTP_HEADER_ACCEPT),
+				   srv_query(r, "fields"), srv_query(r, "rate"),
+				   srv_query(r, "limit"),
+				   srv_header(r, "Last-Event-ID"),
+				   srv_query(r, "since"), &q, pb) != API_OK)
 		return 0;
-	const char *v;
-	char *end;
-	if ((v = srv_query(r, "rate"))) {
-		k->rate = strtod(v, &end);
-		if (*end || !(k->rate > 0 && k->rate <= 100000)) {
-			api_fail(pb, API_QUERY, "rate",
-				 "rate must be a number of samples per "
-				 "simulated second in (0, 100000]");
-			return 0;
-		}
-	}
-	if ((v = srv_query(r, "limit"))) {
-		unsigned long long n = strtoull(v, &end, 10);
-		if (*end || n == 0 || *v == '-') {
-			api_fail(pb, API_QUERY, "limit",
-				 "limit must be a positive integer");
-			return 0;
-		}
-		k->limit = n;
-	}
-	v = srv_header(r, "Last-Event-ID");
-	if (!v)
-		v = srv_query(r, "since");
-	*resume = -1;
-	if (v) {
-		unsigned long long id = strtoull(v, &end, 10);
-		if (*end || !*v || *v == '-') {
-			api_fail(pb, API_QUERY, "Last-Event-ID",
-				 "Last-Event-ID (or since) must be a record "
-				 "id, a non-negative integer");
-			return 0;
-		}
-		*resume = (int64_t)(id > INT64_MAX - 1 ? INT64_MAX - 1 : id);
-	}
+	k->ndjson = q.ndjson;
+	k->fields = q.fields;
+	k->rate = q.rate;
+	k->limit = q.limit;
+	*resume = q.resume;
 	return 1;
 }
 

@@ -4,9 +4,14 @@
  * every integrator, across a beta ramp in progress, a rotation change and
  * an estimator restart; a damaged buffer (cut off anywhere, any bit
  * flipped, another version, another model) is refused with
- * SIM_ECHECKPOINT and never crashes.
+ * SIM_ECHECKPOINT and never crashes; a phase that jumped (what a checkpoint
+ * with a right checksum and a wrong estimator gives: found by the fuzz
+ * harness tests/fuzz/fuzz_store.c) restarts the estimate instead of
+ * counting every period in between.
  */
 #include "testutil.h"
+
+#include "sim_int.h" /* the estimator's phase, set as a damaged checkpoint would */
 
 /* Status and feed of an instance, compared bytewise. */
 static void assert_same(const sim *a, const sim *b)
@@ -147,6 +152,64 @@ static void restore_does_not_settle(void **state)
 /* Every cut, every bit flipped in the header and payload (sampled), and a
  * checkpoint of another model: SIM_ECHECKPOINT, never a crash (run under
  * ASan by make check). */
+/* The estimator's phase 1000 periods behind the state's, as a checkpoint
+ * with a right checksum and a wrong estimator restores it: the next step
+ * must not count 1000 periods (nor walk 1.6e17 of them for a phase of
+ * -1e18, which hung the restored session) but start the estimate over. */
+static void phase_jump_restarts(void **state)
+{
+	(void)state;
+	setup u = small("rk4");
+	sim *a = make(&u);
+	advance(a, 0.3);
+	sim_status before = status(a);
+	assert_true(before.transport_periods >= 1);
+	for (int k = 0; k < 2; k++) {
+		a->est.psi_prev -= k == 0 ? 1000 * 2 * M_PI : 1e18;
+		double t = status(a).t + 0.01;
+		advance(a, t);
+		sim_status st = status(a);
+		assert_true(st.transport_periods < before.transport_periods + 5);
+		assert_true(isnan(st.transport_velocity));
+	}
+	sim_free(a);
+}
+
+/* A checkpoint (right checksum) of an instance failed with a code no step
+ * gives (found by the checkpoint fuzz harness: sim_advance then answered
+ * SIM_EUNKNOWN) is refused; one failed by divergence restores failed. */
+static void failure_code_checked(void **state)
+{
+	(void)state;
+	setup u = small("rk4");
+	sim *a = make(&u);
+	advance(a, 0.05);
+	size_t len;
+	unsigned char *buf = checkpoint_of(a, &len);
+	/* the header (48 bytes), y, y_obs, y_prev, then t_int, t_obs, t_prev
+	 * and three counters before the failure code */
+	size_t at = 48 + 3 * sizeof(double) * (size_t)a->md.n + 48;
+	const int32_t codes[] = {SIM_EUNKNOWN, SIM_EDIVERGED};
+	for (int k = 0; k < 2; k++) {
+		memcpy(buf + at, &codes[k], sizeof codes[k]);
+		uint64_t sum = sim_checksum(buf + 48, len - 48);
+		memcpy(buf + 40, &sum, sizeof sum);
+		char msg[200];
+		int err;
+		sim *b = sim_restore(&u.p, &u.sc, &u.m, buf, len, &err, msg, sizeof msg);
+		if (k == 0) {
+			assert_null(b);
+			assert_int_equal(err, SIM_ECHECKPOINT);
+		} else {
+			assert_non_null(b);
+			assert_int_equal(sim_advance(b, 0.1), SIM_EDIVERGED);
+			sim_free(b);
+		}
+	}
+	free(buf);
+	sim_free(a);
+}
+
 static void damage_is_refused(void **state)
 {
 	(void)state;
@@ -204,6 +267,8 @@ int main(void)
 		cmocka_unit_test(dopri5_continues),
 		cmocka_unit_test(restore_does_not_settle),
 		cmocka_unit_test(damage_is_refused),
+		cmocka_unit_test(phase_jump_restarts),
+		cmocka_unit_test(failure_code_checked),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

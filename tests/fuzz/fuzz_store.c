@@ -1,0 +1,126 @@
+/*
+ * fuzz_store.c - libFuzzer harness of the daemon's stored-session reader:
+ * a session's spec.bin and checkpoint.bin as a restart reads them back
+ * (README "Persistence"): the frame (srv_store_unframe: magic, version,
+ * kind, length, checksum), the spec record (srv_spec_decode, which checks
+ * the spec with api_check_spec), the checkpoint's head (srv_ckpt_decode)
+ * and the core's checkpoint behind it (sim_restore, for that spec).
+ *
+ * Input: byte 0 holds flags (bit 0: the harness writes the right frame
+ * checksums first, bit 1: and the core checkpoint's, so that mutations
+ * reach the checks behind them), bytes 1-4 the length L of the spec file
+ * (little-endian), then L bytes of spec.bin and the rest checkpoint.bin.
+ * Oracles: a file that is refused says why; one that is accepted, framed
+ * again, is the same bytes (but the unused pad); an accepted spec, written back as a create
+ * body by the API's writer, is accepted by POST /sessions' parser and is
+ * the same spec; a restored instance steps (running, or failed with a
+ * reason). The committed seeds are real files of a daemon run with
+ * --data-dir.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fuzz_util.h"
+#include "session_int.h"
+#include "store.h"
+
+/* store.c's frame header: magic, version, kind, pad (unused, written as
+ * 0), then the payload's length and checksum. */
+enum { FRAME_PAD = 12, FRAME_LEN = 16, FRAME_CHECKSUM = 24, FRAME_SIZE = 32 };
+
+/* Unframe n bytes of data as kind; the payload (malloc'd) or NULL. */
+static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size_t *plen)
+{
+	char *buf = fuzz_exact(data, n);
+	if (fixed)
+		fuzz_fix_checksum(buf, n, FRAME_LEN, FRAME_CHECKSUM, FRAME_SIZE);
+	char *copy = fuzz_exact((const uint8_t *)buf, n);
+	const char *bad = NULL;
+	char *payload = srv_store_unframe(buf, n, kind, plen, &bad);
+	if (!payload) {
+		FUZZ_CHECK(bad && bad[0], "a frame refused without a reason");
+		free(copy);
+		return NULL;
+	}
+	size_t len;
+	memset(copy + FRAME_PAD, 0, 4);
+	char *again = srv_store_frame(kind, payload, *plen, &len);
+	FUZZ_CHECK(again && len == n && memcmp(again, copy, n) == 0,
+		   "an accepted file framed again differs");
+	free(again);
+	free(copy);
+	return payload;
+}
+
+static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
+{
+	srv_ckpt_record r;
+	char why[256] = "";
+	if (srv_ckpt_decode(p, len, &r, why, sizeof why) != 0) {
+		FUZZ_CHECK(why[0], "a checkpoint head refused without a reason");
+		return;
+	}
+	FUZZ_CHECK(r.state >= SRV_RUNNING && r.state <= SRV_FAILED &&
+			   sizeof r + r.exp_len + r.sim_len == len,
+		   "checkpoint head accepted with state %d, lengths %zu + %llu + %llu of %zu",
+		   (int)r.state, sizeof r, (unsigned long long)r.exp_len,
+		   (unsigned long long)r.sim_len, len);
+	char *core = p + sizeof r + r.exp_len;
+	if (fix_core)
+		fuzz_fix_checksum(core, r.sim_len, FUZZ_CKPT_PAYLOAD, FUZZ_CKPT_CHECKSUM,
+				  FUZZ_CKPT_HEADER);
+	char msg[256] = "";
+	int err;
+	sim *s = sim_restore(&spec->params, &spec->scene, &spec->method, core, r.sim_len, &err, msg,
+			     sizeof msg);
+	if (!s) {
+		FUZZ_CHECK(err == SIM_ECHECKPOINT && msg[0], "sim_restore gave %d: %s", err, msg);
+		return;
+	}
+	sim_status st;
+	sim_get_status(s, &st);
+	/* two steps of the instance's own size, whatever the spec's dt */
+	double h = st.dt > 0 && isfinite(st.dt) ? st.dt : 1e-4;
+	int rc = sim_advance(s, st.t + 2 * h);
+	if (rc == SIM_EDIVERGED || rc == SIM_ESTEP)
+		FUZZ_CHECK(sim_last_error(s)[0], "failed without a reason");
+	sim_free(s);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+	if (size < 5)
+		return 0;
+	uint32_t spec_len = (uint32_t)data[1] | (uint32_t)data[2] << 8 |
+			    (uint32_t)data[3] << 16 | (uint32_t)data[4] << 24;
+	if (spec_len > size - 5)
+		return 0;
+	size_t plen;
+	char *payload = unframe(data + 5, spec_len, SRV_STORE_SESSION, data[0] & 1, &plen);
+	if (!payload)
+		return 0;
+	api_spec spec, again;
+	double created;
+	int owned;
+	char why[256] = "";
+	int rc = srv_spec_decode(payload, plen, &spec, &created, &owned, why, sizeof why);
+	free(payload);
+	if (rc != 0) {
+		FUZZ_CHECK(why[0], "a spec refused without a reason");
+		return 0;
+	}
+	char *text = fuzz_print(fuzz_spec_body(&spec, 1));
+	api_problem pb;
+	FUZZ_CHECK(api_parse_session(text, strlen(text), &again, &pb) == API_OK,
+		   "a restored spec written back is refused: %s\n%s", pb.detail, text);
+	fuzz_same_spec(&spec, &again, 1, "restored spec");
+	free(text);
+	size_t rest = size - 5 - spec_len;
+	payload = unframe(data + 5 + spec_len, rest, SRV_STORE_CHECKPOINT, data[0] & 1, &plen);
+	if (payload)
+		restore(&spec, payload, plen, data[0] & 2);
+	free(payload);
+	return 0;
+}

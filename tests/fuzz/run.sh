@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Runs each libFuzzer harness of tests/fuzz/ for FUZZ_SECONDS (make fuzz;
+# README "Fuzzing") on its committed seeds (tests/fuzz/corpus/NAME, read
+# only) and its working corpus ($FUZZ_BUILD/corpus/NAME, where new inputs
+# go), with its dictionary, at nice 10, and prints a table: executions,
+# exec/s, coverage (cov: edges, ft: features), CPU seconds (user+sys; the
+# machine may be shared, so wall time says little), crashes. A crash, a
+# leak, a sanitizer report, an oracle failure or an input slower than
+# FUZZ_TIMEOUT seconds stops that harness, keeps the input in
+# $FUZZ_BUILD/crashes/ and makes this script exit 1.
+set -u
+cd "$(dirname "$0")/../.."
+B=${FUZZ_BUILD:-build-fuzz}
+S=${FUZZ_SECONDS:-60}
+T=${FUZZ_TIMEOUT:-60}
+NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep query route checkpoint store}
+mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
+echo "fuzzing each harness for ${S} s: FUZZ_SECONDS=$S make fuzz"
+printf '| %-16s | %8s | %12s | %8s | %6s | %7s | %6s | %7s |\n' harness seconds executions 'exec/s' cov ft 'CPU s' crashes
+printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' ------------------ ---------- -------------- ---------- -------- --------- -------- ---------
+total=0; crashed=0
+for n in $NAMES; do
+	bin=$B/fuzz/$n
+	case $n in
+	body_*) dict=tests/fuzz/dict/json.dict ;;
+	query | route) dict=tests/fuzz/dict/$n.dict ;;
+	*) dict= ;;
+	esac
+	log=$B/logs/$n.log
+	mkdir -p "$B/corpus/$n"
+	/usr/bin/time -f '%U %S' -o "$B/logs/$n.time" \
+		nice -n 10 "$bin" -max_total_time="$S" -timeout="$T" -rss_limit_mb=2048 \
+		-print_final_stats=1 -artifact_prefix="$B/crashes/$n-" ${dict:+-dict=$dict} \
+		"$B/corpus/$n" "tests/fuzz/corpus/$n" >"$log" 2>&1
+	rc=$?
+	execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+	rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+	cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -1)
+	cpu=$(tail -1 "$B/logs/$n.time" 2>/dev/null | awk '{printf "%.0f", $1 + $2}')
+	crashes=0
+	if [ "$rc" -ne 0 ]; then
+		crashes=1
+		crashed=1
+	fi
+	total=$((total + ${execs:-0}))
+	printf '| %-16s | %8s | %12s | %8s | %6s | %7s | %6s | %7s |\n' "$n" "$S" "${execs:-?}" \
+		"${rate:-?}" "$(echo "$cov" | awk '{print $2}')" "$(echo "$cov" | awk '{print $4}')" \
+		"${cpu:-?}" "$crashes"
+	if [ "$rc" -ne 0 ]; then
+		echo "  $n failed (exit $rc); the end of $log:"
+		grep -v '^    #\|^INFO\|^#' "$log" | tail -15 | sed 's/^/  /'
+	fi
+done
+echo "fuzz: $total executions in total, $([ $crashed -eq 0 ] && echo 0 || echo 'some') harness(es) crashed"
+[ "$crashed" -eq 0 ]

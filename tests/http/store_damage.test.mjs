@@ -1,0 +1,68 @@
+// Files of the data directory with a right checksum and wrong contents
+// (what a fuzz harness, tests/fuzz/fuzz_store.c, feeds the restore): a
+// checkpoint whose experiment length wraps the length check, a spec whose
+// preset name is not terminated. The restart lists both sessions as
+// damaged with the reason, reads nothing past a buffer (make check runs
+// this under ASan) and stops cleanly. The offsets are this build's record
+// layouts (server/session_store.c, host order, x86-64).
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
+
+const FRAME = 32;          // store.c's frame header; the checksum at 24
+const CKPT_RECORD = 320;   // srv_ckpt_record; exp_len at 304, sim_len at 312
+const SPEC_PRESET = 24;    // spec_record: id[24], then api_spec's preset[32]
+
+// sim_checksum of the payload into the frame's checksum field: FNV-1a 64
+// with core/checkpoint.c's starting value.
+function reframe(buf) {
+  let h = 1469598103934665603n;
+  for (let i = FRAME; i < buf.length; i++) {
+    h ^= BigInt(buf[i]);
+    h = (h * 0x100000001b3n) & 0xffffffffffffffffn;
+  }
+  buf.writeBigUInt64LE(h, 24);
+  return buf;
+}
+
+test('a checksummed checkpoint with wrapping lengths and a spec with an unterminated preset are listed damaged', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-damage-'));
+  const args = ['--data-dir', dir];
+  let d = await startDaemon(args);
+  try {
+    const ids = [];
+    for (let i = 0; i < 2; i++)
+      ids.push((await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body.id);
+    for (const id of ids)
+      await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished', 20000 * SLOW, id);
+    assert.equal((await d.stop()).code, 0);
+    for (const name of ['checkpoint.bin', 'checkpoint.bin.prev']) {
+      const path = join(dir, 'sessions', ids[0], name);
+      const b = readFileSync(path);
+      const payload = BigInt(b.length - FRAME);
+      const expLen = payload - BigInt(CKPT_RECORD) + 100n;
+      b.writeBigUInt64LE(expLen, FRAME + 304);
+      b.writeBigUInt64LE((payload - BigInt(CKPT_RECORD) - expLen) & 0xffffffffffffffffn, FRAME + 312);
+      writeFileSync(path, reframe(b));
+    }
+    const spec = readFileSync(join(dir, 'sessions', ids[1], 'spec.bin'));
+    assert.equal(spec.toString('latin1', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 10), 'czubak2016', 'the layout this test assumes');
+    spec.fill('x', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 32);
+    writeFileSync(join(dir, 'sessions', ids[1], 'spec.bin'), reframe(spec));
+    d = await startDaemon(args);
+    const a = (await req(d.base, 'GET', `/api/v1/sessions/${ids[0]}`)).body;
+    assert.equal(a.state, 'damaged');
+    assert.match(a.error, /checkpoint\.bin: inconsistent lengths or state.*checkpoint\.bin\.prev: inconsistent lengths/);
+    const b = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
+    assert.equal(b.state, 'damaged');
+    assert.match(b.error, /spec\.bin: the preset or method name is not a string/);
+    assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200);
+    assert.equal((await d.stop()).code, 0, `clean stop; stderr: ${d.stderr()}`);
+  } finally {
+    await d.stop('SIGKILL');
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
