@@ -32,6 +32,13 @@ static const srv_config defaults = {
 	.max_sweeps = 64,
 	.checkpoint_interval = 10.0,
 	.idle_timeout = 0.0,
+	.max_memory = 0,       /* set from the machine: machine_defaults() */
+	.max_cpu_seconds = 1800.0,
+	.max_busy = 0,         /* set from the machine */
+	.max_client_connections = 64,
+	.max_connections = 1024,
+	.connection_timeout = 30.0,
+	.max_queued_points = 4096,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL };
@@ -60,11 +67,32 @@ static const opt opts[] = {
 	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
 	 F(checkpoint_interval)},
 	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout)},
+	{"max-memory", OPT_SIZE, 1L << 20, 1L << 50, F(max_memory)},
+	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds)},
+	{"max-busy", OPT_INT, 1, 1024, F(max_busy)},
+	{"max-client-connections", OPT_INT, 1, 100000,
+	 F(max_client_connections)},
+	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
+	{"connection-timeout", OPT_SECONDS, 1000, 3600000,
+	 F(connection_timeout)},
+	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
 
-static void usage(FILE *f)
+/* The budgets that depend on the machine: 3/4 of its memory, one pace
+ * "max" session per core. */
+static void machine_defaults(srv_config *cfg)
+{
+	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+	long cores = sysconf(_SC_NPROCESSORS_ONLN);
+	cfg->max_memory = pages > 0 && page > 0
+				  ? (size_t)pages / 4 * 3 * (size_t)page
+				  : (size_t)4 << 30;
+	cfg->max_busy = cores > 0 ? (int)cores : 1;
+}
+
+static void usage(FILE *f, const srv_config *cfg)
 {
 	fprintf(f,
 		"usage: convsimd [options]\n"
@@ -86,14 +114,45 @@ static void usage(FILE *f)
 		"  --checkpoint-interval S  wall seconds between session "
 		"checkpoints (default 10)\n"
 		"  --idle-timeout S     remove sessions with no client and no "
-		"request for S seconds (default 0: never)\n");
+		"request for S seconds (default 0: never)\n"
+		"budgets (429/503 with Retry-After when spent; see README "
+		"\"Budgets and load\"):\n"
+		"  --max-memory BYTES   estimated memory of all sessions and "
+		"streams; K, M, G suffixes\n"
+		"                       (default %.1f GiB: 3/4 of this "
+		"machine's memory)\n"
+		"  --max-cpu-seconds S  CPU seconds a session may use before "
+		"it pauses, per grant\n"
+		"                       (default %g)\n"
+		"  --max-busy N         pace \"max\" sessions stepping at once, "
+		"in turns (default %d: the cores)\n"
+		"  --max-client-connections N  open connections per client "
+		"address (default %d)\n"
+		"  --max-connections N  open connections, all clients "
+		"(default %d)\n"
+		"  --connection-timeout S  close a connection silent for S "
+		"seconds; must exceed --heartbeat\n"
+		"                       (default %g)\n"
+		"  --max-queued-points N  sweep points queued or running, "
+		"all sweeps (default %d)\n",
+		(double)cfg->max_memory / (double)(1 << 30),
+		cfg->max_cpu_seconds, cfg->max_busy,
+		cfg->max_client_connections, cfg->max_connections,
+		cfg->connection_timeout, cfg->max_queued_points);
 }
 
+/* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */
 static int parse_int(const char *arg, const char *name, long lo, long hi,
-		     long *out)
+		     int suffix, long *out)
 {
 	char *end;
 	long v = strtol(arg, &end, 10);
+	const char *units = "KMGT", *u = *end ? strchr(units, *end) : NULL;
+	if (suffix && u && end[1] == '\0' && v >= 0 &&
+	    v <= (hi >> (10 * (u - units + 1)))) {
+		v <<= 10 * (u - units + 1);
+		end++;
+	}
 	if (*end || end == arg || v < lo || v > hi) {
 		fprintf(stderr, "convsimd: %s must be an integer in [%ld, %ld]\n",
 			name, lo, hi);
@@ -114,7 +173,7 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	case OPT_STRING: *(const char **)(void *)at = arg; return 0;
 	case OPT_INT:
 	case OPT_SIZE:
-		if (parse_int(arg, flag, o->lo, o->hi, &v))
+		if (parse_int(arg, flag, o->lo, o->hi, o->kind == OPT_SIZE, &v))
 			return -1;
 		if (o->kind == OPT_INT)
 			*(int *)(void *)at = (int)v;
@@ -180,14 +239,15 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 	longopts[NOPTS] = (struct option){"help", no_argument, 0, 'h'};
 	longopts[NOPTS + 1] = (struct option){0, 0, 0, 0};
 	*cfg = defaults;
+	machine_defaults(cfg);
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		if (c == 'h') {
-			usage(stdout);
+			usage(stdout, cfg);
 			return 1;
 		}
 		if (c < 0 || (size_t)c >= NOPTS) {
-			usage(stderr);
+			usage(stderr, cfg);
 			return -1;
 		}
 		if (set_option(cfg, &opts[c], optarg))
@@ -196,6 +256,13 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 	if (optind < argc) {
 		fprintf(stderr, "convsimd: unexpected argument %s\n",
 			argv[optind]);
+		return -1;
+	}
+	if (cfg->connection_timeout <= cfg->heartbeat) {
+		fprintf(stderr, "convsimd: --connection-timeout (%g s) must "
+				"exceed --heartbeat (%g s), or idle streams "
+				"would be cut\n", cfg->connection_timeout,
+			cfg->heartbeat);
 		return -1;
 	}
 	pick_web_root(cfg, argv[0]);

@@ -26,6 +26,14 @@ typedef struct srv_config {
 	int max_experiments, max_sweeps;
 	double checkpoint_interval; /* s of wall time between checkpoints */
 	double idle_timeout;   /* s without client or request; 0: never */
+	/* budgets (budget.c) */
+	size_t max_memory;     /* bytes: sessions' and streams' estimated need */
+	double max_cpu_seconds; /* CPU s a session may use per grant */
+	int max_busy;          /* pace "max" sessions stepping at once */
+	int max_client_connections; /* open connections per client address */
+	int max_connections;   /* open connections, all clients */
+	double connection_timeout; /* s a connection may stay silent */
+	int max_queued_points; /* sweep points queued or running, all sweeps */
 } srv_config;
 
 /* Fill *cfg from the defaults and the command line (argv is borrowed: the

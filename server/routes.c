@@ -17,6 +17,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "budget.h"
 #include "catalog.h"
 #include "experiment_http.h"
 #include "routes.h"
@@ -206,6 +207,11 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		const char *ct = MHD_lookup_connection_value(
 			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
 		st->r.has_content_type = ct != NULL;
+		api_problem pb;
+		if (srv_budget_client_over(conn, &pb)) {
+			st->r.body = "";
+			return srv_reply_problem(&st->r, &pb, NULL);
+		}
 		st->r.json_body = ct && json_type(ct);
 		const char *cl = MHD_lookup_connection_value(
 			conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);

@@ -77,6 +77,7 @@ static void session_free(srv_session *s)
 	if (!s)
 		return;
 	sim_free(s->sim);
+	srv_budget_give(s->mem_reserved);
 	srv_sample_free(&s->scratch);
 	free(s->ring);
 	free(s->ring_store);
@@ -149,6 +150,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->pace = spec->pace;
 	s->until = spec->until;
 	s->state = SRV_RUNNING;
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
 	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
 			 sizeof msg);
 	if (!s->sim) {
@@ -188,6 +191,14 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 			 "delete one first", cfg->max_sessions);
 		return NULL;
 	}
+	int feed = spec->scene.feed && spec->scene.columns > 0 &&
+		   spec->scene.layers > 0;
+	if (srv_budget_take_session(feed ? spec->scene.columns : 0,
+				    feed ? spec->scene.layers : 0,
+				    &s->mem_reserved, pb) != API_OK) {
+		s->mem_reserved = 0;
+		goto fail;
+	}
 	if (session_init(s, spec, pb))
 		goto fail;
 	s->exp = exp;
@@ -226,6 +237,8 @@ srv_session *srv_session_get(const char *id)
 int srv_session_adopt(srv_session *s)
 {
 	s->last_access = s->ckpt_wall = srv_now();
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
 	if (s->damaged) {
 		s->state = SRV_FAILED;
 	} else {
@@ -240,6 +253,9 @@ int srv_session_adopt(srv_session *s)
 				      "reached or id taken", s->entry.id);
 		goto fail;
 	}
+	/* what it had before the restart: reserved even beyond the budget */
+	s->mem_reserved = srv_budget_session_need(s->columns, s->layers);
+	srv_budget_take(s->mem_reserved, "a restored session", 1, NULL);
 	if (alloc_buffers(s)) {
 		srv_registry_cancel(&sessions, &s->entry);
 		goto fail;
@@ -382,6 +398,12 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->rtf = s->rtf;
 	v->samples = s->head;
 	v->streams = s->streams;
+	v->cpu_seconds = s->cpu_seconds;
+	v->cpu_limit = s->cpu_limit;
+	v->pause_reason = s->state != SRV_PAUSED ? NULL
+			  : s->cpu_paused      ? "cpu-budget"
+					       : "client";
+	v->waiting_for_cpu = s->waiting_for_cpu;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));
@@ -434,10 +456,18 @@ double srv_sessions_steps_per_s(void)
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
-	srv_cmd cmd = {.c = *c};
+	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds};
 	pthread_mutex_lock(&s->lock);
 	api_err e = API_OK;
-	if (s->stop)
+	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
+		e = api_fail(pb, API_RANGE, "cpu_budget",
+			     "cpu_budget must be CPU seconds in (0, %g] "
+			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
+			     c->cpu_budget);
+		pb->has_range = 1;
+		pb->min = 0;
+		pb->max = cfg->max_cpu_seconds;
+	} else if (s->stop)
 		e = api_fail(pb, API_NOTFOUND, NULL,
 			     "the session is being deleted");
 	else if (s->state == SRV_FAILED)

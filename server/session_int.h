@@ -8,6 +8,7 @@
 #include <math.h>
 #include <pthread.h>
 
+#include "budget.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"
@@ -57,6 +58,13 @@ struct srv_session {
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
+	/* budgets (budget.c) */
+	size_t mem_reserved;      /* bytes of the memory budget it holds */
+	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
+	int waiting_for_cpu;      /* its turn has not come */
+	double cpu_seconds;       /* the worker's CPU time, s */
+	double cpu_limit;         /* pauses when cpu_seconds reaches it */
+	int cpu_paused;           /* paused because cpu_limit was reached */
 };
 
 /* Slot i of the ring with its arrays pointed into ring_store (set on

@@ -16,6 +16,9 @@
  *               (session_store.c); no file is touched here
  *   until       a running session that reached "until" finishes
  *   idle        a session that is not running sleeps until woken
+ *   turn        a pace "max" session steps only while it holds one of the
+ *               --max-busy CPU slots (budget.c), giving it up after each
+ *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
  *               after a stall; pace "max" runs flat out up to "until")
  *   step        sim_advance by one sample interval (1/sample_rate simulated
@@ -27,6 +30,9 @@
  *   job step    the experiment records the step and, at a segment boundary,
  *               hands over the next segment's command
  *   failure     a core error fails the session and aborts its experiment
+ *   cpu         the worker's CPU time is read (CLOCK_THREAD_CPUTIME_ID: the
+ *               worker steps this session only); a session that spent its
+ *               grant (cpu_limit) pauses with pause_reason "cpu-budget"
  *   meter       achieved steps/s and real-time factor over half-second
  *               windows
  */
@@ -217,6 +223,23 @@ static void extend_until(srv_session *s, double t_end)
 		s->state = SRV_RUNNING;
 }
 
+/* The budget part of a control: a CPU grant from now, a resume of a
+ * session its CPU budget paused (lock held). */
+static void apply_budget(srv_session *s, const srv_cmd *cmd)
+{
+	const api_control *c = &cmd->c;
+	if (c->set & API_C_CPU)
+		s->cpu_limit = s->cpu_seconds + c->cpu_budget;
+	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
+		 cmd->cpu_grant > 0)
+		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
+	if (((c->set & API_C_CPU) || ((c->set & API_C_RUNNING) && c->running)) &&
+	    s->cpu_paused && s->state == SRV_PAUSED)
+		s->state = SRV_RUNNING;
+	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
+		s->cpu_paused = 0;
+}
+
 /* Apply queued controls in order and acknowledge each (lock held).
  * Returns 1 if pacing must restart. */
 static int apply_commands(srv_session *s)
@@ -262,6 +285,11 @@ static int apply_commands(srv_session *s)
 			else if (c->running && s->state == SRV_PAUSED)
 				s->state = SRV_RUNNING;
 			reanchor = 1;
+		}
+		if (rc == SIM_OK) {
+			int was = s->state;
+			apply_budget(s, cmd);
+			reanchor |= was != s->state;
 		}
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
@@ -331,11 +359,54 @@ static void check_until(srv_session *s)
 	}
 }
 
+/* cpu: read the worker's CPU time; a running session that spent its
+ * grant pauses. */
+static void check_cpu(srv_session *s)
+{
+	struct timespec ts;
+	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
+		return;
+	s->state = SRV_PAUSED;
+	s->cpu_paused = 1;
+	s->ckpt_dirty = 1;
+	push_event_reason(s, "paused", "\"reason\":\"cpu-budget\"");
+	pthread_cond_broadcast(&s->data);
+	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
+			      "spent", s->entry.id, s->cpu_limit);
+}
+
+/* turn: a running pace "max" session steps only while it holds a CPU
+ * slot; any other gives its slot (or place in line) up. 1 if it must wait
+ * (the loop then starts over, so that commands are seen at once). */
+static int take_turn(srv_session *s, clocks *c)
+{
+	if (s->state != SRV_RUNNING || s->pace != API_PACE_MAX || s->stop) {
+		srv_cpu_leave(&s->turn);
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	if (srv_cpu_turn_over(&s->turn))
+		srv_cpu_leave(&s->turn); /* to the back of the line */
+	if (srv_cpu_take(&s->turn)) {
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	s->waiting_for_cpu = 1;
+	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
+	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+	restart_clocks(c, s);
+	return 1;
+}
+
 /* idle: a session that is not running sleeps until woken; 1 if it slept. */
 static int idle(srv_session *s, clocks *c)
 {
 	if (s->state == SRV_RUNNING)
 		return 0;
+	srv_cpu_leave(&s->turn);
+	s->waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	pthread_cond_wait(&s->wake, &s->lock);
@@ -441,7 +512,8 @@ void *srv_worker_main(void *arg)
 			break;
 		srv_persist_checkpoint(s, 0);
 		check_until(s);
-		if (idle(s, &clk))
+		check_cpu(s);
+		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
 		if (pace(s, &clk, t_next))
@@ -458,6 +530,7 @@ void *srv_worker_main(void *arg)
 		srv_persist_checkpoint(s, 1);
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
+	srv_cpu_leave(&s->turn);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;
