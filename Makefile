@@ -2,7 +2,8 @@
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
 # `make deps` installs what is missing, `make install` installs,
-# `make bench` writes the work-precision tables. V=1 shows the commands.
+# `make bench` writes the work-precision tables, `make load` runs a bounded
+# load test. V=1 shows the commands.
 
 CC      ?= cc
 CFLAGS  ?= -O2 -g
@@ -55,7 +56,7 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
 
-.PHONY: all deps deps-build run test check bench mutate clean install uninstall
+.PHONY: all deps deps-build run test check bench load mutate clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -136,6 +137,13 @@ check:
 
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
+
+# A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
+# 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
+# prints a table and fails if the daemon crashed, went over its memory
+# budget or stopped answering another client.
+load: all
+	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
 
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
 mutate: all

@@ -95,9 +95,9 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 {
 	return MHD_start_daemon(
 		la->flags, (uint16_t)cfg->port, NULL, NULL, srv_dispatch, NULL,
+		MHD_OPTION_EXTERNAL_LOGGER, srv_budget_mhd_log, NULL,
 		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
 		MHD_OPTION_NOTIFY_CONNECTION, srv_budget_connection, NULL,
-		MHD_OPTION_EXTERNAL_LOGGER, srv_budget_mhd_log, NULL,
 		MHD_OPTION_SOCK_ADDR, la->addr,
 		MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->max_connections,
 		MHD_OPTION_PER_IP_CONNECTION_LIMIT,

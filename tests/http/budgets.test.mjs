@@ -29,13 +29,15 @@ function getFrom(base, path, localAddress) {
   });
 }
 
-// n idle TCP connections from localAddress (they never send a byte).
+// n idle TCP connections from localAddress (they never send a byte); each
+// has .closedAt, a promise of the time the daemon closed it.
 async function idleSockets(port, n, localAddress) {
   const socks = [];
   for (let i = 0; i < n; i++) {
-    socks.push(await new Promise((resolve, reject) => {
+    socks.push(await new Promise((resolve) => {
       const s = net.connect({ port, host: '127.0.0.1', localAddress }, () => resolve(s));
-      s.on('error', reject);
+      s.closedAt = new Promise((done) => s.on('close', () => done(Date.now())));
+      s.on('error', () => resolve(s)); // reset at accept: closed already
     }));
   }
   return socks;
@@ -182,18 +184,17 @@ test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a
       ids.push(r.body.id);
     }
     let sawWaiting = false;
-    for (let k = 0; k < 20; k++) {
+    const list = await until(async () => {
       const m = await metrics(d.base);
       assert.ok(metric(m, 'convsim_cpu_slots_busy') <= 1, 'at most --max-busy step at once');
       if (metric(m, 'convsim_cpu_slots_waiting') === 1) sawWaiting = true;
       await sleep(100);
-    }
+      const all = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
+      return all.every((s) => s.cpu_seconds > 0.3) && all;
+    }, 30000, 'both sessions to use CPU');
     assert.ok(sawWaiting, 'the other one waited its turn');
-    const list = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
     const [a, b] = list.map((s) => s.cpu_seconds);
-    assert.ok(a > 0.2 && b > 0.2, `both ran: ${a}, ${b}`);
     assert.ok(a / b > 0.5 && a / b < 2, `fair shares of CPU: ${a} vs ${b}`);
-    assert.ok(list.some((s) => s.waiting_for_cpu === true) || list.every((s) => s.state === 'running'));
     // the one left alone runs without waiting
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ids[0]}`)).status, 204);
     await until(async () => metric(await metrics(d.base), 'convsim_cpu_slots_waiting') === 0, 5000, 'no one waiting');
@@ -276,7 +277,6 @@ test('connections: a client beyond its budget gets 429 then is closed at accept;
     // timeout, while the idle sockets are closed by it
     const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
     assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${s.body.id}`, { running: false })).status, 200);
-    const closed = socks.map((k) => new Promise((resolve) => k.on('close', () => resolve(Date.now()))));
     const t0 = Date.now();
     let beats = 0;
     for await (const rec of openStream(d.base, `/api/v1/sessions/${s.body.id}/stream?format=ndjson`)) {
@@ -284,7 +284,7 @@ test('connections: a client beyond its budget gets 429 then is closed at accept;
       if (Date.now() - t0 > 4000) break;
     }
     assert.ok(beats >= 5, `the stream stayed open with ${beats} heartbeats`);
-    const when = await Promise.all(closed);
+    const when = await Promise.all(socks.map((k) => k.closedAt));
     assert.ok(when.every((t) => t - t0 < 4000 * SLOW), 'idle sockets were closed by --connection-timeout');
     const back = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
     assert.equal(back.status, 200, 'the client is served again once its sockets are gone');
