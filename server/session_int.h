@@ -82,6 +82,20 @@ static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 	return r;
 }
 
+/* ---- ring.c: the worker's writers (session lock held) ----------------- */
+
+/* Push an event record: type ("control", "finished", ...) and its JSON. */
+void srv_ring_event(srv_session *s, const char *type, const char *json);
+/* Push an event {"t": now, detail...}; detail (may be NULL) is more JSON
+ * members. */
+void srv_ring_event_at(srv_session *s, const char *type, const char *detail);
+/* Push a sample of the published status and the scratch feed arrays, and
+ * a trajectory row when one is due. */
+void srv_ring_sample(srv_session *s);
+/* Copy the feed arrays out of the instance into the scratch record
+ * (worker; no lock needed). */
+void srv_ring_gather(srv_session *s);
+
 /* ---- session_store.c: the session's files (store.h) ------------------ */
 
 /* Queue the spec file (at creation). */

@@ -33,6 +33,12 @@ const check = (ok, what) => { if (!ok) failures.push(what); };
 const d = await startDaemon(['--max-sessions', String(SESSIONS + 16), '--max-streams', String(STREAMS + 16),
   '--max-memory', '3G']);
 const base = d.base;
+// bounded: whatever happens, the run and its daemon end within 6 minutes
+process.on('exit', () => { if (d.proc.exitCode === null) d.proc.kill('SIGKILL'); });
+const deadline = setTimeout(() => {
+  console.log('load: FAILED: did not finish within 6 minutes');
+  process.exit(1);
+}, 360000);
 const agent = new http.Agent({ keepAlive: true, maxSockets: 8, localAddress: '127.0.0.1' });
 const t0 = performance.now();
 const usage0 = procUsage(d.proc.pid);
@@ -41,14 +47,20 @@ const sampler = setInterval(() => {
   try { peakRss = Math.max(peakRss, procUsage(d.proc.pid).rss); } catch { /* exited */ }
 }, 250);
 
-// 1. sessions
+const progress = (what) => console.error(`load: ${fmt((performance.now() - t0) / 1000)} s: ${what}`);
+
+// 1. sessions, four requests at a time
 const ids = [];
-for (let i = 0; i < SESSIONS; i++) {
-  const r = await call(base, 'POST', '/api/v1/sessions', { pace: 1 }, { agent });
-  if (r.status !== 201) throw new Error(`session ${i}: ${r.status} ${JSON.stringify(r.body)}`);
-  ids.push(r.body.id);
-}
+await Promise.all(Array.from({ length: 4 }, async () => {
+  while (ids.length < SESSIONS) {
+    ids.push(null);
+    const r = await call(base, 'POST', '/api/v1/sessions', { pace: 1 }, { agent });
+    if (r.status !== 201) throw new Error(`a session: ${r.status} ${JSON.stringify(r.body)}`);
+    ids[ids.indexOf(null)] = r.body.id;
+  }
+}));
 const created = performance.now();
+progress(`${ids.length} sessions created`);
 
 // 2. the other client, throughout
 const other = { n: 0, bad: [], ms: [] };
@@ -73,16 +85,20 @@ for (let i = 0; i < STREAMS; i++) {
   if (i % 50 === 49) await sleep(50);
 }
 
+progress(`${streams.length} streams opened`);
 // 4. idle sockets from one address: its budget's worth (64), then 20
 // requests from it (429 with a body), then the rest (8 more held in the
 // grace, the others closed at accept)
-const idle = { open: 0, closedEarly: 0, failed: 0, socks: [] };
+const idle = { open: 0, closedEarly: 0, failed: 0, pending: 0, socks: [] };
+// A connect the listen queue did not take within 5 s (the kernel retries
+// the SYN for minutes) counts as pending and is given up.
 const openIdle = (n) => Promise.all(Array.from({ length: n }, () => new Promise((resolve) => {
   const s = net.connect({ port: d.port, host: '127.0.0.1', localAddress: '127.0.0.2' });
   const opened = performance.now();
-  s.on('connect', () => { idle.open++; idle.socks.push(s); resolve(); });
+  const timer = setTimeout(() => { idle.pending++; s.destroy(); resolve(); }, 5000);
+  s.on('connect', () => { clearTimeout(timer); idle.open++; idle.socks.push(s); resolve(); });
   s.on('close', () => { if (performance.now() - opened < 5000) idle.closedEarly++; });
-  s.on('error', () => { idle.failed++; resolve(); });
+  s.on('error', () => { clearTimeout(timer); idle.failed++; resolve(); });
 })));
 await openIdle(Math.min(64, IDLE));
 const fromIdle = {};
@@ -93,6 +109,7 @@ for (let i = 0; i < 20; i++) {
 }
 await openIdle(IDLE - Math.min(64, IDLE));
 
+progress(`idle sockets: ${idle.open} connected`);
 // 5. the measurement window: PATCH beta 20 a second
 const patchMs = [];
 const patchStatus = {};
@@ -110,6 +127,7 @@ while (performance.now() - windowStart < WINDOW * 1000) {
 const usageEnd = procUsage(d.proc.pid);
 const windowS = (performance.now() - windowStart) / 1000;
 
+progress('window over');
 // 6. read out
 const list = (await call(base, 'GET', '/api/v1/sessions', undefined, { agent })).body.sessions;
 const realTime = list.filter((s) => s.status.rtf >= 0.95).length;
@@ -133,6 +151,7 @@ for (const s of idle.socks) s.destroy();
 clearInterval(sampler);
 const alive = d.proc.exitCode === null && d.proc.signalCode === null;
 const reserved = metric('convsim_memory_reserved_bytes');
+progress('deleting the sessions');
 for (const id of ids) await call(base, 'DELETE', `/api/v1/sessions/${id}`, undefined, { agent });
 agent.destroy();
 const stop = await d.stop();
@@ -156,7 +175,7 @@ const lines = [
   `| stream lag p50 / p99 (${lags.length} samples after 5 s, ${STREAMS} streams) | ${fmt(quantile(lags, 0.5))} / ${fmt(quantile(lags, 0.99))} ms |`,
   `| sessions keeping real time (rtf >= 0.95) | ${realTime} of ${list.length} |`,
   `| answers 401 / 429 / 503 (whole run) | ${answers(401)} / ${answers(429)} / ${answers(503)} |`,
-  `| idle sockets from 127.0.0.2 | ${idle.open} connected, ${idle.closedEarly} closed at once by the daemon, ${idle.failed} failed; its 20 requests: ${JSON.stringify(fromIdle)} |`,
+  `| idle sockets from 127.0.0.2 | ${idle.open} connected, ${idle.closedEarly} closed at once by the daemon, ${idle.failed} failed, ${idle.pending} not taken within 5 s; its 20 requests: ${JSON.stringify(fromIdle)} |`,
   `| connections closed at accept (metric) | ${metric('convsim_connections_dropped_total')} |`,
   `| another client (127.0.0.3): requests, p99 latency | ${other.n}, all answered: ${other.bad.length === 0}, ${fmt(quantile(other.ms, 0.99))} ms |`,
   `| daemon resident memory, peak (budget reserved / --max-memory) | ${mb(peakRss)} MiB (${mb(reserved)} / ${mb(MEMORY)} MiB) |`,
@@ -164,6 +183,7 @@ const lines = [
   `| stream records received | ${streamRecords} |`,
 ];
 console.log(lines.join('\n'));
+clearTimeout(deadline);
 if (failures.length) {
   console.log(`\nload: FAILED: ${failures.join('; ')}`);
   process.exit(1);

@@ -31,6 +31,7 @@ export function call(base, method, path, body, { agent, localAddress } = {}) {
       });
     });
     r.on('error', (e) => resolve({ status: 0, error: e.code || e.message, ms: performance.now() - t0 }));
+    r.setTimeout(30000, () => r.destroy(new Error('no answer within 30 s')));
     r.end(data);
   });
 }
