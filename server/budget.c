@@ -91,17 +91,25 @@ static double mib(size_t bytes)
 	return (double)bytes / (1 << 20);
 }
 
+/* Add n to *pool if it stays within cap (or force); *before: the pool
+ * before. 1 if added. */
+static int reserve(size_t *pool, size_t cap, size_t n, int force,
+		   size_t *before)
+{
+	pthread_mutex_lock(&lock);
+	*before = *pool;
+	int room = force || (*pool <= cap && n <= cap - *pool);
+	if (room)
+		*pool += n;
+	pthread_mutex_unlock(&lock);
+	return room;
+}
+
 api_err srv_budget_take(size_t bytes, const char *what, int force,
 			api_problem *pb)
 {
-	pthread_mutex_lock(&lock);
-	size_t used = reserved;
-	int room = force || (used <= cfg->max_memory &&
-			     bytes <= cfg->max_memory - used);
-	if (room)
-		reserved += bytes;
-	pthread_mutex_unlock(&lock);
-	if (room)
+	size_t used;
+	if (reserve(&reserved, cfg->max_memory, bytes, force, &used))
 		return API_OK;
 	api_fail(pb, API_UNAVAILABLE, NULL,
 		 "%s needs %.1f MiB and %.1f MiB of the memory budget of "
@@ -166,17 +174,14 @@ api_err srv_budget_take_points(size_t n, const char *field, int force,
 		pb->max = (double)cap;
 		return api_budget(pb, "sweep-points", (double)cap, 0);
 	}
-	pthread_mutex_lock(&lock);
-	size_t queued = points;
-	int room = force || queued + n <= cap;
-	/* the wait: the points beyond the budget, at the pool's pace */
-	double wait = (double)(queued + n - (room ? queued + n : cap)) *
-		      point_seconds / (cfg->pool_threads > 0 ? cfg->pool_threads : 1);
-	if (room)
-		points += n;
-	pthread_mutex_unlock(&lock);
-	if (room)
+	size_t queued;
+	if (reserve(&points, cap, n, force, &queued))
 		return API_OK;
+	/* the wait: the points beyond the budget, at the pool's pace */
+	pthread_mutex_lock(&lock);
+	double wait = (double)(queued + n - cap) * point_seconds /
+		      (cfg->pool_threads > 0 ? cfg->pool_threads : 1);
+	pthread_mutex_unlock(&lock);
 	api_fail(pb, API_LIMIT, NULL,
 		 "%zu sweep points are queued or running and this sweep adds "
 		 "%zu: the budget is %zu (--max-queued-points); nothing was "
