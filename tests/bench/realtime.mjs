@@ -16,7 +16,10 @@ import { call, lagStream, quantile, procUsage, fmt } from './streamlag.mjs';
 const counts = process.argv.slice(2).map(Number).filter((n) => n > 0);
 const Ns = counts.length ? counts : [50, 100, 150, 200];
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-const rows = [];
+console.log('Command: `node tests/bench/realtime.mjs' + (counts.length ? ` ${counts.join(' ')}` : '') +
+  '` (czubak2016 defaults, pace 1, one NDJSON stream each, 10 s of wall time, 2 cores)\n');
+console.log('| sessions | at >= 0.95 of real time | slowest rtf | median rtf | stream lag p50 / p99, ms | daemon CPU, cores | holds (all real time, p99 < 50 ms) |');
+console.log('|---|---|---|---|---|---|---|');
 for (const N of Ns) {
   const d = await startDaemon(['--max-sessions', String(Math.max(64, N)),
     '--max-streams', String(Math.max(256, N + 16)), '--max-client-connections', String(N + 64)]);
@@ -37,14 +40,9 @@ for (const N of Ns) {
   const ok = rtf.filter((x) => x >= 0.95).length;
   const p99 = quantile(lags, 0.99);
   const holds = ok === N && p99 < 50;
-  rows.push(`| ${N} | ${ok} | ${fmt(quantile(rtf, 0), 2)} | ${fmt(quantile(rtf, 0.5), 2)} | ` +
+  console.log(`| ${N} | ${ok} | ${fmt(quantile(rtf, 0), 2)} | ${fmt(quantile(rtf, 0.5), 2)} | ` +
     `${fmt(quantile(lags, 0.5))} / ${fmt(p99)} | ${fmt(cpu / 10, 2)} | ${holds ? 'yes' : 'no'} |`);
   for (const id of ids) await call(d.base, 'DELETE', `/api/v1/sessions/${id}`, undefined, { agent });
   agent.destroy();
   await d.stop();
 }
-console.log('Command: `node tests/bench/realtime.mjs' + (counts.length ? ` ${counts.join(' ')}` : '') +
-  '` (czubak2016 defaults, pace 1, one NDJSON stream each, 10 s of wall time, 2 cores)\n');
-console.log('| sessions | at >= 0.95 of real time | slowest rtf | median rtf | stream lag p50 / p99, ms | daemon CPU, cores | holds (all real time, p99 < 50 ms) |');
-console.log('|---|---|---|---|---|---|---|');
-for (const r of rows) console.log(r);
