@@ -3,7 +3,7 @@
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
 # `make deps` installs what is missing, `make install` installs,
 # `make bench` writes the work-precision tables, `make fuzz` runs the
-# libFuzzer harnesses. V=1 shows the commands.
+# libFuzzer harnesses, `make load` runs a bounded load test. V=1 shows the commands.
 
 CC      ?= cc
 CFLAGS  ?= -O2 -g
@@ -59,7 +59,7 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
 
-.PHONY: all deps deps-build run cluster test check bench mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench load mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -204,6 +204,13 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 	@$(if $(Q),echo "  FUZZ    $@")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer $(INC_server) -o $@ \
 	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(LDLIBS)
+
+# A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
+# 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
+# prints a table and fails if the daemon crashed, went over its memory
+# budget or stopped answering another client.
+load: all
+	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
 
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
 mutate: all

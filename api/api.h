@@ -80,10 +80,13 @@
 	  "the simulation failed on them, or a PATCH changed nothing.")     \
 	X(LIMIT, 429, "limit-reached", "Limit reached",                       \
 	  "A limit of the daemon is reached (--max-sessions, --max-streams, kept experiments " \
-	  "or sweeps). Delete something or retry later (Retry-After).")     \
+	  "or sweeps, the connections of one client, the queued sweep points). `budget` and " \
+	  "`limit` name a budget that refused it. Delete something or retry later "         \
+	  "(Retry-After).")                                                   \
 	X(UNAVAILABLE, 503, "unavailable", "Service unavailable",             \
-	  "The daemon is shutting down, out of memory, or its worker did not take a control " \
-	  "within 5 s; nothing was changed. Retry later (Retry-After).")
+	  "The daemon is shutting down, its memory budget (--max-memory) has no room for this " \
+	  "now (`budget` and `limit` say so), or its worker did not take a control within 5 s; " \
+	  "nothing was changed. Retry later (Retry-After).")
 
 typedef enum {
 #define API_ERR_ENUM(name, status, slug, title, explanation) API_##name,
@@ -102,6 +105,9 @@ typedef struct api_problem {
 	int has_range;
 	double min, max;
 	char choices[96];
+	char budget[24];   /* the budget that refused it ("memory", ...), "" */
+	double limit;      /* its limit, in the budget's unit */
+	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
 } api_problem;
 
 /* HTTP status of an api_err (500 for an unknown code). */
@@ -116,8 +122,11 @@ api_err api_from_sim(int sim_err);
  * Returns code, so handlers can `return api_fail(...)`. */
 api_err api_fail(api_problem *pb, api_err code, const char *field,
 		 const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* Name the budget that refused a request (copied) and its limit, with the
+ * Retry-After seconds; returns pb->code. */
+api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);
 /* The RFC 9457 body for *pb (type, title, status, detail, instance and the
- * extensions field/min/max/choices). instance (borrowed) may be NULL.
+ * extensions field/min/max/choices/budget/limit). instance (borrowed) may be NULL.
  * Returns malloc'd text, NULL only when out of memory. */
 char *api_problem_json(const api_problem *pb, const char *instance);
 
@@ -242,6 +251,7 @@ enum {
 	API_C_PACE = 1 << 5,
 	API_C_UNTIL = 1 << 6,
 	API_C_MOTOR = 1 << 7,
+	API_C_CPU = 1 << 8,
 };
 typedef struct api_control {
 	unsigned set;
@@ -253,6 +263,8 @@ typedef struct api_control {
 	int motor_on;     /* drive switched on (motor or ideal drive) */
 	double pace;      /* API_PACE_MAX for "max" */
 	double until;     /* s, 0 = none */
+	double cpu_budget; /* CPU s granted from now (the server checks the
+			      upper bound, --max-cpu-seconds) */
 } api_control;
 
 /* Parse a PATCH body against the session's spec (ranges from the settings
@@ -281,6 +293,10 @@ typedef struct api_view {
 	int streams;           /* open stream clients */
 	int columns, layers;
 	char experiment[24];   /* running experiment id or "" */
+	double cpu_seconds;    /* worker CPU time used, s */
+	double cpu_limit;      /* CPU time at which it pauses, s */
+	const char *pause_reason; /* "client", "cpu-budget" or NULL */
+	int waiting_for_cpu;   /* pace "max" waiting for a CPU slot */
 } api_view;
 
 /* Session as JSON; with_spec adds the full settings. malloc'd text. */

@@ -180,6 +180,14 @@ static void add_valid_string(cJSON *o, const char *name, const char *text)
 	free(valid);
 }
 
+api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after)
+{
+	snprintf(pb->budget, sizeof pb->budget, "%s", budget);
+	pb->limit = limit;
+	pb->retry_after = retry_after;
+	return pb->code;
+}
+
 char *api_problem_json(const api_problem *pb, const char *instance)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -198,6 +206,10 @@ char *api_problem_json(const api_problem *pb, const char *instance)
 	if (pb->has_range) {
 		api_add_number(o, "min", pb->min);
 		api_add_number(o, "max", pb->max);
+	}
+	if (pb->budget[0]) {
+		cJSON_AddStringToObject(o, "budget", pb->budget);
+		api_add_number(o, "limit", pb->limit);
 	}
 	if (pb->choices[0]) {
 		cJSON *arr = cJSON_AddArrayToObject(o, "choices");

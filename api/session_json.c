@@ -16,7 +16,8 @@
 #include "json_int.h"
 
 const char *const api_members_control[] = {"beta", "beta_rate", "rotation", "omega_ss",
-					    "running", "motor_on", "pace", "until", NULL};
+					    "running", "motor_on", "pace", "until",
+					    "cpu_budget", NULL};
 
 
 /* A number member for a setting in its user unit (beta in deg), converted
@@ -62,7 +63,7 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 		e = api_fail(pb, API_INVALID, NULL,
 			     "no change given; expected any of beta, "
 			     "beta_rate, rotation, omega_ss, running, "
-			     "motor_on, pace, until");
+			     "motor_on, pace, until, cpu_budget");
 	api_value omega_ss = {0, 0};
 	if (e == API_OK)
 		e = parse_value(root, spec, "beta", API_C_BETA, &c->beta, c, pb);
@@ -102,6 +103,10 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 	    (e = api_parse_real(it, "until", 1e-6, 1e6, 1, &c->until, pb)) ==
 		    API_OK)
 		c->set |= API_C_UNTIL;
+	if (e == API_OK &&
+	    (it = cJSON_GetObjectItemCaseSensitive(root, "cpu_budget")) &&
+	    (e = api_parse_real(it, "cpu_budget", 1e-3, 1e9, 0, &c->cpu_budget, pb)) == API_OK)
+		c->set |= API_C_CPU;
 	cJSON_Delete(root);
 	return e;
 }
@@ -139,6 +144,8 @@ static cJSON *control_object(const api_control *c)
 		else
 			cJSON_AddNullToObject(o, "until");
 	}
+	if (c->set & API_C_CPU)
+		api_add_number(o, "cpu_budget", c->cpu_budget);
 	return o;
 }
 
@@ -231,6 +238,13 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	cJSON_AddNumberToObject(o, "layers", v->layers);
 	api_add_number(o, "samples", (double)v->samples);
 	cJSON_AddNumberToObject(o, "streams", v->streams);
+	api_add_number(o, "cpu_seconds", v->cpu_seconds);
+	api_add_number(o, "cpu_limit", v->cpu_limit);
+	if (v->pause_reason)
+		cJSON_AddStringToObject(o, "pause_reason", v->pause_reason);
+	else
+		cJSON_AddNullToObject(o, "pause_reason");
+	cJSON_AddBoolToObject(o, "waiting_for_cpu", v->waiting_for_cpu);
 	if (v->experiment[0])
 		cJSON_AddStringToObject(o, "experiment", v->experiment);
 	else

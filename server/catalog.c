@@ -9,6 +9,7 @@
 
 #include <pthread.h>
 
+#include "budget.h"
 #include "catalog.h"
 #include "metrics.h"
 #include "pool.h"
@@ -78,10 +79,19 @@ enum MHD_Result srv_h_health(srv_req *r)
 
 enum MHD_Result srv_h_metrics(srv_req *r)
 {
+	int busy, waiting;
+	srv_cpu_counts(&busy, &waiting);
 	srv_gauges g = {
 		.sessions = (double)srv_session_count(),
 		.steps_per_s = srv_sessions_steps_per_s(),
 		.pool_queued = (double)srv_pool_queued(),
+		.memory_reserved = (double)srv_budget_reserved(),
+		.memory_budget = (double)srv_budget_memory(),
+		.cpu_busy = busy,
+		.cpu_waiting = waiting,
+		.sweep_points = (double)srv_budget_points(),
+		.client_refused = (double)srv_budget_client_refused(),
+		.connections_dropped = (double)srv_budget_connections_dropped(),
 	};
 	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
 			 srv_metrics_text(&g), NULL, NULL);

@@ -18,8 +18,10 @@
 #   CONVSIMD [build/convsimd], HAPROXY [/usr/sbin/haproxy]
 #   DAEMON_FLAGS        more flags for every replica
 #   TOKEN_FILE          adds --token-file FILE to every replica
-#   SERVER_NAME [PROXY_HOST:PORT]  given to replicas as --server-name when the
-#                       daemon has that flag (the Host clients send the proxy)
+#   SERVER_NAME [PROXY_HOST:PORT]  given to replicas as --server-name (the Host
+#                       clients send the proxy)
+#   CLIENT_CONNECTIONS [1000]  the replicas' --max-client-connections: behind
+#                       the proxy every client's address is the proxy's
 #   HEARTBEAT [15]      whole seconds: the replicas' --heartbeat; the proxy's idle timeouts
 #                       are four of them, so streams stay open
 #   REQUEST_TIMEOUT [30] s the proxy waits for a replica's answer at least (a
@@ -37,6 +39,7 @@ HAPROXY=${HAPROXY:-/usr/sbin/haproxy}
 HEARTBEAT=${HEARTBEAT:-15}
 REQUEST_TIMEOUT=${REQUEST_TIMEOUT:-30}
 SERVER_NAME=${SERVER_NAME:-$PROXY_HOST:$PROXY_PORT}
+CLIENT_CONNECTIONS=${CLIENT_CONNECTIONS:-1000}
 if [ -z "${PORTS:-}" ]; then
 	PORTS=$(seq -s ' ' $((PROXY_PORT + 1)) $((PROXY_PORT + ${#NODE_NAMES[@]})))
 fi
@@ -128,9 +131,9 @@ replica() {
 	[ -n "$addr" ] || die "no replica named $name in: $REPLICAS"
 	mkdir -p "$DIR/$name"
 	[ -z "${TOKEN_FILE:-}" ] || extra+=(--token-file "$TOKEN_FILE")
-	case $("$CONVSIMD" --help) in
-	*--server-name*) extra+=(--server-name "$SERVER_NAME") ;;
-	esac
+	# Host names the proxy; behind it every client's address is the
+	# proxy's, so the per-client connection cap is the whole cluster's
+	extra+=(--server-name "$SERVER_NAME" --max-client-connections "$CLIENT_CONNECTIONS")
 	# shellcheck disable=SC2086 # DAEMON_FLAGS is a list of flags
 	exec "$CONVSIMD" --node-id "$name" --listen "${addr%:*}" --port "${addr##*:}" \
 		--data-dir "$DIR/$name" --heartbeat "$HEARTBEAT" --peers "${peers%,}" \

@@ -33,6 +33,13 @@ static const srv_config defaults = {
 	.max_fits = 16,
 	.checkpoint_interval = 10.0,
 	.idle_timeout = 0.0,
+	.max_memory = 0,       /* set from the machine: machine_defaults() */
+	.max_cpu_seconds = 1800.0,
+	.max_busy = 0,         /* set from the machine */
+	.max_client_connections = 64,
+	.max_connections = 1024,
+	.connection_timeout = 30.0,
+	.max_queued_points = 4096,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL, OPT_FLAG,
@@ -68,11 +75,32 @@ static const opt opts[] = {
 	{"server-name", OPT_LIST, 0, 0, F(server_names)},
 	{"node-id", OPT_STRING, 0, 0, F(node_id)},
 	{"peers", OPT_STRING, 0, 0, F(peers)},
+	{"max-memory", OPT_SIZE, 1L << 20, 1L << 50, F(max_memory)},
+	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds)},
+	{"max-busy", OPT_INT, 1, 1024, F(max_busy)},
+	{"max-client-connections", OPT_INT, 1, 100000,
+	 F(max_client_connections)},
+	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
+	{"connection-timeout", OPT_SECONDS, 1000, 3600000,
+	 F(connection_timeout)},
+	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
 
-static void usage(FILE *f)
+/* The budgets that depend on the machine: 3/4 of its memory, one pace
+ * "max" session per core. */
+static void machine_defaults(srv_config *cfg)
+{
+	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+	long cores = sysconf(_SC_NPROCESSORS_ONLN);
+	cfg->max_memory = pages > 0 && page > 0
+				  ? (size_t)pages / 4 * 3 * (size_t)page
+				  : (size_t)4 << 30;
+	cfg->max_busy = cores > 0 ? (int)cores : 1;
+}
+
+static void usage(FILE *f, const srv_config *cfg)
 {
 	fprintf(f,
 		"usage: convsimd [options]\n"
@@ -108,14 +136,45 @@ static void usage(FILE *f)
 		"  --node-id NAME       this replica's name (1-10 of a-z 0-9 -): "
 		"every id it makes starts NAME-\n"
 		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
-		"gather theirs\n");
+		"gather theirs\n"
+		"budgets (429/503 with Retry-After when spent; see README "
+		"\"Budgets and load\"):\n"
+		"  --max-memory BYTES   estimated memory of all sessions and "
+		"streams; K, M, G suffixes\n"
+		"                       (default %.1f GiB: 3/4 of this "
+		"machine's memory)\n"
+		"  --max-cpu-seconds S  CPU seconds a session may use before "
+		"it pauses, per grant\n"
+		"                       (default %g)\n"
+		"  --max-busy N         pace \"max\" sessions stepping at once, "
+		"in turns (default %d: the cores)\n"
+		"  --max-client-connections N  open connections per client "
+		"address (default %d)\n"
+		"  --max-connections N  open connections, all clients "
+		"(default %d)\n"
+		"  --connection-timeout S  close a connection silent for S "
+		"seconds; must exceed --heartbeat\n"
+		"                       (default %g)\n"
+		"  --max-queued-points N  sweep points queued or running, "
+		"all sweeps (default %d)\n",
+		(double)cfg->max_memory / (double)(1 << 30),
+		cfg->max_cpu_seconds, cfg->max_busy,
+		cfg->max_client_connections, cfg->max_connections,
+		cfg->connection_timeout, cfg->max_queued_points);
 }
 
+/* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */
 static int parse_int(const char *arg, const char *name, long lo, long hi,
-		     long *out)
+		     int suffix, long *out)
 {
 	char *end;
 	long v = strtol(arg, &end, 10);
+	const char *units = "KMGT", *u = *end ? strchr(units, *end) : NULL;
+	if (suffix && u && end[1] == '\0' && v >= 0 &&
+	    v <= (hi >> (10 * (u - units + 1)))) {
+		v <<= 10 * (u - units + 1);
+		end++;
+	}
 	if (*end || end == arg || v < lo || v > hi) {
 		fprintf(stderr, "convsimd: %s must be an integer in [%ld, %ld]\n",
 			name, lo, hi);
@@ -147,7 +206,7 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	}
 	case OPT_INT:
 	case OPT_SIZE:
-		if (parse_int(arg, flag, o->lo, o->hi, &v))
+		if (parse_int(arg, flag, o->lo, o->hi, o->kind == OPT_SIZE, &v))
 			return -1;
 		if (o->kind == OPT_INT)
 			*(int *)(void *)at = (int)v;
@@ -228,14 +287,15 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 	longopts[NOPTS] = (struct option){"help", no_argument, 0, 'h'};
 	longopts[NOPTS + 1] = (struct option){0, 0, 0, 0};
 	*cfg = defaults;
+	machine_defaults(cfg);
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		if (c == 'h') {
-			usage(stdout);
+			usage(stdout, cfg);
 			return 1;
 		}
 		if (c < 0 || (size_t)c >= NOPTS) {
-			usage(stderr);
+			usage(stderr, cfg);
 			return -1;
 		}
 		if (set_option(cfg, &opts[c], optarg))
@@ -250,6 +310,13 @@ int srv_config_parse(srv_config *cfg, int argc, char **argv)
 		fprintf(stderr, "convsimd: --node-id must be 1 to %d characters "
 				"of a-z, 0-9 and '-', starting with a letter "
 				"or digit\n", SRV_NODE_ID_MAX);
+		return -1;
+	}
+	if (cfg->connection_timeout <= cfg->heartbeat) {
+		fprintf(stderr, "convsimd: --connection-timeout (%g s) must "
+				"exceed --heartbeat (%g s), or idle streams "
+				"would be cut\n", cfg->connection_timeout,
+			cfg->heartbeat);
 		return -1;
 	}
 	pick_web_root(cfg, argv[0]);

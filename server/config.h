@@ -40,6 +40,14 @@ typedef struct srv_config {
 	srv_list server_names; /* --server-name: more Host names */
 	const char *node_id;   /* --node-id: ids start "NODE-"; NULL: none */
 	const char *peers;     /* --peers: comma list of http://HOST:PORT */
+	/* budgets (budget.c) */
+	size_t max_memory;     /* bytes: sessions' and streams' estimated need */
+	double max_cpu_seconds; /* CPU s a session may use per grant */
+	int max_busy;          /* pace "max" sessions stepping at once */
+	int max_client_connections; /* open connections per client address */
+	int max_connections;   /* open connections, all clients */
+	double connection_timeout; /* s a connection may stay silent */
+	int max_queued_points; /* sweep points queued or running, all sweeps */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

@@ -13,11 +13,13 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "budget.h"
 #include "catalog.h"
 #include "config.h"
 #include "experiment_http.h"
@@ -46,8 +48,9 @@ typedef struct listen_addr {
 static int resolve_listen(const srv_config *cfg, listen_addr *la)
 {
 	memset(la, 0, sizeof *la);
+	/* poll(), not select(): descriptors beyond FD_SETSIZE (1024) work */
 	la->flags = MHD_USE_THREAD_PER_CONNECTION |
-		    MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_ITC |
+		    MHD_USE_POLL_INTERNAL_THREAD | MHD_USE_ITC |
 		    MHD_USE_ERROR_LOG;
 	if (inet_pton(AF_INET, cfg->listen, &la->a4.sin_addr) == 1) {
 		la->a4.sin_family = AF_INET;
@@ -64,6 +67,46 @@ static int resolve_listen(const srv_config *cfg, listen_addr *la)
 		return -1;
 	}
 	return 0;
+}
+
+/* Raise the soft limit of open files to what the connection budget needs
+ * (each connection a socket, plus the data directory's files, the
+ * listening socket and libmicrohttpd's pipe); the hard limit caps it. */
+static void raise_nofile(const srv_config *cfg)
+{
+	struct rlimit rl;
+	rlim_t need = (rlim_t)cfg->max_connections + SRV_CLIENT_GRACE + 256;
+	if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur >= need)
+		return;
+	rlim_t was = rl.rlim_cur;
+	rl.rlim_cur = rl.rlim_max == RLIM_INFINITY || rl.rlim_max >= need
+			      ? need : rl.rlim_max;
+	if (setrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur < need)
+		srv_log(SRV_LOG_WARN, "open files limited to %llu (hard "
+				      "limit); --max-connections %d needs %llu",
+			(unsigned long long)rl.rlim_cur, cfg->max_connections,
+			(unsigned long long)need);
+	else
+		srv_log(SRV_LOG_INFO, "open files: soft limit raised from "
+				      "%llu to %llu", (unsigned long long)was,
+			(unsigned long long)need);
+}
+
+/* Start libmicrohttpd with the connection budgets. */
+static struct MHD_Daemon *start_http(const srv_config *cfg,
+				     const listen_addr *la)
+{
+	return MHD_start_daemon(
+		la->flags, (uint16_t)cfg->port, NULL, NULL, srv_dispatch, NULL,
+		MHD_OPTION_EXTERNAL_LOGGER, srv_budget_mhd_log, NULL,
+		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
+		MHD_OPTION_NOTIFY_CONNECTION, srv_budget_connection, NULL,
+		MHD_OPTION_SOCK_ADDR, la->addr,
+		MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->max_connections,
+		MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE),
+		MHD_OPTION_CONNECTION_TIMEOUT,
+		(unsigned)(cfg->connection_timeout + 0.5), MHD_OPTION_END);
 }
 
 /* Stop accepting, let streams end, join every thread, free everything. */
@@ -127,6 +170,8 @@ int main(int argc, char **argv)
 	    srv_peers_init(&cfg))
 		return 2;
 
+	raise_nofile(&cfg);
+	srv_budget_init(&cfg);
 	srv_catalog_init(&cfg);
 	srv_sessions_init(&cfg);
 	srv_experiments_init(&cfg);
@@ -142,12 +187,7 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	restore_state();
-	struct MHD_Daemon *d = MHD_start_daemon(
-		la.flags, (uint16_t)cfg.port, NULL, NULL, srv_dispatch, NULL,
-		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
-		MHD_OPTION_SOCK_ADDR, la.addr, MHD_OPTION_CONNECTION_LIMIT,
-		(unsigned)(cfg.max_streams + 256),
-		MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)120, MHD_OPTION_END);
+	struct MHD_Daemon *d = start_http(&cfg, &la);
 	if (!d) {
 		fprintf(stderr, "convsimd: cannot listen on %s port %d\n",
 			cfg.listen, cfg.port);
@@ -163,8 +203,14 @@ int main(int argc, char **argv)
 	else
 		printf("listening on http://%s:%d\n", cfg.listen, port);
 	fflush(stdout);
-	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max",
-		cfg.web_root, cfg.max_sessions, cfg.max_streams);
+	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
+			      "budgets: %.1f GiB memory, %g CPU s per session, "
+			      "%d pace-max at once, %d connections per client "
+			      "(%d in all), %d queued sweep points",
+		cfg.web_root, cfg.max_sessions, cfg.max_streams,
+		(double)cfg.max_memory / (1 << 30), cfg.max_cpu_seconds,
+		cfg.max_busy, cfg.max_client_connections, cfg.max_connections,
+		cfg.max_queued_points);
 
 	/* once a second: remove the sessions whose experiment ended and
 	 * those idle beyond --idle-timeout */

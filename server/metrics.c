@@ -72,6 +72,29 @@ char *srv_metrics_text(const srv_gauges *g)
 	metric(f, "convsim_pool_queued", "gauge",
 	       "Sweep jobs waiting for a pool thread.",
 	       g->pool_queued);
+	const struct {
+		const char *name, *type, *help;
+		double value;
+	} budgets[] = {
+		{"convsim_memory_reserved_bytes", "gauge", "Estimated memory of live "
+		 "sessions and streams (the memory budget's use).", g->memory_reserved},
+		{"convsim_memory_budget_bytes", "gauge", "The memory budget "
+		 "(--max-memory).", g->memory_budget},
+		{"convsim_cpu_slots_busy", "gauge", "Pace max sessions stepping now "
+		 "(at most --max-busy).", g->cpu_busy},
+		{"convsim_cpu_slots_waiting", "gauge", "Pace max sessions waiting "
+		 "for their turn.", g->cpu_waiting},
+		{"convsim_sweep_points_queued", "gauge", "Sweep points queued or "
+		 "running (at most --max-queued-points).", g->sweep_points},
+		{"convsim_client_connections_refused_total", "counter", "Connections "
+		 "answered 429 beyond --max-client-connections.", g->client_refused},
+		{"convsim_connections_dropped_total", "counter", "Connections closed "
+		 "at accept: beyond a client's budget and its grace, or beyond "
+		 "--max-connections.", g->connections_dropped},
+	};
+	for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
+		metric(f, budgets[i].name, budgets[i].type, budgets[i].help,
+		       budgets[i].value);
 	fprintf(f, "# HELP convsim_http_requests_total HTTP responses by "
 		   "status.\n# TYPE convsim_http_requests_total counter\n");
 	for (int s = 100; s < 600; s++) {

@@ -27,6 +27,12 @@ typedef struct srv_gauges {
 	double sessions;
 	double steps_per_s;   /* summed over running sessions */
 	double pool_queued;
+	/* budgets (budget.c) */
+	double memory_reserved, memory_budget; /* bytes */
+	double cpu_busy, cpu_waiting;  /* pace "max" slots in use, waiting */
+	double sweep_points;           /* queued or running */
+	double client_refused;         /* connections answered 429 */
+	double connections_dropped;    /* closed by libmicrohttpd at accept */
 } srv_gauges;
 
 /* Count one response with this HTTP status. */

@@ -123,8 +123,14 @@ enum MHD_Result srv_reply_problem_with(srv_req *r, const api_problem *pb,
 				"no-store");
 	if (name && value)
 		MHD_add_response_header(resp, name, value);
-	if (status == 429 || status == 503)
-		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+	if (status == 429 || status == 503) {
+		char after[24];
+		snprintf(after, sizeof after, "%d",
+			 pb->retry_after > 0 ? pb->retry_after : 1);
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, after);
+	}
+	if (strcmp(pb->budget, "connections") == 0) /* one too many: close it */
+		MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 	return srv_queue(r, status, resp);
 }
 

@@ -19,6 +19,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "budget.h"
 #include "catalog.h"
 #include "experiment_http.h"
 #include "gate.h"
@@ -207,6 +208,9 @@ static enum MHD_Result route_request(srv_req *r)
 static enum MHD_Result first_look(srv_req *r)
 {
 	enum MHD_Result result;
+	api_problem pb;
+	if (srv_budget_client_over(r->conn, &pb)) /* before anything else */
+		return srv_reply_problem(r, &pb, NULL);
 	if (!srv_gate_check(r, &result))
 		return result;
 	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);

@@ -32,44 +32,6 @@ void srv_sessions_init(const srv_config *config)
 	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
 }
 
-int srv_sample_alloc(api_sample *rec, int columns, int layers)
-{
-	size_t n = (size_t)columns + 2 * (size_t)columns * (size_t)layers;
-	memset(rec, 0, sizeof *rec);
-	rec->column_disp = calloc(n ? n : 1, sizeof(double));
-	if (!rec->column_disp)
-		return -1;
-	rec->columns = columns;
-	rec->layers = layers;
-	rec->xi = rec->column_disp + columns;
-	rec->eta = rec->xi + (size_t)columns * (size_t)layers;
-	return 0;
-}
-
-void srv_sample_free(api_sample *rec)
-{
-	if (!rec)
-		return;
-	free(rec->column_disp);
-	rec->column_disp = rec->xi = rec->eta = NULL;
-}
-
-static void copy_record(api_sample *dst, const api_sample *src)
-{
-	size_t n = (size_t)src->columns +
-		   2 * (size_t)src->columns * (size_t)src->layers;
-	dst->index = src->index;
-	dst->kind = src->kind;
-	dst->st = src->st;
-	dst->columns = src->columns;
-	dst->layers = src->layers;
-	if (src->kind == API_REC_SAMPLE && n)
-		memcpy(dst->column_disp, src->column_disp, n * sizeof(double));
-	memcpy(dst->event_type, src->event_type, sizeof dst->event_type);
-	if (src->kind == API_REC_EVENT)
-		memcpy(dst->event, src->event, sizeof dst->event);
-}
-
 /* ---- lifetime ---------------------------------------------------------- */
 
 static void session_free(srv_session *s)
@@ -77,6 +39,7 @@ static void session_free(srv_session *s)
 	if (!s)
 		return;
 	sim_free(s->sim);
+	srv_budget_give(s->mem_reserved);
 	srv_sample_free(&s->scratch);
 	free(s->ring);
 	free(s->ring_store);
@@ -149,6 +112,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->pace = spec->pace;
 	s->until = spec->until;
 	s->state = SRV_RUNNING;
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
 	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
 			 sizeof msg);
 	if (!s->sim) {
@@ -188,6 +153,14 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 			 "delete one first", cfg->max_sessions);
 		return NULL;
 	}
+	int feed = spec->scene.feed && spec->scene.columns > 0 &&
+		   spec->scene.layers > 0;
+	if (srv_budget_take_session(feed ? spec->scene.columns : 0,
+				    feed ? spec->scene.layers : 0,
+				    &s->mem_reserved, pb) != API_OK) {
+		s->mem_reserved = 0;
+		goto fail;
+	}
 	if (session_init(s, spec, pb))
 		goto fail;
 	s->exp = exp;
@@ -226,6 +199,8 @@ srv_session *srv_session_get(const char *id)
 int srv_session_adopt(srv_session *s)
 {
 	s->last_access = s->ckpt_wall = srv_now();
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
 	if (s->damaged) {
 		s->state = SRV_FAILED;
 	} else {
@@ -240,6 +215,9 @@ int srv_session_adopt(srv_session *s)
 				      "reached or id taken", s->entry.id);
 		goto fail;
 	}
+	/* what it had before the restart: reserved even beyond the budget */
+	s->mem_reserved = srv_budget_session_need(s->columns, s->layers);
+	srv_budget_take(s->mem_reserved, "a restored session", 1, NULL);
 	if (alloc_buffers(s)) {
 		srv_registry_cancel(&sessions, &s->entry);
 		goto fail;
@@ -382,6 +360,12 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->rtf = s->rtf;
 	v->samples = s->head;
 	v->streams = s->streams;
+	v->cpu_seconds = s->cpu_seconds;
+	v->cpu_limit = s->cpu_limit;
+	v->pause_reason = s->state != SRV_PAUSED ? NULL
+			  : s->cpu_paused      ? "cpu-budget"
+					       : "client";
+	v->waiting_for_cpu = s->waiting_for_cpu;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));
@@ -434,10 +418,18 @@ double srv_sessions_steps_per_s(void)
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
-	srv_cmd cmd = {.c = *c};
+	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds};
 	pthread_mutex_lock(&s->lock);
 	api_err e = API_OK;
-	if (s->stop)
+	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
+		e = api_fail(pb, API_RANGE, "cpu_budget",
+			     "cpu_budget must be CPU seconds in (0, %g] "
+			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
+			     c->cpu_budget);
+		pb->has_range = 1;
+		pb->min = 0;
+		pb->max = cfg->max_cpu_seconds;
+	} else if (s->stop)
 		e = api_fail(pb, API_NOTFOUND, NULL,
 			     "the session is being deleted");
 	else if (s->state == SRV_FAILED)
@@ -500,79 +492,4 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	}
 	pthread_mutex_unlock(&s->lock);
 	return rc;
-}
-
-/* ---- snapshot readers ----------------------------------------------------- */
-
-/* The ring's bounds and the run state (lock held). */
-static void look(srv_session *s, srv_ring_read *rd)
-{
-	rd->head = s->head;
-	rd->oldest = s->head > s->ring_cap ? s->head - s->ring_cap : 0;
-	rd->state = s->state;
-	rd->removed = s->stop;
-	rd->t = s->st.t;
-}
-
-srv_ring_read srv_session_ring(srv_session *s)
-{
-	srv_ring_read rd;
-	pthread_mutex_lock(&s->lock);
-	look(s, &rd);
-	pthread_mutex_unlock(&s->lock);
-	return rd;
-}
-
-void srv_session_read(srv_session *s, uint64_t cursor, api_sample *dst,
-		      srv_ring_read *rd)
-{
-	pthread_mutex_lock(&s->lock);
-	look(s, rd);
-	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
-	if (idx < rd->head)
-		copy_record(dst, &s->ring[idx % s->ring_cap]);
-	pthread_mutex_unlock(&s->lock);
-}
-
-void srv_session_wait(srv_session *s, const srv_ring_read *rd,
-		      double seconds)
-{
-	pthread_mutex_lock(&s->lock);
-	if (s->head == rd->head && s->state == rd->state && !s->stop) {
-		struct timespec ts = srv_deadline(seconds);
-		pthread_cond_timedwait(&s->data, &s->lock, &ts);
-	}
-	pthread_mutex_unlock(&s->lock);
-}
-
-void srv_session_stream_count(srv_session *s, int delta)
-{
-	pthread_mutex_lock(&s->lock);
-	s->streams += delta;
-	pthread_mutex_unlock(&s->lock);
-}
-
-void srv_session_feed_size(const srv_session *s, int *columns, int *layers)
-{
-	*columns = s->columns;
-	*layers = s->layers;
-}
-
-size_t srv_session_history(srv_session *s, double from, double to,
-			   double **rows, double *stride)
-{
-	pthread_mutex_lock(&s->lock);
-	size_t width = API_HISTORY_WIDTH(s->columns);
-	size_t first = 0, last = s->hist_n;
-	while (first < s->hist_n && s->hist[first * width] < from)
-		first++;
-	while (last > first && s->hist[(last - 1) * width] > to)
-		last--;
-	size_t n = last - first;
-	*rows = malloc((n ? n : 1) * width * sizeof(double));
-	if (*rows && n)
-		memcpy(*rows, s->hist + first * width, n * width * sizeof(double));
-	*stride = s->hist_stride;
-	pthread_mutex_unlock(&s->lock);
-	return *rows ? n : 0;
 }

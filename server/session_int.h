@@ -8,6 +8,7 @@
 #include <math.h>
 #include <pthread.h>
 
+#include "budget.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"
@@ -57,6 +58,13 @@ struct srv_session {
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
+	/* budgets (budget.c) */
+	size_t mem_reserved;      /* bytes of the memory budget it holds */
+	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
+	int waiting_for_cpu;      /* its turn has not come */
+	double cpu_seconds;       /* the worker's CPU time, s */
+	double cpu_limit;         /* pauses when cpu_seconds reaches it */
+	int cpu_paused;           /* paused because cpu_limit was reached */
 };
 
 /* Slot i of the ring with its arrays pointed into ring_store (set on
@@ -73,6 +81,20 @@ static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
 	return r;
 }
+
+/* ---- ring.c: the worker's writers (session lock held) ----------------- */
+
+/* Push an event record: type ("control", "finished", ...) and its JSON. */
+void srv_ring_event(srv_session *s, const char *type, const char *json);
+/* Push an event {"t": now, detail...}; detail (may be NULL) is more JSON
+ * members. */
+void srv_ring_event_at(srv_session *s, const char *type, const char *detail);
+/* Push a sample of the published status and the scratch feed arrays, and
+ * a trajectory row when one is due. */
+void srv_ring_sample(srv_session *s);
+/* Copy the feed arrays out of the instance into the scratch record
+ * (worker; no lock needed). */
+void srv_ring_gather(srv_session *s);
 
 /* ---- session_store.c: the session's files (store.h) ------------------ */
 

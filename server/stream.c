@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "metrics.h"
 #include "session.h"
 #include "stream.h"
@@ -49,6 +50,7 @@ typedef struct stream {
 	double last_write;
 	double heartbeat;  /* s */
 	int ended;
+	size_t mem_reserved; /* bytes of the memory budget */
 } stream;
 
 static void end_stream(stream *k, const char *reason)
@@ -152,6 +154,7 @@ static void stream_free(void *cls)
 	srv_session_stream_count(k->s, -1);
 	atomic_fetch_sub(&srv_stats.stream_clients, 1);
 	srv_session_put(k->s);
+	srv_budget_give(k->mem_reserved);
 	srv_sample_free(&k->rec);
 	free(k->out);
 	free(k);
@@ -204,10 +207,18 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				"%d stream clients are connected, the limit "
 				"(--max-streams)", cfg->max_streams);
 	}
-	srv_session_stream_count(k->s, 1);
-	atomic_fetch_add(&srv_stats.streams_opened, 1);
 	int columns, layers;
 	srv_session_feed_size(k->s, &columns, &layers);
+	size_t need = srv_budget_stream_need(columns, layers);
+	if (srv_budget_take(need, "this stream", 0, &pb) != API_OK) {
+		atomic_fetch_sub(&srv_stats.stream_clients, 1);
+		srv_session_put(k->s);
+		free(k);
+		return srv_reply_problem(r, &pb, NULL);
+	}
+	k->mem_reserved = need;
+	srv_session_stream_count(k->s, 1);
+	atomic_fetch_add(&srv_stats.streams_opened, 1);
 	k->rec_max = api_record_max(columns, layers);
 	k->out_cap = 4 * k->rec_max + 65536;
 	k->out = malloc(k->out_cap);

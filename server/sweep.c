@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "metrics.h"
 #include "peers.h"
 #include "pool.h"
@@ -177,6 +178,7 @@ static void run_point(void *arg)
 		sw->running++;
 	}
 	pthread_mutex_unlock(&sw->lock);
+	double started = srv_now();
 	if (!skip) {
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
@@ -205,6 +207,7 @@ static void run_point(void *arg)
 			save_results(sw);
 		pthread_mutex_unlock(&sw->lock);
 	}
+	srv_budget_point_done(skip ? 0 : srv_now() - started);
 	srv_registry_put(&sweeps, &sw->entry);
 }
 
@@ -266,8 +269,10 @@ size_t srv_sweeps_restore(void)
 					job->sw = sw;
 					job->i = k;
 					srv_registry_hold(&sweeps, &sw->entry);
+					srv_budget_take_points(1, NULL, 1, NULL);
 					if (srv_pool_submit(run_point, job) != 0) {
 						free(job);
+						srv_budget_give_points(1);
 						refs++;
 					}
 				}
@@ -366,7 +371,12 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 	srv_sweep *sw = sweep_new(r, &pb);
 	if (!sw)
 		return srv_reply_problem(r, &pb, NULL);
+	if (srv_budget_take_points(sw->total, "beta", 0, &pb) != API_OK) {
+		sweep_free(sw);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	if (srv_registry_reserve(&sweeps, &sw->entry, evictable)) {
+		srv_budget_give_points(sw->total);
 		sweep_free(sw);
 		return srv_fail(r, API_LIMIT, NULL,
 				"%d sweeps are running or kept; delete one",
@@ -385,6 +395,7 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 	pthread_mutex_unlock(&sw->lock);
 	for (size_t i = 0; i < unused; i++)
 		srv_registry_put(&sweeps, &sw->entry);
+	srv_budget_give_points(unused);
 	res = srv_reply_created(r, 202, text, "/api/v1/sweeps", v.id);
 	srv_registry_put(&sweeps, &sw->entry);
 	return res;

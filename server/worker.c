@@ -16,6 +16,9 @@
  *               (session_store.c); no file is touched here
  *   until       a running session that reached "until" finishes
  *   idle        a session that is not running sleeps until woken
+ *   turn        a pace "max" session steps only while it holds one of the
+ *               --max-busy CPU slots (budget.c), giving it up after each
+ *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
  *               after a stall; pace "max" runs flat out up to "until")
  *   step        sim_advance by one sample interval (1/sample_rate simulated
@@ -27,6 +30,9 @@
  *   job step    the experiment records the step and, at a segment boundary,
  *               hands over the next segment's command
  *   failure     a core error fails the session and aborts its experiment
+ *   cpu         the worker's CPU time is read (CLOCK_THREAD_CPUTIME_ID: the
+ *               worker steps this session only); a session that spent its
+ *               grant (cpu_limit) pauses with pause_reason "cpu-budget"
  *   meter       achieved steps/s and real-time factor over half-second
  *               windows
  */
@@ -82,93 +88,6 @@ int srv_worker_unqueue(srv_session *s, srv_cmd *cmd)
 	return 1;
 }
 
-/* ---- records ------------------------------------------------------------------ */
-
-static api_sample *push_slot(srv_session *s)
-{
-	api_sample *slot = srv_ring_slot(s, s->head % s->ring_cap);
-	slot->index = s->head++;
-	return slot;
-}
-
-static void push_event(srv_session *s, const char *type, const char *json)
-{
-	api_sample *slot = push_slot(s);
-	slot->kind = API_REC_EVENT;
-	slot->st = s->st;
-	snprintf(slot->event_type, sizeof slot->event_type, "%s", type);
-	snprintf(slot->event, sizeof slot->event, "%s", json);
-}
-
-static void push_event_reason(srv_session *s, const char *type,
-			      const char *detail)
-{
-	char json[API_EVENT_MAX], t[40];
-	api_fmt_double(t, sizeof t, s->st.t);
-	snprintf(json, sizeof json, "{\"t\":%s%s%s}", t, detail ? "," : "",
-		 detail ? detail : "");
-	push_event(s, type, json);
-}
-
-/* 1 if t lies on the grid of multiples of step (to rounding). */
-static int on_grid(double t, double step)
-{
-	double m = t / step;
-	return fabs(m - floor(m + 0.5)) < 1e-6;
-}
-
-/* A trajectory row at every multiple of the stride, exactly: rows are
- * taken at sample times on that grid (the stride is a whole number of
- * sample intervals), so the rows lie `stride` apart as reported. */
-static void record_history(srv_session *s)
-{
-	if (!s->hist_cap || s->st.t < s->hist_next - 1e-9 * s->hist_stride ||
-	    !on_grid(s->st.t, s->hist_stride))
-		return;
-	size_t width = API_HISTORY_WIDTH(s->columns);
-	if (s->hist_n == s->hist_cap) {
-		/* full: keep the rows on the doubled grid, double the stride */
-		size_t k = 0;
-		for (size_t i = 0; i < s->hist_n; i++)
-			if (on_grid(s->hist[i * width], 2 * s->hist_stride))
-				memmove(s->hist + k++ * width, s->hist + i * width,
-					width * sizeof(double));
-		s->hist_n = k;
-		s->hist_stride *= 2;
-		if (!on_grid(s->st.t, s->hist_stride)) {
-			s->hist_next = (floor(s->st.t / s->hist_stride + 1e-6) + 1) * s->hist_stride;
-			return;
-		}
-	}
-	api_history_row(&s->st, s->scratch.column_disp, s->columns,
-			s->hist + s->hist_n * width);
-	s->hist_n++;
-	s->hist_next = (floor(s->st.t / s->hist_stride + 0.5) + 1) * s->hist_stride;
-}
-
-static void record_sample(srv_session *s)
-{
-	api_sample *slot = push_slot(s);
-	slot->kind = API_REC_SAMPLE;
-	slot->st = s->st;
-	slot->event_type[0] = '\0';
-	size_t n = (size_t)s->columns +
-		   2 * (size_t)s->columns * (size_t)s->layers;
-	if (n)
-		memcpy(slot->column_disp, s->scratch.column_disp,
-		       n * sizeof(double));
-	record_history(s);
-}
-
-/* Copy the feed arrays out of the instance (worker, no lock needed). */
-static void gather_feed(srv_session *s)
-{
-	if (!s->columns)
-		return;
-	sim_column_displacement(s->sim, s->scratch.column_disp);
-	sim_feed_state(s->sim, s->scratch.xi, s->scratch.eta);
-}
-
 /* ---- the attached experiment ---------------------------------------------- */
 
 /* Queue the experiment's command, if it handed one over (lock held). */
@@ -217,6 +136,23 @@ static void extend_until(srv_session *s, double t_end)
 		s->state = SRV_RUNNING;
 }
 
+/* The budget part of a control: a CPU grant from now, a resume of a
+ * session its CPU budget paused (lock held). */
+static void apply_budget(srv_session *s, const srv_cmd *cmd)
+{
+	const api_control *c = &cmd->c;
+	if (c->set & API_C_CPU)
+		s->cpu_limit = s->cpu_seconds + c->cpu_budget;
+	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
+		 cmd->cpu_grant > 0)
+		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
+	if (((c->set & API_C_CPU) || ((c->set & API_C_RUNNING) && c->running)) &&
+	    s->cpu_paused && s->state == SRV_PAUSED)
+		s->state = SRV_RUNNING;
+	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
+		s->cpu_paused = 0;
+}
+
 /* Apply queued controls in order and acknowledge each (lock held).
  * Returns 1 if pacing must restart. */
 static int apply_commands(srv_session *s)
@@ -263,12 +199,17 @@ static int apply_commands(srv_session *s)
 				s->state = SRV_RUNNING;
 			reanchor = 1;
 		}
+		if (rc == SIM_OK) {
+			int was = s->state;
+			apply_budget(s, cmd);
+			reanchor |= was != s->state;
+		}
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
 		if (rc == SIM_OK) {
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
-			push_event(s, "control", json);
+			srv_ring_event(s, "control", json);
 			srv_persist_control(s, json);
 			s->ckpt_dirty = 1;
 		}
@@ -326,9 +267,50 @@ static void check_until(srv_session *s)
 	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
 		s->state = SRV_FINISHED;
 		s->ckpt_dirty = 1;
-		push_event_reason(s, "finished", NULL);
+		srv_ring_event_at(s, "finished", NULL);
 		pthread_cond_broadcast(&s->data);
 	}
+}
+
+/* cpu: read the worker's CPU time; a running session that spent its
+ * grant pauses. */
+static void check_cpu(srv_session *s)
+{
+	struct timespec ts;
+	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
+		return;
+	s->state = SRV_PAUSED;
+	s->cpu_paused = 1;
+	s->ckpt_dirty = 1;
+	srv_ring_event_at(s, "paused", "\"reason\":\"cpu-budget\"");
+	pthread_cond_broadcast(&s->data);
+	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
+			      "spent", s->entry.id, s->cpu_limit);
+}
+
+/* turn: a running pace "max" session steps only while it holds a CPU
+ * slot; any other gives its slot (or place in line) up. 1 if it must wait
+ * (the loop then starts over, so that commands are seen at once). */
+static int take_turn(srv_session *s, clocks *c)
+{
+	if (s->state != SRV_RUNNING || s->pace != API_PACE_MAX || s->stop) {
+		srv_cpu_leave(&s->turn);
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	if (srv_cpu_turn_over(&s->turn))
+		srv_cpu_leave(&s->turn); /* to the back of the line */
+	if (srv_cpu_take(&s->turn)) {
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	s->waiting_for_cpu = 1;
+	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
+	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+	restart_clocks(c, s);
+	return 1;
 }
 
 /* idle: a session that is not running sleeps until woken; 1 if it slept. */
@@ -336,6 +318,8 @@ static int idle(srv_session *s, clocks *c)
 {
 	if (s->state == SRV_RUNNING)
 		return 0;
+	srv_cpu_leave(&s->turn);
+	s->waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	pthread_cond_wait(&s->wake, &s->lock);
@@ -371,12 +355,12 @@ static int step_and_publish(srv_session *s, double t_next)
 	pthread_mutex_unlock(&s->lock);
 	int rc = sim_advance(s->sim, t_next);
 	sim_get_status(s->sim, &st);
-	gather_feed(s);
+	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	if (st.steps > s->st.steps)
 		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
 	s->st = st;
-	record_sample(s);
+	srv_ring_sample(s);
 	return rc;
 }
 
@@ -405,7 +389,7 @@ static void fail(srv_session *s, int rc)
 		s->expire = 1;
 	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
 		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
-	push_event_reason(s, "failed", NULL);
+	srv_ring_event_at(s, "failed", NULL);
 	detach_experiment(s, s->error);
 	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
 }
@@ -428,10 +412,10 @@ void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
 	clocks clk;
-	gather_feed(s);
+	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	sim_get_status(s->sim, &s->st);
-	record_sample(s);
+	srv_ring_sample(s);
 	restart_clocks(&clk, s);
 	pthread_cond_broadcast(&s->data);
 	for (;;) {
@@ -441,7 +425,8 @@ void *srv_worker_main(void *arg)
 			break;
 		srv_persist_checkpoint(s, 0);
 		check_until(s);
-		if (idle(s, &clk))
+		check_cpu(s);
+		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
 		if (pace(s, &clk, t_next))
@@ -458,6 +443,7 @@ void *srv_worker_main(void *arg)
 		srv_persist_checkpoint(s, 1);
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
+	srv_cpu_leave(&s->turn);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;

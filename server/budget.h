@@ -1,0 +1,112 @@
+/*
+ * budget.h - the daemon's resource budgets, so that no one client takes the
+ * machine: memory (the need of each session and stream, estimated before it
+ * is created and reserved against --max-memory), CPU turns for pace "max"
+ * sessions (at most --max-busy step at once, taking turns in time slices,
+ * first come first served) and the open connections of each client address
+ * (counted in libmicrohttpd's connection notification).
+ *
+ * A leaf like metrics.c: it calls nothing else of server/ but util.c. Its
+ * lock is a leaf of the lock order (registry.h): nothing is taken under it
+ * (it only signals a waiting worker's condition).
+ */
+#ifndef CONVSIM_BUDGET_H
+#define CONVSIM_BUDGET_H
+
+#include <microhttpd.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include "api.h"
+#include "config.h"
+
+/* Keep cfg (borrowed for the daemon's life). */
+void srv_budget_init(const srv_config *cfg);
+
+/* ---- memory ---------------------------------------------------------------- */
+
+/* Estimated bytes of a session with this feed (0 x 0 without feed): the
+ * core instance, its worker, the record ring (--ring) and the trajectory
+ * history (--history) when full. */
+size_t srv_budget_session_need(int columns, int layers);
+/* Estimated bytes of one stream client of such a session. */
+size_t srv_budget_stream_need(int columns, int layers);
+/* Reserve a session's need: API_OK (*need set), 422 when it alone exceeds
+ * the whole budget (naming scene.layers or scene.columns with the largest
+ * value that fits) or 503 when the budget has no room now; *pb names the
+ * budget. Nothing is reserved on failure. */
+api_err srv_budget_take_session(int columns, int layers, size_t *need,
+				api_problem *pb);
+/* Reserve bytes for what (a noun for the message): API_OK or 503 with *pb.
+ * force: reserve even beyond the budget (a session restored at start-up). */
+api_err srv_budget_take(size_t bytes, const char *what, int force,
+			api_problem *pb);
+/* Give back a reservation (0 is accepted). */
+void srv_budget_give(size_t bytes);
+/* Bytes reserved now, and the budget. */
+size_t srv_budget_reserved(void);
+size_t srv_budget_memory(void);
+
+/* ---- queued sweep points ------------------------------------------------------ */
+
+/* Reserve n sweep points (queued or running, all sweeps): API_OK, 422 when
+ * n alone exceeds --max-queued-points (naming field), or 429 with a
+ * Retry-After from the measured time per point; *pb names the budget.
+ * force: reserve beyond the budget (a sweep restored at start-up). */
+api_err srv_budget_take_points(size_t n, const char *field, int force,
+			       api_problem *pb);
+/* One point is done (or skipped) after seconds of wall time (0: skipped). */
+void srv_budget_point_done(double seconds);
+/* Give back n points that were never queued. */
+void srv_budget_give_points(size_t n);
+/* Points queued or running now. */
+size_t srv_budget_points(void);
+
+/* ---- CPU turns for pace "max" ---------------------------------------------- */
+
+/* A session's place among the pace "max" sessions. Zeroed at start; the
+ * worker owns it. */
+typedef struct srv_cpu_turn {
+	pthread_cond_t *wake;   /* signalled when its turn may have come */
+	int holding, queued;    /* budget lock */
+	double since;           /* srv_now() when it took its slot */
+	struct srv_cpu_turn *next;
+} srv_cpu_turn;
+
+/* 1 if t holds a slot (now or already); else t joins the queue (once) and
+ * its wake condition is signalled when a slot frees: 0. */
+int srv_cpu_take(srv_cpu_turn *t);
+/* 1 if t has held its slot for a whole slice and others wait: it should
+ * leave and take again (to the back of the queue). */
+int srv_cpu_turn_over(const srv_cpu_turn *t);
+/* Give the slot back and leave the queue (either may be the case). */
+void srv_cpu_leave(srv_cpu_turn *t);
+/* Slots in use, sessions waiting. */
+void srv_cpu_counts(int *busy, int *waiting);
+
+/* ---- connections per client ------------------------------------------------- */
+
+/* Connections a client may open beyond its budget that still get a 429
+ * with a body; libmicrohttpd closes any further ones at accept
+ * (MHD_OPTION_PER_IP_CONNECTION_LIMIT is the budget plus this). */
+#define SRV_CLIENT_GRACE 8
+
+/* libmicrohttpd's connection notification: counts the connections of each
+ * client address (MHD_OPTION_NOTIFY_CONNECTION, cls unused). */
+void srv_budget_connection(void *cls, struct MHD_Connection *conn,
+			   void **socket_context,
+			   enum MHD_ConnectionNotificationCode code);
+/* 1 if conn was opened beyond its client's --max-client-connections (it
+ * gets a 429 and is closed), with *pb naming the budget. */
+int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb);
+/* Connections answered 429 by the per-client budget so far, and those
+ * libmicrohttpd closed at accept (beyond the grace or --max-connections). */
+unsigned long long srv_budget_client_refused(void);
+unsigned long long srv_budget_connections_dropped(void);
+/* libmicrohttpd's error log (MHD_OPTION_EXTERNAL_LOGGER): its refusals at
+ * the connection limits are counted and logged at debug level (thousands
+ * of idle sockets must not flood the log), the rest as warnings. */
+void srv_budget_mhd_log(void *cls, const char *fmt, va_list ap);
+
+#endif

@@ -1,0 +1,311 @@
+// The daemon's budgets, each against a real daemon given small limits by
+// flags: memory (--max-memory: 422 for a session larger than the whole
+// budget, 503 + Retry-After when full, nothing created), CPU
+// (--max-cpu-seconds pauses a session with pause_reason "cpu-budget",
+// --max-busy lets pace-max sessions take turns), queued sweep points
+// (--max-queued-points: 422 / 429 + Retry-After) and the connections of one
+// client address (--max-client-connections: 429 with a body, then closed at
+// accept; idle sockets closed after --connection-timeout, live streams
+// kept). After each refusal another client is still served.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import http from 'node:http';
+import net from 'node:net';
+import { startDaemon, req, openStream, until, metric, sleep, NO_FEED, SLOW } from './lib.mjs';
+
+const JSON_HEADERS = { 'Content-Type': 'application/json' };
+
+// One GET from a given loopback source address; {status, headers, body}
+// or {error} when the daemon closed the connection without an answer.
+function getFrom(base, path, localAddress) {
+  return new Promise((resolve) => {
+    const r = http.get(base + path, { localAddress, agent: false }, (res) => {
+      let text = '';
+      res.on('data', (c) => { text += c; });
+      res.on('end', () => resolve({ status: res.statusCode, headers: res.headers,
+        body: text && JSON.parse(text) }));
+    });
+    r.on('error', (e) => resolve({ error: e.code || e.message }));
+  });
+}
+
+// n idle TCP connections from localAddress (they never send a byte); each
+// has .closedAt, a promise of the time the daemon closed it.
+async function idleSockets(port, n, localAddress) {
+  const socks = [];
+  for (let i = 0; i < n; i++) {
+    socks.push(await new Promise((resolve) => {
+      const s = net.connect({ port, host: '127.0.0.1', localAddress }, () => resolve(s));
+      s.closedAt = new Promise((done) => s.on('close', () => done(Date.now())));
+      s.on('error', () => resolve(s)); // reset at accept: closed already
+    }));
+  }
+  return socks;
+}
+
+async function metrics(base) {
+  return (await req(base, 'GET', '/metrics')).text;
+}
+
+async function healthy(base) {
+  const h = await req(base, 'GET', '/api/v1/health');
+  assert.equal(h.status, 200, 'another client is still served');
+}
+
+test('memory: a session larger than the budget is 422 naming the field, a full budget 503', { timeout: 60000 * SLOW }, async () => {
+  const budget = 64 * 1024 * 1024;
+  const d = await startDaemon(['--max-memory', '64M']);
+  try {
+    // alone too large: 422, the largest layer count that fits as max
+    const big = await req(d.base, 'POST', '/api/v1/sessions',
+      { scene: { columns: 64, layers: 64 }, pace: 1 });
+    assert.equal(big.status, 422, big.text);
+    assert.equal(big.headers.get('content-type'), 'application/problem+json');
+    assert.equal(big.body.type, '/api/v1/problems/out-of-range');
+    assert.equal(big.body.field, 'scene.layers');
+    assert.equal(big.body.budget, 'memory');
+    assert.equal(big.body.limit, budget);
+    assert.equal(big.body.min, 1);
+    assert.ok(Number.isInteger(big.body.max) && big.body.max >= 1 && big.body.max < 64, big.text);
+    assert.match(big.body.detail, /more than the whole memory budget of 64\.0 MiB \(--max-memory\)/);
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0);
+    // the max it names fits, one more layer does not
+    const fits = await req(d.base, 'POST', '/api/v1/sessions',
+      { ...NO_FEED, scene: { columns: 64, layers: big.body.max }, pace: 0.001 });
+    assert.equal(fits.status, 201, fits.text);
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${fits.body.id}`)).status, 204);
+    const over = await req(d.base, 'POST', '/api/v1/sessions',
+      { scene: { columns: 64, layers: big.body.max + 1 }, pace: 0.001 });
+    assert.equal(over.status, 422, over.text);
+    assert.equal(metric(await metrics(d.base), 'convsim_memory_reserved_bytes'), 0, 'all given back');
+
+    // default sessions until the budget is full: then 503, nothing created
+    const ids = [];
+    let refused;
+    for (let i = 0; i < 20 && !refused; i++) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 0.01 });
+      if (r.status === 201) ids.push(r.body.id);
+      else refused = r;
+    }
+    assert.ok(refused, 'the budget filled up');
+    assert.equal(refused.status, 503, refused.text);
+    assert.equal(refused.headers.get('retry-after'), '5');
+    assert.equal(refused.body.type, '/api/v1/problems/unavailable');
+    assert.equal(refused.body.budget, 'memory');
+    assert.equal(refused.body.limit, budget);
+    assert.match(refused.body.detail, /memory budget of 64\.0 MiB \(--max-memory\)/);
+    const m = await metrics(d.base);
+    const reserved = metric(m, 'convsim_memory_reserved_bytes');
+    const need = reserved / ids.length;
+    assert.ok(ids.length * need <= budget && (ids.length + 1) * need > budget,
+      `${ids.length} sessions of ${need} bytes fill ${budget}`);
+    assert.equal(metric(m, 'convsim_sessions'), ids.length, 'the refused session was not created');
+    await healthy(d.base);
+    // a deleted session gives its memory back
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ids.pop()}`)).status, 204);
+    const again = await req(d.base, 'POST', '/api/v1/sessions', { pace: 0.01 });
+    assert.equal(again.status, 201, again.text);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('CPU: a session that spent --max-cpu-seconds pauses; a PATCH resumes it within the limit', { timeout: 60000 * SLOW }, async () => {
+  const grant = 0.3;
+  const d = await startDaemon(['--max-cpu-seconds', String(grant), '--heartbeat', '0.5']);
+  try {
+    const c = await req(d.base, 'POST', '/api/v1/sessions', { pace: 'max', until: 1e6 });
+    assert.equal(c.status, 201, c.text);
+    assert.equal(c.body.cpu_limit, grant);
+    assert.equal(c.body.pause_reason, null);
+    const id = c.body.id;
+    const events = [];
+    const reader = (async () => {
+      for await (const rec of openStream(d.base, `/api/v1/sessions/${id}/stream?format=ndjson&fields=trough`)) {
+        if (rec.type === 'paused') { events.push(rec); break; }
+      }
+    })();
+    const paused = await until(async () => {
+      const s = await req(d.base, 'GET', `/api/v1/sessions/${id}`);
+      return s.body.state === 'paused' && s.body;
+    }, 20000, 'the CPU budget to pause the session');
+    assert.equal(paused.pause_reason, 'cpu-budget');
+    assert.ok(paused.cpu_seconds >= grant && paused.cpu_seconds < grant + 0.2, `${paused.cpu_seconds}`);
+    assert.ok(paused.status.t > 0);
+    await reader;
+    assert.equal(events[0].reason, 'cpu-budget');
+    // it stays paused: no more CPU, no more simulated time
+    await sleep(400);
+    const still = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+    assert.equal(still.status.t, paused.status.t);
+    assert.equal(still.cpu_seconds, paused.cpu_seconds);
+
+    // a grant beyond the limit is refused whole
+    const tooMuch = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { cpu_budget: 10 });
+    assert.equal(tooMuch.status, 422, tooMuch.text);
+    assert.equal(tooMuch.body.field, 'cpu_budget');
+    assert.equal(tooMuch.body.max, grant);
+    const same = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+    assert.equal(same.state, 'paused');
+    assert.equal(same.cpu_limit, paused.cpu_limit);
+
+    // resume: a fresh grant from now, then paused again when spent
+    const r = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { running: true });
+    assert.equal(r.status, 200, r.text);
+    assert.equal(r.body.state, 'running');
+    assert.equal(r.body.pause_reason, null);
+    assert.ok(Math.abs(r.body.cpu_limit - (paused.cpu_seconds + grant)) < 1e-6, `${r.body.cpu_limit}`);
+    const again = await until(async () => {
+      const s = await req(d.base, 'GET', `/api/v1/sessions/${id}`);
+      return s.body.state === 'paused' && s.body;
+    }, 20000, 'the second grant to be spent');
+    assert.equal(again.pause_reason, 'cpu-budget');
+    assert.ok(again.status.t > paused.status.t);
+    // a smaller explicit grant, and a client's pause says "client"
+    const g = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { cpu_budget: 0.1 });
+    assert.equal(g.status, 200, g.text);
+    assert.equal(g.body.state, 'running');
+    assert.equal(g.body.applied.cpu_budget, 0.1);
+    const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { running: false });
+    assert.equal(p.body.pause_reason, 'client');
+    await healthy(d.base);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a time', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon(['--max-busy', '1']);
+  try {
+    const ids = [];
+    for (let i = 0; i < 2; i++) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 'max', until: 1e5 });
+      assert.equal(r.status, 201, r.text);
+      ids.push(r.body.id);
+    }
+    let sawWaiting = false;
+    const list = await until(async () => {
+      const m = await metrics(d.base);
+      assert.ok(metric(m, 'convsim_cpu_slots_busy') <= 1, 'at most --max-busy step at once');
+      if (metric(m, 'convsim_cpu_slots_waiting') === 1) sawWaiting = true;
+      await sleep(100);
+      const all = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
+      return all.every((s) => s.cpu_seconds > 0.3) && all;
+    }, 30000, 'both sessions to use CPU');
+    assert.ok(sawWaiting, 'the other one waited its turn');
+    const [a, b] = list.map((s) => s.cpu_seconds);
+    assert.ok(a / b > 0.5 && a / b < 2, `fair shares of CPU: ${a} vs ${b}`);
+    // the one left alone runs without waiting
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ids[0]}`)).status, 204);
+    await until(async () => metric(await metrics(d.base), 'convsim_cpu_slots_waiting') === 0, 5000, 'no one waiting');
+    const s = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
+    assert.equal(s.waiting_for_cpu, false);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('sweep points: 422 beyond the whole budget, 429 + Retry-After when queued points fill it', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon(['--max-queued-points', '10', '--pool-threads', '1']);
+  try {
+    const body = (n) => ({ ...NO_FEED, beta: Array.from({ length: n }, (_, i) => 10 * i), rotations: ['cw'], t_end: 2 });
+    const huge = await req(d.base, 'POST', '/api/v1/sweeps', body(11));
+    assert.equal(huge.status, 422, huge.text);
+    assert.equal(huge.body.field, 'beta');
+    assert.equal(huge.body.max, 10);
+    assert.equal(huge.body.budget, 'sweep-points');
+    const first = await req(d.base, 'POST', '/api/v1/sweeps', body(8));
+    assert.equal(first.status, 202, first.text);
+    assert.equal(metric(await metrics(d.base), 'convsim_sweep_points_queued') <= 8, true);
+    const full = await req(d.base, 'POST', '/api/v1/sweeps', body(4));
+    assert.equal(full.status, 429, full.text);
+    assert.match(full.headers.get('retry-after'), /^[1-9][0-9]*$/);
+    assert.equal(full.body.type, '/api/v1/problems/limit-reached');
+    assert.equal(full.body.budget, 'sweep-points');
+    assert.equal(full.body.limit, 10);
+    assert.match(full.body.detail, /--max-queued-points/);
+    const list = (await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps;
+    assert.equal(list.length, 1, 'nothing was created');
+    await healthy(d.base);
+    await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${first.body.id}`)).body.state === 'done',
+      40000, 'the first sweep to finish');
+    assert.equal(metric(await metrics(d.base), 'convsim_sweep_points_queued'), 0);
+    const later = await req(d.base, 'POST', '/api/v1/sweeps', body(4));
+    assert.equal(later.status, 202, later.text);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('connections: a client beyond its budget gets 429 then is closed at accept; others are served; streams outlive the idle timeout', { timeout: 60000 * SLOW }, async () => {
+  const cap = 3;
+  const d = await startDaemon(['--max-client-connections', String(cap), '--connection-timeout', '2',
+    '--heartbeat', '0.5']);
+  const socks = [];
+  try {
+    socks.push(...await idleSockets(d.port, cap, '127.0.0.2'));
+    await sleep(100);
+    const over = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
+    assert.equal(over.status, 429, JSON.stringify(over));
+    assert.equal(over.headers['retry-after'], '1');
+    assert.equal(over.headers.connection, 'close');
+    assert.equal(over.headers['content-type'], 'application/problem+json');
+    assert.equal(over.body.type, '/api/v1/problems/limit-reached');
+    assert.equal(over.body.budget, 'connections');
+    assert.equal(over.body.limit, cap);
+    assert.match(over.body.detail, /more than 3 connections open.*--max-client-connections/);
+    // a POST beyond the budget creates nothing
+    const post = await new Promise((resolve) => {
+      const r = http.request(d.base + '/api/v1/sessions', { method: 'POST', localAddress: '127.0.0.2',
+        agent: false, headers: JSON_HEADERS }, (res) => { res.resume(); res.on('end', () => resolve(res.statusCode)); });
+      r.on('error', (e) => resolve(e.code));
+      r.end('{}');
+    });
+    assert.equal(post, 429);
+    assert.equal(metric(await metrics(d.base), 'convsim_sessions'), 0);
+    // another client address is served
+    await healthy(d.base);
+    // beyond the grace (8 more), libmicrohttpd closes the socket at accept
+    socks.push(...await idleSockets(d.port, 8, '127.0.0.2'));
+    await sleep(100);
+    const dropped = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
+    assert.ok(dropped.error, `closed without an answer: ${JSON.stringify(dropped)}`);
+    assert.ok(metric(await metrics(d.base), 'convsim_connections_dropped_total') >= 1);
+    await healthy(d.base);
+
+    // a stream of a paused session (heartbeats only) outlives the 2-s idle
+    // timeout, while the idle sockets are closed by it
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
+    assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${s.body.id}`, { running: false })).status, 200);
+    const t0 = Date.now();
+    let beats = 0;
+    for await (const rec of openStream(d.base, `/api/v1/sessions/${s.body.id}/stream?format=ndjson`)) {
+      if (rec.type === 'heartbeat') beats++;
+      if (Date.now() - t0 > 4000) break;
+    }
+    assert.ok(beats >= 5, `the stream stayed open with ${beats} heartbeats`);
+    const when = await Promise.all(socks.map((k) => k.closedAt));
+    assert.ok(when.every((t) => t - t0 < 4000 * SLOW), 'idle sockets were closed by --connection-timeout');
+    const back = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
+    assert.equal(back.status, 200, 'the client is served again once its sockets are gone');
+  } finally {
+    for (const k of socks) k.destroy();
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('--help prints every budget with its default; a timeout not above the heartbeat is refused', async () => {
+  const { spawnSync } = await import('node:child_process');
+  const { BIN } = await import('./lib.mjs');
+  const h = spawnSync(BIN, ['--help'], { encoding: 'utf8' });
+  assert.equal(h.status, 0);
+  for (const re of [/--max-memory BYTES .*\n.*default [0-9.]+ GiB: 3\/4 of this machine's memory/,
+    /--max-cpu-seconds S .*\n.*default 1800/, /--max-busy N .*default \d+: the cores/,
+    /--max-client-connections N .*default 64/, /--max-connections N .*default 1024/,
+    /--connection-timeout S .*\n.*default 30/, /--max-queued-points N .*default 4096/]) {
+    assert.match(h.stdout, re);
+  }
+  const bad = spawnSync(BIN, ['--port', '0', '--heartbeat', '30', '--connection-timeout', '20'], { encoding: 'utf8' });
+  assert.equal(bad.status, 2);
+  assert.match(bad.stderr, /--connection-timeout \(20 s\) must exceed --heartbeat \(30 s\)/);
+});
