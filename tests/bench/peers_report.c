@@ -18,6 +18,7 @@ typedef struct setting_sum {
 	char kind[8], name[24], setting[40], worst_at[32], status[200];
 	int n, beyond;
 	double worst, cpu;
+	double done[74]; /* the errors of the points finished, in order */
 	unsigned long long steps, rejected, rhs;
 } setting_sum;
 
@@ -50,6 +51,8 @@ static void add_row(setting_sum *S, int *ns, const char *line)
 		(*ns)++;
 	}
 	setting_sum *s = &S[i];
+	if (isfinite(e) && s->n < 74)
+		s->done[s->n] = e;
 	s->n += isfinite(e);
 	s->cpu += cpu;
 	s->steps += steps;
@@ -83,14 +86,29 @@ static void peer_line(FILE *f, const setting_sum *S, int ns, const char *name, i
 	}
 	const setting_sum *s = pass ? pass : best;
 	if (!s) {
-		fprintf(f, "| %s | none completed | n/a | n/a | n/a | n/a | %s |\n", name,
-			fail ? fail->status : "not run");
+		/* no setting covered every point: the one that went furthest */
+		const setting_sum *far = NULL;
+		for (int i = 0; i < ns; i++)
+			if (!strcmp(S[i].name, name) && (!far || S[i].n > far->n))
+				far = &S[i];
+		if (!far) {
+			fprintf(f, "| %s | not run |  |  |  |  |  |\n", name);
+			return;
+		}
+		double worst = 0.0; /* over the points it finished */
+		for (int i = 0; i < far->n; i++)
+			worst = fmax(worst, far->done[i]);
+		fprintf(f, "| %s | %s: %d of %d points, then stopped | %.3g %% over those | %.4g | "
+			   "n/a | %llu / %llu in all | %s: %s |\n",
+			name, far->setting, far->n, npts, 100 * worst, far->cpu, far->steps,
+			far->rejected, far->setting, far->status);
 		return;
 	}
 	double per_s = SIM_S_PER_POINT * npts;
-	fprintf(f, "| %s | %s%s | %.2f %% (%s) | %.4g | **%.0f×** | %.3g / %.3g | %s |\n", name,
+	fprintf(f, "| %s | %s%s | %.2f %% (%s) | %.4g | %s%.0f×%s | %.3g / %.3g | %s |\n", name,
 		s->setting, pass ? "" : " (best; 1 % not reached)", 100 * s->worst, s->worst_at,
-		s->cpu, ours ? s->cpu / ours->cpu : NAN, (double)s->steps / per_s,
+		s->cpu, pass ? "**" : "", ours ? s->cpu / ours->cpu : NAN, pass ? "**" : "",
+		(double)s->steps / per_s,
 		(double)s->rejected / per_s,
 		fail ? fail->setting : (pass ? "" : "-"));
 	if (fail)
