@@ -57,9 +57,10 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
              /usr/bin/clang:clang \
              /usr/bin/valgrind:valgrind
 # and in addition to benchmark (`make bench`: the ODE peers).
-DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev
+DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev \
+             /usr/include/gsl/gsl_odeiv2.h:libgsl-dev
 
-.PHONY: all deps deps-build run cluster test check bench load mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench bench-peers load mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -78,7 +79,7 @@ $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps-bench: Makefile
-	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (SUNDIALS)" sh tests/apt-deps.sh
+	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (GSL, SUNDIALS)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 
 # Include floors, by the top directory of the source: core/ sees only
@@ -211,6 +212,11 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 # budget or stopped answering another client.
 load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
+
+# The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
+# tests/bench/peers.sh), into tests/bench/results.
+bench-peers: all $(BUILD)/.deps-bench
+	$(Q)BUILD=$(BUILD) bash tests/bench/peers.sh tests/bench/results "make bench-peers"
 
 # Deliberate faults, each of which `make test` must notice (tests/mutate.sh).
 mutate: all

@@ -193,26 +193,35 @@ fail:
 	return NULL;
 }
 
+int sim_start(sim *s, char *msg, size_t msglen)
+{
+	dynamics_equilibrium(&s->md, &s->ctl, s->y);
+	if (s->md.sc.start == SIM_START_STEADY && s->ctl.drive_on) {
+		dynamics_steady_start(&s->md, &s->ctl, s->y);
+		int e = settle(s);
+		if (e != SIM_OK) {
+			if (msg)
+				snprintf(msg, msglen, "%s", s->error);
+			return e;
+		}
+	}
+	zero_observers(s, 1);
+	return SIM_OK;
+}
+
 sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
 	     size_t msglen)
 {
 	sim *s = sim_alloc(p, sc, m, err, msg, msglen);
 	if (!s)
 		return NULL;
-	dynamics_equilibrium(&s->md, &s->ctl, s->y);
-	if (sc->start == SIM_START_STEADY && s->ctl.drive_on) {
-		dynamics_steady_start(&s->md, &s->ctl, s->y);
-		int e = settle(s);
-		if (e != SIM_OK) {
-			if (msg)
-				snprintf(msg, msglen, "%s", s->error);
-			if (err)
-				*err = e;
-			sim_free(s);
-			return NULL;
-		}
+	int e = sim_start(s, msg, msglen);
+	if (e != SIM_OK) {
+		if (err)
+			*err = e;
+		sim_free(s);
+		return NULL;
 	}
-	zero_observers(s, 1);
 	return s;
 }
 

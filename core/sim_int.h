@@ -39,6 +39,14 @@ struct sim {
 sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
 	       char *msg, size_t msglen);
 
+/* Fill an instance fresh from sim_alloc with the scene's start (static
+ * equilibrium; for `steady`, the forced response and the settling, run by
+ * s->ode) and zero its observers: the rest of sim_new. Returns SIM_OK, or
+ * the settling's failure with its cause in msg. Lets an integrator from
+ * outside the core (the benchmark's peers, tests/bench/peer_*.c) replace
+ * s->ode and s->ws between sim_alloc and sim_start. sim.c */
+int sim_start(sim *s, char *msg, size_t msglen);
+
 /* Recompute s->st at the observed time after any change; reads the state
  * and evaluates the right-hand side for observation only (no counter
  * moves). sim_status.c */

@@ -2,7 +2,8 @@
 # Work-precision benchmark (`make bench`): builds tests/bench/workprec
 # against the core library, runs the scenes in two single-threaded
 # processes (the full scene alone in one, the others in turn in the other),
-# then writes the table and the plot. BENCH_QUICK=1: shorter horizons and
+# then the GSL and SUNDIALS peers at the 1 % gate (peers.sh), then writes
+# the table and the plot. BENCH_QUICK=1: shorter horizons and
 # ladders, results into $BUILD/bench-quick instead of tests/bench/results.
 set -eu
 cd "$(dirname "$0")/../.."
@@ -35,6 +36,8 @@ full_pid=$!
 rest_pid=$!
 wait "$full_pid"
 wait "$rest_pid"
+echo "bench: the GSL and SUNDIALS peers at the 1 % gate (two cores)"
+bash tests/bench/peers.sh "$out" "$cmd"
 "$bin" report "$out" "$cmd"
 echo "bench: the 74-point v(beta) curve against the converged reference (one core per sweep)"
 bash tests/bench/accuracy.sh "$out"

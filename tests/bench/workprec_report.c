@@ -252,8 +252,9 @@ void wp_report(const char *dir, const char *cmd)
 		fprintf(stderr, "workprec: out of memory\n");
 		exit(1);
 	}
-	const char *names[] = {"nofeed", "full", "reduced", "reductions"};
-	for (int i = 0; i < 4; i++) {
+	/* gate.tsv: the peers at the 1 % gate (peers_report.c), if run */
+	const char *names[] = {"nofeed", "full", "reduced", "reductions", "gate"};
+	for (int i = 0; i < 5; i++) {
 		char path[512];
 		snprintf(path, sizeof path, "%s/%s.tsv", dir, names[i]);
 		read_tsv(path, t);

@@ -12,8 +12,14 @@
 
 #include "workprec.h"
 
-static const char *method_names[] = {"rk4", "euler", "dem", "dopri5"};
-static const char *method_colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+/* the core's methods, then the peers (tests/bench/peer.c) */
+static const char *method_names[] = {"rk4",	    "euler",	 "dem",	      "dopri5",
+				     "gsl-rk8pd",   "gsl-rkf45", "gsl-msadams", "gsl-msbdf",
+				     "cvode-adams", "cvode-bdf", "arkode-erk"};
+static const char *method_colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+				      "#ff7f0e", "#8c564b", "#e377c2", "#7f7f7f",
+				      "#bcbd22", "#17becf", "#000000"};
+enum { NMETHODS = sizeof method_names / sizeof method_names[0] };
 
 static void marker(FILE *f, int m, double x, double y)
 {
@@ -29,8 +35,18 @@ static void marker(FILE *f, int m, double x, double y)
 	case 2:
 		fprintf(f, "<path d='M%.1f %.1f l5 8 h-10 z' fill='%s'/>\n", x, y - 5, c);
 		break;
-	default:
+	case 3:
 		fprintf(f, "<path d='M%.1f %.1f l5 5 l-5 5 l-5 -5 z' fill='%s'/>\n", x, y - 5, c);
+		break;
+	default: /* the peers: hollow circles and crosses */
+		if (m % 2)
+			fprintf(f, "<path d='M%.1f %.1f l8 8 m0 -8 l-8 8' stroke='%s' "
+				   "stroke-width='2'/>\n",
+				x - 4, y - 4, c);
+		else
+			fprintf(f, "<circle cx='%.1f' cy='%.1f' r='4' fill='none' stroke='%s' "
+				   "stroke-width='2'/>\n",
+				x, y, c);
 	}
 }
 
@@ -152,7 +168,7 @@ static void panel_axes(FILE *f, const frame *fr, double ox, double oy, int kind,
 static void panel_series(FILE *f, const wp_records *t, const frame *fr, const char *scene,
 			 int kind, double floor_err)
 {
-	for (int m = 0; m < 4; m++) {
+	for (int m = 0; m < NMETHODS; m++) {
 		int first = 1;
 		fprintf(f, "<polyline fill='none' stroke='%s' stroke-width='1' points='",
 			method_colors[m]);
@@ -161,8 +177,9 @@ static void panel_series(FILE *f, const wp_records *t, const frame *fr, const ch
 			if (strcmp(r->kind, "run") || strcmp(r->scene, scene) ||
 			    strcmp(r->method, method_names[m]))
 				continue;
-			/* dem: the substeps=1 ladder only in the line */
-			if (m == 2 && !strstr(r->setting, "substeps=1"))
+			/* dem: the substeps=1 ladder only in the line (the gate:
+			 * every setting) */
+			if (m == 2 && strcmp(scene, "gate") && !strstr(r->setting, "substeps=1"))
 				continue;
 			double e = err_of(r, kind);
 			if (!isfinite(e) || !(r->cps > 0))
@@ -204,7 +221,7 @@ void wp_write_svg(const char *dir, const wp_records *t)
 	fprintf(f,
 		"<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' "
 		"font-family='sans-serif'>\n<rect width='100%%' height='100%%' fill='white'/>\n",
-		3 * W, 2 * H + 40);
+		3 * W, 3 * H + 60);
 	/* reference uncertainty floors */
 	double vfloor[2] = {0, 0}, tfloor[3] = {0, 0, 0};
 	const char *sc[3] = {"nofeed", "full", "reduced"};
@@ -223,16 +240,22 @@ void wp_write_svg(const char *dir, const wp_records *t)
 	panel(f, t, W, H, W, H, sc[1], E_V, "(2) full scene: transport velocity", vfloor[0], 0.01);
 	panel(f, t, 2 * W, H, W, H, sc[2], E_V, "(3) reduced scene: transport velocity", vfloor[1],
 	      0.01);
-	double ly = 2 * H + 20;
-	for (int m = 0; m < 4; m++) {
-		marker(f, m, 80 + 150 * m, ly);
-		fprintf(f, "<text x='%d' y='%.1f' font-size='12'>%s</text>\n", 92 + 150 * m, ly + 4,
+	panel(f, t, 0, 2 * H, 2 * W, H, "gate", E_V,
+	      "(4) the 1 % gate, czubak2016 defaults: worst v error over the gate's points "
+	      "(README); core dem and the GSL / SUNDIALS peers",
+	      0, 0.01);
+	double ly = 3 * H + 20;
+	for (int m = 0; m < NMETHODS; m++) {
+		double lx = 60 + 105 * m;
+		marker(f, m, lx, ly);
+		fprintf(f, "<text x='%.0f' y='%.1f' font-size='12'>%s</text>\n", lx + 10, ly + 4,
 			method_names[m]);
 	}
 	fprintf(f,
-		"<text x='700' y='%.1f' font-size='11'>shaded: below the reference's "
-		"uncertainty (drawn at it); dashed: 1 %% in v; line: dem substeps=1</text>\n",
-		ly + 4);
+		"<text x='80' y='%.1f' font-size='11'>shaded: below the reference's "
+		"uncertainty (drawn at it); dashed: 1 %% in v; line: dem substeps=1 (in (4): every "
+		"dem setting; the peers: their tolerance ladders)</text>\n",
+		ly + 24);
 	fprintf(f, "</svg>\n");
 	fclose(f);
 }
