@@ -180,11 +180,11 @@ bench: all $(BUILD)/.deps-bench
 FUZZ_SECONDS ?= 60
 FUZZ_BUILD   := build-fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-FUZZ_BODIES  := session control experiment sweep
+FUZZ_BODIES  := session control experiment sweep fit
 FUZZ_NAMES   := $(FUZZ_BODIES:%=body_%) query route checkpoint store
 FUZZ_BINS    := $(FUZZ_NAMES:%=$(BUILD)/fuzz/%)
 FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))
-FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libcore.a
+FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 
 fuzz: deps-build
 	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
@@ -198,13 +198,13 @@ $(BUILD)/fuzz/body_%: tests/fuzz/fuzz_body.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  FUZZ    $@")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer -DFUZZ_BODY='"$*"' $(INC_server) -o $@ \
-	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(LDLIBS)
+	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
 $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  FUZZ    $@")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer $(INC_server) -o $@ \
-	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(LDLIBS)
+	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;

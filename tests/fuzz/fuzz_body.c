@@ -233,6 +233,31 @@ static void sweep_body(const char *body, size_t len)
 	free(again.betas);
 }
 
+/* POST /fits: a refused request keeps no points and is a well-formed
+ * problem; an accepted one is one fit_check passes again, with its data
+ * (points or peaks, not both) at least as many as its free parameters. */
+static void fit_body(const char *body, size_t len)
+{
+	fit_request req;
+	fit_point *points;
+	api_problem pb;
+	api_err e = api_parse_fit(body, len, &req, &points, &pb);
+	if (e != API_OK) {
+		FUZZ_CHECK(!points, "a refused fit keeps its points");
+		fuzz_check_problem(e, &pb);
+		return;
+	}
+	size_t data = req.npoints + (size_t)req.npeaks;
+	FUZZ_CHECK(req.nfree >= 1 && req.nfree <= FIT_MAX_FREE && data >= (size_t)req.nfree &&
+			   (req.npoints == 0 || req.npeaks == 0) &&
+			   (req.npoints == 0) == (points == NULL),
+		   "fit with %d free, %zu points, %d peaks", req.nfree, req.npoints, req.npeaks);
+	char field[48], msg[FIT_MSG];
+	FUZZ_CHECK(fit_check(&req, field, sizeof field, msg, sizeof msg) == SIM_OK,
+		   "an accepted fit fails its check again: %s: %s", field, msg);
+	free(points);
+}
+
 typedef struct fuzz_body {
 	const char *name;
 	void (*run)(const char *body, size_t len);
@@ -243,6 +268,7 @@ static const fuzz_body bodies[] = {
 	{"control", control_body},
 	{"experiment", experiment_body},
 	{"sweep", sweep_body},
+	{"fit", fit_body},
 };
 
 static const fuzz_body *chosen;

@@ -13,7 +13,7 @@ cd "$(dirname "$0")/../.."
 B=${FUZZ_BUILD:-build-fuzz}
 S=${FUZZ_SECONDS:-60}
 T=${FUZZ_TIMEOUT:-60}
-NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep query route checkpoint store}
+NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit query route checkpoint store}
 mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
 echo "fuzzing each harness for ${S} s: FUZZ_SECONDS=$S make fuzz"
 printf '| %-16s | %8s | %12s | %8s | %6s | %7s | %6s | %7s |\n' harness seconds executions 'exec/s' cov ft 'CPU s' crashes
