@@ -189,7 +189,7 @@ FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libc
 fuzz: deps-build
 	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
 	  CFLAGS="-O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link" WARN="$(WARN) -Wno-unused-function" fuzz-build
-	$(Q)FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_NAMES="$(FUZZ_NAMES)" \
+	$(Q)FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) FUZZ_NAMES="$(FUZZ_NAMES)" \
 	  bash tests/fuzz/run.sh
 
 fuzz-build: $(FUZZ_BINS)

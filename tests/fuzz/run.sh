@@ -13,9 +13,16 @@ cd "$(dirname "$0")/../.."
 B=${FUZZ_BUILD:-build-fuzz}
 S=${FUZZ_SECONDS:-60}
 T=${FUZZ_TIMEOUT:-60}
+# FUZZ_RUNS=N: N inputs per harness from the fixed seed 1 instead of a time
+# (CI: the same inputs every run, so a pass is repeatable)
+R=${FUZZ_RUNS:-}
 NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit query route checkpoint store}
 mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
-echo "fuzzing each harness for ${S} s: FUZZ_SECONDS=$S make fuzz"
+if [ -n "$R" ]; then
+	echo "fuzzing each harness for $R inputs from seed 1 (at most ${S} s): FUZZ_RUNS=$R make fuzz"
+else
+	echo "fuzzing each harness for ${S} s: FUZZ_SECONDS=$S make fuzz"
+fi
 printf '| %-16s | %8s | %12s | %8s | %6s | %7s | %6s | %7s |\n' harness seconds executions 'exec/s' cov ft 'CPU s' crashes
 printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' ------------------ ---------- -------------- ---------- -------- --------- -------- ---------
 total=0; crashed=0
@@ -29,7 +36,7 @@ for n in $NAMES; do
 	log=$B/logs/$n.log
 	mkdir -p "$B/corpus/$n"
 	/usr/bin/time -f '%U %S' -o "$B/logs/$n.time" \
-		nice -n 10 "$bin" -max_total_time="$S" -timeout="$T" -rss_limit_mb=2048 \
+		nice -n 10 "$bin" ${R:+-runs=$R -seed=1} -max_total_time="$S" -timeout="$T" -rss_limit_mb=2048 \
 		-print_final_stats=1 -artifact_prefix="$B/crashes/$n-" ${dict:+-dict=$dict} \
 		"$B/corpus/$n" "tests/fuzz/corpus/$n" >"$log" 2>&1
 	rc=$?
