@@ -177,7 +177,8 @@ static void phase_jump_restarts(void **state)
 
 /* A checkpoint (right checksum) of an instance failed with a code no step
  * gives (found by the checkpoint fuzz harness: sim_advance then answered
- * SIM_EUNKNOWN) is refused; one failed by divergence restores failed. */
+ * SIM_EUNKNOWN) is refused, so is a failure without its reason; one failed
+ * by divergence with its reason restores failed, and says why. */
 static void failure_code_checked(void **state)
 {
 	(void)state;
@@ -189,20 +190,26 @@ static void failure_code_checked(void **state)
 	/* the header (48 bytes), y, y_obs, y_prev, then t_int, t_obs, t_prev
 	 * and three counters before the failure code */
 	size_t at = 48 + 3 * sizeof(double) * (size_t)a->md.n + 48;
-	const int32_t codes[] = {SIM_EUNKNOWN, SIM_EDIVERGED};
-	for (int k = 0; k < 2; k++) {
+	const int32_t codes[] = {SIM_EUNKNOWN, SIM_EDIVERGED, SIM_EDIVERGED};
+	for (int k = 0; k < 3; k++) {
 		memcpy(buf + at, &codes[k], sizeof codes[k]);
+		/* the reason follows the code and its padding: none (k = 1), one
+		 * (k = 2); a failure without its reason is refused */
+		const char *why = k == 2 ? "diverged at t = 0.05 s: test" : "";
+		memset(buf + at + 8, 0, 160);
+		memcpy(buf + at + 8, why, strlen(why));
 		uint64_t sum = sim_checksum(buf + 48, len - 48);
 		memcpy(buf + 40, &sum, sizeof sum);
 		char msg[200];
 		int err;
 		sim *b = sim_restore(&u.p, &u.sc, &u.m, buf, len, &err, msg, sizeof msg);
-		if (k == 0) {
+		if (k < 2) {
 			assert_null(b);
 			assert_int_equal(err, SIM_ECHECKPOINT);
 		} else {
 			assert_non_null(b);
 			assert_int_equal(sim_advance(b, 0.1), SIM_EDIVERGED);
+			assert_string_equal(sim_last_error(b), "diverged at t = 0.05 s: test");
 			sim_free(b);
 		}
 	}
