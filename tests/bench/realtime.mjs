@@ -32,12 +32,18 @@ export async function heldInRealTime(base, N, seconds = 10) {
   }
   const streams = ids.map((id) => lagStream(base, id, { ndjson: true, rate: 10, warmup: 3000 }));
   await sleep(seconds * 1000);
-  const list = (await call(base, 'GET', '/api/v1/sessions', undefined, { agent })).body.sessions;
+  // a fresh connection: a proxy may have closed the kept-alive one while
+  // the sessions ran
+  const listed = await call(base, 'GET', '/api/v1/sessions');
+  if (listed.status !== 200) throw new Error(`list: ${listed.status} ${listed.error || ''}`);
+  const list = listed.body.sessions;
   const lags = streams.flatMap((s) => s.stop().lags);
   const rtf = list.map((s) => s.status.rtf).filter((x) => Number.isFinite(x)).sort((a, b) => a - b);
   const simulated = list.reduce((sum, s) => sum + s.status.t, 0);
-  for (const id of ids) await call(base, 'DELETE', `/api/v1/sessions/${id}`, undefined, { agent });
   agent.destroy();
+  const fresh = new http.Agent({ keepAlive: true, maxSockets: 4 });
+  for (const id of ids) await call(base, 'DELETE', `/api/v1/sessions/${id}`, undefined, { agent: fresh });
+  fresh.destroy();
   return { ok: rtf.filter((x) => x >= 0.95).length, min: quantile(rtf, 0),
     median: quantile(rtf, 0.5), lags, simulated };
 }
