@@ -289,8 +289,9 @@ const char *sim_reduction_name(int bit);
 /* What reduction bit i leaves out, with its speed-up and the relative
  * change of the transport velocity against the full model, as measured by
  * `make bench` on the czubak2016 start with the default method
- * (tests/bench/results/reductions.tsv; NaN where it does not apply).
- * NULL past the end. Static. */
+ * (tests/bench/results/reductions.tsv; for symmetric_alpha and mirror the
+ * 74-point curve of tests/bench/results/accuracy.md, the change over the
+ * peak; NaN where it does not apply). NULL past the end. Static. */
 typedef struct sim_reduction_info {
 	const char *name;
 	const char *drops;

@@ -219,7 +219,7 @@ static void fill_image(srv_sweep *sw, size_t i)
 		char why[sizeof src->error];
 		memcpy(why, src->error, sizeof why);
 		why[sizeof why - 1] = '\0';
-		snprintf(p->error, sizeof p->error, "mirror image of %g deg %s: %.100s",
+		snprintf(p->error, sizeof p->error, "mirror image of %g deg %s: %.118s",
 			 src->beta.user, src->rotation == SIM_CW ? "cw" : "ccw", why);
 	}
 	sw->done++;

@@ -331,7 +331,7 @@ static void mirror_tasks(task *tasks, int ntasks)
 			char why[sizeof src->msg];
 			memcpy(why, src->msg, sizeof why);
 			why[sizeof why - 1] = '\0';
-			snprintf(t->msg, sizeof t->msg, "mirror image of %g deg %s: %.100s", src->beta,
+			snprintf(t->msg, sizeof t->msg, "mirror image of %g deg %s: %.118s", src->beta,
 				 src->rotation == SIM_CW ? "cw" : "ccw", why);
 		}
 	}
