@@ -462,6 +462,8 @@ typedef struct api_sweep_point {
 	double velocity;    /* m/s */
 	double uncertainty; /* m/s, the estimate's error bar; NaN if none */
 	int steady;         /* the estimate showed no drift */
+	int mirrored;       /* the mirror image of another point of the sweep
+			       (sim_mirror_plan), not run itself */
 	char error[160];
 } api_sweep_point;
 typedef struct api_sweep_view {

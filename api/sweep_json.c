@@ -213,6 +213,18 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	api_add_number(o, "progress",
 		       v->total ? (double)v->done / (double)v->total : 1.0);
 	api_add_number(o, "t_end", v->t_end);
+	if (points) {
+		/* the sweep-level reductions: the mirror reduction when it
+		 * derived any point (every point's own model reductions are a
+		 * session's business) */
+		cJSON *red = cJSON_AddArrayToObject(o, "reductions");
+		int mirrored = 0;
+		for (size_t i = 0; i < v->total; i++)
+			mirrored |= v->pt[i].mirrored;
+		for (int b = 0; mirrored && sim_reduction_name(b); b++)
+			if ((1u << b) == SIM_RED_MIRROR)
+				cJSON_AddItemToArray(red, cJSON_CreateString(sim_reduction_name(b)));
+	}
 	cJSON *pts = points ? cJSON_AddArrayToObject(o, "points") : NULL;
 	cJSON *series = points ? cJSON_AddObjectToObject(o, "series") : NULL;
 	cJSON *cw = points ? cJSON_AddArrayToObject(series, "cw") : NULL;
@@ -233,6 +245,7 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 			cJSON_AddNullToObject(po, "uncertainty");
 			cJSON_AddNullToObject(po, "steady");
 		}
+		cJSON_AddBoolToObject(po, "mirrored", p->mirrored);
 		if (p->error[0])
 			cJSON_AddStringToObject(po, "error", p->error);
 		cJSON_AddItemToArray(pts, po);

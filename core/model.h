@@ -78,6 +78,12 @@ typedef struct model_eval {
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
 } model_eval;
 
+/* 1 when the machine is symmetric about the vertical through G: h = 0,
+ * l1 = l2, the axle at G, the eliminators mirror images of each other
+ * (mass, spring, damper, guide point); what the symmetric_alpha reduction
+ * needs (the columns are mirrored by construction). setup.c */
+int model_machine_symmetric(const sim_params *p);
+
 /* The feed's mass over the machine's (trough, vibrator and eliminator
  * masses): the added-mass ratio of the machine-feed coupling. */
 double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);

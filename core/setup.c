@@ -16,7 +16,7 @@
 
 #include "model.h"
 
-static int machine_symmetric(const sim_params *p)
+int model_machine_symmetric(const sim_params *p)
 {
 	return p->h == 0.0 && p->l1 == p->l2 && p->w_x == 0.0 && p->w_y == 0.0 &&
 	       p->m1 == p->m2 && p->k_s1 == p->k_s2 && p->b_s1 == p->b_s2 &&
@@ -66,7 +66,7 @@ void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene 
 	ctl->beta_rate = p->beta_rate;
 
 	int feed = sc->feed && sc->columns > 0 && sc->layers > 0;
-	int sym = !sc->trough_rotation && machine_symmetric(p);
+	int sym = !sc->trough_rotation && model_machine_symmetric(p);
 	int ideal = sc->drive == SIM_DRIVE_IDEAL;
 	if (!feed)
 		md->reductions |= SIM_RED_NO_FEED;

@@ -109,12 +109,16 @@ typedef struct sim_scene {
 	int drive;            /* SIM_DRIVE_MOTOR (Kloss) or SIM_DRIVE_IDEAL */
 	int trough_rotation;  /* 1: integrate alpha even on a symmetric machine;
 				 0: the engine drops it there by itself */
+	int mirror;           /* 1: sweeps derive (ccw, pi - beta) from (cw,
+				 beta) where the machine allows it
+				 (sim_mirror_plan); 0: every point is run */
 	int feed_coupling;    /* 0: one-way (feed does not act on the trough) */
 	int friction;         /* SIM_FRICTION_* */
 	double friction_eps;  /* m/s, regularised friction width */
 	int motor_on;         /* drive on at t = 0 */
 	double transient;     /* s: transport velocity ignores t < transient */
 	int start;            /* SIM_START_REST or SIM_START_STEADY */
+	double settle;        /* s: `steady` start's settling before t = 0 */
 } sim_scene;
 
 /* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
@@ -277,15 +281,17 @@ enum {
 	SIM_RED_SYMMETRIC = 1 << 1,
 	SIM_RED_IDEAL_DRIVE = 1 << 2,
 	SIM_RED_ONE_WAY = 1 << 3,
+	SIM_RED_MIRROR = 1 << 4, /* of a sweep, never of an instance */
 };
-/* Name of reduction bit i (0..3), NULL past the end. */
+/* Name of reduction bit i (0..4), NULL past the end. */
 const char *sim_reduction_name(int bit);
 
 /* What reduction bit i leaves out, with its speed-up and the relative
  * change of the transport velocity against the full model, as measured by
  * `make bench` on the czubak2016 start with the default method
- * (tests/bench/results/reductions.tsv; NaN where it does not apply).
- * NULL past the end. Static. */
+ * (tests/bench/results/reductions.tsv; for symmetric_alpha and mirror the
+ * 74-point curve of tests/bench/results/accuracy.md, the change over the
+ * peak; NaN where it does not apply). NULL past the end. Static. */
 typedef struct sim_reduction_info {
 	const char *name;
 	const char *drops;
@@ -361,6 +367,30 @@ typedef struct sim_measurement {
  * sim_new's or sim_advance's code. For sweeps (thread-safe). */
 int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen);
+
+/* ---- sweeps: the mirror reduction (mirror.c) ------------------------- */
+
+/* 1 when a sweep of this scene may take the mirror reduction: sc->mirror
+ * and a machine symmetric about the vertical through G (h = 0, l1 = l2,
+ * the axle at G, mirrored eliminators, c = 0; the columns are mirrored by
+ * construction). Then (ccw, pi - beta) moves as the mirror image of (cw,
+ * beta) (docs/MODEL.md "Checks with known answers"): x, alpha and phi'
+ * change sign, y stays, the eliminators swap with their strokes negated,
+ * and the transport velocity changes sign. */
+int sim_mirror_applies(const sim_params *p, const sim_scene *sc);
+
+/* Plan a sweep of n points (beta[i] in rad, rotation[i] SIM_CW/SIM_CCW) on
+ * the model p, sc: source[i] = -1 for a point to be measured, else the
+ * index j < i of a measured point whose mirror image point i is (the other
+ * sense, beta_j within 1e-9 rad of pi - beta_i). Without the reduction
+ * every source is -1. Returns the number of points to measure. */
+size_t sim_mirror_plan(const sim_params *p, const sim_scene *sc, size_t n, const double *beta,
+		       const int *rotation, long *source);
+
+/* The measurement of src's mirror image into *dst: transport velocity and
+ * mean rotor speed negated; error bar, steady flag and periods taken over
+ * (they do not depend on the sense); no CPU time (nothing was run). */
+void sim_mirror_measurement(const sim_measurement *src, sim_measurement *dst);
 
 /* Feed geometry of the instance. */
 /* Physical columns K and layers L; 0 without feed. */

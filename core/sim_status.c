@@ -19,6 +19,9 @@
 #define REDUCTION_SYMMETRIC 3.3, 5.2e-4
 #define REDUCTION_IDEAL 0.97, 2.7e-3
 #define REDUCTION_ONE_WAY 0.99, 4.4e-2
+/* mirror: the 74-point curve at the defaults with and without it (CPU of
+ * the curve; largest |v_image - v_direct| over the peak; accuracy.md). */
+#define REDUCTION_MIRROR 2.07, 4.0e-5
 
 
 /* Energies of the status, each a change since t = 0 (all exactly zero
@@ -192,6 +195,9 @@ static const sim_reduction_info reductions[] = {
 	{"ideal_drive", "the rotor's equation: phi - alpha turns at omega_ss, without slip",
 	 REDUCTION_IDEAL},
 	{"one_way_coupling", "the feed's reaction on the trough", REDUCTION_ONE_WAY},
+	{"mirror",
+	 "a sweep's (ccw, 180 deg - beta) points: each is the mirror image of (cw, beta), v negated",
+	 REDUCTION_MIRROR},
 };
 
 const sim_reduction_info *sim_reduction(int bit)

@@ -3,7 +3,9 @@
  *
  * A sweep is a grid of (beta, rotation) points; each point is one pool
  * job that builds a fresh instance with sim_measure (thread-safe,
- * no session involved) and stores the steady transport velocity. Sweeps
+ * no session involved) and stores the steady transport velocity. Under
+ * the mirror reduction (sim_mirror_plan) a point that is the mirror image
+ * of another is no job of its own: it is filled when the other is done. Sweeps
  * live in a registry (registry.c) that holds one reference, and every
  * queued job holds one, so DELETE (cancel) can unlink a sweep while its
  * jobs drain; beyond --max-sweeps the oldest finished one is evicted. A
@@ -30,7 +32,9 @@ typedef struct srv_sweep {
 	/* guarded by lock */
 	api_sweep_req req;
 	api_sweep_point *pt;
+	long *image;           /* the point derived from point i, or -1 */
 	size_t total, done;
+	size_t jobs;           /* points that run (the others are images) */
 	int running, cancelled;
 	char store_error[256];  /* a write failed: state "error" */
 } srv_sweep;
@@ -61,6 +65,7 @@ static void sweep_free(srv_sweep *sw)
 		return;
 	free(sw->req.betas);
 	free(sw->pt);
+	free(sw->image);
 	pthread_mutex_destroy(&sw->lock);
 	free(sw);
 }
@@ -165,11 +170,67 @@ static void save_results(const srv_sweep *sw)
 				strdup(sw->entry.id));
 }
 
+/* The mirror reduction's plan of the sweep's points: which are mirror
+ * images of which (sw->image, sw->jobs, each point's `mirrored`). The
+ * plan depends only on the request, so a restart makes it again. 0, or
+ * -1 when out of memory. */
+static int plan(srv_sweep *sw)
+{
+	size_t n = sw->total;
+	double *beta = malloc(sizeof *beta * (n ? n : 1));
+	int *rot = malloc(sizeof *rot * (n ? n : 1));
+	long *source = malloc(sizeof *source * (n ? n : 1));
+	sw->image = malloc(sizeof *sw->image * (n ? n : 1));
+	int rc = beta && rot && source && sw->image ? 0 : -1;
+	for (size_t i = 0; rc == 0 && i < n; i++) {
+		beta[i] = sw->pt[i].beta.si;
+		rot[i] = sw->pt[i].rotation;
+		sw->image[i] = -1;
+	}
+	if (rc == 0) {
+		sw->jobs = sim_mirror_plan(&sw->req.spec.params, &sw->req.spec.scene, n, beta,
+					   rot, source);
+		for (size_t i = 0; i < n; i++) {
+			sw->pt[i].mirrored = source[i] >= 0;
+			if (source[i] >= 0)
+				sw->image[source[i]] = (long)i;
+		}
+	}
+	free(beta);
+	free(rot);
+	free(source);
+	return rc;
+}
+
+/* Point i is over (done or failed): its mirror image, if it has one, is
+ * too (lock held). */
+static void fill_image(srv_sweep *sw, size_t i)
+{
+	long j = sw->image[i];
+	if (j < 0 || sw->pt[j].state >= 2)
+		return;
+	const api_sweep_point *src = &sw->pt[i];
+	api_sweep_point *p = &sw->pt[j];
+	p->state = src->state;
+	p->velocity = -src->velocity;
+	p->uncertainty = src->uncertainty;
+	p->steady = src->steady;
+	if (src->state == 3) {
+		char why[sizeof src->error];
+		memcpy(why, src->error, sizeof why);
+		why[sizeof why - 1] = '\0';
+		snprintf(p->error, sizeof p->error, "mirror image of %g deg %s: %.118s",
+			 src->beta.user, src->rotation == SIM_CW ? "cw" : "ccw", why);
+	}
+	sw->done++;
+}
+
 static void run_point(void *arg)
 {
 	sweep_job *job = arg;
 	srv_sweep *sw = job->sw;
-	api_sweep_point *p = &sw->pt[job->i];
+	size_t job_i = job->i;
+	api_sweep_point *p = &sw->pt[job_i];
 	free(job);
 	pthread_mutex_lock(&sw->lock);
 	int skip = sw->cancelled || srv_stopping();
@@ -201,6 +262,7 @@ static void run_point(void *arg)
 				 msg[0] ? msg : sim_strerror(rc));
 		}
 		sw->done++;
+		fill_image(sw, job_i);
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
 		persist_locked(sw);
 		if (sw->done == sw->total)
@@ -256,12 +318,19 @@ size_t srv_sweeps_restore(void)
 					sw->pt[k].state = 0;
 				sw->done += sw->pt[k].state >= 2;
 			}
-			if (srv_registry_reserve(&sweeps, &sw->entry, NULL) == 0) {
+			/* the plan again; an image whose point is over is
+			 * filled (written together, but a stop may fall
+			 * between the two writes) */
+			int planned = plan(sw) == 0;
+			for (size_t k = 0; planned && k < sw->total; k++)
+				if (sw->pt[k].state >= 2)
+					fill_image(sw, k);
+			if (planned && srv_registry_reserve(&sweeps, &sw->entry, NULL) == 0) {
 				srv_registry_publish(&sweeps, &sw->entry);
 				pthread_mutex_lock(&sw->lock);
 				size_t refs = 0;
 				for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
-					if (sw->pt[k].state != 0)
+					if (sw->pt[k].state != 0 || sw->pt[k].mirrored)
 						continue;
 					sweep_job *job = malloc(sizeof *job);
 					if (!job)
@@ -338,15 +407,23 @@ static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
 			p->beta = sw->req.betas[b];
 			p->rotation = sw->req.rotations[ro];
 		}
+	if (plan(sw) != 0) {
+		sweep_free(sw);
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
 	return sw;
 }
 
-/* Queue one pool job per point, each with a reference; a point that cannot
- * be queued is marked failed. Returns the references not handed out. */
+/* Queue one pool job per point that runs (not a mirror image), each with
+ * a reference; a point that cannot be queued is marked failed, and its
+ * image with it. Returns the references not handed out. */
 static size_t submit_points(srv_sweep *sw)
 {
 	size_t unused = 0;
 	for (size_t i = 0; i < sw->total; i++) {
+		if (sw->pt[i].mirrored)
+			continue;
 		sweep_job *job = malloc(sizeof *job);
 		if (job) {
 			job->sw = sw;
@@ -358,6 +435,7 @@ static size_t submit_points(srv_sweep *sw)
 			snprintf(sw->pt[i].error, sizeof sw->pt[i].error,
 				 "not queued (out of memory or stopping)");
 			sw->done++;
+			fill_image(sw, i);
 			unused++;
 		}
 	}
@@ -371,19 +449,19 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 	srv_sweep *sw = sweep_new(r, &pb);
 	if (!sw)
 		return srv_reply_problem(r, &pb, NULL);
-	if (srv_budget_take_points(sw->total, "beta", 0, &pb) != API_OK) {
+	if (srv_budget_take_points(sw->jobs, "beta", 0, &pb) != API_OK) {
 		sweep_free(sw);
 		return srv_reply_problem(r, &pb, NULL);
 	}
 	if (srv_registry_reserve(&sweeps, &sw->entry, evictable)) {
-		srv_budget_give_points(sw->total);
+		srv_budget_give_points(sw->jobs);
 		sweep_free(sw);
 		return srv_fail(r, API_LIMIT, NULL,
 				"%d sweeps are running or kept; delete one",
 				cfg->max_sweeps);
 	}
 	srv_registry_publish(&sweeps, &sw->entry);
-	for (size_t i = 0; i < sw->total; i++)
+	for (size_t i = 0; i < sw->jobs; i++)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */
 	/* jobs wait for the lock: the answer shows the sweep as queued */
 	pthread_mutex_lock(&sw->lock);

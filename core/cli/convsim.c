@@ -247,6 +247,7 @@ static int cmd_run(int argc, char **argv)
 typedef struct task {
 	double beta;
 	int rotation;
+	long source; /* -1: measured; else the task it mirrors (sim_mirror_plan) */
 	sim_measurement r;
 	int err;
 	char msg[160];
@@ -255,6 +256,7 @@ typedef struct task {
 typedef struct pool {
 	const cli_opts *o;
 	task *tasks;
+	int *run;    /* the tasks to measure, in order */
 	int n, next, done;
 	cli_progress progress;
 	pthread_mutex_t lock;
@@ -265,7 +267,7 @@ static void *worker(void *arg)
 	pool *pl = arg;
 	for (;;) {
 		pthread_mutex_lock(&pl->lock);
-		int i = pl->next < pl->n ? pl->next++ : -1;
+		int i = pl->next < pl->n ? pl->run[pl->next++] : -1;
 		pthread_mutex_unlock(&pl->lock);
 		if (i < 0)
 			return NULL;
@@ -285,10 +287,60 @@ static void *worker(void *arg)
 	}
 }
 
+/* The grid (rotation-major, like the daemon's) and its plan: which tasks
+ * to measure (pl->run, pl->n) and which to take as mirror images of
+ * another (sim_mirror_plan). -1 when out of memory. */
+static int plan_sweep(const cli_opts *o, task *tasks, int ntasks, double from, double step, int nb,
+		      const int *rots, pool *pl)
+{
+	double *beta = calloc((size_t)ntasks, sizeof(double));
+	int *rot = calloc((size_t)ntasks, sizeof(int));
+	long *source = calloc((size_t)ntasks, sizeof(long));
+	int rc = beta && rot && source ? 0 : -1;
+	for (int k = 0; rc == 0 && k < ntasks; k++) {
+		tasks[k].beta = from + step * (k % nb);
+		tasks[k].rotation = rots[k / nb];
+		beta[k] = tasks[k].beta * RAD_PER_DEG;
+		rot[k] = tasks[k].rotation;
+	}
+	if (rc == 0) {
+		sim_mirror_plan(&o->p, &o->sc, (size_t)ntasks, beta, rot, source);
+		for (int k = 0; k < ntasks; k++) {
+			tasks[k].source = source[k];
+			if (source[k] < 0)
+				pl->run[pl->n++] = k;
+		}
+	}
+	free(beta);
+	free(rot);
+	free(source);
+	return rc;
+}
+
+/* Fill every mirrored task from the task it mirrors (after the runs). */
+static void mirror_tasks(task *tasks, int ntasks)
+{
+	for (int k = 0; k < ntasks; k++) {
+		task *t = &tasks[k];
+		if (t->source < 0)
+			continue;
+		const task *src = &tasks[t->source];
+		sim_mirror_measurement(&src->r, &t->r);
+		t->err = src->err;
+		if (src->err != SIM_OK) {
+			char why[sizeof src->msg];
+			memcpy(why, src->msg, sizeof why);
+			why[sizeof why - 1] = '\0';
+			snprintf(t->msg, sizeof t->msg, "mirror image of %g deg %s: %.118s", src->beta,
+				 src->rotation == SIM_CW ? "cw" : "ccw", why);
+		}
+	}
+}
+
 /* The sweep's table (CSV with the daemon's header, or JSON with the
  * daemon's point members) on f; failures on stderr. Returns the number of
  * failed points. */
-static int print_sweep(FILE *f, const cli_opts *o, const pool *pl)
+static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 {
 	int json = o->format && strcmp(o->format, "json") == 0, failed = 0;
 	if (json) {
@@ -296,11 +348,12 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl)
 		put_num(f, o->duration, "null");
 		fputs(",\"transient\":", f);
 		put_num(f, o->sc.transient, "null");
-		fprintf(f, ",\"method\":\"%s\",\"points\":[\n", o->m.name);
+		fprintf(f, ",\"method\":\"%s\",\"reductions\":[%s],\"points\":[\n", o->m.name,
+			pl->n < ntasks ? "\"mirror\"" : "");
 	} else {
 		fputs(SIM_SWEEP_CSV_HEADER "\n", f);
 	}
-	for (int i = 0; i < pl->n; i++) {
+	for (int i = 0; i < ntasks; i++) {
 		const task *t = &pl->tasks[i];
 		const char *rot = t->rotation == SIM_CW ? "cw" : "ccw";
 		const char *state = t->err == SIM_OK ? "done" : "failed";
@@ -317,8 +370,8 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl)
 		fputs(json ? ",\"uncertainty\":" : ",", f);
 		put_num(f, t->r.uncertainty, nf);
 		if (json)
-			fprintf(f, ",\"steady\":%s,\"state\":\"%s\"}%s\n", steady, state,
-				i + 1 < pl->n ? "," : "");
+			fprintf(f, ",\"steady\":%s,\"state\":\"%s\",\"mirrored\":%s}%s\n", steady,
+				state, t->source >= 0 ? "true" : "false", i + 1 < ntasks ? "," : "");
 		else
 			fprintf(f, ",%s,%s\n", steady, state);
 	}
@@ -398,15 +451,15 @@ static int cmd_sweep(int argc, char **argv)
 	FILE *out = stdout;
 	if (o.out && !(out = open_out(&o)))
 		return 1;
-	pool pl = {.o = &o, .n = nb * nrot};
-	pl.tasks = calloc((size_t)pl.n, sizeof(task));
-	if (!pl.tasks)
+	int ntasks = nb * nrot;
+	pool pl = {.o = &o};
+	pl.tasks = calloc((size_t)ntasks, sizeof(task));
+	pl.run = calloc((size_t)ntasks, sizeof(int));
+	if (!pl.tasks || !pl.run || plan_sweep(&o, pl.tasks, ntasks, from, step, nb, rots, &pl)) {
+		free(pl.tasks);
+		free(pl.run);
 		return 1;
-	for (int r = 0; r < nrot; r++)
-		for (int i = 0; i < nb; i++) {
-			pl.tasks[r * nb + i].beta = from + step * i;
-			pl.tasks[r * nb + i].rotation = rots[r];
-		}
+	}
 	pthread_mutex_init(&pl.lock, NULL);
 	cli_progress_start(&pl.progress, "sweep", o.quiet, 0);
 	pthread_t th[64];
@@ -415,11 +468,15 @@ static int cmd_sweep(int argc, char **argv)
 		pthread_create(&th[i], NULL, worker, &pl);
 	for (int i = 0; i < nth; i++)
 		pthread_join(th[i], NULL);
-	char done[96];
+	mirror_tasks(pl.tasks, ntasks);
+	char done[128];
 	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl.done, pl.n,
 		 cli_now() - pl.progress.t0);
+	if (pl.n < ntasks)
+		snprintf(done + strlen(done), sizeof done - strlen(done),
+			 "; %d more as their mirror images (mirror reduction)", ntasks - pl.n);
 	cli_progress_end(&pl.progress, done, 1);
-	int failed = print_sweep(out, &o, &pl);
+	int failed = print_sweep(out, &o, &pl, ntasks);
 	int write_failed = 0;
 	if (out != stdout) {
 		write_failed = ferror(out) | (fclose(out) != 0);
@@ -428,6 +485,7 @@ static int cmd_sweep(int argc, char **argv)
 	}
 	pthread_mutex_destroy(&pl.lock);
 	free(pl.tasks);
+	free(pl.run);
 	return failed || write_failed ? 1 : 0;
 }
 

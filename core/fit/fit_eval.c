@@ -7,6 +7,9 @@
  * grid around the measured beta (the grid point of the largest |v|) and a
  * least-squares parabola through that point and two neighbours each side,
  * with its uncertainty propagated from the error bars of those velocities.
+ * A batch takes the mirror reduction (sim_mirror_plan) within each
+ * parameter set: a unit that is the mirror image of another of the same
+ * set is not run but taken from it, v negated.
  */
 #include <math.h>
 #include <stdio.h>
@@ -71,7 +74,26 @@ typedef struct batch {
 	const double *beta;
 	const int *rotation;
 	double *v, *u;
+	const size_t *run;    /* the units that run (the others are images) */
 } batch;
+
+/* The model of parameter set `set`: the request's with the set's free
+ * values. SIM_OK, or sim_set's code with msg. */
+static int set_model(const batch *b, size_t set, sim_params *p, sim_scene *sc, sim_method *m,
+		     char *msg, size_t msglen)
+{
+	const fit_request *r = b->ev->req;
+	*p = r->p;
+	*sc = r->sc;
+	*m = r->m;
+	for (int j = 0; j < r->nfree; j++) {
+		int e = sim_set(p, sc, m, r->free[j].name, b->xs[set * (size_t)r->nfree + (size_t)j],
+				msg, msglen);
+		if (e != SIM_OK)
+			return e;
+	}
+	return SIM_OK;
+}
 
 static void fail(fit_eval *ev, int why, const char *fmt, double beta, int rot, const char *msg)
 {
@@ -98,16 +120,14 @@ static void run_unit(void *arg, size_t k)
 	pthread_mutex_unlock(&ev->lock);
 	if (stop)
 		return;
-	sim_params p = r->p;
-	sim_scene sc = r->sc;
-	sim_method m = r->m;
+	sim_params p;
+	sim_scene sc;
+	sim_method m;
 	char msg[160] = "";
-	for (int j = 0; j < r->nfree; j++)
-		if (sim_set(&p, &sc, &m, r->free[j].name, b->xs[set * (size_t)r->nfree + (size_t)j],
-			    msg, sizeof msg) != SIM_OK) {
-			fail(ev, 1, "beta %g deg %s: %s", b->beta[i], b->rotation[i], msg);
-			return;
-		}
+	if (set_model(b, set, &p, &sc, &m, msg, sizeof msg) != SIM_OK) {
+		fail(ev, 1, "beta %g deg %s: %s", b->beta[i], b->rotation[i], msg);
+		return;
+	}
 	p.beta = b->beta[i];
 	p.rotation = b->rotation[i];
 	sim_measurement ms;
@@ -163,19 +183,70 @@ static void own_threads(int threads, size_t n, fit_job job, void *arg)
 	pthread_mutex_destroy(&om.lock);
 }
 
+static void run_listed(void *arg, size_t k)
+{
+	batch *b = arg;
+	run_unit(b, b->run[k]);
+}
+
+/* The mirror reduction's plan of each set: the units to run into run
+ * (their count returned), image[k] = the unit whose image unit k is, or
+ * (size_t)-1. A set whose values cannot be set runs every unit (and
+ * fails there with the reason). */
+static size_t plan(const batch *b, size_t nsets, size_t *run, size_t *image, long *source)
+{
+	size_t nrun = 0;
+	for (size_t set = 0; set < nsets; set++) {
+		sim_params p;
+		sim_scene sc;
+		sim_method m;
+		char msg[160];
+		if (set_model(b, set, &p, &sc, &m, msg, sizeof msg) == SIM_OK)
+			sim_mirror_plan(&p, &sc, b->n, b->beta, b->rotation, source);
+		else
+			for (size_t i = 0; i < b->n; i++)
+				source[i] = -1;
+		for (size_t i = 0; i < b->n; i++) {
+			size_t k = set * b->n + i;
+			image[k] = source[i] < 0 ? (size_t)-1 : set * b->n + (size_t)source[i];
+			if (source[i] < 0)
+				run[nrun++] = k;
+		}
+	}
+	return nrun;
+}
+
 int fit_eval_curve(fit_eval *ev, size_t nsets, const double *xs, size_t n, const double *beta,
 		   const int *rotation, double *v, double *u)
 {
 	const fit_request *r = ev->req;
-	double *ubuf = u ? NULL : malloc(sizeof *ubuf * nsets * n);
-	if (!u && !ubuf)
+	size_t total = nsets * n;
+	double *ubuf = u ? NULL : malloc(sizeof *ubuf * total);
+	size_t *run = malloc(sizeof *run * (total ? total : 1)),
+	       *image = malloc(sizeof *image * (total ? total : 1));
+	long *source = malloc(sizeof *source * (n ? n : 1));
+	if ((!u && !ubuf) || !run || !image || !source) {
+		free(ubuf);
+		free(run);
+		free(image);
+		free(source);
 		return -1;
-	batch b = {ev, xs, n, beta, rotation, v, u ? u : ubuf};
+	}
+	batch b = {ev, xs, n, beta, rotation, v, u ? u : ubuf, run};
+	size_t nrun = plan(&b, nsets, run, image, source);
 	if (r->map)
-		r->map(r->map_ctx, nsets * n, run_unit, &b);
+		r->map(r->map_ctx, nrun, run_listed, &b);
 	else
-		own_threads(r->threads, nsets * n, run_unit, &b);
+		own_threads(r->threads, nrun, run_listed, &b);
+	for (size_t k = 0; k < total; k++)
+		if (image[k] != (size_t)-1) {
+			b.v[k] = -b.v[image[k]];
+			b.u[k] = b.u[image[k]];
+		}
 	free(ubuf);
+	free(run);
+	free(image);
+	free(source);
 	if (!ev->failed && r->cancelled && r->cancelled(r->ctx))
 		ev->failed = 2;
 	return ev->failed ? -1 : 0;

@@ -4,7 +4,8 @@
 # `convsim sweep` (what daemon sweeps use too), against the converged
 # reference tests/bench/results/vref.tsv (tests/bench/vref.sh). Also the
 # full model (trough_rotation=true) at the same defaults, so the automatic
-# symmetric reduction's own error shows. Accuracy convention (docs/MODEL.md):
+# symmetric reduction's own error shows, and every point run directly
+# (mirror=false), so the mirror reduction's does. Accuracy convention (docs/MODEL.md):
 # a point is within 1 % when |v - v_ref| <= 0.01 |v_ref| where
 # |v_ref| >= 0.3 peak, else <= 0.01 peak. Each point's error bar u (the
 # sweep's `uncertainty`) must contain v_ref. Writes $1/accuracy.md.
@@ -24,9 +25,16 @@ sweep() { # name, extra arguments...: one core, CPU seconds into $tmp/name.cpu
 }
 # name | sweep arguments | what the row shows
 runs=(
-	"default||the defaults (steady start, 4-s window, dem 1e-3 s / 16 sub-steps, symmetric reduction)"
-	"full|--set trough_rotation=true|the same on the full model: the reduction's own error"
+	"default||the defaults (steady start settled 1 s, 4-s window, dem 1e-3 s / 16 sub-steps, symmetric and mirror reductions)"
+	"full|--set trough_rotation=true|the same on the full model: the symmetric reduction's own error"
+	"direct|--set mirror=false|every point run, none taken as a mirror image: the mirror reduction's own error"
+	"settle 1.5 s|--set settle=1.5|the former settling"
+	"settle 0.75 s|--set settle=0.75|shorter settling"
+	"settle 0.6 s|--set settle=0.6|shorter still"
+	"settle 0.4 s|--set settle=0.4|the settling too short"
 	"window 3 s|--duration 3|the defaults with a 3-s window"
+	"window 3 s, settle 1.5 s|--duration 3 --set settle=1.5|a 3-s window after the former settling"
+	"window 3.5 s, settle 0.6 s|--duration 3.5 --set settle=0.6|a 3.5-s window after a 0.6-s settling"
 	"window 2 s|--duration 2|the defaults with a 2-s window"
 	"rest 2+2 s|--set start=rest --set transient=2 --duration 4|the former measurement: run-up from rest, window [2, 4] s"
 	"rest 8+4 s|--set start=rest --set transient=8 --duration 12|run-up from rest, window [8, 12] s"
@@ -88,6 +96,21 @@ gate() { # name, what: the summary row of one sweep against the reference
 			printf "The symmetric reduction (applied by the defaults) against the full model at the same\n"
 			printf "step and start, all 74 points: largest |v - v_full| = %.2g m/s (%.3f %% of the peak, at %s);\n", worst, 100 * worst / peak, at
 			printf "speed-up %.2f (CPU of the curve).\n", cf / cd
+		}'
+	echo
+	# the mirror reduction against running every point
+	paste -d, "$tmp/default.csv" "$tmp/direct.csv" | awk -F, -v cd="$(cat "$tmp/default.cpu")" \
+		-v cf="$(cat "$tmp/direct.cpu")" '
+		function abs(x) { return x < 0 ? -x : x }
+		NR == 1 { next }
+		{
+			a = abs($9); if (a > peak) peak = a; d = abs($3 - $9); if (d > worst) { worst = d; at = $1 "° " $2 }
+			du = abs($4 - $10) / $10; if (du > wu) wu = du; if ($5 != $11) flags++
+		}
+		END {
+			printf "The mirror reduction (applied by the defaults) against running every point, all 74 points:\n"
+			printf "largest |v - v_direct| = %.2g m/s (%.4f %% of the peak, at %s), error bars within %.1f %%,\n", worst, 100 * worst / peak, at, 100 * wu
+			printf "%d steady flags differ; speed-up %.2f (CPU of the curve).\n", flags, cf / cd
 		}'
 	echo
 	echo "Per point (default run): beta, rotation, v, uncertainty, v_ref, error (convention, %)."

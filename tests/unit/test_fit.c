@@ -117,6 +117,45 @@ static void recovers_known_parameters(void **state)
 	fit_result_free(&res);
 }
 
+/* The batches take the mirror reduction: with the data in mirrored pairs
+ * ((cw, beta) and (ccw, 180 deg - beta)) each pair's second point is the
+ * image of its first, so half the evaluations run, and the fit is the one
+ * that runs every point (mirror = false) within a tenth of its standard
+ * errors. */
+static void mirror_reduction_in_batches(void **state)
+{
+	(void)state;
+	fit_point clean[NPTS], pts[2 * NPTS];
+	truth(clean);
+	unsigned long long seed = 20161124;
+	for (int i = 0; i < NPTS; i++) {
+		pts[2 * i] = clean[i];
+		pts[2 * i + 1] = (fit_point){SIM_PI - clean[i].beta, SIM_CCW, -clean[i].v, SIGMA};
+	}
+	for (int i = 0; i < 2 * NPTS; i++)
+		pts[i].v += SIGMA * gauss(&seed);
+	fit_result res[2];
+	for (int mirror = 0; mirror < 2; mirror++) {
+		fit_request r;
+		cheap_request(&r);
+		r.sc.mirror = mirror;
+		r.free[0].start = 0.018;
+		r.free[1].start = 0.5;
+		r.points = pts;
+		r.npoints = 2 * NPTS;
+		char field[48], msg[FIT_MSG];
+		assert_int_equal(fit_check(&r, field, sizeof field, msg, sizeof msg), SIM_OK);
+		assert_int_equal(fit_run(&r, &res[mirror]), FIT_CONVERGED);
+	}
+	printf("  evaluations: %ld every point, %ld with the mirror reduction\n", res[0].evaluations,
+	       res[1].evaluations);
+	assert_true(res[1].evaluations <= res[0].evaluations * 6 / 10);
+	for (int j = 0; j < 2; j++)
+		assert_true(fabs(res[1].x[j] - res[0].x[j]) <= 0.1 * res[0].se[j]);
+	fit_result_free(&res[0]);
+	fit_result_free(&res[1]);
+}
+
 /* Repeated fits, each from the truth, each with fresh noise: the scatter of
  * the estimates against the mean standard error. */
 static void standard_errors_match_scatter(void **state)
@@ -236,6 +275,7 @@ int main(void)
 		cmocka_unit_test(parses_csv),
 		cmocka_unit_test(recovers_known_parameters),
 		cmocka_unit_test(standard_errors_match_scatter),
+		cmocka_unit_test(mirror_reduction_in_batches),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
