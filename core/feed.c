@@ -191,11 +191,16 @@ enum { BOND = 0, HI = 1, LO = 2 };
 static void chain_solve(int L, double m, const double *vs, double v0, const double *lo,
 			const double *hi, double *P, double *v, signed char *mode)
 {
+	int changed = 0;
 	for (int iter = 0; iter < 4 * L + 8; iter++) {
+		/* clusters: a run of layers a..b bonded above a, resting on
+		 * the fixed impulse of contact a (or riding with the deck),
+		 * with the fixed impulse of contact b + 1 on top */
 		for (int a = 0; a < L;) {
+			double sum = vs[a];
 			int b = a;
 			while (b + 1 < L && mode[b + 1] == BOND)
-				b++;
+				sum += vs[++b];
 			double Ptop = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
 			if (a == 0 && mode[0] == BOND) {
 				/* rides with the deck */
@@ -206,34 +211,40 @@ static void chain_solve(int L, double m, const double *vs, double v0, const doub
 					v[j] = v0;
 				}
 			} else {
-				double Pbot = mode[a] == HI ? hi[a] : lo[a], sum = 0.0;
-				for (int j = a; j <= b; j++)
-					sum += vs[j];
+				double Pbot = mode[a] == HI ? hi[a] : lo[a];
 				double n = (double)(b - a + 1);
 				double vc = (m * sum + Pbot - Ptop) / (n * m);
-				P[a] = Pbot;
-				for (int j = a; j <= b; j++) {
+				/* the running impulse in a register: the chain is
+				 * serial, so no store-to-load round trip per layer */
+				double Pj = Pbot;
+				for (int j = a; j < b; j++) {
+					P[j] = Pj;
 					v[j] = vc;
-					if (j < b)
-						P[j + 1] = P[j] - m * (vc - vs[j]);
+					Pj -= m * (vc - vs[j]);
 				}
+				P[b] = Pj;
+				v[b] = vc;
 			}
 			a = b + 1;
 		}
 		/* consistency; after L rounds switch one contact at a time */
-		int changed = 0;
+		changed = 0;
+		double below = v0;
 		for (int j = 0; j < L && !(changed && iter >= L); j++) {
-			double sj = (j == 0 ? v0 : v[j - 1]) - v[j];
-			double tolP = 1e-12 * (fabs(hi[j]) + fabs(lo[j])) + 1e-300;
+			double sj = below - v[j];
+			below = v[j];
 			signed char nm = mode[j];
-			if (hi[j] == lo[j])
+			if (hi[j] == lo[j]) {
 				nm = HI; /* fixed impulse (or no contact) */
-			else if (mode[j] == BOND)
+			} else if (nm == BOND) {
+				double tolP = 1e-12 * (fabs(hi[j]) + fabs(lo[j])) + 1e-300;
 				nm = P[j] > hi[j] + tolP ? HI : P[j] < lo[j] - tolP ? LO : BOND;
-			else if (mode[j] == HI && sj < -1e-13)
+			} else if (nm == HI) {
+				if (sj < -1e-13)
+					nm = BOND;
+			} else if (sj > 1e-13) {
 				nm = BOND;
-			else if (mode[j] == LO && sj > 1e-13)
-				nm = BOND;
+			}
 			if (nm != mode[j]) {
 				mode[j] = nm;
 				changed = 1;
@@ -242,65 +253,89 @@ static void chain_solve(int L, double m, const double *vs, double v0, const doub
 		if (!changed)
 			break;
 	}
-	for (int j = 0; j < L; j++)
-		if (mode[j] != BOND)
-			P[j] = mode[j] == HI ? hi[j] : lo[j];
+	/* every cluster's bottom already carries its fixed impulse, unless
+	 * the iteration stopped on a switch it did not follow */
+	if (changed)
+		for (int j = 0; j < L; j++)
+			if (mode[j] != BOND)
+				P[j] = mode[j] == HI ? hi[j] : lo[j];
 }
 
-void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
-		      const double deck_vel[2], double h, signed char *modes, double impulse[2],
-		      double *fric, double *contact)
+/* Sub-steps of one column (feed.h); the column's state is held in local
+ * arrays from the first sub-step to the last. */
+void feed_dem_column(const model *md, double *y, int k, int ns, double h,
+		     const double (*deck_pos)[2], const double (*deck_vel)[2], signed char *modes,
+		     double impulse[2], double *fric, double *contact)
 {
 	const int L = md->L, base = k * L;
 	double *xi = XI(md, y), *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
 	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
+	const int coulomb = md->sc.friction == SIM_FRICTION_COULOMB;
 	double hi[SIM_MAX_LAYERS], lo[SIM_MAX_LAYERS], vs[SIM_MAX_LAYERS], Pn[SIM_MAX_LAYERS],
 		Pt[SIM_MAX_LAYERS], vn[SIM_MAX_LAYERS], vt[SIM_MAX_LAYERS];
+	double cx[SIM_MAX_LAYERS], cy[SIM_MAX_LAYERS], cvx[SIM_MAX_LAYERS], cvy[SIM_MAX_LAYERS];
 	signed char *mn = modes + base, *mt = modes + md->nf + base;
 	if (L < 1 || L > SIM_MAX_LAYERS)
 		return;
-	/* normal impulse bounds from the compressions at the sub-step's start:
-	 * loading k delta^p h, unloading R^2 k delta^p h */
-	double prev_eta = deck_pos[1];
 	for (int j = 0; j < L; j++) {
-		int e = base + j;
-		double delta = prev_eta - eta[e];
-		hi[j] = delta > 0.0 ? h * contact_force(md, delta, 1.0) : 0.0;
-		lo[j] = R2 * hi[j];
-		vs[j] = etad[e] - g * h;
-		prev_eta = eta[e];
+		cx[j] = xi[base + j];
+		cy[j] = eta[base + j];
+		cvx[j] = xid[base + j];
+		cvy[j] = etad[base + j];
 	}
-	chain_solve(L, m, vs, deck_vel[1], lo, hi, Pn, vn, mn);
-	/* friction impulses within [-mu, mu] times the normal ones */
-	for (int j = 0; j < L; j++) {
-		vs[j] = xid[base + j];
-		hi[j] = mu * Pn[j];
-		lo[j] = -hi[j];
-	}
-	if (md->sc.friction == SIM_FRICTION_COULOMB) {
-		chain_solve(L, m, vs, deck_vel[0], lo, hi, Pt, vt, mt);
-	} else {
-		/* regularised: explicit in the velocities at the start */
+	double imp_x = 0.0, imp_y = 0.0, work_f = 0.0, work_c = 0.0;
+	for (int i = 0; i < ns; i++) {
+		const double *dp = deck_pos[i], *dv = deck_vel[i];
+		/* normal impulse bounds from the compressions at the sub-step's
+		 * start: loading k delta^p h, unloading R^2 k delta^p h */
+		double prev_eta = dp[1];
 		for (int j = 0; j < L; j++) {
-			double below = j == 0 ? deck_vel[0] : vs[j - 1];
-			Pt[j] = hi[j] * tanh((below - vs[j]) / md->sc.friction_eps);
+			double delta = prev_eta - cy[j];
+			hi[j] = delta > 0.0 ? h * contact_force(md, delta, 1.0) : 0.0;
+			lo[j] = R2 * hi[j];
+			vs[j] = cvy[j] - g * h;
+			prev_eta = cy[j];
 		}
-		for (int j = 0; j < L; j++)
-			vt[j] = vs[j] + (Pt[j] - (j + 1 < L ? Pt[j + 1] : 0.0)) / m;
+		chain_solve(L, m, vs, dv[1], lo, hi, Pn, vn, mn);
+		/* friction impulses within [-mu, mu] times the normal ones */
+		for (int j = 0; j < L; j++) {
+			hi[j] = mu * Pn[j];
+			lo[j] = -hi[j];
+		}
+		if (coulomb) {
+			chain_solve(L, m, cvx, dv[0], lo, hi, Pt, vt, mt);
+		} else {
+			/* regularised: explicit in the velocities at the start */
+			for (int j = 0; j < L; j++) {
+				double below = j == 0 ? dv[0] : cvx[j - 1];
+				Pt[j] = hi[j] * tanh((below - cvx[j]) / md->sc.friction_eps);
+			}
+			for (int j = 0; j < L; j++)
+				vt[j] = cvx[j] + (Pt[j] - (j + 1 < L ? Pt[j + 1] : 0.0)) / m;
+		}
+		double prev_vy = dv[1], prev_vx = dv[0];
+		for (int j = 0; j < L; j++) {
+			cvy[j] = vn[j];
+			cvx[j] = vt[j];
+			/* work on the relative motion at the new velocities */
+			work_c += Pn[j] * (prev_vy - vn[j]);
+			work_f += Pt[j] * (prev_vx - vt[j]);
+			prev_vy = vn[j];
+			prev_vx = vt[j];
+			cx[j] += h * vt[j];
+			cy[j] += h * vn[j];
+		}
+		imp_x -= Pt[0];
+		imp_y -= Pn[0];
 	}
-	double prev_vy = deck_vel[1], prev_vx = deck_vel[0];
 	for (int j = 0; j < L; j++) {
-		int e = base + j;
-		etad[e] = vn[j];
-		xid[e] = vt[j];
-		/* work on the relative motion at the new velocities */
-		*contact += Pn[j] * (prev_vy - vn[j]);
-		*fric += Pt[j] * (prev_vx - vt[j]);
-		prev_vy = vn[j];
-		prev_vx = vt[j];
-		xi[e] += h * vt[j];
-		eta[e] += h * vn[j];
+		xi[base + j] = cx[j];
+		eta[base + j] = cy[j];
+		xid[base + j] = cvx[j];
+		etad[base + j] = cvy[j];
 	}
-	impulse[0] -= Pt[0];
-	impulse[1] -= Pn[0];
+	impulse[0] += imp_x;
+	impulse[1] += imp_y;
+	*fric += work_f;
+	*contact += work_c;
 }

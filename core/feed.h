@@ -34,21 +34,22 @@ double feed_mean_xi(const model *md, const double *y, int k);
 /* Mean horizontal velocity (m/s) of all elements; 0 without feed. */
 double feed_mean_xi_rate(const model *md, const double *y);
 
-/* One sub-step of length h of column k for the split method "dem",
- * semi-implicit and staggered as leapfrog: impulse bounds from the
- * compressions at the start, then the normal and friction impulses of the
- * whole column solved for the velocities over the sub-step (those of its
- * middle), with which the positions advance. At zero relative velocity the laws are
- * set-valued (normal impulse in [R^2 k delta^p h, k delta^p h], friction in
- * [-mu, mu] times it), so resting and sticking layers rest and stick
- * exactly instead of chattering. The column's impulses are solved exactly
- * (an active-set solve over bonded clusters of layers, warm-started from
- * modes[2 nf]: normal then tangential contact modes). The deck moves as
- * prescribed: deck_pos at the start, deck_vel at the middle. Adds the
- * impulse on the deck to impulse[2] and the friction and contact work to
- * *fric, *contact. */
-void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
-		      const double deck_vel[2], double h, signed char *modes, double impulse[2],
-		      double *fric, double *contact);
+/* The feed's part of one macro step of the split method "dem" for column
+ * k: ns sub-steps of length h, each semi-implicit and staggered as
+ * leapfrog: impulse bounds from the compressions at its start, then the
+ * normal and friction impulses of the whole column solved for the
+ * velocities over the sub-step (those of its middle), with which the
+ * positions advance. At zero relative velocity the laws are set-valued
+ * (normal impulse in [R^2 k delta^p h, k delta^p h], friction in [-mu, mu]
+ * times it), so resting and sticking layers rest and stick exactly instead
+ * of chattering. The column's impulses are solved exactly (an active-set
+ * solve over bonded clusters of layers, warm-started from modes[2 nf]:
+ * normal then tangential contact modes). The deck moves as prescribed:
+ * deck_pos[i] at sub-step i's start, deck_vel[i] at its middle (borrowed,
+ * ns rows each). Adds the impulse on the deck to impulse[2] and the
+ * friction and contact work to *fric, *contact. */
+void feed_dem_column(const model *md, double *y, int k, int ns, double h,
+		     const double (*deck_pos)[2], const double (*deck_vel)[2], signed char *modes,
+		     double impulse[2], double *fric, double *contact);
 
 #endif

@@ -43,6 +43,7 @@ typedef struct dem {
 	double Qfeed[NQ_FULL];
 	double *k1, *k2, *k3, *k4, *tmp, *save;
 	signed char *modes;
+	double (*deck_pos)[2], (*deck_vel)[2]; /* a column's deck track, per sub-step */
 } dem;
 
 static void dem_free(void *p)
@@ -52,6 +53,7 @@ static void dem_free(void *p)
 		return;
 	free(w->k1);
 	free(w->modes);
+	free(w->deck_pos);
 	free(w);
 }
 
@@ -69,7 +71,8 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->nmodes = (int)nf;
 	w->k1 = calloc(6 * (size_t)md->n, sizeof(double));
 	w->modes = calloc(2 * nf, 1);
-	if (!w->k1 || !w->modes) {
+	w->deck_pos = calloc(2 * (size_t)w->substeps, sizeof *w->deck_pos);
+	if (!w->k1 || !w->modes || !w->deck_pos) {
 		dem_free(w);
 		return NULL;
 	}
@@ -78,6 +81,7 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->k4 = w->k3 + md->n;
 	w->tmp = w->k4 + md->n;
 	w->save = w->tmp + md->n;
+	w->deck_vel = w->deck_pos + w->substeps;
 	return w;
 }
 
@@ -190,14 +194,14 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		double impulse[2] = {0.0, 0.0};
 		for (int i = 0; i < ns; i++) {
 			double s0 = (double)i / ns, s1 = (double)(i + 1) / ns;
-			double pos[2], vel[2];
 			for (int c = 0; c < 2; c++) {
-				pos[c] = ode_hermite(p0[c], v0[c], p1[c], v1[c], H, s0);
-				vel[c] = ode_hermite(v0[c], a0[c], v1[c], a1[c], H, 0.5 * (s0 + s1));
+				w->deck_pos[i][c] = ode_hermite(p0[c], v0[c], p1[c], v1[c], H, s0);
+				w->deck_vel[i][c] =
+					ode_hermite(v0[c], a0[c], v1[c], a1[c], H, 0.5 * (s0 + s1));
 			}
-			feed_dem_substep(md, y, k, pos, vel, h, w->modes, impulse, &fric,
-					 &contact);
 		}
+		feed_dem_column(md, y, k, ns, h, (const double(*)[2])w->deck_pos,
+				(const double(*)[2])w->deck_vel, w->modes, impulse, &fric, &contact);
 		F[k][0] = impulse[0] / H;
 		F[k][1] = impulse[1] / H;
 	}
