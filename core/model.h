@@ -43,6 +43,7 @@ typedef struct model {
 	 * the trough (x, y, alpha), and the inverse constant inertia of each
 	 * point mass's own coordinate (phi, s1, s2; 0 for the trough's) */
 	int n_body, body[3];
+	int selection;                /* each reduced coordinate one full one, none prescribed */
 	double own_inv[NQ_FULL];
 	double own_m[NQ_FULL];        /* ... and that inertia, by full coordinate */
 	/* feed */
