@@ -27,8 +27,8 @@
  *     heavier feeds keep the lagged coupling, which is stable.
  *
  * With feed_events (the default) two first-order errors of that scheme
- * are removed, which halves the sub-steps the 1 % gate needs (8 instead of
- * 16 per 1e-3-s step):
+ * are removed, which quarters the sub-steps the 1 % gate needs (4 instead
+ * of 16 per 1e-3-s step):
  *
  *  - slip reversals inside a feed sub-step are located (feed.c,
  *    friction_events), not given the end's friction for the whole
@@ -156,7 +156,9 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
  * accelerations qr[c] that unit generalized forces on x, y (and alpha,
  * nb = 3) give the machine: C[k][j] = w J_k B J_j^T, with B the trough's
  * (x, y, alpha) part, J_k the deck point's Jacobian on (x, y, alpha) and
- * w the physical columns one integrated column stands for. */
+ * w the physical columns one integrated column stands for. Mirrored
+ * states give mirrored C to the last bit (each entry's terms change sign
+ * together). */
 static void deck_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
 			    const deck_rot *R, feed_yield *yl)
 {
@@ -169,28 +171,24 @@ static void deck_compliance(const model *md, int nb, const double (*qr)[NQ_FULL]
 		for (int i = 0; i < 3; i++)
 			B[i][c] = qdd[i];
 	}
+	/* T_k = w J_k B, then C[k][j] = T_k J_j^T; J_k = [[1, 0, -Rd_y],
+	 * [0, 1, Rd_x]] with Rd_k the deck point's arm from G */
 	const deck *dk = &md->dk;
-	double J[SIM_MAX_COLUMNS][2][3];
+	double Rd[SIM_MAX_COLUMNS][2], T[SIM_MAX_COLUMNS][2][3];
 	for (int k = 0; k < dk->K; k++) {
-		double b[2] = {dk->d[k], dk->h_d}, Rd[2];
-		deck_rotate(R, b, Rd);
-		J[k][0][0] = 1.0;
-		J[k][0][1] = 0.0;
-		J[k][0][2] = -Rd[1];
-		J[k][1][0] = 0.0;
-		J[k][1][1] = 1.0;
-		J[k][1][2] = Rd[0];
+		double b[2] = {dk->d[k], dk->h_d};
+		deck_rotate(R, b, Rd[k]);
+		for (int q = 0; q < 3; q++) {
+			T[k][0][q] = md->col_weight * (B[0][q] - Rd[k][1] * B[2][q]);
+			T[k][1][q] = md->col_weight * (B[1][q] + Rd[k][0] * B[2][q]);
+		}
 	}
 	for (int k = 0; k < dk->K; k++)
 		for (int j = 0; j < dk->K; j++)
-			for (int a = 0; a < 2; a++)
-				for (int b = 0; b < 2; b++) {
-					double s = 0.0;
-					for (int p = 0; p < 3; p++)
-						for (int q = 0; q < 3; q++)
-							s += J[k][a][p] * B[p][q] * J[j][b][q];
-					yl->C[k][j][a][b] = md->col_weight * s;
-				}
+			for (int a = 0; a < 2; a++) {
+				yl->C[k][j][a][0] = T[k][a][0] - T[k][a][2] * Rd[j][1];
+				yl->C[k][j][a][1] = T[k][a][1] + T[k][a][2] * Rd[j][0];
+			}
 }
 
 /* 3. The corrector: the machine's step as if taken with the feed's

@@ -175,7 +175,7 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * feed is light enough for its corrected coupling. */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 /* The feed sub-steps that substeps = 0 stands for with macro step dt (s)
- * under method m: as many as keep the feed's step at or below 1.25e-4 s
+ * under method m: as many as keep the feed's step at or below 2.5e-4 s
  * with m->feed_events, 6.25e-5 s without. */
 int sim_default_substeps(const sim_method *m, double dt);
 
