@@ -34,21 +34,39 @@ double feed_mean_xi(const model *md, const double *y, int k);
 /* Mean horizontal velocity (m/s) of all elements; 0 without feed. */
 double feed_mean_xi_rate(const model *md, const double *y);
 
-/* One sub-step of length h of column k for the split method "dem",
- * semi-implicit and staggered as leapfrog: impulse bounds from the
- * compressions at the start, then the normal and friction impulses of the
- * whole column solved for the velocities over the sub-step (those of its
- * middle), with which the positions advance. At zero relative velocity the laws are
- * set-valued (normal impulse in [R^2 k delta^p h, k delta^p h], friction in
- * [-mu, mu] times it), so resting and sticking layers rest and stick
- * exactly instead of chattering. The column's impulses are solved exactly
- * (an active-set solve over bonded clusters of layers, warm-started from
- * modes[2 nf]: normal then tangential contact modes). The deck moves as
- * prescribed: deck_pos at the start, deck_vel at the middle. Adds the
- * impulse on the deck to impulse[2] and the friction and contact work to
- * *fric, *contact. */
-void feed_dem_substep(const model *md, double *y, int k, const double deck_pos[2],
-		      const double deck_vel[2], double h, signed char *modes, double impulse[2],
-		      double *fric, double *contact);
+/* How the deck yields to the feed within a machine step (dem's coupling):
+ * C[k][j] (2 x 2, 1/kg) is the change of column k's deck velocity per
+ * unit impulse of column j on the deck (the machine's inverse mass matrix
+ * seen at the deck points, all the physical columns j stands for
+ * counted), F[j] (N) the reaction of column j that the machine's step
+ * already holds. */
+typedef struct feed_yield {
+	double C[SIM_MAX_COLUMNS][SIM_MAX_COLUMNS][2][2];
+	double F[SIM_MAX_COLUMNS][2];
+} feed_yield;
+
+/* The feed's part of one macro step of the split method "dem": ns
+ * sub-steps of length h of every column, each semi-implicit and staggered
+ * as leapfrog: impulse bounds from the compressions at its start, then the
+ * normal and friction impulses of the whole column solved for the
+ * velocities over the sub-step (those of its middle), with which the
+ * positions advance. At zero relative velocity the laws are set-valued
+ * (normal impulse in [R^2 k delta^p h, k delta^p h], friction in [-mu, mu]
+ * times it), so resting and sticking layers rest and stick exactly instead
+ * of chattering. The column's impulses are solved exactly (an active-set
+ * solve over bonded clusters of layers, warm-started from modes[2 nf]:
+ * normal then tangential contact modes). With events, a slipping contact
+ * that stops or reverses inside a sub-step is located there (feed.c,
+ * friction_events) instead of taking its end's friction over the whole
+ * sub-step. The deck moves as prescribed (borrowed; column k's rows start
+ * at k ns and k (ns + 1)): deck_pos[i] at sub-step i's start,
+ * deck_vel[i + 1] at its middle and deck_vel[0] at the middle of the
+ * sub-step before the first; with yield (else NULL) it also yields to the
+ * feed's impulses as they come, the columns then stepped side by side.
+ * Writes each column's impulse on the deck into impulse[k] and adds the
+ * friction and contact work to *fric, *contact. */
+void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
+		   const double (*deck_vel)[2], int events, const feed_yield *yield,
+		   signed char *modes, double (*impulse)[2], double *fric, double *contact);
 
 #endif

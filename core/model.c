@@ -401,12 +401,20 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
 			  const double Q[NQ_FULL], double *qrdd)
 {
+	model_force_responses(md, ctl, t, y, 1, (const double(*)[NQ_FULL])Q,
+			      (double(*)[NQ_FULL])qrdd);
+}
+
+void model_force_responses(const model *md, const model_ctl *ctl, double t, const double *y,
+			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL])
+{
 	config cf;
 	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], none[NQ_FULL] = {0};
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
 	symmetrize(M);
-	model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q, none, qrdd);
+	for (int i = 0; i < n; i++)
+		model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q[i], none, qrdd[i]);
 }
 
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,

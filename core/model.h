@@ -43,6 +43,7 @@ typedef struct model {
 	 * the trough (x, y, alpha), and the inverse constant inertia of each
 	 * point mass's own coordinate (phi, s1, s2; 0 for the trough's) */
 	int n_body, body[3];
+	int selection;                /* each reduced coordinate one full one, none prescribed */
 	double own_inv[NQ_FULL];
 	double own_m[NQ_FULL];        /* ... and that inertia, by full coordinate */
 	/* feed */
@@ -123,6 +124,9 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
  * alone gives the machine in state y at t: (T^t M T)^-1 T^t Q. */
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
 			  const double Q[NQ_FULL], double *qrdd);
+/* The same for n forces Q[i] at once (one mass matrix): qrdd[i]. */
+void model_force_responses(const model *md, const model_ctl *ctl, double t, const double *y,
+			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL]);
 
 /* Kinetic and potential energy (J) of the machine alone in state y at t
  * (written); the potential includes gravity, springs and preload. */

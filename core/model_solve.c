@@ -22,7 +22,10 @@ void model_solve_layout(model *md)
 	md->own_m[Q_S1] = p->m1;
 	md->own_m[Q_S2] = p->m2;
 	md->n_body = 0;
+	md->selection = !md->phi_prescribed;
 	for (int r = 0; r < md->nq; r++) {
+		if (md->ncol[r] != 1)
+			md->selection = 0;
 		int i = md->col[r][0];
 		md->own_inv[r] = 0.0;
 		if (md->ncol[r] == 1 && (i == Q_PHI || i == Q_S1 || i == Q_S2))
@@ -67,10 +70,63 @@ static int ldlt_solve(int n, double A[3][3], double *b)
  * have constant, mutually uncoupled diagonals (md->own_inv holds their
  * inverses), so they are eliminated first and only the Schur complement
  * on the trough's coordinates (x, y and alpha, at most 3) is factored. */
+/* model_reduced_solve where every reduced coordinate is one full
+ * coordinate (no ideal drive: nothing prescribed, nothing combined): the
+ * same arithmetic in the same order, without the general case's
+ * index combinations. */
+static void selection_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			    const double rhs[NQ_FULL], double br[NQ_FULL])
+{
+	const int n = md->nq, nb = md->n_body;
+	int full[NQ_FULL], bf[3];
+	double S[3][3], x[3];
+	for (int r = 0; r < n; r++) {
+		full[r] = md->col[r][0];
+		br[r] = rhs[full[r]];
+	}
+	for (int a = 0; a < nb; a++)
+		bf[a] = full[md->body[a]];
+	for (int a = 0; a < nb; a++) {
+		x[a] = br[md->body[a]];
+		for (int c = 0; c <= a; c++)
+			S[a][c] = M[bf[a]][bf[c]];
+		for (int d = 0; d < n; d++) {
+			double inv = md->own_inv[d];
+			if (inv == 0.0)
+				continue;
+			const double *Md = M[full[d]];
+			x[a] -= Md[bf[a]] * inv * br[d];
+			for (int c = 0; c <= a; c++)
+				S[a][c] -= Md[bf[a]] * inv * Md[bf[c]];
+		}
+	}
+	if (ldlt_solve(nb, S, x) != 0) {
+		for (int r = 0; r < n; r++)
+			br[r] = NAN;
+		return;
+	}
+	for (int d = 0; d < n; d++) {
+		double inv = md->own_inv[d];
+		if (inv == 0.0)
+			continue;
+		const double *Md = M[full[d]];
+		double s = br[d];
+		for (int c = 0; c < nb; c++)
+			s -= Md[bf[c]] * x[c];
+		br[d] = s * inv;
+	}
+	for (int a = 0; a < nb; a++)
+		br[md->body[a]] = x[a];
+}
+
 void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
 {
 	int n = md->nq, nb = md->n_body;
+	if (md->selection) {
+		selection_solve(md, M, rhs, br);
+		return;
+	}
 	double Mr[NQ_FULL][NQ_FULL], res[NQ_FULL], S[3][3], x[3];
 	for (int i = 0; i < NQ_FULL; i++)
 		res[i] = md->phi_prescribed ? rhs[i] - M[i][Q_PHI] * qpdd[Q_PHI] : rhs[i];

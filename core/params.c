@@ -79,7 +79,8 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
-	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 6.25e-5 s")
+	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 2.5e-4 s (6.25e-5 s without feed_events)") \
+	X(G_METHOD, feed_events, BOOL, "", 0, 1, NULL, 1, "dem: locate slip reversals inside the feed's sub-steps and let the deck yield to the feed's impulses within the machine step; false: the former dem")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -173,18 +174,23 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	m->rtol = 1e-6;
 	m->atol = 1e-9;
 	m->substeps = 0; /* as many as the feed step needs */
+	m->feed_events = 1;
 }
 
 /* Defaults per scene kind, measured against the converged reference at
  * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
  * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
- * of 1e-3 s and feed sub-steps of at most 6.25e-5 s (16) with its
- * corrected coupling (worst 0.69 % by docs/MODEL.md's convention after a
- * `steady` start and a 4-s window; 8e-5 s sub-steps are 1.07 % off); a
+ * of 1e-3 s and feed sub-steps of at most 2.5e-4 s (4) with its slip
+ * reversals located and the deck yielding within the step (worst 0.77 %
+ * by docs/MODEL.md's convention after a `steady` start and a 4-s window;
+ * 0.34 % with 8 sub-steps);
+ * without those (feed_events = false, the former dem) sub-steps of at
+ * most 6.25e-5 s (16: worst 0.69 %; 8e-5 s sub-steps are 1.07 % off); a
  * feed too heavy for the corrector (added mass) takes single steps of
  * 2.5e-5 s; without feed the machine is smooth and RK4 at 1e-3 s keeps the
  * trajectory within 2e-4. */
 #define FEED_STEP_MAX 6.25e-5
+#define FEED_STEP_MAX_EVENTS 2.5e-4
 #define HEAVY_FEED_STEP 2.5e-5
 
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
@@ -201,9 +207,10 @@ double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method 
 	return 1e-3;
 }
 
-int sim_default_substeps(double dt)
+int sim_default_substeps(const sim_method *m, double dt)
 {
-	int n = (int)ceil(dt / FEED_STEP_MAX - 1e-9);
+	double hmax = m->feed_events ? FEED_STEP_MAX_EVENTS : FEED_STEP_MAX;
+	int n = (int)ceil(dt / hmax - 1e-9);
 	return n < 1 ? 1 : n;
 }
 

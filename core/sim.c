@@ -179,7 +179,7 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
 	if (s->cfg.dt == 0.0)
 		s->cfg.dt = sim_default_dt(p, sc, m);
 	if (s->cfg.substeps == 0)
-		s->cfg.substeps = s->md.nf > 0 ? sim_default_substeps(s->cfg.dt) : 1;
+		s->cfg.substeps = s->md.nf > 0 ? sim_default_substeps(&s->cfg, s->cfg.dt) : 1;
 	s->ode = ode_find(m->name);
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(4 * n, sizeof(double));

@@ -124,12 +124,15 @@ typedef struct sim_scene {
 /* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
  * default of the scene kind (sim_default_dt); rtol/atol for adaptive
  * methods; substeps: feed sub-steps per macro step (method "dem"), 0 for
- * sim_default_substeps(dt). */
+ * sim_default_substeps(); feed_events (dem): slip reversals located inside
+ * the feed's sub-steps and the deck yielding to the feed within the
+ * machine's step (0: the former dem). */
 typedef struct sim_method {
 	char name[24];
 	double dt;
 	double rtol, atol;
 	int substeps;
+	int feed_events;
 } sim_method;
 
 /* Description of one named setting, for validation, docs and OpenAPI. */
@@ -175,9 +178,10 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * for the kind of scene: with or without feed, and, for dem, whether the
  * feed is light enough for its corrected coupling. */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
-/* The feed sub-steps that substeps = 0 stands for with macro step dt (s):
- * as many as keep the feed's step at or below 6.25e-5 s. */
-int sim_default_substeps(double dt);
+/* The feed sub-steps that substeps = 0 stands for with macro step dt (s)
+ * under method m: as many as keep the feed's step at or below 2.5e-4 s
+ * with m->feed_events, 6.25e-5 s without. */
+int sim_default_substeps(const sim_method *m, double dt);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
  * method). Same error convention as sim_set. */

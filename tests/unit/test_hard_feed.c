@@ -341,6 +341,10 @@ static void heavy_feed_coupling_stays_stable(void **state)
 	set(&heavy, "layers", "24");
 	s = make(&light);
 	assert_close(status(s).dt, 1e-3, 0.0);
+	assert_int_equal(status(s).substeps, 4);
+	sim_free(s);
+	set(&light, "feed_events", "false"); /* the former dem */
+	s = make(&light);
 	assert_int_equal(status(s).substeps, 16);
 	sim_free(s);
 	s = make(&heavy);
