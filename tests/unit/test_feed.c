@@ -43,15 +43,6 @@ static void rebound_speed_is_R_times_impact(void **state)
 		}
 }
 
-static double run_velocity(setup *u, double t_end)
-{
-	sim *s = make(u);
-	advance(s, t_end);
-	double v = status(s).transport_velocity;
-	sim_free(s);
-	return v;
-}
-
 /* beta sets the direction: about 38 deg throws right, about 128 deg left
  * (clockwise rotation), and a beta change in a running session reverses
  * the feed without a change of rotation. */

@@ -142,15 +142,6 @@ static void feed_step_order_two_with_events(void **state)
 	}
 }
 
-static double run_velocity(setup *u, double t_end)
-{
-	sim *s = make(u);
-	advance(s, t_end);
-	double v = status(s).transport_velocity;
-	sim_free(s);
-	return v;
-}
-
 /* v at 20 deg cw (steady start, 4-s window) at the default machine step
  * against a step 8 x finer with the same feed step: the yielding deck
  * keeps them within 0.3 % (the feed not seeing its own reaction within the

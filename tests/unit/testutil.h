@@ -111,6 +111,17 @@ static inline sim_status status(const sim *s)
 	return st;
 }
 
+/* The running transport velocity (m/s) of a fresh instance of u after
+ * t_end simulated seconds. */
+static inline double run_velocity(const setup *u, double t_end)
+{
+	sim *s = make(u);
+	advance(s, t_end);
+	double v = status(s).transport_velocity;
+	sim_free(s);
+	return v;
+}
+
 #define assert_close(a, b, tol)                                                           \
 	do {                                                                              \
 		double a_ = (a), b_ = (b), t_ = (tol);                                    \
