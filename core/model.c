@@ -409,12 +409,11 @@ void model_force_responses(const model *md, const model_ctl *ctl, double t, cons
 			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL])
 {
 	config cf;
-	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], none[NQ_FULL] = {0};
+	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL];
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
 	symmetrize(M);
-	for (int i = 0; i < n; i++)
-		model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q[i], none, qrdd[i]);
+	model_reduced_solves(md, (const double(*)[NQ_FULL])M, n, Q, qrdd);
 }
 
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,
