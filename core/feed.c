@@ -101,6 +101,24 @@ void feed_rhs(const model *md, const double *y, const deck_motion *dm, double *d
 	*contact_power = md->col_weight * contact;
 }
 
+void feed_deck_forces(const model *md, const double *y, const deck_motion *dm,
+		      double (*F)[2])
+{
+	const double *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
+	for (int k = 0; k < md->dk.K; k++) {
+		/* column_rhs's bottom contact, the same arithmetic */
+		const int e = k * md->L;
+		double delta = dm->pos[k][1] - eta[e];
+		F[k][0] = F[k][1] = 0.0;
+		if (md->L > 0 && delta > 0.0) {
+			double Fn = contact_force(md, delta, dm->vel[k][1] - etad[e]);
+			double T = -md->p.mu * Fn * friction_sign(md, xid[e] - dm->vel[k][0]);
+			F[k][0] = -T;
+			F[k][1] = -Fn;
+		}
+	}
+}
+
 void feed_energy(const model *md, const double *y, double *kinetic, double *potential)
 {
 	const double *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
