@@ -129,8 +129,10 @@ static void machine_axpy(const model *md, double *out, const double *y, double h
 }
 
 /* One classical RK4 step of the machine's entries of y over H, with the
- * feed's reaction held at w->Qfeed; ev0 receives the start evaluation. */
-static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0)
+ * feed's reaction held at w->Qfeed; ev0 receives the start evaluation and
+ * ev3 (if not NULL) the last stage's. */
+static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0,
+			model_eval *ev3)
 {
 	const model *md = sys->md;
 	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
@@ -140,7 +142,7 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
 	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
 	machine_axpy(md, w->tmp, y, H, w->k3);
-	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, NULL);
+	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, ev3);
 	for (int r = 0; r < md->nq; r++) {
 		int v = md->npos + r;
 		y[r] += H / 6.0 * (w->k1[r] + 2.0 * (w->k2[r] + w->k3[r]) + w->k4[r]);
@@ -243,7 +245,7 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		memcpy(w->save, y, sizeof(double) * (size_t)n);
 	/* 1. machine RK4 with the feed force held */
 	model_eval ev0, ev1;
-	machine_rk4(w, sys, *t, H, y, &ev0);
+	machine_rk4(w, sys, *t, H, y, &ev0, w->events ? &ev1 : NULL);
 	double t1 = (H == t_max - *t) ? t_max : *t + H;
 	if (md->nf == 0) {
 		*t = t1;
@@ -257,7 +259,15 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	 * advance. Free flight is then exact, and a layer riding on the deck
 	 * follows the deck's displacement to O(h^3) per sub-step instead of
 	 * drifting by h^2 a / 2 (which moved lift-off by O(h)). */
-	dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
+	if (w->events) {
+		/* the end's accelerations from RK4's last stage (at t1, on the
+		 * state y + H k3): they enter the deck velocity's cubic only,
+		 * whose error is O(H^4) either way; the end's positions and
+		 * velocities are the step's own */
+		model_full_coords(md, sys->ctl, t1, y, ev1.q, ev1.qd);
+	} else {
+		dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
+	}
 	const double h = H / ns;
 	double F[SIM_MAX_COLUMNS][2], impulse[SIM_MAX_COLUMNS][2];
 	double fric = 0.0, contact = 0.0;
