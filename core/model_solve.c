@@ -146,25 +146,33 @@ static void selection_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
 			       const int n, const int nb, const int *full, double S[3][3])
 {
+#pragma GCC unroll 6
 	for (int a = 0; a < nb; a++) {
+#pragma GCC unroll 6
 		for (int c = 0; c <= a; c++)
 			S[a][c] = M[full[a]][full[c]];
+#pragma GCC unroll 6
 		for (int d = nb; d < n; d++) {
 			const double *Md = M[full[d]];
+#pragma GCC unroll 6
 			for (int c = 0; c <= a; c++)
 				S[a][c] -= Md[full[a]] * own_inv[d] * Md[full[c]];
 		}
 	}
+#pragma GCC unroll 6
 	for (int j = 0; j < nb; j++) {
 		double dj = S[j][j];
+#pragma GCC unroll 6
 		for (int k = 0; k < j; k++)
 			dj -= S[j][k] * S[j][k] * S[k][k];
 		if (!(dj > 0.0))
 			return -1;
 		S[j][j] = dj;
 		double inv = 1.0 / dj;
+#pragma GCC unroll 6
 		for (int i = j + 1; i < nb; i++) {
 			double s = S[i][j];
+#pragma GCC unroll 6
 			for (int k = 0; k < j; k++)
 				s -= S[i][k] * S[j][k] * S[k][k];
 			S[i][j] = s * inv;
@@ -180,28 +188,38 @@ static inline void schur_solve(const double M[NQ_FULL][NQ_FULL], const double *o
 			       const double rhs[NQ_FULL], double br[NQ_FULL])
 {
 	double x[3];
+#pragma GCC unroll 6
 	for (int r = 0; r < n; r++)
 		br[r] = rhs[full[r]];
+#pragma GCC unroll 6
 	for (int a = 0; a < nb; a++) {
 		x[a] = br[a];
+#pragma GCC unroll 6
 		for (int d = nb; d < n; d++)
 			x[a] -= M[full[d]][full[a]] * own_inv[d] * br[d];
 	}
+#pragma GCC unroll 6
 	for (int i = 0; i < nb; i++)
+#pragma GCC unroll 6
 		for (int k = 0; k < i; k++)
 			x[i] -= S[i][k] * x[k];
+#pragma GCC unroll 6
 	for (int i = nb - 1; i >= 0; i--) {
 		x[i] /= S[i][i];
+#pragma GCC unroll 6
 		for (int k = i + 1; k < nb; k++)
 			x[i] -= S[k][i] * x[k];
 	}
+#pragma GCC unroll 6
 	for (int d = nb; d < n; d++) {
 		const double *Md = M[full[d]];
 		double s = br[d];
+#pragma GCC unroll 6
 		for (int c = 0; c < nb; c++)
 			s -= Md[full[c]] * x[c];
 		br[d] = s * own_inv[d];
 	}
+#pragma GCC unroll 6
 	for (int a = 0; a < nb; a++)
 		br[a] = x[a];
 }
@@ -248,19 +266,12 @@ void model_reduced_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int
 			model_reduced_solve(md, M, rhs[i], none, br[i]);
 }
 
-void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+/* The general case: reduced coordinates that combine full ones, and
+ * prescribed accelerations. */
+static void general_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
 {
 	int n = md->nq, nb = md->n_body;
-	if (md->layout != MODEL_LAYOUT_GENERAL) {
-		model_reduced_solves(md, M, 1, (const double(*)[NQ_FULL])rhs,
-				     (double(*)[NQ_FULL])br);
-		return;
-	}
-	if (md->selection) {
-		selection_solve(md, M, rhs, br);
-		return;
-	}
 	double Mr[NQ_FULL][NQ_FULL], res[NQ_FULL], S[3][3], x[3];
 	for (int i = 0; i < NQ_FULL; i++)
 		res[i] = md->phi_prescribed ? rhs[i] - M[i][Q_PHI] * qpdd[Q_PHI] : rhs[i];
@@ -307,4 +318,17 @@ void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 	}
 	for (int a = 0; a < nb; a++)
 		br[md->body[a]] = x[a];
+}
+
+void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
+{
+	if (md->layout == MODEL_LAYOUT_TROUGH3)
+		trough3_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
+	else if (md->layout == MODEL_LAYOUT_TROUGH2)
+		trough2_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
+	else if (md->selection)
+		selection_solve(md, M, rhs, br);
+	else
+		general_solve(md, M, rhs, qpdd, br);
 }
