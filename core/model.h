@@ -83,6 +83,7 @@ typedef struct model_eval {
 	double torque;        /* N m on the rotor (motor, or ideal drive's) */
 	double rotor_speed;   /* phi' - alpha' */
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
+	deck_rot R;           /* R(alpha), deck_rotation(q) */
 } model_eval;
 
 /* The feed's mass over the machine's (trough, vibrator and eliminator

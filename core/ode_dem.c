@@ -292,7 +292,7 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	double F[SIM_MAX_COLUMNS][2], impulse[SIM_MAX_COLUMNS][2];
 	double fric = 0.0, contact = 0.0;
 	const deck *dk = &md->dk;
-	deck_rot R0 = deck_rotation(ev0.q), R1 = deck_rotation(ev1.q);
+	deck_rot R0 = ev0.R, R1 = w->events ? deck_rotation(ev1.q) : ev1.R;
 	/* the cubic's four weights at each sub-step's start (positions) and
 	 * middle (velocities), the same for every column: ode_hermite's
 	 * terms, operation for operation */
