@@ -209,8 +209,10 @@ enum { BOND = 0, HI = 1, LO = 2 };
 /* The velocities v and impulses P of the column for the contact modes
  * mode as they stand (no switching): bonded runs move as one cluster,
  * every other contact carries its fixed impulse (HI: hi, LO: lo). */
-static inline void chain_clusters(int L, double m, const double *vs, double v0, const double *lo,
-			   const double *hi, double *P, double *v, const signed char *mode)
+static inline void chain_clusters(int L, double m, const double *restrict vs, double v0,
+				  const double *restrict lo, const double *restrict hi,
+				  double *restrict P, double *restrict v,
+				  const signed char *restrict mode)
 {
 	/* clusters: a run of layers a..b bonded above a, resting on
 	 * the fixed impulse of contact a (or riding with the deck),
@@ -248,8 +250,9 @@ static inline void chain_clusters(int L, double m, const double *vs, double v0, 
 	}
 }
 
-static void chain_solve(int L, double m, const double *vs, double v0, const double *lo,
-			const double *hi, double *P, double *v, signed char *mode)
+static void chain_solve(int L, double m, const double *restrict vs, double v0,
+			const double *restrict lo, const double *restrict hi, double *restrict P,
+			double *restrict v, signed char *restrict mode)
 {
 	int changed = 0;
 	for (int iter = 0; iter < 4 * L + 8; iter++) {
@@ -389,6 +392,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	double *xi = XI(md, y) + base, *eta = ETA(md, y) + base, *xid = XID(md, y) + base,
 	       *etad = ETAD(md, y) + base;
 	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
+	const double k_c = md->p.k_c, p = md->p.p;
 	double hi[SIM_MAX_LAYERS], lo[SIM_MAX_LAYERS], vs[SIM_MAX_LAYERS], Pn[SIM_MAX_LAYERS],
 		Pt[SIM_MAX_LAYERS], vn[SIM_MAX_LAYERS], vt[SIM_MAX_LAYERS];
 	signed char *mn = modes + base, *mt = modes + md->nf + base;
@@ -399,7 +403,9 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	double prev_eta = dp[1];
 	for (int j = 0; j < L; j++) {
 		double delta = prev_eta - eta[j];
-		hi[j] = delta > 0.0 ? h * contact_force(md, delta, 1.0) : 0.0;
+		/* contact_force (delta, rate >= 0) with the parameters in
+		 * registers: the arrays written here may not alias md */
+		hi[j] = delta > 0.0 ? h * (p == 1.0 ? k_c * delta : k_c * pow(delta, p)) : 0.0;
 		lo[j] = R2 * hi[j];
 		vs[j] = etad[j] - g * h;
 		prev_eta = eta[j];
