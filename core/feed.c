@@ -488,18 +488,24 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 			const double(*vel)[2] = deck_vel + (size_t)k * (ns + 1);
 			/* mirrored columns j and K-1-j summed first, so that a
 			 * mirrored motion stays mirrored to the last bit */
-			double dvk[2] = {0.0, 0.0}, p[2], v0[2], v1[2];
+			double p[2], v0[2], v1[2];
+			/* the two sums as scalars, each in a register: stored
+			 * one element at a time into an array and read back as
+			 * a pair, they stalled on the store forwarding */
+			double dvx = 0.0, dvy = 0.0;
 			for (int j = 0; j <= (K - 1) / 2; j++) {
 				int jj = K - 1 - j;
-				for (int a = 0; a < 2; a++) {
-					double s = yield->C[k][j][a][0] * E[j][0] +
-						   yield->C[k][j][a][1] * E[j][1];
-					if (jj != j)
-						s += yield->C[k][jj][a][0] * E[jj][0] +
-						     yield->C[k][jj][a][1] * E[jj][1];
-					dvk[a] += s;
+				const double(*Cj)[2] = yield->C[k][j], (*Cjj)[2] = yield->C[k][jj];
+				double sx = Cj[0][0] * E[j][0] + Cj[0][1] * E[j][1];
+				double sy = Cj[1][0] * E[j][0] + Cj[1][1] * E[j][1];
+				if (jj != j) {
+					sx += Cjj[0][0] * E[jj][0] + Cjj[0][1] * E[jj][1];
+					sy += Cjj[1][0] * E[jj][0] + Cjj[1][1] * E[jj][1];
 				}
+				dvx += sx;
+				dvy += sy;
 			}
+			const double dvk[2] = {dvx, dvy};
 			for (int c = 0; c < 2; c++) {
 				p[c] = pos[i][c] + dp[k][c];
 				v0[c] = vel[i][c] + dv[k][c];
