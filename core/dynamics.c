@@ -48,6 +48,22 @@ void dynamics_eval(const model *md, const model_ctl *ctl, double t, const double
 	model_machine_rhs(md, ctl, t, y, Qfeed, dy, ev);
 }
 
+void dynamics_observe(const model *md, const model_ctl *ctl, double t, const double *y,
+		      double *dy, model_eval *ev)
+{
+	double Qfeed[NQ_FULL] = {0};
+	if (md->nf > 0 && md->sc.feed_coupling) {
+		double q[NQ_FULL], qd[NQ_FULL], F[SIM_MAX_COLUMNS][2];
+		deck_motion dm;
+		model_full_coords(md, ctl, t, y, q, qd);
+		deck_motion_eval(&md->dk, q, qd, &dm);
+		feed_deck_forces(md, y, &dm, F);
+		deck_rot R = deck_rotation(q);
+		deck_forces(&md->dk, &R, (const double(*)[2])F, md->col_weight, Qfeed);
+	}
+	model_machine_rhs(md, ctl, t, y, Qfeed, dy, ev);
+}
+
 double dynamics_energy_stored(const model *md, const model_ctl *ctl, double t, const double *y,
 			      double *kinetic, double *potential)
 {

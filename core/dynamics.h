@@ -31,6 +31,12 @@ typedef struct dyn {
 void dynamics_eval(const model *md, const model_ctl *ctl, double t, const double *y, double *dy,
 		   model_eval *ev);
 
+/* What dynamics_eval shows in ev, for observation: the feed's reaction
+ * from its bottom contacts alone (the same to the last bit), the feed's
+ * part of dy and the ACC_FRIC and ACC_CONTACT powers not written. */
+void dynamics_observe(const model *md, const model_ctl *ctl, double t, const double *y,
+		      double *dy, model_eval *ev);
+
 /* The feed's part of dy (written) and its reaction on the machine, added
  * to Qfeed (nothing under one-way coupling); no feed: nothing. */
 void dynamics_feed_reaction(const model *md, const model_ctl *ctl, double t, const double *y,

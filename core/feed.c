@@ -101,6 +101,24 @@ void feed_rhs(const model *md, const double *y, const deck_motion *dm, double *d
 	*contact_power = md->col_weight * contact;
 }
 
+void feed_deck_forces(const model *md, const double *y, const deck_motion *dm,
+		      double (*F)[2])
+{
+	const double *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
+	for (int k = 0; k < md->dk.K; k++) {
+		/* column_rhs's bottom contact, the same arithmetic */
+		const int e = k * md->L;
+		double delta = dm->pos[k][1] - eta[e];
+		F[k][0] = F[k][1] = 0.0;
+		if (md->L > 0 && delta > 0.0) {
+			double Fn = contact_force(md, delta, dm->vel[k][1] - etad[e]);
+			double T = -md->p.mu * Fn * friction_sign(md, xid[e] - dm->vel[k][0]);
+			F[k][0] = -T;
+			F[k][1] = -Fn;
+		}
+	}
+}
+
 void feed_energy(const model *md, const double *y, double *kinetic, double *potential)
 {
 	const double *eta = ETA(md, y), *xid = XID(md, y), *etad = ETAD(md, y);
@@ -173,11 +191,6 @@ double feed_mean_xi_rate(const model *md, const double *y)
 	return md->nf > 0 ? s / md->nf : 0.0;
 }
 
-static inline double clamp(double v, double lo, double hi)
-{
-	return v < lo ? lo : v > hi ? hi : v;
-}
-
 enum { BOND = 0, HI = 1, LO = 2 };
 
 /* Exact solve of one column's impulses over a sub-step (a convex problem:
@@ -191,8 +204,10 @@ enum { BOND = 0, HI = 1, LO = 2 };
 /* The velocities v and impulses P of the column for the contact modes
  * mode as they stand (no switching): bonded runs move as one cluster,
  * every other contact carries its fixed impulse (HI: hi, LO: lo). */
-static inline void chain_clusters(int L, double m, const double *vs, double v0, const double *lo,
-			   const double *hi, double *P, double *v, const signed char *mode)
+static inline void chain_clusters(int L, double m, const double *restrict vs, double v0,
+				  const double *restrict lo, const double *restrict hi,
+				  double *restrict P, double *restrict v,
+				  const signed char *restrict mode)
 {
 	/* clusters: a run of layers a..b bonded above a, resting on
 	 * the fixed impulse of contact a (or riding with the deck),
@@ -230,8 +245,9 @@ static inline void chain_clusters(int L, double m, const double *vs, double v0, 
 	}
 }
 
-static void chain_solve(int L, double m, const double *vs, double v0, const double *lo,
-			const double *hi, double *P, double *v, signed char *mode)
+static void chain_solve(int L, double m, const double *restrict vs, double v0,
+			const double *restrict lo, const double *restrict hi, double *restrict P,
+			double *restrict v, signed char *restrict mode)
 {
 	int changed = 0;
 	for (int iter = 0; iter < 4 * L + 8; iter++) {
@@ -371,6 +387,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	double *xi = XI(md, y) + base, *eta = ETA(md, y) + base, *xid = XID(md, y) + base,
 	       *etad = ETAD(md, y) + base;
 	const double m = md->p.m_n, g = md->p.g, mu = md->p.mu, R2 = md->p.R * md->p.R;
+	const double k_c = md->p.k_c, p = md->p.p;
 	double hi[SIM_MAX_LAYERS], lo[SIM_MAX_LAYERS], vs[SIM_MAX_LAYERS], Pn[SIM_MAX_LAYERS],
 		Pt[SIM_MAX_LAYERS], vn[SIM_MAX_LAYERS], vt[SIM_MAX_LAYERS];
 	signed char *mn = modes + base, *mt = modes + md->nf + base;
@@ -381,7 +398,9 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	double prev_eta = dp[1];
 	for (int j = 0; j < L; j++) {
 		double delta = prev_eta - eta[j];
-		hi[j] = delta > 0.0 ? h * contact_force(md, delta, 1.0) : 0.0;
+		/* contact_force (delta, rate >= 0) with the parameters in
+		 * registers: the arrays written here may not alias md */
+		hi[j] = delta > 0.0 ? h * (p == 1.0 ? k_c * delta : k_c * pow(delta, p)) : 0.0;
 		lo[j] = R2 * hi[j];
 		vs[j] = etad[j] - g * h;
 		prev_eta = eta[j];
@@ -464,18 +483,24 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 			const double(*vel)[2] = deck_vel + (size_t)k * (ns + 1);
 			/* mirrored columns j and K-1-j summed first, so that a
 			 * mirrored motion stays mirrored to the last bit */
-			double dvk[2] = {0.0, 0.0}, p[2], v0[2], v1[2];
+			double p[2], v0[2], v1[2];
+			/* the two sums as scalars, each in a register: stored
+			 * one element at a time into an array and read back as
+			 * a pair, they stalled on the store forwarding */
+			double dvx = 0.0, dvy = 0.0;
 			for (int j = 0; j <= (K - 1) / 2; j++) {
 				int jj = K - 1 - j;
-				for (int a = 0; a < 2; a++) {
-					double s = yield->C[k][j][a][0] * E[j][0] +
-						   yield->C[k][j][a][1] * E[j][1];
-					if (jj != j)
-						s += yield->C[k][jj][a][0] * E[jj][0] +
-						     yield->C[k][jj][a][1] * E[jj][1];
-					dvk[a] += s;
+				const double(*Cj)[2] = yield->C[k][j], (*Cjj)[2] = yield->C[k][jj];
+				double sx = Cj[0][0] * E[j][0] + Cj[0][1] * E[j][1];
+				double sy = Cj[1][0] * E[j][0] + Cj[1][1] * E[j][1];
+				if (jj != j) {
+					sx += Cjj[0][0] * E[jj][0] + Cjj[0][1] * E[jj][1];
+					sy += Cjj[1][0] * E[jj][0] + Cjj[1][1] * E[jj][1];
 				}
+				dvx += sx;
+				dvy += sy;
 			}
+			const double dvk[2] = {dvx, dvy};
 			for (int c = 0; c < 2; c++) {
 				p[c] = pos[i][c] + dp[k][c];
 				v0[c] = vel[i][c] + dv[k][c];

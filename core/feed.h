@@ -20,6 +20,11 @@
 void feed_rhs(const model *md, const double *y, const deck_motion *dm, double *dy,
 	      double (*F)[2], double *fric_power, double *contact_power);
 
+/* The force (N) of each column on its deck point alone, F[k] as feed_rhs
+ * gives it (the bottom layers' contacts; nothing else is evaluated). */
+void feed_deck_forces(const model *md, const double *y, const deck_motion *dm,
+		      double (*F)[2]);
+
 /* Kinetic and gravitational energy of the feed (written, J). */
 void feed_energy(const model *md, const double *y, double *kinetic, double *potential);
 

@@ -126,6 +126,14 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
+	if (md->layout == MODEL_LAYOUT_TROUGH3) {
+		/* each full coordinate its reduced one, added to zero as below */
+		for (int i = 0; i < NQ_FULL; i++) {
+			q[i] = 0.0 + qr[i];
+			qd[i] = 0.0 + qrd[i];
+		}
+		return;
+	}
 	memset(q, 0, sizeof(double) * NQ_FULL);
 	memset(qd, 0, sizeof(double) * NQ_FULL);
 	for (int r = 0; r < md->nq; r++)
@@ -370,6 +378,7 @@ static void observe(const model *md, const config *cf, const double qdd[NQ_FULL]
 	ev->beta_dot = cf->beta_d;
 	ev->torque = dt->torque;
 	ev->rotor_speed = dt->omega;
+	ev->R = cf->R;
 	/* the centre deck point, from its rest position */
 	deck_point(&md->dk, 0.0, &cf->R, cf->q, cf->qd, ev->deck, ev->deck_vel);
 	ev->deck[1] -= md->dk.h_d;
@@ -409,12 +418,11 @@ void model_force_responses(const model *md, const model_ctl *ctl, double t, cons
 			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL])
 {
 	config cf;
-	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], none[NQ_FULL] = {0};
+	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL];
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
 	symmetrize(M);
-	for (int i = 0; i < n; i++)
-		model_reduced_solve(md, (const double(*)[NQ_FULL])M, Q[i], none, qrdd[i]);
+	model_reduced_solves(md, (const double(*)[NQ_FULL])M, n, Q, qrdd);
 }
 
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,

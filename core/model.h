@@ -28,6 +28,11 @@
 
 enum { ACC_IN, ACC_DAMP, ACC_FRIC, ACC_CONTACT, ACC_N };
 
+/* The solve's layouts (model_solve.c): general, or the trough's
+ * coordinates first (x, y, alpha, or x, y with alpha fixed) and the point
+ * masses' own ones (phi, s1, s2) after them. */
+enum { MODEL_LAYOUT_GENERAL, MODEL_LAYOUT_TROUGH3, MODEL_LAYOUT_TROUGH2 };
+
 /* Constant during a run. */
 typedef struct model {
 	sim_params p;
@@ -44,6 +49,7 @@ typedef struct model {
 	 * point mass's own coordinate (phi, s1, s2; 0 for the trough's) */
 	int n_body, body[3];
 	int selection;                /* each reduced coordinate one full one, none prescribed */
+	int layout;                   /* MODEL_LAYOUT_*: a solve of constant sizes, or the general */
 	double own_inv[NQ_FULL];
 	double own_m[NQ_FULL];        /* ... and that inertia, by full coordinate */
 	/* feed */
@@ -77,6 +83,7 @@ typedef struct model_eval {
 	double torque;        /* N m on the rotor (motor, or ideal drive's) */
 	double rotor_speed;   /* phi' - alpha' */
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
+	deck_rot R;           /* R(alpha), deck_rotation(q) */
 } model_eval;
 
 /* 1 when the machine is symmetric about the vertical through G: h = 0,
@@ -105,6 +112,12 @@ void model_solve_layout(model *md);
  * br (NaN if M is not positive definite). model_solve.c */
 void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 			 const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL]);
+
+/* The same without prescribed accelerations for nrhs right-hand sides
+ * rhs[i] into br[i], sharing one factorisation where the layout allows
+ * (the results are model_reduced_solve's to the last bit). model_solve.c */
+void model_reduced_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int nrhs,
+			  const double (*rhs)[NQ_FULL], double (*br)[NQ_FULL]);
 
 /* Static strokes s1, s2 (m) of the eliminators at rest at the initial
  * beta (written). setup.c */

@@ -13,6 +13,17 @@
 
 #include "model.h"
 
+/* The two layouts of every scene with the Kloss drive, the trough's
+ * coordinates first and the own ones after them: (x, y, alpha | phi, s1,
+ * s2) and, alpha fixed, (x, y | phi, s1, s2). For them the solve is
+ * written with the sizes and indices as constants (the compiler then
+ * unrolls it), and split into the Schur complement's factorisation and
+ * the solve for one right-hand side, so that several forces share one
+ * factorisation (model_reduced_solves). The arithmetic is selection_solve's,
+ * operation for operation: the results are the same to the last bit. */
+static const int full_trough3[NQ_FULL] = {Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2};
+static const int full_trough2[NQ_FULL] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2, 0};
+
 void model_solve_layout(model *md)
 {
 	const sim_params *p = &md->p;
@@ -32,6 +43,17 @@ void model_solve_layout(model *md)
 			md->own_inv[r] = 1.0 / md->own_m[i];
 		else
 			md->body[md->n_body++] = r;
+	}
+	/* the layouts with a solve of constant sizes: the trough's
+	 * coordinates first, in order, the own ones after them */
+	md->layout = MODEL_LAYOUT_GENERAL;
+	if (md->selection) {
+		const int *full = md->n_body == 3 ? full_trough3 : full_trough2;
+		int same = md->nq == md->n_body + 3 && (md->n_body == 3 || md->n_body == 2);
+		for (int r = 0; same && r < md->nq; r++)
+			same = md->col[r][0] == full[r] && (r < md->n_body) == (md->own_inv[r] == 0.0);
+		if (same)
+			md->layout = md->n_body == 3 ? MODEL_LAYOUT_TROUGH3 : MODEL_LAYOUT_TROUGH2;
 	}
 }
 
@@ -119,14 +141,137 @@ static void selection_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 		br[md->body[a]] = x[a];
 }
 
-void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+/* The Schur complement S on the trough's nb coordinates, factored as
+ * LDL^T in place (ldlt_solve's arithmetic); -1 if not positive definite. */
+static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
+			       const int n, const int nb, const int *full, double S[3][3])
+{
+#pragma GCC unroll 6
+	for (int a = 0; a < nb; a++) {
+#pragma GCC unroll 6
+		for (int c = 0; c <= a; c++)
+			S[a][c] = M[full[a]][full[c]];
+#pragma GCC unroll 6
+		for (int d = nb; d < n; d++) {
+			const double *Md = M[full[d]];
+#pragma GCC unroll 6
+			for (int c = 0; c <= a; c++)
+				S[a][c] -= Md[full[a]] * own_inv[d] * Md[full[c]];
+		}
+	}
+#pragma GCC unroll 6
+	for (int j = 0; j < nb; j++) {
+		double dj = S[j][j];
+#pragma GCC unroll 6
+		for (int k = 0; k < j; k++)
+			dj -= S[j][k] * S[j][k] * S[k][k];
+		if (!(dj > 0.0))
+			return -1;
+		S[j][j] = dj;
+		double inv = 1.0 / dj;
+#pragma GCC unroll 6
+		for (int i = j + 1; i < nb; i++) {
+			double s = S[i][j];
+#pragma GCC unroll 6
+			for (int k = 0; k < j; k++)
+				s -= S[i][k] * S[j][k] * S[k][k];
+			S[i][j] = s * inv;
+		}
+	}
+	return 0;
+}
+
+/* One right-hand side through schur_factor's S (selection_solve's
+ * arithmetic). */
+static inline void schur_solve(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
+			       const int n, const int nb, const int *full, const double S[3][3],
+			       const double rhs[NQ_FULL], double br[NQ_FULL])
+{
+	double x[3];
+#pragma GCC unroll 6
+	for (int r = 0; r < n; r++)
+		br[r] = rhs[full[r]];
+#pragma GCC unroll 6
+	for (int a = 0; a < nb; a++) {
+		x[a] = br[a];
+#pragma GCC unroll 6
+		for (int d = nb; d < n; d++)
+			x[a] -= M[full[d]][full[a]] * own_inv[d] * br[d];
+	}
+#pragma GCC unroll 6
+	for (int i = 0; i < nb; i++)
+#pragma GCC unroll 6
+		for (int k = 0; k < i; k++)
+			x[i] -= S[i][k] * x[k];
+#pragma GCC unroll 6
+	for (int i = nb - 1; i >= 0; i--) {
+		x[i] /= S[i][i];
+#pragma GCC unroll 6
+		for (int k = i + 1; k < nb; k++)
+			x[i] -= S[k][i] * x[k];
+	}
+#pragma GCC unroll 6
+	for (int d = nb; d < n; d++) {
+		const double *Md = M[full[d]];
+		double s = br[d];
+#pragma GCC unroll 6
+		for (int c = 0; c < nb; c++)
+			s -= Md[full[c]] * x[c];
+		br[d] = s * own_inv[d];
+	}
+#pragma GCC unroll 6
+	for (int a = 0; a < nb; a++)
+		br[a] = x[a];
+}
+
+/* nrhs right-hand sides through one factorisation, for a layout with the
+ * sizes n, nb and the indices full as constants. */
+static inline void trough_solves(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
+				 const int n, const int nb, const int *full, int nrhs,
+				 const double (*rhs)[NQ_FULL], double (*br)[NQ_FULL])
+{
+	double S[3][3];
+	if (schur_factor(M, own_inv, n, nb, full, S) != 0) {
+		for (int i = 0; i < nrhs; i++)
+			for (int r = 0; r < n; r++)
+				br[i][r] = NAN;
+		return;
+	}
+	for (int i = 0; i < nrhs; i++)
+		schur_solve(M, own_inv, n, nb, full, (const double(*)[3])S, rhs[i], br[i]);
+}
+
+static void trough3_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int nrhs,
+			   const double (*rhs)[NQ_FULL], double (*br)[NQ_FULL])
+{
+	trough_solves(M, md->own_inv, 6, 3, full_trough3, nrhs, rhs, br);
+}
+
+static void trough2_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int nrhs,
+			   const double (*rhs)[NQ_FULL], double (*br)[NQ_FULL])
+{
+	trough_solves(M, md->own_inv, 5, 2, full_trough2, nrhs, rhs, br);
+}
+
+void model_reduced_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int nrhs,
+			  const double (*rhs)[NQ_FULL], double (*br)[NQ_FULL])
+{
+	static const double none[NQ_FULL];
+	if (md->layout == MODEL_LAYOUT_TROUGH3)
+		trough3_solves(md, M, nrhs, rhs, br);
+	else if (md->layout == MODEL_LAYOUT_TROUGH2)
+		trough2_solves(md, M, nrhs, rhs, br);
+	else
+		for (int i = 0; i < nrhs; i++)
+			model_reduced_solve(md, M, rhs[i], none, br[i]);
+}
+
+/* The general case: reduced coordinates that combine full ones, and
+ * prescribed accelerations. */
+static void general_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
 {
 	int n = md->nq, nb = md->n_body;
-	if (md->selection) {
-		selection_solve(md, M, rhs, br);
-		return;
-	}
 	double Mr[NQ_FULL][NQ_FULL], res[NQ_FULL], S[3][3], x[3];
 	for (int i = 0; i < NQ_FULL; i++)
 		res[i] = md->phi_prescribed ? rhs[i] - M[i][Q_PHI] * qpdd[Q_PHI] : rhs[i];
@@ -173,4 +318,17 @@ void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 	}
 	for (int a = 0; a < nb; a++)
 		br[md->body[a]] = x[a];
+}
+
+void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
+			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
+{
+	if (md->layout == MODEL_LAYOUT_TROUGH3)
+		trough3_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
+	else if (md->layout == MODEL_LAYOUT_TROUGH2)
+		trough2_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
+	else if (md->selection)
+		selection_solve(md, M, rhs, br);
+	else
+		general_solve(md, M, rhs, qpdd, br);
 }

@@ -62,6 +62,7 @@ typedef struct dem {
 	double *k1, *k2, *k3, *k4, *tmp, *save;
 	signed char *modes;
 	double (*deck_pos)[2], (*deck_vel)[2]; /* the columns' deck tracks, per sub-step */
+	double (*hermite)[4]; /* the tracks' cubic weights, per sub-step: positions, velocities */
 	int events;        /* slip reversals located inside the feed's sub-steps */
 	int couple;        /* the deck yields to the feed's impulses within the step */
 	int have_yield;    /* yield holds the step before's compliance and reaction */
@@ -77,6 +78,7 @@ static void dem_free(void *p)
 	free(w->k1);
 	free(w->modes);
 	free(w->deck_pos);
+	free(w->hermite);
 	free(w->yield);
 	free(w);
 }
@@ -98,11 +100,12 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	int K = md->dk.K > 0 ? md->dk.K : 1;
 	w->K = md->dk.K;
 	w->deck_pos = calloc((size_t)K * (2 * (size_t)w->substeps + 1), sizeof *w->deck_pos);
+	w->hermite = calloc(2 * ((size_t)w->substeps + 1), sizeof *w->hermite);
 	w->events = cfg->feed_events && md->nf > 0;
 	w->couple = w->correct && w->events;
 	if (w->couple)
 		w->yield = calloc(1, sizeof *w->yield);
-	if (!w->k1 || !w->modes || !w->deck_pos || (w->couple && !w->yield)) {
+	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || (w->couple && !w->yield)) {
 		dem_free(w);
 		return NULL;
 	}
@@ -128,9 +131,28 @@ static void machine_axpy(const model *md, double *out, const double *y, double h
 		out[2 * md->npos + a] = y[2 * md->npos + a] + h * k[2 * md->npos + a];
 }
 
+/* ode_hermite's weights of p0, v0, p1, v1 at u over H (w[4])... */
+static void hermite_weights(double u, double H, double w[4])
+{
+	double u2 = u * u, u3 = u2 * u;
+	w[0] = 2 * u3 - 3 * u2 + 1;
+	w[1] = (u3 - 2 * u2 + u) * H;
+	w[2] = -2 * u3 + 3 * u2;
+	w[3] = (u3 - u2) * H;
+}
+
+/* ... and its sum with them: ode_hermite (p0, v0, p1, v1, H, u) to the
+ * last bit. */
+static inline double hermite_sum(const double w[4], double p0, double v0, double p1, double v1)
+{
+	return w[0] * p0 + w[1] * v0 + w[2] * p1 + w[3] * v1;
+}
+
 /* One classical RK4 step of the machine's entries of y over H, with the
- * feed's reaction held at w->Qfeed; ev0 receives the start evaluation. */
-static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0)
+ * feed's reaction held at w->Qfeed; ev0 receives the start evaluation and
+ * ev3 (if not NULL) the last stage's. */
+static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0,
+			model_eval *ev3)
 {
 	const model *md = sys->md;
 	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
@@ -140,7 +162,7 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
 	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
 	machine_axpy(md, w->tmp, y, H, w->k3);
-	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, NULL);
+	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, ev3);
 	for (int r = 0; r < md->nq; r++) {
 		int v = md->npos + r;
 		y[r] += H / 6.0 * (w->k1[r] + 2.0 * (w->k2[r] + w->k3[r]) + w->k4[r]);
@@ -243,7 +265,7 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		memcpy(w->save, y, sizeof(double) * (size_t)n);
 	/* 1. machine RK4 with the feed force held */
 	model_eval ev0, ev1;
-	machine_rk4(w, sys, *t, H, y, &ev0);
+	machine_rk4(w, sys, *t, H, y, &ev0, w->events ? &ev1 : NULL);
 	double t1 = (H == t_max - *t) ? t_max : *t + H;
 	if (md->nf == 0) {
 		*t = t1;
@@ -257,12 +279,28 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	 * advance. Free flight is then exact, and a layer riding on the deck
 	 * follows the deck's displacement to O(h^3) per sub-step instead of
 	 * drifting by h^2 a / 2 (which moved lift-off by O(h)). */
-	dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
+	if (w->events) {
+		/* the end's accelerations from RK4's last stage (at t1, on the
+		 * state y + H k3): they enter the deck velocity's cubic only,
+		 * whose error is O(H^4) either way; the end's positions and
+		 * velocities are the step's own */
+		model_full_coords(md, sys->ctl, t1, y, ev1.q, ev1.qd);
+	} else {
+		dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
+	}
 	const double h = H / ns;
 	double F[SIM_MAX_COLUMNS][2], impulse[SIM_MAX_COLUMNS][2];
 	double fric = 0.0, contact = 0.0;
 	const deck *dk = &md->dk;
-	deck_rot R0 = deck_rotation(ev0.q), R1 = deck_rotation(ev1.q);
+	deck_rot R0 = ev0.R, R1 = w->events ? deck_rotation(ev1.q) : ev1.R;
+	/* the cubic's four weights at each sub-step's start (positions) and
+	 * middle (velocities), the same for every column: ode_hermite's
+	 * terms, operation for operation */
+	double(*wp)[4] = w->hermite, (*wv)[4] = w->hermite + ns + 1;
+	for (int i = 0; i <= ns; i++) {
+		hermite_weights((double)i / ns, H, wp[i]);
+		hermite_weights(((double)i - 0.5) / ns, H, wv[i]);
+	}
 	for (int k = 0; k < dk->K; k++) {
 		double p0[2], v0[2], p1[2], v1[2], a0[2], a1[2];
 		deck_point(dk, dk->d[k], &R0, ev0.q, ev0.qd, p0, v0);
@@ -275,11 +313,10 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		double(*pos)[2] = w->deck_pos + (size_t)k * ns;
 		double(*vel)[2] = w->deck_vel + (size_t)k * (ns + 1);
 		for (int i = 0; i <= ns; i++) {
-			double s0 = (double)i / ns, sm = ((double)i - 0.5) / ns;
 			for (int c = 0; c < 2; c++) {
 				if (i < ns)
-					pos[i][c] = ode_hermite(p0[c], v0[c], p1[c], v1[c], H, s0);
-				vel[i][c] = ode_hermite(v0[c], a0[c], v1[c], a1[c], H, sm);
+					pos[i][c] = hermite_sum(wp[i], p0[c], v0[c], p1[c], v1[c]);
+				vel[i][c] = hermite_sum(wv[i], v0[c], a0[c], v1[c], a1[c]);
 			}
 		}
 	}

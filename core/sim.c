@@ -44,6 +44,16 @@ static const char *feed_runaway(const model *md, const double *y, const double q
 	for (int k = 0; k < md->dk.K; k++) {
 		double pos[2], vel[2];
 		deck_point(&md->dk, md->dk.d[k], &R, q, qd, pos, vel);
+		/* the column's lowest and highest element first (a loop without
+		 * branches); the elements in order only when one is out */
+		const double *col = eta + k * md->L;
+		double lo = col[0], hi = col[0];
+		for (int j = 1; j < md->L; j++) {
+			lo = col[j] < lo ? col[j] : lo;
+			hi = col[j] > hi ? col[j] : hi;
+		}
+		if (!(lo - pos[1] < -0.05 || hi - pos[1] > 100.0))
+			continue;
 		for (int j = 0; j < md->L; j++) {
 			double rel = eta[k * md->L + j] - pos[1];
 			if (rel < -0.05)
@@ -60,7 +70,18 @@ static const char *feed_runaway(const model *md, const double *y, const double q
 static int check_state(sim *s)
 {
 	const model *md = &s->md;
-	for (int i = 0; i < md->n; i++) {
+	/* y - y is 0 for a finite entry and NaN for any other: a sum (four
+	 * partial ones, a loop without branches or a serial chain), and the
+	 * entries in order only when it is not 0 */
+	double part[4] = {0.0, 0.0, 0.0, 0.0};
+	int i4 = md->n - md->n % 4;
+	for (int i = 0; i < i4; i += 4)
+		for (int l = 0; l < 4; l++)
+			part[l] += s->y[i + l] - s->y[i + l];
+	for (int i = i4; i < md->n; i++)
+		part[0] += s->y[i] - s->y[i];
+	double nonfinite = (part[0] + part[1]) + (part[2] + part[3]);
+	for (int i = 0; nonfinite != 0.0 && i < md->n; i++) {
 		if (!isfinite(s->y[i])) {
 			snprintf(s->error, sizeof s->error,
 				 "diverged at t = %.9g s: non-finite state (component %d); "

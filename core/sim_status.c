@@ -101,7 +101,7 @@ void sim_update_status(sim *s)
 	const model_ctl *ctl = &s->ctl;
 	sim_status *st = &s->st;
 	model_eval ev;
-	dynamics_eval(md, ctl, s->t_obs, s->y_obs, s->dy, &ev);
+	dynamics_observe(md, ctl, s->t_obs, s->y_obs, s->dy, &ev);
 	st->t = s->t_obs;
 	st->t_int = s->t_int;
 	st->beta = ev.beta;

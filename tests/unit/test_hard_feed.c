@@ -309,6 +309,24 @@ static void one_way_machine_ignores_the_feed(void **state)
 	sim_free(b);
 }
 
+/* The divergence guard's feed check: contacts far too soft for the feed's
+ * weight let the bottom layers sink through the deck, and the run stops
+ * with SIM_EDIVERGED naming that cause (the check runs after every step). */
+static void sinking_feed_is_reported(void **state)
+{
+	(void)state;
+	setup u = preset();
+	set(&u, "start", "rest");
+	set(&u, "k_c", "1e3");
+	sim *s = make(&u);
+	int e = sim_advance(s, 1.0);
+	const char *msg = sim_last_error(s);
+	assert_int_equal(e, SIM_EDIVERGED);
+	assert_non_null(strstr(msg, "sank 5 cm into the deck"));
+	assert_true(status(s).t < 1.0);
+	sim_free(s);
+}
+
 /* The corrected machine-feed coupling of dem is unstable under added mass
  * (a feed over ~30 % of the machine's mass): dem corrects only light
  * feeds, and the default step follows. A heavy feed (24 layers, 60 kg on a
@@ -364,6 +382,7 @@ int main(void)
 		cmocka_unit_test(sliding_block_stops),
 		cmocka_unit_test(one_way_machine_ignores_the_feed),
 		cmocka_unit_test(heavy_feed_coupling_stays_stable),
+		cmocka_unit_test(sinking_feed_is_reported),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
