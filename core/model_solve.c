@@ -19,8 +19,9 @@
  * written with the sizes and indices as constants (the compiler then
  * unrolls it), and split into the Schur complement's factorisation and
  * the solve for one right-hand side, so that several forces share one
- * factorisation (model_reduced_solves). The arithmetic is selection_solve's,
- * operation for operation: the results are the same to the last bit. */
+ * factorisation (model_reduced_solves). The arithmetic is general_solve's for
+ * these layouts, operation for operation: the results are the same to the
+ * last bit. */
 static const int full_trough3[NQ_FULL] = {Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2};
 static const int full_trough2[NQ_FULL] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2, 0};
 
@@ -92,55 +93,6 @@ static int ldlt_solve(int n, double A[3][3], double *b)
  * have constant, mutually uncoupled diagonals (md->own_inv holds their
  * inverses), so they are eliminated first and only the Schur complement
  * on the trough's coordinates (x, y and alpha, at most 3) is factored. */
-/* model_reduced_solve where every reduced coordinate is one full
- * coordinate (no ideal drive: nothing prescribed, nothing combined): the
- * same arithmetic in the same order, without the general case's
- * index combinations. */
-static void selection_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
-			    const double rhs[NQ_FULL], double br[NQ_FULL])
-{
-	const int n = md->nq, nb = md->n_body;
-	int full[NQ_FULL], bf[3];
-	double S[3][3], x[3];
-	for (int r = 0; r < n; r++) {
-		full[r] = md->col[r][0];
-		br[r] = rhs[full[r]];
-	}
-	for (int a = 0; a < nb; a++)
-		bf[a] = full[md->body[a]];
-	for (int a = 0; a < nb; a++) {
-		x[a] = br[md->body[a]];
-		for (int c = 0; c <= a; c++)
-			S[a][c] = M[bf[a]][bf[c]];
-		for (int d = 0; d < n; d++) {
-			double inv = md->own_inv[d];
-			if (inv == 0.0)
-				continue;
-			const double *Md = M[full[d]];
-			x[a] -= Md[bf[a]] * inv * br[d];
-			for (int c = 0; c <= a; c++)
-				S[a][c] -= Md[bf[a]] * inv * Md[bf[c]];
-		}
-	}
-	if (ldlt_solve(nb, S, x) != 0) {
-		for (int r = 0; r < n; r++)
-			br[r] = NAN;
-		return;
-	}
-	for (int d = 0; d < n; d++) {
-		double inv = md->own_inv[d];
-		if (inv == 0.0)
-			continue;
-		const double *Md = M[full[d]];
-		double s = br[d];
-		for (int c = 0; c < nb; c++)
-			s -= Md[bf[c]] * x[c];
-		br[d] = s * inv;
-	}
-	for (int a = 0; a < nb; a++)
-		br[md->body[a]] = x[a];
-}
-
 /* The Schur complement S on the trough's nb coordinates, factored as
  * LDL^T in place (ldlt_solve's arithmetic); -1 if not positive definite. */
 static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
@@ -181,7 +133,7 @@ static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *o
 	return 0;
 }
 
-/* One right-hand side through schur_factor's S (selection_solve's
+/* One right-hand side through schur_factor's S (general_solve's
  * arithmetic). */
 static inline void schur_solve(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
 			       const int n, const int nb, const int *full, const double S[3][3],
@@ -267,7 +219,8 @@ void model_reduced_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int
 }
 
 /* The general case: reduced coordinates that combine full ones, and
- * prescribed accelerations. */
+ * prescribed accelerations; with neither (one full coordinate each) every
+ * sum below has one term, so the layouts above are this arithmetic. */
 static void general_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 			  const double rhs[NQ_FULL], const double qpdd[NQ_FULL], double br[NQ_FULL])
 {
@@ -327,8 +280,6 @@ void model_reduced_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 		trough3_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
 	else if (md->layout == MODEL_LAYOUT_TROUGH2)
 		trough2_solves(md, M, 1, (const double(*)[NQ_FULL])rhs, (double(*)[NQ_FULL])br);
-	else if (md->selection)
-		selection_solve(md, M, rhs, br);
 	else
 		general_solve(md, M, rhs, qpdd, br);
 }
