@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "experiment.h"
 #include "metrics.h"
@@ -41,8 +42,8 @@ static void session_free(srv_session *s)
 	sim_free(s->sim);
 	srv_budget_give(s->mem_reserved);
 	srv_sample_free(&s->scratch);
-	free(s->ring);
-	free(s->ring_store);
+	if (s->ring_bytes)
+		munmap(s->ring, s->ring_bytes);
 	free(s->hist);
 	free(s->controls);
 	pthread_mutex_destroy(&s->lock);
@@ -85,15 +86,24 @@ static int alloc_buffers(srv_session *s)
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
 	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
-	s->ring = calloc(s->ring_cap, sizeof *s->ring);
-	s->ring_store = calloc(per ? s->ring_cap * per : 1, sizeof(double));
+	/* the record ring, slots then their arrays, in one mapping whose
+	 * pages are all made now (MAP_POPULATE): the memory budget reserved
+	 * them anyway, and a worker that fills a fresh ring would otherwise
+	 * take a page fault every few samples over its first 16 s */
+	size_t bytes = s->ring_cap * (sizeof *s->ring + per * sizeof(double));
+	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
+			 MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+	if (map != MAP_FAILED) {
+		s->ring_bytes = bytes;
+		s->ring = map;
+		s->ring_store = (double *)(void *)(s->ring + s->ring_cap);
+	}
+	s->wake_t = INFINITY;
 	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
 	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
-	if (!s->ring || !s->ring_store || !s->hist ||
+	if (!s->ring_bytes || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
-	/* the slots' array pointers are set when a slot is first written
-	 * (srv_ring_slot): megabytes of ring are not touched up front */
 	/* trajectory rows every whole number of sample intervals, at least
 	 * 0.01 s apart */
 	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);

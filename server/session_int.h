@@ -36,8 +36,12 @@ struct srv_session {
 	double steps_per_s, rtf;
 	api_sample *ring;
 	double *ring_store;
-	size_t ring_cap;
+	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
 	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
 	double *hist;
 	size_t hist_cap, hist_n;
 	double hist_stride, hist_next;
@@ -68,7 +72,7 @@ struct srv_session {
 };
 
 /* Slot i of the ring with its arrays pointed into ring_store (set on
- * every use, so that untouched slots cost no page). */
+ * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +
