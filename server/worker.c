@@ -1,6 +1,8 @@
 /*
  * worker.c - a session's worker thread: the only thread that touches the
- * session's sim instance.
+ * session's sim instance. It runs at the lowest priority (nice 19,
+ * srv_thread_background), below the request and stream threads: when the
+ * sessions want more CPU than there is, they fall behind, not the answers.
  *
  * The loop runs a few named phases per turn, with the session lock held
  * except while the core advances (libuv's uv_run is the model):
@@ -20,25 +22,28 @@
  *               --max-busy CPU slots (budget.c), giving it up after each
  *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
- *               after a stall; pace "max" runs flat out up to "until")
+ *               after a stall; pace "max" runs flat out up to "until"): a
+ *               paced session sleeps until its next sample is due, then
+ *               steps every sample due within the next 20 ms (a batch)
  *   step        sim_advance by one sample interval (1/sample_rate simulated
  *               seconds, cut at "until" and at experiment boundaries), then
  *               publish the status snapshot and a record in the bounded ring
  *               (samples and control events, indexed by a sequence number
  *               that never repeats) and, every stride, a trajectory row (the
- *               stride doubles whenever the history fills)
+ *               stride doubles whenever the history fills); the readers are
+ *               woken once per batch (every 10 ms of a flat-out session),
+ *               and only when a record one of them waits for exists
  *   job step    the experiment records the step and, at a segment boundary,
  *               hands over the next segment's command
  *   failure     a core error fails the session and aborts its experiment
  *   cpu         the worker's CPU time is read (CLOCK_THREAD_CPUTIME_ID: the
- *               worker steps this session only); a session that spent its
- *               grant (cpu_limit) pauses with pause_reason "cpu-budget"
+ *               worker steps this session only), at most every 10 ms of
+ *               wall time; a session that spent its grant (cpu_limit)
+ *               pauses with pause_reason "cpu-budget"
  *   meter       achieved steps/s and real-time factor over half-second
  *               windows
  */
-#define _GNU_SOURCE /* pthread_setname_np: workers show as "session" */
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -462,7 +467,7 @@ void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
 	clocks clk;
-	pthread_setname_np(pthread_self(), "session");
+	srv_thread_background("session");
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	sim_get_status(s->sim, &s->st);
