@@ -36,14 +36,15 @@ static const srv_config defaults = {
 	.max_memory = 0,       /* set from the machine: machine_defaults() */
 	.max_cpu_seconds = 1800.0,
 	.max_busy = 0,         /* set from the machine */
+	.max_paced_cores = 0,  /* set from the machine */
 	.max_client_connections = 64,
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
 	.max_queued_points = 4096,
 };
 
-enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL, OPT_FLAG,
-       OPT_LIST };
+enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
+       OPT_FLAG, OPT_LIST };
 
 typedef struct opt {
 	const char *name;
@@ -78,6 +79,7 @@ static const opt opts[] = {
 	{"max-memory", OPT_SIZE, 1L << 20, 1L << 50, F(max_memory)},
 	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds)},
 	{"max-busy", OPT_INT, 1, 1024, F(max_busy)},
+	{"max-paced-cores", OPT_CORES, 10, 4096000000L, F(max_paced_cores)},
 	{"max-client-connections", OPT_INT, 1, 100000,
 	 F(max_client_connections)},
 	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
@@ -89,7 +91,8 @@ static const opt opts[] = {
 #define NOPTS (sizeof opts / sizeof *opts)
 
 /* The budgets that depend on the machine: 3/4 of its memory, one pace
- * "max" session per core. */
+ * "max" session per core, 3/4 of the cores for paced sessions (the rest
+ * answers requests and feeds streams). */
 static void machine_defaults(srv_config *cfg)
 {
 	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -98,6 +101,7 @@ static void machine_defaults(srv_config *cfg)
 				  ? (size_t)pages / 4 * 3 * (size_t)page
 				  : (size_t)4 << 30;
 	cfg->max_busy = cores > 0 ? (int)cores : 1;
+	cfg->max_paced_cores = 0.75 * (cores > 0 ? (double)cores : 1.0);
 }
 
 static void usage(FILE *f, const srv_config *cfg)
@@ -148,6 +152,10 @@ static void usage(FILE *f, const srv_config *cfg)
 		"                       (default %g)\n"
 		"  --max-busy N         pace \"max\" sessions stepping at once, "
 		"in turns (default %d: the cores)\n"
+		"  --max-paced-cores C  cores the running paced sessions may "
+		"need together: each its CPU s\n"
+		"                       per simulated s times its pace (default "
+		"%g: 3/4 of the cores)\n"
 		"  --max-client-connections N  open connections per client "
 		"address (default %d)\n"
 		"  --max-connections N  open connections, all clients "
@@ -158,7 +166,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --max-queued-points N  sweep points queued or running, "
 		"all sweeps (default %d)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
-		cfg->max_cpu_seconds, cfg->max_busy,
+		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
 		cfg->connection_timeout, cfg->max_queued_points);
 }
@@ -213,14 +221,16 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 		else
 			*(size_t *)(void *)at = (size_t)v;
 		return 0;
-	case OPT_SECONDS: {
-		/* lo, hi: the range in milliseconds */
+	case OPT_SECONDS:
+	case OPT_CORES: {
+		/* lo, hi: the range in milliseconds, millionths of a core */
+		double unit = o->kind == OPT_CORES ? 1e-6 : 1e-3;
 		double s = strtod(arg, &end);
-		if (*end || end == arg || !(s >= 1e-3 * (double)o->lo &&
-					    s <= 1e-3 * (double)o->hi)) {
-			fprintf(stderr, "convsimd: %s must be seconds in "
-					"[%g, %g]\n", flag, 1e-3 * (double)o->lo,
-				1e-3 * (double)o->hi);
+		if (*end || end == arg || !(s >= unit * (double)o->lo &&
+					    s <= unit * (double)o->hi)) {
+			fprintf(stderr, "convsimd: %s must be %s in [%g, %g]\n",
+				flag, o->kind == OPT_CORES ? "cores" : "seconds",
+				unit * (double)o->lo, unit * (double)o->hi);
 			return -1;
 		}
 		*(double *)(void *)at = s;

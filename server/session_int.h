@@ -69,7 +69,21 @@ struct srv_session {
 	double cpu_seconds;       /* the worker's CPU time, s */
 	double cpu_limit;         /* pauses when cpu_seconds reaches it */
 	int cpu_paused;           /* paused because cpu_limit was reached */
+	double cpu_per_s;         /* CPU s per simulated s: estimated at
+				     creation, then measured by the worker */
+	int cpu_measured;         /* cpu_per_s is the worker's measure */
+	double paced_held;        /* cores of the paced budget it holds */
 };
+
+/* Cores a session needs from the paced budget as it is now: its CPU s per
+ * simulated s times its pace while it runs paced, else none (lock
+ * held). */
+static inline double srv_paced_need(const srv_session *s)
+{
+	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
+		return 0;
+	return s->cpu_per_s * s->pace;
+}
 
 /* Slot i of the ring with its arrays pointed into ring_store (set on
  * every use). */

@@ -60,6 +60,8 @@ typedef struct clocks {
 	double cpu_wall;              /* when the CPU clock was last read */
 	double publish_wall;          /* when readers were last woken */
 	double batch_end;             /* pacing: samples due by then step now */
+	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
+					 the cost window */
 } clocks;
 
 /* Restart pacing and metering from now (after a pause or a pace change). */
@@ -307,6 +309,41 @@ static void check_until(srv_session *s, clocks *c)
 	}
 }
 
+/* The CPU a simulated second costs this session, over windows of 50 ms of
+ * CPU or 2 simulated s, whichever comes first; the mean of the last and
+ * this window's (a session's cost changes with its state: a run-up, a
+ * moving feed). */
+#define COST_WINDOW_CPU 0.05
+#define COST_WINDOW_T 2.0
+
+static void measure_cost(srv_session *s, clocks *c)
+{
+	double cpu = s->cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
+	if (t <= 0 || (cpu < COST_WINDOW_CPU && t < COST_WINDOW_T)) {
+		if (t < 0) /* not a window: start one */
+			c->cost_cpu = s->cpu_seconds, c->cost_t = s->st.t;
+		return;
+	}
+	double cost = cpu / t;
+	s->cpu_per_s = s->cpu_measured ? 0.5 * (s->cpu_per_s + cost) : cost;
+	s->cpu_measured = 1;
+	c->cost_cpu = s->cpu_seconds;
+	c->cost_t = s->st.t;
+}
+
+/* need: the session's hold on the paced cores follows what it needs now
+ * (its state, pace and measured cost), even beyond the budget: admission
+ * is checked where a request raises it (session.c). Called in the same
+ * turn as the commands phase (the lock is not let go in between), so that
+ * a hold a handler raised for its queued command is kept until the worker
+ * has applied it. */
+static void commit_need(srv_session *s)
+{
+	double need = srv_paced_need(s);
+	if (need != s->paced_held)
+		srv_budget_set_paced(&s->paced_held, need);
+}
+
 /* cpu: read the worker's CPU time; a running session that spent its
  * grant pauses. */
 static void check_cpu(srv_session *s, clocks *c)
@@ -318,6 +355,7 @@ static void check_cpu(srv_session *s, clocks *c)
 	c->cpu_wall = now;
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
 		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
 		return;
 	s->state = SRV_PAUSED;
@@ -466,7 +504,7 @@ static void meter(srv_session *s, clocks *c)
 void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
-	clocks clk;
+	clocks clk = {0};
 	srv_thread_background("session");
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
@@ -474,6 +512,7 @@ void *srv_worker_main(void *arg)
 	srv_ring_sample(s);
 	restart_clocks(&clk, s);
 	clk.cpu_wall = -INFINITY;
+	clk.cost_t = s->st.t; /* the thread's CPU clock starts at 0 */
 	publish(s, &clk);
 	for (;;) {
 		start_job(s);
@@ -483,6 +522,7 @@ void *srv_worker_main(void *arg)
 		srv_persist_checkpoint(s, 0);
 		check_until(s, &clk);
 		check_cpu(s, &clk);
+		commit_need(s);
 		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
@@ -502,6 +542,7 @@ void *srv_worker_main(void *arg)
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
 	srv_cpu_leave(&s->turn);
+	srv_budget_set_paced(&s->paced_held, 0);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;
