@@ -91,8 +91,10 @@ static const opt opts[] = {
 #define NOPTS (sizeof opts / sizeof *opts)
 
 /* The budgets that depend on the machine: 3/4 of its memory, one pace
- * "max" session per core, 3/4 of the cores for paced sessions (the rest
- * answers requests and feeds streams). */
+ * "max" session per core, half the cores for paced sessions (the other
+ * half answers requests, feeds their streams, about 15 % more than the
+ * sessions themselves, and takes what a measured cost exceeds its
+ * estimate). */
 static void machine_defaults(srv_config *cfg)
 {
 	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -101,7 +103,7 @@ static void machine_defaults(srv_config *cfg)
 				  ? (size_t)pages / 4 * 3 * (size_t)page
 				  : (size_t)4 << 30;
 	cfg->max_busy = cores > 0 ? (int)cores : 1;
-	cfg->max_paced_cores = 0.75 * (cores > 0 ? (double)cores : 1.0);
+	cfg->max_paced_cores = 0.5 * (cores > 0 ? (double)cores : 1.0);
 }
 
 static void usage(FILE *f, const srv_config *cfg)
@@ -155,7 +157,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --max-paced-cores C  cores the running paced sessions may "
 		"need together: each its CPU s\n"
 		"                       per simulated s times its pace (default "
-		"%g: 3/4 of the cores)\n"
+		"%g: half the cores)\n"
 		"  --max-client-connections N  open connections per client "
 		"address (default %d)\n"
 		"  --max-connections N  open connections, all clients "

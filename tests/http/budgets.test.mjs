@@ -417,7 +417,7 @@ test('--help prints every budget with its default; a timeout not above the heart
   assert.equal(h.status, 0);
   for (const re of [/--max-memory BYTES .*\n.*default [0-9.]+ GiB: 3\/4 of this machine's memory/,
     /--max-cpu-seconds S .*\n.*default 1800/, /--max-busy N .*default \d+: the cores/,
-    /--max-paced-cores C .*\n.*default [0-9.]+: 3\/4 of the cores/,
+    /--max-paced-cores C .*\n.*default [0-9.]+: half the cores/,
     /--max-client-connections N .*default 64/, /--max-connections N .*default 1024/,
     /--connection-timeout S .*\n.*default 30/, /--max-queued-points N .*default 4096/]) {
     assert.match(h.stdout, re);
