@@ -32,7 +32,9 @@ struct timespec srv_deadline(double seconds);
  * and fit pool): the lowest, below the request and stream threads (0), so
  * that answers stay prompt when the computations want more CPU than there
  * is; they then fall behind, not the answers. */
+#ifndef SRV_BACKGROUND_NICE /* -DSRV_BACKGROUND_NICE=0 to compare */
 #define SRV_BACKGROUND_NICE 19
+#endif
 /* Give the calling thread SRV_BACKGROUND_NICE (Linux: nice is per thread,
  * set by its thread id); name (<= 15 characters) shows in ps and top.
  * Failures are logged at debug level and otherwise ignored. */

@@ -18,6 +18,7 @@
 // (exit 1) if the daemon crashed, its memory went over the budget, or the
 // other client was not answered every time.
 // Environment: CONVSIMD (the binary), WINDOW (s), SESSIONS, STREAMS, IDLE,
+// MEMORY_GIB (--max-memory, default 3: about 290 default sessions),
 // DAEMON_FLAGS (more daemon flags, e.g. "--max-paced-cores 64" to measure
 // the daemon overloaded).
 import { startDaemon } from '../http/lib.mjs';
@@ -29,14 +30,15 @@ const SESSIONS = Number(process.env.SESSIONS || 200);
 const STREAMS = Number(process.env.STREAMS || 500);
 const IDLE = Number(process.env.IDLE || 2000);
 const WINDOW = Number(process.env.WINDOW || 30);
-const MEMORY = 3 * 1024 ** 3;
+const MEMORY_GIB = Number(process.env.MEMORY_GIB || 3);
+const MEMORY = MEMORY_GIB * 1024 ** 3;
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const failures = [];
 const check = (ok, what) => { if (!ok) failures.push(what); };
 
 const FLAGS = (process.env.DAEMON_FLAGS || '').split(/\s+/).filter(Boolean);
 const d = await startDaemon(['--max-sessions', String(SESSIONS + 16), '--max-streams', String(STREAMS + 16),
-  '--max-memory', '3G', ...FLAGS]);
+  '--max-memory', `${MEMORY_GIB}G`, ...FLAGS]);
 const base = d.base;
 // bounded: whatever happens, the run and its daemon end within 6 minutes
 process.on('exit', () => { if (d.proc.exitCode === null) d.proc.kill('SIGKILL'); });
@@ -133,6 +135,7 @@ const patchMs = [];
 const patchStatus = {};
 const windowStart = performance.now();
 const usageStart = procUsage(d.proc.pid);
+const selfStart = process.cpuUsage();
 let k = 0;
 while (performance.now() - windowStart < WINDOW * 1000) {
   const id = ids[k++ % ids.length];
@@ -143,6 +146,7 @@ while (performance.now() - windowStart < WINDOW * 1000) {
   await sleep(50);
 }
 const usageEnd = procUsage(d.proc.pid);
+const selfCpu = process.cpuUsage(selfStart);
 const windowS = (performance.now() - windowStart) / 1000;
 
 progress('window over');
@@ -202,6 +206,7 @@ const lines = [
   `| another client (127.0.0.3): requests, p99 latency | ${other.n}, all answered: ${other.bad.length === 0}, ${fmt(quantile(other.ms, 0.99))} ms |`,
   `| daemon resident memory, peak (budget reserved / --max-memory) | ${mb(peakRss)} MiB (${mb(reserved)} / ${mb(MEMORY)} MiB) |`,
   `| daemon CPU (user + sys) in the window | ${fmt(cpu)} s = ${fmt(cpu / windowS, 2)} cores |`,
+  `| this load generator's CPU (node, same machine) in the window | ${fmt((selfCpu.user + selfCpu.system) / 1e6 / windowS, 2)} cores |`,
   `| stream records received | ${streamRecords} |`,
 ];
 console.log(lines.join('\n'));
