@@ -27,6 +27,7 @@ static const srv_config defaults = {
 	.ring = 4096,
 	.history = 20000,
 	.pool_threads = 2,
+	.worker_nice = 5,
 	.heartbeat = 15.0,
 	.max_experiments = 256,
 	.max_sweeps = 64,
@@ -66,6 +67,7 @@ static const opt opts[] = {
 	{"ring", OPT_INT, 16, 1 << 22, F(ring)},
 	{"history", OPT_INT, 16, 1 << 24, F(history)},
 	{"pool-threads", OPT_INT, 1, 256, F(pool_threads)},
+	{"worker-nice", OPT_INT, 0, 19, F(worker_nice)},
 	{"heartbeat", OPT_SECONDS, 50, 3600000, F(heartbeat)},
 	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
 	 F(checkpoint_interval)},
@@ -123,6 +125,10 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --history N          trajectory rows kept per session "
 		"(default 20000)\n"
 		"  --pool-threads N     sweep worker threads (default 2)\n"
+		"  --worker-nice N      nice value (0-19) of session workers and "
+		"sweep threads, below\n"
+		"                       the request and stream threads' 0 "
+		"(default 5)\n"
 		"  --heartbeat S        seconds between stream heartbeats "
 		"(default 15)\n"
 		"  --checkpoint-interval S  wall seconds between session "

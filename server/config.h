@@ -29,6 +29,7 @@ typedef struct srv_config {
 	int ring;              /* stream records kept per session */
 	int history;           /* trajectory rows kept per session */
 	int pool_threads;      /* sweep workers */
+	int worker_nice;       /* nice value of session workers and the pool */
 	double heartbeat;      /* s between stream heartbeats */
 	int max_experiments, max_sweeps;
 	int max_fits;          /* fits kept (running or over) */

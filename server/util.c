@@ -38,10 +38,17 @@ void srv_log(int level, const char *fmt, ...)
 	fprintf(stderr, "convsimd %s: %s\n", names[level & 3], line);
 }
 
+static int background_nice;
+
+void srv_background_nice_init(int nice)
+{
+	background_nice = nice;
+}
+
 void srv_thread_background(const char *name)
 {
 	pthread_setname_np(pthread_self(), name);
-	if (setpriority(PRIO_PROCESS, (id_t)gettid(), SRV_BACKGROUND_NICE) != 0)
+	if (setpriority(PRIO_PROCESS, (id_t)gettid(), background_nice) != 0)
 		srv_log(SRV_LOG_DEBUG, "cannot lower the priority of a %s thread",
 			name);
 }

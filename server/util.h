@@ -28,15 +28,13 @@ void srv_new_id(char *id);
  * (clamped to [0, 3600]). */
 struct timespec srv_deadline(double seconds);
 
-/* The nice value of the threads that compute (session workers, the sweep
- * and fit pool): the lowest, below the request and stream threads (0), so
- * that answers stay prompt when the computations want more CPU than there
- * is; they then fall behind, not the answers. */
-#ifndef SRV_BACKGROUND_NICE /* -DSRV_BACKGROUND_NICE=0 to compare */
-#define SRV_BACKGROUND_NICE 19
-#endif
-/* Give the calling thread SRV_BACKGROUND_NICE (Linux: nice is per thread,
- * set by its thread id); name (<= 15 characters) shows in ps and top.
+/* The threads that compute (session workers, the sweep and fit pool) run
+ * at a nice value above the request and stream threads' 0 (--worker-nice),
+ * so that answers stay prompt when the computations want more CPU than
+ * there is. Set it once at start-up, before any such thread starts. */
+void srv_background_nice_init(int nice);
+/* Give the calling thread that nice value (Linux: nice is per thread, set
+ * by its thread id); name (<= 15 characters) shows in ps and top.
  * Failures are logged at debug level and otherwise ignored. */
 void srv_thread_background(const char *name);
 

@@ -1,8 +1,8 @@
 /*
  * worker.c - a session's worker thread: the only thread that touches the
- * session's sim instance. It runs at the lowest priority (nice 19,
- * srv_thread_background), below the request and stream threads: when the
- * sessions want more CPU than there is, they fall behind, not the answers.
+ * session's sim instance. It runs below the request and stream threads
+ * (--worker-nice, srv_thread_background): when the sessions want more CPU
+ * than there is, they fall behind before the answers do.
  *
  * The loop runs a few named phases per turn, with the session lock held
  * except while the core advances (libuv's uv_run is the model):
