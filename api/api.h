@@ -84,9 +84,10 @@
 	  "`limit` name a budget that refused it. Delete something or retry later "         \
 	  "(Retry-After).")                                                   \
 	X(UNAVAILABLE, 503, "unavailable", "Service unavailable",             \
-	  "The daemon is shutting down, its memory budget (--max-memory) has no room for this " \
-	  "now (`budget` and `limit` say so), or its worker did not take a control within 5 s; " \
-	  "nothing was changed. Retry later (Retry-After).")
+	  "The daemon is shutting down, its memory budget (--max-memory) or the cores for " \
+	  "paced sessions (--max-paced-cores) have no room for this now (`budget` and `limit` " \
+	  "say so; `field` names what asked for the cores: pace, running), or its worker did " \
+	  "not take a control within 5 s; nothing was changed. Retry later (Retry-After).")
 
 typedef enum {
 #define API_ERR_ENUM(name, status, slug, title, explanation) API_##name,

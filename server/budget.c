@@ -1,13 +1,17 @@
 /*
- * budget.c - the daemon's resource budgets: memory reservations, CPU turns
- * for pace "max" sessions, connections per client address.
+ * budget.c - the daemon's resource budgets: memory reservations, the cores
+ * of paced sessions, CPU turns for pace "max" sessions, connections per
+ * client address.
  *
  * Memory is an estimate made before anything is allocated: the buffers the
  * server allocates are counted exactly from their sizes (record ring,
  * trajectory history, stream buffers); the core instance and the threads
  * are a constant plus a cost per feed element, calibrated against the
  * resident memory the daemon gained per session (README "Budgets and
- * load" has the measurement). CPU turns are a first-come-first-served
+ * load" has the measurement). The cores of paced sessions are committed
+ * the same way: each session holds its need (CPU s per simulated s, first
+ * estimated from its integrator and feed, then measured by its worker,
+ * times its pace) while it runs. CPU turns are a first-come-first-served
  * queue of at most --max-busy holders, each holding for a time slice while
  * others wait (round robin: each gets an equal share of the cores).
  * Connections are counted per client address in a small table sized by
@@ -33,10 +37,23 @@
 #define CPU_SLICE_S 0.1
 /* Retry-After of a memory refusal: sessions come and go in seconds. */
 #define MEMORY_RETRY_S 5
+/* Calibration of the CPU estimate (README "Budgets and load"): CPU s of
+ * one macro step of the machine (four right-hand sides: RK4, or dem's
+ * macro step), of one feed sub-step per integrated column and per
+ * integrated element, and of one published sample (status, ring record,
+ * trajectory row); `build/convsim run` on this machine, the cost of 5
+ * simulated s less that of 0.01 s, and the daemon's workers. */
+#define STEP_CPU_S 0.76e-6
+#define COLUMN_SUBSTEP_CPU_S 4.1e-8
+#define ELEMENT_SUBSTEP_CPU_S 1.0e-8
+#define SAMPLE_CPU_S 4e-6
+/* Retry-After of a refusal for CPU: paced sessions come and go. */
+#define CPU_RETRY_S 5
 
 static const srv_config *cfg;
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static size_t reserved;                 /* lock */
+static double paced;                    /* lock: cores held */
 static srv_cpu_turn *queue_head, *queue_tail; /* lock */
 static int busy, waiting;               /* lock */
 
@@ -153,6 +170,102 @@ void srv_budget_give(size_t bytes)
 	pthread_mutex_lock(&lock);
 	reserved -= bytes < reserved ? bytes : reserved;
 	pthread_mutex_unlock(&lock);
+}
+
+/* ---- cores of paced sessions ------------------------------------------------ */
+
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers)
+{
+	const sim_method *m = &spec->method;
+	double dt = st->dt, evals = 1;
+	int substeps = st->substeps;
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(all[i]->name, m->name) == 0 && all[i]->adaptive) {
+			/* its steps follow the solution: guess dem's */
+			sim_method dem = *m;
+			snprintf(dem.name, sizeof dem.name, "dem");
+			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
+			substeps = sim_default_substeps(dt);
+		}
+	if (strcmp(m->name, "euler") == 0)
+		evals = 0.25; /* one right-hand side a step, not four */
+	if (!(dt > 0))
+		dt = 1e-3;
+	if (substeps < 1)
+		substeps = 1;
+	/* the symmetric reduction integrates one representative column */
+	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
+	if (columns <= 0 || layers <= 0)
+		integrated = 0;
+	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
+			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
+	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
+}
+
+api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
+			      const char *field, const char *verb,
+			      api_problem *pb)
+{
+	double need = cpu_per_s * pace, limit = cfg->max_paced_cores;
+	pthread_mutex_lock(&lock);
+	double others = paced - *held;
+	int fits = need <= *held || others + need <= limit * (1 + 1e-12);
+	if (fits) {
+		if (need > *held) {
+			paced = others + need;
+			*held = need;
+		}
+		pthread_mutex_unlock(&lock);
+		return API_OK;
+	}
+	pthread_mutex_unlock(&lock);
+	if (need > limit) {
+		api_fail(pb, API_RANGE, field,
+			 "this session needs %.3g cores (%.3g ms of CPU per "
+			 "simulated s at pace %g), more than the %g cores for "
+			 "paced sessions (--max-paced-cores); nothing was %s, "
+			 "lower the pace", need, 1e3 * cpu_per_s, pace, limit,
+			 verb);
+		pb->has_range = 1;
+		pb->min = 0.001; /* the least pace (api/) */
+		pb->max = limit / cpu_per_s;
+		return api_budget(pb, "cpu", limit, 0);
+	}
+	api_fail(pb, API_UNAVAILABLE, field,
+		 "this session needs %.3g cores (%.3g ms of CPU per simulated s "
+		 "at pace %g) and running paced sessions hold %.3g of the %g "
+		 "cores for paced sessions (--max-paced-cores); nothing was %s, "
+		 "retry when paced sessions have ended, paused or slowed down",
+		 need, 1e3 * cpu_per_s, pace, others, limit, verb);
+	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
+}
+
+void srv_budget_set_paced(double *held, double need)
+{
+	if (!(need >= 0))
+		need = 0;
+	pthread_mutex_lock(&lock);
+	paced += need - *held;
+	if (paced < 1e-12)
+		paced = 0; /* no drift below nothing */
+	*held = need;
+	pthread_mutex_unlock(&lock);
+}
+
+double srv_budget_paced(void)
+{
+	pthread_mutex_lock(&lock);
+	double c = paced;
+	pthread_mutex_unlock(&lock);
+	return c;
+}
+
+double srv_budget_paced_limit(void)
+{
+	return cfg->max_paced_cores;
 }
 
 /* ---- queued sweep points ------------------------------------------------------ */

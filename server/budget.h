@@ -1,10 +1,13 @@
 /*
  * budget.h - the daemon's resource budgets, so that no one client takes the
  * machine: memory (the need of each session and stream, estimated before it
- * is created and reserved against --max-memory), CPU turns for pace "max"
- * sessions (at most --max-busy step at once, taking turns in time slices,
- * first come first served) and the open connections of each client address
- * (counted in libmicrohttpd's connection notification).
+ * is created and reserved against --max-memory), the cores that running
+ * paced sessions need (each its CPU s per simulated s times its pace,
+ * committed against --max-paced-cores before it is created, resumed or
+ * sped up), CPU turns for pace "max" sessions (at most --max-busy step at
+ * once, taking turns in time slices, first come first served) and the
+ * open connections of each client address (counted in libmicrohttpd's
+ * connection notification).
  *
  * A leaf like metrics.c: it calls nothing else of server/ but util.c. Its
  * lock is a leaf of the lock order (registry.h): nothing is taken under it
@@ -47,6 +50,33 @@ void srv_budget_give(size_t bytes);
 /* Bytes reserved now, and the budget. */
 size_t srv_budget_reserved(void);
 size_t srv_budget_memory(void);
+
+/* ---- cores of paced sessions ------------------------------------------------ */
+
+/* Estimated CPU s per simulated s of a session before it has run: from
+ * its integrator (method, the step dt and the feed sub-steps in use, as
+ * sim_get_status reports them after sim_new) and the feed elements it
+ * integrates (feed: columns x layers; the symmetric reduction integrates
+ * one representative column). Calibrated on this machine (README "Budgets
+ * and load"); a running session's worker measures its own. */
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers);
+/* Raise what a paced session holds (*held, cores; the caller's, guarded
+ * by its lock) to need = cpu_per_s x pace. API_OK when need <= *held or
+ * the running paced sessions' sum stays within --max-paced-cores; else
+ * nothing changes and *pb is 503 (budget "cpu", Retry-After, field named)
+ * or, when need alone is more than the whole budget, 422 naming field
+ * with the largest pace that fits as max. verb: "created" or "changed",
+ * for the message. */
+api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
+			      const char *field, const char *verb,
+			      api_problem *pb);
+/* Set what a session holds to need (cores, >= 0), even beyond the budget:
+ * its worker's own measure, a pause, the end. */
+void srv_budget_set_paced(double *held, double need);
+/* Cores held by running paced sessions now, and the budget. */
+double srv_budget_paced(void);
+double srv_budget_paced_limit(void);
 
 /* ---- queued sweep points ------------------------------------------------------ */
 

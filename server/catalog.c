@@ -87,6 +87,8 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.pool_queued = (double)srv_pool_queued(),
 		.memory_reserved = (double)srv_budget_reserved(),
 		.memory_budget = (double)srv_budget_memory(),
+		.paced_cores = srv_budget_paced(),
+		.paced_cores_budget = srv_budget_paced_limit(),
 		.cpu_busy = busy,
 		.cpu_waiting = waiting,
 		.sweep_points = (double)srv_budget_points(),

@@ -27,6 +27,7 @@ static const srv_config defaults = {
 	.ring = 4096,
 	.history = 20000,
 	.pool_threads = 2,
+	.worker_nice = 5,
 	.heartbeat = 15.0,
 	.max_experiments = 256,
 	.max_sweeps = 64,
@@ -36,14 +37,15 @@ static const srv_config defaults = {
 	.max_memory = 0,       /* set from the machine: machine_defaults() */
 	.max_cpu_seconds = 1800.0,
 	.max_busy = 0,         /* set from the machine */
+	.max_paced_cores = 0,  /* set from the machine */
 	.max_client_connections = 64,
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
 	.max_queued_points = 4096,
 };
 
-enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_LEVEL, OPT_FLAG,
-       OPT_LIST };
+enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
+       OPT_FLAG, OPT_LIST };
 
 typedef struct opt {
 	const char *name;
@@ -65,6 +67,7 @@ static const opt opts[] = {
 	{"ring", OPT_INT, 16, 1 << 22, F(ring)},
 	{"history", OPT_INT, 16, 1 << 24, F(history)},
 	{"pool-threads", OPT_INT, 1, 256, F(pool_threads)},
+	{"worker-nice", OPT_INT, 0, 19, F(worker_nice)},
 	{"heartbeat", OPT_SECONDS, 50, 3600000, F(heartbeat)},
 	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
 	 F(checkpoint_interval)},
@@ -78,6 +81,7 @@ static const opt opts[] = {
 	{"max-memory", OPT_SIZE, 1L << 20, 1L << 50, F(max_memory)},
 	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds)},
 	{"max-busy", OPT_INT, 1, 1024, F(max_busy)},
+	{"max-paced-cores", OPT_CORES, 10, 4096000000L, F(max_paced_cores)},
 	{"max-client-connections", OPT_INT, 1, 100000,
 	 F(max_client_connections)},
 	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
@@ -89,7 +93,10 @@ static const opt opts[] = {
 #define NOPTS (sizeof opts / sizeof *opts)
 
 /* The budgets that depend on the machine: 3/4 of its memory, one pace
- * "max" session per core. */
+ * "max" session per core, half the cores for paced sessions (the other
+ * half answers requests, feeds their streams, about 15 % more than the
+ * sessions themselves, and takes what a measured cost exceeds its
+ * estimate). */
 static void machine_defaults(srv_config *cfg)
 {
 	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -98,6 +105,7 @@ static void machine_defaults(srv_config *cfg)
 				  ? (size_t)pages / 4 * 3 * (size_t)page
 				  : (size_t)4 << 30;
 	cfg->max_busy = cores > 0 ? (int)cores : 1;
+	cfg->max_paced_cores = 0.5 * (cores > 0 ? (double)cores : 1.0);
 }
 
 static void usage(FILE *f, const srv_config *cfg)
@@ -117,6 +125,10 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --history N          trajectory rows kept per session "
 		"(default 20000)\n"
 		"  --pool-threads N     sweep worker threads (default 2)\n"
+		"  --worker-nice N      nice value (0-19) of session workers and "
+		"sweep threads, below\n"
+		"                       the request and stream threads' 0 "
+		"(default 5)\n"
 		"  --heartbeat S        seconds between stream heartbeats "
 		"(default 15)\n"
 		"  --checkpoint-interval S  wall seconds between session "
@@ -148,6 +160,10 @@ static void usage(FILE *f, const srv_config *cfg)
 		"                       (default %g)\n"
 		"  --max-busy N         pace \"max\" sessions stepping at once, "
 		"in turns (default %d: the cores)\n"
+		"  --max-paced-cores C  cores the running paced sessions may "
+		"need together: each its CPU s\n"
+		"                       per simulated s times its pace (default "
+		"%g: half the cores)\n"
 		"  --max-client-connections N  open connections per client "
 		"address (default %d)\n"
 		"  --max-connections N  open connections, all clients "
@@ -158,7 +174,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --max-queued-points N  sweep points queued or running, "
 		"all sweeps (default %d)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
-		cfg->max_cpu_seconds, cfg->max_busy,
+		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
 		cfg->connection_timeout, cfg->max_queued_points);
 }
@@ -213,14 +229,16 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 		else
 			*(size_t *)(void *)at = (size_t)v;
 		return 0;
-	case OPT_SECONDS: {
-		/* lo, hi: the range in milliseconds */
+	case OPT_SECONDS:
+	case OPT_CORES: {
+		/* lo, hi: the range in milliseconds, millionths of a core */
+		double unit = o->kind == OPT_CORES ? 1e-6 : 1e-3;
 		double s = strtod(arg, &end);
-		if (*end || end == arg || !(s >= 1e-3 * (double)o->lo &&
-					    s <= 1e-3 * (double)o->hi)) {
-			fprintf(stderr, "convsimd: %s must be seconds in "
-					"[%g, %g]\n", flag, 1e-3 * (double)o->lo,
-				1e-3 * (double)o->hi);
+		if (*end || end == arg || !(s >= unit * (double)o->lo &&
+					    s <= unit * (double)o->hi)) {
+			fprintf(stderr, "convsimd: %s must be %s in [%g, %g]\n",
+				flag, o->kind == OPT_CORES ? "cores" : "seconds",
+				unit * (double)o->lo, unit * (double)o->hi);
 			return -1;
 		}
 		*(double *)(void *)at = s;

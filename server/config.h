@@ -29,6 +29,7 @@ typedef struct srv_config {
 	int ring;              /* stream records kept per session */
 	int history;           /* trajectory rows kept per session */
 	int pool_threads;      /* sweep workers */
+	int worker_nice;       /* nice value of session workers and the pool */
 	double heartbeat;      /* s between stream heartbeats */
 	int max_experiments, max_sweeps;
 	int max_fits;          /* fits kept (running or over) */
@@ -44,6 +45,9 @@ typedef struct srv_config {
 	size_t max_memory;     /* bytes: sessions' and streams' estimated need */
 	double max_cpu_seconds; /* CPU s a session may use per grant */
 	int max_busy;          /* pace "max" sessions stepping at once */
+	double max_paced_cores; /* cores the running paced sessions may need,
+				   all together (their CPU s per simulated s
+				   times their pace) */
 	int max_client_connections; /* open connections per client address */
 	int max_connections;   /* open connections, all clients */
 	double connection_timeout; /* s a connection may stay silent */

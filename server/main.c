@@ -156,6 +156,7 @@ int main(int argc, char **argv)
 	if (parsed)
 		return parsed > 0 ? 0 : 2;
 	srv_log_init(cfg.log_level);
+	srv_background_nice_init(cfg.worker_nice);
 	srv_ids_init(cfg.node_id);
 
 	sigset_t sigs;

@@ -80,6 +80,12 @@ char *srv_metrics_text(const srv_gauges *g)
 		 "sessions and streams (the memory budget's use).", g->memory_reserved},
 		{"convsim_memory_budget_bytes", "gauge", "The memory budget "
 		 "(--max-memory).", g->memory_budget},
+		{"convsim_paced_cpu_cores", "gauge", "Cores committed to running "
+		 "paced sessions: each its CPU s per simulated s times its pace "
+		 "(the paced CPU budget's use).", g->paced_cores},
+		{"convsim_paced_cpu_budget_cores", "gauge", "The cores running "
+		 "paced sessions may need together (--max-paced-cores).",
+		 g->paced_cores_budget},
 		{"convsim_cpu_slots_busy", "gauge", "Pace max sessions stepping now "
 		 "(at most --max-busy).", g->cpu_busy},
 		{"convsim_cpu_slots_waiting", "gauge", "Pace max sessions waiting "

@@ -29,6 +29,8 @@ typedef struct srv_gauges {
 	double pool_queued;
 	/* budgets (budget.c) */
 	double memory_reserved, memory_budget; /* bytes */
+	double paced_cores, paced_cores_budget; /* held by running paced
+						   sessions, --max-paced-cores */
 	double cpu_busy, cpu_waiting;  /* pace "max" slots in use, waiting */
 	double sweep_points;           /* queued or running */
 	double client_refused;         /* connections answered 429 */

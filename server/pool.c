@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "pool.h"
+#include "util.h"
 
 typedef struct job {
 	void (*fn)(void *);
@@ -25,6 +26,7 @@ static pthread_t *threads;
 static void *pool_main(void *unused)
 {
 	(void)unused;
+	srv_thread_background("pool");
 	pthread_mutex_lock(&pool_lock);
 	for (;;) {
 		while (!queue_head && !stopping)

@@ -29,6 +29,7 @@ void srv_ring_event(srv_session *s, const char *type, const char *json)
 	slot->st = s->st;
 	snprintf(slot->event_type, sizeof slot->event_type, "%s", type);
 	snprintf(slot->event, sizeof slot->event, "%s", json);
+	s->event_head = s->head;
 }
 
 void srv_ring_event_at(srv_session *s, const char *type, const char *detail)
@@ -159,22 +160,37 @@ srv_ring_read srv_session_ring(srv_session *s)
 	return rd;
 }
 
-void srv_session_read(srv_session *s, uint64_t cursor, api_sample *dst,
-		      srv_ring_read *rd)
+void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
+		      api_sample *dst, srv_ring_read *rd)
 {
 	pthread_mutex_lock(&s->lock);
 	look(s, rd);
 	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
+	/* samples before from_t are passed over here, without a copy */
+	while (idx < rd->head) {
+		const api_sample *r = &s->ring[idx % s->ring_cap];
+		if (r->kind != API_REC_SAMPLE || r->st.t >= from_t)
+			break;
+		idx++;
+	}
+	rd->next = idx;
 	if (idx < rd->head)
 		copy_record(dst, &s->ring[idx % s->ring_cap]);
 	pthread_mutex_unlock(&s->lock);
 }
 
-void srv_session_wait(srv_session *s, const srv_ring_read *rd,
+void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 		      double seconds)
 {
 	pthread_mutex_lock(&s->lock);
-	if (s->head == rd->head && s->state == rd->state && !s->stop) {
+	/* what would wake it: an event, a sample at or past from_t, a change
+	 * of state, the deletion */
+	int news = s->event_head > rd->head ||
+		   (s->head > rd->head && s->st.t >= from_t) ||
+		   s->state != rd->state || s->stop;
+	if (!news) {
+		if (from_t < s->wake_t)
+			s->wake_t = from_t; /* the worker wakes it from then */
 		struct timespec ts = srv_deadline(seconds);
 		pthread_cond_timedwait(&s->data, &s->lock, &ts);
 	}

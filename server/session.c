@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "experiment.h"
 #include "metrics.h"
@@ -40,9 +41,10 @@ static void session_free(srv_session *s)
 		return;
 	sim_free(s->sim);
 	srv_budget_give(s->mem_reserved);
+	srv_budget_set_paced(&s->paced_held, 0);
 	srv_sample_free(&s->scratch);
-	free(s->ring);
-	free(s->ring_store);
+	if (s->ring_bytes)
+		munmap(s->ring, s->ring_bytes);
 	free(s->hist);
 	free(s->controls);
 	pthread_mutex_destroy(&s->lock);
@@ -85,15 +87,24 @@ static int alloc_buffers(srv_session *s)
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
 	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
-	s->ring = calloc(s->ring_cap, sizeof *s->ring);
-	s->ring_store = calloc(per ? s->ring_cap * per : 1, sizeof(double));
+	/* the record ring, slots then their arrays, in one mapping whose
+	 * pages are all made now (MAP_POPULATE): the memory budget reserved
+	 * them anyway, and a worker that fills a fresh ring would otherwise
+	 * take a page fault every few samples over its first 16 s */
+	size_t bytes = s->ring_cap * (sizeof *s->ring + per * sizeof(double));
+	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
+			 MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+	if (map != MAP_FAILED) {
+		s->ring_bytes = bytes;
+		s->ring = map;
+		s->ring_store = (double *)(void *)(s->ring + s->ring_cap);
+	}
+	s->wake_t = INFINITY;
 	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
 	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
-	if (!s->ring || !s->ring_store || !s->hist ||
+	if (!s->ring_bytes || !s->hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
-	/* the slots' array pointers are set when a slot is first written
-	 * (srv_ring_slot): megabytes of ring are not touched up front */
 	/* trajectory rows every whole number of sample intervals, at least
 	 * 0.01 s apart */
 	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
@@ -128,6 +139,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
+	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
+					       s->layers);
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -162,6 +175,11 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 		goto fail;
 	}
 	if (session_init(s, spec, pb))
+		goto fail;
+	/* the cores it needs at its pace, before it runs */
+	if (s->pace != API_PACE_MAX &&
+	    srv_budget_take_paced(&s->paced_held, s->cpu_per_s, s->pace, "pace",
+				  "created", pb) != API_OK)
 		goto fail;
 	s->exp = exp;
 	s->owned = exp && !srv_exp_keeps_session(exp);
@@ -209,6 +227,10 @@ int srv_session_adopt(srv_session *s)
 			s->columns = sim_columns(s->sim);
 			s->layers = sim_layers(s->sim);
 		}
+		/* its worker commits the cores it needs, even beyond the
+		 * budget: it existed before */
+		s->cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
+						       s->columns, s->layers);
 	}
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		srv_log(SRV_LOG_WARN, "session %s not restored: --max-sessions "
@@ -415,6 +437,40 @@ double srv_sessions_steps_per_s(void)
 	return sum;
 }
 
+/* Whether s runs after control c (lock held): what the worker's commands
+ * phase will make of its state (worker.c apply_commands, apply_budget). */
+static int runs_after(const srv_session *s, const api_control *c)
+{
+	int state = s->state;
+	if ((c->set & API_C_UNTIL) && state == SRV_FINISHED &&
+	    (c->until == 0 || c->until > s->st.t))
+		state = SRV_RUNNING;
+	if ((c->set & API_C_RUNNING) && !c->running && state == SRV_RUNNING)
+		state = SRV_PAUSED;
+	else if ((c->set & API_C_RUNNING) && c->running && state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	if ((c->set & API_C_CPU) && s->cpu_paused && state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	return state == SRV_RUNNING;
+}
+
+/* The paced cores s needs after c: raise its hold before c is queued, or
+ * refuse (lock held). The field named is the one that raises it. */
+static api_err admit_control(srv_session *s, const api_control *c,
+			     api_problem *pb)
+{
+	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
+	if (pace == API_PACE_MAX || !runs_after(s, c) ||
+	    s->cpu_per_s * pace <= s->paced_held)
+		return API_OK;
+	const char *field = (c->set & API_C_PACE)      ? "pace"
+			    : (c->set & API_C_RUNNING) ? "running"
+			    : (c->set & API_C_CPU)     ? "cpu_budget"
+						       : "until";
+	return srv_budget_take_paced(&s->paced_held, s->cpu_per_s, pace, field,
+				     "changed", pb);
+}
+
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
@@ -445,6 +501,8 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 		e = api_fail(pb, API_CONFLICT, "running",
 			     "the session finished at until = %g s; raise "
 			     "until to run on", s->until);
+	else
+		e = admit_control(s, c, pb);
 	if (e != API_OK) {
 		pthread_mutex_unlock(&s->lock);
 		return e;
@@ -457,6 +515,7 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 			break;
 	if (!cmd.done) { /* take it back: nothing changes */
 		srv_worker_unqueue(s, &cmd);
+		srv_budget_set_paced(&s->paced_held, srv_paced_need(s));
 		pthread_mutex_unlock(&s->lock);
 		return api_fail(pb, API_UNAVAILABLE, NULL,
 				"the session's worker did not take the change "

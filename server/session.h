@@ -86,18 +86,25 @@ typedef struct srv_ring_read {
 	int state;            /* SRV_RUNNING ... */
 	int removed;          /* the session is being deleted */
 	double t;             /* s: the latest simulated time */
+	uint64_t next;        /* srv_session_read: the record copied, or
+				 head when none was */
 } srv_ring_read;
 
 /* The ring's bounds and state now. */
 srv_ring_read srv_session_ring(srv_session *s);
-/* One consistent look: the bounds and state in *rd and, when
- * max(cursor, oldest) < head, that record copied into dst (arrays sized by
- * srv_sample_alloc for this session's feed). */
-void srv_session_read(srv_session *s, uint64_t cursor, api_sample *dst,
-		      srv_ring_read *rd);
-/* Wait up to seconds for anything newer than *rd (a record, a state
- * change, deletion). */
-void srv_session_wait(srv_session *s, const srv_ring_read *rd,
+/* One consistent look: the bounds and state in *rd and the first record
+ * from max(cursor, oldest) on that is an event or a sample at or after
+ * from_t (s; -INFINITY: every sample), copied into dst (arrays sized by
+ * srv_sample_alloc for this session's feed) with its index in rd->next;
+ * rd->next = head when there is none (the samples passed over are not
+ * copied). */
+void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
+		      api_sample *dst, srv_ring_read *rd);
+/* Wait up to seconds for a record newer than *rd that a reader wanting
+ * samples from from_t on would take (an event, such a sample), a state
+ * change or the deletion. The worker wakes waiting readers once per batch
+ * of steps, and only when such a record exists. */
+void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 		      double seconds);
 /* Count a stream client in or out (delta +1 / -1) for the view. */
 void srv_session_stream_count(srv_session *s, int delta);

@@ -36,8 +36,12 @@ struct srv_session {
 	double steps_per_s, rtf;
 	api_sample *ring;
 	double *ring_store;
-	size_t ring_cap;
+	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
 	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
 	double *hist;
 	size_t hist_cap, hist_n;
 	double hist_stride, hist_next;
@@ -65,10 +69,24 @@ struct srv_session {
 	double cpu_seconds;       /* the worker's CPU time, s */
 	double cpu_limit;         /* pauses when cpu_seconds reaches it */
 	int cpu_paused;           /* paused because cpu_limit was reached */
+	double cpu_per_s;         /* CPU s per simulated s: estimated at
+				     creation, then measured by the worker */
+	int cpu_measured;         /* cpu_per_s is the worker's measure */
+	double paced_held;        /* cores of the paced budget it holds */
 };
 
+/* Cores a session needs from the paced budget as it is now: its CPU s per
+ * simulated s times its pace while it runs paced, else none (lock
+ * held). */
+static inline double srv_paced_need(const srv_session *s)
+{
+	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
+		return 0;
+	return s->cpu_per_s * s->pace;
+}
+
 /* Slot i of the ring with its arrays pointed into ring_store (set on
- * every use, so that untouched slots cost no page). */
+ * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +

@@ -61,6 +61,14 @@ static void end_stream(stream *k, const char *reason)
 	k->ended = 1;
 }
 
+/* The earliest sample time k takes next (s): ?rate thins samples out
+ * (-INFINITY: every sample). The ring's reader passes over the others
+ * without copying them, and the worker wakes k only when one exists. */
+static double from_t(const stream *k)
+{
+	return k->rate > 0 ? k->next_t - 1e-9 : -INFINITY;
+}
+
 /* Format the record just copied into k->rec unless ?rate thins it out. */
 static void put_record(stream *k)
 {
@@ -84,7 +92,7 @@ static void fill(stream *k)
 {
 	while (!k->ended) {
 		srv_ring_read rd;
-		srv_session_read(k->s, k->cursor, &k->rec, &rd);
+		srv_session_read(k->s, k->cursor, from_t(k), &k->rec, &rd);
 		if (srv_stopping()) {
 			end_stream(k, "shutdown");
 			break;
@@ -101,13 +109,14 @@ static void fill(stream *k)
 				missed, rd.oldest, k->ndjson);
 			k->cursor = rd.oldest;
 		}
-		if (k->cursor < rd.head) { /* srv_session_read copied it */
-			k->cursor++;
+		if (rd.next < rd.head) { /* srv_session_read copied it */
+			k->cursor = rd.next + 1;
 			put_record(k);
 			if (k->out_len + k->rec_max > k->out_cap)
 				break;
 			continue;
 		}
+		k->cursor = rd.head; /* the samples passed over are done */
 		if (k->out_len)
 			break;
 		if (rd.state == SRV_FINISHED || rd.state == SRV_FAILED) {
@@ -123,7 +132,7 @@ static void fill(stream *k)
 			break;
 		}
 		double wait = k->heartbeat - idle;
-		srv_session_wait(k->s, &rd, wait < 0.5 ? wait : 0.5);
+		srv_session_wait(k->s, &rd, from_t(k), wait < 0.5 ? wait : 0.5);
 	}
 	k->last_write = srv_now();
 }

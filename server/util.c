@@ -3,12 +3,15 @@
  * clocks, timed-wait deadlines, random ids (with the replica's node id)
  * and the stopping flag.
  */
+#define _GNU_SOURCE /* gettid, pthread_setname_np */
 #include <fcntl.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/random.h>
+#include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -33,6 +36,21 @@ void srv_log(int level, const char *fmt, ...)
 	vsnprintf(line, sizeof line, fmt, ap);
 	va_end(ap);
 	fprintf(stderr, "convsimd %s: %s\n", names[level & 3], line);
+}
+
+static int background_nice;
+
+void srv_background_nice_init(int nice)
+{
+	background_nice = nice;
+}
+
+void srv_thread_background(const char *name)
+{
+	pthread_setname_np(pthread_self(), name);
+	if (setpriority(PRIO_PROCESS, (id_t)gettid(), background_nice) != 0)
+		srv_log(SRV_LOG_DEBUG, "cannot lower the priority of a %s thread",
+			name);
 }
 
 double srv_now(void)

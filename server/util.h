@@ -28,6 +28,16 @@ void srv_new_id(char *id);
  * (clamped to [0, 3600]). */
 struct timespec srv_deadline(double seconds);
 
+/* The threads that compute (session workers, the sweep and fit pool) run
+ * at a nice value above the request and stream threads' 0 (--worker-nice),
+ * so that answers stay prompt when the computations want more CPU than
+ * there is. Set it once at start-up, before any such thread starts. */
+void srv_background_nice_init(int nice);
+/* Give the calling thread that nice value (Linux: nice is per thread, set
+ * by its thread id); name (<= 15 characters) shows in ps and top.
+ * Failures are logged at debug level and otherwise ignored. */
+void srv_thread_background(const char *name);
+
 /* The daemon is shutting down (set once, on SIGTERM/SIGINT): streams end,
  * pool jobs return at once, the API answers 503. */
 int srv_stopping(void);

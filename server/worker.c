@@ -1,6 +1,8 @@
 /*
  * worker.c - a session's worker thread: the only thread that touches the
- * session's sim instance.
+ * session's sim instance. It runs below the request and stream threads
+ * (--worker-nice, srv_thread_background): when the sessions want more CPU
+ * than there is, they fall behind before the answers do.
  *
  * The loop runs a few named phases per turn, with the session lock held
  * except while the core advances (libuv's uv_run is the model):
@@ -20,19 +22,24 @@
  *               --max-busy CPU slots (budget.c), giving it up after each
  *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
- *               after a stall; pace "max" runs flat out up to "until")
+ *               after a stall; pace "max" runs flat out up to "until"): a
+ *               paced session sleeps until its next sample is due, then
+ *               steps every sample due within the next 20 ms (a batch)
  *   step        sim_advance by one sample interval (1/sample_rate simulated
  *               seconds, cut at "until" and at experiment boundaries), then
  *               publish the status snapshot and a record in the bounded ring
  *               (samples and control events, indexed by a sequence number
  *               that never repeats) and, every stride, a trajectory row (the
- *               stride doubles whenever the history fills)
+ *               stride doubles whenever the history fills); the readers are
+ *               woken once per batch (every 10 ms of a flat-out session),
+ *               and only when a record one of them waits for exists
  *   job step    the experiment records the step and, at a segment boundary,
  *               hands over the next segment's command
  *   failure     a core error fails the session and aborts its experiment
  *   cpu         the worker's CPU time is read (CLOCK_THREAD_CPUTIME_ID: the
- *               worker steps this session only); a session that spent its
- *               grant (cpu_limit) pauses with pause_reason "cpu-budget"
+ *               worker steps this session only), at most every 10 ms of
+ *               wall time; a session that spent its grant (cpu_limit)
+ *               pauses with pause_reason "cpu-budget"
  *   meter       achieved steps/s and real-time factor over half-second
  *               windows
  */
@@ -50,6 +57,11 @@ typedef struct clocks {
 	double anchor_wall, anchor_t; /* pacing: wall time at simulated t */
 	double rate_wall, rate_t;     /* metering window start */
 	uint64_t rate_steps;
+	double cpu_wall;              /* when the CPU clock was last read */
+	double publish_wall;          /* when readers were last woken */
+	double batch_end;             /* pacing: samples due by then step now */
+	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
+					 the cost window */
 } clocks;
 
 /* Restart pacing and metering from now (after a pause or a pace change). */
@@ -58,6 +70,31 @@ static void restart_clocks(clocks *c, const srv_session *s)
 	c->anchor_wall = c->rate_wall = srv_now();
 	c->anchor_t = c->rate_t = s->st.t;
 	c->rate_steps = s->st.steps;
+	c->batch_end = -INFINITY;
+}
+
+/* The CPU clock is read at most this often (s of wall time): once per
+ * batch of a paced session, every 10 ms of a flat-out one. */
+#define CPU_READ_EVERY 0.01
+/* A flat-out session wakes its readers this often (s of wall time); a
+ * paced one once per batch, before it sleeps. */
+#define PUBLISH_EVERY 0.01
+
+/* Wake the readers if a record one of them waits for was pushed since
+ * the last time: an event, or a sample at or past the earliest time a
+ * waiting stream wants (wake_t, which the streams lower before they wait).
+ * Once per batch, not once per sample: every waiting stream is a thread
+ * to wake (lock held). */
+static void publish(srv_session *s, clocks *c)
+{
+	c->publish_wall = srv_now();
+	if (s->head == s->published)
+		return;
+	if (s->event_head > s->published || s->st.t >= s->wake_t) {
+		s->wake_t = INFINITY;
+		pthread_cond_broadcast(&s->data);
+	}
+	s->published = s->head;
 }
 
 /* ---- the command queue ------------------------------------------------------ */
@@ -262,30 +299,70 @@ static void run_commands(srv_session *s, clocks *c)
 }
 
 /* until: a running session that reached until finishes there. */
-static void check_until(srv_session *s)
+static void check_until(srv_session *s, clocks *c)
 {
 	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
 		s->state = SRV_FINISHED;
 		s->ckpt_dirty = 1;
 		srv_ring_event_at(s, "finished", NULL);
-		pthread_cond_broadcast(&s->data);
+		publish(s, c);
 	}
+}
+
+/* The CPU a simulated second costs this session, over windows of 50 ms of
+ * CPU or 2 simulated s, whichever comes first; the mean of the last and
+ * this window's (a session's cost changes with its state: a run-up, a
+ * moving feed). */
+#define COST_WINDOW_CPU 0.05
+#define COST_WINDOW_T 2.0
+
+static void measure_cost(srv_session *s, clocks *c)
+{
+	double cpu = s->cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
+	if (t <= 0 || (cpu < COST_WINDOW_CPU && t < COST_WINDOW_T)) {
+		if (t < 0) /* not a window: start one */
+			c->cost_cpu = s->cpu_seconds, c->cost_t = s->st.t;
+		return;
+	}
+	double cost = cpu / t;
+	s->cpu_per_s = s->cpu_measured ? 0.5 * (s->cpu_per_s + cost) : cost;
+	s->cpu_measured = 1;
+	c->cost_cpu = s->cpu_seconds;
+	c->cost_t = s->st.t;
+}
+
+/* need: the session's hold on the paced cores follows what it needs now
+ * (its state, pace and measured cost), even beyond the budget: admission
+ * is checked where a request raises it (session.c). Called in the same
+ * turn as the commands phase (the lock is not let go in between), so that
+ * a hold a handler raised for its queued command is kept until the worker
+ * has applied it. */
+static void commit_need(srv_session *s)
+{
+	double need = srv_paced_need(s);
+	if (need != s->paced_held)
+		srv_budget_set_paced(&s->paced_held, need);
 }
 
 /* cpu: read the worker's CPU time; a running session that spent its
  * grant pauses. */
-static void check_cpu(srv_session *s)
+static void check_cpu(srv_session *s, clocks *c)
 {
+	double now = srv_now();
 	struct timespec ts;
+	if (now - c->cpu_wall < CPU_READ_EVERY)
+		return;
+	c->cpu_wall = now;
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
 		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
 		return;
 	s->state = SRV_PAUSED;
 	s->cpu_paused = 1;
 	s->ckpt_dirty = 1;
 	srv_ring_event_at(s, "paused", "\"reason\":\"cpu-budget\"");
-	pthread_cond_broadcast(&s->data);
+	publish(s, c);
 	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
 			      "spent", s->entry.id, s->cpu_limit);
 }
@@ -307,6 +384,7 @@ static int take_turn(srv_session *s, clocks *c)
 		return 0;
 	}
 	s->waiting_for_cpu = 1;
+	publish(s, c);
 	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
 	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
 	restart_clocks(c, s);
@@ -322,28 +400,34 @@ static int idle(srv_session *s, clocks *c)
 	s->waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
+	publish(s, c);
 	pthread_cond_wait(&s->wake, &s->lock);
 	restart_clocks(c, s);
 	return 1;
 }
 
-/* A paced session may run this far (s of wall time) ahead of its clock:
- * it wakes once per PACE_AHEAD and steps every sample due by then, not
- * once per sample (at 1 kHz sampling, 1,000 wake-ups a second each, which
- * cost more than the simulation itself with many sessions). */
+/* A paced session steps in batches: it wakes when its next sample is due
+ * and steps every sample due within PACE_AHEAD (s of wall time) from then,
+ * so it runs at most that far ahead of its clock and wakes (and wakes its
+ * readers) once per PACE_AHEAD, not once per sample (at 250 Hz sampling,
+ * 250 wake-ups a second each, which cost more than the simulation itself
+ * with many sessions). */
 #define PACE_AHEAD 0.02
 
-/* pacing: wait until t_next is due in wall time (less PACE_AHEAD); 1 if
- * it waited (the loop then starts over, so that commands are seen at
- * once). */
+/* pacing: step t_next now if it is due within the current batch, else
+ * wait until it is due and start a batch; 1 if it waited (the loop then
+ * starts over, so that commands are seen at once). */
 static int pace(srv_session *s, clocks *c, double t_next)
 {
 	if (s->pace == API_PACE_MAX)
 		return 0;
 	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
+	if (due <= c->batch_end)
+		return 0;
 	double now = srv_now();
-	if (now < due - PACE_AHEAD) {
-		struct timespec ts = srv_deadline(due - PACE_AHEAD - now);
+	if (now < due) {
+		publish(s, c); /* the batch is over */
+		struct timespec ts = srv_deadline(due - now);
 		pthread_cond_timedwait(&s->wake, &s->lock, &ts);
 		return 1;
 	}
@@ -351,12 +435,14 @@ static int pace(srv_session *s, clocks *c, double t_next)
 		c->anchor_wall = now;
 		c->anchor_t = s->st.t;
 	}
+	c->batch_end = now + PACE_AHEAD;
 	return 0;
 }
 
 /* step: advance to t_next with the lock released, then publish the status
- * and a sample. Returns the core's code. */
-static int step_and_publish(srv_session *s, double t_next)
+ * and push a sample (its readers are woken once per batch: publish).
+ * Returns the core's code. */
+static int step(srv_session *s, double t_next)
 {
 	sim_status st;
 	pthread_mutex_unlock(&s->lock);
@@ -418,32 +504,37 @@ static void meter(srv_session *s, clocks *c)
 void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
-	clocks clk;
+	clocks clk = {0};
+	srv_thread_background("session");
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	sim_get_status(s->sim, &s->st);
 	srv_ring_sample(s);
 	restart_clocks(&clk, s);
-	pthread_cond_broadcast(&s->data);
+	clk.cpu_wall = -INFINITY;
+	clk.cost_t = s->st.t; /* the thread's CPU clock starts at 0 */
+	publish(s, &clk);
 	for (;;) {
 		start_job(s);
 		run_commands(s, &clk);
 		if (s->stop)
 			break;
 		srv_persist_checkpoint(s, 0);
-		check_until(s);
-		check_cpu(s);
+		check_until(s, &clk);
+		check_cpu(s, &clk);
+		commit_need(s);
 		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
 		if (pace(s, &clk, t_next))
 			continue;
-		int rc = step_and_publish(s, t_next);
+		int rc = step(s, t_next);
 		run_job(s);
 		if (rc != SIM_OK)
 			fail(s, rc);
 		meter(s, &clk);
-		pthread_cond_broadcast(&s->data);
+		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
+			publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
 		s->ckpt_dirty = 1;
@@ -451,6 +542,7 @@ void *srv_worker_main(void *arg)
 	}
 	detach_experiment(s, "the session was deleted or the daemon stopped");
 	srv_cpu_leave(&s->turn);
+	srv_budget_set_paced(&s->paced_held, 0);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;

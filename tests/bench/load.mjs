@@ -1,7 +1,9 @@
 // `make load`: a bounded load run on loopback that stops by itself (about
 // two minutes). It starts its own daemon (with --max-memory 3G, so that
 // "memory stayed under the budget" means something) and then:
-//   - creates 200 default sessions and runs them at pace 1 (real time),
+//   - creates 200 default sessions and runs them at pace 1 (real time) as
+//     far as the cores for paced sessions (--max-paced-cores) take them:
+//     a pace change beyond is 503 with budget "cpu", counted as correct,
 //   - opens 500 stream clients, half SSE and half NDJSON, spread over the
 //     source addresses 127.0.1.1-127.0.1.10 (50 each: ten users),
 //   - sends a steady stream of PATCH beta from 127.0.0.1 (20 a second),
@@ -15,7 +17,10 @@
 // 401/429/503 answers, the daemon's resident memory and CPU. It fails
 // (exit 1) if the daemon crashed, its memory went over the budget, or the
 // other client was not answered every time.
-// Environment: CONVSIMD (the binary), WINDOW (s), SESSIONS, STREAMS, IDLE.
+// Environment: CONVSIMD (the binary), WINDOW (s), SESSIONS, STREAMS, IDLE,
+// MEMORY_GIB (--max-memory, default 3: about 290 default sessions),
+// DAEMON_FLAGS (more daemon flags, e.g. "--max-paced-cores 64" to measure
+// the daemon overloaded).
 import { startDaemon } from '../http/lib.mjs';
 import net from 'node:net';
 import http from 'node:http';
@@ -25,13 +30,15 @@ const SESSIONS = Number(process.env.SESSIONS || 200);
 const STREAMS = Number(process.env.STREAMS || 500);
 const IDLE = Number(process.env.IDLE || 2000);
 const WINDOW = Number(process.env.WINDOW || 30);
-const MEMORY = 3 * 1024 ** 3;
+const MEMORY_GIB = Number(process.env.MEMORY_GIB || 3);
+const MEMORY = MEMORY_GIB * 1024 ** 3;
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const failures = [];
 const check = (ok, what) => { if (!ok) failures.push(what); };
 
+const FLAGS = (process.env.DAEMON_FLAGS || '').split(/\s+/).filter(Boolean);
 const d = await startDaemon(['--max-sessions', String(SESSIONS + 16), '--max-streams', String(STREAMS + 16),
-  '--max-memory', '3G']);
+  '--max-memory', `${MEMORY_GIB}G`, ...FLAGS]);
 const base = d.base;
 // bounded: whatever happens, the run and its daemon end within 6 minutes
 process.on('exit', () => { if (d.proc.exitCode === null) d.proc.kill('SIGKILL'); });
@@ -61,12 +68,19 @@ await fourAtATime(SESSIONS, async (i) => {
   if (r.status !== 201) throw new Error(`session ${i}: ${r.status} ${JSON.stringify(r.body)}`);
   ids[i] = r.body.id;
 });
+// a pace the paced sessions' cores (--max-paced-cores) cannot take is
+// refused with 503, budget "cpu", and changes nothing: that session stays
+// at pace 0.001 (correct behaviour, counted)
+const admitted = new Set();
+const admission = { refused: 0, other: [] };
 await fourAtATime(SESSIONS, async (i) => {
   const r = await call(base, 'PATCH', `/api/v1/sessions/${ids[i]}`, { pace: 1 }, { agent });
-  if (r.status !== 200) throw new Error(`session ${i}: ${r.status} ${JSON.stringify(r.body)}`);
+  if (r.status === 200) admitted.add(ids[i]);
+  else if (r.status === 503 && r.body && r.body.budget === 'cpu' && r.body.field === 'pace') admission.refused++;
+  else throw new Error(`session ${i}: ${r.status} ${JSON.stringify(r.body)}`);
 });
 const created = performance.now();
-progress(`${ids.length} sessions created, running at pace 1`);
+progress(`${ids.length} sessions created, ${admitted.size} running at pace 1, ${admission.refused} refused for CPU (503)`);
 
 // 2. the other client, throughout
 const other = { n: 0, bad: [], ms: [] };
@@ -121,6 +135,7 @@ const patchMs = [];
 const patchStatus = {};
 const windowStart = performance.now();
 const usageStart = procUsage(d.proc.pid);
+const selfStart = process.cpuUsage();
 let k = 0;
 while (performance.now() - windowStart < WINDOW * 1000) {
   const id = ids[k++ % ids.length];
@@ -131,12 +146,14 @@ while (performance.now() - windowStart < WINDOW * 1000) {
   await sleep(50);
 }
 const usageEnd = procUsage(d.proc.pid);
+const selfCpu = process.cpuUsage(selfStart);
 const windowS = (performance.now() - windowStart) / 1000;
 
 progress('window over');
 // 6. read out
 const list = (await call(base, 'GET', '/api/v1/sessions', undefined, { agent })).body.sessions;
-const realTime = list.filter((s) => s.status.rtf >= 0.95).length;
+const paced1 = list.filter((s) => admitted.has(s.id));
+const realTime = paced1.filter((s) => s.status.rtf >= 0.95).length;
 const metricsText = (await call(base, 'GET', '/metrics', undefined, { agent })).body;
 const metric = (key) => {
   const line = metricsText.split('\n').find((l) => l.startsWith(key + ' '));
@@ -172,20 +189,24 @@ check(streamErrors === 0, `${streamErrors} stream clients failed`);
 const mb = (b) => fmt(b / 2 ** 20, 0);
 const cpu = usageEnd.cpu - usageStart.cpu;
 const lines = [
-  `Command: \`make load\` (${SESSIONS} sessions, ${STREAMS} streams, ${IDLE} idle sockets, ${fmt(windowS, 0)}-s window; ` +
+  `Command: \`make load\` (${SESSIONS} sessions, ${STREAMS} streams, ${IDLE} idle sockets, ${fmt(windowS, 0)}-s window` +
+    `${FLAGS.length ? `, daemon flags ${FLAGS.join(' ')}` : ''}; ` +
     `setup ${fmt((created - t0) / 1000)} s to create the sessions)`,
   '',
   '| what | measured |',
   '|---|---|',
   `| PATCH beta (${patchMs.length}, ${fmt(patchMs.length / windowS, 0)}/s) latency p50 / p99 | ${fmt(quantile(patchMs, 0.5))} / ${fmt(quantile(patchMs, 0.99))} ms (answers ${JSON.stringify(patchStatus)}) |`,
   `| stream lag p50 / p99 (${lags.length} samples after 5 s, ${STREAMS} streams) | ${fmt(quantile(lags, 0.5))} / ${fmt(quantile(lags, 0.99))} ms |`,
-  `| sessions keeping real time (rtf >= 0.95) | ${realTime} of ${list.length} |`,
+  `| sessions admitted at pace 1 (the others: 503, budget "cpu") | ${admitted.size} of ${ids.length} (${admission.refused} refused) |`,
+  `| admitted sessions keeping real time (rtf >= 0.95) | ${realTime} of ${paced1.length} |`,
+  `| cores held by paced sessions (metric) / --max-paced-cores | ${fmt(metric('convsim_paced_cpu_cores'), 3)} / ${fmt(metric('convsim_paced_cpu_budget_cores'), 2)} |`,
   `| answers 401 / 429 / 503 (whole run) | ${answers(401)} / ${answers(429)} / ${answers(503)} |`,
   `| idle sockets from 127.0.0.2 | ${idle.open} connected, ${idle.closedEarly} closed at once by the daemon, ${idle.failed} failed, ${idle.pending} not taken within 5 s; its 20 requests: ${JSON.stringify(fromIdle)} |`,
   `| connections closed at accept (metric) | ${metric('convsim_connections_dropped_total')} |`,
   `| another client (127.0.0.3): requests, p99 latency | ${other.n}, all answered: ${other.bad.length === 0}, ${fmt(quantile(other.ms, 0.99))} ms |`,
   `| daemon resident memory, peak (budget reserved / --max-memory) | ${mb(peakRss)} MiB (${mb(reserved)} / ${mb(MEMORY)} MiB) |`,
   `| daemon CPU (user + sys) in the window | ${fmt(cpu)} s = ${fmt(cpu / windowS, 2)} cores |`,
+  `| this load generator's CPU (node, same machine) in the window | ${fmt((selfCpu.user + selfCpu.system) / 1e6 / windowS, 2)} cores |`,
   `| stream records received | ${streamRecords} |`,
 ];
 console.log(lines.join('\n'));

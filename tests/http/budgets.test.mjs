@@ -2,7 +2,9 @@
 // flags: memory (--max-memory: 422 for a session larger than the whole
 // budget, 503 + Retry-After when full, nothing created), CPU
 // (--max-cpu-seconds pauses a session with pause_reason "cpu-budget",
-// --max-busy lets pace-max sessions take turns), queued sweep points
+// --max-busy lets pace-max sessions take turns, --max-paced-cores admits
+// paced sessions by the cores they need: 503 + Retry-After or 422, nothing
+// created or changed), queued sweep points
 // (--max-queued-points: 422 / 429 + Retry-After) and the connections of one
 // client address (--max-client-connections: 429 with a body, then closed at
 // accept; idle sockets closed after --connection-timeout, live streams
@@ -11,7 +13,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
 import net from 'node:net';
-import { startDaemon, req, openStream, until, metric, sleep, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, openStream, until, metric, near, sleep, NO_FEED, SLOW } from './lib.mjs';
 
 const JSON_HEADERS = { 'Content-Type': 'application/json' };
 
@@ -205,6 +207,120 @@ test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a
   }
 });
 
+test('paced CPU: a creation, pace change or resume beyond --max-paced-cores is 503 (422 alone), nothing changes', { timeout: 60000 * SLOW }, async () => {
+  // Paces so small that no session runs long enough for its worker to
+  // measure its cost (50 ms of CPU or 2 simulated s): every hold is the
+  // estimate from the scene, read back once.
+  const limit = 1e-4;
+  const d = await startDaemon(['--max-paced-cores', String(limit)]);
+  const paced = async () => metric(await metrics(d.base), 'convsim_paced_cpu_cores');
+  const get = async (id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+  const refused = (r, status, field, verb) => {
+    assert.equal(r.status, status, r.text);
+    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    assert.equal(r.body.type, status === 503 ? '/api/v1/problems/unavailable' : '/api/v1/problems/out-of-range');
+    assert.equal(r.headers.get('retry-after'), status === 503 ? '5' : null);
+    assert.equal(r.body.budget, 'cpu');
+    assert.equal(r.body.limit, limit);
+    assert.equal(r.body.field, field);
+    assert.match(r.body.detail, new RegExp(`0\\.0001 cores for paced sessions \\(--max-paced-cores\\); nothing was ${verb}`));
+  };
+  try {
+    const a = await req(d.base, 'POST', '/api/v1/sessions', { pace: 0.001 });
+    assert.equal(a.status, 201, a.text);
+    const cost = (await paced()) / 0.001; // CPU s per simulated s, estimated
+    assert.ok(cost > 1e-4 && cost < 0.1, `a default session's estimate: ${cost}`);
+    const pace = (share) => share * limit / cost; // the pace that needs share x limit
+    const A = `/api/v1/sessions/${a.body.id}`;
+    assert.equal((await req(d.base, 'PATCH', A, { pace: pace(0.6) })).status, 200);
+    near(await paced(), 0.6 * limit, 1e-12, 'A holds 0.6 of the budget');
+
+    // a creation that does not fit beside A: 503, nothing created or held
+    const before = await metrics(d.base);
+    refused(await req(d.base, 'POST', '/api/v1/sessions', { pace: pace(0.5) }), 503, 'pace', 'created');
+    const after = await metrics(d.base);
+    for (const k of ['convsim_sessions', 'convsim_sessions_created_total', 'convsim_memory_reserved_bytes',
+      'convsim_paced_cpu_cores']) assert.equal(metric(after, k), metric(before, k), k);
+    await healthy(d.base);
+
+    // a pace that alone needs more than the budget: 422 with the largest that fits
+    const big = await req(d.base, 'PATCH', A, { pace: pace(2) });
+    refused(big, 422, 'pace', 'changed');
+    near(big.body.max, pace(1), 1e-9 * pace(1), 'max: the pace that needs the whole budget');
+    assert.equal(big.body.min, 0.001);
+    near((await get(a.body.id)).pace, pace(0.6), 1e-12, 'A kept its pace');
+
+    // a pace change that does not fit beside another session: 503
+    const b = await req(d.base, 'POST', '/api/v1/sessions', { pace: pace(0.3) });
+    assert.equal(b.status, 201, b.text);
+    near(await paced(), 0.9 * limit, 1e-12, 'A and B hold 0.9');
+    refused(await req(d.base, 'PATCH', A, { pace: pace(0.8), beta: 60 }), 503, 'pace', 'changed');
+    const a1 = await get(a.body.id);
+    near(a1.pace, pace(0.6), 1e-12, 'A kept its pace');
+    assert.notEqual(Math.round(a1.status.beta_target), 60, 'nothing of the refused PATCH was applied');
+    near(await paced(), 0.9 * limit, 1e-12, 'the holds did not change');
+
+    // a paused session gives its hold back; its resume is refused when
+    // another took the room, and allowed when it is free again
+    assert.equal((await req(d.base, 'PATCH', A, { running: false })).status, 200);
+    near(await paced(), 0.3 * limit, 1e-12, 'A paused holds nothing');
+    const c = await req(d.base, 'POST', '/api/v1/sessions', { pace: pace(0.5) });
+    assert.equal(c.status, 201, c.text);
+    const paused = await get(a.body.id);
+    refused(await req(d.base, 'PATCH', A, { running: true }), 503, 'running', 'changed');
+    const still = await get(a.body.id);
+    assert.equal(still.state, 'paused');
+    assert.equal(still.status.t, paused.status.t);
+    near(await paced(), 0.8 * limit, 1e-12, 'B and C hold 0.8');
+    await healthy(d.base);
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${c.body.id}`)).status, 204);
+    near(await paced(), 0.3 * limit, 1e-12, 'a deleted session holds nothing');
+    const resumed = await req(d.base, 'PATCH', A, { running: true });
+    assert.equal(resumed.status, 200, resumed.text);
+    assert.equal(resumed.body.state, 'running');
+    near(await paced(), 0.9 * limit, 1e-12, 'A resumed holds 0.6 again');
+
+    // pace "max" is not paced (--max-busy takes turns): never refused for CPU
+    const max = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 'max', until: 0.5 });
+    assert.equal(max.status, 201, max.text);
+    near(await paced(), 0.9 * limit, 1e-12, 'pace max holds nothing');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('paced CPU: a running session holds its measured cost times its pace; paused or deleted, nothing', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon([]);
+  const paced = async () => metric(await metrics(d.base), 'convsim_paced_cpu_cores');
+  try {
+    const m = await metrics(d.base);
+    assert.ok(metric(m, 'convsim_paced_cpu_budget_cores') > 0, 'the budget is shown');
+    assert.equal(metric(m, 'convsim_paced_cpu_cores'), 0);
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const id = s.body.id, S = `/api/v1/sessions/${id}`;
+    const estimate = await paced();
+    // after 2 simulated s (or 50 ms of CPU) the worker's own measure
+    // replaces the estimate: it matches the session's CPU per simulated s
+    const measured = await until(async () => { const p = await paced(); return p !== estimate && p; },
+      10000, 'the worker to measure its cost');
+    const v = (await req(d.base, 'GET', S)).body;
+    const mean = v.cpu_seconds / v.status.t;
+    assert.ok(measured / mean > 0.5 && measured / mean < 2, `held ${measured}, used ${mean} CPU s per simulated s`);
+    assert.equal((await req(d.base, 'PATCH', S, { pace: 2 })).status, 200);
+    const twice = await paced();
+    assert.ok(twice / measured > 1.4 && twice / measured < 2.8, `pace 2 holds about twice: ${twice} vs ${measured}`);
+    assert.equal((await req(d.base, 'PATCH', S, { running: false })).status, 200);
+    assert.equal(await paced(), 0, 'paused: nothing');
+    assert.equal((await req(d.base, 'PATCH', S, { running: true })).status, 200);
+    assert.ok(await paced() > 0, 'resumed');
+    assert.equal((await req(d.base, 'DELETE', S)).status, 204);
+    assert.equal(await paced(), 0, 'deleted: nothing');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
 test('sweep points: 422 beyond the whole budget, 429 + Retry-After when queued points fill it', { timeout: 60000 * SLOW }, async () => {
   const d = await startDaemon(['--max-queued-points', '10', '--pool-threads', '1']);
   try {
@@ -301,6 +417,7 @@ test('--help prints every budget with its default; a timeout not above the heart
   assert.equal(h.status, 0);
   for (const re of [/--max-memory BYTES .*\n.*default [0-9.]+ GiB: 3\/4 of this machine's memory/,
     /--max-cpu-seconds S .*\n.*default 1800/, /--max-busy N .*default \d+: the cores/,
+    /--max-paced-cores C .*\n.*default [0-9.]+: half the cores/,
     /--max-client-connections N .*default 64/, /--max-connections N .*default 1024/,
     /--connection-timeout S .*\n.*default 30/, /--max-queued-points N .*default 4096/]) {
     assert.match(h.stdout, re);
