@@ -43,10 +43,10 @@
  * integrated element, and of one published sample (status, ring record,
  * trajectory row); `build/convsim run` on this machine, the cost of 5
  * simulated s less that of 0.01 s, and the daemon's workers. */
-#define STEP_CPU_S 0.76e-6
-#define COLUMN_SUBSTEP_CPU_S 4.1e-8
-#define ELEMENT_SUBSTEP_CPU_S 1.0e-8
-#define SAMPLE_CPU_S 4e-6
+#define STEP_CPU_S 0.41e-6
+#define COLUMN_SUBSTEP_CPU_S 8.0e-8
+#define ELEMENT_SUBSTEP_CPU_S 0.8e-8
+#define SAMPLE_CPU_S 7e-6
 /* Retry-After of a refusal for CPU: paced sessions come and go. */
 #define CPU_RETRY_S 5
 
@@ -188,7 +188,7 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			sim_method dem = *m;
 			snprintf(dem.name, sizeof dem.name, "dem");
 			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
-			substeps = sim_default_substeps(dt);
+			substeps = sim_default_substeps(&dem, dt);
 		}
 	if (strcmp(m->name, "euler") == 0)
 		evals = 0.25; /* one right-hand side a step, not four */
