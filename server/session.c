@@ -544,6 +544,12 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 		rc = api_fail(pb, API_CONFLICT, "session",
 			      "the session already runs experiment %s",
 			      srv_exp_id(s->exp));
+	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
+		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
+					     s->pace, "session", "attached",
+					     pb)) != API_OK)
+		; /* the experiment would run it on (worker.c extend_until)
+		     past the cores for paced sessions: nothing attached */
 	else {
 		s->exp = e;
 		s->exp_started = 0;

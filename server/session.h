@@ -73,7 +73,10 @@ double srv_sessions_steps_per_s(void);
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb);
 /* Attach an experiment (borrowed until it detaches) to a running
- * session's worker. API_CONFLICT if it already runs one or has failed. */
+ * session's worker. API_CONFLICT if it already runs one or has failed;
+ * a finished paced session, which the experiment runs on, first takes its
+ * hold of the cores for paced sessions: API_UNAVAILABLE (budget "cpu")
+ * when they are taken, and nothing is attached. */
 api_err srv_session_attach(srv_session *s, srv_experiment *e,
 			   api_problem *pb);
 

@@ -280,6 +280,36 @@ test('paced CPU: a creation, pace change or resume beyond --max-paced-cores is 5
     assert.equal(resumed.body.state, 'running');
     near(await paced(), 0.9 * limit, 1e-12, 'A resumed holds 0.6 again');
 
+    // an experiment on a finished paced session runs it on: it needs the
+    // session's hold first (503 naming "session", nothing attached), and
+    // gets it when there is room
+    const f = await req(d.base, 'POST', '/api/v1/sessions', { pace: pace(0.05), until: 0.001 });
+    assert.equal(f.status, 201, f.text);
+    const F = `/api/v1/sessions/${f.body.id}`;
+    const finished = async () => (await get(f.body.id)).state === 'finished';
+    for (let i = 0; i < 200 && !(await finished()); i++) await new Promise((r) => setTimeout(r, 50));
+    assert.ok(await finished(), 'F reached its until');
+    near(await paced(), 0.9 * limit, 1e-12, 'a finished session holds nothing');
+    const e = await req(d.base, 'POST', '/api/v1/sessions', { pace: pace(0.08) });
+    assert.equal(e.status, 201, e.text);
+    const schedule = { session: f.body.id, schedule: [{ beta: 40, until: 0.001 }] };
+    const exps = async () => (await req(d.base, 'GET', '/api/v1/experiments')).body.experiments.length;
+    const nexp = await exps();
+    const tF = (await get(f.body.id)).status.t;
+    refused(await req(d.base, 'POST', '/api/v1/experiments', schedule), 503, 'session', 'attached');
+    assert.equal(await exps(), nexp, 'no experiment was created');
+    const f1 = await get(f.body.id);
+    assert.equal(f1.state, 'finished');
+    assert.equal(f1.status.t, tF, 'F did not run on');
+    assert.equal(f1.experiment ?? null, null, 'nothing attached to F');
+    near(await paced(), 0.98 * limit, 1e-12, 'the holds did not change');
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${e.body.id}`)).status, 204);
+    const x = await req(d.base, 'POST', '/api/v1/experiments', schedule);
+    assert.equal(x.status, 201, x.text);
+    assert.equal(await exps(), nexp + 1);
+    near(await paced(), 0.95 * limit, 1e-12, 'F holds its need again');
+    assert.equal((await req(d.base, 'DELETE', F)).status, 204);
+
     // pace "max" is not paced (--max-busy takes turns): never refused for CPU
     const max = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 'max', until: 0.5 });
     assert.equal(max.status, 201, max.text);
