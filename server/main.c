@@ -206,11 +206,13 @@ int main(int argc, char **argv)
 	fflush(stdout);
 	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
 			      "budgets: %.1f GiB memory, %g CPU s per session, "
-			      "%d pace-max at once, %d connections per client "
-			      "(%d in all), %d queued sweep points",
+			      "%g cores for paced sessions, %d pace-max at once, "
+			      "%d connections per client (%d in all), %d queued "
+			      "sweep points",
 		cfg.web_root, cfg.max_sessions, cfg.max_streams,
 		(double)cfg.max_memory / (1 << 30), cfg.max_cpu_seconds,
-		cfg.max_busy, cfg.max_client_connections, cfg.max_connections,
+		cfg.max_paced_cores, cfg.max_busy, cfg.max_client_connections,
+		cfg.max_connections,
 		cfg.max_queued_points);
 
 	/* once a second: remove the sessions whose experiment ended and
