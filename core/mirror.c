@@ -26,6 +26,8 @@
  * measured difference over the 74 points.
  */
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 #include "model.h"
 #include "sim.h"
@@ -69,4 +71,15 @@ void sim_mirror_measurement(const sim_measurement *src, sim_measurement *dst)
 	dst->transport_velocity = -src->transport_velocity;
 	dst->rotor_speed_mean = -src->rotor_speed_mean;
 	dst->cpu_seconds = 0.0;
+}
+
+void sim_mirror_failure(char *out, size_t len, double beta_deg, int rotation, const char *why)
+{
+	/* the cause copied first: out may be the very buffer why is in */
+	char cause[119];
+	size_t k = strnlen(why, sizeof cause - 1);
+	memcpy(cause, why, k);
+	cause[k] = '\0';
+	snprintf(out, len, "mirror image of %g deg %s: %s", beta_deg,
+		 rotation == SIM_CW ? "cw" : "ccw", cause);
 }

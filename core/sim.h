@@ -396,6 +396,11 @@ size_t sim_mirror_plan(const sim_params *p, const sim_scene *sc, size_t n, const
  * (they do not depend on the sense); no CPU time (nothing was run). */
 void sim_mirror_measurement(const sim_measurement *src, sim_measurement *dst);
 
+/* The failure of a mirror image whose source point (beta_deg in degrees,
+ * rotation SIM_CW/SIM_CCW) failed with why: "mirror image of B deg cw:
+ * WHY" into out (len bytes), the cause cut at 118 characters. */
+void sim_mirror_failure(char *out, size_t len, double beta_deg, int rotation, const char *why);
+
 /* Feed geometry of the instance. */
 /* Physical columns K and layers L; 0 without feed. */
 int sim_columns(const sim *s);

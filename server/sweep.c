@@ -215,13 +215,9 @@ static void fill_image(srv_sweep *sw, size_t i)
 	p->velocity = -src->velocity;
 	p->uncertainty = src->uncertainty;
 	p->steady = src->steady;
-	if (src->state == 3) {
-		char why[sizeof src->error];
-		memcpy(why, src->error, sizeof why);
-		why[sizeof why - 1] = '\0';
-		snprintf(p->error, sizeof p->error, "mirror image of %g deg %s: %.118s",
-			 src->beta.user, src->rotation == SIM_CW ? "cw" : "ccw", why);
-	}
+	if (src->state == 3)
+		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
+				   src->error);
 	sw->done++;
 }
 

@@ -335,13 +335,8 @@ static void mirror_tasks(task *tasks, int ntasks)
 		const task *src = &tasks[t->source];
 		sim_mirror_measurement(&src->r, &t->r);
 		t->err = src->err;
-		if (src->err != SIM_OK) {
-			char why[sizeof src->msg];
-			memcpy(why, src->msg, sizeof why);
-			why[sizeof why - 1] = '\0';
-			snprintf(t->msg, sizeof t->msg, "mirror image of %g deg %s: %.118s", src->beta,
-				 src->rotation == SIM_CW ? "cw" : "ccw", why);
-		}
+		if (src->err != SIM_OK)
+			sim_mirror_failure(t->msg, sizeof t->msg, src->beta, src->rotation, src->msg);
 	}
 }
 
