@@ -320,10 +320,23 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb)
 	char msg[256] = "";
 	int rc = sim_validate(&spec->params, &spec->scene, &spec->method, msg,
 			      sizeof msg);
-	if (rc != SIM_OK)
-		return api_fail(pb, api_from_sim(rc), NULL, "%s",
-				msg[0] ? msg : sim_strerror(rc));
-	return API_OK;
+	if (rc == SIM_OK)
+		return API_OK;
+	/* the one check that depends on other settings: dt against the
+	 * method's stability bound, which the problem gives as the range
+	 * (when nothing else is wrong: the default step always passes) */
+	sim_method m0 = spec->method;
+	m0.dt = 0.0;
+	double bound = sim_max_dt(&spec->params, &spec->scene, &spec->method);
+	if (spec->method.dt > bound &&
+	    sim_validate(&spec->params, &spec->scene, &m0, NULL, 0) == SIM_OK) {
+		api_fail(pb, API_RANGE, "integrator.dt", "%s", msg);
+		pb->has_range = 1;
+		pb->min = 0.0;
+		pb->max = bound;
+		return pb->code;
+	}
+	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }
 
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,

@@ -98,6 +98,15 @@ double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
 /* Largest ratio for which dem corrects its coupling (README "dem"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 
+/* The decay rate (1/s) of the Kloss motor's slip mode, the machine's
+ * stiffest: a change of the rotor's relative speed omega relaxes at
+ * lambda = |dM/domega| e^T M^-1 e, with |dM/domega| the drive's steepest
+ * slope (the Kloss curve's at zero slip, 2 M_ut / slip_ut, plus the
+ * bearing drag's 2 b_phi omega_ss) and e^T M^-1 e the inverse inertia
+ * that a torque on phi against alpha meets (the largest over the
+ * rotor's angle). 0 under the ideal drive. setup.c */
+double model_slip_rate(const sim_params *p, const sim_scene *sc);
+
 /* Build the reduced model (with its suspension preload) and the initial
  * controls from parameters and scene (validated already). setup.c */
 void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene *sc);

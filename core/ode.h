@@ -11,6 +11,10 @@
 
 #include "dynamics.h"
 
+/* Classical RK4's stability region along the negative real axis: the
+ * real root of 1 + z/2 + z^2/6 + z^3/24 (where |R(z)| returns to 1). */
+#define RK4_REAL_LIMIT 2.785293563405282
+
 typedef struct ode_method {
 	/* name, order, adaptive, doc: the public description. First member,
 	 * so that the registry lists descriptors through it. */

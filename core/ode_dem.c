@@ -413,6 +413,7 @@ const ode_method ode_dem = {
 	.info = {.name = "dem",
 		 .order = 1,
 		 .adaptive = 0,
+		 .real_limit = RK4_REAL_LIMIT,
 		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction"},
 	.dense = 0,
 	.alloc = dem_alloc,

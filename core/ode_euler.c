@@ -62,6 +62,7 @@ const ode_method ode_euler = {
 	.info = {.name = "euler",
 		 .order = 1,
 		 .adaptive = 0,
+		 .real_limit = 2.0,
 		 .doc = "semi-implicit (symplectic) Euler, fixed step dt"},
 	.dense = 0,
 	.alloc = euler_alloc,

@@ -71,6 +71,7 @@ const ode_method ode_rk4 = {
 	.info = {.name = "rk4",
 		 .order = 4,
 		 .adaptive = 0,
+		 .real_limit = RK4_REAL_LIMIT,
 		 .doc = "classical Runge-Kutta, fixed step dt, whole state"},
 	.dense = 0,
 	.alloc = rk4_alloc,

@@ -176,15 +176,25 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 
 /* The integrator step (s) that dt = 0 stands for: the default of method m
  * for the kind of scene: with or without feed, and, for dem, whether the
- * feed is light enough for its corrected coupling. */
+ * feed is light enough for its corrected coupling; never more than 0.7 of
+ * the method's stability bound on the motor's slip mode (sim_max_dt), so
+ * that the mode stays damped (czubak2016: 1.34e-3 s, the 1e-3-s default
+ * holds; a smaller eccentricity or a steeper motor takes a shorter step). */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 /* The feed sub-steps that substeps = 0 stands for with macro step dt (s)
  * under method m: as many as keep the feed's step at or below 2.5e-4 s
  * with m->feed_events, 6.25e-5 s without. */
 int sim_default_substeps(const sim_method *m, double dt);
 
-/* Whole-set consistency checks (ranges, sizes, known integrator, dt vs
- * method). Same error convention as sim_set. */
+/* The largest fixed step (s) method m keeps stable on the machine's
+ * stiffest mode, the Kloss motor's slip (its real_limit over the slip
+ * mode's decay rate); INFINITY for an adaptive method or the ideal drive.
+ * Above it the run blows up within a few seconds (README "Stability"). */
+double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
+
+/* Whole-set consistency checks (ranges, sizes, known integrator, dt within
+ * the method's stability bound, sim_max_dt). Same error convention as
+ * sim_set. */
 int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m,
 		 char *msg, size_t msglen);
 
@@ -194,6 +204,10 @@ typedef struct sim_method_info {
 	const char *name;
 	int order;        /* classical order on smooth problems */
 	int adaptive;     /* 1 if rtol/atol drive the step */
+	/* fixed-step methods: the largest h lambda for which a decaying mode
+	 * y' = -lambda y stays bounded (the stability region's reach along
+	 * the negative real axis); 0 for the adaptive ones */
+	double real_limit;
 	const char *doc;
 } sim_method_info;
 /* Registry of integrators, built from each method's own descriptor: an

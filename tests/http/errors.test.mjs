@@ -63,6 +63,21 @@ test('bad session bodies: 400/413/415/422 and nothing is created', { timeout: 20
   assert.equal(b.field, 'pace');
   b = problem(await post({ preset: 'nosuch' }), 422, 'out-of-range');
   assert.ok(b.choices.includes('czubak2016'));
+  // a step above the fixed-step method's stability bound for these
+  // parameters (the motor's slip mode; test_hard_machine.c shows the bound
+  // on the dynamics): refused, the bound as the range, in the message too
+  b = problem(await post({ integrator: { method: 'dem', dt: 0.0019 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'integrator.dt');
+  assert.equal(b.min, 0);
+  assert.ok(b.max > 0.00185 && b.max < 0.00189, String(b.max));
+  assert.match(b.detail, /dt must be at most 0\.00189 s for dem/);
+  b = problem(await post({ params: { e: 0.012 }, integrator: { method: 'rk4', dt: 0.001 } }), 422,
+    'out-of-range');
+  assert.equal(b.field, 'integrator.dt');
+  assert.ok(b.max > 0.0006 && b.max < 0.00063, String(b.max));
+  // another setting wrong as well: that one is named, not the step
+  b = problem(await post({ params: { k_s1: -5 }, integrator: { dt: 0.0019 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'params.k_s1');
   // unknown names
   b = problem(await post({ colour: 'red' }), 422, 'unknown-field');
   assert.equal(b.field, 'colour');

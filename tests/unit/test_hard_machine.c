@@ -2,11 +2,12 @@
  * test_hard_machine.c - hard cases of the machine, its drive and beta
  * (issue 5): beta reversed at the maximum slew rate and beta oscillating,
  * the motor start-up through the suspension resonance, a 60 s energy
- * balance, undamped eliminators, and a diverging run that must stop with a
- * named cause. Each asserts physics, not only survival. Short horizons keep
+ * balance, undamped eliminators, a diverging run that must stop with a
+ * named cause, and the motor's slip mode, which bounds every fixed step. Each asserts physics, not only survival. Short horizons keep
  * the file fast (it also runs under ASan+UBSan in `make check`). The
  * contact and feed hard cases are in test_hard_feed.c.
  */
+#include "ode.h"
 #include "testutil.h"
 
 static void assert_status_finite(const sim_status *st)
@@ -244,6 +245,118 @@ static void divergence_is_reported(void **state)
 	sim_free(s);
 }
 
+/* The machine alone (scene of u) from rest with the motor on, stepped by
+ * method's own step at factor times sim_max_dt (past sim_validate, which
+ * refuses a step above the bound): the motor's mean slip (omega_ss less
+ * the rotor's relative speed) over [3, 4] s, once the run-up is over, and
+ * into *kink the largest second difference of that speed from step to step
+ * there (a mode that alternates from step to step shows in it). */
+static double slip_mean(setup u, const char *method, double factor, double *kink)
+{
+	set(&u, "feed", "false");
+	set(&u, "method", method);
+	double dt = factor * sim_max_dt(&u.p, &u.sc, &u.m);
+	model md;
+	model_ctl ctl;
+	model_init(&md, &ctl, &u.p, &u.sc);
+	double *y = calloc((size_t)md.n, sizeof *y);
+	assert_non_null(y);
+	dynamics_equilibrium(&md, &ctl, y);
+	const ode_method *om = ode_find(method);
+	sim_method cfg = u.m;
+	cfg.dt = dt;
+	cfg.substeps = 1;
+	void *ws = om->alloc(&md, &cfg);
+	assert_non_null(ws);
+	dyn sys = {.md = &md, .ctl = &ctl, .rhs_evals = 0};
+	double t = 0.0, sum = 0.0, w1 = NAN, w2 = NAN;
+	int n = 0;
+	*kink = 0.0;
+	while (t < 4.0 && isfinite(y[0])) {
+		om->step(ws, &sys, &t, y, INFINITY);
+		double q[NQ_FULL], qd[NQ_FULL];
+		model_full_coords(&md, &ctl, t, y, q, qd);
+		double w = qd[Q_PHI] - qd[Q_ALPHA];
+		if (t >= 3.0) {
+			sum += w;
+			n++;
+			*kink = fmax(*kink, fabs(w - 2.0 * w1 + w2));
+		}
+		w2 = w1;
+		w1 = w;
+	}
+	double slip = isfinite(y[0]) && n > 0 ? u.p.omega_ss - sum / n : INFINITY;
+	om->free(ws);
+	free(y);
+	return slip;
+}
+
+/* The machine's stiffest mode is the motor's slip, not an oscillation:
+ * lambda = 2 M_ut / slip_ut over the rotor's inertia (czubak2016: about
+ * 1,480 1/s, against 157 rad/s for the fastest oscillation), so every
+ * fixed step is bounded by real_limit / lambda (RK4 1.89e-3 s, Euler
+ * 1.35e-3 s). Shown on the dynamics, not on the formula, 5 % either side
+ * of the bound, against a step 20 x finer. RK4's stability region ends on
+ * the real axis where its growth factor returns to +1: above the bound the
+ * mode drifts, and the motor's mean slip after the run-up goes from 0.064
+ * rad/s (0.055 at the fine step) to 1.35 rad/s, the motor running on a
+ * flatter part of its curve (dem, which steps the machine by RK4, moves v
+ * by 5 % at 15 deg cw at 2e-3 s). Euler's ends where the factor is -1:
+ * above the bound the speed alternates from step to step (its second
+ * difference 13 rad/s against 0.1 below the bound). A smaller
+ * eccentricity makes the rotor lighter and the bound shorter; the default
+ * step follows it (0.7 of the bound when that is below the scene's
+ * default), and sim_validate refuses a dt above it, naming the bound. */
+static void slip_mode_bounds_the_step(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	double rk4 = sim_max_dt(&u.p, &u.sc, &u.m);
+	print_message("czubak2016: slip rate %.1f 1/s, dem/rk4 bound %.4g s\n",
+		      model_slip_rate(&u.p, &u.sc), rk4);
+	assert_true(rk4 > 1.85e-3 && rk4 < 1.92e-3);
+	const char *methods[] = {"rk4", "euler"};
+	for (int i = 0; i < 2; i++) {
+		double k0, k1, k2;
+		double ref = slip_mean(u, methods[i], 0.05, &k0);
+		double below = slip_mean(u, methods[i], 0.95, &k1);
+		double above = slip_mean(u, methods[i], 1.05, &k2);
+		print_message("%s: mean slip %.4g rad/s at 0.05 of the bound, %.4g at 0.95, %.4g at "
+			      "1.05; largest second difference %.3g, %.3g, %.3g rad/s\n",
+			      methods[i], ref, below, above, k0, k1, k2);
+		assert_true(ref > 0.0);
+		assert_true(fabs(below - ref) < 0.2 * ref);
+		if (i == 0)
+			assert_true(above > 5.0 * ref);
+		else
+			assert_true(k2 > 20.0 * k1);
+	}
+	/* refused above the bound, with the bound in the message; accepted
+	 * below; the adaptive method has none */
+	char msg[256] = "";
+	u.m.dt = 1.01 * rk4;
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_EPARAM);
+	char bound[32];
+	snprintf(bound, sizeof bound, "%.3g s", rk4);
+	assert_non_null(strstr(msg, bound));
+	u.m.dt = 0.99 * rk4;
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_OK);
+	set(&u, "method", "dopri5");
+	assert_true(isinf(sim_max_dt(&u.p, &u.sc, &u.m)));
+	/* the ideal drive has no slip mode */
+	setup v = reduced_ideal();
+	assert_true(isinf(sim_max_dt(&v.p, &v.sc, &v.m)));
+	/* a small eccentricity: the bound falls below 1e-3 s and the default
+	 * step with it, to 0.7 of the bound rounded down to two digits */
+	set(&u, "method", "dem");
+	set(&u, "e", "0.012");
+	double b = sim_max_dt(&u.p, &u.sc, &u.m), d = sim_default_dt(&u.p, &u.sc, &u.m);
+	print_message("e = 0.012 m: bound %.4g s, default step %.4g s\n", b, d);
+	assert_true(b < 1e-3);
+	assert_true(d <= 0.7 * b && d > 0.6 * b);
+	assert_close(d * 1e5, round(d * 1e5), 1e-9);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -253,6 +366,7 @@ int main(void)
 		cmocka_unit_test(energy_balance_60s),
 		cmocka_unit_test(eliminators_undamped),
 		cmocka_unit_test(divergence_is_reported),
+		cmocka_unit_test(slip_mode_bounds_the_step),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
