@@ -180,10 +180,12 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 /* Defaults per scene kind, measured against the converged reference at
  * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
  * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
- * of 1e-3 s and feed sub-steps of at most 2.5e-4 s (4) with its slip
- * reversals located and the deck yielding within the step (worst 0.77 %
+ * of 1.25e-3 s and feed sub-steps of at most 2.5e-4 s (5) with its slip
+ * reversals located and the deck yielding within the step (worst 0.76 %
  * by docs/MODEL.md's convention after a `steady` start and a 4-s window;
- * 0.34 % with 8 sub-steps);
+ * 1e-3 s with 4 sub-steps 0.77 %, with 8 sub-steps 0.34 %: the feed step,
+ * not the machine's, sets the error; the machine step is kept within 0.7
+ * of its stability bound, 1.89e-3 s for czubak2016, see sim_max_dt);
  * without those (feed_events = false, the former dem) sub-steps of at
  * most 6.25e-5 s (16: worst 0.69 %; 8e-5 s sub-steps are 1.07 % off); a
  * feed too heavy for the corrector (added mass) takes single steps of
@@ -192,6 +194,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 #define FEED_STEP_MAX 6.25e-5
 #define FEED_STEP_MAX_EVENTS 2.5e-4
 #define HEAVY_FEED_STEP 2.5e-5
+#define FEED_MACHINE_STEP 1.25e-3
 
 static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
@@ -204,7 +207,7 @@ static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim
 		return 1e-5; /* the first step */
 	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO)
 		return HEAVY_FEED_STEP;
-	return 1e-3;
+	return feed && m->feed_events ? FEED_MACHINE_STEP : 1e-3;
 }
 
 /* The default step's share of the stability bound: RK4 at 0.7 of it damps

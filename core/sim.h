@@ -178,7 +178,7 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * for the kind of scene: with or without feed, and, for dem, whether the
  * feed is light enough for its corrected coupling; never more than 0.7 of
  * the method's stability bound on the motor's slip mode (sim_max_dt), so
- * that the mode stays damped (czubak2016: 1.34e-3 s, the 1e-3-s default
+ * that the mode stays damped (czubak2016: 1.32e-3 s, the 1.25e-3-s default
  * holds; a smaller eccentricity or a steeper motor takes a shorter step). */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 /* The feed sub-steps that substeps = 0 stands for with macro step dt (s)

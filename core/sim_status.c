@@ -62,9 +62,11 @@ static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 #define DEM_V_ERROR_FLOOR 0.0004
 #define DEM_V_ERROR_DT 1e-3
 #define DEM_V_ERROR_H 6.25e-5
-/* With feed_events the default feed step is 2.5e-4 s (4 sub-steps); the
- * same two terms hold the 74 points there (tests/bench/accuracy.sh). */
+/* With feed_events the default steps are 1.25e-3 s with 5 feed sub-steps
+ * of 2.5e-4 s; the same two terms hold the 74 points there
+ * (tests/bench/accuracy.sh; and at 1e-3 s with 4 sub-steps). */
 #define DEM_V_ERROR_H_EVENTS 2.5e-4
+#define DEM_V_ERROR_DT_EVENTS 1.25e-3
 
 static double step_error(const sim *s, double v)
 {
@@ -72,7 +74,8 @@ static double step_error(const sim *s, double v)
 		return 0.0;
 	double h = s->cfg.dt / s->cfg.substeps;
 	double h_ref = s->cfg.feed_events ? DEM_V_ERROR_H_EVENTS : DEM_V_ERROR_H;
-	double ratio = fmax(1.0, fmax(s->cfg.dt / DEM_V_ERROR_DT, h / h_ref));
+	double dt_ref = s->cfg.feed_events ? DEM_V_ERROR_DT_EVENTS : DEM_V_ERROR_DT;
+	double ratio = fmax(1.0, fmax(s->cfg.dt / dt_ref, h / h_ref));
 	return (DEM_V_ERROR * fabs(v) + DEM_V_ERROR_FLOOR * s->est.speed_max) * ratio;
 }
 

@@ -25,7 +25,7 @@ sweep() { # name, extra arguments...: one core, CPU seconds into $tmp/name.cpu
 }
 # name | sweep arguments | what the row shows
 runs=(
-	"default||the defaults (steady start settled 1 s, 4-s window, dem 1e-3 s / 4 sub-steps with feed_events, symmetric and mirror reductions)"
+	"default||the defaults (steady start settled 1 s, 4-s window, dem 1.25e-3 s / 5 sub-steps with feed_events, symmetric and mirror reductions)"
 	"full|--set trough_rotation=true|the same on the full model: the symmetric reduction's own error"
 	"direct|--set mirror=false|every point run, none taken as a mirror image: the mirror reduction's own error"
 	"settle 1.5 s|--set settle=1.5|the former settling"
@@ -38,10 +38,11 @@ runs=(
 	"window 2 s|--duration 2|the defaults with a 2-s window"
 	"rest 2+2 s|--set start=rest --set transient=2 --duration 4|the former measurement: run-up from rest, window [2, 4] s"
 	"rest 8+4 s|--set start=rest --set transient=8 --duration 12|run-up from rest, window [8, 12] s"
-	"1e-3 / 3|--set dt=1e-3 --set substeps=3|feed step 3.3e-4 s"
-	"1e-3 / 8|--set dt=1e-3 --set substeps=8|feed step halved"
-	"5e-4 / 2|--set dt=5e-4 --set substeps=2|machine step halved, the same feed step"
-	"2e-3 / 8|--set dt=2e-3 --set substeps=8|machine step doubled, the same feed step"
+	"1.25e-3 / 4|--set substeps=4|feed step 3.1e-4 s"
+	"1.25e-3 / 10|--set substeps=10|feed step halved"
+	"1e-3 / 4|--set dt=1e-3 --set substeps=4|the former default: machine step 1e-3 s, the same feed step"
+	"5e-4 / 2|--set dt=5e-4 --set substeps=2|machine step 5e-4 s, the same feed step"
+	"1.8e-3 / 7|--set dt=1.8e-3 --set substeps=7|machine step near its stability bound (1.89e-3 s: the motor's slip mode), feed step 2.6e-4 s"
 	"former dem|--set feed_events=false|the former dem (feed_events=false: 1e-3 s / 16 sub-steps, no located reversals, no yielding deck)"
 	"former 1e-3 / 12|--set feed_events=false --set substeps=12|the former dem, feed step 8.3e-5 s"
 	"former full|--set feed_events=false --set trough_rotation=true|the former dem on the full model"

@@ -51,11 +51,11 @@ static void scene_nofeed(void)
 	wp_row("ref", "nofeed", "trajectory", &ra, a, a, NAN);
 	wp_row("refcheck", "nofeed", "trajectory", &rb, b, a, NAN);
 	run_spec L[] = {
-		{"rk4", 2e-3, 1, 0, H},      {"rk4", 1e-3, 1, 0, H},     {"rk4", 5e-4, 1, 0, H},
+		{"rk4", 1.8e-3, 1, 0, H},    {"rk4", 1e-3, 1, 0, H},     {"rk4", 5e-4, 1, 0, H},
 		{"rk4", 2.5e-4, 1, 0, H},    {"rk4", 1e-4, 1, 0, H},     {"rk4", 5e-5, 1, 0, H},
 		{"rk4", 2.5e-5, 1, 0, H},    {"euler", 2e-4, 1, 0, H},   {"euler", 1e-4, 1, 0, H},
 		{"euler", 5e-5, 1, 0, H},    {"euler", 2.5e-5, 1, 0, H}, {"euler", 1e-5, 1, 0, H},
-		{"euler", 5e-6, 1, 0, H},    {"euler", 2.5e-6, 1, 0, H}, {"dem", 2e-3, 1, 0, H},
+		{"euler", 5e-6, 1, 0, H},    {"euler", 2.5e-6, 1, 0, H}, {"dem", 1.8e-3, 1, 0, H},
 		{"dem", 1e-3, 1, 0, H},      {"dem", 5e-4, 1, 0, H},     {"dem", 2.5e-4, 1, 0, H},
 		{"dem", 1e-4, 1, 0, H},      {"dopri5", 1e-4, 1, 1e-3, H}, {"dopri5", 1e-4, 1, 1e-4, H},
 		{"dopri5", 1e-4, 1, 1e-5, H}, {"dopri5", 1e-4, 1, 1e-6, H}, {"dopri5", 1e-4, 1, 1e-7, H},
@@ -117,11 +117,11 @@ static void scene_feed(const char *scene, const char *const *sets)
 	run_spec L[] = {
 		{"euler", 2e-5, 1, 0, H},        {"euler", 1e-5, 1, 0, H},
 		{"euler", 5e-6, 1, 0, H},        {"euler", 2.5e-6, 1, 0, H},
-		{"euler", 1.25e-6, 1, 0, H},     {"dem", 2e-3, 1, 0, H},
+		{"euler", 1.25e-6, 1, 0, H},     {"dem", 1.8e-3, 1, 0, H},
 		{"dem", 1e-3, 1, 0, H},          {"dem", 5e-4, 1, 0, H},
 		{"dem", 2.5e-4, 1, 0, H},        {"dem", 1e-4, 1, 0, H},
 		{"dem", 5e-5, 1, 0, H},          {"dem", 2e-5, 1, 0, H},
-		{"dem", 2e-3, 2, 0, H},          {"dem", 2e-3, 4, 0, H},
+		{"dem", 1.8e-3, 2, 0, H},        {"dem", 1.8e-3, 4, 0, H},
 		{"dem", 1e-3, 2, 0, H},          {"dem", 1e-3, 4, 0, H},
 		{"dem", 5e-4, 4, 0, H},          {"dem", 1e-4, 4, 0, H},
 		{"dem", 5e-4, 5, 0, H},          {"dem", 1e-3, 10, 0, H}, /* the former default */

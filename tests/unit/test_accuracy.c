@@ -89,7 +89,9 @@ static void hopping_theory_through_the_engine(void **state)
 		}
 		double A = 0.5 * (hi - lo), w = u.p.omega_ss, f = w / (2 * M_PI);
 		double Gamma = A * w * w * sin(psi) / u.p.g;
-		assert_true(across < 1e-4 * A);
+		/* across n: the machine step's own error, 1.5e-4 A at the
+		 * default 1.25e-3 s (7.8e-5 A at 1e-3 s) */
+		assert_true(across < 2e-4 * A);
 		assert_true(Gamma > 1.0 && Gamma < 3.3);
 		advance(s, 8.0);
 		double v = status(s).transport_velocity;

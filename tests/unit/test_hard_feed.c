@@ -358,8 +358,8 @@ static void heavy_feed_coupling_stays_stable(void **state)
 	setup light = preset(), heavy = preset();
 	set(&heavy, "layers", "24");
 	s = make(&light);
-	assert_close(status(s).dt, 1e-3, 0.0);
-	assert_int_equal(status(s).substeps, 4);
+	assert_close(status(s).dt, 1.25e-3, 0.0);
+	assert_int_equal(status(s).substeps, 5);
 	sim_free(s);
 	set(&light, "feed_events", "false"); /* the former dem */
 	s = make(&light);
