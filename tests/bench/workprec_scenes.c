@@ -124,8 +124,8 @@ static void scene_feed(const char *scene, const char *const *sets)
 		{"dem", 1.8e-3, 2, 0, H},        {"dem", 1.8e-3, 4, 0, H},
 		{"dem", 1e-3, 2, 0, H},          {"dem", 1e-3, 4, 0, H},
 		{"dem", 5e-4, 4, 0, H},          {"dem", 1e-4, 4, 0, H},
-		{"dem", 5e-4, 5, 0, H},          {"dem", 1e-3, 10, 0, H}, /* the former default */
-		{"dem", 5e-4, 20, 0, H}, /* the default */
+		{"dem", 5e-4, 5, 0, H},          {"dem", 1e-3, 10, 0, H},
+		{"dem", 5e-4, 20, 0, H},         {"dem", 1.25e-3, 5, 0, H}, /* the default */
 		{"dopri5", 1e-4, 1, 1e-3, Hdp},  {"dopri5", 1e-4, 1, 1e-4, Hdp},
 		{"dopri5", 1e-4, 1, 1e-5, Hdp},
 	};
