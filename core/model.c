@@ -134,6 +134,16 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		}
 		return;
 	}
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		/* x, y, phi, s1, s2 their reduced ones and alpha zero, as below */
+		static const int full[5] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2};
+		q[Q_ALPHA] = qd[Q_ALPHA] = 0.0;
+		for (int r = 0; r < 5; r++) {
+			q[full[r]] = 0.0 + qr[r];
+			qd[full[r]] = 0.0 + qrd[r];
+		}
+		return;
+	}
 	memset(q, 0, sizeof(double) * NQ_FULL);
 	memset(qd, 0, sizeof(double) * NQ_FULL);
 	for (int r = 0; r < md->nq; r++)

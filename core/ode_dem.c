@@ -64,6 +64,7 @@ typedef struct dem {
 	signed char *modes;
 	double (*deck_pos)[2], (*deck_vel)[2]; /* the columns' deck tracks, per sub-step */
 	double (*hermite)[4]; /* the tracks' cubic weights, per sub-step: positions, velocities */
+	double hermite_H;     /* ... for this step (0: none yet); they depend on it alone */
 	int events;        /* slip reversals located inside the feed's sub-steps */
 	int couple;        /* the deck yields to the feed's impulses within the step */
 	int have_yield;    /* yield holds the step before's compliance and reaction */
@@ -298,9 +299,12 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	 * middle (velocities), the same for every column: ode_hermite's
 	 * terms, operation for operation */
 	double(*wp)[4] = w->hermite, (*wv)[4] = w->hermite + ns + 1;
-	for (int i = 0; i <= ns; i++) {
-		hermite_weights((double)i / ns, H, wp[i]);
-		hermite_weights(((double)i - 0.5) / ns, H, wv[i]);
+	if (H != w->hermite_H) {
+		for (int i = 0; i <= ns; i++) {
+			hermite_weights((double)i / ns, H, wp[i]);
+			hermite_weights(((double)i - 0.5) / ns, H, wv[i]);
+		}
+		w->hermite_H = H;
 	}
 	for (int k = 0; k < dk->K; k++) {
 		double p0[2], v0[2], p1[2], v1[2], a0[2], a1[2];
