@@ -104,7 +104,7 @@ double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
  * slope (the Kloss curve's at zero slip, 2 M_ut / slip_ut, plus the
  * bearing drag's 2 b_phi omega_ss) and e^T M^-1 e the inverse inertia
  * that a torque on phi against alpha meets (the largest over the
- * rotor's angle). 0 under the ideal drive. setup.c */
+ * rotor's angle and over beta). 0 under the ideal drive. setup.c */
 double model_slip_rate(const sim_params *p, const sim_scene *sc);
 
 /* Build the reduced model (with its suspension preload) and the initial
