@@ -32,7 +32,7 @@ window() { # settings...: CPU s per simulated s of the window, and the start's C
 	start=$(cpu 0.001 "$@")
 	awk -v f="$full" -v s="$start" -v T="$T" 'BEGIN { printf "%.6g %.6g", (f - s) / T, s }'
 }
-read -r c0 _ <<<"$(window --set feed=false --set dt=1e-3)"
+read -r c0 _ <<<"$(window --set feed=false --set dt=1.25e-3)"
 tsv="$out/scaling.tsv"
 echo "K	L	N	cpu_per_sim_s	start_cpu_s" > "$tsv"
 for K in 1 2 5 10 20; do
@@ -71,7 +71,7 @@ table() { # the grid: CPU s per simulated s, real time factor in brackets
 	echo
 	echo "Command: \`bash tests/bench/scaling.sh\` (part of \`make bench\`). Full model"
 	echo "(trough_rotation=true), K columns x L layers at a constant feed mass of 20 kg, dem defaults"
-	echo "(1e-3 s, 4 sub-steps, feed_events), one core. CPU seconds per simulated second of the 4-s window after the"
+	echo "(1.25e-3 s, 5 sub-steps, feed_events), one core. CPU seconds per simulated second of the 4-s window after the"
 	echo "steady start (a 4-s run less the start alone, the least of three repeats), real-time factor in"
 	echo "brackets. Machine alone at the same step: $c0 CPU s per simulated s. Raw: scaling.tsv (with"
 	echo "the start's own CPU seconds)."
