@@ -32,9 +32,15 @@ static inline deck_rot deck_rotation(const double q[NQ_FULL])
 	return r;
 }
 
-/* out = R b: a body vector turned into the world frame. */
+/* out = R b: a body vector turned into the world frame (as it is where
+ * alpha = 0, as in every scene the symmetric reduction runs). */
 static inline void deck_rotate(const deck_rot *R, const double b[2], double out[2])
 {
+	if (R->s == 0.0 && R->c == 1.0) {
+		out[0] = b[0];
+		out[1] = b[1];
+		return;
+	}
 	out[0] = R->c * b[0] - R->s * b[1];
 	out[1] = R->s * b[0] + R->c * b[1];
 }

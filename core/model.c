@@ -313,9 +313,12 @@ static void drive(const model *md, const model_ctl *ctl, const config *cf, doubl
 	*damp_power += dt->drag * dt->omega - dt->load * dt->omega;
 }
 
-/* The upper half of M from its lower half. */
-static void symmetrize(double M[NQ_FULL][NQ_FULL])
+/* The upper half of M from its lower half, for the general solve: the
+ * layouts of constant sizes read the lower half only. */
+static void symmetrize(const model *md, double M[NQ_FULL][NQ_FULL])
 {
+	if (md->layout != MODEL_LAYOUT_GENERAL)
+		return;
 	for (int i = 0; i < NQ_FULL; i++)
 		for (int j = i + 1; j < NQ_FULL; j++)
 			M[i][j] = M[j][i];
@@ -327,7 +330,7 @@ static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_F
 		  const double rhs[NQ_FULL], drive_terms *dt, double br[NQ_FULL],
 		  double qdd[NQ_FULL])
 {
-	symmetrize(M);
+	symmetrize(md, M);
 	/* prescribed accelerations q_p'' */
 	double qpdd[NQ_FULL] = {0};
 	if (md->phi_prescribed) {
@@ -431,7 +434,7 @@ void model_force_responses(const model *md, const model_ctl *ctl, double t, cons
 	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL];
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
-	symmetrize(M);
+	symmetrize(md, M);
 	model_reduced_solves(md, (const double(*)[NQ_FULL])M, n, Q, qrdd);
 }
 
