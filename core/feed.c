@@ -20,11 +20,17 @@
 
 #include "feed.h"
 
+/* The loading branch of the paper's contact law (eq. 7): k delta^p. */
+static inline double loading_force(double k_c, double p, double delta)
+{
+	return p == 1.0 ? k_c * delta : k_c * pow(delta, p);
+}
+
 /* Normal contact force of the paper's law (eq. 7) for compression delta > 0
  * and its rate: loading k delta^p for rate >= 0, unloading R^2 k delta^p. */
 static double contact_force(const model *md, double delta, double delta_dot)
 {
-	double f = md->p.p == 1.0 ? md->p.k_c * delta : md->p.k_c * pow(delta, md->p.p);
+	double f = loading_force(md->p.k_c, md->p.p, delta);
 	return delta_dot >= 0.0 ? f : f * md->p.R * md->p.R;
 }
 
@@ -400,7 +406,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 		double delta = prev_eta - eta[j];
 		/* contact_force (delta, rate >= 0) with the parameters in
 		 * registers: the arrays written here may not alias md */
-		hi[j] = delta > 0.0 ? h * (p == 1.0 ? k_c * delta : k_c * pow(delta, p)) : 0.0;
+		hi[j] = delta > 0.0 ? h * loading_force(k_c, p, delta) : 0.0;
 		lo[j] = R2 * hi[j];
 		vs[j] = etad[j] - g * h;
 		prev_eta = eta[j];

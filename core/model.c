@@ -126,31 +126,19 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
-	if (md->layout == MODEL_LAYOUT_TROUGH3) {
-		/* each full coordinate its reduced one, added to zero as below */
-		for (int i = 0; i < NQ_FULL; i++) {
-			q[i] = 0.0 + qr[i];
-			qd[i] = 0.0 + qrd[i];
-		}
-		return;
-	}
-	if (md->layout == MODEL_LAYOUT_TROUGH2) {
-		/* x, y, phi, s1, s2 their reduced ones and alpha zero, as below */
-		static const int full[5] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2};
-		q[Q_ALPHA] = qd[Q_ALPHA] = 0.0;
-		for (int r = 0; r < 5; r++) {
-			q[full[r]] = 0.0 + qr[r];
-			qd[full[r]] = 0.0 + qrd[r];
-		}
-		return;
-	}
 	memset(q, 0, sizeof(double) * NQ_FULL);
 	memset(qd, 0, sizeof(double) * NQ_FULL);
-	for (int r = 0; r < md->nq; r++)
-		for (int a = 0; a < md->ncol[r]; a++) {
-			q[md->col[r][a]] += qr[r];
-			qd[md->col[r][a]] += qrd[r];
+	if (md->selection) {
+		/* each reduced coordinate one full one, none prescribed: that
+		 * one set to it, added to zero as model_add_reduced would */
+		for (int r = 0; r < md->nq; r++) {
+			q[md->col[r][0]] = 0.0 + qr[r];
+			qd[md->col[r][0]] = 0.0 + qrd[r];
 		}
+		return;
+	}
+	model_add_reduced(md, qr, q);
+	model_add_reduced(md, qrd, qd);
 	if (md->phi_prescribed) {
 		double psi, psid, psidd;
 		ramp_eval(&ctl->psi_ramp, t, &psi, &psid, &psidd);
@@ -339,9 +327,7 @@ static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_F
 	}
 	model_reduced_solve(md, (const double(*)[NQ_FULL])M, rhs, qpdd, br);
 	memcpy(qdd, qpdd, sizeof(double) * NQ_FULL);
-	for (int r = 0; r < md->nq; r++)
-		for (int a = 0; a < md->ncol[r]; a++)
-			qdd[md->col[r][a]] += br[r];
+	model_add_reduced(md, br, qdd);
 	if (md->phi_prescribed) {
 		double s = -rhs[Q_PHI] - dt->drag + dt->load;
 		for (int j = 0; j < NQ_FULL; j++)

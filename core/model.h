@@ -95,6 +95,15 @@ int model_machine_symmetric(const sim_params *p);
 /* The feed's mass over the machine's (trough, vibrator and eliminator
  * masses): the added-mass ratio of the machine-feed coupling. */
 double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc);
+/* Add each reduced coordinate's value qr[r] (a position, rate or
+ * acceleration) to the full coordinates it moves: full[i] += qr[r]. */
+static inline void model_add_reduced(const model *md, const double *qr, double full[NQ_FULL])
+{
+	for (int r = 0; r < md->nq; r++)
+		for (int a = 0; a < md->ncol[r]; a++)
+			full[md->col[r][a]] += qr[r];
+}
+
 /* Largest ratio for which dem corrects its coupling (README "dem"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 

@@ -189,9 +189,7 @@ static void deck_compliance(const model *md, int nb, const double (*qr)[NQ_FULL]
 	double B[3][3] = {{0}};
 	for (int c = 0; c < nb; c++) {
 		double qdd[NQ_FULL] = {0};
-		for (int r = 0; r < md->nq; r++)
-			for (int a = 0; a < md->ncol[r]; a++)
-				qdd[md->col[r][a]] += qr[c][r];
+		model_add_reduced(md, qr[c], qdd);
 		for (int i = 0; i < 3; i++)
 			B[i][c] = qdd[i];
 	}

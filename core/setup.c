@@ -62,9 +62,7 @@ double model_slip_rate(const sim_params *p, const sim_scene *sc)
 			Q[Q_PHI] = 1.0;
 			Q[Q_ALPHA] = -1.0;
 			model_force_response(&md, &ctl, 0.0, y, Q, qrdd);
-			for (int r = 0; r < md.nq; r++)
-				for (int a = 0; a < md.ncol[r]; a++)
-					qdd[md.col[r][a]] += qrdd[r];
+			model_add_reduced(&md, qrdd, qdd);
 			inv_inertia = fmax(inv_inertia, qdd[Q_PHI] - qdd[Q_ALPHA]);
 		}
 	}

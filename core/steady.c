@@ -18,8 +18,8 @@
  *
  * The steps per period: at least 32, and more where a mode of the machine
  * is fast, so that h omega <= 0.2 for its fastest mode. For czubak2016
- * that is 32 (T = 0.04 s, h = 1.25e-3 s, about as fine as the 1e-3-s
- * step that follows). Measured over the 74 points: v moved by at most
+ * that is 32 (T = 0.04 s, h = 1.25e-3 s, as fine as the default
+ * machine step that follows). Measured over the 74 points: v moved by at most
  * 4.2e-6 m/s against 128 steps per period, as much as a round-off change
  * moves it (the settling that follows forgets the start's own small
  * error); with the early end of the speed iteration the shooting fell
