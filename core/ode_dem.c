@@ -372,44 +372,41 @@ static size_t dem_state_size(const void *p)
 	return sizeof w->have_q + sizeof w->Qfeed + 2 * (size_t)w->nmodes + yield_size(w);
 }
 
-static void dem_save(const void *p, void *buf)
+/* One field of the carried state, n bytes, into the buffer (save) or out
+ * of it; *b moves past it. */
+static void carry(char **b, void *field, size_t n, int save)
 {
-	const dem *w = p;
+	if (save)
+		memcpy(*b, field, n);
+	else
+		memcpy(field, *b, n);
+	*b += n;
+}
+
+/* The carried state in dem_state_size's order, saved into buf or loaded
+ * from it (saving only reads w). */
+static void carry_state(dem *w, char *buf, int save)
+{
 	char *b = buf;
-	memcpy(b, &w->have_q, sizeof w->have_q);
-	memcpy(b + sizeof w->have_q, w->Qfeed, sizeof w->Qfeed);
-	b += sizeof w->have_q + sizeof w->Qfeed;
-	memcpy(b, w->modes, 2 * (size_t)w->nmodes);
-	b += 2 * (size_t)w->nmodes;
+	carry(&b, &w->have_q, sizeof w->have_q, save);
+	carry(&b, w->Qfeed, sizeof w->Qfeed, save);
+	carry(&b, w->modes, 2 * (size_t)w->nmodes, save);
 	if (!w->couple)
 		return;
-	memcpy(b, &w->have_yield, sizeof w->have_yield);
-	b += sizeof w->have_yield;
-	for (int k = 0; k < w->K; k++) {
-		memcpy(b, w->yield->C[k], (size_t)w->K * sizeof w->yield->C[k][0]);
-		b += (size_t)w->K * sizeof w->yield->C[k][0];
-	}
-	memcpy(b, w->yield->F, (size_t)w->K * sizeof w->yield->F[0]);
+	carry(&b, &w->have_yield, sizeof w->have_yield, save);
+	for (int k = 0; k < w->K; k++)
+		carry(&b, w->yield->C[k], (size_t)w->K * sizeof w->yield->C[k][0], save);
+	carry(&b, w->yield->F, (size_t)w->K * sizeof w->yield->F[0], save);
+}
+
+static void dem_save(const void *p, void *buf)
+{
+	carry_state((dem *)p, buf, 1);
 }
 
 static void dem_load(void *p, const void *buf)
 {
-	dem *w = p;
-	const char *b = buf;
-	memcpy(&w->have_q, b, sizeof w->have_q);
-	memcpy(w->Qfeed, b + sizeof w->have_q, sizeof w->Qfeed);
-	b += sizeof w->have_q + sizeof w->Qfeed;
-	memcpy(w->modes, b, 2 * (size_t)w->nmodes);
-	b += 2 * (size_t)w->nmodes;
-	if (!w->couple)
-		return;
-	memcpy(&w->have_yield, b, sizeof w->have_yield);
-	b += sizeof w->have_yield;
-	for (int k = 0; k < w->K; k++) {
-		memcpy(w->yield->C[k], b, (size_t)w->K * sizeof w->yield->C[k][0]);
-		b += (size_t)w->K * sizeof w->yield->C[k][0];
-	}
-	memcpy(w->yield->F, b, (size_t)w->K * sizeof w->yield->F[0]);
+	carry_state(p, (char *)buf, 0);
 }
 
 const ode_method ode_dem = {
