@@ -58,35 +58,49 @@ void model_solve_layout(model *md)
 	}
 }
 
-/* In-place LDL^T solve of the n x n (n <= 3) SPD system A x = b (lower
- * half of A used and overwritten). Returns 0, or -1 if A is not positive
- * definite. */
-static int ldlt_solve(int n, double A[3][3], double *b)
+/* In-place LDL^T factorisation of the n x n (n <= 3) SPD matrix A (lower
+ * half used and overwritten: L below the diagonal, D on it). Returns 0,
+ * or -1 if A is not positive definite. Inlined where n is a constant, so
+ * the loops unroll there. */
+static inline int ldlt_factor(const int n, double A[3][3])
 {
+#pragma GCC unroll 6
 	for (int j = 0; j < n; j++) {
 		double d = A[j][j];
+#pragma GCC unroll 6
 		for (int k = 0; k < j; k++)
 			d -= A[j][k] * A[j][k] * A[k][k];
 		if (!(d > 0.0))
 			return -1;
 		A[j][j] = d;
 		double inv = 1.0 / d;
+#pragma GCC unroll 6
 		for (int i = j + 1; i < n; i++) {
 			double s = A[i][j];
+#pragma GCC unroll 6
 			for (int k = 0; k < j; k++)
 				s -= A[i][k] * A[j][k] * A[k][k];
 			A[i][j] = s * inv;
 		}
 	}
+	return 0;
+}
+
+/* Solve A x = b in place (x into b) with ldlt_factor's A. */
+static inline void ldlt_subst(const int n, const double A[3][3], double *b)
+{
+#pragma GCC unroll 6
 	for (int i = 0; i < n; i++)
+#pragma GCC unroll 6
 		for (int k = 0; k < i; k++)
 			b[i] -= A[i][k] * b[k];
+#pragma GCC unroll 6
 	for (int i = n - 1; i >= 0; i--) {
 		b[i] /= A[i][i];
+#pragma GCC unroll 6
 		for (int k = i + 1; k < n; k++)
 			b[i] -= A[k][i] * b[k];
 	}
-	return 0;
 }
 
 /* The point masses' own coordinates (phi, s1, s2 where integrated alone)
@@ -94,7 +108,7 @@ static int ldlt_solve(int n, double A[3][3], double *b)
  * inverses), so they are eliminated first and only the Schur complement
  * on the trough's coordinates (x, y and alpha, at most 3) is factored. */
 /* The Schur complement S on the trough's nb coordinates, factored as
- * LDL^T in place (ldlt_solve's arithmetic); -1 if not positive definite. */
+ * LDL^T in place (ldlt_factor); -1 if not positive definite. */
 static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *own_inv,
 			       const int n, const int nb, const int *full, double S[3][3])
 {
@@ -111,26 +125,7 @@ static inline int schur_factor(const double M[NQ_FULL][NQ_FULL], const double *o
 				S[a][c] -= Md[full[a]] * own_inv[d] * Md[full[c]];
 		}
 	}
-#pragma GCC unroll 6
-	for (int j = 0; j < nb; j++) {
-		double dj = S[j][j];
-#pragma GCC unroll 6
-		for (int k = 0; k < j; k++)
-			dj -= S[j][k] * S[j][k] * S[k][k];
-		if (!(dj > 0.0))
-			return -1;
-		S[j][j] = dj;
-		double inv = 1.0 / dj;
-#pragma GCC unroll 6
-		for (int i = j + 1; i < nb; i++) {
-			double s = S[i][j];
-#pragma GCC unroll 6
-			for (int k = 0; k < j; k++)
-				s -= S[i][k] * S[j][k] * S[k][k];
-			S[i][j] = s * inv;
-		}
-	}
-	return 0;
+	return ldlt_factor(nb, S);
 }
 
 /* One right-hand side through schur_factor's S (general_solve's
@@ -150,18 +145,7 @@ static inline void schur_solve(const double M[NQ_FULL][NQ_FULL], const double *o
 		for (int d = nb; d < n; d++)
 			x[a] -= M[full[d]][full[a]] * own_inv[d] * br[d];
 	}
-#pragma GCC unroll 6
-	for (int i = 0; i < nb; i++)
-#pragma GCC unroll 6
-		for (int k = 0; k < i; k++)
-			x[i] -= S[i][k] * x[k];
-#pragma GCC unroll 6
-	for (int i = nb - 1; i >= 0; i--) {
-		x[i] /= S[i][i];
-#pragma GCC unroll 6
-		for (int k = i + 1; k < nb; k++)
-			x[i] -= S[k][i] * x[k];
-	}
+	ldlt_subst(nb, S, x);
 #pragma GCC unroll 6
 	for (int d = nb; d < n; d++) {
 		const double *Md = M[full[d]];
@@ -255,11 +239,12 @@ static void general_solve(const model *md, const double M[NQ_FULL][NQ_FULL],
 				S[a][c] -= Mr[d][a] * inv * Mr[d][c];
 		}
 	}
-	if (ldlt_solve(nb, S, x) != 0) {
+	if (ldlt_factor(nb, S) != 0) {
 		for (int r = 0; r < n; r++)
 			br[r] = NAN;
 		return;
 	}
+	ldlt_subst(nb, (const double(*)[3])S, x);
 	for (int d = 0; d < n; d++) {
 		double inv = md->own_inv[d];
 		if (inv == 0.0)
