@@ -367,9 +367,10 @@ static double guide_power(const sim_params *p, const config *cf, const double qd
 }
 
 /* What an evaluation shows the observer. */
-static void observe(const model *md, const config *cf, const double qdd[NQ_FULL],
-		    const drive_terms *dt, model_eval *ev)
+static void observe(const model *md, const config *cf, const double M[NQ_FULL][NQ_FULL],
+		    const double qdd[NQ_FULL], const drive_terms *dt, model_eval *ev)
 {
+	memcpy(ev->M, M, sizeof ev->M);
 	memcpy(ev->q, cf->q, sizeof ev->q);
 	memcpy(ev->qd, cf->qd, sizeof ev->qd);
 	memcpy(ev->qdd, qdd, sizeof ev->qdd);
@@ -403,25 +404,19 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd);
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev)
-		observe(md, &cf, qdd, &dt, ev);
+		observe(md, &cf, (const double(*)[NQ_FULL])M, qdd, &dt, ev);
 }
 
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
 			  const double Q[NQ_FULL], double *qrdd)
-{
-	model_force_responses(md, ctl, t, y, 1, (const double(*)[NQ_FULL])Q,
-			      (double(*)[NQ_FULL])qrdd);
-}
-
-void model_force_responses(const model *md, const model_ctl *ctl, double t, const double *y,
-			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL])
 {
 	config cf;
 	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL];
 	configure(md, ctl, t, y, &cf);
 	mass_matrix_and_bias(md, &cf, NULL, M, rhs);
 	symmetrize(md, M);
-	model_reduced_solves(md, (const double(*)[NQ_FULL])M, n, Q, qrdd);
+	model_reduced_solves(md, (const double(*)[NQ_FULL])M, 1, (const double(*)[NQ_FULL])Q,
+			     (double(*)[NQ_FULL])qrdd);
 }
 
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,

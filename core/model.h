@@ -84,6 +84,7 @@ typedef struct model_eval {
 	double rotor_speed;   /* phi' - alpha' */
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
 	deck_rot R;           /* R(alpha), deck_rotation(q) */
+	double M[NQ_FULL][NQ_FULL]; /* the mass matrix (lower half; both for the general layout) */
 } model_eval;
 
 /* 1 when the machine is symmetric about the vertical through G: h = 0,
@@ -155,10 +156,6 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
  * alone gives the machine in state y at t: (T^t M T)^-1 T^t Q. */
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
 			  const double Q[NQ_FULL], double *qrdd);
-/* The same for n forces Q[i] at once (one mass matrix): qrdd[i]. */
-void model_force_responses(const model *md, const model_ctl *ctl, double t, const double *y,
-			   int n, const double (*Q)[NQ_FULL], double (*qrdd)[NQ_FULL]);
-
 /* Kinetic and potential energy (J) of the machine alone in state y at t
  * (written); the potential includes gravity, springs and preload. */
 void model_machine_energy(const model *md, const model_ctl *ctl, double t, const double *y,

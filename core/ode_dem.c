@@ -60,7 +60,7 @@ typedef struct dem {
 	int correct; /* corrector on: feed light enough (added mass) */
 	double dt;
 	double Qfeed[NQ_FULL];
-	double *k1, *k2, *k3, *k4, *tmp, *save;
+	double *k1, *k2, *k3, *k4, *tmp;
 	signed char *modes;
 	double (*deck_pos)[2], (*deck_vel)[2]; /* the columns' deck tracks, per sub-step */
 	double (*hermite)[4]; /* the tracks' cubic weights, per sub-step: positions, velocities */
@@ -97,7 +97,7 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 		     model_feed_mass_ratio(&md->p, &md->sc) <= MODEL_CORRECTOR_MAX_RATIO;
 	size_t nf = (size_t)(md->nf > 0 ? md->nf : 1);
 	w->nmodes = (int)nf;
-	w->k1 = calloc(6 * (size_t)md->n, sizeof(double));
+	w->k1 = calloc(5 * (size_t)md->n, sizeof(double));
 	w->modes = calloc(2 * nf, 1);
 	int K = md->dk.K > 0 ? md->dk.K : 1;
 	w->K = md->dk.K;
@@ -115,7 +115,6 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->k3 = w->k2 + md->n;
 	w->k4 = w->k3 + md->n;
 	w->tmp = w->k4 + md->n;
-	w->save = w->tmp + md->n;
 	w->deck_vel = w->deck_pos + (size_t)K * w->substeps;
 	return w;
 }
@@ -151,10 +150,10 @@ static inline double hermite_sum(const double w[4], double p0, double v0, double
 }
 
 /* One classical RK4 step of the machine's entries of y over H, with the
- * feed's reaction held at w->Qfeed; ev0 receives the start evaluation and
- * ev3 (if not NULL) the last stage's. */
+ * feed's reaction held at w->Qfeed; ev0 receives the start evaluation,
+ * evm and ev3 (where not NULL) the third and the last stage's. */
 static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0,
-			model_eval *ev3)
+			model_eval *evm, model_eval *ev3)
 {
 	const model *md = sys->md;
 	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
@@ -162,7 +161,7 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k1);
 	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k2);
-	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, NULL);
+	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k3, evm);
 	machine_axpy(md, w->tmp, y, H, w->k3);
 	dyn_machine_rhs(sys, t + H, w->tmp, w->Qfeed, w->k4, ev3);
 	for (int r = 0; r < md->nq; r++) {
@@ -219,27 +218,24 @@ static void deck_compliance(const model *md, int nb, const double (*qr)[NQ_FULL]
  * the RK4 step taken again would differ by H^2/2 M^-1 dQ in the positions
  * and H M^-1 dQ in the rates, up to terms (omega H)^2 smaller (the
  * machine's frequencies omega <= 160 rad/s: 2.5 % of the correction at
- * 1e-3 s); the energy accumulators keep the predictor's values. One mass
- * matrix solve instead of four right-hand sides. */
-static void correct(dem *w, dyn *sys, double t, double H, double *y, const double Qold[NQ_FULL],
-		    const deck_rot *R1)
+ * 1e-3 s); the energy accumulators keep the predictor's values. M is the
+ * one RK4's third stage formed (evm: at t + H/2 on y + H/2 k2, the step's
+ * middle to O(H^2) like the mean of its ends), so the corrector costs
+ * back-substitutions only: no configuration, mass matrix or factorisation
+ * of its own. */
+static void correct(dem *w, const model *md, double H, double *y, const double Qold[NQ_FULL],
+		    const model_eval *evm, const deck_rot *R1)
 {
-	const model *md = sys->md;
 	double Q[4][NQ_FULL] = {{0}}, a[4][NQ_FULL];
 	for (int i = 0; i < NQ_FULL; i++)
 		Q[0][i] = w->Qfeed[i] - Qold[i];
-	for (int r = 0; r < md->nq; r++) {
-		int v = md->npos + r;
-		w->tmp[r] = 0.5 * (y[r] + w->save[r]);
-		w->tmp[v] = 0.5 * (y[v] + w->save[v]);
-	}
 	/* with the deck yielding, the same mass matrix's response to unit
 	 * forces on x, y (and alpha): the next step's compliance */
 	int nb = w->couple ? (md->alpha_fixed ? 2 : 3) : 0;
 	for (int c = 0; c < nb; c++)
 		Q[1 + c][c] = 1.0; /* Q_X, Q_Y, Q_ALPHA */
-	model_force_responses(md, sys->ctl, t + 0.5 * H, w->tmp, 1 + nb,
-			      (const double(*)[NQ_FULL])Q, a);
+	model_reduced_solves(md, (const double(*)[NQ_FULL])evm->M, 1 + nb,
+			     (const double(*)[NQ_FULL])Q, a);
 	for (int r = 0; r < md->nq; r++) {
 		y[r] += 0.5 * H * H * a[0][r];
 		y[md->npos + r] += H * a[0][r];
@@ -252,7 +248,6 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
 	dem *w = p;
 	const model *md = sys->md;
-	const int n = w->n;
 	double H = ode_fixed_step(*t, w->dt, t_max);
 	if (md->nf > 0 && !w->have_q) {
 		/* first step: the feed's reaction from the smooth law now */
@@ -261,11 +256,9 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		w->have_q = 1;
 	}
 	const int ns = w->substeps;
-	if (w->correct)
-		memcpy(w->save, y, sizeof(double) * (size_t)n);
 	/* 1. machine RK4 with the feed force held */
-	model_eval ev0, ev1;
-	machine_rk4(w, sys, *t, H, y, &ev0, w->events ? &ev1 : NULL);
+	model_eval ev0, evm, ev1;
+	machine_rk4(w, sys, *t, H, y, &ev0, w->correct ? &evm : NULL, w->events ? &ev1 : NULL);
 	double t1 = (H == t_max - *t) ? t_max : *t + H;
 	if (md->nf == 0) {
 		*t = t1;
@@ -339,7 +332,7 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	if (md->sc.feed_coupling)
 		deck_forces(dk, &R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
 	if (w->correct)
-		correct(w, sys, *t, H, y, Qold, &R1);
+		correct(w, md, H, y, Qold, &evm, &R1);
 	if (w->couple) {
 		for (int k = 0; k < dk->K; k++)
 			for (int c = 0; c < 2; c++)
