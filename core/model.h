@@ -84,7 +84,8 @@ typedef struct model_eval {
 	double rotor_speed;   /* phi' - alpha' */
 	double deck[2], deck_vel[2]; /* centre deck point displacement */
 	deck_rot R;           /* R(alpha), deck_rotation(q) */
-	double M[NQ_FULL][NQ_FULL]; /* the mass matrix (lower half; both for the general layout) */
+	double M[NQ_FULL][NQ_FULL]; /* the mass matrix as the layout's solve reads it (lower half;
+				     * both for the general layout; model.c, trough2_held) */
 } model_eval;
 
 /* 1 when the machine is symmetric about the vertical through G: h = 0,
