@@ -437,30 +437,14 @@ double srv_sessions_steps_per_s(void)
 	return sum;
 }
 
-/* Whether s runs after control c (lock held): what the worker's commands
- * phase will make of its state (worker.c apply_commands, apply_budget). */
-static int runs_after(const srv_session *s, const api_control *c)
-{
-	int state = s->state;
-	if ((c->set & API_C_UNTIL) && state == SRV_FINISHED &&
-	    (c->until == 0 || c->until > s->st.t))
-		state = SRV_RUNNING;
-	if ((c->set & API_C_RUNNING) && !c->running && state == SRV_RUNNING)
-		state = SRV_PAUSED;
-	else if ((c->set & API_C_RUNNING) && c->running && state == SRV_PAUSED)
-		state = SRV_RUNNING;
-	if ((c->set & API_C_CPU) && s->cpu_paused && state == SRV_PAUSED)
-		state = SRV_RUNNING;
-	return state == SRV_RUNNING;
-}
-
 /* The paced cores s needs after c: raise its hold before c is queued, or
  * refuse (lock held). The field named is the one that raises it. */
 static api_err admit_control(srv_session *s, const api_control *c,
 			     api_problem *pb)
 {
 	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
-	if (pace == API_PACE_MAX || !runs_after(s, c) ||
+	if (pace == API_PACE_MAX ||
+	    srv_state_after(s->state, s->cpu_paused, s->st.t, c) != SRV_RUNNING ||
 	    s->cpu_per_s * pace <= s->paced_held)
 		return API_OK;
 	const char *field = (c->set & API_C_PACE)      ? "pace"

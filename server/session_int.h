@@ -85,6 +85,27 @@ static inline double srv_paced_need(const srv_session *s)
 	return s->cpu_per_s * s->pace;
 }
 
+/* The state control c leaves a session in, from its state, whether its
+ * CPU budget paused it and its time t: until raised past t resumes a
+ * finished session, running pauses or resumes, and a new CPU budget (or
+ * running = true) resumes one its budget paused. The one rule for the
+ * worker, which applies c (worker.c apply_commands), and for admission,
+ * which must know beforehand whether the session will run paced
+ * (session.c admit_control). */
+static inline int srv_state_after(int state, int cpu_paused, double t, const api_control *c)
+{
+	if ((c->set & API_C_UNTIL) && state == SRV_FINISHED && (c->until == 0 || c->until > t))
+		state = SRV_RUNNING;
+	if ((c->set & API_C_RUNNING) && !c->running && state == SRV_RUNNING)
+		state = SRV_PAUSED;
+	else if ((c->set & API_C_RUNNING) && c->running && state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	if (((c->set & API_C_CPU) || ((c->set & API_C_RUNNING) && c->running)) && cpu_paused &&
+	    state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	return state;
+}
+
 /* Slot i of the ring with its arrays pointed into ring_store (set on
  * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)

@@ -173,8 +173,10 @@ static void extend_until(srv_session *s, double t_end)
 		s->state = SRV_RUNNING;
 }
 
-/* The budget part of a control: a CPU grant from now, a resume of a
- * session its CPU budget paused (lock held). */
+/* The budget part of a control, after its state change
+ * (srv_state_after): a CPU grant from now, and the budget's pause flag
+ * cleared once the session runs or is paused or resumed by hand (lock
+ * held). */
 static void apply_budget(srv_session *s, const srv_cmd *cmd)
 {
 	const api_control *c = &cmd->c;
@@ -183,9 +185,6 @@ static void apply_budget(srv_session *s, const srv_cmd *cmd)
 	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
 		 cmd->cpu_grant > 0)
 		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
-	if (((c->set & API_C_CPU) || ((c->set & API_C_RUNNING) && c->running)) &&
-	    s->cpu_paused && s->state == SRV_PAUSED)
-		s->state = SRV_RUNNING;
 	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
 		s->cpu_paused = 0;
 }
@@ -223,23 +222,17 @@ static int apply_commands(srv_session *s)
 			s->pace = c->pace;
 			reanchor = 1;
 		}
-		if (rc == SIM_OK && (c->set & API_C_UNTIL)) {
+		if (rc == SIM_OK && (c->set & API_C_UNTIL))
 			s->until = c->until;
-			if (s->state == SRV_FINISHED &&
-			    (s->until == 0 || s->until > s->st.t))
-				s->state = SRV_RUNNING;
-		}
-		if (rc == SIM_OK && (c->set & API_C_RUNNING)) {
-			if (!c->running && s->state == SRV_RUNNING)
-				s->state = SRV_PAUSED;
-			else if (c->running && s->state == SRV_PAUSED)
-				s->state = SRV_RUNNING;
-			reanchor = 1;
-		}
 		if (rc == SIM_OK) {
+			/* pacing restarts on running and on a resume from a
+			 * pause (not on a finished session resumed by until:
+			 * it restarts its clocks when it wakes, idle) */
 			int was = s->state;
+			s->state = srv_state_after(was, s->cpu_paused, s->st.t, c);
+			reanchor |= (c->set & API_C_RUNNING) ||
+				    (was == SRV_PAUSED && s->state != was);
 			apply_budget(s, cmd);
-			reanchor |= was != s->state;
 		}
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
