@@ -14,7 +14,11 @@
  * the means of: the bottom and top layer's horizontal velocity, the
  * column's mean horizontal velocity, the deck point's velocity (x, y),
  * the share of samples with the bottom contact closed, the bottom layer's
- * vertical velocity and its compression (m/s, m).
+ * vertical velocity and its compression (m/s, m). The layers' velocities
+ * are dem's, those of the last feed sub-step's middle, half a feed step
+ * before the sample: in contact they differ from the deck's at the sample
+ * by its acceleration times h/2, so compare settings there by positions
+ * or in flight.
  */
 #include <math.h>
 #include <stdio.h>
