@@ -114,7 +114,8 @@ static int check_state(sim *s)
  * machine follows its forced response as the damping goes. Measured over
  * the 74 points of czubak2016 (tests/bench/accuracy.sh): every point is
  * within the 1 % gate, inside its bar and steady with any settling from
- * 0.6 to 1.5 s (0.4 to 0.55 s leave 2 points not steady). The damping's
+ * 0.4 to 1.5 s (with the former 1e-3-s machine step 0.4 and 0.55 s left 2
+ * points not steady). The damping's
  * fade itself moves the machine off its orbit a little (its forced
  * response at the drive frequency changes with the damping): without
  * feed, one period after t = 0 the orbit closes within 2.3e-5 of its size

@@ -31,7 +31,7 @@ runs=(
 	"settle 1.5 s|--set settle=1.5|the former settling"
 	"settle 0.75 s|--set settle=0.75|shorter settling"
 	"settle 0.6 s|--set settle=0.6|shorter still"
-	"settle 0.4 s|--set settle=0.4|the settling too short"
+	"settle 0.4 s|--set settle=0.4|the shortest settling tried"
 	"window 3 s|--duration 3|the defaults with a 3-s window"
 	"window 3 s, settle 1.5 s|--duration 3 --set settle=1.5|a 3-s window after the former settling"
 	"window 3.5 s, settle 0.6 s|--duration 3.5 --set settle=0.6|a 3.5-s window after a 0.6-s settling"
