@@ -206,7 +206,7 @@ static void rotation_convention_and_mirror(void **state)
  * 180 deg - beta, and the image's measurement (v negated, the bar and the
  * steady flag taken over) agrees with the ccw point measured directly to
  * 1e-4 of the peak in v and 5 % in the bar (measured over the 74 points,
- * tests/bench/results/accuracy.md: 4.0e-5 and 1.8 %). An asymmetric
+ * tests/bench/results/accuracy.md: 1.7e-5 and 4.2 %). An asymmetric
  * machine (l2, or c != 0, which moves the mirrored eliminator mass to the
  * wrong side of its guide point) and mirror = false plan every point. */
 static void mirror_reduction_of_sweeps(void **state)
