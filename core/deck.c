@@ -33,6 +33,29 @@ void deck_accel(const deck *dk, int k, const deck_rot *R, const double qd[NQ_FUL
 	acc[1] = qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
 }
 
+void deck_point_affine(const deck *dk, const deck_rot *R, const double q[NQ_FULL],
+		       const double qd[NQ_FULL], const double qdd[NQ_FULL], double out[3][2][2])
+{
+	/* the point at body x = 0, and R e_x, the arm's rate per metre of x */
+	double Rd[2], Re[2];
+	const double ex[2] = {1.0, 0.0};
+	deck_arm(dk, 0.0, R, Rd);
+	deck_rotate(R, ex, Re);
+	double ad = qd[Q_ALPHA], add = qdd[Q_ALPHA];
+	out[0][0][0] = q[Q_X] + Rd[0];
+	out[0][0][1] = q[Q_Y] + Rd[1];
+	out[1][0][0] = qd[Q_X] - ad * Rd[1];
+	out[1][0][1] = qd[Q_Y] + ad * Rd[0];
+	out[2][0][0] = qdd[Q_X] - add * Rd[1] - ad * ad * Rd[0];
+	out[2][0][1] = qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
+	out[0][1][0] = Re[0];
+	out[0][1][1] = Re[1];
+	out[1][1][0] = -ad * Re[1];
+	out[1][1][1] = ad * Re[0];
+	out[2][1][0] = -add * Re[1] - ad * ad * Re[0];
+	out[2][1][1] = add * Re[0] - ad * ad * Re[1];
+}
+
 void deck_motion_eval(const deck *dk, const double q[NQ_FULL], const double qd[NQ_FULL],
 		      deck_motion *out)
 {

@@ -61,6 +61,13 @@ void deck_point(const deck *dk, double x, const deck_rot *R, const double q[NQ_F
 void deck_accel(const deck *dk, int k, const deck_rot *R, const double qd[NQ_FULL],
 		const double qdd[NQ_FULL], double acc[2]);
 
+/* A deck point's position, velocity and acceleration are affine in its
+ * body x: out[i][0] + x out[i][1] (i = 0, 1, 2 for position, velocity,
+ * acceleration; from q, q', q''), so one pair of them serves every
+ * column. */
+void deck_point_affine(const deck *dk, const deck_rot *R, const double q[NQ_FULL],
+		       const double qd[NQ_FULL], const double qdd[NQ_FULL], double out[3][2][2]);
+
 /* Every integrated column's deck point: pos[k], vel[k]. */
 typedef struct deck_motion {
 	double pos[SIM_MAX_COLUMNS][2], vel[SIM_MAX_COLUMNS][2];

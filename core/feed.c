@@ -449,6 +449,68 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	imp[1] -= Pn[0];
 }
 
+/* feed.h. T_k = w J_k B, with B the trough's (x, y, alpha) part, J_k the
+ * deck point's Jacobian on (x, y, alpha) and w the physical columns one
+ * integrated column stands for. Mirrored states give mirrored T to the
+ * last bit (each entry's terms change sign together). */
+void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL], const deck_rot *R,
+			   feed_yield *yl)
+{
+	double B[3][3] = {{0}};
+	for (int c = 0; c < nb; c++) {
+		double qdd[NQ_FULL] = {0};
+		model_add_reduced(md, qr[c], qdd);
+		for (int i = 0; i < 3; i++)
+			B[i][c] = qdd[i];
+	}
+	/* J_k = [[1, 0, -Rd_y], [0, 1, Rd_x]] with Rd_k the deck point's
+	 * arm from G */
+	const deck *dk = &md->dk;
+	yl->nb = nb;
+	for (int k = 0; k < dk->K; k++) {
+		double b[2] = {dk->d[k], dk->h_d}, *Rd = yl->Rd[k];
+		deck_rotate(R, b, Rd);
+		for (int q = 0; q < 3; q++) {
+			yl->T[k][0][q] = md->col_weight * (B[0][q] - Rd[1] * B[2][q]);
+			yl->T[k][1][q] = md->col_weight * (B[1][q] + Rd[0] * B[2][q]);
+		}
+	}
+}
+
+void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], double (*dv)[2])
+{
+	const int turns = yl->nb > 2;
+	/* mirrored columns j and K-1-j summed first, so that a mirrored
+	 * motion stays mirrored to the last bit (the pair's x and alpha parts
+	 * cancel exactly); the three sums as scalars, in registers */
+	double Gx = 0.0, Gy = 0.0, Ga = 0.0;
+	for (int j = 0; j <= (K - 1) / 2; j++) {
+		int jj = K - 1 - j;
+		const double *Rj = yl->Rd[j], *Rjj = yl->Rd[jj];
+		double gx = E[j][0], gy = E[j][1], ga = 0.0;
+		if (turns)
+			ga = -Rj[1] * E[j][0] + Rj[0] * E[j][1];
+		if (jj != j) {
+			gx += E[jj][0];
+			gy += E[jj][1];
+			if (turns)
+				ga += -Rjj[1] * E[jj][0] + Rjj[0] * E[jj][1];
+		}
+		Gx += gx;
+		Gy += gy;
+		Ga += ga;
+	}
+	for (int k = 0; k < K; k++) {
+		const double(*T)[3] = yl->T[k];
+		dv[k][0] = T[0][0] * Gx + T[0][1] * Gy;
+		dv[k][1] = T[1][0] * Gx + T[1][1] * Gy;
+		if (turns) {
+			dv[k][0] += T[0][2] * Ga;
+			dv[k][1] += T[1][2] * Ga;
+		}
+	}
+}
+
 void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
 		   const double (*deck_vel)[2], int events, const feed_yield *yield,
 		   signed char *modes, double (*impulse)[2], double *fric, double *contact)
@@ -469,44 +531,30 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 		return;
 	}
 	/* the deck yields: at the middle of sub-step i its velocity at
-	 * column k moves by sum_j C[k][j] E_j, E_j the impulse column j gave
-	 * the deck by then (each sub-step's spread over it, as the corrector
-	 * spreads the step's; half of the one in progress, taken as the last
-	 * one) less what the held reaction F_j accounts for by then; its
-	 * position by the sum of those over the sub-steps before. At rest E
-	 * is zero. */
-	double last[SIM_MAX_COLUMNS][2], dv[SIM_MAX_COLUMNS][2] = {{0}},
-	       dp[SIM_MAX_COLUMNS][2] = {{0}}, E[SIM_MAX_COLUMNS][2];
+	 * column k moves by T_k G, G = sum_j J_j^T E_j the generalized
+	 * impulse of E_j, the impulse column j gave the deck by then (each
+	 * sub-step's spread over it, as the corrector spreads the step's;
+	 * half of the one in progress, taken as the last one) less what the
+	 * held reaction F_j accounts for by then; its position by the sum of
+	 * those over the sub-steps before. At rest E is zero. */
+	double last[SIM_MAX_COLUMNS][2], dv[SIM_MAX_COLUMNS][2], dp[SIM_MAX_COLUMNS][2],
+		E[SIM_MAX_COLUMNS][2];
 	for (int j = 0; j < K; j++) /* before the first: the held mean's */
-		for (int c = 0; c < 2; c++)
+		for (int c = 0; c < 2; c++) {
 			last[j][c] = yield->F[j][c] * h;
+			dv[j][c] = dp[j][c] = 0.0;
+		}
 	for (int i = 0; i < ns; i++) {
 		for (int j = 0; j < K; j++)
 			for (int c = 0; c < 2; c++)
 				E[j][c] = impulse[j][c] + 0.5 * last[j][c] - yield->F[j][c] * (i + 0.5) * h;
+		double dvn[SIM_MAX_COLUMNS][2];
+		feed_yield_velocity(yield, K, (const double(*)[2])E, dvn);
 		for (int k = 0; k < K; k++) {
 			const double(*pos)[2] = deck_pos + (size_t)k * ns;
 			const double(*vel)[2] = deck_vel + (size_t)k * (ns + 1);
-			/* mirrored columns j and K-1-j summed first, so that a
-			 * mirrored motion stays mirrored to the last bit */
+			const double *dvk = dvn[k];
 			double p[2], v0[2], v1[2];
-			/* the two sums as scalars, each in a register: stored
-			 * one element at a time into an array and read back as
-			 * a pair, they stalled on the store forwarding */
-			double dvx = 0.0, dvy = 0.0;
-			for (int j = 0; j <= (K - 1) / 2; j++) {
-				int jj = K - 1 - j;
-				const double(*Cj)[2] = yield->C[k][j], (*Cjj)[2] = yield->C[k][jj];
-				double sx = Cj[0][0] * E[j][0] + Cj[0][1] * E[j][1];
-				double sy = Cj[1][0] * E[j][0] + Cj[1][1] * E[j][1];
-				if (jj != j) {
-					sx += Cjj[0][0] * E[jj][0] + Cjj[0][1] * E[jj][1];
-					sy += Cjj[1][0] * E[jj][0] + Cjj[1][1] * E[jj][1];
-				}
-				dvx += sx;
-				dvy += sy;
-			}
-			const double dvk[2] = {dvx, dvy};
 			for (int c = 0; c < 2; c++) {
 				p[c] = pos[i][c] + dp[k][c];
 				v0[c] = vel[i][c] + dv[k][c];

@@ -39,16 +39,32 @@ double feed_mean_xi(const model *md, const double *y, int k);
 /* Mean horizontal velocity (m/s) of all elements; 0 without feed. */
 double feed_mean_xi_rate(const model *md, const double *y);
 
-/* How the deck yields to the feed within a machine step (dem's coupling):
- * C[k][j] (2 x 2, 1/kg) is the change of column k's deck velocity per
- * unit impulse of column j on the deck (the machine's inverse mass matrix
- * seen at the deck points, all the physical columns j stands for
- * counted), F[j] (N) the reaction of column j that the machine's step
- * already holds. */
+/* How the deck yields to the feed within a machine step (dem's coupling),
+ * as the machine's inverse mass matrix seen at the deck points, in
+ * factored form: column j's impulse E_j on the deck is the generalized
+ * impulse J_j^T E_j on (x, y, alpha) (J_j = [[1, 0, -Rd_y], [0, 1, Rd_x]],
+ * Rd[j] the deck point's arm from G), and column k's deck velocity moves
+ * by T[k] (2 x 3, 1/kg, all the physical columns an integrated column
+ * stands for counted) times the sum of those. nb = 2 where alpha is fixed
+ * (the third row and column then unused), 3 where the trough turns. F[j]
+ * (N) is the reaction of column j that the machine's step already holds.
+ * With K columns a sub-step costs O(K), where the K x K matrix of the
+ * pairs' compliances T_k J_j^T cost O(K^2). */
 typedef struct feed_yield {
-	double C[SIM_MAX_COLUMNS][SIM_MAX_COLUMNS][2][2];
+	int nb;
+	double T[SIM_MAX_COLUMNS][2][3];
+	double Rd[SIM_MAX_COLUMNS][2];
 	double F[SIM_MAX_COLUMNS][2];
 } feed_yield;
+
+/* The deck points' compliance from the reduced accelerations qr[c] that
+ * unit generalized forces on x, y (and alpha, nb = 3) give the machine
+ * (model_force_response), the deck turned by R. */
+void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL], const deck_rot *R,
+			   feed_yield *yl);
+/* The change of each of the K columns' deck velocities, dv[k], that the
+ * columns' impulses E[j] on the deck give it. */
+void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], double (*dv)[2]);
 
 /* The feed's part of one macro step of the split method "dem": ns
  * sub-steps of length h of every column, each semi-implicit and staggered

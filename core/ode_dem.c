@@ -64,6 +64,8 @@ typedef struct dem {
 	signed char *modes;
 	double (*deck_pos)[2], (*deck_vel)[2]; /* the columns' deck tracks, per sub-step */
 	double (*hermite)[4]; /* the tracks' cubic weights, per sub-step: positions, velocities */
+	double (*cubic)[2][2]; /* the deck's cubics at x = 0 and per metre of x, per sub-step:
+				* positions (substeps), velocities (substeps + 1) */
 	double hermite_H;     /* ... for this step (0: none yet); they depend on it alone */
 	int events;        /* slip reversals located inside the feed's sub-steps */
 	int couple;        /* the deck yields to the feed's impulses within the step */
@@ -81,6 +83,7 @@ static void dem_free(void *p)
 	free(w->modes);
 	free(w->deck_pos);
 	free(w->hermite);
+	free(w->cubic);
 	free(w->yield);
 	free(w);
 }
@@ -103,11 +106,12 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->K = md->dk.K;
 	w->deck_pos = calloc((size_t)K * (2 * (size_t)w->substeps + 1), sizeof *w->deck_pos);
 	w->hermite = calloc(2 * ((size_t)w->substeps + 1), sizeof *w->hermite);
+	w->cubic = calloc(2 * (size_t)w->substeps + 1, sizeof *w->cubic);
 	w->events = cfg->feed_events && md->nf > 0;
 	w->couple = w->correct && w->events;
 	if (w->couple)
 		w->yield = calloc(1, sizeof *w->yield);
-	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || (w->couple && !w->yield)) {
+	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || !w->cubic || (w->couple && !w->yield)) {
 		dem_free(w);
 		return NULL;
 	}
@@ -175,43 +179,6 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 	}
 }
 
-/* The deck points' compliance (feed_yield.C) from the reduced
- * accelerations qr[c] that unit generalized forces on x, y (and alpha,
- * nb = 3) give the machine: C[k][j] = w J_k B J_j^T, with B the trough's
- * (x, y, alpha) part, J_k the deck point's Jacobian on (x, y, alpha) and
- * w the physical columns one integrated column stands for. Mirrored
- * states give mirrored C to the last bit (each entry's terms change sign
- * together). */
-static void deck_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
-			    const deck_rot *R, feed_yield *yl)
-{
-	double B[3][3] = {{0}};
-	for (int c = 0; c < nb; c++) {
-		double qdd[NQ_FULL] = {0};
-		model_add_reduced(md, qr[c], qdd);
-		for (int i = 0; i < 3; i++)
-			B[i][c] = qdd[i];
-	}
-	/* T_k = w J_k B, then C[k][j] = T_k J_j^T; J_k = [[1, 0, -Rd_y],
-	 * [0, 1, Rd_x]] with Rd_k the deck point's arm from G */
-	const deck *dk = &md->dk;
-	double Rd[SIM_MAX_COLUMNS][2], T[SIM_MAX_COLUMNS][2][3];
-	for (int k = 0; k < dk->K; k++) {
-		double b[2] = {dk->d[k], dk->h_d};
-		deck_rotate(R, b, Rd[k]);
-		for (int q = 0; q < 3; q++) {
-			T[k][0][q] = md->col_weight * (B[0][q] - Rd[k][1] * B[2][q]);
-			T[k][1][q] = md->col_weight * (B[1][q] + Rd[k][0] * B[2][q]);
-		}
-	}
-	for (int k = 0; k < dk->K; k++)
-		for (int j = 0; j < dk->K; j++)
-			for (int a = 0; a < 2; a++) {
-				yl->C[k][j][a][0] = T[k][a][0] - T[k][a][2] * Rd[j][1];
-				yl->C[k][j][a][1] = T[k][a][1] + T[k][a][2] * Rd[j][0];
-			}
-}
-
 /* 3. The corrector: the machine's step as if taken with the feed's
  * reaction of this very step. The reaction's change dQ enters the
  * machine's accelerations linearly, through M^-1 at the step's middle, so
@@ -241,7 +208,7 @@ static void correct(dem *w, const model *md, double H, double *y, const double Q
 		y[md->npos + r] += H * a[0][r];
 	}
 	if (nb > 0)
-		deck_compliance(md, nb, (const double(*)[NQ_FULL])(a + 1), R1, w->yield);
+		feed_yield_compliance(md, nb, (const double(*)[NQ_FULL])(a + 1), R1, w->yield);
 }
 
 static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
@@ -297,23 +264,39 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 		}
 		w->hermite_H = H;
 	}
+	/* a deck point's data are affine in its body x (deck_point_affine),
+	 * and so is their cubic: that of the point at x = 0 and that of the
+	 * rate per metre of x give every column's, two cubics for any number
+	 * of columns; where the deck does not turn the rate is (1, 0) in
+	 * position and 0 in velocity throughout, and one cubic does */
+	double e0[3][2][2], e1[3][2][2];
+	deck_point_affine(dk, &R0, ev0.q, ev0.qd, ev0.qdd, e0);
+	deck_point_affine(dk, &R1, ev1.q, ev1.qd, ev1.qdd, e1);
+	const int turns = !md->alpha_fixed;
+	double(*cp)[2][2] = w->cubic, (*cv)[2][2] = w->cubic + ns;
+	for (int b = 0; b <= turns; b++)
+		for (int i = 0; i <= ns; i++)
+			for (int c = 0; c < 2; c++) {
+				if (i < ns)
+					cp[i][b][c] = hermite_sum(wp[i], e0[0][b][c], e0[1][b][c],
+								  e1[0][b][c], e1[1][b][c]);
+				cv[i][b][c] = hermite_sum(wv[i], e0[1][b][c], e0[2][b][c],
+							  e1[1][b][c], e1[2][b][c]);
+			}
 	for (int k = 0; k < dk->K; k++) {
-		double p0[2], v0[2], p1[2], v1[2], a0[2], a1[2];
-		deck_point(dk, dk->d[k], &R0, ev0.q, ev0.qd, p0, v0);
-		deck_point(dk, dk->d[k], &R1, ev1.q, ev1.qd, p1, v1);
-		deck_accel(dk, k, &R0, ev0.qd, ev0.qdd, a0);
-		deck_accel(dk, k, &R1, ev1.qd, ev1.qdd, a1);
+		const double d = dk->d[k];
 		/* positions at the sub-steps' starts; velocities at their
 		 * middles, vel[i + 1] for sub-step i and vel[0] for the one
 		 * before the first (the cubic, half a sub-step outside) */
 		double(*pos)[2] = w->deck_pos + (size_t)k * ns;
 		double(*vel)[2] = w->deck_vel + (size_t)k * (ns + 1);
 		for (int i = 0; i <= ns; i++) {
-			for (int c = 0; c < 2; c++) {
-				if (i < ns)
-					pos[i][c] = hermite_sum(wp[i], p0[c], v0[c], p1[c], v1[c]);
-				vel[i][c] = hermite_sum(wv[i], v0[c], a0[c], v1[c], a1[c]);
+			if (i < ns) {
+				pos[i][0] = cp[i][0][0] + d * (turns ? cp[i][1][0] : 1.0);
+				pos[i][1] = cp[i][0][1] + (turns ? d * cp[i][1][1] : 0.0);
 			}
+			vel[i][0] = cv[i][0][0] + (turns ? d * cv[i][1][0] : 0.0);
+			vel[i][1] = cv[i][0][1] + (turns ? d * cv[i][1][1] : 0.0);
 		}
 	}
 	feed_dem_step(md, y, ns, h, (const double(*)[2])w->deck_pos,
@@ -354,8 +337,8 @@ static void dem_reset(void *p)
 static size_t yield_size(const dem *w)
 {
 	size_t K = (size_t)w->K;
-	return w->couple ? sizeof w->have_yield + K * sizeof w->yield->C[0][0] * K +
-				   K * sizeof w->yield->F[0]
+	return w->couple ? sizeof w->have_yield + sizeof w->yield->nb + K * sizeof w->yield->T[0] +
+				   K * sizeof w->yield->Rd[0] + K * sizeof w->yield->F[0]
 			 : 0;
 }
 
@@ -387,8 +370,9 @@ static void carry_state(dem *w, char *buf, int save)
 	if (!w->couple)
 		return;
 	carry(&b, &w->have_yield, sizeof w->have_yield, save);
-	for (int k = 0; k < w->K; k++)
-		carry(&b, w->yield->C[k], (size_t)w->K * sizeof w->yield->C[k][0], save);
+	carry(&b, &w->yield->nb, sizeof w->yield->nb, save);
+	carry(&b, w->yield->T, (size_t)w->K * sizeof w->yield->T[0], save);
+	carry(&b, w->yield->Rd, (size_t)w->K * sizeof w->yield->Rd[0], save);
 	carry(&b, w->yield->F, (size_t)w->K * sizeof w->yield->F[0], save);
 }
 

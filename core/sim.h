@@ -242,7 +242,7 @@ const char *sim_last_error(const sim *s);
 
 /* Version of the checkpoint format (checkpoint.c); a checkpoint of
  * another version is refused. */
-#define SIM_CHECKPOINT_VERSION 1
+#define SIM_CHECKPOINT_VERSION 2
 
 /* FNV-1a 64 of len bytes: the checkpoints' checksum, for callers that
  * frame their own files the same way. */

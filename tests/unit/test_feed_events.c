@@ -4,7 +4,8 @@
  * exact where the forces are constant (a block on a deck accelerating
  * faster than friction can follow), the feed step's order in v is two with
  * events and one without, and the yielding deck removes the machine
- * step's error in v (at 20 deg cw, against a machine step 8 x finer).
+ * step's error in v (at 20 deg cw, against a machine step 8 x finer); its
+ * compliance is the machine's response at the deck points.
  */
 #include "feed.h"
 #include "testutil.h"
@@ -160,12 +161,86 @@ static void yielding_deck_removes_the_machine_steps_error(void **state)
 	assert_rel(v, fine, 3e-3);
 }
 
+/* The yielding deck's compliance in its factored form (feed_yield: the
+ * columns' impulses summed as one generalized impulse on x, y, alpha, then
+ * seen at each deck point) against the machine's own response: a unit
+ * impulse of column j along x or y, as the generalized force deck_forces
+ * gives it, through model_force_response's reduced accelerations, seen at
+ * every column k's deck point (its Jacobian on x, y, alpha, times the
+ * columns it stands for). On the full model (5 columns, the deck turned
+ * and turning, alpha = 0.02) and on the defaults (one column standing for
+ * five, alpha fixed), at random machine states. */
+static void yield_is_the_machines_response_at_the_deck_points(void **state)
+{
+	(void)state;
+	for (int full = 0; full < 2; full++) {
+		setup u = preset_defaults();
+		if (full)
+			set(&u, "trough_rotation", "true");
+		model md;
+		model_ctl ctl;
+		model_init(&md, &ctl, &u.p, &u.sc);
+		const int K = md.dk.K, nb = md.alpha_fixed ? 2 : 3;
+		assert_int_equal(K, full ? 5 : 1);
+		assert_true(md.col_weight == (full ? 1.0 : 5.0));
+		double *y = calloc((size_t)md.n, sizeof *y);
+		assert_non_null(y);
+		srand(11);
+		for (int trial = 0; trial < 20; trial++) {
+			for (int r = 0; r < md.nq; r++) {
+				y[r] = 2e-3 * (2.0 * rand() / RAND_MAX - 1.0);
+				y[md.npos + r] = 0.3 * (2.0 * rand() / RAND_MAX - 1.0);
+			}
+			double q[NQ_FULL], qd[NQ_FULL];
+			if (full) {
+				model_full_coords(&md, &ctl, 0.0, y, q, qd);
+				for (int r = 0; r < md.nq; r++) /* alpha's own entry */
+					if (md.ncol[r] == 1 && md.col[r][0] == Q_ALPHA)
+						y[r] = 0.02;
+			}
+			model_full_coords(&md, &ctl, 0.0, y, q, qd);
+			deck_rot R = deck_rotation(q);
+			assert_true(full ? R.s != 0.0 : R.s == 0.0);
+			double unit[3][NQ_FULL] = {{0}}, qr[3][NQ_FULL];
+			for (int c = 0; c < nb; c++) {
+				unit[c][c] = 1.0; /* Q_X, Q_Y, Q_ALPHA */
+				model_force_response(&md, &ctl, 0.0, y, unit[c], qr[c]);
+			}
+			feed_yield yl;
+			feed_yield_compliance(&md, nb, (const double(*)[NQ_FULL])qr, &R, &yl);
+			for (int j = 0; j < K; j++)
+				for (int c = 0; c < 2; c++) {
+					double E[SIM_MAX_COLUMNS][2] = {{0}}, dv[SIM_MAX_COLUMNS][2];
+					E[j][c] = 1.0;
+					feed_yield_velocity(&yl, K, (const double(*)[2])E, dv);
+					double Q[NQ_FULL] = {0}, qrdd[NQ_FULL], a[NQ_FULL] = {0};
+					deck_forces(&md.dk, &R, (const double(*)[2])E, 1.0, Q);
+					model_force_response(&md, &ctl, 0.0, y, Q, qrdd);
+					model_add_reduced(&md, qrdd, a);
+					for (int k = 0; k < K; k++) {
+						double b[2] = {md.dk.d[k], md.dk.h_d}, Rd[2];
+						deck_rotate(&R, b, Rd);
+						double want[2] = {
+							md.col_weight * (a[Q_X] - Rd[1] * a[Q_ALPHA]),
+							md.col_weight * (a[Q_Y] + Rd[0] * a[Q_ALPHA])};
+						double size = fabs(want[0]) + fabs(want[1]);
+						assert_true(size > 1e-4); /* 1/kg: a machine of ~1e2 kg */
+						for (int e = 0; e < 2; e++)
+							assert_true(fabs(dv[k][e] - want[e]) <= 1e-12 * size);
+					}
+				}
+		}
+		free(y);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(reversal_inside_a_substep_is_exact),
 		cmocka_unit_test(feed_step_order_two_with_events),
 		cmocka_unit_test(yielding_deck_removes_the_machine_steps_error),
+		cmocka_unit_test(yield_is_the_machines_response_at_the_deck_points),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
