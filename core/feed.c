@@ -251,11 +251,16 @@ static inline void chain_clusters(int L, double m, const double *restrict vs, do
 	}
 }
 
-static void chain_solve(int L, double m, const double *restrict vs, double v0,
-			const double *restrict lo, const double *restrict hi, double *restrict P,
-			double *restrict v, signed char *restrict mode)
+/* chain_clusters with the modes switched until consistent. With entry
+ * (else NULL): returns 1 if a contact that was not bonded on entry ended
+ * in another mode (a slipping contact stopped or reversed), entry[] then
+ * holding the modes on entry; 0 otherwise (entry[] then unset: the modes
+ * are copied only at the first switch, which most solves never make). */
+static int chain_solve(int L, double m, const double *restrict vs, double v0,
+		       const double *restrict lo, const double *restrict hi, double *restrict P,
+		       double *restrict v, signed char *restrict mode, signed char *restrict entry)
 {
-	int changed = 0;
+	int changed = 0, switched = 0;
 	for (int iter = 0; iter < 4 * L + 8; iter++) {
 		chain_clusters(L, m, vs, v0, lo, hi, P, v, mode);
 		/* consistency; after L rounds switch one contact at a time */
@@ -277,6 +282,9 @@ static void chain_solve(int L, double m, const double *restrict vs, double v0,
 				nm = BOND;
 			}
 			if (nm != mode[j]) {
+				if (!switched && entry)
+					memcpy(entry, mode, (size_t)L);
+				switched = 1;
 				mode[j] = nm;
 				changed = 1;
 			}
@@ -290,6 +298,11 @@ static void chain_solve(int L, double m, const double *restrict vs, double v0,
 		for (int j = 0; j < L; j++)
 			if (mode[j] != BOND)
 				P[j] = mode[j] == HI ? hi[j] : lo[j];
+	int stopped = 0;
+	if (switched && entry)
+		for (int j = 0; j < L; j++)
+			stopped |= entry[j] != BOND && mode[j] != entry[j];
+	return stopped;
 }
 
 /* Friction of one sub-step with its slip reversals located (the split
@@ -316,11 +329,7 @@ static void friction_events(int L, double m, const double *vs, double dv0, doubl
 	double va[SIM_MAX_LAYERS], Pacc[SIM_MAX_LAYERS], los[SIM_MAX_LAYERS], his[SIM_MAX_LAYERS],
 		Po[SIM_MAX_LAYERS], vo[SIM_MAX_LAYERS];
 	double rest = 1.0, d0 = dv0;
-	memcpy(old, mode, (size_t)L);
-	chain_solve(L, m, vs, dv1, lo, hi, P, v, mode);
-	int stopped = 0;
-	for (int j = 0; j < L; j++)
-		stopped |= old[j] != BOND && mode[j] != old[j];
+	int stopped = chain_solve(L, m, vs, dv1, lo, hi, P, v, mode, old);
 	if (!stopped)
 		return; /* no slipping contact stopped: nothing to locate */
 	for (int j = 0; j < L; j++) {
@@ -330,13 +339,8 @@ static void friction_events(int L, double m, const double *vs, double dv0, doubl
 		his[j] = hi[j];
 	}
 	for (int ev = 0;; ev++) {
-		if (ev > 0) {
-			memcpy(old, mode, (size_t)L);
-			chain_solve(L, m, va, dv1, los, his, P, v, mode);
-			stopped = 0;
-			for (int j = 0; j < L; j++)
-				stopped |= old[j] != BOND && mode[j] != old[j];
-		}
+		if (ev > 0)
+			stopped = chain_solve(L, m, va, dv1, los, his, P, v, mode, old);
 		if (!stopped || ev == FRICTION_MAX_EVENTS)
 			break;
 		/* the rest of the sub-step under the old modes: the first
@@ -411,7 +415,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 		vs[j] = etad[j] - g * h;
 		prev_eta = eta[j];
 	}
-	chain_solve(L, m, vs, dv1[1], lo, hi, Pn, vn, mn);
+	chain_solve(L, m, vs, dv1[1], lo, hi, Pn, vn, mn, NULL);
 	/* friction impulses within [-mu, mu] times the normal ones */
 	for (int j = 0; j < L; j++) {
 		hi[j] = mu * Pn[j];
@@ -421,7 +425,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 		if (events)
 			friction_events(L, m, xid, dv0[0], dv1[0], lo, hi, Pt, vt, mt);
 		else
-			chain_solve(L, m, xid, dv1[0], lo, hi, Pt, vt, mt);
+			chain_solve(L, m, xid, dv1[0], lo, hi, Pt, vt, mt, NULL);
 	} else {
 		/* regularised: explicit in the velocities at the start */
 		for (int j = 0; j < L; j++) {
