@@ -218,7 +218,8 @@ sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, 
 		  (s->failed != SIM_OK && s->failed != SIM_EDIVERGED && s->failed != SIM_ESTEP) ||
 		  s->est.n_rec < 0 || (!s->est.pending && s->est.n_rec < 1) ||
 		  s->est.n_rec > EST_RECORDS || s->ctl.beta_ramp.n < 0 || s->ctl.beta_ramp.n > 4 ||
-		  s->ctl.psi_ramp.n < 0 || s->ctl.psi_ramp.n > 4 || s->est.stride < 1 ||
+		  s->ctl.psi_ramp.n < 0 || s->ctl.psi_ramp.n > 4 ||
+		  (!s->est.pending && s->est.stride < 1) || /* set at its first boundary */
 		  (s->failed != SIM_OK && !s->error[0]); /* a failure says why */
 	for (int i = 0; !bad && i < s->md.n; i++)
 		bad = !isfinite(s->y[i]);

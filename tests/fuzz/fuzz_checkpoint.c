@@ -144,6 +144,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (!s) {
 		FUZZ_CHECK(err == SIM_ECHECKPOINT && strncmp(msg, "checkpoint refused: ", 20) == 0,
 			   "refused with code %d: %s", err, msg);
+		fuzz_refused("sim_restore", msg);
 		return 0;
 	}
 	FUZZ_CHECK(err == SIM_OK, "restored with code %d", err);

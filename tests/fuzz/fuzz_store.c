@@ -41,6 +41,7 @@ static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, si
 	char *payload = srv_store_unframe(buf, n, kind, plen, &bad);
 	if (!payload) {
 		FUZZ_CHECK(bad && bad[0], "a frame refused without a reason");
+		fuzz_refused("srv_store_unframe", bad);
 		free(copy);
 		return NULL;
 	}
@@ -60,6 +61,7 @@ static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 	char why[256] = "";
 	if (srv_ckpt_decode(p, len, &r, why, sizeof why) != 0) {
 		FUZZ_CHECK(why[0], "a checkpoint head refused without a reason");
+		fuzz_refused("srv_ckpt_decode", why);
 		return;
 	}
 	FUZZ_CHECK(r.state >= SRV_RUNNING && r.state <= SRV_FAILED &&
@@ -77,6 +79,7 @@ static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 			     sizeof msg);
 	if (!s) {
 		FUZZ_CHECK(err == SIM_ECHECKPOINT && msg[0], "sim_restore gave %d: %s", err, msg);
+		fuzz_refused("sim_restore", msg);
 		return;
 	}
 	sim_status st;
@@ -95,8 +98,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		return 0;
 	uint32_t spec_len = (uint32_t)data[1] | (uint32_t)data[2] << 8 |
 			    (uint32_t)data[3] << 16 | (uint32_t)data[4] << 24;
-	if (spec_len > size - 5)
+	if (spec_len > size - 5) {
+		fuzz_refused("store seed", "spec length beyond the input");
 		return 0;
+	}
 	size_t plen;
 	char *payload = unframe(data + 5, spec_len, SRV_STORE_SESSION, data[0] & 1, &plen);
 	if (!payload)
@@ -109,6 +114,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	free(payload);
 	if (rc != 0) {
 		FUZZ_CHECK(why[0], "a spec refused without a reason");
+		fuzz_refused("srv_spec_decode", why);
 		return 0;
 	}
 	char *text = fuzz_print(fuzz_spec_body(&spec, 1));

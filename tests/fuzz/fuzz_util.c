@@ -21,6 +21,14 @@ void fuzz_fail(const char *fmt, ...)
 	abort();
 }
 
+void fuzz_refused(const char *what, const char *why)
+{
+	if (getenv("FUZZ_MUST_ACCEPT"))
+		fuzz_fail("a committed seed is refused (%s: %s): the seeds are stale, make them "
+			  "again (README \"Fuzzing\")",
+			  what, why);
+}
+
 char *fuzz_exact(const uint8_t *data, size_t size)
 {
 	char *b = malloc(size ? size : 1);

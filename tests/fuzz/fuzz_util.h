@@ -22,6 +22,12 @@ void fuzz_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2), noretu
 			fuzz_fail(__VA_ARGS__); \
 	} while (0)
 
+/* A reader refused the input (what: which, why: its reason). Under
+ * FUZZ_MUST_ACCEPT (tests/fuzz/run.sh, on the committed real seeds before
+ * fuzzing) that fails the oracle: the seeds no longer match the formats
+ * and must be made again (README "Fuzzing"); otherwise nothing. */
+void fuzz_refused(const char *what, const char *why);
+
 /* The input as an exact-size heap buffer with no terminating NUL, so that
  * ASan sees any read past the length (caller frees). */
 char *fuzz_exact(const uint8_t *data, size_t size);

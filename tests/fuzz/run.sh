@@ -35,6 +35,20 @@ for n in $NAMES; do
 	esac
 	log=$B/logs/$n.log
 	mkdir -p "$B/corpus/$n"
+	# the readers' committed real seeds (all but the regression inputs)
+	# must still be accepted: seeds of a format since changed are refused
+	# at its first check and fuzz nothing behind it
+	case $n in
+	checkpoint | store)
+		seeds=$(ls "tests/fuzz/corpus/$n"/* | grep -v '/regress-')
+		# shellcheck disable=SC2086
+		if ! FUZZ_MUST_ACCEPT=1 "$bin" $seeds >"$B/logs/$n.seeds.log" 2>&1; then
+			echo "  $n: a committed seed is refused; the end of $B/logs/$n.seeds.log:"
+			grep 'fuzz oracle' "$B/logs/$n.seeds.log" | tail -3 | sed 's/^/  /'
+			crashed=1
+		fi
+		;;
+	esac
 	/usr/bin/time -f '%U %S' -o "$B/logs/$n.time" \
 		nice -n 10 "$bin" ${R:+-runs=$R -seed=1} -max_total_time="$S" -timeout="$T" -rss_limit_mb=2048 \
 		-print_final_stats=1 -artifact_prefix="$B/crashes/$n-" ${dict:+-dict=$dict} \

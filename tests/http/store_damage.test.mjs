@@ -1,8 +1,11 @@
 // Files of the data directory with a right checksum and wrong contents
 // (what a fuzz harness, tests/fuzz/fuzz_store.c, feeds the restore): a
 // checkpoint whose experiment length wraps the length check, a spec whose
-// preset name is not terminated. The restart lists both sessions as
-// damaged with the reason, reads nothing past a buffer (make check runs
+// preset name is not terminated, and specs holding what no request can set
+// (a method named rk2, an atol out of its range on a method that does not
+// read it, pace "max" without until: the fuzz harness's regression inputs,
+// as real files). The restart lists every such session as damaged with the
+// reason, reads nothing past a buffer (make check runs
 // this under ASan) and stops cleanly. The offsets are this build's record
 // layouts (server/session_store.c, host order, x86-64).
 import { test } from 'node:test';
@@ -15,6 +18,9 @@ import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
 const FRAME = 32;          // store.c's frame header; the checksum at 24
 const CKPT_RECORD = 320;   // srv_ckpt_record; exp_len at 304, sim_len at 312
 const SPEC_PRESET = 24;    // spec_record: id[24], then api_spec's preset[32]
+const SPEC_METHOD = 472;   // api_spec's method.name[24] (api_spec at 24)
+const SPEC_ATOL = 512;     // method.atol
+const SPEC_PACE = 528;     // pace (0: "max"), then until at 536
 
 // sim_checksum of the payload into the frame's checksum field: FNV-1a 64
 // with core/checkpoint.c's starting value.
@@ -28,13 +34,13 @@ function reframe(buf) {
   return buf;
 }
 
-test('a checksummed checkpoint with wrapping lengths and a spec with an unterminated preset are listed damaged', { timeout: 60000 * SLOW }, async () => {
+test('a checksummed checkpoint with wrapping lengths and specs no request could make are listed damaged', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-damage-'));
   const args = ['--data-dir', dir];
   let d = await startDaemon(args);
   try {
     const ids = [];
-    for (let i = 0; i < 2; i++)
+    for (let i = 0; i < 5; i++)
       ids.push((await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body.id);
     for (const id of ids)
       await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished', 20000 * SLOW, id);
@@ -52,6 +58,17 @@ test('a checksummed checkpoint with wrapping lengths and a spec with an untermin
     assert.equal(spec.toString('latin1', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 10), 'czubak2016', 'the layout this test assumes');
     spec.fill('x', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 32);
     writeFileSync(join(dir, 'sessions', ids[1], 'spec.bin'), reframe(spec));
+    const edit = (id, f) => {
+      const path = join(dir, 'sessions', id, 'spec.bin');
+      const b = readFileSync(path);
+      assert.equal(b.toString('latin1', FRAME + SPEC_METHOD, FRAME + SPEC_METHOD + 4), 'dem\0', 'the layout this test assumes');
+      assert.equal(b.readDoubleLE(FRAME + SPEC_PACE + 8), 0.2, 'the layout this test assumes');
+      f(b);
+      writeFileSync(path, reframe(b));
+    };
+    edit(ids[2], (b) => b.write('rk2\0', FRAME + SPEC_METHOD, 'latin1'));
+    edit(ids[3], (b) => b.writeDoubleLE(3e-48, FRAME + SPEC_ATOL));
+    edit(ids[4], (b) => { b.writeDoubleLE(0, FRAME + SPEC_PACE); b.writeDoubleLE(0, FRAME + SPEC_PACE + 8); });
     d = await startDaemon(args);
     const a = (await req(d.base, 'GET', `/api/v1/sessions/${ids[0]}`)).body;
     assert.equal(a.state, 'damaged');
@@ -59,6 +76,15 @@ test('a checksummed checkpoint with wrapping lengths and a spec with an untermin
     const b = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
     assert.equal(b.state, 'damaged');
     assert.match(b.error, /spec\.bin: the preset or method name is not a string/);
+    const why = [];
+    for (const id of ids.slice(2)) {
+      const v = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+      assert.equal(v.state, 'damaged', JSON.stringify(v));
+      why.push(v.error);
+    }
+    assert.match(why[0], /spec\.bin: method must be one of rk4\|dopri5\|euler\|dem$/);
+    assert.match(why[1], /spec\.bin: atol must be a finite number in \[1e-15, 1\]$/);
+    assert.match(why[2], /spec\.bin: pace "max" without until/);
     assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200);
     assert.equal((await d.stop()).code, 0, `clean stop; stderr: ${d.stderr()}`);
   } finally {

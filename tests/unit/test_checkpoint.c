@@ -131,6 +131,31 @@ static void dopri5_continues(void **state)
 	continues_bit_for_bit(&u, 0.3137, 0.45);
 }
 
+/* A checkpoint taken before the estimate's first period boundary (a
+ * session stopped or checkpointed within its first rotor period; the
+ * estimator has no batch stride yet) restores and continues bit for bit:
+ * the restore once refused it as "values out of range", which a daemon
+ * restart would have listed as a damaged session. */
+static void checkpoint_before_the_first_period(void **state)
+{
+	(void)state;
+	setup u = small("dem");
+	sim *a = make(&u);
+	advance(a, 0.01);
+	assert_int_equal(sim_set_beta(a, 80.0 * RAD_PER_DEG, 0.0), SIM_OK);
+	advance(a, 0.02);
+	size_t len;
+	void *buf = checkpoint_of(a, &len);
+	sim *b = restore(&u, buf, len);
+	assert_same(a, b);
+	advance(a, 0.4);
+	advance(b, 0.4);
+	assert_same(a, b);
+	free(buf);
+	sim_free(a);
+	sim_free(b);
+}
+
 /* A restore does not settle again: it takes no time at all beyond the
  * allocation, and the restored t is the checkpoint's. */
 static void restore_does_not_settle(void **state)
@@ -273,6 +298,7 @@ int main(void)
 		cmocka_unit_test(euler_continues),
 		cmocka_unit_test(dopri5_continues),
 		cmocka_unit_test(restore_does_not_settle),
+		cmocka_unit_test(checkpoint_before_the_first_period),
 		cmocka_unit_test(damage_is_refused),
 		cmocka_unit_test(phase_jump_restarts),
 		cmocka_unit_test(failure_code_checked),
