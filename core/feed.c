@@ -453,7 +453,7 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	imp[1] -= Pn[0];
 }
 
-/* feed.h. T_k = w J_k B, with B the trough's (x, y, alpha) part, J_k the
+/* (feed.h) T_k = w J_k B, with B the trough's (x, y, alpha) part, J_k the
  * deck point's Jacobian on (x, y, alpha) and w the physical columns one
  * integrated column stands for. Mirrored states give mirrored T to the
  * last bit (each entry's terms change sign together). */
