@@ -41,16 +41,16 @@ TIMEFORMAT=%U
 for i in 1 2 3 4; do
 	{ time "$BUILD/convsim" sweep --beta 0:180:5 --rotation cw,ccw --threads 1 -q > /dev/null; } 2>> "$tmp/curve"
 done
-stat() { # column, file: "best median" (best = largest for column 1, least for 2)
+pick() { # column, file: "best median" (best = largest for column 1, least for 2)
 	sort -g -k"$1","$1" "$2" | awk -v c="$1" '{ v[NR] = $c } END {
 		m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
 		printf "%s %s", (c == 1 ? v[NR] : v[1]), m }'
 }
 row() { # scene, target
 	local b20 m20 c20 c60 w start
-	read -r b20 m20 <<<"$(stat 1 "$tmp/${1}20")"
-	read -r c20 _ <<<"$(stat 2 "$tmp/${1}20")"
-	read -r c60 _ <<<"$(stat 2 "$tmp/${1}60")"
+	read -r b20 m20 <<<"$(pick 1 "$tmp/${1}20")"
+	read -r c20 _ <<<"$(pick 2 "$tmp/${1}20")"
+	read -r c60 _ <<<"$(pick 2 "$tmp/${1}60")"
 	awk -v s="$1" -v t="$2" -v b="$b20" -v m="$m20" -v c20="$c20" -v c60="$c60" 'BEGIN {
 		w = (c60 - c20) / 40; st = c20 - 20 * w
 		if (b >= t) v = "met by the 20-s run"
@@ -60,8 +60,8 @@ row() { # scene, target
 			s, t, b, m, 1 / w, 1e3 * w, 1e3 * st, v
 	}'
 }
-read -r mb mm <<<"$(stat 1 "$tmp/machine20")"
-read -r cl cm <<<"$(stat 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
+read -r mb mm <<<"$(pick 1 "$tmp/machine20")"
+read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 {
 	echo "# Speed targets"
 	echo
