@@ -5,6 +5,7 @@
  * with the full model, and the energy balance (the hopping theory of VDI
  * 2333 runs through the engine in test_accuracy.c).
  */
+#include "sim_int.h" /* the state at t = 0, column by column */
 #include "testutil.h"
 
 /* One element dropped on a fixed deck (no gravity, so that the contact
@@ -153,6 +154,54 @@ static void reduction_agrees_with_full_model(void **state)
 	sim_free(b);
 }
 
+/* The steady start of the full model on a symmetric machine settles
+ * through the symmetric reduction (sim.c, settle_reduced): at t = 0 its
+ * machine is the reduced scene's to the last bit with alpha exactly 0, and
+ * every column is the reduced scene's one column at its own deck point
+ * (the same bits, the horizontal position moved by d_k). An asymmetric
+ * machine (l2 != l1) settles its full model as before: it rocks at t = 0. */
+static void full_model_settles_through_the_reduction(void **state)
+{
+	(void)state;
+	setup full = preset_defaults(), red = preset_defaults();
+	set(&full, "trough_rotation", "true");
+	sim *a = make(&full), *b = make(&red);
+	sim_status x = status(a), y = status(b);
+	assert_int_equal(x.reductions, 0);
+	assert_int_equal(y.reductions, SIM_RED_SYMMETRIC);
+	assert_true(x.t == 0.0 && y.t == 0.0);
+	const int idx[5] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2};
+	for (int i = 0; i < 5; i++) {
+		assert_true(x.q[idx[i]] == y.q[idx[i]]);
+		assert_true(x.qd[idx[i]] == y.qd[idx[i]]);
+	}
+	assert_true(x.q[Q_ALPHA] == 0.0 && x.qd[Q_ALPHA] == 0.0);
+	assert_true(y.q[Q_S1] != 0.0);
+	const model *ma = &a->md, *mb = &b->md;
+	assert_int_equal(ma->dk.K, 5);
+	assert_int_equal(mb->dk.K, 1);
+	for (int k = 0; k < ma->dk.K; k++)
+		for (int j = 0; j < ma->L; j++) {
+			int e = k * ma->L + j;
+			assert_true(a->y[ma->nq + e] == b->y[mb->nq + j] + ma->dk.d[k]);
+			assert_true(a->y[ma->nq + ma->nf + e] == b->y[mb->nq + mb->nf + j]);
+			assert_true(a->y[ma->npos + ma->nq + e] == b->y[mb->npos + mb->nq + j]);
+			assert_true(a->y[ma->npos + ma->nq + ma->nf + e] ==
+				    b->y[mb->npos + mb->nq + mb->nf + j]);
+		}
+	/* it then runs as the full model: the columns part by round-off */
+	advance(a, 0.5);
+	assert_true(status(a).t == 0.5);
+	sim_free(a);
+	sim_free(b);
+	setup asym = preset_defaults();
+	set(&asym, "trough_rotation", "true");
+	set(&asym, "l2", "0.9");
+	sim *c = make(&asym);
+	assert_true(fabs(status(c).q[Q_ALPHA]) > 1e-6);
+	sim_free(c);
+}
+
 /* Energy: input = stored change + dissipated, to the method's accuracy;
  * the split method's residual shrinks with its sub-step. */
 static void energy_balance_with_feed(void **state)
@@ -185,6 +234,7 @@ int main(void)
 		cmocka_unit_test(beta_sets_and_reverses_direction),
 		cmocka_unit_test(mirror_symmetry_with_feed),
 		cmocka_unit_test(reduction_agrees_with_full_model),
+		cmocka_unit_test(full_model_settles_through_the_reduction),
 		cmocka_unit_test(energy_balance_with_feed),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
