@@ -481,7 +481,9 @@ void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
 	}
 }
 
-void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], double (*dv)[2])
+/* feed_yield_velocity's body, inlined into the sub-step loop */
+static inline void yield_velocity(const feed_yield *yl, int K, const double (*E)[2],
+				  double (*dv)[2])
 {
 	const int turns = yl->nb > 2;
 	/* mirrored columns j and K-1-j summed first, so that a mirrored
@@ -513,6 +515,11 @@ void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], doub
 			dv[k][1] += T[1][2] * Ga;
 		}
 	}
+}
+
+void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], double (*dv)[2])
+{
+	yield_velocity(yl, K, E, dv);
 }
 
 void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
@@ -553,7 +560,7 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 			for (int c = 0; c < 2; c++)
 				E[j][c] = impulse[j][c] + 0.5 * last[j][c] - yield->F[j][c] * (i + 0.5) * h;
 		double dvn[SIM_MAX_COLUMNS][2];
-		feed_yield_velocity(yield, K, (const double(*)[2])E, dvn);
+		yield_velocity(yield, K, (const double(*)[2])E, dvn);
 		for (int k = 0; k < K; k++) {
 			const double(*pos)[2] = deck_pos + (size_t)k * ns;
 			const double(*vel)[2] = deck_vel + (size_t)k * (ns + 1);
