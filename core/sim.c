@@ -252,11 +252,9 @@ static int settle_reduced(sim *s)
 		sim_free(r);
 		return -1;
 	}
-	dynamics_equilibrium(&r->md, &r->ctl, r->y);
-	dynamics_steady_start(&r->md, &r->ctl, r->y);
-	int e = settle(r);
+	/* the reduced scene's own start (it settles itself: alpha fixed) */
+	int e = sim_start(r, s->error, sizeof s->error);
 	if (e != SIM_OK) {
-		snprintf(s->error, sizeof s->error, "%s", r->error);
 		sim_free(r);
 		return e;
 	}
