@@ -23,37 +23,30 @@ void deck_point(const deck *dk, double x, const deck_rot *R, const double q[NQ_F
 	vel[1] = qd[Q_Y] + qd[Q_ALPHA] * Rd[0];
 }
 
-void deck_accel(const deck *dk, int k, const deck_rot *R, const double qd[NQ_FULL],
-		const double qdd[NQ_FULL], double acc[2])
+/* Position, velocity and acceleration (out[0..2][b]) of the point at arm r
+ * (world frame) from G's p, v, a and alpha's rates ad, add. */
+static void arm_kinematics(const double p[2], const double v[2], const double a[2], double ad,
+			   double add, const double r[2], double out[3][2][2], int b)
 {
-	double Rd[2];
-	deck_arm(dk, dk->d[k], R, Rd);
-	double ad = qd[Q_ALPHA], add = qdd[Q_ALPHA];
-	acc[0] = qdd[Q_X] - add * Rd[1] - ad * ad * Rd[0];
-	acc[1] = qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
+	out[0][b][0] = p[0] + r[0];
+	out[0][b][1] = p[1] + r[1];
+	out[1][b][0] = v[0] - ad * r[1];
+	out[1][b][1] = v[1] + ad * r[0];
+	out[2][b][0] = a[0] - add * r[1] - ad * ad * r[0];
+	out[2][b][1] = a[1] + add * r[0] - ad * ad * r[1];
 }
 
 void deck_point_affine(const deck *dk, const deck_rot *R, const double q[NQ_FULL],
 		       const double qd[NQ_FULL], const double qdd[NQ_FULL], double out[3][2][2])
 {
-	/* the point at body x = 0, and R e_x, the arm's rate per metre of x */
+	/* the point at body x = 0 (G's motion and the arm R (0, h_d)), and
+	 * the rate per metre of x (no motion of G and the arm R e_x) */
 	double Rd[2], Re[2];
-	const double ex[2] = {1.0, 0.0};
+	const double ex[2] = {1.0, 0.0}, none[2] = {0.0, 0.0};
 	deck_arm(dk, 0.0, R, Rd);
 	deck_rotate(R, ex, Re);
-	double ad = qd[Q_ALPHA], add = qdd[Q_ALPHA];
-	out[0][0][0] = q[Q_X] + Rd[0];
-	out[0][0][1] = q[Q_Y] + Rd[1];
-	out[1][0][0] = qd[Q_X] - ad * Rd[1];
-	out[1][0][1] = qd[Q_Y] + ad * Rd[0];
-	out[2][0][0] = qdd[Q_X] - add * Rd[1] - ad * ad * Rd[0];
-	out[2][0][1] = qdd[Q_Y] + add * Rd[0] - ad * ad * Rd[1];
-	out[0][1][0] = Re[0];
-	out[0][1][1] = Re[1];
-	out[1][1][0] = -ad * Re[1];
-	out[1][1][1] = ad * Re[0];
-	out[2][1][0] = -add * Re[1] - ad * ad * Re[0];
-	out[2][1][1] = add * Re[0] - ad * ad * Re[1];
+	arm_kinematics(q, qd, qdd, qd[Q_ALPHA], qdd[Q_ALPHA], Rd, out, 0);
+	arm_kinematics(none, none, none, qd[Q_ALPHA], qdd[Q_ALPHA], Re, out, 1);
 }
 
 void deck_motion_eval(const deck *dk, const double q[NQ_FULL], const double qd[NQ_FULL],

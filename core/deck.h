@@ -57,9 +57,6 @@ typedef struct deck {
  * of the deck point at body x for the machine state q, qd. */
 void deck_point(const deck *dk, double x, const deck_rot *R, const double q[NQ_FULL],
 		const double qd[NQ_FULL], double pos[2], double vel[2]);
-/* Acceleration of column k's deck point from q', q''. */
-void deck_accel(const deck *dk, int k, const deck_rot *R, const double qd[NQ_FULL],
-		const double qdd[NQ_FULL], double acc[2]);
 
 /* A deck point's position, velocity and acceleration are affine in its
  * body x: out[i][0] + x out[i][1] (i = 0, 1, 2 for position, velocity,
