@@ -14,9 +14,10 @@
 #include "ode.h"
 
 /* phi - alpha and its rate, the mean feed position and its rate, the
- * drive's input energy, and the speed of the trough's centre of mass. */
+ * drive's input energy, and the velocity of the trough's centre of mass
+ * (V, 2). */
 static void period_probe(const model *md, const model_ctl *ctl, double t, const double *y,
-			 double *psi, double *psid, double *X, double *Xd, double *E, double *V)
+			 double *psi, double *psid, double *X, double *Xd, double *E, double V[2])
 {
 	double q[NQ_FULL], qd[NQ_FULL];
 	model_full_coords(md, ctl, t, y, q, qd);
@@ -25,16 +26,17 @@ static void period_probe(const model *md, const model_ctl *ctl, double t, const 
 	*X = md->nf > 0 ? feed_mean_xi(md, y, -1) : 0.0;
 	*Xd = feed_mean_xi_rate(md, y);
 	*E = y[2 * md->npos + ACC_IN];
-	*V = hypot(qd[Q_X], qd[Q_Y]);
+	V[0] = qd[Q_X];
+	V[1] = qd[Q_Y];
 }
 
 void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double t,
 		    const double *y, double start)
 {
 	*e = (estimator){0};
-	double V;
+	double V[2];
 	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
-		     &e->E_prev, &V);
+		     &e->E_prev, V);
 	estimator_restart(e, start);
 }
 
@@ -137,10 +139,13 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
 		    const double *y)
 {
-	double psi, psid, X, Xd, E, V;
-	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E, &V);
-	if (!e->pending)
-		e->speed_max = fmax(e->speed_max, V);
+	double psi, psid, X, Xd, E, V[2];
+	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E, V);
+	/* the speed by hypot only where it may raise the maximum: V^2 is
+	 * within a few ulps of hypot's square, so the maximum is the same */
+	double sm = e->speed_max;
+	if (!e->pending && V[0] * V[0] + V[1] * V[1] >= sm * sm * (1.0 - 1e-12))
+		e->speed_max = fmax(sm, hypot(V[0], V[1]));
 	double H = t1 - t0;
 	double n0 = floor(e->psi_prev / (2 * M_PI)), n1 = floor(psi / (2 * M_PI));
 	/* a step passes a few periods at most; a phase that jumped by more

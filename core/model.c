@@ -71,7 +71,8 @@ static void point_mass_vibrator(const model *md, const deck_rot *R, const double
 {
 	double w[2] = {md->p.w_x, md->p.w_y}, Rw[2];
 	deck_rotate(R, w, Rw);
-	double cf = cos(q[Q_PHI]), sf = sin(q[Q_PHI]), e = md->p.e;
+	double cf, sf, e = md->p.e;
+	model_phase_sincos(q[Q_PHI], &sf, &cf);
 	k->m = md->p.m;
 	k->own = Q_PHI;
 	k->ja[0] = -Rw[1];
@@ -252,7 +253,9 @@ static int trough2_held(const model *md, const model_ctl *ctl, double t, const d
 		rhs[i] = Qfeed ? Qfeed[i] : 0.0;
 	rhs[Q_Y] -= p->M_r * p->g;
 	/* the vibrator (point_mass_vibrator with R = I, alpha' = 0) */
-	const double cf = cos(c->q[Q_PHI]), sf = sin(c->q[Q_PHI]), e = p->e, m = p->m;
+	double cf, sf;
+	model_phase_sincos(c->q[Q_PHI], &sf, &cf);
+	const double e = p->e, m = p->m;
 	const double pd2 = c->qd[Q_PHI] * c->qd[Q_PHI];
 	const double jo0 = -e * sf, jo1 = e * cf;
 	const double a0 = -(e * pd2 * cf), a1 = -(e * pd2 * sf);
@@ -428,10 +431,9 @@ static double guide_power(const sim_params *p, const config *cf, const double qd
 }
 
 /* What an evaluation shows the observer. */
-static void observe(const model *md, const config *cf, const double M[NQ_FULL][NQ_FULL],
-		    const double qdd[NQ_FULL], const drive_terms *dt, model_eval *ev)
+static void observe(const model *md, const config *cf, const double qdd[NQ_FULL],
+		    const drive_terms *dt, model_eval *ev)
 {
-	memcpy(ev->M, M, sizeof ev->M);
 	memcpy(ev->q, cf->q, sizeof ev->q);
 	memcpy(ev->qd, cf->qd, sizeof ev->qd);
 	memcpy(ev->qdd, qdd, sizeof ev->qdd);
@@ -449,7 +451,9 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev)
 {
 	config cf;
-	double M[NQ_FULL][NQ_FULL], rhs[NQ_FULL], br[NQ_FULL], qdd[NQ_FULL];
+	double Mown[NQ_FULL][NQ_FULL], rhs[NQ_FULL], br[NQ_FULL], qdd[NQ_FULL];
+	/* M formed where the observer reads it, not copied there */
+	double(*M)[NQ_FULL] = ev ? ev->M : Mown;
 	double damp_power = 0.0;
 	drive_terms dt;
 	if (!trough2_held(md, ctl, t, y, Qfeed, &cf, M, rhs)) {
@@ -467,7 +471,7 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd);
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev)
-		observe(md, &cf, (const double(*)[NQ_FULL])M, qdd, &dt, ev);
+		observe(md, &cf, qdd, &dt, ev);
 }
 
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,
