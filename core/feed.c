@@ -210,7 +210,7 @@ enum { BOND = 0, HI = 1, LO = 2 };
 /* The velocities v and impulses P of the column for the contact modes
  * mode as they stand (no switching): bonded runs move as one cluster,
  * every other contact carries its fixed impulse (HI: hi, LO: lo). */
-static inline void chain_clusters(int L, double m, const double *restrict vs, double v0,
+static inline __attribute__((always_inline)) void chain_clusters(int L, double m, const double *restrict vs, double v0,
 				  const double *restrict lo, const double *restrict hi,
 				  double *restrict P, double *restrict v,
 				  const signed char *restrict mode)
@@ -385,6 +385,27 @@ static void friction_events(int L, double m, const double *vs, double dv0, doubl
 			P[j] += Pacc[j];
 }
 
+/* A column's normal impulse bounds from the compressions at a sub-step's
+ * start (the deck at height top): loading k delta^p h (hi), unloading
+ * R^2 k delta^p h (lo); and the velocities the layers would reach under
+ * gravity alone (vs). Inlined, with p a constant where the caller can
+ * make it one. */
+static inline void normal_bounds(int L, double h, double k_c, double p, double R2, double g,
+				 double top, const double *eta, const double *etad, double *hi,
+				 double *lo, double *vs)
+{
+	double prev_eta = top;
+	for (int j = 0; j < L; j++) {
+		double delta = prev_eta - eta[j];
+		/* contact_force (delta, rate >= 0) with the parameters in
+		 * registers: the arrays written here may not alias md */
+		hi[j] = delta > 0.0 ? h * loading_force(k_c, p, delta) : 0.0;
+		lo[j] = R2 * hi[j];
+		vs[j] = etad[j] - g * h;
+		prev_eta = eta[j];
+	}
+}
+
 /* One sub-step of column k on the state y itself: the deck at dp (the
  * sub-step's start), its velocity dv1 at the middle and dv0 at the middle
  * of the sub-step before (friction events). Impulse on the deck into
@@ -403,18 +424,10 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 	signed char *mn = modes + base, *mt = modes + md->nf + base;
 	if (L < 1 || L > SIM_MAX_LAYERS)
 		return;
-	/* normal impulse bounds from the compressions at the sub-step's
-	 * start: loading k delta^p h, unloading R^2 k delta^p h */
-	double prev_eta = dp[1];
-	for (int j = 0; j < L; j++) {
-		double delta = prev_eta - eta[j];
-		/* contact_force (delta, rate >= 0) with the parameters in
-		 * registers: the arrays written here may not alias md */
-		hi[j] = delta > 0.0 ? h * loading_force(k_c, p, delta) : 0.0;
-		lo[j] = R2 * hi[j];
-		vs[j] = etad[j] - g * h;
-		prev_eta = eta[j];
-	}
+	if (p == 1.0) /* the linear law: its test out of the loop */
+		normal_bounds(L, h, k_c, 1.0, R2, g, dp[1], eta, etad, hi, lo, vs);
+	else
+		normal_bounds(L, h, k_c, p, R2, g, dp[1], eta, etad, hi, lo, vs);
 	chain_solve(L, m, vs, dv1[1], lo, hi, Pn, vn, mn, NULL);
 	/* friction impulses within [-mu, mu] times the normal ones */
 	for (int j = 0; j < L; j++) {

@@ -431,8 +431,8 @@ static double guide_power(const sim_params *p, const config *cf, const double qd
 }
 
 /* What an evaluation shows the observer. */
-static void observe(const model *md, const config *cf, const double qdd[NQ_FULL],
-		    const drive_terms *dt, model_eval *ev)
+static void observe(const config *cf, const double qdd[NQ_FULL], const drive_terms *dt,
+		    model_eval *ev)
 {
 	memcpy(ev->q, cf->q, sizeof ev->q);
 	memcpy(ev->qd, cf->qd, sizeof ev->qd);
@@ -442,9 +442,6 @@ static void observe(const model *md, const config *cf, const double qdd[NQ_FULL]
 	ev->torque = dt->torque;
 	ev->rotor_speed = dt->omega;
 	ev->R = cf->R;
-	/* the centre deck point, from its rest position */
-	deck_point(&md->dk, 0.0, &cf->R, cf->q, cf->qd, ev->deck, ev->deck_vel);
-	ev->deck[1] -= md->dk.h_d;
 }
 
 void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
@@ -471,7 +468,7 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd);
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev)
-		observe(md, &cf, qdd, &dt, ev);
+		observe(&cf, qdd, &dt, ev);
 }
 
 void model_force_response(const model *md, const model_ctl *ctl, double t, const double *y,

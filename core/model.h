@@ -115,7 +115,6 @@ typedef struct model_eval {
 	double beta, beta_dot;
 	double torque;        /* N m on the rotor (motor, or ideal drive's) */
 	double rotor_speed;   /* phi' - alpha' */
-	double deck[2], deck_vel[2]; /* centre deck point displacement */
 	deck_rot R;           /* R(alpha), deck_rotation(q) */
 	double M[NQ_FULL][NQ_FULL]; /* the mass matrix as the layout's solve reads it (lower half;
 				     * both for the general layout; model.c, trough2_held) */

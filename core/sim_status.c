@@ -119,8 +119,9 @@ void sim_update_status(sim *s)
 	st->rotor_speed = ev.rotor_speed;
 	st->motor_torque = ev.torque;
 	st->power = ev.torque * ev.rotor_speed + 0.0; /* no negative zero */
-	memcpy(st->deck, ev.deck, sizeof st->deck);
-	memcpy(st->deck_vel, ev.deck_vel, sizeof st->deck_vel);
+	/* the centre deck point, from its rest position */
+	deck_point(&md->dk, 0.0, &ev.R, ev.q, ev.qd, st->deck, st->deck_vel);
+	st->deck[1] -= md->dk.h_d;
 	st->feed_displacement = md->nf > 0 ? feed_mean_xi(md, s->y_obs, -1) - s->X0 : 0.0;
 	status_estimate(s, st);
 	status_energy(s, &ev, st);
