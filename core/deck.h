@@ -12,6 +12,7 @@
 
 #include <math.h>
 
+#include "angle.h"
 #include "sim.h"
 
 /* Machine coordinates q = (x, y, alpha, phi, s1, s2) (docs/MODEL.md). */
@@ -26,8 +27,7 @@ static inline deck_rot deck_rotation(const double q[NQ_FULL])
 {
 	deck_rot r = {1.0, 0.0};
 	if (q[Q_ALPHA] != 0.0) {
-		r.c = cos(q[Q_ALPHA]);
-		r.s = sin(q[Q_ALPHA]);
+		angle_sincos(q[Q_ALPHA], &r.s, &r.c);
 	}
 	return r;
 }

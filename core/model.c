@@ -72,7 +72,7 @@ static void point_mass_vibrator(const model *md, const deck_rot *R, const double
 	double w[2] = {md->p.w_x, md->p.w_y}, Rw[2];
 	deck_rotate(R, w, Rw);
 	double cf, sf, e = md->p.e;
-	model_phase_sincos(q[Q_PHI], &sf, &cf);
+	angle_sincos(q[Q_PHI], &sf, &cf);
 	k->m = md->p.m;
 	k->own = Q_PHI;
 	k->ja[0] = -Rw[1];
@@ -254,7 +254,7 @@ static int trough2_held(const model *md, const model_ctl *ctl, double t, const d
 	rhs[Q_Y] -= p->M_r * p->g;
 	/* the vibrator (point_mass_vibrator with R = I, alpha' = 0) */
 	double cf, sf;
-	model_phase_sincos(c->q[Q_PHI], &sf, &cf);
+	angle_sincos(c->q[Q_PHI], &sf, &cf);
 	const double e = p->e, m = p->m;
 	const double pd2 = c->qd[Q_PHI] * c->qd[Q_PHI];
 	const double jo0 = -e * sf, jo1 = e * cf;

@@ -351,9 +351,9 @@ static void reduced_evaluation_is_the_general_one(void **state)
 	free(b);
 }
 
-/* The rotor's sine and cosine (model_phase_sincos) against libm's: within
+/* The machine's sine and cosine (angle_sincos, core/angle.h) against libm's: within
  * 3 ulps of libm's value (libm is within half an ulp of the exact one,
- * model_phase_sincos within about 2.2) at random angles up to 1.2e7 rad
+ * angle_sincos within about 2.2) at random angles up to 1.2e7 rad
  * and next to multiples of pi/2, where the value is small and the
  * reduction must hold to its last bits; odd and even exactly, as libm's
  * are; libm's own values beyond the reduction's range and for x not
@@ -364,7 +364,7 @@ static double ulp_of(double v)
 	return nextafter(a, INFINITY) - a;
 }
 
-static void rotor_sine_and_cosine(void **state)
+static void angle_sine_and_cosine(void **state)
 {
 	(void)state;
 	srand(11);
@@ -378,10 +378,10 @@ static void rotor_sine_and_cosine(void **state)
 		default: x = (double)(rand() % 4) * (M_PI / 4) + 1e-12 * u; break;
 		}
 		double s, c, ms, mc;
-		model_phase_sincos(x, &s, &c);
+		angle_sincos(x, &s, &c);
 		worst = fmax(worst, fabs(s - sin(x)) / ulp_of(sin(x)));
 		worst = fmax(worst, fabs(c - cos(x)) / ulp_of(cos(x)));
-		model_phase_sincos(-x, &ms, &mc);
+		angle_sincos(-x, &ms, &mc);
 		assert_true(ms == -s && mc == c);
 	}
 	assert_true(worst <= 3.0);
@@ -389,7 +389,7 @@ static void rotor_sine_and_cosine(void **state)
 	const double beyond[] = {1.3e7, -4e9, 1e300, INFINITY, NAN};
 	for (int i = 0; i < 5; i++) {
 		double s, c;
-		model_phase_sincos(beyond[i], &s, &c);
+		angle_sincos(beyond[i], &s, &c);
 		assert_memory_equal(&s, &(double){sin(beyond[i])}, sizeof s);
 		assert_memory_equal(&c, &(double){cos(beyond[i])}, sizeof c);
 	}
@@ -406,7 +406,7 @@ int main(void)
 		cmocka_unit_test(beta_ramps_are_continuous),
 		cmocka_unit_test(mirror_symmetry_machine),
 		cmocka_unit_test(reduced_evaluation_is_the_general_one),
-		cmocka_unit_test(rotor_sine_and_cosine),
+		cmocka_unit_test(angle_sine_and_cosine),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
