@@ -18,7 +18,7 @@
  * (tests/bench/results/reductions.tsv). */
 #define REDUCTION_NO_FEED 1.75, NAN
 #define REDUCTION_SYMMETRIC 2.5, 2.5e-4
-#define REDUCTION_IDEAL 0.77, 2.7e-3
+#define REDUCTION_IDEAL 0.80, 2.7e-3
 #define REDUCTION_ONE_WAY 1.01, 4.4e-2
 /* mirror: the 74-point curve at the defaults with and without it (CPU of
  * the curve; largest |v_image - v_direct| over the peak; accuracy.md). */
