@@ -16,11 +16,10 @@
 /* phi - alpha and its rate, the mean feed position and its rate, the
  * drive's input energy, and the velocity of the trough's centre of mass
  * (V, 2). */
-static void period_probe(const model *md, const model_ctl *ctl, double t, const double *y,
-			 double *psi, double *psid, double *X, double *Xd, double *E, double V[2])
+static void period_probe(const model *md, const double *y, const double q[NQ_FULL],
+			 const double qd[NQ_FULL], double *psi, double *psid, double *X, double *Xd,
+			 double *E, double V[2])
 {
-	double q[NQ_FULL], qd[NQ_FULL];
-	model_full_coords(md, ctl, t, y, q, qd);
 	*psi = q[Q_PHI] - q[Q_ALPHA];
 	*psid = qd[Q_PHI] - qd[Q_ALPHA];
 	*X = md->nf > 0 ? feed_mean_xi(md, y, -1) : 0.0;
@@ -34,8 +33,9 @@ void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double 
 		    const double *y, double start)
 {
 	*e = (estimator){0};
-	double V[2];
-	period_probe(md, ctl, t, y, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
+	double q[NQ_FULL], qd[NQ_FULL], V[2];
+	model_full_coords(md, ctl, t, y, q, qd);
+	period_probe(md, y, q, qd, &e->psi_prev, &e->psid_prev, &e->X_prev, &e->Xd_prev,
 		     &e->E_prev, V);
 	estimator_restart(e, start);
 }
@@ -136,11 +136,11 @@ static void on_boundary(estimator *e, double tb, double Xb, double Eb)
 	error_bar(e);
 }
 
-void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
-		    const double *y)
+void estimator_step(estimator *e, const model *md, double t0, double t1, const double *y,
+		    const double q[NQ_FULL], const double qd[NQ_FULL])
 {
 	double psi, psid, X, Xd, E, V[2];
-	period_probe(md, ctl, t1, y, &psi, &psid, &X, &Xd, &E, V);
+	period_probe(md, y, q, qd, &psi, &psid, &X, &Xd, &E, V);
 	/* the speed by hypot only where it may raise the maximum: V^2 is
 	 * within a few ulps of hypot's square, so the maximum is the same */
 	double sm = e->speed_max;

@@ -37,10 +37,11 @@ void estimator_init(estimator *e, const model *md, const model_ctl *ctl, double 
 		    const double *y, double start);
 /* Restart the estimate at the next boundary at or after start (s). */
 void estimator_restart(estimator *e, double start);
-/* After a step from t0 to t1 that ended in state y: locate the period
+/* After a step from t0 to t1 that ended in state y, whose machine has the
+ * full coordinates q, qd (model_full_coords at t1): locate the period
  * boundaries within the step. */
-void estimator_step(estimator *e, const model *md, const model_ctl *ctl, double t0, double t1,
-		    const double *y);
+void estimator_step(estimator *e, const model *md, double t0, double t1, const double *y,
+		    const double q[NQ_FULL], const double qd[NQ_FULL]);
 
 /* The estimate (NaN before one whole period; see sim_status).
  * uncertainty: the batch velocities (between records) fitted by a straight

@@ -160,7 +160,7 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 			model_eval *evm, model_eval *ev3)
 {
 	const model *md = sys->md;
-	memcpy(w->tmp, y, sizeof(double) * (size_t)w->n);
+	/* tmp's machine entries only: the machine's evaluation reads no other */
 	dyn_machine_rhs(sys, t, y, w->Qfeed, w->k1, ev0);
 	machine_axpy(md, w->tmp, y, 0.5 * H, w->k1);
 	dyn_machine_rhs(sys, t + 0.5 * H, w->tmp, w->Qfeed, w->k2, NULL);

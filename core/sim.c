@@ -66,8 +66,10 @@ static const char *feed_runaway(const model *md, const double *y, const double q
 	return NULL;
 }
 
-/* Divergence guard: finite state, bounded machine motion and feed. */
-static int check_state(sim *s)
+/* Divergence guard: finite state, bounded machine motion and feed; q, qd
+ * receive the machine's full coordinates at s->t_int (for the caller's
+ * other observers). */
+static int check_state(sim *s, double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const model *md = &s->md;
 	/* y - y is 0 for a finite entry and NaN for any other: a sum (four
@@ -90,7 +92,6 @@ static int check_state(sim *s)
 			return SIM_EDIVERGED;
 		}
 	}
-	double q[NQ_FULL], qd[NQ_FULL];
 	model_full_coords(md, &s->ctl, s->t_int, s->y, q, qd);
 	const char *cause = machine_runaway(md, q, qd);
 	if (!cause && md->nf > 0)
@@ -143,8 +144,9 @@ static int settle(sim *s)
 	int e = SIM_OK;
 	while (e == SIM_OK && s->t_int < 0.0) {
 		e = s->ode->step(s->ws, &s->sys, &s->t_int, s->y, 0.0);
+		double q[NQ_FULL], qd[NQ_FULL];
 		if (e == SIM_OK)
-			e = check_state(s);
+			e = check_state(s, q, qd);
 		else
 			snprintf(s->error, sizeof s->error, "step size underflow while settling");
 	}
@@ -368,12 +370,19 @@ int sim_advance(sim *s, double t_end)
 	size_t n = (size_t)s->md.n;
 	while (s->t_int < t_end - eps) {
 		double t0 = s->t_int;
-		if (!s->ode->dense)
+		/* the state before the step, for interpolate_step: read only
+		 * at the end, so kept before the step that ends the loop (a
+		 * fixed step ends at (k_fixed + 1) dt) */
+		if (!s->ode->dense && (double)(s->k_fixed + 1) * s->cfg.dt >= t_end - eps)
 			memcpy(s->y_prev, s->y, sizeof(double) * n);
 		int e = s->ode->step(s->ws, &s->sys, &s->t_int, s->y,
 				     s->ode->dense ? t_end : INFINITY);
+		/* a fixed step's end is k dt, not the sum of the steps */
+		if (e == SIM_OK && !s->ode->dense)
+			s->t_int = (double)(s->k_fixed + 1) * s->cfg.dt;
+		double q[NQ_FULL], qd[NQ_FULL]; /* at t_int, for both observers */
 		if (e == SIM_OK)
-			e = check_state(s);
+			e = check_state(s, q, qd);
 		else
 			snprintf(s->error, sizeof s->error,
 				 "step size underflow at t = %.9g s (tolerance too tight or a "
@@ -385,10 +394,10 @@ int sim_advance(sim *s, double t_end)
 			return e;
 		}
 		if (!s->ode->dense)
-			s->t_int = (double)++s->k_fixed * s->cfg.dt;
+			s->k_fixed++;
 		s->t_prev = t0;
 		s->steps++;
-		estimator_step(&s->est, &s->md, &s->ctl, t0, s->t_int, s->y);
+		estimator_step(&s->est, &s->md, t0, s->t_int, s->y, q, qd);
 	}
 	if (s->t_int > t_end + eps) {
 		if (s->ode->dense)
