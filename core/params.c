@@ -387,7 +387,7 @@ static int set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 	int i = find(name);
 	if (i < 0 || !value)
 		return sim_set(p, s, m, name, NAN, msg, msglen);
-	double v;
+	double v = NAN; /* parse_value sets it where it returns SIM_OK */
 	int e = parse_value((size_t)i, value, &v, msg, msglen);
 	if (e != SIM_OK)
 		return e;

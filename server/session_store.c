@@ -245,7 +245,8 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	memcpy(&r, p, sizeof r);
 	api_problem pb;
 	if (api_check_spec(&r.spec, &pb) != API_OK) {
-		snprintf(why, whylen, "%s", pb.detail);
+		/* the reason cut to the caller's room, as snprintf would */
+		snprintf(why, whylen, "%.*s", whylen > 0 ? (int)(whylen - 1) : 0, pb.detail);
 		return -1;
 	}
 	*spec = r.spec;
