@@ -10,10 +10,11 @@
 
 /* sin and cos of x (rad), inlined: x = k pi/2 + r with |r| <= pi/4,
  * pi/2 in three parts, the first two of at most 30 bits, so that k times
- * each is exact for |k| < 2^23; then the Taylor series of sin r to r^17 and of cos r to
- * r^16 (the first terms left out are below 1e-17). Beyond |x| = 1.26e7
- * rad (a day of the rotor at 145 rad/s), and for x not finite, libm's.
- * Within 3 ulps of libm's (test_machine.c), odd and even exactly. */
+ * each is exact for |k| < 2^23; then the Taylor series of sin r to r^17
+ * and of cos r to r^16 (the first terms left out are below 1e-17).
+ * Beyond |x| = 1.26e7 rad (a day of the rotor at 145 rad/s), and for x
+ * not finite, libm's. Within 3 ulps of libm's (test_machine.c), odd and
+ * even exactly. */
 static inline void angle_sincos(double x, double *s, double *c)
 {
 	static const double P1 = 0x1.921fb54p+0, P2 = 0x1.10b46118p-30,
