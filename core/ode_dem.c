@@ -111,7 +111,8 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 	w->couple = w->correct && w->events;
 	if (w->couple)
 		w->yield = calloc(1, sizeof *w->yield);
-	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || !w->cubic || (w->couple && !w->yield)) {
+	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || !w->cubic ||
+	    (w->couple && !w->yield)) {
 		dem_free(w);
 		return NULL;
 	}

@@ -370,16 +370,16 @@ int sim_advance(sim *s, double t_end)
 	size_t n = (size_t)s->md.n;
 	while (s->t_int < t_end - eps) {
 		double t0 = s->t_int;
+		/* a fixed step's end: k dt, not the sum of the steps */
+		const double t_fixed = (double)(s->k_fixed + 1) * s->cfg.dt;
 		/* the state before the step, for interpolate_step: read only
-		 * at the end, so kept before the step that ends the loop (a
-		 * fixed step ends at (k_fixed + 1) dt) */
-		if (!s->ode->dense && (double)(s->k_fixed + 1) * s->cfg.dt >= t_end - eps)
+		 * at the end, so kept before the step that ends the loop */
+		if (!s->ode->dense && t_fixed >= t_end - eps)
 			memcpy(s->y_prev, s->y, sizeof(double) * n);
 		int e = s->ode->step(s->ws, &s->sys, &s->t_int, s->y,
 				     s->ode->dense ? t_end : INFINITY);
-		/* a fixed step's end is k dt, not the sum of the steps */
 		if (e == SIM_OK && !s->ode->dense)
-			s->t_int = (double)(s->k_fixed + 1) * s->cfg.dt;
+			s->t_int = t_fixed;
 		double q[NQ_FULL], qd[NQ_FULL]; /* at t_int, for both observers */
 		if (e == SIM_OK)
 			e = check_state(s, q, qd);
