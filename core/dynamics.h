@@ -77,9 +77,10 @@ void dynamics_dense_solve(int n, int lda, double *A, double *b);
 
 /* The `steady` start (steady.c): replace the machine part of the
  * equilibrium state y by the periodic forced response at the loaded motor
- * speed (shooting), and move the settled feed with its deck points. The
- * motor off: y is kept. */
-void dynamics_steady_start(const model *md, model_ctl *ctl, double *y);
+ * speed (frequency domain or shooting), move the settled feed with its
+ * deck points, and write the response's trough orbit into *orbit (sense 0
+ * where there is none). The motor off: y is kept, no orbit. */
+void dynamics_steady_start(const model *md, model_ctl *ctl, double *y, trough_orbit *orbit);
 
 /* Fill y (length md->n) with the static equilibrium with the feed settled;
  * the ideal drive's psi ramp is re-anchored to it. */

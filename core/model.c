@@ -296,9 +296,9 @@ static void suspension_point(const sim_params *p, const config *cf, int i, doubl
 	u[1] = cf->q[Q_Y] + RP[1] - Pb[1];
 }
 
-/* The settling damping the `steady` start adds at time t < 0 (N s/m): full
- * until settle_t0, then faded out by a half cosine to none at t = 0. */
-static double settle_damping(const model_ctl *ctl, double t)
+/* The share of the settling damping the `steady` start adds at time t < 0:
+ * full until settle_t0, then faded out by a half cosine to none at t = 0. */
+static double settle_share(const model_ctl *ctl, double t)
 {
 	if (!(t < 0.0 && ctl->settle_b > 0.0))
 		return 0.0;
@@ -314,17 +314,30 @@ static void suspension(const model *md, const model_ctl *ctl, double t, const co
 {
 	const sim_params *p = &md->p;
 	const double *qd = cf->qd;
-	double extra = settle_damping(ctl, t), b_x = p->b_x + extra, b_y = p->b_y + extra;
+	double extra = settle_share(ctl, t), vo[3] = {0.0, 0.0, 0.0};
+	const trough_orbit *o = &md->settle_orbit;
+	if (extra > 0.0 && o->sense != 0) {
+		/* the forced response's rates at the rotor's present phase */
+		double th = o->sense * (cf->q[Q_PHI] - cf->q[Q_ALPHA] - o->psi0);
+		double thd = o->sense * (qd[Q_PHI] - qd[Q_ALPHA]);
+		double sn = sin(th), cs = cos(th);
+		for (int c = 0; c < 3; c++)
+			vo[c] = thd * (-o->xya[c][1] * sn + o->xya[c][2] * cs);
+	}
 	for (int i = 0; i < 2; i++) {
 		double RP[2], u[2];
 		suspension_point(p, cf, i, RP, u);
 		double vx = qd[Q_X] - qd[Q_ALPHA] * RP[1], vy = qd[Q_Y] + qd[Q_ALPHA] * RP[0];
-		double Fx = -p->k_x * u[0] - b_x * vx;
-		double Fy = -p->k_y * u[1] - b_y * vy + md->F0[i];
-		rhs[Q_X] += Fx;
-		rhs[Q_Y] += Fy;
-		rhs[Q_ALPHA] += -RP[1] * Fx + RP[0] * Fy;
-		*damp_power += b_x * vx * vx + b_y * vy * vy;
+		double Fx = -p->k_x * u[0] - p->b_x * vx;
+		double Fy = -p->k_y * u[1] - p->b_y * vy + md->F0[i];
+		/* the settling's damper: on the spring set's velocity relative
+		 * to that on the forced response */
+		double Ex = -extra * md->settle_damping[0] * (vx - (vo[0] - vo[2] * RP[1]));
+		double Ey = -extra * md->settle_damping[1] * (vy - (vo[1] + vo[2] * RP[0]));
+		rhs[Q_X] += Fx + Ex;
+		rhs[Q_Y] += Fy + Ey;
+		rhs[Q_ALPHA] += -RP[1] * (Fx + Ex) + RP[0] * (Fy + Ey);
+		*damp_power += p->b_x * vx * vx + p->b_y * vy * vy - Ex * vx - Ey * vy;
 	}
 }
 

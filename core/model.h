@@ -34,6 +34,15 @@ enum { ACC_IN, ACC_DAMP, ACC_FRIC, ACC_CONTACT, ACC_N };
 enum { MODEL_LAYOUT_GENERAL, MODEL_LAYOUT_TROUGH3, MODEL_LAYOUT_TROUGH2 };
 
 /* Constant during a run. */
+/* A periodic motion of the trough's x, y (m) and alpha (rad): the mean,
+ * cos and sin parts of each in the rotor's phase theta = sense (phi -
+ * alpha - psi0), first harmonic only; sense 0: none. */
+typedef struct trough_orbit {
+	double xya[3][3];
+	double psi0;
+	int sense;
+} trough_orbit;
+
 typedef struct model {
 	sim_params p;
 	sim_scene sc;
@@ -60,6 +69,12 @@ typedef struct model {
 	int npos, n;
 	/* preload of the suspension (vertical, N) at P1 and P2 */
 	double F0[2];
+	/* the `steady` start's settling: the damping it adds per spring set
+	 * in x and y (N s/m; the trough's critical damping on its
+	 * suspension), relative to the forced response's motion
+	 * (dynamics_steady_start sets it) */
+	double settle_damping[2];
+	trough_orbit settle_orbit;
 } model;
 
 /* The controls: changed between steps by sim_set_* (SI units). */
@@ -70,9 +85,9 @@ typedef struct model_ctl {
 	int rotation;                 /* SIM_CW / SIM_CCW */
 	double omega_ss;              /* rad/s */
 	int drive_on;
-	/* the `steady` start's settling (steady.c): before t = 0 the
-	 * suspension carries settle_b (N s/m per spring set and direction)
-	 * more damping, faded out to none over [settle_t0, 0] */
+	/* the `steady` start's settling (sim.c): before t = 0 the suspension
+	 * carries settle_b (0 or 1) times model.settle_damping more damping,
+	 * faded out to none over [settle_t0, 0] */
 	double settle_b, settle_t0;
 } model_ctl;
 

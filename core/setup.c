@@ -161,6 +161,11 @@ void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene 
 	md->n = 2 * md->npos + ACC_N;
 
 	preload(p, md->F0);
+	/* the settling's damping: critical for the trough's translation on
+	 * its two spring sets, sqrt(2 k M) a set (4,990 N s/m in czubak2016) */
+	double M = p->M_r + p->m + p->m1 + p->m2;
+	md->settle_damping[0] = sqrt(2.0 * p->k_x * M);
+	md->settle_damping[1] = sqrt(2.0 * p->k_y * M);
 
 	ramp_hold(&ctl->beta_ramp, 0.0, p->beta, 0.0);
 	double speed = ideal && sc->motor_on ? (double)p->rotation * p->omega_ss : 0.0;

@@ -47,6 +47,9 @@ typedef struct shooter {
 	double T;           /* s, the period */
 	int steps;          /* RK4 steps per period */
 	double mean_torque; /* N m, of the last period integrated */
+	double orbit[3][3]; /* the trough's x, y, alpha on it: mean, cos and sin
+			     * parts in the rotor's phase (the last period
+			     * one_period recorded, or harmonic_orbit's) */
 } shooter;
 
 static void shoot_rhs(const shooter *sh, double t, const double *y, double *dy, model_eval *ev)
@@ -58,8 +61,11 @@ static void shoot_rhs(const shooter *sh, double t, const double *y, double *dy, 
 }
 
 /* One period of classical RK4 from z (positions then rates, 2 nq values):
- * the end state into out, the drive's mean torque into sh->mean_torque. */
-static void one_period(shooter *sh, const double *z, double *out)
+ * the end state into out, the drive's mean torque into sh->mean_torque,
+ * and with record the trough's x, y, alpha over it into sh->orbit (the mean
+ * and the first harmonic of the steps' starts, a discrete Fourier
+ * transform in the phase 2 pi s / steps). */
+static void one_period(shooter *sh, const double *z, double *out, int record)
 {
 	const model *mm = &sh->mm;
 	int nq = mm->nq, n = mm->n;
@@ -67,11 +73,19 @@ static void one_period(shooter *sh, const double *z, double *out)
 	       k4[NZ + ACC_N], tmp[NZ + ACC_N];
 	memcpy(y, z, sizeof(double) * (size_t)nq);
 	memcpy(y + mm->npos, z + nq, sizeof(double) * (size_t)nq);
-	double h = sh->T / sh->steps, t = 0.0, torque = 0.0;
+	double h = sh->T / sh->steps, t = 0.0, torque = 0.0, dft[3][3] = {{0}};
 	model_eval ev;
 	for (int s = 0; s < sh->steps; s++) {
 		shoot_rhs(sh, t, y, k1, &ev);
 		torque += ev.torque;
+		if (record) {
+			double th = 2.0 * M_PI * s / sh->steps, c = cos(th), sn = sin(th);
+			for (int i = 0; i < 3; i++) { /* x, y, alpha */
+				dft[i][0] += ev.q[i] / sh->steps;
+				dft[i][1] += 2.0 * c * ev.q[i] / sh->steps;
+				dft[i][2] += 2.0 * sn * ev.q[i] / sh->steps;
+			}
+		}
 		for (int i = 0; i < n; i++)
 			tmp[i] = y[i] + 0.5 * h * k1[i];
 		shoot_rhs(sh, t + 0.5 * h, tmp, k2, NULL);
@@ -86,6 +100,8 @@ static void one_period(shooter *sh, const double *z, double *out)
 		t += h;
 	}
 	sh->mean_torque = torque / sh->steps;
+	if (record)
+		memcpy(sh->orbit, dft, sizeof dft);
 	memcpy(out, y, sizeof(double) * (size_t)nq);
 	memcpy(out + nq, y + mm->npos, sizeof(double) * (size_t)nq);
 }
@@ -100,7 +116,7 @@ static void shoot_jacobian(shooter *sh, const double *z, const double *end, doub
 		memcpy(pert, z, sizeof(double) * (size_t)m);
 		double hz = 1e-7 * fmax(fabs(z[b]), b < m / 2 ? 1e-3 : 1e-1);
 		pert[b] += hz;
-		one_period(sh, pert, endp);
+		one_period(sh, pert, endp, 0);
 		for (int a = 0; a < m; a++)
 			J[a][b] = (endp[a] - end[a]) / hz - (a == b ? 1.0 : 0.0);
 	}
@@ -116,7 +132,7 @@ static void shoot(shooter *sh, double *z, double J[NZ][NZ], int *have_J)
 	int m = 2 * sh->mm.nq;
 	double end[NZ], A[NZ][NZ], r[NZ], last = INFINITY;
 	for (int it = 0; it < NEWTON_MAX; it++) {
-		one_period(sh, z, end);
+		one_period(sh, z, end, 1);
 		double norm = 0.0, scale = 0.0;
 		for (int i = 0; i < m; i++) {
 			r[i] = z[i] - end[i];
@@ -225,6 +241,14 @@ static int harmonic_orbit(shooter *sh, double *z)
 		z[r] = g0[r] + b[r];
 		z[nq + r] = w * b[nq + r];
 	}
+	for (int r = 0; r < nq; r++) {
+		int i = mm->col[r][0];
+		if (i == Q_X || i == Q_Y) {
+			sh->orbit[i][0] = g0[r];
+			sh->orbit[i][1] = b[r];
+			sh->orbit[i][2] = b[nq + r];
+		}
+	}
 	return 0;
 }
 
@@ -278,8 +302,9 @@ static void move_feed(const model *md, const double q0[NQ_FULL], const double qd
 	}
 }
 
-void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
+void dynamics_steady_start(const model *md, model_ctl *ctl, double *y, trough_orbit *orbit)
 {
+	orbit->sense = 0;
 	if (!ctl->drive_on)
 		return;
 	double q0[NQ_FULL], qd0[NQ_FULL];
@@ -326,4 +351,11 @@ void dynamics_steady_start(const model *md, model_ctl *ctl, double *y)
 	}
 	if (md->nf > 0)
 		move_feed(md, q0, qd0, q, qd, y);
+	memcpy(orbit->xya, sh.orbit, sizeof sh.orbit);
+	orbit->psi0 = psi0;
+	orbit->sense = Omega < 0.0 ? -1 : 1;
+	for (int i = 0; i < 3; i++)
+		for (int c = 0; c < 3; c++)
+			if (!isfinite(orbit->xya[i][c]))
+				orbit->sense = 0;
 }

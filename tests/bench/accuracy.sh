@@ -25,16 +25,15 @@ sweep() { # name, extra arguments...: one core, CPU seconds into $tmp/name.cpu
 }
 # name | sweep arguments | what the row shows
 runs=(
-	"default||the defaults (steady start settled 1 s, 4-s window, dem 1.25e-3 s / 5 sub-steps with feed_events, symmetric and mirror reductions)"
+	"default||the defaults (steady start settled 0.6 s, 4-s window, dem 1.25e-3 s / 5 sub-steps with feed_events, symmetric and mirror reductions)"
 	"full|--set trough_rotation=true|the same on the full model: the symmetric reduction's own error"
 	"direct|--set mirror=false|every point run, none taken as a mirror image: the mirror reduction's own error"
-	"settle 1.5 s|--set settle=1.5|the former settling"
-	"settle 0.75 s|--set settle=0.75|shorter settling"
-	"settle 0.6 s|--set settle=0.6|shorter still"
-	"settle 0.4 s|--set settle=0.4|the shortest settling tried"
+	"settle 1 s|--set settle=1|the former settling's length"
+	"settle 0.5 s|--set settle=0.5|shorter settling"
+	"settle 0.4 s|--set settle=0.4|shorter still"
+	"settle 0.3 s|--set settle=0.3|the shortest settling tried"
 	"window 3 s|--duration 3|the defaults with a 3-s window"
-	"window 3 s, settle 1.5 s|--duration 3 --set settle=1.5|a 3-s window after the former settling"
-	"window 3.5 s, settle 0.6 s|--duration 3.5 --set settle=0.6|a 3.5-s window after a 0.6-s settling"
+	"window 3 s, settle 1 s|--duration 3 --set settle=1|a 3-s window after a 1-s settling"
 	"window 2 s|--duration 2|the defaults with a 2-s window"
 	"rest 2+2 s|--set start=rest --set transient=2 --duration 4|the former measurement: run-up from rest, window [2, 4] s"
 	"rest 8+4 s|--set start=rest --set transient=8 --duration 12|run-up from rest, window [8, 12] s"

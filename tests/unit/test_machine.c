@@ -315,8 +315,13 @@ static void reduced_evaluation_is_the_general_one(void **state)
 	assert_int_equal(md.layout, MODEL_LAYOUT_TROUGH2);
 	gen = md;
 	gen.layout = MODEL_LAYOUT_GENERAL;
-	ctl.settle_b = 2e4;
+	ctl.settle_b = 1.0;
 	ctl.settle_t0 = -0.5;
+	/* the settling's damper relative to a forced response */
+	md.settle_orbit = gen.settle_orbit = (trough_orbit){
+		.xya = {{1e-4, 5e-4, -3e-4}, {-2e-4, 4e-4, 6e-4}, {0.0, 0.0, 0.0}},
+		.psi0 = -M_PI / 2.0,
+		.sense = 1};
 	double *y = calloc((size_t)md.n, sizeof *y), *a = calloc((size_t)md.n, sizeof *a),
 	       *b = calloc((size_t)md.n, sizeof *b);
 	assert_non_null(y);
