@@ -330,14 +330,19 @@ static void suspension(const model *md, const model_ctl *ctl, double t, const co
 		double vx = qd[Q_X] - qd[Q_ALPHA] * RP[1], vy = qd[Q_Y] + qd[Q_ALPHA] * RP[0];
 		double Fx = -p->k_x * u[0] - p->b_x * vx;
 		double Fy = -p->k_y * u[1] - p->b_y * vy + md->F0[i];
-		/* the settling's damper: on the spring set's velocity relative
-		 * to that on the forced response */
-		double Ex = -extra * md->settle_damping[0] * (vx - (vo[0] - vo[2] * RP[1]));
-		double Ey = -extra * md->settle_damping[1] * (vy - (vo[1] + vo[2] * RP[0]));
-		rhs[Q_X] += Fx + Ex;
-		rhs[Q_Y] += Fy + Ey;
-		rhs[Q_ALPHA] += -RP[1] * (Fx + Ex) + RP[0] * (Fy + Ey);
-		*damp_power += p->b_x * vx * vx + p->b_y * vy * vy - Ex * vx - Ey * vy;
+		if (extra > 0.0) {
+			/* the settling's damper: on the spring set's velocity
+			 * relative to that on the forced response */
+			double Ex = -extra * md->settle_damping[0] * (vx - (vo[0] - vo[2] * RP[1]));
+			double Ey = -extra * md->settle_damping[1] * (vy - (vo[1] + vo[2] * RP[0]));
+			Fx += Ex;
+			Fy += Ey;
+			*damp_power -= Ex * vx + Ey * vy;
+		}
+		rhs[Q_X] += Fx;
+		rhs[Q_Y] += Fy;
+		rhs[Q_ALPHA] += -RP[1] * Fx + RP[0] * Fy;
+		*damp_power += p->b_x * vx * vx + p->b_y * vy * vy;
 	}
 }
 
