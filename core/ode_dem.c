@@ -194,14 +194,17 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
 static void correct(dem *w, const model *md, double H, double *y, const double Qold[NQ_FULL],
 		    const model_eval *evm, const deck_rot *R1)
 {
-	double Q[4][NQ_FULL] = {{0}}, a[4][NQ_FULL];
+	double Q[4][NQ_FULL], a[4][NQ_FULL];
 	for (int i = 0; i < NQ_FULL; i++)
 		Q[0][i] = w->Qfeed[i] - Qold[i];
 	/* with the deck yielding, the same mass matrix's response to unit
-	 * forces on x, y (and alpha): the next step's compliance */
+	 * forces on x, y (and alpha): the next step's compliance (the rows
+	 * cleared one by one: a few vector stores, not a string instruction) */
 	int nb = w->couple ? (md->alpha_fixed ? 2 : 3) : 0;
-	for (int c = 0; c < nb; c++)
+	for (int c = 0; c < nb; c++) {
+		memset(Q[1 + c], 0, sizeof Q[1 + c]);
 		Q[1 + c][c] = 1.0; /* Q_X, Q_Y, Q_ALPHA */
+	}
 	model_reduced_solves(md, (const double(*)[NQ_FULL])evm->M, 1 + nb,
 			     (const double(*)[NQ_FULL])Q, a);
 	for (int r = 0; r < md->nq; r++) {
