@@ -127,6 +127,17 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		/* the selection below with its indices as constants: (x, y |
+		 * phi, s1, s2), alpha zero */
+		static const int full[5] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2};
+		q[Q_ALPHA] = qd[Q_ALPHA] = 0.0;
+		for (int r = 0; r < 5; r++) {
+			q[full[r]] = 0.0 + qr[r];
+			qd[full[r]] = 0.0 + qrd[r];
+		}
+		return;
+	}
 	memset(q, 0, sizeof(double) * NQ_FULL);
 	memset(qd, 0, sizeof(double) * NQ_FULL);
 	if (md->selection) {
