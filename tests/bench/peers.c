@@ -75,8 +75,11 @@ static double run_point(const char *name, double rtol, double dt, int substeps, 
 		r->rhs = s->sys.rhs_evals;
 		r->steps = name ? peer_of(s)->steps : st.steps;
 		r->rejected = name ? peer_of(s)->rejected : 0;
+		/* a peer's own reason, else the engine's (its state check
+		 * stops a diverging run without the peer saying why) */
 		if (err != SIM_OK)
-			snprintf(msg, sizeof msg, "%s", name ? peer_of(s)->msg : sim_last_error(s));
+			snprintf(msg, sizeof msg, "%s",
+				 name && peer_of(s)->msg[0] ? peer_of(s)->msg : sim_last_error(s));
 		sim_free(s);
 	} else if (err == SIM_OK) {
 		err = SIM_ESTEP;
