@@ -278,6 +278,28 @@ static void symmetric_reduction_by_itself(void **state)
 	sim_free(s);
 }
 
+/* The machine of u without feed, under the ideal drive (phi - alpha turns
+ * at omega_ss exactly), from a steady start at a 1e-4-s step: its status
+ * at t = 0 into *a and one rotor period later into *b; returns the orbit's
+ * size, the largest |q| at t = 0 but the rotor's angle. */
+static double one_period_apart(setup *u, sim_status *a, sim_status *b)
+{
+	set(u, "feed", "false");
+	set(u, "drive", "ideal");
+	set(u, "start", "steady");
+	set(u, "dt", "1e-4");
+	sim *s = make(u);
+	*a = status(s);
+	advance(s, 2 * M_PI / a->rotor_speed);
+	*b = status(s);
+	sim_free(s);
+	double size = 0.0;
+	for (int k = 0; k < 6; k++)
+		if (k != 3)
+			size = fmax(size, fabs(a->q[k]));
+	return size;
+}
+
 /* The `steady` start: at t = 0 every energy term is exactly zero, the
  * rotor turns near its loaded speed, and without a feed the machine (ideal
  * drive) is on its periodic orbit after the default settling: one period
@@ -307,24 +329,13 @@ static void steady_start(void **state)
 	}
 	for (int asym = 0; asym < 2; asym++) {
 		setup u = preset_defaults();
-		set(&u, "feed", "false");
-		set(&u, "drive", "ideal"); /* phi - alpha turns at omega_ss exactly */
-		set(&u, "start", "steady");
-		set(&u, "dt", "1e-4");
 		if (asym)
 			set(&u, "l2", "0.9");
-		sim *s = make(&u);
-		sim_status a = status(s);
-		double T = 2 * M_PI / a.rotor_speed, size = 0.0;
-		advance(s, T);
-		sim_status b = status(s);
-		for (int k = 0; k < 6; k++)
-			if (k != 3)
-				size = fmax(size, fabs(a.q[k]));
+		sim_status a, b;
+		double size = one_period_apart(&u, &a, &b);
 		for (int k = 0; k < 6; k++)
 			if (k != 3)
 				assert_close(b.q[k], a.q[k], (asym ? 1e-4 : 1e-7) * size);
-		sim_free(s);
 	}
 }
 
@@ -343,17 +354,9 @@ static void steady_start_is_the_frequency_domain_orbit(void **state)
 {
 	(void)state;
 	setup u = preset_defaults();
-	set(&u, "feed", "false");
-	set(&u, "drive", "ideal");
 	set(&u, "settle", "0");
-	set(&u, "dt", "1e-4");
-	sim *s = make(&u);
-	sim_status a = status(s);
-	double T = 2 * M_PI / a.rotor_speed, size = 0.0;
-	advance(s, T);
-	sim_status b = status(s);
-	for (int k = 0; k < 6; k++)
-		size = fmax(size, k == 3 ? 0.0 : fabs(a.q[k]));
+	sim_status a, b;
+	double size = one_period_apart(&u, &a, &b);
 	for (int k = 0; k < 6; k++) {
 		if (k == 3)
 			continue;
@@ -361,7 +364,6 @@ static void steady_start_is_the_frequency_domain_orbit(void **state)
 		/* rates observed between steps are linear in time: 1e-7 */
 		assert_close(b.qd[k], a.qd[k], 1e-6 * size * a.rotor_speed);
 	}
-	sim_free(s);
 	const char *feeds[] = {"true", "false"};
 	for (int f = 0; f < 2; f++) {
 		sim_status st[2];
