@@ -230,11 +230,11 @@ fail:
 
 /* The settling of a full model (trough_rotation) on a symmetric machine
  * with the Kloss drive and dem, done through the symmetric reduction:
- * there alpha = 0 and identical columns are an exact solution of the
- * full model (every moment cancels), so its settled state is the reduced
- * scene's, each column at its own deck point; the full model itself would
- * stray from it only by round-off that the feed's hopping amplifies
- * (alpha < 2e-6 rad after 1 s). The reduced settling costs a fifth of the
+ * there alpha = 0 and identical columns are the full model's solution
+ * but for the drive's reaction torque on the trough, which the reduction
+ * drops (it tilts the full model by about 1e-6 rad: alpha < 2e-6 rad
+ * after 1 s), so its settled state is the reduced scene's, each column at
+ * its own deck point. The reduced settling costs a fifth of the
  * feed's part (one column for K). Returns -1 where it does not apply (the
  * caller settles the full model), else SIM_OK or the settling's failure. */
 static int settle_reduced(sim *s)
