@@ -231,10 +231,11 @@ fail:
 /* The settling of a full model (trough_rotation) on a symmetric machine
  * with the Kloss drive and dem, done through the symmetric reduction:
  * there alpha = 0 and identical columns are the full model's solution
- * but for the drive's reaction torque on the trough, which the reduction
- * drops (it tilts the full model by about 1e-6 rad: alpha < 2e-6 rad
- * after 1 s), so its settled state is the reduced scene's, each column at
- * its own deck point. The reduced settling costs a fifth of the
+ * but for the small rocking the reduction drops (the moments of the
+ * eliminator masses, off G by their strokes, and the drive's reaction on
+ * the trough: alpha about 1e-6 rad, < 2e-6 rad after 1 s), so its
+ * settled state is the reduced scene's, each column at its own deck
+ * point. The reduced settling costs a fifth of the
  * feed's part (one column for K). Returns -1 where it does not apply (the
  * caller settles the full model), else SIM_OK or the settling's failure. */
 static int settle_reduced(sim *s)

@@ -381,8 +381,9 @@ static void steady_start_is_the_frequency_domain_orbit(void **state)
 		for (int k = 0; k < 6; k++)
 			orbit = fmax(orbit, k == 3 ? 0.0 : fabs(st[0].q[k]));
 		/* x, y, alpha and the eliminators' mean stroke: the full model
-		 * rocks a little against them (its rotor's reaction on alpha),
-		 * s1 - s2 = 1.4e-5 m, alpha 5e-7 rad, which the reduction drops */
+		 * rocks a little (the moments of the eliminator masses off G and
+		 * of the drive's reaction), s1 - s2 = 1.4e-5 m, alpha 5e-7 rad,
+		 * which the reduction drops */
 		for (int k = 0; k < 3; k++)
 			assert_close(st[1].q[k], st[0].q[k], 3e-4 * orbit);
 		assert_close(st[1].q[4] + st[1].q[5], st[0].q[4] + st[0].q[5], 6e-4 * orbit);
