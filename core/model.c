@@ -127,28 +127,20 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
-	if (md->layout == MODEL_LAYOUT_TROUGH2) {
-		/* the selection below with its indices as constants: (x, y |
-		 * phi, s1, s2), alpha zero */
-		static const int full[5] = {Q_X, Q_Y, Q_PHI, Q_S1, Q_S2};
-		q[Q_ALPHA] = qd[Q_ALPHA] = 0.0;
-		for (int r = 0; r < 5; r++) {
-			q[full[r]] = 0.0 + qr[r];
-			qd[full[r]] = 0.0 + qrd[r];
+	if (md->selection) {
+		/* each reduced coordinate one full one, none prescribed: each
+		 * full coordinate its reduced one added to zero, as
+		 * model_add_reduced would, or zero (no clear of the whole
+		 * arrays first: this runs several times a step) */
+		for (int i = 0; i < NQ_FULL; i++) {
+			int r = md->sel[i];
+			q[i] = r < 0 ? 0.0 : 0.0 + qr[r];
+			qd[i] = r < 0 ? 0.0 : 0.0 + qrd[r];
 		}
 		return;
 	}
 	memset(q, 0, sizeof(double) * NQ_FULL);
 	memset(qd, 0, sizeof(double) * NQ_FULL);
-	if (md->selection) {
-		/* each reduced coordinate one full one, none prescribed: that
-		 * one set to it, added to zero as model_add_reduced would */
-		for (int r = 0; r < md->nq; r++) {
-			q[md->col[r][0]] = 0.0 + qr[r];
-			qd[md->col[r][0]] = 0.0 + qrd[r];
-		}
-		return;
-	}
 	model_add_reduced(md, qr, q);
 	model_add_reduced(md, qrd, qd);
 	if (md->phi_prescribed) {

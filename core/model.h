@@ -58,6 +58,7 @@ typedef struct model {
 	 * point mass's own coordinate (phi, s1, s2; 0 for the trough's) */
 	int n_body, body[3];
 	int selection;                /* each reduced coordinate one full one, none prescribed */
+	int sel[NQ_FULL];             /* ... and then each full one's reduced one, -1 for none */
 	int layout;                   /* MODEL_LAYOUT_*: a solve of constant sizes, or the general */
 	double own_inv[NQ_FULL];
 	double own_m[NQ_FULL];        /* ... and that inertia, by full coordinate */

@@ -35,10 +35,13 @@ void model_solve_layout(model *md)
 	md->own_m[Q_S2] = p->m2;
 	md->n_body = 0;
 	md->selection = !md->phi_prescribed;
+	for (int i = 0; i < NQ_FULL; i++)
+		md->sel[i] = -1;
 	for (int r = 0; r < md->nq; r++) {
 		if (md->ncol[r] != 1)
 			md->selection = 0;
 		int i = md->col[r][0];
+		md->sel[i] = r;
 		md->own_inv[r] = 0.0;
 		if (md->ncol[r] == 1 && (i == Q_PHI || i == Q_S1 || i == Q_S2))
 			md->own_inv[r] = 1.0 / md->own_m[i];
