@@ -182,8 +182,14 @@ static int harmonic_orbit(shooter *sh, double *z)
 	const double w = 2.0 * M_PI / sh->T;
 	double y[NZ + ACC_N] = {0}, dy[NZ + ACC_N], g[HARMONIC_SAMPLES][NQ_FULL];
 	double A[NQ_FULL][NQ_FULL], B[NQ_FULL][NQ_FULL];
+	/* the samples: their times, and cos and sin of their phases */
+	double ts[HARMONIC_SAMPLES], cs[HARMONIC_SAMPLES], sn[HARMONIC_SAMPLES];
 	for (int k = 0; k < HARMONIC_SAMPLES; k++) {
-		shoot_rhs(sh, k * sh->T / HARMONIC_SAMPLES, y, dy, NULL);
+		double th = 2.0 * M_PI * k / HARMONIC_SAMPLES;
+		ts[k] = k * sh->T / HARMONIC_SAMPLES;
+		cs[k] = cos(th);
+		sn[k] = sin(th);
+		shoot_rhs(sh, ts[k], y, dy, NULL);
 		memcpy(g[k], dy + npos, sizeof(double) * (size_t)nq);
 	}
 	for (int c = 0; c < 2 * nq; c++) {
@@ -202,14 +208,12 @@ static int harmonic_orbit(shooter *sh, double *z)
 	}
 	double g0[NQ_FULL] = {0}, L[2 * NQ_FULL][2 * NQ_FULL], S[NQ_FULL][NQ_FULL],
 	       b[2 * NQ_FULL] = {0};
-	for (int k = 0; k < HARMONIC_SAMPLES; k++) {
-		double th = 2.0 * M_PI * k / HARMONIC_SAMPLES, c = cos(th), s = sin(th);
+	for (int k = 0; k < HARMONIC_SAMPLES; k++)
 		for (int r = 0; r < nq; r++) {
 			g0[r] -= g[k][r] / HARMONIC_SAMPLES;
-			b[r] -= 2.0 * c * g[k][r] / HARMONIC_SAMPLES;
-			b[nq + r] -= 2.0 * s * g[k][r] / HARMONIC_SAMPLES;
+			b[r] -= 2.0 * cs[k] * g[k][r] / HARMONIC_SAMPLES;
+			b[nq + r] -= 2.0 * sn[k] * g[k][r] / HARMONIC_SAMPLES;
 		}
-	}
 	for (int r = 0; r < nq; r++)
 		for (int c = 0; c < nq; c++) {
 			double a = A[r][c] + (r == c ? w * w : 0.0);
@@ -226,14 +230,13 @@ static int harmonic_orbit(shooter *sh, double *z)
 	/* the drive's mean torque over the orbit */
 	double torque = 0.0;
 	for (int k = 0; k < HARMONIC_SAMPLES; k++) {
-		double th = 2.0 * M_PI * k / HARMONIC_SAMPLES, c = cos(th), s = sin(th);
 		memset(y, 0, sizeof y);
 		for (int r = 0; r < nq; r++) {
-			y[r] = g0[r] + c * b[r] + s * b[nq + r];
-			y[npos + r] = w * (-s * b[r] + c * b[nq + r]);
+			y[r] = g0[r] + cs[k] * b[r] + sn[k] * b[nq + r];
+			y[npos + r] = w * (-sn[k] * b[r] + cs[k] * b[nq + r]);
 		}
 		model_eval ev;
-		shoot_rhs(sh, k * sh->T / HARMONIC_SAMPLES, y, dy, &ev);
+		shoot_rhs(sh, ts[k], y, dy, &ev);
 		torque += ev.torque;
 	}
 	sh->mean_torque = torque / HARMONIC_SAMPLES;
