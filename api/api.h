@@ -465,6 +465,10 @@ typedef struct api_sweep_point {
 	int steady;         /* the estimate showed no drift */
 	int mirrored;       /* the mirror image of another point of the sweep
 			       (sim_mirror_plan), not run itself */
+	double dt;          /* s: the machine step it was measured with */
+	int substeps;       /* feed sub-steps it was measured with */
+	double step_error;  /* m/s: the steps' share of the uncertainty */
+	int tol_met;        /* the uncertainty within the accuracy target */
 	char error[160];
 } api_sweep_point;
 typedef struct api_sweep_view {

@@ -184,6 +184,9 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(o, "transport_velocity_uncertainty",
 		       st->transport_velocity_uncertainty);
 	cJSON_AddBoolToObject(o, "steady", st->steady);
+	api_add_number(o, "step_error", st->step_error);
+	api_add_number(o, "tol", st->tol);
+	cJSON_AddBoolToObject(o, "tol_met", st->tol_met);
 	api_add_number(o, "transport_periods", st->transport_periods);
 	api_add_number(o, "feed_velocity", st->feed_velocity);
 	api_add_number(o, "feed_displacement", st->feed_displacement);

@@ -146,6 +146,10 @@ static void sample_body(writer *w, const api_sample *s, unsigned f)
 		w_num(w, "transport_velocity_uncertainty",
 		      st->transport_velocity_uncertainty);
 		w_str(w, st->steady ? ",\"steady\":true" : ",\"steady\":false");
+		w_num(w, "step_error", st->step_error);
+		w_str(w, st->tol_met ? ",\"tol_met\":true" : ",\"tol_met\":false");
+		w_num(w, "dt", st->dt);
+		w_num(w, "substeps", st->substeps);
 		w_array(w, "columns", s->column_disp, s->columns);
 	}
 	if (f & API_F_ENERGY) {

@@ -240,6 +240,10 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 			api_add_number(po, "velocity", p->velocity);
 			api_add_number(po, "uncertainty", p->uncertainty);
 			cJSON_AddBoolToObject(po, "steady", p->steady);
+			api_add_number(po, "dt", p->dt);
+			cJSON_AddNumberToObject(po, "substeps", p->substeps);
+			api_add_number(po, "step_error", p->step_error);
+			cJSON_AddBoolToObject(po, "tol_met", p->tol_met);
 		} else {
 			cJSON_AddNullToObject(po, "velocity");
 			cJSON_AddNullToObject(po, "uncertainty");
@@ -294,7 +298,16 @@ char *api_sweep_csv(const api_sweep_view *v)
 		if (done && isfinite(p->uncertainty))
 			api_buf_double(&b, p->uncertainty);
 		api_buf_puts(&b, !done ? "," : p->steady ? ",true" : ",false");
-		api_buf_printf(&b, ",%s\n", point_state(p->state));
+		api_buf_printf(&b, ",%s,", point_state(p->state));
+		if (done) {
+			api_buf_double(&b, p->dt);
+			api_buf_printf(&b, ",%d,", p->substeps);
+			if (isfinite(p->step_error))
+				api_buf_double(&b, p->step_error);
+			api_buf_puts(&b, p->tol_met ? ",true\n" : ",false\n");
+		} else {
+			api_buf_puts(&b, ",,,\n");
+		}
 	}
 	return api_buf_take(&b);
 }

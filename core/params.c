@@ -80,7 +80,8 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
 	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 2.5e-4 s (6.25e-5 s without feed_events)") \
-	X(G_METHOD, feed_events, BOOL, "", 0, 1, NULL, 1, "dem: locate slip reversals inside the feed's sub-steps and let the deck yield to the feed's impulses within the machine step; false: the former dem")
+	X(G_METHOD, feed_events, BOOL, "", 0, 1, NULL, 1, "dem: locate slip reversals inside the feed's sub-steps and let the deck yield to the feed's impulses within the machine step; false: the former dem") \
+	X(G_METHOD, tol, REAL, "", 1e-3, 0.2, NULL, 1, "accuracy target of the transport velocity (docs/MODEL.md's convention): the default steps scale with it, a measurement refines its steps until its estimated step error is within it")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"
@@ -175,26 +176,63 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	m->atol = 1e-9;
 	m->substeps = 0; /* as many as the feed step needs */
 	m->feed_events = 1;
+	m->tol = 0.01;
 }
 
-/* Defaults per scene kind, measured against the converged reference at
- * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
- * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
- * of 1.25e-3 s and feed sub-steps of at most 2.5e-4 s (5) with its slip
- * reversals located and the deck yielding within the step (worst 0.76 %
- * by docs/MODEL.md's convention after a `steady` start and a 4-s window;
- * 1e-3 s with 4 sub-steps 0.77 %, with 8 sub-steps 0.34 %: the feed step,
- * not the machine's, sets the error; the machine step is kept within 0.7
- * of its stability bound, 1.89e-3 s for czubak2016, see sim_max_dt);
- * without those (feed_events = false, the former dem) sub-steps of at
- * most 6.25e-5 s (16: worst 0.69 %; 8e-5 s sub-steps are 1.07 % off); a
- * feed too heavy for the corrector (added mass) takes single steps of
+/* Defaults from the scene's own time scales (docs/machine-zoo.md), so that
+ * a machine other than the preset gets steps that hold its accuracy
+ * target (tol, 1 % by default):
+ *  - the feed step resolves the contact: at most 1/17 of the contact
+ *    period 2 pi sqrt(m_n / k_t), k_t the contact's tangent stiffness at
+ *    the bottom of a settled column (p k delta^(p-1) at the compression
+ *    (W / k)^(1/p) of the column's weight W); below about 17 sub-steps a
+ *    contact period dem's v is not yet in its first-order regime and
+ *    wanders by several per cent (k_c = 1e7: +6.3 % at 10 sub-steps a
+ *    period, -0.3 % from 18 on), and never more than 2.5e-4 s (the
+ *    preset's feed step: 5 sub-steps of its 1.25e-3-s machine step);
+ *  - the machine step is at most 1/30 of the excitation period 2 pi /
+ *    omega_ss and never more than the preset's 1.25e-3 s (32 steps a
+ *    period at its 25 Hz; the machine step's error is first order, 0.2
+ *    to 0.5 % of v there on the zoo), within 0.7 of the method's
+ *    stability bound (sim_max_dt);
+ *  - both scale with tol / 1 % below 1 % (dem is first order in both);
+ *    a looser tol keeps the 1 % steps, since coarser ones leave the
+ *    first-order regime.
+ * Without feed_events (the former dem) the feed step is at most 6.25e-5 s;
+ * a feed too heavy for the corrector (added mass) takes single steps of
  * 2.5e-5 s; without feed the machine is smooth and RK4 at 1e-3 s keeps the
  * trajectory within 2e-4. */
 #define FEED_STEP_MAX 6.25e-5
 #define FEED_STEP_MAX_EVENTS 2.5e-4
 #define HEAVY_FEED_STEP 2.5e-5
 #define FEED_MACHINE_STEP 1.25e-3
+#define CONTACT_STEPS 17.0
+#define PERIOD_STEPS 30.0
+
+/* tol's factor on the default steps: tol / 1 %, at most 1. */
+static double tol_scale(const sim_method *m)
+{
+	return m->tol > 0.0 && m->tol < 0.01 ? m->tol / 0.01 : 1.0;
+}
+
+double sim_contact_period(const sim_params *p, const sim_scene *s)
+{
+	double k_t = p->k_c;
+	if (p->p != 1.0) {
+		double W = (double)s->layers * p->m_n * p->g;
+		double delta = pow(W / p->k_c, 1.0 / p->p);
+		k_t = p->p * p->k_c * pow(delta, p->p - 1.0);
+	}
+	return 2.0 * M_PI * sqrt(p->m_n / k_t);
+}
+
+/* A step rounded down to two significant digits: a step a reader can
+ * repeat. */
+static double two_digits(double dt)
+{
+	double unit = pow(10.0, floor(log10(dt)) - 1.0);
+	return floor(dt / unit * (1.0 + 1e-12)) * unit;
+}
 
 static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
@@ -205,9 +243,17 @@ static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim
 		return feed ? 1e-5 : 1e-3;
 	if (strcmp(m->name, "dopri5") == 0)
 		return 1e-5; /* the first step */
-	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO)
-		return HEAVY_FEED_STEP;
-	return feed && m->feed_events ? FEED_MACHINE_STEP : 1e-3;
+	double dt, top;
+	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO) {
+		top = HEAVY_FEED_STEP;
+		dt = fmin(top, sim_contact_period(p, s) / CONTACT_STEPS) * tol_scale(m);
+	} else if (feed && m->feed_events) {
+		top = FEED_MACHINE_STEP;
+		dt = fmin(top, 2.0 * M_PI / p->omega_ss / PERIOD_STEPS) * tol_scale(m);
+	} else {
+		return 1e-3;
+	}
+	return dt < top ? two_digits(dt) : top;
 }
 
 /* The default step's share of the stability bound: RK4 at 0.7 of it keeps
@@ -218,11 +264,7 @@ double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method 
 {
 	double dt = kind_default_dt(p, s, m);
 	double cap = DEFAULT_DT_STABILITY * sim_max_dt(p, s, m);
-	if (!(cap < dt))
-		return dt;
-	/* two significant digits, rounded down: a step a reader can repeat */
-	double unit = pow(10.0, floor(log10(cap)) - 1.0);
-	return floor(cap / unit) * unit;
+	return cap < dt ? two_digits(cap) : dt;
 }
 
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
@@ -234,11 +276,16 @@ double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 	return om->info.real_limit / rate;
 }
 
-int sim_default_substeps(const sim_method *m, double dt)
+double sim_default_feed_step(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
 	double hmax = m->feed_events ? FEED_STEP_MAX_EVENTS : FEED_STEP_MAX;
-	int n = (int)ceil(dt / hmax - 1e-9);
-	return n < 1 ? 1 : n;
+	return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS) * tol_scale(m);
+}
+
+int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_method *m, double dt)
+{
+	int n = (int)ceil(dt / sim_default_feed_step(p, s, m) - 1e-9);
+	return n < 1 ? 1 : n > 1000 ? 1000 : n;
 }
 
 /* czubak2016 with the eccentricity fitted to the paper's clockwise peaks

@@ -133,6 +133,9 @@ typedef struct sim_method {
 	double rtol, atol;
 	int substeps;
 	int feed_events;
+	double tol;   /* accuracy target of v (docs/MODEL.md's convention):
+			 the default steps scale with it and sim_measure
+			 refines until the estimated step error is within it */
 } sim_method;
 
 /* Description of one named setting, for validation, docs and OpenAPI. */
@@ -181,10 +184,17 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
  * that the mode stays damped (czubak2016: 1.32e-3 s, the 1.25e-3-s default
  * holds; a smaller eccentricity or a steeper motor takes a shorter step). */
 double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
-/* The feed sub-steps that substeps = 0 stands for with macro step dt (s)
- * under method m: as many as keep the feed's step at or below 2.5e-4 s
- * with m->feed_events, 6.25e-5 s without. */
-int sim_default_substeps(const sim_method *m, double dt);
+/* The feed step (s) of the scene's defaults: at most 1/17 of the contact
+ * period (sim_contact_period), 2.5e-4 s with m->feed_events (6.25e-5 s
+ * without), both times tol / 1 % where tol < 1 %. */
+double sim_default_feed_step(const sim_params *p, const sim_scene *s, const sim_method *m);
+/* The feed sub-steps that substeps = 0 stands for with macro step dt (s):
+ * as many as keep the feed's step within sim_default_feed_step (1 to
+ * 1000). */
+int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_method *m, double dt);
+/* The contact's period (s): 2 pi sqrt(m_n / k_t), k_t the contact law's
+ * tangent stiffness at the bottom of a settled column (k_c for p = 1). */
+double sim_contact_period(const sim_params *p, const sim_scene *s);
 
 /* The largest fixed step (s) method m keeps stable on the machine's
  * stiffest mode, the Kloss motor's slip (its real_limit over the slip
@@ -346,6 +356,19 @@ typedef struct sim_status {
 	int steady;               /* 1 when the estimate spans at least 8
 				     periods and shows no drift beyond its
 				     scatter */
+	double step_error;        /* m/s: the steps' part of the uncertainty:
+				     the feed step's error measured on the run
+				     (the shadow's Richardson estimate, sim.c)
+				     plus the machine step's a-priori term;
+				     before a shadow has finished (or where none
+				     runs) the calibrated term of the preset */
+	double machine_error;     /* m/s: the machine step's term within it */
+	double tol;               /* the accuracy target in use (sim_method.tol) */
+	double tol_allowed;       /* m/s: the error tol allows at this v:
+				     tol max(|v|, 0.3 v_peak), v_peak estimated
+				     from the trough's vibration speed */
+	int tol_met;              /* 1 when the whole uncertainty is within
+				     tol_allowed */
 	double rotor_speed_mean;  /* rad/s, motor_torque_mean N m, power_mean W:
 				     means over the same whole periods as
 				     transport_velocity; NaN before one */
@@ -378,11 +401,20 @@ typedef struct sim_measurement {
 	double periods;                         /* whole periods spanned */
 	double rotor_speed_mean;                /* rad/s */
 	double cpu_seconds;                     /* of this thread */
+	double step_error;                      /* m/s, sim_status's */
+	int tol_met;                            /* sim_status's */
+	double dt;                              /* s: the machine step chosen */
+	int substeps;                           /* feed sub-steps chosen */
+	int refinements;                        /* runs repeated at finer steps */
 } sim_measurement;
 
 /* Create a fresh instance, run it to t_end (s) and fill *out (NaN fields
- * where undefined); msg as sim_new, or the failure's cause. Returns
- * sim_new's or sim_advance's code. For sweeps (thread-safe). */
+ * where undefined); msg as sim_new, or the failure's cause. Where the
+ * steps are the engine's (dem, dt = 0 and substeps = 0) and the
+ * uncertainty is beyond what m->tol allows because of the steps' error,
+ * the run is repeated at finer steps (at most 3 times; *out says which
+ * steps and how many repeats). Returns sim_new's or sim_advance's code.
+ * For sweeps (thread-safe). */
 int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen);
 

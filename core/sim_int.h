@@ -29,6 +29,15 @@ struct sim {
 	estimator est;
 	double X0;
 	double *X0k;
+	/* the measured step error (sim.c, "shadow"): a second instance with
+	 * fewer feed sub-steps, restored from this one's checkpoint where an estimate
+	 * starts and stepped beside it until shadow_until; NULL when none
+	 * runs */
+	struct sim *shadow;
+	double shadow_until;  /* s */
+	double shadow_window; /* s: how long a shadow runs after the estimate's start */
+	double step_error;    /* m/s: the last shadow's Richardson estimate of
+				 the feed step's error in v; NaN before one */
 	sim_status st;
 };
 

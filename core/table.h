@@ -106,7 +106,11 @@ static inline void sim_trajectory_row(const sim_status *st, double *row)
 
 /* The v(beta) sweep's CSV header: beta in deg, rotation cw|ccw, velocity
  * and uncertainty in m/s (empty when not measured), steady true|false,
- * state queued|running|done|failed|cancelled. */
-#define SIM_SWEEP_CSV_HEADER "beta,rotation,velocity,uncertainty,steady,state"
+ * state queued|running|done|failed|cancelled; then the steps the point
+ * was measured with (dt in s, feed sub-steps), the steps' share of the
+ * uncertainty (step_error, m/s) and whether the uncertainty is within
+ * the accuracy target tol (tol_met true|false). */
+#define SIM_SWEEP_CSV_HEADER \
+	"beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met"
 
 #endif

@@ -188,7 +188,7 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			sim_method dem = *m;
 			snprintf(dem.name, sizeof dem.name, "dem");
 			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
-			substeps = sim_default_substeps(&dem, dt);
+			substeps = sim_default_substeps(&spec->params, &spec->scene, &dem, dt);
 		}
 	if (strcmp(m->name, "euler") == 0)
 		evals = 0.25; /* one right-hand side a step, not four */

@@ -215,6 +215,10 @@ static void fill_image(srv_sweep *sw, size_t i)
 	p->velocity = -src->velocity;
 	p->uncertainty = src->uncertainty;
 	p->steady = src->steady;
+	p->dt = src->dt;
+	p->substeps = src->substeps;
+	p->step_error = src->step_error;
+	p->tol_met = src->tol_met;
 	if (src->state == 3)
 		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
 				   src->error);
@@ -252,6 +256,10 @@ static void run_point(void *arg)
 			p->velocity = r.transport_velocity;
 			p->uncertainty = r.uncertainty;
 			p->steady = r.steady;
+			p->dt = r.dt;
+			p->substeps = r.substeps;
+			p->step_error = r.step_error;
+			p->tol_met = r.tol_met;
 		} else {
 			p->state = 3;
 			snprintf(p->error, sizeof p->error, "%s",

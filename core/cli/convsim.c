@@ -128,6 +128,10 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 	NUM("transport_velocity", st->transport_velocity);
 	NUM("transport_velocity_uncertainty", st->transport_velocity_uncertainty);
 	fprintf(f, ",\n  \"steady\": %s", st->steady ? "true" : "false");
+	NUM("step_error", st->step_error);
+	NUM("tol", st->tol);
+	NUM("tol_allowed", st->tol_allowed);
+	fprintf(f, ",\n  \"tol_met\": %s", st->tol_met ? "true" : "false");
 	NUM("transport_periods", st->transport_periods);
 	NUM("rotor_speed", st->rotor_speed_mean);
 	NUM("motor_torque", st->motor_torque_mean);
@@ -373,10 +377,16 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 		fputs(json ? ",\"uncertainty\":" : ",", f);
 		put_num(f, t->r.uncertainty, nf);
 		if (json)
-			fprintf(f, ",\"steady\":%s,\"state\":\"%s\",\"mirrored\":%s}%s\n", steady,
-				state, t->source >= 0 ? "true" : "false", i + 1 < ntasks ? "," : "");
+			fprintf(f, ",\"steady\":%s,\"state\":\"%s\",\"mirrored\":%s", steady, state,
+				t->source >= 0 ? "true" : "false");
 		else
-			fprintf(f, ",%s,%s\n", steady, state);
+			fprintf(f, ",%s,%s", steady, state);
+		fputs(json ? ",\"dt\":" : ",", f);
+		put_num(f, t->r.dt, nf);
+		fprintf(f, json ? ",\"substeps\":%d,\"step_error\":" : ",%d,", t->r.substeps);
+		put_num(f, t->r.step_error, nf);
+		fprintf(f, json ? ",\"tol_met\":%s}%s\n" : ",%s%s\n", t->r.tol_met ? "true" : "false",
+			json && i + 1 < ntasks ? "," : "");
 	}
 	if (json)
 		fputs("]}\n", f);
