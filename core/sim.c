@@ -3,7 +3,7 @@
  * state, the chosen integrator's workspace and the observers (the
  * transport-velocity estimator of estimator.c, the energy baselines); the
  * `steady` start's settling; stepping with observation on the step's
- * interpolant; the controls; sim_measure. The caller decides when to step
+ * interpolant; the controls. The caller decides when to step
  * (sim_advance); controls take effect at the integrator's current time.
  * What the instance shows is computed in sim_status.c after each change,
  * with an evaluation that counts nothing.
@@ -12,16 +12,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "feed.h"
 #include "sim_int.h"
 #include "units.h"
 
-/* The shadow's window (see "the measured step error" below). */
-#define SHADOW_PERIODS 40.0
-#define SHADOW_MEASURE_SHARE 0.45
-static void shadow_begin(sim *s);
 
 /* Divergence guard, machine: bounded displacements, rotation, strokes and
  * rotor speed; NULL or the cause. */
@@ -191,50 +186,6 @@ static void zero_observers(sim *s, int origins)
 	sim_update_status(s);
 }
 
-sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
-	       char *msg, size_t msglen)
-{
-	int e = sim_validate(p, sc, m, msg, msglen);
-	sim *s = NULL;
-	if (e != SIM_OK)
-		goto fail;
-	e = SIM_ENOMEM;
-	s = calloc(1, sizeof *s);
-	if (!s)
-		goto fail;
-	model_init(&s->md, &s->ctl, p, sc);
-	s->sys = (dyn){.md = &s->md, .ctl = &s->ctl, .rhs_evals = 0};
-	s->cfg = *m;
-	if (s->cfg.dt == 0.0)
-		s->cfg.dt = sim_default_dt(p, sc, m);
-	if (s->cfg.substeps == 0)
-		s->cfg.substeps = s->md.nf > 0 ? sim_default_substeps(p, sc, &s->cfg, s->cfg.dt) : 1;
-	s->ode = ode_find(m->name);
-	s->step_error = NAN;
-	s->shadow_window = SHADOW_PERIODS * 2.0 * M_PI / p->omega_ss;
-	size_t n = (size_t)s->md.n;
-	s->y = calloc(4 * n, sizeof(double));
-	s->X0k = calloc((size_t)(s->md.dk.K > 0 ? s->md.dk.K : 1), sizeof(double));
-	if (!s->y || !s->X0k)
-		goto fail;
-	s->y_obs = s->y + n;
-	s->dy = s->y_obs + n;
-	s->y_prev = s->dy + n;
-	s->ws = s->ode->alloc(&s->md, &s->cfg);
-	if (!s->ws)
-		goto fail;
-	if (err)
-		*err = SIM_OK;
-	return s;
-fail:
-	if (e == SIM_ENOMEM && msg)
-		snprintf(msg, msglen, "out of memory for the simulation workspace");
-	if (err)
-		*err = e;
-	sim_free(s);
-	return NULL;
-}
-
 /* The settling of a full model (trough_rotation) on a symmetric machine
  * with the Kloss drive and dem, done through the symmetric reduction:
  * there alpha = 0 and identical columns are the full model's solution
@@ -312,8 +263,7 @@ int sim_start(sim *s, char *msg, size_t msglen)
 	return SIM_OK;
 }
 
-/* sim_new with the shadow's window (s; <= 0: the default, 40 periods). */
-static sim *new_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
+sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			 double shadow_window, int *err, char *msg, size_t msglen)
 {
 	sim *s = sim_alloc(p, sc, m, err, msg, msglen);
@@ -335,19 +285,7 @@ static sim *new_instance(const sim_params *p, const sim_scene *sc, const sim_met
 sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
 	     size_t msglen)
 {
-	return new_instance(p, sc, m, 0.0, err, msg, msglen);
-}
-
-void sim_free(sim *s)
-{
-	if (!s)
-		return;
-	sim_free(s->shadow);
-	if (s->ode && s->ws)
-		s->ode->free(s->ws);
-	free(s->y);
-	free(s->X0k);
-	free(s);
+	return sim_new_windowed(p, sc, m, 0.0, err, msg, msglen);
 }
 
 const char *sim_last_error(const sim *s)
@@ -434,69 +372,6 @@ static int advance(sim *s, double t_end)
 	return SIM_OK;
 }
 
-
-/* ---- the measured step error ("shadow") ----
- *
- * dem's transport velocity is first order in the feed step h once the
- * step resolves the contact (docs/machine-zoo.md): v(h) = v* + C h. A
- * second instance with fewer feed sub-steps (the same machine steps, so
- * the same time grid, and the same controls), restored from this one's
- * checkpoint where an estimate starts, is stepped beside it over the
- * first shadow_window seconds of the estimate; then the two estimates
- * over the same whole periods give Richardson's estimate of this run's
- * feed-step error, |v(r h) - v(h)| / (r - 1) (exact for a first-order
- * error, an overestimate for a higher order), and the shadow is freed. A
- * shadow that fails (the coarser step too coarse for the contact) makes
- * the error infinite. The shadow takes ceil(n / 2) sub-steps, so r = n /
- * ceil(n / 2) (5/3 for the preset's 5): halving them would put the
- * preset's shadow at a seventh of the contact period, outside dem's
- * first-order regime, where ceil(n / 2) keeps it within a tenth. The
- * machine step cannot be lengthened alike (the motor's slip mode bounds
- * it; a shadow at 0.9 of that bound gave estimates both far over and far
- * under the error on czubak2016), so its error is an a-priori term
- * (sim_status.c). The shadow needs n >= 3 (dem's corrector needs 2
- * sub-steps on each side); with fewer, without feed or with another
- * method there is none and the error bar keeps the preset's calibrated
- * step term. It costs about 0.8 of this instance while it runs: 40
- * periods after each estimate's start (a control, a restart), and
- * SHADOW_MEASURE_SHARE of a measurement's window (sim_measure). */
-
-static void shadow_stop(sim *s)
-{
-	sim_free(s->shadow);
-	s->shadow = NULL;
-}
-
-/* Start a shadow from the present state, to run until the estimate's
- * start plus the shadow's window. */
-static void shadow_begin(sim *s)
-{
-	shadow_stop(s);
-	if (s->ode != &ode_dem || s->md.nf == 0 || s->cfg.substeps < 3 || s->failed)
-		return;
-	sim_method m = s->cfg;
-	m.substeps = (s->cfg.substeps + 1) / 2;
-	size_t len = sim_checkpoint_size(s);
-	void *buf = malloc(len);
-	if (!buf)
-		return;
-	if (sim_checkpoint(s, buf, len) == SIM_OK)
-		s->shadow = sim_restore(&s->md.p, &s->md.sc, &m, buf, len, NULL, NULL, 0);
-	free(buf);
-	s->shadow_until = fmax(s->t_int, s->est.start) + s->shadow_window;
-}
-
-/* The shadow's estimate against this instance's, both at shadow_until. */
-static void shadow_finish(sim *s)
-{
-	estimate a, b;
-	estimator_read(&s->est, &a);
-	estimator_read(&s->shadow->est, &b);
-	double r = (double)s->cfg.substeps / (double)s->shadow->cfg.substeps;
-	s->step_error = s->shadow->failed ? INFINITY
-			: fabs(b.transport_velocity - a.transport_velocity) / (r - 1.0);
-	shadow_stop(s);
-}
 
 int sim_advance(sim *s, double t_end)
 {
@@ -614,75 +489,4 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 	zero_observers(s, 0); /* displacements still count from the start */
 	shadow_begin(s);
 	return SIM_OK;
-}
-
-/* sim_measure's refinements at most: each shrinks the feed step (and the
- * machine step where its term is large) by the factor the first-order
- * error asks for, within [1/4, 3/5]. */
-#define MEASURE_REFINEMENTS 3
-
-/* One run of sim_measure: a fresh instance to t_end, its shadow over the
- * first SHADOW_MEASURE_SHARE of the window; *st its final status. */
-static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, sim_status *st, char *msg, size_t msglen)
-{
-	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
-			   .rotor_speed_mean = NAN, .step_error = NAN, .tol_allowed = NAN};
-	int err;
-	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
-	sim *s = new_instance(p, sc, m, window > 0.0 ? window : 0.0, &err, msg, msglen);
-	if (!s)
-		return err;
-	err = sim_advance(s, t_end);
-	if (err != SIM_OK && msg)
-		snprintf(msg, msglen, "%s", s->error);
-	*st = s->st;
-	sim_free(s);
-	return err;
-}
-
-int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
-		sim_measurement *out, char *msg, size_t msglen)
-{
-	struct timespec c0, c1;
-	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
-	*out = (sim_measurement){.transport_velocity = NAN, .uncertainty = NAN,
-				 .rotor_speed_mean = NAN, .step_error = NAN};
-	sim_method run = *m;
-	sim_status st;
-	int err;
-	/* the steps are the engine's to choose only where the user left them */
-	int own_steps = m->dt == 0.0 && m->substeps == 0 && strcmp(m->name, "dem") == 0;
-	for (int attempt = 0;; attempt++) {
-		err = measure_once(p, sc, &run, t_end, &st, msg, msglen);
-		out->refinements = attempt;
-		if (err != SIM_OK || !own_steps || st.tol_met || attempt == MEASURE_REFINEMENTS ||
-		    !(st.step_error > st.tol_allowed) || st.substeps < 1)
-			break;
-		/* first order in both steps: the feed step shrinks by the factor
-		 * asked, and the machine step too where its a-priori term alone
-		 * exceeds half of what tol allows */
-		double f = fmin(0.6, fmax(0.25, 0.7 * st.tol_allowed / st.step_error));
-		if (st.machine_error > 0.5 * st.tol_allowed) {
-			run.dt = st.dt * f;
-			run.substeps = st.substeps;
-		} else {
-			run.dt = st.dt;
-			run.substeps = (int)ceil(st.substeps / f);
-		}
-		if (run.substeps > 1000)
-			break;
-	}
-	out->transport_velocity = st.transport_velocity;
-	out->uncertainty = st.transport_velocity_uncertainty;
-	out->steady = st.steady;
-	out->periods = st.transport_periods;
-	out->rotor_speed_mean = st.rotor_speed_mean;
-	out->step_error = st.step_error;
-	out->tol_met = st.tol_met;
-	out->dt = st.dt;
-	out->substeps = st.substeps;
-	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
-	out->cpu_seconds = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-	return err;
 }

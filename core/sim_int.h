@@ -56,6 +56,21 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
  * s->ode and s->ws between sim_alloc and sim_start. sim.c */
 int sim_start(sim *s, char *msg, size_t msglen);
 
+/* sim_new with the shadow's window (s; <= 0: the default, SHADOW_PERIODS
+ * excitation periods). sim.c */
+sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method *m,
+		      double shadow_window, int *err, char *msg, size_t msglen);
+
+/* The measured step error (shadow.c): shadow_begin starts a shadow from
+ * the instance's present state (none where it cannot run), to run until
+ * the estimate's start plus s->shadow_window; shadow_finish sets
+ * s->step_error from the shadow's estimate against the instance's, both
+ * at shadow_until, and frees it; shadow_stop frees it. */
+#define SHADOW_PERIODS 40.0
+void shadow_begin(sim *s);
+void shadow_finish(sim *s);
+void shadow_stop(sim *s);
+
 /* Recompute s->st at the observed time after any change; reads the state
  * and evaluates the right-hand side for observation only (no counter
  * moves). sim_status.c */

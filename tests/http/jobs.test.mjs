@@ -106,12 +106,18 @@ test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, as
   const csv = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`);
   assert.equal(csv.headers.get('content-type'), 'text/csv');
   const lines = csv.text.trim().split('\n');
-  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state');
+  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
   assert.equal(lines.length, 5);
   const first = lines[1].split(',');
   const p0 = done.points[0];
   assert.deepEqual(first, [String(p0.beta), p0.rotation, String(p0.velocity), String(p0.uncertainty),
-    String(p0.steady), 'done']);
+    String(p0.steady), 'done', String(p0.dt), String(p0.substeps), String(p0.step_error), String(p0.tol_met)]);
+  for (const p of done.points) {
+    assert.ok(p.dt > 0 && p.dt <= 1.25e-3, `dt ${p.dt}`);
+    assert.ok(Number.isInteger(p.substeps) && p.substeps >= 5, `substeps ${p.substeps}`);
+    assert.ok(p.step_error > 0 && p.step_error <= p.uncertainty, `step_error ${p.step_error}`);
+    assert.equal(typeof p.tol_met, 'boolean');
+  }
   const bad = await req(d.base, 'POST', '/api/v1/sweeps', { rotations: ['up'] });
   assert.equal(bad.status, 422);
   const bad2 = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [10, 'x'] });

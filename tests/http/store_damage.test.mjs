@@ -20,7 +20,7 @@ const CKPT_RECORD = 320;   // srv_ckpt_record; exp_len at 304, sim_len at 312
 const SPEC_PRESET = 24;    // spec_record: id[24], then api_spec's preset[32]
 const SPEC_METHOD = 472;   // api_spec's method.name[24] (api_spec at 24)
 const SPEC_ATOL = 512;     // method.atol
-const SPEC_PACE = 528;     // pace (0: "max"), then until at 536
+const SPEC_PACE = 536;     // pace (0: "max"), then until at 544
 
 // sim_checksum of the payload into the frame's checksum field: FNV-1a 64
 // with core/checkpoint.c's starting value.

@@ -311,7 +311,7 @@ test('a sweep draws v(β) for both rotations', async () => {
 	assert.equal((await fetch(base + href)).status, 401, 'the link alone is not enough');
 	const csv = (await (await fetch(base + href, { headers: AUTH })).text()).trim().split('\n');
 	assert.equal(csv.length, 7, csv.join('\n'));
-	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state');
+	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
 	const got = csvLines(await download('#sweep-csv'));
 	assert.deepEqual(got, csv);
 	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));

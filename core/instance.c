@@ -1,0 +1,68 @@
+/*
+ * instance.c - an instance's workspace: allocated once for a validated
+ * set (the model, the controls, the state vectors, the integrator's
+ * workspace), released with everything it owns. Shared by sim.c (a new
+ * instance), checkpoint.c (a restored one) and shadow.c (the measured
+ * step error's second instance).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "sim_int.h"
+
+sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
+	       char *msg, size_t msglen)
+{
+	int e = sim_validate(p, sc, m, msg, msglen);
+	sim *s = NULL;
+	if (e != SIM_OK)
+		goto fail;
+	e = SIM_ENOMEM;
+	s = calloc(1, sizeof *s);
+	if (!s)
+		goto fail;
+	model_init(&s->md, &s->ctl, p, sc);
+	s->sys = (dyn){.md = &s->md, .ctl = &s->ctl, .rhs_evals = 0};
+	s->cfg = *m;
+	if (s->cfg.dt == 0.0)
+		s->cfg.dt = sim_default_dt(p, sc, m);
+	if (s->cfg.substeps == 0)
+		s->cfg.substeps = s->md.nf > 0 ? sim_default_substeps(p, sc, &s->cfg, s->cfg.dt) : 1;
+	s->ode = ode_find(m->name);
+	s->step_error = NAN;
+	s->shadow_window = SHADOW_PERIODS * 2.0 * M_PI / p->omega_ss;
+	size_t n = (size_t)s->md.n;
+	s->y = calloc(4 * n, sizeof(double));
+	s->X0k = calloc((size_t)(s->md.dk.K > 0 ? s->md.dk.K : 1), sizeof(double));
+	if (!s->y || !s->X0k)
+		goto fail;
+	s->y_obs = s->y + n;
+	s->dy = s->y_obs + n;
+	s->y_prev = s->dy + n;
+	s->ws = s->ode->alloc(&s->md, &s->cfg);
+	if (!s->ws)
+		goto fail;
+	if (err)
+		*err = SIM_OK;
+	return s;
+fail:
+	if (e == SIM_ENOMEM && msg)
+		snprintf(msg, msglen, "out of memory for the simulation workspace");
+	if (err)
+		*err = e;
+	sim_free(s);
+	return NULL;
+}
+
+void sim_free(sim *s)
+{
+	if (!s)
+		return;
+	sim_free(s->shadow);
+	if (s->ode && s->ws)
+		s->ode->free(s->ws);
+	free(s->y);
+	free(s->X0k);
+	free(s);
+}
