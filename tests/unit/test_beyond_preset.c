@@ -119,7 +119,7 @@ static void settled_stack_compressions(void **state)
  *   M = M_r + m + m1 + m2,
  * and the motion is x0 cos(omega t) about the static equilibrium. The run
  * is compared with it every 5 ms over 1 s. Tolerance 1e-7 of x0: rk4 at
- * omega h < 0.005 has a phase error below 1e-9 rad over the second and the
+ * omega h < 0.006 has a phase error below 1e-9 rad over the second and the
  * observation's interpolant one below 1e-11 of x0; 0.1 % off in omega is
  * already 3e-2 (y) to 6e-2 (x) of x0 at t = 1 s. */
 static void suspension_frequencies(void **state)
