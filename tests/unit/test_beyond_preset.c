@@ -31,6 +31,14 @@ static void displace(sim *s, int coord, double by)
 	fail_msg("coordinate %d is not integrated on its own", coord);
 }
 
+/* Each NAME=VALUE of a table of n (user units) in turn, or fail the test. */
+static void set_all(setup *u, const char *const (*sets)[2], size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		set(u, sets[i][0], sets[i][1]);
+}
+#define SET_ALL(u, sets) set_all(u, sets, sizeof sets / sizeof sets[0])
+
 /* A machine without feed, on the ideal drive switched off: the rotor is
  * held at its angle relative to the trough, so the unbalanced mass rides
  * with the trough as a fixed point mass; no damping anywhere but the
@@ -38,14 +46,11 @@ static void displace(sim *s, int coord, double by)
 static setup free_machine(void)
 {
 	setup u = preset();
-	set(&u, "feed", "false");
-	set(&u, "drive", "ideal");
-	set(&u, "motor_on", "false");
-	set(&u, "b_x", "0");
-	set(&u, "b_y", "0");
-	set(&u, "trough_rotation", "false");
-	set(&u, "method", "rk4");
-	set(&u, "dt", "1e-4");
+	static const char *const sets[][2] = {{"feed", "false"},  {"drive", "ideal"},
+					      {"motor_on", "false"}, {"b_x", "0"},
+					      {"b_y", "0"},         {"trough_rotation", "false"},
+					      {"method", "rk4"},    {"dt", "1e-4"}};
+	SET_ALL(&u, sets);
 	return u;
 }
 
@@ -74,14 +79,11 @@ static void settled_stack_compressions(void **state)
 	for (int pi = 0; pi < 2; pi++)
 		for (int mi = 0; mi < 2; mi++) {
 			setup u = one_element();
-			set(&u, "layers", "6");
-			set(&u, "p", ps[pi]);
-			set(&u, "k_c", "3e5");
-			set(&u, "m_n", "0.3");
-			set(&u, "R", "1");
-			set(&u, "method", methods[mi][0]);
-			set(&u, "dt", methods[mi][1]);
-			set(&u, "substeps", "1");
+			const char *const sets[][2] = {{"layers", "6"}, {"p", ps[pi]},
+						       {"k_c", "3e5"},  {"m_n", "0.3"},
+						       {"R", "1"},      {"method", methods[mi][0]},
+						       {"dt", methods[mi][1]}, {"substeps", "1"}};
+			SET_ALL(&u, sets);
 			double p = atof(ps[pi]), k = 3e5, w = 0.3 * 9.81;
 			sim *s = make(&u);
 			for (int pass = 0; pass < 2; pass++) {
@@ -129,13 +131,10 @@ static void suspension_frequencies(void **state)
 	const double M = M_r + m + 2.0 * m1;
 	for (int dir = 0; dir < 2; dir++) {
 		setup u = free_machine();
-		set(&u, "M_r", "90");
-		set(&u, "m", "6");
-		set(&u, "m1", "12");
-		set(&u, "m2", "12");
-		set(&u, "k_x", "2e5");
-		set(&u, "k_y", "6e4");
-		set(&u, "beta", dir == 0 ? "0" : "90");
+		const char *const sets[][2] = {{"M_r", "90"},  {"m", "6"},     {"m1", "12"},
+					       {"m2", "12"},   {"k_x", "2e5"}, {"k_y", "6e4"},
+					       {"beta", dir == 0 ? "0" : "90"}};
+		SET_ALL(&u, sets);
 		sim *s = make(&u);
 		assert_int_equal(status(s).reductions & SIM_RED_SYMMETRIC, SIM_RED_SYMMETRIC);
 		int coord = dir == 0 ? Q_X : Q_Y;
@@ -246,13 +245,12 @@ static void statics_with_h_and_c(void **state)
 {
 	(void)state;
 	setup u = preset();
-	const char *sets[][2] = {{"l1", "1.1"},   {"l2", "0.7"},       {"h", "0.3"},   {"c", "0.15"},
+	const char *const sets[][2] = {{"l1", "1.1"},   {"l2", "0.7"},       {"h", "0.3"},   {"c", "0.15"},
 				 {"k_x", "2e5"},  {"k_y", "5e4"},      {"beta", "50"}, {"w_x", "0.1"},
 				 {"w_y", "0.05"}, {"columns", "3"},    {"layers", "4"}, {"m_n", "2"},
 				 {"h_d", "0.12"}, {"column_span", "0.6"}, {"motor_on", "false"},
 				 {"method", "dem"}, {"dt", "1e-4"}};
-	for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++)
-		set(&u, sets[i][0], sets[i][1]);
+	SET_ALL(&u, sets);
 	double q[NQ_FULL], a0 = 0.0, a1 = 1e-4;
 	double m0 = hand_statics(&u.p, 3, 4, a0, q), m1 = hand_statics(&u.p, 3, 4, a1, q);
 	for (int it = 0; it < 50 && m1 != m0 && a1 != a0; it++) {
@@ -300,12 +298,11 @@ static void lever_arm_rocks_the_trough(void **state)
 	const double M_r = 100.0, J_r = 20.0, k_x = 1.0e5, k_y = 4.0e4, h = 0.25, l = 0.8;
 	const double x0 = 1e-3, W = (M_r + 3e-3) * 9.81;
 	setup u = free_machine();
-	const char *sets[][2] = {{"M_r", "100"}, {"J_r", "20"}, {"k_x", "1e5"}, {"k_y", "4e4"},
+	const char *const sets[][2] = {{"M_r", "100"}, {"J_r", "20"}, {"k_x", "1e5"}, {"k_y", "4e4"},
 				 {"h", "0.25"},  {"l1", "0.8"}, {"l2", "0.8"},  {"m", "0.001"},
 				 {"e", "0"},     {"m1", "0.001"}, {"m2", "0.001"}, {"k_s1", "1"},
 				 {"k_s2", "1"},  {"b_s1", "0"},  {"b_s2", "0"}};
-	for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++)
-		set(&u, sets[i][0], sets[i][1]);
+	SET_ALL(&u, sets);
 	/* the 2 x 2 problem K v = w^2 M v, M = diag(M_r, J_r) */
 	const double Kxx = 2 * k_x, Kxa = 2 * k_x * h, Kaa = 2 * k_y * l * l + 2 * k_x * h * h - h * W;
 	const double A = Kxx / M_r, B = Kxa / M_r, C = Kxa / J_r, D = Kaa / J_r;
@@ -371,15 +368,11 @@ static void two_layers_slide_on_each_other(void **state)
 	const double v0[2] = {2.0, 1.0}, acc[2] = {-3.0 * mu * g, mu * g};
 	for (int mi = 0; mi < 2; mi++) {
 		setup u = one_element();
-		set(&u, "layers", "2");
-		set(&u, "mu", "0.7");
-		set(&u, "R", "1");
-		set(&u, "p", "1.5");
-		set(&u, "friction", "regularised");
-		set(&u, "friction_eps", "1e-3");
-		set(&u, "method", methods[mi][0]);
-		set(&u, "dt", methods[mi][1]);
-		set(&u, "substeps", "1");
+		const char *const sets[][2] = {{"layers", "2"}, {"mu", "0.7"}, {"R", "1"}, {"p", "1.5"},
+					       {"friction", "regularised"}, {"friction_eps", "1e-3"},
+					       {"method", methods[mi][0]}, {"dt", methods[mi][1]},
+					       {"substeps", "1"}};
+		SET_ALL(&u, sets);
 		sim *s = make(&u);
 		double xi0[2];
 		sim_feed_state(s, xi0, NULL);
@@ -422,11 +415,10 @@ static void rotor_speed_mean_counts_periods(void **state)
 	(void)state;
 	for (int r = 0; r < 2; r++) {
 		setup u = preset();
-		const char *sets[][2] = {{"feed", "false"}, {"l2", "0.8"},   {"h", "0.2"},
+		const char *const sets[][2] = {{"feed", "false"}, {"l2", "0.8"},   {"h", "0.2"},
 					 {"omega_ss", "100"}, {"e", "0.03"},  {"M_load", "3"},
 					 {"method", "rk4"}, {"dt", "1e-4"}, {"transient", "1"}};
-		for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++)
-			set(&u, sets[i][0], sets[i][1]);
+		SET_ALL(&u, sets);
 		set(&u, "rotation", r ? "ccw" : "cw");
 		const double dt = 1e-4, transient = 1.0;
 		const int steps = 50000;
