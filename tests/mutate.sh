@@ -19,6 +19,17 @@ mutations=(
 	"restitution ignored (unloading as loading)|core/feed.c|s|R2 = md->p.R \* md->p.R;|R2 = 1.0;|"
 	"a degree passed as a radian (beta's scale)|core/params.c|s|\"deg\", 0, 180, NULL, RAD_PER_DEG,|\"deg\", 0, 180, NULL, 1,|"
 	"the drive's reaction on the trough with the wrong sign|core/model.c|s|rhs\[Q_ALPHA\] -= dt->torque - dt->drag + dt->load;|rhs[Q_ALPHA] += dt->torque - dt->drag + dt->load;|"
+	# faults that change nothing on the preset (p = 1, k_x = k_y, h = 0,
+	# c = 0, l1 = l2, Coulomb friction): tests/unit/test_beyond_preset.c
+	"the contact exponent p ignored (k delta for k delta^p)|core/feed.c|s|: k_c \* pow(delta, p);|: k_c * delta;|"
+	"the settled stack's compressions ignore p|core/feed.c|s|pow(load / md->p.k_c, 1.0 / md->p.p)|load / md->p.k_c|"
+	"the vertical spring using k_x|core/model.c|s|double Fy = -p->k_y \* u\[1\]|double Fy = -p->k_x * u[1]|"
+	"friction measured against the deck, not the layer below (the feed's right-hand side)|core/feed.c|s|prev_xid = xid\[e\];|prev_xid = dvel[0];|"
+	"the regularised law's friction measured against the deck, not the layer below (dem)|core/feed.c|s|double below = j == 0 ? dv1\[0\] : xid\[j - 1\];|double below = dv1[0];|"
+	"the eliminator offset c ignored in the eliminators' geometry|core/model.c|s|double cs = md->p.c + q\[qs\]|double cs = q[qs]|"
+	"the eliminator offset c ignored in the preload|core/setup.c|s|(p->c + s\([12]\))|(0.0 + s\1)|"
+	"the lever arm h with the wrong sign|core/model.c|s|double Pb\[2\] = {i == 0 ? p->l1 : -p->l2, -p->h};|double Pb[2] = {i == 0 ? p->l1 : -p->l2, p->h};|"
+	"the mean rotor speed one period off|core/estimator.c|s|sense \* 2.0 \* M_PI \* e->n_bound / span|sense * 2.0 * M_PI * (e->n_bound + 1) / span|"
 )
 printf '| mutation | file | first failing test group | verdict |\n|---|---|---|---|\n'
 survived=0
