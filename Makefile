@@ -60,7 +60,7 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev \
              /usr/include/gsl/gsl_odeiv2.h:libgsl-dev
 
-.PHONY: all deps deps-build run cluster test check bench bench-peers load mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -168,6 +168,12 @@ check:
 
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
+
+# The machine zoo's converged references (tests/bench/zoo/ref.tsv, which
+# `make bench`'s zoo.sh reads): one to two hours of CPU. ZOO="stiff deep"
+# redoes those machines only.
+bench-zoo-ref: all
+	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
 # libFuzzer harnesses (tests/fuzz/, README "Fuzzing"): clang builds core/,
 # api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each

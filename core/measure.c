@@ -12,9 +12,9 @@
 #include "sim_int.h"
 
 /* A measurement's shadow runs over this share of its window: long enough
- * for its estimate to settle (about 45 periods of the preset's 4-s
- * window), short enough to keep the shadow's cost near a third. */
-#define SHADOW_MEASURE_SHARE 0.45
+ * for its estimate to settle (30 periods of the preset's 4-s
+ * window), short enough to keep the shadow's cost near a fifth. */
+#define SHADOW_MEASURE_SHARE 0.3
 
 /* sim_measure's refinements at most: each shrinks the feed step (and the
  * machine step where its term is large) by the factor the first-order
@@ -53,12 +53,19 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	int err;
 	/* the steps are the engine's to choose only where the user left them */
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && strcmp(m->name, "dem") == 0;
+	double last = INFINITY;
 	for (int attempt = 0;; attempt++) {
 		err = measure_once(p, sc, &run, t_end, &st, msg, msglen);
 		out->refinements = attempt;
+		/* done: within tol, the user's own steps, no step error to blame
+		 * (the feed's scatter, a drift: steps cannot help), or a
+		 * refinement that did not shrink the step error as a first-order
+		 * one shrinks (by 0.6 at least): what remains is not the steps' */
 		if (err != SIM_OK || !own_steps || st.tol_met || attempt == MEASURE_REFINEMENTS ||
-		    !(st.step_error > st.tol_allowed) || st.substeps < 1)
+		    !(st.step_error > st.tol_allowed) || !(st.step_error < 0.8 * last) ||
+		    st.substeps < 1)
 			break;
+		last = st.step_error;
 		/* first order in both steps: the feed step shrinks by the factor
 		 * asked, and the machine step too where its a-priori term alone
 		 * exceeds half of what tol allows */

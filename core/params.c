@@ -230,8 +230,8 @@ double sim_contact_period(const sim_params *p, const sim_scene *s)
  * repeat. */
 static double two_digits(double dt)
 {
-	double unit = pow(10.0, floor(log10(dt)) - 1.0);
-	return floor(dt / unit * (1.0 + 1e-12)) * unit;
+	double scale = pow(10.0, 1.0 - floor(log10(dt))); /* an exact power of ten */
+	return floor(dt * scale * (1.0 + 1e-12)) / scale;
 }
 
 static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
