@@ -230,7 +230,10 @@ install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
 	install -m 755 $(BUILD)/convsim $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
-	install -m 644 README.md docs/MODEL.md $(DESTDIR)$(DOCDIR)/
+	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img
+	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
+	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
 	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service
 	chmod 644 $(DESTDIR)$(UNITDIR)/convsimd.service

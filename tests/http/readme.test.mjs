@@ -11,14 +11,14 @@ import { join } from 'node:path';
 import { promisify } from 'node:util';
 import { startDaemon, tokenFile, SLOW } from './lib.mjs';
 
-const README = new URL('../../README.md', import.meta.url);
+const README = new URL('../../docs/api.md', import.meta.url);
 const TOKEN = 'readme-example-token-0123456789';
 let d;
 before(async () => { d = await startDaemon(['--token-file', tokenFile(TOKEN)]); });
 after(async () => { await d?.stop(); });
 
 export function pythonExample(text) {
-  const m = text.match(/<!-- test:python-example -->\s*```python\n([\s\S]*?)\n```/);
+  const m = text.match(/## From Python[\s\S]*?```python\n([\s\S]*?)\n```/);
   assert.ok(m, 'README has a python block after <!-- test:python-example -->');
   return m[1];
 }
