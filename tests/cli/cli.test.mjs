@@ -93,3 +93,24 @@ test('sweep: plain progress lines off a terminal, the table to --out', () => {
   assert.equal(q.err, '');
   assert.equal(JSON.parse(q.out).points[0].state, 'done');
 });
+
+test('run takes --beta DEG and --rotation cw|ccw as sweep does, the same as --set', () => {
+  const args = ['run', '--duration', '0.5', '-q', '--set', 'feed=false'];
+  const summary = (...more) => {
+    const r = run(...args, ...more);
+    assert.equal(r.code, 0, r.err);
+    return JSON.parse(r.out);
+  };
+  const byOption = summary('--beta', '30', '--rotation', 'ccw');
+  const bySet = summary('--set', 'beta=30', '--set', 'rotation=ccw');
+  assert.equal(byOption.rotor_speed, bySet.rotor_speed);
+  assert.ok(byOption.rotor_speed < -100, `ccw turns the rotor backwards: ${byOption.rotor_speed}`);
+  assert.ok(summary('-b', '30').rotor_speed > 100, 'the preset is clockwise');
+  assert.equal(summary('-b', '30').transport_velocity, summary('--set', 'beta=30').transport_velocity);
+  let r = run('run', '--beta', '181');
+  assert.equal(r.code, 2);
+  assert.match(r.err, /^convsim run: --beta 181: beta must be a finite number in \[0, 180\] deg/);
+  r = run('run', '--rotation', 'up');
+  assert.equal(r.code, 2);
+  assert.match(r.err, /^convsim run: --rotation up: rotation must be one of cw\|ccw/);
+});
