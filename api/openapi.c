@@ -184,12 +184,17 @@ static cJSON *operation(const api_route *rt)
 	cJSON *ok = cJSON_AddObjectToObject(responses, status);
 	cJSON_AddStringToObject(ok, "description", rt->status == 204 ? "done, no body" : "OK");
 	if (strcmp(rt->response, "StreamRecord") == 0) {
-		cJSON *c = content("text/event-stream", NULL);
-		cJSON_AddItemToObject(c, "application/x-ndjson",
-				      cJSON_Parse("{\"itemSchema\":{\"$ref\":"
-						  "\"#/components/schemas/StreamRecord\"},"
-						  "\"schema\":{\"$ref\":"
-						  "\"#/components/schemas/StreamRecord\"}}"));
+		/* A stream's body is a sequence of records, not one JSON value:
+		 * its schema is text, and each record's schema goes in
+		 * x-itemSchema (OpenAPI 3.1 has no keyword for it; 3.2's
+		 * itemSchema is the same idea), so validating proxies accept
+		 * the stream and tools that know the extension check records. */
+		static const char stream_media[] =
+			"{\"schema\":{\"type\":\"string\"},"
+			"\"x-itemSchema\":{\"$ref\":\"#/components/schemas/StreamRecord\"}}";
+		cJSON *c = cJSON_CreateObject();
+		cJSON_AddItemToObject(c, "text/event-stream", cJSON_Parse(stream_media));
+		cJSON_AddItemToObject(c, "application/x-ndjson", cJSON_Parse(stream_media));
 		cJSON_AddItemToObject(ok, "content", c);
 	} else if (strchr(rt->response, '/')) {
 		cJSON_AddItemToObject(ok, "content", content(rt->response, NULL));
