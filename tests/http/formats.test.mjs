@@ -142,6 +142,10 @@ test('each problem type URI serves a page that explains it', async () => {
     const p = await req(d.base, 'GET', `/api/v1/problems/${slug}`);
     assert.equal(p.status, 200, slug);
     assert.ok(page.text.includes(`href="${slug}"`), slug);
+    /* rendered: the explanation's code spans are <code>, no raw backticks */
+    assert.doesNotMatch(p.text, /`/, slug);
   }
+  const range = await req(d.base, 'GET', '/api/v1/problems/out-of-range');
+  assert.match(range.text, /<code>field<\/code> names it/);
   assert.equal((await req(d.base, 'GET', '/api/v1/problems/nonsense')).status, 404);
 });
