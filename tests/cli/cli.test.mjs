@@ -107,6 +107,8 @@ test('run takes --beta DEG and --rotation cw|ccw as sweep does, the same as --se
   assert.ok(byOption.rotor_speed < -100, `ccw turns the rotor backwards: ${byOption.rotor_speed}`);
   assert.ok(summary('-b', '30').rotor_speed > 100, 'the preset is clockwise');
   assert.equal(summary('-b', '30').transport_velocity, summary('--set', 'beta=30').transport_velocity);
+  /* as given: 30, not 29.999999999999996 (the degrees a radian came from) */
+  assert.match(run(...args, '--beta', '30').out, /"beta": 30,/);
   let r = run('run', '--beta', '181');
   assert.equal(r.code, 2);
   assert.match(r.err, /^convsim run: --beta 181: beta must be a finite number in \[0, 180\] deg/);
