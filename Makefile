@@ -170,7 +170,7 @@ check:
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
 
-# libFuzzer harnesses (tests/fuzz/, README "Fuzzing"): clang builds core/,
+# libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
 # api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of

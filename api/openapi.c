@@ -216,7 +216,7 @@ static cJSON *operation(const api_route *rt)
 	char *save = NULL;
 	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save))
 		cJSON_AddItemToObject(responses, t, ref("responses", "Problem"));
-	/* the request gate's answers, the same for every route (README
+	/* the request gate's answers, the same for every route (docs/operations.md
 	 * "Security"): the token (not on health), Origin, Host */
 	int open_route = strcmp(rt->pattern, "/api/v1/health") == 0;
 	if (open_route)

@@ -166,7 +166,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	s->motor_on = 1;
 	s->start = SIM_START_STEADY;
 	s->transient = 0.0;
-	s->settle = 0.6; /* README "Start": the settled orbit closes, the gate holds */
+	s->settle = 0.6; /* docs/MODEL.md "Start": the settled orbit closes, the gate holds */
 
 	memset(m, 0, sizeof *m);
 	snprintf(m->name, sizeof m->name, "%s", "dem");
@@ -178,7 +178,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 }
 
 /* Defaults per scene kind, measured against the converged reference at
- * the 74 points beta = 0..180 deg every 5 deg, both rotations (README
+ * the 74 points beta = 0..180 deg every 5 deg, both rotations (docs/accuracy.md
  * "Accuracy", tests/bench/accuracy.sh): with feed, dem takes machine steps
  * of 1.25e-3 s and feed sub-steps of at most 2.5e-4 s (5) with its slip
  * reversals located and the deck yielding within the step (worst 0.76 %
@@ -242,7 +242,7 @@ int sim_default_substeps(const sim_method *m, double dt)
 }
 
 /* czubak2016 with the eccentricity fitted to the paper's clockwise peaks
- * at 38 and 128 deg (README "Calibration": `convsim fit --peaks
+ * at 38 and 128 deg (docs/calibration.md "Calibration": `convsim fit --peaks
  * cw:38,cw:128 --free e:0.005:0.04`, e = 0.01551 +- 0.0049 m, rounded to
  * three digits); everything else as czubak2016. */
 #define CZUBAK2016_FIT_E 0.0155

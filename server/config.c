@@ -149,7 +149,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"every id it makes starts NAME-\n"
 		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
 		"gather theirs\n"
-		"budgets (429/503 with Retry-After when spent; see README "
+		"budgets (429/503 with Retry-After when spent; see docs/operations.md "
 		"\"Budgets and load\"):\n"
 		"  --max-memory BYTES   estimated memory of all sessions and "
 		"streams; K, M, G suffixes\n"

@@ -18,7 +18,7 @@
  * rotation v v_ref err cpu steps rejected rhs_evals status. The scene is
  * czubak2016 with its defaults (the steady start, v over [0, 4] s: what
  * `convsim sweep` measures), so v_ref and the convention are those of
- * tests/bench/accuracy.sh (README "Accuracy and speed"). CPU: process CPU
+ * tests/bench/accuracy.sh (docs/accuracy.md "Accuracy and speed"). CPU: process CPU
  * seconds of the whole point (shooting, settling, the 4-s window), the
  * least of up to three repeats while a point costs under a second.
  */

@@ -1,5 +1,5 @@
 // `make install PREFIX=...` into a temporary prefix: the binaries, the
-// dashboard, the docs and the systemd unit land where README says; the
+// dashboard, the docs and the systemd unit land where docs/operations.md says; the
 // unit passes `systemd-analyze verify` (which the install rule runs when it
 // exists); the installed daemon finds its dashboard by itself.
 import { test } from 'node:test';

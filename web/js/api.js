@@ -162,7 +162,7 @@ export async function integratorNames() {
 /* ---- fits ---------------------------------------------------------------- */
 
 /* A fit job as the page uses it: progress, and the daemon's result object
- * (fields as README "Calibration" lists them) once over. */
+ * (fields as docs/calibration.md "Calibration" lists them) once over. */
 export function normalizeFit(raw) {
 	const r = raw || {};
 	return {
