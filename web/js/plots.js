@@ -112,7 +112,7 @@ export class TimePlot {
 		scales.y = { range: yRange ?? autoRange };
 		if (y2Label) scales.y2 = { range: y2Range ?? autoRange };
 		this.labels = [xLabel, ...series.map(d => d.label)];
-		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })];
+		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })];
 		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 50, space: 24, grid: { show: false } }));
 		this.plot = new uPlot({
 			width: s.width,
@@ -345,7 +345,7 @@ export class XYPlot {
 			legend: { show: legend, live: false },
 			cursor: { show: false, drag: { x: false, y: false } },
 			scales: { x: { time: false, range: rangeFn('x') }, y: { range: rangeFn('y') } },
-			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })],
+			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })],
 			hooks,
 			series: [{}, ...series.map((d, i) => ({
 				label: d.label,
