@@ -151,16 +151,11 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 		case OPT_OUT: o->out = arg; break;
 		case OPT_FORMAT: o->format = arg; break;
 		case OPT_BETA:
+		case OPT_ROTATION: /* run: one setting, as --set; sweep: a range, a list */
 			if (cmd == CMD_RUN)
-				bad = set_option(o, "beta", arg);
+				bad = set_option(o, id == OPT_BETA ? "beta" : "rotation", arg);
 			else
-				o->beta = arg;
-			break;
-		case OPT_ROTATION:
-			if (cmd == CMD_RUN)
-				bad = set_option(o, "rotation", arg);
-			else
-				o->rotation = arg;
+				*(id == OPT_BETA ? &o->beta : &o->rotation) = arg;
 			break;
 		case OPT_QUIET: o->quiet = 1; break;
 		case OPT_DATA: o->data = arg; break;

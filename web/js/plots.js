@@ -163,17 +163,6 @@ export class TimePlot {
 		this.plot.redraw(false);
 	}
 
-	/* The legend's entry of each series only while it has points (an empty
-	 * plot lists them all, as a key of what will come). */
-	showLegend(shown) {
-		const any = shown.some(Boolean);
-		const names = this.labels[2];
-		for (const row of this.plot.root.querySelectorAll('.u-legend .u-series')) {
-			const k = names.indexOf(row.querySelector('.u-label')?.textContent);
-			if (k >= 0) row.style.display = !any || shown[k] ? '' : 'none';
-		}
-	}
-
 	destroy() {
 		this.ro.disconnect();
 		this.plot.destroy();
