@@ -213,6 +213,31 @@ test('every relative link between the documents resolves (file and #anchor)', ()
   assert.deepEqual(bad, []);
 });
 
+// Operations of the OpenAPI document that docs/api.md does not name (the
+// method on a line with the path, a path parameter as any word), and
+// operations docs/api.md names that the document lacks.
+export function apiDrift(doc, text) {
+  const ops = Object.entries(doc.paths).flatMap(([p, item]) => Object.keys(item).map((m) => [m.toUpperCase(), p]));
+  const re = (p) => new RegExp(p.replace(/[.*+?^$()|[\]\\]/g, '\\$&').replace(/\{[^}]+\}/g, '[A-Za-z0-9_-]+') + '(?![A-Za-z0-9_/-])');
+  const lines = text.split('\n');
+  const missing = ops.filter(([m, p]) => !lines.some((l) => re(p).test(l) && (m === 'GET' || new RegExp(`\\b${m}\\b`).test(l))))
+    .map(([m, p]) => `${m} ${p}`);
+  const named = [...text.matchAll(/\b(GET|POST|PATCH|PUT|DELETE) (\/(?:api\/v1\/)?[A-Za-z0-9_./{}-]+)/g)]
+    .filter(([, m, p]) => !ops.some(([om, op]) => om === m && re(op).test(p)))
+    .map(([, m, p]) => `${m} ${p}`);
+  return { missing, named };
+}
+
+test('docs/api.md and the served OpenAPI document name the same operations', async () => {
+  const doc = (await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH)).body;
+  const text = readFileSync(join(ROOT, 'docs/api.md'), 'utf8');
+  assert.deepEqual(apiDrift(doc, text), { missing: [], named: [] });
+  /* and it can fail both ways */
+  const less = apiDrift(doc, text.replace(/PATCH/g, 'PUT'));
+  assert.ok(less.missing.includes('PATCH /api/v1/sessions/{id}'), JSON.stringify(less));
+  assert.deepEqual(apiDrift(doc, text + '\nPOST /api/v1/sessions/ID/rewind\n').named, ['POST /api/v1/sessions/ID/rewind']);
+});
+
 test('the link checker sees a missing file and a missing anchor', () => {
   const bad = brokenLinks('README.md', '[a](docs/nothing-here.md) [b](docs/api.md#no-such-heading) [c](docs/api.md#sessions)');
   assert.equal(bad.length, 2, bad.join('\n'));
