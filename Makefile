@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Conveyor simulator: one Makefile for the core library, the CLI, the daemon,
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * errors.c - error codes to HTTP statuses and RFC 9457 problem details.
  *

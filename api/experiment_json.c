@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment_json.c - the beta-schedule experiment in JSON.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * openapi.c - the OpenAPI 3.1 description of the HTTP API, served at
  * /api/v1/openapi.json, generated from the tables the daemon validates

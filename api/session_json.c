@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_json.c - sessions in JSON: the PATCH control body and the
  * session document (spec and live status) that GET, POST and PATCH answer.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * mirror.c - the mirror reduction of v(beta) sweeps ("model only what a
  * scene needs", applied to a set of points rather than to one instance).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * model.h - internal: the machine of docs/MODEL.md (trough, vibrator, two
  * eliminators on guides at beta(t), suspension, drive) and the layout of

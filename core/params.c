@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * params.c - every named setting with its unit and allowed range, the
  * czubak2016 preset (docs/MODEL.md "Parameters"), and checked assignment by name.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim.c - one simulation instance: owns the const model, the controls, the
  * state, the chosen integrator's workspace and the observers (the

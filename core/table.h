@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * table.h - the tables a user takes away, as the CLI and the daemon write
  * them: one column list for trajectories, one header for v(beta) sweeps,

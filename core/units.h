@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * units.h - user units at the edges. The core's interface is SI; the
  * settings table (sim_settings()) says for each setting the unit a user

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * budget.c - the daemon's resource budgets: memory reservations, the cores
  * of paced sessions, CPU turns for pace "max" sessions, connections per

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * budget.h - the daemon's resource budgets, so that no one client takes the
  * machine: memory (the need of each session and stream, estimated before it

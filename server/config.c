@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * config.c - the daemon's options: defaults, the command line and the
  * checks of what it names (web root guess, writable data directory).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment.c - the beta-schedule experiment (POST /api/v1/experiments)
  * as its session's worker runs it.

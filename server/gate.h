@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * gate.h - the request gate: what every request must satisfy, seen once,
  * on its headers, before its body is read or a route runs.

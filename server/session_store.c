@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_store.c - a session's files in the data directory and the
  * sessions rebuilt from them at start-up (docs/operations.md "Persistence").

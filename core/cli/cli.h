@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * cli.h - what the files of the command-line runner share: the option
  * table (one entry per option: its names, argument, unit, default and

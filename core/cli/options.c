@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * options.c - the command line's options as one table: getopt_long's
  * table and the help are both made from it, so they cannot drift. Also

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * parse.c - a command's options into one cli_opts: the preset first (a
  * first pass finds it, so that --set applies on top of it wherever it

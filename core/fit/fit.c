@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit.c - the least-squares driver of a calibration: Levenberg-Marquardt in
  * a trust region (GSL's gsl_multifit_nlinear, trs_lm, More scaling) on the

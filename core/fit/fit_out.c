@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_out.c - a fit's result as text, the same for the CLI and the daemon:
  * JSON (parameters with standard errors, correlation, per-datum model and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.c - the benchmark's peers at the 1 % gate (`make bench`; peer.h).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.h - the peers harness's parts (peers.c): the gate's points with
  * their reference and the error convention (peers_points.c), and the

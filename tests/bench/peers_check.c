@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers_check.c - the peers harness's own sanity check (peers.h): a wrong
  * wrapper (a state copied wrongly, a restart from the wrong state, the

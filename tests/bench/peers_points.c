@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers_points.c - the gate's points for the peers harness (peers.h): the
  * converged reference tests/bench/results/vref.tsv, a chosen subset, and

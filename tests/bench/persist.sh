@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Persistence figures (docs/operations.md "Persistence"), bounded (about 1 minute):
 #  1. CPU cost of checkpointing 64 default sessions: the writer thread's
 #     CPU with --checkpoint-interval 0.5, scaled to the default 10 s;

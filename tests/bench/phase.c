@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * phase.c - the feed's motion over one vibration period, averaged by the
  * rotor's angle: where in the period two settings part (docs/accuracy.md "Targets",

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec_svg.c - the benchmark's plot, workprec.svg: log-log panels of
  * each scene's error (trajectory, transport velocity, energy residual)

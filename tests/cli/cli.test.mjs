@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The command line as a user meets it: help on stdout with exit 0 for
 // `help CMD` and `CMD --help`, every option with its default and unit;
 // --version; errors on stderr prefixed "convsim CMD:", specific, with a

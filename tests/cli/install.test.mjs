@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `make install PREFIX=...` into a temporary prefix: the binaries, the
 // dashboard, the docs and the systemd unit land where docs/operations.md says; the
 // unit passes `systemd-analyze verify` (which the install rule runs when it

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_store.c - libFuzzer harness of the daemon's stored-session reader:
  * a session's spec.bin and checkpoint.bin as a restart reads them back

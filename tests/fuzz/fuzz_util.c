@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_util.c - the oracles the harnesses share (fuzz_util.h).
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_util.h - what the libFuzzer harnesses of tests/fuzz/ share: the
  * oracle's failure (an abort libFuzzer keeps as a crash with its input),

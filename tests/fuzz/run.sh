@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Runs each libFuzzer harness of tests/fuzz/ for FUZZ_SECONDS (make fuzz;
 # docs/development.md "Fuzzing") on its committed seeds (tests/fuzz/corpus/NAME, read
 # only) and its working corpus ($FUZZ_BUILD/corpus/NAME, where new inputs

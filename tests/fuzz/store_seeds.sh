@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Makes the real seeds of the `store` fuzz harness again (docs/development.md
 # "Fuzzing"): runs the daemon ($BUILD/convsimd, from `make`) on a fresh
 # --data-dir with two sessions, a running default one and a finished rk4

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The documents cannot drift from the program: every sh and python block of
 // README.md and docs/*.md runs against the real daemon (started with a
 // token, as `make run` starts it), every `<!-- output -->` block is compared

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One content negotiation for every result route: JSON and CSV by Accept
 // or ?format=, 406 for an Accept naming neither, 400 for unknown query
 // parameters on every route; the trajectory's rows exactly `stride` apart;

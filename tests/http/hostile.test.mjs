@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Hostile bytes and files: the web root serves regular files only (a FIFO,
 // a directory or a link out of the root is "not found", at once, and the
 // daemon still stops cleanly); every problem is valid UTF-8 JSON whatever

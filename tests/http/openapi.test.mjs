@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The OpenAPI document against the live daemon, with ajv's JSON Schema
 // 2020-12 validator: every operation it lists is exercised and its answer
 // validated against the schema the document gives for that status; every

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // State on disk (--data-dir, docs/operations.md "Persistence"): a daemon with 10
 // sessions receiving controls, one experiment and one sweep is killed with
 // SIGKILL at random moments and restarted on the same directory; nothing

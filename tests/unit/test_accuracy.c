@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_accuracy.c - known answers for the engine's main result, the
  * transport velocity, through the public interface only: the hopping

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Browser test of the dashboard against the real daemon: starts
 // $CONVSIMD (default build/convsimd) on port 0, drives web/ in Debian's
 // chromium through playwright-core and checks what a user sees against

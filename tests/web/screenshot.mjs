@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Makes README's picture of the dashboard, docs/img/dashboard.png: the real
 // daemon (CONVSIMD, default build/convsimd) on port 0, one default session
 // at beta = 38 deg, clockwise, pace 1, and Debian's chromium (CHROMIUM)

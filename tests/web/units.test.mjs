@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Unit tests of the dashboard's pure modules (no browser, no daemon):
 // the API field mapping, the sample buffers and velocity fit, number
 // formatting and the schematic's geometry.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * api.js - the dashboard's one link to the convsimd daemon: the HTTP
  * client (one function an endpoint) and its errors.

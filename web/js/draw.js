@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * draw.js - redraws plots, the velocity tile and the schematic from the
  * traces at most every animation frame (every 50 ms), and only when the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * figures.js - the page's plots: which plot shows what, with its series,
  * labels and axes (plots.js draws them), and the schematic. The feed plot

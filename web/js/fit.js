@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * fit.js - the calibration panel: measured points pasted or loaded as CSV,
  * free parameters by name, POST /api/v1/fits on the new-session form's

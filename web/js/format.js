@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * format.js - numbers, units and directions as the dashboard shows them.
  * SI throughout (displacements in mm where metres would be all zeros),

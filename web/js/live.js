@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * live.js - the attached session's stream: samples into the bounded
  * traces (series.js) behind the live plots, control events into the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * plots.js - the dashboard's charts, thin wrappers around the vendored uPlot.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * session.js - the attached session: the new-session form, attaching to a
  * session (its stream feeds live.js, its status is polled every STATUS_MS

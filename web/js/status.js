@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * status.js - the attached session's polled status on the page: the tiles
  * (the daemon's transport velocity with its error bar and steady mark,
