@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Conveyor simulator: one Makefile for the core library, the CLI, the daemon,
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
@@ -74,7 +75,8 @@ $(BUILD)/.deps-build: Makefile
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze, haproxy, clang for libFuzzer, valgrind)" sh tests/apt-deps.sh
-	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ]; then \
+	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ] || \
+	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@
@@ -175,7 +177,7 @@ bench: all $(BUILD)/.deps-bench
 bench-zoo-ref: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
-# libFuzzer harnesses (tests/fuzz/, README "Fuzzing"): clang builds core/,
+# libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
 # api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
@@ -236,7 +238,10 @@ install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
 	install -m 755 $(BUILD)/convsim $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
-	install -m 644 README.md docs/MODEL.md $(DESTDIR)$(DOCDIR)/
+	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img
+	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
+	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
 	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service
 	chmod 644 $(DESTDIR)$(UNITDIR)/convsimd.service

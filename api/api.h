@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * api.h - the JSON face of the conveyor simulator.
  *
@@ -384,13 +385,17 @@ typedef struct api_segment {
 	double until;           /* s after the experiment start */
 	/* results, filled by the server */
 	int state;              /* 0 pending, 1 running, 2 done */
+	int beta_same;          /* 1: beta was already there at the command,
+				 * so there is no reversal to time (fills the
+				 * padding: saved records keep their size) */
 	double t_command;       /* s simulated time of the beta command */
 	double t_end;           /* s */
 	double steady_velocity; /* m/s mean feed velocity, last half */
 	double mean_velocity;   /* m/s transport estimate over the segment */
 	double uncertainty;     /* m/s error bar of mean_velocity; NaN if none */
 	int steady;             /* the estimate showed no drift at the end */
-	double reversal_time;   /* s command -> 90 % of steady; NaN if never */
+	double reversal_time;   /* s command -> 90 % of steady; NaN if never or
+				 * without a beta change (beta_same) */
 	double start_velocity;  /* m/s feed velocity at the command */
 } api_segment;
 

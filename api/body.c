@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * body.c - the one way a request body is read: parse the bytes as one JSON
  * object, check that every member is a known one, and answer the common

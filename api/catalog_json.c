@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * catalog_json.c - what the daemon offers: presets with their full
  * settings, the settings table (names, groups, units, ranges, docs) and

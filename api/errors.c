@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * errors.c - error codes to HTTP statuses and RFC 9457 problem details.
  *
@@ -223,6 +224,24 @@ char *api_problem_json(const api_problem *pb, const char *instance)
 	return api_print_free(o);
 }
 
+/* Text of the error table as HTML: `code` spans become <code>, and the
+ * characters HTML gives a meaning are escaped. */
+static void put_html(api_buf *b, const char *text)
+{
+	int code = 0;
+	for (const char *c = text; *c; c++) {
+		switch (*c) {
+		case '`': api_buf_puts(b, code ? "</code>" : "<code>"); code = !code; break;
+		case '<': api_buf_puts(b, "&lt;"); break;
+		case '>': api_buf_puts(b, "&gt;"); break;
+		case '&': api_buf_puts(b, "&amp;"); break;
+		default: api_buf_printf(b, "%c", *c); break;
+		}
+	}
+	if (code)
+		api_buf_puts(b, "</code>");
+}
+
 char *api_problem_page(const char *slug)
 {
 	int at = -1;
@@ -238,14 +257,16 @@ char *api_problem_page(const char *slug)
 		       "<style>body{font:16px/1.5 system-ui,sans-serif;max-width:46em;margin:2em "
 		       "auto;padding:0 1em}code{background:#eee;padding:0 .2em}td,th{padding:.2em "
 		       ".6em;text-align:left;vertical-align:top}</style></head><body>\n"
-		       "<h1>%s</h1>\n<p><code>/api/v1/problems/%s</code> &middot; HTTP %d</p>\n"
-		       "<p>%s</p>\n"
+		       "<h1>%s</h1>\n<p><code>/api/v1/problems/%s</code> &middot; HTTP %d</p>\n<p>",
+		       api_errors[at].status, api_errors[at].title, api_errors[at].title,
+		       api_errors[at].slug, api_errors[at].status);
+	put_html(&b, api_errors[at].explanation);
+	api_buf_printf(&b,
+		       "</p>\n"
 		       "<p>The problem's <code>detail</code> says what exactly was wrong; "
 		       "<code>instance</code> is the request's path. A refused request changed "
 		       "nothing.</p>\n<h2>Every problem type of this API</h2>\n<table>"
-		       "<tr><th>status</th><th>type</th><th>title</th></tr>\n",
-		       api_errors[at].status, api_errors[at].title, api_errors[at].title,
-		       api_errors[at].slug, api_errors[at].status, api_errors[at].explanation);
+		       "<tr><th>status</th><th>type</th><th>title</th></tr>\n");
 	for (int i = 1; i < API_NERR; i++)
 		api_buf_printf(&b, "<tr><td>%d</td><td><a href=\"%s\">%s</a></td><td>%s</td></tr>\n",
 			       api_errors[i].status, api_errors[i].slug, api_errors[i].slug,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment_json.c - the beta-schedule experiment in JSON.
  *
@@ -12,6 +13,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "table.h"
 
 const char *const api_members_segment[] = {"beta", "until", NULL};
 const char *const api_members_experiment_session[] = {"preset", "params", "scene", "integrator",
@@ -153,8 +155,8 @@ static cJSON *experiment_object(const api_experiment_view *v)
 	cJSON_AddStringToObject(o, "state", v->state);
 	if (v->error[0])
 		cJSON_AddStringToObject(o, "error", v->error);
-	api_add_number(o, "t_start", v->t_start);
-	api_add_number(o, "t", v->t_now);
+	api_add_number(o, "t_start", sim_time_ns(v->t_start));
+	api_add_number(o, "t", sim_time_ns(v->t_now));
 	api_add_number(o, "progress", v->progress);
 	cJSON *arr = cJSON_AddArrayToObject(o, "segments");
 	for (int i = 0; i < v->nseg; i++) {
@@ -166,8 +168,8 @@ static cJSON *experiment_object(const api_experiment_view *v)
 					seg_state[s->state < 0 || s->state > 2
 							  ? 0
 							  : s->state]);
-		api_add_number(so, "t_command", s->t_command);
-		api_add_number(so, "t_end", s->t_end);
+		api_add_number(so, "t_command", sim_time_ns(s->t_command));
+		api_add_number(so, "t_end", sim_time_ns(s->t_end));
 		api_add_number(so, "start_velocity", s->start_velocity);
 		api_add_number(so, "steady_velocity", s->steady_velocity);
 		api_add_number(so, "mean_velocity", s->mean_velocity);
@@ -176,7 +178,7 @@ static cJSON *experiment_object(const api_experiment_view *v)
 			cJSON_AddBoolToObject(so, "steady", s->steady);
 		else
 			cJSON_AddNullToObject(so, "steady");
-		api_add_number(so, "reversal_time", s->reversal_time);
+		api_add_number(so, "reversal_time", sim_time_ns(s->reversal_time));
 		cJSON_AddItemToArray(arr, so);
 	}
 	cJSON *links = cJSON_AddObjectToObject(o, "links");
@@ -222,14 +224,14 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n)
 			csv_num(&b, g->beta.user);
 			csv_num(&b, g->until);
 			api_buf_printf(&b, ",%s", seg_state[g->state >= 0 && g->state <= 2 ? g->state : 0]);
-			csv_num(&b, g->state ? g->t_command : NAN);
-			csv_num(&b, done ? g->t_end : NAN);
+			csv_num(&b, g->state ? sim_time_ns(g->t_command) : NAN);
+			csv_num(&b, done ? sim_time_ns(g->t_end) : NAN);
 			csv_num(&b, g->state ? g->start_velocity : NAN);
 			csv_num(&b, done ? g->steady_velocity : NAN);
 			csv_num(&b, done ? g->mean_velocity : NAN);
 			csv_num(&b, done ? g->uncertainty : NAN);
 			api_buf_puts(&b, !done ? "," : g->steady ? ",true" : ",false");
-			csv_num(&b, done ? g->reversal_time : NAN);
+			csv_num(&b, done ? sim_time_ns(g->reversal_time) : NAN);
 			api_buf_put(&b, "\n", 1);
 		}
 	return api_buf_take(&b);

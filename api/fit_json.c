@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_json.c - calibration fits in JSON (POST /api/v1/fits): the request
  * (the model members as for sessions, the free parameters, the data as

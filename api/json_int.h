@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * json_int.h - helpers shared inside api/ (not for the server): an exact
  * printer for cJSON trees, a growable text buffer, and the lookups that

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * list_json.c - one listing gathered from several replicas (--peers): the
  * receiving daemon's own list, then each peer's, in one answer.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * openapi.c - the OpenAPI 3.1 description of the HTTP API, served at
  * /api/v1/openapi.json, generated from the tables the daemon validates
@@ -184,12 +185,17 @@ static cJSON *operation(const api_route *rt)
 	cJSON *ok = cJSON_AddObjectToObject(responses, status);
 	cJSON_AddStringToObject(ok, "description", rt->status == 204 ? "done, no body" : "OK");
 	if (strcmp(rt->response, "StreamRecord") == 0) {
-		cJSON *c = content("text/event-stream", NULL);
-		cJSON_AddItemToObject(c, "application/x-ndjson",
-				      cJSON_Parse("{\"itemSchema\":{\"$ref\":"
-						  "\"#/components/schemas/StreamRecord\"},"
-						  "\"schema\":{\"$ref\":"
-						  "\"#/components/schemas/StreamRecord\"}}"));
+		/* A stream's body is a sequence of records, not one JSON value:
+		 * its schema is text, and each record's schema goes in
+		 * x-itemSchema (OpenAPI 3.1 has no keyword for it; 3.2's
+		 * itemSchema is the same idea), so validating proxies accept
+		 * the stream and tools that know the extension check records. */
+		static const char stream_media[] =
+			"{\"schema\":{\"type\":\"string\"},"
+			"\"x-itemSchema\":{\"$ref\":\"#/components/schemas/StreamRecord\"}}";
+		cJSON *c = cJSON_CreateObject();
+		cJSON_AddItemToObject(c, "text/event-stream", cJSON_Parse(stream_media));
+		cJSON_AddItemToObject(c, "application/x-ndjson", cJSON_Parse(stream_media));
 		cJSON_AddItemToObject(ok, "content", c);
 	} else if (strchr(rt->response, '/')) {
 		cJSON_AddItemToObject(ok, "content", content(rt->response, NULL));
@@ -211,7 +217,7 @@ static cJSON *operation(const api_route *rt)
 	char *save = NULL;
 	for (char *t = strtok_r(list, ",", &save); t; t = strtok_r(NULL, ",", &save))
 		cJSON_AddItemToObject(responses, t, ref("responses", "Problem"));
-	/* the request gate's answers, the same for every route (README
+	/* the request gate's answers, the same for every route (docs/operations.md
 	 * "Security"): the token (not on health), Origin, Host */
 	int open_route = strcmp(rt->pattern, "/api/v1/health") == 0;
 	if (open_route)

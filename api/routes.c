@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * routes.c - the API's routes as data: method, path, the query parameters
  * each takes and whether it answers results (JSON or CSV). The server

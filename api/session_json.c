@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_json.c - sessions in JSON: the PATCH control body and the
  * session document (spec and live status) that GET, POST and PATCH answer.
@@ -14,6 +15,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "table.h"
 
 const char *const api_members_control[] = {"beta", "beta_rate", "rotation", "omega_ss",
 					    "running", "motor_on", "pace", "until",
@@ -153,7 +155,7 @@ int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective)
 {
 	cJSON *o = control_object(c);
-	api_add_number(o, "t_effective", t_effective);
+	api_add_number(o, "t_effective", sim_time_ns(t_effective));
 	char *text = api_print_free(o);
 	int n = snprintf(buf, len, "%s", text ? text : "{}");
 	free(text);
@@ -164,8 +166,8 @@ static cJSON *status_object(const api_view *v)
 {
 	const sim_status *st = &v->st;
 	cJSON *o = cJSON_CreateObject();
-	api_add_number(o, "t", st->t);
-	api_add_number(o, "t_integrator", st->t_int);
+	api_add_number(o, "t", sim_time_ns(st->t));
+	api_add_number(o, "t_integrator", sim_time_ns(st->t_int));
 	api_add_number(o, "beta", api_user_of("beta", st->beta));
 	api_add_number(o, "beta_target", api_user_of("beta", st->beta_target));
 	api_add_number(o, "beta_dot", api_user_of("beta_rate", st->beta_dot));
@@ -306,7 +308,7 @@ char *api_control_result_json(const api_view *v, const api_control *c,
 	cJSON_AddItemToObject(o, "applied", control_object(c));
 	cJSON_AddBoolToObject(o, "acknowledged", acked);
 	if (acked)
-		api_add_number(o, "t_effective", t_effective);
+		api_add_number(o, "t_effective", sim_time_ns(t_effective));
 	else
 		cJSON_AddNullToObject(o, "t_effective");
 	return api_print_free(o);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * settings_json.c - JSON members to the core's named settings and back.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * stream_json.c - text of the session streams and of the trajectory.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep_json.c - the v(beta) sweep in JSON and CSV.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * angle.h - sine and cosine of the machine's angles (the rotor's phi four
  * times a machine step, the trough's alpha), cheaper than libm's call

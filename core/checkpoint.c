@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * checkpoint.c - a sim's checkpoint: everything that determines its future
  * in one versioned binary buffer with a checksum, and an instance rebuilt

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * deck.c - deck-point kinematics and the generalized force of forces at
  * the deck points (see deck.h). One function, deck_arm, turns a deck point's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * deck.h - internal: the trough as a rigid body seen from its body points
  * (docs/MODEL.md "Frames and coordinates"): the rotation R(alpha), body vectors

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * dynamics.c - machine plus feed (see dynamics.h): the deck's motion from
  * the machine state, the feed's right-hand side along it, the feed's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * dynamics.h - internal: the whole system, machine plus feed, as the
  * integrators and the observables see it. The layer above model.c (the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * errors.c - text of the core's return codes, generated from SIM_ERRNO_MAP
  * so that the enum and the messages share one list.

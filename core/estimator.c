@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * estimator.c - transport velocity (docs/MODEL.md "Observables"): the mean feed
  * displacement is sampled at the excitation period boundaries, i.e. where

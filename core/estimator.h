@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * estimator.h - internal: the transport-velocity estimator of a sim
  * (docs/MODEL.md "Observables"). It samples the mean feed displacement at the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * feed.c - the feed model (docs/MODEL.md "Feed", paper eqs. 6-9).
  *

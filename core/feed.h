@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * feed.h - internal: the feed of docs/MODEL.md (paper eqs. 6-9): columns of
  * zero-thickness layers of point masses on the deck, normal contact with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * instance.c - an instance's workspace: allocated once for a validated
  * set (the model, the controls, the state vectors, the integrator's

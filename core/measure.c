@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * measure.c - sim_measure: one measurement of the transport velocity, a
  * fresh instance run to a time with its shadow (shadow.c) over the first

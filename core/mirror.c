@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * mirror.c - the mirror reduction of v(beta) sweeps ("model only what a
  * scene needs", applied to a set of points rather than to one instance).
@@ -22,7 +23,7 @@
  * off (sin(pi - beta) is not bit for bit sin(beta)), which the feed's
  * hopping amplifies, and the estimator's period boundaries, which fall
  * half a period later on the mirrored run (phi - alpha crosses 2 pi k where
- * the original's crosses pi + 2 pi k). README "Model reductions" gives the
+ * the original's crosses pi + 2 pi k). docs/MODEL.md "Model reductions" gives the
  * measured difference over the 74 points.
  */
 #include <math.h>

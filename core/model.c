@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * model.c - equations of motion of the machine (docs/MODEL.md "Equations of
  * motion"): exact planar rigid-body kinematics of the trough with three

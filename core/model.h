@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * model.h - internal: the machine of docs/MODEL.md (trough, vibrator, two
  * eliminators on guides at beta(t), suspension, drive) and the layout of
@@ -121,7 +122,7 @@ static inline void model_add_reduced(const model *md, const double *qr, double f
 			full[md->col[r][a]] += qr[r];
 }
 
-/* Largest ratio for which dem corrects its coupling (README "dem"). */
+/* Largest ratio for which dem corrects its coupling (docs/MODEL.md "Integrators"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 
 /* The decay rate (1/s) of the Kloss motor's slip mode, the machine's

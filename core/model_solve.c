@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * model_solve.c - the machine's mass matrix solve (model.h): the reduced
  * system T^t M T qr'' = T^t (rhs - M qp'') for the accelerations. Each

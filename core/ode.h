@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode.h - internal: integrators as data. Each method is one file of static
  * functions exporting one const descriptor; ode_registry.c lists them so

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode_dem.c - split (multirate) method for the non-smooth feed, in the
  * manner of discrete-element codes coupled to a rigid machine:

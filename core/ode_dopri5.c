@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode_dopri5.c - Dormand-Prince 5(4) with PI step-size control and the
  * fourth-order continuous extension for dense output (Dormand & Prince,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode_euler.c - semi-implicit (symplectic) Euler with a fixed step:
  * v_{n+1} = v_n + h a(q_n, v_n), q_{n+1} = q_n + h v_{n+1}

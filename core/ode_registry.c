@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode_registry.c - the table of integrators the API can name, built from
  * the methods' own descriptors (name, order, adaptive, doc live in each

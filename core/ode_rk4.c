@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ode_rk4.c - classical fourth-order Runge-Kutta with a fixed step
  * (Kutta 1901; Hairer, Norsett, Wanner, Solving ODEs I, sec. II.1).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * params.c - every named setting with its unit and allowed range, the
  * czubak2016 preset (docs/MODEL.md "Parameters"), and checked assignment by name.
@@ -167,7 +168,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	s->motor_on = 1;
 	s->start = SIM_START_STEADY;
 	s->transient = 0.0;
-	s->settle = 0.6; /* README "Start": the settled orbit closes, the gate holds */
+	s->settle = 0.6; /* docs/MODEL.md "Start": the settled orbit closes, the gate holds */
 
 	memset(m, 0, sizeof *m);
 	snprintf(m->name, sizeof m->name, "%s", "dem");
@@ -289,7 +290,7 @@ int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_meth
 }
 
 /* czubak2016 with the eccentricity fitted to the paper's clockwise peaks
- * at 38 and 128 deg (README "Calibration": `convsim fit --peaks
+ * at 38 and 128 deg (docs/calibration.md "Calibration": `convsim fit --peaks
  * cw:38,cw:128 --free e:0.005:0.04`, e = 0.01551 +- 0.0049 m, rounded to
  * three digits); everything else as czubak2016. */
 #define CZUBAK2016_FIT_E 0.0155

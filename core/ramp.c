@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ramp.c - prescribed C1 motions for the controls: beta ramps (time-optimal
  * with bounded rate and acceleration, so beta' is continuous and beta'' is

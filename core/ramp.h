@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ramp.h - internal: prescribed C1 motions for the controls (beta ramps,
  * the ideal drive's speed ramps). Units are those of the value: rad, rad/s,

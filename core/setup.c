@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * setup.c - builds the cheapest model a scene needs (docs/MODEL.md "Model only
  * what a scene needs"): the reduced layout, the deck geometry, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * shadow.c - the measured step error of dem's transport velocity: a second
  * instance with fewer feed sub-steps, stepped beside an instance (sim.c

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim.c - one simulation instance: owns the const model, the controls, the
  * state, the chosen integrator's workspace and the observers (the
@@ -116,7 +117,7 @@ static int check_state(sim *s, double q[NQ_FULL], double qd[NQ_FULL])
  * relative to its velocity on the start's forced response (the orbit
  * dynamics_steady_start found, at the rotor's present phase), so the
  * forced response itself carries no added damping and the fade does not
- * move the machine off it. Measured (README "Start"): without feed one
+ * move the machine off it. Measured (docs/MODEL.md "Start"): without feed one
  * period after t = 0 the orbit closes within 2e-10 of its size after 0.6
  * s (with the former damper on the velocity itself, 2,000 N s/m: 1e-3
  * after 0.6 s, 2.3e-5 after 1 s); with feed the trough's period means

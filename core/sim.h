@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim.h - public interface of the conveyor simulation core.
  *
@@ -199,7 +200,7 @@ double sim_contact_period(const sim_params *p, const sim_scene *s);
 /* The largest fixed step (s) method m keeps stable on the machine's
  * stiffest mode, the Kloss motor's slip (its real_limit over the slip
  * mode's decay rate); INFINITY for an adaptive method or the ideal drive.
- * Above it the run blows up within a few seconds (README "Stability"). */
+ * Above it the run blows up within a few seconds (docs/MODEL.md "Stability"). */
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt within

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim_int.h - internal: the inside of a sim, shared by sim.c (the
  * instance, its controls and stepping) and sim_status.c (what it shows:

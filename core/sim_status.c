@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sim_status.c - what an instance shows at the observed time: the status
  * (kinematics, drive, the transport estimate with its error bar and the

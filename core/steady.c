@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * steady.c - the machine part of the `steady` start (docs/MODEL.md "Start
  * steady"): the machine on its periodic forced response at the loaded

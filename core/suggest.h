@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * suggest.h - "did you mean": the nearest of a list of names to a word
  * that is not one of them, by edit distance. Header only (static inline,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * table.h - the tables a user takes away, as the CLI and the daemon write
  * them: one column list for trajectories, one header for v(beta) sweeps,
@@ -37,6 +38,16 @@ static inline int sim_fmt_double(char *buf, size_t len, double v, const char *no
 	return n;
 }
 
+/* A time in s as the tables and answers print it: rounded to the
+ * nanosecond, so that a time on a step or sample grid reads as k dt (0.052,
+ * not 0.052000000000000005). Every grid of the engine (steps of at least
+ * 1e-7 s, sample intervals of whole microseconds) is a whole number of
+ * nanoseconds; adaptive dopri5 times lose what lies below one. */
+static inline double sim_time_ns(double t)
+{
+	return isfinite(t) && fabs(t) < 1e6 ? nearbyint(t * 1e9) / 1e9 : t;
+}
+
 /* A user-unit value of a setting from SI (beta: rad to deg), by the
  * settings table's scale, as the API converts it. */
 static inline double sim_table_user(const char *setting, double si)
@@ -52,7 +63,7 @@ static inline double sim_table_user(const char *setting, double si)
  * GET /sessions/ID/trajectory and `convsim run --out` write exactly these.
  */
 #define SIM_TRAJECTORY_COLUMNS(X)                                               \
-	X(t, "s", st->t)                                                        \
+	X(t, "s", sim_time_ns(st->t))                                           \
 	X(beta, "deg", sim_table_user("beta", st->beta))                        \
 	X(beta_target, "deg", sim_table_user("beta", st->beta_target))          \
 	X(x, "m", st->q[0])                                                     \

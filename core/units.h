@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * units.h - user units at the edges. The core's interface is SI; the
  * settings table (sim_settings()) says for each setting the unit a user
@@ -20,14 +21,28 @@
 /* The setting named name, or NULL. Static. */
 const sim_setting *sim_setting_find(const char *name);
 
-/* A value of setting t between user units and SI (value * scale). */
+/* A value of setting t between user units and SI (value * scale). From
+ * SI, a scaled value is the number with the fewest decimals (up to 9) that
+ * converts back to the same SI double, so that a value a user gave comes
+ * back as given: 30 deg, not 29.999999999999996; 121.9 after a restart,
+ * not 121.89999999999999. Where none converts back (a beta in mid-ramp),
+ * the plain quotient. */
 static inline double sim_setting_to_si(const sim_setting *t, double user)
 {
 	return user * t->scale;
 }
 static inline double sim_setting_from_si(const sim_setting *t, double si)
 {
-	return si / t->scale;
+	double user = si / t->scale;
+	if (t->scale == 1 || !isfinite(user) || fabs(user) >= 1e9)
+		return user;
+	double p = 1;
+	for (int k = 0; k <= 9; k++, p *= 10) {
+		double c = nearbyint(user * p) / p;
+		if (c * t->scale == si)
+			return c;
+	}
+	return user;
 }
 
 /* 1 if the SI value lies in setting t's range (finite, [min, max] scaled). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * budget.c - the daemon's resource budgets: memory reservations, the cores
  * of paced sessions, CPU turns for pace "max" sessions, connections per
@@ -7,7 +8,7 @@
  * server allocates are counted exactly from their sizes (record ring,
  * trajectory history, stream buffers); the core instance and the threads
  * are a constant plus a cost per feed element, calibrated against the
- * resident memory the daemon gained per session (README "Budgets and
+ * resident memory the daemon gained per session (docs/operations.md "Budgets and
  * load" has the measurement). The cores of paced sessions are committed
  * the same way: each session holds its need (CPU s per simulated s, first
  * estimated from its integrator and feed, then measured by its worker,
@@ -27,7 +28,7 @@
 #include "budget.h"
 #include "util.h"
 
-/* Calibration (README "Budgets and load"): resident bytes a session holds
+/* Calibration (docs/operations.md "Budgets and load"): resident bytes a session holds
  * besides its ring and history, as base + per feed element. */
 #define SESSION_BASE_BYTES ((size_t)128 << 10)
 #define ELEMENT_BYTES ((size_t)384)
@@ -37,7 +38,7 @@
 #define CPU_SLICE_S 0.1
 /* Retry-After of a memory refusal: sessions come and go in seconds. */
 #define MEMORY_RETRY_S 5
-/* Calibration of the CPU estimate (README "Budgets and load"): CPU s of
+/* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
  * one macro step of the machine (four right-hand sides: RK4, or dem's
  * macro step), of one feed sub-step per integrated column and per
  * integrated element, and of one published sample (status, ring record,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * budget.h - the daemon's resource budgets, so that no one client takes the
  * machine: memory (the need of each session and stream, estimated before it
@@ -57,7 +58,7 @@ size_t srv_budget_memory(void);
  * its integrator (method, the step dt and the feed sub-steps in use, as
  * sim_get_status reports them after sim_new) and the feed elements it
  * integrates (feed: columns x layers; the symmetric reduction integrates
- * one representative column). Calibrated on this machine (README "Budgets
+ * one representative column). Calibrated on this machine (docs/operations.md "Budgets
  * and load"); a running session's worker measures its own. */
 double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			       int columns, int layers);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * catalog.c - the daemon's read-only resources: presets and the settings
  * table, health, /metrics (the gauges gathered here, the text by

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * catalog.h - the read-only resources: presets, health, metrics, OpenAPI.
  */

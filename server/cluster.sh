@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # cluster.sh - convsimd replicas behind one HAProxy: the configuration
 # generator and a runner for one machine (`make cluster N=3`).
 #

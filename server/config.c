@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * config.c - the daemon's options: defaults, the command line and the
  * checks of what it names (web root guess, writable data directory).
@@ -149,7 +150,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"every id it makes starts NAME-\n"
 		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
 		"gather theirs\n"
-		"budgets (429/503 with Retry-After when spent; see README "
+		"budgets (429/503 with Retry-After when spent; see docs/operations.md "
 		"\"Budgets and load\"):\n"
 		"  --max-memory BYTES   estimated memory of all sessions and "
 		"streams; K, M, G suffixes\n"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment.c - the beta-schedule experiment (POST /api/v1/experiments)
  * as its session's worker runs it.
@@ -11,7 +12,8 @@
  * feed_velocity). When a segment ends, its steady velocity is the mean
  * feed velocity over the segment's second half and its reversal time runs
  * from the command until the feed velocity first reaches 90 % of that
- * steady value. Fields are guarded by the experiment's lock, taken inside
+ * steady value (none when the segment's beta was already set: nothing
+ * reverses). Fields are guarded by the experiment's lock, taken inside
  * the session lock by the worker's hooks and alone by the handlers (lock
  * order: registry.h).
  */
@@ -157,6 +159,9 @@ static srv_cmd *start_segment(srv_experiment *e, int i, const sim_status *st)
 	cmd->restart_transport = 1;
 	cmd->from_experiment = 1;
 	seg->start_velocity = st->feed_velocity;
+	/* a segment that commands the beta already set (and reached) changes
+	 * nothing there is to time */
+	seg->beta_same = seg->beta.si == st->beta_target && st->beta == st->beta_target;
 	seg->state = 1;
 	e->cur = i;
 	e->seg_first = e->rec_n;
@@ -182,7 +187,7 @@ static void finish_segment(srv_experiment *e, const sim_status *st)
 	double steady = n ? sum / (double)n : NAN;
 	seg->steady_velocity = steady;
 	seg->reversal_time = NAN;
-	if (isfinite(steady) && steady != 0)
+	if (isfinite(steady) && steady != 0 && !seg->beta_same)
 		for (size_t i = e->seg_first; i < e->rec_n; i++) {
 			double v = e->rec_v[i];
 			if (e->rec_t[i] >= seg->t_command &&

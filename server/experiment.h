@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment.h - the beta-schedule experiment as the worker runs it.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * experiment_http.c - the experiment resources: POST/GET
  * /api/v1/experiments and GET /api/v1/experiments/{id}.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fitjob.c - calibration fits as jobs (POST /api/v1/fits).
  *

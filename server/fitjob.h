@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fitjob.h - calibration fits as jobs: a driver thread per fit, its model
  * evaluations on the worker pool, progress, results, cancel.

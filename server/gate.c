@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * gate.c - the request gate (see gate.h): Host, Origin, CORS preflight,
  * bearer token and the JSON Content-Type of mutating requests, checked on

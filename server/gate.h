@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * gate.h - the request gate: what every request must satisfy, seen once,
  * on its headers, before its body is read or a route runs.
@@ -6,7 +7,7 @@
  * sent, is ours or an --allow-origin (403), a CORS preflight for an
  * allowed origin is answered here (204), the bearer token when the daemon
  * has one (401; the dashboard's files and /api/v1/health are open), and a
- * JSON Content-Type on POST, PATCH, PUT and DELETE (415). See README
+ * JSON Content-Type on POST, PATCH, PUT and DELETE (415). See docs/operations.md
  * "Security".
  */
 #ifndef CONVSIM_GATE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * metrics.c - counters and the Prometheus text exposition at /metrics.
  *

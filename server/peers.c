@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.c - listings across replicas. Replicas share nothing: each keeps
  * its own sessions, experiments and sweeps, and a proxy routes by the node

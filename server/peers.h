@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.h - listings across replicas (--peers): a GET of the sessions,
  * experiments or sweeps gathers the entries of every peer with its own.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * pool.h - a fixed pool of worker threads for sweep points: jobs are
  * fn(arg) pairs run once each, in order of submission.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * registry.c - the one registry of objects kept by id (see registry.h for
  * the contract and the daemon's lock order).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * registry.h - one registry for every kind of object the daemon keeps by
  * id (sessions, experiments, sweeps): a list under one lock, lookup by id,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * reply.h - one HTTP request as the handlers see it, and the ways to
  * answer it (libmicrohttpd stays behind these, in server/ only).

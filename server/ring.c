@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * ring.c - what a session's worker writes for its readers: records into the
  * bounded ring (samples and events, indexed by a sequence number that never

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * routes.c - the route table and the libmicrohttpd access handler.
  *

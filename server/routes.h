@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * routes.h - the route table and the callbacks given to libmicrohttpd.
  */

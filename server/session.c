@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session.c - sessions: registry, lifetime, views, the control entry point
  * and the snapshot readers of the record ring and history.

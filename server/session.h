@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session.h - simulation sessions: one sim instance each, stepped by its
  * own worker thread (worker.c), kept in a registry by id.

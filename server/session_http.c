@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_http.c - the session resources: POST/GET /api/v1/sessions,
  * GET/PATCH/DELETE /api/v1/sessions/{id} and its trajectory.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_int.h - the inside of a session, shared by session.c (registry,
  * lifetime, readers) and worker.c (the thread that steps the core).

@@ -1,6 +1,7 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_store.c - a session's files in the data directory and the
- * sessions rebuilt from them at start-up (README "Persistence").
+ * sessions rebuilt from them at start-up (docs/operations.md "Persistence").
  *
  *   sessions/ID/spec.bin         the spec as created (framed, store.h)
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * static.c - the dashboard's files: GET / serves web/index.html, other
  * paths the file of that name under --web-root, with a Content-Type by

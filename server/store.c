@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store.c - the writer thread and the framed files of the data directory
  * (store.h).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store.h - the daemon's state on disk (--data-dir): one writer thread
  * that writes every file as temporary file -> fsync -> rename -> fsync of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * stream.c - GET /api/v1/sessions/{id}/stream: Server-Sent Events or
  * NDJSON.

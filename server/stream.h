@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * stream.h - GET /api/v1/sessions/{id}/stream (SSE or NDJSON).
  */

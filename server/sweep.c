@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep.c - v(beta) sweeps on the worker pool (POST /api/v1/sweeps).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
  * clocks, timed-wait deadlines, random ids (with the replica's node id)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * util.h - small services every part of the daemon uses: levelled logging
  * to stderr, clocks, timed-wait deadlines, random ids, the daemon's

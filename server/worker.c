@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * worker.c - a session's worker thread: the only thread that touches the
  * session's sim instance. It runs below the request and stream threads

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Installs the Debian packages of $NEEDS ("FILE:PACKAGE ..." pairs) whose
 # FILE is missing, saying which and why ($WHY). apt-get needs root: as root
 # it runs directly, otherwise through sudo if there is one; without either

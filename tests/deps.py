@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """deps.py - dependency loops between the files of a module, counted by symbols.
 
 For each object file of a folder (build/server/*.o), every undefined symbol is

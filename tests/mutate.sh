@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # `make mutate`: proves that `make test` can fail. Each mutation below is a
 # deliberate fault in the code (a factor, a sign, a skipped term, a unit);
 # for each, a copy of the working tree gets the fault, is built, and runs

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Runs every test group against the built binaries and closes with one line
 # "tests: N passed, M failed" counting the individual tests of all groups.
 # Unit tests are cmocka binaries; HTTP and browser tests are node:test files

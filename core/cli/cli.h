@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * cli.h - what the files of the command-line runner share: the option
  * table (one entry per option: its names, argument, unit, default and
@@ -26,7 +27,7 @@ enum {
 
 /* The default measuring window (s after the transient) of run, sweep and
  * fit: with the `steady` start, 4 s keep all 74 points of czubak2016
- * within 1 % of the converged reference (README "Accuracy"). */
+ * within 1 % of the converged reference (docs/accuracy.md "Accuracy"). */
 #define MEASURE_WINDOW 4.0
 
 /* A command's options as parsed (parse.c): the model (preset and --set),

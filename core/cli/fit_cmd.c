@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_cmd.c - `convsim fit`: free parameters (--free) fitted to measured
  * points (--data, CSV) or peak positions (--peaks) by the fitting module

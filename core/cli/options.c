@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * options.c - the command line's options as one table: getopt_long's
  * table and the help are both made from it, so they cannot drift. Also
@@ -36,6 +37,10 @@ static const cli_opt options[] = {
 	{CMD_SWEEP, OPT_FORMAT, "format", 'f', "csv|json", NULL, "csv", "format of the v(beta) table"},
 	{CMD_RUN, OPT_RATE, "sample-rate", 'r', "HZ", "Hz", "1000",
 	 "trajectory rows per simulated second, in (0, 1e6]"},
+	{CMD_RUN, OPT_BETA, "beta", 'b', "DEG", "deg", "the preset's (38)",
+	 "guide angle in [0, 180]; the same as --set beta=DEG"},
+	{CMD_RUN, OPT_ROTATION, "rotation", 0, "cw|ccw", NULL, "the preset's (cw)",
+	 "cw (the paper's clockwise, rotor speed > 0) or ccw; the same as --set rotation=..."},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
 	 "guide angles in [0, 180], or one angle"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * parse.c - a command's options into one cli_opts: the preset first (a
  * first pass finds it, so that --set applies on top of it wherever it
@@ -14,16 +15,29 @@
 #include "suggest.h"
 #include "units.h"
 
-/* "unknown setting 'x'" gets the nearest setting's name. */
-static void setting_error(const cli_opts *o, const char *arg, const char *name, const char *msg)
+/* "unknown setting 'x'" gets the nearest setting's name; opt is how the
+ * user gave it ("--set beta=x", "--beta x"). */
+static void setting_error(const cli_opts *o, const char *opt, const char *name, const char *msg)
 {
 	size_t n;
 	const sim_setting *t = sim_settings(&n);
 	char hint[96] = "";
 	if (!sim_setting_find(name))
 		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, n, sizeof *t));
-	fprintf(stderr, "convsim %s: --set %s: %s%s; 'convsim list' shows every setting\n", o->cmd,
-		arg, msg, hint);
+	fprintf(stderr, "convsim %s: %s: %s%s; 'convsim list' shows every setting\n", o->cmd, opt,
+		msg, hint);
+}
+
+/* Setting name to text value (in the unit `convsim list` shows): 0, or -1
+ * after a message naming opt. */
+static int set_setting(cli_opts *o, const char *opt, const char *name, const char *value)
+{
+	char msg[200];
+	if (sim_set_user_str(&o->p, &o->sc, &o->m, name, value, msg, sizeof msg) != SIM_OK) {
+		setting_error(o, opt, name, msg);
+		return -1;
+	}
+	return 0;
 }
 
 static int apply_set(cli_opts *o, const char *v)
@@ -33,13 +47,19 @@ static int apply_set(cli_opts *o, const char *v)
 		fprintf(stderr, "convsim %s: --set needs NAME=VALUE, got '%s'\n", o->cmd, v);
 		return -1;
 	}
-	char name[64], msg[200];
+	char name[64], opt[96];
 	snprintf(name, sizeof name, "%.*s", (int)(eq - v), v);
-	if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg) != SIM_OK) {
-		setting_error(o, v, name, msg);
-		return -1;
-	}
-	return 0;
+	snprintf(opt, sizeof opt, "--set %s", v);
+	return set_setting(o, opt, name, eq + 1);
+}
+
+/* run's --beta DEG and --rotation cw|ccw: the settings beta and rotation,
+ * as --set would set them (sweep's take lists instead). */
+static int set_option(cli_opts *o, const char *name, const char *value)
+{
+	char opt[96];
+	snprintf(opt, sizeof opt, "--%s %s", name, value);
+	return set_setting(o, opt, name, value);
 }
 
 /* The first pass over command cmd's options: help (shown, -1), a wrong
@@ -131,8 +151,13 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 		case OPT_THREADS: bad = whole(o->cmd, "threads", arg, 64, &o->threads); break;
 		case OPT_OUT: o->out = arg; break;
 		case OPT_FORMAT: o->format = arg; break;
-		case OPT_BETA: o->beta = arg; break;
-		case OPT_ROTATION: o->rotation = arg; break;
+		case OPT_BETA:
+		case OPT_ROTATION: /* run: one setting, as --set; sweep: a range, a list */
+			if (cmd == CMD_RUN)
+				bad = set_option(o, id == OPT_BETA ? "beta" : "rotation", arg);
+			else
+				*(id == OPT_BETA ? &o->beta : &o->rotation) = arg;
+			break;
 		case OPT_QUIET: o->quiet = 1; break;
 		case OPT_DATA: o->data = arg; break;
 		case OPT_PEAKS: o->peaks = arg; break;

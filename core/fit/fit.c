@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit.c - the least-squares driver of a calibration: Levenberg-Marquardt in
  * a trust region (GSL's gsl_multifit_nlinear, trs_lm, More scaling) on the
@@ -14,7 +15,7 @@
  * backwards when x_j + h_j passes hi_j. The steady-state measure is not
  * smooth at the 0.3 % level (its 4-s window sees whole periods only, and
  * the feed's contact pattern shifts), so the step must move v well beyond
- * that: 5 % of e moves v by about 12 %, 40 times the jitter (README
+ * that: 5 % of e moves v by about 12 %, 40 times the jitter (docs/calibration.md
  * "Calibration"). Then J_z = J_x dx/dz.
  *
  * Standard errors, correlations and warnings at the optimum: fit_cov.c.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit.h - calibration: least-squares fits of model parameters to measured
  * transport velocities v(beta), or to the positions of the v(beta) peaks.

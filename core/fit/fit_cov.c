@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_cov.c - what a fit's optimum is worth: standard errors from the
  * Jacobian J of the weighted residuals in the parameters' own units,

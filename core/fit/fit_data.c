@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_data.c - what a fit is given, checked before anything runs: the
  * free parameters (by name from the settings table, bounds from their

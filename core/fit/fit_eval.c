@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_eval.c - the model evaluations of a fit. Each unit is one fresh
  * sim_measure (steady start, window up to t_end) at a set of free-parameter

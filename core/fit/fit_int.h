@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_int.h - inside the fit module: the batch evaluator that fit.c's
  * least-squares driver calls (fit_eval.c). Not for callers of fit.h.

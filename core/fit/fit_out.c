@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_out.c - a fit's result as text, the same for the CLI and the daemon:
  * JSON (parameters with standard errors, correlation, per-datum model and
@@ -202,16 +203,21 @@ char *fit_result_json(const fit_request *q, const fit_result *r)
 		put(&t, "null");
 	put(&t, ",");
 	json_parameters(&t, q, r);
+	/* chi2 and the residual variance in the data's unit, as the residuals
+	 * are: dimensionless with sigma, (m/s)^2 for points, deg^2 for peaks
+	 * (the solver works in rad) */
+	double k2 = q->npoints || r->sigma_given ? 1 : DEG_PER_RAD * DEG_PER_RAD;
 	const char *keys[] = {"chi2", "residual_variance", "condition_number", "cpu_seconds",
 			      "wall_seconds"};
-	double vals[] = {r->chi2, r->s2, r->cond, r->cpu_seconds, r->wall_seconds};
+	double vals[] = {r->chi2 * k2, r->s2 * k2, r->cond, r->cpu_seconds, r->wall_seconds};
 	for (int k = 0; k < 5; k++) {
 		put(&t, ",\"%s\":", keys[k]);
 		num(&t, vals[k], "null");
 	}
-	put(&t, ",\"dof\":%d,\"standard_errors_from\":\"%s\",\"iterations\":%d,"
-		"\"evaluations\":%ld",
-	    r->dof, r->sigma_given ? "sigma" : "residual variance", r->iterations, r->evaluations);
+	put(&t, ",\"chi2_unit\":\"%s\",\"dof\":%d,\"standard_errors_from\":\"%s\","
+		"\"iterations\":%d,\"evaluations\":%ld",
+	    r->sigma_given ? "" : q->npoints ? "(m/s)^2" : "deg^2", r->dof,
+	    r->sigma_given ? "sigma" : "residual variance", r->iterations, r->evaluations);
 	json_data(&t, q, r);
 	json_curve(&t, r);
 	put(&t, ",\"warnings\":[");

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The accuracy gate (part of `make bench`): the 74-point v(beta) curve,
 # beta = 0..180 deg every 5 deg, both senses, with the defaults of
 # `convsim sweep` (what daemon sweeps use too), against the converged

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The calibration target (`make bench`, or alone: bash tests/bench/fit.sh
 # [OUTDIR]): a 2-parameter fit (e and mu) on 20 points of the czubak2016
 # defaults (beta 15..150 deg every 15, both rotations) must converge in

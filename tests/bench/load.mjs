@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `make load`: a bounded load run on loopback that stops by itself (about
 // two minutes). It starts its own daemon (with --max-memory 3G, so that
 // "memory stayed under the budget" means something) and then:

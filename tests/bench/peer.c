@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peer.c - what the benchmark's peers share (peer.h): their names and
  * set-ups, a sim stepped by a peer (sim_alloc, the peer's descriptor in

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peer.h - the benchmark's peers: integrators from GSL (odeiv2) and
  * SUNDIALS (CVODE, ARKODE) wrapped as core integrator descriptors

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peer_gsl.c - GSL's odeiv2 steppers as a core integrator descriptor
  * (peer.h; GSL Reference Manual, "Ordinary Differential Equations"): the

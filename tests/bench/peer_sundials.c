@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peer_sundials.c - SUNDIALS' CVODE and ARKODE (ERKStep) as core
  * integrator descriptors (peer.h; Hindmarsh et al., "SUNDIALS: Suite of

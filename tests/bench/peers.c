@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.c - the benchmark's peers at the 1 % gate (`make bench`; peer.h).
  *
@@ -18,7 +19,7 @@
  * rotation v v_ref err cpu steps rejected rhs_evals status. The scene is
  * czubak2016 with its defaults (the steady start, v over [0, 4] s: what
  * `convsim sweep` measures), so v_ref and the convention are those of
- * tests/bench/accuracy.sh (README "Accuracy and speed"). CPU: process CPU
+ * tests/bench/accuracy.sh (docs/accuracy.md "Accuracy and speed"). CPU: process CPU
  * seconds of the whole point (shooting, settling, the 4-s window), the
  * least of up to three repeats while a point costs under a second.
  */

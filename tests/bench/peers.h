@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers.h - the peers harness's parts (peers.c): the gate's points with
  * their reference and the error convention (peers_points.c), and the
@@ -35,7 +36,7 @@ typedef struct prow {
  * or -1 with a message on stderr. */
 int pset_load(pset *ps, const char *path, const char *list);
 
-/* |v - v_ref| by the convention of README "Accuracy and speed": relative
+/* |v - v_ref| by the convention of docs/accuracy.md "Accuracy and speed": relative
  * to |v_ref| where |v_ref| >= 0.3 peak, else to the peak. */
 double pset_error(const pset *ps, const pt *p, double v);
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The peers at the 1 % gate (part of `make bench`; `make bench-peers` runs
 # it alone): builds tests/bench/peers against the core library, GSL and
 # SUNDIALS, runs its sanity check (every peer against the core's rk4 on

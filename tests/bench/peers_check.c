@@ -1,9 +1,10 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers_check.c - the peers harness's own sanity check (peers.h): a wrong
  * wrapper (a state copied wrongly, a restart from the wrong state, the
  * wrong right-hand side) must not produce a pretty table. On the machine alone, whose right-hand
  * side is smooth, every peer at rtol = 1e-10 must follow the core's rk4 at
- * dt = 1e-5 s (itself within about 1e-9 of the orbit: README
+ * dt = 1e-5 s (itself within about 1e-9 of the orbit: docs/accuracy.md
  * "Work-precision benchmark") from the steady start, its settling included.
  */
 #include <math.h>

@@ -1,7 +1,8 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers_points.c - the gate's points for the peers harness (peers.h): the
  * converged reference tests/bench/results/vref.tsv, a chosen subset, and
- * the accuracy convention of README "Accuracy and speed".
+ * the accuracy convention of docs/accuracy.md "Accuracy and speed".
  */
 #include <math.h>
 #include <stdio.h>

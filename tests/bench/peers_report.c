@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * peers_report.c - the peers' table (peers.h): reads the harness's rows
  * (peers.c: one per setting and point) back, sums each setting over its

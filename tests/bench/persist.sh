@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Persistence figures (README "Persistence"), bounded (about 1 minute):
+# SPDX-License-Identifier: GPL-3.0-or-later
+# Persistence figures (docs/operations.md "Persistence"), bounded (about 1 minute):
 #  1. CPU cost of checkpointing 64 default sessions: the writer thread's
 #     CPU with --checkpoint-interval 0.5, scaled to the default 10 s;
 #  2. restart with 64 sessions on disk: wall time from exec to all 64

@@ -1,6 +1,7 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * phase.c - the feed's motion over one vibration period, averaged by the
- * rotor's angle: where in the period two settings part (README "Targets",
+ * rotor's angle: where in the period two settings part (docs/accuracy.md "Targets",
  * the feed step's remaining error). Not part of `make bench`; build and
  * run it against the core library:
  *

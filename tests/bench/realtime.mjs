@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // How many default sessions one daemon holds in real time on this machine
 // (`node tests/bench/realtime.mjs [N ...]`, not part of `make bench`: about
 // half a minute per N, loopback only, bounded). For each N it starts N

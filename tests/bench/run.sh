@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Work-precision benchmark (`make bench`): builds tests/bench/workprec
 # against the core library, runs the scenes in two single-threaded
 # processes (the full scene alone in one, the others in turn in the other),

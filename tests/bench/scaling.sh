@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Cost against the feed's size (part of `make bench`): the full model
 # (trough_rotation=true, so every column is integrated) on the whole grid
 # K = 1, 2, 5, 10, 20 columns x L = 1, 2, 4, 8, 16, 32 layers at a constant

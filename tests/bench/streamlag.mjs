@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared by the load run (load.mjs) and the real-time capacity figure
 // (realtime.mjs): plain node:http requests with a chosen source address,
 // stream clients that measure each sample's lag, percentiles, and the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * vref.c - transport velocity over consecutive windows, for the converged
  * reference v_ref(beta, rotation) and for the accuracy gate.

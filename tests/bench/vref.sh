@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The converged reference v_ref(beta, rotation) at the 74 points beta =
 # 0..180 deg every 5 deg, both senses (docs/MODEL.md "Accuracy convention").
 #

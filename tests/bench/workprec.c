@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec.c - work-precision benchmark of the integrators (`make bench`).
  *

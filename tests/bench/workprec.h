@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec.h - the work-precision benchmark's parts (see workprec.c): one
  * run of the core and its TSV row (workprec_run.c), the scenes with their

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec_report.c - the benchmark's report: reads the scenes' TSV rows
  * back and writes workprec.md (a table a scene, the references and their

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec_run.c - one run of the work-precision benchmark: the preset with
  * a scene's settings and one integrator setting, timed in CPU seconds,

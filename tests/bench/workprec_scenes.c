@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec_scenes.c - the benchmark's scenes: for each, the references
  * (trajectory: the finest runs of two different methods; transport

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * workprec_svg.c - the benchmark's plot, workprec.svg: log-log panels of
  * each scene's error (trajectory, transport velocity, energy residual)
@@ -242,7 +243,7 @@ void wp_write_svg(const char *dir, const wp_records *t)
 	      0.01);
 	panel(f, t, 0, 2 * H, 2 * W, H, "gate", E_V,
 	      "(4) the 1 % gate, czubak2016 defaults: worst v error over the gate's points "
-	      "(README); core dem and the GSL / SUNDIALS peers",
+	      "(docs/accuracy.md); core dem and the GSL / SUNDIALS peers",
 	      0, 0.01);
 	double ly = 3 * H + 20;
 	for (int m = 0; m < NMETHODS; m++) {

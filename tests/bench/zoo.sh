@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The machine zoo's accuracy gate (part of `make bench`): for every machine
 # of tests/bench/zoo/machines.tsv, the v(beta) curve at beta = 0..180 deg
 # every 10 deg, both senses, with the defaults of `convsim sweep` (steps

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The machine zoo's converged references (tests/bench/zoo/machines.tsv):
 # v(beta) at beta = 0..180 deg every 10 deg, both senses, for every
 # machine, by runs far finer than any default and with a longer window

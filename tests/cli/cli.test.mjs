@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The command line as a user meets it: help on stdout with exit 0 for
 // `help CMD` and `CMD --help`, every option with its default and unit;
 // --version; errors on stderr prefixed "convsim CMD:", specific, with a
@@ -92,4 +93,27 @@ test('sweep: plain progress lines off a terminal, the table to --out', () => {
     '--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2', '-f', 'json');
   assert.equal(q.err, '');
   assert.equal(JSON.parse(q.out).points[0].state, 'done');
+});
+
+test('run takes --beta DEG and --rotation cw|ccw as sweep does, the same as --set', () => {
+  const args = ['run', '--duration', '0.5', '-q', '--set', 'feed=false'];
+  const summary = (...more) => {
+    const r = run(...args, ...more);
+    assert.equal(r.code, 0, r.err);
+    return JSON.parse(r.out);
+  };
+  const byOption = summary('--beta', '30', '--rotation', 'ccw');
+  const bySet = summary('--set', 'beta=30', '--set', 'rotation=ccw');
+  assert.equal(byOption.rotor_speed, bySet.rotor_speed);
+  assert.ok(byOption.rotor_speed < -100, `ccw turns the rotor backwards: ${byOption.rotor_speed}`);
+  assert.ok(summary('-b', '30').rotor_speed > 100, 'the preset is clockwise');
+  assert.equal(summary('-b', '30').transport_velocity, summary('--set', 'beta=30').transport_velocity);
+  /* as given: 30, not 29.999999999999996 (the degrees a radian came from) */
+  assert.match(run(...args, '--beta', '30').out, /"beta": 30,/);
+  let r = run('run', '--beta', '181');
+  assert.equal(r.code, 2);
+  assert.match(r.err, /^convsim run: --beta 181: beta must be a finite number in \[0, 180\] deg/);
+  r = run('run', '--rotation', 'up');
+  assert.equal(r.code, 2);
+  assert.match(r.err, /^convsim run: --rotation up: rotation must be one of cw\|ccw/);
 });

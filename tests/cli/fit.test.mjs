@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `convsim fit` as a user meets it: bad input refused before anything runs
 // (exit 2, a message naming the option and the problem, nothing on stdout),
 // and a small fit on a cheap scene whose result carries the values, their

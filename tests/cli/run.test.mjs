@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `make run` always runs the daemon with a token: it makes TOKEN once (mode
 // 0600, 64 hex digits), keeps it across runs, and prints the dashboard's
 // address with the token in the fragment; the API refuses requests without

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_body.c - libFuzzer harness of the JSON request bodies: the bytes
  * are a request body handed to the API's real parser, as the server hands

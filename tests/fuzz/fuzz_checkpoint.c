@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_checkpoint.c - libFuzzer harness of the core's checkpoint reader,
  * sim_restore (core/checkpoint.c), on the instances the daemon checkpoints.

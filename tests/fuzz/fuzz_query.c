@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_query.c - libFuzzer harness of the query strings and the headers
  * the API reads: which parameters a route takes (api_check_query), the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_route.c - libFuzzer harness of the daemon's path routing,
  * srv_route_resolve (server/routes.c): the route table and its "*"

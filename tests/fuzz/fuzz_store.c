@@ -1,7 +1,8 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_store.c - libFuzzer harness of the daemon's stored-session reader:
  * a session's spec.bin and checkpoint.bin as a restart reads them back
- * (README "Persistence"): the frame (srv_store_unframe: magic, version,
+ * (docs/operations.md "Persistence"): the frame (srv_store_unframe: magic, version,
  * kind, length, checksum), the spec record (srv_spec_decode, which checks
  * the spec with api_check_spec), the checkpoint's head (srv_ckpt_decode)
  * and the core's checkpoint behind it (sim_restore, for that spec).

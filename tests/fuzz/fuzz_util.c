@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_util.c - the oracles the harnesses share (fuzz_util.h).
  */
@@ -25,7 +26,7 @@ void fuzz_refused(const char *what, const char *why)
 {
 	if (getenv("FUZZ_MUST_ACCEPT"))
 		fuzz_fail("a committed seed is refused (%s: %s): the seeds are stale, make them "
-			  "again (README \"Fuzzing\")",
+			  "again (docs/development.md \"Fuzzing\")",
 			  what, why);
 }
 
@@ -67,7 +68,7 @@ static int terminated(const char *s, size_t cap)
 }
 
 /* A problem's text as written: the same as given when that is ASCII;
- * otherwise bytes that are not valid UTF-8 came back as U+FFFD (README
+ * otherwise bytes that are not valid UTF-8 came back as U+FFFD (docs/operations.md
  * "Security"), so only its being a string is checked. */
 static int as_given(const char *written, const char *given)
 {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The bearer token (--token-file): every route but the dashboard's files and
 // /api/v1/health answers 401 with WWW-Authenticate without it or with another
 // token, and the right one opens them; a refused request changes nothing.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The daemon's budgets, each against a real daemon given small limits by
 // flags: memory (--max-memory: 422 for a session larger than the whole
 // budget, 503 + Retry-After when full, nothing created), CPU

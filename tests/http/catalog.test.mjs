@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Read-only resources: presets, health, metrics format, the OpenAPI
 // document, and the dashboard's static files (with no way out of web/).
 import { test, before, after } from 'node:test';

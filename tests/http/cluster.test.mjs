@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Three replicas behind the real HAProxy, started by server/cluster.sh run
 // (as `make cluster N=3`) on free ports: creations spread over all three,
 // every id is routed to its replica, streams and PATCH beta pass the proxy,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bad requests: each gets its exact status and an RFC 9457 body naming the
 // field and range, and none of them changes anything.
 import { test, before, after } from 'node:test';

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Calibration fits as jobs (POST /api/v1/fits): bad input refused whole with
 // a 422 naming the field and nothing started; a fit's life (queued or
 // running with progress, done with its result as JSON and CSV, listed,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One content negotiation for every result route: JSON and CSV by Accept
 // or ?format=, 406 for an Accept naming neither, 400 for unknown query
 // parameters on every route; the trajectory's rows exactly `stride` apart;
@@ -142,6 +143,38 @@ test('each problem type URI serves a page that explains it', async () => {
     const p = await req(d.base, 'GET', `/api/v1/problems/${slug}`);
     assert.equal(p.status, 200, slug);
     assert.ok(page.text.includes(`href="${slug}"`), slug);
+    /* rendered: the explanation's code spans are <code>, no raw backticks */
+    assert.doesNotMatch(p.text, /`/, slug);
   }
+  const range = await req(d.base, 'GET', '/api/v1/problems/out-of-range');
+  assert.match(range.text, /<code>field<\/code> names it/);
   assert.equal((await req(d.base, 'GET', '/api/v1/problems/nonsense')).status, 404);
+});
+
+test('numbers as the user gave them: beta in degrees as sent, times on the grid as k dt', async () => {
+  const r = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, params: { beta: 121.9 }, pace: 'max', until: 0.5 });
+  assert.equal(r.status, 201, r.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body.state === 'finished', 30000);
+  const s = await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`);
+  /* the text, not only the value: 121.9, never 121.89999999999999 */
+  assert.match(s.text, /"beta":121\.9[,}]/);
+  assert.match(s.text, /"beta_target":121\.9[,}]/);
+  assert.match(s.text, /"t":0\.5[,}]/);
+  const csv = (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}/trajectory?format=csv`)).text.trim().split('\n');
+  for (const line of csv.slice(1)) {
+    const [t, beta, target] = line.split(',');
+    assert.equal(beta, '121.9', line);
+    assert.equal(target, '121.9', line);
+    assert.match(t, /^\d+(\.\d{1,9})?$/, `t on the grid: ${line}`);
+  }
+  const e = await req(d.base, 'POST', '/api/v1/experiments', { session: CHEAP, schedule: [{ beta: 38, until: 0.6 }, { beta: 128, until: 1.2 }] });
+  assert.equal(e.status, 201, e.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${e.body.id}`)).body.state === 'done', 60000);
+  const rows = (await req(d.base, 'GET', `/api/v1/experiments/${e.body.id}?format=csv`)).text.trim().split('\n').slice(1);
+  assert.equal(rows.length, 2);
+  for (const row of rows) {
+    const c = row.split(',');
+    for (const k of [6, 7, 13]) assert.match(c[k], /^(|\d+(\.\d{1,9})?)$/, `column ${k} of ${row}`);
+  }
+  assert.ok(rows[1].split(',')[13] !== '', 'the beta change has its reversal time');
 });

@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Hostile bytes and files: the web root serves regular files only (a FIFO,
 // a directory or a link out of the root is "not found", at once, and the
 // daemon still stops cleanly); every problem is valid UTF-8 JSON whatever
 // bytes the request held; a malformed Content-Length is refused with 400
-// before any of the daemon's code runs (libmicrohttpd answers it; README
+// before any of the daemon's code runs (libmicrohttpd answers it; docs/operations.md
 // "Security" says what it sends).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Experiments (a beta schedule with per-segment steady velocity and
 // reversal time) and sweeps (v(beta) for both rotations on the pool).
 // Where a job runs the czubak2016 defaults at a clockwise peak, its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Helpers for the HTTP tests: start the real daemon on an ephemeral port,
 // talk JSON to it, and read its SSE / NDJSON streams record by record.
 // CONVSIMD names the binary (build/convsimd or build-san/convsimd); the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fifty sessions, each with its own streaming client, run at once without
 // an error; metrics move with them.
 import { test, before, after } from 'node:test';

@@ -1,12 +1,16 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The OpenAPI document against the live daemon, with ajv's JSON Schema
 // 2020-12 validator: every operation it lists is exercised and its answer
 // validated against the schema the document gives for that status; every
 // stream record kind seen (SSE and NDJSON) against StreamRecord; the
 // request bodies sent against their (closed) request schemas, and a body
 // with an unknown member is refused by both the schema and the daemon.
+// Besides, the document itself is validated as OpenAPI 3.1 by an external
+// validator, @apidevtools/swagger-parser.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import Ajv2020 from 'ajv/dist/2020.js';
+import SwaggerParser from '@apidevtools/swagger-parser';
 import { startDaemon, req, until, openStream, SLOW, CHEAP } from './lib.mjs';
 
 const ID = 'https://convsim.invalid/openapi.json';
@@ -20,6 +24,21 @@ before(async () => {
   ajv.addSchema({ ...doc, $id: ID });
 });
 after(async () => { await d?.stop(); });
+
+test('the served document is valid OpenAPI 3.1 (swagger-parser)', async () => {
+  assert.equal(doc.openapi, '3.1.0');
+  await SwaggerParser.validate(structuredClone(doc));
+  // a stream is a sequence of records: the body is text, each record is a StreamRecord
+  const ok = doc.paths['/api/v1/sessions/{id}/stream'].get.responses['200'].content;
+  for (const type of ['text/event-stream', 'application/x-ndjson']) {
+    assert.deepEqual(ok[type].schema, { type: 'string' }, type);
+    assert.equal(ok[type]['x-itemSchema'].$ref, '#/components/schemas/StreamRecord', type);
+  }
+  // and the validator does reject what is not OpenAPI 3.1
+  const bad = structuredClone(doc);
+  bad.paths['/api/v1/sessions/{id}/stream'].get.responses['200'].content['application/x-ndjson'].itemSchema = { type: 'object' };
+  await assert.rejects(SwaggerParser.validate(bad), /unevaluated properties|itemSchema/);
+});
 
 const schema = (name) => {
   const v = ajv.getSchema(`${ID}#/components/schemas/${name}`);

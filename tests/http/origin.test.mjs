@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Cross-origin safety: Host must name the daemon (421: DNS rebinding),
 // Origin must be its own or an --allow-origin (403), CORS preflights are
 // answered exactly, and POST, PATCH, PUT and DELETE need Content-Type:

@@ -1,4 +1,5 @@
-// State on disk (--data-dir, README "Persistence"): a daemon with 10
+// SPDX-License-Identifier: GPL-3.0-or-later
+// State on disk (--data-dir, docs/operations.md "Persistence"): a daemon with 10
 // sessions receiving controls, one experiment and one sweep is killed with
 // SIGKILL at random moments and restarted on the same directory; nothing
 // acknowledged more than one checkpoint interval before the kill may be

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A daemon as one replica of several: --node-id in every id it makes (and
 // its data directory kept to that node id), --peers gathering lists.
 import { test } from 'node:test';

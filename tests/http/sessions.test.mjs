@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sessions end to end: the transport velocity of the default scene at the
 // clockwise peaks against converged references; the status at t = 0;
 // create, stream, steer beta from 38 to 128 deg on the fly and watch the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // SIGTERM (and SIGINT) with sessions running and streams open: every
 // stream gets an "end" record with reason "shutdown" and the daemon exits 0.
 import { test } from 'node:test';

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Files of the data directory with a right checksum and wrong contents
 // (what a fuzz harness, tests/fuzz/fuzz_store.c, feeds the restore): a
 // checkpoint whose experiment length wraps the length check, a spec whose

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_accuracy.c - known answers for the engine's main result, the
  * transport velocity, through the public interface only: the hopping
@@ -55,7 +56,7 @@ static double flight_fraction(double G)
  * A w^2 sin(psi) / g with the deck's amplitude A read off the run. The
  * theory assumes no slip at all; with a finite mu the element slides
  * forward just before lift-off, where the normal force vanishes, so the
- * engine runs 0.8-1.7 % faster here. Tolerance 3 % (README says the same). */
+ * engine runs 0.8-1.7 % faster here. Tolerance 3 % (docs/accuracy.md says the same). */
 static void hopping_theory_through_the_engine(void **state)
 {
 	(void)state;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_beyond_preset.c - known answers at parameters other than the
  * czubak2016 preset's, where the terms that vanish on the preset (p = 1,

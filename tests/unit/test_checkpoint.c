@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_checkpoint.c - checkpoints of an instance (core/checkpoint.c):
  * a restored instance continues bit for bit as the uninterrupted one, for

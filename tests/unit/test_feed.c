@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_feed.c - the feed against known answers: rebound at R times the
  * impact speed, transport direction and its reversal by beta, mirror

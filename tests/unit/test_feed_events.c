@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_feed_events.c - dem's located slip reversals and yielding deck
  * (feed_events) against known answers: a reversal inside a sub-step is

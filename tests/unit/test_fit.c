@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_fit.c - the fitting module (core/fit) against known answers: data
  * made by the model itself from known parameters plus Gaussian noise of

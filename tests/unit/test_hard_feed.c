@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_hard_feed.c - hard cases of the core's contact and feed (issue 5):
  * stiff, nearly elastic and nearly plastic contact, frictionless and

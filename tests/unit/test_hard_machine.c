@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_hard_machine.c - hard cases of the machine, its drive and beta
  * (issue 5): beta reversed at the maximum slew rate and beta oscillating,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_machine.c - the machine against answers known without the code:
  * static equilibrium, the Kloss steady speed under a constant load, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_params.c - parameter validation: every setting has a unit and a
  * range; bad values (negative or zero masses, non-finite numbers, sizes

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * testutil.h - shared set-up for the core's unit tests (cmocka): the
  * czubak2016 preset with changes, running an instance to a time, and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Browser test of the dashboard against the real daemon: starts
 // $CONVSIMD (default build/convsimd) on port 0, drives web/ in Debian's
 // chromium through playwright-core and checks what a user sees against
@@ -227,6 +228,25 @@ test('β = 38°, clockwise: the page shows transport to the right', async () => 
 	assert.ok(Math.abs(v - st.transport_velocity) < 0.01 && u > 0, `shown ${shown.d}, API ${st.transport_velocity}`);
 });
 
+test('the session picker says what the tiles say: the same time and the state', async () => {
+	await until(async () => {
+		const { tile, label } = await page.evaluate(() => ({
+			tile: document.querySelector('#t-now').textContent,
+			label: document.querySelector('#session-select').selectedOptions[0].textContent,
+		}));
+		const t = Number.parseFloat(tile);
+		const m = / · t (\d+\.\d) s · (\w+)$/.exec(label);
+		return m && Number(m[1]) === Math.round(t * 10) / 10 && m[2] === 'running';
+	}, 5000, 'the picker with the tile\'s time and "running"');
+});
+
+test('identical strokes: one line, said so, as for the feed\'s columns', async () => {
+	await until(() => visible('#strokes-note'), 5000, 'the strokes note');
+	assert.match(await page.$eval('#strokes-note', e => e.textContent), /Both eliminators move identically/);
+	assert.equal(csvLines(await download('#plot-strokes + .plot-export button[data-export="csv"]'))[0],
+		't / s,s₁ = s₂ / mm (identical)');
+});
+
 test('moving the β slider turns the session to 128° and reverses the shown direction', async () => {
 	await page.locator('#beta-slider').fill('128');
 	const s = await until(async () => {
@@ -281,6 +301,20 @@ test('a refused input shows the daemon\'s problem detail', async () => {
 	assert.ok(text.includes(problem.detail), `message "${text}" lacks the detail "${problem.detail}"`);
 	assert.match(text, /422/);
 	assert.equal(await page.$eval('input[name="layers"]', e => e.getAttribute('aria-invalid')), 'true');
+	/* the message covers nothing, wherever the page is scrolled */
+	for (const y of [0, 400, 900]) {
+		const covered = await page.evaluate(y => {
+			window.scrollTo(0, y);
+			const box = document.querySelector('#messages').getBoundingClientRect();
+			const hit = r => r.width > 0 && r.height > 0 && r.left < box.right && r.right > box.left &&
+				r.top < box.bottom && r.bottom > box.top;
+			return Array.from(document.querySelectorAll('input, select, button, textarea, td, th, .plot, h2, h3'))
+				.filter(e => !e.closest('#messages') && hit(e.getBoundingClientRect()))
+				.map(e => e.id || e.name || e.tagName);
+		}, y);
+		assert.deepEqual(covered, [], `scrolled to ${y}: the message covers ${covered}`);
+	}
+	await page.evaluate(() => window.scrollTo(0, 0));
 	/* nothing else was created, and the page still follows the same session */
 	const list = await apiGet('/api/v1/sessions');
 	assert.equal(list.sessions.length, 1);
@@ -347,6 +381,19 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	assert.ok(Math.abs(Number(row[1]) - e.value) <= 1e-4 * Math.abs(e.value), `${row[1]} vs ${e.value}`);
 	assert.equal(Number(row[3]), 0.0215);
 	assert.equal(fit.result.standard_errors_from, 'sigma');
+	/* χ² at three significant digits (with σ it has no unit) and the reduced χ² */
+	const chi2 = await page.$eval('#fit-table .fit-chi2', e => e.textContent);
+	const m = /χ² = (\S+) with 3 degrees of freedom; reduced χ²\/dof = (\S+)$/.exec(chi2);
+	assert.ok(m, chi2);
+	assert.equal(Number(m[1]), Number(fit.result.chi2.toPrecision(3)), chi2);
+	assert.equal(Number(m[2]), Number((fit.result.chi2 / 3).toPrecision(3)), chi2);
+	/* measured points as markers, not joined; a legend of the series there are (no ccw data) */
+	assert.deepEqual(await page.evaluate(() => window.convsim.plots.fit.joined), [false, true, true, false, true, true]);
+	const legend = await page.$$eval('#plot-fit .u-legend .u-series', rows => rows
+		.filter(r => getComputedStyle(r).display !== 'none').map(r => r.querySelector('.u-label').textContent));
+	assert.deepEqual(legend, ['data cw', 'fitted cw', 'original cw']);
+	/* the progress line says "done" once, not "done · done" */
+	assert.match(await page.$eval('#fit-progress .ptext', e => e.textContent), /^done · iteration \d+ · \d+ evaluations/);
 	const csv = csvLines(await download('#fit-csv'));
 	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
 	assert.equal(csv.filter(l => l.startsWith('curve,')).length, 4);
@@ -386,6 +433,11 @@ test('a β-change experiment reports its reversal time', async () => {
 		'steady_velocity,mean_velocity,uncertainty,steady,reversal_time');
 	assert.equal(seg.length, 3);
 	assert.deepEqual(seg.slice(1).map(l => l.split(',')[3]), ['38', '128']);
+	/* the first segment commands the β the session already has: nothing reverses, no time */
+	assert.deepEqual(seg.slice(1).map(l => l.split(',')[13] !== ''), [false, true], seg.join('\n'));
+	const reversals = await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[5].textContent));
+	assert.equal(reversals[0], '–');
+	assert.match(reversals[1], /^\d+\.\d{3}$/);
 	const et = csvLines(await download('#experiment-traj'));
 	assert.ok(et[0].startsWith(TRAJ_HEAD));
 	assert.ok(Number(et[et.length - 1].split(',')[0]) >= 3.9, 'the trajectory covers the experiment');
@@ -418,9 +470,57 @@ test('screenshot of the dashboard', async () => {
 	assert.deepEqual(pageErrors, []);
 });
 
-test('the page says so when the daemon goes away', async () => {
+test('a Kloss-drive session from the picker: the rotor plot\'s period means leave β visible', async () => {
+	const r = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json', ...AUTH },
+		body: JSON.stringify({ params: { beta: 38 }, scene: { drive: 'motor', columns: 5, layers: 2 }, pace: Number(PACE), sample_rate: 500 }) });
+	assert.equal(r.status, 201);
+	const id = (await r.json()).id;
+	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(id), 10000, 'the new session in the picker');
+	await page.selectOption('#session-select', id);
+	await until(async () => await page.$eval('body', b => b.dataset.sessionId) === id, 5000, 'attached');
+	await until(async () => await tEnd('#plot-rotor') > 2, 30000, 'two seconds of rotor speed');
+	const shown = await page.evaluate(() => {
+		const [t, w] = window.convsim.plots.rotor.plot.data;
+		const last = t.length - 1, from = t.findIndex(x => x >= t[last] - 1);
+		const ws = w.slice(from).filter(Number.isFinite);
+		return Math.max(...ws) - Math.min(...ws);
+	});
+	/* the raw rotor speed ripples at the excitation frequency */
+	const traj = await apiGet(`/api/v1/sessions/${id}/trajectory?from=1`);
+	const k = traj.fields.indexOf('rotor_speed');
+	const raw = traj.rows.map(row => row[k]);
+	const ripple = Math.max(...raw) - Math.min(...raw);
+	assert.ok(ripple > 0.5, `raw ripple ${ripple} rad/s`);
+	assert.ok(shown < ripple / 4, `the plot's rotor speed spans ${shown} rad/s over its last second, the raw ${ripple}`);
+});
+
+test('Delete clears the tiles and the plots', async () => {
 	await page.click('#delete');
 	await until(async () => !(await page.$eval('body', b => b.dataset.sessionId)), 5000, 'the session detached');
+	await until(async () => await page.$eval('#state-now', e => e.textContent) === 'no session', 5000, 'no session shown');
+	for (const sel of ['#t-now', '#rotor-now', '#rtf-now', '#v-value', '#v-daemon'])
+		assert.equal(await page.$eval(sel, e => e.textContent), '–', sel);
+	for (const sel of ['#plot-rotor', '#plot-feed', '#plot-orbit', '#plot-strokes', '#plot-trough'])
+		assert.equal(await count(sel), 0, `${sel} emptied`);
+	/* and it stays so: no poll brings the deleted session back */
+	await new Promise(r => setTimeout(r, 1500));
+	assert.equal(await page.$eval('#state-now', e => e.textContent), 'no session');
+});
+
+test('problem pages are rendered: code as code, no raw backticks', async () => {
+	const other = await browser.newPage({ extraHTTPHeaders: AUTH });
+	try {
+		const res = await other.goto(`${base}/api/v1/problems/out-of-range`);
+		assert.equal(res.status(), 200);
+		const text = await other.evaluate(() => document.body.innerText);
+		assert.doesNotMatch(text, /`/);
+		assert.ok(await other.$$eval('p code', c => c.map(x => x.textContent).includes('field')));
+	} finally {
+		await other.close();
+	}
+});
+
+test('the page says so when the daemon goes away', async () => {
 	await stopDaemon();
 	await page.waitForSelector('#conn[data-state="offline"]', { timeout: 10000 });
 	const text = await page.$eval('#messages', e => e.textContent);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Unit tests of the dashboard's pure modules (no browser, no daemon):
 // the API field mapping, the sample buffers and velocity fit, number
 // formatting and the schematic's geometry.
@@ -5,7 +6,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import * as api from '../../web/js/api.js';
 import { Trace, slope, recentVelocity } from '../../web/js/series.js';
-import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText } from '../../web/js/format.js';
+import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText } from '../../web/js/format.js';
 import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
 
 const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
@@ -237,4 +238,18 @@ test('the token header: set for the tab, none without a token', () => {
 	assert.equal(api.hasToken(), true);
 	api.setToken(null);
 	assert.deepEqual(api.authHeaders(), {});
+});
+
+test('fit panel: χ² with its unit and the reduced χ², at three significant digits; progress without "done · done"', () => {
+	assert.equal(fitChi2Text({ chi2: 1.9e-4, dof: 4, chi2_unit: '(m/s)^2' }),
+		'χ² = 1.90e-4 (m/s)² with 4 degrees of freedom; reduced χ²/dof = 4.75e-5 (m/s)²');
+	assert.equal(fitChi2Text({ chi2: 3.9, dof: 1, chi2_unit: 'deg^2' }),
+		'χ² = 3.9 deg² with 1 degrees of freedom; reduced χ²/dof = 3.9 deg²');
+	assert.equal(fitChi2Text({ chi2: 2.5, dof: 3, chi2_unit: '' }),
+		'χ² = 2.5 with 3 degrees of freedom; reduced χ²/dof = 0.833');
+	assert.equal(fitChi2Text({ chi2: 0, dof: 0, chi2_unit: '' }), 'χ² = 0 with 0 degrees of freedom');
+	assert.equal(fitProgressText({ state: 'done', phase: 'done', iteration: 3, evaluations: 40, values: { e: 0.0181234 } }),
+		'done · iteration 3 · 40 evaluations · e = 0.01812');
+	assert.equal(fitProgressText({ state: 'running', phase: 'covariance', iteration: 2, evaluations: 9, values: {} }),
+		'running · covariance · iteration 2 · 9 evaluations');
 });

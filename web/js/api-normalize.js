@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * api-normalize.js - the daemon's JSON as the dashboard's plain objects.
  *

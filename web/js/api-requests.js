@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * api-requests.js - what the dashboard sends the daemon: the base URL, the
  * bearer token's header, the request bodies of POST /sessions, /sweeps

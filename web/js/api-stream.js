@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * api-stream.js - the session's live stream: the daemon's server-sent
  * events (samples, control changes, missed-sample counts, the end) read

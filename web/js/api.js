@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * api.js - the dashboard's one link to the convsimd daemon: the HTTP
  * client (one function an endpoint) and its errors.
@@ -162,7 +163,7 @@ export async function integratorNames() {
 /* ---- fits ---------------------------------------------------------------- */
 
 /* A fit job as the page uses it: progress, and the daemon's result object
- * (fields as README "Calibration" lists them) once over. */
+ * (fields as docs/calibration.md "Calibration" lists them) once over. */
 export function normalizeFit(raw) {
 	const r = raw || {};
 	return {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * auth.js - the daemon's token in the page. `make run` prints the
  * dashboard's address with the token in the fragment (#token=...), which

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * controls.js - the live-control card of the attached session: pause,
  * resume and delete; the beta slider, its number field and the quick

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * draw.js - redraws plots, the velocity tile and the schematic from the
  * traces at most every animation frame (every 50 ms), and only when the
@@ -7,7 +8,7 @@
 import { fmtVelocity, direction, ARROW } from './format.js';
 import { app, $, numberOf } from './ui.js';
 import { currentVelocity, MM } from './live.js';
-import { buildFeedPlot } from './figures.js';
+import { buildFeedPlot, buildStrokesPlot } from './figures.js';
 
 let lastDraw = 0;
 export function frame(now) {
@@ -23,7 +24,10 @@ function draw() {
 	if (tr) {
 		const o = tr.orbit.data();
 		app.plots.orbit.setData([[o[1], o[2]]]);
-		app.plots.strokes.setData(tr.strokes.data());
+		const sd = tr.strokes.data();
+		const same = columnsAlike(sd);
+		buildStrokesPlot(same);
+		app.plots.strokes.setData(same ? sd.slice(0, 2) : sd);
 		app.plots.trough.setData(tr.trough.data());
 		app.plots.rotor.setData(tr.rotor.data());
 		if (app.columns) {
@@ -66,7 +70,8 @@ function draw() {
 	});
 }
 
-/* 1 if every column's trace equals the first's (to 1e-12 of its size). */
+/* 1 if every column's trace equals the first's (to 1e-12 of its size):
+ * the feed's columns, the two strokes. */
 function columnsAlike(d) {
 	if (d.length < 3 || !d[0].length) return false;
 	let size = 1e-12;

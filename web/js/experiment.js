@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * experiment.js - the beta-change experiment panel: runs a fresh session
  * of the new-session form's model with beta1 then beta2, optionally

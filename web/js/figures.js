@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * figures.js - the page's plots: which plot shows what, with its series,
  * labels and axes (plots.js draws them), and the schematic. The feed plot
@@ -18,10 +19,7 @@ export function makePlots() {
 		series: [{ label: 'rotor speed / (rad/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
 		yLabel: 'rotor speed / (rad/s)', y2Label: 'β / °', y2Range: [0, 180],
 	});
-	app.plots.strokes = new TimePlot($('#plot-strokes'), {
-		series: [{ label: 's₁ / mm', color: PALETTE[4] }, { label: 's₂ / mm', color: PALETTE[5] }],
-		yLabel: 'stroke / mm',
-	});
+	buildStrokesPlot(false);
 	app.plots.trough = new TimePlot($('#plot-trough'), {
 		series: [{ label: 'x / mm', color: PALETTE[0] }, { label: 'y / mm', color: PALETTE[1] }],
 		yLabel: 'displacement / mm',
@@ -34,15 +32,29 @@ export function makePlots() {
 		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
 	});
 	app.plots.fit = new XYPlot($('#plot-fit'), {
-		series: [{ label: 'data cw', color: PALETTE[0] }, { label: 'fitted cw', color: PALETTE[2] },
-			{ label: 'original cw', color: '#94a3b8' }, { label: 'data ccw', color: PALETTE[1] },
+		series: [{ label: 'data cw', color: PALETTE[0], line: false }, { label: 'fitted cw', color: PALETTE[2] },
+			{ label: 'original cw', color: '#94a3b8' }, { label: 'data ccw', color: PALETTE[1], line: false },
 			{ label: 'fitted ccw', color: PALETTE[4] }, { label: 'original ccw', color: '#cbd5e1' }],
-		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
+		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', zeroLine: true, aspect: 0.5,
 	});
 	app.plots.experiment = new TimePlot($('#plot-experiment'), {
 		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
 		yLabel: 'v / (m/s)', y2Label: 'β / °', y2Range: [0, 180], aspect: 0.5,
 	});
+}
+
+/* The strokes plot; alike: both eliminators move the same (the symmetric
+ * machine), drawn as one line with a note saying so, as the feed plot does. */
+export function buildStrokesPlot(alike) {
+	if (app.plots.strokes && app.plots.strokesAlike === alike) return;
+	app.plots.strokes?.destroy();
+	const series = alike ? [{ label: 's₁ = s₂ / mm (identical)', color: PALETTE[4] }]
+		: [{ label: 's₁ / mm', color: PALETTE[4] }, { label: 's₂ / mm', color: PALETTE[5] }];
+	app.plots.strokes = new TimePlot($('#plot-strokes'), { series, yLabel: 'stroke / mm' });
+	app.plots.strokesAlike = alike;
+	const note = $('#strokes-note');
+	note.hidden = !alike;
+	note.textContent = alike ? 'Both eliminators move identically (a symmetric machine), so one line stands for s₁ and s₂.' : '';
 }
 
 /* The feed plot for K columns; alike: every column moves the same (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * fit.js - the calibration panel: measured points pasted or loaded as CSV,
  * free parameters by name, POST /api/v1/fits on the new-session form's
@@ -8,7 +9,7 @@
  */
 
 import * as api from './api.js';
-import { fmt } from './format.js';
+import { fitProgressText, fitChi2Text } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm } from './session.js';
 
@@ -46,9 +47,7 @@ async function runFit(ev) {
 		csv.href = api.fitCsvUrl(j.id);
 		csv.download = `fit-${j.id}.csv`;
 		progress(box, 0, 'started');
-		const end = await poll(api.getFit, j.id, u => progress(box, u.progress,
-			`${u.state} · ${u.phase} · iteration ${u.iteration} · ${u.evaluations} evaluations · ` +
-			Object.entries(u.values).map(([k, v]) => `${k} = ${fmt(v, 5)}`).join(', ')));
+		const end = await poll(api.getFit, j.id, u => progress(box, u.progress, fitProgressText(u)));
 		if (end.result) showFit(end.result);
 		csv.hidden = !end.result;
 		const r = end.result;
@@ -95,7 +94,8 @@ function showFit(r) {
 	}
 	const note = body.insertRow().insertCell();
 	note.colSpan = 6;
-	note.textContent = `standard errors from ${r.standard_errors_from}; χ² = ${fmt(r.chi2, 3)} with ${r.dof} degrees of freedom`;
+	note.className = 'fit-chi2';
+	note.textContent = `standard errors from ${r.standard_errors_from}; ${fitChi2Text(r)}`;
 	const list = $('#fit-warnings');
 	list.replaceChildren(...r.warnings.map(w => Object.assign(document.createElement('li'), { textContent: w })));
 }

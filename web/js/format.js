@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * format.js - numbers, units and directions as the dashboard shows them.
  * SI throughout (displacements in mm where metres would be all zeros),
@@ -100,4 +101,21 @@ export function problemText(err) {
 	const status = err.status ?? p.status;
 	const head = status ? `${status} ` : '';
 	return head + parts.join(' ').trim();
+}
+
+/* A fit's progress line: its state, the phase while it runs (not "done ·
+ * done"), the iteration, evaluations and current values. */
+export function fitProgressText(u) {
+	const phase = u.phase && u.phase !== u.state ? ` · ${u.phase}` : '';
+	const values = Object.entries(u.values ?? {}).map(([k, v]) => `${k} = ${fmt(v, 5)}`).join(', ');
+	return `${u.state}${phase} · iteration ${u.iteration} · ${u.evaluations} evaluations` + (values ? ` · ${values}` : '');
+}
+
+/* χ² with its unit (none when every datum has its σ, else the data's unit
+ * squared: (m/s)² for points, deg² for peaks) and the reduced χ²/dof, at
+ * three significant digits so that a small cost is not rounded away. */
+export function fitChi2Text(r) {
+	const unit = { '(m/s)^2': ' (m/s)²', 'deg^2': ' deg²' }[r.chi2_unit] ?? '';
+	const reduced = r.dof > 0 && Number.isFinite(r.chi2) ? `; reduced χ²/dof = ${fmtSig(r.chi2 / r.dof, 3)}${unit}` : '';
+	return `χ² = ${fmtSig(r.chi2, 3)}${unit} with ${r.dof} degrees of freedom${reduced}`;
 }

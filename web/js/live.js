@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * live.js - the attached session's stream: samples into the bounded
  * traces (series.js) behind the live plots, control events into the
@@ -20,6 +21,7 @@ export function resetTraces(columns) {
 		strokes: new Trace(2, { policy: 'window', span: 0.25, capacity: 4000 }),
 		trough: new Trace(2, { policy: 'window', span: 0.25, capacity: 4000 }),
 		rotor: new Trace(2, { policy: 'history', capacity: 3000 }),
+		rotorPeriod: { t0: NaN, t: 0, sum: 0, n: 0 },
 		feed: new Trace(K, { policy: 'history', capacity: 3000 }),
 		feedMean: new Trace(1, { policy: 'window', span: 2, capacity: 20000 }),
 	};
@@ -46,13 +48,30 @@ export function onSample(s) {
 	if (s.strokes.length) tr.strokes.push(s.t, [s.strokes[0] * MM, s.strokes[1] * MM]);
 	if (s.trough.length >= 2) tr.trough.push(s.t, [s.trough[0] * MM, s.trough[1] * MM]);
 	const beta = Number.isFinite(s.beta) ? s.beta : app.session?.beta;
-	tr.rotor.push(s.t, [s.rotorSpeed, beta]);
+	pushRotor(tr, s.t, s.rotorSpeed, beta, omega);
 	if (s.columns.length) tr.feed.push(s.t, s.columns.map(x => x * MM));
 	if (Number.isFinite(s.feedMean)) tr.feedMean.push(s.t, [s.feedMean]);
 	if (app.experiment && app.experiment.sessionId === app.id && app.expTrace)
 		app.expTrace.push(s.t, [s.feedVelocity, beta]);
 	app.lastSample = s;
 	app.dirty = true;
+}
+
+/* The rotor speed as its mean over each excitation period (at most 0.1 s
+ * while it runs up), so the ripple at the excitation frequency does not
+ * fill the plot and hide beta; beta as it is at the period's end. */
+function pushRotor(tr, t, speed, beta, omega) {
+	const p = tr.rotorPeriod;
+	if (!Number.isFinite(speed)) { tr.rotor.push(t, [null, beta]); return; }
+	if (!Number.isFinite(p.t0)) Object.assign(p, { t0: t, t: t, sum: 0, n: 0 });
+	p.sum += speed;
+	p.n++;
+	p.t = t;
+	const period = omega > 1 ? Math.min(0.1, 2 * Math.PI / omega) : 0.1;
+	if (t - p.t0 >= period * (1 - 1e-9)) {
+		tr.rotor.push((p.t0 + t) / 2, [p.sum / p.n, beta]);
+		Object.assign(p, { t0: t, sum: 0, n: 0 });
+	}
 }
 
 export function onControl(c) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * main.js - the dashboard page: builds the plots, wires the forms and
  * controls to their modules, fills the preset and integrator lists from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * plots.js - the dashboard's charts, thin wrappers around the vendored uPlot.
  *
@@ -112,7 +113,7 @@ export class TimePlot {
 		scales.y = { range: yRange ?? autoRange };
 		if (y2Label) scales.y2 = { range: y2Range ?? autoRange };
 		this.labels = [xLabel, ...series.map(d => d.label)];
-		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })];
+		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })];
 		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 50, space: 24, grid: { show: false } }));
 		this.plot = new uPlot({
 			width: s.width,
@@ -202,22 +203,23 @@ function fmtVal(v) {
 	return v.toPrecision(4);
 }
 
-/* A polyline through the finite points of series sidx (data order), with
- * optional round markers and vertical error bars y ± errs(sidx)[i] (errs
- * returns an array or nothing). Returns uPlot's path object. */
-function polylinePaths(markers, errs) {
+/* A polyline through the finite points of series sidx (data order; none
+ * when line is false: measured points are not joined), with optional
+ * round markers and vertical error bars y ± errs(sidx)[i] (errs returns an
+ * array or nothing). Returns uPlot's path object. */
+function polylinePaths(markers, errs, line = true) {
 	return (u, sidx) => {
 		const [xs, ys] = u.data[sidx];
 		const s = u.series[sidx];
 		const xk = s.facets[0].scale, yk = s.facets[1].scale;
-		const line = new Path2D();
+		const path = new Path2D();
 		let pen = false;
 		const r = 3 * uPlot.pxRatio;
-		for (let i = 0; i < xs.length; i++) {
+		for (let i = 0; line && i < xs.length; i++) {
 			const x = xs[i], y = ys[i];
 			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) { pen = false; continue; }
 			const X = u.valToPos(x, xk, true), Y = u.valToPos(y, yk, true);
-			if (pen) line.lineTo(X, Y); else line.moveTo(X, Y);
+			if (pen) path.lineTo(X, Y); else path.moveTo(X, Y);
 			pen = true;
 		}
 		if (markers) {
@@ -225,9 +227,9 @@ function polylinePaths(markers, errs) {
 				const x = xs[i], y = ys[i];
 				if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y)) continue;
 				const X = u.valToPos(x, xk, true), Y = u.valToPos(y, yk, true);
-				line.moveTo(X + r, Y);
-				line.arc(X, Y, r, 0, 2 * Math.PI);
-				line.moveTo(X, Y);
+				path.moveTo(X + r, Y);
+				path.arc(X, Y, r, 0, 2 * Math.PI);
+				path.moveTo(X, Y);
 			}
 		}
 		const es = errs?.(sidx);
@@ -236,15 +238,15 @@ function polylinePaths(markers, errs) {
 			if (x == null || y == null || !Number.isFinite(x) || !Number.isFinite(y) || !(e > 0)) continue;
 			const X = u.valToPos(x, xk, true);
 			const Y0 = u.valToPos(y - e, yk, true), Y1 = u.valToPos(y + e, yk, true);
-			line.moveTo(X, Y0);
-			line.lineTo(X, Y1);
-			line.moveTo(X - r, Y0);
-			line.lineTo(X + r, Y0);
-			line.moveTo(X - r, Y1);
-			line.lineTo(X + r, Y1);
-			line.moveTo(X, Y1);
+			path.moveTo(X, Y0);
+			path.lineTo(X, Y1);
+			path.moveTo(X - r, Y0);
+			path.lineTo(X + r, Y0);
+			path.moveTo(X - r, Y1);
+			path.lineTo(X + r, Y1);
+			path.moveTo(X, Y1);
 		}
-		return { stroke: line, fill: null, clip: null, band: null, gaps: null, flags: 0 };
+		return { stroke: path, fill: null, clip: null, band: null, gaps: null, flags: 0 };
 	};
 }
 
@@ -284,14 +286,18 @@ function padRange(min, max, pad = 0.08) {
 }
 
 export class XYPlot {
-	/* series: [{label, color}]; equal: keep aspect 1:1 in data units;
-	 * markers: draw a dot per point; zeroLine: draw y = 0. */
+	/* series: [{label, color, line}] (line: false draws the points alone);
+	 * equal: keep aspect 1:1 in data units; markers: draw a dot per point;
+	 * zeroLine: draw y = 0. The legend lists only the series that have
+	 * points. */
 	constructor(el, { series, xLabel, yLabel, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange }) {
 		this.el = el;
 		this.equal = equal;
 		this.xRange = xRange;
 		this.errs = [];
 		this.labels = [xLabel, yLabel, series.map(d => d.label)];
+		this.legend = series.length > 1;
+		this.joined = series.map(d => d.line !== false); /* which series are lines, which points */
 		const s = sizeOf(el, aspect);
 		const legend = series.length > 1;
 		const legendRoom = legend ? 26 : 0;
@@ -329,14 +335,14 @@ export class XYPlot {
 			legend: { show: legend, live: false },
 			cursor: { show: false, drag: { x: false, y: false } },
 			scales: { x: { time: false, range: rangeFn('x') }, y: { range: rangeFn('y') } },
-			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 56, space: 24 })],
+			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })],
 			hooks,
 			series: [{}, ...series.map((d, i) => ({
 				label: d.label,
 				stroke: d.color ?? PALETTE[i % PALETTE.length],
 				width: d.width ?? 1.5,
 				facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }],
-				paths: polylinePaths(markers, sidx => self.errs[sidx - 1]),
+				paths: polylinePaths(markers || d.line === false, sidx => self.errs[sidx - 1], d.line !== false),
 				points: { show: false },
 			}))],
 		}, [null, ...series.map(() => [[], []])], el);
@@ -366,11 +372,28 @@ export class XYPlot {
 		this.ext = extent(data, errs);
 		this.plot.setData(data);
 		let n = 0;
-		for (const [xs, ys] of pairs)
-			for (let i = 0; i < xs.length; i++) if (Number.isFinite(xs[i]) && Number.isFinite(ys[i])) n++;
+		const shown = [];
+		for (const [xs, ys] of pairs) {
+			let m = 0;
+			for (let i = 0; i < xs.length; i++) if (Number.isFinite(xs[i]) && Number.isFinite(ys[i])) m++;
+			shown.push(m > 0);
+			n += m;
+		}
+		if (this.legend) this.showLegend(shown);
 		this.el.dataset.points = String(n);
 		this.el.classList.toggle('empty', n === 0);
 		this.bar.hidden = n === 0;
+	}
+
+	/* The legend's entry of each series only while it has points (an empty
+	 * plot lists them all, as a key of what will come). */
+	showLegend(shown) {
+		const any = shown.some(Boolean);
+		const names = this.labels[2];
+		for (const row of this.plot.root.querySelectorAll('.u-legend .u-series')) {
+			const k = names.indexOf(row.querySelector('.u-label')?.textContent);
+			if (k >= 0) row.style.display = !any || shown[k] ? '' : 'none';
+		}
 	}
 
 	destroy() {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * schematic.js - a side view of the conveyor drawn in SVG: the trough on its
  * suspension, the vibrator with its sense of rotation, the two Frahm

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * series.js - bounded sample buffers behind the live plots, and the
  * dashboard's own transport-velocity reading.

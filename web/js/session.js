@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * session.js - the attached session: the new-session form, attaching to a
  * session (its stream feeds live.js, its status is polled every STATUS_MS
@@ -10,7 +11,7 @@ import * as api from './api.js';
 import { fmt, fmtTime, rotationLabel, parsePace } from './format.js';
 import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
 import { resetTraces, onSample, onControl } from './live.js';
-import { showStatus } from './status.js';
+import { showStatus, clearStatus, sessionLabel } from './status.js';
 
 const STATUS_MS = 500;
 
@@ -72,6 +73,7 @@ export function detach() {
 	$('#session-label').textContent = 'no session';
 	$('#live-state').textContent = 'stream: idle';
 	$('#session-select').value = '';
+	clearStatus();
 }
 
 export function attach(id, initial) {
@@ -181,7 +183,8 @@ export async function refreshSessionList() {
 		const keep = app.id ?? '';
 		sel.replaceChildren(new Option('none', ''));
 		for (const s of list) {
-			const label = `${s.id} · β ${fmt(s.beta, 0)}° · ${s.rotation ?? ''} · t ${fmt(s.t, 1)} s`;
+			/* the attached session's label follows its polled status (showStatus) */
+			const label = s.id === app.id && app.session?.id === s.id ? sessionLabel(app.session) : sessionLabel(s);
 			sel.append(new Option(label, s.id));
 		}
 		if (keep && !list.some(s => s.id === keep)) sel.append(new Option(keep, keep));

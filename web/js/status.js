@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * status.js - the attached session's polled status on the page: the tiles
  * (the daemon's transport velocity with its error bar and steady mark,
@@ -11,8 +12,17 @@ import { fmt, fmtSig, fmtTime, fmtVelocityPm, steadyLabel, fmtPace, RAD_S_TO_RPM
 import { app, $ } from './ui.js';
 import { resetTraces } from './live.js';
 
+/* The picker's label of a session: id, beta, sense, time and state, from
+ * one status, so that it says what the tiles say. */
+export function sessionLabel(s) {
+	const state = s.state || (s.running === false ? 'paused' : s.running ? 'running' : '');
+	return `${s.id} · β ${fmt(s.beta, 0)}° · ${s.rotation ?? ''} · t ${fmt(s.t, 1)} s` + (state ? ` · ${state}` : '');
+}
+
 export function showStatus(s) {
 	app.session = s;
+	const opt = Array.from($('#session-select').options).find(o => o.value === app.id);
+	if (opt && s.id === app.id) opt.textContent = sessionLabel(s);
 	$('#t-now').textContent = fmtTime(s.t);
 	const state = s.error ? `error: ${s.error}` : s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
 	$('#state-now').textContent = state;
@@ -60,6 +70,24 @@ export function showStatus(s) {
 	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
 	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
 	app.dirty = true;
+}
+
+/* No session attached: every tile, readout and model field back to a dash,
+ * and the live plots emptied (a deleted session leaves nothing behind). */
+export function clearStatus() {
+	app.session = null;
+	app.lastSample = null;
+	for (const sel of ['#t-now', '#rotor-now', '#rotor-rpm', '#rtf-now', '#sps-now', '#v-daemon', '#beta-now',
+		'#beta-target', '#rotation-now', '#drive-now', '#m-preset', '#m-scene', '#m-method', '#m-pace'])
+		$(sel).textContent = DASH;
+	$('#state-now').textContent = 'no session';
+	$('#v-steady').textContent = '';
+	$('#v-steady').dataset.steady = '';
+	delete document.body.dataset.running;
+	const box = $('#reductions');
+	box.dataset.key = '';
+	box.replaceChildren(DASH);
+	resetTraces(0);
 }
 
 function showReductions(list) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * sweep.js - the sweep panel: runs v(beta) for both rotations on the
  * new-session form's model, follows its progress, and shows the plot (with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * ui.js - what every part of the dashboard page shares: the page state
  * (app, also window.convsim for the console and the browser test), the
