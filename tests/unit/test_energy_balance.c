@@ -28,11 +28,7 @@ static sim_status run(const char *const *changes, int n, int beta, const char *r
 	snprintf(b, sizeof b, "%d", beta);
 	set(&u, "beta", b);
 	set(&u, "rotation", rotation);
-	sim *s = make(&u);
-	advance(s, RUN_TIME);
-	sim_status st = status(s);
-	sim_free(s);
-	return st;
+	return run_status(&u, RUN_TIME);
 }
 
 /* How far the reported terms are from closing, over the input: computed
