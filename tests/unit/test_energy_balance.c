@@ -97,8 +97,10 @@ static void closes_on_other_machines(void **state)
 }
 
 /* The full model (alpha integrated, every column), the one-way coupling
- * (the deck's work on the feed is then an input of its own), and the
- * machine without feed (the drive's work and the damping alone). */
+ * (the deck's work on the feed is then an input of its own), the machine
+ * without feed (the drive's work and the damping alone), the run-up from
+ * rest, the former dem (no events, no yielding deck) and the regularised
+ * friction law. */
 static void closes_on_other_scenes(void **state)
 {
 	(void)state;
@@ -106,11 +108,15 @@ static void closes_on_other_scenes(void **state)
 	static const char *const one_way[] = {"feed_coupling", "false"};
 	static const char *const no_feed[] = {"feed", "false"};
 	static const char *const rest[] = {"start", "rest", "k_c", "3e7"};
+	static const char *const former[] = {"feed_events", "false"};
+	static const char *const smooth[] = {"friction", "regularised"};
 	const int betas[] = {30, 110};
 	worst_gap(full, 6, betas, 2, "full model");
 	worst_gap(one_way, 2, betas, 2, "one-way coupling");
 	worst_gap(no_feed, 2, betas, 2, "no feed");
 	worst_gap(rest, 4, betas, 2, "run-up from rest");
+	worst_gap(former, 2, betas, 2, "feed_events=false");
+	worst_gap(smooth, 2, betas, 2, "regularised friction");
 }
 
 /* The coupling's own work in dem's dissipated term (status_energy): what
