@@ -44,6 +44,8 @@ void dynamics_eval(const model *md, const model_ctl *ctl, double t, const double
 	double *acc = dy + 2 * md->npos;
 	acc[ACC_FRIC] = 0.0;
 	acc[ACC_CONTACT] = 0.0;
+	acc[ACC_FEED] = 0.0; /* dem's alone */
+	acc[ACC_DECK] = 0.0;
 	if (md->nf > 0)
 		feed_reaction(md, ctl, t, y, dy, Qfeed, &acc[ACC_FRIC], &acc[ACC_CONTACT]);
 	model_machine_rhs(md, ctl, t, y, Qfeed, dy, ev);

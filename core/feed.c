@@ -411,10 +411,10 @@ static inline void normal_bounds(int L, double h, double k_c, double p, double R
 /* One sub-step of column k on the state y itself: the deck at dp (the
  * sub-step's start), its velocity dv1 at the middle and dv0 at the middle
  * of the sub-step before (friction events). Impulse on the deck into
- * imp[2], friction and contact work into *wf, *wc. */
+ * imp[2]; its work added to *w. */
 static inline void column_substep(const model *md, double *y, int k, double h, const double dp[2],
 				  const double dv0[2], const double dv1[2], int events,
-				  signed char *modes, double imp[2], double *wf, double *wc)
+				  signed char *modes, double imp[2], feed_work *w)
 {
 	const int L = md->L, base = k * L;
 	double *xi = XI(md, y) + base, *eta = ETA(md, y) + base, *xid = XID(md, y) + base,
@@ -450,20 +450,32 @@ static inline void column_substep(const model *md, double *y, int k, double h, c
 		for (int j = 0; j < L; j++)
 			vt[j] = xid[j] + (Pt[j] - (j + 1 < L ? Pt[j + 1] : 0.0)) / m;
 	}
-	double prev_vy = dv1[1], prev_vx = dv1[0], work_c = 0.0, work_f = 0.0;
+	/* Each impulse's work at the velocities the sub-step gives it: a
+	 * layer's is the mean of its velocity before and after the impulses
+	 * (an impulse P changes m v^2 / 2 by exactly P (v_before + v_after) /
+	 * 2), the deck's the one the solve used (dv1). Contact j's work on the
+	 * relative motion is then what it takes from the kinetic energy of
+	 * the two sides, and the deck's work on the bottom layer what it
+	 * gives: per sub-step, the column's kinetic and gravitational energy
+	 * change by deck - friction - contact work exactly, but for gravity's
+	 * m g h (v_after - v_before) / 2 per layer (the leapfrog's positions
+	 * advance with v_after), which sums to a bounded term, not a drift. */
+	double prev_vy = 2.0 * dv1[1], prev_vx = 2.0 * dv1[0], work_c = 0.0, work_f = 0.0;
 	for (int j = 0; j < L; j++) {
+		/* twice the mean velocities: the half taken once, below */
+		double sum_vy = etad[j] + vn[j], sum_vx = xid[j] + vt[j];
 		etad[j] = vn[j];
 		xid[j] = vt[j];
-		/* work on the relative motion at the new velocities */
-		work_c += Pn[j] * (prev_vy - vn[j]);
-		work_f += Pt[j] * (prev_vx - vt[j]);
-		prev_vy = vn[j];
-		prev_vx = vt[j];
+		work_c += Pn[j] * (prev_vy - sum_vy);
+		work_f += Pt[j] * (prev_vx - sum_vx);
+		prev_vy = sum_vy;
+		prev_vx = sum_vx;
 		xi[j] += h * vt[j];
 		eta[j] += h * vn[j];
 	}
-	*wc += work_c;
-	*wf += work_f;
+	w->contact += 0.5 * work_c;
+	w->friction += 0.5 * work_f;
+	w->deck += Pn[0] * dv1[1] + Pt[0] * dv1[0];
 	imp[0] -= Pt[0];
 	imp[1] -= Pn[0];
 }
@@ -539,7 +551,7 @@ void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], doub
 
 void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
 		   const double (*deck_vel)[2], int events, const feed_yield *yield,
-		   signed char *modes, double (*impulse)[2], double *fric, double *contact)
+		   signed char *modes, double (*impulse)[2], feed_work *work)
 {
 	const int K = md->dk.K;
 	if (md->L < 1 || md->L > SIM_MAX_LAYERS)
@@ -552,7 +564,7 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 			const double(*vel)[2] = deck_vel + (size_t)k * (ns + 1);
 			for (int i = 0; i < ns; i++)
 				column_substep(md, y, k, h, pos[i], vel[i], vel[i + 1], events, modes,
-					       impulse[k], fric, contact);
+					       impulse[k], work);
 		}
 		return;
 	}
@@ -589,8 +601,7 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 				dv[k][c] = dvk[c];
 			}
 			double before[2] = {impulse[k][0], impulse[k][1]};
-			column_substep(md, y, k, h, p, v0, v1, events, modes, impulse[k], fric,
-				       contact);
+			column_substep(md, y, k, h, p, v0, v1, events, modes, impulse[k], work);
 			last[k][0] = impulse[k][0] - before[0];
 			last[k][1] = impulse[k][1] - before[1];
 		}

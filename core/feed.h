@@ -67,6 +67,18 @@ void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
  * columns' impulses E[j] on the deck give it. */
 void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], double (*dv)[2]);
 
+/* The work a feed step of dem does (J; the integrated columns, each
+ * counted once): the friction and the normal contacts' on the relative
+ * motion, the deck's on the bottom layers, each impulse's at the
+ * velocities the sub-step gives it (feed.c, column_substep). The feed's
+ * kinetic and gravitational energy changes by deck - friction - contact
+ * to round-off, but for gravity's m g h (v1 - v0) / 2 per layer and
+ * sub-step (the leapfrog's positions advance with the new velocity v1),
+ * which sums to a bounded term, not a drift. */
+typedef struct feed_work {
+	double friction, contact, deck;
+} feed_work;
+
 /* The feed's part of one macro step of the split method "dem": ns
  * sub-steps of length h of every column, each semi-implicit and staggered
  * as leapfrog: impulse bounds from the compressions at its start, then the
@@ -86,9 +98,9 @@ void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], doub
  * sub-step before the first; with yield (else NULL) it also yields to the
  * feed's impulses as they come, the columns then stepped side by side.
  * Writes each column's impulse on the deck into impulse[k] and adds the
- * friction and contact work to *fric, *contact. */
+ * step's work to *work. */
 void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
 		   const double (*deck_vel)[2], int events, const feed_yield *yield,
-		   signed char *modes, double (*impulse)[2], double *fric, double *contact);
+		   signed char *modes, double (*impulse)[2], feed_work *work);
 
 #endif

@@ -27,7 +27,10 @@
 #include "ramp.h"
 #include "sim.h"
 
-enum { ACC_IN, ACC_DAMP, ACC_FRIC, ACC_CONTACT, ACC_N };
+/* Energy accumulators (J): the drive's input, the machine's damping, the
+ * feed's friction and contact work; with dem only (else zero), the feed's
+ * energy change and the deck's work on the feed (docs/energy.md). */
+enum { ACC_IN, ACC_DAMP, ACC_FRIC, ACC_CONTACT, ACC_FEED, ACC_DECK, ACC_N };
 
 /* The solve's layouts (model_solve.c): general, or the trough's
  * coordinates first (x, y, alpha, or x, y with alpha fixed) and the point

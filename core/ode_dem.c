@@ -73,6 +73,13 @@ typedef struct dem {
 	int have_yield;    /* yield holds the step before's compliance and reaction */
 	int K;             /* integrated columns */
 	feed_yield *yield;
+	/* the feed's kinetic and gravitational energy (J) at the last step's
+	 * end, where have_feed_energy: the next step's start, since whoever
+	 * places a state anew does so with a fresh workspace (as for Qfeed);
+	 * forgotten on reset and load, and then computed again from y, to the
+	 * same bits */
+	int have_feed_energy;
+	double feed_energy;
 } dem;
 
 static void dem_free(void *p)
@@ -255,7 +262,6 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	}
 	const double h = H / ns;
 	double F[SIM_MAX_COLUMNS][2], impulse[SIM_MAX_COLUMNS][2];
-	double fric = 0.0, contact = 0.0;
 	const deck *dk = &md->dk;
 	deck_rot R0 = ev0.R, R1 = w->events ? deck_rotation(ev1.q) : ev1.R;
 	/* the cubic's four weights at each sub-step's start (positions) and
@@ -304,16 +310,28 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 			vel[i][1] = cv[i][0][1] + (turns ? d * cv[i][1][1] : 0.0);
 		}
 	}
+	feed_work work = {0.0, 0.0, 0.0};
+	double kin, pot, before = w->feed_energy;
+	if (!w->have_feed_energy) {
+		feed_energy(md, y, &kin, &pot);
+		before = kin + pot;
+	}
 	feed_dem_step(md, y, ns, h, (const double(*)[2])w->deck_pos,
 		      (const double(*)[2])w->deck_vel, w->events,
-		      w->couple && w->have_yield ? w->yield : NULL, w->modes, impulse, &fric,
-		      &contact);
+		      w->couple && w->have_yield ? w->yield : NULL, w->modes, impulse, &work);
 	for (int k = 0; k < dk->K; k++) {
 		F[k][0] = impulse[k][0] / H;
 		F[k][1] = impulse[k][1] / H;
 	}
-	y[2 * md->npos + ACC_FRIC] += md->col_weight * fric;
-	y[2 * md->npos + ACC_CONTACT] += md->col_weight * contact;
+	/* the energy the feed's sub-steps moved (docs/energy.md) */
+	feed_energy(md, y, &kin, &pot);
+	w->feed_energy = kin + pot;
+	w->have_feed_energy = 1;
+	double *acc = y + 2 * md->npos;
+	acc[ACC_FRIC] += md->col_weight * work.friction;
+	acc[ACC_CONTACT] += md->col_weight * work.contact;
+	acc[ACC_DECK] += md->col_weight * work.deck;
+	acc[ACC_FEED] += w->feed_energy - before;
 	double Qold[NQ_FULL];
 	memcpy(Qold, w->Qfeed, sizeof Qold);
 	memset(w->Qfeed, 0, sizeof w->Qfeed);
@@ -333,7 +351,8 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 
 static void dem_reset(void *p)
 {
-	(void)p;
+	dem *w = p;
+	w->have_feed_energy = 0;
 }
 
 /* Carried between steps: the held reaction, the contacts' modes and, with
@@ -389,6 +408,7 @@ static void dem_save(const void *p, void *buf)
 static void dem_load(void *p, const void *buf)
 {
 	carry_state(p, (char *)buf, 0);
+	dem_reset(p);
 }
 
 const ode_method ode_dem = {

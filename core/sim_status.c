@@ -28,7 +28,7 @@
 
 /* Energies of the status, each a change since t = 0 (all exactly zero
  * then): kinetic, potential (with the contacts' elastic energy), input,
- * dissipated, and the balance's residual. */
+ * dissipated, and the balance's residual (docs/energy.md). */
 static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 {
 	const model *md = &s->md;
@@ -38,12 +38,26 @@ static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 	double elastic = 0.0;
 	if (md->nf > 0)
 		elastic = dynamics_contact_energy(md, s->y_obs, ev->q, ev->qd);
-	st->e_input = acc[ACC_IN];
+	/* dem's machine and feed see the deck apart: the machine gives the
+	 * feed what its energy lost beyond input and damping (the held
+	 * reaction's work over its step and the corrector's), the feed gains
+	 * the deck's work at the velocities its sub-steps saw (ACC_DECK); the
+	 * difference, the coupling's own work, is booked as dissipated at the
+	 * deck. With one-way coupling the machine gives nothing and the deck's
+	 * work on the feed is an input of its own. */
+	double input = acc[ACC_IN], coupling = 0.0;
+	if (s->ode == &ode_dem && md->nf > 0 && md->sc.feed_coupling) {
+		double machine_change = kin + pot - s->e0 - acc[ACC_FEED];
+		coupling = acc[ACC_IN] - acc[ACC_DAMP] - machine_change - acc[ACC_DECK];
+	} else if (s->ode == &ode_dem && md->nf > 0) {
+		input += acc[ACC_DECK];
+	}
+	double dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + acc[ACC_CONTACT] + coupling;
+	st->e_input = input;
 	st->e_kinetic = kin - s->kin0;
 	st->e_potential = (pot - s->pot0) + (elastic - s->elastic0);
-	st->e_dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + (acc[ACC_CONTACT] - (elastic - s->elastic0));
-	st->e_residual = kin + pot - s->e0 + acc[ACC_CONTACT] + acc[ACC_DAMP] + acc[ACC_FRIC] -
-			 acc[ACC_IN];
+	st->e_dissipated = dissipated - (elastic - s->elastic0);
+	st->e_residual = kin + pot - s->e0 + dissipated - input;
 }
 
 /* The discretisation error of dem's transport velocity at its default

@@ -18,6 +18,7 @@ mutations=(
 	"feed's moment applied at G, not at the deck points|core/deck.c|s|Q\[Q_ALPHA\] += -Rd\[1\] \* F\[0\] + Rd\[0\] \* F\[1\];|Q[Q_ALPHA] += 0.0 * (-Rd[1] * F[0] + Rd[0] * F[1]);|"
 	"friction ignored|core/feed.c|s|mu = md->p.mu, R2|mu = 0.0 * md->p.mu, R2|"
 	"restitution ignored (unloading as loading)|core/feed.c|s|R2 = md->p.R \* md->p.R;|R2 = 1.0;|"
+	"friction work booked at the end-of-sub-step velocity|core/feed.c|s|sum_vx = xid\[j\] + vt\[j\];|sum_vx = 2.0 * vt[j];|"
 	"a degree passed as a radian (beta's scale)|core/params.c|s|\"deg\", 0, 180, NULL, RAD_PER_DEG,|\"deg\", 0, 180, NULL, 1,|"
 	"the drive's reaction on the trough with the wrong sign|core/model.c|s|rhs\[Q_ALPHA\] -= dt->torque - dt->drag + dt->load;|rhs[Q_ALPHA] += dt->torque - dt->drag + dt->load;|"
 	# faults that change nothing on the preset (p = 1, k_x = k_y, h = 0,

@@ -54,9 +54,10 @@ static double reversal_error(int events, double frac)
 		vel[i][0] = a * (i - 0.5) * h;
 		vel[i][1] = 0.0;
 	}
-	double imp[1][2], fric = 0.0, contact = 0.0;
+	double imp[1][2];
+	feed_work work = {0.0, 0.0, 0.0};
 	feed_dem_step(&md, y, ns, h, (const double(*)[2])pos, (const double(*)[2])vel, events, NULL,
-		      modes, imp, &fric, &contact);
+		      modes, imp, &work);
 	double t_end = (ns - 0.5) * h;
 	double exact = a * t_end - (a - mu * g) * (ns * h - tstar);
 	double err = fabs(y[md.npos + md.nq] - exact) / (mu * g * h);

@@ -112,15 +112,21 @@ static inline sim_status status(const sim *s)
 	return st;
 }
 
+/* The status of a fresh instance of u after t_end simulated seconds. */
+static inline sim_status run_status(const setup *u, double t_end)
+{
+	sim *s = make(u);
+	advance(s, t_end);
+	sim_status st = status(s);
+	sim_free(s);
+	return st;
+}
+
 /* The running transport velocity (m/s) of a fresh instance of u after
  * t_end simulated seconds. */
 static inline double run_velocity(const setup *u, double t_end)
 {
-	sim *s = make(u);
-	advance(s, t_end);
-	double v = status(s).transport_velocity;
-	sim_free(s);
-	return v;
+	return run_status(u, t_end).transport_velocity;
 }
 
 #define assert_close(a, b, tol)                                                           \
