@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_energy_balance.c - the summary's energy terms close (docs/MODEL.md
  * "Checks with known answers", docs/energy.md): kinetic + potential
