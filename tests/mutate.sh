@@ -32,6 +32,11 @@ mutations=(
 	"the eliminator offset c ignored in the preload|core/setup.c|s|(p->c + s\([12]\))|(0.0 + s\1)|"
 	"the lever arm h with the wrong sign|core/model.c|s|double Pb\[2\] = {i == 0 ? p->l1 : -p->l2, -p->h};|double Pb[2] = {i == 0 ? p->l1 : -p->l2, p->h};|"
 	"the mean rotor speed one period off|core/estimator.c|s|sense \* 2.0 \* M_PI \* e->n_bound / span|sense * 2.0 * M_PI * (e->n_bound + 1) / span|"
+	"the shadow's Richardson estimate divided by r + 1, not r - 1|core/shadow.c|s|/ (r - 1.0);|/ (r + 1.0);|"
+	"the shadow as fine as its instance (no step error measured)|core/shadow.c|s|m.substeps = (s->cfg.substeps + 1) / 2;|m.substeps = s->cfg.substeps;|"
+	"the contact period without the Hertzian tangent stiffness|core/params.c|s|if (p->p != 1.0) {|if (0) {|"
+	"the default feed step blind to the contact period|core/params.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
+	"no refinement of a measurement's steps|core/measure.c|s|^#define MEASURE_REFINEMENTS 3$|#define MEASURE_REFINEMENTS 0|"
 )
 printf '| mutation | file | first failing test group | verdict |\n|---|---|---|---|\n'
 survived=0

@@ -116,7 +116,9 @@ static void the_shadow_sees_a_coarse_step(void **state)
 /* Points of the zoo with sim_measure's defaults (the steps the scene
  * asks for, refined until the step error is within tol = 1 %): within
  * 1 % by docs/MODEL.md's convention (the machine's own peak) of the
- * converged reference, and inside the reported bar. */
+ * converged reference, inside the reported bar, and that bar within what
+ * tol allows (the stiff machine at 20 deg cw gets there by one
+ * refinement, 16 -> 57 sub-steps). */
 static const struct {
 	const char *settings;
 	double beta;
@@ -157,6 +159,11 @@ static void zoo_points_hold_their_bars(void **state)
 			fail_msg("%s, %g deg %s: |v - v_ref| = %.3g outside the bar %.3g",
 				 ZOO[i].settings, ZOO[i].beta, ZOO[i].rotation, d, r.uncertainty);
 		assert_true(r.step_error > 0.0 && r.step_error <= r.uncertainty);
+		/* the stiff machine's 20 deg cw needs a refinement for it */
+		if (!r.tol_met)
+			fail_msg("%s, %g deg %s: tol not met (bar %.3g, %d refinements)",
+				 ZOO[i].settings, ZOO[i].beta, ZOO[i].rotation, r.uncertainty,
+				 r.refinements);
 		assert_true(r.dt > 0.0 && r.substeps >= 1);
 	}
 }
