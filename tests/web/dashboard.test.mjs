@@ -223,6 +223,15 @@ test('β = 38°, clockwise: the page shows transport to the right', async () => 
 	}, 30000, 'the daemon estimate ± its error bar, steady');
 	assert.equal(await page.$eval('#v-steady', e => e.textContent), 'steady');
 	const st = (await apiGet(`/api/v1/sessions/${sessionId}`)).status;
+	/* the bar against the accuracy target, as the status says, and the
+	 * steps the engine chose for the scene */
+	const tol = await until(async () => await page.$eval('#v-tol', e => e.dataset.tol) || null, 10000, 'the tol mark');
+	const now = (await apiGet(`/api/v1/sessions/${sessionId}`)).status;
+	assert.ok(tol === 'within' || tol === 'beyond', `tol mark ${tol}`);
+	assert.equal(typeof now.tol_met, 'boolean');
+	assert.equal(now.tol, 0.01);
+	assert.equal(await page.$eval('#v-tol', e => e.textContent), `${tol} 1.0 %`);
+	assert.match(await page.$eval('#m-method', e => e.textContent), /^dem · step 1\.25 ms, 5 feed sub-steps$/);
 	assert.equal(typeof st.transport_velocity_uncertainty, 'number');
 	const [v, u] = shown.d.split(' ± ').map(Number.parseFloat);
 	assert.ok(Math.abs(v - st.transport_velocity) < 0.01 && u > 0, `shown ${shown.d}, API ${st.transport_velocity}`);

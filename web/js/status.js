@@ -48,6 +48,11 @@ export function showStatus(s) {
 	const mark = steadyLabel(Number.isFinite(s.transportVelocity) ? s.steady : undefined);
 	$('#v-steady').textContent = mark;
 	$('#v-steady').dataset.steady = mark;
+	/* the whole bar against the accuracy target (docs/machine-zoo.md) */
+	const tol = Number.isFinite(s.transportUncertainty) && Number.isFinite(s.tol) && s.tolMet !== undefined
+		? (s.tolMet ? 'within' : 'beyond') : '';
+	$('#v-tol').textContent = tol ? `${tol} ${fmt(100 * s.tol, 1)} %` : '';
+	$('#v-tol').dataset.tol = tol;
 	/* slider follows the target unless the user is moving it */
 	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
 	if (!app.betaEditing && Number.isFinite(target) && document.activeElement !== $('#beta-number')) {
@@ -64,7 +69,8 @@ export function showStatus(s) {
 	if (s.drive) scene.push(`${s.drive} drive`);
 	if (s.start) scene.push(`${s.start} start`);
 	$('#m-scene').textContent = scene.join(', ') || DASH;
-	$('#m-method').textContent = s.method ?? DASH;
+	$('#m-method').textContent = (s.method ?? DASH) + (Number.isFinite(s.dt) && Number.isFinite(s.substeps)
+		? ` · step ${fmtSig(1e3 * s.dt, 3)} ms, ${s.substeps} feed sub-steps` : '');
 	$('#m-pace').textContent = fmtPace(s.pace);
 	showReductions(s.reductions);
 	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
@@ -83,6 +89,8 @@ export function clearStatus() {
 	$('#state-now').textContent = 'no session';
 	$('#v-steady').textContent = '';
 	$('#v-steady').dataset.steady = '';
+	$('#v-tol').textContent = '';
+	$('#v-tol').dataset.tol = '';
 	delete document.body.dataset.running;
 	const box = $('#reductions');
 	box.dataset.key = '';
