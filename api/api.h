@@ -109,6 +109,8 @@ typedef struct api_problem {
 	char budget[24];   /* the budget that refused it ("memory", ...), "" */
 	double limit;      /* its limit, in the budget's unit */
 	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
+	int has_position;  /* a malformed body: the byte where it goes wrong */
+	size_t position;
 } api_problem;
 
 /* HTTP status of an api_err (500 for an unknown code). */
@@ -127,7 +129,7 @@ api_err api_fail(api_problem *pb, api_err code, const char *field,
  * Retry-After seconds; returns pb->code. */
 api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);
 /* The RFC 9457 body for *pb (type, title, status, detail, instance and the
- * extensions field/min/max/choices/budget/limit). instance (borrowed) may be NULL.
+ * extensions field/position/min/max/choices/budget/limit). instance (borrowed) may be NULL.
  * Returns malloc'd text, NULL only when out of memory. */
 char *api_problem_json(const api_problem *pb, const char *instance);
 

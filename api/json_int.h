@@ -41,6 +41,17 @@ char *api_print_free(cJSON *item);
 cJSON *api_parse_body(const char *body, size_t len, int empty_ok,
 		      const char *const *members, api_problem *pb);
 
+/* Length of the valid UTF-8 sequence at s of at most avail bytes (RFC
+ * 3629: no overlong forms, no surrogates, nothing above U+10FFFF), 0 if
+ * the bytes there are not one. */
+size_t api_utf8_seq(const unsigned char *s, size_t avail);
+/* Check len bytes of text against RFC 8259 and I-JSON (RFC 7493): the
+ * grammar (no `01`, no `1.`), no raw control byte or invalid UTF-8 in a
+ * string, no unpaired surrogate escape, no member name twice in one
+ * object. API_OK, or API_MALFORMED (400) with *pb naming the byte where
+ * it goes wrong (pb->position) and the duplicated name as the field. */
+api_err api_json_check(const char *text, size_t len, api_problem *pb);
+
 /* The settings-table entry of name in group, or NULL. */
 const sim_setting *api_setting(const char *group, const char *name);
 /* Apply one JSON member to the settings of its group ("params", "scene",
