@@ -40,8 +40,9 @@
 	  "A query parameter is unknown to this route or malformed, or Last-Event-ID is not a " \
 	  "record id. `field` names it; the route's parameters are in /api/v1/openapi.json.") \
 	X(BADREQUEST, 400, "bad-request", "Bad request",                      \
-	  "The request itself is malformed: no Host header, or a header the daemon cannot " \
-	  "read. `field` names the header.")                                  \
+	  "The request itself is malformed: no Host header, a Host or Content-Length header " \
+	  "given twice (RFC 9112), or a header the daemon cannot read. `field` names the " \
+	  "header.")                                                          \
 	X(UNAUTHORIZED, 401, "unauthorized", "Unauthorized",                  \
 	  "The daemon runs with --token-file: send Authorization: Bearer TOKEN (the token in " \
 	  "that file). Only the dashboard's files and /api/v1/health are open without it.") \
@@ -66,6 +67,9 @@
 	  "--server-name (a defence against DNS rebinding); nothing was changed.") \
 	X(TOOLARGE, 413, "body-too-large", "Request body too large",          \
 	  "The body is larger than the daemon's --max-body; it was not read.") \
+	X(HEADERS, 431, "header-fields-too-large", "Request header fields too large", \
+	  "The query has more parameters than any route takes (at most 64); it was not " \
+	  "read.")                                                            \
 	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type", \
 	  "POST, PATCH, PUT and DELETE must carry Content-Type: application/json, even with " \
 	  "an empty body (a web page of another origin cannot send that type unasked).") \

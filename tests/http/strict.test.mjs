@@ -73,3 +73,47 @@ test('a body JSON forbids is refused with 400 and its position on every route; n
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
+
+test('a Host or Content-Length header given twice is 400 and changes nothing; 500 query parameters get 431', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const host = `Host: 127.0.0.1:${d.port}`;
+    const body = JSON.stringify(CHEAP);
+    const cases = [
+      [`GET /api/v1/health HTTP/1.1\r\n${host}\r\nHost: evil.example`, '', 'Host'],
+      [`GET /api/v1/health HTTP/1.1\r\n${host}\r\n${host}`, '', 'Host'],
+      [`POST /api/v1/sessions HTTP/1.1\r\n${host}\r\nContent-Type: application/json\r\n` +
+        `Content-Length: ${body.length}\r\nContent-Length: ${body.length}`, body, 'Content-Length'],
+      [`POST /api/v1/sessions HTTP/1.1\r\n${host}\r\nContent-Type: application/json\r\n` +
+        `Content-Length: ${body.length}\r\ncontent-length: 5`, body, 'Content-Length'],
+    ];
+    for (const [head, b, field] of cases) {
+      const r = await rawRequest(d.port, head, b);
+      assert.equal(r.status, 400, r.raw.toString('latin1'));
+      const p = JSON.parse(r.body.toString('utf8'));
+      assert.equal(p.type, '/api/v1/problems/bad-request');
+      assert.equal(p.field, field);
+    }
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+    // one Host and one Content-Length still pass
+    const ok = await rawRequest(d.port, `POST /api/v1/sessions HTTP/1.1\r\n${host}\r\n` +
+      `Content-Type: application/json\r\nContent-Length: ${body.length}`, body);
+    assert.equal(ok.status, 201, ok.raw.toString('latin1'));
+    // ~500 query parameters (a 4 kB URL): an answer, not a closed socket
+    for (const n of [500, 3000]) {
+      const query = Array.from({ length: n }, (_, i) => `a${i}=${i}`).join('&');
+      const r = await rawRequest(d.port, `GET /api/v1/sessions?${query} HTTP/1.1\r\n${host}`);
+      assert.equal(r.status, 431, `${n} parameters: ${r.raw.toString('latin1').slice(0, 300)}`);
+      const p = JSON.parse(r.body.toString('utf8'));
+      assert.equal(p.type, '/api/v1/problems/header-fields-too-large');
+      assert.match(p.detail, new RegExp(`has ${n} parameters`));
+    }
+    // a few unknown ones are still named one by one
+    const few = await req(d.base, 'GET', '/api/v1/sessions?a=1&b=2');
+    assert.equal(few.status, 400);
+    assert.equal(few.body.field, 'a');
+    assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200, 'the daemon still answers');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
