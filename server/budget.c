@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "budget.h"
+#include "conns.h"
 #include "util.h"
 
 /* Calibration (README "Budgets and load"): resident bytes a session holds
@@ -418,6 +419,7 @@ typedef struct client {
 typedef struct client_conn {
 	client *c;
 	int over;
+	srv_conn *live; /* conns.c: the idle ones closed at the global cap */
 } client_conn;
 
 static client *clients;  /* lock; cfg->max_connections + 1 entries */
@@ -447,7 +449,7 @@ static int peer(struct MHD_Connection *conn, unsigned char addr[16],
 /* The entry of addr, or a free one for it; NULL when full (lock held). */
 static client *find_client(const unsigned char addr[16], int family)
 {
-	size_t n = (size_t)cfg->max_connections + 1;
+	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
 	client *free_one = NULL;
 	if (!clients && !(clients = calloc(n, sizeof *clients)))
 		return NULL;
@@ -477,6 +479,8 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			cc->c->count--;
 			pthread_mutex_unlock(&lock);
 		}
+		if (cc)
+			srv_conn_close(cc->live);
 		free(cc);
 		*socket_context = NULL;
 		return;
@@ -484,6 +488,8 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 	unsigned char addr[16];
 	int family;
 	cc = calloc(1, sizeof *cc);
+	if (cc)
+		cc->live = srv_conn_open(conn);
 	if (!cc || !peer(conn, addr, &family)) {
 		*socket_context = cc;
 		return;
@@ -494,6 +500,15 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 		cc->over = ++cc->c->count > cfg->max_client_connections;
 	pthread_mutex_unlock(&lock);
 	*socket_context = cc;
+}
+
+void srv_budget_request(struct MHD_Connection *conn, int busy)
+{
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+	const client_conn *cc = ci ? ci->socket_context : NULL;
+	if (cc)
+		srv_conn_busy(cc->live, busy);
 }
 
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)

@@ -279,6 +279,7 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->r.method = method;
 		st->r.url = url;
 		st->r.body = "";
+		srv_budget_request(conn, 1);
 		return first_look(&st->r);
 	}
 	if (*upload_data_size) {
@@ -319,9 +320,10 @@ void srv_request_done(void *cls, struct MHD_Connection *conn,
 		      void **con_cls, enum MHD_RequestTerminationCode toe)
 {
 	(void)cls;
-	(void)conn;
 	(void)toe;
 	req_state *st = *con_cls;
+	if (st && st->r.conn)
+		srv_budget_request(conn, 0);
 	if (!st)
 		return;
 	free(st->body);
