@@ -72,7 +72,8 @@ api_err api_parse_user_value(const api_spec *spec, const char *name,
 			     const cJSON *it, const char *field,
 			     api_value *out, api_problem *pb);
 /* An SI value of setting name in its user unit, for answers (the table's
- * scale; unchanged for an unknown name). */
+ * scale, to 15 significant digits when it is not 1, so that 60 deg sent
+ * is 60 shown; unchanged for an unknown name). */
 double api_user_of(const char *name, double si);
 /* Apply preset/params/scene/integrator members of obj (others ignored)
  * to *spec, starting from the preset (default czubak2016). */

@@ -249,6 +249,9 @@ static int apply_commands(srv_session *s)
 		if (cmd->from_experiment)
 			experiment_commanded(s, cmd);
 	}
+	/* the status shows the accepted targets at once: no step publishes
+	 * one while paused or finished, nor before the answer when running */
+	sim_get_status(s->sim, &s->st);
 	pthread_cond_broadcast(&s->data);
 	return reanchor;
 }
