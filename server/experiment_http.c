@@ -58,7 +58,7 @@ void srv_experiment_put(srv_experiment *e)
 size_t srv_experiments_restore(void)
 {
 	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list("experiments", &names)
+	size_t n = srv_store_enabled() ? srv_store_list_ids("experiments", 0, &names)
 				       : 0,
 	       count = 0;
 	for (size_t i = 0; i < n; i++) {

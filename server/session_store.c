@@ -313,7 +313,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	exp_find = find;
 	exp_put = put;
 	char **names = NULL;
-	size_t n = srv_store_list("sessions", &names), count = 0;
+	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {

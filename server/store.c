@@ -448,6 +448,48 @@ void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
 	return payload;
 }
 
+/* Is the entry name of rel one of the kind srv_store_list_ids lists? 1
+ * yes, 0 the store's own leftovers (.tmp, .prev: skipped silently), -1
+ * junk (the reason in *why). */
+static int stored_entry(const char *rel, const char *name, int dirs,
+			const char **why)
+{
+	size_t n = strlen(name);
+	if (n > 4 && (strcmp(name + n - 4, ".tmp") == 0 ||
+		      strcmp(name + n - 5, ".prev") == 0))
+		return 0;
+	char path[4096];
+	struct stat sb;
+	snprintf(path, sizeof path, "%s/%s/%s", st.dir, rel, name);
+	size_t idlen = dirs ? n : n > 4 && strcmp(name + n - 4, ".bin") == 0 ? n - 4 : 0;
+	if (lstat(path, &sb) != 0)
+		*why = strerror(errno);
+	else if (dirs ? !S_ISDIR(sb.st_mode) : !S_ISREG(sb.st_mode))
+		*why = dirs ? "not a directory" : "not a regular file";
+	else if (!srv_id_valid(name, idlen))
+		*why = dirs ? "not named by an id" : "not named ID.bin";
+	else
+		return 1;
+	return -1;
+}
+
+size_t srv_store_list_ids(const char *rel, int dirs, char ***names)
+{
+	size_t n = srv_store_list(rel, names), kept = 0;
+	for (size_t i = 0; i < n; i++) {
+		const char *why = NULL;
+		int ok = stored_entry(rel, (*names)[i], dirs, &why);
+		if (ok < 0)
+			srv_log(SRV_LOG_WARN, "data dir: ignored %s/%.100s: %s",
+				rel, (*names)[i], why);
+		if (ok > 0)
+			(*names)[kept++] = (*names)[i];
+		else
+			free((*names)[i]);
+	}
+	return kept;
+}
+
 size_t srv_store_list(const char *rel, char ***names)
 {
 	char path[4096];

@@ -87,5 +87,9 @@ char *srv_store_read_text(const char *path, size_t *len);
 /* Entries of a directory (relative path), malloc'd array of malloc'd
  * names (free each and the array); the count, 0 if none. */
 size_t srv_store_list(const char *path, char ***names);
+/* The same for the entries of one kind of record under rel: directories
+ * named by an id (dirs) or regular files ID.bin. Anything else is skipped
+ * with one log line each (the store's own .tmp and .prev files without). */
+size_t srv_store_list_ids(const char *rel, int dirs, char ***names);
 
 #endif

@@ -272,7 +272,7 @@ static void run_point(void *arg)
 size_t srv_sweeps_restore(void)
 {
 	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list("sweeps", &names) : 0,
+	size_t n = srv_store_enabled() ? srv_store_list_ids("sweeps", 0, &names) : 0,
 	       count = 0;
 	for (size_t i = 0; i < n; i++) {
 		char path[300], why[300];
