@@ -20,7 +20,7 @@ const char *const api_members_session_create[] = {"preset", "params", "scene", "
 
 /* The ranges of a session's pace (a real-time factor; or "max"), until
  * (s; or none) and sample_rate (1/s): the parsers and api_check_spec. */
-#define PACE_MIN 0.001
+#define PACE_MIN API_PACE_MIN
 #define PACE_MAX 1000.0
 #define UNTIL_MIN 1e-6
 #define UNTIL_MAX 1e6

@@ -18,6 +18,7 @@
  * --max-connections (libmicrohttpd never holds more).
  */
 #include <arpa/inet.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -48,6 +49,8 @@
 #define COLUMN_SUBSTEP_CPU_S 8.0e-8
 #define ELEMENT_SUBSTEP_CPU_S 0.8e-8
 #define SAMPLE_CPU_S 7e-6
+/* and of each double of a published sample's feed record (ring, history) */
+#define RECORD_DOUBLE_CPU_S 2e-9
 /* Retry-After of a refusal for CPU: paced sessions come and go. */
 #define CPU_RETRY_S 5
 
@@ -206,6 +209,11 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
 }
 
+double srv_budget_sample_cpu(int columns, int layers)
+{
+	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)record_doubles(columns, layers);
+}
+
 api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			      const char *field, const char *verb,
 			      api_problem *pb)
@@ -242,6 +250,26 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		 "retry when paced sessions have ended, paused or slowed down",
 		 need, 1e3 * cpu_per_s, pace, others, limit, verb);
 	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
+}
+
+double srv_budget_fit_pace(double *held, double cpu_per_s, double pace)
+{
+	pthread_mutex_lock(&lock);
+	double others = paced - *held, room = cfg->max_paced_cores - others;
+	double fit = pace;
+	if (cpu_per_s > 0 && cpu_per_s * pace > room * (1 + 1e-12)) {
+		fit = room / cpu_per_s; /* NaN when no room: the least pace */
+		double unit = pow(10, floor(log10(fit)) - 2);
+		fit = floor(fit / unit) * unit; /* three significant digits */
+	}
+	if (!(fit >= API_PACE_MIN))
+		fit = API_PACE_MIN;
+	if (fit > pace)
+		fit = pace;
+	*held = cpu_per_s * fit;
+	paced = others + *held;
+	pthread_mutex_unlock(&lock);
+	return fit;
 }
 
 void srv_budget_set_paced(double *held, double need)

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/mman.h>
 
+#include "cpu_probe.h"
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
@@ -139,8 +140,14 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
+	/* what a simulated second costs: the estimate from the integrator,
+	 * unless a short run of a copy (cpu_probe.c) measures more than twice
+	 * that (what grows with a large feed): then the measurement */
 	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
+	double probed = srv_cpu_probe(s->sim, spec, s->columns, s->layers);
+	if (probed > 2 * s->cpu_per_s)
+		s->cpu_per_s = probed;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;

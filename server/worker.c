@@ -327,16 +327,41 @@ static void measure_cost(srv_session *s, clocks *c)
 	c->cost_t = s->st.t;
 }
 
+/* The session measured more than it was admitted for: it goes on at the
+ * pace that fits the cores for paced sessions (budget.c), taken as a
+ * control would be (the stream's and the control log's "control" event),
+ * so that it does not starve the others (lock held). */
+static void pace_down(srv_session *s, clocks *c)
+{
+	double was = s->pace, cost = s->cpu_per_s;
+	double pace = srv_budget_fit_pace(&s->paced_held, cost, was);
+	if (pace >= was)
+		return;
+	api_control ctl = {.set = API_C_PACE, .pace = pace};
+	char json[API_EVENT_MAX];
+	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
+	s->pace = pace;
+	srv_ring_event(s, "control", json);
+	srv_persist_control(s, json);
+	s->ckpt_dirty = 1;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
+			      "admitted; paced down from %g to %g to fit "
+			      "--max-paced-cores", s->entry.id, cost, was, pace);
+}
+
 /* need: the session's hold on the paced cores follows what it needs now
  * (its state, pace and measured cost), even beyond the budget: admission
  * is checked where a request raises it (session.c). Called in the same
  * turn as the commands phase (the lock is not let go in between), so that
  * a hold a handler raised for its queued command is kept until the worker
  * has applied it. */
-static void commit_need(srv_session *s)
+static void commit_need(srv_session *s, clocks *c)
 {
 	double need = srv_paced_need(s);
-	if (need != s->paced_held)
+	if (need > s->paced_held * (1 + 1e-9) && need > 1e-9)
+		pace_down(s, c);
+	else if (need != s->paced_held)
 		srv_budget_set_paced(&s->paced_held, need);
 }
 
@@ -518,7 +543,7 @@ void *srv_worker_main(void *arg)
 		srv_persist_checkpoint(s, 0);
 		check_until(s, &clk);
 		check_cpu(s, &clk);
-		commit_need(s);
+		commit_need(s, &clk);
 		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
