@@ -62,6 +62,11 @@ struct srv_session {
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
+	int spec_unwritten;       /* spec.bin failed to be written: the
+				     session stays "error" until a rewrite
+				     (queued at the next write that works)
+				     is on disk */
+	int spec_retrying;        /* that rewrite is queued */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */

@@ -43,20 +43,37 @@ static void session_dir(char *out, size_t len, const char *id,
 		 file ? file : "");
 }
 
-/* A write's outcome for session id (malloc'd, freed here): a failure puts
- * the session in state "error" with the reason; a later success clears
- * it. */
+/* Which write of which session a callback is about (malloc'd, freed by
+ * written). */
+typedef struct write_of {
+	char id[SRV_ID_LEN];
+	int spec; /* spec.bin */
+} write_of;
+
+/* A write's outcome: a failure puts the session in state "error" with the
+ * reason. A later success clears it, unless spec.bin is not on disk: the
+ * first success after its failure (space came back) queues it again, and
+ * the session reports healthy only once that rewrite is written (lock
+ * order: the session's, then the store's). */
 static void written(void *arg, int err, const char *what)
 {
-	char *id = arg;
-	srv_session *s = srv_session_get(id);
-	free(id);
+	write_of *w = arg;
+	srv_session *s = srv_session_get(w->id);
+	int spec = w->spec;
+	free(w);
 	if (!s)
 		return;
 	pthread_mutex_lock(&s->lock);
+	if (spec) {
+		s->spec_unwritten = err != 0;
+		s->spec_retrying = 0;
+	}
 	if (err)
 		snprintf(s->store_error, sizeof s->store_error, "%s", what);
-	else if (what && what[0] == '\0' && s->store_error[0])
+	else if (s->spec_unwritten && !s->spec_retrying) {
+		s->spec_retrying = 1;
+		srv_persist_spec(s);
+	} else if (!s->spec_unwritten && what && what[0] == '\0')
 		s->store_error[0] = '\0';
 	pthread_mutex_unlock(&s->lock);
 	srv_session_put(s);
@@ -67,8 +84,12 @@ static void queue(const srv_session *s, const char *file, void *buf,
 {
 	char path[128];
 	session_dir(path, sizeof path, s->entry.id, file);
-	srv_store_write(path, buf, len, keep_prev, written,
-			strdup(s->entry.id));
+	write_of *w = calloc(1, sizeof *w);
+	if (w) {
+		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
+		w->spec = strcmp(file, "spec.bin") == 0;
+	}
+	srv_store_write(path, buf, len, keep_prev, w ? written : NULL, w);
 }
 
 void srv_persist_spec(srv_session *s)
@@ -154,6 +175,13 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	free(exp);
 	s->ckpt_wall = now;
 	s->ckpt_dirty = 0;
+}
+
+api_err srv_session_check_removable(const srv_session *s, api_problem *pb)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, NULL);
+	return srv_store_check_removable(path, pb);
 }
 
 void srv_persist_remove(const srv_session *s)

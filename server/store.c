@@ -349,6 +349,35 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 	enqueue(j);
 }
 
+api_err srv_store_check_removable(const char *rel, api_problem *pb)
+{
+	if (!st.started)
+		return API_OK;
+	char path[4096];
+	struct stat sb;
+	full_path(path, sizeof path, rel);
+	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
+	/* its directory (the entry goes), and the entry's own when it is
+	 * one (its files go) */
+	char *slash = strrchr(path, '/');
+	int err = 0;
+	if (slash) {
+		*slash = '\0';
+		err = access(path, W_OK) != 0 && errno != ENOENT ? errno : 0;
+		*slash = '/';
+	}
+	if (!err && is_dir && access(path, W_OK) != 0 && errno != ENOENT)
+		err = errno;
+	if (!err)
+		return API_OK;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "the data directory cannot be changed (%s): %s cannot be "
+		 "removed; nothing was deleted, retry once it is writable",
+		 strerror(err), rel);
+	pb->retry_after = 30;
+	return API_UNAVAILABLE;
+}
+
 void srv_store_remove(const char *path)
 {
 	if (!st.started)

@@ -518,6 +518,13 @@ enum MHD_Result srv_h_sweep_delete(srv_req *r)
 		return srv_fail(r, API_NOTFOUND, NULL,
 				"no sweep with id \"%.40s\"", r->arg[0]);
 	srv_sweep *sw = sweep_of(en);
+	char rec[64];
+	api_problem pb;
+	snprintf(rec, sizeof rec, "sweeps/%s.bin", sw->entry.id);
+	if (srv_store_check_removable(rec, &pb) != API_OK) {
+		srv_registry_put(&sweeps, en);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	pthread_mutex_lock(&sw->lock);
 	if (sw->done < sw->total)
 		sw->cancelled = 1;

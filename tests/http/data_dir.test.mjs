@@ -5,10 +5,10 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync, symlinkSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, mkdtempSync, rmSync, symlinkSync, unlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, CHEAP, SLOW, BIN } from './lib.mjs';
 
 test('junk in the data directory is ignored with one log line each, the real records restored', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-junk-'));
@@ -48,6 +48,75 @@ test('junk in the data directory is ignored with one log line each, the real rec
     }
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+// A private mount namespace with a tmpfs as the data directory (as
+// persistence.test.mjs does); the test reaches into it through
+// /proc/PID/root and nsenter.
+function namespaces() {
+  const probe = spawnSync('sh', ['-c', 'command -v nsenter >/dev/null && unshare -m sh -c \'d=$(mktemp -d) && ' +
+    'mount -t tmpfs -o size=64k tmpfs "$d" && mount -o remount,ro "$d" && umount "$d"; rmdir "$d"\''], { encoding: 'utf8' });
+  return probe.status === 0;
+}
+const NS_SKIP = !namespaces() && 'unshare -m with a tmpfs, or nsenter, is not possible here (needs root)';
+
+test('a full disk: the session stays "error" until its spec is on disk; read-only: DELETE is 503 and deletes nothing', { timeout: 60000 * SLOW, skip: NS_SKIP }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-full-'));
+  const script = `mount -t tmpfs -o size=64k tmpfs "${dir}" && mkdir "${dir}/sessions" "${dir}/experiments" "${dir}/sweeps" && ` +
+    `(dd if=/dev/zero of="${dir}/filler" bs=4k 2>/dev/null; true) && exec "${BIN}" "$@"`;
+  const d = await startDaemon([], { wrap: ['unshare', '-m', 'sh', '-c', script, 'sh'], tail: ['--data-dir', dir, '--checkpoint-interval', '0.2'] });
+  const inside = (p) => `/proc/${d.proc.pid}/root${dir}/${p}`;
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const id = s.body.id;
+    const path = `/api/v1/sessions/${id}`;
+    const failed = await until(async () => {
+      const g = (await req(d.base, 'GET', path)).body;
+      return g.state === 'error' && g;
+    }, 5000, 'the session in state error');
+    assert.match(failed.error, /spec\.bin.*No space left on device/);
+    assert.ok(!existsSync(inside(`sessions/${id}/spec.bin`)), 'no spec.bin on the full disk');
+    // space comes back: healthy again only with its spec on disk
+    unlinkSync(inside('filler'));
+    const healed = await until(async () => {
+      const g = (await req(d.base, 'GET', path)).body;
+      return g.state !== 'error' && g;
+    }, 10000, 'the session healthy again');
+    assert.equal(healed.state, 'running');
+    assert.ok(!healed.error, healed.error);
+    assert.ok(existsSync(inside(`sessions/${id}/spec.bin`)), 'a session reported healthy has its spec.bin');
+    // read-only: DELETE is refused with a problem the client can act on
+    const ro = spawnSync('nsenter', ['-t', String(d.proc.pid), '-m', 'mount', '-o', 'remount,ro', dir], { encoding: 'utf8' });
+    assert.equal(ro.status, 0, ro.stderr);
+    const del = await req(d.base, 'DELETE', path);
+    assert.equal(del.status, 503, del.text);
+    assert.equal(del.body.type, '/api/v1/problems/unavailable');
+    assert.match(del.body.detail, /Read-only file system.*nothing was deleted/);
+    assert.equal(del.headers.get('retry-after'), '30');
+    assert.equal((await req(d.base, 'GET', path)).status, 200, 'the session is still there');
+    assert.ok(existsSync(inside(`sessions/${id}/spec.bin`)), 'its files are still there');
+    assert.doesNotMatch(d.stderr(), new RegExp(`session ${id} deleted`));
+    // writable again: DELETE works
+    spawnSync('nsenter', ['-t', String(d.proc.pid), '-m', 'mount', '-o', 'remount,rw', dir]);
+    assert.equal((await req(d.base, 'DELETE', path)).status, 204);
+    await until(async () => !existsSync(inside(`sessions/${id}`)), 5000, 'the files removed');
+  } finally {
+    await d.stop('SIGKILL');
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+test('starting on a read-only data directory exits 2 with a message', { timeout: 30000 * SLOW, skip: NS_SKIP }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-ro-'));
+  try {
+    const r = spawnSync('unshare', ['-m', 'sh', '-c', `mount -t tmpfs -o size=64k,ro tmpfs "${dir}" && exec "${BIN}" --port 0 --data-dir "${dir}"`],
+      { encoding: 'utf8', timeout: 20000 * SLOW });
+    assert.equal(r.status, 2, r.stderr);
+    assert.equal(r.stderr, `convsimd: --data-dir ${dir} is not a writable directory\n`);
+  } finally {
     rmSync(dir, { recursive: true, force: true });
   }
 });
