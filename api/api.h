@@ -476,8 +476,9 @@ typedef struct api_sweep_point {
 } api_sweep_point;
 typedef struct api_sweep_view {
 	char id[24];
-	const char *state;  /* queued, running, done, cancelled, error */
-	const char *error;  /* why "error" (a write failed); NULL or "" */
+	const char *state;  /* queued, running, done, cancelled, error, damaged */
+	const char *error;  /* why "error" (a write failed) or "damaged" (its
+			       record is unusable); NULL or "" */
 	size_t total, done;
 	double t_end;
 	const api_sweep_point *pt; /* borrowed, total entries */

@@ -5,10 +5,10 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { existsSync, mkdirSync, mkdtempSync, rmSync, symlinkSync, unlinkSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, symlinkSync, unlinkSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, CHEAP, SLOW, BIN } from './lib.mjs';
+import { startDaemon, req, until, CHEAP, NO_FEED, SLOW, BIN } from './lib.mjs';
 
 test('junk in the data directory is ignored with one log line each, the real records restored', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-junk-'));
@@ -46,6 +46,46 @@ test('junk in the data directory is ignored with one log line each, the real rec
       const lines = d.stderr().split('\n').filter((l) => l.includes(`ignored ${sub}/${name}:`));
       assert.equal(lines.length, 1, `one log line for ${sub}/${name}: ${d.stderr()}`);
     }
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+test('a damaged sweep record is listed "damaged" with the reason, as a session is; its CSV result is still served', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-dsweep-'));
+  const args = ['--data-dir', dir];
+  let d = await startDaemon(args);
+  let id, csv;
+  try {
+    const sw = await req(d.base, 'POST', '/api/v1/sweeps', { ...NO_FEED, beta: [20, 40], rotations: ['cw'], t_end: 0.2 });
+    assert.equal(sw.status, 202, sw.text);
+    id = sw.body.id;
+    await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${id}`)).body.state === 'done', 20000, 'the sweep done');
+    csv = (await req(d.base, 'GET', `/api/v1/sweeps/${id}?format=csv`)).text;
+    await until(() => existsSync(join(dir, `sweep-${id}.csv`)), 5000, 'the CSV result stored');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+  const file = join(dir, 'sweeps', `${id}.bin`);
+  const rec = readFileSync(file);
+  rec[rec.length - 3] ^= 0x55; // the checksum no longer matches
+  writeFileSync(file, rec);
+  d = await startDaemon(args);
+  try {
+    const list = (await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps;
+    assert.equal(list.length, 1, JSON.stringify(list));
+    assert.equal(list[0].id, id);
+    assert.equal(list[0].state, 'damaged');
+    assert.match(list[0].error, new RegExp(`^damaged: sweeps/${id}\\.bin: .*checksum`));
+    const g = await req(d.base, 'GET', `/api/v1/sweeps/${id}`);
+    assert.equal(g.status, 200, g.text);
+    assert.equal(g.body.state, 'damaged');
+    const again = await req(d.base, 'GET', `/api/v1/sweeps/${id}?format=csv`);
+    assert.equal(again.status, 200);
+    assert.equal(again.text, csv, 'the stored CSV result, byte for byte');
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${id}`)).status, 204);
+    assert.equal((await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps.length, 0);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
     rmSync(dir, { recursive: true, force: true });
