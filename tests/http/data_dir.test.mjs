@@ -92,6 +92,38 @@ test('a damaged sweep record is listed "damaged" with the reason, as a session i
   }
 });
 
+test('a damaged experiment record is listed "damaged" with the reason', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-dexp-'));
+  const args = ['--data-dir', dir];
+  let d = await startDaemon(args);
+  let id;
+  try {
+    const ex = await req(d.base, 'POST', '/api/v1/experiments', { session: { ...NO_FEED, pace: 'max' }, schedule: [{ beta: 50, until: 0.2 }] });
+    assert.equal(ex.status, 201, ex.text);
+    id = ex.body.id;
+    await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${id}`)).body.state === 'done', 20000, 'the experiment done');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+  const file = join(dir, 'experiments', `${id}.bin`);
+  writeFileSync(file, readFileSync(file).subarray(0, 100)); // cut off
+  d = await startDaemon(args);
+  try {
+    const list = (await req(d.base, 'GET', '/api/v1/experiments')).body.experiments;
+    const mine = list.find((e) => e.id === id);
+    assert.ok(mine, `listed: ${JSON.stringify(list)}`);
+    assert.equal(mine.state, 'damaged');
+    assert.match(mine.error, new RegExp(`^damaged: experiments/${id}\\.bin: `));
+    const g = await req(d.base, 'GET', `/api/v1/experiments/${id}`);
+    assert.equal(g.status, 200, g.text);
+    assert.equal(g.body.state, 'damaged');
+    assert.equal((await req(d.base, 'GET', `/api/v1/experiments/${id}?format=csv`)).status, 200);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
 // A private mount namespace with a tmpfs as the data directory (as
 // persistence.test.mjs does); the test reaches into it through
 // /proc/PID/root and nsenter.
