@@ -5,6 +5,7 @@
 // Nothing refused changes anything.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
 import { startDaemon, req, rawRequest, CHEAP, SLOW } from './lib.mjs';
 
 const bytes = (...parts) => Buffer.concat(parts.map((p) => (typeof p === 'string' ? Buffer.from(p, 'latin1') : Buffer.from(p))));
@@ -113,6 +114,21 @@ test('a Host or Content-Length header given twice is 400 and changes nothing; 50
     assert.equal(few.status, 400);
     assert.equal(few.body.field, 'a');
     assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200, 'the daemon still answers');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('docs/hardening.md: its example body gets the answer it shows', { timeout: 30000 * SLOW }, async () => {
+  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
+  const m = doc.match(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/);
+  assert.ok(m, 'docs/hardening.md has a json block after <!-- test:strict-example -->');
+  const example = JSON.parse(m[1]);
+  const d = await startDaemon();
+  try {
+    const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
+    assert.equal(r.status, example.answer.status);
+    assert.deepEqual(r.body, example.answer);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
