@@ -208,6 +208,17 @@ static int check_number(checker *c)
 
 static int check_value(checker *c, int depth);
 
+/* After a member or an element: ',' (1: another follows) or the closing
+ * bracket (0, consumed); -1 for anything else. */
+static int next_item(checker *c, unsigned char close)
+{
+	skip_ws(c);
+	if (c->at < c->len && (c->s[c->at] == ',' || c->s[c->at] == close))
+		return c->s[c->at++] == ',';
+	return fail_at(c, c->at, close == '}' ? "',' or '}' is expected"
+					      : "',' or ']' is expected");
+}
+
 /* An object: members with distinct names (RFC 7493 section 2.3). */
 static int check_object(checker *c, int depth)
 {
@@ -262,17 +273,11 @@ static int check_object(checker *c, int depth)
 		c->at++;
 		if ((rc = check_value(c, depth + 1)) != 0)
 			break;
-		skip_ws(c);
-		if (c->at < c->len && c->s[c->at] == ',') {
-			c->at++;
-			continue;
-		}
-		if (c->at < c->len && c->s[c->at] == '}') {
-			c->at++;
+		int more = next_item(c, '}');
+		if (more <= 0) {
+			rc = more;
 			break;
 		}
-		rc = fail_at(c, c->at, "',' or '}' is expected");
-		break;
 	}
 	free(seen);
 	return rc;
@@ -286,20 +291,10 @@ static int check_array(checker *c, int depth)
 		c->at++;
 		return 0;
 	}
-	for (;;) {
-		if (check_value(c, depth + 1))
-			return -1;
-		skip_ws(c);
-		if (c->at < c->len && c->s[c->at] == ',') {
-			c->at++;
-			continue;
-		}
-		if (c->at < c->len && c->s[c->at] == ']') {
-			c->at++;
-			return 0;
-		}
-		return fail_at(c, c->at, "',' or ']' is expected");
-	}
+	int more = 1;
+	while (more > 0)
+		more = check_value(c, depth + 1) ? -1 : next_item(c, ']');
+	return more;
 }
 
 static int check_value(checker *c, int depth)
