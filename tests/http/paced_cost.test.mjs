@@ -14,18 +14,21 @@ const LARGE = { scene: { columns: 16, layers: 64 } };
 const LIMIT = 0.3;
 const paced = async (d) => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
 
-test('a large scene is admitted by its measured cost: alone too much at pace 1 (422), two at 0.35 do not fit (503)', { timeout: 120000 * SLOW }, async () => {
+test('a large scene is admitted by its measured cost: alone too much at pace 1 (422), two at 0.6 of what fits do not fit (503)', { timeout: 120000 * SLOW }, async () => {
   const d = await startDaemon(['--max-paced-cores', String(LIMIT)]);
   try {
     const one = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 1 });
     assert.equal(one.status, 422, `16 x 64 at pace 1 needs more than ${LIMIT} cores: ${one.text}`);
     assert.equal(one.body.budget, 'cpu');
-    assert.ok(one.body.max > 0.2 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
-    const a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 0.35 });
+    // the largest pace that fits: about 0.6 here (0.5 CPU s per simulated
+    // s), less under the sanitizers; the estimate alone said 7
+    assert.ok(one.body.max > 0.01 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
+    const pace = Math.round(0.6 * one.body.max * 1000) / 1000;
+    const a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
     assert.equal(a.status, 201, a.text);
     const held = await paced(d);
-    assert.ok(held > 0.1 && held <= LIMIT, `16 x 64 at pace 0.35 holds ${held} cores`);
-    const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 0.35 });
+    assert.ok(held > 0.3 * LIMIT && held <= LIMIT, `16 x 64 at pace ${pace} holds ${held} cores`);
+    const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
     assert.equal(b.status, 503, `a second one does not fit: ${b.text}`);
     assert.ok(await paced(d) <= LIMIT, 'the holds stay within the budget');
   } finally {
@@ -55,7 +58,7 @@ test('a session that measures more than it was admitted for is paced down to wha
       return b.pace < 0.9 && b;
     }, 20000, 'the session paced down');
     assert.equal(g.state, 'running');
-    assert.ok(g.pace >= 0.1 && g.pace < 0.9, `paced down to ${g.pace}`);
+    assert.ok(g.pace >= 0.01 && g.pace < 0.9, `paced down to ${g.pace}`);
     assert.ok(await paced(d) <= LIMIT * (1 + 1e-9), `it holds no more than the budget: ${await paced(d)}`);
     assert.match(d.stderr(), new RegExp(`session ${id}: .* paced down from 0\\.9 to ${g.pace}`));
   } finally {
