@@ -275,6 +275,11 @@ typedef struct api_control {
 			      upper bound, --max-cpu-seconds) */
 } api_control;
 
+/* Parse one line of a session's control log (the "control" event of
+ * api_control_event: a PATCH body with t_effective) back into *c and
+ * *t_effective (s), checked as api_parse_control checks a PATCH. */
+api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
+				api_control *c, double *t_effective, api_problem *pb);
 /* Parse a PATCH body against the session's spec (ranges from the settings
  * table). All or nothing: on error *c is unspecified and nothing is to be
  * applied. An empty object is a 422. */

@@ -111,6 +111,25 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 	return e;
 }
 
+api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
+				api_control *c, double *t_effective, api_problem *pb)
+{
+	cJSON *o = cJSON_ParseWithLength(line, len);
+	cJSON *te = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "t_effective") : NULL;
+	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble);
+	*t_effective = ok ? te->valuedouble : 0;
+	cJSON_Delete(te);
+	char *body = ok ? api_print(o) : NULL;
+	cJSON_Delete(o);
+	if (!body)
+		return api_fail(pb, API_MALFORMED, NULL,
+				"a control log line is not a control event "
+				"with t_effective");
+	api_err e = api_parse_control(body, strlen(body), spec, c, pb);
+	free(body);
+	return e;
+}
+
 static void put_pace(cJSON *o, const char *name, double pace)
 {
 	if (pace == API_PACE_MAX)

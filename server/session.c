@@ -48,6 +48,7 @@ static void session_free(srv_session *s)
 		munmap(s->ring, s->ring_bytes);
 	free(s->hist);
 	free(s->controls);
+	free(s->replay);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);

@@ -13,6 +13,12 @@
 #include "session.h"
 #include "worker.h"
 
+/* A control of the log to apply again once the integrator reaches at. */
+typedef struct srv_replay {
+	srv_cmd cmd;
+	double at; /* its t_effective, s */
+} srv_replay;
+
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
@@ -67,6 +73,11 @@ struct srv_session {
 				     (queued at the next write that works)
 				     is on disk */
 	int spec_retrying;        /* that rewrite is queued */
+	srv_replay *replay;       /* controls logged after the checkpoint it
+				     was restored from, in order: applied
+				     again as the integrator reaches each
+				     (session_store.c loads, worker.c runs) */
+	size_t nreplay, replayed;
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
@@ -156,6 +167,11 @@ void srv_persist_remove(const srv_session *s);
 
 /* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
  * the core's checkpoint (sim_len bytes) follow. */
+/* A checkpoint's payload: this head, the experiment's state, the core's
+ * checkpoint, then (from this build on; older ones end with the core's)
+ * a trailer of SRV_CKPT_TRAILER bytes: the length of the control log it
+ * holds (uint64_t), so that a restore replays what came after. */
+#define SRV_CKPT_TRAILER 8
 typedef struct srv_ckpt_record {
 	int32_t state, exp_started;
 	double pace, until;

@@ -157,7 +157,9 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		snprintf(r.exp_id, sizeof r.exp_id, "%s", srv_exp_id(s->exp));
 	}
 	r.sim_len = sim_checkpoint_size(s->sim);
-	size_t plen = sizeof r + r.exp_len + r.sim_len;
+	/* the trailer: how much of the control log the checkpoint holds */
+	uint64_t logged = s->controls_len;
+	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof logged;
 	char *payload = malloc(plen);
 	if (payload) {
 		memcpy(payload, &r, sizeof r);
@@ -165,6 +167,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 			memcpy(payload + sizeof r, exp, r.exp_len);
 		sim_checkpoint(s->sim, payload + sizeof r + r.exp_len,
 			       r.sim_len);
+		memcpy(payload + plen - sizeof logged, &logged, sizeof logged);
 		size_t len;
 		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
 					    &len);
@@ -208,8 +211,11 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	}
 	memcpy(r, p, sizeof *r);
 	/* exp_len first: a length between len - sizeof *r and len wrapped
-	 * the difference below and let sim_len point past the buffer */
-	if (r->exp_len > len - sizeof *r || r->sim_len != len - sizeof *r - r->exp_len ||
+	 * the difference below and let sim_len point past the buffer; the
+	 * core's checkpoint ends the payload or is followed by the trailer */
+	size_t left = r->exp_len <= len - sizeof *r ? len - sizeof *r - (size_t)r->exp_len : 0;
+	if (r->exp_len > len - sizeof *r ||
+	    (r->sim_len != left && !(left >= SRV_CKPT_TRAILER && r->sim_len == left - SRV_CKPT_TRAILER)) ||
 	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
 		snprintf(why, whylen, "inconsistent lengths or state");
 		return -1;
@@ -219,8 +225,8 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	return 0;
 }
 
-static int load_checkpoint(srv_session *s, const char *file, char *why,
-			   size_t whylen)
+static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
+			   char *why, size_t whylen)
 {
 	size_t len;
 	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
@@ -243,6 +249,12 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 	}
 	sim_free(s->sim);
 	s->sim = sm;
+	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
+	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
+		uint64_t at;
+		memcpy(&at, p + len - sizeof at, sizeof at);
+		*logged = at <= SIZE_MAX ? (size_t)at : SIZE_MAX;
+	}
 	s->state = r.state;
 	s->pace = r.pace;
 	s->until = r.until;
@@ -283,6 +295,45 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	return 0;
 }
 
+/* The control log back into s->controls (later controls are appended to
+ * it), and the controls logged after its first `logged` bytes (what the
+ * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
+ * does not say) into s->replay, for the worker to apply again. */
+static void load_controls(srv_session *s, size_t logged)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, "controls.ndjson");
+	size_t len = 0;
+	char *text = srv_store_read_text(path, &len);
+	if (!text)
+		return;
+	s->controls = text;
+	s->controls_len = s->controls_cap = len;
+	if (logged >= len)
+		return;
+	size_t lines = 0;
+	for (size_t i = logged; i < len; i++)
+		lines += text[i] == '\n';
+	s->replay = calloc(lines ? lines : 1, sizeof *s->replay);
+	for (size_t at = logged; s->replay && at < len;) {
+		const char *nl = memchr(text + at, '\n', len - at);
+		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
+		srv_replay *rp = &s->replay[s->nreplay];
+		api_problem pb;
+		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
+						 &rp->at, &pb) == API_OK)
+			s->nreplay++;
+		else if (n)
+			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
+					      "replayed: %s", s->entry.id, path, pb.detail);
+		at += n + 1;
+	}
+	if (s->nreplay)
+		srv_log(SRV_LOG_INFO, "session %s: %zu controls logged after "
+				      "its checkpoint are replayed", s->entry.id,
+			s->nreplay);
+}
+
 /* Build session id from its files into s (calloc'd, lock initialised). */
 static void restore_one(srv_session *s, const char *id)
 {
@@ -310,13 +361,17 @@ static void restore_one(srv_session *s, const char *id)
 	s->until = s->spec.until;
 	s->state = SRV_RUNNING;
 	session_dir(path, sizeof path, id, "checkpoint.bin");
-	if (load_checkpoint(s, path, why, sizeof why) == 0)
+	size_t logged = 0;
+	if (load_checkpoint(s, path, &logged, why, sizeof why) == 0) {
+		load_controls(s, logged);
 		return;
+	}
 	char prev[160];
 	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, why2, sizeof why2) == 0) {
+	if (load_checkpoint(s, prev, &logged, why2, sizeof why2) == 0) {
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
+		load_controls(s, logged);
 		return;
 	}
 	int none = strstr(why, "missing") && strstr(why2, "missing");
@@ -325,8 +380,10 @@ static void restore_one(srv_session *s, const char *id)
 		int err;
 		s->sim = sim_new(&s->spec.params, &s->spec.scene,
 				 &s->spec.method, &err, msg, sizeof msg);
-		if (s->sim)
+		if (s->sim) {
+			load_controls(s, 0); /* every control it took */
 			return;
+		}
 		snprintf(why, sizeof why, "its spec is refused: %s", msg);
 	}
 	s->damaged = 1;

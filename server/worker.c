@@ -240,7 +240,8 @@ static int apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
 			srv_ring_event(s, "control", json);
-			srv_persist_control(s, json);
+			if (!cmd->replay)
+				srv_persist_control(s, json);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
@@ -285,6 +286,20 @@ static void start_job(srv_session *s)
 	queue_experiment_command(s, cmd);
 	s->exp_started = 1;
 	pthread_cond_broadcast(&s->data);
+}
+
+/* replay: the controls logged after the checkpoint the session was
+ * restored from go through the commands phase again, each once the
+ * integrator reaches its t_effective, so that no acknowledged control is
+ * lost to a crash. */
+static void run_replay(srv_session *s)
+{
+	double t = sim_effective_time(s->sim);
+	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
+		srv_cmd *cmd = &s->replay[s->replayed++].cmd;
+		cmd->replay = 1;
+		srv_worker_queue(s, cmd);
+	}
 }
 
 /* commands: apply what is queued; pacing restarts after pace or pause. */
@@ -537,6 +552,7 @@ void *srv_worker_main(void *arg)
 	publish(s, &clk);
 	for (;;) {
 		start_job(s);
+		run_replay(s);
 		run_commands(s, &clk);
 		if (s->stop)
 			break;
