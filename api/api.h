@@ -243,6 +243,15 @@ typedef struct api_spec {
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb);
 
+/* A session's spec as stored (sessions/ID/spec.json): its creation time
+ * (unix s), whether an experiment owns it, and the create body that makes
+ * it again ("session": preset, pace, until, sample_rate and every setting
+ * by group), the API's own JSON, so that another build reads it. malloc'd
+ * text, NULL when out of memory. api_parse_spec_file reads it back through
+ * api_parse_session (400/422 as a POST would be). */
+char *api_spec_file(const api_spec *spec, double created, int owned);
+api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
+			    double *created, int *owned, api_problem *pb);
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
  * sample_rate within the ranges the parser allows, every setting within
@@ -310,6 +319,10 @@ typedef struct api_view {
 	double cpu_limit;      /* CPU time at which it pauses, s */
 	const char *pause_reason; /* "client", "cpu-budget" or NULL */
 	int waiting_for_cpu;   /* pace "max" waiting for a CPU slot */
+	int replayed;          /* re-created from its spec at the last start
+				  (its checkpoint unusable), its control log
+				  replayed: "restored": "replayed" */
+	double replay_seconds; /* wall s the replay took; NAN while it runs */
 } api_view;
 
 /* Session as JSON; with_spec adds the full settings. malloc'd text. */

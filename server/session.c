@@ -396,6 +396,8 @@ void srv_session_view(srv_session *s, api_view *v)
 			  : s->cpu_paused      ? "cpu-budget"
 					       : "client";
 	v->waiting_for_cpu = s->waiting_for_cpu;
+	v->replayed = s->rebuilt;
+	v->replay_seconds = s->replay_seconds;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

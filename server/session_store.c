@@ -2,7 +2,10 @@
  * session_store.c - a session's files in the data directory and the
  * sessions rebuilt from them at start-up (README "Persistence").
  *
- *   sessions/ID/spec.bin         the spec as created (framed, store.h)
+ *   sessions/ID/spec.json        the spec as created, the API's JSON
+ *                                (api_spec_file), read first
+ *   sessions/ID/spec.bin         the same as this build's record (framed,
+ *                                store.h), for earlier builds
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
  *                                object a line with t_effective (s)
  *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
@@ -47,11 +50,11 @@ static void session_dir(char *out, size_t len, const char *id,
  * written). */
 typedef struct write_of {
 	char id[SRV_ID_LEN];
-	int spec; /* spec.bin */
+	int spec; /* spec.json */
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
- * reason. A later success clears it, unless spec.bin is not on disk: the
+ * reason. A later success clears it, unless spec.json is not on disk: the
  * first success after its failure (space came back) queues it again, and
  * the session reports healthy only once that rewrite is written (lock
  * order: the session's, then the store's). */
@@ -87,7 +90,7 @@ static void queue(const srv_session *s, const char *file, void *buf,
 	write_of *w = calloc(1, sizeof *w);
 	if (w) {
 		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
-		w->spec = strcmp(file, "spec.bin") == 0;
+		w->spec = strcmp(file, "spec.json") == 0;
 	}
 	srv_store_write(path, buf, len, keep_prev, w ? written : NULL, w);
 }
@@ -96,6 +99,7 @@ void srv_persist_spec(srv_session *s)
 {
 	if (!srv_store_enabled() || s->damaged)
 		return;
+	/* spec.bin too, for an earlier build started on this directory */
 	spec_record r;
 	memset(&r, 0, sizeof r);
 	snprintf(r.id, sizeof r.id, "%s", s->entry.id);
@@ -106,6 +110,9 @@ void srv_persist_spec(srv_session *s)
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
 		queue(s, "spec.bin", buf, len, 0);
+	char *text = api_spec_file(&s->spec, s->created, s->owned);
+	if (text)
+		queue(s, "spec.json", text, strlen(text), 0);
 }
 
 void srv_persist_control(srv_session *s, const char *json)
@@ -157,9 +164,10 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		snprintf(r.exp_id, sizeof r.exp_id, "%s", srv_exp_id(s->exp));
 	}
 	r.sim_len = sim_checkpoint_size(s->sim);
-	/* the trailer: how much of the control log the checkpoint holds */
-	uint64_t logged = s->controls_len;
-	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof logged;
+	/* the trailer: how much of the control log the checkpoint holds,
+	 * and its time */
+	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t};
+	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof tr;
 	char *payload = malloc(plen);
 	if (payload) {
 		memcpy(payload, &r, sizeof r);
@@ -167,7 +175,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 			memcpy(payload + sizeof r, exp, r.exp_len);
 		sim_checkpoint(s->sim, payload + sizeof r + r.exp_len,
 			       r.sim_len);
-		memcpy(payload + plen - sizeof logged, &logged, sizeof logged);
+		memcpy(payload + plen - sizeof tr, &tr, sizeof tr);
 		size_t len;
 		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
 					    &len);
@@ -239,6 +247,15 @@ static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
 		snprintf(why, whylen, "%s: %s", file, msg);
 		goto done;
 	}
+	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
+	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
+		srv_ckpt_trailer tr;
+		memcpy(&tr, p + len - sizeof tr, sizeof tr);
+		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
+		if (isfinite(tr.t) && tr.t > s->catch_up_t)
+			s->catch_up_t = tr.t; /* where it was, if the core's
+						 part is refused */
+	}
 	int err;
 	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
 			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
@@ -247,14 +264,9 @@ static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
 		snprintf(why, whylen, "%s: %s", file, msg);
 		goto done;
 	}
+	s->catch_up_t = 0;
 	sim_free(s->sim);
 	s->sim = sm;
-	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
-	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
-		uint64_t at;
-		memcpy(&at, p + len - sizeof at, sizeof at);
-		*logged = at <= SIZE_MAX ? (size_t)at : SIZE_MAX;
-	}
 	s->state = r.state;
 	s->pace = r.pace;
 	s->until = r.until;
@@ -334,6 +346,51 @@ static void load_controls(srv_session *s, size_t logged)
 			s->nreplay);
 }
 
+/* The spec of s from spec.json (the API's JSON: this build on) or, when
+ * there is none, spec.bin (earlier builds); 0, or -1 with why. */
+static int load_spec(srv_session *s, char *why, size_t whylen)
+{
+	char path[128], msg[256];
+	size_t len = 0;
+	session_dir(path, sizeof path, s->entry.id, "spec.json");
+	char *text = srv_store_read_text(path, &len);
+	if (text) {
+		api_problem pb;
+		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
+						&s->owned, &pb);
+		free(text);
+		if (e != API_OK)
+			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		return e == API_OK ? 0 : -1;
+	}
+	session_dir(path, sizeof path, s->entry.id, "spec.bin");
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, whylen);
+	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
+				     msg, sizeof msg)
+		   : -1;
+	if (r && rc)
+		snprintf(why, whylen, "%s: %s", path, msg);
+	free(r);
+	return rc;
+}
+
+/* s was re-created from its spec because neither checkpoint could be used
+ * (why, why2): its worker replays the whole control log and runs flat out
+ * to where it was, the later of the time a checkpoint's trailer gave and
+ * the last control's, then at its pace again (worker.c). */
+static void rebuild(srv_session *s, const char *why, const char *why2)
+{
+	for (size_t i = 0; i < s->nreplay; i++)
+		if (s->replay[i].at > s->catch_up_t)
+			s->catch_up_t = s->replay[i].at;
+	s->rebuilt = 1;
+	s->replay_wall = srv_now();
+	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
+	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
+			      "spec, %zu controls replayed to t = %g s",
+		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
+}
+
 /* Build session id from its files into s (calloc'd, lock initialised). */
 static void restore_one(srv_session *s, const char *id)
 {
@@ -341,22 +398,11 @@ static void restore_one(srv_session *s, const char *id)
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
 	s->created = srv_unix_time();
 	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
-	session_dir(path, sizeof path, id, "spec.bin");
-	size_t len;
-	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, sizeof why);
-	char msg[256];
-	if (r && srv_spec_decode(r, len, &s->spec, &s->created, &s->owned, msg,
-				 sizeof msg) != 0) {
-		snprintf(why, sizeof why, "%s: %s", path, msg);
-		free(r);
-		r = NULL;
-	}
-	if (!r) {
+	if (load_spec(s, why, sizeof why) != 0) {
 		s->damaged = 1;
 		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
 		return;
 	}
-	free(r);
 	s->pace = s->spec.pace;
 	s->until = s->spec.until;
 	s->state = SRV_RUNNING;
@@ -374,18 +420,23 @@ static void restore_one(srv_session *s, const char *id)
 		load_controls(s, logged);
 		return;
 	}
+	/* none: created less than one interval before the crash; else both
+	 * copies are unusable (another build's, damaged): either way it
+	 * starts again from its spec and takes every control it took */
 	int none = strstr(why, "missing") && strstr(why2, "missing");
-	if (none) { /* created less than one interval before the crash */
-		char msg[256] = "";
-		int err;
-		s->sim = sim_new(&s->spec.params, &s->spec.scene,
-				 &s->spec.method, &err, msg, sizeof msg);
-		if (s->sim) {
-			load_controls(s, 0); /* every control it took */
-			return;
-		}
-		snprintf(why, sizeof why, "its spec is refused: %s", msg);
+	char msg[256] = "";
+	int err;
+	s->sim = sim_new(&s->spec.params, &s->spec.scene, &s->spec.method,
+			 &err, msg, sizeof msg);
+	if (s->sim) {
+		load_controls(s, 0);
+		if (!none)
+			rebuild(s, why, why2);
+		else
+			s->catch_up_t = 0;
+		return;
 	}
+	snprintf(why, sizeof why, "its spec is refused: %s", msg);
 	s->damaged = 1;
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }

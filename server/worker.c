@@ -302,6 +302,22 @@ static void run_replay(srv_session *s)
 	}
 }
 
+/* caught up: a session re-created from its spec (session_store.c rebuild)
+ * ran flat out to where it was, or a replayed control stopped it short of
+ * that: from here on it keeps its pace. */
+static void check_caught_up(srv_session *s, clocks *c)
+{
+	if (!(s->catch_up_t > 0) ||
+	    (s->st.t < s->catch_up_t &&
+	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
+		return;
+	s->catch_up_t = 0;
+	s->replay_seconds = srv_now() - s->replay_wall;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_INFO, "session %s: replayed to t = %g s in %.3f s",
+		s->entry.id, s->st.t, s->replay_seconds);
+}
+
 /* commands: apply what is queued; pacing restarts after pace or pause. */
 static void run_commands(srv_session *s, clocks *c)
 {
@@ -455,7 +471,7 @@ static int idle(srv_session *s, clocks *c)
  * starts over, so that commands are seen at once). */
 static int pace(srv_session *s, clocks *c, double t_next)
 {
-	if (s->pace == API_PACE_MAX)
+	if (s->pace == API_PACE_MAX || s->catch_up_t > 0)
 		return 0;
 	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
 	if (due <= c->batch_end)
@@ -554,6 +570,7 @@ void *srv_worker_main(void *arg)
 		start_job(s);
 		run_replay(s);
 		run_commands(s, &clk);
+		check_caught_up(s, &clk);
 		if (s->stop)
 			break;
 		srv_persist_checkpoint(s, 0);

@@ -149,8 +149,8 @@ test('a full disk: the session stays "error" until its spec is on disk; read-onl
       const g = (await req(d.base, 'GET', path)).body;
       return g.state === 'error' && g;
     }, 5000, 'the session in state error');
-    assert.match(failed.error, /spec\.bin.*No space left on device/);
-    assert.ok(!existsSync(inside(`sessions/${id}/spec.bin`)), 'no spec.bin on the full disk');
+    assert.match(failed.error, /spec\.json: No space left on device/);
+    assert.ok(!existsSync(inside(`sessions/${id}/spec.json`)), 'no spec.json on the full disk');
     // space comes back: healthy again only with its spec on disk
     unlinkSync(inside('filler'));
     const healed = await until(async () => {
@@ -159,7 +159,7 @@ test('a full disk: the session stays "error" until its spec is on disk; read-onl
     }, 10000, 'the session healthy again');
     assert.equal(healed.state, 'running');
     assert.ok(!healed.error, healed.error);
-    assert.ok(existsSync(inside(`sessions/${id}/spec.bin`)), 'a session reported healthy has its spec.bin');
+    assert.ok(existsSync(inside(`sessions/${id}/spec.json`)), 'a session reported healthy has its spec.json');
     // read-only: DELETE is refused with a problem the client can act on
     const ro = spawnSync('nsenter', ['-t', String(d.proc.pid), '-m', 'mount', '-o', 'remount,ro', dir], { encoding: 'utf8' });
     assert.equal(ro.status, 0, ro.stderr);
@@ -169,7 +169,7 @@ test('a full disk: the session stays "error" until its spec is on disk; read-onl
     assert.match(del.body.detail, /Read-only file system.*nothing was deleted/);
     assert.equal(del.headers.get('retry-after'), '30');
     assert.equal((await req(d.base, 'GET', path)).status, 200, 'the session is still there');
-    assert.ok(existsSync(inside(`sessions/${id}/spec.bin`)), 'its files are still there');
+    assert.ok(existsSync(inside(`sessions/${id}/spec.json`)), 'its files are still there');
     assert.doesNotMatch(d.stderr(), new RegExp(`session ${id} deleted`));
     // writable again: DELETE works
     spawnSync('nsenter', ['-t', String(d.proc.pid), '-m', 'mount', '-o', 'remount,rw', dir]);
