@@ -12,7 +12,7 @@ import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, truncateSync, writeFileSync, statSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
 
 const INTERVAL = 0.5;            // --checkpoint-interval, s
 const MARGIN = 0.8 * SLOW;       // s: scheduling slack on top of it (shared CI cores)
@@ -134,10 +134,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
     assert.match(dm.error, /spec\.bin/);
     // both checkpoints of another version: re-created from its spec, its
     // controls replayed (replay.test.mjs), not damaged
-    const dv = await until(async () => {
-      const b = (await req(d.base, 'GET', `/api/v1/sessions/${ids[2]}`)).body;
-      return b.replay_seconds !== null && b;
-    }, 20000, 'the replay over');
+    const dv = await untilReplayed(d.base, ids[2]);
     assert.equal(dv.state, 'running');
     assert.equal(dv.restored, 'replayed');
     assert.match(d.stderr(), new RegExp(`session ${ids[2]}: .*version.*re-created from its spec`));

@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, sleep, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, sleep, reframe, STORE_FRAME, CHEAP, SLOW } from './lib.mjs';
 
 const get = async (d, id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
 
@@ -58,20 +58,10 @@ for (const [name, interval, wait] of [['without a checkpoint yet', 3600, 0], ['a
   });
 }
 
-// store.c's frame (the checksum at 24) and this build's checkpoint head
-// (srv_ckpt_record, exp_len at 304); the core's version follows its
-// 8-byte magic (core/checkpoint.c).
-const FRAME = 32;
+// this build's checkpoint head (srv_ckpt_record, exp_len at 304); the
+// core's version follows its 8-byte magic (core/checkpoint.c).
+const FRAME = STORE_FRAME;
 const CKPT_RECORD = 320;
-function reframe(buf) {
-  let h = 1469598103934665603n;
-  for (let i = FRAME; i < buf.length; i++) {
-    h ^= BigInt(buf[i]);
-    h = (h * 0x100000001b3n) & 0xffffffffffffffffn;
-  }
-  buf.writeBigUInt64LE(h, 24);
-  return buf;
-}
 
 test('a checkpoint of another core version: re-created from its spec, its controls replayed to where it was', { timeout: 90000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-rebuild-'));
@@ -99,10 +89,7 @@ test('a checkpoint of another core version: re-created from its spec, its contro
   }
   d = await startDaemon(args);
   try {
-    const g = await until(async () => {
-      const b = await get(d, id);
-      return b.replay_seconds !== null && b;
-    }, 20000, 'the replay over');
+    const g = await untilReplayed(d.base, id);
     assert.equal(g.state, 'running', JSON.stringify(g));
     assert.equal(g.restored, 'replayed');
     assert.ok(g.replay_seconds >= 0 && g.replay_seconds < 10, `replay took ${g.replay_seconds} s`);

@@ -14,26 +14,14 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, reframe, STORE_FRAME, CHEAP, SLOW } from './lib.mjs';
 
-const FRAME = 32;          // store.c's frame header; the checksum at 24
+const FRAME = STORE_FRAME;
 const CKPT_RECORD = 320;   // srv_ckpt_record; exp_len at 304, sim_len at 312
 const SPEC_PRESET = 24;    // spec_record: id[24], then api_spec's preset[32]
 const SPEC_METHOD = 472;   // api_spec's method.name[24] (api_spec at 24)
 const SPEC_ATOL = 512;     // method.atol
 const SPEC_PACE = 528;     // pace (0: "max"), then until at 536
-
-// sim_checksum of the payload into the frame's checksum field: FNV-1a 64
-// with core/checkpoint.c's starting value.
-function reframe(buf) {
-  let h = 1469598103934665603n;
-  for (let i = FRAME; i < buf.length; i++) {
-    h ^= BigInt(buf[i]);
-    h = (h * 0x100000001b3n) & 0xffffffffffffffffn;
-  }
-  buf.writeBigUInt64LE(h, 24);
-  return buf;
-}
 
 test('a checksummed checkpoint with wrapping lengths and specs no request could make are listed damaged', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-damage-'));
@@ -75,10 +63,7 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
     d = await startDaemon(args);
     // both checkpoints refused: re-created from its spec (replay.test.mjs),
     // the reasons logged
-    const a = await until(async () => {
-      const b = (await req(d.base, 'GET', `/api/v1/sessions/${ids[0]}`)).body;
-      return b.replay_seconds !== null && b;
-    }, 20000, 'the replay over');
+    const a = await untilReplayed(d.base, ids[0]);
     assert.equal(a.state, 'finished');
     assert.equal(a.restored, 'replayed');
     assert.match(d.stderr(), /checkpoint\.bin: inconsistent lengths or state.*checkpoint\.bin\.prev: inconsistent lengths.*re-created from its spec/);
