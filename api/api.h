@@ -41,8 +41,9 @@
 	  "A query parameter is unknown to this route or malformed, or Last-Event-ID is not a " \
 	  "record id. `field` names it; the route's parameters are in /api/v1/openapi.json.") \
 	X(BADREQUEST, 400, "bad-request", "Bad request",                      \
-	  "The request itself is malformed: no Host header, or a header the daemon cannot " \
-	  "read. `field` names the header.")                                  \
+	  "The request itself is malformed: no Host header, a Host or Content-Length header " \
+	  "given twice (RFC 9112), or a header the daemon cannot read. `field` names the " \
+	  "header.")                                                          \
 	X(UNAUTHORIZED, 401, "unauthorized", "Unauthorized",                  \
 	  "The daemon runs with --token-file: send Authorization: Bearer TOKEN (the token in " \
 	  "that file). Only the dashboard's files and /api/v1/health are open without it.") \
@@ -67,6 +68,9 @@
 	  "--server-name (a defence against DNS rebinding); nothing was changed.") \
 	X(TOOLARGE, 413, "body-too-large", "Request body too large",          \
 	  "The body is larger than the daemon's --max-body; it was not read.") \
+	X(HEADERS, 431, "header-fields-too-large", "Request header fields too large", \
+	  "The query has more parameters than any route takes (at most 64); it was not " \
+	  "read.")                                                            \
 	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type", \
 	  "POST, PATCH, PUT and DELETE must carry Content-Type: application/json, even with " \
 	  "an empty body (a web page of another origin cannot send that type unasked).") \
@@ -110,6 +114,8 @@ typedef struct api_problem {
 	char budget[24];   /* the budget that refused it ("memory", ...), "" */
 	double limit;      /* its limit, in the budget's unit */
 	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
+	int has_position;  /* a malformed body: the byte where it goes wrong */
+	size_t position;
 } api_problem;
 
 /* HTTP status of an api_err (500 for an unknown code). */
@@ -128,7 +134,7 @@ api_err api_fail(api_problem *pb, api_err code, const char *field,
  * Retry-After seconds; returns pb->code. */
 api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);
 /* The RFC 9457 body for *pb (type, title, status, detail, instance and the
- * extensions field/min/max/choices/budget/limit). instance (borrowed) may be NULL.
+ * extensions field/position/min/max/choices/budget/limit). instance (borrowed) may be NULL.
  * Returns malloc'd text, NULL only when out of memory. */
 char *api_problem_json(const api_problem *pb, const char *instance);
 
@@ -216,6 +222,7 @@ typedef struct api_value {
 /* ---- sessions ----------------------------------------------------------- */
 
 #define API_PACE_MAX 0.0         /* pace value meaning "as fast as possible" */
+#define API_PACE_MIN 0.001       /* the least real-time factor a request may set */
 #define API_DEFAULT_MAX_UNTIL 60.0 /* s: "until" for pace "max" if none given */
 #define API_DEFAULT_SAMPLE_RATE 250.0
 
@@ -237,6 +244,15 @@ typedef struct api_spec {
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb);
 
+/* A session's spec as stored (sessions/ID/spec.json): its creation time
+ * (unix s), whether an experiment owns it, and the create body that makes
+ * it again ("session": preset, pace, until, sample_rate and every setting
+ * by group), the API's own JSON, so that another build reads it. malloc'd
+ * text, NULL when out of memory. api_parse_spec_file reads it back through
+ * api_parse_session (400/422 as a POST would be). */
+char *api_spec_file(const api_spec *spec, double created, int owned);
+api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
+			    double *created, int *owned, api_problem *pb);
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
  * sample_rate within the ranges the parser allows, every setting within
@@ -269,6 +285,11 @@ typedef struct api_control {
 			      upper bound, --max-cpu-seconds) */
 } api_control;
 
+/* Parse one line of a session's control log (the "control" event of
+ * api_control_event: a PATCH body with t_effective) back into *c and
+ * *t_effective (s), checked as api_parse_control checks a PATCH. */
+api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
+				api_control *c, double *t_effective, api_problem *pb);
 /* Parse a PATCH body against the session's spec (ranges from the settings
  * table). All or nothing: on error *c is unspecified and nothing is to be
  * applied. An empty object is a 422. */
@@ -299,6 +320,10 @@ typedef struct api_view {
 	double cpu_limit;      /* CPU time at which it pauses, s */
 	const char *pause_reason; /* "client", "cpu-budget" or NULL */
 	int waiting_for_cpu;   /* pace "max" waiting for a CPU slot */
+	int replayed;          /* re-created from its spec at the last start
+				  (its checkpoint unusable), its control log
+				  replayed: "restored": "replayed" */
+	double replay_seconds; /* wall s the replay took; NAN while it runs */
 } api_view;
 
 /* Session as JSON; with_spec adds the full settings. malloc'd text. */
@@ -478,8 +503,9 @@ typedef struct api_sweep_point {
 } api_sweep_point;
 typedef struct api_sweep_view {
 	char id[24];
-	const char *state;  /* queued, running, done, cancelled, error */
-	const char *error;  /* why "error" (a write failed); NULL or "" */
+	const char *state;  /* queued, running, done, cancelled, error, damaged */
+	const char *error;  /* why "error" (a write failed) or "damaged" (its
+			       record is unusable); NULL or "" */
 	size_t total, done;
 	double t_end;
 	const api_sweep_point *pt; /* borrowed, total entries */

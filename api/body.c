@@ -2,7 +2,8 @@
 /*
  * body.c - the one way a request body is read: parse the bytes as one JSON
  * object, check that every member is a known one, and answer the common
- * problems (400 empty or malformed body, 400 not an object, 422 unknown
+ * problems (400 empty or malformed body, strictly by RFC 8259 and
+ * I-JSON (json_check.c), 400 not an object, 422 unknown
  * member) the same way for sessions, controls, sweeps and experiments.
  */
 #include <stdio.h>
@@ -26,6 +27,8 @@ static cJSON *parse_object(const char *body, size_t len, int empty_ok,
 			 "a JSON object is expected");
 		return NULL;
 	}
+	if (api_json_check(body, len, pb) != API_OK)
+		return NULL;
 	const char *end = NULL;
 	cJSON *root = cJSON_ParseWithLengthOpts(body, len, &end, 0);
 	if (!root) {

@@ -118,17 +118,18 @@ api_err api_fail(api_problem *pb, api_err code, const char *field,
 	return code;
 }
 
-/* Length of the valid UTF-8 sequence at s (RFC 3629: no overlong forms,
- * no surrogates, nothing above U+10FFFF), 0 if the bytes there are not
- * one. */
-static size_t utf8_seq(const unsigned char *s)
+size_t api_utf8_seq(const unsigned char *s, size_t avail)
 {
+	if (avail == 0)
+		return 0;
 	if (s[0] < 0x80)
 		return 1;
 	size_t n = s[0] >= 0xc2 && s[0] <= 0xdf   ? 2
 		   : s[0] >= 0xe0 && s[0] <= 0xef ? 3
 		   : s[0] >= 0xf0 && s[0] <= 0xf4 ? 4
 						  : 0;
+	if (n > avail)
+		return 0;
 	unsigned lo = 0x80, hi = 0xbf; /* the second byte's range */
 	if (s[0] == 0xe0)
 		lo = 0xa0;
@@ -157,8 +158,9 @@ static char *utf8_valid(const char *text)
 	char *out = malloc(3 * len + 1), *o = out;
 	if (!out)
 		return NULL;
+	const unsigned char *end = s + len;
 	while (*s) {
-		size_t n = utf8_seq(s);
+		size_t n = api_utf8_seq(s, (size_t)(end - s));
 		if (n == 0) {
 			memcpy(o, "\xef\xbf\xbd", 3);
 			o += 3;
@@ -204,6 +206,8 @@ char *api_problem_json(const api_problem *pb, const char *instance)
 		add_valid_string(o, "instance", instance);
 	if (pb->field[0])
 		add_valid_string(o, "field", pb->field);
+	if (pb->has_position)
+		cJSON_AddNumberToObject(o, "position", (double)pb->position);
 	if (pb->has_range) {
 		api_add_number(o, "min", pb->min);
 		api_add_number(o, "max", pb->max);

@@ -42,6 +42,17 @@ char *api_print_free(cJSON *item);
 cJSON *api_parse_body(const char *body, size_t len, int empty_ok,
 		      const char *const *members, api_problem *pb);
 
+/* Length of the valid UTF-8 sequence at s of at most avail bytes (RFC
+ * 3629: no overlong forms, no surrogates, nothing above U+10FFFF), 0 if
+ * the bytes there are not one. */
+size_t api_utf8_seq(const unsigned char *s, size_t avail);
+/* Check len bytes of text against RFC 8259 and I-JSON (RFC 7493): the
+ * grammar (no `01`, no `1.`), no raw control byte or invalid UTF-8 in a
+ * string, no unpaired surrogate escape, no member name twice in one
+ * object. API_OK, or API_MALFORMED (400) with *pb naming the byte where
+ * it goes wrong (pb->position) and the duplicated name as the field. */
+api_err api_json_check(const char *text, size_t len, api_problem *pb);
+
 /* The settings-table entry of name in group, or NULL. */
 const sim_setting *api_setting(const char *group, const char *name);
 /* Apply one JSON member to the settings of its group ("params", "scene",
@@ -62,7 +73,8 @@ api_err api_parse_user_value(const api_spec *spec, const char *name,
 			     const cJSON *it, const char *field,
 			     api_value *out, api_problem *pb);
 /* An SI value of setting name in its user unit, for answers (the table's
- * scale; unchanged for an unknown name). */
+ * scale, to 15 significant digits when it is not 1, so that 60 deg sent
+ * is 60 shown; unchanged for an unknown name). */
 double api_user_of(const char *name, double si);
 /* Apply preset/params/scene/integrator members of obj (others ignored)
  * to *spec, starting from the preset (default czubak2016). */

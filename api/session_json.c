@@ -113,6 +113,25 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 	return e;
 }
 
+api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
+				api_control *c, double *t_effective, api_problem *pb)
+{
+	cJSON *o = cJSON_ParseWithLength(line, len);
+	cJSON *te = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "t_effective") : NULL;
+	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble);
+	*t_effective = ok ? te->valuedouble : 0;
+	cJSON_Delete(te);
+	char *body = ok ? api_print(o) : NULL;
+	cJSON_Delete(o);
+	if (!body)
+		return api_fail(pb, API_MALFORMED, NULL,
+				"a control log line is not a control event "
+				"with t_effective");
+	api_err e = api_parse_control(body, strlen(body), spec, c, pb);
+	free(body);
+	return e;
+}
+
 static void put_pace(cJSON *o, const char *name, double pace)
 {
 	if (pace == API_PACE_MAX)
@@ -223,6 +242,53 @@ static cJSON *status_object(const api_view *v)
 	return o;
 }
 
+/* The settings of sp by group: params, scene, integrator. */
+static void add_settings(cJSON *o, const api_spec *sp)
+{
+	static const char *const groups[] = {"params", "scene", "integrator"};
+	for (size_t g = 0; g < sizeof groups / sizeof *groups; g++)
+		cJSON_AddItemToObject(o, groups[g],
+				      api_settings_object(&sp->params, &sp->scene,
+							  &sp->method, groups[g]));
+}
+
+char *api_spec_file(const api_spec *spec, double created, int owned)
+{
+	cJSON *o = cJSON_CreateObject();
+	api_add_number(o, "created", created);
+	cJSON_AddBoolToObject(o, "owned", owned);
+	cJSON *body = cJSON_AddObjectToObject(o, "session");
+	cJSON_AddStringToObject(body, "preset", spec->preset);
+	put_pace(body, "pace", spec->pace);
+	if (spec->until > 0)
+		api_add_number(body, "until", spec->until);
+	else
+		cJSON_AddNullToObject(body, "until");
+	api_add_number(body, "sample_rate", spec->sample_rate);
+	add_settings(body, spec);
+	return api_print_free(o);
+}
+
+api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
+			    double *created, int *owned, api_problem *pb)
+{
+	cJSON *o = cJSON_ParseWithLength(text, len);
+	const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "created");
+	const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "owned");
+	const cJSON *b = cJSON_GetObjectItemCaseSensitive(o, "session");
+	char *body = cJSON_IsNumber(c) && cJSON_IsBool(w) && cJSON_IsObject(b) ? api_print(b)
+									  : NULL;
+	*created = cJSON_IsNumber(c) ? c->valuedouble : 0;
+	*owned = cJSON_IsTrue(w);
+	cJSON_Delete(o);
+	if (!body)
+		return api_fail(pb, API_MALFORMED, NULL, "not a session's spec "
+				"(created, owned and session expected)");
+	api_err e = api_parse_session(body, strlen(body), spec, pb);
+	free(body);
+	return e;
+}
+
 static cJSON *session_object(const api_view *v, int with_spec)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -250,6 +316,10 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	else
 		cJSON_AddNullToObject(o, "pause_reason");
 	cJSON_AddBoolToObject(o, "waiting_for_cpu", v->waiting_for_cpu);
+	if (v->replayed) {
+		cJSON_AddStringToObject(o, "restored", "replayed");
+		api_add_number(o, "replay_seconds", v->replay_seconds);
+	}
 	if (v->experiment[0])
 		cJSON_AddStringToObject(o, "experiment", v->experiment);
 	else
@@ -265,25 +335,8 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	cJSON_AddStringToObject(links, "stream", link);
 	snprintf(link, sizeof link, "/api/v1/sessions/%s/trajectory", v->id);
 	cJSON_AddStringToObject(links, "trajectory", link);
-	if (with_spec) {
-		const api_spec *sp = v->spec;
-		cJSON *spec = cJSON_AddObjectToObject(o, "spec");
-		cJSON_AddItemToObject(spec, "params",
-				      api_settings_object(&sp->params,
-							  &sp->scene,
-							  &sp->method,
-							  "params"));
-		cJSON_AddItemToObject(spec, "scene",
-				      api_settings_object(&sp->params,
-							  &sp->scene,
-							  &sp->method,
-							  "scene"));
-		cJSON_AddItemToObject(spec, "integrator",
-				      api_settings_object(&sp->params,
-							  &sp->scene,
-							  &sp->method,
-							  "integrator"));
-	}
+	if (with_spec)
+		add_settings(cJSON_AddObjectToObject(o, "spec"), v->spec);
 	return o;
 }
 

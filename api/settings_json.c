@@ -10,6 +10,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "json_int.h"
@@ -20,7 +21,7 @@ const char *const api_members_session_create[] = {"preset", "params", "scene", "
 
 /* The ranges of a session's pace (a real-time factor; or "max"), until
  * (s; or none) and sample_rate (1/s): the parsers and api_check_spec. */
-#define PACE_MIN 0.001
+#define PACE_MIN API_PACE_MIN
 #define PACE_MAX 1000.0
 #define UNTIL_MIN 1e-6
 #define UNTIL_MAX 1e6
@@ -160,7 +161,17 @@ api_err api_parse_user_value(const api_spec *spec, const char *name,
 double api_user_of(const char *name, double si)
 {
 	const sim_setting *set = sim_setting_find(name);
-	return set ? sim_setting_from_si(set, si) : si;
+	if (!set)
+		return si;
+	double user = sim_setting_from_si(set, si);
+	if (set->scale == 1 || !isfinite(user))
+		return user;
+	/* the division leaves noise in the last bits (60 deg comes back as
+	 * 59.99999999999999): 15 significant digits, what a double carried
+	 * through a scale and back keeps, so that what was sent is shown */
+	char text[32];
+	snprintf(text, sizeof text, "%.15g", user);
+	return strtod(text, NULL);
 }
 
 api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)

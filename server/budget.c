@@ -19,6 +19,7 @@
  * --max-connections (libmicrohttpd never holds more).
  */
 #include <arpa/inet.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -26,6 +27,7 @@
 #include <string.h>
 
 #include "budget.h"
+#include "conns.h"
 #include "util.h"
 
 /* Calibration (docs/operations.md "Budgets and load"): resident bytes a session holds
@@ -48,6 +50,8 @@
 #define COLUMN_SUBSTEP_CPU_S 8.0e-8
 #define ELEMENT_SUBSTEP_CPU_S 0.8e-8
 #define SAMPLE_CPU_S 7e-6
+/* and of each double of a published sample's feed record (ring, history) */
+#define RECORD_DOUBLE_CPU_S 2e-9
 /* Retry-After of a refusal for CPU: paced sessions come and go. */
 #define CPU_RETRY_S 5
 
@@ -206,6 +210,11 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
 }
 
+double srv_budget_sample_cpu(int columns, int layers)
+{
+	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)record_doubles(columns, layers);
+}
+
 api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			      const char *field, const char *verb,
 			      api_problem *pb)
@@ -242,6 +251,26 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		 "retry when paced sessions have ended, paused or slowed down",
 		 need, 1e3 * cpu_per_s, pace, others, limit, verb);
 	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
+}
+
+double srv_budget_fit_pace(double *held, double cpu_per_s, double pace)
+{
+	pthread_mutex_lock(&lock);
+	double others = paced - *held, room = cfg->max_paced_cores - others;
+	double fit = pace;
+	if (cpu_per_s > 0 && cpu_per_s * pace > room * (1 + 1e-12)) {
+		fit = room / cpu_per_s; /* NaN when no room: the least pace */
+		double unit = pow(10, floor(log10(fit)) - 2);
+		fit = floor(fit / unit) * unit; /* three significant digits */
+	}
+	if (!(fit >= API_PACE_MIN))
+		fit = API_PACE_MIN;
+	if (fit > pace)
+		fit = pace;
+	*held = cpu_per_s * fit;
+	paced = others + *held;
+	pthread_mutex_unlock(&lock);
+	return fit;
 }
 
 void srv_budget_set_paced(double *held, double need)
@@ -419,6 +448,7 @@ typedef struct client {
 typedef struct client_conn {
 	client *c;
 	int over;
+	srv_conn *live; /* conns.c: the idle ones closed at the global cap */
 } client_conn;
 
 static client *clients;  /* lock; cfg->max_connections + 1 entries */
@@ -448,7 +478,7 @@ static int peer(struct MHD_Connection *conn, unsigned char addr[16],
 /* The entry of addr, or a free one for it; NULL when full (lock held). */
 static client *find_client(const unsigned char addr[16], int family)
 {
-	size_t n = (size_t)cfg->max_connections + 1;
+	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
 	client *free_one = NULL;
 	if (!clients && !(clients = calloc(n, sizeof *clients)))
 		return NULL;
@@ -478,6 +508,8 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			cc->c->count--;
 			pthread_mutex_unlock(&lock);
 		}
+		if (cc)
+			srv_conn_close(cc->live);
 		free(cc);
 		*socket_context = NULL;
 		return;
@@ -485,6 +517,8 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 	unsigned char addr[16];
 	int family;
 	cc = calloc(1, sizeof *cc);
+	if (cc)
+		cc->live = srv_conn_open(conn);
 	if (!cc || !peer(conn, addr, &family)) {
 		*socket_context = cc;
 		return;
@@ -495,6 +529,15 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 		cc->over = ++cc->c->count > cfg->max_client_connections;
 	pthread_mutex_unlock(&lock);
 	*socket_context = cc;
+}
+
+void srv_budget_request(struct MHD_Connection *conn, int busy)
+{
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+	const client_conn *cc = ci ? ci->socket_context : NULL;
+	if (cc)
+		srv_conn_busy(cc->live, busy);
 }
 
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)

@@ -54,6 +54,9 @@ size_t srv_budget_memory(void);
 
 /* ---- cores of paced sessions ------------------------------------------------ */
 
+/* CPU s the server spends on one published sample of a feed of columns x
+ * layers (status, ring record, trajectory row), besides the core's. */
+double srv_budget_sample_cpu(int columns, int layers);
 /* Estimated CPU s per simulated s of a session before it has run: from
  * its integrator (method, the step dt and the feed sub-steps in use, as
  * sim_get_status reports them after sim_new) and the feed elements it
@@ -75,6 +78,12 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 /* Set what a session holds to need (cores, >= 0), even beyond the budget:
  * its worker's own measure, a pause, the end. */
 void srv_budget_set_paced(double *held, double need);
+/* The pace, at most pace, at which a running paced session that measured
+ * cpu_per_s (CPU s per simulated s) fits beside the other paced sessions'
+ * holds within --max-paced-cores (three significant digits, rounded
+ * down; at least API_PACE_MIN even where that does not fit); *held is set
+ * to its need at that pace. */
+double srv_budget_fit_pace(double *held, double cpu_per_s, double pace);
 /* Cores held by running paced sessions now, and the budget. */
 double srv_budget_paced(void);
 double srv_budget_paced_limit(void);
@@ -128,6 +137,10 @@ void srv_cpu_counts(int *busy, int *waiting);
 void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			   void **socket_context,
 			   enum MHD_ConnectionNotificationCode code);
+/* A request reached the access handler (busy 1) or completed (busy 0) on
+ * conn: a connection with none in flight may be closed at the global cap
+ * (conns.h). */
+void srv_budget_request(struct MHD_Connection *conn, int busy);
 /* 1 if conn was opened beyond its client's --max-client-connections (it
  * gets a 429 and is closed), with *pb naming the budget. */
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb);

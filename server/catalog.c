@@ -12,6 +12,7 @@
 
 #include "budget.h"
 #include "catalog.h"
+#include "conns.h"
 #include "metrics.h"
 #include "pool.h"
 #include "session.h"
@@ -95,6 +96,7 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.sweep_points = (double)srv_budget_points(),
 		.client_refused = (double)srv_budget_client_refused(),
 		.connections_dropped = (double)srv_budget_connections_dropped(),
+		.connections_evicted = (double)srv_conns_evicted(),
 	};
 	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
 			 srv_metrics_text(&g), NULL, NULL);

@@ -34,6 +34,7 @@ enum {
 	EXP_ABORTED,
 	EXP_INTERRUPTED, /* running when the daemon died, not resumed */
 	EXP_ERROR,       /* its result could not be written */
+	EXP_DAMAGED,     /* its record could not be read back */
 	EXP_NSTATES
 };
 
@@ -213,7 +214,8 @@ static void drop_record(srv_experiment *e)
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
 	static const char *const names[EXP_NSTATES] = {
-		"waiting", "running", "done", "aborted", "interrupted", "error"};
+		"waiting", "running", "done", "aborted", "interrupted", "error",
+		"damaged"};
 	memset(v, 0, sizeof *v);
 	snprintf(v->id, sizeof v->id, "%s", e->entry.id);
 	snprintf(v->session_id, sizeof v->session_id, "%s", e->session_id);
@@ -221,7 +223,9 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 	snprintf(v->error, sizeof v->error, "%s", e->error);
 	v->t_start = e->t0;
 	v->t_now = e->t_now;
-	double p = e->state == EXP_WAITING ? 0 : (e->t_now - e->t0) / exp_end(e);
+	double p = e->state == EXP_WAITING || e->req.nseg < 1
+			   ? 0
+			   : (e->t_now - e->t0) / exp_end(e);
 	v->progress = e->state == EXP_DONE ? 1 : p < 0 ? 0 : p > 1 ? 1 : p;
 	v->nseg = e->req.nseg;
 	v->seg = e->req.seg;
@@ -374,6 +378,18 @@ int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
 	}
 	pthread_mutex_unlock(&e->lock);
 	return rc;
+}
+
+srv_experiment *srv_exp_damaged(const char *id, const char *why)
+{
+	srv_experiment *e = calloc(1, sizeof *e);
+	if (!e)
+		return NULL;
+	pthread_mutex_init(&e->lock, NULL);
+	snprintf(e->entry.id, sizeof e->entry.id, "%.23s", id);
+	e->state = EXP_DAMAGED;
+	snprintf(e->error, sizeof e->error, "damaged: %.200s", why);
+	return e;
 }
 
 srv_experiment *srv_exp_load(const char *id, api_problem *pb)

@@ -73,6 +73,11 @@ void *srv_exp_save(srv_experiment *e, size_t *len);
 int srv_exp_resume(srv_experiment *e, const void *buf, size_t len);
 /* An experiment from experiments/ID (a file name) as it was last written,
  * not attached; NULL with *pb when the file does not pass its checks. */
+/* An experiment whose record (experiments/ID.bin) cannot be read back:
+ * listed in state "damaged" with why and no segments, as a damaged
+ * session is; a session checkpoint that carries its progress still
+ * resumes it (srv_exp_resume). NULL when out of memory. */
+srv_experiment *srv_exp_damaged(const char *id, const char *why);
 srv_experiment *srv_exp_load(const char *file, api_problem *pb);
 /* Still running but no session resumed it: "interrupted", its finished
  * segments kept. Returns 1 if it was. */

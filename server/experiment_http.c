@@ -59,7 +59,7 @@ void srv_experiment_put(srv_experiment *e)
 size_t srv_experiments_restore(void)
 {
 	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list("experiments", &names)
+	size_t n = srv_store_enabled() ? srv_store_list_ids("experiments", 0, &names)
 				       : 0,
 	       count = 0;
 	for (size_t i = 0; i < n; i++) {
@@ -78,6 +78,16 @@ size_t srv_experiments_restore(void)
 		} else if (l > 4 && strcmp(names[i] + l - 4, ".bin") == 0) {
 			srv_log(SRV_LOG_WARN, "experiment not restored: %s",
 				pb.detail);
+			names[i][l - 4] = '\0';
+			e = srv_exp_damaged(names[i], pb.detail);
+			if (e && srv_registry_reserve(&experiments, srv_exp_entry(e),
+						      NULL) == 0) {
+				srv_registry_publish(&experiments, srv_exp_entry(e));
+				srv_registry_put(&experiments, srv_exp_entry(e));
+				count++;
+			} else {
+				srv_exp_free(e);
+			}
 		}
 		free(names[i]);
 	}

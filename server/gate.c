@@ -292,6 +292,12 @@ static int check_peer(srv_req *r, enum MHD_Result *result)
 				   "the request has no Host header");
 		return 0;
 	}
+	if (srv_header_count(r, MHD_HTTP_HEADER_HOST) > 1) {
+		*result = srv_fail(r, API_BADREQUEST, "Host",
+				   "Host is given more than once (RFC 9112 "
+				   "section 3.2)");
+		return 0;
+	}
 	if (!host_ok(host)) {
 		*result = srv_fail(r, API_MISDIRECTED, "Host",
 				   "Host \"%.100s\" names neither the address "

@@ -23,6 +23,7 @@
 #include "budget.h"
 #include "catalog.h"
 #include "config.h"
+#include "conns.h"
 #include "experiment_http.h"
 #include "gate.h"
 #include "metrics.h"
@@ -76,7 +77,8 @@ static int resolve_listen(const srv_config *cfg, listen_addr *la)
 static void raise_nofile(const srv_config *cfg)
 {
 	struct rlimit rl;
-	rlim_t need = (rlim_t)cfg->max_connections + SRV_CLIENT_GRACE + 256;
+	rlim_t need = (rlim_t)cfg->max_connections + SRV_CONN_HEADROOM +
+		      SRV_CLIENT_GRACE + 256;
 	if (getrlimit(RLIMIT_NOFILE, &rl) != 0 || rl.rlim_cur >= need)
 		return;
 	rlim_t was = rl.rlim_cur;
@@ -101,9 +103,11 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 		la->flags, (uint16_t)cfg->port, NULL, NULL, srv_dispatch, NULL,
 		MHD_OPTION_EXTERNAL_LOGGER, srv_budget_mhd_log, NULL,
 		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
+		MHD_OPTION_URI_LOG_CALLBACK, srv_uri_seen, NULL,
 		MHD_OPTION_NOTIFY_CONNECTION, srv_budget_connection, NULL,
 		MHD_OPTION_SOCK_ADDR, la->addr,
-		MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->max_connections,
+		MHD_OPTION_CONNECTION_LIMIT,
+		(unsigned)(cfg->max_connections + SRV_CONN_HEADROOM),
 		MHD_OPTION_PER_IP_CONNECTION_LIMIT,
 		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE),
 		MHD_OPTION_CONNECTION_TIMEOUT,
@@ -130,6 +134,7 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_catalog_shutdown();
 	srv_store_close(); /* every queued write is on disk */
 	srv_gate_shutdown();
+	srv_conns_shutdown();
 }
 
 /* Rebuild what the data directory holds: experiments first (the sessions
@@ -174,6 +179,7 @@ int main(int argc, char **argv)
 
 	raise_nofile(&cfg);
 	srv_budget_init(&cfg);
+	srv_conns_init(&cfg);
 	srv_catalog_init(&cfg);
 	srv_sessions_init(&cfg);
 	srv_experiments_init(&cfg);

@@ -98,6 +98,9 @@ char *srv_metrics_text(const srv_gauges *g)
 		{"convsim_connections_dropped_total", "counter", "Connections closed "
 		 "at accept: beyond a client's budget and its grace, or beyond "
 		 "--max-connections.", g->connections_dropped},
+		{"convsim_connections_evicted_total", "counter", "Idle connections "
+		 "(no request in flight) closed to make room at --max-connections.",
+		 g->connections_evicted},
 	};
 	for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
 		metric(f, budgets[i].name, budgets[i].type, budgets[i].help,

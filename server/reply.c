@@ -158,6 +158,28 @@ const char *srv_header(srv_req *r, const char *name)
 	return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);
 }
 
+typedef struct header_count {
+	const char *name;
+	int n;
+} header_count;
+
+static enum MHD_Result count_one(void *cls, enum MHD_ValueKind kind,
+				 const char *key, const char *value)
+{
+	(void)kind;
+	(void)value;
+	header_count *hc = cls;
+	hc->n += key && strcasecmp(key, hc->name) == 0;
+	return MHD_YES;
+}
+
+int srv_header_count(srv_req *r, const char *name)
+{
+	header_count hc = {name, 0};
+	MHD_get_connection_values(r->conn, MHD_HEADER_KIND, count_one, &hc);
+	return hc.n;
+}
+
 enum MHD_Result srv_reply_result(srv_req *r, char *text)
 {
 	return srv_reply_result_with(r, text, NULL, NULL);

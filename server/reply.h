@@ -57,6 +57,8 @@ enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp);
  * connection). */
 const char *srv_query(srv_req *r, const char *key);
 const char *srv_header(srv_req *r, const char *name);
+/* How many times the header name (any case) was sent. */
+int srv_header_count(srv_req *r, const char *name);
 /* 200 with a result in the negotiated representation (r->csv): text is
  * JSON or CSV accordingly (taken). */
 enum MHD_Result srv_reply_result(srv_req *r, char *text);

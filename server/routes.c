@@ -76,7 +76,35 @@ typedef struct req_state {
 	char *body;
 	size_t len, cap;
 	int too_large;
+	size_t query_params; /* over SRV_MAX_QUERY_PARAMS: the query was cut */
 } req_state;
+
+/* More query parameters than any route takes (the most is a handful). */
+#define SRV_MAX_QUERY_PARAMS 64
+
+void *srv_uri_seen(void *cls, const char *uri, struct MHD_Connection *conn)
+{
+	(void)cls;
+	(void)conn;
+	req_state *st = calloc(1, sizeof *st);
+	char *query = strchr(uri, '?');
+	if (!st || !query)
+		return st;
+	size_t n = 1;
+	for (const char *c = query + 1; *c; c++)
+		n += *c == '&' || *c == ';';
+	if (n > SRV_MAX_QUERY_PARAMS) {
+		/* libmicrohttpd splits the query into one record per
+		 * parameter in the connection's memory pool once this
+		 * returns; hundreds of them exhaust the pool and it closes
+		 * the connection without an answer. The text is the
+		 * connection's own read buffer: end it after the '?', so
+		 * that nothing is split and first_look can answer 431. */
+		st->query_params = n;
+		query[1] = '\0';
+	}
+	return st;
+}
 
 /* Match url against pattern; path arguments go to arg. */
 static int match(const char *pattern, const char *url, char arg[2][64])
@@ -212,8 +240,20 @@ static enum MHD_Result first_look(srv_req *r)
 	api_problem pb;
 	if (srv_budget_client_over(r->conn, &pb)) /* before anything else */
 		return srv_reply_problem(r, &pb, NULL);
+	if (((req_state *)r)->query_params)
+		return srv_fail(r, API_HEADERS, NULL,
+				"the query has %zu parameters; no route takes "
+				"more than %d", ((req_state *)r)->query_params,
+				SRV_MAX_QUERY_PARAMS);
 	if (!srv_gate_check(r, &result))
 		return result;
+	if (srv_header_count(r, MHD_HTTP_HEADER_CONTENT_LENGTH) > 1) {
+		api_fail(&pb, API_BADREQUEST, "Content-Length",
+			 "Content-Length is given more than once (RFC 9112 "
+			 "section 6.3)");
+		return srv_reply_problem_with(r, &pb, MHD_HTTP_HEADER_CONNECTION,
+					      "close");
+	}
 	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
 	if (cl && strtoull(cl, NULL, 10) > cfg->max_body)
 		return srv_fail(r, API_TOOLARGE, NULL,
@@ -230,8 +270,9 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 	(void)cls;
 	(void)version;
 	req_state *st = *con_cls;
-	if (!st) {
-		st = calloc(1, sizeof *st);
+	if (!st || !st->r.conn) { /* the first call (srv_uri_seen made st) */
+		if (!st)
+			st = calloc(1, sizeof *st);
 		if (!st)
 			return MHD_NO;
 		*con_cls = st;
@@ -239,6 +280,7 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->r.method = method;
 		st->r.url = url;
 		st->r.body = "";
+		srv_budget_request(conn, 1);
 		return first_look(&st->r);
 	}
 	if (*upload_data_size) {
@@ -279,9 +321,10 @@ void srv_request_done(void *cls, struct MHD_Connection *conn,
 		      void **con_cls, enum MHD_RequestTerminationCode toe)
 {
 	(void)cls;
-	(void)conn;
 	(void)toe;
 	req_state *st = *con_cls;
+	if (st && st->r.conn)
+		srv_budget_request(conn, 0);
 	if (!st)
 		return;
 	free(st->body);

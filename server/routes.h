@@ -15,6 +15,10 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 			     const char *url, const char *method,
 			     const char *version, const char *upload_data,
 			     size_t *upload_data_size, void **con_cls);
+/* The URI log callback: makes the request's state before libmicrohttpd
+ * splits the query, and cuts a query of more parameters than any route
+ * takes (answered 431 by the access handler). */
+void *srv_uri_seen(void *cls, const char *uri, struct MHD_Connection *conn);
 void srv_request_done(void *cls, struct MHD_Connection *conn,
 		      void **con_cls, enum MHD_RequestTerminationCode toe);
 

@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/mman.h>
 
+#include "cpu_probe.h"
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
@@ -48,6 +49,7 @@ static void session_free(srv_session *s)
 		munmap(s->ring, s->ring_bytes);
 	free(s->hist);
 	free(s->controls);
+	free(s->replay);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);
@@ -140,8 +142,14 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
+	/* what a simulated second costs: the estimate from the integrator,
+	 * unless a short run of a copy (cpu_probe.c) measures more than twice
+	 * that (what grows with a large feed): then the measurement */
 	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
+	double probed = srv_cpu_probe(s->sim, spec, s->columns, s->layers);
+	if (probed > 2 * s->cpu_per_s)
+		s->cpu_per_s = probed;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -389,6 +397,8 @@ void srv_session_view(srv_session *s, api_view *v)
 			  : s->cpu_paused      ? "cpu-budget"
 					       : "client";
 	v->waiting_for_cpu = s->waiting_for_cpu;
+	v->replayed = s->rebuilt;
+	v->replay_seconds = s->replay_seconds;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

@@ -44,6 +44,9 @@ void srv_session_put(srv_session *s);
 /* Remove from the registry, stop the worker, end the streams, remove its
  * files. The caller holds a reference (and still puts it). */
 void srv_session_delete(srv_session *s);
+/* API_OK if its files could be removed now (store.c
+ * srv_store_check_removable); else 503 in *pb. */
+api_err srv_session_check_removable(const srv_session *s, api_problem *pb);
 /* Delete the sessions whose experiment ended (created by it, not kept)
  * and, with idle_timeout > 0 (s), those with no stream client, no
  * experiment and no request for that long. Returns how many. */

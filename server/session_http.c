@@ -101,6 +101,11 @@ enum MHD_Result srv_h_session_delete(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	api_problem pb;
+	if (srv_session_check_removable(s, &pb) != API_OK) {
+		srv_session_put(s);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	srv_session_delete(s);
 	srv_session_put(s);
 	return srv_reply_empty(r);

@@ -14,6 +14,12 @@
 #include "session.h"
 #include "worker.h"
 
+/* A control of the log to apply again once the integrator reaches at. */
+typedef struct srv_replay {
+	srv_cmd cmd;
+	double at; /* its t_effective, s */
+} srv_replay;
+
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
@@ -63,6 +69,23 @@ struct srv_session {
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
+	int spec_unwritten;       /* spec.json failed to be written: the
+				     session stays "error" until a rewrite
+				     (queued at the next write that works)
+				     is on disk */
+	int spec_retrying;        /* that rewrite is queued */
+	srv_replay *replay;       /* controls logged after the checkpoint it
+				     was restored from, in order: applied
+				     again as the integrator reaches each
+				     (session_store.c loads, worker.c runs) */
+	size_t nreplay, replayed;
+	int rebuilt;              /* re-created from its spec, its checkpoint
+				     unusable (another build): the whole log
+				     is replayed */
+	double catch_up_t;        /* rebuilt: runs flat out until its time
+				     reaches where it was (0: not) */
+	double replay_wall, replay_seconds; /* when the replay began, how
+				     long it took (NAN until over) */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
@@ -152,6 +175,16 @@ void srv_persist_remove(const srv_session *s);
 
 /* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
  * the core's checkpoint (sim_len bytes) follow. */
+/* A checkpoint's payload: this head, the experiment's state, the core's
+ * checkpoint, then (from this build on; older ones end with the core's)
+ * this trailer: the length of the control log it holds, so that a restore
+ * replays what came after, and its time, so that a session re-created
+ * from its spec knows where it was. */
+typedef struct srv_ckpt_trailer {
+	uint64_t logged;
+	double t; /* s */
+} srv_ckpt_trailer;
+#define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
 typedef struct srv_ckpt_record {
 	int32_t state, exp_started;
 	double pace, until;

@@ -3,7 +3,10 @@
  * session_store.c - a session's files in the data directory and the
  * sessions rebuilt from them at start-up (docs/operations.md "Persistence").
  *
- *   sessions/ID/spec.bin         the spec as created (framed, store.h)
+ *   sessions/ID/spec.json        the spec as created, the API's JSON
+ *                                (api_spec_file), read first
+ *   sessions/ID/spec.bin         the same as this build's record (framed,
+ *                                store.h), for earlier builds
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
  *                                object a line with t_effective (s)
  *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
@@ -44,20 +47,37 @@ static void session_dir(char *out, size_t len, const char *id,
 		 file ? file : "");
 }
 
-/* A write's outcome for session id (malloc'd, freed here): a failure puts
- * the session in state "error" with the reason; a later success clears
- * it. */
+/* Which write of which session a callback is about (malloc'd, freed by
+ * written). */
+typedef struct write_of {
+	char id[SRV_ID_LEN];
+	int spec; /* spec.json */
+} write_of;
+
+/* A write's outcome: a failure puts the session in state "error" with the
+ * reason. A later success clears it, unless spec.json is not on disk: the
+ * first success after its failure (space came back) queues it again, and
+ * the session reports healthy only once that rewrite is written (lock
+ * order: the session's, then the store's). */
 static void written(void *arg, int err, const char *what)
 {
-	char *id = arg;
-	srv_session *s = srv_session_get(id);
-	free(id);
+	write_of *w = arg;
+	srv_session *s = srv_session_get(w->id);
+	int spec = w->spec;
+	free(w);
 	if (!s)
 		return;
 	pthread_mutex_lock(&s->lock);
+	if (spec) {
+		s->spec_unwritten = err != 0;
+		s->spec_retrying = 0;
+	}
 	if (err)
 		snprintf(s->store_error, sizeof s->store_error, "%s", what);
-	else if (what && what[0] == '\0' && s->store_error[0])
+	else if (s->spec_unwritten && !s->spec_retrying) {
+		s->spec_retrying = 1;
+		srv_persist_spec(s);
+	} else if (!s->spec_unwritten && what && what[0] == '\0')
 		s->store_error[0] = '\0';
 	pthread_mutex_unlock(&s->lock);
 	srv_session_put(s);
@@ -68,14 +88,19 @@ static void queue(const srv_session *s, const char *file, void *buf,
 {
 	char path[128];
 	session_dir(path, sizeof path, s->entry.id, file);
-	srv_store_write(path, buf, len, keep_prev, written,
-			strdup(s->entry.id));
+	write_of *w = calloc(1, sizeof *w);
+	if (w) {
+		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
+		w->spec = strcmp(file, "spec.json") == 0;
+	}
+	srv_store_write(path, buf, len, keep_prev, w ? written : NULL, w);
 }
 
 void srv_persist_spec(srv_session *s)
 {
 	if (!srv_store_enabled() || s->damaged)
 		return;
+	/* spec.bin too, for an earlier build started on this directory */
 	spec_record r;
 	memset(&r, 0, sizeof r);
 	snprintf(r.id, sizeof r.id, "%s", s->entry.id);
@@ -86,6 +111,9 @@ void srv_persist_spec(srv_session *s)
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
 		queue(s, "spec.bin", buf, len, 0);
+	char *text = api_spec_file(&s->spec, s->created, s->owned);
+	if (text)
+		queue(s, "spec.json", text, strlen(text), 0);
 }
 
 void srv_persist_control(srv_session *s, const char *json)
@@ -137,7 +165,10 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		snprintf(r.exp_id, sizeof r.exp_id, "%s", srv_exp_id(s->exp));
 	}
 	r.sim_len = sim_checkpoint_size(s->sim);
-	size_t plen = sizeof r + r.exp_len + r.sim_len;
+	/* the trailer: how much of the control log the checkpoint holds,
+	 * and its time */
+	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t};
+	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof tr;
 	char *payload = malloc(plen);
 	if (payload) {
 		memcpy(payload, &r, sizeof r);
@@ -145,6 +176,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 			memcpy(payload + sizeof r, exp, r.exp_len);
 		sim_checkpoint(s->sim, payload + sizeof r + r.exp_len,
 			       r.sim_len);
+		memcpy(payload + plen - sizeof tr, &tr, sizeof tr);
 		size_t len;
 		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
 					    &len);
@@ -155,6 +187,13 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	free(exp);
 	s->ckpt_wall = now;
 	s->ckpt_dirty = 0;
+}
+
+api_err srv_session_check_removable(const srv_session *s, api_problem *pb)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, NULL);
+	return srv_store_check_removable(path, pb);
 }
 
 void srv_persist_remove(const srv_session *s)
@@ -181,8 +220,11 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	}
 	memcpy(r, p, sizeof *r);
 	/* exp_len first: a length between len - sizeof *r and len wrapped
-	 * the difference below and let sim_len point past the buffer */
-	if (r->exp_len > len - sizeof *r || r->sim_len != len - sizeof *r - r->exp_len ||
+	 * the difference below and let sim_len point past the buffer; the
+	 * core's checkpoint ends the payload or is followed by the trailer */
+	size_t left = r->exp_len <= len - sizeof *r ? len - sizeof *r - (size_t)r->exp_len : 0;
+	if (r->exp_len > len - sizeof *r ||
+	    (r->sim_len != left && !(left >= SRV_CKPT_TRAILER && r->sim_len == left - SRV_CKPT_TRAILER)) ||
 	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
 		snprintf(why, whylen, "inconsistent lengths or state");
 		return -1;
@@ -192,8 +234,8 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	return 0;
 }
 
-static int load_checkpoint(srv_session *s, const char *file, char *why,
-			   size_t whylen)
+static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
+			   char *why, size_t whylen)
 {
 	size_t len;
 	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
@@ -206,6 +248,15 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 		snprintf(why, whylen, "%s: %s", file, msg);
 		goto done;
 	}
+	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
+	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
+		srv_ckpt_trailer tr;
+		memcpy(&tr, p + len - sizeof tr, sizeof tr);
+		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
+		if (isfinite(tr.t) && tr.t > s->catch_up_t)
+			s->catch_up_t = tr.t; /* where it was, if the core's
+						 part is refused */
+	}
 	int err;
 	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
 			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
@@ -214,6 +265,7 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 		snprintf(why, whylen, "%s: %s", file, msg);
 		goto done;
 	}
+	s->catch_up_t = 0;
 	sim_free(s->sim);
 	s->sim = sm;
 	s->state = r.state;
@@ -256,6 +308,90 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	return 0;
 }
 
+/* The control log back into s->controls (later controls are appended to
+ * it), and the controls logged after its first `logged` bytes (what the
+ * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
+ * does not say) into s->replay, for the worker to apply again. */
+static void load_controls(srv_session *s, size_t logged)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, "controls.ndjson");
+	size_t len = 0;
+	char *text = srv_store_read_text(path, &len);
+	if (!text)
+		return;
+	s->controls = text;
+	s->controls_len = s->controls_cap = len;
+	if (logged >= len)
+		return;
+	size_t lines = 0;
+	for (size_t i = logged; i < len; i++)
+		lines += text[i] == '\n';
+	s->replay = calloc(lines ? lines : 1, sizeof *s->replay);
+	for (size_t at = logged; s->replay && at < len;) {
+		const char *nl = memchr(text + at, '\n', len - at);
+		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
+		srv_replay *rp = &s->replay[s->nreplay];
+		api_problem pb;
+		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
+						 &rp->at, &pb) == API_OK)
+			s->nreplay++;
+		else if (n)
+			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
+					      "replayed: %s", s->entry.id, path, pb.detail);
+		at += n + 1;
+	}
+	if (s->nreplay)
+		srv_log(SRV_LOG_INFO, "session %s: %zu controls logged after "
+				      "its checkpoint are replayed", s->entry.id,
+			s->nreplay);
+}
+
+/* The spec of s from spec.json (the API's JSON: this build on) or, when
+ * there is none, spec.bin (earlier builds); 0, or -1 with why. */
+static int load_spec(srv_session *s, char *why, size_t whylen)
+{
+	char path[128], msg[256];
+	size_t len = 0;
+	session_dir(path, sizeof path, s->entry.id, "spec.json");
+	char *text = srv_store_read_text(path, &len);
+	if (text) {
+		api_problem pb;
+		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
+						&s->owned, &pb);
+		free(text);
+		if (e != API_OK)
+			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		return e == API_OK ? 0 : -1;
+	}
+	session_dir(path, sizeof path, s->entry.id, "spec.bin");
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, whylen);
+	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
+				     msg, sizeof msg)
+		   : -1;
+	if (r && rc)
+		snprintf(why, whylen, "%s: %s", path, msg);
+	free(r);
+	return rc;
+}
+
+/* s was re-created from its spec because neither checkpoint could be used
+ * (why, why2): its worker replays the whole control log and runs flat out
+ * to where it was, the later of the time a checkpoint's trailer gave and
+ * the last control's, then at its pace again (worker.c). */
+static void rebuild(srv_session *s, const char *why, const char *why2)
+{
+	for (size_t i = 0; i < s->nreplay; i++)
+		if (s->replay[i].at > s->catch_up_t)
+			s->catch_up_t = s->replay[i].at;
+	s->rebuilt = 1;
+	s->replay_wall = srv_now();
+	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
+	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
+			      "spec, %zu controls replayed to t = %g s",
+		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
+}
+
 /* Build session id from its files into s (calloc'd, lock initialised). */
 static void restore_one(srv_session *s, const char *id)
 {
@@ -263,45 +399,45 @@ static void restore_one(srv_session *s, const char *id)
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
 	s->created = srv_unix_time();
 	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
-	session_dir(path, sizeof path, id, "spec.bin");
-	size_t len;
-	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, sizeof why);
-	char msg[256];
-	if (r && srv_spec_decode(r, len, &s->spec, &s->created, &s->owned, msg,
-				 sizeof msg) != 0) {
-		snprintf(why, sizeof why, "%s: %s", path, msg);
-		free(r);
-		r = NULL;
-	}
-	if (!r) {
+	if (load_spec(s, why, sizeof why) != 0) {
 		s->damaged = 1;
 		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
 		return;
 	}
-	free(r);
 	s->pace = s->spec.pace;
 	s->until = s->spec.until;
 	s->state = SRV_RUNNING;
 	session_dir(path, sizeof path, id, "checkpoint.bin");
-	if (load_checkpoint(s, path, why, sizeof why) == 0)
+	size_t logged = 0;
+	if (load_checkpoint(s, path, &logged, why, sizeof why) == 0) {
+		load_controls(s, logged);
 		return;
+	}
 	char prev[160];
 	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, why2, sizeof why2) == 0) {
+	if (load_checkpoint(s, prev, &logged, why2, sizeof why2) == 0) {
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
+		load_controls(s, logged);
 		return;
 	}
+	/* none: created less than one interval before the crash; else both
+	 * copies are unusable (another build's, damaged): either way it
+	 * starts again from its spec and takes every control it took */
 	int none = strstr(why, "missing") && strstr(why2, "missing");
-	if (none) { /* created less than one interval before the crash */
-		char msg[256] = "";
-		int err;
-		s->sim = sim_new(&s->spec.params, &s->spec.scene,
-				 &s->spec.method, &err, msg, sizeof msg);
-		if (s->sim)
-			return;
-		snprintf(why, sizeof why, "its spec is refused: %s", msg);
+	char msg[256] = "";
+	int err;
+	s->sim = sim_new(&s->spec.params, &s->spec.scene, &s->spec.method,
+			 &err, msg, sizeof msg);
+	if (s->sim) {
+		load_controls(s, 0);
+		if (!none)
+			rebuild(s, why, why2);
+		else
+			s->catch_up_t = 0;
+		return;
 	}
+	snprintf(why, sizeof why, "its spec is refused: %s", msg);
 	s->damaged = 1;
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
@@ -314,7 +450,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	exp_find = find;
 	exp_put = put;
 	char **names = NULL;
-	size_t n = srv_store_list("sessions", &names), count = 0;
+	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {

@@ -350,6 +350,35 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 	enqueue(j);
 }
 
+api_err srv_store_check_removable(const char *rel, api_problem *pb)
+{
+	if (!st.started)
+		return API_OK;
+	char path[4096];
+	struct stat sb;
+	full_path(path, sizeof path, rel);
+	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
+	/* its directory (the entry goes), and the entry's own when it is
+	 * one (its files go) */
+	char *slash = strrchr(path, '/');
+	int err = 0;
+	if (slash) {
+		*slash = '\0';
+		err = access(path, W_OK) != 0 && errno != ENOENT ? errno : 0;
+		*slash = '/';
+	}
+	if (!err && is_dir && access(path, W_OK) != 0 && errno != ENOENT)
+		err = errno;
+	if (!err)
+		return API_OK;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "the data directory cannot be changed (%s): %s cannot be "
+		 "removed; nothing was deleted, retry once it is writable",
+		 strerror(err), rel);
+	pb->retry_after = 30;
+	return API_UNAVAILABLE;
+}
+
 void srv_store_remove(const char *path)
 {
 	if (!st.started)
@@ -447,6 +476,48 @@ void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
 	if (!payload)
 		snprintf(why, whylen, "%s: %s", rel, bad);
 	return payload;
+}
+
+/* Is the entry name of rel one of the kind srv_store_list_ids lists? 1
+ * yes, 0 the store's own leftovers (.tmp, .prev: skipped silently), -1
+ * junk (the reason in *why). */
+static int stored_entry(const char *rel, const char *name, int dirs,
+			const char **why)
+{
+	size_t n = strlen(name);
+	if (n > 4 && (strcmp(name + n - 4, ".tmp") == 0 ||
+		      strcmp(name + n - 5, ".prev") == 0))
+		return 0;
+	char path[4096];
+	struct stat sb;
+	snprintf(path, sizeof path, "%s/%s/%s", st.dir, rel, name);
+	size_t idlen = dirs ? n : n > 4 && strcmp(name + n - 4, ".bin") == 0 ? n - 4 : 0;
+	if (lstat(path, &sb) != 0)
+		*why = strerror(errno);
+	else if (dirs ? !S_ISDIR(sb.st_mode) : !S_ISREG(sb.st_mode))
+		*why = dirs ? "not a directory" : "not a regular file";
+	else if (!srv_id_valid(name, idlen))
+		*why = dirs ? "not named by an id" : "not named ID.bin";
+	else
+		return 1;
+	return -1;
+}
+
+size_t srv_store_list_ids(const char *rel, int dirs, char ***names)
+{
+	size_t n = srv_store_list(rel, names), kept = 0;
+	for (size_t i = 0; i < n; i++) {
+		const char *why = NULL;
+		int ok = stored_entry(rel, (*names)[i], dirs, &why);
+		if (ok < 0)
+			srv_log(SRV_LOG_WARN, "data dir: ignored %s/%.100s: %s",
+				rel, (*names)[i], why);
+		if (ok > 0)
+			(*names)[kept++] = (*names)[i];
+		else
+			free((*names)[i]);
+	}
+	return kept;
 }
 
 size_t srv_store_list(const char *rel, char ***names)

@@ -27,6 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "api.h"
 #include "config.h"
 
 #define SRV_STORE_VERSION 1
@@ -65,6 +66,12 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 /* Queue the removal of path (a file, or a directory and what it holds),
  * after every write queued before it. */
 void srv_store_remove(const char *path);
+/* API_OK if what rel (relative) names could be removed now: the directory
+ * holding it, and rel itself when it is a directory, may be written
+ * (always API_OK without a data directory). Else 503 in *pb naming the
+ * cause (a read-only file system: EROFS), so that a DELETE answers it
+ * and changes nothing rather than answering 204 for files that stay. */
+api_err srv_store_check_removable(const char *rel, api_problem *pb);
 
 /* A framed file of kind around payload (borrowed): malloc'd, its length
  * in *len; NULL when out of memory. */
@@ -88,5 +95,9 @@ char *srv_store_read_text(const char *path, size_t *len);
 /* Entries of a directory (relative path), malloc'd array of malloc'd
  * names (free each and the array); the count, 0 if none. */
 size_t srv_store_list(const char *path, char ***names);
+/* The same for the entries of one kind of record under rel: directories
+ * named by an id (dirs) or regular files ID.bin. Anything else is skipped
+ * with one log line each (the store's own .tmp and .prev files without). */
+size_t srv_store_list_ids(const char *rel, int dirs, char ***names);
 
 #endif

@@ -38,6 +38,10 @@ typedef struct srv_sweep {
 	size_t jobs;           /* points that run (the others are images) */
 	int running, cancelled;
 	char store_error[256];  /* a write failed: state "error" */
+	char damaged[256];      /* its record is unusable: why (state
+				   "damaged", no points) */
+	char *csv;              /* damaged: the result file as stored, or NULL */
+	size_t csv_len;
 } srv_sweep;
 
 typedef struct sweep_job {
@@ -67,6 +71,7 @@ static void sweep_free(srv_sweep *sw)
 	free(sw->req.betas);
 	free(sw->pt);
 	free(sw->image);
+	free(sw->csv);
 	pthread_mutex_destroy(&sw->lock);
 	free(sw);
 }
@@ -78,6 +83,8 @@ static void destroy(srv_entry *en)
 
 static const char *sweep_state(const srv_sweep *sw)
 {
+	if (sw->damaged[0])
+		return "damaged";
 	if (sw->store_error[0])
 		return "error";
 	if (sw->cancelled)
@@ -91,7 +98,7 @@ static void fill_view(const srv_sweep *sw, api_sweep_view *v)
 {
 	snprintf(v->id, sizeof v->id, "%s", sw->entry.id);
 	v->state = sweep_state(sw);
-	v->error = sw->store_error;
+	v->error = sw->damaged[0] ? sw->damaged : sw->store_error;
 	v->total = sw->total;
 	v->done = sw->done;
 	v->t_end = sw->req.t_end;
@@ -278,10 +285,33 @@ static void run_point(void *arg)
 	srv_registry_put(&sweeps, &sw->entry);
 }
 
+/* A sweep whose record is unusable is listed as "damaged" with why, as
+ * a session is, and its CSV result, when one was stored, is still served
+ * as it is. 0, or -1 when the registry has no room or memory ran out. */
+static int restore_damaged(const char *id, const char *why)
+{
+	srv_sweep *sw = calloc(1, sizeof *sw);
+	if (!sw)
+		return -1;
+	pthread_mutex_init(&sw->lock, NULL);
+	snprintf(sw->entry.id, sizeof sw->entry.id, "%.23s", id);
+	snprintf(sw->damaged, sizeof sw->damaged, "damaged: %.200s", why);
+	char name[64];
+	snprintf(name, sizeof name, "sweep-%s.csv", sw->entry.id);
+	sw->csv = srv_store_read_text(name, &sw->csv_len);
+	if (srv_registry_reserve(&sweeps, &sw->entry, NULL)) {
+		sweep_free(sw);
+		return -1;
+	}
+	srv_registry_publish(&sweeps, &sw->entry);
+	srv_registry_put(&sweeps, &sw->entry);
+	return 0;
+}
+
 size_t srv_sweeps_restore(void)
 {
 	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list("sweeps", &names) : 0,
+	size_t n = srv_store_enabled() ? srv_store_list_ids("sweeps", 0, &names) : 0,
 	       count = 0;
 	for (size_t i = 0; i < n; i++) {
 		char path[300], why[300];
@@ -360,8 +390,11 @@ size_t srv_sweeps_restore(void)
 		} else if (!ok && p) {
 			snprintf(why, sizeof why, "%.200s: inconsistent", path);
 		}
-		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0)
+		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0) {
 			srv_log(SRV_LOG_WARN, "sweep not restored: %s", why);
+			path[l - 4] = '\0';
+			count += restore_damaged(path + strlen("sweeps/"), why) == 0;
+		}
 		sweep_free(sw);
 		free(p);
 	}
@@ -494,7 +527,9 @@ enum MHD_Result srv_h_sweep_get(srv_req *r)
 	api_sweep_view v;
 	pthread_mutex_lock(&sw->lock);
 	fill_view(sw, &v);
-	char *text = r->csv ? api_sweep_csv(&v) : api_sweep_json(&v);
+	char *text = r->csv && sw->csv ? strndup(sw->csv, sw->csv_len)
+		     : r->csv	       ? api_sweep_csv(&v)
+				       : api_sweep_json(&v);
 	pthread_mutex_unlock(&sw->lock);
 	srv_registry_put(&sweeps, en);
 	return srv_reply_result(r, text);
@@ -527,6 +562,13 @@ enum MHD_Result srv_h_sweep_delete(srv_req *r)
 		return srv_fail(r, API_NOTFOUND, NULL,
 				"no sweep with id \"%.40s\"", r->arg[0]);
 	srv_sweep *sw = sweep_of(en);
+	char rec[64];
+	api_problem pb;
+	snprintf(rec, sizeof rec, "sweeps/%s.bin", sw->entry.id);
+	if (srv_store_check_removable(rec, &pb) != API_OK) {
+		srv_registry_put(&sweeps, en);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	pthread_mutex_lock(&sw->lock);
 	if (sw->done < sw->total)
 		sw->cancelled = 1;

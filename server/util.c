@@ -110,6 +110,29 @@ void srv_new_id(char *id)
 		snprintf(id + 2 * i, 3, "%02x", raw[i]);
 }
 
+/* 1 if the n bytes at s are lowercase hex digits. */
+static int hex_digits(const char *s, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!((s[i] >= '0' && s[i] <= '9') || (s[i] >= 'a' && s[i] <= 'f')))
+			return 0;
+	return 1;
+}
+
+int srv_id_valid(const char *s, size_t n)
+{
+	if (n == 16)
+		return hex_digits(s, 16);
+	/* NODE-: 1 to 10 of a-z 0-9 - (any replica's, config.c), then 12 */
+	if (n < 14 || n > 23 || s[n - 13] != '-' || !hex_digits(s + n - 12, 12))
+		return 0;
+	for (size_t i = 0; i < n - 13; i++)
+		if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9') ||
+		      s[i] == '-'))
+			return 0;
+	return 1;
+}
+
 int srv_stopping(void)
 {
 	return atomic_load(&stopping);

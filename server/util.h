@@ -22,6 +22,9 @@ double srv_unix_time(void);
 /* Ids made from now on start "node_id-" (borrowed, kept; NULL or "": no
  * prefix). Call once at start-up, before any id is made. */
 void srv_ids_init(const char *node_id);
+/* 1 if the n bytes at s are an id srv_new_id could make, with any
+ * replica's prefix. */
+int srv_id_valid(const char *s, size_t n);
 /* A fresh random id into id (>= 24 bytes): 16 hex digits, or with a node
  * id "NODE-" and 12 hex digits (a proxy routes by the prefix). */
 void srv_new_id(char *id);

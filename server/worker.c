@@ -241,7 +241,8 @@ static int apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
 			srv_ring_event(s, "control", json);
-			srv_persist_control(s, json);
+			if (!cmd->replay)
+				srv_persist_control(s, json);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
@@ -250,6 +251,9 @@ static int apply_commands(srv_session *s)
 		if (cmd->from_experiment)
 			experiment_commanded(s, cmd);
 	}
+	/* the status shows the accepted targets at once: no step publishes
+	 * one while paused or finished, nor before the answer when running */
+	sim_get_status(s->sim, &s->st);
 	pthread_cond_broadcast(&s->data);
 	return reanchor;
 }
@@ -283,6 +287,36 @@ static void start_job(srv_session *s)
 	queue_experiment_command(s, cmd);
 	s->exp_started = 1;
 	pthread_cond_broadcast(&s->data);
+}
+
+/* replay: the controls logged after the checkpoint the session was
+ * restored from go through the commands phase again, each once the
+ * integrator reaches its t_effective, so that no acknowledged control is
+ * lost to a crash. */
+static void run_replay(srv_session *s)
+{
+	double t = sim_effective_time(s->sim);
+	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
+		srv_cmd *cmd = &s->replay[s->replayed++].cmd;
+		cmd->replay = 1;
+		srv_worker_queue(s, cmd);
+	}
+}
+
+/* caught up: a session re-created from its spec (session_store.c rebuild)
+ * ran flat out to where it was, or a replayed control stopped it short of
+ * that: from here on it keeps its pace. */
+static void check_caught_up(srv_session *s, clocks *c)
+{
+	if (!(s->catch_up_t > 0) ||
+	    (s->st.t < s->catch_up_t &&
+	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
+		return;
+	s->catch_up_t = 0;
+	s->replay_seconds = srv_now() - s->replay_wall;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_INFO, "session %s: replayed to t = %g s in %.3f s",
+		s->entry.id, s->st.t, s->replay_seconds);
 }
 
 /* commands: apply what is queued; pacing restarts after pace or pause. */
@@ -325,16 +359,41 @@ static void measure_cost(srv_session *s, clocks *c)
 	c->cost_t = s->st.t;
 }
 
+/* The session measured more than it was admitted for: it goes on at the
+ * pace that fits the cores for paced sessions (budget.c), taken as a
+ * control would be (the stream's and the control log's "control" event),
+ * so that it does not starve the others (lock held). */
+static void pace_down(srv_session *s, clocks *c)
+{
+	double was = s->pace, cost = s->cpu_per_s;
+	double pace = srv_budget_fit_pace(&s->paced_held, cost, was);
+	if (pace >= was)
+		return;
+	api_control ctl = {.set = API_C_PACE, .pace = pace};
+	char json[API_EVENT_MAX];
+	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
+	s->pace = pace;
+	srv_ring_event(s, "control", json);
+	srv_persist_control(s, json);
+	s->ckpt_dirty = 1;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
+			      "admitted; paced down from %g to %g to fit "
+			      "--max-paced-cores", s->entry.id, cost, was, pace);
+}
+
 /* need: the session's hold on the paced cores follows what it needs now
  * (its state, pace and measured cost), even beyond the budget: admission
  * is checked where a request raises it (session.c). Called in the same
  * turn as the commands phase (the lock is not let go in between), so that
  * a hold a handler raised for its queued command is kept until the worker
  * has applied it. */
-static void commit_need(srv_session *s)
+static void commit_need(srv_session *s, clocks *c)
 {
 	double need = srv_paced_need(s);
-	if (need != s->paced_held)
+	if (need > s->paced_held * (1 + 1e-9) && need > 1e-9)
+		pace_down(s, c);
+	else if (need != s->paced_held)
 		srv_budget_set_paced(&s->paced_held, need);
 }
 
@@ -413,7 +472,7 @@ static int idle(srv_session *s, clocks *c)
  * starts over, so that commands are seen at once). */
 static int pace(srv_session *s, clocks *c, double t_next)
 {
-	if (s->pace == API_PACE_MAX)
+	if (s->pace == API_PACE_MAX || s->catch_up_t > 0)
 		return 0;
 	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
 	if (due <= c->batch_end)
@@ -510,13 +569,15 @@ void *srv_worker_main(void *arg)
 	publish(s, &clk);
 	for (;;) {
 		start_job(s);
+		run_replay(s);
 		run_commands(s, &clk);
+		check_caught_up(s, &clk);
 		if (s->stop)
 			break;
 		srv_persist_checkpoint(s, 0);
 		check_until(s, &clk);
 		check_cpu(s, &clk);
-		commit_need(s);
+		commit_need(s, &clk);
 		if (idle(s, &clk) || take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);

@@ -20,6 +20,8 @@ typedef struct srv_cmd {
 	api_control c;           /* the changes, as PATCH parses them */
 	int restart_transport;   /* then restart the transport estimator */
 	int from_experiment;     /* sent by the attached experiment */
+	int replay;              /* taken again from the control log at a
+				    restore: applied, not logged again */
 	double cpu_grant;        /* CPU s a "running": true grants a session
 				    its CPU budget paused (0: none) */
 	/* set by the worker, under the session lock */

@@ -13,12 +13,19 @@
 //     held in the grace, the rest closed at accept),
 //   - asks GET /api/v1/health and one session from 127.0.0.3 (another
 //     client) twice a second throughout,
+//   - then opens FLOOD (2,000) idle sockets from FLOOD_ADDRESSES (500)
+//     addresses 127.2.x.y, 4 each (within each one's budget: any local
+//     user may pick 127.x.y.z), while an active client from 127.0.0.4
+//     asks for one session back to back, each on a fresh connection: at
+//     --max-connections the daemon closes the idlest connections, so the
+//     active client's p99 stays low and it is answered every time,
 // measures for WINDOW seconds (default 30) and prints a table: PATCH
 // latency, stream lag (see streamlag.mjs), sessions keeping real time,
 // 401/429/503 answers, the daemon's resident memory and CPU. It fails
 // (exit 1) if the daemon crashed, its memory went over the budget, or the
 // other client was not answered every time.
 // Environment: CONVSIMD (the binary), WINDOW (s), SESSIONS, STREAMS, IDLE,
+// FLOOD, FLOOD_ADDRESSES,
 // MEMORY_GIB (--max-memory, default 3: about 290 default sessions),
 // DAEMON_FLAGS (more daemon flags, e.g. "--max-paced-cores 64" to measure
 // the daemon overloaded).
@@ -30,6 +37,8 @@ import { call, lagStream, quantile, procUsage, fmt } from './streamlag.mjs';
 const SESSIONS = Number(process.env.SESSIONS || 200);
 const STREAMS = Number(process.env.STREAMS || 500);
 const IDLE = Number(process.env.IDLE || 2000);
+const FLOOD = Number(process.env.FLOOD ?? 2000);
+const FLOOD_ADDRESSES = Number(process.env.FLOOD_ADDRESSES || 500);
 const WINDOW = Number(process.env.WINDOW || 30);
 const MEMORY_GIB = Number(process.env.MEMORY_GIB || 3);
 const MEMORY = MEMORY_GIB * 1024 ** 3;
@@ -131,6 +140,42 @@ for (let i = 0; i < 20; i++) {
 await openIdle(IDLE - Math.min(64, IDLE));
 
 progress(`idle sockets: ${idle.open} connected`);
+// 4b. the idle flood from many addresses, and an active client meanwhile
+const flood = { open: 0, closed: 0, failed: 0, pending: 0, socks: [] };
+const active = { n: 0, bad: [], ms: [] };
+let flooding = true;
+const activeLoop = (async () => {
+  while (flooding) {
+    const r = await call(base, 'GET', `/api/v1/sessions/${ids[0]}`, undefined, { localAddress: '127.0.0.4' });
+    active.n++;
+    active.ms.push(r.ms);
+    if (r.status !== 200) active.bad.push(r.status || r.error);
+    await sleep(20);
+  }
+})();
+const floodStart = performance.now();
+// in batches of 100, so that this process's own event loop (the active
+// client's too) is not starved by 2,000 connects at once
+const floodSocket = (i) => new Promise((resolve) => {
+  const a = i % FLOOD_ADDRESSES;
+  const s = net.connect({ port: d.port, host: '127.0.0.1', localAddress: `127.2.${Math.floor(a / 250)}.${1 + (a % 250)}` });
+  const timer = setTimeout(() => { flood.pending++; resolve(); }, 5000);
+  s.on('connect', () => { clearTimeout(timer); flood.open++; flood.socks.push(s); resolve(); });
+  s.on('close', () => { if (flooding) flood.closed++; });
+  s.on('error', () => { clearTimeout(timer); flood.failed++; resolve(); });
+});
+const floodOpened = [];
+for (let i = 0; i < FLOOD; i += 100) {
+  for (let k = i; k < Math.min(FLOOD, i + 100); k++) floodOpened.push(floodSocket(k));
+  await sleep(5);
+}
+await Promise.all(floodOpened);
+await sleep(2000); // the active client goes on while the flood's sockets sit idle
+flooding = false;
+const floodClosed = flood.closed;
+await activeLoop;
+const floodS = (performance.now() - floodStart) / 1000;
+progress(`idle flood: ${flood.open} connected, ${flood.closed} closed by the daemon`);
 // 5. the measurement window: PATCH beta 20 a second
 const patchMs = [];
 const patchStatus = {};
@@ -172,6 +217,7 @@ for (const s of streams) {
   if (s.status !== 200 || s.error) streamErrors++;
 }
 for (const s of idle.socks) s.destroy();
+for (const s of flood.socks) s.destroy();
 clearInterval(sampler);
 const alive = d.proc.exitCode === null && d.proc.signalCode === null;
 const reserved = metric('convsim_memory_reserved_bytes');
@@ -186,11 +232,13 @@ check(peakRss < MEMORY, `resident memory ${peakRss} stayed under the budget ${ME
 check(reserved <= MEMORY, `the reserved memory ${reserved} stayed within the budget`);
 check(other.bad.length === 0 && other.n > 0, `the other client was answered every time (${other.bad.slice(0, 3)})`);
 check(streamErrors === 0, `${streamErrors} stream clients failed`);
+check(FLOOD === 0 || (active.bad.length === 0 && active.n > 0),
+  `the active client was answered every time during the idle flood (${active.bad.slice(0, 3)})`);
 
 const mb = (b) => fmt(b / 2 ** 20, 0);
 const cpu = usageEnd.cpu - usageStart.cpu;
 const lines = [
-  `Command: \`make load\` (${SESSIONS} sessions, ${STREAMS} streams, ${IDLE} idle sockets, ${fmt(windowS, 0)}-s window` +
+  `Command: \`make load\` (${SESSIONS} sessions, ${STREAMS} streams, ${IDLE} idle sockets, ${FLOOD} flood sockets, ${fmt(windowS, 0)}-s window` +
     `${FLAGS.length ? `, daemon flags ${FLAGS.join(' ')}` : ''}; ` +
     `setup ${fmt((created - t0) / 1000)} s to create the sessions)`,
   '',
@@ -204,6 +252,8 @@ const lines = [
   `| answers 401 / 429 / 503 (whole run) | ${answers(401)} / ${answers(429)} / ${answers(503)} |`,
   `| idle sockets from 127.0.0.2 | ${idle.open} connected, ${idle.closedEarly} closed at once by the daemon, ${idle.failed} failed, ${idle.pending} not taken within 5 s; its 20 requests: ${JSON.stringify(fromIdle)} |`,
   `| connections closed at accept (metric) | ${metric('convsim_connections_dropped_total')} |`,
+  `| idle flood: ${FLOOD} sockets from ${FLOOD_ADDRESSES} addresses 127.2.x.y | ${flood.open} connected, ${floodClosed} closed by the daemon (idle ones closed at the cap, metric: ${metric('convsim_connections_evicted_total')}), ${flood.failed} failed, ${flood.pending} not taken within 5 s |`,
+  `| active client (127.0.0.4) during the idle flood (${fmt(floodS)} s): requests, p50 / p99 latency | ${active.n}, all answered: ${active.bad.length === 0}, ${fmt(quantile(active.ms, 0.5))} / ${fmt(quantile(active.ms, 0.99))} ms |`,
   `| another client (127.0.0.3): requests, p99 latency | ${other.n}, all answered: ${other.bad.length === 0}, ${fmt(quantile(other.ms, 0.99))} ms |`,
   `| daemon resident memory, peak (budget reserved / --max-memory) | ${mb(peakRss)} MiB (${mb(reserved)} / ${mb(MEMORY)} MiB) |`,
   `| daemon CPU (user + sys) in the window | ${fmt(cpu)} s = ${fmt(cpu / windowS, 2)} cores |`,

@@ -66,7 +66,8 @@ static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 		return;
 	}
 	FUZZ_CHECK(r.state >= SRV_RUNNING && r.state <= SRV_FAILED &&
-			   sizeof r + r.exp_len + r.sim_len == len,
+			   (sizeof r + r.exp_len + r.sim_len == len ||
+			    sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER == len),
 		   "checkpoint head accepted with state %d, lengths %zu + %llu + %llu of %zu",
 		   (int)r.state, sizeof r, (unsigned long long)r.exp_len,
 		   (unsigned long long)r.sim_len, len);

@@ -77,6 +77,30 @@ export async function req(base, method, path, body, headers = {}) {
   return { status: res.status, headers: res.headers, body: parsed, text };
 }
 
+// store.c's frame header: 32 bytes, the payload's checksum at 24.
+export const STORE_FRAME = 32;
+// A file of the data directory with its frame's checksum made right again
+// after an edit: core/checkpoint.c's sim_checksum (FNV-1a 64 with its
+// starting value) of the payload.
+export function reframe(buf) {
+  let h = 1469598103934665603n;
+  for (let i = STORE_FRAME; i < buf.length; i++) {
+    h ^= BigInt(buf[i]);
+    h = (h * 0x100000001b3n) & 0xffffffffffffffffn;
+  }
+  buf.writeBigUInt64LE(h, 24);
+  return buf;
+}
+
+// A session re-created from its spec at the last start (its checkpoint
+// unusable) once its replay is over: its document.
+export async function untilReplayed(base, id, ms = 20000) {
+  return until(async () => {
+    const b = (await req(base, 'GET', `/api/v1/sessions/${id}`)).body;
+    return b.replay_seconds !== null && b;
+  }, ms, `session ${id}'s replay over`);
+}
+
 // |actual - expected| <= tol, with both in the message.
 export function near(actual, expected, tol, what = 'value') {
   if (!(Math.abs(actual - expected) <= tol)) {

@@ -6,7 +6,8 @@
 // (a method named rk2, an atol out of its range on a method that does not
 // read it, pace "max" without until: the fuzz harness's regression inputs,
 // as real files). The restart lists every such session as damaged with the
-// reason, reads nothing past a buffer (make check runs
+// reason (the one whose both checkpoints are refused is re-created from
+// its spec, the reasons logged), reads nothing past a buffer (make check runs
 // this under ASan) and stops cleanly. The offsets are this build's record
 // layouts (server/session_store.c, host order, x86-64).
 import { test } from 'node:test';
@@ -14,26 +15,14 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, reframe, STORE_FRAME, CHEAP, SLOW } from './lib.mjs';
 
-const FRAME = 32;          // store.c's frame header; the checksum at 24
+const FRAME = STORE_FRAME;
 const CKPT_RECORD = 320;   // srv_ckpt_record; exp_len at 304, sim_len at 312
 const SPEC_PRESET = 24;    // spec_record: id[24], then api_spec's preset[32]
 const SPEC_METHOD = 472;   // api_spec's method.name[24] (api_spec at 24)
 const SPEC_ATOL = 512;     // method.atol
 const SPEC_PACE = 536;     // pace (0: "max"), then until at 544
-
-// sim_checksum of the payload into the frame's checksum field: FNV-1a 64
-// with core/checkpoint.c's starting value.
-function reframe(buf) {
-  let h = 1469598103934665603n;
-  for (let i = FRAME; i < buf.length; i++) {
-    h ^= BigInt(buf[i]);
-    h = (h * 0x100000001b3n) & 0xffffffffffffffffn;
-  }
-  buf.writeBigUInt64LE(h, 24);
-  return buf;
-}
 
 test('a checksummed checkpoint with wrapping lengths and specs no request could make are listed damaged', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-damage-'));
@@ -55,6 +44,8 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
       b.writeBigUInt64LE((payload - BigInt(CKPT_RECORD) - expLen) & 0xffffffffffffffffn, FRAME + 312);
       writeFileSync(path, reframe(b));
     }
+    // the binary specs an earlier build wrote: this build's spec.json gone
+    for (const id of ids.slice(1)) rmSync(join(dir, 'sessions', id, 'spec.json'));
     const spec = readFileSync(join(dir, 'sessions', ids[1], 'spec.bin'));
     assert.equal(spec.toString('latin1', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 10), 'czubak2016', 'the layout this test assumes');
     spec.fill('x', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 32);
@@ -71,9 +62,12 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
     edit(ids[3], (b) => b.writeDoubleLE(3e-48, FRAME + SPEC_ATOL));
     edit(ids[4], (b) => { b.writeDoubleLE(0, FRAME + SPEC_PACE); b.writeDoubleLE(0, FRAME + SPEC_PACE + 8); });
     d = await startDaemon(args);
-    const a = (await req(d.base, 'GET', `/api/v1/sessions/${ids[0]}`)).body;
-    assert.equal(a.state, 'damaged');
-    assert.match(a.error, /checkpoint\.bin: inconsistent lengths or state.*checkpoint\.bin\.prev: inconsistent lengths/);
+    // both checkpoints refused: re-created from its spec (replay.test.mjs),
+    // the reasons logged
+    const a = await untilReplayed(d.base, ids[0]);
+    assert.equal(a.state, 'finished');
+    assert.equal(a.restored, 'replayed');
+    assert.match(d.stderr(), /checkpoint\.bin: inconsistent lengths or state.*checkpoint\.bin\.prev: inconsistent lengths.*re-created from its spec/);
     const b = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
     assert.equal(b.state, 'damaged');
     assert.match(b.error, /spec\.bin: the preset or method name is not a string/);

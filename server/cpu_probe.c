@@ -1,0 +1,61 @@
+/*
+ * cpu_probe.c - the measured cost of a session before it runs (see
+ * cpu_probe.h). The copy goes through sim_checkpoint and sim_restore,
+ * which continue bit for bit from the live instance's state without its
+ * equilibrium and settling (seconds for a large feed), so the probe costs
+ * what it measures and little more. Its time is the calling thread's CPU
+ * clock, as the worker's own measurement (worker.c measure_cost) is.
+ */
+#include <stdlib.h>
+#include <time.h>
+
+#include "budget.h"
+#include "cpu_probe.h"
+
+static double thread_cpu(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double srv_cpu_probe(const sim *live, const api_spec *spec, int columns,
+		     int layers)
+{
+	size_t len = sim_checkpoint_size(live), n = (size_t)columns * (size_t)layers;
+	void *buf = malloc(len);
+	double *feed = malloc(((size_t)columns + 2 * n + 1) * sizeof *feed);
+	sim *copy = NULL;
+	double cost = -1;
+	char msg[160];
+	int err = 0;
+	if (!buf || !feed || sim_checkpoint(live, buf, len) != SIM_OK)
+		goto out;
+	copy = sim_restore(&spec->params, &spec->scene, &spec->method, buf, len,
+			   &err, msg, sizeof msg);
+	if (!copy)
+		goto out;
+	sim_status st;
+	sim_get_status(copy, &st);
+	double t0 = st.t, t = t0, dt = 1.0 / spec->sample_rate;
+	double cpu0 = thread_cpu(), cpu = cpu0;
+	while (cpu - cpu0 < SRV_PROBE_CPU_S && t - t0 < SRV_PROBE_T_S) {
+		t += dt;
+		if (sim_advance(copy, t) != SIM_OK)
+			break;
+		sim_get_status(copy, &st);
+		if (columns > 0) {
+			sim_column_displacement(copy, feed);
+			sim_feed_state(copy, feed + columns, feed + columns + n);
+		}
+		cpu = thread_cpu();
+	}
+	if (t > t0)
+		cost = (cpu - cpu0) / (t - t0) +
+		       srv_budget_sample_cpu(columns, layers) * spec->sample_rate;
+out:
+	sim_free(copy);
+	free(feed);
+	free(buf);
+	return cost;
+}

@@ -1,0 +1,28 @@
+/*
+ * cpu_probe.h - what a simulated second of a session costs, measured
+ * before it is admitted to the cores for paced sessions: the estimate from
+ * the integrator alone (budget.c) misses what grows with the scene (a
+ * 64 x 64 feed was estimated at 0.04 cores and used 1.3).
+ */
+#ifndef CONVSIM_CPU_PROBE_H
+#define CONVSIM_CPU_PROBE_H
+
+#include "api.h"
+#include "sim.h"
+
+/* Longest a probe runs: CPU s of the calling thread, simulated s. */
+#define SRV_PROBE_CPU_S 0.03
+#define SRV_PROBE_T_S 0.2
+
+/* CPU s per simulated s of running live (borrowed, read only) as its
+ * worker would: a copy made from a checkpoint of it (no settling) is
+ * advanced sample by sample at spec's sample rate, with the status and
+ * the feed's state read at each sample as the worker reads them, for
+ * SRV_PROBE_CPU_S of this thread's CPU or SRV_PROBE_T_S simulated s,
+ * whichever comes first; plus the server's cost per published sample.
+ * columns x layers: the feed recorded (0 without). Returns a negative
+ * value if the copy cannot be made (out of memory): then estimate. */
+double srv_cpu_probe(const sim *live, const api_spec *spec, int columns,
+		     int layers);
+
+#endif

@@ -1,0 +1,68 @@
+// The cores for paced sessions hold for every scene size: a large feed's
+// cost is measured on a copy before it is admitted (the estimate from the
+// integrator alone saw 0.04 cores where 16 x 64 uses 0.5), and a session
+// whose measured cost exceeds what it was admitted for is paced down to
+// what fits, taken as a control (docs/hardening.md).
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startDaemon, req, metric, until, SLOW } from './lib.mjs';
+
+const LARGE = { scene: { columns: 16, layers: 64 } };
+const LIMIT = 0.3;
+const paced = async (d) => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+
+test('a large scene is admitted by its measured cost: alone too much at pace 1 (422), two at 0.6 of what fits do not fit (503)', { timeout: 120000 * SLOW }, async () => {
+  const d = await startDaemon(['--max-paced-cores', String(LIMIT)]);
+  try {
+    const one = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 1 });
+    assert.equal(one.status, 422, `16 x 64 at pace 1 needs more than ${LIMIT} cores: ${one.text}`);
+    assert.equal(one.body.budget, 'cpu');
+    // the largest pace that fits: about 0.6 here (0.5 CPU s per simulated
+    // s), less under the sanitizers; the estimate alone said 7
+    assert.ok(one.body.max > 0.01 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
+    const pace = Math.round(0.6 * one.body.max * 1000) / 1000;
+    const a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
+    assert.equal(a.status, 201, a.text);
+    const held = await paced(d);
+    assert.ok(held > 0.3 * LIMIT && held <= LIMIT, `16 x 64 at pace ${pace} holds ${held} cores`);
+    const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
+    assert.equal(b.status, 503, `a second one does not fit: ${b.text}`);
+    assert.ok(await paced(d) <= LIMIT, 'the holds stay within the budget');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('a session that measures more than it was admitted for is paced down to what fits', { timeout: 120000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-paced-'));
+  let d = await startDaemon(['--data-dir', dir]);
+  let id;
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 0.001 });
+    assert.equal(s.status, 201, s.text);
+    id = s.body.id;
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+  // restored sessions start from the estimate (no copy is run at start-up):
+  // pace 0.9 is admitted, then its worker measures what it costs
+  d = await startDaemon(['--data-dir', dir, '--max-paced-cores', String(LIMIT)]);
+  try {
+    const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { pace: 0.9 });
+    assert.equal(p.status, 200, p.text);
+    const g = await until(async () => {
+      const b = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+      return b.pace < 0.9 && b;
+    }, 20000, 'the session paced down');
+    assert.equal(g.state, 'running');
+    assert.ok(g.pace >= 0.01 && g.pace < 0.9, `paced down to ${g.pace}`);
+    assert.ok(await paced(d) <= LIMIT * (1 + 1e-9), `it holds no more than the budget: ${await paced(d)}`);
+    assert.match(d.stderr(), new RegExp(`session ${id}: .* paced down from 0\\.9 to ${g.pace}`));
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});

@@ -1,0 +1,135 @@
+// Strict reading of requests: a body JSON forbids (RFC 8259, I-JSON RFC
+// 7493) is refused with 400 and the byte where it goes wrong, whichever
+// route reads it; a duplicated Host or Content-Length header is refused
+// with 400 (RFC 9112); a very long query still gets an answer (431).
+// Nothing refused changes anything.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import { startDaemon, req, rawRequest, CHEAP, SLOW } from './lib.mjs';
+
+const bytes = (...parts) => Buffer.concat(parts.map((p) => (typeof p === 'string' ? Buffer.from(p, 'latin1') : Buffer.from(p))));
+
+// [body, position of the fault, field (a duplicated name) or null]
+const BAD = [
+  ['{"pace":01}', 8, null],
+  ['{"pace":1.}', 8, null],
+  ['{"pace":-}', 9, null],
+  ['{"pace":1e}', 8, null],
+  ['{"preset":"czubak2016\u0000x"}', 21, null],
+  ['{"preset":"czubak\u00012016"}', 17, null],
+  ['{"preset":"czu\tbak"}', 14, null],
+  [bytes('{"preset":"czubak', [0xff], '2016"}'), 17, null],
+  [bytes('{"preset":"', [0xc0, 0xaf], '"}'), 11, null],
+  [bytes('{"preset":"', [0xed, 0xa0, 0x80], '"}'), 11, null],
+  [bytes('{"preset":"abc', [0xe2, 0x82], '"}'), 14, null],
+  ['{"preset":"\\ud800"}', 11, null],
+  ['{"preset":"\\udc00\\ud800"}', 11, null],
+  ['{"preset":"\\x41"}', 11, null],
+  ['{"pace":1,"pace":"max"}', 10, 'pace'],
+  ['{"pace":1,"p\\u0061ce":2}', 10, 'p\\u0061ce'],
+  ['{"scene":{"columns":1,"layers":2,"columns":3}}', 33, 'columns'],
+  ['{"pace":1,}', 10, null],
+  ['{"pace":1} x', 11, null],
+  ['{"pace":true1}', 12, null],
+  ['{\'pace\':1}', 1, null],
+];
+
+test('a body JSON forbids is refused with 400 and its position on every route; nothing is created', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const post = (path, body, method = 'POST') => rawRequest(d.port, bytes(`${method} ${path} HTTP/1.1\r\n` +
+      `Host: 127.0.0.1:${d.port}\r\nContent-Type: application/json\r\nContent-Length: ${Buffer.from(body).length}`), body);
+    for (const [body, position, field] of BAD) {
+      const r = await post('/api/v1/sessions', body);
+      const shown = Buffer.from(body).toString('latin1');
+      assert.equal(r.status, 400, `${shown}: ${r.raw.toString('latin1')}`);
+      assert.match(r.headers['content-type'], /^application\/problem\+json/);
+      const p = JSON.parse(r.body.toString('utf8'));
+      assert.equal(p.type, '/api/v1/problems/malformed-json', shown);
+      assert.equal(p.position, position, `${shown}: ${p.detail}`);
+      assert.match(p.detail, new RegExp(`at byte ${position}$`), shown);
+      assert.equal(p.field, field ?? undefined, shown);
+    }
+    // the other readers of a body go through the same check
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    for (const [method, path] of [['PATCH', `/api/v1/sessions/${s.body.id}`], ['POST', '/api/v1/sweeps'],
+      ['POST', '/api/v1/experiments'], ['POST', '/api/v1/fits']]) {
+      const r = await post(path, '{"beta":30,"beta":40}', method);
+      assert.equal(r.status, 400, `${method} ${path}: ${r.raw.toString('latin1')}`);
+      assert.equal(JSON.parse(r.body.toString('utf8')).position, 11, path);
+    }
+    // what JSON allows still passes: escapes, a paired surrogate, exponents, -0
+    const ok = await post('/api/v1/sessions', bytes('{"preset":"czubak2016","pace":1e0,"sample_rate":2.5E2,' +
+      '"scene":{"drive":"ide\\u0061l","columns":1,"layers":2}}'));
+    assert.equal(ok.status, 201, ok.raw.toString('latin1'));
+    const names = await post('/api/v1/sessions', '{"params":{"\\ud83d\\ude00":1,"\\u00e9":1}}');
+    assert.equal(names.status, 422, 'two distinct names decode apart and reach the member check');
+    const list = await req(d.base, 'GET', '/api/v1/sessions');
+    assert.equal(list.body.sessions.length, 2, 'only the two valid sessions exist');
+    const g = await req(d.base, 'GET', `/api/v1/sessions/${s.body.id}`);
+    assert.notEqual(g.body.status.beta_target, 40, 'the refused PATCH changed nothing');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('a Host or Content-Length header given twice is 400 and changes nothing; 500 query parameters get 431', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const host = `Host: 127.0.0.1:${d.port}`;
+    const body = JSON.stringify(CHEAP);
+    const cases = [
+      [`GET /api/v1/health HTTP/1.1\r\n${host}\r\nHost: evil.example`, '', 'Host'],
+      [`GET /api/v1/health HTTP/1.1\r\n${host}\r\n${host}`, '', 'Host'],
+      [`POST /api/v1/sessions HTTP/1.1\r\n${host}\r\nContent-Type: application/json\r\n` +
+        `Content-Length: ${body.length}\r\nContent-Length: ${body.length}`, body, 'Content-Length'],
+      [`POST /api/v1/sessions HTTP/1.1\r\n${host}\r\nContent-Type: application/json\r\n` +
+        `Content-Length: ${body.length}\r\ncontent-length: 5`, body, 'Content-Length'],
+    ];
+    for (const [head, b, field] of cases) {
+      const r = await rawRequest(d.port, head, b);
+      assert.equal(r.status, 400, r.raw.toString('latin1'));
+      const p = JSON.parse(r.body.toString('utf8'));
+      assert.equal(p.type, '/api/v1/problems/bad-request');
+      assert.equal(p.field, field);
+    }
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+    // one Host and one Content-Length still pass
+    const ok = await rawRequest(d.port, `POST /api/v1/sessions HTTP/1.1\r\n${host}\r\n` +
+      `Content-Type: application/json\r\nContent-Length: ${body.length}`, body);
+    assert.equal(ok.status, 201, ok.raw.toString('latin1'));
+    // ~500 query parameters (a 4 kB URL): an answer, not a closed socket
+    for (const n of [500, 3000]) {
+      const query = Array.from({ length: n }, (_, i) => `a${i}=${i}`).join('&');
+      const r = await rawRequest(d.port, `GET /api/v1/sessions?${query} HTTP/1.1\r\n${host}`);
+      assert.equal(r.status, 431, `${n} parameters: ${r.raw.toString('latin1').slice(0, 300)}`);
+      const p = JSON.parse(r.body.toString('utf8'));
+      assert.equal(p.type, '/api/v1/problems/header-fields-too-large');
+      assert.match(p.detail, new RegExp(`has ${n} parameters`));
+    }
+    // a few unknown ones are still named one by one
+    const few = await req(d.base, 'GET', '/api/v1/sessions?a=1&b=2');
+    assert.equal(few.status, 400);
+    assert.equal(few.body.field, 'a');
+    assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200, 'the daemon still answers');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('docs/hardening.md: its example body gets the answer it shows', { timeout: 30000 * SLOW }, async () => {
+  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
+  const m = doc.match(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/);
+  assert.ok(m, 'docs/hardening.md has a json block after <!-- test:strict-example -->');
+  const example = JSON.parse(m[1]);
+  const d = await startDaemon();
+  try {
+    const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
+    assert.equal(r.status, example.answer.status);
+    assert.deepEqual(r.body, example.answer);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
