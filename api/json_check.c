@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * json_check.c - the strict reading of a request body, before cJSON sees
  * it. cJSON is lenient: it reads `01` and `1.` as numbers, stops a string

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * conns.c - the open connections and the idle ones closed at the global
  * cap (see conns.h).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * conns.h - the open connections, so that idle ones make room at the
  * global cap: libmicrohttpd admits up to SRV_CONN_HEADROOM connections

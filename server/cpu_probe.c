@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * cpu_probe.c - the measured cost of a session before it runs (see
  * cpu_probe.h). The copy goes through sim_checkpoint and sim_restore,

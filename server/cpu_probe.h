@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * cpu_probe.h - what a simulated second of a session costs, measured
  * before it is admitted to the cores for paced sessions: the estimate from

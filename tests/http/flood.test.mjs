@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Idle sockets from many loopback addresses (any local user may pick
 // 127.x.y.z, so the per-client budget does not hold them back) must not
 // lock anyone out: at --max-connections the daemon closes the idlest

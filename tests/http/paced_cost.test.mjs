@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The cores for paced sessions hold for every scene size: a large feed's
 // cost is measured on a copy before it is admitted (the estimate from the
 // integrator alone saw 0.04 cores where 16 x 64 uses 0.5), and a session

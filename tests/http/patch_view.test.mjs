@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A PATCH's answer and every later GET show the accepted targets: on a
 // running session at once (not the target before the change), on a
 // paused or finished one without waiting for a resume, and in the unit

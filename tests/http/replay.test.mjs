@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // No acknowledged control is lost to a crash: the controls logged after
 // the checkpoint a session is restored from (all of them when it had none
 // yet) are applied again as its integrator reaches each one's

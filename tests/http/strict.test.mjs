@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Strict reading of requests: a body JSON forbids (RFC 8259, I-JSON RFC
 // 7493) is refused with 400 and the byte where it goes wrong, whichever
 // route reads it; a duplicated Host or Content-Length header is refused
