@@ -33,10 +33,16 @@ fine() { # machine name, label, window, settings...
 	"$BUILD/convsim" sweep -q --beta 0:180:10 --rotation cw,ccw --duration "$window" \
 		--threads "$THREADS" --format csv "$@" > "$tmp/$name.$label.csv"
 }
-# the largest |v_fine - v_coarse| over the peak of v_fine, of two tables
+# two tables side by side: the coarse and the fine velocity's columns
+# found by the header (a, b), the rest as the caller's awk says
+pair() { # coarse.csv, fine.csv, awk program (after the columns are known)
+	paste -d, "$1" "$2" | awk -F, -v m="${4:-}" 'function abs(x) { return x < 0 ? -x : x }
+		NR == 1 { for (i = 1; i <= NF; i++) if ($i == "velocity") { if (a) b = i; else a = i }; next }
+		'"$3"
+}
+# the largest |v_fine - v_coarse| over the peak of v_fine
 spread() {
-	paste -d, "$1" "$2" | awk -F, 'function abs(x) { return x < 0 ? -x : x }
-		NR > 1 { d = abs($13 - $3); if (d > dm) dm = d; if (abs($13) > pk) pk = abs($13) }
+	pair "$1" "$2" '{ d = abs($b - $a); if (d > dm) dm = d; if (abs($b) > pk) pk = abs($b) }
 		END { printf "%.6f\n", dm / pk }'
 }
 printf 'machine\tbeta_deg\trotation\tv_ref\tv_prev\td_conv\n' > "$tmp/ref.tsv"
@@ -52,8 +58,9 @@ while IFS=$'\t' read -r name sets window _; do
 		fine "$name" C "$window" "${args[@]}" --set dt=3.125e-5 --set substeps=160 --set feed_events=false
 		coarse=B finest=C
 	fi
-	paste -d, "$tmp/$name.$coarse.csv" "$tmp/$name.$finest.csv" | awk -F, -v m="$name" 'NR > 1 {
-		printf "%s\t%s\t%s\t%.8g\t%.8g\t%+.3g\n", m, $1, $2, $13, $3, $13 - $3 }' >> "$tmp/ref.tsv"
+	pair "$tmp/$name.$coarse.csv" "$tmp/$name.$finest.csv" \
+		'{ printf "%s\t%s\t%s\t%.8g\t%.8g\t%+.3g\n", m, $1, $2, $b, $a, $b - $a }' "$name" \
+		>> "$tmp/ref.tsv"
 	echo "zoo_ref: $name done ($finest against $coarse)" >&2
 done < tests/bench/zoo/machines.tsv
 if [ -e "$out" ] && [ "$only" != "  " ]; then
