@@ -122,6 +122,11 @@ const char *srv_exp_id(const srv_experiment *e)
 	return e->entry.id;
 }
 
+const api_experiment_req *srv_exp_request(const srv_experiment *e)
+{
+	return &e->req;
+}
+
 int srv_exp_keeps_session(const srv_experiment *e)
 {
 	return e->req.keep_session || !e->req.fresh;
@@ -371,27 +376,19 @@ int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
 	return rc;
 }
 
-srv_experiment *srv_exp_load(const char *id, api_problem *pb)
+srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen)
 {
-	char path[64], why[256];
-	snprintf(path, sizeof path, "experiments/%s", id);
-	size_t len;
-	exp_record *r = srv_store_read(path, SRV_STORE_EXPERIMENT, &len, why,
-				       sizeof why);
-	if (r && (len != sizeof *r || r->state < 0 ||
-		  r->state >= EXP_NSTATES || r->req.nseg < 1 ||
-		  r->req.nseg > API_EXP_MAX_SEGMENTS)) {
+	exp_record *r = payload;
+	if (len != sizeof *r || r->state < 0 || r->state >= EXP_NSTATES || r->req.nseg < 1 ||
+	    r->req.nseg > API_EXP_MAX_SEGMENTS) {
 		free(r);
-		r = NULL;
-		snprintf(why, sizeof why, "%s: inconsistent", path);
-	}
-	if (!r) {
-		api_fail(pb, API_INVALID, NULL, "%s", why);
+		snprintf(why, whylen, "inconsistent");
 		return NULL;
 	}
 	r->id[SRV_ID_LEN - 1] = r->session_id[SRV_ID_LEN - 1] = '\0';
 	r->error[sizeof r->error - 1] = '\0';
-	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, pb);
+	api_problem pb;
+	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, &pb);
 	if (e) {
 		snprintf(e->entry.id, sizeof e->entry.id, "%s", r->id);
 		snprintf(e->session_id, sizeof e->session_id, "%s",
@@ -403,6 +400,8 @@ srv_experiment *srv_exp_load(const char *id, api_problem *pb)
 		e->t_now = r->t_now;
 		e->attached = 0;
 		drop_record(e);
+	} else {
+		snprintf(why, whylen, "%s", pb.detail);
 	}
 	free(r);
 	return e;

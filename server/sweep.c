@@ -10,7 +10,8 @@
  * queued job holds one, so DELETE (cancel) can unlink a sweep while its
  * jobs drain; beyond --max-sweeps the oldest finished one is evicted. A
  * sweep's fields are guarded by its own lock. Results are served as JSON
- * or CSV and, with --data-dir, saved as CSV when done.
+ * or CSV and, with --data-dir, saved as CSV when done. The sweep is
+ * one kind of job (job.h): srv_sweep_job below is its descriptor.
  */
 #include <pthread.h>
 #include <stdio.h>
@@ -18,12 +19,11 @@
 #include <string.h>
 
 #include "budget.h"
+#include "job.h"
 #include "metrics.h"
-#include "peers.h"
 #include "pool.h"
 #include "registry.h"
 #include "store.h"
-#include "sweep.h"
 #include "util.h"
 
 typedef struct srv_sweep {
@@ -46,13 +46,6 @@ typedef struct sweep_job {
 
 static void destroy(srv_entry *en);
 static srv_registry sweeps = SRV_REGISTRY_INIT(destroy);
-static const srv_config *cfg;
-
-void srv_sweeps_init(const srv_config *config)
-{
-	cfg = config;
-	srv_registry_open(&sweeps, (size_t)cfg->max_sweeps);
-}
 
 static srv_sweep *sweep_of(srv_entry *en)
 {
@@ -146,13 +139,10 @@ static void persist_locked(const srv_sweep *sw)
 	memcpy(p, &r, sizeof r);
 	memcpy(p + sizeof r, sw->req.betas, nb);
 	memcpy(p + sizeof r + nb, sw->pt, np);
-	size_t len;
-	void *buf = srv_store_frame(SRV_STORE_SWEEP, p, sizeof r + nb + np, &len);
+	char *id = strdup(sw->entry.id);
+	if (id && srv_job_save(&srv_sweep_job, id, p, sizeof r + nb + np, written, id) != 0)
+		free(id);
 	free(p);
-	char path[64];
-	snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
-	if (buf)
-		srv_store_write(path, buf, len, 0, written, strdup(sw->entry.id));
 }
 
 /* The CSV result (lock held). */
@@ -269,101 +259,87 @@ static void run_point(void *arg)
 	srv_registry_put(&sweeps, &sw->entry);
 }
 
-size_t srv_sweeps_restore(void)
+/* Queue one pool job for each point of a restored sweep that was pending
+ * or running, each with a reference (the caller holds one). */
+static void sweep_resume(srv_entry *en)
 {
-	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list("sweeps", &names) : 0,
-	       count = 0;
-	for (size_t i = 0; i < n; i++) {
-		char path[300], why[300];
-		snprintf(path, sizeof path, "sweeps/%s", names[i]);
-		free(names[i]);
-		size_t l = strlen(path), len = 0;
-		char *p = l > 4 && strcmp(path + l - 4, ".bin") == 0
-				  ? srv_store_read(path, SRV_STORE_SWEEP, &len,
-						   why, sizeof why)
-				  : NULL;
-		sweep_record r;
-		size_t nb = 0, np = 0;
-		int ok = p && len >= sizeof r;
-		if (ok) {
-			memcpy(&r, p, sizeof r);
-			nb = (size_t)r.req.nbeta * sizeof(api_value);
-			np = r.total * sizeof(api_sweep_point);
-			ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
-			     r.total <= API_SWEEP_MAX_POINTS &&
-			     len == sizeof r + nb + np;
+	srv_sweep *sw = sweep_of(en);
+	pthread_mutex_lock(&sw->lock);
+	size_t refs = 0;
+	for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
+		if (sw->pt[k].state != 0 || sw->pt[k].mirrored)
+			continue;
+		sweep_job *job = malloc(sizeof *job);
+		if (!job)
+			continue;
+		job->sw = sw;
+		job->i = k;
+		srv_registry_hold(&sweeps, &sw->entry);
+		srv_budget_take_points(1, NULL, 1, NULL);
+		if (srv_pool_submit(run_point, job) != 0) {
+			free(job);
+			srv_budget_give_points(1);
+			refs++;
 		}
-		srv_sweep *sw = ok ? calloc(1, sizeof *sw) : NULL;
-		if (sw) {
-			pthread_mutex_init(&sw->lock, NULL);
-			sw->req = r.req;
-			sw->req.betas = malloc(nb ? nb : 1);
-			sw->pt = malloc(np ? np : 1);
-			r.id[SRV_ID_LEN - 1] = '\0';
-			snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
-		}
-		if (sw && sw->req.betas && sw->pt) {
-			memcpy(sw->req.betas, p + sizeof r, nb);
-			memcpy(sw->pt, p + sizeof r + nb, np);
-			sw->total = r.total;
-			sw->cancelled = r.cancelled;
-			sw->done = 0;
-			for (size_t k = 0; k < sw->total; k++) {
-				if (sw->pt[k].state == 1) /* was running */
-					sw->pt[k].state = 0;
-				sw->done += sw->pt[k].state >= 2;
-			}
-			/* the plan again; an image whose point is over is
-			 * filled (written together, but a stop may fall
-			 * between the two writes) */
-			int planned = plan(sw) == 0;
-			for (size_t k = 0; planned && k < sw->total; k++)
-				if (sw->pt[k].state >= 2)
-					fill_image(sw, k);
-			if (planned && srv_registry_reserve(&sweeps, &sw->entry, NULL) == 0) {
-				srv_registry_publish(&sweeps, &sw->entry);
-				pthread_mutex_lock(&sw->lock);
-				size_t refs = 0;
-				for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
-					if (sw->pt[k].state != 0 || sw->pt[k].mirrored)
-						continue;
-					sweep_job *job = malloc(sizeof *job);
-					if (!job)
-						continue;
-					job->sw = sw;
-					job->i = k;
-					srv_registry_hold(&sweeps, &sw->entry);
-					srv_budget_take_points(1, NULL, 1, NULL);
-					if (srv_pool_submit(run_point, job) != 0) {
-						free(job);
-						srv_budget_give_points(1);
-						refs++;
-					}
-				}
-				pthread_mutex_unlock(&sw->lock);
-				for (size_t k = 0; k < refs; k++)
-					srv_registry_put(&sweeps, &sw->entry);
-				srv_registry_put(&sweeps, &sw->entry);
-				count++;
-				sw = NULL;
-			}
-		} else if (!ok && p) {
-			snprintf(why, sizeof why, "%.200s: inconsistent", path);
-		}
-		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0)
-			srv_log(SRV_LOG_WARN, "sweep not restored: %s", why);
-		sweep_free(sw);
-		free(p);
 	}
-	free(names);
-	return count;
+	pthread_mutex_unlock(&sw->lock);
+	for (size_t k = 0; k < refs; k++)
+		srv_registry_put(&sweeps, &sw->entry);
 }
 
-void srv_sweeps_shutdown(void)
+/* A sweep from its record (taken), its points as they were: those that
+ * were running are pending again; NULL with the reason. */
+static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen)
 {
-	/* the pool has drained: only the registry's references remain */
-	srv_registry_clear(&sweeps);
+	char *p = payload;
+	sweep_record r;
+	size_t nb = 0, np = 0;
+	int ok = len >= sizeof r;
+	if (ok) {
+		memcpy(&r, p, sizeof r);
+		nb = (size_t)r.req.nbeta * sizeof(api_value);
+		np = r.total * sizeof(api_sweep_point);
+		ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
+		     r.total <= API_SWEEP_MAX_POINTS && len == sizeof r + nb + np;
+	}
+	if (!ok)
+		snprintf(why, whylen, "inconsistent");
+	srv_sweep *sw = ok ? calloc(1, sizeof *sw) : NULL;
+	if (sw) {
+		pthread_mutex_init(&sw->lock, NULL);
+		sw->req = r.req;
+		sw->req.betas = malloc(nb ? nb : 1);
+		sw->pt = malloc(np ? np : 1);
+		r.id[SRV_ID_LEN - 1] = '\0';
+		snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
+	}
+	int planned = 0;
+	if (sw && sw->req.betas && sw->pt) {
+		memcpy(sw->req.betas, p + sizeof r, nb);
+		memcpy(sw->pt, p + sizeof r + nb, np);
+		sw->total = r.total;
+		sw->cancelled = r.cancelled;
+		sw->done = 0;
+		for (size_t k = 0; k < sw->total; k++) {
+			if (sw->pt[k].state == 1) /* was running */
+				sw->pt[k].state = 0;
+			sw->done += sw->pt[k].state >= 2;
+		}
+		/* the plan again; an image whose point is over is filled
+		 * (written together, but a stop may fall between the two
+		 * writes) */
+		planned = plan(sw) == 0;
+		for (size_t k = 0; planned && k < sw->total; k++)
+			if (sw->pt[k].state >= 2)
+				fill_image(sw, k);
+	}
+	if (ok && !planned) {
+		snprintf(why, whylen, "out of memory");
+		sweep_free(sw);
+		sw = NULL;
+	}
+	free(p);
+	return sw ? &sw->entry : NULL;
 }
 
 static int evictable(srv_entry *en)
@@ -375,8 +351,9 @@ static int evictable(srv_entry *en)
 	return over;
 }
 
-/* A sweep for the body of r with its grid of points; NULL with *pb. */
-static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
+/* A sweep for a request body with its grid of points and their place in
+ * the points' budget; NULL with *pb. */
+static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 {
 	srv_sweep *sw = calloc(1, sizeof *sw);
 	if (!sw) {
@@ -384,7 +361,7 @@ static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
 		return NULL;
 	}
 	pthread_mutex_init(&sw->lock, NULL);
-	if (api_parse_sweep(r->body, r->body_len, &sw->req, pb) != API_OK) {
+	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK) {
 		sweep_free(sw);
 		return NULL;
 	}
@@ -408,7 +385,19 @@ static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
-	return sw;
+	if (srv_budget_take_points(sw->jobs, "beta", 0, pb) != API_OK) {
+		sweep_free(sw);
+		return NULL;
+	}
+	return &sw->entry;
+}
+
+/* A created sweep that was not kept: its points' budget goes back. */
+static void sweep_discard(srv_entry *en)
+{
+	srv_sweep *sw = sweep_of(en);
+	srv_budget_give_points(sw->jobs);
+	sweep_free(sw);
 }
 
 /* Queue one pool job per point that runs (not a mirror image), each with
@@ -438,25 +427,11 @@ static size_t submit_points(srv_sweep *sw)
 	return unused;
 }
 
-enum MHD_Result srv_h_sweeps_create(srv_req *r)
+/* Queue the points of a published sweep; the answer shows it queued. */
+static api_err sweep_start(srv_entry *en, char **answer, api_problem *pb)
 {
-	enum MHD_Result res;
-	api_problem pb;
-	srv_sweep *sw = sweep_new(r, &pb);
-	if (!sw)
-		return srv_reply_problem(r, &pb, NULL);
-	if (srv_budget_take_points(sw->jobs, "beta", 0, &pb) != API_OK) {
-		sweep_free(sw);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	if (srv_registry_reserve(&sweeps, &sw->entry, evictable)) {
-		srv_budget_give_points(sw->jobs);
-		sweep_free(sw);
-		return srv_fail(r, API_LIMIT, NULL,
-				"%d sweeps are running or kept; delete one",
-				cfg->max_sweeps);
-	}
-	srv_registry_publish(&sweeps, &sw->entry);
+	(void)pb;
+	srv_sweep *sw = sweep_of(en);
 	for (size_t i = 0; i < sw->jobs; i++)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */
 	/* jobs wait for the lock: the answer shows the sweep as queued */
@@ -465,71 +440,66 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 	size_t unused = submit_points(sw);
 	api_sweep_view v;
 	fill_view(sw, &v);
-	char *text = api_sweep_json(&v);
+	*answer = api_sweep_json(&v);
 	pthread_mutex_unlock(&sw->lock);
 	for (size_t i = 0; i < unused; i++)
 		srv_registry_put(&sweeps, &sw->entry);
 	srv_budget_give_points(unused);
-	res = srv_reply_created(r, 202, text, "/api/v1/sweeps", v.id);
-	srv_registry_put(&sweeps, &sw->entry);
-	return res;
+	return API_OK;
 }
 
-enum MHD_Result srv_h_sweep_get(srv_req *r)
+static char *sweep_text(srv_entry *en, int csv)
 {
-	srv_entry *en = srv_registry_get(&sweeps, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no sweep with id \"%.40s\"", r->arg[0]);
 	srv_sweep *sw = sweep_of(en);
 	api_sweep_view v;
 	pthread_mutex_lock(&sw->lock);
 	fill_view(sw, &v);
-	char *text = r->csv ? api_sweep_csv(&v) : api_sweep_json(&v);
+	char *text = csv ? api_sweep_csv(&v) : api_sweep_json(&v);
 	pthread_mutex_unlock(&sw->lock);
-	srv_registry_put(&sweeps, en);
-	return srv_reply_result(r, text);
+	return text;
 }
 
-enum MHD_Result srv_h_sweeps_list(srv_req *r)
+static void sweep_view(srv_entry *en, void *view, void *scratch)
 {
-	srv_entry **all = NULL;
-	size_t n = srv_registry_snapshot(&sweeps, &all);
-	api_sweep_view *v = calloc(n + 1, sizeof *v);
-	char *text = NULL;
-	if (v) {
-		for (size_t i = 0; i < n; i++) {
-			srv_sweep *sw = sweep_of(all[i]);
-			pthread_mutex_lock(&sw->lock);
-			fill_view(sw, &v[i]);
-			pthread_mutex_unlock(&sw->lock);
-		}
-		text = r->csv ? api_sweep_list_csv(v, n) : api_sweep_list_json(v, n);
-	}
-	srv_registry_release(&sweeps, all, n);
-	free(v);
-	return srv_peers_reply(r, text, "sweeps");
+	(void)scratch;
+	srv_sweep *sw = sweep_of(en);
+	pthread_mutex_lock(&sw->lock);
+	fill_view(sw, view);
+	pthread_mutex_unlock(&sw->lock);
 }
 
-enum MHD_Result srv_h_sweep_delete(srv_req *r)
+static char *sweep_list_text(const void *views, size_t n, int csv)
 {
-	srv_entry *en = srv_registry_get(&sweeps, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no sweep with id \"%.40s\"", r->arg[0]);
+	return csv ? api_sweep_list_csv(views, n) : api_sweep_list_json(views, n);
+}
+
+/* DELETE: the points not yet run are skipped. */
+static void sweep_cancel(srv_entry *en)
+{
 	srv_sweep *sw = sweep_of(en);
 	pthread_mutex_lock(&sw->lock);
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
 	pthread_mutex_unlock(&sw->lock);
-	if (srv_registry_remove(&sweeps, en) && srv_store_enabled()) {
-		/* the record and the result go with it */
-		char path[64];
-		snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
-		srv_store_remove(path);
-		snprintf(path, sizeof path, "sweep-%s.csv", sw->entry.id);
-		srv_store_remove(path);
-	}
-	srv_registry_put(&sweeps, en);
-	return srv_reply_empty(r);
 }
+
+const srv_job_kind srv_sweep_job = {
+	.name = "sweep",
+	.plural = "sweeps",
+	.reg = &sweeps,
+	.created_status = 202,
+	.limit = "sweeps are running or kept; delete one",
+	.store_kind = SRV_STORE_SWEEP,
+	.result_file = "sweep-%s.csv",
+	.create = sweep_create,
+	.discard = sweep_discard,
+	.start = sweep_start,
+	.evictable = evictable,
+	.text = sweep_text,
+	.view_size = sizeof(api_sweep_view),
+	.view = sweep_view,
+	.list_text = sweep_list_text,
+	.cancel = sweep_cancel,
+	.load = sweep_load,
+	.resume = sweep_resume,
+};
