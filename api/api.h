@@ -109,6 +109,8 @@ typedef struct api_problem {
 	char budget[24];   /* the budget that refused it ("memory", ...), "" */
 	double limit;      /* its limit, in the budget's unit */
 	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
+	int close;         /* 1: the answer closes its connection (a client
+			      over its connections' budget) */
 } api_problem;
 
 /* HTTP status of an api_err (500 for an unknown code). */

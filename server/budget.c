@@ -510,6 +510,7 @@ int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
 		 "close after %g s) and retry", cfg->max_client_connections,
 		 cfg->connection_timeout);
 	api_budget(pb, "connections", cfg->max_client_connections, 1);
+	pb->close = 1; /* one too many: the answer closes it */
 	return 1;
 }
 
