@@ -16,13 +16,13 @@
  */
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "cli.h"
+#include "pmap.h"
 #include "sim.h"
 #include "suggest.h"
 #include "table.h"
@@ -265,34 +265,32 @@ typedef struct pool {
 	const cli_opts *o;
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
-	int n, next, done;
+	int n, done;
 	cli_progress progress;
-	pthread_mutex_t lock;
 } pool;
 
-static void *worker(void *arg)
+/* Measure the k-th task to run (a job of the map). */
+static void measure_task(void *arg, size_t k)
 {
 	pool *pl = arg;
-	for (;;) {
-		pthread_mutex_lock(&pl->lock);
-		int i = pl->next < pl->n ? pl->run[pl->next++] : -1;
-		pthread_mutex_unlock(&pl->lock);
-		if (i < 0)
-			return NULL;
-		task *t = &pl->tasks[i];
-		sim_params p = pl->o->p;
-		p.beta = t->beta * RAD_PER_DEG;
-		p.rotation = t->rotation;
-		t->err = sim_measure(&p, &pl->o->sc, &pl->o->m, pl->o->duration, &t->r, t->msg,
-				     sizeof t->msg);
-		pthread_mutex_lock(&pl->lock);
-		pl->done++;
-		char detail[48];
-		snprintf(detail, sizeof detail, " (last: %g deg %s)", t->beta,
-			 t->rotation == SIM_CW ? "cw" : "ccw");
-		cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
-		pthread_mutex_unlock(&pl->lock);
-	}
+	task *t = &pl->tasks[pl->run[k]];
+	sim_params p = pl->o->p;
+	p.beta = t->beta * RAD_PER_DEG;
+	p.rotation = t->rotation;
+	t->err = sim_measure(&p, &pl->o->sc, &pl->o->m, pl->o->duration, &t->r, t->msg,
+			     sizeof t->msg);
+}
+
+/* The progress line after each task (the map calls it one at a time). */
+static void task_done(void *arg, size_t k, size_t done)
+{
+	pool *pl = arg;
+	const task *t = &pl->tasks[pl->run[k]];
+	pl->done = (int)done;
+	char detail[48];
+	snprintf(detail, sizeof detail, " (last: %g deg %s)", t->beta,
+		 t->rotation == SIM_CW ? "cw" : "ccw");
+	cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
 }
 
 /* The grid (rotation-major, like the daemon's) and its plan: which tasks
@@ -463,14 +461,8 @@ static int cmd_sweep(int argc, char **argv)
 		free(pl.run);
 		return 1;
 	}
-	pthread_mutex_init(&pl.lock, NULL);
 	cli_progress_start(&pl.progress, "sweep", o.quiet, 0);
-	pthread_t th[64];
-	int nth = o.threads < pl.n ? o.threads : pl.n;
-	for (int i = 0; i < nth; i++)
-		pthread_create(&th[i], NULL, worker, &pl);
-	for (int i = 0; i < nth; i++)
-		pthread_join(th[i], NULL);
+	pmap_run(o.threads, (size_t)pl.n, measure_task, &pl, task_done);
 	mirror_tasks(pl.tasks, ntasks);
 	char done[128];
 	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl.done, pl.n,
@@ -486,7 +478,6 @@ static int cmd_sweep(int argc, char **argv)
 		if (write_failed)
 			fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
 	}
-	pthread_mutex_destroy(&pl.lock);
 	free(pl.tasks);
 	free(pl.run);
 	return failed || write_failed ? 1 : 0;
