@@ -1,6 +1,6 @@
 /*
- * session_store.c - a session's files in the data directory and the
- * sessions rebuilt from them at start-up (README "Persistence").
+ * session_store.c - a session's files in the data directory, written and
+ * read back (README "Persistence"); session.c's restore calls it.
  *
  *   sessions/ID/spec.bin         the spec as created (framed, store.h)
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
@@ -165,12 +165,6 @@ void srv_persist_remove(const srv_session *s)
 
 /* ---- restore ------------------------------------------------------------ */
 
-/* The checkpoint of s from file (relative): restores s->sim, run state and
- * the experiment; 0, or -1 with why. */
-/* The experiments' registry, for the restore (srv_sessions_restore). */
-static srv_experiment *(*exp_find)(const char *id);
-static void (*exp_put)(srv_experiment *e);
-
 int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 		    size_t whylen)
 {
@@ -191,8 +185,11 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	return 0;
 }
 
-static int load_checkpoint(srv_session *s, const char *file, char *why,
-			   size_t whylen)
+/* The checkpoint of s from file (relative): restores s->sim, run state and
+ * the experiment (found with find, given back with put); 0, or -1 with
+ * why. */
+static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finder *ef,
+			   char *why, size_t whylen)
 {
 	size_t len;
 	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
@@ -220,13 +217,13 @@ static int load_checkpoint(srv_session *s, const char *file, char *why,
 	s->until = r.until;
 	snprintf(s->error, sizeof s->error, "%s", r.error);
 	if (r.exp_started && r.exp_len) {
-		srv_experiment *e = exp_find(r.exp_id);
+		srv_experiment *e = ef->find(r.exp_id);
 		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
 			s->exp = e;
 			s->exp_started = 1;
 		}
 		if (e)
-			exp_put(e); /* the registry keeps it */
+			ef->put(e); /* the registry keeps it */
 	}
 	rc = 0;
 done:
@@ -255,8 +252,7 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	return 0;
 }
 
-/* Build session id from its files into s (calloc'd, lock initialised). */
-static void restore_one(srv_session *s, const char *id)
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	char path[128], why[512] = "", why2[512] = "";
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
@@ -282,11 +278,11 @@ static void restore_one(srv_session *s, const char *id)
 	s->until = s->spec.until;
 	s->state = SRV_RUNNING;
 	session_dir(path, sizeof path, id, "checkpoint.bin");
-	if (load_checkpoint(s, path, why, sizeof why) == 0)
+	if (load_checkpoint(s, path, ef, why, sizeof why) == 0)
 		return;
 	char prev[160];
 	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, why2, sizeof why2) == 0) {
+	if (load_checkpoint(s, prev, ef, why2, sizeof why2) == 0) {
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
 		return;
@@ -305,32 +301,3 @@ static void restore_one(srv_session *s, const char *id)
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
-size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
-			    void (*put)(srv_experiment *e))
-{
-	if (!srv_store_enabled())
-		return 0;
-	exp_find = find;
-	exp_put = put;
-	char **names = NULL;
-	size_t n = srv_store_list("sessions", &names), count = 0;
-	for (size_t i = 0; i < n; i++) {
-		srv_session *s = calloc(1, sizeof *s);
-		if (s) {
-			pthread_mutex_init(&s->lock, NULL);
-			pthread_cond_init(&s->wake, NULL);
-			pthread_cond_init(&s->data, NULL);
-			restore_one(s, names[i]);
-			if (s->damaged)
-				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
-					s->error);
-			if (srv_session_adopt(s) == 0)
-				count++;
-		}
-		free(names[i]);
-	}
-	free(names);
-	/* all in first: the restore does not compete with running workers */
-	srv_sessions_start_restored();
-	return count;
-}
