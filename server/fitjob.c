@@ -342,26 +342,23 @@ static api_err fit_start(srv_entry *en, char **answer, api_problem *pb)
 	return API_OK;
 }
 
+static pthread_mutex_t *fit_lock(srv_entry *en)
+{
+	return &fit_of(en)->lock;
+}
+
 static char *fit_text(srv_entry *en, int csv)
 {
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
-	pthread_mutex_lock(&f->lock);
 	fill_view(f, &v);
-	char *text = !csv ? api_fit_json(&v)
-		     : f->csv ? strdup(f->csv)
-			      : strdup(FIT_CSV_HEADER "\n");
-	pthread_mutex_unlock(&f->lock);
-	return text;
+	return !csv ? api_fit_json(&v) : f->csv ? strdup(f->csv) : strdup(FIT_CSV_HEADER "\n");
 }
 
 static void fit_view(srv_entry *en, void *view, void *scratch)
 {
 	(void)scratch;
-	srv_fit *f = fit_of(en);
-	pthread_mutex_lock(&f->lock);
-	fill_view(f, view);
-	pthread_mutex_unlock(&f->lock);
+	fill_view(fit_of(en), view);
 }
 
 static char *fit_list_text(const void *views, size_t n, int csv)
@@ -372,10 +369,7 @@ static char *fit_list_text(const void *views, size_t n, int csv)
 /* DELETE: the driver's evaluations return at once. */
 static void fit_cancel(srv_entry *en)
 {
-	srv_fit *f = fit_of(en);
-	pthread_mutex_lock(&f->lock);
-	f->cancelled = 1;
-	pthread_mutex_unlock(&f->lock);
+	fit_of(en)->cancelled = 1;
 }
 
 /* A fit from its record (taken): over with its progress and result, or
@@ -442,6 +436,7 @@ const srv_job_kind srv_fit_job = {
 	.discard = fit_discard,
 	.start = fit_start,
 	.evictable = evictable,
+	.lock = fit_lock,
 	.text = fit_text,
 	.view_size = sizeof(api_fit_view),
 	.view = fit_view,

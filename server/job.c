@@ -96,6 +96,19 @@ static void forget(const srv_job_kind *kind, const char *id)
 	}
 }
 
+/* The job's lock around a hook, when its kind has one. */
+static void job_lock(const srv_job_kind *kind, srv_entry *e)
+{
+	if (kind->lock)
+		pthread_mutex_lock(kind->lock(e));
+}
+
+static void job_unlock(const srv_job_kind *kind, srv_entry *e)
+{
+	if (kind->lock)
+		pthread_mutex_unlock(kind->lock(e));
+}
+
 static enum MHD_Result not_found(srv_req *r)
 {
 	return srv_fail(r, API_NOTFOUND, NULL, "no %s with id \"%.40s\"", r->job->name,
@@ -133,7 +146,9 @@ enum MHD_Result srv_h_job_get(srv_req *r)
 	srv_entry *e = srv_registry_get(r->job->reg, r->arg[0]);
 	if (!e)
 		return not_found(r);
+	job_lock(r->job, e);
 	char *text = r->job->text(e, r->csv);
+	job_unlock(r->job, e);
 	srv_registry_put(r->job->reg, e);
 	return srv_reply_result(r, text);
 }
@@ -147,9 +162,12 @@ enum MHD_Result srv_h_job_list(srv_req *r)
 	char *scratch = calloc(n + 1, kind->scratch_size ? kind->scratch_size : 1);
 	char *text = NULL;
 	if (views && scratch) {
-		for (size_t i = 0; i < n; i++)
+		for (size_t i = 0; i < n; i++) {
+			job_lock(kind, all[i]);
 			kind->view(all[i], views + i * kind->view_size,
 				   scratch + i * kind->scratch_size);
+			job_unlock(kind, all[i]);
+		}
 		text = kind->list_text(views, n, r->csv);
 	}
 	srv_registry_release(kind->reg, all, n);
@@ -164,7 +182,9 @@ enum MHD_Result srv_h_job_delete(srv_req *r)
 	srv_entry *e = srv_registry_get(kind->reg, r->arg[0]);
 	if (!e)
 		return not_found(r);
+	job_lock(kind, e);
 	kind->cancel(e);
+	job_unlock(kind, e);
 	if (srv_registry_remove(kind->reg, e))
 		forget(kind, e->id);
 	srv_registry_put(kind->reg, e);

@@ -9,13 +9,14 @@
  * checklist.
  *
  * A job embeds a srv_entry (registry.h) and lives in its kind's registry;
- * the hooks below receive that entry. Hooks that read a job take its own
- * lock inside; none is called with a registry lock held, except
- * evictable (registry.h's lock order).
+ * the hooks below receive that entry. text, view and cancel run under the
+ * job's own lock (the lock hook's) when it has one; no hook is called with
+ * a registry lock held, except evictable (registry.h's lock order).
  */
 #ifndef CONVSIM_JOB_H
 #define CONVSIM_JOB_H
 
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -45,6 +46,9 @@ typedef struct srv_job_kind {
 	api_err (*start)(srv_entry *e, char **answer, api_problem *pb);
 	/* 1 when the registry may push it out (over); registry lock held. */
 	int (*evictable)(srv_entry *e);
+	/* The job's own lock, which job.c holds around text, view and
+	 * cancel; NULL: those hooks take what they need themselves. */
+	pthread_mutex_t *(*lock)(srv_entry *e);
 	/* One job as JSON or CSV (malloc'd), from a consistent state. */
 	char *(*text)(srv_entry *e, int csv);
 	/* A listing: view copies one job into view (view_size bytes, zeroed)

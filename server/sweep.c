@@ -11,7 +11,8 @@
  * jobs drain; beyond --max-sweeps the oldest finished one is evicted. A
  * sweep's fields are guarded by its own lock. Results are served as JSON
  * or CSV and, with --data-dir, saved as CSV when done. The sweep is
- * one kind of job (job.h): srv_sweep_job below is its descriptor.
+ * one kind of job (job.h): srv_sweep_job below is its descriptor. The
+ * mirror reduction's plan of its points is sweep_plan.c.
  */
 #include <pthread.h>
 #include <stdio.h>
@@ -24,20 +25,8 @@
 #include "pool.h"
 #include "registry.h"
 #include "store.h"
+#include "sweep_int.h"
 #include "util.h"
-
-typedef struct srv_sweep {
-	srv_entry entry;       /* id and references: the registry */
-	pthread_mutex_t lock;
-	/* guarded by lock */
-	api_sweep_req req;
-	api_sweep_point *pt;
-	long *image;           /* the point derived from point i, or -1 */
-	size_t total, done;
-	size_t jobs;           /* points that run (the others are images) */
-	int running, cancelled;
-	char store_error[256];  /* a write failed: state "error" */
-} srv_sweep;
 
 typedef struct sweep_job {
 	srv_sweep *sw;
@@ -160,57 +149,6 @@ static void save_results(const srv_sweep *sw)
 				strdup(sw->entry.id));
 }
 
-/* The mirror reduction's plan of the sweep's points: which are mirror
- * images of which (sw->image, sw->jobs, each point's `mirrored`). The
- * plan depends only on the request, so a restart makes it again. 0, or
- * -1 when out of memory. */
-static int plan(srv_sweep *sw)
-{
-	size_t n = sw->total;
-	double *beta = malloc(sizeof *beta * (n ? n : 1));
-	int *rot = malloc(sizeof *rot * (n ? n : 1));
-	long *source = malloc(sizeof *source * (n ? n : 1));
-	sw->image = malloc(sizeof *sw->image * (n ? n : 1));
-	int rc = beta && rot && source && sw->image ? 0 : -1;
-	for (size_t i = 0; rc == 0 && i < n; i++) {
-		beta[i] = sw->pt[i].beta.si;
-		rot[i] = sw->pt[i].rotation;
-		sw->image[i] = -1;
-	}
-	if (rc == 0) {
-		sw->jobs = sim_mirror_plan(&sw->req.spec.params, &sw->req.spec.scene, n, beta,
-					   rot, source);
-		for (size_t i = 0; i < n; i++) {
-			sw->pt[i].mirrored = source[i] >= 0;
-			if (source[i] >= 0)
-				sw->image[source[i]] = (long)i;
-		}
-	}
-	free(beta);
-	free(rot);
-	free(source);
-	return rc;
-}
-
-/* Point i is over (done or failed): its mirror image, if it has one, is
- * too (lock held). */
-static void fill_image(srv_sweep *sw, size_t i)
-{
-	long j = sw->image[i];
-	if (j < 0 || sw->pt[j].state >= 2)
-		return;
-	const api_sweep_point *src = &sw->pt[i];
-	api_sweep_point *p = &sw->pt[j];
-	p->state = src->state;
-	p->velocity = -src->velocity;
-	p->uncertainty = src->uncertainty;
-	p->steady = src->steady;
-	if (src->state == 3)
-		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
-				   src->error);
-	sw->done++;
-}
-
 static void run_point(void *arg)
 {
 	sweep_job *job = arg;
@@ -248,7 +186,7 @@ static void run_point(void *arg)
 				 msg[0] ? msg : sim_strerror(rc));
 		}
 		sw->done++;
-		fill_image(sw, job_i);
+		srv_sweep_fill_image(sw, job_i);
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
 		persist_locked(sw);
 		if (sw->done == sw->total)
@@ -328,10 +266,10 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 		/* the plan again; an image whose point is over is filled
 		 * (written together, but a stop may fall between the two
 		 * writes) */
-		planned = plan(sw) == 0;
+		planned = srv_sweep_plan(sw) == 0;
 		for (size_t k = 0; planned && k < sw->total; k++)
 			if (sw->pt[k].state >= 2)
-				fill_image(sw, k);
+				srv_sweep_fill_image(sw, k);
 	}
 	if (ok && !planned) {
 		snprintf(why, whylen, "out of memory");
@@ -380,7 +318,7 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 			p->beta = sw->req.betas[b];
 			p->rotation = sw->req.rotations[ro];
 		}
-	if (plan(sw) != 0) {
+	if (srv_sweep_plan(sw) != 0) {
 		sweep_free(sw);
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
@@ -420,7 +358,7 @@ static size_t submit_points(srv_sweep *sw)
 			snprintf(sw->pt[i].error, sizeof sw->pt[i].error,
 				 "not queued (out of memory or stopping)");
 			sw->done++;
-			fill_image(sw, i);
+			srv_sweep_fill_image(sw, i);
 			unused++;
 		}
 	}
@@ -448,24 +386,22 @@ static api_err sweep_start(srv_entry *en, char **answer, api_problem *pb)
 	return API_OK;
 }
 
+static pthread_mutex_t *sweep_lock(srv_entry *en)
+{
+	return &sweep_of(en)->lock;
+}
+
 static char *sweep_text(srv_entry *en, int csv)
 {
-	srv_sweep *sw = sweep_of(en);
 	api_sweep_view v;
-	pthread_mutex_lock(&sw->lock);
-	fill_view(sw, &v);
-	char *text = csv ? api_sweep_csv(&v) : api_sweep_json(&v);
-	pthread_mutex_unlock(&sw->lock);
-	return text;
+	fill_view(sweep_of(en), &v);
+	return csv ? api_sweep_csv(&v) : api_sweep_json(&v);
 }
 
 static void sweep_view(srv_entry *en, void *view, void *scratch)
 {
 	(void)scratch;
-	srv_sweep *sw = sweep_of(en);
-	pthread_mutex_lock(&sw->lock);
-	fill_view(sw, view);
-	pthread_mutex_unlock(&sw->lock);
+	fill_view(sweep_of(en), view);
 }
 
 static char *sweep_list_text(const void *views, size_t n, int csv)
@@ -477,10 +413,8 @@ static char *sweep_list_text(const void *views, size_t n, int csv)
 static void sweep_cancel(srv_entry *en)
 {
 	srv_sweep *sw = sweep_of(en);
-	pthread_mutex_lock(&sw->lock);
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
-	pthread_mutex_unlock(&sw->lock);
 }
 
 const srv_job_kind srv_sweep_job = {
@@ -495,6 +429,7 @@ const srv_job_kind srv_sweep_job = {
 	.discard = sweep_discard,
 	.start = sweep_start,
 	.evictable = evictable,
+	.lock = sweep_lock,
 	.text = sweep_text,
 	.view_size = sizeof(api_sweep_view),
 	.view = sweep_view,
