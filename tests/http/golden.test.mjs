@@ -211,3 +211,22 @@ test('every job route answers as recorded, and the data directory holds the same
   assert.deepEqual(got.files, want.files, 'the data directory');
   assert.deepEqual(got.files_after_deletes, want.files_after_deletes, 'the data directory after the deletes');
 });
+
+// docs/jobs.md's table of the descriptor names every field of
+// srv_job_kind (server/job.h), and nothing else.
+test('docs/jobs.md lists the job descriptor\'s fields as server/job.h has them', () => {
+  const header = readFileSync(fileURLToPath(new URL('../../server/job.h', import.meta.url)), 'utf8');
+  const body = header.match(/typedef struct srv_job_kind \{([\s\S]*?)\} srv_job_kind;/)[1]
+    .replace(/\/\*[\s\S]*?\*\//g, '');
+  const fields = [];
+  for (const decl of body.split(';')) {
+    const fn = decl.match(/\(\*(\w+)\)/);
+    if (fn) { fields.push(fn[1]); continue; }
+    const names = decl.replace(/^[^*\w]*(const\s+)?[\w ]+?\s+(?=[*\w]+\s*(,|$))/, '').split(',');
+    for (const n of names) if (n.trim()) fields.push(n.trim().replace(/^\*+/, ''));
+  }
+  const doc = readFileSync(fileURLToPath(new URL('../../docs/jobs.md', import.meta.url)), 'utf8');
+  const table = doc.split('## The descriptor')[1].split('\n## ')[0];
+  const documented = [...table.matchAll(/^\| `(\w+)`/gm)].map((m) => m[1]);
+  assert.deepEqual(documented, fields);
+});
