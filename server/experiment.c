@@ -13,7 +13,8 @@
  * from the command until the feed velocity first reaches 90 % of that
  * steady value. Fields are guarded by the experiment's lock, taken inside
  * the session lock by the worker's hooks and alone by the handlers (lock
- * order: registry.h).
+ * order: registry.h). A segment's start and its measurements at its end
+ * are experiment_segment.c.
  */
 #include <math.h>
 #include <pthread.h>
@@ -22,38 +23,9 @@
 #include <string.h>
 
 #include "experiment.h"
+#include "experiment_int.h"
 #include "store.h"
 #include "util.h"
-
-enum {
-	EXP_WAITING,
-	EXP_RUNNING,
-	EXP_DONE,
-	EXP_ABORTED,
-	EXP_INTERRUPTED, /* running when the daemon died, not resumed */
-	EXP_ERROR,       /* its result could not be written */
-	EXP_NSTATES
-};
-
-struct srv_experiment {
-	srv_entry entry;         /* id and references: experiment_http.c */
-	const char *data_dir;    /* borrowed; NULL: results are not saved */
-	pthread_mutex_t lock;
-	/* guarded by lock */
-	char session_id[SRV_ID_LEN];
-	api_experiment_req req;  /* schedule and per-segment results */
-	int state;
-	int attached;            /* a session worker still refers to it */
-	char error[256];
-	double t0, t_now;        /* s: start and latest simulated time */
-	int cur;                 /* running segment */
-	double *rec_t, *rec_v;   /* feed velocity record */
-	size_t rec_n, rec_cap, seg_first;
-	double rec_spacing;      /* s between records, at least */
-	srv_cmd cmd;             /* the running segment's command */
-	int writes;              /* queued store writes (they refer to e) */
-	int freed;               /* srv_exp_free came while writes > 0 */
-};
 
 #define EXP_RECORDS 50000
 
@@ -145,59 +117,6 @@ int srv_exp_finished(srv_experiment *e)
 	int over = !e->attached && e->state >= EXP_DONE;
 	pthread_mutex_unlock(&e->lock);
 	return over;
-}
-
-/* Start segment i at status st (lock held): its command for the worker. */
-static srv_cmd *start_segment(srv_experiment *e, int i, const sim_status *st)
-{
-	api_segment *seg = &e->req.seg[i];
-	srv_cmd *cmd = &e->cmd;
-	memset(cmd, 0, sizeof *cmd);
-	cmd->c.set = API_C_BETA;
-	cmd->c.beta = seg->beta;
-	if (e->req.beta_rate.si > 0) {
-		cmd->c.set |= API_C_BETA_RATE;
-		cmd->c.beta_rate = e->req.beta_rate;
-	}
-	cmd->restart_transport = 1;
-	cmd->from_experiment = 1;
-	seg->start_velocity = st->feed_velocity;
-	seg->state = 1;
-	e->cur = i;
-	e->seg_first = e->rec_n;
-	return cmd;
-}
-
-static void finish_segment(srv_experiment *e, const sim_status *st)
-{
-	api_segment *seg = &e->req.seg[e->cur];
-	seg->t_end = st->t;
-	/* the estimator restarted at the segment's command */
-	seg->mean_velocity = st->transport_velocity;
-	seg->uncertainty = st->transport_velocity_uncertainty;
-	seg->steady = st->steady;
-	double half = seg->t_command + 0.5 * (seg->t_end - seg->t_command);
-	double sum = 0;
-	size_t n = 0;
-	for (size_t i = e->seg_first; i < e->rec_n; i++)
-		if (e->rec_t[i] >= half) {
-			sum += e->rec_v[i];
-			n++;
-		}
-	double steady = n ? sum / (double)n : NAN;
-	seg->steady_velocity = steady;
-	seg->reversal_time = NAN;
-	if (isfinite(steady) && steady != 0)
-		for (size_t i = e->seg_first; i < e->rec_n; i++) {
-			double v = e->rec_v[i];
-			if (e->rec_t[i] >= seg->t_command &&
-			    (steady > 0 ? v >= 0.9 * steady
-					: v <= 0.9 * steady)) {
-				seg->reversal_time = e->rec_t[i] - seg->t_command;
-				break;
-			}
-		}
-	seg->state = 2;
 }
 
 /* The feed-velocity record is only needed while running (lock held). */
@@ -461,7 +380,7 @@ srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 	e->t0 = e->t_now = st->t;
 	e->state = EXP_RUNNING;
 	*t_end = e->t0 + exp_end(e);
-	srv_cmd *cmd = start_segment(e, 0, st);
+	srv_cmd *cmd = srv_exp_start_segment(e, 0, st);
 	pthread_mutex_unlock(&e->lock);
 	return cmd;
 }
@@ -486,9 +405,9 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 		e->rec_v[e->rec_n++] = st->feed_velocity;
 	}
 	if (st->t >= srv_exp_boundary(e) - 1e-9) {
-		finish_segment(e, st);
+		srv_exp_finish_segment(e, st);
 		if (e->cur + 1 < e->req.nseg) {
-			cmd = start_segment(e, e->cur + 1, st);
+			cmd = srv_exp_start_segment(e, e->cur + 1, st);
 		} else {
 			e->state = EXP_DONE;
 			e->attached = 0;
