@@ -115,11 +115,7 @@ void srv_cpu_leave(srv_cpu_turn *t);
 /* Slots in use, sessions waiting. */
 void srv_cpu_counts(int *busy, int *waiting);
 
-/* ---- connections per client (budget_clients.c) ---------------------------- */
-
-/* Start counting (cfg borrowed for the daemon's life; srv_budget_init
- * calls it). */
-void srv_budget_clients_init(const srv_config *cfg);
+/* ---- connections per client ------------------------------------------------- */
 
 /* Connections a client may open beyond its budget that still get a 429
  * with a body; libmicrohttpd closes any further ones at accept
