@@ -217,8 +217,12 @@ test('experiment at a clockwise peak: the segment\'s mean velocity, its error ba
     keep_session: true,
   });
   assert.equal(r.status, 201, r.text);
-  assert.equal(r.body.segments[0].uncertainty, null);
-  assert.equal(r.body.segments[0].steady, null);
+  // the answer is written once its session runs, which may have ended the
+  // segment already (4 s of the defaults take milliseconds)
+  if (r.body.segments[0].state !== 'done') {
+    assert.equal(r.body.segments[0].uncertainty, null);
+    assert.equal(r.body.segments[0].steady, null);
+  }
   const done = await until(async () => {
     const g = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`);
     return ['done', 'aborted'].includes(g.body.state) && g.body;
