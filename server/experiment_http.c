@@ -62,8 +62,8 @@ size_t srv_experiments_interrupt_orphans(void)
 	return count;
 }
 
-/* Run e on a fresh session or attach it to the one it names; the session's
- * id is noted in e. */
+/* Run e on a fresh session or attach it to the one it names; the session
+ * notes its id in e before its worker can run it. */
 static api_err start_on_session(srv_experiment *e,
 				const api_experiment_req *req, api_problem *pb)
 {
@@ -83,8 +83,7 @@ static api_err start_on_session(srv_experiment *e,
 			return pb->code;
 		}
 	}
-	srv_exp_set_session(e, srv_session_id(s));
-	srv_session_put(s);
+	srv_session_put(s); /* it noted its id in e before its worker ran */
 	return API_OK;
 }
 

@@ -186,6 +186,8 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 		goto fail;
 	s->exp = exp;
 	s->owned = exp && !srv_exp_keeps_session(exp);
+	if (exp) /* before its worker can end it and write its result */
+		srv_exp_set_session(exp, s->entry.id);
 	s->last_access = s->ckpt_wall = srv_now();
 	s->ckpt_dirty = 1;
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
@@ -430,6 +432,7 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	else {
 		s->exp = e;
 		s->exp_started = 0;
+		srv_exp_set_session(e, s->entry.id);
 		pthread_cond_broadcast(&s->wake);
 	}
 	pthread_mutex_unlock(&s->lock);

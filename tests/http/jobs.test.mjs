@@ -273,3 +273,33 @@ test('--data-dir keeps finished sweeps and experiments', { timeout: 60000 * SLOW
     rmSync(dir, { recursive: true, force: true });
   }
 });
+
+// An experiment short enough to end before its creation's answer is
+// written still names its session in its saved result, on a fresh session
+// and on an existing one (the session notes itself before its worker runs).
+test('a short experiment\'s saved result names its session', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-'));
+  const dd = await startDaemon(['--data-dir', dir]);
+  try {
+    const host = await req(dd.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 'max', until: 0.05 });
+    assert.equal(host.status, 201, host.text);
+    await until(async () => (await req(dd.base, 'GET', `/api/v1/sessions/${host.body.id}`)).body.state === 'finished', 20000, 'the session');
+    const made = [];
+    for (let i = 0; i < 12; i++) {
+      const ex = await req(dd.base, 'POST', '/api/v1/experiments', { session: { ...NO_FEED }, schedule: [{ beta: 50, until: 0.05 }] });
+      assert.equal(ex.status, 201, ex.text);
+      made.push(ex.body);
+    }
+    const on = await req(dd.base, 'POST', '/api/v1/experiments', { session: host.body.id, schedule: [{ beta: 60, until: 0.05 }], keep_session: true });
+    assert.equal(on.status, 201, on.text);
+    made.push(on.body);
+    for (const ex of made) {
+      const file = join(dir, `experiment-${ex.id}.json`);
+      await until(() => existsSync(file), 20000, `experiment-${ex.id}.json`);
+      assert.equal(JSON.parse(readFileSync(file, 'utf8')).session, ex.session, file);
+    }
+  } finally {
+    assert.equal((await dd.stop()).code, 0, dd.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
