@@ -188,9 +188,12 @@ static void run_point(void *arg)
 		sw->done++;
 		srv_sweep_fill_image(sw, job_i);
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
-		persist_locked(sw);
-		if (sw->done == sw->total)
-			save_results(sw);
+		/* a deleted sweep's files are gone: none are written again */
+		if (!sw->cancelled) {
+			persist_locked(sw);
+			if (sw->done == sw->total)
+				save_results(sw);
+		}
 		pthread_mutex_unlock(&sw->lock);
 	}
 	srv_budget_point_done(skip ? 0 : srv_now() - started);

@@ -303,3 +303,29 @@ test('a short experiment\'s saved result names its session', { timeout: 60000 * 
     rmSync(dir, { recursive: true, force: true });
   }
 });
+
+// A sweep deleted while its points run stays deleted: the points that were
+// running when it went write no record of it again, so a restart does not
+// bring it back.
+test('a sweep deleted while its points run leaves no record behind', { timeout: 120000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-'));
+  let dd = await startDaemon(['--data-dir', dir]);
+  try {
+    // points of a few tenths of a second each (600 s of the defaults)
+    const sw = await req(dd.base, 'POST', '/api/v1/sweeps', { beta: [10, 30, 50, 70, 90, 110], rotations: ['cw'], t_end: 600 });
+    assert.equal(sw.status, 202, sw.text);
+    const path = `/api/v1/sweeps/${sw.body.id}`;
+    await until(async () => (await req(dd.base, 'GET', path)).body.state === 'running', 20000, 'a point to run');
+    assert.equal((await req(dd.base, 'DELETE', path, undefined, { 'Content-Type': 'application/json' })).status, 204);
+    // the points that were running end (the others are skipped)
+    await until(async () => (await req(dd.base, 'GET', '/api/v1/health')).body.pool_queued === 0, 60000, 'the pool to drain');
+    await new Promise((res) => setTimeout(res, 5000 * SLOW)); // and the ones running then
+    assert.equal((await dd.stop()).code, 0, dd.stderr());
+    assert.ok(!existsSync(join(dir, 'sweeps', `${sw.body.id}.bin`)), 'the record is gone');
+    dd = await startDaemon(['--data-dir', dir]);
+    assert.equal((await req(dd.base, 'GET', path)).status, 404);
+  } finally {
+    await dd.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
