@@ -3,7 +3,7 @@
  *
  * A fit is one driver thread running the fitting module's fit_run (the
  * Levenberg-Marquardt loop, which mostly waits) whose model evaluations go
- * to the worker pool as jobs, a batch at a time (the map function below),
+ * to the worker pool as jobs, a batch at a time (srv_pool_map, pool.c),
  * so fits and sweeps share the pool's threads. Fits live in a registry
  * (registry.c) like sweeps: the registry holds one reference, the driver
  * one; DELETE cancels (the driver's evaluations then return at once and
@@ -98,63 +98,6 @@ static void fill_view(const srv_fit *f, api_fit_view *v)
 	if (!f->has_pr)
 		v->pr.phase = NULL, v->pr.cost = NAN;
 	v->result = f->json;
-}
-
-/* ---- the pool as the fit's map ------------------------------------------ */
-
-typedef struct batch {
-	pthread_mutex_t lock;
-	pthread_cond_t done;
-	size_t left;
-	fit_job job;
-	void *arg;
-} batch;
-
-typedef struct batch_item {
-	batch *b;
-	size_t i;
-} batch_item;
-
-static void batch_finish(batch *b)
-{
-	pthread_mutex_lock(&b->lock);
-	if (--b->left == 0)
-		pthread_cond_signal(&b->done);
-	pthread_mutex_unlock(&b->lock);
-}
-
-static void run_item(void *arg)
-{
-	batch_item *it = arg;
-	batch *b = it->b;
-	size_t i = it->i;
-	free(it);
-	b->job(b->arg, i); /* cheap when cancelled or stopping: it checks */
-	batch_finish(b);
-}
-
-/* Every job of the batch on the pool (inline when it cannot take one);
- * returns when all are done. */
-static void pool_map(void *ctx, size_t n, fit_job job, void *arg)
-{
-	(void)ctx;
-	batch b = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, n, job, arg};
-	for (size_t i = 0; i < n; i++) {
-		batch_item *it = malloc(sizeof *it);
-		if (it)
-			*it = (batch_item){&b, i};
-		if (!it || srv_pool_submit(run_item, it) != 0) {
-			free(it);
-			job(arg, i);
-			batch_finish(&b);
-		}
-	}
-	pthread_mutex_lock(&b.lock);
-	while (b.left)
-		pthread_cond_wait(&b.done, &b.lock);
-	pthread_mutex_unlock(&b.lock);
-	pthread_mutex_destroy(&b.lock);
-	pthread_cond_destroy(&b.done);
 }
 
 static int is_cancelled(void *ctx)
@@ -306,7 +249,7 @@ static srv_fit *fit_new(const char *body, size_t len, api_problem *pb)
 	memcpy(f->body, body, len);
 	f->body[len] = '\0';
 	f->body_len = len;
-	f->req.map = pool_map;
+	f->req.map = srv_pool_map;
 	f->req.progress = on_progress;
 	f->req.cancelled = is_cancelled;
 	f->req.ctx = f;
