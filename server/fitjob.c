@@ -162,8 +162,10 @@ static void persist_locked(const srv_fit *f)
 		return;
 	memcpy(p, &r, sizeof r);
 	memcpy(p + sizeof r, f->body, r.body_len);
-	memcpy(p + sizeof r + r.body_len, f->json, r.json_len);
-	memcpy(p + sizeof r + r.body_len + r.json_len, f->csv, r.csv_len);
+	if (r.json_len) /* none until over */
+		memcpy(p + sizeof r + r.body_len, f->json, r.json_len);
+	if (r.csv_len)
+		memcpy(p + sizeof r + r.body_len + r.json_len, f->csv, r.csv_len);
 	srv_job_save(&srv_fit_job, f->entry.id, p, n, NULL, NULL);
 	free(p);
 }
