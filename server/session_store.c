@@ -187,14 +187,19 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 
 /* The checkpoint of s from file (relative): restores s->sim, run state and
  * the experiment (found with find, given back with put); 0, or -1 with
- * why. */
+ * why and *unread set when the file could not be read at all (missing). */
 static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finder *ef,
-			   char *why, size_t whylen)
+			   int *unread, char *why, size_t whylen)
 {
-	size_t len;
-	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
-	if (!p)
+	size_t n = 0, len;
+	char *raw = srv_store_read_text(file, &n);
+	const char *bad = "missing or unreadable";
+	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &bad) : NULL;
+	*unread = !raw;
+	if (!p) {
+		snprintf(why, whylen, "%s: %s", file, bad);
 		return -1;
+	}
 	srv_ckpt_record r;
 	int rc = -1;
 	char msg[256] = "";
@@ -278,16 +283,17 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	s->until = s->spec.until;
 	s->state = SRV_RUNNING;
 	session_dir(path, sizeof path, id, "checkpoint.bin");
-	if (load_checkpoint(s, path, ef, why, sizeof why) == 0)
+	int unread = 0, unread_prev = 0;
+	if (load_checkpoint(s, path, ef, &unread, why, sizeof why) == 0)
 		return;
 	char prev[160];
 	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, ef, why2, sizeof why2) == 0) {
+	if (load_checkpoint(s, prev, ef, &unread_prev, why2, sizeof why2) == 0) {
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
 		return;
 	}
-	int none = strstr(why, "missing") && strstr(why2, "missing");
+	int none = unread && unread_prev;
 	if (none) { /* created less than one interval before the crash */
 		char msg[256] = "";
 		int err;
