@@ -1,17 +1,14 @@
 /*
- * experiment_http.c - the experiment resources: POST/GET
- * /api/v1/experiments and GET /api/v1/experiments/{id}.
+ * experiment_http.c - the experiments as a kind of job: their registry and
+ * the descriptor the handlers of /api/v1/experiments[/{id}] use (job.c).
  *
  * Experiments are kept in a registry until shutdown; beyond
  * --max-experiments the oldest finished one that no worker refers to is
  * evicted. Creating one either creates a fresh session with the
  * experiment attached before its first step, or attaches it to a running
- * session; the session's worker then runs it (experiment.c). The
- * experiment is one kind of job (job.h): srv_experiment_job below is its
- * descriptor.
+ * session; the session's worker then runs it (experiment.c).
  */
 #include <stdlib.h>
-#include <string.h>
 
 #include "experiment.h"
 #include "experiment_http.h"
