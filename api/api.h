@@ -10,7 +10,9 @@
  * shortest of %.15g/%.16g/%.17g that parses back to the same value);
  * non-finite values are written as null. Nothing here keeps state or
  * aborts on bad input: errors are reported as api_problem values that
- * map to an HTTP status and an RFC 9457 problem+json body.
+ * map to an HTTP status and an RFC 9457 problem+json body. The jobs'
+ * part (experiments, sweeps, fits, listings) is api_jobs.h, which this
+ * header includes.
  */
 #ifndef CONVSIM_API_H
 #define CONVSIM_API_H
@@ -116,6 +118,8 @@ typedef struct api_problem {
 	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
 	int has_position;  /* a malformed body: the byte where it goes wrong */
 	size_t position;
+	int close;         /* 1: the answer closes its connection (a client
+			      over its connections' budget) */
 } api_problem;
 
 /* HTTP status of an api_err (500 for an unknown code). */
@@ -402,165 +406,6 @@ void api_history_row(const sim_status *st, const double *column_disp, int column
 char *api_trajectory_json(const double *rows, size_t n, int columns, double stride);
 char *api_trajectory_csv(const double *rows, size_t n, int columns);
 
-/* ---- experiments --------------------------------------------------------- */
-
-#define API_EXP_MAX_SEGMENTS 32
-typedef struct api_segment {
-	api_value beta;         /* rad (deg as sent) commanded at the start */
-	double until;           /* s after the experiment start */
-	/* results, filled by the server */
-	int state;              /* 0 pending, 1 running, 2 done */
-	int beta_same;          /* 1: beta was already there at the command,
-				 * so there is no reversal to time (fills the
-				 * padding: saved records keep their size) */
-	double t_command;       /* s simulated time of the beta command */
-	double t_end;           /* s */
-	double steady_velocity; /* m/s mean feed velocity, last half */
-	double mean_velocity;   /* m/s transport estimate over the segment */
-	double uncertainty;     /* m/s error bar of mean_velocity; NaN if none */
-	int steady;             /* the estimate showed no drift at the end */
-	double reversal_time;   /* s command -> 90 % of steady; NaN if never or
-				 * without a beta change (beta_same) */
-	double start_velocity;  /* m/s feed velocity at the command */
-} api_segment;
-
-typedef struct api_experiment_req {
-	int fresh;              /* 1: create a session from spec */
-	api_spec spec;
-	char session_id[24];    /* fresh == 0 */
-	api_value beta_rate;    /* rad/s (deg/s as sent), 0 = keep */
-	int keep_session;       /* a fresh session stays after the end */
-	int nseg;
-	api_segment seg[API_EXP_MAX_SEGMENTS];
-} api_experiment_req;
-
-/* Parse POST /experiments: {"session": ID} or {"session": {create body}}
- * (or none: a fresh czubak2016 session at pace "max"), "schedule":
- * [{"beta": DEG, "until": S}, ...] with increasing until, optional
- * "beta_rate" and "keep_session" (a fresh session is removed when the
- * experiment ends unless true). Returns API_OK or the error in *pb. */
-api_err api_parse_experiment(const char *body, size_t len,
-			     api_experiment_req *req, api_problem *pb);
-
-typedef struct api_experiment_view {
-	char id[24];
-	char session_id[24];
-	const char *state;      /* waiting, running, done, aborted,
-				   interrupted, error */
-	char error[256];
-	double t_start, t_now;  /* s simulated */
-	double progress;        /* 0..1 */
-	int nseg;
-	const api_segment *seg; /* borrowed */
-} api_experiment_view;
-char *api_experiment_json(const api_experiment_view *v);
-/* {"experiments": [...]} of n views. malloc'd text. */
-char *api_experiment_list_json(const api_experiment_view *v, size_t n);
-/* The segments of n experiments as CSV, one row each (API_EXPERIMENT_CSV
- * columns). malloc'd text. */
-#define API_EXPERIMENT_CSV                                                            \
-	"experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,"   \
-	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time"
-char *api_experiment_csv(const api_experiment_view *v, size_t n);
-
-/* ---- sweeps --------------------------------------------------------------- */
-
-#define API_SWEEP_MAX_POINTS 2000
-typedef struct api_sweep_req {
-	api_spec spec;
-	int nbeta;
-	api_value *betas;      /* rad (deg as sent), malloc'd by the parser
-				  (caller frees) */
-	int nrot;
-	int rotations[2];      /* SIM_CW / SIM_CCW */
-	double t_end;          /* s simulated per point */
-} api_sweep_req;
-/* Default simulated time per point after scene.transient, s: after a steady
- * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
- * 1 % (docs/MODEL.md's convention). */
-#define API_SWEEP_WINDOW 4.0
-/* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
- * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],
- * "t_end" (default scene.transient + API_SWEEP_WINDOW; it must exceed
- * scene.transient). */
-api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
-			api_problem *pb);
-
-typedef struct api_sweep_point {
-	api_value beta;  /* rad (deg as sent) */
-	int rotation;    /* SIM_CW / SIM_CCW */
-	int state;       /* 0 pending, 1 running, 2 done, 3 failed */
-	double velocity;    /* m/s */
-	double uncertainty; /* m/s, the estimate's error bar; NaN if none */
-	int steady;         /* the estimate showed no drift */
-	int mirrored;       /* the mirror image of another point of the sweep
-			       (sim_mirror_plan), not run itself */
-	double dt;          /* s: the machine step it was measured with */
-	int substeps;       /* feed sub-steps it was measured with */
-	double step_error;  /* m/s: the steps' share of the uncertainty */
-	int tol_met;        /* the uncertainty within the accuracy target */
-	char error[160];
-} api_sweep_point;
-typedef struct api_sweep_view {
-	char id[24];
-	const char *state;  /* queued, running, done, cancelled, error, damaged */
-	const char *error;  /* why "error" (a write failed) or "damaged" (its
-			       record is unusable); NULL or "" */
-	size_t total, done;
-	double t_end;
-	const api_sweep_point *pt; /* borrowed, total entries */
-} api_sweep_view;
-char *api_sweep_json(const api_sweep_view *v);
-char *api_sweep_csv(const api_sweep_view *v);
-/* n sweeps as CSV, one row each: sweep, state, done, total, t_end. */
-char *api_sweep_list_csv(const api_sweep_view *v, size_t n);
-/* {"sweeps": [...]} of n views without their points. malloc'd text. */
-char *api_sweep_list_json(const api_sweep_view *v, size_t n);
-
-/* ---- listings across replicas (--peers) ------------------------------------ */
-
-/* One listing gathered from several replicas (list_json.c). */
-typedef struct api_list api_list;
-/* Start from the receiving replica's own listing (borrowed text): JSON
- * with the array member `member` ("sessions", "experiments", "sweeps"),
- * or CSV. NULL when that text is not such a listing or out of memory. */
-api_list *api_list_new(const char *member, int csv, const char *local);
-/* Append a peer's listing of the same kind (len bytes). Returns 0, or -1
- * if it is not one (nothing appended): report the peer unreachable. */
-int api_list_add(api_list *l, const char *body, size_t len);
-/* Name a peer whose entries are missing (JSON: the "unreachable" member;
- * CSV carries no such member: the server says it in a header). */
-void api_list_unreachable(api_list *l, const char *peer, const char *reason);
-/* The merged text (malloc'd; NULL if out of memory); frees l (NULL is
- * accepted). */
-char *api_list_finish(api_list *l);
-
-/* ---- fits ------------------------------------------------------------------ */
-
-/* Parse POST /fits: preset/params/scene/integrator as for sessions, "free"
- * (names, or {name, min, max, start} in the setting's unit), the data as
- * "points" [{beta, rotation, v, sigma}], "csv" (text with the header
- * beta,rotation,v[,sigma]) or "peaks" [{rotation, beta, sigma}], and
- * "t_end", "curve_step" (deg), "max_iter", "fd_step". Checked whole with
- * fit_check: a 422 naming the field, nothing started. *points (malloc'd,
- * the caller frees; req->points points into it) holds the points. */
-api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point **points,
-		      api_problem *pb);
-
-typedef struct api_fit_view {
-	char id[24];
-	const char *state;        /* queued, running, done, failed, cancelled */
-	const fit_request *req;   /* borrowed */
-	fit_progress pr;          /* the last report (phase NULL before one) */
-	const char *result;       /* fit_result_json's text when over, or NULL */
-} api_fit_view;
-/* One fit: progress, current values and the result (null until over). */
-char *api_fit_json(const api_fit_view *v);
-/* {"fits": [...]} without results; CSV: fit,state,phase,iteration,
- * evaluations,cost. malloc'd text. */
-char *api_fit_list_json(const api_fit_view *v, size_t n);
-char *api_fit_list_csv(const api_fit_view *v, size_t n);
-
 /* ---- catalogue ------------------------------------------------------------- */
 
 /* {"presets": [{name, params, scene, integrator}], "settings": [...],
@@ -577,5 +422,8 @@ typedef struct api_health {
 char *api_health_json(const api_health *h);
 /* The OpenAPI 3.1 document of the HTTP API. malloc'd text. */
 char *api_openapi_json(void);
+
+/* experiments, sweeps, fits and the listings across replicas */
+#include "api_jobs.h"
 
 #endif

@@ -194,13 +194,15 @@ char *api_experiment_json(const api_experiment_view *v)
 	return api_print_free(experiment_object(v));
 }
 
+/* A listing's entry. */
+static cJSON *experiment_entry(const void *view)
+{
+	return experiment_object(view);
+}
+
 char *api_experiment_list_json(const api_experiment_view *v, size_t n)
 {
-	cJSON *o = cJSON_CreateObject();
-	cJSON *arr = cJSON_AddArrayToObject(o, "experiments");
-	for (size_t i = 0; i < n; i++)
-		cJSON_AddItemToArray(arr, experiment_object(&v[i]));
-	return api_print_free(o);
+	return api_list_json("experiments", v, n, sizeof *v, experiment_entry);
 }
 
 /* A CSV cell: the number, or nothing when not finite. */

@@ -265,13 +265,15 @@ char *api_fit_json(const api_fit_view *v)
 	return api_print_free(fit_object(v, 1));
 }
 
+/* A listing's entry. */
+static cJSON *fit_entry(const void *view)
+{
+	return fit_object(view, 0);
+}
+
 char *api_fit_list_json(const api_fit_view *v, size_t n)
 {
-	cJSON *o = cJSON_CreateObject();
-	cJSON *arr = cJSON_AddArrayToObject(o, "fits");
-	for (size_t i = 0; i < n; i++)
-		cJSON_AddItemToArray(arr, fit_object(&v[i], 0));
-	return api_print_free(o);
+	return api_list_json("fits", v, n, sizeof *v, fit_entry);
 }
 
 char *api_fit_list_csv(const api_fit_view *v, size_t n)

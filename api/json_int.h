@@ -105,6 +105,10 @@ void api_add_number(cJSON *obj, const char *name, double v);
 /* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
  * ?format=csv} (a job's result, as JSON and as CSV). */
 void api_add_result_links(cJSON *obj, const char *collection, const char *id);
+/* One listing: {"member": [entry(view 0), ..., entry(view n - 1)]} of n
+ * views of size bytes each (list_json.c). malloc'd text. */
+char *api_list_json(const char *member, const void *views, size_t n, size_t size,
+		    cJSON *(*entry)(const void *view));
 
 /* The members each request body may have (NULL-terminated): the parsers
  * refuse any other, and openapi.c builds the request schemas from these

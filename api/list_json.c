@@ -8,7 +8,8 @@
  * CSV: the first answer's header once, then every answer's rows. A peer's
  * answer that does not have the same shape (not JSON with that array, or
  * another CSV header) is refused, and the caller reports that peer as
- * unreachable instead.
+ * unreachable instead. The one replica's listing of every kind is written
+ * here too (api_list_json).
  */
 #include <stdlib.h>
 #include <string.h>
@@ -91,4 +92,14 @@ char *api_list_finish(api_list *l)
 	char *text = l->csv ? api_buf_take(&l->text) : api_print_free(l->root);
 	free(l);
 	return text;
+}
+
+char *api_list_json(const char *member, const void *views, size_t n, size_t size,
+		    cJSON *(*entry)(const void *view))
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON *arr = cJSON_AddArrayToObject(o, member);
+	for (size_t i = 0; i < n; i++)
+		cJSON_AddItemToArray(arr, entry((const char *)views + i * size));
+	return api_print_free(o);
 }

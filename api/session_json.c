@@ -345,13 +345,15 @@ char *api_session_json(const api_view *v, int with_spec)
 	return api_print_free(session_object(v, with_spec));
 }
 
+/* A listing's entry. */
+static cJSON *session_entry(const void *view)
+{
+	return session_object(view, 0);
+}
+
 char *api_session_list_json(const api_view *v, size_t n)
 {
-	cJSON *o = cJSON_CreateObject();
-	cJSON *arr = cJSON_AddArrayToObject(o, "sessions");
-	for (size_t i = 0; i < n; i++)
-		cJSON_AddItemToArray(arr, session_object(&v[i], 0));
-	return api_print_free(o);
+	return api_list_json("sessions", v, n, sizeof *v, session_entry);
 }
 
 char *api_control_result_json(const api_view *v, const api_control *c,

@@ -275,13 +275,15 @@ char *api_sweep_json(const api_sweep_view *v)
 	return api_print_free(sweep_object(v, 1));
 }
 
+/* A listing's entry. */
+static cJSON *sweep_entry(const void *view)
+{
+	return sweep_object(view, 0);
+}
+
 char *api_sweep_list_json(const api_sweep_view *v, size_t n)
 {
-	cJSON *o = cJSON_CreateObject();
-	cJSON *arr = cJSON_AddArrayToObject(o, "sweeps");
-	for (size_t i = 0; i < n; i++)
-		cJSON_AddItemToArray(arr, sweep_object(&v[i], 0));
-	return api_print_free(o);
+	return api_list_json("sweeps", v, n, sizeof *v, sweep_entry);
 }
 
 char *api_sweep_csv(const api_sweep_view *v)

@@ -36,8 +36,6 @@
 #define ELEMENT_BYTES ((size_t)384)
 /* A stream's connection thread and its bookkeeping. */
 #define STREAM_BASE_BYTES ((size_t)96 << 10)
-/* How long a pace "max" session holds its CPU slot while others wait. */
-#define CPU_SLICE_S 0.1
 /* Retry-After of a memory refusal: sessions come and go in seconds. */
 #define MEMORY_RETRY_S 5
 /* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
@@ -59,12 +57,11 @@ static const srv_config *cfg;
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static size_t reserved;                 /* lock */
 static double paced;                    /* lock: cores held */
-static srv_cpu_turn *queue_head, *queue_tail; /* lock */
-static int busy, waiting;               /* lock */
 
 void srv_budget_init(const srv_config *config)
 {
 	cfg = config;
+	srv_cpu_turns_init(config);
 }
 
 /* ---- memory ---------------------------------------------------------------- */
@@ -358,84 +355,6 @@ size_t srv_budget_points(void)
 	return n;
 }
 
-/* ---- CPU turns ------------------------------------------------------------------ */
-
-/* Unlink t from the queue (lock held). */
-static void unqueue(srv_cpu_turn *t)
-{
-	srv_cpu_turn **pp = &queue_head, *prev = NULL;
-	while (*pp && *pp != t) {
-		prev = *pp;
-		pp = &(*pp)->next;
-	}
-	if (!*pp)
-		return;
-	*pp = t->next;
-	if (queue_tail == t)
-		queue_tail = prev;
-	t->next = NULL;
-	t->queued = 0;
-	waiting--;
-}
-
-int srv_cpu_take(srv_cpu_turn *t)
-{
-	pthread_mutex_lock(&lock);
-	if (!t->holding) {
-		if (!t->queued) {
-			t->next = NULL;
-			if (queue_tail)
-				queue_tail->next = t;
-			else
-				queue_head = t;
-			queue_tail = t;
-			t->queued = 1;
-			waiting++;
-		}
-		if (busy < cfg->max_busy && queue_head == t) {
-			unqueue(t);
-			busy++;
-			t->holding = 1;
-			t->since = srv_now();
-		}
-	}
-	int holding = t->holding;
-	pthread_mutex_unlock(&lock);
-	return holding;
-}
-
-int srv_cpu_turn_over(const srv_cpu_turn *t)
-{
-	pthread_mutex_lock(&lock);
-	int over = t->holding && queue_head &&
-		   srv_now() - t->since >= CPU_SLICE_S;
-	pthread_mutex_unlock(&lock);
-	return over;
-}
-
-void srv_cpu_leave(srv_cpu_turn *t)
-{
-	pthread_mutex_lock(&lock);
-	if (t->holding) {
-		busy--;
-		t->holding = 0;
-	}
-	if (t->queued)
-		unqueue(t);
-	/* the next in line may take the slot now */
-	if (queue_head && busy < cfg->max_busy)
-		pthread_cond_broadcast(queue_head->wake);
-	pthread_mutex_unlock(&lock);
-}
-
-void srv_cpu_counts(int *b, int *w)
-{
-	pthread_mutex_lock(&lock);
-	*b = busy;
-	*w = waiting;
-	pthread_mutex_unlock(&lock);
-}
-
 /* ---- connections per client -------------------------------------------------------- */
 
 typedef struct client {
@@ -554,6 +473,7 @@ int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
 		 "close after %g s) and retry", cfg->max_client_connections,
 		 cfg->connection_timeout);
 	api_budget(pb, "connections", cfg->max_client_connections, 1);
+	pb->close = 1; /* one too many: the answer closes it */
 	return 1;
 }
 

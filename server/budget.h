@@ -105,6 +105,10 @@ size_t srv_budget_points(void);
 
 /* ---- CPU turns for pace "max" ---------------------------------------------- */
 
+/* budget_turns.c; cfg (borrowed) gives --max-busy (srv_budget_init calls
+ * it). */
+void srv_cpu_turns_init(const srv_config *cfg);
+
 /* A session's place among the pace "max" sessions. Zeroed at start; the
  * worker owns it. */
 typedef struct srv_cpu_turn {

@@ -118,7 +118,7 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --max-sessions N     live sessions (default 64)\n"
 		"  --max-streams N      open stream clients (default 256)\n"
 		"  --max-body BYTES     request body limit (default 1048576)\n"
-		"  --data-dir DIR       save experiment and sweep results here\n"
+		"  --data-dir DIR       save sessions, experiments, sweeps and fits here\n"
 		"  --web-root DIR       static files served at / (default web)\n"
 		"  --log-level L        error|warn|info|debug (default info)\n"
 		"  --ring N             stream records kept per session "

@@ -15,7 +15,8 @@
  * steady value (none when the segment's beta was already set: nothing
  * reverses). Fields are guarded by the experiment's lock, taken inside
  * the session lock by the worker's hooks and alone by the handlers (lock
- * order: registry.h).
+ * order: registry.h). A segment's start and its measurements at its end
+ * are experiment_segment.c.
  */
 #include <math.h>
 #include <pthread.h>
@@ -24,39 +25,9 @@
 #include <string.h>
 
 #include "experiment.h"
+#include "experiment_int.h"
 #include "store.h"
 #include "util.h"
-
-enum {
-	EXP_WAITING,
-	EXP_RUNNING,
-	EXP_DONE,
-	EXP_ABORTED,
-	EXP_INTERRUPTED, /* running when the daemon died, not resumed */
-	EXP_ERROR,       /* its result could not be written */
-	EXP_DAMAGED,     /* its record could not be read back */
-	EXP_NSTATES
-};
-
-struct srv_experiment {
-	srv_entry entry;         /* id and references: experiment_http.c */
-	const char *data_dir;    /* borrowed; NULL: results are not saved */
-	pthread_mutex_t lock;
-	/* guarded by lock */
-	char session_id[SRV_ID_LEN];
-	api_experiment_req req;  /* schedule and per-segment results */
-	int state;
-	int attached;            /* a session worker still refers to it */
-	char error[256];
-	double t0, t_now;        /* s: start and latest simulated time */
-	int cur;                 /* running segment */
-	double *rec_t, *rec_v;   /* feed velocity record */
-	size_t rec_n, rec_cap, seg_first;
-	double rec_spacing;      /* s between records, at least */
-	srv_cmd cmd;             /* the running segment's command */
-	int writes;              /* queued store writes (they refer to e) */
-	int freed;               /* srv_exp_free came while writes > 0 */
-};
 
 #define EXP_RECORDS 50000
 
@@ -125,6 +96,11 @@ const char *srv_exp_id(const srv_experiment *e)
 	return e->entry.id;
 }
 
+const api_experiment_req *srv_exp_request(const srv_experiment *e)
+{
+	return &e->req;
+}
+
 int srv_exp_keeps_session(const srv_experiment *e)
 {
 	return e->req.keep_session || !e->req.fresh;
@@ -143,62 +119,6 @@ int srv_exp_finished(srv_experiment *e)
 	int over = !e->attached && e->state >= EXP_DONE;
 	pthread_mutex_unlock(&e->lock);
 	return over;
-}
-
-/* Start segment i at status st (lock held): its command for the worker. */
-static srv_cmd *start_segment(srv_experiment *e, int i, const sim_status *st)
-{
-	api_segment *seg = &e->req.seg[i];
-	srv_cmd *cmd = &e->cmd;
-	memset(cmd, 0, sizeof *cmd);
-	cmd->c.set = API_C_BETA;
-	cmd->c.beta = seg->beta;
-	if (e->req.beta_rate.si > 0) {
-		cmd->c.set |= API_C_BETA_RATE;
-		cmd->c.beta_rate = e->req.beta_rate;
-	}
-	cmd->restart_transport = 1;
-	cmd->from_experiment = 1;
-	seg->start_velocity = st->feed_velocity;
-	/* a segment that commands the beta already set (and reached) changes
-	 * nothing there is to time */
-	seg->beta_same = seg->beta.si == st->beta_target && st->beta == st->beta_target;
-	seg->state = 1;
-	e->cur = i;
-	e->seg_first = e->rec_n;
-	return cmd;
-}
-
-static void finish_segment(srv_experiment *e, const sim_status *st)
-{
-	api_segment *seg = &e->req.seg[e->cur];
-	seg->t_end = st->t;
-	/* the estimator restarted at the segment's command */
-	seg->mean_velocity = st->transport_velocity;
-	seg->uncertainty = st->transport_velocity_uncertainty;
-	seg->steady = st->steady;
-	double half = seg->t_command + 0.5 * (seg->t_end - seg->t_command);
-	double sum = 0;
-	size_t n = 0;
-	for (size_t i = e->seg_first; i < e->rec_n; i++)
-		if (e->rec_t[i] >= half) {
-			sum += e->rec_v[i];
-			n++;
-		}
-	double steady = n ? sum / (double)n : NAN;
-	seg->steady_velocity = steady;
-	seg->reversal_time = NAN;
-	if (isfinite(steady) && steady != 0 && !seg->beta_same)
-		for (size_t i = e->seg_first; i < e->rec_n; i++) {
-			double v = e->rec_v[i];
-			if (e->rec_t[i] >= seg->t_command &&
-			    (steady > 0 ? v >= 0.9 * steady
-					: v <= 0.9 * steady)) {
-				seg->reversal_time = e->rec_t[i] - seg->t_command;
-				break;
-			}
-		}
-	seg->state = 2;
 }
 
 /* The feed-velocity record is only needed while running (lock held). */
@@ -392,27 +312,19 @@ srv_experiment *srv_exp_damaged(const char *id, const char *why)
 	return e;
 }
 
-srv_experiment *srv_exp_load(const char *id, api_problem *pb)
+srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen)
 {
-	char path[64], why[256];
-	snprintf(path, sizeof path, "experiments/%s", id);
-	size_t len;
-	exp_record *r = srv_store_read(path, SRV_STORE_EXPERIMENT, &len, why,
-				       sizeof why);
-	if (r && (len != sizeof *r || r->state < 0 ||
-		  r->state >= EXP_NSTATES || r->req.nseg < 1 ||
-		  r->req.nseg > API_EXP_MAX_SEGMENTS)) {
+	exp_record *r = payload;
+	if (len != sizeof *r || r->state < 0 || r->state >= EXP_NSTATES || r->req.nseg < 1 ||
+	    r->req.nseg > API_EXP_MAX_SEGMENTS) {
 		free(r);
-		r = NULL;
-		snprintf(why, sizeof why, "%s: inconsistent", path);
-	}
-	if (!r) {
-		api_fail(pb, API_INVALID, NULL, "%s", why);
+		snprintf(why, whylen, "inconsistent");
 		return NULL;
 	}
 	r->id[SRV_ID_LEN - 1] = r->session_id[SRV_ID_LEN - 1] = '\0';
 	r->error[sizeof r->error - 1] = '\0';
-	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, pb);
+	api_problem pb;
+	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, &pb);
 	if (e) {
 		snprintf(e->entry.id, sizeof e->entry.id, "%s", r->id);
 		snprintf(e->session_id, sizeof e->session_id, "%s",
@@ -424,6 +336,8 @@ srv_experiment *srv_exp_load(const char *id, api_problem *pb)
 		e->t_now = r->t_now;
 		e->attached = 0;
 		drop_record(e);
+	} else {
+		snprintf(why, whylen, "%s", pb.detail);
 	}
 	free(r);
 	return e;
@@ -483,7 +397,7 @@ srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 	e->t0 = e->t_now = st->t;
 	e->state = EXP_RUNNING;
 	*t_end = e->t0 + exp_end(e);
-	srv_cmd *cmd = start_segment(e, 0, st);
+	srv_cmd *cmd = srv_exp_start_segment(e, 0, st);
 	pthread_mutex_unlock(&e->lock);
 	return cmd;
 }
@@ -508,9 +422,9 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 		e->rec_v[e->rec_n++] = st->feed_velocity;
 	}
 	if (st->t >= srv_exp_boundary(e) - 1e-9) {
-		finish_segment(e, st);
+		srv_exp_finish_segment(e, st);
 		if (e->cur + 1 < e->req.nseg) {
-			cmd = start_segment(e, e->cur + 1, st);
+			cmd = srv_exp_start_segment(e, e->cur + 1, st);
 		} else {
 			e->state = EXP_DONE;
 			e->attached = 0;

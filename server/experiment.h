@@ -29,6 +29,9 @@ void srv_exp_free(srv_experiment *e);
 srv_entry *srv_exp_entry(srv_experiment *e);
 srv_experiment *srv_exp_from_entry(srv_entry *en);
 const char *srv_exp_id(const srv_experiment *e);
+/* Its request as parsed (borrowed; its schedule's results change while it
+ * runs: read it before it starts). */
+const api_experiment_req *srv_exp_request(const srv_experiment *e);
 /* 1 when its session stays after the end (it was not created by the
  * experiment, or keep_session was asked). */
 int srv_exp_keeps_session(const srv_experiment *e);
@@ -71,14 +74,15 @@ void *srv_exp_save(srv_experiment *e, size_t *len);
 /* Continue from a running state srv_exp_save wrote: attached again. 0, or
  * -1 when buf does not pass its checks (nothing changed). */
 int srv_exp_resume(srv_experiment *e, const void *buf, size_t len);
-/* An experiment from experiments/ID (a file name) as it was last written,
- * not attached; NULL with *pb when the file does not pass its checks. */
+/* An experiment from the payload of experiments/ID.bin (taken) as it was
+ * last written, not attached; NULL with the reason in why when it does not
+ * pass its checks. */
+srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen);
 /* An experiment whose record (experiments/ID.bin) cannot be read back:
  * listed in state "damaged" with why and no segments, as a damaged
  * session is; a session checkpoint that carries its progress still
  * resumes it (srv_exp_resume). NULL when out of memory. */
 srv_experiment *srv_exp_damaged(const char *id, const char *why);
-srv_experiment *srv_exp_load(const char *file, api_problem *pb);
 /* Still running but no session resumed it: "interrupted", its finished
  * segments kept. Returns 1 if it was. */
 int srv_exp_interrupt(srv_experiment *e);

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * experiment_http.c - the experiment resources: POST/GET
- * /api/v1/experiments and GET /api/v1/experiments/{id}.
+ * experiment_http.c - the experiments as a kind of job: their registry and
+ * the descriptor the handlers of /api/v1/experiments[/{id}] use (job.c).
  *
  * Experiments are kept in a registry until shutdown; beyond
  * --max-experiments the oldest finished one that no worker refers to is
@@ -10,12 +10,11 @@
  * session; the session's worker then runs it (experiment.c).
  */
 #include <stdlib.h>
-#include <string.h>
 
 #include "experiment.h"
 #include "experiment_http.h"
+#include "job.h"
 #include "metrics.h"
-#include "peers.h"
 #include "session.h"
 #include "store.h"
 #include "util.h"
@@ -31,12 +30,7 @@ static const srv_config *cfg;
 void srv_experiments_init(const srv_config *config)
 {
 	cfg = config;
-	srv_registry_open(&experiments, (size_t)cfg->max_experiments);
-}
-
-void srv_experiments_shutdown(void)
-{
-	srv_registry_clear(&experiments);
+	srv_job_open(&srv_experiment_job, (size_t)cfg->max_experiments);
 }
 
 static int evictable(srv_entry *en)
@@ -56,45 +50,6 @@ void srv_experiment_put(srv_experiment *e)
 		srv_registry_put(&experiments, srv_exp_entry(e));
 }
 
-size_t srv_experiments_restore(void)
-{
-	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list_ids("experiments", 0, &names)
-				       : 0,
-	       count = 0;
-	for (size_t i = 0; i < n; i++) {
-		size_t l = strlen(names[i]);
-		api_problem pb;
-		srv_experiment *e = NULL;
-		if (l > 4 && strcmp(names[i] + l - 4, ".bin") == 0)
-			e = srv_exp_load(names[i], &pb);
-		if (e && srv_registry_reserve(&experiments, srv_exp_entry(e),
-					      evictable) == 0) {
-			srv_registry_publish(&experiments, srv_exp_entry(e));
-			srv_registry_put(&experiments, srv_exp_entry(e));
-			count++;
-		} else if (e) {
-			srv_exp_free(e);
-		} else if (l > 4 && strcmp(names[i] + l - 4, ".bin") == 0) {
-			srv_log(SRV_LOG_WARN, "experiment not restored: %s",
-				pb.detail);
-			names[i][l - 4] = '\0';
-			e = srv_exp_damaged(names[i], pb.detail);
-			if (e && srv_registry_reserve(&experiments, srv_exp_entry(e),
-						      NULL) == 0) {
-				srv_registry_publish(&experiments, srv_exp_entry(e));
-				srv_registry_put(&experiments, srv_exp_entry(e));
-				count++;
-			} else {
-				srv_exp_free(e);
-			}
-		}
-		free(names[i]);
-	}
-	free(names);
-	return count;
-}
-
 size_t srv_experiments_interrupt_orphans(void)
 {
 	srv_entry **all = NULL;
@@ -105,8 +60,8 @@ size_t srv_experiments_interrupt_orphans(void)
 	return count;
 }
 
-/* Run e on a fresh session or attach it to the one it names; the session's
- * id is noted in e. */
+/* Run e on a fresh session or attach it to the one it names; the session
+ * notes its id in e before its worker can run it. */
 static api_err start_on_session(srv_experiment *e,
 				const api_experiment_req *req, api_problem *pb)
 {
@@ -126,8 +81,7 @@ static api_err start_on_session(srv_experiment *e,
 			return pb->code;
 		}
 	}
-	srv_exp_set_session(e, srv_session_id(s));
-	srv_session_put(s);
+	srv_session_put(s); /* it noted its id in e before its worker ran */
 	return API_OK;
 }
 
@@ -140,71 +94,83 @@ static char *experiment_json(srv_experiment *e, int csv)
 	return csv ? api_experiment_csv(&v, 1) : api_experiment_json(&v);
 }
 
-enum MHD_Result srv_h_experiments_create(srv_req *r)
+/* An experiment for a request body; NULL with *pb. */
+static srv_entry *experiment_create(const char *body, size_t len, api_problem *pb)
 {
-	enum MHD_Result res;
-	api_problem pb;
 	api_experiment_req *req = malloc(sizeof *req);
-	if (!req)
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	if (api_parse_experiment(r->body, r->body_len, req, &pb) != API_OK) {
-		free(req);
-		return srv_reply_problem(r, &pb, NULL);
+	if (!req) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
 	}
-	srv_experiment *e = srv_exp_new(req, cfg->data_dir, &pb);
-	if (!e) {
-		free(req);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	if (srv_registry_reserve(&experiments, srv_exp_entry(e), evictable)) {
-		free(req);
-		srv_exp_free(e);
-		return srv_fail(r, API_LIMIT, NULL,
-				"%d experiments are running or kept "
-				"(--max-experiments)", cfg->max_experiments);
-	}
-	if (start_on_session(e, req, &pb) != API_OK) {
-		free(req);
-		srv_registry_cancel(&experiments, srv_exp_entry(e));
-		srv_exp_free(e);
-		return srv_reply_problem(r, &pb, NULL);
-	}
+	srv_experiment *e = NULL;
+	if (api_parse_experiment(body, len, req, pb) == API_OK)
+		e = srv_exp_new(req, cfg->data_dir, pb);
 	free(req);
-	srv_registry_publish(&experiments, srv_exp_entry(e));
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+static void experiment_discard(srv_entry *en)
+{
+	srv_exp_free(srv_exp_from_entry(en));
+}
+
+/* On its session (a fresh one or the one it names), then its record. */
+static api_err experiment_start(srv_entry *en, char **answer, api_problem *pb)
+{
+	srv_experiment *e = srv_exp_from_entry(en);
+	if (start_on_session(e, srv_exp_request(e), pb) != API_OK)
+		return pb->code;
 	srv_exp_persist(e);
 	atomic_fetch_add(&srv_stats.experiments, 1);
-	res = srv_reply_created(r, 201, experiment_json(e, 0),
-				"/api/v1/experiments", srv_exp_id(e));
-	srv_registry_put(&experiments, srv_exp_entry(e));
-	return res;
+	*answer = experiment_json(e, 0);
+	return API_OK;
 }
 
-enum MHD_Result srv_h_experiment_get(srv_req *r)
+static char *experiment_text(srv_entry *en, int csv)
 {
-	srv_entry *en = srv_registry_get(&experiments, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no experiment with id \"%.40s\"", r->arg[0]);
-	char *text = experiment_json(srv_exp_from_entry(en), r->csv);
-	srv_registry_put(&experiments, en);
-	return srv_reply_result(r, text);
+	return experiment_json(srv_exp_from_entry(en), csv);
 }
 
-enum MHD_Result srv_h_experiments_list(srv_req *r)
+static void experiment_view(srv_entry *en, void *view, void *scratch)
 {
-	srv_entry **all = NULL;
-	size_t n = srv_registry_snapshot(&experiments, &all);
-	api_experiment_view *v = calloc(n + 1, sizeof *v);
-	api_segment *seg = calloc(n * API_EXP_MAX_SEGMENTS + 1, sizeof *seg);
-	char *text = NULL;
-	if (v && seg) {
-		for (size_t i = 0; i < n; i++)
-			srv_exp_view(srv_exp_from_entry(all[i]), &v[i],
-				     seg + i * API_EXP_MAX_SEGMENTS);
-		text = r->csv ? api_experiment_csv(v, n) : api_experiment_list_json(v, n);
-	}
-	srv_registry_release(&experiments, all, n);
-	free(v);
-	free(seg);
-	return srv_peers_reply(r, text, "experiments");
+	srv_exp_view(srv_exp_from_entry(en), view, scratch);
 }
+
+static char *experiment_list_text(const void *views, size_t n, int csv)
+{
+	return csv ? api_experiment_csv(views, n) : api_experiment_list_json(views, n);
+}
+
+static srv_entry *experiment_load(void *payload, size_t len, char *why, size_t whylen)
+{
+	srv_experiment *e = srv_exp_load(payload, len, why, whylen);
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+static srv_entry *experiment_damaged(const char *id, const char *why)
+{
+	srv_experiment *e = srv_exp_damaged(id, why);
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+/* No DELETE: an experiment goes with its session's end or is pushed out. */
+const srv_job_kind srv_experiment_job = {
+	.name = "experiment",
+	.plural = "experiments",
+	.reg = &experiments,
+	.created_status = 201,
+	.limit = "experiments are running or kept (--max-experiments)",
+	.store_kind = SRV_STORE_EXPERIMENT,
+	.restore_evicts = 1,
+	.create = experiment_create,
+	.discard = experiment_discard,
+	.start = experiment_start,
+	.evictable = evictable,
+	.text = experiment_text,
+	.view_size = sizeof(api_experiment_view),
+	.scratch_size = API_EXP_MAX_SEGMENTS * sizeof(api_segment),
+	.view = experiment_view,
+	.list_text = experiment_list_text,
+	.load = experiment_load,
+	.damaged = experiment_damaged,
+};

@@ -4,13 +4,19 @@
  *
  * A fit is one driver thread running the fitting module's fit_run (the
  * Levenberg-Marquardt loop, which mostly waits) whose model evaluations go
- * to the worker pool as jobs, a batch at a time (the map function below),
+ * to the worker pool as jobs, a batch at a time (srv_pool_map, pool.c),
  * so fits and sweeps share the pool's threads. Fits live in a registry
  * (registry.c) like sweeps: the registry holds one reference, the driver
  * one; DELETE cancels (the driver's evaluations then return at once and
  * the fit stops after those already running) and unlinks it. A fit's
- * fields are guarded by its own lock. Fits are kept in memory only: they
- * do not outlive the daemon.
+ * fields are guarded by its own lock. The fit is one kind of job
+ * (job.h): srv_fit_job below is its descriptor.
+ *
+ * With --data-dir a fit persists like a sweep: fits/ID.bin holds its
+ * request body, written at creation, and once over its progress and its
+ * result's JSON and CSV, so a restart serves a finished fit byte for byte;
+ * a fit that was running when the daemon stopped or died runs again from
+ * its start. A fit that ends because the daemon stops is not written over.
  */
 #include <math.h>
 #include <pthread.h>
@@ -20,9 +26,10 @@
 
 #include "fit.h"
 #include "fitjob.h"
-#include "peers.h"
+#include "job.h"
 #include "pool.h"
 #include "registry.h"
+#include "store.h"
 #include "util.h"
 
 typedef struct srv_fit {
@@ -30,6 +37,8 @@ typedef struct srv_fit {
 	pthread_mutex_t lock;
 	fit_request req;       /* read-only once the driver runs */
 	fit_point *points;
+	char *body;            /* the request as posted (persisted) */
+	size_t body_len;
 	pthread_t thread;
 	/* guarded by lock */
 	int running, over, cancelled;
@@ -46,11 +55,6 @@ static pthread_mutex_t drivers_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t drivers_gone = PTHREAD_COND_INITIALIZER;
 static int drivers;
 
-void srv_fits_init(const srv_config *cfg)
-{
-	srv_registry_open(&fits, (size_t)cfg->max_fits);
-}
-
 static srv_fit *fit_of(srv_entry *en)
 {
 	return SRV_CONTAINER(en, srv_fit, entry);
@@ -62,6 +66,7 @@ static void fit_free_job(srv_fit *f)
 		return;
 	fit_result_free(&f->res);
 	free(f->points);
+	free(f->body);
 	free(f->json);
 	free(f->csv);
 	pthread_mutex_destroy(&f->lock);
@@ -96,63 +101,6 @@ static void fill_view(const srv_fit *f, api_fit_view *v)
 	v->result = f->json;
 }
 
-/* ---- the pool as the fit's map ------------------------------------------ */
-
-typedef struct batch {
-	pthread_mutex_t lock;
-	pthread_cond_t done;
-	size_t left;
-	fit_job job;
-	void *arg;
-} batch;
-
-typedef struct batch_item {
-	batch *b;
-	size_t i;
-} batch_item;
-
-static void batch_finish(batch *b)
-{
-	pthread_mutex_lock(&b->lock);
-	if (--b->left == 0)
-		pthread_cond_signal(&b->done);
-	pthread_mutex_unlock(&b->lock);
-}
-
-static void run_item(void *arg)
-{
-	batch_item *it = arg;
-	batch *b = it->b;
-	size_t i = it->i;
-	free(it);
-	b->job(b->arg, i); /* cheap when cancelled or stopping: it checks */
-	batch_finish(b);
-}
-
-/* Every job of the batch on the pool (inline when it cannot take one);
- * returns when all are done. */
-static void pool_map(void *ctx, size_t n, fit_job job, void *arg)
-{
-	(void)ctx;
-	batch b = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, n, job, arg};
-	for (size_t i = 0; i < n; i++) {
-		batch_item *it = malloc(sizeof *it);
-		if (it)
-			*it = (batch_item){&b, i};
-		if (!it || srv_pool_submit(run_item, it) != 0) {
-			free(it);
-			job(arg, i);
-			batch_finish(&b);
-		}
-	}
-	pthread_mutex_lock(&b.lock);
-	while (b.left)
-		pthread_cond_wait(&b.done, &b.lock);
-	pthread_mutex_unlock(&b.lock);
-	pthread_mutex_destroy(&b.lock);
-	pthread_cond_destroy(&b.done);
-}
-
 static int is_cancelled(void *ctx)
 {
 	srv_fit *f = ctx;
@@ -171,6 +119,58 @@ static void on_progress(void *ctx, const fit_progress *pr)
 	pthread_mutex_unlock(&f->lock);
 }
 
+/* ---- persistence (store.h) ---------------------------------------------
+ *
+ * fits/ID.bin: the record below, then the request body, the result's JSON
+ * and its CSV (empty until over). */
+static const char *const phases[] = {"fitting", "covariance", "curve", "done"};
+#define NPHASES (sizeof phases / sizeof *phases)
+
+typedef struct fit_record {
+	char id[SRV_ID_LEN];
+	int32_t over, status, has_pr, phase; /* phase: index in phases, or -1 */
+	int32_t iteration, pad;
+	int64_t evaluations;
+	double cost, x[FIT_MAX_FREE];
+	uint64_t body_len, json_len, csv_len;
+} fit_record;
+
+/* Queue fits/ID.bin (lock held). */
+static void persist_locked(const srv_fit *f)
+{
+	if (!srv_store_enabled())
+		return;
+	fit_record r;
+	memset(&r, 0, sizeof r);
+	snprintf(r.id, sizeof r.id, "%s", f->entry.id);
+	r.over = f->over;
+	r.status = f->res.status;
+	r.has_pr = f->has_pr;
+	r.phase = -1;
+	for (size_t i = 0; f->has_pr && f->pr.phase && i < NPHASES; i++)
+		if (strcmp(f->pr.phase, phases[i]) == 0)
+			r.phase = (int32_t)i;
+	r.iteration = f->pr.iteration;
+	r.evaluations = f->pr.evaluations;
+	r.cost = f->pr.cost;
+	memcpy(r.x, f->pr.x, sizeof r.x);
+	r.body_len = f->body_len;
+	r.json_len = f->over && f->json ? strlen(f->json) : 0;
+	r.csv_len = f->over && f->csv ? strlen(f->csv) : 0;
+	size_t n = sizeof r + r.body_len + r.json_len + r.csv_len;
+	char *p = malloc(n);
+	if (!p)
+		return;
+	memcpy(p, &r, sizeof r);
+	memcpy(p + sizeof r, f->body, r.body_len);
+	if (r.json_len) /* none until over */
+		memcpy(p + sizeof r + r.body_len, f->json, r.json_len);
+	if (r.csv_len)
+		memcpy(p + sizeof r + r.body_len + r.json_len, f->csv, r.csv_len);
+	srv_job_save(&srv_fit_job, f->entry.id, p, n, NULL, NULL);
+	free(p);
+}
+
 static void *driver(void *arg)
 {
 	srv_fit *f = arg;
@@ -186,6 +186,9 @@ static void *driver(void *arg)
 	f->csv = csv;
 	f->running = 0;
 	f->over = 1;
+	/* not when deleted, nor when the daemon stops it: it runs again */
+	if (!f->cancelled && !srv_stopping())
+		persist_locked(f);
 	pthread_mutex_unlock(&f->lock);
 	srv_log(SRV_LOG_INFO, "fit %s: %s after %d iterations, %ld evaluations", f->entry.id,
 		fit_status_name(res.status), res.iterations, res.evaluations);
@@ -227,94 +230,167 @@ static int start_driver(srv_fit *f)
 	return rc;
 }
 
-enum MHD_Result srv_h_fits_create(srv_req *r)
+/* A fit for a request body (kept for its record); NULL with *pb. */
+static srv_fit *fit_new(const char *body, size_t len, api_problem *pb)
 {
-	enum MHD_Result res;
-	api_problem pb;
 	srv_fit *f = calloc(1, sizeof *f);
-	if (!f)
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	pthread_mutex_init(&f->lock, NULL);
-	if (api_parse_fit(r->body, r->body_len, &f->req, &f->points, &pb) != API_OK) {
-		fit_free_job(f);
-		return srv_reply_problem(r, &pb, NULL);
+	if (!f) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
 	}
-	f->req.map = pool_map;
+	pthread_mutex_init(&f->lock, NULL);
+	if (api_parse_fit(body, len, &f->req, &f->points, pb) != API_OK) {
+		fit_free_job(f);
+		return NULL;
+	}
+	f->body = malloc(len + 1);
+	if (!f->body) {
+		fit_free_job(f);
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
+	memcpy(f->body, body, len);
+	f->body[len] = '\0';
+	f->body_len = len;
+	f->req.map = srv_pool_map;
 	f->req.progress = on_progress;
 	f->req.cancelled = is_cancelled;
 	f->req.ctx = f;
-	if (srv_registry_reserve(&fits, &f->entry, evictable)) {
-		fit_free_job(f);
-		return srv_fail(r, API_LIMIT, NULL, "%zu fits are running or kept; delete one",
-				fits.cap);
-	}
-	srv_registry_publish(&fits, &f->entry);
+	return f;
+}
+
+static srv_entry *fit_create(const char *body, size_t len, api_problem *pb)
+{
+	srv_fit *f = fit_new(body, len, pb);
+	return f ? &f->entry : NULL;
+}
+
+static void fit_discard(srv_entry *en)
+{
+	fit_free_job(fit_of(en));
+}
+
+/* Its record first, then its driver: the answer shows it queued. */
+static api_err fit_start(srv_entry *en, char **answer, api_problem *pb)
+{
+	srv_fit *f = fit_of(en);
 	api_fit_view v;
 	pthread_mutex_lock(&f->lock);
 	fill_view(f, &v);
 	char *text = api_fit_json(&v);
+	persist_locked(f);
 	pthread_mutex_unlock(&f->lock);
 	if (start_driver(f) != 0) {
-		srv_registry_remove(&fits, &f->entry);
-		srv_registry_put(&fits, &f->entry);
 		free(text);
-		return srv_fail(r, API_UNAVAILABLE, NULL, "cannot start the fit (stopping?)");
+		return api_fail(pb, API_UNAVAILABLE, NULL, "cannot start the fit (stopping?)");
 	}
-	res = srv_reply_created(r, 202, text, "/api/v1/fits", v.id);
-	srv_registry_put(&fits, &f->entry);
-	return res;
+	*answer = text;
+	return API_OK;
 }
 
-enum MHD_Result srv_h_fit_get(srv_req *r)
+static pthread_mutex_t *fit_lock(srv_entry *en)
 {
-	srv_entry *en = srv_registry_get(&fits, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL, "no fit with id \"%.40s\"", r->arg[0]);
+	return &fit_of(en)->lock;
+}
+
+static char *fit_text(srv_entry *en, int csv)
+{
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
-	pthread_mutex_lock(&f->lock);
 	fill_view(f, &v);
-	char *text = !r->csv ? api_fit_json(&v)
-		     : f->csv ? strdup(f->csv)
-			      : strdup(FIT_CSV_HEADER "\n");
-	pthread_mutex_unlock(&f->lock);
-	srv_registry_put(&fits, en);
-	return srv_reply_result(r, text);
+	return !csv ? api_fit_json(&v) : f->csv ? strdup(f->csv) : strdup(FIT_CSV_HEADER "\n");
 }
 
-enum MHD_Result srv_h_fits_list(srv_req *r)
+static void fit_view(srv_entry *en, void *view, void *scratch)
 {
-	srv_entry **all = NULL;
-	size_t n = srv_registry_snapshot(&fits, &all);
-	api_fit_view *v = calloc(n + 1, sizeof *v);
-	char *text = NULL;
-	if (v) {
-		for (size_t i = 0; i < n; i++) {
-			srv_fit *f = fit_of(all[i]);
-			pthread_mutex_lock(&f->lock);
-			fill_view(f, &v[i]);
-			pthread_mutex_unlock(&f->lock);
-		}
-		text = r->csv ? api_fit_list_csv(v, n) : api_fit_list_json(v, n);
+	(void)scratch;
+	fill_view(fit_of(en), view);
+}
+
+static char *fit_list_text(const void *views, size_t n, int csv)
+{
+	return csv ? api_fit_list_csv(views, n) : api_fit_list_json(views, n);
+}
+
+/* DELETE: the driver's evaluations return at once. */
+static void fit_cancel(srv_entry *en)
+{
+	fit_of(en)->cancelled = 1;
+}
+
+/* A fit from its record (taken): over with its progress and result, or
+ * to run again (fit_resume); NULL with the reason. */
+static srv_entry *fit_load(void *payload, size_t len, char *why, size_t whylen)
+{
+	char *p = payload;
+	fit_record r;
+	int ok = len >= sizeof r;
+	if (ok) {
+		memcpy(&r, p, sizeof r);
+		ok = r.body_len <= len && r.json_len <= len && r.csv_len <= len &&
+		     len == sizeof r + r.body_len + r.json_len + r.csv_len &&
+		     r.phase >= -1 && r.phase < (int32_t)NPHASES &&
+		     (!r.over || (r.json_len > 0 && r.csv_len > 0));
 	}
-	srv_registry_release(&fits, all, n);
-	free(v);
-	return srv_peers_reply(r, text, "fits");
+	api_problem pb;
+	srv_fit *f = ok ? fit_new(p + sizeof r, r.body_len, &pb) : NULL;
+	if (!ok)
+		snprintf(why, whylen, "inconsistent");
+	else if (!f)
+		snprintf(why, whylen, "%s", pb.detail);
+	if (f && r.over) {
+		f->json = strndup(p + sizeof r + r.body_len, r.json_len);
+		f->csv = strndup(p + sizeof r + r.body_len + r.json_len, r.csv_len);
+		f->over = 1;
+		f->res.status = r.status;
+		f->has_pr = r.has_pr;
+		f->pr.phase = r.phase >= 0 ? phases[r.phase] : NULL;
+		f->pr.iteration = r.iteration;
+		f->pr.evaluations = r.evaluations;
+		f->pr.cost = r.cost;
+		memcpy(f->pr.x, r.x, sizeof r.x);
+		if (!f->json || !f->csv) {
+			snprintf(why, whylen, "out of memory");
+			fit_free_job(f);
+			f = NULL;
+		}
+	}
+	if (f) {
+		r.id[SRV_ID_LEN - 1] = '\0';
+		snprintf(f->entry.id, sizeof f->entry.id, "%s", r.id);
+	}
+	free(p);
+	return f ? &f->entry : NULL;
 }
 
-enum MHD_Result srv_h_fit_delete(srv_req *r)
+/* A restored fit that was not over runs again from its start. */
+static void fit_resume(srv_entry *en)
 {
-	srv_entry *en = srv_registry_get(&fits, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL, "no fit with id \"%.40s\"", r->arg[0]);
 	srv_fit *f = fit_of(en);
-	pthread_mutex_lock(&f->lock);
-	f->cancelled = 1;
-	pthread_mutex_unlock(&f->lock);
-	srv_registry_remove(&fits, en);
-	srv_registry_put(&fits, en);
-	return srv_reply_empty(r);
+	if (!f->over && start_driver(f) != 0)
+		srv_log(SRV_LOG_WARN, "fit %s: cannot run again (stopping?)", f->entry.id);
 }
+
+const srv_job_kind srv_fit_job = {
+	.name = "fit",
+	.plural = "fits",
+	.reg = &fits,
+	.created_status = 202,
+	.limit = "fits are running or kept; delete one",
+	.store_kind = SRV_STORE_FIT,
+	.create = fit_create,
+	.discard = fit_discard,
+	.start = fit_start,
+	.evictable = evictable,
+	.lock = fit_lock,
+	.text = fit_text,
+	.view_size = sizeof(api_fit_view),
+	.view = fit_view,
+	.list_text = fit_list_text,
+	.cancel = fit_cancel,
+	.load = fit_load,
+	.resume = fit_resume,
+};
 
 void srv_fits_shutdown(void)
 {
@@ -323,5 +399,5 @@ void srv_fits_shutdown(void)
 	while (drivers > 0)
 		pthread_cond_wait(&drivers_gone, &drivers_lock);
 	pthread_mutex_unlock(&drivers_lock);
-	srv_registry_clear(&fits);
+	srv_job_close(&srv_fit_job);
 }

@@ -35,7 +35,7 @@
 #include "store.h"
 #include "stream.h"
 #include "fitjob.h"
-#include "sweep.h"
+#include "job.h"
 #include "util.h"
 
 /* The address to bind and the MHD flags it needs. */
@@ -128,9 +128,9 @@ static void shut_down(struct MHD_Daemon *d)
 	MHD_stop_daemon(d);
 	srv_fits_shutdown(); /* their evaluations need the pool */
 	srv_pool_stop();
-	srv_sweeps_shutdown();
+	srv_job_close(&srv_sweep_job);
 	srv_sessions_shutdown();
-	srv_experiments_shutdown();
+	srv_job_close(&srv_experiment_job);
 	srv_catalog_shutdown();
 	srv_store_close(); /* every queued write is on disk */
 	srv_gate_shutdown();
@@ -138,21 +138,22 @@ static void shut_down(struct MHD_Daemon *d)
 }
 
 /* Rebuild what the data directory holds: experiments first (the sessions
- * resume theirs), then sessions, then sweeps (on the pool). */
+ * resume theirs), then sessions, then sweeps and fits (on the pool). */
 static void restore_state(void)
 {
 	if (!srv_store_enabled())
 		return;
 	double t0 = srv_now();
-	size_t ne = srv_experiments_restore();
+	size_t ne = srv_job_restore(&srv_experiment_job);
 	size_t ns = srv_sessions_restore(srv_experiment_get, srv_experiment_put);
 	size_t ni = srv_experiments_interrupt_orphans();
-	size_t nw = srv_sweeps_restore();
-	if (ne + ns + nw)
+	size_t nw = srv_job_restore(&srv_sweep_job);
+	size_t nf = srv_job_restore(&srv_fit_job);
+	if (ne + ns + nw + nf)
 		srv_log(SRV_LOG_INFO,
 			"restored %zu sessions, %zu experiments (%zu "
-			"interrupted), %zu sweeps in %.3f s",
-			ns, ne, ni, nw, srv_now() - t0);
+			"interrupted), %zu sweeps, %zu fits in %.3f s",
+			ns, ne, ni, nw, nf, srv_now() - t0);
 }
 
 int main(int argc, char **argv)
@@ -183,8 +184,8 @@ int main(int argc, char **argv)
 	srv_catalog_init(&cfg);
 	srv_sessions_init(&cfg);
 	srv_experiments_init(&cfg);
-	srv_sweeps_init(&cfg);
-	srv_fits_init(&cfg);
+	srv_job_open(&srv_sweep_job, (size_t)cfg.max_sweeps);
+	srv_job_open(&srv_fit_job, (size_t)cfg.max_fits);
 	srv_streams_init(&cfg);
 	srv_static_init(&cfg);
 	srv_routes_init(&cfg);

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * pool.c - a fixed pool of worker threads for sweep points.
+ * pool.c - a fixed pool of worker threads for sweep points and, as a
+ * parallel map (pmap.h's pmap_fn: srv_pool_map), for a fit's batches.
  *
  * Jobs are fn(arg) pairs on a FIFO list. Stopping lets the threads drain
  * what is queued (jobs check srv_stopping() and return at once), then joins
@@ -9,6 +10,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 
+#include "pmap.h"
 #include "pool.h"
 #include "util.h"
 
@@ -105,4 +107,61 @@ int srv_pool_queued(void)
 	int n = queued;
 	pthread_mutex_unlock(&pool_lock);
 	return n;
+}
+
+/* ---- the pool as a parallel map (pmap.h) ----------------------------------- */
+
+typedef struct batch {
+	pthread_mutex_t lock;
+	pthread_cond_t done;
+	size_t left;
+	pmap_job job;
+	void *arg;
+} batch;
+
+typedef struct batch_item {
+	batch *b;
+	size_t i;
+} batch_item;
+
+static void batch_finish(batch *b)
+{
+	pthread_mutex_lock(&b->lock);
+	if (--b->left == 0)
+		pthread_cond_signal(&b->done);
+	pthread_mutex_unlock(&b->lock);
+}
+
+static void run_item(void *arg)
+{
+	batch_item *it = arg;
+	batch *b = it->b;
+	size_t i = it->i;
+	free(it);
+	b->job(b->arg, i); /* cheap when cancelled or stopping: it checks */
+	batch_finish(b);
+}
+
+/* Every job of the batch on the pool (inline when it cannot take one);
+ * returns when all are done. */
+void srv_pool_map(void *ctx, size_t n, pmap_job job, void *arg)
+{
+	(void)ctx;
+	batch b = {PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, n, job, arg};
+	for (size_t i = 0; i < n; i++) {
+		batch_item *it = malloc(sizeof *it);
+		if (it)
+			*it = (batch_item){&b, i};
+		if (!it || srv_pool_submit(run_item, it) != 0) {
+			free(it);
+			job(arg, i);
+			batch_finish(&b);
+		}
+	}
+	pthread_mutex_lock(&b.lock);
+	while (b.left)
+		pthread_cond_wait(&b.done, &b.lock);
+	pthread_mutex_unlock(&b.lock);
+	pthread_mutex_destroy(&b.lock);
+	pthread_cond_destroy(&b.done);
 }

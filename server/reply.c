@@ -130,7 +130,7 @@ enum MHD_Result srv_reply_problem_with(srv_req *r, const api_problem *pb,
 			 pb->retry_after > 0 ? pb->retry_after : 1);
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, after);
 	}
-	if (strcmp(pb->budget, "connections") == 0) /* one too many: close it */
+	if (pb->close)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
 	return srv_queue(r, status, resp);
 }

@@ -23,6 +23,7 @@ typedef struct srv_req {
 	size_t body_len;
 	const char *cors_origin; /* an allowed Origin (gate.c), or NULL */
 	int csv;               /* a result route answers CSV (negotiated) */
+	const struct srv_job_kind *job; /* a job route's kind (job.h), or NULL */
 } srv_req;
 
 typedef enum MHD_Result (*srv_handler)(srv_req *r);

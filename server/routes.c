@@ -22,46 +22,45 @@
 
 #include "budget.h"
 #include "catalog.h"
-#include "experiment_http.h"
 #include "gate.h"
-#include "fitjob.h"
+#include "job.h"
 #include "routes.h"
 #include "session_http.h"
 #include "static.h"
 #include "stream.h"
-#include "sweep.h"
 #include "util.h"
 
 typedef struct route {
 	const char *method;
 	const char *pattern;
 	srv_handler handler;
+	const srv_job_kind *job; /* a job route's kind (job.h) */
 } route;
 
 static const route routes[] = {
-	{"POST", "/api/v1/sessions", srv_h_sessions_create},
-	{"GET", "/api/v1/sessions", srv_h_sessions_list},
-	{"GET", "/api/v1/sessions/*", srv_h_session_get},
-	{"PATCH", "/api/v1/sessions/*", srv_h_session_patch},
-	{"DELETE", "/api/v1/sessions/*", srv_h_session_delete},
-	{"GET", "/api/v1/sessions/*/stream", srv_h_stream},
-	{"GET", "/api/v1/sessions/*/trajectory", srv_h_trajectory},
-	{"POST", "/api/v1/experiments", srv_h_experiments_create},
-	{"GET", "/api/v1/experiments", srv_h_experiments_list},
-	{"GET", "/api/v1/experiments/*", srv_h_experiment_get},
-	{"POST", "/api/v1/sweeps", srv_h_sweeps_create},
-	{"GET", "/api/v1/sweeps", srv_h_sweeps_list},
-	{"GET", "/api/v1/sweeps/*", srv_h_sweep_get},
-	{"DELETE", "/api/v1/sweeps/*", srv_h_sweep_delete},
-	{"POST", "/api/v1/fits", srv_h_fits_create},
-	{"GET", "/api/v1/fits", srv_h_fits_list},
-	{"GET", "/api/v1/fits/*", srv_h_fit_get},
-	{"DELETE", "/api/v1/fits/*", srv_h_fit_delete},
-	{"GET", "/api/v1/presets", srv_h_presets},
-	{"GET", "/api/v1/health", srv_h_health},
-	{"GET", "/api/v1/openapi.json", srv_h_openapi},
-	{"GET", "/api/v1/problems/*", srv_h_problem},
-	{"GET", "/metrics", srv_h_metrics},
+	{"POST", "/api/v1/sessions", srv_h_sessions_create, NULL},
+	{"GET", "/api/v1/sessions", srv_h_sessions_list, NULL},
+	{"GET", "/api/v1/sessions/*", srv_h_session_get, NULL},
+	{"PATCH", "/api/v1/sessions/*", srv_h_session_patch, NULL},
+	{"DELETE", "/api/v1/sessions/*", srv_h_session_delete, NULL},
+	{"GET", "/api/v1/sessions/*/stream", srv_h_stream, NULL},
+	{"GET", "/api/v1/sessions/*/trajectory", srv_h_trajectory, NULL},
+	{"POST", "/api/v1/experiments", srv_h_job_create, &srv_experiment_job},
+	{"GET", "/api/v1/experiments", srv_h_job_list, &srv_experiment_job},
+	{"GET", "/api/v1/experiments/*", srv_h_job_get, &srv_experiment_job},
+	{"POST", "/api/v1/sweeps", srv_h_job_create, &srv_sweep_job},
+	{"GET", "/api/v1/sweeps", srv_h_job_list, &srv_sweep_job},
+	{"GET", "/api/v1/sweeps/*", srv_h_job_get, &srv_sweep_job},
+	{"DELETE", "/api/v1/sweeps/*", srv_h_job_delete, &srv_sweep_job},
+	{"POST", "/api/v1/fits", srv_h_job_create, &srv_fit_job},
+	{"GET", "/api/v1/fits", srv_h_job_list, &srv_fit_job},
+	{"GET", "/api/v1/fits/*", srv_h_job_get, &srv_fit_job},
+	{"DELETE", "/api/v1/fits/*", srv_h_job_delete, &srv_fit_job},
+	{"GET", "/api/v1/presets", srv_h_presets, NULL},
+	{"GET", "/api/v1/health", srv_h_health, NULL},
+	{"GET", "/api/v1/openapi.json", srv_h_openapi, NULL},
+	{"GET", "/api/v1/problems/*", srv_h_problem, NULL},
+	{"GET", "/metrics", srv_h_metrics, NULL},
 };
 
 static const srv_config *cfg;
@@ -161,6 +160,7 @@ static enum MHD_Result call_route(srv_req *r, const route *ro)
 				  srv_header(r, MHD_HTTP_HEADER_ACCEPT), &r->csv, &pb) != API_OK)
 			return srv_reply_problem(r, &pb, NULL);
 	}
+	r->job = ro->job;
 	return ro->handler(r);
 }
 

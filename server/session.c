@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * session.c - sessions: registry, lifetime, views, the control entry point
- * and the snapshot readers of the record ring and history.
+ * session.c - sessions: lifetime (create, restore, delete, reap), the
+ * control entry point and attaching an experiment. The registry of
+ * sessions and what reads it are session_list.c; their files are
+ * session_store.c, which this file calls and which never calls back.
  *
  * Sessions live in a registry (registry.c) and are reference counted: the
  * registry, each handler while it works and each stream hold one. Handlers
@@ -26,12 +28,13 @@
 #include "util.h"
 
 static void destroy(srv_entry *en);
-static srv_registry sessions = SRV_REGISTRY_INIT(destroy);
+#define sessions srv_sessions_registry /* session_list.c's */
 static const srv_config *cfg;
 
 void srv_sessions_init(const srv_config *config)
 {
 	cfg = config;
+	sessions.destroy = destroy;
 	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
 }
 
@@ -192,6 +195,8 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 		goto fail;
 	s->exp = exp;
 	s->owned = exp && !srv_exp_keeps_session(exp);
+	if (exp) /* before its worker can end it and write its result */
+		srv_exp_set_session(exp, s->entry.id);
 	s->last_access = s->ckpt_wall = srv_now();
 	s->ckpt_dirty = 1;
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
@@ -209,18 +214,6 @@ fail:
 	srv_registry_cancel(&sessions, &s->entry);
 	session_free(s);
 	return NULL;
-}
-
-srv_session *srv_session_get(const char *id)
-{
-	srv_entry *en = srv_registry_get(&sessions, id);
-	if (!en)
-		return NULL;
-	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
-	pthread_mutex_lock(&s->lock);
-	s->last_access = srv_now();
-	pthread_mutex_unlock(&s->lock);
-	return s;
 }
 
 int srv_session_adopt(srv_session *s)
@@ -261,12 +254,6 @@ fail:
 		srv_exp_abort(s->exp, "its session could not be restored");
 	session_free(s);
 	return -1;
-}
-
-void srv_session_put(srv_session *s)
-{
-	if (s)
-		srv_registry_put(&sessions, &s->entry);
 }
 
 /* Unlink s and stop its worker; its files go too unless the daemon
@@ -352,100 +339,6 @@ size_t srv_sessions_reap(double idle_timeout)
 	}
 	srv_sessions_release(all, n);
 	return reaped;
-}
-
-/* ---- queries --------------------------------------------------------------- */
-
-const char *srv_session_id(const srv_session *s)
-{
-	return s->entry.id;
-}
-
-static const char *state_name(int state)
-{
-	static const char *const names[] = {"running", "paused", "finished",
-					    "failed"};
-	return state >= 0 && state <= 3 ? names[state] : "failed";
-}
-
-void srv_session_view(srv_session *s, api_view *v)
-{
-	memset(v, 0, sizeof *v);
-	snprintf(v->id, sizeof v->id, "%s", s->entry.id);
-	v->spec = &s->spec;
-	v->created = s->created;
-	v->columns = s->columns;
-	v->layers = s->layers;
-	pthread_mutex_lock(&s->lock);
-	v->state = s->damaged ? "damaged"
-		   : s->store_error[0] && s->state != SRV_FAILED
-			   ? "error"
-			   : state_name(s->state);
-	snprintf(v->error, sizeof v->error, "%s",
-		 s->store_error[0] && !s->damaged ? s->store_error : s->error);
-	v->pace = s->pace;
-	v->until = s->until;
-	v->has_status = 1;
-	v->st = s->st;
-	v->steps_per_s = s->steps_per_s;
-	v->rtf = s->rtf;
-	v->samples = s->head;
-	v->streams = s->streams;
-	v->cpu_seconds = s->cpu_seconds;
-	v->cpu_limit = s->cpu_limit;
-	v->pause_reason = s->state != SRV_PAUSED ? NULL
-			  : s->cpu_paused      ? "cpu-budget"
-					       : "client";
-	v->waiting_for_cpu = s->waiting_for_cpu;
-	v->replayed = s->rebuilt;
-	v->replay_seconds = s->replay_seconds;
-	if (s->exp)
-		snprintf(v->experiment, sizeof v->experiment, "%s",
-			 srv_exp_id(s->exp));
-	pthread_mutex_unlock(&s->lock);
-}
-
-size_t srv_session_count(void)
-{
-	return srv_registry_count(&sessions);
-}
-
-size_t srv_sessions_all(srv_session ***out)
-{
-	srv_entry **all = NULL;
-	size_t n = srv_registry_snapshot(&sessions, &all);
-	srv_session **arr = calloc(n ? n : 1, sizeof *arr);
-	if (!arr) {
-		srv_registry_release(&sessions, all, n);
-		n = 0;
-	}
-	for (size_t i = 0; i < n; i++)
-		arr[i] = SRV_CONTAINER(all[i], srv_session, entry);
-	if (arr)
-		free(all);
-	*out = arr;
-	return n;
-}
-
-void srv_sessions_release(srv_session **all, size_t n)
-{
-	for (size_t i = 0; i < n; i++)
-		srv_session_put(all[i]);
-	free(all);
-}
-
-double srv_sessions_steps_per_s(void)
-{
-	double sum = 0;
-	srv_session **all = NULL;
-	size_t n = srv_sessions_all(&all);
-	for (size_t i = 0; i < n; i++) {
-		pthread_mutex_lock(&all[i]->lock);
-		sum += all[i]->steps_per_s;
-		pthread_mutex_unlock(&all[i]->lock);
-	}
-	srv_sessions_release(all, n);
-	return sum;
 }
 
 /* The paced cores s needs after c: raise its hold before c is queued, or
@@ -548,8 +441,38 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	else {
 		s->exp = e;
 		s->exp_started = 0;
+		srv_exp_set_session(e, s->entry.id);
 		pthread_cond_broadcast(&s->wake);
 	}
 	pthread_mutex_unlock(&s->lock);
 	return rc;
+}
+
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e))
+{
+	if (!srv_store_enabled())
+		return 0;
+	const srv_exp_finder ef = {find, put};
+	char **names = NULL;
+	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = calloc(1, sizeof *s);
+		if (s) {
+			pthread_mutex_init(&s->lock, NULL);
+			pthread_cond_init(&s->wake, NULL);
+			pthread_cond_init(&s->data, NULL);
+			srv_persist_load(s, names[i], &ef);
+			if (s->damaged)
+				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
+					s->error);
+			if (srv_session_adopt(s) == 0)
+				count++;
+		}
+		free(names[i]);
+	}
+	free(names);
+	/* all in first: the restore does not compete with running workers */
+	srv_sessions_start_restored();
+	return count;
 }

@@ -173,6 +173,18 @@ void srv_persist_checkpoint(srv_session *s, int force);
 /* Queue the removal of the session's files. */
 void srv_persist_remove(const srv_session *s);
 
+/* The experiments' registry as the restore sees it (session.h's
+ * srv_sessions_restore): a new reference by id, or NULL; put it back. */
+typedef struct srv_exp_finder {
+	srv_experiment *(*find)(const char *id);
+	void (*put)(srv_experiment *e);
+} srv_exp_finder;
+/* Build session id from its files into s (calloc'd, lock initialised):
+ * spec, checkpoint (or the previous one, or a fresh start from the spec),
+ * the experiment it ran resumed; s->damaged with the reason in s->error
+ * when they do not pass their checks. */
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
+
 /* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
  * the core's checkpoint (sim_len bytes) follow. */
 /* A checkpoint's payload: this head, the experiment's state, the core's
@@ -204,6 +216,9 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 		    int *owned, char *why, size_t whylen);
 int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 		    size_t whylen);
+
+/* The registry of sessions (session_list.c; session.c sets its destroy). */
+extern srv_registry srv_sessions_registry;
 
 /* session.c: publish a session built by session_store.c: s has its
  * registry id set in s->entry.id, spec, sim (NULL when damaged), state;

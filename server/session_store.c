@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * session_store.c - a session's files in the data directory and the
- * sessions rebuilt from them at start-up (docs/operations.md "Persistence").
+ * session_store.c - a session's files in the data directory, written and
+ * read back (docs/operations.md "Persistence"); session.c's restore calls it.
  *
  *   sessions/ID/spec.json        the spec as created, the API's JSON
  *                                (api_spec_file), read first
@@ -205,12 +205,6 @@ void srv_persist_remove(const srv_session *s)
 
 /* ---- restore ------------------------------------------------------------ */
 
-/* The checkpoint of s from file (relative): restores s->sim, run state and
- * the experiment; 0, or -1 with why. */
-/* The experiments' registry, for the restore (srv_sessions_restore). */
-static srv_experiment *(*exp_find)(const char *id);
-static void (*exp_put)(srv_experiment *e);
-
 int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 		    size_t whylen)
 {
@@ -234,13 +228,22 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 	return 0;
 }
 
-static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
-			   char *why, size_t whylen)
+/* The checkpoint of s from file (relative): restores s->sim, run state and
+ * the experiment (found with find, given back with put), and *logged, the
+ * bytes of the control log it holds; 0, or -1 with why and *unread set
+ * when the file could not be read at all (missing). */
+static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finder *ef,
+			   size_t *logged, int *unread, char *why, size_t whylen)
 {
-	size_t len;
-	char *p = srv_store_read(file, SRV_STORE_CHECKPOINT, &len, why, whylen);
-	if (!p)
+	size_t n = 0, len;
+	char *raw = srv_store_read_text(file, &n);
+	const char *bad = "missing or unreadable";
+	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &bad) : NULL;
+	*unread = !raw;
+	if (!p) {
+		snprintf(why, whylen, "%s: %s", file, bad);
 		return -1;
+	}
 	srv_ckpt_record r;
 	int rc = -1;
 	char msg[256] = "";
@@ -273,13 +276,13 @@ static int load_checkpoint(srv_session *s, const char *file, size_t *logged,
 	s->until = r.until;
 	snprintf(s->error, sizeof s->error, "%s", r.error);
 	if (r.exp_started && r.exp_len) {
-		srv_experiment *e = exp_find(r.exp_id);
+		srv_experiment *e = ef->find(r.exp_id);
 		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
 			s->exp = e;
 			s->exp_started = 1;
 		}
 		if (e)
-			exp_put(e); /* the registry keeps it */
+			ef->put(e); /* the registry keeps it */
 	}
 	rc = 0;
 done:
@@ -392,8 +395,7 @@ static void rebuild(srv_session *s, const char *why, const char *why2)
 		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
 }
 
-/* Build session id from its files into s (calloc'd, lock initialised). */
-static void restore_one(srv_session *s, const char *id)
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	char path[128], why[512] = "", why2[512] = "";
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
@@ -409,13 +411,14 @@ static void restore_one(srv_session *s, const char *id)
 	s->state = SRV_RUNNING;
 	session_dir(path, sizeof path, id, "checkpoint.bin");
 	size_t logged = 0;
-	if (load_checkpoint(s, path, &logged, why, sizeof why) == 0) {
+	int unread = 0, unread_prev = 0;
+	if (load_checkpoint(s, path, ef, &logged, &unread, why, sizeof why) == 0) {
 		load_controls(s, logged);
 		return;
 	}
 	char prev[160];
 	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, &logged, why2, sizeof why2) == 0) {
+	if (load_checkpoint(s, prev, ef, &logged, &unread_prev, why2, sizeof why2) == 0) {
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
 		load_controls(s, logged);
@@ -424,7 +427,7 @@ static void restore_one(srv_session *s, const char *id)
 	/* none: created less than one interval before the crash; else both
 	 * copies are unusable (another build's, damaged): either way it
 	 * starts again from its spec and takes every control it took */
-	int none = strstr(why, "missing") && strstr(why2, "missing");
+	int none = unread && unread_prev;
 	char msg[256] = "";
 	int err;
 	s->sim = sim_new(&s->spec.params, &s->spec.scene, &s->spec.method,
@@ -442,32 +445,3 @@ static void restore_one(srv_session *s, const char *id)
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
-size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
-			    void (*put)(srv_experiment *e))
-{
-	if (!srv_store_enabled())
-		return 0;
-	exp_find = find;
-	exp_put = put;
-	char **names = NULL;
-	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
-	for (size_t i = 0; i < n; i++) {
-		srv_session *s = calloc(1, sizeof *s);
-		if (s) {
-			pthread_mutex_init(&s->lock, NULL);
-			pthread_cond_init(&s->wake, NULL);
-			pthread_cond_init(&s->data, NULL);
-			restore_one(s, names[i]);
-			if (s->damaged)
-				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
-					s->error);
-			if (srv_session_adopt(s) == 0)
-				count++;
-		}
-		free(names[i]);
-	}
-	free(names);
-	/* all in first: the restore does not compete with running workers */
-	srv_sessions_start_restored();
-	return count;
-}

@@ -251,7 +251,7 @@ int srv_store_open(const srv_config *cfg)
 	st.interval = cfg->checkpoint_interval;
 	if (!st.dir)
 		return 0;
-	static const char *const subdirs[] = {"sessions", "experiments", "sweeps"};
+	static const char *const subdirs[] = {"sessions", "experiments", "sweeps", "fits"};
 	for (int i = 0; i < 3; i++) {
 		char p[4096];
 		full_path(p, sizeof p, subdirs[i]);

@@ -38,6 +38,7 @@ enum {
 	SRV_STORE_CHECKPOINT = 2, /* sessions/ID/checkpoint.bin (+ .prev) */
 	SRV_STORE_EXPERIMENT = 3, /* experiments/ID.bin */
 	SRV_STORE_SWEEP = 4,      /* sweeps/ID.bin */
+	SRV_STORE_FIT = 5,        /* fits/ID.bin */
 };
 
 /* Called on the writer thread after a write: err 0 or an errno, what a

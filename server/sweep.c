@@ -11,7 +11,9 @@
  * queued job holds one, so DELETE (cancel) can unlink a sweep while its
  * jobs drain; beyond --max-sweeps the oldest finished one is evicted. A
  * sweep's fields are guarded by its own lock. Results are served as JSON
- * or CSV and, with --data-dir, saved as CSV when done.
+ * or CSV and, with --data-dir, saved as CSV when done. The sweep is
+ * one kind of job (job.h): srv_sweep_job below is its descriptor. The
+ * mirror reduction's plan of its points is sweep_plan.c.
  */
 #include <pthread.h>
 #include <stdio.h>
@@ -19,30 +21,13 @@
 #include <string.h>
 
 #include "budget.h"
+#include "job.h"
 #include "metrics.h"
-#include "peers.h"
 #include "pool.h"
 #include "registry.h"
 #include "store.h"
-#include "sweep.h"
+#include "sweep_int.h"
 #include "util.h"
-
-typedef struct srv_sweep {
-	srv_entry entry;       /* id and references: the registry */
-	pthread_mutex_t lock;
-	/* guarded by lock */
-	api_sweep_req req;
-	api_sweep_point *pt;
-	long *image;           /* the point derived from point i, or -1 */
-	size_t total, done;
-	size_t jobs;           /* points that run (the others are images) */
-	int running, cancelled;
-	char store_error[256];  /* a write failed: state "error" */
-	char damaged[256];      /* its record is unusable: why (state
-				   "damaged", no points) */
-	char *csv;              /* damaged: the result file as stored, or NULL */
-	size_t csv_len;
-} srv_sweep;
 
 typedef struct sweep_job {
 	srv_sweep *sw;
@@ -51,13 +36,6 @@ typedef struct sweep_job {
 
 static void destroy(srv_entry *en);
 static srv_registry sweeps = SRV_REGISTRY_INIT(destroy);
-static const srv_config *cfg;
-
-void srv_sweeps_init(const srv_config *config)
-{
-	cfg = config;
-	srv_registry_open(&sweeps, (size_t)cfg->max_sweeps);
-}
 
 static srv_sweep *sweep_of(srv_entry *en)
 {
@@ -154,13 +132,10 @@ static void persist_locked(const srv_sweep *sw)
 	memcpy(p, &r, sizeof r);
 	memcpy(p + sizeof r, sw->req.betas, nb);
 	memcpy(p + sizeof r + nb, sw->pt, np);
-	size_t len;
-	void *buf = srv_store_frame(SRV_STORE_SWEEP, p, sizeof r + nb + np, &len);
+	char *id = strdup(sw->entry.id);
+	if (id && srv_job_save(&srv_sweep_job, id, p, sizeof r + nb + np, written, id) != 0)
+		free(id);
 	free(p);
-	char path[64];
-	snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
-	if (buf)
-		srv_store_write(path, buf, len, 0, written, strdup(sw->entry.id));
 }
 
 /* The CSV result (lock held). */
@@ -176,61 +151,6 @@ static void save_results(const srv_sweep *sw)
 	if (text)
 		srv_store_write(name, text, strlen(text), 0, written,
 				strdup(sw->entry.id));
-}
-
-/* The mirror reduction's plan of the sweep's points: which are mirror
- * images of which (sw->image, sw->jobs, each point's `mirrored`). The
- * plan depends only on the request, so a restart makes it again. 0, or
- * -1 when out of memory. */
-static int plan(srv_sweep *sw)
-{
-	size_t n = sw->total;
-	double *beta = malloc(sizeof *beta * (n ? n : 1));
-	int *rot = malloc(sizeof *rot * (n ? n : 1));
-	long *source = malloc(sizeof *source * (n ? n : 1));
-	sw->image = malloc(sizeof *sw->image * (n ? n : 1));
-	int rc = beta && rot && source && sw->image ? 0 : -1;
-	for (size_t i = 0; rc == 0 && i < n; i++) {
-		beta[i] = sw->pt[i].beta.si;
-		rot[i] = sw->pt[i].rotation;
-		sw->image[i] = -1;
-	}
-	if (rc == 0) {
-		sw->jobs = sim_mirror_plan(&sw->req.spec.params, &sw->req.spec.scene, n, beta,
-					   rot, source);
-		for (size_t i = 0; i < n; i++) {
-			sw->pt[i].mirrored = source[i] >= 0;
-			if (source[i] >= 0)
-				sw->image[source[i]] = (long)i;
-		}
-	}
-	free(beta);
-	free(rot);
-	free(source);
-	return rc;
-}
-
-/* Point i is over (done or failed): its mirror image, if it has one, is
- * too (lock held). */
-static void fill_image(srv_sweep *sw, size_t i)
-{
-	long j = sw->image[i];
-	if (j < 0 || sw->pt[j].state >= 2)
-		return;
-	const api_sweep_point *src = &sw->pt[i];
-	api_sweep_point *p = &sw->pt[j];
-	p->state = src->state;
-	p->velocity = -src->velocity;
-	p->uncertainty = src->uncertainty;
-	p->steady = src->steady;
-	p->dt = src->dt;
-	p->substeps = src->substeps;
-	p->step_error = src->step_error;
-	p->tol_met = src->tol_met;
-	if (src->state == 3)
-		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
-				   src->error);
-	sw->done++;
 }
 
 static void run_point(void *arg)
@@ -274,138 +194,101 @@ static void run_point(void *arg)
 				 msg[0] ? msg : sim_strerror(rc));
 		}
 		sw->done++;
-		fill_image(sw, job_i);
+		srv_sweep_fill_image(sw, job_i);
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
-		persist_locked(sw);
-		if (sw->done == sw->total)
-			save_results(sw);
+		/* a deleted sweep's files are gone: none are written again */
+		if (!sw->cancelled) {
+			persist_locked(sw);
+			if (sw->done == sw->total)
+				save_results(sw);
+		}
 		pthread_mutex_unlock(&sw->lock);
 	}
 	srv_budget_point_done(skip ? 0 : srv_now() - started);
 	srv_registry_put(&sweeps, &sw->entry);
 }
 
-/* A sweep whose record is unusable is listed as "damaged" with why, as
- * a session is, and its CSV result, when one was stored, is still served
- * as it is. 0, or -1 when the registry has no room or memory ran out. */
-static int restore_damaged(const char *id, const char *why)
+/* Queue one pool job for each point of a restored sweep that was pending
+ * or running, each with a reference (the caller holds one). */
+static void sweep_resume(srv_entry *en)
 {
-	srv_sweep *sw = calloc(1, sizeof *sw);
-	if (!sw)
-		return -1;
-	pthread_mutex_init(&sw->lock, NULL);
-	snprintf(sw->entry.id, sizeof sw->entry.id, "%.23s", id);
-	snprintf(sw->damaged, sizeof sw->damaged, "damaged: %.200s", why);
-	char name[64];
-	snprintf(name, sizeof name, "sweep-%s.csv", sw->entry.id);
-	sw->csv = srv_store_read_text(name, &sw->csv_len);
-	if (srv_registry_reserve(&sweeps, &sw->entry, NULL)) {
-		sweep_free(sw);
-		return -1;
+	srv_sweep *sw = sweep_of(en);
+	pthread_mutex_lock(&sw->lock);
+	size_t refs = 0;
+	for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
+		if (sw->pt[k].state != 0 || sw->pt[k].mirrored)
+			continue;
+		sweep_job *job = malloc(sizeof *job);
+		if (!job)
+			continue;
+		job->sw = sw;
+		job->i = k;
+		srv_registry_hold(&sweeps, &sw->entry);
+		srv_budget_take_points(1, NULL, 1, NULL);
+		if (srv_pool_submit(run_point, job) != 0) {
+			free(job);
+			srv_budget_give_points(1);
+			refs++;
+		}
 	}
-	srv_registry_publish(&sweeps, &sw->entry);
-	srv_registry_put(&sweeps, &sw->entry);
-	return 0;
+	pthread_mutex_unlock(&sw->lock);
+	for (size_t k = 0; k < refs; k++)
+		srv_registry_put(&sweeps, &sw->entry);
 }
 
-size_t srv_sweeps_restore(void)
+/* A sweep from its record (taken), its points as they were: those that
+ * were running are pending again; NULL with the reason. */
+static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen)
 {
-	char **names = NULL;
-	size_t n = srv_store_enabled() ? srv_store_list_ids("sweeps", 0, &names) : 0,
-	       count = 0;
-	for (size_t i = 0; i < n; i++) {
-		char path[300], why[300];
-		snprintf(path, sizeof path, "sweeps/%s", names[i]);
-		free(names[i]);
-		size_t l = strlen(path), len = 0;
-		char *p = l > 4 && strcmp(path + l - 4, ".bin") == 0
-				  ? srv_store_read(path, SRV_STORE_SWEEP, &len,
-						   why, sizeof why)
-				  : NULL;
-		sweep_record r;
-		size_t nb = 0, np = 0;
-		int ok = p && len >= sizeof r;
-		if (ok) {
-			memcpy(&r, p, sizeof r);
-			nb = (size_t)r.req.nbeta * sizeof(api_value);
-			np = r.total * sizeof(api_sweep_point);
-			ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
-			     r.total <= API_SWEEP_MAX_POINTS &&
-			     len == sizeof r + nb + np;
-		}
-		srv_sweep *sw = ok ? calloc(1, sizeof *sw) : NULL;
-		if (sw) {
-			pthread_mutex_init(&sw->lock, NULL);
-			sw->req = r.req;
-			sw->req.betas = malloc(nb ? nb : 1);
-			sw->pt = malloc(np ? np : 1);
-			r.id[SRV_ID_LEN - 1] = '\0';
-			snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
-		}
-		if (sw && sw->req.betas && sw->pt) {
-			memcpy(sw->req.betas, p + sizeof r, nb);
-			memcpy(sw->pt, p + sizeof r + nb, np);
-			sw->total = r.total;
-			sw->cancelled = r.cancelled;
-			sw->done = 0;
-			for (size_t k = 0; k < sw->total; k++) {
-				if (sw->pt[k].state == 1) /* was running */
-					sw->pt[k].state = 0;
-				sw->done += sw->pt[k].state >= 2;
-			}
-			/* the plan again; an image whose point is over is
-			 * filled (written together, but a stop may fall
-			 * between the two writes) */
-			int planned = plan(sw) == 0;
-			for (size_t k = 0; planned && k < sw->total; k++)
-				if (sw->pt[k].state >= 2)
-					fill_image(sw, k);
-			if (planned && srv_registry_reserve(&sweeps, &sw->entry, NULL) == 0) {
-				srv_registry_publish(&sweeps, &sw->entry);
-				pthread_mutex_lock(&sw->lock);
-				size_t refs = 0;
-				for (size_t k = 0; k < sw->total && !sw->cancelled; k++) {
-					if (sw->pt[k].state != 0 || sw->pt[k].mirrored)
-						continue;
-					sweep_job *job = malloc(sizeof *job);
-					if (!job)
-						continue;
-					job->sw = sw;
-					job->i = k;
-					srv_registry_hold(&sweeps, &sw->entry);
-					srv_budget_take_points(1, NULL, 1, NULL);
-					if (srv_pool_submit(run_point, job) != 0) {
-						free(job);
-						srv_budget_give_points(1);
-						refs++;
-					}
-				}
-				pthread_mutex_unlock(&sw->lock);
-				for (size_t k = 0; k < refs; k++)
-					srv_registry_put(&sweeps, &sw->entry);
-				srv_registry_put(&sweeps, &sw->entry);
-				count++;
-				sw = NULL;
-			}
-		} else if (!ok && p) {
-			snprintf(why, sizeof why, "%.200s: inconsistent", path);
-		}
-		if (!ok && l > 4 && strcmp(path + l - 4, ".bin") == 0) {
-			srv_log(SRV_LOG_WARN, "sweep not restored: %s", why);
-			path[l - 4] = '\0';
-			count += restore_damaged(path + strlen("sweeps/"), why) == 0;
-		}
-		sweep_free(sw);
-		free(p);
+	char *p = payload;
+	sweep_record r;
+	size_t nb = 0, np = 0;
+	int ok = len >= sizeof r;
+	if (ok) {
+		memcpy(&r, p, sizeof r);
+		nb = (size_t)r.req.nbeta * sizeof(api_value);
+		np = r.total * sizeof(api_sweep_point);
+		ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
+		     r.total <= API_SWEEP_MAX_POINTS && len == sizeof r + nb + np;
 	}
-	free(names);
-	return count;
-}
-
-void srv_sweeps_shutdown(void)
-{
-	/* the pool has drained: only the registry's references remain */
-	srv_registry_clear(&sweeps);
+	if (!ok)
+		snprintf(why, whylen, "inconsistent");
+	srv_sweep *sw = ok ? calloc(1, sizeof *sw) : NULL;
+	if (sw) {
+		pthread_mutex_init(&sw->lock, NULL);
+		sw->req = r.req;
+		sw->req.betas = malloc(nb ? nb : 1);
+		sw->pt = malloc(np ? np : 1);
+		r.id[SRV_ID_LEN - 1] = '\0';
+		snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
+	}
+	int planned = 0;
+	if (sw && sw->req.betas && sw->pt) {
+		memcpy(sw->req.betas, p + sizeof r, nb);
+		memcpy(sw->pt, p + sizeof r + nb, np);
+		sw->total = r.total;
+		sw->cancelled = r.cancelled;
+		sw->done = 0;
+		for (size_t k = 0; k < sw->total; k++) {
+			if (sw->pt[k].state == 1) /* was running */
+				sw->pt[k].state = 0;
+			sw->done += sw->pt[k].state >= 2;
+		}
+		/* the plan again; an image whose point is over is filled
+		 * (written together, but a stop may fall between the two
+		 * writes) */
+		planned = srv_sweep_plan(sw) == 0;
+		for (size_t k = 0; planned && k < sw->total; k++)
+			if (sw->pt[k].state >= 2)
+				srv_sweep_fill_image(sw, k);
+	}
+	if (ok && !planned) {
+		snprintf(why, whylen, "out of memory");
+		sweep_free(sw);
+		sw = NULL;
+	}
+	free(p);
+	return sw ? &sw->entry : NULL;
 }
 
 static int evictable(srv_entry *en)
@@ -417,8 +300,9 @@ static int evictable(srv_entry *en)
 	return over;
 }
 
-/* A sweep for the body of r with its grid of points; NULL with *pb. */
-static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
+/* A sweep for a request body with its grid of points and their place in
+ * the points' budget; NULL with *pb. */
+static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 {
 	srv_sweep *sw = calloc(1, sizeof *sw);
 	if (!sw) {
@@ -426,7 +310,7 @@ static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
 		return NULL;
 	}
 	pthread_mutex_init(&sw->lock, NULL);
-	if (api_parse_sweep(r->body, r->body_len, &sw->req, pb) != API_OK) {
+	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK) {
 		sweep_free(sw);
 		return NULL;
 	}
@@ -445,12 +329,24 @@ static srv_sweep *sweep_new(srv_req *r, api_problem *pb)
 			p->beta = sw->req.betas[b];
 			p->rotation = sw->req.rotations[ro];
 		}
-	if (plan(sw) != 0) {
+	if (srv_sweep_plan(sw) != 0) {
 		sweep_free(sw);
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
-	return sw;
+	if (srv_budget_take_points(sw->jobs, "beta", 0, pb) != API_OK) {
+		sweep_free(sw);
+		return NULL;
+	}
+	return &sw->entry;
+}
+
+/* A created sweep that was not kept: its points' budget goes back. */
+static void sweep_discard(srv_entry *en)
+{
+	srv_sweep *sw = sweep_of(en);
+	srv_budget_give_points(sw->jobs);
+	sweep_free(sw);
 }
 
 /* Queue one pool job per point that runs (not a mirror image), each with
@@ -473,32 +369,18 @@ static size_t submit_points(srv_sweep *sw)
 			snprintf(sw->pt[i].error, sizeof sw->pt[i].error,
 				 "not queued (out of memory or stopping)");
 			sw->done++;
-			fill_image(sw, i);
+			srv_sweep_fill_image(sw, i);
 			unused++;
 		}
 	}
 	return unused;
 }
 
-enum MHD_Result srv_h_sweeps_create(srv_req *r)
+/* Queue the points of a published sweep; the answer shows it queued. */
+static api_err sweep_start(srv_entry *en, char **answer, api_problem *pb)
 {
-	enum MHD_Result res;
-	api_problem pb;
-	srv_sweep *sw = sweep_new(r, &pb);
-	if (!sw)
-		return srv_reply_problem(r, &pb, NULL);
-	if (srv_budget_take_points(sw->jobs, "beta", 0, &pb) != API_OK) {
-		sweep_free(sw);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	if (srv_registry_reserve(&sweeps, &sw->entry, evictable)) {
-		srv_budget_give_points(sw->jobs);
-		sweep_free(sw);
-		return srv_fail(r, API_LIMIT, NULL,
-				"%d sweeps are running or kept; delete one",
-				cfg->max_sweeps);
-	}
-	srv_registry_publish(&sweeps, &sw->entry);
+	(void)pb;
+	srv_sweep *sw = sweep_of(en);
 	for (size_t i = 0; i < sw->jobs; i++)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */
 	/* jobs wait for the lock: the answer shows the sweep as queued */
@@ -507,80 +389,85 @@ enum MHD_Result srv_h_sweeps_create(srv_req *r)
 	size_t unused = submit_points(sw);
 	api_sweep_view v;
 	fill_view(sw, &v);
-	char *text = api_sweep_json(&v);
+	*answer = api_sweep_json(&v);
 	pthread_mutex_unlock(&sw->lock);
 	for (size_t i = 0; i < unused; i++)
 		srv_registry_put(&sweeps, &sw->entry);
 	srv_budget_give_points(unused);
-	res = srv_reply_created(r, 202, text, "/api/v1/sweeps", v.id);
-	srv_registry_put(&sweeps, &sw->entry);
-	return res;
+	return API_OK;
 }
 
-enum MHD_Result srv_h_sweep_get(srv_req *r)
+static pthread_mutex_t *sweep_lock(srv_entry *en)
 {
-	srv_entry *en = srv_registry_get(&sweeps, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no sweep with id \"%.40s\"", r->arg[0]);
+	return &sweep_of(en)->lock;
+}
+
+static char *sweep_text(srv_entry *en, int csv)
+{
 	srv_sweep *sw = sweep_of(en);
 	api_sweep_view v;
-	pthread_mutex_lock(&sw->lock);
 	fill_view(sw, &v);
-	char *text = r->csv && sw->csv ? strndup(sw->csv, sw->csv_len)
-		     : r->csv	       ? api_sweep_csv(&v)
-				       : api_sweep_json(&v);
-	pthread_mutex_unlock(&sw->lock);
-	srv_registry_put(&sweeps, en);
-	return srv_reply_result(r, text);
+	/* a damaged sweep's stored result, as it was written */
+	if (csv && sw->csv)
+		return strndup(sw->csv, sw->csv_len);
+	return csv ? api_sweep_csv(&v) : api_sweep_json(&v);
 }
 
-enum MHD_Result srv_h_sweeps_list(srv_req *r)
+static void sweep_view(srv_entry *en, void *view, void *scratch)
 {
-	srv_entry **all = NULL;
-	size_t n = srv_registry_snapshot(&sweeps, &all);
-	api_sweep_view *v = calloc(n + 1, sizeof *v);
-	char *text = NULL;
-	if (v) {
-		for (size_t i = 0; i < n; i++) {
-			srv_sweep *sw = sweep_of(all[i]);
-			pthread_mutex_lock(&sw->lock);
-			fill_view(sw, &v[i]);
-			pthread_mutex_unlock(&sw->lock);
-		}
-		text = r->csv ? api_sweep_list_csv(v, n) : api_sweep_list_json(v, n);
-	}
-	srv_registry_release(&sweeps, all, n);
-	free(v);
-	return srv_peers_reply(r, text, "sweeps");
+	(void)scratch;
+	fill_view(sweep_of(en), view);
 }
 
-enum MHD_Result srv_h_sweep_delete(srv_req *r)
+static char *sweep_list_text(const void *views, size_t n, int csv)
 {
-	srv_entry *en = srv_registry_get(&sweeps, r->arg[0]);
-	if (!en)
-		return srv_fail(r, API_NOTFOUND, NULL,
-				"no sweep with id \"%.40s\"", r->arg[0]);
+	return csv ? api_sweep_list_csv(views, n) : api_sweep_list_json(views, n);
+}
+
+/* A sweep whose record is unusable: listed as "damaged" with why, as a
+ * session is, and its CSV result, when one was stored, still served as it
+ * is. NULL when out of memory. */
+static srv_entry *sweep_damaged(const char *id, const char *why)
+{
+	srv_sweep *sw = calloc(1, sizeof *sw);
+	if (!sw)
+		return NULL;
+	pthread_mutex_init(&sw->lock, NULL);
+	snprintf(sw->entry.id, sizeof sw->entry.id, "%.23s", id);
+	snprintf(sw->damaged, sizeof sw->damaged, "damaged: %.200s", why);
+	char name[64];
+	snprintf(name, sizeof name, "sweep-%s.csv", sw->entry.id);
+	sw->csv = srv_store_read_text(name, &sw->csv_len);
+	return &sw->entry;
+}
+
+/* DELETE: the points not yet run are skipped. */
+static void sweep_cancel(srv_entry *en)
+{
 	srv_sweep *sw = sweep_of(en);
-	char rec[64];
-	api_problem pb;
-	snprintf(rec, sizeof rec, "sweeps/%s.bin", sw->entry.id);
-	if (srv_store_check_removable(rec, &pb) != API_OK) {
-		srv_registry_put(&sweeps, en);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	pthread_mutex_lock(&sw->lock);
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
-	pthread_mutex_unlock(&sw->lock);
-	if (srv_registry_remove(&sweeps, en) && srv_store_enabled()) {
-		/* the record and the result go with it */
-		char path[64];
-		snprintf(path, sizeof path, "sweeps/%s.bin", sw->entry.id);
-		srv_store_remove(path);
-		snprintf(path, sizeof path, "sweep-%s.csv", sw->entry.id);
-		srv_store_remove(path);
-	}
-	srv_registry_put(&sweeps, en);
-	return srv_reply_empty(r);
 }
+
+const srv_job_kind srv_sweep_job = {
+	.name = "sweep",
+	.plural = "sweeps",
+	.reg = &sweeps,
+	.created_status = 202,
+	.limit = "sweeps are running or kept; delete one",
+	.store_kind = SRV_STORE_SWEEP,
+	.result_file = "sweep-%s.csv",
+	.create = sweep_create,
+	.discard = sweep_discard,
+	.start = sweep_start,
+	.evictable = evictable,
+	.lock = sweep_lock,
+	.text = sweep_text,
+	.view_size = sizeof(api_sweep_view),
+	.view = sweep_view,
+	.list_text = sweep_list_text,
+	.cancel = sweep_cancel,
+	.damaged = sweep_damaged,
+	.load = sweep_load,
+	.resume = sweep_resume,
+};

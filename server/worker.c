@@ -43,6 +43,9 @@
  *               pauses with pause_reason "cpu-budget"
  *   meter       achieved steps/s and real-time factor over half-second
  *               windows
+ *
+ * The command queue, and the attached experiment's command in it, are
+ * worker_queue.c.
  */
 #include <math.h>
 #include <stdio.h>
@@ -98,61 +101,7 @@ static void publish(srv_session *s, clocks *c)
 	s->published = s->head;
 }
 
-/* ---- the command queue ------------------------------------------------------ */
-
-void srv_worker_queue(srv_session *s, srv_cmd *cmd)
-{
-	cmd->next = NULL;
-	if (s->cmd_tail)
-		s->cmd_tail->next = cmd;
-	else
-		s->cmd_head = cmd;
-	s->cmd_tail = cmd;
-	pthread_cond_broadcast(&s->wake);
-}
-
-int srv_worker_unqueue(srv_session *s, srv_cmd *cmd)
-{
-	srv_cmd **pp = &s->cmd_head, *prev = NULL;
-	while (*pp && *pp != cmd) {
-		prev = *pp;
-		pp = &(*pp)->next;
-	}
-	if (!*pp)
-		return 0;
-	*pp = cmd->next;
-	if (s->cmd_tail == cmd)
-		s->cmd_tail = prev;
-	return 1;
-}
-
-/* ---- the attached experiment ---------------------------------------------- */
-
-/* Queue the experiment's command, if it handed one over (lock held). */
-static void queue_experiment_command(srv_session *s, srv_cmd *cmd)
-{
-	if (!cmd)
-		return;
-	if (s->exp_cmd)
-		srv_worker_unqueue(s, s->exp_cmd);
-	s->exp_cmd = cmd;
-	srv_worker_queue(s, cmd);
-}
-
-/* Let go of the experiment, aborting it with why unless why is NULL; its
- * command is taken back if still queued (lock held). */
-static void detach_experiment(srv_session *s, const char *why)
-{
-	if (!s->exp)
-		return;
-	if (s->exp_cmd)
-		srv_worker_unqueue(s, s->exp_cmd);
-	s->exp_cmd = NULL;
-	if (why)
-		srv_exp_abort(s->exp, why);
-	s->exp = NULL;
-	s->exp_started = 0;
-}
+/* ---- the attached experiment (its command queue: worker_queue.c) ---------- */
 
 /* The experiment's command was applied or refused (lock held). */
 static void experiment_commanded(srv_session *s, const srv_cmd *cmd)
@@ -161,7 +110,7 @@ static void experiment_commanded(srv_session *s, const srv_cmd *cmd)
 		return;
 	s->exp_cmd = NULL;
 	if (srv_exp_commanded(s->exp, cmd))
-		detach_experiment(s, NULL);
+		srv_worker_detach_exp(s, NULL);
 }
 
 /* Let the session run at least up to t_end (s): raise until, resume a
@@ -284,7 +233,7 @@ static void start_job(srv_session *s)
 	double t_end;
 	srv_cmd *cmd = srv_exp_begin(s->exp, &s->st, &t_end);
 	extend_until(s, t_end);
-	queue_experiment_command(s, cmd);
+	srv_worker_queue_exp_command(s, cmd);
 	s->exp_started = 1;
 	pthread_cond_broadcast(&s->data);
 }
@@ -517,9 +466,9 @@ static void run_job(srv_session *s)
 	if (!s->exp || !s->exp_started)
 		return;
 	int over = 0;
-	queue_experiment_command(s, srv_exp_step(s->exp, &s->st, &over));
+	srv_worker_queue_exp_command(s, srv_exp_step(s->exp, &s->st, &over));
 	if (over) {
-		detach_experiment(s, NULL);
+		srv_worker_detach_exp(s, NULL);
 		s->ckpt_dirty = 1;
 		if (s->owned) /* created by it and not kept */
 			s->expire = 1;
@@ -536,7 +485,7 @@ static void fail(srv_session *s, int rc)
 	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
 		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
 	srv_ring_event_at(s, "failed", NULL);
-	detach_experiment(s, s->error);
+	srv_worker_detach_exp(s, s->error);
 	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
 }
 
@@ -595,7 +544,7 @@ void *srv_worker_main(void *arg)
 		s->ckpt_dirty = 1;
 		srv_persist_checkpoint(s, 1);
 	}
-	detach_experiment(s, "the session was deleted or the daemon stopped");
+	srv_worker_detach_exp(s, "the session was deleted or the daemon stopped");
 	srv_cpu_leave(&s->turn);
 	srv_budget_set_paced(&s->paced_held, 0);
 	pthread_cond_broadcast(&s->data);

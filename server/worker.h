@@ -41,4 +41,11 @@ int srv_worker_unqueue(srv_session *s, srv_cmd *cmd);
  * session's stop flag is set. */
 void *srv_worker_main(void *arg);
 
+/* worker_queue.c, for the worker's phases (session lock held): queue the
+ * experiment's command, if it handed one over (the one still queued is
+ * taken back); let go of the experiment, aborting it with why unless why
+ * is NULL, its command taken back if still queued. */
+void srv_worker_queue_exp_command(srv_session *s, srv_cmd *cmd);
+void srv_worker_detach_exp(srv_session *s, const char *why);
+
 #endif

@@ -58,6 +58,17 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o);
 /* convsim fit (fit_cmd.c): exit status 0, 1 (the fit failed or a file
  * could not be written) or 2 (usage). */
 int cli_cmd_fit(int argc, char **argv);
+/* convsim sweep (sweep_cmd.c): exit status 0, 1 (a point failed or the
+ * table could not be written) or 2 (usage). */
+int cli_cmd_sweep(int argc, char **argv);
+
+/* Output (options.c): a number as the daemon prints it (shortest round
+ * trip), non-finite as `nonfinite`; whether a file is JSON (--format, else
+ * the name's extension); --out opened for writing, or NULL with the reason
+ * on stderr. */
+void cli_put_num(FILE *f, double v, const char *nonfinite);
+int cli_wants_json(const char *format, const char *file);
+FILE *cli_open_out(const cli_opts *o);
 
 typedef struct cli_opt {
 	unsigned cmds;    /* CMD_* bits: the commands that take it */

@@ -6,6 +6,7 @@
  * specific messages, and the progress reporter (a bar on a terminal,
  * plain lines into a file or pipe).
  */
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -16,6 +17,7 @@
 
 #include "cli.h"
 #include "suggest.h"
+#include "table.h"
 
 #define RS (CMD_RUN | CMD_SWEEP | CMD_FIT)
 #define ALL (CMD_RUN | CMD_SWEEP | CMD_LIST | CMD_FIT)
@@ -302,4 +304,34 @@ void cli_progress_end(cli_progress *p, const char *summary, int force)
 	if (p->tty && p->shown)
 		fputs("\r\033[K", stderr);
 	fprintf(stderr, "%s: %s\n", p->label, summary);
+}
+
+/* ---- output ---- */
+
+/* Print a number as the daemon does (shortest round trip); non-finite as
+ * `nonfinite`. */
+void cli_put_num(FILE *f, double v, const char *nonfinite)
+{
+	char num[40];
+	sim_fmt_double(num, sizeof num, v, nonfinite);
+	fputs(num, f);
+}
+
+/* The file's format: --format, else by the name's extension. */
+int cli_wants_json(const char *format, const char *file)
+{
+	if (format)
+		return strcmp(format, "json") == 0;
+	size_t n = file ? strlen(file) : 0;
+	return n > 5 && strcmp(file + n - 5, ".json") == 0;
+}
+
+FILE *cli_open_out(const cli_opts *o)
+{
+	FILE *f = fopen(o->out, "w");
+	if (!f) {
+		fprintf(stderr, "convsim %s: --out: cannot write '%s': %s\n", o->cmd, o->out,
+			strerror(errno));
+	}
+	return f;
 }

@@ -20,6 +20,7 @@
 
 #include <stddef.h>
 
+#include "pmap.h"
 #include "sim.h"
 
 #define FIT_MAX_FREE 8
@@ -64,10 +65,10 @@ typedef struct fit_progress {
 	double x[FIT_MAX_FREE];
 } fit_progress;
 
-/* Runs job(arg, i) for i = 0..n-1, in parallel or not, and returns when
- * all are done; the jobs are independent and thread-safe. */
-typedef void (*fit_job)(void *arg, size_t i);
-typedef void (*fit_map_fn)(void *ctx, size_t n, fit_job job, void *arg);
+/* A fit's batches run on a map (pmap.h): the caller's (the daemon's pool)
+ * or the library's threads. */
+typedef pmap_job fit_job;
+typedef pmap_fn fit_map_fn;
 
 typedef struct fit_request {
 	sim_params p;          /* the model; the free parameters' values are */

@@ -3,7 +3,7 @@
  * fit_eval.c - the model evaluations of a fit. Each unit is one fresh
  * sim_measure (steady start, window up to t_end) at a set of free-parameter
  * values, one beta and one rotation; a batch of them runs through the
- * caller's map function (the daemon's pool) or on this file's threads.
+ * caller's map function (the daemon's pool) or on the library's (pmap.h).
  * A measured peak's model value comes from a scan of v(beta) on a fixed
  * grid around the measured beta (the grid point of the largest |v|) and a
  * least-squares parabola through that point and two neighbours each side,
@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "fit_int.h"
+#include "pmap.h"
 #include "units.h"
 
 int fit_eval_init(fit_eval *ev, const fit_request *req)
@@ -147,43 +148,6 @@ static void run_unit(void *arg, size_t k)
 	b->u[k] = ms.uncertainty;
 }
 
-typedef struct own_map {
-	size_t n, next;
-	fit_job job;
-	void *arg;
-	pthread_mutex_t lock;
-} own_map;
-
-static void *own_worker(void *arg)
-{
-	own_map *om = arg;
-	for (;;) {
-		pthread_mutex_lock(&om->lock);
-		size_t i = om->next < om->n ? om->next++ : om->n;
-		pthread_mutex_unlock(&om->lock);
-		if (i == om->n)
-			return NULL;
-		om->job(om->arg, i);
-	}
-}
-
-/* The library's map: min(threads, n) threads; inline when one. */
-static void own_threads(int threads, size_t n, fit_job job, void *arg)
-{
-	own_map om = {n, 0, job, arg, PTHREAD_MUTEX_INITIALIZER};
-	pthread_t th[64];
-	int nth = threads < 1 ? 1 : threads > 64 ? 64 : threads, started = 0;
-	if ((size_t)nth > n)
-		nth = (int)n;
-	for (int t = 1; t < nth; t++)
-		if (pthread_create(&th[started], NULL, own_worker, &om) == 0)
-			started++;
-	own_worker(&om);
-	for (int t = 0; t < started; t++)
-		pthread_join(th[t], NULL);
-	pthread_mutex_destroy(&om.lock);
-}
-
 static void run_listed(void *arg, size_t k)
 {
 	batch *b = arg;
@@ -238,7 +202,7 @@ int fit_eval_curve(fit_eval *ev, size_t nsets, const double *xs, size_t n, const
 	if (r->map)
 		r->map(r->map_ctx, nrun, run_listed, &b);
 	else
-		own_threads(r->threads, nrun, run_listed, &b);
+		pmap_run(r->threads, nrun, run_listed, &b, NULL);
 	for (size_t k = 0; k < total; k++)
 		if (image[k] != (size_t)-1) {
 			b.v[k] = -b.v[image[k]];

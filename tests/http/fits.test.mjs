@@ -2,9 +2,13 @@
 // Calibration fits as jobs (POST /api/v1/fits): bad input refused whole with
 // a 422 naming the field and nothing started; a fit's life (queued or
 // running with progress, done with its result as JSON and CSV, listed,
-// deleted); DELETE cancels a running fit, whose driver then stops.
+// deleted); DELETE cancels a running fit, whose driver then stops; fits
+// outlive a kill -9 of the daemon (--data-dir).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
 
 let d;
@@ -101,4 +105,56 @@ test('DELETE cancels a running fit', { timeout: 120000 * SLOW }, async () => {
   assert.ok(!(await req(d.base, 'GET', '/api/v1/fits')).body.fits.some((f) => f.id === r.body.id));
   // the driver stops after the evaluations already running
   await until(async () => d.stderr().includes(`fit ${r.body.id}: cancelled`), 30000 * SLOW, 'the driver to stop');
+});
+
+// Fits persist like sweeps (--data-dir): after a kill -9 and a restart a
+// finished fit answers byte for byte as before, a running one runs again
+// from its start, and a deleted one leaves no file behind.
+test('fits outlive a kill -9: finished ones served as they were, running ones run again', { timeout: 240000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-fits-'));
+  const args = ['--data-dir', dir, '--log-level', 'info'];
+  let p = await startDaemon(args);
+  try {
+    const r = await req(p.base, 'POST', '/api/v1/fits', body({ t_end: 1, points: POINTS.slice(0, 2) }));
+    assert.equal(r.status, 202, r.text);
+    const path = `/api/v1/fits/${r.body.id}`;
+    await until(async () => (await req(p.base, 'GET', path)).body.state === 'done', 100000 * SLOW, 'the fit');
+    const before = {
+      json: (await req(p.base, 'GET', path)).text,
+      csv: (await req(p.base, 'GET', `${path}?format=csv`)).text,
+      list: (await req(p.base, 'GET', '/api/v1/fits?format=csv')).text,
+    };
+    // the default scene and many points: still running when killed
+    const pts = [];
+    for (let b = 5; b < 180; b += 10) pts.push({ beta: b, rotation: 'cw', v: 0.05 });
+    const long = await req(p.base, 'POST', '/api/v1/fits', { free: ['e', 'mu'], points: pts });
+    assert.equal(long.status, 202, long.text);
+    const longPath = `/api/v1/fits/${long.body.id}`;
+    await until(async () => (await req(p.base, 'GET', longPath)).body.evaluations > 0, 60000 * SLOW, 'first evaluations');
+    assert.ok(existsSync(join(dir, 'fits', `${long.body.id}.bin`)), 'the running fit\'s record');
+    p.proc.kill('SIGKILL');
+    await p.exited;
+
+    p = await startDaemon(args);
+    assert.equal((await req(p.base, 'GET', path)).text, before.json);
+    assert.equal((await req(p.base, 'GET', `${path}?format=csv`)).text, before.csv);
+    const g = await req(p.base, 'GET', longPath);
+    assert.equal(g.status, 200, g.text);
+    assert.ok(['queued', 'running'].includes(g.body.state), g.text);
+    assert.equal(g.body.result, null);
+    await until(async () => (await req(p.base, 'GET', longPath)).body.evaluations > 0, 60000 * SLOW, 'evaluations again');
+    // the finished fit's row as it was (the restore's order is the directory's)
+    const row = before.list.trim().split('\n')[1];
+    assert.ok((await req(p.base, 'GET', '/api/v1/fits?format=csv')).text.split('\n').includes(row), row);
+    assert.equal((await req(p.base, 'DELETE', longPath, undefined, JSON_CT)).status, 204);
+    await until(async () => !existsSync(join(dir, 'fits', `${long.body.id}.bin`)), 10000 * SLOW, 'the deleted fit\'s record to go');
+    // and it stays gone once its driver has stopped
+    await until(async () => p.stderr().includes(`fit ${long.body.id}: cancelled`), 30000 * SLOW, 'the driver to stop');
+    assert.equal((await p.stop()).code, 0, p.stderr());
+    assert.ok(!existsSync(join(dir, 'fits', `${long.body.id}.bin`)));
+    assert.ok(existsSync(join(dir, 'fits', `${r.body.id}.bin`)));
+  } finally {
+    await p.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
 });

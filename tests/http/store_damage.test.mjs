@@ -12,7 +12,7 @@
 // layouts (server/session_store.c, host order, x86-64).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startDaemon, req, until, untilReplayed, reframe, STORE_FRAME, CHEAP, SLOW } from './lib.mjs';
@@ -82,6 +82,45 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
     assert.match(why[2], /spec\.bin: pace "max" without until/);
     assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200);
     assert.equal((await d.stop()).code, 0, `clean stop; stderr: ${d.stderr()}`);
+  } finally {
+    await d.stop('SIGKILL');
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+// A session whose two checkpoints are damaged is damaged, and one that has
+// none yet starts again from its spec, whatever its id reads: the restore
+// asks whether the files could be read, not whether their reason's text
+// says "missing" (a replica named "missing" has ids that do).
+test('checkpoints damaged or absent, on a replica named "missing"', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-damage-'));
+  const args = ['--data-dir', dir, '--node-id', 'missing'];
+  let d = await startDaemon(args);
+  try {
+    const ids = [];
+    for (let i = 0; i < 2; i++)
+      ids.push((await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body.id);
+    for (const id of ids)
+      await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished', 20000 * SLOW, id);
+    assert.equal((await d.stop()).code, 0);
+    assert.match(ids[0], /^missing-/);
+    for (const name of ['checkpoint.bin', 'checkpoint.bin.prev']) {
+      const path = join(dir, 'sessions', ids[0], name);
+      if (existsSync(path)) {
+        const v = readFileSync(path);
+        v[FRAME] ^= 0xff; // the payload: its checksum no longer matches
+        writeFileSync(path, v);
+      }
+      rmSync(join(dir, 'sessions', ids[1], name), { force: true });
+    }
+    assert.ok(existsSync(join(dir, 'sessions', ids[0], 'checkpoint.bin')));
+    d = await startDaemon(args);
+    const damaged = (await req(d.base, 'GET', `/api/v1/sessions/${ids[0]}`)).body;
+    assert.equal(damaged.state, 'damaged', JSON.stringify(damaged));
+    assert.match(damaged.error, /checksum/);
+    const fresh = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
+    assert.notEqual(fresh.state, 'damaged', JSON.stringify(fresh)); // started again from its spec
+    assert.equal((await d.stop()).code, 0);
   } finally {
     await d.stop('SIGKILL');
     rmSync(dir, { recursive: true, force: true });

@@ -1,0 +1,69 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * experiment_segment.c - one segment of a beta-schedule experiment: its
+ * start (the command the worker applies: the segment's beta, then a
+ * restart of the transport estimator) and its measurements at its end: the
+ * mean velocity from the restarted estimator, the steady velocity as the
+ * mean feed velocity over the segment's second half, and the reversal time
+ * from the command until the feed velocity first reaches 90 % of that
+ * steady value.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "experiment_int.h"
+
+srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st)
+{
+	api_segment *seg = &e->req.seg[i];
+	srv_cmd *cmd = &e->cmd;
+	memset(cmd, 0, sizeof *cmd);
+	cmd->c.set = API_C_BETA;
+	cmd->c.beta = seg->beta;
+	if (e->req.beta_rate.si > 0) {
+		cmd->c.set |= API_C_BETA_RATE;
+		cmd->c.beta_rate = e->req.beta_rate;
+	}
+	cmd->restart_transport = 1;
+	cmd->from_experiment = 1;
+	seg->start_velocity = st->feed_velocity;
+	/* a segment that commands the beta already set (and reached) changes
+	 * nothing there is to time */
+	seg->beta_same = seg->beta.si == st->beta_target && st->beta == st->beta_target;
+	seg->state = 1;
+	e->cur = i;
+	e->seg_first = e->rec_n;
+	return cmd;
+}
+
+void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
+{
+	api_segment *seg = &e->req.seg[e->cur];
+	seg->t_end = st->t;
+	/* the estimator restarted at the segment's command */
+	seg->mean_velocity = st->transport_velocity;
+	seg->uncertainty = st->transport_velocity_uncertainty;
+	seg->steady = st->steady;
+	double half = seg->t_command + 0.5 * (seg->t_end - seg->t_command);
+	double sum = 0;
+	size_t n = 0;
+	for (size_t i = e->seg_first; i < e->rec_n; i++)
+		if (e->rec_t[i] >= half) {
+			sum += e->rec_v[i];
+			n++;
+		}
+	double steady = n ? sum / (double)n : NAN;
+	seg->steady_velocity = steady;
+	seg->reversal_time = NAN;
+	if (isfinite(steady) && steady != 0 && !seg->beta_same)
+		for (size_t i = e->seg_first; i < e->rec_n; i++) {
+			double v = e->rec_v[i];
+			if (e->rec_t[i] >= seg->t_command &&
+			    (steady > 0 ? v >= 0.9 * steady
+					: v <= 0.9 * steady)) {
+				seg->reversal_time = e->rec_t[i] - seg->t_command;
+				break;
+			}
+		}
+	seg->state = 2;
+}

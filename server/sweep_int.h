@@ -1,0 +1,41 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * sweep_int.h - a sweep as sweep.c and sweep_plan.c see it (the rest of
+ * the daemon knows a sweep only as a kind of job, job.h).
+ */
+#ifndef CONVSIM_SWEEP_INT_H
+#define CONVSIM_SWEEP_INT_H
+
+#include <pthread.h>
+#include <stddef.h>
+
+#include "api.h"
+#include "registry.h"
+
+typedef struct srv_sweep {
+	srv_entry entry;       /* id and references: the registry */
+	pthread_mutex_t lock;
+	/* guarded by lock */
+	api_sweep_req req;
+	api_sweep_point *pt;
+	long *image;           /* the point derived from point i, or -1 */
+	size_t total, done;
+	size_t jobs;           /* points that run (the others are images) */
+	int running, cancelled;
+	char store_error[256];  /* a write failed: state "error" */
+	char damaged[256];      /* its record is unusable: why (state
+				   "damaged", no points) */
+	char *csv;              /* damaged: the result file as stored, or NULL */
+	size_t csv_len;
+} srv_sweep;
+
+/* The mirror reduction's plan of the sweep's points (sweep_plan.c): which
+ * are mirror images of which (sw->image, sw->jobs, each point's
+ * `mirrored`). The plan depends only on the request, so a restart makes it
+ * again. 0, or -1 when out of memory. */
+int srv_sweep_plan(srv_sweep *sw);
+/* Point i is over (done or failed): its mirror image, if it has one, is
+ * too (lock held). */
+void srv_sweep_fill_image(srv_sweep *sw, size_t i);
+
+#endif
