@@ -17,9 +17,9 @@
  * window), short enough to keep the shadow's cost near a fifth. */
 #define SHADOW_MEASURE_SHARE 0.3
 
-/* sim_measure's refinements at most: each shrinks the feed step (and the
- * machine step where its term is large) by the factor the first-order
- * error asks for, within [1/4, 3/5]. */
+/* sim_measure's refinements at most: each shrinks the feed step, or the
+ * machine step where its term is the larger, by the factor the
+ * first-order error asks for, within [1/4, 3/5]. */
 #define MEASURE_REFINEMENTS 3
 
 /* One run of sim_measure: a fresh instance to t_end, its shadow over the
@@ -58,20 +58,23 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	for (int attempt = 0;; attempt++) {
 		err = measure_once(p, sc, &run, t_end, &st, msg, msglen);
 		out->refinements = attempt;
-		/* done: within tol, the user's own steps, no step error to blame
-		 * (the feed's scatter, a drift: steps cannot help), or a
-		 * refinement that did not shrink the step error as a first-order
-		 * one shrinks (by 0.6 at least): what remains is not the steps' */
+		/* what the steps may take of tol: the bar less its scatter and
+		 * drift, which finer steps cannot shrink */
+		double room = st.tol_allowed - (st.transport_velocity_uncertainty - st.step_error);
+		/* done: within tol, the user's own steps, no room the steps could
+		 * fit in, or a refinement that did not shrink the step error as a
+		 * first-order one shrinks (by 0.6 at least): what remains is not
+		 * the steps' */
 		if (err != SIM_OK || !own_steps || st.tol_met || attempt == MEASURE_REFINEMENTS ||
-		    !(st.step_error > st.tol_allowed) || !(st.step_error < 0.8 * last) ||
+		    !(room > 0.0) || !(st.step_error > room) || !(st.step_error < 0.8 * last) ||
 		    st.substeps < 1)
 			break;
 		last = st.step_error;
-		/* first order in both steps: the feed step shrinks by the factor
-		 * asked, and the machine step too where its a-priori term alone
-		 * exceeds half of what tol allows */
-		double f = fmin(0.6, fmax(0.25, 0.7 * st.tol_allowed / st.step_error));
-		if (st.machine_error > 0.5 * st.tol_allowed) {
+		/* first order in both steps: the step whose term is the larger
+		 * shrinks by the factor asked (the machine step with the feed
+		 * step, which the sub-steps keep in proportion) */
+		double f = fmin(0.6, fmax(0.25, 0.7 * room / st.step_error));
+		if (st.machine_error > st.step_error - st.machine_error) {
 			run.dt = st.dt * f;
 			run.substeps = st.substeps;
 		} else {

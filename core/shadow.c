@@ -22,9 +22,12 @@
  * it; a shadow at 0.9 of that bound gave estimates both far over and far
  * under the error on czubak2016), so its error is an a-priori term
  * (sim_status.c). The shadow needs n >= 3 (dem's corrector needs 2
- * sub-steps on each side); with fewer, without feed or with another
- * method there is none and the error bar keeps the preset's calibrated
- * step term. It costs about 0.8 of this instance while it runs: 40
+ * sub-steps on each side) and feed events: without them (the former dem)
+ * the first-order error of the deck that ignores the feed's reaction
+ * within the step is the machine step's, which the shadow keeps (the
+ * 74-point curve put 14 points outside such bars). With fewer sub-steps,
+ * without events, without feed or with another method there is none and
+ * the error bar keeps the preset's calibrated step term. It costs about 0.8 of this instance while it runs: 40
  * periods after each estimate's start (a control, a restart), and
  * SHADOW_MEASURE_SHARE of a measurement's window (sim_measure). */
 
@@ -49,7 +52,8 @@ void shadow_stop(sim *s)
 void shadow_begin(sim *s)
 {
 	shadow_stop(s);
-	if (s->ode != &ode_dem || s->md.nf == 0 || s->cfg.substeps < 3 || s->failed)
+	if (s->ode != &ode_dem || !s->cfg.feed_events || s->md.nf == 0 || s->cfg.substeps < 3 ||
+	    s->failed)
 		return;
 	sim_method m = s->cfg;
 	m.substeps = (s->cfg.substeps + 1) / 2;

@@ -9,6 +9,8 @@
 #   B: dem, machine step 6.25e-5 s, 80 feed sub-steps (h = 7.8e-7 s),
 #   C: dem, machine step 3.125e-5 s, 160 sub-steps, only where B and A
 #      differ by more than 0.1 % of the peak somewhere,
+#   D: dem, machine step 1.5625e-5 s, 320 sub-steps, only where C and B
+#      still do,
 # all without feed events (the former dem: nothing located, no yielding
 # deck), so the reference shares no step rule with what it checks. The
 # finest run is the reference; the change from the one before shows it
@@ -54,10 +56,14 @@ while IFS=$'\t' read -r name sets window _; do
 	fine "$name" A "$window" "${args[@]}" --set dt=1.25e-4 --set substeps=40 --set feed_events=false
 	fine "$name" B "$window" "${args[@]}" --set dt=6.25e-5 --set substeps=80 --set feed_events=false
 	coarse=A finest=B
-	if awk -v s="$(spread "$tmp/$name.A.csv" "$tmp/$name.B.csv")" 'BEGIN { exit !(s > 0.001) }'; then
-		fine "$name" C "$window" "${args[@]}" --set dt=3.125e-5 --set substeps=160 --set feed_events=false
-		coarse=B finest=C
-	fi
+	for level in "C 3.125e-5 160" "D 1.5625e-5 320"; do
+		read -r next dt n <<<"$level"
+		awk -v s="$(spread "$tmp/$name.$coarse.csv" "$tmp/$name.$finest.csv")" \
+			'BEGIN { exit !(s > 0.001) }' || break
+		fine "$name" "$next" "$window" "${args[@]}" --set dt="$dt" --set substeps="$n" \
+			--set feed_events=false
+		coarse=$finest finest=$next
+	done
 	pair "$tmp/$name.$coarse.csv" "$tmp/$name.$finest.csv" \
 		'{ printf "%s\t%s\t%s\t%.8g\t%.8g\t%+.3g\n", m, $1, $2, $b, $a, $b - $a }' "$name" \
 		>> "$tmp/ref.tsv"
