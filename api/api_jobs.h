@@ -98,15 +98,12 @@ typedef struct api_sweep_point {
 	api_value beta;  /* rad (deg as sent) */
 	int rotation;    /* SIM_CW / SIM_CCW */
 	int state;       /* 0 pending, 1 running, 2 done, 3 failed */
-	double velocity;    /* m/s */
-	double uncertainty; /* m/s, the estimate's error bar; NaN if none */
-	int steady;         /* the estimate showed no drift */
+	sim_measurement m; /* when done: v and its error bar (NaN if none),
+			      steady, the steps it was measured with, the
+			      steps' share of the bar and whether it is
+			      within tol (sim.h) */
 	int mirrored;       /* the mirror image of another point of the sweep
 			       (sim_mirror_plan), not run itself */
-	double dt;          /* s: the machine step it was measured with */
-	int substeps;       /* feed sub-steps it was measured with */
-	double step_error;  /* m/s: the steps' share of the uncertainty */
-	int tol_met;        /* the uncertainty within the accuracy target */
 	char error[160];
 } api_sweep_point;
 typedef struct api_sweep_view {

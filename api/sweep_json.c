@@ -238,13 +238,13 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 					p->rotation == SIM_CW ? "cw" : "ccw");
 		cJSON_AddStringToObject(po, "state", point_state(p->state));
 		if (p->state == 2) {
-			api_add_number(po, "velocity", p->velocity);
-			api_add_number(po, "uncertainty", p->uncertainty);
-			cJSON_AddBoolToObject(po, "steady", p->steady);
-			api_add_number(po, "dt", p->dt);
-			cJSON_AddNumberToObject(po, "substeps", p->substeps);
-			api_add_number(po, "step_error", p->step_error);
-			cJSON_AddBoolToObject(po, "tol_met", p->tol_met);
+			api_add_number(po, "velocity", p->m.transport_velocity);
+			api_add_number(po, "uncertainty", p->m.uncertainty);
+			cJSON_AddBoolToObject(po, "steady", p->m.steady);
+			api_add_number(po, "dt", p->m.dt);
+			cJSON_AddNumberToObject(po, "substeps", p->m.substeps);
+			api_add_number(po, "step_error", p->m.step_error);
+			cJSON_AddBoolToObject(po, "tol_met", p->m.tol_met);
 		} else {
 			cJSON_AddNullToObject(po, "velocity");
 			cJSON_AddNullToObject(po, "uncertainty");
@@ -259,8 +259,8 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 			cJSON_AddItemToArray(pair,
 					     cJSON_CreateNumber(p->beta.user));
 			cJSON_AddItemToArray(
-				pair, isfinite(p->velocity)
-					      ? cJSON_CreateNumber(p->velocity)
+				pair, isfinite(p->m.transport_velocity)
+					      ? cJSON_CreateNumber(p->m.transport_velocity)
 					      : cJSON_CreateNull());
 			cJSON_AddItemToArray(p->rotation == SIM_CW ? cw : ccw,
 					     pair);
@@ -295,19 +295,19 @@ char *api_sweep_csv(const api_sweep_view *v)
 		int done = p->state == 2;
 		api_buf_double(&b, p->beta.user);
 		api_buf_puts(&b, p->rotation == SIM_CW ? ",cw," : ",ccw,");
-		if (done && isfinite(p->velocity))
-			api_buf_double(&b, p->velocity);
+		if (done && isfinite(p->m.transport_velocity))
+			api_buf_double(&b, p->m.transport_velocity);
 		api_buf_put(&b, ",", 1);
-		if (done && isfinite(p->uncertainty))
-			api_buf_double(&b, p->uncertainty);
-		api_buf_puts(&b, !done ? "," : p->steady ? ",true" : ",false");
+		if (done && isfinite(p->m.uncertainty))
+			api_buf_double(&b, p->m.uncertainty);
+		api_buf_puts(&b, !done ? "," : p->m.steady ? ",true" : ",false");
 		api_buf_printf(&b, ",%s,", point_state(p->state));
 		if (done) {
-			api_buf_double(&b, p->dt);
-			api_buf_printf(&b, ",%d,", p->substeps);
-			if (isfinite(p->step_error))
-				api_buf_double(&b, p->step_error);
-			api_buf_puts(&b, p->tol_met ? ",true\n" : ",false\n");
+			api_buf_double(&b, p->m.dt);
+			api_buf_printf(&b, ",%d,", p->m.substeps);
+			if (isfinite(p->m.step_error))
+				api_buf_double(&b, p->m.step_error);
+			api_buf_puts(&b, p->m.tol_met ? ",true\n" : ",false\n");
 		} else {
 			api_buf_puts(&b, ",,,\n");
 		}

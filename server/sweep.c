@@ -181,13 +181,9 @@ static void run_point(void *arg)
 		sw->running--;
 		if (rc == SIM_OK) {
 			p->state = 2;
-			p->velocity = r.transport_velocity;
-			p->uncertainty = r.uncertainty;
-			p->steady = r.steady;
-			p->dt = r.dt;
-			p->substeps = r.substeps;
-			p->step_error = r.step_error;
-			p->tol_met = r.tol_met;
+			p->m = r;
+			/* not shown: the record stays the same for the same sweep */
+			p->m.cpu_seconds = 0.0;
 		} else {
 			p->state = 3;
 			snprintf(p->error, sizeof p->error, "%s",

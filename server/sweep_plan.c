@@ -51,13 +51,7 @@ void srv_sweep_fill_image(srv_sweep *sw, size_t i)
 	const api_sweep_point *src = &sw->pt[i];
 	api_sweep_point *p = &sw->pt[j];
 	p->state = src->state;
-	p->velocity = -src->velocity;
-	p->uncertainty = src->uncertainty;
-	p->steady = src->steady;
-	p->dt = src->dt;
-	p->substeps = src->substeps;
-	p->step_error = src->step_error;
-	p->tol_met = src->tol_met;
+	sim_mirror_measurement(&src->m, &p->m);
 	if (src->state == 3)
 		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
 				   src->error);
