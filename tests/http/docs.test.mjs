@@ -239,6 +239,15 @@ test('docs/api.md and the served OpenAPI document name the same operations', asy
   assert.deepEqual(apiDrift(doc, text + '\nPOST /api/v1/sessions/ID/rewind\n').named, ['POST /api/v1/sessions/ID/rewind']);
 });
 
+// Benchmark tables between <!-- bench: FILE table N --> and <!-- /bench -->
+// are the N-th table of `make bench`'s output file, line for line
+// (tests/docs_bench.py writes them, --check compares).
+test('benchmark tables in the documents are those of the bench results', async () => {
+  const r = await run('python3', [join(ROOT, 'tests/docs_bench.py'), '--check']).catch((e) => e);
+  assert.equal(r.code ?? 0, 0, `${r.stdout}${r.stderr ?? ''}`);
+  assert.match(r.stdout, /docs_bench: [1-9]\d* tables from the bench results, 0 differ/);
+});
+
 test('the link checker sees a missing file and a missing anchor', () => {
   const bad = brokenLinks('README.md', '[a](docs/nothing-here.md) [b](docs/api.md#no-such-heading) [c](docs/api.md#sessions)');
   assert.equal(bad.length, 2, bad.join('\n'));
