@@ -43,6 +43,7 @@ static const srv_config defaults = {
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
 	.max_queued_points = 4096,
+	.cpu_probe = 0.03,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
@@ -89,6 +90,7 @@ static const opt opts[] = {
 	{"connection-timeout", OPT_SECONDS, 1000, 3600000,
 	 F(connection_timeout)},
 	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
+	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -173,11 +175,15 @@ static void usage(FILE *f, const srv_config *cfg)
 		"seconds; must exceed --heartbeat\n"
 		"                       (default %g)\n"
 		"  --max-queued-points N  sweep points queued or running, "
-		"all sweeps (default %d)\n",
+		"all sweeps (default %d)\n"
+		"  --cpu-probe S        CPU seconds a new session's cost is "
+		"measured for before it is\n"
+		"                       admitted; 0: the estimate alone "
+		"(default %g)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
-		cfg->connection_timeout, cfg->max_queued_points);
+		cfg->connection_timeout, cfg->max_queued_points, cfg->cpu_probe);
 }
 
 /* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */

@@ -53,6 +53,8 @@ typedef struct srv_config {
 	int max_connections;   /* open connections, all clients */
 	double connection_timeout; /* s a connection may stay silent */
 	int max_queued_points; /* sweep points queued or running, all sweeps */
+	double cpu_probe;      /* CPU s a new session's cost is probed for
+				  (cpu_probe.c); 0: the estimate alone */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

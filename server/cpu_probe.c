@@ -20,8 +20,8 @@ static double thread_cpu(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-double srv_cpu_probe(const sim *live, const api_spec *spec, int columns,
-		     int layers)
+double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
+		     double cpu_s)
 {
 	size_t len = sim_checkpoint_size(live), n = (size_t)columns * (size_t)layers;
 	void *buf = malloc(len);
@@ -40,7 +40,7 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns,
 	sim_get_status(copy, &st);
 	double t0 = st.t, t = t0, dt = 1.0 / spec->sample_rate;
 	double cpu0 = thread_cpu(), cpu = cpu0;
-	while (cpu - cpu0 < SRV_PROBE_CPU_S && t - t0 < SRV_PROBE_T_S) {
+	while (cpu - cpu0 < cpu_s && t - t0 < SRV_PROBE_T_S) {
 		t += dt;
 		if (sim_advance(copy, t) != SIM_OK)
 			break;

@@ -11,19 +11,18 @@
 #include "api.h"
 #include "sim.h"
 
-/* Longest a probe runs: CPU s of the calling thread, simulated s. */
-#define SRV_PROBE_CPU_S 0.03
+/* Longest a probe runs in simulated s (its CPU s: --cpu-probe). */
 #define SRV_PROBE_T_S 0.2
 
 /* CPU s per simulated s of running live (borrowed, read only) as its
  * worker would: a copy made from a checkpoint of it (no settling) is
  * advanced sample by sample at spec's sample rate, with the status and
  * the feed's state read at each sample as the worker reads them, for
- * SRV_PROBE_CPU_S of this thread's CPU or SRV_PROBE_T_S simulated s,
+ * cpu_s of this thread's CPU (--cpu-probe) or SRV_PROBE_T_S simulated s,
  * whichever comes first; plus the server's cost per published sample.
  * columns x layers: the feed recorded (0 without). Returns a negative
  * value if the copy cannot be made (out of memory): then estimate. */
-double srv_cpu_probe(const sim *live, const api_spec *spec, int columns,
-		     int layers);
+double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
+		     double cpu_s);
 
 #endif

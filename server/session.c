@@ -147,10 +147,13 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	}
 	/* what a simulated second costs: the estimate from the integrator,
 	 * unless a short run of a copy (cpu_probe.c) measures more than twice
-	 * that (what grows with a large feed): then the measurement */
+	 * that (what grows with a large feed): then the measurement;
+	 * --cpu-probe 0: the estimate alone */
 	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
-	double probed = srv_cpu_probe(s->sim, spec, s->columns, s->layers);
+	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
+							   cfg->cpu_probe)
+					   : -1.0;
 	if (probed > 2 * s->cpu_per_s)
 		s->cpu_per_s = probed;
 	if (alloc_buffers(s)) {

@@ -210,10 +210,12 @@ test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a
 
 test('paced CPU: a creation, pace change or resume beyond --max-paced-cores is 503 (422 alone), nothing changes', { timeout: 60000 * SLOW }, async () => {
   // Paces so small that no session runs long enough for its worker to
-  // measure its cost (50 ms of CPU or 2 simulated s): every hold is the
-  // estimate from the scene, read back once.
+  // measure its cost (50 ms of CPU or 2 simulated s), and no probe at
+  // creation (--cpu-probe 0; paced_cost.test.mjs tests it): every hold is
+  // the estimate from the scene, read back once (under the sanitizers a
+  // probe measures each session anew, more than twice the estimate).
   const limit = 1e-4;
-  const d = await startDaemon(['--max-paced-cores', String(limit)]);
+  const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
   const paced = async () => metric(await metrics(d.base), 'convsim_paced_cpu_cores');
   const get = async (id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
   const refused = (r, status, field, verb) => {
