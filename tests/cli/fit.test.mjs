@@ -79,7 +79,7 @@ test('a one-parameter fit: values, errors, residuals and curves in JSON and CSV'
   const c = run('fit', ...CHEAP, '--data', data, '--free', 'e', '--curve-step', '60', '-q', '--format', 'csv');
   assert.equal(c.code, 0, c.err);
   const lines = c.out.trim().split('\n');
-  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
   const par = lines[1].split(',');
   assert.deepEqual(par.slice(0, 6), ['parameter', 'e', '', '', '', '']);
   assert.equal(Number(par[6]), e.value);

@@ -404,7 +404,7 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	/* the progress line says "done" once, not "done · done" */
 	assert.match(await page.$eval('#fit-progress .ptext', e => e.textContent), /^done · iteration \d+ · \d+ evaluations/);
 	const csv = csvLines(await download('#fit-csv'));
-	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
 	assert.equal(csv.filter(l => l.startsWith('curve,')).length, 4);
 });
 
