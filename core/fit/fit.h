@@ -153,9 +153,9 @@ typedef struct fit_result {
 	double *curve_beta;         /* rad, ncurve */
 	double *curve_fit, *curve_fit_u, *curve_start; /* [rot * ncurve + k] */
 	/* the 95 % band of the fitted curve from the parameters' covariance
-	 * (delta method: v +- q sqrt(g^T cov g), g = dv/dx by forward
-	 * differences, q the normal or, with the residual variance, Student's
-	 * quantile); NaN without a covariance */
+	 * (delta method: v +- q sqrt(g^T cov g + u^2), g = dv/dx by forward
+	 * differences, u = curve_fit_u, q the normal or, with the residual
+	 * variance, Student's quantile); NaN without a covariance */
 	double *band_lo, *band_hi;  /* [rot * ncurve + k], m/s */
 	double band_quantile;       /* q */
 	int nwarn;

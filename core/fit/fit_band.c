@@ -4,14 +4,17 @@
  * the fit and at the start, and the 95 % band of the fitted curve from the
  * parameters' covariance C by the delta method,
  *
- *     v(beta) +- q sqrt(g^T C g),  g_j = dv(beta)/dx_j,
+ *     v(beta) +- q sqrt(g^T C g + u^2),  g_j = dv(beta)/dx_j,
  *
  * g by forward differences with the Jacobian's steps (fit_fd_step), all
  * in the same batch as the curves (Bard, "Nonlinear Parameter
  * Estimation", 1974, ch. 7; Seber & Wild, "Nonlinear Regression", 1989,
  * sec. 5.1). q is the normal 97.5 % quantile when every datum has its
  * sigma, Student's t with the fit's degrees of freedom when C comes from
- * the residual variance. The band is of the model's curve at the true
+ * the residual variance. u is the curve point's own error bar (the
+ * steady-state measure's jitter and step error), which is all there is
+ * where v hardly depends on the parameters (where the curves of nearby
+ * parameter values cross). The band is of the model's curve at the true
  * parameters, not of a new measurement (which adds its own sigma).
  *
  * fit_band_sampled checks it: parameter sets drawn from N(x, C), their
@@ -57,10 +60,10 @@ static void curve_grid(const fit_result *res, double *beta, int *rot)
 	}
 }
 
-/* The delta method's band from the curve at the fit (v), at the
- * perturbed sets (vp[j * total + k]) and their steps h. */
-static void delta_band(fit_result *res, int p, size_t total, const double *v, const double *vp,
-		       const double *h)
+/* The delta method's band from the curve at the fit (v, its error bar
+ * u), at the perturbed sets (vp[j * total + k]) and their steps h. */
+static void delta_band(fit_result *res, int p, size_t total, const double *v, const double *u,
+		       const double *vp, const double *h)
 {
 	res->band_quantile = band_quantile(res);
 	for (size_t k = 0; k < total; k++) {
@@ -70,7 +73,7 @@ static void delta_band(fit_result *res, int p, size_t total, const double *v, co
 		for (int a = 0; a < p; a++)
 			for (int b = 0; b < p; b++)
 				var += g[a] * res->cov[a * p + b] * g[b];
-		double half = res->band_quantile * sqrt(fmax(var, 0));
+		double half = res->band_quantile * sqrt(fmax(var, 0) + (isfinite(u[k]) ? u[k] * u[k] : 0));
 		res->band_lo[k] = isfinite(half) ? v[k] - half : NAN;
 		res->band_hi[k] = isfinite(half) ? v[k] + half : NAN;
 	}
@@ -115,7 +118,7 @@ int fit_curves(fit_ctx *c)
 			res->curve_start[k] = v[total + k];
 		}
 		if (rc == 0)
-			delta_band(res, p, total, v, v + 2 * total, h);
+			delta_band(res, p, total, v, u, v + 2 * total, h);
 	}
 	free(beta);
 	free(v);
