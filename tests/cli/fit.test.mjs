@@ -88,3 +88,21 @@ test('a one-parameter fit: values, errors, residuals and curves in JSON and CSV'
   assert.equal(lines.filter((l) => l.startsWith('point,')).length, 4);
   assert.equal(lines.filter((l) => l.startsWith('curve,')).length, 4);
 });
+
+test('the peaks fit that used to stop at a peak outside its scan converges', { timeout: 600000 * SLOW }, () => {
+  // e and mu to the paper's clockwise peaks: a trial step used to move the peak at 128 deg
+  // out of its +-10 deg scan and end the fit with the start values and standard errors 0
+  const r = run('fit', '--peaks', 'cw:38,cw:128', '--free', 'e:0.005:0.04,mu:0.1:1.5', '--curve-step', '0', '-q');
+  assert.equal(r.code, 0, r.err);
+  const res = JSON.parse(r.out);
+  assert.equal(res.status, 'converged', res.error);
+  assert.equal(res.error, null);
+  assert.ok(res.iterations > 1, `${res.iterations} iterations`);
+  for (const p of res.peaks) assert.ok(Math.abs(p.residual) < 1.5, JSON.stringify(p));
+  // two peaks, two parameters: no residual variance, so no standard errors (null, never 0)
+  for (const p of res.parameters) {
+    assert.equal(p.standard_error, null);
+    assert.notEqual(p.value, p.start);
+  }
+  assert.deepEqual(res.starts.map((s) => s.status), ['converged']);
+});

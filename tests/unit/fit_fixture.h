@@ -63,6 +63,14 @@ static inline void noisy(const fit_point *clean, fit_point *pts, unsigned long l
 	}
 }
 
+/* The true points plus one draw of noise from seed. */
+static inline void noisy_data(fit_point *pts, unsigned long long seed)
+{
+	fit_point clean[NPTS];
+	truth(clean);
+	noisy(clean, pts, &seed);
+}
+
 /* A fit of the cheap scene's e and mu to NPTS points from (e0, mu0). */
 static inline void fit_points(fit_point *pts, double e0, double mu0, fit_result *res)
 {

@@ -26,10 +26,8 @@
 static void recovers_known_parameters(void **state)
 {
 	(void)state;
-	fit_point clean[NPTS], pts[NPTS];
-	truth(clean);
-	unsigned long long seed = 20160601;
-	noisy(clean, pts, &seed);
+	fit_point pts[NPTS];
+	noisy_data(pts, 20160601);
 	fit_result res;
 	fit_points(pts, 0.018, 0.5, &res);
 	const double want[2] = {TRUE_E, TRUE_MU};

@@ -78,10 +78,8 @@ static void true_curve_inside_the_band(void **state)
 static void band_agrees_with_sampling(void **state)
 {
 	(void)state;
-	fit_point clean[NPTS], pts[NPTS];
-	truth(clean);
-	unsigned long long seed = 4242;
-	noisy(clean, pts, &seed);
+	fit_point pts[NPTS];
+	noisy_data(pts, 4242);
 	fit_request r;
 	fit_result res;
 	fit_with_curve(pts, &r, &res);

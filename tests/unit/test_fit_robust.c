@@ -37,14 +37,6 @@ static int veto(void *ctx, const double *x)
 	return no;
 }
 
-static void noisy_data(fit_point *pts)
-{
-	fit_point clean[NPTS];
-	truth(clean);
-	unsigned long long seed = 20160601;
-	noisy(clean, pts, &seed);
-}
-
 static void planted_request(fit_request *r, fit_point *pts, planted *pl)
 {
 	cheap_request(r);
@@ -63,7 +55,7 @@ static void failed_trial_point_is_a_rejected_step(void **state)
 {
 	(void)state;
 	fit_point pts[NPTS];
-	noisy_data(pts);
+	noisy_data(pts, 20160601);
 	fit_result clean, res;
 	planted none = {0}, one = {.at = 4};
 	fit_request r;
@@ -100,7 +92,7 @@ static void failed_fit_reports_best_point(void **state)
 {
 	(void)state;
 	fit_point pts[NPTS];
-	noisy_data(pts);
+	noisy_data(pts, 20160601);
 	planted pl = {.from = 5};
 	fit_request r;
 	planted_request(&r, pts, &pl);
@@ -159,7 +151,7 @@ static void multistart_keeps_the_lowest_cost(void **state)
 {
 	(void)state;
 	fit_point pts[NPTS];
-	noisy_data(pts);
+	noisy_data(pts, 20160601);
 	fit_request r;
 	cheap_request(&r);
 	r.free[0] = (fit_free){"e", 0.01, 0.03, 0.018};
