@@ -5,8 +5,7 @@
  * fresh noise on data the model made at known parameters, the true curve
  * lies inside the band at >= 90 % of the beta grid; and the band agrees
  * with the one from sampling the covariance (fit_band_sampled). The cheap
- * scene of fit_fixture.h, a 15-deg grid; the long version (more fits, the
- * default scene) is tests/bench/fit.sh's band table.
+ * scene of fit_fixture.h and a 15-deg grid keep it to some 20 s.
  */
 #include <math.h>
 #include <setjmp.h>
