@@ -69,13 +69,13 @@ typedef struct fit_ctx {
 	char why[FIT_MSG];    /* the last reason a set could not be evaluated */
 } fit_ctx;
 
-/* The data at nsets parameter sets xs[s * p + j] (SI) in one batch, as
+/* (fit_try.c) The data at nsets parameter sets xs[s * p + j] (SI) in one batch, as
  * fit_eval_data, but a set that cannot be evaluated (the model fails, a
  * peak is not found, the request's veto) is not the end: ok[s] = 0 for
  * it (its out NaN) and c->why says why. 0, or -1 when cancelled or out of
  * memory (c->ev.failed, c->ev.error). */
 int fit_evaluate(fit_ctx *c, size_t nsets, const double *xs, double *out, double *out_u, int *ok);
-/* The forward-difference step of parameter j at x (signed: backwards
+/* (fit_cov.c) The forward-difference step of parameter j at x (signed: backwards
  * when x + h passes the upper bound). */
 double fit_fd_step(const fit_ctx *c, int j, double x);
 /* The curves at the fit and at the start on the grid, per rotation of the
