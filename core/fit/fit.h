@@ -124,8 +124,9 @@ typedef struct fit_result {
 	int status;                 /* FIT_* */
 	char error[FIT_MSG];        /* FIT_FAILED: why */
 	int nfree;
-	double x[FIT_MAX_FREE];     /* SI; fitted values */
-	double x0[FIT_MAX_FREE];    /* the start */
+	double x[FIT_MAX_FREE];     /* SI; fitted values (FIT_FAILED: the best
+				     * point seen, the start when none was) */
+	double x0[FIT_MAX_FREE];    /* the request's start */
 	double se[FIT_MAX_FREE];    /* standard errors, SI; NaN: not determined */
 	double corr[FIT_MAX_FREE * FIT_MAX_FREE]; /* row-major, NaN where undefined */
 	double cov[FIT_MAX_FREE * FIT_MAX_FREE]; /* SI, row-major; NaN where undefined */
