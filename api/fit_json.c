@@ -18,7 +18,7 @@
 
 const char *const api_members_fit[] = {"preset", "params", "scene", "integrator", "free",
 				       "points", "csv", "peaks", "t_end", "curve_step",
-				       "max_iter", "fd_step", NULL};
+				       "max_iter", "fd_step", "starts", NULL};
 const char *const api_members_fit_free[] = {"name", "min", "max", "start", NULL};
 const char *const api_members_fit_point[] = {"beta", "rotation", "v", "sigma", NULL};
 const char *const api_members_fit_peak[] = {"beta", "rotation", "sigma", NULL};
@@ -191,6 +191,12 @@ static api_err parse_options(const cJSON *root, fit_request *req, api_problem *p
 			return api_fail(pb, API_RANGE, "max_iter", "max_iter must be an integer");
 		req->max_iter = (int)fmax(fmin(v, 1e6), -1);
 	}
+	if (e == API_OK && (e = number(root, "starts", "", 0, &v, pb)) == API_OK && !isnan(v)) {
+		if (v != floor(v))
+			return api_fail(pb, API_RANGE, "starts", "starts must be an integer in [1, %d]",
+					FIT_MAX_STARTS);
+		req->starts = (int)fmax(fmin(v, 1e6), -1);
+	}
 	return e;
 }
 
@@ -224,7 +230,8 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 	if (e == API_OK && fit_check(req, field, sizeof field, msg, sizeof msg) != SIM_OK) {
 		int range = strstr(field, "beta") || strstr(field, "sigma") || strstr(field, ".v") ||
 			    strcmp(field, "t_end") == 0 || strcmp(field, "fd_step") == 0 ||
-			    strcmp(field, "max_iter") == 0 || strcmp(field, "curve_step") == 0;
+			    strcmp(field, "max_iter") == 0 || strcmp(field, "curve_step") == 0 ||
+			    strcmp(field, "starts") == 0;
 		e = api_fail(pb, range ? API_RANGE : API_INVALID, field, "%s", msg);
 	}
 	cJSON_Delete(root);

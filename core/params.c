@@ -289,11 +289,13 @@ int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_meth
 	return n < 1 ? 1 : n > 1000 ? 1000 : n;
 }
 
-/* czubak2016 with the eccentricity fitted to the paper's clockwise peaks
- * at 38 and 128 deg (docs/calibration.md "Calibration": `convsim fit --peaks
- * cw:38,cw:128 --free e:0.005:0.04`, e = 0.01551 +- 0.0049 m, rounded to
- * three digits); everything else as czubak2016. */
-#define CZUBAK2016_FIT_E 0.0155
+/* czubak2016 with the eccentricity and the feed element's mass fitted to
+ * the paper's clockwise peaks at 38 and 128 deg (docs/calibration.md "The
+ * paper's case": `convsim fit --peaks cw:38,cw:128 --free
+ * e:0.005:0.04,m_n:0.25:1 --starts 4`, e = 0.01509 m, m_n = 0.3136 kg,
+ * rounded to three digits); everything else as czubak2016. */
+#define CZUBAK2016_FIT_E 0.0151
+#define CZUBAK2016_FIT_M_N 0.314
 
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)
 {
@@ -304,6 +306,7 @@ int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)
 	if (name && strcmp(name, "czubak2016-fit") == 0) {
 		sim_preset_czubak2016(p, s, m);
 		p->e = CZUBAK2016_FIT_E;
+		p->m_n = CZUBAK2016_FIT_M_N;
 		return SIM_OK;
 	}
 	return SIM_EUNKNOWN;

@@ -22,7 +22,7 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
-	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
@@ -43,7 +43,7 @@ typedef struct cli_opts {
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
-	int max_iter;
+	int max_iter, starts;
 } cli_opts;
 
 /* The first pass over command cmd's options: help (shown, -1), a wrong

@@ -131,6 +131,7 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 	req->curve_step = o->curve_step * RAD_PER_DEG;
 	req->fd_rel = o->fd_step;
 	req->max_iter = o->max_iter;
+	req->starts = o->starts;
 	if (!o->free_list) {
 		fprintf(stderr, "convsim fit: --free is required: name the parameters to fit, e.g. "
 				"--free e or --free e:0.005:0.05\n");
@@ -179,6 +180,22 @@ static void summary(const fit_request *req, const fit_result *res)
 			sim_setting_from_si(t, res->x[j]), sim_setting_from_si(t, res->se[j]),
 			t->unit, sim_setting_from_si(t, res->x0[j]));
 	}
+	/* costs in the data's unit, as the JSON's chi2 (peaks: deg^2) */
+	int peaks_deg = !req->npoints && !res->sigma_given;
+	double k2 = peaks_deg ? DEG_PER_RAD * DEG_PER_RAD : 1;
+	for (int s = 0; res->nstarts > 1 && s < res->nstarts; s++) {
+		const fit_start *st = &res->starts[s];
+		fprintf(stderr, "  %s start %d:", s == res->best_start ? "*" : " ", s + 1);
+		for (int j = 0; j < res->nfree; j++)
+			fprintf(stderr, " %s %.4g -> %.6g", req->free[j].name,
+				sim_table_user(req->free[j].name, st->x0[j]),
+				sim_table_user(req->free[j].name, st->x[j]));
+		fprintf(stderr, ", chi2 %.4g%s, %s\n", st->chi2 * k2, peaks_deg ? " deg^2" : "",
+			fit_status_name(st->status));
+	}
+	if (res->rejected)
+		fprintf(stderr, "  %d trial points could not be evaluated (rejected steps)\n",
+			res->rejected);
 	for (int w = 0; w < res->nwarn; w++)
 		fprintf(stderr, "  warning: %s\n", res->warnings[w]);
 	if (res->error[0])

@@ -64,6 +64,9 @@ static const cli_opt options[] = {
 	{CMD_FIT, OPT_FD_STEP, "fd-step", 0, "REL", NULL, "0.05",
 	 "finite-difference step relative to each parameter's value"},
 	{CMD_FIT, OPT_MAX_ITER, "max-iter", 0, "N", NULL, "30", "Levenberg-Marquardt iterations, at most"},
+	{CMD_FIT, OPT_STARTS, "starts", 0, "N", NULL, "1",
+	 "runs from the start and N - 1 points of a Halton design over the bounds; the lowest "
+	 "cost wins"},
 	{CMD_FIT, OPT_OUT, "out", 'o', "FILE", NULL, "stdout", "write the result to FILE"},
 	{CMD_FIT, OPT_FORMAT, "format", 'f', "json|csv", NULL, "json", "format of the result"},
 	{RS, OPT_QUIET, "quiet", 'q', NULL, NULL, NULL, "no progress on stderr"},

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "fit.h"
 #include "suggest.h"
 #include "units.h"
 
@@ -115,6 +116,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 	o->curve_step = 5;
 	o->fd_step = 0.05;
 	o->max_iter = 30;
+	o->starts = 1;
 	/* the preset first, so that --set applies on top of it wherever it
 	 * stands; a first pass finds it */
 	int rc = cli_first_pass(argc, argv, cmd, &o->preset);
@@ -169,6 +171,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 			bad = cli_number(o->cmd, "fd-step", NULL, arg, 0, 0.5, 1, &o->fd_step);
 			break;
 		case OPT_MAX_ITER: bad = whole(o->cmd, "max-iter", arg, 1000, &o->max_iter); break;
+		case OPT_STARTS: bad = whole(o->cmd, "starts", arg, FIT_MAX_STARTS, &o->starts); break;
 		default: break;
 		}
 		if (bad)

@@ -18,7 +18,13 @@
  * that: 5 % of e moves v by about 12 %, 40 times the jitter (docs/calibration.md
  * "Calibration"). Then J_z = J_x dx/dz.
  *
- * Standard errors, correlations and warnings at the optimum: fit_cov.c.
+ * A trial point the model cannot be evaluated at (fit_try.c finds it) is a
+ * rejected step: residuals far above any real cost, so that the trust
+ * region shrinks. Multi-start: the request's start, then a Halton design
+ * over the bounds; the lowest cost wins.
+ *
+ * Standard errors, correlations and warnings at the optimum: fit_cov.c;
+ * the curves and their band: fit_band.c.
  */
 #include <gsl/gsl_blas.h>
 #include <gsl/gsl_errno.h>
@@ -45,12 +51,17 @@ static int log_scale(const fit_free *f)
 	return f->lo > 0 && f->hi / f->lo >= 1000;
 }
 
-static double x_of_z(const fit_free *f, double z)
+/* x at u in [0, 1] across the bounds (in log x on a log scale). */
+static double x_of_u(const fit_free *f, double u)
 {
-	double u = 0.5 * (1 + sin(z));
 	if (log_scale(f))
 		return exp(log(f->lo) + u * (log(f->hi) - log(f->lo)));
 	return f->lo + u * (f->hi - f->lo);
+}
+
+static double x_of_z(const fit_free *f, double z)
+{
+	return x_of_u(f, 0.5 * (1 + sin(z)));
 }
 
 static double dx_dz(const fit_free *f, double z)
@@ -90,17 +101,33 @@ static void report(fit_ctx *c, const char *phase, const double *x, double cost)
 	c->req->progress(c->req->ctx, &pr);
 }
 
+/* The residuals of a trial point the model cannot be evaluated at: a cost
+ * far above any real one, so that the solver rejects the step and shrinks
+ * its trust region, as for a step that made things worse. */
+#define FAILED_RESIDUAL 1e30
+
 static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
 {
 	fit_ctx *c = arg;
 	double x[FIT_MAX_FREE];
+	int ok;
 	xs_of(c, z, x);
 	if (c->iteration > 0 && ++c->trials > MAX_TRIALS) {
 		c->stalled = 1;
 		return GSL_EBADFUNC;
 	}
-	if (fit_eval_data(&c->ev, 1, x, c->fmodel, c->fmodel_u) != 0)
+	if (fit_evaluate(c, 1, x, c->fmodel, c->fmodel_u, &ok) != 0)
 		return GSL_EBADFUNC;
+	if (!ok) {
+		/* the start itself: this run cannot begin */
+		if (c->iteration == 0)
+			return GSL_EBADFUNC;
+		c->res->rejected++;
+		c->fvalid = 0;
+		gsl_vector_set_all(f, FAILED_RESIDUAL);
+		report(c, "fitting", x, NAN);
+		return GSL_SUCCESS;
+	}
 	memcpy(c->fx, x, sizeof x);
 	c->fvalid = 1;
 	double cost = 0;
@@ -108,6 +135,12 @@ static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
 		double r = (c->fmodel[i] - c->data[i]) / c->w[i];
 		gsl_vector_set(f, i, r);
 		cost += r * r;
+	}
+	if (cost < c->best_cost) {
+		c->best_cost = cost;
+		memcpy(c->best_x, x, sizeof x);
+		memcpy(c->best_model, c->fmodel, sizeof(double) * c->n);
+		memcpy(c->best_model_u, c->fmodel_u, sizeof(double) * c->n);
 	}
 	report(c, "fitting", x, cost);
 	return GSL_SUCCESS;
@@ -118,17 +151,11 @@ static int same_x(const double *a, const double *b, int p)
 	return memcmp(a, b, sizeof *a * (size_t)p) == 0;
 }
 
-/* The forward-difference step of parameter j at x (signed). */
-static double fd_step(const fit_ctx *c, int j, double x)
-{
-	const fit_free *f = &c->req->free[j];
-	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
-	h = fmin(h, 0.25 * (f->hi - f->lo));
-	return x + h <= f->hi ? h : -h;
-}
-
 /* J_x (weighted) at x into c->jac_x: the base set (unless f has it) and
- * one perturbed set per parameter, in one batch. */
+ * one perturbed set per parameter, in one batch; a perturbed set the
+ * model cannot be evaluated at is tried once more with the step reversed
+ * (where that stays within the bounds). 0, or -1 (c->why or c->ev say
+ * why). */
 static int jacobian_x(fit_ctx *c, const double *x)
 {
 	int p = c->p, base = !(c->fvalid && same_x(c->fx, x, p));
@@ -136,16 +163,29 @@ static int jacobian_x(fit_ctx *c, const double *x)
 	double *xs = malloc(sizeof *xs * sets * (size_t)p), *out = malloc(sizeof *out * sets * n),
 	       *out_u = malloc(sizeof *out_u * sets * n);
 	double h[FIT_MAX_FREE];
-	int rc = xs && out && out_u ? 0 : -1;
+	int ok[FIT_MAX_FREE + 1], rc = xs && out && out_u ? 0 : -1;
 	for (size_t s = 0; rc == 0 && s < sets; s++)
 		for (int j = 0; j < p; j++) {
 			int pert = (int)s - base;
 			if (pert == j)
-				h[j] = fd_step(c, j, x[j]);
+				h[j] = fit_fd_step(c, j, x[j]);
 			xs[s * (size_t)p + (size_t)j] = x[j] + (pert == j ? h[j] : 0);
 		}
 	if (rc == 0)
-		rc = fit_eval_data(&c->ev, sets, xs, out, out_u);
+		rc = fit_evaluate(c, sets, xs, out, out_u, ok);
+	for (int j = 0; rc == 0 && j < p; j++) {
+		size_t s = (size_t)j + (size_t)base;
+		const fit_free *f = &c->req->free[j];
+		double *xj = xs + s * (size_t)p;
+		if (ok[s] || x[j] - h[j] < f->lo || x[j] - h[j] > f->hi)
+			continue;
+		h[j] = -h[j];
+		xj[j] = x[j] + h[j];
+		rc = fit_evaluate(c, 1, xj, out + s * n, out_u + s * n, &ok[s]);
+	}
+	for (size_t s = 0; rc == 0 && s < sets; s++)
+		if (!ok[s])
+			rc = -1;
 	const double *f0 = base ? out : c->fmodel;
 	for (size_t i = 0; rc == 0 && i < n; i++)
 		for (int j = 0; j < p; j++)
@@ -178,52 +218,6 @@ static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 	return GSL_SUCCESS;
 }
 
-/* The curves at the fit and at the start on the grid, per rotation of
- * the data. */
-static int curves(fit_ctx *c)
-{
-	const fit_request *r = c->req;
-	fit_result *res = c->res;
-	int p = c->p;
-	size_t n = (size_t)floor(SIM_PI / r->curve_step + 1e-9) + 1, total = 0;
-	for (size_t d = 0; d < c->n; d++) {
-		int rot = r->npoints ? r->points[d].rotation : r->peaks[d].rotation;
-		if (!(res->nrot > 0 && res->rotations[0] == rot) &&
-		    !(res->nrot > 1 && res->rotations[1] == rot))
-			res->rotations[res->nrot++] = rot;
-	}
-	total = n * (size_t)res->nrot;
-	res->ncurve = n;
-	res->curve_beta = malloc(sizeof(double) * n);
-	double *beta = malloc(sizeof(double) * total), *v = malloc(sizeof(double) * 2 * total),
-	       *u = malloc(sizeof(double) * 2 * total), xs[2 * FIT_MAX_FREE];
-	int *rot = malloc(sizeof(int) * total), rc = -1;
-	res->curve_fit = malloc(sizeof(double) * total);
-	res->curve_fit_u = malloc(sizeof(double) * total);
-	res->curve_start = malloc(sizeof(double) * total);
-	if (beta && v && u && rot && res->curve_beta && res->curve_fit && res->curve_fit_u &&
-	    res->curve_start) {
-		for (size_t k = 0; k < total; k++) {
-			beta[k] = fmin((double)(k % n) * r->curve_step, SIM_PI);
-			rot[k] = res->rotations[k / n];
-		}
-		memcpy(res->curve_beta, beta, sizeof(double) * n);
-		memcpy(xs, res->x, sizeof(double) * (size_t)p);
-		memcpy(xs + p, res->x0, sizeof(double) * (size_t)p);
-		rc = fit_eval_curve(&c->ev, 2, xs, total, beta, rot, v, u);
-		for (size_t k = 0; rc == 0 && k < total; k++) {
-			res->curve_fit[k] = v[k];
-			res->curve_fit_u[k] = u[k];
-			res->curve_start[k] = v[total + k];
-		}
-	}
-	free(beta);
-	free(v);
-	free(u);
-	free(rot);
-	return rc;
-}
-
 static double wall_now(void)
 {
 	struct timespec ts;
@@ -248,16 +242,25 @@ static int prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
 	c->jmodel = malloc(sizeof(double) * n);
 	c->jmodel_u = malloc(sizeof(double) * n);
+	c->best_model = malloc(sizeof(double) * n);
+	c->best_model_u = malloc(sizeof(double) * n);
+	c->best_cost = INFINITY;
 	res->ndata = n;
 	res->model = malloc(sizeof(double) * n);
 	res->model_u = malloc(sizeof(double) * n);
 	res->model_start = malloc(sizeof(double) * n);
 	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !c->jmodel ||
-	    !c->jmodel_u || !res->model ||
-	    !res->model_u || !res->model_start)
+	    !c->jmodel_u || !c->best_model || !c->best_model_u || !res->model || !res->model_u ||
+	    !res->model_start)
 		return -1;
+	for (int j = 0; j < FIT_MAX_FREE * FIT_MAX_FREE; j++)
+		res->cov[j] = res->corr[j] = NAN;
+	for (int j = 0; j < FIT_MAX_FREE; j++)
+		res->se[j] = NAN;
+	res->chi2 = res->s2 = res->cond = NAN;
 	res->sigma_given = 1;
 	for (size_t i = 0; i < n; i++) {
+		res->model[i] = res->model_u[i] = NAN;
 		double s = r->npoints ? r->points[i].sigma : r->peaks[i].sigma;
 		c->data[i] = r->npoints ? r->points[i].v : r->peaks[i].beta;
 		c->w[i] = isnan(s) ? 1 : s;
@@ -271,7 +274,8 @@ static int prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 }
 
 /* Rough standard errors (SI) from the last Jacobian and the cost at the
- * current iterate, for the stopping test: 0, or -1 when J^T J is singular. */
+ * current iterate, for the stopping test: 0, or -1 when J^T J is singular
+ * or there is no residual variance. */
 static int rough_se(const fit_ctx *c, double cost, double *se)
 {
 	int p = c->p, rc = -1;
@@ -282,8 +286,10 @@ static int rough_se(const fit_ctx *c, double cost, double *se)
 				*gsl_matrix_ptr(A, (size_t)a, (size_t)b) +=
 					c->jac_x[i * (size_t)p + (size_t)a] *
 					c->jac_x[i * (size_t)p + (size_t)b];
-	double s2 = c->res->sigma_given ? 1 : cost / fmax((double)c->n - p, 1);
-	if (A && gsl_linalg_cholesky_decomp1(A) == GSL_SUCCESS &&
+	double s2 = c->res->sigma_given ? 1 : cost / ((double)c->n - p);
+	/* without sigma and with as many data as parameters there is no
+	 * residual variance: the misfit itself would pass for the error */
+	if (A && isfinite(s2) && s2 >= 0 && gsl_linalg_cholesky_decomp1(A) == GSL_SUCCESS &&
 	    gsl_linalg_cholesky_invert(A) == GSL_SUCCESS) {
 		for (int j = 0; j < p; j++)
 			se[j] = sqrt(s2 * gsl_matrix_get(A, (size_t)j, (size_t)j));
@@ -303,6 +309,7 @@ static int iterate(fit_ctx *c, gsl_multifit_nlinear_workspace *w)
 	xs_of(c, gsl_multifit_nlinear_position(w), prev);
 	for (c->iteration = 1; c->iteration <= r->max_iter; c->iteration++) {
 		c->trials = 0;
+		c->stalled = 0;
 		int rc = gsl_multifit_nlinear_iterate(w);
 		if (c->ev.failed)
 			return c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
@@ -332,7 +339,9 @@ static int iterate(fit_ctx *c, gsl_multifit_nlinear_workspace *w)
 			return FIT_CONVERGED;
 		}
 		if (rc != GSL_SUCCESS) {
-			snprintf(c->res->error, FIT_MSG, "the solver stopped: %s", gsl_strerror(rc));
+			/* the Jacobian at an accepted point failed both ways */
+			snprintf(c->res->error, FIT_MSG, "no Jacobian in iteration %d: %.200s", c->iteration,
+				 c->why[0] ? c->why : gsl_strerror(rc));
 			return FIT_FAILED;
 		}
 		int info;
@@ -346,8 +355,9 @@ static int iterate(fit_ctx *c, gsl_multifit_nlinear_workspace *w)
 	return FIT_MAXITER;
 }
 
-/* Levenberg-Marquardt from the start; fills res->x, iterations, status. */
-static int solve(fit_ctx *c)
+/* One Levenberg-Marquardt run from x0 (SI) into *run: where it ended, its
+ * cost and status. */
+static void solve(fit_ctx *c, const double *x0, fit_start *run)
 {
 	int p = c->p;
 	gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
@@ -357,38 +367,122 @@ static int solve(fit_ctx *c)
 	gsl_multifit_nlinear_workspace *w =
 		gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, c->n, (size_t)p);
 	gsl_vector *z0 = gsl_vector_alloc((size_t)p);
-	int status = FIT_FAILED;
+	memcpy(run->x0, x0, sizeof(double) * (size_t)p);
+	memcpy(run->x, x0, sizeof(double) * (size_t)p);
+	run->chi2 = NAN;
+	run->status = FIT_FAILED;
+	c->iteration = 0;
+	c->why[0] = '\0';
+	c->res->error[0] = '\0';
 	if (!w || !z0) {
 		snprintf(c->res->error, FIT_MSG, "out of memory");
 		goto done;
 	}
 	for (int j = 0; j < p; j++)
-		gsl_vector_set(z0, (size_t)j, z_of_x(&c->req->free[j], c->req->free[j].start));
+		gsl_vector_set(z0, (size_t)j, z_of_x(&c->req->free[j], x0[j]));
 	int rc = gsl_multifit_nlinear_init(z0, &fdf, w);
-	if (rc == GSL_SUCCESS)
+	if (rc == GSL_SUCCESS && run == &c->res->starts[0])
 		memcpy(c->res->model_start, c->fmodel, sizeof(double) * c->n);
-	status = rc != GSL_SUCCESS ? (c->ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED) : iterate(c, w);
-	if (status == FIT_FAILED && !c->res->error[0])
-		snprintf(c->res->error, FIT_MSG, "%s", c->ev.error);
-	if (status != FIT_FAILED)
-		xs_of(c, gsl_multifit_nlinear_position(w), c->res->x);
-	c->res->iterations = c->iteration;
+	if (rc == GSL_SUCCESS)
+		run->status = iterate(c, w);
+	else if (c->ev.failed == 2)
+		run->status = FIT_CANCELLED;
+	else
+		snprintf(c->res->error, FIT_MSG, "the run cannot begin at its start: %.200s",
+			 c->why[0] ? c->why : c->ev.failed ? c->ev.error : gsl_strerror(rc));
+	if (rc == GSL_SUCCESS && run->status != FIT_CANCELLED) {
+		xs_of(c, gsl_multifit_nlinear_position(w), run->x);
+		gsl_blas_ddot(gsl_multifit_nlinear_residual(w), gsl_multifit_nlinear_residual(w),
+			      &run->chi2);
+	}
+	run->iterations = c->iteration;
 done:
 	gsl_multifit_nlinear_free(w);
 	gsl_vector_free(z0);
-	return status;
 }
 
-/* Model, residual statistics, Jacobian and covariance at res->x. */
+/* Start k of a multi-start fit: the request's start, then the points of a
+ * Halton sequence (bases 2, 3, 5, ...) across the bounds, in the solver's
+ * scale (log x on a log scale). */
+static void start_point(const fit_ctx *c, int k, double *x0)
+{
+	static const int base[FIT_MAX_FREE] = {2, 3, 5, 7, 11, 13, 17, 19};
+	for (int j = 0; j < c->p; j++) {
+		const fit_free *f = &c->req->free[j];
+		double u = 0, scale = 1;
+		for (int i = k; i > 0; i /= base[j]) {
+			scale /= base[j];
+			u += scale * (i % base[j]);
+		}
+		x0[j] = k == 0 ? f->start : x_of_u(f, u);
+	}
+}
+
+/* Every run of the request; the result is the run of the lowest cost,
+ * with its warnings (a failed run counts only when all failed: then the
+ * status is FIT_FAILED with the best point seen, the last reason and the
+ * last run's warnings). */
+static int multistart(fit_ctx *c)
+{
+	fit_result *res = c->res;
+	int n = c->req->starts > 1 ? c->req->starts : 1, best = -1, nwarn = 0;
+	char error[FIT_MSG] = "", warnings[FIT_MAX_WARNINGS][FIT_MSG];
+	res->nstarts = 0;
+	for (int k = 0; k < n; k++) {
+		double x0[FIT_MAX_FREE];
+		start_point(c, k, x0);
+		fit_start *run = &res->starts[res->nstarts++];
+		res->nwarn = 0;
+		solve(c, x0, run);
+		if (run->status == FIT_CANCELLED)
+			return FIT_CANCELLED;
+		if (run->status == FIT_FAILED)
+			snprintf(error, sizeof error, "%s%.200s", n > 1 ? "every start failed; the last: " : "",
+				 res->error);
+		if ((run->status != FIT_FAILED && (best < 0 || run->chi2 < res->starts[best].chi2)) ||
+		    (best < 0 && k == n - 1)) {
+			best = run->status != FIT_FAILED ? k : best;
+			nwarn = res->nwarn;
+			memcpy(warnings, res->warnings, sizeof warnings);
+		}
+	}
+	res->nwarn = nwarn;
+	memcpy(res->warnings, warnings, sizeof warnings);
+	res->best_start = best;
+	if (best >= 0) {
+		memcpy(res->x, res->starts[best].x, sizeof res->x);
+		res->iterations = res->starts[best].iterations;
+		res->error[0] = '\0';
+		return res->starts[best].status;
+	}
+	/* no run came through: its best point, no standard errors */
+	snprintf(res->error, FIT_MSG, "%s", error);
+	res->best_start = 0;
+	res->iterations = res->starts[0].iterations;
+	if (isfinite(c->best_cost)) {
+		memcpy(res->x, c->best_x, sizeof res->x);
+		memcpy(res->model, c->best_model, sizeof(double) * c->n);
+		memcpy(res->model_u, c->best_model_u, sizeof(double) * c->n);
+		res->chi2 = c->best_cost;
+	}
+	return FIT_FAILED;
+}
+
+/* Model, residual statistics, Jacobian and covariance at res->x. -1 when
+ * cancelled or the model there cannot be evaluated; a Jacobian that cannot
+ * be had leaves the standard errors undetermined, with a warning. */
 static int at_optimum(fit_ctx *c)
 {
 	fit_result *res = c->res;
+	int ok = 1;
 	if (c->jvalid && same_x(c->jx, res->x, c->p)) {
 		/* the Jacobian's base: the model at the optimum */
 		memcpy(c->fmodel, c->jmodel, sizeof(double) * c->n);
 		memcpy(c->fmodel_u, c->jmodel_u, sizeof(double) * c->n);
 	} else if (!(c->fvalid && same_x(c->fx, res->x, c->p)) &&
-		   fit_eval_data(&c->ev, 1, res->x, c->fmodel, c->fmodel_u) != 0) {
+		   (fit_evaluate(c, 1, res->x, c->fmodel, c->fmodel_u, &ok) != 0 || !ok)) {
+		if (!ok)
+			snprintf(res->error, FIT_MSG, "the fit's point cannot be evaluated: %.190s", c->why);
 		return -1;
 	}
 	c->fvalid = 1;
@@ -401,9 +495,14 @@ static int at_optimum(fit_ctx *c)
 	res->dof = (int)c->n - c->p;
 	res->s2 = res->dof > 0 ? res->chi2 / res->dof : NAN;
 	report(c, "covariance", res->x, res->chi2);
-	if (!(c->jvalid && same_x(c->jx, res->x, c->p)) && jacobian_x(c, res->x) != 0)
-		return -1;
-	fit_covariance(c);
+	if (!(c->jvalid && same_x(c->jx, res->x, c->p)) && jacobian_x(c, res->x) != 0) {
+		if (c->ev.failed)
+			return -1;
+		fit_warn(res, "no standard errors: the Jacobian at the fit cannot be evaluated (%.160s)",
+			 c->why);
+	} else {
+		fit_covariance(c);
+	}
 	fit_bound_warnings(c);
 	return 0;
 }
@@ -420,14 +519,17 @@ int fit_run(const fit_request *req, fit_result *res)
 		snprintf(res->error, FIT_MSG, "out of memory");
 		goto done;
 	}
-	res->status = solve(&c);
+	res->status = multistart(&c);
 	if (res->status != FIT_FAILED && res->status != FIT_CANCELLED && at_optimum(&c) != 0)
 		res->status = c.ev.failed == 2 ? FIT_CANCELLED : FIT_FAILED;
 	if (res->status == FIT_FAILED && !res->error[0])
 		snprintf(res->error, FIT_MSG, "%s", c.ev.error);
+	if (res->rejected)
+		fit_warn(res, "%d trial point%s could not be evaluated (%.170s): rejected steps", res->rejected,
+			 res->rejected > 1 ? "s" : "", c.why[0] ? c.why : "see the error");
 	if ((res->status == FIT_CONVERGED || res->status == FIT_MAXITER) && req->curve_step > 0) {
 		report(&c, "curve", res->x, res->chi2);
-		if (curves(&c) != 0) {
+		if (fit_curves(&c) != 0) {
 			if (c.ev.failed == 2)
 				res->status = FIT_CANCELLED;
 			else
@@ -448,6 +550,8 @@ done:
 	free(c.jac_x);
 	free(c.jmodel);
 	free(c.jmodel_u);
+	free(c.best_model);
+	free(c.best_model_u);
 	return res->status;
 }
 
@@ -462,5 +566,7 @@ void fit_result_free(fit_result *res)
 	free(res->curve_fit);
 	free(res->curve_fit_u);
 	free(res->curve_start);
+	free(res->band_lo);
+	free(res->band_hi);
 	memset(res, 0, sizeof *res);
 }

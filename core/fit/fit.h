@@ -28,6 +28,7 @@
 #define FIT_MAX_PEAKS 8
 #define FIT_MAX_WARNINGS 8
 #define FIT_MSG 240
+#define FIT_MAX_STARTS 32
 
 /* One measured point: beta (rad), rotation SIM_CW / SIM_CCW, v (m/s) and
  * its standard deviation sigma (m/s; NaN when not given). */
@@ -85,6 +86,9 @@ typedef struct fit_request {
 	double peak_step;      /* rad: its spacing */
 	double curve_step;     /* rad: the fitted curve's grid on [0, 180] deg; 0: none */
 	int max_iter;
+	int starts;            /* Levenberg-Marquardt runs, 1..FIT_MAX_STARTS: the
+				* start, then points of a Halton design over
+				* the bounds; the lowest cost wins */
 	double fd_rel;         /* finite-difference step relative to the scale */
 	double xtol;           /* convergence: relative step in the parameters */
 	int threads;           /* own threads when map is NULL */
@@ -92,6 +96,10 @@ typedef struct fit_request {
 	void *map_ctx;
 	void (*progress)(void *ctx, const fit_progress *pr); /* may be NULL */
 	int (*cancelled)(void *ctx); /* may be NULL; nonzero stops the fit */
+	/* may be NULL; nonzero: the model counts as failing at the free
+	 * values x (SI), as when a run fails or a peak is not found: a
+	 * constraint the caller knows, and how the tests plant a failure */
+	int (*veto)(void *ctx, const double *x);
 	void *ctx;
 } fit_request;
 
@@ -104,14 +112,25 @@ enum { FIT_CONVERGED = 0, FIT_MAXITER, FIT_CANCELLED, FIT_FAILED };
 /* "converged", "max-iterations", "cancelled", "failed". */
 const char *fit_status_name(int status);
 
+/* One Levenberg-Marquardt run of a multi-start fit. */
+typedef struct fit_start {
+	double x0[FIT_MAX_FREE];    /* SI: where it started */
+	double x[FIT_MAX_FREE];     /* SI: where it ended (its best point) */
+	double chi2;                /* the cost there; NaN: not even the start evaluated */
+	int status;                 /* FIT_* */
+	int iterations;
+} fit_start;
+
 typedef struct fit_result {
 	int status;                 /* FIT_* */
 	char error[FIT_MSG];        /* FIT_FAILED: why */
 	int nfree;
-	double x[FIT_MAX_FREE];     /* SI; fitted values */
-	double x0[FIT_MAX_FREE];    /* the start */
+	double x[FIT_MAX_FREE];     /* SI; fitted values (FIT_FAILED: the best
+				     * point seen, the start when none was) */
+	double x0[FIT_MAX_FREE];    /* the request's start */
 	double se[FIT_MAX_FREE];    /* standard errors, SI; NaN: not determined */
 	double corr[FIT_MAX_FREE * FIT_MAX_FREE]; /* row-major, NaN where undefined */
+	double cov[FIT_MAX_FREE * FIT_MAX_FREE]; /* SI, row-major; NaN where undefined */
 	int at_bound[FIT_MAX_FREE]; /* -1 lower, +1 upper, 0 inside */
 	int sigma_given;            /* 1: se from (J^T W J)^-1; 0: times s2 */
 	double chi2;                /* sum of squared weighted residuals */
@@ -120,6 +139,9 @@ typedef struct fit_result {
 	double cond;                /* condition number of J (columns scaled) */
 	int iterations;
 	long evaluations;
+	int rejected;               /* trial points that could not be evaluated */
+	int nstarts, best_start;    /* the runs (starts[best_start] gave x) */
+	fit_start starts[FIT_MAX_STARTS];
 	double cpu_seconds;         /* of the threads that evaluated */
 	double wall_seconds;
 	/* per datum (npoints or npeaks): the model at the fit */
@@ -132,6 +154,12 @@ typedef struct fit_result {
 	int nrot, rotations[2];
 	double *curve_beta;         /* rad, ncurve */
 	double *curve_fit, *curve_fit_u, *curve_start; /* [rot * ncurve + k] */
+	/* the 95 % band of the fitted curve from the parameters' covariance
+	 * (delta method: v +- q sqrt(g^T cov g + u^2), g = dv/dx by forward
+	 * differences, u = curve_fit_u, q the normal or, with the residual
+	 * variance, Student's quantile); NaN without a covariance */
+	double *band_lo, *band_hi;  /* [rot * ncurve + k], m/s */
+	double band_quantile;       /* q */
 	int nwarn;
 	char warnings[FIT_MAX_WARNINGS][FIT_MSG];
 } fit_result;
@@ -142,6 +170,21 @@ typedef struct fit_result {
  * res->status. */
 int fit_run(const fit_request *req, fit_result *res);
 void fit_result_free(fit_result *res);
+
+/* A standard normal deviate from the state *seed (nonzero; advanced):
+ * xorshift64* (Marsaglia 2003; Vigna 2016) and Box-Muller. The band's
+ * check draws with it, the tests make their noise with it. */
+double fit_normal(unsigned long long *seed);
+
+/* The check of res's band (fit_band.c): nsamples parameter sets drawn
+ * from the fit's covariance (N(res->x, cov), scaled to res's band
+ * quantile, clamped to the bounds; fixed seed), their curves on res's
+ * grid, and at each grid point the 2.5 and 97.5 percentiles into lo and
+ * hi ([rot * ncurve + k], m/s; the caller's arrays). req is the request
+ * res answers. 0, or -1: no curve or covariance, a failed run, out of
+ * memory. Costs nsamples curves. */
+int fit_band_sampled(const fit_request *req, const fit_result *res, int nsamples,
+		     unsigned long long seed, double *lo, double *hi);
 
 /* ---- checks and parsers (user units in messages) ---------------------- */
 
@@ -165,7 +208,8 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 /* Whole-request checks: data present (points or peaks, not both), beta
  * finite in [0, 180] deg, rotation known, v and sigma finite (sigma > 0,
  * given for every point or none), no duplicate (beta, rotation), at least
- * as many data as free parameters, starts within bounds, t_end after the
+ * as many data as free parameters, starts within bounds, 1 to
+ * FIT_MAX_STARTS runs, t_end after the
  * transient, the model valid. On error returns SIM_EPARAM with the field
  * ("points[3].beta", "free", "t_end", ...) and the message. */
 int fit_check(const fit_request *req, char *field, size_t flen, char *msg, size_t mlen);
@@ -177,8 +221,11 @@ int fit_check(const fit_request *req, char *field, size_t flen, char *msg, size_
  * "parameter": model = fitted value, uncertainty = standard error, start),
  * per point or peak (measured, sigma, model, uncertainty, residual = model
  * - measured, start = the model at the start) and per curve point (model,
- * uncertainty and start = v at the fit and at the start). */
-#define FIT_CSV_HEADER "kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start"
+ * uncertainty and start = v at the fit and at the start, band_lower and
+ * band_upper = the 95 % band of the fitted curve). */
+#define FIT_CSV_HEADER                                                                  \
+	"kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower," \
+	"band_upper"
 
 /* The result as JSON (an object) or CSV: malloc'd text, NULL when out of
  * memory. req is the request the result answers. */

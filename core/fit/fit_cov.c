@@ -31,6 +31,15 @@ void fit_warn(fit_result *res, const char *fmt, ...)
 	va_end(ap);
 }
 
+/* The step of the forward differences (the Jacobian's and the band's). */
+double fit_fd_step(const fit_ctx *c, int j, double x)
+{
+	const fit_free *f = &c->req->free[j];
+	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
+	h = fmin(h, 0.25 * (f->hi - f->lo));
+	return x + h <= f->hi ? h : -h;
+}
+
 /* The parameter combination the data fix least (the right singular vector
  * of the smallest singular value, as relative changes) into buf. */
 static void weak_combination(const fit_ctx *c, const gsl_matrix *V, const double *scale,
@@ -103,6 +112,8 @@ void fit_covariance(fit_ctx *c)
 				     pow(gsl_vector_get(S, (size_t)k), 2);
 			cov[a * p + b] = factor * s / (scale[a] * scale[b]);
 		}
+	for (int a = 0; a < p * p; a++)
+		res->cov[a] = cov[a];
 	for (int a = 0; a < p; a++)
 		res->se[a] = sqrt(cov[a * p + a]);
 	for (int a = 0; a < p; a++)

@@ -24,6 +24,7 @@ void fit_request_init(fit_request *r)
 	r->peak_step = 2.0 * RAD_PER_DEG;
 	r->curve_step = 5.0 * RAD_PER_DEG;
 	r->max_iter = 30;
+	r->starts = 1;
 	r->fd_rel = 0.05;
 	r->xtol = 1e-3;
 	r->threads = 2;
@@ -338,6 +339,8 @@ int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t 
 		FAIL("fd_step", "fd_step must be in (0, 0.5]");
 	if (!(r->max_iter >= 1 && r->max_iter <= 1000))
 		FAIL("max_iter", "max_iter must be in [1, 1000]");
+	if (!(r->starts >= 1 && r->starts <= FIT_MAX_STARTS))
+		FAIL("starts", "starts must be in [1, %d]", FIT_MAX_STARTS);
 	if (!(r->curve_step == 0 || (r->curve_step >= 0.5 * RAD_PER_DEG &&
 				     r->curve_step <= 90 * RAD_PER_DEG)))
 		FAIL("curve_step", "curve_step must be 0 (no curve) or in [0.5, 90] deg");

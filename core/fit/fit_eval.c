@@ -7,7 +7,9 @@
  * A measured peak's model value comes from a scan of v(beta) on a fixed
  * grid around the measured beta (the grid point of the largest |v|) and a
  * least-squares parabola through that point and two neighbours each side,
- * with its uncertainty propagated from the error bars of those velocities.
+ * with its uncertainty propagated from the error bars of those velocities;
+ * when the largest |v| is on an end of the scan (or next to it), the scan
+ * follows the peak beyond it (follow_peak).
  * A batch takes the mirror reduction (sim_mirror_plan) within each
  * parameter set: a unit that is the mirror image of another of the same
  * set is not run but taken from it, v negated.
@@ -262,23 +264,89 @@ static int parabola(const double *beta, const double *v, const double *u, int n,
 	return 0;
 }
 
-/* The peak of a scan: the grid point of the largest |v| and the
- * least-squares parabola through it and up to two neighbours each side. */
-static int vertex(const double *beta, const double *v, const double *u, int n, double *peak,
-		  double *peak_u)
+/* The grid point of the largest sign * v. */
+static int best_of(const double *v, int n, double sign)
 {
-	double mean = 0;
-	for (int i = 0; i < n; i++)
-		mean += v[i];
-	double sign = mean < 0 ? -1 : 1;
 	int best = 0;
 	for (int i = 1; i < n; i++)
 		if (sign * v[i] > sign * v[best])
 			best = i;
-	int lo = best - 2 < 0 ? 0 : best - 2, hi = best + 2 >= n ? n - 1 : best + 2;
-	if (hi - lo < 2)
-		lo = hi - 2 < 0 ? 0 : hi - 2, hi = lo + 2;
-	return parabola(beta + lo, v + lo, u + lo, hi - lo + 1, sign, peak, peak_u);
+	return best;
+}
+
+/* The peak of a scan: the grid point of the largest sign * v and the
+ * least-squares parabola through it and up to two neighbours each side;
+ * when those show no extremum (a kink of v(beta) near the peak), the
+ * parabola through it and one neighbour each side. */
+static int vertex(const double *beta, const double *v, const double *u, int n, double sign,
+		  double *peak, double *peak_u)
+{
+	int best = best_of(v, n, sign);
+	for (int reach = 2; reach >= 1; reach--) {
+		int lo = best - reach < 0 ? 0 : best - reach;
+		int hi = best + reach >= n ? n - 1 : best + reach;
+		if (hi - lo < 2)
+			lo = hi - 2 < 0 ? 0 : hi - 2, hi = lo + 2;
+		if (parabola(beta + lo, v + lo, u + lo, hi - lo + 1, sign, peak, peak_u) == 0)
+			return 0;
+	}
+	return -1;
+}
+
+/* The scan of peak d at the free values x, followed past its ends: while
+ * the largest |v| sits on an end of the scan or next to it (the peak may
+ * lie beyond, and the parabola wants two neighbours each side), half a
+ * scan more on that side, as far as [0, 180] deg allows, each in one more
+ * batch. The vertex of the whole. 0, -1 with ev->failed when a
+ * run fails, 1 when there is no peak. */
+static int follow_peak(fit_eval *ev, const double *x, size_t d, const double *v0,
+		       const double *u0, double *peak, double *peak_u)
+{
+	const fit_request *r = ev->req;
+	int ng = ev->ngrid, cap = (int)floor(SIM_PI / r->peak_step + 1e-9) + 1 + ng, n = ng,
+	    more = ng / 2 > 0 ? ng / 2 : 1, rc = 0;
+	double *beta = malloc(sizeof(double) * (size_t)cap * 3), *v = beta + cap, *u = v + cap;
+	if (!beta)
+		return -1;
+	memcpy(beta, ev->ubeta + d * (size_t)ng, sizeof(double) * (size_t)ng);
+	memcpy(v, v0, sizeof(double) * (size_t)ng);
+	memcpy(u, u0, sizeof(double) * (size_t)ng);
+	double mean = 0;
+	for (int i = 0; i < ng; i++)
+		mean += v[i];
+	double sign = mean < 0 ? -1 : 1;
+	for (;;) {
+		int best = best_of(v, n, sign), left = best < 2, k = 0;
+		double nb[64], nv[64], nu[64];
+		int rot[64];
+		for (; k < more && k < 64 && n + k < cap; k++) {
+			nb[k] = left ? beta[0] - (k + 1) * r->peak_step
+				     : beta[n - 1] + (k + 1) * r->peak_step;
+			if (nb[k] < -1e-9 || nb[k] > SIM_PI + 1e-9)
+				break;
+			rot[k] = r->peaks[d].rotation;
+		}
+		if ((best >= 2 && best <= n - 3) || k == 0)
+			break;
+		if (fit_eval_curve(ev, 1, x, (size_t)k, nb, rot, nv, nu) != 0) {
+			rc = -1;
+			break;
+		}
+		if (left) {
+			memmove(beta + k, beta, sizeof(double) * (size_t)n);
+			memmove(v + k, v, sizeof(double) * (size_t)n);
+			memmove(u + k, u, sizeof(double) * (size_t)n);
+		}
+		for (int i = 0; i < k; i++) {
+			int at = left ? k - 1 - i : n + i;
+			beta[at] = nb[i], v[at] = nv[i], u[at] = nu[i];
+		}
+		n += k;
+	}
+	if (rc == 0 && vertex(beta, v, u, n, sign, peak, peak_u) != 0)
+		rc = 1;
+	free(beta);
+	return rc;
 }
 
 int fit_eval_data(fit_eval *ev, size_t nsets, const double *xs, double *out, double *out_u)
@@ -300,11 +368,13 @@ int fit_eval_data(fit_eval *ev, size_t nsets, const double *xs, double *out, dou
 			}
 			size_t at = s * nu + d * (size_t)ev->ngrid;
 			double pu;
-			if (vertex(ev->ubeta + d * (size_t)ev->ngrid, v + at, u + at, ev->ngrid,
-				   &out[o], &pu) != 0) {
+			int found = follow_peak(ev, xs + s * (size_t)r->nfree, d, v + at, u + at,
+						&out[o], &pu);
+			if (found == 1)
 				fail(ev, 1, "no peak of v near beta %g deg %s: %s", r->peaks[d].beta,
 				     r->peaks[d].rotation,
-				     "v(beta) over the scan has no maximum of |v|");
+				     "v(beta) has no maximum of |v| there, even followed to 0 or 180 deg");
+			if (found != 0) {
 				rc = -1;
 				break;
 			}

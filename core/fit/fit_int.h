@@ -64,7 +64,24 @@ typedef struct fit_ctx {
 	int jvalid;
 	int iteration;
 	int trials, stalled;  /* f evaluations in this iteration; gave up */
+	/* the lowest cost seen at any f evaluation, where, and the model there */
+	double best_cost, best_x[FIT_MAX_FREE], *best_model, *best_model_u;
+	char why[FIT_MSG];    /* the last reason a set could not be evaluated */
 } fit_ctx;
+
+/* (fit_try.c) The data at nsets parameter sets xs[s * p + j] (SI) in one batch, as
+ * fit_eval_data, but a set that cannot be evaluated (the model fails, a
+ * peak is not found, the request's veto) is not the end: ok[s] = 0 for
+ * it (its out NaN) and c->why says why. 0, or -1 when cancelled or out of
+ * memory (c->ev.failed, c->ev.error). */
+int fit_evaluate(fit_ctx *c, size_t nsets, const double *xs, double *out, double *out_u, int *ok);
+/* (fit_cov.c) The forward-difference step of parameter j at x (signed: backwards
+ * when x + h passes the upper bound). */
+double fit_fd_step(const fit_ctx *c, int j, double x);
+/* The curves at the fit and at the start on the grid, per rotation of the
+ * data, and the fitted curve's 95 % band from res->cov (fit_band.c).
+ * 0, or -1 (c->ev.failed says why). */
+int fit_curves(fit_ctx *c);
 
 /* One more warning into res (at most FIT_MAX_WARNINGS). */
 void fit_warn(fit_result *res, const char *fmt, ...) __attribute__((format(printf, 2, 3)));

@@ -176,11 +176,14 @@ static void json_curve(text *t, const fit_result *r)
 		num(t, deg(r->curve_beta[k]), "null");
 	}
 	put(t, "]");
+	put(t, ",\"band_level\":0.95,\"band_quantile\":");
+	num(t, r->band_quantile, "null");
 	for (int ro = 0; ro < r->nrot; ro++) {
-		const double *arr[] = {r->curve_fit, r->curve_fit_u, r->curve_start};
-		const char *keys[] = {"fit", "fit_uncertainty", "start"};
+		const double *arr[] = {r->curve_fit, r->curve_fit_u, r->curve_start, r->band_lo,
+				       r->band_hi};
+		const char *keys[] = {"fit", "fit_uncertainty", "start", "band\":{\"lower", "upper"};
 		put(t, ",\"%s\":{", rot_name(r->rotations[ro]));
-		for (int a = 0; a < 3; a++) {
+		for (int a = 0; a < 5; a++) {
 			put(t, "%s\"%s\":[", a ? "," : "", keys[a]);
 			for (size_t k = 0; k < r->ncurve; k++) {
 				put(t, "%s", k ? "," : "");
@@ -188,9 +191,35 @@ static void json_curve(text *t, const fit_result *r)
 			}
 			put(t, "]");
 		}
-		put(t, "}");
+		put(t, "}}");
 	}
 	put(t, "}");
+}
+
+/* The runs of a multi-start fit: where each started and ended (user
+ * units), its cost (in chi2's unit, k2 converting) and status. */
+static void json_starts(text *t, const fit_request *q, const fit_result *r, double k2)
+{
+	put(t, ",\"best_start\":%d,\"starts\":[", r->nstarts ? r->best_start : 0);
+	for (int s = 0; s < r->nstarts; s++) {
+		const fit_start *st = &r->starts[s];
+		const double *arr[] = {st->x0, st->x};
+		const char *keys[] = {"start", "value"};
+		put(t, "%s{", s ? "," : "");
+		for (int a = 0; a < 2; a++) {
+			put(t, "%s\"%s\":[", a ? "," : "", keys[a]);
+			for (int j = 0; j < r->nfree; j++) {
+				put(t, "%s", j ? "," : "");
+				num(t, user(&q->free[j], arr[a][j]), "null");
+			}
+			put(t, "]");
+		}
+		put(t, ",\"chi2\":");
+		num(t, st->chi2 * k2, "null");
+		put(t, ",\"status\":\"%s\",\"iterations\":%d}", fit_status_name(st->status),
+		    st->iterations);
+	}
+	put(t, "]");
 }
 
 char *fit_result_json(const fit_request *q, const fit_result *r)
@@ -218,6 +247,8 @@ char *fit_result_json(const fit_request *q, const fit_result *r)
 		"\"iterations\":%d,\"evaluations\":%ld",
 	    r->sigma_given ? "" : q->npoints ? "(m/s)^2" : "deg^2", r->dof,
 	    r->sigma_given ? "sigma" : "residual variance", r->iterations, r->evaluations);
+	put(&t, ",\"rejected\":%d", r->rejected);
+	json_starts(&t, q, r, k2);
 	json_data(&t, q, r);
 	json_curve(&t, r);
 	put(&t, ",\"warnings\":[");
@@ -230,12 +261,12 @@ char *fit_result_json(const fit_request *q, const fit_result *r)
 }
 
 static void csv_row(text *t, const char *kind, const char *name, double beta, const char *rot,
-		    const double v[6])
+		    const double v[8])
 {
 	put(t, "%s,%s,", kind, name);
 	num(t, beta, "");
 	put(t, ",%s", rot);
-	for (int k = 0; k < 6; k++) {
+	for (int k = 0; k < 8; k++) {
 		put(t, ",");
 		num(t, v[k], "");
 	}
@@ -248,14 +279,15 @@ char *fit_result_csv(const fit_request *q, const fit_result *r)
 	put(&t, "%s\n", FIT_CSV_HEADER);
 	for (int j = 0; j < r->nfree; j++) {
 		const fit_free *f = &q->free[j];
-		double v[6] = {NAN, NAN, user(f, r->x[j]), user(f, r->se[j]), NAN, user(f, r->x0[j])};
+		double v[8] = {NAN, NAN, user(f, r->x[j]), user(f, r->se[j]), NAN, user(f, r->x0[j]),
+			       NAN, NAN};
 		csv_row(&t, "parameter", f->name, NAN, "", v);
 	}
 	size_t n = q->npoints ? q->npoints : (size_t)q->npeaks;
 	for (size_t i = 0; i < n; i++) {
 		double d[5];
 		datum(q, r, i, d);
-		double v[6] = {d[0], d[1], d[2], d[3], d[2] - d[0], d[4]};
+		double v[8] = {d[0], d[1], d[2], d[3], d[2] - d[0], d[4], NAN, NAN};
 		double beta = q->npoints ? q->points[i].beta : q->peaks[i].beta;
 		int rot = q->npoints ? q->points[i].rotation : q->peaks[i].rotation;
 		csv_row(&t, q->npoints ? "point" : "peak", "", deg(beta), rot_name(rot), v);
@@ -263,8 +295,8 @@ char *fit_result_csv(const fit_request *q, const fit_result *r)
 	for (int ro = 0; ro < r->nrot && r->ncurve; ro++)
 		for (size_t k = 0; k < r->ncurve; k++) {
 			size_t i = (size_t)ro * r->ncurve + k;
-			double v[6] = {NAN, NAN, r->curve_fit[i], r->curve_fit_u[i], NAN,
-				       r->curve_start[i]};
+			double v[8] = {NAN, NAN, r->curve_fit[i], r->curve_fit_u[i], NAN,
+				       r->curve_start[i], r->band_lo[i], r->band_hi[i]};
 			csv_row(&t, "curve", "", deg(r->curve_beta[k]),
 				rot_name(r->rotations[ro]), v);
 		}

@@ -79,7 +79,7 @@ test('a one-parameter fit: values, errors, residuals and curves in JSON and CSV'
   const c = run('fit', ...CHEAP, '--data', data, '--free', 'e', '--curve-step', '60', '-q', '--format', 'csv');
   assert.equal(c.code, 0, c.err);
   const lines = c.out.trim().split('\n');
-  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
   const par = lines[1].split(',');
   assert.deepEqual(par.slice(0, 6), ['parameter', 'e', '', '', '', '']);
   assert.equal(Number(par[6]), e.value);
@@ -87,4 +87,22 @@ test('a one-parameter fit: values, errors, residuals and curves in JSON and CSV'
   assert.equal(Number(par[9]), 0.0215);
   assert.equal(lines.filter((l) => l.startsWith('point,')).length, 4);
   assert.equal(lines.filter((l) => l.startsWith('curve,')).length, 4);
+});
+
+test('the peaks fit that used to stop at a peak outside its scan converges', { timeout: 600000 * SLOW }, () => {
+  // e and mu to the paper's clockwise peaks: a trial step used to move the peak at 128 deg
+  // out of its +-10 deg scan and end the fit with the start values and standard errors 0
+  const r = run('fit', '--peaks', 'cw:38,cw:128', '--free', 'e:0.005:0.04,mu:0.1:1.5', '--curve-step', '0', '-q');
+  assert.equal(r.code, 0, r.err);
+  const res = JSON.parse(r.out);
+  assert.equal(res.status, 'converged', res.error);
+  assert.equal(res.error, null);
+  assert.ok(res.iterations > 1, `${res.iterations} iterations`);
+  for (const p of res.peaks) assert.ok(Math.abs(p.residual) < 1.5, JSON.stringify(p));
+  // two peaks, two parameters: no residual variance, so no standard errors (null, never 0)
+  for (const p of res.parameters) {
+    assert.equal(p.standard_error, null);
+    assert.notEqual(p.value, p.start);
+  }
+  assert.deepEqual(res.starts.map((s) => s.status), ['converged']);
 });

@@ -39,6 +39,9 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
     [{ peaks: [{ rotation: 'cw', beta: 38 }] }, 'peaks', /points or peaks, not both/],
     [{ t_end: 0 }, 't_end', /t_end must exceed/],
     [{ free: [{ name: 'e', min: 0.1, max: 0.01 }] }, 'free[0]', /bounds of 'e'/],
+    [{ starts: 0 }, 'starts', /starts must be in \[1, 32\]/],
+    [{ starts: 33 }, 'starts', /starts must be in \[1, 32\]/],
+    [{ starts: 1.5 }, 'starts', /starts must be an integer/],
   ];
   for (const [extra, field, re] of cases) {
     const r = await req(d.base, 'POST', '/api/v1/fits', body(extra));
@@ -55,7 +58,7 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
 });
 
 test('a fit job: progress, JSON and CSV result, list, delete', { timeout: 240000 * SLOW }, async () => {
-  const r = await req(d.base, 'POST', '/api/v1/fits', body());
+  const r = await req(d.base, 'POST', '/api/v1/fits', body({ starts: 2 }));
   assert.equal(r.status, 202, r.text);
   assert.equal(r.headers.get('location'), `/api/v1/fits/${r.body.id}`);
   assert.ok(['queued', 'running'].includes(r.body.state));
@@ -78,11 +81,23 @@ test('a fit job: progress, JSON and CSV result, list, delete', { timeout: 240000
   for (const p of res.points) assert.ok(Math.abs(p.residual - (p.model - p.v)) < 1e-12);
   assert.deepEqual(res.curve.beta, [0, 45, 90, 135, 180]);
   assert.equal(res.evaluations, done.evaluations);
+  // two runs: the start and the middle of e's range; the result is the cheaper
+  assert.equal(res.starts.length, 2);
+  assert.deepEqual(res.starts.map((s) => s.start[0]), [0.0215, 0.5 * (res.parameters[0].min + res.parameters[0].max)]);
+  assert.equal(res.starts[res.best_start].value[0], res.parameters[0].value);
+  assert.ok(res.starts.every((s) => s.chi2 >= res.starts[res.best_start].chi2));
+  assert.equal(res.rejected, 0);
+  // the band: around the fitted curve, as wide as t(3 dof) times e's error moves v
+  const { fit, band } = res.curve.cw;
+  assert.ok(res.curve.band_quantile > 3.18 && res.curve.band_quantile < 3.19, String(res.curve.band_quantile));
+  for (let k = 0; k < fit.length; k++) assert.ok(band.lower[k] < fit[k] && fit[k] < band.upper[k], `${k}: ${band.lower[k]} ${fit[k]} ${band.upper[k]}`);
   const csv = await req(d.base, 'GET', `${path}?format=csv`);
   assert.equal(csv.status, 200);
   const lines = csv.text.trim().split('\n');
-  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+  assert.equal(lines[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
   assert.equal(Number(lines[1].split(',')[6]), res.parameters[0].value);
+  const c45 = lines.find((l) => l.startsWith('curve,,45,')).split(',');
+  assert.deepEqual(c45.slice(10).map(Number), [band.lower[1], band.upper[1]]);
   assert.equal(lines.length, 1 + 1 + 4 + 5);
   const list = await req(d.base, 'GET', '/api/v1/fits');
   assert.ok(list.body.fits.some((f) => f.id === r.body.id && f.state === 'done' && f.result === null));

@@ -19,86 +19,15 @@
 
 #include <cmocka.h>
 
-#include "fit.h"
-#include "units.h"
+#include "fit_fixture.h"
 
-#define NPTS 6
-#define SIGMA 0.003 /* m/s: the noise added, about 3 % of the peak */
-#define TRUE_E 0.0215
-#define TRUE_MU 0.4
 #define REPEATS 10
-
-/* A fixed-seed normal deviate (xorshift64* and Box-Muller). */
-static double gauss(unsigned long long *s)
-{
-	double u[2];
-	for (int k = 0; k < 2; k++) {
-		*s ^= *s >> 12, *s ^= *s << 25, *s ^= *s >> 27;
-		u[k] = ((double)((*s * 2685821657736338717ULL) >> 11) + 0.5) / 9007199254740992.0;
-	}
-	return sqrt(-2 * log(u[0])) * cos(2 * SIM_PI * u[1]);
-}
-
-static void cheap_request(fit_request *r)
-{
-	fit_request_init(r);
-	r->sc.drive = SIM_DRIVE_IDEAL;
-	r->sc.columns = 1;
-	r->sc.layers = 2;
-	r->t_end = 2.0;
-	r->curve_step = 0;
-	r->threads = 2;
-	char field[48], msg[FIT_MSG];
-	assert_int_equal(fit_add_free(r, "e", NAN, NAN, field, sizeof field, msg, sizeof msg), SIM_OK);
-	assert_int_equal(fit_add_free(r, "mu", NAN, NAN, field, sizeof field, msg, sizeof msg), SIM_OK);
-}
-
-/* v at the points with the true parameters (the noise-free data). */
-static void truth(fit_point *pts)
-{
-	fit_request r;
-	cheap_request(&r);
-	for (int i = 0; i < NPTS; i++) {
-		sim_params p = r.p;
-		p.e = TRUE_E;
-		p.mu = TRUE_MU;
-		p.beta = (15.0 + 30.0 * i) * RAD_PER_DEG;
-		p.rotation = SIM_CW;
-		sim_measurement ms;
-		char msg[160];
-		assert_int_equal(sim_measure(&p, &r.sc, &r.m, r.t_end, &ms, msg, sizeof msg), SIM_OK);
-		pts[i] = (fit_point){p.beta, SIM_CW, ms.transport_velocity, SIGMA};
-	}
-}
-
-static void noisy(const fit_point *clean, fit_point *pts, unsigned long long *seed)
-{
-	for (int i = 0; i < NPTS; i++) {
-		pts[i] = clean[i];
-		pts[i].v += SIGMA * gauss(seed);
-	}
-}
-
-static void fit_points(fit_point *pts, double e0, double mu0, fit_result *res)
-{
-	fit_request r;
-	cheap_request(&r);
-	r.free[0].start = e0;
-	r.free[1].start = mu0;
-	r.points = pts;
-	r.npoints = NPTS;
-	char field[48], msg[FIT_MSG];
-	assert_int_equal(fit_check(&r, field, sizeof field, msg, sizeof msg), SIM_OK);
-	assert_int_equal(fit_run(&r, res), FIT_CONVERGED);
-}
 
 static void recovers_known_parameters(void **state)
 {
 	(void)state;
-	fit_point clean[NPTS], pts[NPTS];
-	truth(clean);
-	unsigned long long seed = 20160601;
-	noisy(clean, pts, &seed);
+	fit_point pts[NPTS];
+	noisy_data(pts, 20160601);
 	fit_result res;
 	fit_points(pts, 0.018, 0.5, &res);
 	const double want[2] = {TRUE_E, TRUE_MU};
@@ -134,7 +63,7 @@ static void mirror_reduction_in_batches(void **state)
 		pts[2 * i + 1] = (fit_point){SIM_PI - clean[i].beta, SIM_CCW, -clean[i].v, SIGMA};
 	}
 	for (int i = 0; i < 2 * NPTS; i++)
-		pts[i].v += SIGMA * gauss(&seed);
+		pts[i].v += SIGMA * fit_normal(&seed);
 	fit_result res[2];
 	for (int mirror = 0; mirror < 2; mirror++) {
 		fit_request r;

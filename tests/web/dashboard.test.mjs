@@ -377,8 +377,8 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	await page.fill('#fit-form input[name="curve_step"]', '60');
 	await page.click('#fit-run');
 	await page.waitForSelector('#fit-table tr[data-name="e"]', { timeout: 240000 });
-	/* data (4), fitted and original curves (4 each) on the plot */
-	assert.equal(await count('#plot-fit'), 12);
+	/* the band (4), data (4), fitted and original curves (4 each) on the plot */
+	assert.equal(await count('#plot-fit'), 16);
 	const href = await page.$eval('#fit-csv', a => a.hidden ? null : a.getAttribute('href'));
 	assert.match(href, /^\/api\/v1\/fits\/[^/?]+\?format=csv$/);
 	const id = href.split('/').pop().split('?')[0];
@@ -397,14 +397,19 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	assert.equal(Number(m[1]), Number(fit.result.chi2.toPrecision(3)), chi2);
 	assert.equal(Number(m[2]), Number((fit.result.chi2 / 3).toPrecision(3)), chi2);
 	/* measured points as markers, not joined; a legend of the series there are (no ccw data) */
-	assert.deepEqual(await page.evaluate(() => window.convsim.plots.fit.joined), [false, true, true, false, true, true]);
+	assert.deepEqual(await page.evaluate(() => window.convsim.plots.fit.joined), [true, true, false, true, true, false, true, true]);
 	const legend = await page.$$eval('#plot-fit .u-legend .u-series', rows => rows
 		.filter(r => getComputedStyle(r).display !== 'none').map(r => r.querySelector('.u-label').textContent));
-	assert.deepEqual(legend, ['data cw', 'fitted cw', 'original cw']);
+	assert.deepEqual(legend, ['95 % band cw', 'data cw', 'fitted cw', 'original cw']);
+	/* the band: the fitted curve ± half the band's width, shaded around it */
+	const band = await page.evaluate(() => ({ data: window.convsim.plots.fit.plot.data[1], errs: window.convsim.plots.fit.errs[0] }));
+	const cw = fit.result.curve.cw;
+	assert.deepEqual(band.data, [fit.result.curve.beta, cw.fit]);
+	band.errs.forEach((h, k) => assert.ok(Math.abs(cw.fit[k] + h - cw.band.upper[k]) < 1e-12 && h > 0, `${k}: ${h}`));
 	/* the progress line says "done" once, not "done · done" */
 	assert.match(await page.$eval('#fit-progress .ptext', e => e.textContent), /^done · iteration \d+ · \d+ evaluations/);
 	const csv = csvLines(await download('#fit-csv'));
-	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start');
+	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
 	assert.equal(csv.filter(l => l.startsWith('curve,')).length, 4);
 });
 

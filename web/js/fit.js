@@ -4,8 +4,8 @@
  * free parameters by name, POST /api/v1/fits on the new-session form's
  * model; follows the fit's progress (iteration, evaluations, current
  * values), can cancel it, and shows the data with their sigma, the fitted
- * and the original curve, the values with standard errors and the
- * warnings, and the result's CSV link.
+ * and the original curve with the fitted curve's 95 % band shaded, the
+ * values with standard errors and the warnings, and the result's CSV link.
  */
 
 import * as api from './api.js';
@@ -64,10 +64,17 @@ async function runFit(ev) {
 	}
 }
 
-/* The plot (data with sigma, fitted and original curves per rotation),
- * the parameters' table and the warnings. */
+/* The plot (per rotation: the fitted curve's 95 % band shaded, data with
+ * sigma, fitted and original curves), the parameters' table and the
+ * warnings. The band is symmetric about the fitted curve: drawn as the
+ * curve ± the band's half-width. */
 function showFit(r) {
 	const pairs = [], errs = [];
+	for (const rot of ['cw', 'ccw']) {
+		const c = r.curve?.[rot];
+		pairs.push(c ? [r.curve.beta, c.fit] : [[], []]);
+		errs.push(c ? c.band.upper.map((hi, k) => (hi - c.band.lower[k]) / 2) : []);
+	}
 	for (const rot of ['cw', 'ccw']) {
 		const pts = (r.points || []).filter(p => p.rotation === rot);
 		pairs.push([pts.map(p => p.beta), pts.map(p => p.v)]);

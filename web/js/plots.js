@@ -250,6 +250,33 @@ function polylinePaths(markers, errs, line = true) {
 	};
 }
 
+/* A shaded band y ± errs(sidx)[i] along the series' points (a run of
+ * finite points is one polygon), for a series drawn as a band. Returns
+ * uPlot's path object: nothing stroked, the polygon filled. */
+function bandPaths(errs) {
+	return (u, sidx) => {
+		const [xs, ys] = u.data[sidx];
+		const s = u.series[sidx];
+		const xk = s.facets[0].scale, yk = s.facets[1].scale;
+		const es = errs(sidx) || [];
+		const fill = new Path2D();
+		const ok = i => Number.isFinite(xs[i]) && Number.isFinite(ys[i]) && es[i] >= 0;
+		for (let i = 0; i < xs.length;) {
+			if (!ok(i)) { i++; continue; }
+			let j = i;
+			while (j + 1 < xs.length && ok(j + 1)) j++;
+			for (let k = i; k <= j; k++) {
+				const X = u.valToPos(xs[k], xk, true), Y = u.valToPos(ys[k] + es[k], yk, true);
+				if (k === i) fill.moveTo(X, Y); else fill.lineTo(X, Y);
+			}
+			for (let k = j; k >= i; k--) fill.lineTo(u.valToPos(xs[k], xk, true), u.valToPos(ys[k] - es[k], yk, true));
+			fill.closePath();
+			i = j + 1;
+		}
+		return { stroke: new Path2D(), fill, clip: null, band: null, gaps: null, flags: 0 };
+	};
+}
+
 /* Axis ranges over every finite x and y of the data (y ± its error bar
  * where errs[i - 1] gives one). */
 export function extent(data, errs = []) {
@@ -286,7 +313,8 @@ function padRange(min, max, pad = 0.08) {
 }
 
 export class XYPlot {
-	/* series: [{label, color, line}] (line: false draws the points alone);
+	/* series: [{label, color, line, band}] (line: false draws the points
+	 * alone; band: true shades y ± the error bars instead, in fill);
 	 * equal: keep aspect 1:1 in data units; markers: draw a dot per point;
 	 * zeroLine: draw y = 0. The legend lists only the series that have
 	 * points. */
@@ -342,7 +370,9 @@ export class XYPlot {
 				stroke: d.color ?? PALETTE[i % PALETTE.length],
 				width: d.width ?? 1.5,
 				facets: [{ scale: 'x', auto: true }, { scale: 'y', auto: true }],
-				paths: polylinePaths(markers || d.line === false, sidx => self.errs[sidx - 1], d.line !== false),
+				paths: d.band ? bandPaths(sidx => self.errs[sidx - 1])
+					: polylinePaths(markers || d.line === false, sidx => self.errs[sidx - 1], d.line !== false),
+				...(d.band ? { fill: d.fill, width: 0 } : {}),
 				points: { show: false },
 			}))],
 		}, [null, ...series.map(() => [[], []])], el);
