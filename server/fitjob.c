@@ -271,7 +271,7 @@ static void fit_discard(srv_entry *en)
 }
 
 /* Its record first, then its driver: the answer shows it queued. */
-static api_err fit_start(srv_entry *en, char **answer, api_problem *pb)
+static api_err fitjob_start(srv_entry *en, char **answer, api_problem *pb)
 {
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
@@ -380,7 +380,7 @@ const srv_job_kind srv_fit_job = {
 	.store_kind = SRV_STORE_FIT,
 	.create = fit_create,
 	.discard = fit_discard,
-	.start = fit_start,
+	.start = fitjob_start,
 	.evictable = evictable,
 	.lock = fit_lock,
 	.text = fit_text,
