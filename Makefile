@@ -40,6 +40,19 @@ API_OBJ    := $(API_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
+# The DEM coupling (dem/: LIGGGHTS and MPI, which core/ never sees) is
+# built only where LIGGGHTS is installed; `make test` and `make bench-dem`
+# install it first (DEB_DEM) and then build it in a second make, which
+# sees the new header.
+HAVE_LIGGGHTS := $(wildcard /usr/include/liggghts/library.h)
+DEM_SRC     := $(wildcard dem/*.c)
+DEM_CLI_SRC := $(wildcard dem/cli/*.c)
+DEM_OBJ     := $(DEM_SRC:%.c=$(BUILD)/%.o)
+DEM_CLI_OBJ := $(DEM_CLI_SRC:%.c=$(BUILD)/%.o)
+DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem)
+MPI_CFLAGS  := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --cflags ompi-c))
+MPI_LIBS    := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --libs ompi-c))
+
 # Debian packages the project needs, by the file each provides: to build
 # and run (`make`, `make run`), and in addition to test (`make test`,
 # `make install`'s unit check).
@@ -59,15 +72,22 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev \
              /usr/include/gsl/gsl_odeiv2.h:libgsl-dev
+# and in addition for the DEM coupling (dem/, `make test`, `make bench-dem`):
+# LIGGGHTS's C library, whose header includes <mpi.h>, and mpirun.
+DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
+             /usr/bin/liggghts:liggghts \
+             /usr/lib/x86_64-linux-gnu/pkgconfig/ompi-c.pc:libopenmpi-dev \
+             /usr/bin/mpirun:openmpi-bin \
+             /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-peers load mutate fuzz fuzz-build clean install uninstall
-all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
+.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers load mutate fuzz fuzz-build clean install uninstall
+all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
 # run as root or have sudo) and the npm test tools (tests/node_modules, no
 # root). Says what it installs and why; idempotent. deps-build is the part
 # that building and running need.
-deps: deps-build $(BUILD)/.deps
+deps: deps-build $(BUILD)/.deps $(BUILD)/.deps-dem
 deps-build: $(BUILD)/.deps-build
 $(BUILD)/.deps-build: Makefile
 	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
@@ -77,6 +97,9 @@ $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps-dem: Makefile
+	$(Q)NEEDS="$(DEB_DEM)" WHY="to cross-check and couple the feed with the LIGGGHTS DEM code (dem/)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps-bench: Makefile
 	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (GSL, SUNDIALS)" sh tests/apt-deps.sh
@@ -91,6 +114,7 @@ INC_core   := -Icore
 INC_api    := -Icore -Icore/fit -Iapi
 INC_server := -Icore -Icore/fit -Iapi -Iserver
 INC_tests  := -Icore -Icore/fit
+INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 $(CLI_OBJ): INC_EXTRA := -Icore/fit
 
 $(BUILD)/%.o: %.c
@@ -117,6 +141,16 @@ $(BUILD)/libfit.a: $(FIT_OBJ)
 $(BUILD)/libapi.a: $(API_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/libdem.a: $(DEM_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(LDLIBS)
+
+dem-build: $(BUILD)/convsim-dem
 
 $(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
@@ -160,6 +194,7 @@ cluster: deps-build $(BUILD)/convsimd
 	$(Q)N=$(N) CONVSIMD=$(BUILD)/convsimd bash server/cluster.sh run
 
 test: deps all
+	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
 
 check:
@@ -247,4 +282,5 @@ uninstall:
 clean:
 	rm -rf build build-san build-fuzz
 
+-include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d)
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)
