@@ -70,6 +70,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_SCENE, trough_rotation, BOOL, "", 0, 1, NULL, 1, "true: integrate alpha even on a symmetric machine; false: the engine drops it there") \
 	X(G_SCENE, mirror, BOOL, "", 0, 1, NULL, 1, "true: a sweep or fit over both senses of a mirror-symmetric machine takes (ccw, 180 - beta) as the mirror image of (cw, beta); false: it integrates every point") \
 	X(G_SCENE, feed_coupling, BOOL, "", 0, 1, NULL, 1, "false: the feed does not act on the trough") \
+	X(G_SCENE, feed_model, ENUM, "", 0, 1, "column|liggghts", 1, "column: the paper's columns of layers; liggghts: a LIGGGHTS bed coupled at the machine step (convsim built with LIGGGHTS, docs/dem.md)") \
 	X(G_SCENE, friction, ENUM, "", 0, 1, "coulomb|regularised", 1, "friction law")          \
 	X(G_SCENE, friction_eps, REAL, "m/s", 1e-6, 1, NULL, 1, "regularised friction width")  \
 	X(G_SCENE, motor_on, BOOL, "", 0, 1, NULL, 1, "drive switched on at t = 0")            \
