@@ -26,8 +26,10 @@ else
 Q := @
 endif
 
+# LIGGGHTS installed: the DEM coupling (dem/, below) is built
+HAVE_LIGGGHTS := $(wildcard /usr/include/liggghts/library.h)
 CORE_SRC   := $(wildcard core/*.c)
-CLI_SRC    := $(wildcard core/cli/*.c)
+CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),core/cli/coupled_none.c),$(wildcard core/cli/*.c))
 FIT_SRC    := $(wildcard core/fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 SERVER_SRC := $(wildcard server/*.c)
@@ -44,12 +46,15 @@ UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 # built only where LIGGGHTS is installed; `make test` and `make bench-dem`
 # install it first (DEB_DEM) and then build it in a second make, which
 # sees the new header.
-HAVE_LIGGGHTS := $(wildcard /usr/include/liggghts/library.h)
 DEM_SRC     := $(wildcard dem/*.c)
-DEM_CLI_SRC := $(wildcard dem/cli/*.c)
+DEM_CLI_SRC := dem/cli/convsim_dem.c
 DEM_OBJ     := $(DEM_SRC:%.c=$(BUILD)/%.o)
 DEM_CLI_OBJ := $(DEM_CLI_SRC:%.c=$(BUILD)/%.o)
 DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem)
+# convsim's `run --set feed_model=liggghts`: the coupled runner and its
+# libraries where LIGGGHTS is installed, else a stub that says how to get it
+CLI_DEM_OBJ := $(if $(HAVE_LIGGGHTS),$(BUILD)/dem/cli/run_coupled.o $(BUILD)/libdem.a)
+CLI_DEM_LIBS = $(if $(HAVE_LIGGGHTS),-lliggghts $(MPI_LIBS))
 MPI_CFLAGS  := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --cflags ompi-c))
 MPI_LIBS    := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --libs ompi-c))
 
@@ -114,7 +119,7 @@ INC_core   := -Icore
 INC_api    := -Icore -Icore/fit -Iapi
 INC_server := -Icore -Icore/fit -Iapi -Iserver
 INC_tests  := -Icore -Icore/fit
-INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
+INC_dem    := -Icore -Icore/cli -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 $(CLI_OBJ): INC_EXTRA := -Icore/fit
 
 $(BUILD)/%.o: %.c
@@ -150,11 +155,11 @@ $(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(LDLIBS)
 
-dem-build: $(BUILD)/convsim-dem
+dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim
 
-$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
+$(BUILD)/convsim: $(CLI_OBJ) $(CLI_DEM_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(LDLIBS)
 
 $(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
@@ -247,6 +252,12 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 # budget or stopped answering another client.
 load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
+
+# The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
+# process at a time, niced, into tests/bench/results/dem.md.
+bench-dem: all $(BUILD)/.deps-dem
+	$(Q)$(MAKE) --no-print-directory dem-build
+	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.

@@ -164,6 +164,27 @@ static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
 	}
 }
 
+void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
+{
+	double d_mean = 0.004;
+	memset(b, 0, sizeof *b);
+	b->d_min = 0.0036;
+	b->d_max = 0.0044;
+	b->density = 2500;
+	b->cell_x = 20 * d_mean;
+	b->cell_y = 4 * d_mean;
+	b->grains = (int)lround(0.6 * b->cell_x * b->cell_y * depth * d_mean /
+				(M_PI / 6 * d_mean * d_mean * d_mean));
+	if (b->grains < 1)
+		b->grains = 1;
+	b->k_over_m = p->k_c / p->m_n;
+	b->restitution = p->R;
+	b->mu = p->mu;
+	b->g = p->g;
+	b->seed = 1;
+	b->settle = b->grains == 1 ? 0.05 : 0.3;
+}
+
 dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size_t msglen)
 {
 	if (spec_check(spec, msg, msglen))
@@ -224,6 +245,8 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	bed_cmd(b, "variable px equal mass(all)*vcm(all,x)");
 	bed_cmd(b, "variable pz equal mass(all)*vcm(all,z)");
 	bed_cmd(b, "variable ke equal c_ke");
+	bed_cmd(b, "compute rke all erotate/sphere update_on_run_end yes");
+	bed_cmd(b, "variable rke equal c_rke");
 	if (s->settle > 0)
 		bed_cmd(b, "run %ld", (long)ceil(s->settle / b->dt));
 	else
@@ -276,4 +299,5 @@ void dem_bed_get(const dem_bed *b, dem_bed_state *st)
 	st->p_x = bed_var(b, "px");
 	st->p_z = bed_var(b, "pz");
 	st->kinetic = bed_var(b, "ke");
+	st->kinetic_rot = bed_var(b, "rke");
 }

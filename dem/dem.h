@@ -20,6 +20,8 @@
 
 #include <stddef.h>
 
+#include "sim.h"
+
 /* What a bed is made of. Contact law: linear spring (LIGGGHTS's
  * hooke/stiffness) with the stiffness of k_over_m times the mean grain's
  * mass, a viscous normal damper calibrated so that a grain dropped on the
@@ -40,6 +42,13 @@ typedef struct dem_bed_spec {
 	double g;              /* m/s^2 gravity */
 	double settle;         /* s of settling under gravity before t = 0 */
 } dem_bed_spec;
+
+/* The bed this project uses unless told otherwise: spheres 3.6-4.4 mm of
+ * density 2500 kg/m^3 in a cell of 20 x 4 mean diameters, `depth` mean
+ * diameters deep at packing 0.6 (at least one grain), with the column
+ * model's contact numbers: k_c/m_n, R, mu; no rolling friction; seed 1;
+ * settled 0.3 s (0.05 s for one grain). */
+void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b);
 
 typedef struct dem_bed dem_bed;
 
@@ -70,6 +79,7 @@ typedef struct dem_bed_state {
 	double z_mean;       /* m: mass-weighted mean height */
 	double p_x, p_z;     /* kg m/s: momentum relative to the deck */
 	double kinetic;      /* J: translational kinetic energy relative to the deck */
+	double kinetic_rot;  /* J: the grains' rotational kinetic energy */
 } dem_bed_state;
 void dem_bed_get(const dem_bed *b, dem_bed_state *st);
 

@@ -142,6 +142,48 @@ fail:
 	return err;
 }
 
+int dem_motion_sample(const sim_params *p, const sim_scene *sc, const sim_method *m, int steps,
+		      double t_end, double **acc, long *n, double *interval, char *msg, size_t msglen)
+{
+	sim_scene one_way = *sc;
+	one_way.feed_model = SIM_FEED_EXTERNAL;
+	one_way.feed_coupling = 0;
+	int err = SIM_OK;
+	*acc = NULL;
+	sim *s = sim_new(p, &one_way, m, &err, msg, msglen);
+	if (!s)
+		return err;
+	sim_status st;
+	sim_get_status(s, &st);
+	double dt = st.dt, H = steps * dt, v0[2] = {st.deck_vel[0], st.deck_vel[1]};
+	long k, count = (long)floor(t_end / H + 1e-9);
+	double *a = malloc((size_t)(count > 0 ? count : 1) * 2 * sizeof *a);
+	if (!a) {
+		snprintf(msg, msglen, "deck motion: out of memory");
+		sim_free(s);
+		return SIM_ENOMEM;
+	}
+	for (k = 0; k < count; k++) {
+		/* the time as the coupled run computes it (couple.c) */
+		if ((err = sim_advance(s, (double)((k + 1) * steps) * dt)) != SIM_OK) {
+			snprintf(msg, msglen, "deck motion: %s", sim_last_error(s));
+			free(a);
+			sim_free(s);
+			return err;
+		}
+		sim_get_status(s, &st);
+		a[2 * k] = (st.deck_vel[0] - v0[0]) / H;
+		a[2 * k + 1] = (st.deck_vel[1] - v0[1]) / H;
+		v0[0] = st.deck_vel[0];
+		v0[1] = st.deck_vel[1];
+	}
+	sim_free(s);
+	*acc = a;
+	*n = count;
+	*interval = H;
+	return SIM_OK;
+}
+
 void dem_motion_velocity(const dem_motion *mo, double t, double vel[2])
 {
 	vel[0] = vel[1] = 0;

@@ -30,6 +30,14 @@ typedef struct dem_motion {
 int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m, double t0,
 		   double t1, int harmonics, dem_motion *out, char *msg, size_t msglen);
 
+/* The one-way machine's own deck (p, sc with feed_model external and
+ * feed_coupling = 0, as a coupled run builds it): the centre deck point's
+ * mean acceleration over each interval of `steps` machine steps up to
+ * t_end, into *acc (a_x, a_y pairs, malloc'd: the caller frees), *n
+ * intervals of *interval s. SIM_OK or a core error with msg. */
+int dem_motion_sample(const sim_params *p, const sim_scene *sc, const sim_method *m, int steps,
+		      double t_end, double **acc, long *n, double *interval, char *msg, size_t msglen);
+
 /* The fit's deck velocity (m/s) at t. */
 void dem_motion_velocity(const dem_motion *mo, double t, double vel[2]);
 

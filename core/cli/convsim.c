@@ -182,6 +182,8 @@ static int cmd_run(int argc, char **argv)
 	int rc = cli_parse(argc, argv, CMD_RUN, &o);
 	if (rc)
 		return rc < 0 ? 0 : rc;
+	if (o.sc.feed_model == SIM_FEED_EXTERNAL)
+		return cli_run_coupled(&o);
 	char msg[200];
 	int err;
 	double w0 = cli_now(), c0 = cpu_now(); /* the steady start's settling included */

@@ -36,6 +36,8 @@ static const cli_opt options[] = {
 	{CMD_SWEEP, OPT_FORMAT, "format", 'f', "csv|json", NULL, "csv", "format of the v(beta) table"},
 	{CMD_RUN, OPT_RATE, "sample-rate", 'r', "HZ", "Hz", "1000",
 	 "trajectory rows per simulated second, in (0, 1e6]"},
+	{CMD_RUN, OPT_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
+	 "feed_model=liggghts: machine steps per coupling interval with the bed (docs/dem.md)"},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
 	 "guide angles in [0, 180], or one angle"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",

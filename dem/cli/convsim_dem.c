@@ -17,8 +17,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "dem.h"
+#include "couple.h"
 #include "motion.h"
 #include "sim.h"
 #include "units.h"
@@ -31,6 +33,7 @@ typedef struct dem_opts {
 	double duration, transient, depth, stiffness, d_min, d_max, cell_x, cell_y, mu_roll, settle;
 	double restitution, mu; /* NaN: the model's R and mu */
 	int grains, seed, freeze_rotation, intervals, harmonics, column;
+	int motion_machine, coupling_steps; /* --motion machine: the one-way machine's own deck */
 } dem_opts;
 
 static const struct option dem_long[] = {
@@ -44,6 +47,7 @@ static const struct option dem_long[] = {
 	{"mu-roll", required_argument, 0, 'r'},    {"freeze-rotation", no_argument, 0, 'f'},
 	{"intervals", required_argument, 0, 'i'},  {"harmonics", required_argument, 0, 'H'},
 	{"settle", required_argument, 0, 'w'},     {"no-column", no_argument, 0, 'C'},
+	{"motion", required_argument, 0, 'M'},     {"coupling-steps", required_argument, 0, 'c'},
 	{"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
 
 static const char dem_usage[] =
@@ -66,7 +70,13 @@ static const char dem_usage[] =
 	"  -i, --intervals N        coupling intervals a period (64)\n"
 	"  -H, --harmonics H        harmonics of the deck motion's fit (3)\n"
 	"  -w, --settle S           settling before t = 0 (0.3 s; 0.05 s for one grain)\n"
-	"      --no-column          skip the column model's run\n";
+	"      --no-column          skip the column model's run\n"
+	"      --motion fit|machine fit: the deck's harmonic fit, in --intervals a period (the\n"
+	"                           default); machine: the one-way machine's deck itself, its\n"
+	"                           mean acceleration over every --coupling-steps machine steps, as\n"
+	"                           `convsim run --set feed_model=liggghts` couples it (v from t = 0\n"
+	"                           or --transient, least squares)\n"
+	"      --coupling-steps N   machine steps a coupling interval (1)\n";
 
 /* A number in [lo, hi] or exit 2 with the option's name and range. */
 static double dem_number(const char *opt, const char *text, double lo, double hi)
@@ -95,6 +105,7 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	o->duration = 2, o->transient = 0.5, o->depth = 8, o->stiffness = 1, o->seed = 1;
 	o->d_min = 0.0036, o->d_max = 0.0044, o->cell_x = 20, o->cell_y = 4, o->settle = NAN;
 	o->restitution = NAN, o->mu = NAN, o->intervals = 64, o->harmonics = 3, o->column = 1;
+	o->coupling_steps = 1;
 	while ((c = getopt_long(argc, argv, "p:s:d:t:n:D:S:k:e:u:r:fi:H:w:h", dem_long, NULL)) != -1) {
 		char msg[200], name[64];
 		const char *eq;
@@ -130,6 +141,15 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 		case 'H': o->harmonics = (int)dem_number("harmonics", optarg, 1, DEM_MAX_HARMONICS); break;
 		case 'w': o->settle = dem_number("settle", optarg, 0, 100); break;
 		case 'C': o->column = 0; break;
+		case 'M':
+			if (strcmp(optarg, "fit") && strcmp(optarg, "machine")) {
+				fprintf(stderr, "convsim-dem: --motion must be fit or machine, got '%s'\n",
+					optarg);
+				exit(2);
+			}
+			o->motion_machine = !strcmp(optarg, "machine");
+			break;
+		case 'c': o->coupling_steps = (int)dem_number("coupling-steps", optarg, 1, 1000); break;
 		case 'h': fputs(dem_usage, stdout); exit(0);
 		default: fputs(dem_usage, stderr); exit(2);
 		}
@@ -142,14 +162,13 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	}
 }
 
-/* The bed of the options: the model's contact numbers unless overridden. */
+/* The bed of the options: dem_bed_spec_default's, with what they change. */
 static void dem_spec(const dem_opts *o, dem_bed_spec *b)
 {
 	double d_mean = 0.5 * (o->d_min + o->d_max);
-	memset(b, 0, sizeof *b);
+	dem_bed_spec_default(&o->p, o->depth * 0.004 / d_mean, b);
 	b->d_min = o->d_min;
 	b->d_max = o->d_max;
-	b->density = 2500;
 	b->cell_x = o->cell_x * d_mean;
 	b->cell_y = o->cell_y * d_mean;
 	b->grains = o->grains > 0 ? o->grains
@@ -157,14 +176,45 @@ static void dem_spec(const dem_opts *o, dem_bed_spec *b)
 						(M_PI / 6 * d_mean * d_mean * d_mean));
 	if (b->grains < 1)
 		b->grains = 1;
-	b->k_over_m = o->stiffness * o->p.k_c / o->p.m_n;
-	b->restitution = isnan(o->restitution) ? o->p.R : o->restitution;
-	b->mu = isnan(o->mu) ? o->p.mu : o->mu;
+	b->k_over_m *= o->stiffness;
+	if (!isnan(o->restitution))
+		b->restitution = o->restitution;
+	if (!isnan(o->mu))
+		b->mu = o->mu;
 	b->mu_roll = o->mu_roll;
 	b->freeze_rotation = o->freeze_rotation;
 	b->seed = (unsigned)o->seed;
-	b->g = o->p.g;
 	b->settle = isnan(o->settle) ? (b->grains == 1 ? 0.05 : 0.3) : o->settle;
+}
+
+/* "  \"name\": value,\n", null where the value is not finite (JSON has no NaN). */
+static void put(const char *name, double v, int last)
+{
+	if (isfinite(v))
+		printf("  \"%s\": %.17g%s\n", name, v, last ? "" : ",");
+	else
+		printf("  \"%s\": null%s\n", name, last ? "" : ",");
+}
+
+/* The bed under the one-way machine's own deck, as a coupled run drives
+ * it (--motion machine); 0 or -1 with msg. */
+static int run_machine_motion(const dem_opts *o, dem_bed *bed, dem_prescribed *r, char *msg,
+			      size_t msglen)
+{
+	double *acc, H;
+	long n;
+	if (dem_motion_sample(&o->p, &o->sc, &o->m, o->coupling_steps, o->duration, &acc, &n, &H, msg,
+			      msglen) != SIM_OK)
+		return -1;
+	dem_bed_state st;
+	dem_bed_get(bed, &st);
+	r->mass = st.mass;
+	r->bed_height = 2 * st.z_mean;
+	r->dt = dem_bed_dt(bed);
+	r->periods = NAN;
+	int rc = dem_replay(bed, acc, n, H, o->transient, &r->transport_velocity, msg, msglen);
+	free(acc);
+	return rc;
 }
 
 int main(int argc, char **argv)
@@ -173,9 +223,10 @@ int main(int argc, char **argv)
 	memset(&o, 0, sizeof o);
 	dem_parse(argc, argv, &o);
 	char msg[300];
-	dem_motion mo;
-	int err = dem_motion_fit(&o.p, &o.sc, &o.m, o.transient, o.duration, o.harmonics, &mo, msg,
-				 sizeof msg);
+	dem_motion mo = {.omega = NAN, .residual = NAN, .amplitude = NAN};
+	int err = o.motion_machine ? SIM_OK
+				   : dem_motion_fit(&o.p, &o.sc, &o.m, o.transient, o.duration,
+						    o.harmonics, &mo, msg, sizeof msg);
 	if (err != SIM_OK) {
 		fprintf(stderr, "convsim-dem: %s\n", msg);
 		return 1;
@@ -183,6 +234,7 @@ int main(int argc, char **argv)
 	sim_measurement col = {.transport_velocity = NAN, .uncertainty = NAN};
 	sim_scene one_way = o.sc;
 	one_way.feed_coupling = 0;
+	one_way.feed_model = SIM_FEED_COLUMN;
 	one_way.transient = o.transient;
 	if (o.column &&
 	    sim_measure(&o.p, &one_way, &o.m, o.duration, &col, msg, sizeof msg) != SIM_OK) {
@@ -197,33 +249,41 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	dem_prescribed r;
-	if (dem_run_prescribed(bed, &mo, o.duration, o.transient, o.intervals, &r, msg, sizeof msg)) {
+	double cpu0 = (double)clock() / CLOCKS_PER_SEC;
+	if (o.motion_machine ? run_machine_motion(&o, bed, &r, msg, sizeof msg)
+			     : dem_run_prescribed(bed, &mo, o.duration, o.transient, o.intervals, &r,
+						  msg, sizeof msg)) {
 		fprintf(stderr, "convsim-dem: %s\n", msg);
 		dem_bed_free(bed);
 		return 1;
 	}
+	if (o.motion_machine)
+		r.cpu_seconds = (double)clock() / CLOCKS_PER_SEC - cpu0;
 	dem_bed_free(bed);
 	double zeta = dem_restitution_damping(spec.restitution);
 	printf("{\n  \"beta\": %.17g,\n  \"rotation\": \"%s\",\n", o.p.beta / RAD_PER_DEG,
 	       o.p.rotation == SIM_CW ? "cw" : "ccw");
-	printf("  \"grains\": %d,\n  \"bed_height\": %.17g,\n  \"bed_mass\": %.17g,\n", spec.grains,
-	       r.bed_height, r.mass);
-	printf("  \"k_over_m\": %.17g,\n  \"restitution_floor\": %.17g,\n", spec.k_over_m,
-	       spec.restitution);
-	printf("  \"restitution_pair\": %.17g,\n", dem_restitution(zeta / sqrt(2)));
-	printf("  \"mu\": %.17g,\n  \"mu_roll\": %.17g,\n  \"seed\": %d,\n", spec.mu, spec.mu_roll,
-	       o.seed);
-	printf("  \"deck_omega\": %.17g,\n  \"deck_fit_residual\": %.17g,\n  \"deck_amplitude\": %.17g,\n",
-	       mo.omega, mo.residual, mo.amplitude);
-	printf("  \"dem_dt\": %.17g,\n  \"intervals\": %d,\n  \"periods\": %.17g,\n", r.dt, o.intervals,
-	       r.periods);
-	printf("  \"v_dem\": %.17g,\n", r.transport_velocity);
-	/* null where the column model was not run (JSON has no NaN) */
-	if (isfinite(col.transport_velocity))
-		printf("  \"v_column\": %.17g,\n  \"v_column_uncertainty\": %.17g,\n",
-		       col.transport_velocity, col.uncertainty);
-	else
-		printf("  \"v_column\": null,\n  \"v_column_uncertainty\": null,\n");
-	printf("  \"layers\": %d,\n  \"dem_cpu_seconds\": %.17g\n}\n", o.sc.layers, r.cpu_seconds);
+	printf("  \"motion\": \"%s\",\n  \"grains\": %d,\n", o.motion_machine ? "machine" : "fit",
+	       spec.grains);
+	put("bed_height", r.bed_height, 0);
+	put("bed_mass", r.mass, 0);
+	put("k_over_m", spec.k_over_m, 0);
+	put("restitution_floor", spec.restitution, 0);
+	put("restitution_pair", dem_restitution(zeta / sqrt(2)), 0);
+	put("mu", spec.mu, 0);
+	put("mu_roll", spec.mu_roll, 0);
+	put("seed", o.seed, 0);
+	put("deck_omega", mo.omega, 0);
+	put("deck_fit_residual", mo.residual, 0);
+	put("deck_amplitude", mo.amplitude, 0);
+	put("dem_dt", r.dt, 0);
+	put("intervals", o.motion_machine ? NAN : o.intervals, 0);
+	put("periods", r.periods, 0);
+	put("v_dem", r.transport_velocity, 0);
+	put("v_column", col.transport_velocity, 0);
+	put("v_column_uncertainty", col.uncertainty, 0);
+	put("layers", o.sc.layers, 0);
+	put("dem_cpu_seconds", r.cpu_seconds, 1);
+	printf("}\n");
 	return 0;
 }
