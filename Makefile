@@ -2,7 +2,8 @@
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
 # `make deps` installs what is missing, `make install` installs,
-# `make bench` writes the work-precision tables, `make fuzz` runs the
+# `make bench` writes the work-precision tables, `make bench-dem` the feed
+# against LIGGGHTS (docs/dem.md), `make fuzz` runs the
 # libFuzzer harnesses, `make load` runs a bounded load test. V=1 shows the commands.
 
 CC      ?= cc
@@ -153,7 +154,7 @@ $(BUILD)/libdem.a: $(DEM_OBJ)
 
 $(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
 
 dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim
 

@@ -1,7 +1,7 @@
 /*
  * motion.c - the deck's prescribed motion (motion.h): the machine run
  * one-way, its centre deck point fitted by a few harmonics of the mean
- * rotor speed (least squares, normal equations), and a DEM bed driven by
+ * rotor speed (least squares, GSL), and a DEM bed driven by
  * that motion over whole periods.
  */
 #include <math.h>
@@ -9,6 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_multifit.h>
 
 #include "motion.h"
 
@@ -29,40 +32,6 @@ static void motion_basis(double omega, int harmonics, double t, double *phi)
 	}
 }
 
-/* Solve the n x n system A x = r in place (Gaussian elimination with
- * partial pivoting); -1 if singular. */
-static int motion_solve(int n, double *A, double *r)
-{
-	for (int c = 0; c < n; c++) {
-		int piv = c;
-		for (int i = c + 1; i < n; i++)
-			if (fabs(A[i * n + c]) > fabs(A[piv * n + c]))
-				piv = i;
-		if (!(fabs(A[piv * n + c]) > 0))
-			return -1;
-		for (int j = 0; j < n; j++) {
-			double tmp = A[c * n + j];
-			A[c * n + j] = A[piv * n + j];
-			A[piv * n + j] = tmp;
-		}
-		double tmp = r[c];
-		r[c] = r[piv];
-		r[piv] = tmp;
-		for (int i = c + 1; i < n; i++) {
-			double f = A[i * n + c] / A[c * n + c];
-			for (int j = c; j < n; j++)
-				A[i * n + j] -= f * A[c * n + j];
-			r[i] -= f * r[c];
-		}
-	}
-	for (int c = n - 1; c >= 0; c--) {
-		for (int j = c + 1; j < n; j++)
-			r[c] -= A[c * n + j] * r[j];
-		r[c] /= A[c * n + c];
-	}
-	return 0;
-}
-
 int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m, double t0,
 		   double t1, int harmonics, dem_motion *out, char *msg, size_t msglen)
 {
@@ -77,6 +46,7 @@ int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m
 	sim *s = sim_new(p, &one_way, m, &err, msg, msglen);
 	if (!s)
 		return err;
+	gsl_set_error_handler_off(); /* GSL's errors come back as codes */
 	/* samples: 64 a period of the synchronous speed, at least */
 	long n = (long)ceil((t1 - t0) * p->omega_ss / (2 * M_PI) * 64) + 1;
 	double *t = malloc((size_t)n * sizeof *t), *dx = malloc((size_t)n * sizeof *dx),
@@ -100,23 +70,34 @@ int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m
 		omega += fabs(st.rotor_speed) / (double)n;
 	}
 	int nb = 2 * harmonics + 1;
-	double A[2 * (2 * DEM_MAX_HARMONICS + 1) * (2 * DEM_MAX_HARMONICS + 1)], phi[2 * DEM_MAX_HARMONICS + 1];
-	double *Ay = A + nb * nb;
+	double phi[2 * DEM_MAX_HARMONICS + 1], chisq;
 	memset(out, 0, sizeof *out);
-	memset(A, 0, sizeof A);
-	for (long i = 0; i < n; i++) {
+	/* least squares for x and y on the same basis (GSL's SVD solver) */
+	gsl_matrix *X = gsl_matrix_alloc((size_t)n, (size_t)nb);
+	gsl_vector *obs = gsl_vector_alloc((size_t)n), *coef = gsl_vector_alloc((size_t)nb);
+	gsl_matrix *cov = gsl_matrix_alloc((size_t)nb, (size_t)nb);
+	gsl_multifit_linear_workspace *ws = gsl_multifit_linear_alloc((size_t)n, (size_t)nb);
+	int bad = !X || !obs || !coef || !cov || !ws;
+	for (long i = 0; i < n && !bad; i++) {
 		motion_basis(omega, harmonics, t[i], phi);
-		for (int r = 0; r < nb; r++) {
-			out->a[r] += phi[r] * dx[i];
-			out->b[r] += phi[r] * dy[i];
-			for (int c = 0; c < nb; c++)
-				A[r * nb + c] += phi[r] * phi[c];
-		}
+		for (int r = 0; r < nb; r++)
+			gsl_matrix_set(X, (size_t)i, (size_t)r, phi[r]);
 	}
-	memcpy(Ay, A, (size_t)(nb * nb) * sizeof *A);
-	if (motion_solve(nb, A, out->a) || motion_solve(nb, Ay, out->b)) {
-		snprintf(msg, msglen, "deck motion: the fit is singular");
-		err = SIM_EPARAM;
+	for (int axis = 0; axis < 2 && !bad; axis++) {
+		for (long i = 0; i < n; i++)
+			gsl_vector_set(obs, (size_t)i, axis ? dy[i] : dx[i]);
+		bad = gsl_multifit_linear(X, obs, coef, cov, &chisq, ws) != GSL_SUCCESS;
+		for (int r = 0; r < nb && !bad; r++)
+			(axis ? out->b : out->a)[r] = gsl_vector_get(coef, (size_t)r);
+	}
+	gsl_multifit_linear_free(ws);
+	gsl_matrix_free(cov);
+	gsl_vector_free(coef);
+	gsl_vector_free(obs);
+	gsl_matrix_free(X);
+	if (bad) {
+		snprintf(msg, msglen, "deck motion: the fit failed (out of memory or singular)");
+		err = SIM_ENOMEM;
 		goto fail;
 	}
 	out->omega = omega;
