@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <library.h>
 
@@ -46,6 +47,13 @@ static double bed_var(const dem_bed *b, const char *name)
 	double out = v ? *v : NAN;
 	free(v);
 	return out;
+}
+
+double dem_cpu_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* xorshift64*: the packing's reproducible random numbers in [0, 1). */

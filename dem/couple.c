@@ -8,7 +8,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "couple.h"
 
@@ -28,13 +27,6 @@ struct dem_coupled {
 	double cpu;
 	long k;
 };
-
-static double couple_cpu_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void dem_slope_add(dem_slope *s, double t, double x)
 {
@@ -147,11 +139,11 @@ static int couple_interval(dem_coupled *c, FILE *deck_out, char *msg, size_t msg
 	double ay = (m1.deck_vel[1] - c->ms.deck_vel[1]) / H;
 	if (deck_out)
 		fprintf(deck_out, "%.17g %.17g\n", ax, ay);
-	double cpu0 = couple_cpu_now();
+	double cpu0 = dem_cpu_now();
 	if (dem_bed_advance(c->bed, ax, ay, H, msg, msglen))
 		return -1;
 	dem_bed_get(c->bed, &b1);
-	c->cpu += couple_cpu_now() - cpu0;
+	c->cpu += dem_cpu_now() - cpu0;
 	/* 3. the floor's impulse on the grains, scaled: the next load */
 	double Jx = c->scale * (b1.p_x - c->bs.p_x + b1.mass * ax * H);
 	double Jy = c->scale * (b1.p_z - c->bs.p_z + b1.mass * (ay + c->g) * H);

@@ -83,6 +83,10 @@ typedef struct dem_bed_state {
 } dem_bed_state;
 void dem_bed_get(const dem_bed *b, dem_bed_state *st);
 
+/* CPU seconds of this process so far (CLOCK_PROCESS_CPUTIME_ID): the
+ * cost figures of dem/ and its tools. */
+double dem_cpu_now(void);
+
 /* The viscous damping ratio of a linear contact (spring stiffness k,
  * mass m, force never attractive) that gives restitution e; found by
  * bisection on the integrated collision. In (0, 1]. */

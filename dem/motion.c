@@ -8,19 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_multifit.h>
 
 #include "motion.h"
-
-static double motion_cpu_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The basis at t: 1, cos(h w t), sin(h w t), h = 1..H. */
 static void motion_basis(double omega, int harmonics, double t, double *phi)
@@ -188,7 +180,7 @@ int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double tr
 		snprintf(msg, msglen, "prescribed run: no whole period between the transient and the end");
 		return -1;
 	}
-	double cpu0 = motion_cpu_now(), x_first = 0, x_last = 0;
+	double cpu0 = dem_cpu_now(), x_first = 0, x_last = 0;
 	dem_bed_state st;
 	dem_bed_get(b, &st);
 	out->mass = st.mass;
@@ -208,7 +200,7 @@ int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double tr
 	}
 	out->periods = (double)(last - first);
 	out->transport_velocity = (x_last - x_first) / (out->periods * period);
-	out->cpu_seconds = motion_cpu_now() - cpu0;
+	out->cpu_seconds = dem_cpu_now() - cpu0;
 	out->dt = dem_bed_dt(b);
 	return 0;
 }

@@ -17,7 +17,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "dem.h"
 #include "couple.h"
@@ -249,7 +248,7 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	dem_prescribed r;
-	double cpu0 = (double)clock() / CLOCKS_PER_SEC;
+	double cpu0 = dem_cpu_now();
 	if (o.motion_machine ? run_machine_motion(&o, bed, &r, msg, sizeof msg)
 			     : dem_run_prescribed(bed, &mo, o.duration, o.transient, o.intervals, &r,
 						  msg, sizeof msg)) {
@@ -258,7 +257,7 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	if (o.motion_machine)
-		r.cpu_seconds = (double)clock() / CLOCKS_PER_SEC - cpu0;
+		r.cpu_seconds = dem_cpu_now() - cpu0;
 	dem_bed_free(bed);
 	double zeta = dem_restitution_damping(spec.restitution);
 	printf("{\n  \"beta\": %.17g,\n  \"rotation\": \"%s\",\n", o.p.beta / RAD_PER_DEG,

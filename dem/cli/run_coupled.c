@@ -22,7 +22,6 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
 #include <mpi.h>
 
@@ -31,13 +30,6 @@
 #include "dem.h"
 
 #define RUN_COUPLED_DT 3.125e-4
-
-static double run_cpu_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void run_summary(const cli_opts *o, const dem_coupled *c, const dem_bed_spec *spec, int ranks,
 			int failed, double cpu, double wall)
@@ -85,7 +77,7 @@ int cli_run_coupled(const cli_opts *o)
 	MPI_Comm_size(world, &ranks);
 	dem_bed_spec spec;
 	dem_bed_spec_default(&o->p, (double)o->sc.layers, &spec);
-	double w0 = cli_now(), c0 = run_cpu_now();
+	double w0 = cli_now(), c0 = dem_cpu_now();
 	sim_method m = o->m;
 	if (m.dt == 0.0)
 		m.dt = RUN_COUPLED_DT;
@@ -105,7 +97,7 @@ int cli_run_coupled(const cli_opts *o)
 		failed = dem_coupled_advance(c, t, NULL, msg, sizeof msg) != 0;
 		cli_progress_update(&pr, t, o->duration, "s simulated", "");
 	}
-	double wall = cli_now() - w0, cpu = run_cpu_now() - c0;
+	double wall = cli_now() - w0, cpu = dem_cpu_now() - c0;
 	char done[96];
 	snprintf(done, sizeof done, "%g s simulated in %.1f s", o->duration, wall);
 	cli_progress_end(&pr, done, 0);
