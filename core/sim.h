@@ -125,8 +125,10 @@ typedef struct sim_scene {
 	int motor_on;         /* drive on at t = 0 */
 	double transient;     /* s: transport velocity ignores t < transient */
 	int start;            /* SIM_START_REST or SIM_START_STEADY */
+	int feed_model;       /* SIM_FEED_COLUMN or SIM_FEED_EXTERNAL (in start's
+				 padding: the struct's size and the offsets after
+				 it stay, and a zeroed old record reads column) */
 	double settle;        /* s: `steady` start's settling before t = 0 */
-	int feed_model;       /* SIM_FEED_COLUMN or SIM_FEED_EXTERNAL */
 } sim_scene;
 
 /* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
@@ -161,6 +163,17 @@ const sim_setting *sim_settings(size_t *n);
 
 /* The czubak2016 preset (docs/MODEL.md), default scene and default method. */
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
+
+/* Whether the column model of a scene lies inside the domain where it was
+ * checked against LIGGGHTS beds (docs/dem.md, `make bench-dem`: the
+ * czubak2016 machine at beta = 30 deg): 1 inside; 0 outside, with the
+ * reason and what to use instead written into why (len bytes); -1 where
+ * the scene has no column feed (no feed, or feed_model liggghts). The
+ * rule: at most 2 layers (within 5 % of the DEM bed of that depth); or at
+ * most 8 layers with contacts 100x the preset's stiffness or stiffer,
+ * k_c / m_n >= 2e8 s^-2 (within 10-11 %); or the preset liggghts-bed4's
+ * contact fitted to a 4-diameter bed, at most 4 layers. */
+int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len);
 
 /* Names of known presets, NULL-terminated, static. Fill by name. */
 extern const char *const sim_preset_names[];
