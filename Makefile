@@ -255,10 +255,13 @@ load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
 
 # The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
-# process at a time, niced, into tests/bench/results/dem.md.
+# process at a time, niced, into tests/bench/results/dem.md; then the
+# coupled scene's cost against grains and ranks (tests/bench/dem_cost.sh,
+# dem_cost.md).
 bench-dem: all $(BUILD)/.deps-dem
 	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
+	$(Q)BUILD=$(BUILD) bash tests/bench/dem_cost.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.
@@ -294,5 +297,5 @@ uninstall:
 clean:
 	rm -rf build build-san build-fuzz
 
--include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d)
+-include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d) $(BUILD)/dem/cli/run_coupled.d
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)
