@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <library.h>
 
@@ -24,6 +25,7 @@
 struct dem_bed {
 	void *lmp;
 	dem_bed_spec spec;
+	char stl[64];   /* the moving floor's mesh file (frame check), "" for none */
 	double dt;      /* s DEM step */
 	double t;       /* s since the end of the settling */
 	double m_mean;  /* kg of the mean grain */
@@ -124,6 +126,10 @@ static int spec_check(const dem_bed_spec *s, char *msg, size_t msglen)
 		bad = "mu and mu_roll must be in [0, 10]";
 	else if (!(s->g >= 0) || !(s->g <= 100) || !(s->settle >= 0) || !(s->settle <= 100))
 		bad = "g must be in [0, 100] m/s^2 and settle in [0, 100] s";
+	else if (!(s->wiggle_period >= 0) || !isfinite(s->wiggle_x) || !isfinite(s->wiggle_z) ||
+		 (s->wiggle_period > 0 &&
+		  (s->grains != 1 || fabs(s->wiggle_x) > 0.01 || fabs(s->wiggle_z) > 0.01)))
+		bad = "the moving floor takes one grain and amplitudes of at most 0.01 m";
 	if (bad)
 		snprintf(msg, msglen, "dem bed: %s", bad);
 	return bad ? -1 : 0;
@@ -149,8 +155,40 @@ static void bed_contacts(dem_bed *b)
 			s->mu_roll);
 	bed_cmd(b, "pair_style gran model hooke/stiffness tangential history%s limitForce on", roll);
 	bed_cmd(b, "pair_coeff * *");
+	if (!b->stl[0]) {
+		bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
+			   "primitive type 1 zplane 0.0 limitForce on", roll);
+		return;
+	}
+	bed_cmd(b, "fix cad all mesh/surface file %s type 1", b->stl);
 	bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
-		   "primitive type 1 zplane 0.0 limitForce on", roll);
+		   "mesh n_meshes 1 meshes cad limitForce on", roll);
+}
+
+/* The frame check's floor: a rectangle at z = 0, 2 mm inside the cell's
+ * sides, as an ASCII STL file of two facets in a fresh temporary file. */
+static int bed_floor_mesh(dem_bed *b)
+{
+	const dem_bed_spec *s = &b->spec;
+	double x0 = 0.002, x1 = s->cell_x - 0.002, y0 = 0.002, y1 = s->cell_y - 0.002;
+	/* LIGGGHTS reads a mesh by its name's extension */
+	snprintf(b->stl, sizeof b->stl, "/tmp/convsim-dem-floor-XXXXXX.stl");
+	int fd = mkstemps(b->stl, 4);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	if (!f) {
+		b->stl[0] = 0;
+		return -1;
+	}
+	fprintf(f, "solid floor\n");
+	const double tri[2][3][2] = {{{x0, y0}, {x1, y0}, {x1, y1}}, {{x0, y0}, {x1, y1}, {x0, y1}}};
+	for (int t = 0; t < 2; t++) {
+		fprintf(f, "facet normal 0 0 1\nouter loop\n");
+		for (int v = 0; v < 3; v++)
+			fprintf(f, "vertex %.17g %.17g 0\n", tri[t][v][0], tri[t][v][1]);
+		fprintf(f, "endloop\nendfacet\n");
+	}
+	fprintf(f, "endsolid floor\n");
+	return fclose(f) ? -1 : 0;
 }
 
 /* Grains on a lattice of pitch 1.05 d_max, jittered, diameters drawn
@@ -166,8 +204,10 @@ static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
 		double jx = 0.02 * pitch * (bed_random(&rng) - 0.5);
 		double jy = 0.02 * pitch * (bed_random(&rng) - 0.5);
 		double d = s->d_min + (s->d_max - s->d_min) * bed_random(&rng);
-		bed_cmd(b, "create_atoms 1 single %.17g %.17g %.17g units box",
-			(ix + 0.5) * pitch + jx, (iy + 0.5) * pitch + jy, (iz + 0.5) * pitch + 0.1 * s->d_max);
+		double x = s->wiggle_period > 0 ? 0.5 * s->cell_x : (ix + 0.5) * pitch + jx;
+		double y = s->wiggle_period > 0 ? 0.5 * s->cell_y : (iy + 0.5) * pitch + jy;
+		bed_cmd(b, "create_atoms 1 single %.17g %.17g %.17g units box", x, y,
+			(iz + 0.5) * pitch + 0.1 * s->d_max);
 		bed_cmd(b, "set atom %d diameter %.17g density %.17g", i + 1, d, s->density);
 	}
 }
@@ -221,7 +261,10 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	/* CONVSIM_DEM_LOG names a file for LIGGGHTS's own output (its error
 	 * messages among it): the one way to see why it ended the process */
 	const char *screen = getenv("CONVSIM_DEM_LOG");
-	char *args[] = {"liggghts", "-log", "none", "-screen", (char *)(screen ? screen : "none"), NULL};
+	/* the mesh reader writes to the screen unasked: /dev/null, not none */
+	if (!screen)
+		screen = s->wiggle_period > 0 ? "/dev/null" : "none";
+	char *args[] = {"liggghts", "-log", "none", "-screen", (char *)screen, NULL};
 	if (comm)
 		lammps_open(5, args, *(const MPI_Comm *)comm, &b->lmp);
 	else
@@ -233,11 +276,18 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	}
 	bed_cmd(b, "atom_style granular");
 	bed_cmd(b, "atom_modify map array");
-	bed_cmd(b, "boundary p p f");
+	if (s->wiggle_period > 0 && bed_floor_mesh(b)) {
+		snprintf(msg, msglen, "dem bed: the floor mesh's file could not be written");
+		dem_bed_free(b);
+		return NULL;
+	}
+	bed_cmd(b, "boundary %s", s->wiggle_period > 0 ? "f f f" : "p p f");
 	bed_cmd(b, "newton off");
 	bed_cmd(b, "communicate single vel yes");
 	bed_cmd(b, "units si");
-	bed_cmd(b, "region cell block 0 %.17g 0 %.17g 0 %.17g units box", s->cell_x, s->cell_y, z_top);
+	/* below the floor: room for the moving floor's mesh */
+	bed_cmd(b, "region cell block 0 %.17g 0 %.17g %.17g %.17g units box", s->cell_x, s->cell_y,
+		s->wiggle_period > 0 ? -0.02 : 0.0, z_top);
 	bed_cmd(b, "create_box 1 cell");
 	bed_cmd(b, "neighbor %.17g bin", 0.2 * s->d_max);
 	bed_cmd(b, "neigh_modify delay 0");
@@ -259,6 +309,12 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 		bed_cmd(b, "run %ld", (long)ceil(s->settle / b->dt));
 	else
 		bed_cmd(b, "run 0");
+	if (s->wiggle_period > 0) { /* the floor starts moving, the grain with it */
+		double w = 2 * M_PI / s->wiggle_period;
+		bed_cmd(b, "velocity all set %.17g 0 %.17g units box", w * s->wiggle_x, w * s->wiggle_z);
+		bed_cmd(b, "fix move all move/mesh mesh cad wiggle amplitude %.17g 0 %.17g period %.17g",
+			s->wiggle_x, s->wiggle_z, s->wiggle_period);
+	}
 	b->t = 0;
 	return b;
 }
@@ -269,6 +325,8 @@ void dem_bed_free(dem_bed *b)
 		return;
 	if (b->lmp)
 		lammps_close(b->lmp);
+	if (b->stl[0])
+		unlink(b->stl);
 	free(b);
 }
 

@@ -41,6 +41,12 @@ typedef struct dem_bed_spec {
 	unsigned seed;         /* packing: diameters and the lattice's jitter */
 	double g;              /* m/s^2 gravity */
 	double settle;         /* s of settling under gravity before t = 0 */
+	/* the frame check (one grain): wiggle_period > 0 replaces the fixed
+	 * floor plane by a floor mesh that LIGGGHTS moves in the lab frame,
+	 * (wiggle_x, wiggle_z) sin(2 pi t / wiggle_period) from t = 0 (the
+	 * grain then starts with the floor's velocity), the cell closed in x
+	 * and y; the bed's frame is then the lab's (advance with a = 0) */
+	double wiggle_x, wiggle_z, wiggle_period;
 } dem_bed_spec;
 
 /* The bed this project uses unless told otherwise: spheres 3.6-4.4 mm of

@@ -33,6 +33,7 @@ typedef struct dem_opts {
 	double restitution, mu; /* NaN: the model's R and mu */
 	int grains, seed, freeze_rotation, intervals, harmonics, column;
 	int motion_machine, coupling_steps; /* --motion machine: the one-way machine's own deck */
+	double frame_amp, frame_angle;      /* --frame-check: m, deg; amplitude 0: none */
 } dem_opts;
 
 static const struct option dem_long[] = {
@@ -47,6 +48,7 @@ static const struct option dem_long[] = {
 	{"intervals", required_argument, 0, 'i'},  {"harmonics", required_argument, 0, 'H'},
 	{"settle", required_argument, 0, 'w'},     {"no-column", no_argument, 0, 'C'},
 	{"motion", required_argument, 0, 'M'},     {"coupling-steps", required_argument, 0, 'c'},
+	{"frame-check", required_argument, 0, 'F'},
 	{"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
 
 static const char dem_usage[] =
@@ -75,7 +77,10 @@ static const char dem_usage[] =
 	"                           mean acceleration over every --coupling-steps machine steps, as\n"
 	"                           `convsim run --set feed_model=liggghts` couples it (v from t = 0\n"
 	"                           or --transient, least squares)\n"
-	"      --coupling-steps N   machine steps a coupling interval (1)\n";
+	"      --coupling-steps N   machine steps a coupling interval (1)\n"
+	"      --frame-check A:DEG  one grain on a floor moving A sin(omega_ss t) along DEG, as a\n"
+	"                           body force over the fixed floor and as LIGGGHTS's moving mesh\n"
+	"                           (v_body, v_mesh); no machine, no column model\n";
 
 /* A number in [lo, hi] or exit 2 with the option's name and range. */
 static double dem_number(const char *opt, const char *text, double lo, double hi)
@@ -149,6 +154,15 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 			o->motion_machine = !strcmp(optarg, "machine");
 			break;
 		case 'c': o->coupling_steps = (int)dem_number("coupling-steps", optarg, 1, 1000); break;
+		case 'F':
+			if (sscanf(optarg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
+			    !(o->frame_amp > 0) || !(o->frame_amp <= 0.01) || !(o->frame_angle >= 0) ||
+			    !(o->frame_angle <= 180)) {
+				fprintf(stderr, "convsim-dem: --frame-check must be A:DEG with A in (0, 0.01] m "
+						"and DEG in [0, 180], got '%s'\n", optarg);
+				exit(2);
+			}
+			break;
 		case 'h': fputs(dem_usage, stdout); exit(0);
 		default: fputs(dem_usage, stderr); exit(2);
 		}
@@ -216,11 +230,52 @@ static int run_machine_motion(const dem_opts *o, dem_bed *bed, dem_prescribed *r
 	return rc;
 }
 
+/* The frame check (--frame-check): v of one grain under the body force
+ * of a harmonic line motion over the fixed floor, and on LIGGGHTS's floor
+ * mesh moving so; prints both. 0, or 1 with the reason on stderr. */
+static int frame_check(const dem_opts *o)
+{
+	char msg[300];
+	double w = o->p.omega_ss, T = 2 * M_PI / w, a = o->frame_angle * M_PI / 180;
+	double v[2];
+	dem_motion line = {.omega = w, .harmonics = 1}, still = {.omega = w, .harmonics = 1};
+	line.a[2] = o->frame_amp * cos(a);
+	line.b[2] = o->frame_amp * sin(a);
+	for (int mesh = 0; mesh < 2; mesh++) {
+		dem_bed_spec spec;
+		dem_spec(o, &spec);
+		spec.grains = 1;
+		spec.freeze_rotation = 1;
+		spec.cell_x = 1.0; /* the closed cell of the mesh: room to travel */
+		if (mesh) {
+			spec.wiggle_x = line.a[2];
+			spec.wiggle_z = line.b[2];
+			spec.wiggle_period = T;
+		}
+		dem_prescribed r;
+		dem_bed *bed = dem_bed_new(&spec, NULL, msg, sizeof msg);
+		if (!bed || dem_run_prescribed(bed, mesh ? &still : &line, o->duration, o->transient,
+					       o->intervals, &r, msg, sizeof msg)) {
+			fprintf(stderr, "convsim-dem: %s\n", msg);
+			dem_bed_free(bed);
+			return 1;
+		}
+		dem_bed_free(bed);
+		v[mesh] = r.transport_velocity;
+	}
+	printf("{\n  \"amplitude\": %.17g,\n  \"angle\": %.17g,\n  \"omega\": %.17g,\n", o->frame_amp,
+	       o->frame_angle, w);
+	printf("  \"v_body\": %.17g,\n  \"v_mesh\": %.17g\n}\n", v[0], v[1]);
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
 	dem_opts o;
 	memset(&o, 0, sizeof o);
 	dem_parse(argc, argv, &o);
+	if (o.frame_amp > 0)
+		return frame_check(&o);
 	char msg[300];
 	dem_motion mo = {.omega = NAN, .residual = NAN, .amplitude = NAN};
 	int err = o.motion_machine ? SIM_OK
