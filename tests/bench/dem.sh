@@ -47,6 +47,7 @@ for seed in $seeds; do
 	run rolling --depth 8 --set layers=8 --set beta=30 --mu-roll 0.1 --seed $seed
 done
 run restitution --depth 8 --set layers=8 --set beta=30 --restitution 0.5 --set R=0.5 --seed 1
+python3 tests/bench/dem_plot.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" > "$out/dem.svg"
 python3 tests/bench/dem_report.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" \
 	"$(( $(date +%s) - start ))" > "$out/dem.md"
 cat "$out/dem.md"
