@@ -28,3 +28,13 @@ test('feed_model: listed, column by default, liggghts refused with 422 and nothi
   const ok = await req(d.base, 'POST', '/api/v1/sessions', { scene: { feed_model: 'column' }, pace: 1 });
   assert.equal(ok.status, 201);
 });
+
+test('status.feed_warning: the preset\'s 8 soft layers lie outside the domain checked against LIGGGHTS, 2 layers inside', { timeout: 20000 * SLOW }, async () => {
+  const a = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1 });
+  assert.equal(a.status, 201);
+  const sa = (await req(d.base, 'GET', `/api/v1/sessions/${a.body.id}`)).body.status;
+  assert.match(sa.feed_warning, /8 layers/);
+  const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 2 }, pace: 1 });
+  const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
+  assert.equal(sb.feed_warning, null);
+});
