@@ -212,6 +212,12 @@ static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
 	}
 }
 
+int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth)
+{
+	long n = lround(0.6 * cell_x * cell_y * depth * d_mean / (M_PI / 6 * d_mean * d_mean * d_mean));
+	return n < 1 ? 1 : n > 1000000 ? 1000000 : (int)n;
+}
+
 void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
 {
 	double d_mean = 0.004;
@@ -221,10 +227,7 @@ void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
 	b->density = 2500;
 	b->cell_x = 20 * d_mean;
 	b->cell_y = 4 * d_mean;
-	b->grains = (int)lround(0.6 * b->cell_x * b->cell_y * depth * d_mean /
-				(M_PI / 6 * d_mean * d_mean * d_mean));
-	if (b->grains < 1)
-		b->grains = 1;
+	b->grains = dem_bed_grains(b->cell_x, b->cell_y, d_mean, depth);
 	b->k_over_m = p->k_c / p->m_n;
 	b->restitution = p->R;
 	b->mu = p->mu;

@@ -55,6 +55,9 @@ typedef struct dem_bed_spec {
  * model's contact numbers: k_c/m_n, R, mu; no rolling friction; seed 1;
  * settled 0.3 s (0.05 s for one grain). */
 void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b);
+/* Grains of mean diameter d_mean (m) that fill a cell_x x cell_y cell
+ * (m) `depth` mean diameters deep at packing 0.6; at least 1. */
+int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth);
 
 typedef struct dem_bed dem_bed;
 

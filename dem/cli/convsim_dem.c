@@ -184,11 +184,7 @@ static void dem_spec(const dem_opts *o, dem_bed_spec *b)
 	b->d_max = o->d_max;
 	b->cell_x = o->cell_x * d_mean;
 	b->cell_y = o->cell_y * d_mean;
-	b->grains = o->grains > 0 ? o->grains
-				  : (int)lround(0.6 * b->cell_x * b->cell_y * o->depth * d_mean /
-						(M_PI / 6 * d_mean * d_mean * d_mean));
-	if (b->grains < 1)
-		b->grains = 1;
+	b->grains = o->grains > 0 ? o->grains : dem_bed_grains(b->cell_x, b->cell_y, d_mean, o->depth);
 	b->k_over_m *= o->stiffness;
 	if (!isnan(o->restitution))
 		b->restitution = o->restitution;
