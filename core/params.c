@@ -289,13 +289,13 @@ int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size
 	double k_over_m = p->k_c / p->m_n;
 	int fitted = p->k_c == LIGGGHTS_BED4_K_C && p->R == LIGGGHTS_BED4_R &&
 		     p->mu == LIGGGHTS_BED4_MU;
-	if (sc->layers <= 2 || (sc->layers <= 8 && k_over_m >= 2e8) || (fitted && sc->layers <= 4))
+	if (sc->layers <= 2 || (sc->layers <= 8 && k_over_m >= 2e7) || (fitted && sc->layers <= 4))
 		return 1;
 	if (why)
 		snprintf(why, len,
 			 "the column model with %d layers and k_c/m_n = %.3g 1/s^2 lies outside the "
 			 "domain checked against LIGGGHTS beds (at most 2 layers; at most 8 with "
-			 "k_c/m_n >= 2e8; beds of 4 and 8 diameters move 16 %% and 52 %% slower than "
+			 "k_c/m_n >= 2e7; beds of 4 and 8 diameters move 16 %% and 52 %% slower than "
 			 "the column model says with the preset's contacts): feed_model=liggghts "
 			 "couples a DEM bed (docs/dem.md)",
 			 sc->layers, k_over_m);

@@ -170,8 +170,8 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
  * reason and what to use instead written into why (len bytes); -1 where
  * the scene has no column feed (no feed, or feed_model liggghts). The
  * rule: at most 2 layers (within 5 % of the DEM bed of that depth); or at
- * most 8 layers with contacts 100x the preset's stiffness or stiffer,
- * k_c / m_n >= 2e8 s^-2 (within 10-11 %); or the preset liggghts-bed4's
+ * most 8 layers with contacts 10x the preset's stiffness or stiffer,
+ * k_c / m_n >= 2e7 s^-2 (within 6-8 %); or the preset liggghts-bed4's
  * contact fitted to a 4-diameter bed, at most 4 layers. */
 int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len);
 

@@ -2,7 +2,7 @@
 """The table of `make bench-dem` (tests/bench/dem.sh) from its JSON lines:
 one row per scene (seeds pooled: mean and sample standard deviation), the
 column model's relative error against the DEM, and the rows where it is
-within 5, 10 and 30 %. Usage: dem_report.py FILE.jsonl COMMAND DATE SECONDS."""
+within 5, 10 and 30 %. Usage: dem_report.py FILE.jsonl COMMAND DATE SECONDS [NOTE]."""
 import json
 import math
 import statistics
@@ -16,13 +16,14 @@ def scene_key(r):
 
 def main():
     path, command, date, seconds = sys.argv[1:5]
+    note = sys.argv[5] if len(sys.argv) > 5 else ""
     rows = [json.loads(line) for line in open(path) if line.strip()]
     scenes = {}
     for r in rows:
         scenes.setdefault(scene_key(r), []).append(r)
     out = []
-    out.append(f"`{command}`, {date}, {seconds} s wall on one core (nice 15), "
-               f"{sum(r['dem_cpu_seconds'] for r in rows):.0f} s of DEM CPU in all.")
+    out.append(f"`{command}`, {date}, {seconds} s wall on one core (nice 15){note}, "
+               f"{sum(r['dem_cpu_seconds'] for r in rows):.0f} s of DEM CPU in all the rows.")
     out.append("")
     out.append("| group | β (°) | sense | depth (d) | grains | k/m (1/s²) | μ_roll | e | seeds | "
                "v DEM (m/s) | v column (m/s) | column − DEM | DEM CPU s per s |")
