@@ -3,7 +3,8 @@
 # the tests and the benchmarks. `make` builds, `make run` starts the daemon,
 # `make test` runs every test, `make check` runs them under ASan+UBSan,
 # `make deps` installs what is missing, `make install` installs,
-# `make bench` writes the work-precision tables, `make fuzz` runs the
+# `make bench` writes the work-precision tables, `make bench-dem` the feed
+# against LIGGGHTS (docs/dem.md), `make fuzz` runs the
 # libFuzzer harnesses, `make load` runs a bounded load test. V=1 shows the commands.
 
 CC      ?= cc
@@ -27,8 +28,10 @@ else
 Q := @
 endif
 
+# LIGGGHTS installed: the DEM coupling (dem/, below) is built
+HAVE_LIGGGHTS := $(wildcard /usr/include/liggghts/library.h)
 CORE_SRC   := $(wildcard core/*.c)
-CLI_SRC    := $(wildcard core/cli/*.c)
+CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),core/cli/coupled_none.c),$(wildcard core/cli/*.c))
 FIT_SRC    := $(wildcard core/fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 SERVER_SRC := $(wildcard server/*.c)
@@ -40,6 +43,22 @@ FIT_OBJ    := $(FIT_SRC:%.c=$(BUILD)/%.o)
 API_OBJ    := $(API_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+
+# The DEM coupling (dem/: LIGGGHTS and MPI, which core/ never sees) is
+# built only where LIGGGHTS is installed; `make test` and `make bench-dem`
+# install it first (DEB_DEM) and then build it in a second make, which
+# sees the new header.
+DEM_SRC     := $(wildcard dem/*.c)
+DEM_CLI_SRC := dem/cli/convsim_dem.c
+DEM_OBJ     := $(DEM_SRC:%.c=$(BUILD)/%.o)
+DEM_CLI_OBJ := $(DEM_CLI_SRC:%.c=$(BUILD)/%.o)
+DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem)
+# convsim's `run --set feed_model=liggghts`: the coupled runner and its
+# libraries where LIGGGHTS is installed, else a stub that says how to get it
+CLI_DEM_OBJ := $(if $(HAVE_LIGGGHTS),$(BUILD)/dem/cli/run_coupled.o $(BUILD)/libdem.a)
+CLI_DEM_LIBS = $(if $(HAVE_LIGGGHTS),-lliggghts $(MPI_LIBS))
+MPI_CFLAGS  := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --cflags ompi-c))
+MPI_LIBS    := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --libs ompi-c))
 
 # Debian packages the project needs, by the file each provides: to build
 # and run (`make`, `make run`), and in addition to test (`make test`,
@@ -60,15 +79,22 @@ DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev \
              /usr/include/gsl/gsl_odeiv2.h:libgsl-dev
+# and in addition for the DEM coupling (dem/, `make test`, `make bench-dem`):
+# LIGGGHTS's C library, whose header includes <mpi.h>, and mpirun.
+DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
+             /usr/bin/liggghts:liggghts \
+             /usr/lib/x86_64-linux-gnu/pkgconfig/ompi-c.pc:libopenmpi-dev \
+             /usr/bin/mpirun:openmpi-bin \
+             /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
-all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN)
+.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
+all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
 # run as root or have sudo) and the npm test tools (tests/node_modules, no
 # root). Says what it installs and why; idempotent. deps-build is the part
 # that building and running need.
-deps: deps-build $(BUILD)/.deps
+deps: deps-build $(BUILD)/.deps $(BUILD)/.deps-dem
 deps-build: $(BUILD)/.deps-build
 $(BUILD)/.deps-build: Makefile
 	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
@@ -79,6 +105,9 @@ $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps-dem: Makefile
+	$(Q)NEEDS="$(DEB_DEM)" WHY="to cross-check and couple the feed with the LIGGGHTS DEM code (dem/)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps-bench: Makefile
 	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (GSL, SUNDIALS)" sh tests/apt-deps.sh
@@ -93,6 +122,7 @@ INC_core   := -Icore
 INC_api    := -Icore -Icore/fit -Iapi
 INC_server := -Icore -Icore/fit -Iapi -Iserver
 INC_tests  := -Icore -Icore/fit
+INC_dem    := -Icore -Icore/cli -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 $(CLI_OBJ): INC_EXTRA := -Icore/fit
 
 $(BUILD)/%.o: %.c
@@ -120,9 +150,19 @@ $(BUILD)/libapi.a: $(API_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
+$(BUILD)/libdem.a: $(DEM_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
+
+$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
+
+dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim
+
+$(BUILD)/convsim: $(CLI_OBJ) $(CLI_DEM_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(LDLIBS)
 
 $(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
@@ -162,6 +202,7 @@ cluster: deps-build $(BUILD)/convsimd
 	$(Q)N=$(N) CONVSIMD=$(BUILD)/convsimd bash server/cluster.sh run
 
 test: deps all
+	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
 
 check:
@@ -221,6 +262,15 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
 
+# The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
+# process at a time, niced, into tests/bench/results/dem.md; then the
+# coupled scene's cost against grains and ranks (tests/bench/dem_cost.sh,
+# dem_cost.md).
+bench-dem: all $(BUILD)/.deps-dem
+	$(Q)$(MAKE) --no-print-directory dem-build
+	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
+	$(Q)BUILD=$(BUILD) bash tests/bench/dem_cost.sh
+
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.
 bench-peers: all $(BUILD)/.deps-bench
@@ -258,4 +308,5 @@ uninstall:
 clean:
 	rm -rf build build-san build-fuzz
 
+-include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d) $(BUILD)/dem/cli/run_coupled.d
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)

@@ -233,6 +233,13 @@ static cJSON *status_object(const api_view *v)
 		api_add_number(f, "error", r->v_error);
 		cJSON_AddItemToArray(fig, f);
 	}
+	/* the column model outside the domain checked against LIGGGHTS beds
+	 * (docs/dem.md), a property of the scene */
+	char why[400];
+	if (sim_feed_validated(&v->spec->params, &v->spec->scene, why, sizeof why) == 0)
+		cJSON_AddStringToObject(o, "feed_warning", why);
+	else
+		cJSON_AddNullToObject(o, "feed_warning");
 	cJSON *en = cJSON_AddObjectToObject(o, "energy");
 	api_add_number(en, "input", st->e_input);
 	api_add_number(en, "kinetic", st->e_kinetic);

@@ -330,6 +330,17 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
 api_err api_validate_spec(api_spec *spec, api_problem *pb)
 {
 	char msg[256] = "";
+	/* the LIGGGHTS bed couples in the CLI built with it (dem/), not in
+	 * the daemon: refused here rather than run as a dead weight */
+	if (spec->scene.feed_model != SIM_FEED_COLUMN) {
+		api_fail(pb, API_RANGE, "scene.feed_model",
+			 "scene.feed_model must be column in the daemon; liggghts runs in `convsim run` "
+			 "built with LIGGGHTS (docs/dem.md)");
+		pb->has_range = 1;
+		pb->min = 0.0;
+		pb->max = 0.0;
+		return pb->code;
+	}
 	int rc = sim_validate(&spec->params, &spec->scene, &spec->method, msg,
 			      sizeof msg);
 	if (rc == SIM_OK)

@@ -400,6 +400,23 @@ static void observe(const config *cf, const double qdd[NQ_FULL], const drive_ter
 	ev->R = cf->R;
 }
 
+/* Stage deck load: an external feed's force at the centre deck point D =
+ * G + R(alpha) (0, h_d) and its moment, J_D^T F + moment on alpha, into
+ * rhs; returns its power F . v_D + moment alpha'. Nothing (and no
+ * arithmetic) without a load, or under one-way coupling. */
+static double deck_load(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FULL])
+{
+	const double *L = ctl->deck_load;
+	if (!md->sc.feed_coupling || (L[0] == 0.0 && L[1] == 0.0 && L[2] == 0.0))
+		return 0.0;
+	const double rx = -cf->R.s * md->p.h_d, ry = cf->R.c * md->p.h_d;
+	const double ad = cf->qd[Q_ALPHA];
+	rhs[Q_X] += L[0];
+	rhs[Q_Y] += L[1];
+	rhs[Q_ALPHA] += rx * L[1] - ry * L[0] + L[2];
+	return L[0] * (cf->qd[Q_X] - ad * ry) + L[1] * (cf->qd[Q_Y] + ad * rx) + L[2] * ad;
+}
+
 void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
 		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev)
 {
@@ -413,6 +430,7 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 		configure(md, ctl, t, y, &cf);
 		mass_matrix_and_bias(md, &cf, Qfeed, M, rhs);
 	}
+	double load_power = deck_load(md, ctl, &cf, rhs);
 	suspension(md, ctl, t, &cf, rhs, &damp_power);
 	eliminators(&md->p, &cf, rhs, &damp_power);
 	drive(md, ctl, &cf, rhs, &damp_power, &dt);
@@ -421,7 +439,7 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 		dy[r] = y[md->npos + r];
 		dy[md->npos + r] = br[r];
 	}
-	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd);
+	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd) + load_power;
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
 	if (ev)
 		observe(&cf, qdd, &dt, ev);

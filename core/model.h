@@ -94,6 +94,10 @@ typedef struct model_ctl {
 	 * carries settle_b (0 or 1) times model.settle_damping more damping,
 	 * faded out to none over [settle_t0, 0] */
 	double settle_b, settle_t0;
+	/* an external feed's load on the deck (sim_set_deck_load): fx, fy (N)
+	 * at the centre deck point, moment (N m) about it; zero for the
+	 * column model */
+	double deck_load[3];
 } model_ctl;
 
 /* Everything an evaluation yields besides dy. */

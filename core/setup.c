@@ -105,7 +105,11 @@ void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene 
 	ctl->drive_on = sc->motor_on;
 	ctl->beta_rate = p->beta_rate;
 
-	int feed = sc->feed && sc->columns > 0 && sc->layers > 0;
+	int feed = sc->feed && sc->columns > 0 && sc->layers > 0 && sc->feed_model == SIM_FEED_COLUMN;
+	/* an external feed: no feed coordinates; its weight on the deck until
+	 * the caller sets its load (sim_set_deck_load) */
+	if (sc->feed && sc->feed_model == SIM_FEED_EXTERNAL && sc->feed_coupling)
+		ctl->deck_load[1] = -(double)sc->columns * (double)sc->layers * p->m_n * p->g;
 	int sym = !sc->trough_rotation && model_machine_symmetric(p);
 	int ideal = sc->drive == SIM_DRIVE_IDEAL;
 	if (!feed)

@@ -375,6 +375,20 @@ int sim_set_drive_on(sim *s, int on)
 	return SIM_OK;
 }
 
+int sim_set_deck_load(sim *s, double fx, double fy, double moment)
+{
+	if (s->md.sc.feed_model != SIM_FEED_EXTERNAL || !isfinite(fx) || !isfinite(fy) ||
+	    !isfinite(moment))
+		return SIM_EPARAM;
+	s->ctl.deck_load[0] = fx;
+	s->ctl.deck_load[1] = fy;
+	s->ctl.deck_load[2] = moment;
+	/* the integrator's cached derivatives held the old load */
+	s->ode->reset(s->ws);
+	sim_update_status(s);
+	return SIM_OK;
+}
+
 void sim_restart_transport(sim *s)
 {
 	estimator_restart(&s->est, s->t_int);

@@ -61,6 +61,13 @@ enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
  * the machine on its periodic forced response at the loaded motor speed
  * with the feed settled on the moving deck. */
 enum { SIM_START_REST = 0, SIM_START_STEADY = 1 };
+/* What carries the feed (scene setting `feed_model`): the paper's columns
+ * of layers, integrated by the core; or a bed outside the core (the
+ * setting's choice `liggghts`: dem/ couples a LIGGGHTS bed), which the
+ * core sees only as a load on the deck that its caller sets each step
+ * (sim_set_deck_load): no feed coordinates, the feed's weight on the deck
+ * at the start. */
+enum { SIM_FEED_COLUMN = 0, SIM_FEED_EXTERNAL = 1 };
 
 /* Physical parameters, docs/MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
@@ -119,6 +126,9 @@ typedef struct sim_scene {
 	int motor_on;         /* drive on at t = 0 */
 	double transient;     /* s: transport velocity ignores t < transient */
 	int start;            /* SIM_START_REST or SIM_START_STEADY */
+	int feed_model;       /* SIM_FEED_COLUMN or SIM_FEED_EXTERNAL (in start's
+				 padding: the struct's size and the offsets after
+				 it stay, and a zeroed old record reads column) */
 	double settle;        /* s: `steady` start's settling before t = 0 */
 } sim_scene;
 
@@ -157,6 +167,17 @@ const sim_setting *sim_settings(size_t *n);
 
 /* The czubak2016 preset (docs/MODEL.md), default scene and default method. */
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
+
+/* Whether the column model of a scene lies inside the domain where it was
+ * checked against LIGGGHTS beds (docs/dem.md, `make bench-dem`: the
+ * czubak2016 machine at beta = 30 deg): 1 inside; 0 outside, with the
+ * reason and what to use instead written into why (len bytes); -1 where
+ * the scene has no column feed (no feed, or feed_model liggghts). The
+ * rule: at most 2 layers (within 5 % of the DEM bed of that depth); or at
+ * most 8 layers with contacts 10x the preset's stiffness or stiffer,
+ * k_c / m_n >= 2e7 s^-2 (within 6-8 %); or the preset liggghts-bed4's
+ * contact fitted to a 4-diameter bed, at most 4 layers. */
+int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len);
 
 /* Names of known presets, NULL-terminated, static. Fill by name. */
 extern const char *const sim_preset_names[];
@@ -292,6 +313,16 @@ int sim_set_rotation(sim *s, int rotation);
 int sim_set_omega_ss(sim *s, double omega_ss);
 /* Switch the drive on (on != 0) or off; always SIM_OK. */
 int sim_set_drive_on(sim *s, int on);
+/* An external feed's load on the deck (feed_model = SIM_FEED_EXTERNAL):
+ * force (fx, fy) in N, global axes, at the centre deck point (body point
+ * (0, h_d)) and moment (N m, counter-clockwise) about it, held constant
+ * from sim_effective_time() until the next call. Its work enters the
+ * status's e_input (input = drive work + the load's work), so the energy
+ * balance closes. At sim_new the load is the feed's weight, -K L m_n g
+ * vertically; under feed_coupling = false the load is not applied.
+ * SIM_EPARAM (nothing changed) for a non-finite value or a scene whose
+ * feed_model is not external. */
+int sim_set_deck_load(sim *s, double fx, double fy, double moment);
 
 /* Place the feed at the observed time (which must equal the integrator's:
  * true after sim_new, and wherever a step ended exactly there): xi, eta,

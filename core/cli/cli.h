@@ -22,7 +22,7 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
-	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
@@ -40,6 +40,7 @@ typedef struct cli_opts {
 	const char *preset, *out, *format, *beta, *rotation;
 	double duration, rate;
 	int threads, quiet;
+	int coupling_steps; /* feed_model liggghts: machine steps per coupling interval */
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
@@ -69,6 +70,11 @@ int cli_cmd_sweep(int argc, char **argv);
 void cli_put_num(FILE *f, double v, const char *nonfinite);
 int cli_wants_json(const char *format, const char *file);
 FILE *cli_open_out(const cli_opts *o);
+
+/* convsim run with feed_model = liggghts: the machine coupled to a
+ * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else
+ * core/cli/coupled_none.c, which says how to get it). Exit status as run. */
+int cli_run_coupled(const cli_opts *o);
 
 typedef struct cli_opt {
 	unsigned cmds;    /* CMD_* bits: the commands that take it */

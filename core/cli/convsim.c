@@ -117,6 +117,13 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 			first = 0;
 		}
 	fputc(']', f);
+	/* the column model outside the domain checked against a DEM bed */
+	char why[400];
+	fputs(",\n  \"feed_warning\": ", f);
+	if (sim_feed_validated(&o->p, &o->sc, why, sizeof why) == 0)
+		fprintf(f, "\"%s\"", why);
+	else
+		fputs("null", f);
 	NUM("transport_velocity", st->transport_velocity);
 	NUM("transport_velocity_uncertainty", st->transport_velocity_uncertainty);
 	fprintf(f, ",\n  \"steady\": %s", st->steady ? "true" : "false");
@@ -159,6 +166,8 @@ static int cmd_run(int argc, char **argv)
 	int rc = cli_parse(argc, argv, CMD_RUN, &o);
 	if (rc)
 		return rc < 0 ? 0 : rc;
+	if (o.sc.feed_model == SIM_FEED_EXTERNAL)
+		return cli_run_coupled(&o);
 	char msg[200];
 	int err;
 	double w0 = cli_now(), c0 = cpu_now(); /* the steady start's settling included */

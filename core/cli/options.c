@@ -43,6 +43,8 @@ static const cli_opt options[] = {
 	 "guide angle in [0, 180]; the same as --set beta=DEG"},
 	{CMD_RUN, OPT_ROTATION, "rotation", 0, "cw|ccw", NULL, "the preset's (cw)",
 	 "cw (the paper's clockwise, rotor speed > 0) or ccw; the same as --set rotation=..."},
+	{CMD_RUN, OPT_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
+	 "feed_model=liggghts: machine steps per coupling interval with the bed (docs/dem.md)"},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
 	 "guide angles in [0, 180], or one angle"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",

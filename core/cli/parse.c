@@ -111,6 +111,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 	o->duration = NAN;
 	o->rate = 1000.0;
 	o->threads = 2;
+	o->coupling_steps = 1;
 	o->rotation = "cw,ccw";
 	o->beta = "0:180:10";
 	o->curve_step = 5;
@@ -151,6 +152,9 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 			bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
 			break;
 		case OPT_THREADS: bad = whole(o->cmd, "threads", arg, 64, &o->threads); break;
+		case OPT_COUPLING_STEPS:
+			bad = whole(o->cmd, "coupling-steps", arg, 1000, &o->coupling_steps);
+			break;
 		case OPT_OUT: o->out = arg; break;
 		case OPT_FORMAT: o->format = arg; break;
 		case OPT_BETA:

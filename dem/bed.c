@@ -1,0 +1,373 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * bed.c - a bed of spheres in LIGGGHTS on the deck (dem.h): the input
+ * deck of commands that builds it, the settling, the advance over one
+ * coupling interval under the deck's acceleration, and the bed's totals
+ * read back through equal-style variables.
+ *
+ * LIGGGHTS's fix gravity takes no variables, so the deck's acceleration
+ * enters as a new gravity fix at each interval ("unfix", "fix", then a run
+ * with its set-up), which LIGGGHTS evaluates once per run. LIGGGHTS ends
+ * the process on a command it refuses, so every value is checked here
+ * before it is sent.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <library.h>
+
+#include "dem.h"
+
+struct dem_bed {
+	void *lmp;
+	dem_bed_spec spec;
+	char stl[64];   /* the moving floor's mesh file (frame check), "" for none */
+	double dt;      /* s DEM step */
+	double t;       /* s since the end of the settling */
+	double m_mean;  /* kg of the mean grain */
+};
+
+/* One LIGGGHTS command, printf-style. */
+static void bed_cmd(dem_bed *b, const char *fmt, ...)
+{
+	char line[512];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof line, fmt, ap);
+	va_end(ap);
+	lammps_command(b->lmp, line);
+}
+
+/* An equal-style variable's value (LIGGGHTS returns a malloc'd copy). */
+static double bed_var(const dem_bed *b, const char *name)
+{
+	double *v = lammps_extract_variable(b->lmp, (char *)name, NULL);
+	double out = v ? *v : NAN;
+	free(v);
+	return out;
+}
+
+double dem_cpu_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* xorshift64*: the packing's reproducible random numbers in [0, 1). */
+static double bed_random(unsigned long long *s)
+{
+	*s ^= *s >> 12;
+	*s ^= *s << 25;
+	*s ^= *s >> 27;
+	return (double)((*s * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
+}
+
+/* Restitution of the linear contact with damping ratio zeta, the force
+ * never attractive: x'' = -max(0, x + 2 zeta x') from x = 0, x' = 1 until
+ * x < 0 again (time in units of 1/omega), RK4. */
+double dem_restitution(double zeta)
+{
+	double x = 0, v = 1, h = 1e-4;
+	for (int i = 0; i < 400000; i++) {
+		double k1x = v, k1v = -fmax(0, x + 2 * zeta * v);
+		double x2 = x + 0.5 * h * k1x, v2 = v + 0.5 * h * k1v;
+		double k2x = v2, k2v = -fmax(0, x2 + 2 * zeta * v2);
+		double x3 = x + 0.5 * h * k2x, v3 = v + 0.5 * h * k2v;
+		double k3x = v3, k3v = -fmax(0, x3 + 2 * zeta * v3);
+		double x4 = x + h * k3x, v4 = v + h * k3v;
+		double k4x = v4, k4v = -fmax(0, x4 + 2 * zeta * v4);
+		double xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+		double vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+		if (xn < 0) /* interpolate the exit speed linearly */
+			return -(v + (vn - v) * x / (x - xn));
+		x = xn;
+		v = vn;
+	}
+	return 0; /* overdamped: the grain never leaves by itself */
+}
+
+double dem_restitution_damping(double e)
+{
+	double lo = 0, hi = 1;
+	if (e >= 1)
+		return 0;
+	for (int i = 0; i < 50; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (dem_restitution(mid) > e)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return 0.5 * (lo + hi);
+}
+
+static int spec_check(const dem_bed_spec *s, char *msg, size_t msglen)
+{
+	const char *bad = NULL;
+	if (s->grains < 1 || s->grains > 1000000)
+		bad = "grains must be in [1, 1e6]";
+	else if (!(s->d_min > 0) || !(s->d_max >= s->d_min) || !(s->d_max < 1))
+		bad = "diameters must satisfy 0 < d_min <= d_max < 1 m";
+	else if (!(s->density > 0) || !isfinite(s->density))
+		bad = "density must be > 0";
+	else if (!(s->cell_x >= 2 * s->d_max) || !(s->cell_y >= 2 * s->d_max) ||
+		 !isfinite(s->cell_x) || !isfinite(s->cell_y))
+		bad = "the cell must be at least 2 d_max wide in x and y";
+	else if (!(s->k_over_m > 0) || !isfinite(s->k_over_m))
+		bad = "k_over_m must be > 0";
+	else if (!(s->restitution > 0) || !(s->restitution <= 1))
+		bad = "restitution must be in (0, 1]";
+	else if (!(s->mu >= 0) || !(s->mu <= 10) || !(s->mu_roll >= 0) || !(s->mu_roll <= 10))
+		bad = "mu and mu_roll must be in [0, 10]";
+	else if (!(s->g >= 0) || !(s->g <= 100) || !(s->settle >= 0) || !(s->settle <= 100))
+		bad = "g must be in [0, 100] m/s^2 and settle in [0, 100] s";
+	else if (!(s->wiggle_period >= 0) || !isfinite(s->wiggle_x) || !isfinite(s->wiggle_z) ||
+		 (s->wiggle_period > 0 &&
+		  (s->grains != 1 || fabs(s->wiggle_x) > 0.01 || fabs(s->wiggle_z) > 0.01)))
+		bad = "the moving floor takes one grain and amplitudes of at most 0.01 m";
+	if (bad)
+		snprintf(msg, msglen, "dem bed: %s", bad);
+	return bad ? -1 : 0;
+}
+
+/* The contact law and the floor (dem.h's spec). */
+static void bed_contacts(dem_bed *b)
+{
+	const dem_bed_spec *s = &b->spec;
+	double kn = s->k_over_m * b->m_mean;
+	double zeta = dem_restitution_damping(s->restitution);
+	/* hooke/stiffness multiplies gamma by the contact's effective mass:
+	 * 2 zeta omega for the mean grain on the floor */
+	double gamman = 2 * zeta * sqrt(s->k_over_m);
+	const char *roll = s->mu_roll > 0 ? " rolling_friction cdt" : "";
+	bed_cmd(b, "fix m1 all property/global kn peratomtypepair 1 %.17g", kn);
+	bed_cmd(b, "fix m2 all property/global kt peratomtypepair 1 %.17g", kn * 2.0 / 7.0);
+	bed_cmd(b, "fix m3 all property/global gamman peratomtypepair 1 %.17g", gamman);
+	bed_cmd(b, "fix m4 all property/global gammat peratomtypepair 1 %.17g", gamman);
+	bed_cmd(b, "fix m5 all property/global coefficientFriction peratomtypepair 1 %.17g", s->mu);
+	if (s->mu_roll > 0)
+		bed_cmd(b, "fix m6 all property/global coefficientRollingFriction peratomtypepair 1 %.17g",
+			s->mu_roll);
+	bed_cmd(b, "pair_style gran model hooke/stiffness tangential history%s limitForce on", roll);
+	bed_cmd(b, "pair_coeff * *");
+	if (!b->stl[0]) {
+		bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
+			   "primitive type 1 zplane 0.0 limitForce on", roll);
+		return;
+	}
+	bed_cmd(b, "fix cad all mesh/surface file %s type 1", b->stl);
+	bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
+		   "mesh n_meshes 1 meshes cad limitForce on", roll);
+}
+
+/* The frame check's floor: a rectangle at z = 0, 2 mm inside the cell's
+ * sides, as an ASCII STL file of two facets in a fresh temporary file. */
+static int bed_floor_mesh(dem_bed *b)
+{
+	const dem_bed_spec *s = &b->spec;
+	double x0 = 0.002, x1 = s->cell_x - 0.002, y0 = 0.002, y1 = s->cell_y - 0.002;
+	/* LIGGGHTS reads a mesh by its name's extension */
+	snprintf(b->stl, sizeof b->stl, "/tmp/convsim-dem-floor-XXXXXX.stl");
+	int fd = mkstemps(b->stl, 4);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	if (!f) {
+		b->stl[0] = 0;
+		return -1;
+	}
+	fprintf(f, "solid floor\n");
+	const double tri[2][3][2] = {{{x0, y0}, {x1, y0}, {x1, y1}}, {{x0, y0}, {x1, y1}, {x0, y1}}};
+	for (int t = 0; t < 2; t++) {
+		fprintf(f, "facet normal 0 0 1\nouter loop\n");
+		for (int v = 0; v < 3; v++)
+			fprintf(f, "vertex %.17g %.17g 0\n", tri[t][v][0], tri[t][v][1]);
+		fprintf(f, "endloop\nendfacet\n");
+	}
+	fprintf(f, "endsolid floor\n");
+	return fclose(f) ? -1 : 0;
+}
+
+/* Grains on a lattice of pitch 1.05 d_max, jittered, diameters drawn
+ * uniformly: both from the seed. */
+static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
+{
+	const dem_bed_spec *s = &b->spec;
+	unsigned long long rng = 0x9E3779B97F4A7C15ULL ^ ((unsigned long long)s->seed * 0x100000001B3ULL);
+	for (int i = 0; i < 4; i++)
+		bed_random(&rng);
+	for (int i = 0; i < s->grains; i++) {
+		int ix = i % nx, iy = (i / nx) % ny, iz = i / (nx * ny);
+		double jx = 0.02 * pitch * (bed_random(&rng) - 0.5);
+		double jy = 0.02 * pitch * (bed_random(&rng) - 0.5);
+		double d = s->d_min + (s->d_max - s->d_min) * bed_random(&rng);
+		double x = s->wiggle_period > 0 ? 0.5 * s->cell_x : (ix + 0.5) * pitch + jx;
+		double y = s->wiggle_period > 0 ? 0.5 * s->cell_y : (iy + 0.5) * pitch + jy;
+		bed_cmd(b, "create_atoms 1 single %.17g %.17g %.17g units box", x, y,
+			(iz + 0.5) * pitch + 0.1 * s->d_max);
+		bed_cmd(b, "set atom %d diameter %.17g density %.17g", i + 1, d, s->density);
+	}
+}
+
+int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth)
+{
+	long n = lround(0.6 * cell_x * cell_y * depth * d_mean / (M_PI / 6 * d_mean * d_mean * d_mean));
+	return n < 1 ? 1 : n > 1000000 ? 1000000 : (int)n;
+}
+
+void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
+{
+	double d_mean = 0.004;
+	memset(b, 0, sizeof *b);
+	b->d_min = 0.0036;
+	b->d_max = 0.0044;
+	b->density = 2500;
+	b->cell_x = 20 * d_mean;
+	b->cell_y = 4 * d_mean;
+	b->grains = dem_bed_grains(b->cell_x, b->cell_y, d_mean, depth);
+	b->k_over_m = p->k_c / p->m_n;
+	b->restitution = p->R;
+	b->mu = p->mu;
+	b->g = p->g;
+	b->seed = 1;
+	b->settle = b->grains == 1 ? 0.05 : 0.3;
+}
+
+dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size_t msglen)
+{
+	if (spec_check(spec, msg, msglen))
+		return NULL;
+	dem_bed *b = calloc(1, sizeof *b);
+	if (!b) {
+		snprintf(msg, msglen, "dem bed: out of memory");
+		return NULL;
+	}
+	b->spec = *spec;
+	const dem_bed_spec *s = &b->spec;
+	double pitch = 1.05 * s->d_max;
+	int nx = (int)floor(s->cell_x / pitch), ny = (int)floor(s->cell_y / pitch);
+	int nz = (s->grains + nx * ny - 1) / (nx * ny);
+	double d_mean = 0.5 * (s->d_min + s->d_max);
+	/* the mean of d^3 over the uniform distribution of d */
+	double d3 = (pow(s->d_max, 4) - pow(s->d_min, 4)) / (4 * fmax(s->d_max - s->d_min, 1e-300));
+	if (s->d_max - s->d_min < 1e-12 * d_mean)
+		d3 = d_mean * d_mean * d_mean;
+	b->m_mean = s->density * M_PI / 6 * d3;
+	double m_min = s->density * M_PI / 6 * pow(s->d_min, 3);
+	double kn = s->k_over_m * b->m_mean;
+	b->dt = M_PI / sqrt(kn / m_min) / 50;
+	double z_top = 4 * nz * pitch + 20 * s->d_max;
+
+	/* CONVSIM_DEM_LOG names a file for LIGGGHTS's own output (its error
+	 * messages among it): the one way to see why it ended the process */
+	const char *screen = getenv("CONVSIM_DEM_LOG");
+	/* the mesh reader writes to the screen unasked: /dev/null, not none */
+	if (!screen)
+		screen = s->wiggle_period > 0 ? "/dev/null" : "none";
+	char *args[] = {"liggghts", "-log", "none", "-screen", (char *)screen, NULL};
+	if (comm)
+		lammps_open(5, args, *(const MPI_Comm *)comm, &b->lmp);
+	else
+		lammps_open_no_mpi(5, args, &b->lmp);
+	if (!b->lmp) {
+		snprintf(msg, msglen, "dem bed: LIGGGHTS did not open");
+		free(b);
+		return NULL;
+	}
+	bed_cmd(b, "atom_style granular");
+	bed_cmd(b, "atom_modify map array");
+	if (s->wiggle_period > 0 && bed_floor_mesh(b)) {
+		snprintf(msg, msglen, "dem bed: the floor mesh's file could not be written");
+		dem_bed_free(b);
+		return NULL;
+	}
+	bed_cmd(b, "boundary %s", s->wiggle_period > 0 ? "f f f" : "p p f");
+	bed_cmd(b, "newton off");
+	bed_cmd(b, "communicate single vel yes");
+	bed_cmd(b, "units si");
+	/* below the floor: room for the moving floor's mesh */
+	bed_cmd(b, "region cell block 0 %.17g 0 %.17g %.17g %.17g units box", s->cell_x, s->cell_y,
+		s->wiggle_period > 0 ? -0.02 : 0.0, z_top);
+	bed_cmd(b, "create_box 1 cell");
+	bed_cmd(b, "neighbor %.17g bin", 0.2 * s->d_max);
+	bed_cmd(b, "neigh_modify delay 0");
+	bed_contacts(b);
+	bed_cmd(b, "timestep %.17g", b->dt);
+	bed_grains(b, pitch, nx, ny);
+	bed_cmd(b, "fix deck all gravity %.17g vector 0 0 -1", s->g);
+	bed_cmd(b, "fix step all %s", s->freeze_rotation ? "nve" : "nve/sphere");
+	bed_cmd(b, "compute ke all ke update_on_run_end yes");
+	bed_cmd(b, "variable m equal mass(all)");
+	bed_cmd(b, "variable xm equal xcm(all,x)");
+	bed_cmd(b, "variable zm equal xcm(all,z)");
+	bed_cmd(b, "variable px equal mass(all)*vcm(all,x)");
+	bed_cmd(b, "variable pz equal mass(all)*vcm(all,z)");
+	bed_cmd(b, "variable ke equal c_ke");
+	bed_cmd(b, "compute rke all erotate/sphere update_on_run_end yes");
+	bed_cmd(b, "variable rke equal c_rke");
+	if (s->settle > 0)
+		bed_cmd(b, "run %ld", (long)ceil(s->settle / b->dt));
+	else
+		bed_cmd(b, "run 0");
+	if (s->wiggle_period > 0) { /* the floor starts moving, the grain with it */
+		double w = 2 * M_PI / s->wiggle_period;
+		bed_cmd(b, "velocity all set %.17g 0 %.17g units box", w * s->wiggle_x, w * s->wiggle_z);
+		bed_cmd(b, "fix move all move/mesh mesh cad wiggle amplitude %.17g 0 %.17g period %.17g",
+			s->wiggle_x, s->wiggle_z, s->wiggle_period);
+	}
+	b->t = 0;
+	return b;
+}
+
+void dem_bed_free(dem_bed *b)
+{
+	if (!b)
+		return;
+	if (b->lmp)
+		lammps_close(b->lmp);
+	if (b->stl[0])
+		unlink(b->stl);
+	free(b);
+}
+
+double dem_bed_dt(const dem_bed *b)
+{
+	return b->dt;
+}
+
+int dem_bed_advance(dem_bed *b, double ax, double ay, double interval, char *msg, size_t msglen)
+{
+	if (!isfinite(ax) || !isfinite(ay) || !(interval > 0) || !isfinite(interval)) {
+		snprintf(msg, msglen, "dem bed: the deck's acceleration and the interval must be finite, "
+				      "the interval > 0");
+		return -1;
+	}
+	long n = (long)ceil(interval / b->dt * (1 - 1e-12));
+	double gx = -ax, gz = -b->spec.g - ay;
+	double gmag = hypot(gx, gz);
+	bed_cmd(b, "timestep %.17g", interval / (double)n);
+	bed_cmd(b, "unfix deck");
+	if (gmag > 0)
+		bed_cmd(b, "fix deck all gravity %.17g vector %.17g 0 %.17g", gmag, gx, gz);
+	else
+		bed_cmd(b, "fix deck all gravity 0 vector 0 0 -1");
+	bed_cmd(b, "run %ld post no", n);
+	b->t += interval;
+	return 0;
+}
+
+void dem_bed_get(const dem_bed *b, dem_bed_state *st)
+{
+	st->t = b->t;
+	st->mass = bed_var(b, "m");
+	st->x_mean = bed_var(b, "xm");
+	st->z_mean = bed_var(b, "zm");
+	st->p_x = bed_var(b, "px");
+	st->p_z = bed_var(b, "pz");
+	st->kinetic = bed_var(b, "ke");
+	st->kinetic_rot = bed_var(b, "rke");
+}

@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The feed against LIGGGHTS (dem/, docs/dem.md): one grain on the preset's
+// deck at beta = 30 deg, the deck's motion fitted to the one-way machine
+// and applied as a body force over a fixed floor, against the column model
+// with one layer on the same machine. Needs build/convsim-dem, which
+// `make test` builds after installing LIGGGHTS.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+
+const BUILD = process.env.BUILD || 'build';
+const ROOT = new URL('../..', import.meta.url).pathname;
+const DEM = process.env.CONVSIM_DEM || `${ROOT}${BUILD}/convsim-dem`;
+// Under `make check` (ASan): the MPI stack LIGGGHTS loads leaks at exit in
+// its own plugins, which no suppression can name; leak detection is off for
+// these processes, every other check stays on.
+const ENV = { ...process.env, ASAN_OPTIONS: [process.env.ASAN_OPTIONS, 'detect_leaks=0'].filter(Boolean).join(':') };
+
+function dem(args) {
+  const out = execFileSync('nice', ['-n', '15', DEM, ...args], { encoding: 'utf8', timeout: 120000, env: ENV });
+  return JSON.parse(out);
+}
+
+const ONE_GRAIN = ['--grains', '1', '--d-min', '0.004', '--d-max', '0.004', '--freeze-rotation',
+  '--set', 'layers=1', '--duration', '2', '--transient', '0'];
+
+// The bound is 5 %, not the issue's 0.5 %: the column model's contact
+// (loading k, unloading R^2 k, Coulomb friction without a tangential
+// spring) is not LIGGGHTS's spring-dashpot with a tangential spring, and
+// the two differ by 4 % here (docs/dem.md "One grain").
+test('one grain: LIGGGHTS and the column model with one layer agree within 5 % at beta 30 deg, both senses', () => {
+  for (const [rot, beta] of [['cw', 30], ['ccw', 150]]) {
+    const r = dem([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', `rotation=${rot}`]);
+    assert.equal(r.grains, 1);
+    assert.ok(r.deck_fit_residual < 1e-3 * r.deck_amplitude, `deck fit residual ${r.deck_fit_residual}`);
+    assert.ok(Math.abs(r.v_column) > 0.1, `column model v ${r.v_column}`);
+    const rel = Math.abs(r.v_dem - r.v_column) / Math.abs(r.v_column);
+    assert.ok(rel < 0.05, `${rot} ${beta}: v_dem ${r.v_dem} v_column ${r.v_column} (${(100 * rel).toFixed(2)} %)`);
+  }
+});
+
+// With contacts 100x stiffer (k_c = 1e8 N/m, the column model converged
+// with 160 feed sub-steps) both contact laws near the rigid limit and the
+// two agree to 0.16 % at 256 intervals a period; over 64-512 intervals the
+// DEM's v scatters by +-0.9 % about 0.1518 against the column model's
+// 0.1521 (docs/dem.md "One grain"). Tested within 1 %.
+test('one grain, contacts 100x stiffer: LIGGGHTS and the column model within 1 %', () => {
+  const r = dem([...ONE_GRAIN, '--set', 'beta=30', '--set', 'k_c=1e8', '--set', 'substeps=160',
+    '--intervals', '256']);
+  assert.equal(r.k_over_m, 2e8);
+  const rel = Math.abs(r.v_dem - r.v_column) / Math.abs(r.v_column);
+  assert.ok(rel < 0.01, `v_dem ${r.v_dem} v_column ${r.v_column} (${(100 * rel).toFixed(2)} %)`);
+});
+
+test('one grain: the mirror pair (cw, 60 deg) and (ccw, 120 deg) moves at opposite velocities', () => {
+  // (cw, 60) and (ccw, 120) are mirror images on the symmetric machine
+  const a = dem([...ONE_GRAIN, '--set', 'beta=60', '--set', 'rotation=cw', '--no-column']);
+  const b = dem([...ONE_GRAIN, '--set', 'beta=120', '--set', 'rotation=ccw', '--no-column']);
+  assert.ok(Math.abs(a.v_dem) > 0.05, `v ${a.v_dem}`);
+  assert.ok(Math.abs(a.v_dem + b.v_dem) < 0.01 * Math.abs(a.v_dem), `cw 60: ${a.v_dem}, ccw 120: ${b.v_dem}`);
+});
+
+test('the contact damping gives the restitution asked for, and a bad option is refused with its range', () => {
+  const r = dem([...ONE_GRAIN, '--set', 'beta=30', '--restitution', '0.5', '--duration', '0.2', '--no-column']);
+  assert.equal(r.restitution_floor, 0.5);
+  assert.ok(r.restitution_pair > 0.5, `pair ${r.restitution_pair}`);
+  assert.throws(() => execFileSync(DEM, ['--grains', '0'], { encoding: 'utf8', stdio: 'pipe', env: ENV }),
+    (e) => e.status === 2 && /--grains must be a number in \[1, 1e\+06\]/.test(e.stderr));
+});
+
+// The preset calibrated to the 4-diameter DEM bed (docs/dem.md
+// "Calibrated to a bed"): the column model with it against the DEM's v of
+// tests/bench/results/dem.md (β 30° cw: mean of 3 seeds; 150° cw: seed 1),
+// where the preset itself is 18 % and 45 % off.
+test('liggghts-bed4: the calibrated column model meets the DEM bed within 5 % where czubak2016 misses by 15 % or more', () => {
+  const CONVSIM = process.env.CONVSIM || `${ROOT}${BUILD}/convsim`;
+  const v = (preset, beta) => JSON.parse(execFileSync(CONVSIM, ['run', '-q', '-p', preset, '--set', 'layers=4',
+    '--set', 'feed_coupling=false', '--set', `beta=${beta}`, '-d', '4.5', '--set', 'transient=0.5'],
+  { encoding: 'utf8', env: ENV })).transport_velocity;
+  for (const [beta, dem] of [[30, 0.1296], [150, -0.1340]]) {
+    const fitted = v('liggghts-bed4', beta), preset = v('czubak2016', beta);
+    assert.ok(Math.abs(fitted - dem) < 0.05 * Math.abs(dem), `β ${beta}: fitted ${fitted}, DEM ${dem}`);
+    assert.ok(Math.abs(preset - dem) > 0.15 * Math.abs(dem), `β ${beta}: czubak2016 ${preset}, DEM ${dem}`);
+  }
+});
+
+// The body-force frame against LIGGGHTS's own moving floor (a mesh wall
+// moved by fix move/mesh wiggle): one grain on a floor vibrating 2 mm
+// along 30° (Γ = 2.5) and 1.5 mm along 45°, the same v within 1 %
+// (measured: 0.07 % and 0.03 %; docs/dem.md "The bed and its frame").
+test('frame check: the deck as a body force and as a moving mesh give one v', () => {
+  for (const spec of ['0.002:30', '0.0015:45']) {
+    const r = JSON.parse(execFileSync('nice', ['-n', '15', DEM, '--frame-check', spec, '--duration', '2',
+      '--transient', '0.5'], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'], timeout: 120000, env: ENV }));
+    assert.ok(Math.abs(r.v_mesh) > 0.1, `${spec}: v_mesh ${r.v_mesh}`);
+    assert.ok(Math.abs(r.v_body - r.v_mesh) < 0.01 * Math.abs(r.v_mesh), `${spec}: body ${r.v_body}, mesh ${r.v_mesh}`);
+  }
+});

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// scene.feed_model in the daemon: the settings list it (column|liggghts),
+// the column model is the default and runs, and liggghts, which couples a
+// LIGGGHTS bed only in `convsim run` built with it (docs/dem.md), is
+// refused with a problem naming the field and its range; nothing is
+// created then.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { startDaemon, req, SLOW } from './lib.mjs';
+
+let d;
+before(async () => { d = await startDaemon([]); });
+after(async () => { await d.stop(); });
+
+test('feed_model: listed, column by default, liggghts refused with 422 and nothing created', { timeout: 20000 * SLOW }, async () => {
+  const settings = (await req(d.base, 'GET', '/api/v1/presets')).body.settings;
+  const fm = settings.find((s) => s.name === 'feed_model');
+  assert.ok(fm, 'feed_model in the settings');
+  assert.equal(fm.group, 'scene');
+  const n0 = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length;
+  const r = await req(d.base, 'POST', '/api/v1/sessions', { scene: { feed_model: 'liggghts' } });
+  assert.equal(r.status, 422);
+  assert.equal(r.headers.get('content-type'), 'application/problem+json');
+  assert.equal(r.body.field, 'scene.feed_model');
+  assert.equal(r.body.min, 0);
+  assert.equal(r.body.max, 0);
+  assert.match(r.body.detail, /feed_model must be column in the daemon/);
+  assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, n0);
+  const ok = await req(d.base, 'POST', '/api/v1/sessions', { scene: { feed_model: 'column' }, pace: 1 });
+  assert.equal(ok.status, 201);
+});
+
+test('status.feed_warning: the preset\'s 8 soft layers lie outside the domain checked against LIGGGHTS, 2 layers inside', { timeout: 20000 * SLOW }, async () => {
+  const a = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1 });
+  assert.equal(a.status, 201);
+  const sa = (await req(d.base, 'GET', `/api/v1/sessions/${a.body.id}`)).body.status;
+  assert.match(sa.feed_warning, /8 layers/);
+  const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 2 }, pace: 1 });
+  const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
+  assert.equal(sb.feed_warning, null);
+});
