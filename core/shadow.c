@@ -27,9 +27,11 @@
  * within the step is the machine step's, which the shadow keeps (the
  * 74-point curve put 14 points outside such bars). With fewer sub-steps,
  * without events, without feed or with another method there is none and
- * the error bar keeps the preset's calibrated step term. It costs about 0.8 of this instance while it runs: 40
- * periods after each estimate's start (a control, a restart), and
- * SHADOW_MEASURE_SHARE of a measurement's window (sim_measure). */
+ * the error bar keeps the preset's calibrated step term. The shadow
+ * costs about 0.8 of this instance while it runs: 40 periods after each
+ * estimate's start (a control, a restart), and SHADOW_MEASURE_SHARE of a
+ * measurement's window (sim_measure). It is not checkpointed: a restored
+ * instance keeps the calibrated term until its next estimate starts. */
 
 #include <math.h>
 #include <stdlib.h>
