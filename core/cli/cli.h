@@ -22,13 +22,16 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
-	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_VARY, OPT_LHS, OPT_SEED
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
  * fit: with the `steady` start, 4 s keep all 74 points of czubak2016
  * within 1 % of the converged reference (docs/accuracy.md "Accuracy"). */
 #define MEASURE_WINDOW 4.0
+
+/* The most --vary options a sweep takes (SIM_STUDY_MAX_AXES). */
+#define CLI_MAX_VARY 8
 
 /* A command's options as parsed (parse.c): the model (preset and --set),
  * and each command's own options. */
@@ -40,6 +43,11 @@ typedef struct cli_opts {
 	const char *preset, *out, *format, *beta, *rotation;
 	double duration, rate;
 	int threads, quiet;
+	/* sweep: --vary NAME=SPEC in the order given, --lhs N, --seed S */
+	const char *vary[CLI_MAX_VARY];
+	int nvary, lhs;
+	int beta_at; /* sweep: --beta's place among the --vary (it is one) */
+	double seed;
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */

@@ -7,11 +7,12 @@
  *   convsim sweep [--preset NAME] [--beta FROM:TO:STEP] [--rotation cw,ccw]
  *                 [--set NAME=VALUE ...] [--duration S] [--threads N]
  *                 [--out FILE] [--format csv|json]
+ *                 [--vary NAME=FROM:TO:STEP|NAME=V1,V2,... ...] [--lhs N --seed S]
  *   convsim fit   (--data FILE | --peaks ROT:DEG,...) --free NAME,... (fit_cmd.c)
  *   convsim list | help [COMMAND] | --version
  *
- * `run` prints a JSON summary on stdout; `sweep` prints v(beta) per
- * rotation sense. Options come from one table (options.c); numbers are
+ * `run` prints a JSON summary on stdout; `sweep` prints v(beta), or a
+ * study of v over any settings (core/study.h), per rotation sense. Options come from one table (options.c); numbers are
  * printed as the daemon prints them, and the trajectory and sweep tables
  * have the daemon's columns (core/table.h). Uses the core only. `sweep`
  * is sweep_cmd.c, `fit` fit_cmd.c.

@@ -44,7 +44,13 @@ static const cli_opt options[] = {
 	{CMD_RUN, OPT_ROTATION, "rotation", 0, "cw|ccw", NULL, "the preset's (cw)",
 	 "cw (the paper's clockwise, rotor speed > 0) or ccw; the same as --set rotation=..."},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
-	 "guide angles in [0, 180], or one angle"},
+	 "guide angles in [0, 180], or one angle; the same as --vary beta=FROM:TO:STEP"},
+	{CMD_SWEEP, OPT_VARY, "vary", 'V', "NAME=FROM:TO:STEP|NAME=V1,V2,...", NULL, NULL,
+	 "vary a number setting of `convsim list` over a range or a list, in its unit; "
+	 "repeatable (a grid, the first outermost); without beta varied, beta stays the model's"},
+	{CMD_SWEEP, OPT_LHS, "lhs", 0, "N", NULL, "the full grid",
+	 "a Latin-hypercube sample of N points over the --vary ranges instead of their grid"},
+	{CMD_SWEEP, OPT_SEED, "seed", 0, "S", NULL, "1", "seed of the --lhs sample, 0..4294967295"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",
 	 "cw (the paper's clockwise, rotor speed > 0), ccw, or both"},
 	{CMD_SWEEP | CMD_FIT, OPT_THREADS, "threads", 'j', "N", NULL, "2",
@@ -81,7 +87,8 @@ static const struct {
 	 "error bar, means over whole periods, cost, energy balance); with --out also the\n"
 	 "trajectory. Progress goes to stderr on runs longer than a second."},
 	{"sweep", CMD_SWEEP, "convsim sweep [OPTIONS]",
-	 "Measure the steady transport velocity v(beta): one fresh simulation per angle and\n"
+	 "Measure the steady transport velocity v(beta), or a study of v over any number\n"
+	 "settings (--vary, a grid or a --lhs sample): one fresh simulation per point and\n"
 	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
 	 "stderr: a bar on a terminal, plain lines otherwise."},
 	{"fit", CMD_FIT, "convsim fit (--data FILE | --peaks ROT:DEG,...) --free NAME,... [OPTIONS]",
