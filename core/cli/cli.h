@@ -75,6 +75,9 @@ int cli_cmd_sweep(int argc, char **argv);
  * the name's extension); --out opened for writing, or NULL with the reason
  * on stderr. */
 void cli_put_num(FILE *f, double v, const char *nonfinite);
+/* JSON text head (a member's name and colon, with what comes before it),
+ * then v as cli_put_num writes it, null when not finite. */
+void cli_put_json_num(FILE *f, const char *head, double v);
 int cli_wants_json(const char *format, const char *file);
 FILE *cli_open_out(const cli_opts *o);
 

@@ -98,10 +98,9 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 			  double wall)
 {
 	FILE *f = stdout;
-#define NUM(name, v)                                   \
-	do {                                           \
-		fputs(",\n  \"" name "\": ", f);       \
-		cli_put_num(f, (v), "null");               \
+#define NUM(name, v)                                           \
+	do {                                                   \
+		cli_put_json_num(f, ",\n  \"" name "\": ", (v)); \
 	} while (0)
 	fprintf(f, "{\n  \"preset\": \"%s\"", o->preset);
 	NUM("duration", st->t);
@@ -136,16 +135,11 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 	NUM("cpu_seconds", cpu);
 	NUM("wall_seconds", wall);
 	NUM("real_time_factor", cpu > 0 ? st->t / cpu : NAN);
-	fputs(",\n  \"energy\": {\"input\": ", f);
-	cli_put_num(f, st->e_input, "null");
-	fputs(", \"kinetic\": ", f);
-	cli_put_num(f, st->e_kinetic, "null");
-	fputs(", \"potential\": ", f);
-	cli_put_num(f, st->e_potential, "null");
-	fputs(", \"dissipated\": ", f);
-	cli_put_num(f, st->e_dissipated, "null");
-	fputs(", \"residual\": ", f);
-	cli_put_num(f, st->e_residual, "null");
+	cli_put_json_num(f, ",\n  \"energy\": {\"input\": ", st->e_input);
+	cli_put_json_num(f, ", \"kinetic\": ", st->e_kinetic);
+	cli_put_json_num(f, ", \"potential\": ", st->e_potential);
+	cli_put_json_num(f, ", \"dissipated\": ", st->e_dissipated);
+	cli_put_json_num(f, ", \"residual\": ", st->e_residual);
 	fputs("},\n  \"error\": ", f);
 	if (err != SIM_OK)
 		fprintf(f, "\"%s\"\n}\n", sim_last_error(s));

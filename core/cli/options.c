@@ -324,6 +324,12 @@ void cli_put_num(FILE *f, double v, const char *nonfinite)
 	fputs(num, f);
 }
 
+void cli_put_json_num(FILE *f, const char *head, double v)
+{
+	fputs(head, f);
+	cli_put_num(f, v, "null");
+}
+
 /* The file's format: --format, else by the name's extension. */
 int cli_wants_json(const char *format, const char *file)
 {

@@ -114,28 +114,21 @@ static void mirror_tasks(const pool *pl, int ntasks)
 static void print_json_head(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 {
 	const sim_study *st = pl->st;
-	fputs("{\"duration\":", f);
-	cli_put_num(f, o->duration, "null");
-	fputs(",\"transient\":", f);
-	cli_put_num(f, o->sc.transient, "null");
+	cli_put_json_num(f, "{\"duration\":", o->duration);
+	cli_put_json_num(f, ",\"transient\":", o->sc.transient);
 	fprintf(f, ",\"method\":\"%s\",\"vary\":[", o->m.name);
 	for (size_t a = 0; a < st->naxes; a++) {
 		const sim_study_axis *ax = &st->axis[a];
 		fprintf(f, "%s{\"name\":\"%s\",\"unit\":\"%s\",", a ? "," : "", ax->setting->name,
 			ax->setting->unit);
 		if (ax->step > 0) {
-			fputs("\"from\":", f);
-			cli_put_num(f, ax->from, "null");
-			fputs(",\"to\":", f);
-			cli_put_num(f, ax->to, "null");
-			fputs(",\"step\":", f);
-			cli_put_num(f, ax->step, "null");
+			cli_put_json_num(f, "\"from\":", ax->from);
+			cli_put_json_num(f, ",\"to\":", ax->to);
+			cli_put_json_num(f, ",\"step\":", ax->step);
 		} else {
 			fputs("\"values\":[", f);
-			for (size_t k = 0; k < ax->n; k++) {
-				fputs(k ? "," : "", f);
-				cli_put_num(f, ax->values[k], "null");
-			}
+			for (size_t k = 0; k < ax->n; k++)
+				cli_put_json_num(f, k ? "," : "", ax->values[k]);
 			fputc(']', f);
 		}
 		fputc('}', f);
