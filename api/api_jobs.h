@@ -9,6 +9,7 @@
 #define CONVSIM_API_JOBS_H
 
 #include "api.h"
+#include "study.h"
 
 /* ---- experiments --------------------------------------------------------- */
 
@@ -74,14 +75,25 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n);
 /* ---- sweeps --------------------------------------------------------------- */
 
 #define API_SWEEP_MAX_POINTS 2000
+#define API_SWEEP_NAME_LEN 24
 typedef struct api_sweep_req {
 	api_spec spec;
-	int nbeta;
-	api_value *betas;      /* rad (deg as sent), malloc'd by the parser
-				  (caller frees) */
+	int nbeta;             /* points per rotation sense */
+	api_value *betas;      /* rad (deg as sent), each point's beta (the
+				  model's where beta is not varied), malloc'd
+				  by the parser (caller frees) */
 	int nrot;
 	int rotations[2];      /* SIM_CW / SIM_CCW */
 	double t_end;          /* s simulated per point */
+	/* the varied settings, in their order ("beta" alone for a v(beta)
+	 * sweep), each point's values in api_sweep_point.vary */
+	int nvary;
+	char vary[SIM_STUDY_MAX_AXES][API_SWEEP_NAME_LEN];
+	int lhs;               /* a Latin-hypercube sample of lhs points, or 0 */
+	uint32_t seed;
+	double *values;        /* nbeta x nvary user values, malloc'd by the
+				  parser (caller frees; not kept after the
+				  points are made) */
 } api_sweep_req;
 /* Default simulated time per point after scene.transient, s: after a steady
  * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
@@ -90,7 +102,11 @@ typedef struct api_sweep_req {
 /* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
  * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],
  * "t_end" (default scene.transient + API_SWEEP_WINDOW; it must exceed
- * scene.transient). */
+ * scene.transient); a study: "vary": {"NAME": {"from","to","step"} or
+ * [v, ...], ...} over number settings in their user units (beta, when
+ * given as "beta", the first), "lhs": N for a Latin-hypercube sample of
+ * the ranges, "seed" (core/study.h). A 4xx names the field ("vary.mu")
+ * and its range; nothing is kept then. */
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb);
 
@@ -105,6 +121,8 @@ typedef struct api_sweep_point {
 	int mirrored;       /* the mirror image of another point of the sweep
 			       (sim_mirror_plan), not run itself */
 	char error[160];
+	double vary[SIM_STUDY_MAX_AXES]; /* the varied settings' values, user
+					    units (api_sweep_req.vary) */
 } api_sweep_point;
 typedef struct api_sweep_view {
 	char id[24];
@@ -113,6 +131,7 @@ typedef struct api_sweep_view {
 			       record is unusable); NULL or "" */
 	size_t total, done;
 	double t_end;
+	const api_sweep_req *req;  /* borrowed: the varied settings */
 	const api_sweep_point *pt; /* borrowed, total entries */
 } api_sweep_view;
 char *api_sweep_json(const api_sweep_view *v);

@@ -95,6 +95,12 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
  * naming prefix + member otherwise). body.c. */
 api_err api_check_members(const cJSON *obj, const char *const *names,
 			  const char *prefix, api_problem *pb);
+/* The varied settings of a sweep request (study_json.c): "vary", "lhs"
+ * and "seed" members (each may be NULL) into req's points (nbeta,
+ * betas, nvary, vary, values, lhs, seed); req->betas, when set, is the
+ * "beta" member's grid, varied first. Needs req->spec and req->nrot. */
+api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
+			api_sweep_req *req, api_problem *pb);
 /* sim_validate on the spec, as a 422 problem. */
 api_err api_validate_spec(api_spec *spec, api_problem *pb);
 /* The settings table as a JSON array of {name, group, kind, unit,

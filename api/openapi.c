@@ -126,6 +126,28 @@ static cJSON *request_schema(const cJSON *types, const cJSON *required, const ch
 	return o;
 }
 
+/* A sweep point's varied settings: each number setting of the table as
+ * an optional member (a study names its columns by setting), so that the
+ * point stays closed. */
+static void add_varied_members(cJSON *point)
+{
+	cJSON *props = cJSON_GetObjectItemCaseSensitive(point, "properties");
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n);
+	for (size_t i = 0; props && i < n; i++) {
+		if ((tab[i].kind != SIM_KIND_REAL && tab[i].kind != SIM_KIND_INT) ||
+		    cJSON_GetObjectItemCaseSensitive(props, tab[i].name))
+			continue;
+		cJSON *p = cJSON_CreateObject();
+		cJSON_AddStringToObject(p, "type", "number");
+		char doc[96];
+		snprintf(doc, sizeof doc, "%s%s(when %s is varied)", tab[i].unit,
+			 *tab[i].unit ? " " : "", tab[i].name);
+		cJSON_AddStringToObject(p, "description", doc);
+		cJSON_AddItemToObject(props, tab[i].name, p);
+	}
+}
+
 static cJSON *ref(const char *kind, const char *name)
 {
 	char r[96];
@@ -284,6 +306,7 @@ char *api_openapi_json(void)
 			goto fail; /* schemas.json and a parser disagree */
 		cJSON_AddItemToObject(schemas, bodies[i].name, b);
 	}
+	add_varied_members(cJSON_GetObjectItemCaseSensitive(schemas, "SweepPoint"));
 	cJSON_AddItemToObject(schemas, "Params", group_schema("params"));
 	cJSON_AddItemToObject(schemas, "Scene", group_schema("scene"));
 	cJSON_AddItemToObject(schemas, "Integrator", group_schema("integrator"));

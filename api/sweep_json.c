@@ -3,10 +3,11 @@
  * sweep_json.c - the v(beta) sweep in JSON and CSV.
  *
  * A sweep measures the steady transport velocity for a list of beta
- * values and rotation directions (the paper's Figs. 9 and 11), one fresh
- * instance per point. This file parses the request (the model members as
- * for sessions, plus the beta grid, the rotations and the simulated time
- * per point) and writes progress and results.
+ * values and rotation directions (the paper's Figs. 9 and 11), or a study
+ * over any number settings (study_json.c), one fresh instance per point.
+ * This file parses the request (the model members as for sessions, plus
+ * the beta grid, the rotations and the simulated time per point) and
+ * writes progress and results, the varied settings' columns first.
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,7 +18,8 @@
 
 const char *const api_members_beta_range[] = {"from", "to", "step", NULL};
 const char *const api_members_sweep[] = {"preset", "params", "scene", "integrator",
-					  "beta", "rotations", "t_end", NULL};
+					  "beta", "rotations", "t_end", "vary", "lhs",
+					  "seed", NULL};
 
 #define T_END_MAX 600.0 /* s simulated per point, at most */
 
@@ -180,19 +182,43 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 	const cJSON *te = cJSON_GetObjectItemCaseSensitive(root, "t_end");
 	if (e == API_OK)
 		e = parse_t_end(te, &req->spec.scene, &req->t_end, pb);
-	if (e == API_OK)
-		e = parse_grid(cJSON_GetObjectItemCaseSensitive(root, "beta"),
-			       req, pb);
+	const cJSON *beta = cJSON_GetObjectItemCaseSensitive(root, "beta");
+	const cJSON *vary = cJSON_GetObjectItemCaseSensitive(root, "vary");
+	/* a study that does not vary beta keeps the model's */
+	if (e == API_OK && (beta || !vary))
+		e = parse_grid(beta, req, pb);
 	if (e == API_OK)
 		e = parse_rotations(
 			cJSON_GetObjectItemCaseSensitive(root, "rotations"),
 			req, pb);
+	if (e == API_OK)
+		e = api_parse_study(vary, cJSON_GetObjectItemCaseSensitive(root, "lhs"),
+				    cJSON_GetObjectItemCaseSensitive(root, "seed"), req, pb);
 	cJSON_Delete(root);
 	if (e != API_OK) {
 		free(req->betas);
+		free(req->values);
 		req->betas = NULL;
+		req->values = NULL;
 	}
 	return e;
+}
+
+/* The table's leading columns: the varied settings (beta alone where the
+ * view has no request: a damaged sweep's). */
+static int vary_count(const api_sweep_view *v)
+{
+	return v->req && v->req->nvary > 0 ? v->req->nvary : 1;
+}
+
+static const char *vary_name(const api_sweep_view *v, int a)
+{
+	return v->req && v->req->nvary > 0 ? v->req->vary[a] : "beta";
+}
+
+static double vary_value(const api_sweep_view *v, const api_sweep_point *p, int a)
+{
+	return v->req && v->req->nvary > 0 ? p->vary[a] : p->beta.user;
 }
 
 static const char *point_state(int s)
@@ -214,6 +240,19 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	api_add_number(o, "progress",
 		       v->total ? (double)v->done / (double)v->total : 1.0);
 	api_add_number(o, "t_end", v->t_end);
+	int nvary = vary_count(v);
+	cJSON *vary = cJSON_AddArrayToObject(o, "vary");
+	for (int a = 0; a < nvary; a++) {
+		const sim_setting *t = sim_setting_find(vary_name(v, a));
+		cJSON *ax = cJSON_CreateObject();
+		cJSON_AddStringToObject(ax, "name", vary_name(v, a));
+		cJSON_AddStringToObject(ax, "unit", t ? t->unit : "");
+		cJSON_AddItemToArray(vary, ax);
+	}
+	if (v->req && v->req->lhs) {
+		api_add_number(o, "lhs", v->req->lhs);
+		api_add_number(o, "seed", v->req->seed);
+	}
 	if (points) {
 		/* the sweep-level reductions: the mirror reduction when it
 		 * derived any point (every point's own model reductions are a
@@ -233,7 +272,8 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	for (size_t i = 0; points && i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		cJSON *po = cJSON_CreateObject();
-		api_add_number(po, "beta", p->beta.user);
+		for (int a = 0; a < nvary; a++)
+			api_add_number(po, vary_name(v, a), vary_value(v, p, a));
 		cJSON_AddStringToObject(po, "rotation",
 					p->rotation == SIM_CW ? "cw" : "ccw");
 		cJSON_AddStringToObject(po, "state", point_state(p->state));
@@ -256,8 +296,8 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 		cJSON_AddItemToArray(pts, po);
 		if (p->state == 2) {
 			cJSON *pair = cJSON_CreateArray();
-			cJSON_AddItemToArray(pair,
-					     cJSON_CreateNumber(p->beta.user));
+			/* [the first varied setting, v] */
+			cJSON_AddItemToArray(pair, cJSON_CreateNumber(vary_value(v, p, 0)));
 			cJSON_AddItemToArray(
 				pair, isfinite(p->m.transport_velocity)
 					      ? cJSON_CreateNumber(p->m.transport_velocity)
@@ -289,12 +329,18 @@ char *api_sweep_list_json(const api_sweep_view *v, size_t n)
 char *api_sweep_csv(const api_sweep_view *v)
 {
 	api_buf b = {0};
-	api_buf_puts(&b, SIM_SWEEP_CSV_HEADER "\n");
+	int nvary = vary_count(v);
+	for (int a = 0; a < nvary; a++)
+		api_buf_printf(&b, "%s,", vary_name(v, a));
+	api_buf_puts(&b, SIM_SWEEP_POINT_COLUMNS "\n");
 	for (size_t i = 0; i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		int done = p->state == 2;
-		api_buf_double(&b, p->beta.user);
-		api_buf_puts(&b, p->rotation == SIM_CW ? ",cw," : ",ccw,");
+		for (int a = 0; a < nvary; a++) {
+			api_buf_double(&b, vary_value(v, p, a));
+			api_buf_put(&b, ",", 1);
+		}
+		api_buf_puts(&b, p->rotation == SIM_CW ? "cw," : "ccw,");
 		if (done && isfinite(p->m.transport_velocity))
 			api_buf_double(&b, p->m.transport_velocity);
 		api_buf_put(&b, ",", 1);

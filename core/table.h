@@ -120,8 +120,11 @@ static inline void sim_trajectory_row(const sim_status *st, double *row)
  * state queued|running|done|failed|cancelled; then the steps the point
  * was measured with (dt in s, feed sub-steps), the steps' share of the
  * uncertainty (step_error, m/s) and whether the uncertainty is within
- * the accuracy target tol (tol_met true|false). */
-#define SIM_SWEEP_CSV_HEADER \
-	"beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met"
+ * the accuracy target tol (tol_met true|false). A study over other
+ * settings has their columns in place of beta (SIM_SWEEP_POINT_COLUMNS
+ * after them). */
+#define SIM_SWEEP_POINT_COLUMNS \
+	"rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met"
+#define SIM_SWEEP_CSV_HEADER "beta," SIM_SWEEP_POINT_COLUMNS
 
 #endif

@@ -2,7 +2,8 @@
 /*
  * sweep.c - v(beta) sweeps on the worker pool (POST /api/v1/sweeps).
  *
- * A sweep is a grid of (beta, rotation) points; each point is one pool
+ * A sweep is a grid of (beta, rotation) points, or of any number
+ * settings' values and rotation (a study, core/study.h); each point is one pool
  * job that builds a fresh instance with sim_measure (thread-safe,
  * no session involved) and stores the steady transport velocity. Under
  * the mirror reduction (sim_mirror_plan) a point that is the mirror image
@@ -47,6 +48,7 @@ static void sweep_free(srv_sweep *sw)
 	if (!sw)
 		return;
 	free(sw->req.betas);
+	free(sw->req.values);
 	free(sw->pt);
 	free(sw->image);
 	free(sw->csv);
@@ -80,12 +82,14 @@ static void fill_view(const srv_sweep *sw, api_sweep_view *v)
 	v->total = sw->total;
 	v->done = sw->done;
 	v->t_end = sw->req.t_end;
+	v->req = sw->damaged[0] ? NULL : &sw->req;
 	v->pt = sw->pt;
 }
 
 /* ---- persistence (store.h) ---------------------------------------------
  *
- * sweeps/ID.bin: the record below, the betas and every point, written at
+ * sweeps/ID.bin: the record below (the varied settings' names in its
+ * request), the betas and every point (with its values), written at
  * creation, after each point and at a cancel (a pending write is replaced
  * by the newer one); at the end, sweep-ID.csv. A restart serves finished
  * sweeps again and queues the points that were pending or running. */
@@ -121,6 +125,7 @@ static void persist_locked(const srv_sweep *sw)
 	snprintf(r.id, sizeof r.id, "%s", sw->entry.id);
 	r.req = sw->req;
 	r.req.betas = NULL;
+	r.req.values = NULL;
 	r.total = sw->total;
 	r.done = sw->done;
 	r.cancelled = sw->cancelled;
@@ -172,11 +177,12 @@ static void run_point(void *arg)
 		api_spec spec = sw->req.spec;
 		char msg[160] = "";
 		sim_measurement r;
-		/* beta was checked and converted to SI by api/ */
-		spec.params.beta = p->beta.si;
-		spec.params.rotation = p->rotation;
-		int rc = sim_measure(&spec.params, &spec.scene, &spec.method,
-				     sw->req.t_end, &r, msg, sizeof msg);
+		/* beta was checked and converted to SI by api/, the other
+		 * varied settings checked there */
+		int rc = srv_sweep_apply(sw, job_i, &spec, msg, sizeof msg);
+		if (rc == SIM_OK)
+			rc = sim_measure(&spec.params, &spec.scene, &spec.method,
+					 sw->req.t_end, &r, msg, sizeof msg);
 		pthread_mutex_lock(&sw->lock);
 		sw->running--;
 		if (rc == SIM_OK) {
@@ -245,6 +251,7 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 		nb = (size_t)r.req.nbeta * sizeof(api_value);
 		np = r.total * sizeof(api_sweep_point);
 		ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
+		     r.req.nvary >= 0 && r.req.nvary <= SIM_STUDY_MAX_AXES &&
 		     r.total <= API_SWEEP_MAX_POINTS && len == sizeof r + nb + np;
 	}
 	if (!ok)
@@ -253,6 +260,7 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 	if (sw) {
 		pthread_mutex_init(&sw->lock, NULL);
 		sw->req = r.req;
+		sw->req.values = NULL;
 		sw->req.betas = malloc(nb ? nb : 1);
 		sw->pt = malloc(np ? np : 1);
 		r.id[SRV_ID_LEN - 1] = '\0';
@@ -324,7 +332,13 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 					(size_t)b];
 			p->beta = sw->req.betas[b];
 			p->rotation = sw->req.rotations[ro];
+			for (int a = 0; a < sw->req.nvary; a++)
+				p->vary[a] = sw->req.values[(size_t)b * (size_t)sw->req.nvary +
+							    (size_t)a];
 		}
+	/* the points hold the values from here on (and in the record) */
+	free(sw->req.values);
+	sw->req.values = NULL;
 	if (srv_sweep_plan(sw) != 0) {
 		sweep_free(sw);
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");

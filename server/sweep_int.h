@@ -34,6 +34,10 @@ typedef struct srv_sweep {
  * `mirrored`). The plan depends only on the request, so a restart makes it
  * again. 0, or -1 when out of memory. */
 int srv_sweep_plan(srv_sweep *sw);
+/* Point i's settings on *spec (a copy of the request's): its beta
+ * (SI, from api/), rotation and every other varied setting. SIM_OK, or
+ * the setting's error with msg. */
+int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, size_t msglen);
 /* Point i is over (done or failed): its mirror image, if it has one, is
  * too (lock held). */
 void srv_sweep_fill_image(srv_sweep *sw, size_t i);

@@ -1,44 +1,72 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * sweep_plan.c - the mirror reduction of a sweep's points
- * (sim_mirror_plan): a point that is the mirror image of another is no
- * job of its own, and is filled, velocity negated, when the other is over.
+ * (sim_study_mirror_plan): a point that is the mirror image of another is
+ * no job of its own, and is filled, velocity negated, when the other is
+ * over; and a point's varied settings applied to its model.
  */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "study.h"
 #include "sweep_int.h"
+#include "units.h"
 
 /* The mirror reduction's plan of the sweep's points: which are mirror
- * images of which (sw->image, sw->jobs, each point's `mirrored`). The
- * plan depends only on the request, so a restart makes it again. 0, or
- * -1 when out of memory. */
+ * images of which (sw->image, sw->jobs, each point's `mirrored`), over
+ * points that differ in sense and beta alone (sim_study_mirror_plan on
+ * the sweep's varied settings, their values borrowed from the points).
+ * The plan depends only on the request, so a restart makes it again. 0,
+ * or -1 when out of memory. */
 int srv_sweep_plan(srv_sweep *sw)
 {
-	size_t n = sw->total;
-	double *beta = malloc(sizeof *beta * (n ? n : 1));
-	int *rot = malloc(sizeof *rot * (n ? n : 1));
+	size_t n = sw->total, np = (size_t)sw->req.nbeta, na = (size_t)sw->req.nvary;
+	sim_study st = {.naxes = na, .nrot = (size_t)sw->req.nrot, .npoints = np};
+	st.values = malloc(sizeof *st.values * (np * na > 0 ? np * na : 1));
 	long *source = malloc(sizeof *source * (n ? n : 1));
 	sw->image = malloc(sizeof *sw->image * (n ? n : 1));
-	int rc = beta && rot && source && sw->image ? 0 : -1;
-	for (size_t i = 0; rc == 0 && i < n; i++) {
-		beta[i] = sw->pt[i].beta.si;
-		rot[i] = sw->pt[i].rotation;
-		sw->image[i] = -1;
-	}
+	int rc = st.values && source && sw->image && n == np * st.nrot ? 0 : -1;
+	for (size_t a = 0; rc == 0 && a < na; a++)
+		if (!(st.axis[a].setting = sim_setting_find(sw->req.vary[a])))
+			rc = -1;
+	for (size_t r = 0; rc == 0 && r < st.nrot; r++)
+		st.rotation[r] = sw->req.rotations[r];
+	for (size_t k = 0; rc == 0 && k < np; k++)
+		for (size_t a = 0; a < na; a++)
+			st.values[k * na + a] = sw->pt[k].vary[a];
 	if (rc == 0) {
-		sw->jobs = sim_mirror_plan(&sw->req.spec.params, &sw->req.spec.scene, n, beta,
-					   rot, source);
-		for (size_t i = 0; i < n; i++) {
-			sw->pt[i].mirrored = source[i] >= 0;
-			if (source[i] >= 0)
-				sw->image[source[i]] = (long)i;
-		}
+		size_t run = sim_study_mirror_plan(&st, &sw->req.spec.params, &sw->req.spec.scene,
+						   &sw->req.spec.method, source);
+		rc = run == (size_t)-1 ? -1 : 0;
+		sw->jobs = run;
 	}
-	free(beta);
-	free(rot);
+	for (size_t i = 0; rc == 0 && i < n; i++)
+		sw->image[i] = -1;
+	for (size_t i = 0; rc == 0 && i < n; i++) {
+		sw->pt[i].mirrored = source[i] >= 0;
+		if (source[i] >= 0)
+			sw->image[source[i]] = (long)i;
+	}
+	free(st.values);
 	free(source);
 	return rc;
+}
+
+int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, size_t msglen)
+{
+	const api_sweep_point *p = &sw->pt[i];
+	spec->params.beta = p->beta.si;
+	spec->params.rotation = p->rotation;
+	for (int a = 0; a < sw->req.nvary; a++) {
+		if (strcmp(sw->req.vary[a], "beta") == 0)
+			continue;
+		int rc = sim_set_user(&spec->params, &spec->scene, &spec->method, sw->req.vary[a],
+				      p->vary[a], msg, msglen);
+		if (rc != SIM_OK)
+			return rc;
+	}
+	return SIM_OK;
 }
 
 /* Point i is over (done or failed): its mirror image, if it has one, is

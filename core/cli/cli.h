@@ -22,13 +22,17 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
-	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_VARY,
+	OPT_LHS, OPT_SEED
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
  * fit: with the `steady` start, 4 s keep all 74 points of czubak2016
  * within 1 % of the converged reference (docs/accuracy.md "Accuracy"). */
 #define MEASURE_WINDOW 4.0
+
+/* The most --vary options a sweep takes (SIM_STUDY_MAX_AXES). */
+#define CLI_MAX_VARY 8
 
 /* A command's options as parsed (parse.c): the model (preset and --set),
  * and each command's own options. */
@@ -41,6 +45,11 @@ typedef struct cli_opts {
 	double duration, rate;
 	int threads, quiet;
 	int coupling_steps; /* feed_model liggghts: machine steps per coupling interval */
+	/* sweep: --vary NAME=SPEC in the order given, --lhs N, --seed S */
+	const char *vary[CLI_MAX_VARY];
+	int nvary, lhs;
+	int beta_at; /* sweep: --beta's place among the --vary (it is one) */
+	double seed;
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
@@ -68,6 +77,9 @@ int cli_cmd_sweep(int argc, char **argv);
  * the name's extension); --out opened for writing, or NULL with the reason
  * on stderr. */
 void cli_put_num(FILE *f, double v, const char *nonfinite);
+/* JSON text head (a member's name and colon, with what comes before it),
+ * then v as cli_put_num writes it, null when not finite. */
+void cli_put_json_num(FILE *f, const char *head, double v);
 int cli_wants_json(const char *format, const char *file);
 FILE *cli_open_out(const cli_opts *o);
 

@@ -7,11 +7,12 @@
  *   convsim sweep [--preset NAME] [--beta FROM:TO:STEP] [--rotation cw,ccw]
  *                 [--set NAME=VALUE ...] [--duration S] [--threads N]
  *                 [--out FILE] [--format csv|json]
+ *                 [--vary NAME=FROM:TO:STEP|NAME=V1,V2,... ...] [--lhs N --seed S]
  *   convsim fit   (--data FILE | --peaks ROT:DEG,...) --free NAME,... (fit_cmd.c)
  *   convsim list | help [COMMAND] | --version
  *
- * `run` prints a JSON summary on stdout; `sweep` prints v(beta) per
- * rotation sense. Options come from one table (options.c); numbers are
+ * `run` prints a JSON summary on stdout; `sweep` prints v(beta), or a
+ * study of v over any settings (core/study.h), per rotation sense. Options come from one table (options.c); numbers are
  * printed as the daemon prints them, and the trajectory and sweep tables
  * have the daemon's columns (core/table.h). Uses the core only. `sweep`
  * is sweep_cmd.c, `fit` fit_cmd.c.
@@ -97,10 +98,9 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 			  double wall)
 {
 	FILE *f = stdout;
-#define NUM(name, v)                                   \
-	do {                                           \
-		fputs(",\n  \"" name "\": ", f);       \
-		cli_put_num(f, (v), "null");               \
+#define NUM(name, v)                                           \
+	do {                                                   \
+		cli_put_json_num(f, ",\n  \"" name "\": ", (v)); \
 	} while (0)
 	fprintf(f, "{\n  \"preset\": \"%s\"", o->preset);
 	NUM("duration", st->t);
@@ -142,16 +142,11 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 	NUM("cpu_seconds", cpu);
 	NUM("wall_seconds", wall);
 	NUM("real_time_factor", cpu > 0 ? st->t / cpu : NAN);
-	fputs(",\n  \"energy\": {\"input\": ", f);
-	cli_put_num(f, st->e_input, "null");
-	fputs(", \"kinetic\": ", f);
-	cli_put_num(f, st->e_kinetic, "null");
-	fputs(", \"potential\": ", f);
-	cli_put_num(f, st->e_potential, "null");
-	fputs(", \"dissipated\": ", f);
-	cli_put_num(f, st->e_dissipated, "null");
-	fputs(", \"residual\": ", f);
-	cli_put_num(f, st->e_residual, "null");
+	cli_put_json_num(f, ",\n  \"energy\": {\"input\": ", st->e_input);
+	cli_put_json_num(f, ", \"kinetic\": ", st->e_kinetic);
+	cli_put_json_num(f, ", \"potential\": ", st->e_potential);
+	cli_put_json_num(f, ", \"dissipated\": ", st->e_dissipated);
+	cli_put_json_num(f, ", \"residual\": ", st->e_residual);
 	fputs("},\n  \"error\": ", f);
 	if (err != SIM_OK)
 		fprintf(f, "\"%s\"\n}\n", sim_last_error(s));

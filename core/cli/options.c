@@ -46,7 +46,13 @@ static const cli_opt options[] = {
 	{CMD_RUN, OPT_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
 	 "feed_model=liggghts: machine steps per coupling interval with the bed (docs/dem.md)"},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
-	 "guide angles in [0, 180], or one angle"},
+	 "guide angles in [0, 180], or one angle; the same as --vary beta=FROM:TO:STEP"},
+	{CMD_SWEEP, OPT_VARY, "vary", 'V', "NAME=FROM:TO:STEP|NAME=V1,V2,...", NULL, NULL,
+	 "vary a number setting of `convsim list` over a range or a list, in its unit; "
+	 "repeatable (a grid, the first outermost); without beta varied, beta stays the model's"},
+	{CMD_SWEEP, OPT_LHS, "lhs", 0, "N", NULL, "the full grid",
+	 "a Latin-hypercube sample of N points over the --vary ranges instead of their grid"},
+	{CMD_SWEEP, OPT_SEED, "seed", 0, "S", NULL, "1", "seed of the --lhs sample, 0..4294967295"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",
 	 "cw (the paper's clockwise, rotor speed > 0), ccw, or both"},
 	{CMD_SWEEP | CMD_FIT, OPT_THREADS, "threads", 'j', "N", NULL, "2",
@@ -86,7 +92,8 @@ static const struct {
 	 "error bar, means over whole periods, cost, energy balance); with --out also the\n"
 	 "trajectory. Progress goes to stderr on runs longer than a second."},
 	{"sweep", CMD_SWEEP, "convsim sweep [OPTIONS]",
-	 "Measure the steady transport velocity v(beta): one fresh simulation per angle and\n"
+	 "Measure the steady transport velocity v(beta), or a study of v over any number\n"
+	 "settings (--vary, a grid or a --lhs sample): one fresh simulation per point and\n"
 	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
 	 "stderr: a bar on a terminal, plain lines otherwise."},
 	{"fit", CMD_FIT, "convsim fit (--data FILE | --peaks ROT:DEG,...) --free NAME,... [OPTIONS]",
@@ -320,6 +327,12 @@ void cli_put_num(FILE *f, double v, const char *nonfinite)
 	char num[40];
 	sim_fmt_double(num, sizeof num, v, nonfinite);
 	fputs(num, f);
+}
+
+void cli_put_json_num(FILE *f, const char *head, double v)
+{
+	fputs(head, f);
+	cli_put_num(f, v, "null");
 }
 
 /* The file's format: --format, else by the name's extension. */

@@ -113,7 +113,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 	o->threads = 2;
 	o->coupling_steps = 1;
 	o->rotation = "cw,ccw";
-	o->beta = "0:180:10";
+	o->seed = 1;
 	o->curve_step = 5;
 	o->fd_step = 0.05;
 	o->max_iter = 30;
@@ -163,8 +163,28 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 				bad = set_option(o, id == OPT_BETA ? "beta" : "rotation", arg);
 			else
 				*(id == OPT_BETA ? &o->beta : &o->rotation) = arg;
+			if (id == OPT_BETA)
+				o->beta_at = o->nvary;
 			break;
 		case OPT_QUIET: o->quiet = 1; break;
+		case OPT_VARY:
+			if (o->nvary == CLI_MAX_VARY) {
+				fprintf(stderr, "convsim %s: --vary: at most %d settings are varied\n",
+					o->cmd, CLI_MAX_VARY);
+				bad = 1;
+			} else {
+				o->vary[o->nvary++] = arg;
+			}
+			break;
+		case OPT_LHS: bad = whole(o->cmd, "lhs", arg, 10000, &o->lhs); break;
+		case OPT_SEED:
+			bad = cli_number(o->cmd, "seed", NULL, arg, 0, 4294967295.0, 0, &o->seed);
+			if (!bad && o->seed != floor(o->seed)) {
+				fprintf(stderr, "convsim %s: --seed must be a whole number, got '%s'\n",
+					o->cmd, arg);
+				bad = 1;
+			}
+			break;
 		case OPT_DATA: o->data = arg; break;
 		case OPT_PEAKS: o->peaks = arg; break;
 		case OPT_FREE: o->free_list = arg; break;

@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * sweep_cmd.c - convsim sweep: v(beta) per rotation sense, one fresh
- * sim_measure per angle and sense on the library's parallel map (pmap.h),
- * the mirror reduction's images taken from their sources; the table has
- * the daemon's columns (core/table.h).
+ * sweep_cmd.c - convsim sweep: a study of v over any number settings
+ * (--vary NAME=FROM:TO:STEP or NAME=V1,V2,..., --beta as the shorthand
+ * for --vary beta=..., a grid or a --lhs sample; core/study.h) per
+ * rotation sense, one fresh sim_measure per point and sense on the
+ * library's parallel map (pmap.h), the mirror reduction's images taken
+ * from their sources. The table has the varied settings' columns, then
+ * the daemon's point columns (core/table.h).
  */
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +16,7 @@
 #include "cli.h"
 #include "pmap.h"
 #include "sim.h"
+#include "study.h"
 #include "suggest.h"
 #include "table.h"
 #include "units.h"
@@ -20,9 +24,7 @@
 /* ---- sweep ---- */
 
 typedef struct task {
-	double beta;
-	int rotation;
-	long source; /* -1: measured; else the task it mirrors (sim_mirror_plan) */
+	long source; /* -1: measured; else the task it mirrors (sim_study_mirror_plan) */
 	sim_measurement r;
 	int err;
 	char msg[160];
@@ -30,110 +32,147 @@ typedef struct task {
 
 typedef struct pool {
 	const cli_opts *o;
+	const sim_study *st;
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
 	int n, done;
 	cli_progress progress;
 } pool;
 
+/* Task k's settings and sense as the messages name them: "mu=0.5, beta=30
+ * deg, cw" into buf. */
+static const char *describe_task(const sim_study *st, size_t k, char *buf, size_t len)
+{
+	size_t at = 0;
+	buf[0] = '\0';
+	for (size_t a = 0; a < st->naxes && at < len; a++) {
+		const sim_setting *t = st->axis[a].setting;
+		at += (size_t)snprintf(buf + at, len - at, "%s=%g%s%s, ", t->name,
+				       sim_study_value(st, k % st->npoints, a), *t->unit ? " " : "",
+				       t->unit);
+	}
+	if (at < len)
+		snprintf(buf + at, len - at, "%s",
+			 st->rotation[k / st->npoints] == SIM_CW ? "cw" : "ccw");
+	return buf;
+}
+
 /* Measure the k-th task to run (a job of the map). */
 static void measure_task(void *arg, size_t k)
 {
 	pool *pl = arg;
-	task *t = &pl->tasks[pl->run[k]];
+	size_t i = (size_t)pl->run[k];
+	task *t = &pl->tasks[i];
 	sim_params p = pl->o->p;
-	p.beta = t->beta * RAD_PER_DEG;
-	p.rotation = t->rotation;
-	t->err = sim_measure(&p, &pl->o->sc, &pl->o->m, pl->o->duration, &t->r, t->msg,
-			     sizeof t->msg);
+	sim_scene sc = pl->o->sc;
+	sim_method m = pl->o->m;
+	t->err = sim_study_apply(pl->st, i, &p, &sc, &m, t->msg, sizeof t->msg);
+	if (t->err == SIM_OK)
+		t->err = sim_measure(&p, &sc, &m, pl->o->duration, &t->r, t->msg, sizeof t->msg);
 }
 
 /* The progress line after each task (the map calls it one at a time). */
 static void task_done(void *arg, size_t k, size_t done)
 {
 	pool *pl = arg;
-	const task *t = &pl->tasks[pl->run[k]];
+	char what[200], detail[220];
 	pl->done = (int)done;
-	char detail[48];
-	snprintf(detail, sizeof detail, " (last: %g deg %s)", t->beta,
-		 t->rotation == SIM_CW ? "cw" : "ccw");
+	snprintf(detail, sizeof detail, " (last: %s)",
+		 describe_task(pl->st, (size_t)pl->run[k], what, sizeof what));
 	cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
 }
 
-/* The grid (rotation-major, like the daemon's) and its plan: which tasks
- * to measure (pl->run, pl->n) and which to take as mirror images of
- * another (sim_mirror_plan). -1 when out of memory. */
-static int plan_sweep(const cli_opts *o, task *tasks, int ntasks, double from, double step, int nb,
-		      const int *rots, pool *pl)
+/* Task k's beta in degrees: its axis value, else the model's. */
+static double task_beta(const pool *pl, size_t k)
 {
-	double *beta = calloc((size_t)ntasks, sizeof(double));
-	int *rot = calloc((size_t)ntasks, sizeof(int));
-	long *source = calloc((size_t)ntasks, sizeof(long));
-	int rc = beta && rot && source ? 0 : -1;
-	for (int k = 0; rc == 0 && k < ntasks; k++) {
-		tasks[k].beta = from + step * (k % nb);
-		tasks[k].rotation = rots[k / nb];
-		beta[k] = tasks[k].beta * RAD_PER_DEG;
-		rot[k] = tasks[k].rotation;
-	}
-	if (rc == 0) {
-		sim_mirror_plan(&o->p, &o->sc, (size_t)ntasks, beta, rot, source);
-		for (int k = 0; k < ntasks; k++) {
-			tasks[k].source = source[k];
-			if (source[k] < 0)
-				pl->run[pl->n++] = k;
-		}
-	}
-	free(beta);
-	free(rot);
-	free(source);
-	return rc;
+	const sim_study *st = pl->st;
+	for (size_t a = 0; a < st->naxes; a++)
+		if (strcmp(st->axis[a].setting->name, "beta") == 0)
+			return sim_study_value(st, k % st->npoints, a);
+	return sim_table_user("beta", pl->o->p.beta);
 }
 
 /* Fill every mirrored task from the task it mirrors (after the runs). */
-static void mirror_tasks(task *tasks, int ntasks)
+static void mirror_tasks(const pool *pl, int ntasks)
 {
 	for (int k = 0; k < ntasks; k++) {
-		task *t = &tasks[k];
+		task *t = &pl->tasks[k];
 		if (t->source < 0)
 			continue;
-		const task *src = &tasks[t->source];
+		const task *src = &pl->tasks[t->source];
 		sim_mirror_measurement(&src->r, &t->r);
 		t->err = src->err;
 		if (src->err != SIM_OK)
-			sim_mirror_failure(t->msg, sizeof t->msg, src->beta, src->rotation, src->msg);
+			sim_mirror_failure(t->msg, sizeof t->msg, task_beta(pl, (size_t)t->source),
+					   pl->st->rotation[(size_t)t->source / pl->st->npoints],
+					   src->msg);
 	}
 }
 
-/* The sweep's table (CSV with the daemon's header, or JSON with the
- * daemon's point members) on f; failures on stderr. Returns the number of
- * failed points. */
+/* The JSON table's head: the run's settings, the varied settings (name,
+ * unit, range or list), the sample, the reductions. */
+static void print_json_head(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
+{
+	const sim_study *st = pl->st;
+	cli_put_json_num(f, "{\"duration\":", o->duration);
+	cli_put_json_num(f, ",\"transient\":", o->sc.transient);
+	fprintf(f, ",\"method\":\"%s\",\"vary\":[", o->m.name);
+	for (size_t a = 0; a < st->naxes; a++) {
+		const sim_study_axis *ax = &st->axis[a];
+		fprintf(f, "%s{\"name\":\"%s\",\"unit\":\"%s\",", a ? "," : "", ax->setting->name,
+			ax->setting->unit);
+		if (ax->step > 0) {
+			cli_put_json_num(f, "\"from\":", ax->from);
+			cli_put_json_num(f, ",\"to\":", ax->to);
+			cli_put_json_num(f, ",\"step\":", ax->step);
+		} else {
+			fputs("\"values\":[", f);
+			for (size_t k = 0; k < ax->n; k++)
+				cli_put_json_num(f, k ? "," : "", ax->values[k]);
+			fputc(']', f);
+		}
+		fputc('}', f);
+	}
+	fputc(']', f);
+	if (st->lhs)
+		fprintf(f, ",\"lhs\":%zu,\"seed\":%.0f", st->lhs, (double)st->seed);
+	fprintf(f, ",\"reductions\":[%s],\"points\":[\n", pl->n < ntasks ? "\"mirror\"" : "");
+}
+
+/* The sweep's table (CSV: the varied settings, then the daemon's point
+ * columns; or JSON with the daemon's point members, the varied settings
+ * first) on f; failures on stderr. Returns the number of failed points. */
 static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 {
+	const sim_study *st = pl->st;
 	int json = o->format && strcmp(o->format, "json") == 0, failed = 0;
 	if (json) {
-		fputs("{\"duration\":", f);
-		cli_put_num(f, o->duration, "null");
-		fputs(",\"transient\":", f);
-		cli_put_num(f, o->sc.transient, "null");
-		fprintf(f, ",\"method\":\"%s\",\"reductions\":[%s],\"points\":[\n", o->m.name,
-			pl->n < ntasks ? "\"mirror\"" : "");
+		print_json_head(f, o, pl, ntasks);
 	} else {
-		fputs(SIM_SWEEP_CSV_HEADER "\n", f);
+		for (size_t a = 0; a < st->naxes; a++)
+			fprintf(f, "%s,", st->axis[a].setting->name);
+		fputs(SIM_SWEEP_POINT_COLUMNS "\n", f);
 	}
 	for (int i = 0; i < ntasks; i++) {
 		const task *t = &pl->tasks[i];
-		const char *rot = t->rotation == SIM_CW ? "cw" : "ccw";
+		const char *rot = st->rotation[(size_t)i / st->npoints] == SIM_CW ? "cw" : "ccw";
 		const char *state = t->err == SIM_OK ? "done" : "failed";
 		const char *steady = t->r.steady ? "true" : "false";
 		if (t->err != SIM_OK) {
+			char what[200];
 			failed++;
-			fprintf(stderr, "convsim sweep: beta %g %s: %s\n", t->beta, rot, t->msg);
+			fprintf(stderr, "convsim sweep: %s: %s\n",
+				describe_task(st, (size_t)i, what, sizeof what), t->msg);
 		}
 		const char *nf = json ? "null" : "";
-		fputs(json ? "{\"beta\":" : "", f);
-		cli_put_num(f, t->beta, nf);
-		fprintf(f, json ? ",\"rotation\":\"%s\",\"velocity\":" : ",%s,", rot);
+		fputs(json ? "{" : "", f);
+		for (size_t a = 0; a < st->naxes; a++) {
+			if (json)
+				fprintf(f, "\"%s\":", st->axis[a].setting->name);
+			cli_put_num(f, sim_study_value(st, (size_t)i % st->npoints, a), nf);
+			fputc(',', f);
+		}
+		fprintf(f, json ? "\"rotation\":\"%s\",\"velocity\":" : "%s,", rot);
 		cli_put_num(f, t->r.transport_velocity, nf);
 		fputs(json ? ",\"uncertainty\":" : ",", f);
 		cli_put_num(f, t->r.uncertainty, nf);
@@ -173,6 +212,61 @@ static int parse_beta(const char *text, double *from, double *to, double *step)
 	return 0;
 }
 
+/* One --vary NAME=FROM:TO:STEP or NAME=V1,V2,... (or NAME=V) as an axis
+ * of st, checked by the study (name, range); 0 or -1 after a message. */
+static int add_vary(sim_study *st, const cli_opts *o, const char *text)
+{
+	const char *eq = strchr(text, '=');
+	char name[64], msg[240], hint[96] = "";
+	double v[3];
+	int rc = SIM_EPARAM;
+	if (!eq || eq == text || (size_t)(eq - text) >= sizeof name) {
+		fprintf(stderr, "convsim sweep: --vary needs NAME=FROM:TO:STEP or NAME=V1,V2,..., "
+				"got '%s'\n",
+			text);
+		return -1;
+	}
+	snprintf(name, sizeof name, "%.*s", (int)(eq - text), text);
+	const char *spec = eq + 1;
+	char tail;
+	if (strchr(spec, ':')) {
+		if (sscanf(spec, "%lf:%lf:%lf%c", &v[0], &v[1], &v[2], &tail) == 3)
+			rc = sim_study_add_range(st, &o->p, &o->sc, &o->m, name, v[0], v[1], v[2],
+						 msg, sizeof msg);
+		else
+			snprintf(msg, sizeof msg, "a range is FROM:TO:STEP, three numbers");
+	} else {
+		size_t n = 1;
+		for (const char *c = spec; *c; c++)
+			n += *c == ',';
+		double *list = calloc(n, sizeof(double));
+		char *copy = strdup(spec);
+		size_t k = 0;
+		int ok = list && copy;
+		char *save = NULL;
+		for (char *tok = ok ? strtok_r(copy, ",", &save) : NULL; ok && tok;
+		     tok = strtok_r(NULL, ",", &save))
+			ok = sscanf(tok, "%lf%c", &list[k++], &tail) == 1;
+		if (ok && k == n)
+			rc = sim_study_add_list(st, &o->p, &o->sc, &o->m, name, list, n, msg,
+						sizeof msg);
+		else
+			snprintf(msg, sizeof msg, "a list is numbers separated by commas");
+		free(list);
+		free(copy);
+	}
+	if (rc == SIM_OK)
+		return 0;
+	if (rc == SIM_EUNKNOWN && !sim_setting_find(name)) {
+		size_t nset;
+		const sim_setting *t = sim_settings(&nset);
+		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, nset, sizeof *t));
+	}
+	fprintf(stderr, "convsim sweep: --vary %s: %s%s; 'convsim list' shows every setting\n", text,
+		msg, hint);
+	return -1;
+}
+
 /* --rotation cw, ccw, cw,ccw (or ccw,cw) into rots; the count or -1. */
 static int parse_rotation(const char *text, int rots[2])
 {
@@ -200,6 +294,81 @@ static int parse_rotation(const char *text, int rots[2])
 	return n ? n : -1;
 }
 
+/* --beta TEXT as the axis beta (the shorthand's own message for a bad
+ * range); 0 or -1 after a message. */
+static int add_beta(sim_study *st, const cli_opts *o, const char *text)
+{
+	double from, to, step;
+	char msg[240];
+	if (parse_beta(text, &from, &to, &step))
+		return -1;
+	if (sim_study_add_range(st, &o->p, &o->sc, &o->m, "beta", from, to, step, msg,
+				sizeof msg) != SIM_OK) {
+		fprintf(stderr, "convsim sweep: --beta %s: %s\n", text, msg);
+		return -1;
+	}
+	return 0;
+}
+
+/* The study of the options: --beta (default 0:180:10 when nothing is
+ * varied) and every --vary in the order given, --lhs, --seed, the senses, planned.
+ * 0, or 2 after a message. */
+static int plan_study(const cli_opts *o, sim_study *st)
+{
+	int nrot;
+	if ((nrot = parse_rotation(o->rotation, st->rotation)) < 0)
+		return 2;
+	st->nrot = (size_t)nrot;
+	st->lhs = (size_t)o->lhs;
+	st->seed = (uint64_t)o->seed;
+	const char *beta = o->beta ? o->beta : o->nvary ? NULL : "0:180:10";
+	char msg[240];
+	for (int i = 0; i <= o->nvary; i++) {
+		if (beta && i == o->beta_at && add_beta(st, o, beta))
+			return 2;
+		if (i < o->nvary && add_vary(st, o, o->vary[i]))
+			return 2;
+	}
+	if (o->lhs && !o->nvary) {
+		fprintf(stderr, "convsim sweep: --lhs samples the --vary ranges; give at least one "
+				"--vary\n");
+		return 2;
+	}
+	if (sim_study_plan(st, msg, sizeof msg) != SIM_OK) {
+		fprintf(stderr, "convsim sweep: %s\n", msg);
+		return 2;
+	}
+	return 0;
+}
+
+/* Measure the study's tasks on o->threads threads, the mirror images
+ * derived after; the closing progress line. 0, or 1 out of memory. */
+static int measure_study(const cli_opts *o, pool *pl, int ntasks)
+{
+	long *source = calloc((size_t)ntasks, sizeof(long));
+	if (!source || sim_study_mirror_plan(pl->st, &o->p, &o->sc, &o->m, source) == (size_t)-1) {
+		free(source);
+		return 1;
+	}
+	for (int k = 0; k < ntasks; k++) {
+		pl->tasks[k].source = source[k];
+		if (source[k] < 0)
+			pl->run[pl->n++] = k;
+	}
+	free(source);
+	cli_progress_start(&pl->progress, "sweep", o->quiet, 0);
+	pmap_run(o->threads, (size_t)pl->n, measure_task, pl, task_done);
+	mirror_tasks(pl, ntasks);
+	char done[128];
+	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl->done, pl->n,
+		 cli_now() - pl->progress.t0);
+	if (pl->n < ntasks)
+		snprintf(done + strlen(done), sizeof done - strlen(done),
+			 "; %d more as their mirror images (mirror reduction)", ntasks - pl->n);
+	cli_progress_end(&pl->progress, done, 1);
+	return 0;
+}
+
 int cli_cmd_sweep(int argc, char **argv)
 {
 	cli_opts o = {0};
@@ -212,40 +381,27 @@ int cli_cmd_sweep(int argc, char **argv)
 			o.duration, o.sc.transient);
 		return 2;
 	}
-	double from, to, step;
-	int rots[2], nrot;
-	if (parse_beta(o.beta, &from, &to, &step) || (nrot = parse_rotation(o.rotation, rots)) < 0)
-		return 2;
-	int nb = (int)floor((to - from) / step + 1e-9) + 1;
-	if (nb > 10000) {
-		fprintf(stderr, "convsim sweep: --beta %s gives %d angles; at most 10000\n", o.beta,
-			nb);
-		return 2;
+	sim_study st = {0};
+	if ((rc = plan_study(&o, &st)) != 0) {
+		sim_study_free(&st);
+		return rc;
 	}
 	FILE *out = stdout;
-	if (o.out && !(out = cli_open_out(&o)))
-		return 1;
-	int ntasks = nb * nrot;
-	pool pl = {.o = &o};
-	pl.tasks = calloc((size_t)ntasks, sizeof(task));
-	pl.run = calloc((size_t)ntasks, sizeof(int));
-	if (!pl.tasks || !pl.run || plan_sweep(&o, pl.tasks, ntasks, from, step, nb, rots, &pl)) {
-		free(pl.tasks);
-		free(pl.run);
+	if (o.out && !(out = cli_open_out(&o))) {
+		sim_study_free(&st);
 		return 1;
 	}
-	cli_progress_start(&pl.progress, "sweep", o.quiet, 0);
-	pmap_run(o.threads, (size_t)pl.n, measure_task, &pl, task_done);
-	mirror_tasks(pl.tasks, ntasks);
-	char done[128];
-	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl.done, pl.n,
-		 cli_now() - pl.progress.t0);
-	if (pl.n < ntasks)
-		snprintf(done + strlen(done), sizeof done - strlen(done),
-			 "; %d more as their mirror images (mirror reduction)", ntasks - pl.n);
-	cli_progress_end(&pl.progress, done, 1);
-	int failed = print_sweep(out, &o, &pl, ntasks);
-	int write_failed = 0;
+	int ntasks = (int)sim_study_tasks(&st);
+	pool pl = {.o = &o, .st = &st};
+	pl.tasks = calloc((size_t)ntasks, sizeof(task));
+	pl.run = calloc((size_t)ntasks, sizeof(int));
+	int failed = 0, write_failed = 0;
+	if (!pl.tasks || !pl.run || measure_study(&o, &pl, ntasks)) {
+		fprintf(stderr, "convsim sweep: out of memory\n");
+		failed = 1;
+	} else {
+		failed = print_sweep(out, &o, &pl, ntasks);
+	}
 	if (out != stdout) {
 		write_failed = ferror(out) | (fclose(out) != 0);
 		if (write_failed)
@@ -253,5 +409,6 @@ int cli_cmd_sweep(int argc, char **argv)
 	}
 	free(pl.tasks);
 	free(pl.run);
+	sim_study_free(&st);
 	return failed || write_failed ? 1 : 0;
 }

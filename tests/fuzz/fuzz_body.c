@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "fuzz_util.h"
+#include "units.h"
 
 #ifndef FUZZ_BODY
 #error "build with -DFUZZ_BODY='\"session\"' (or control, experiment, sweep)"
@@ -206,14 +207,29 @@ static void sweep_body(const char *body, size_t len)
 	api_problem pb;
 	api_err e = api_parse_sweep(body, len, &req, &pb);
 	if (e != API_OK) {
-		FUZZ_CHECK(!req.betas, "a refused sweep keeps its betas");
+		FUZZ_CHECK(!req.betas && !req.values, "a refused sweep keeps its betas or values");
 		fuzz_check_problem(e, &pb);
 		return;
 	}
 	FUZZ_CHECK(req.nbeta >= 1 && req.nbeta * req.nrot <= API_SWEEP_MAX_POINTS &&
 			   req.nrot >= 1 && req.nrot <= 2 &&
-			   req.t_end > req.spec.scene.transient,
-		   "sweep of %d x %d points, t_end %g", req.nbeta, req.nrot, req.t_end);
+			   req.t_end > req.spec.scene.transient &&
+			   req.nvary >= 1 && req.nvary <= SIM_STUDY_MAX_AXES && req.values,
+		   "sweep of %d x %d points, t_end %g, %d varied", req.nbeta, req.nrot, req.t_end,
+		   req.nvary);
+	/* a study over other settings: every value within its setting's range */
+	for (int k = 0; k < req.nbeta; k++)
+		for (int a = 0; a < req.nvary; a++) {
+			const sim_setting *t = sim_setting_find(req.vary[a]);
+			double u = req.values[(size_t)k * (size_t)req.nvary + (size_t)a];
+			FUZZ_CHECK(t && u >= t->min && u <= t->max, "%s = %g outside its range",
+				   req.vary[a], u);
+		}
+	free(req.values);
+	if (req.nvary != 1 || strcmp(req.vary[0], "beta") != 0) {
+		free(req.betas);
+		return; /* the round trip below is the plain v(beta) sweep's */
+	}
 	char *text = sweep_text(&req);
 	e = api_parse_sweep(text, strlen(text), &again, &pb);
 	FUZZ_CHECK(e == API_OK, "sweep written back is refused: %s\n%.2000s", pb.detail, text);
@@ -232,6 +248,7 @@ static void sweep_body(const char *body, size_t len)
 	free(text);
 	free(req.betas);
 	free(again.betas);
+	free(again.values);
 }
 
 /* POST /fits: a refused request keeps no points and is a well-formed

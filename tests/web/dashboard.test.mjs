@@ -362,6 +362,46 @@ test('a sweep draws v(β) for both rotations', async () => {
 	assert.equal(plot.length, 7);
 });
 
+test('a study over two settings draws a map of v per rotation, its bars on hover; over one, curves over it', async () => {
+	await page.fill('#sweep-form input[name="t_end"]', '0.5');
+	await page.fill('#sweep-form input[name="vary"]', 'mu=0.3,0.9; beta=30:150:60');
+	await page.click('#sweep-run');
+	const cellsOf = rot => page.$$eval(`#sweep-map .heatmap[data-rotation="${rot}"] .cell`,
+		c => c.map(x => ({ title: x.title, v: Number(x.dataset.v), bg: x.style.background })));
+	await until(async () => (await page.$$eval('#sweep-map .cell[data-v]', c => c.length)) === 12, 60000, 'a map of 2 x 3 points per rotation');
+	assert.equal(await visible('#plot-sweep'), false, 'the map in place of the curves');
+	/* the cells are the daemon's points: mu down, beta across */
+	const href = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
+	const study = (await (await fetch(base + href.replace('?format=csv', ''), { headers: AUTH })).json());
+	assert.deepEqual(study.vary.map(a => a.name), ['mu', 'beta']);
+	for (const rot of ['cw', 'ccw']) {
+		const cells = await cellsOf(rot);
+		const points = study.points.filter(p => p.rotation === rot);
+		assert.equal(cells.length, 6);
+		cells.forEach((c, i) => {
+			const p = points[i];
+			assert.equal(c.v, p.velocity, `${rot} cell ${i}`);
+			assert.equal(c.title, `mu = ${p.mu}, beta = ${p.beta}, ${rot}: v = ${p.velocity.toFixed(4)} ± ${p.uncertainty.toFixed(4)} m/s`);
+			/* red for v > 0, blue for v < 0 */
+			assert.match(c.bg, p.velocity > 0 ? /^rgb\(255, / : /, 255\)$/, `${rot} cell ${i}: ${c.bg} for v = ${p.velocity}`);
+		});
+	}
+	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));
+	assert.equal(rows.length, 12);
+	assert.deepEqual(rows[0].slice(0, 3), ['0.3', '30', 'cw']);
+	const csv = (await (await fetch(base + href, { headers: AUTH })).text()).split('\n');
+	assert.equal(csv[0], 'mu,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+	/* one setting: v against it, a curve per rotation */
+	await page.fill('#sweep-form input[name="vary"]', 'mu=0.3,0.6,0.9,1.2');
+	await page.click('#sweep-run');
+	await until(async () => await visible('#plot-sweep') && await count('#plot-sweep') === 8, 60000, 'the curves over mu');
+	assert.equal(await visible('#sweep-map'), false);
+	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
+	assert.equal(plot[0], 'series,mu,transport velocity v / (m/s),error');
+	assert.deepEqual(plot.slice(1, 5).map(l => l.split(',')[1]), ['0.3', '0.6', '0.9', '1.2']);
+	await page.fill('#sweep-form input[name="vary"]', '');
+});
+
 test('the calibration panel: pasted points, a fit, data with fitted and original curves', async () => {
 	assert.equal(await visible('#fit-csv'), false, 'no fit CSV link before a fit');
 	/* a refused CSV: the daemon's detail, nothing started */

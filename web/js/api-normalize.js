@@ -303,13 +303,18 @@ function stateOf(raw, F) {
 
 /* v(beta) points of a sweep, flattened to [{beta, rotation, v}], with u
  * (the error bar, m/s) and steady where the daemon gives them. Accepts a
- * list of points or an object keyed by rotation holding lists or columns. */
-export function sweepPoints(results) {
+ * list of points or an object keyed by rotation holding lists or columns.
+ * A study's points (vary names other settings) carry `at`: each varied
+ * setting's value by name. */
+export function sweepPoints(results, vary = ['beta']) {
 	const out = [];
+	const study = vary.some(n => n !== 'beta');
 	const push = (beta, rotation, v, p) => {
 		const b = num(beta);
-		if (!Number.isFinite(b)) return;
+		if (!Number.isFinite(b) && !study) return;
 		const point = { beta: b, rotation: rotationName(rotation), v: num(v) };
+		/* a study's point: its value of each varied setting */
+		if (study && p) point.at = Object.fromEntries(vary.map(n => [n, num(p[n])]));
 		if (p && 'uncertainty' in p) point.u = num(p.uncertainty);
 		if (p && typeof p.steady === 'boolean') point.steady = p.steady;
 		out.push(point);
@@ -330,6 +335,12 @@ export function sweepPoints(results) {
 	return out.filter(p => p.rotation);
 }
 
+/* The varied settings' names of a sweep (["beta"] for a plain one). */
+function sweepVary(raw) {
+	const v = raw && Array.isArray(raw.vary) ? raw.vary.map(a => a && a.name).filter(n => typeof n === 'string') : [];
+	return v.length ? v : ['beta'];
+}
+
 export function normalizeSweep(raw) {
 	const F = FIELDS.sweep;
 	const state = stateOf(raw, F);
@@ -337,7 +348,8 @@ export function normalizeSweep(raw) {
 		id: pick(raw, F.id) !== undefined ? String(pick(raw, F.id)) : undefined,
 		state,
 		progress: progressOf(raw, F),
-		points: sweepPoints(pick(raw, F.results)),
+		vary: sweepVary(raw),
+		points: sweepPoints(pick(raw, F.results), sweepVary(raw)),
 		done: isFinished(state),
 		failed: isFailed(state),
 		error: raw && (raw.error ?? raw.detail),

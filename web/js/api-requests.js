@@ -53,10 +53,29 @@ function jobModel(f) {
 	return body;
 }
 
-/* POST /sweeps: the session form's model, a beta grid, both rotations. */
+/* A study's settings as the form takes them, "mu=0.2:1.2:0.2; beta=0,90":
+ * {NAME: {from, to, step}} for a range, {NAME: [v, ...]} for a list, or
+ * null when empty. A value that is not a number goes as null, which the
+ * daemon refuses naming the member. */
+export function parseVary(text) {
+	const vary = {};
+	for (const part of String(text || '').split(/[;\s]+/).filter(Boolean)) {
+		const eq = part.indexOf('=');
+		const name = eq > 0 ? part.slice(0, eq) : part;
+		const spec = eq > 0 ? part.slice(eq + 1) : '';
+		const nums = spec.split(spec.includes(':') ? ':' : ',').map(x => (x.trim() === '' ? NaN : Number(x)));
+		vary[name] = spec.includes(':') ? { from: nums[0], to: nums[1], step: nums[2] } : nums;
+	}
+	return Object.keys(vary).length ? vary : null;
+}
+
+/* POST /sweeps: the session form's model, a beta grid (or the study of
+ * the form's vary), both rotations. */
 export function sweepRequest(f) {
 	const body = jobModel(f);
-	body.beta = { from: f.from, to: f.to, step: f.step };
+	const vary = parseVary(f.vary);
+	if (vary) body.vary = vary;
+	else body.beta = { from: f.from, to: f.to, step: f.step };
 	body.rotations = ['cw', 'ccw'];
 	body.t_end = f.tEnd;
 	return body;

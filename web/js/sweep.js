@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * sweep.js - the sweep panel: runs v(beta) for both rotations on the
- * new-session form's model, follows its progress, and shows the plot (with
- * each point's error bar), the table (v, its error bar u, steady or
- * settling) and the CSV link.
+ * new-session form's model, or a study over the settings of its "vary"
+ * field, follows its progress, and shows the plot (with each point's error
+ * bar; a study over one setting as curves over it), a study over two
+ * settings as a map of v per rotation (each cell's title: v and its error
+ * bar), the table (v, its error bar u, steady or settling) and the CSV
+ * link.
  */
 
 import * as api from './api.js';
@@ -15,7 +18,7 @@ export async function runSweep(ev) {
 	ev.preventDefault();
 	const f = $('#sweep-form').elements;
 	const base = readSessionForm();
-	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end) };
+	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end), vary: f.vary.value };
 	const btn = $('#sweep-run');
 	const box = $('#sweep-progress');
 	busy(btn, true);
@@ -51,6 +54,14 @@ function showSweep(j) {
 		csv.href = api.sweepCsvUrl(j.id);
 		csv.download = `sweep-${j.id}.csv`;
 	}
+	const vary = j.vary || ['beta'];
+	const map = $('#sweep-map');
+	map.hidden = vary.length !== 2;
+	$('#plot-sweep').hidden = vary.length === 2;
+	if (vary.length === 2) drawMaps(map, j.points, vary);
+	if (vary.length === 1 && vary[0] !== 'beta') return showCurves(j.points, vary[0]);
+	if (vary.length !== 1) return showStudyTable(j.points, vary);
+	setXLabel('β / °');
 	const by = rot => j.points.filter(p => p.rotation === rot).sort((a, b) => a.beta - b.beta);
 	const cw = by('cw'), ccw = by('ccw');
 	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]],
@@ -68,10 +79,94 @@ function showSweep(j) {
 		for (const p of [cw.find(q => q.beta === b), ccw.find(q => q.beta === b)]) {
 			row.insertCell().textContent = fmt(p?.v, 4);
 			row.insertCell().textContent = fmt(p?.u, 4);
-			const mark = row.insertCell();
-			mark.textContent = steadyLabel(Number.isFinite(p?.v) ? p.steady : undefined);
-			mark.className = 'steady-mark';
-			mark.dataset.steady = mark.textContent;
+			addSteady(row, p);
 		}
+	}
+}
+
+/* The steady / settling mark of point p in a new cell of row. */
+function addSteady(row, p) {
+	const mark = row.insertCell();
+	mark.textContent = steadyLabel(Number.isFinite(p?.v) ? p.steady : undefined);
+	mark.className = 'steady-mark';
+	mark.dataset.steady = mark.textContent;
+}
+
+/* The plot's x axis names what it is over (and its CSV export's column). */
+function setXLabel(label) {
+	const plot = app.plots.sweep;
+	if (plot.labels[0] === label) return;
+	plot.labels[0] = label;
+	plot.plot.axes[0].label = label;
+	plot.plot.redraw(false, true);
+}
+
+/* A study over one setting: v against it, one curve per rotation. */
+function showCurves(points, name) {
+	setXLabel(name);
+	const by = rot => points.filter(p => p.rotation === rot).sort((a, b) => a.at[name] - b.at[name]);
+	const cw = by('cw'), ccw = by('ccw');
+	app.plots.sweep.setData([[cw.map(p => p.at[name]), cw.map(p => p.v)], [ccw.map(p => p.at[name]), ccw.map(p => p.v)]],
+		[cw.map(p => p.u), ccw.map(p => p.u)]);
+	showStudyTable(points, [name]);
+}
+
+/* A study's table: the varied settings, the rotation, v, u, steady. */
+function showStudyTable(points, vary) {
+	const table = $('#sweep-table');
+	table.replaceChildren();
+	const head = table.createTHead().insertRow();
+	for (const h of [...vary, 'rotation', 'v / (m/s)', '± u', ''])
+		head.append(Object.assign(document.createElement('th'), { textContent: h }));
+	const body = table.createTBody();
+	for (const p of points) {
+		const row = body.insertRow();
+		for (const n of vary) row.insertCell().textContent = String(p.at?.[n]);
+		row.insertCell().textContent = p.rotation;
+		row.insertCell().textContent = fmt(p.v, 4);
+		row.insertCell().textContent = fmt(p.u, 4);
+		addSteady(row, p);
+	}
+}
+
+/* The colour of v on a scale symmetric about 0 (blue < 0 < red), vmax
+ * its largest magnitude; grey when there is no v. */
+function colourOf(v, vmax) {
+	if (!Number.isFinite(v)) return '#e5e7eb';
+	const t = vmax > 0 ? Math.min(1, Math.abs(v) / vmax) : 0;
+	const c = Math.round(255 * (1 - t));
+	return v >= 0 ? `rgb(255,${c},${c})` : `rgb(${c},${c},255)`;
+}
+
+/* A study over two settings: per rotation, a grid of cells, the first
+ * setting down, the second across, each coloured by v, its title naming
+ * the point and v with its error bar. */
+function drawMaps(box, points, [rowName, colName]) {
+	box.replaceChildren();
+	const values = n => [...new Set(points.map(p => p.at[n]))].sort((a, b) => a - b);
+	const rows = values(rowName), cols = values(colName);
+	const vmax = Math.max(0, ...points.map(p => Math.abs(p.v)).filter(Number.isFinite));
+	for (const rot of ['cw', 'ccw']) {
+		const mine = points.filter(p => p.rotation === rot);
+		if (!mine.length) continue;
+		const grid = Object.assign(document.createElement('div'), { className: 'heatmap' });
+		grid.dataset.rotation = rot;
+		grid.style.gridTemplateColumns = `auto repeat(${cols.length}, 1fr)`;
+		grid.append(Object.assign(document.createElement('div'), { className: 'title',
+			textContent: `v / (m/s), ${rot === 'cw' ? 'clockwise' : 'counter-clockwise'}: ${rowName} down, ${colName} across` }));
+		grid.append(Object.assign(document.createElement('div'), { className: 'label' }));
+		for (const c of cols) grid.append(Object.assign(document.createElement('div'), { className: 'label', textContent: String(c) }));
+		for (const r of rows) {
+			grid.append(Object.assign(document.createElement('div'), { className: 'label', textContent: String(r) }));
+			for (const c of cols) {
+				const p = mine.find(q => q.at[rowName] === r && q.at[colName] === c);
+				const cell = Object.assign(document.createElement('div'), { className: 'cell' });
+				cell.style.background = colourOf(p?.v, vmax);
+				cell.title = `${rowName} = ${r}, ${colName} = ${c}, ${rot}: v = ${fmt(p?.v, 4)} ± ${fmt(p?.u, 4)} m/s`;
+				if (p && Number.isFinite(p.v)) cell.dataset.v = String(p.v);
+				grid.append(cell);
+			}
+		}
+		box.append(grid);
 	}
 }

@@ -1,0 +1,210 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * study_json.c - the varied settings of a sweep request: "vary" (each
+ * member a number setting by name with {"from","to","step"} or a list of
+ * values, in its user unit), "lhs" and "seed", checked and planned by the
+ * core's study (core/study.h) into the request's points; a plain v(beta)
+ * sweep as the study over beta alone. A 4xx names the member ("vary.mu",
+ * "lhs") and, for a setting, its range; nothing is kept then.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "json_int.h"
+#include "suggest.h"
+#include "units.h"
+
+static const char *const range_members[] = {"from", "to", "step", NULL};
+
+/* A study's refusal of member `field` (setting `name`) as a problem: an
+ * unknown name with the nearest one, a setting that is not a number as
+ * an invalid value, a value out of range with the range (api_fail adds it
+ * for a field ending in a setting's name). */
+static api_err study_problem(int rc, const char *field, const char *name, const char *msg,
+			     api_problem *pb)
+{
+	const sim_setting *t = sim_setting_find(name);
+	if (rc == SIM_ENOMEM)
+		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+	if (!t) {
+		size_t n;
+		const sim_setting *all = sim_settings(&n);
+		const char *near = sim_suggest(name, &all->name, n, sizeof *all);
+		return api_fail(pb, API_UNKNOWN, field,
+				"%s: unknown setting \"%s\"%s%s%s; GET /api/v1/presets lists the settings",
+				field, name, near ? " (did you mean \"" : "", near ? near : "",
+				near ? "\"?)" : "");
+	}
+	int number = (t->kind == SIM_KIND_REAL || t->kind == SIM_KIND_INT) &&
+		     strcmp(name, "rotation") != 0;
+	api_fail(pb, number ? API_RANGE : API_INVALID, field, "%s: %s", field, msg);
+	if (number) { /* "vary" is no settings group: the range is added here */
+		pb->has_range = 1;
+		pb->min = t->min;
+		pb->max = t->max;
+	}
+	return pb->code;
+}
+
+/* One member of "vary" as an axis of st: {"from","to","step"} or a
+ * list of numbers, on the request's model. */
+static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *st,
+			  api_problem *pb)
+{
+	char field[96], msg[256] = "", sub[128];
+	const api_spec *sp = &req->spec;
+	snprintf(field, sizeof field, "vary.%.80s", it->string);
+	int rc;
+	if (cJSON_IsObject(it)) {
+		snprintf(sub, sizeof sub, "%s.", field);
+		api_err e = api_check_members(it, range_members, sub, pb);
+		if (e != API_OK)
+			return e;
+		double g[3];
+		for (int k = 0; k < 3; k++) {
+			const cJSON *v = cJSON_GetObjectItemCaseSensitive(it, range_members[k]);
+			if (!cJSON_IsNumber(v))
+				return api_fail(pb, API_TYPE, field, "%s.%s must be a number",
+						field, range_members[k]);
+			g[k] = v->valuedouble;
+		}
+		rc = sim_study_add_range(st, &sp->params, &sp->scene, &sp->method, it->string,
+					 g[0], g[1], g[2], msg, sizeof msg);
+	} else if (cJSON_IsArray(it)) {
+		int n = cJSON_GetArraySize(it), k = 0;
+		if (n < 1 || n > API_SWEEP_MAX_POINTS)
+			return api_fail(pb, API_RANGE, field, "%s must list 1 to %d values",
+					field, API_SWEEP_MAX_POINTS);
+		double *values = malloc((size_t)n * sizeof *values);
+		if (!values)
+			return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		for (const cJSON *v = it->child; v; v = v->next, k++) {
+			if (!cJSON_IsNumber(v)) {
+				free(values);
+				return api_fail(pb, API_TYPE, field, "%s[%d] must be a number",
+						field, k);
+			}
+			values[k] = v->valuedouble;
+		}
+		rc = sim_study_add_list(st, &sp->params, &sp->scene, &sp->method, it->string,
+					values, (size_t)n, msg, sizeof msg);
+		free(values);
+	} else {
+		return api_fail(pb, API_TYPE, field,
+				"%s must be {\"from\",\"to\",\"step\"} or an array of values",
+				field);
+	}
+	return rc == SIM_OK ? API_OK : study_problem(rc, field, it->string, msg, pb);
+}
+
+/* "lhs" (1 to API_SWEEP_MAX_POINTS points) and "seed" (0 to 2^32 - 1),
+ * whole numbers. */
+static api_err parse_sample(const cJSON *lhs, const cJSON *seed, sim_study *st,
+			    api_problem *pb)
+{
+	double v = 0;
+	api_err e = API_OK;
+	if (lhs) {
+		e = api_parse_real(lhs, "lhs", 1, API_SWEEP_MAX_POINTS, 0, &v, pb);
+		if (e == API_OK && v != floor(v))
+			e = api_fail(pb, API_RANGE, "lhs", "lhs must be a whole number of points");
+		st->lhs = (size_t)v;
+	}
+	st->seed = 1;
+	if (e == API_OK && seed) {
+		e = api_parse_real(seed, "seed", 0, 4294967295.0, 0, &v, pb);
+		if (e == API_OK && v != floor(v))
+			e = api_fail(pb, API_RANGE, "seed", "seed must be a whole number");
+		st->seed = (uint64_t)v;
+	}
+	return e;
+}
+
+/* The planned study into the request: its names, each point's values
+ * and beta (the axis's, else the model's), the sample. */
+static api_err take_study(const sim_study *st, api_sweep_req *req, api_problem *pb)
+{
+	size_t n = st->npoints, na = st->naxes;
+	api_value *betas = malloc((n ? n : 1) * sizeof *betas);
+	double *values = malloc((n * na > 0 ? n * na : 1) * sizeof *values);
+	if (!betas || !values) {
+		free(betas);
+		free(values);
+		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+	}
+	long beta_axis = -1;
+	req->nvary = (int)na;
+	for (size_t a = 0; a < na; a++) {
+		snprintf(req->vary[a], sizeof req->vary[a], "%s", st->axis[a].setting->name);
+		if (strcmp(req->vary[a], "beta") == 0)
+			beta_axis = (long)a;
+	}
+	memcpy(values, st->values, n * na * sizeof *values);
+	for (size_t k = 0; k < n; k++) {
+		if (beta_axis >= 0) {
+			betas[k].user = sim_study_value(st, k, (size_t)beta_axis);
+			betas[k].si = betas[k].user * RAD_PER_DEG;
+		} else {
+			betas[k].si = req->spec.params.beta;
+			betas[k].user = api_user_of("beta", betas[k].si);
+		}
+	}
+	free(req->betas);
+	req->betas = betas;
+	req->values = values;
+	req->nbeta = (int)n;
+	req->lhs = (int)st->lhs;
+	req->seed = (uint32_t)st->seed;
+	return API_OK;
+}
+
+api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
+			api_sweep_req *req, api_problem *pb)
+{
+	sim_study st = {0};
+	api_err e = API_OK;
+	if (!vary && (lhs || seed))
+		return api_fail(pb, API_INVALID, lhs ? "lhs" : "seed",
+				"%s samples the ranges of vary: give vary", lhs ? "lhs" : "seed");
+	if (vary && (!cJSON_IsObject(vary) || !vary->child))
+		return api_fail(pb, API_TYPE, "vary",
+				"vary must be an object of settings, each {\"from\",\"to\",\"step\"} "
+				"or an array of values");
+	/* beta first: the "beta" member's grid (for a plain sweep, the
+	 * study over beta alone) */
+	if (req->betas) {
+		double *user = malloc((size_t)req->nbeta * sizeof *user);
+		char msg[256] = "";
+		int rc = user ? SIM_OK : SIM_ENOMEM;
+		for (int k = 0; user && k < req->nbeta; k++)
+			user[k] = req->betas[k].user;
+		if (rc == SIM_OK)
+			rc = sim_study_add_list(&st, &req->spec.params, &req->spec.scene,
+						&req->spec.method, "beta", user, (size_t)req->nbeta,
+						msg, sizeof msg);
+		free(user);
+		if (rc != SIM_OK)
+			e = study_problem(rc, "beta", "beta", msg, pb);
+	}
+	for (const cJSON *it = vary ? vary->child : NULL; e == API_OK && it; it = it->next)
+		e = strcmp(it->string, "beta") == 0 && req->betas
+			    ? api_fail(pb, API_INVALID, "vary.beta",
+				       "beta is varied twice: as \"beta\" and as vary.beta")
+			    : parse_axis(it, req, &st, pb);
+	if (e == API_OK)
+		e = parse_sample(lhs, seed, &st, pb);
+	char msg[256] = "";
+	if (e == API_OK && sim_study_plan(&st, msg, sizeof msg) != SIM_OK)
+		e = api_fail(pb, API_RANGE, st.lhs ? "lhs" : "vary", "%s", msg);
+	if (e == API_OK && st.npoints * (size_t)req->nrot > API_SWEEP_MAX_POINTS)
+		e = api_fail(pb, API_RANGE, st.lhs ? "lhs" : "vary",
+			     "the study has %zu points (%zu per rotation sense); a sweep has at "
+			     "most %d",
+			     st.npoints * (size_t)req->nrot, st.npoints, API_SWEEP_MAX_POINTS);
+	if (e == API_OK)
+		e = take_study(&st, req, pb);
+	sim_study_free(&st);
+	return e;
+}
