@@ -145,16 +145,18 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
-	/* what a simulated second costs: the estimate from the integrator,
-	 * unless a short run of a copy (cpu_probe.c) measures more than twice
-	 * that (what grows with a large feed): then the measurement;
-	 * --cpu-probe 0: the estimate alone */
+	/* what a simulated second costs: the larger of the estimate from the
+	 * integrator and a short run of a copy (cpu_probe.c; what grows with
+	 * a large feed). A threshold (the measurement only beyond twice the
+	 * estimate) made a large scene's hold jump to the estimate when a
+	 * busy machine's probe fell just below it; --cpu-probe 0: the
+	 * estimate alone */
 	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
 	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
 							   cfg->cpu_probe)
 					   : -1.0;
-	if (probed > 2 * s->cpu_per_s)
+	if (probed > s->cpu_per_s)
 		s->cpu_per_s = probed;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
