@@ -390,7 +390,7 @@ typedef struct sim_status {
 				     scatter */
 	double step_error;        /* m/s: the steps' part of the uncertainty:
 				     the feed step's error measured on the run
-				     (the shadow's Richardson estimate, sim.c)
+				     (the shadow's Richardson estimate, shadow.c)
 				     plus the machine step's a-priori term;
 				     before a shadow has finished (or where none
 				     runs) the calibrated term of the preset */

@@ -30,7 +30,7 @@ struct sim {
 	estimator est;
 	double X0;
 	double *X0k;
-	/* the measured step error (sim.c, "shadow"): a second instance with
+	/* the measured step error (shadow.c): a second instance with
 	 * fewer feed sub-steps, restored from this one's checkpoint where an estimate
 	 * starts and stepped beside it until shadow_until; NULL when none
 	 * runs */

@@ -114,11 +114,12 @@ static double machine_step_error(const sim *s, double v)
 
 /* The peak |v| of a machine's curve, estimated from the trough's largest
  * vibration speed for tol's rule near v = 0 (docs/MODEL.md: relative to
- * the peak where |v| < 0.3 peak): on the zoo the peak is 0.5 to 1.2 times
- * that speed; the smaller share makes the rule the stricter. */
+ * the peak where |v| < 0.3 peak): on the zoo's machines at 25 Hz the
+ * peak is 0.64 to 0.72 times that speed (docs/machine-zoo.md); the
+ * smaller share makes the rule the stricter. */
 #define PEAK_SHARE 0.5
 
-/* The step error (the feed step's measured by the shadow, sim.c, plus the
+/* The step error (the feed step's measured by the shadow, shadow.c, plus the
  * machine step's a-priori term; before a shadow has finished the preset's
  * calibrated term), what tol allows, and whether the whole bar is within
  * it. */
