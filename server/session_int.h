@@ -28,6 +28,10 @@ struct srv_session {
 	sim *sim;                 /* worker only */
 	pthread_t worker;
 	int worker_started;
+	int first_applied;        /* its worker has applied what was due at its
+				     start (the controls logged after a restored
+				     checkpoint): srv_sessions_start_restored
+				     waits for it (lock) */
 	api_sample scratch;       /* worker only */
 
 	pthread_mutex_t lock;

@@ -520,6 +520,11 @@ void *srv_worker_main(void *arg)
 		start_job(s);
 		run_replay(s);
 		run_commands(s, &clk);
+		if (!s->first_applied) {
+			/* what was due at the start is in: the status shows it */
+			s->first_applied = 1;
+			pthread_cond_broadcast(&s->data);
+		}
 		check_caught_up(s, &clk);
 		if (s->stop)
 			break;
