@@ -6,16 +6,21 @@
  * rotation sense, one fresh sim_measure per point and sense on the
  * library's parallel map (pmap.h), the mirror reduction's images taken
  * from their sources. The table has the varied settings' columns, then
- * the daemon's point columns (core/table.h).
+ * the daemon's point columns (core/table.h). Under mpirun the points to
+ * measure are spread over the ranks (spread.h) and rank 0 writes the
+ * table, the same bytes as one process writes.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <fcntl.h>
 
 #include "cli.h"
 #include "pmap.h"
 #include "sim.h"
+#include "spread.h"
 #include "study.h"
 #include "suggest.h"
 #include "table.h"
@@ -33,9 +38,10 @@ typedef struct task {
 typedef struct pool {
 	const cli_opts *o;
 	const sim_study *st;
+	const cli_spread *sp;
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
-	int n, done;
+	int n, done; /* done: of this rank's share */
 	cli_progress progress;
 } pool;
 
@@ -57,11 +63,17 @@ static const char *describe_task(const sim_study *st, size_t k, char *buf, size_
 	return buf;
 }
 
-/* Measure the k-th task to run (a job of the map). */
-static void measure_task(void *arg, size_t k)
+/* The task of this rank's j-th job: the (rank + j ranks)-th to run. */
+static size_t share_task(const pool *pl, size_t j)
+{
+	return (size_t)pl->run[(size_t)pl->sp->rank + j * (size_t)pl->sp->ranks];
+}
+
+/* Measure this rank's j-th task (a job of the map). */
+static void measure_task(void *arg, size_t j)
 {
 	pool *pl = arg;
-	size_t i = (size_t)pl->run[k];
+	size_t i = share_task(pl, j);
 	task *t = &pl->tasks[i];
 	sim_params p = pl->o->p;
 	sim_scene sc = pl->o->sc;
@@ -72,14 +84,16 @@ static void measure_task(void *arg, size_t k)
 }
 
 /* The progress line after each task (the map calls it one at a time). */
-static void task_done(void *arg, size_t k, size_t done)
+static void task_done(void *arg, size_t j, size_t done)
 {
 	pool *pl = arg;
 	char what[200], detail[220];
 	pl->done = (int)done;
 	snprintf(detail, sizeof detail, " (last: %s)",
-		 describe_task(pl->st, (size_t)pl->run[k], what, sizeof what));
-	cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
+		 describe_task(pl->st, share_task(pl, j), what, sizeof what));
+	cli_progress_update(&pl->progress, pl->done,
+			    (double)cli_spread_share(pl->sp, (size_t)pl->n),
+			    pl->sp->ranks > 1 ? "points of rank 0's share" : "points", detail);
 }
 
 /* Task k's beta in degrees: its axis value, else the model's. */
@@ -341,12 +355,20 @@ static int plan_study(const cli_opts *o, sim_study *st)
 	return 0;
 }
 
-/* Measure the study's tasks on o->threads threads, the mirror images
- * derived after; the closing progress line. 0, or 1 out of memory. */
+/* Measure this rank's share of the study's tasks on o->threads threads,
+ * gather every rank's into point order on rank 0 (which derives the
+ * mirror images and closes the progress: rank 0 reports its own share
+ * while it runs, then the whole). 0, or 1 out of memory (before the
+ * measuring: every rank stops with it); an error in the gathering ends
+ * every rank (cli_spread_abort). */
 static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 {
 	long *source = calloc((size_t)ntasks, sizeof(long));
-	if (!source || sim_study_mirror_plan(pl->st, &o->p, &o->sc, &o->m, source) == (size_t)-1) {
+	int rc = !source || sim_study_mirror_plan(pl->st, &o->p, &o->sc, &o->m, source) ==
+				    (size_t)-1;
+	if (rc)
+		fprintf(stderr, "convsim sweep: out of memory\n");
+	if (cli_spread_agree(pl->sp, rc)) {
 		free(source);
 		return 1;
 	}
@@ -356,12 +378,20 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 			pl->run[pl->n++] = k;
 	}
 	free(source);
-	cli_progress_start(&pl->progress, "sweep", o->quiet, 0);
-	pmap_run(o->threads, (size_t)pl->n, measure_task, pl, task_done);
+	const cli_spread *sp = pl->sp;
+	cli_progress_start(&pl->progress, "sweep", o->quiet || sp->rank > 0, 0);
+	pmap_run(o->threads, cli_spread_share(sp, (size_t)pl->n), measure_task, pl, task_done);
+	if (cli_spread_gather(sp, pl->tasks, sizeof(task), pl->run, (size_t)pl->n))
+		cli_spread_abort(sp, 1);
+	if (sp->rank > 0)
+		return 0;
 	mirror_tasks(pl, ntasks);
-	char done[128];
-	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl->done, pl->n,
-		 cli_now() - pl->progress.t0);
+	char done[160];
+	snprintf(done, sizeof done, "%d/%d points in %.1f s", sp->ranks > 1 ? pl->n : pl->done,
+		 pl->n, cli_now() - pl->progress.t0);
+	if (sp->ranks > 1)
+		snprintf(done + strlen(done), sizeof done - strlen(done),
+			 " on %d ranks (%d on rank 0)", sp->ranks, pl->done);
 	if (pl->n < ntasks)
 		snprintf(done + strlen(done), sizeof done - strlen(done),
 			 "; %d more as their mirror images (mirror reduction)", ntasks - pl->n);
@@ -369,46 +399,97 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 	return 0;
 }
 
-int cli_cmd_sweep(int argc, char **argv)
+/* Point fds 1 and 2 at /dev/null (mute) or back (saved): the ranks but
+ * rank 0 parse and plan in silence, since every rank finds the same
+ * usage errors and rank 0 reports them; saved holds the originals. */
+static void mute_output(int mute, int saved[2])
 {
-	cli_opts o = {0};
-	int rc = cli_parse(argc, argv, CMD_SWEEP, &o);
+	if (mute) {
+		int null = open("/dev/null", O_WRONLY);
+		for (int fd = 1; fd <= 2; fd++) {
+			saved[fd - 1] = dup(fd);
+			if (null >= 0)
+				dup2(null, fd);
+		}
+		if (null >= 0)
+			close(null);
+		return;
+	}
+	fflush(stdout);
+	for (int fd = 1; fd <= 2; fd++)
+		if (saved[fd - 1] >= 0) {
+			dup2(saved[fd - 1], fd);
+			close(saved[fd - 1]);
+		}
+}
+
+/* The options parsed and checked, the study planned: 0, 2 (usage,
+ * reported) or -1 (help shown). */
+static int prepare(int argc, char **argv, cli_opts *o, sim_study *st)
+{
+	int rc = cli_parse(argc, argv, CMD_SWEEP, o);
 	if (rc)
-		return rc < 0 ? 0 : rc;
-	if (!(o.duration > o.sc.transient)) {
+		return rc;
+	if (!(o->duration > o->sc.transient)) {
 		fprintf(stderr, "convsim sweep: --duration (%g s) must exceed the scene's transient "
 				"(%g s): v is measured over [transient, duration]\n",
-			o.duration, o.sc.transient);
+			o->duration, o->sc.transient);
 		return 2;
 	}
+	return plan_study(o, st);
+}
+
+/* The sweep on this rank (spread.h): every rank parses, plans and
+ * measures its share; rank 0 alone opens --out and writes the table.
+ * The ranks agree on every early stop, so none waits for another. */
+static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
+{
+	cli_opts o = {0};
 	sim_study st = {0};
-	if ((rc = plan_study(&o, &st)) != 0) {
-		sim_study_free(&st);
-		return rc;
-	}
+	int saved[2] = {-1, -1}, rc;
+	if (sp->rank > 0)
+		mute_output(1, saved);
+	rc = prepare(argc, argv, &o, &st);
+	if (sp->rank > 0)
+		mute_output(0, saved);
 	FILE *out = stdout;
-	if (o.out && !(out = cli_open_out(&o))) {
-		sim_study_free(&st);
-		return 1;
+	if (rc == 0 && sp->rank == 0 && o.out && !(out = cli_open_out(&o))) {
+		out = stdout;
+		rc = 1;
 	}
-	int ntasks = (int)sim_study_tasks(&st);
-	pool pl = {.o = &o, .st = &st};
-	pl.tasks = calloc((size_t)ntasks, sizeof(task));
-	pl.run = calloc((size_t)ntasks, sizeof(int));
-	int failed = 0, write_failed = 0;
-	if (!pl.tasks || !pl.run || measure_study(&o, &pl, ntasks)) {
-		fprintf(stderr, "convsim sweep: out of memory\n");
-		failed = 1;
-	} else {
-		failed = print_sweep(out, &o, &pl, ntasks);
+	int ntasks = rc ? 0 : (int)sim_study_tasks(&st);
+	pool pl = {.o = &o, .st = &st, .sp = sp};
+	pl.tasks = calloc(ntasks ? (size_t)ntasks : 1, sizeof(task));
+	pl.run = calloc(ntasks ? (size_t)ntasks : 1, sizeof(int));
+	if (rc == 0 && (!pl.tasks || !pl.run)) {
+		fprintf(stderr, "convsim sweep: rank %d: out of memory\n", sp->rank);
+		rc = 1;
 	}
-	if (out != stdout) {
-		write_failed = ferror(out) | (fclose(out) != 0);
-		if (write_failed)
-			fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
+	if ((rc = cli_spread_agree(sp, rc)) != 0 || (rc = measure_study(&o, &pl, ntasks)) != 0 ||
+	    sp->rank > 0) {
+		rc = rc < 0 ? 0 : rc; /* -1: help shown */
+		goto done;
 	}
+	rc = print_sweep(out, &o, &pl, ntasks) ? 1 : 0;
+	if (out != stdout && (ferror(out) | (fclose(out) != 0))) {
+		fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
+		rc = 1;
+	}
+	out = stdout;
+done:
+	if (out != stdout)
+		fclose(out);
 	free(pl.tasks);
 	free(pl.run);
 	sim_study_free(&st);
-	return failed || write_failed ? 1 : 0;
+	return rc;
+}
+
+int cli_cmd_sweep(int argc, char **argv)
+{
+	cli_spread sp;
+	cli_spread_start(&sp);
+	int rc = sweep_on_rank(argc, argv, &sp);
+	cli_spread_end(&sp);
+	return rc;
 }
