@@ -386,6 +386,22 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 			assert.match(c.bg, p.velocity > 0 ? /^rgb\(255, / : /, 255\)$/, `${rot} cell ${i}: ${c.bg} for v = ${p.velocity}`);
 		});
 	}
+	/* the map's own export: the CSV rows are the sweep's points, the PNG
+	 * an image of the map's size */
+	const mapCsv = csvLines(await download('#sweep-map + .plot-export button[data-export="csv"]'));
+	assert.equal(mapCsv[0], 'mu,beta,rotation,velocity,uncertainty,steady,dt,substeps');
+	assert.deepEqual(mapCsv.slice(1), study.points.map(p =>
+		[p.mu, p.beta, p.rotation, p.velocity, p.uncertainty, p.steady, p.dt, p.substeps].map(String).join(',')));
+	const png = await download('#sweep-map + .plot-export button[data-export="png"]');
+	assert.equal(png.name, 'sweep-map.png');
+	assert.equal(png.bytes.subarray(0, 8).toString('hex'), '89504e470d0a1a0a', 'a PNG');
+	const size = await page.$eval('#sweep-map', el => {
+		const r = el.getBoundingClientRect(), d = window.devicePixelRatio || 1;
+		return [Math.round(r.width * d), Math.round(r.height * d)];
+	});
+	assert.ok(size[0] > 100 && size[1] > 40, `map ${size}`);
+	assert.deepEqual([png.bytes.readUInt32BE(16), png.bytes.readUInt32BE(20)], size, 'the PNG has the map\'s size');
+	assert.ok(png.bytes.length > 1000, `${png.bytes.length} bytes`);
 	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));
 	assert.equal(rows.length, 12);
 	assert.deepEqual(rows[0].slice(0, 3), ['0.3', '30', 'cw']);
@@ -396,6 +412,7 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 	await page.click('#sweep-run');
 	await until(async () => await visible('#plot-sweep') && await count('#plot-sweep') === 8, 60000, 'the curves over mu');
 	assert.equal(await visible('#sweep-map'), false);
+	assert.equal(await visible('#sweep-map + .plot-export'), false, 'no map, no map export');
 	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
 	assert.equal(plot[0], 'series,mu,transport velocity v / (m/s),error');
 	assert.deepEqual(plot.slice(1, 5).map(l => l.split(',')[1]), ['0.3', '0.6', '0.9', '1.2']);

@@ -5,14 +5,15 @@
  * field, follows its progress, and shows the plot (with each point's error
  * bar; a study over one setting as curves over it), a study over two
  * settings as a map of v per rotation (each cell's title: v and its error
- * bar), the table (v, its error bar u, steady or settling) and the CSV
- * link.
+ * bar; exported beside it as a PNG and as the CSV of its points), the
+ * table (v, its error bar u, steady or settling) and the CSV link.
  */
 
 import * as api from './api.js';
 import { fmt, steadyLabel } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm } from './session.js';
+import { addExport } from './plots.js';
 
 export async function runSweep(ev) {
 	ev.preventDefault();
@@ -59,6 +60,10 @@ function showSweep(j) {
 	map.hidden = vary.length !== 2;
 	$('#plot-sweep').hidden = vary.length === 2;
 	if (vary.length === 2) drawMaps(map, j.points, vary);
+	const exp = mapExport(map);
+	exp.points = vary.length === 2 ? j.points : [];
+	exp.vary = vary;
+	exp.bar.hidden = !exp.points.length;
 	if (vary.length === 1 && vary[0] !== 'beta') return showCurves(j.points, vary[0]);
 	if (vary.length !== 1) return showStudyTable(j.points, vary);
 	setXLabel('β / °');
@@ -169,4 +174,51 @@ function drawMaps(box, points, [rowName, colName]) {
 		}
 		box.append(grid);
 	}
+}
+
+/* The map's export buttons (PNG, CSV) beside it, made once: the owner
+ * holds the points and settings shown. */
+let mapOwner = null;
+function mapExport(box) {
+	if (mapOwner) return mapOwner;
+	mapOwner = { points: [], vary: [], csvRows: () => mapRows(mapOwner.points, mapOwner.vary), canvas: () => mapCanvas(box) };
+	mapOwner.bar = addExport(mapOwner, box);
+	return mapOwner;
+}
+
+/* The tidy rows behind the map: a header, then one row per point in the
+ * daemon's order: both varied settings, the rotation, v and its error bar
+ * (m/s), steady, and the steps it was measured with (dt in s, substeps). */
+function mapRows(points, [rowName, colName]) {
+	return [[rowName, colName, 'rotation', 'velocity', 'uncertainty', 'steady', 'dt', 'substeps'],
+		...points.map(p => [p.at?.[rowName], p.at?.[colName], p.rotation, p.v, p.u, p.steady, p.dt, p.substeps])];
+}
+
+/* The map as it is on the page, drawn onto a canvas of its size (CSS
+ * pixels times the device's pixel ratio): each cell's colour, each
+ * label's and title's text where they are. */
+function mapCanvas(box) {
+	const dpr = window.devicePixelRatio || 1;
+	const at = box.getBoundingClientRect();
+	const c = document.createElement('canvas');
+	c.width = Math.round(at.width * dpr);
+	c.height = Math.round(at.height * dpr);
+	const ctx = c.getContext('2d');
+	ctx.scale(dpr, dpr);
+	ctx.fillStyle = '#fff';
+	ctx.fillRect(0, 0, at.width, at.height);
+	for (const el of box.querySelectorAll('.cell, .label, .title')) {
+		const r = el.getBoundingClientRect(), css = getComputedStyle(el);
+		const x = r.left - at.left, y = r.top - at.top;
+		if (el.classList.contains('cell')) {
+			ctx.fillStyle = css.backgroundColor;
+			ctx.fillRect(x, y, r.width, r.height);
+			continue;
+		}
+		ctx.fillStyle = css.color;
+		ctx.font = css.font;
+		ctx.textBaseline = 'middle';
+		ctx.fillText(el.textContent, x + parseFloat(css.paddingLeft || '0'), y + r.height / 2);
+	}
+	return c;
 }
