@@ -23,7 +23,7 @@ enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
 	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_VARY,
-	OPT_LHS, OPT_SEED
+	OPT_LHS, OPT_SEED, OPT_BAND_FROM
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
@@ -50,6 +50,7 @@ typedef struct cli_opts {
 	int nvary, lhs;
 	int beta_at; /* sweep: --beta's place among the --vary (it is one) */
 	double seed;
+	const char *band_from; /* sweep: a fit's JSON result (bands on every point) */
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
@@ -82,6 +83,9 @@ void cli_put_num(FILE *f, double v, const char *nonfinite);
 void cli_put_json_num(FILE *f, const char *head, double v);
 int cli_wants_json(const char *format, const char *file);
 FILE *cli_open_out(const cli_opts *o);
+/* The whole of file path (stdin for "-", at most 16 MB), malloc'd (the
+ * caller frees); NULL after "convsim CMD: --OPT: ..." on stderr. */
+char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
  * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else

@@ -17,6 +17,7 @@
 #include <unistd.h>
 #include <fcntl.h>
 
+#include "band_from.h"
 #include "cli.h"
 #include "pmap.h"
 #include "sim.h"
@@ -31,6 +32,7 @@
 typedef struct task {
 	long source; /* -1: measured; else the task it mirrors (sim_study_mirror_plan) */
 	sim_measurement r;
+	double band[2]; /* --band-from: the 95 % band's lower and upper ends, m/s */
 	int err;
 	char msg[160];
 } task;
@@ -39,6 +41,8 @@ typedef struct pool {
 	const cli_opts *o;
 	const sim_study *st;
 	const cli_spread *sp;
+	const fit_band_source *band; /* NULL: no bands */
+	const int *skip;             /* the band's parameters the study varies */
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
 	int n, done; /* done: of this rank's share */
@@ -78,9 +82,13 @@ static void measure_task(void *arg, size_t j)
 	sim_params p = pl->o->p;
 	sim_scene sc = pl->o->sc;
 	sim_method m = pl->o->m;
+	t->band[0] = t->band[1] = NAN;
 	t->err = sim_study_apply(pl->st, i, &p, &sc, &m, t->msg, sizeof t->msg);
 	if (t->err == SIM_OK)
 		t->err = sim_measure(&p, &sc, &m, pl->o->duration, &t->r, t->msg, sizeof t->msg);
+	if (t->err == SIM_OK && pl->band)
+		t->err = fit_band_point(pl->band, pl->skip, &p, &sc, &m, pl->o->duration, &t->r,
+					&t->band[0], &t->band[1], t->msg, sizeof t->msg);
 }
 
 /* The progress line after each task (the map calls it one at a time). */
@@ -115,6 +123,8 @@ static void mirror_tasks(const pool *pl, int ntasks)
 			continue;
 		const task *src = &pl->tasks[t->source];
 		sim_mirror_measurement(&src->r, &t->r);
+		t->band[0] = -src->band[1]; /* the band's image: v -> -v */
+		t->band[1] = -src->band[0];
 		t->err = src->err;
 		if (src->err != SIM_OK)
 			sim_mirror_failure(t->msg, sizeof t->msg, task_beta(pl, (size_t)t->source),
@@ -150,6 +160,17 @@ static void print_json_head(FILE *f, const cli_opts *o, const pool *pl, int ntas
 	fputc(']', f);
 	if (st->lhs)
 		fprintf(f, ",\"lhs\":%zu,\"seed\":%.0f", st->lhs, (double)st->seed);
+	if (pl->band) { /* the band's parameters, and those the study varies */
+		fputs(",\"band\":{\"level\":0.95,\"parameters\":[", f);
+		for (int j = 0, n = 0; j < pl->band->nfree; j++)
+			if (!pl->skip[j])
+				fprintf(f, "%s\"%s\"", n++ ? "," : "", pl->band->free[j].name);
+		fputs("],\"varied\":[", f);
+		for (int j = 0, n = 0; j < pl->band->nfree; j++)
+			if (pl->skip[j])
+				fprintf(f, "%s\"%s\"", n++ ? "," : "", pl->band->free[j].name);
+		fputs("]}", f);
+	}
 	fprintf(f, ",\"reductions\":[%s],\"points\":[\n", pl->n < ntasks ? "\"mirror\"" : "");
 }
 
@@ -165,7 +186,8 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 	} else {
 		for (size_t a = 0; a < st->naxes; a++)
 			fprintf(f, "%s,", st->axis[a].setting->name);
-		fputs(SIM_SWEEP_POINT_COLUMNS "\n", f);
+		fputs(SIM_SWEEP_POINT_COLUMNS, f);
+		fputs(pl->band ? ",band_lower,band_upper\n" : "\n", f);
 	}
 	for (int i = 0; i < ntasks; i++) {
 		const task *t = &pl->tasks[i];
@@ -199,8 +221,15 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 		cli_put_num(f, t->r.dt, nf);
 		fprintf(f, json ? ",\"substeps\":%d,\"step_error\":" : ",%d,", t->r.substeps);
 		cli_put_num(f, t->r.step_error, nf);
-		fprintf(f, json ? ",\"tol_met\":%s}%s\n" : ",%s%s\n", t->r.tol_met ? "true" : "false",
-			json && i + 1 < ntasks ? "," : "");
+		fprintf(f, json ? ",\"tol_met\":%s" : ",%s", t->r.tol_met ? "true" : "false");
+		if (pl->band) {
+			fputs(json ? ",\"band\":{\"lower\":" : ",", f);
+			cli_put_num(f, t->band[0], nf);
+			fputs(json ? ",\"upper\":" : ",", f);
+			cli_put_num(f, t->band[1], nf);
+			fputs(json ? "}" : "", f);
+		}
+		fprintf(f, "%s%s\n", json ? "}" : "", json && i + 1 < ntasks ? "," : "");
 	}
 	if (json)
 		fputs("]}\n", f);
@@ -423,9 +452,10 @@ static void mute_output(int mute, int saved[2])
 		}
 }
 
-/* The options parsed and checked, the study planned: 0, 2 (usage,
- * reported) or -1 (help shown). */
-static int prepare(int argc, char **argv, cli_opts *o, sim_study *st)
+/* The options parsed and checked, the study planned, --band-from read
+ * into band (with skip): 0, 2 (usage, reported) or -1 (help shown). */
+static int prepare(int argc, char **argv, cli_opts *o, sim_study *st, fit_band_source *band,
+		   int *skip)
 {
 	int rc = cli_parse(argc, argv, CMD_SWEEP, o);
 	if (rc)
@@ -436,7 +466,9 @@ static int prepare(int argc, char **argv, cli_opts *o, sim_study *st)
 			o->duration, o->sc.transient);
 		return 2;
 	}
-	return plan_study(o, st);
+	if ((rc = plan_study(o, st)) != 0)
+		return rc;
+	return o->band_from ? cli_band_from(o, st, band, skip) : 0;
 }
 
 /* The sweep on this rank (spread.h): every rank parses, plans and
@@ -446,10 +478,11 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 {
 	cli_opts o = {0};
 	sim_study st = {0};
-	int saved[2] = {-1, -1}, rc;
+	fit_band_source band;
+	int saved[2] = {-1, -1}, skip[FIT_MAX_FREE] = {0}, rc;
 	if (sp->rank > 0)
 		mute_output(1, saved);
-	rc = prepare(argc, argv, &o, &st);
+	rc = prepare(argc, argv, &o, &st, &band, skip);
 	if (sp->rank > 0)
 		mute_output(0, saved);
 	FILE *out = stdout;
@@ -458,7 +491,7 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 		rc = 1;
 	}
 	int ntasks = rc ? 0 : (int)sim_study_tasks(&st);
-	pool pl = {.o = &o, .st = &st, .sp = sp};
+	pool pl = {.o = &o, .st = &st, .sp = sp, .band = o.band_from ? &band : NULL, .skip = skip};
 	pl.tasks = calloc(ntasks ? (size_t)ntasks : 1, sizeof(task));
 	pl.run = calloc(ntasks ? (size_t)ntasks : 1, sizeof(int));
 	if (rc == 0 && (!pl.tasks || !pl.run)) {

@@ -3,7 +3,8 @@
 // measure their share of the points, rank 0 gathers them into point order
 // and writes the table, the very bytes one process writes (CSV and JSON,
 // a study with the mirror reduction, a beta sweep, a Latin hypercube, an
-// uneven split over 3 ranks, one thread or two per rank). A usage error
+// uneven split over 3 ranks, one thread or two per rank, bands from a
+// fit). A usage error
 // and an unwritable --out stop every rank with one message, no hang.
 // The build without MPI (`make NO_MPI=1`, CONVSIM_NOMPI; built here when
 // missing) links no MPI and writes the same bytes. CONVSIM names the
@@ -11,7 +12,9 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { existsSync } from 'node:fs';
+import { existsSync, mkdtempSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 const BUILD = process.env.BUILD || 'build';
@@ -70,6 +73,23 @@ test('a beta sweep, a Latin hypercube, 3 ranks and one or two threads per rank: 
       assert.equal(r.out, one.out, `${args[1]}: ${n} ranks, ${j} threads`);
     }
   }
+});
+
+test('a study with bands from a fit (--band-from): the same bytes over 2 ranks', () => {
+  const fit = join(mkdtempSync(join(tmpdir(), 'convsim-mpi-')), 'fit.json');
+  writeFileSync(fit, JSON.stringify({
+    status: 'converged', dof: 6, standard_errors_from: 'sigma',
+    parameters: [{ name: 'e', value: 0.0215, standard_error: 0.0004, min: 0.005, max: 0.04 },
+      { name: 'mu', value: 0.41, standard_error: 0.03, min: 0.1, max: 1.5 }],
+    correlation: [[1, -0.6], [-0.6, 1]],
+  }));
+  const args = [...STUDY, '--band-from', fit, '-q', '-f', 'json'];
+  const one = alone(args);
+  assert.equal(one.code, 0, one.err);
+  assert.deepEqual(JSON.parse(one.out).band.varied, ['mu']);
+  const two = mpirun(2, args);
+  assert.equal(two.code, 0, two.err);
+  assert.equal(two.out, one.out);
 });
 
 test('the progress comes from rank 0 alone: its share while it runs, then the whole', () => {
