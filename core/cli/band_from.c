@@ -1,9 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * band_from.c - `convsim sweep --band-from FIT.json`: a fit's result (the
- * JSON of `convsim fit`) read back as a band source (core/fit/fit.h), its
- * fitted values set on the study's model for the parameters the study
- * does not vary, and the varied ones marked to leave the band. The
+ * JSON of `convsim fit`) read back as a band source (core/fit/fit.h) and
+ * the study's model prepared for it (fit_band_source_prepare). The
  * points' bands themselves are fit_band_point's, per task in
  * sweep_cmd.c.
  */
@@ -25,27 +24,13 @@ int cli_band_from(cli_opts *o, const sim_study *st, fit_band_source *src, int sk
 		fprintf(stderr, "convsim sweep: --band-from %s: %s\n", o->band_from, msg);
 		return 2;
 	}
-	for (int j = 0; j < src->nfree; j++) {
-		skip[j] = 0;
-		for (size_t a = 0; a < st->naxes; a++)
-			skip[j] |= strcmp(st->axis[a].setting->name, src->free[j].name) == 0;
-	}
-	if (fit_band_source_apply(src, skip, &o->p, &o->sc, &o->m, msg, sizeof msg) != SIM_OK) {
+	const char *varied[SIM_STUDY_MAX_AXES];
+	for (size_t a = 0; a < st->naxes; a++)
+		varied[a] = st->axis[a].setting->name;
+	if (fit_band_source_prepare(src, varied, st->naxes, skip, &o->p, &o->sc, &o->m, msg,
+				    sizeof msg) != SIM_OK) {
 		fprintf(stderr, "convsim sweep: --band-from %s: %s\n", o->band_from, msg);
 		return 2;
-	}
-	/* the images of the mirror reduction take their sources' bands only
-	 * where every perturbed model is mirror-symmetric as well */
-	for (int j = 0; j < src->nfree; j++) {
-		sim_params p = o->p;
-		sim_scene sc = o->sc;
-		sim_method m = o->m;
-		if (skip[j] || !sim_mirror_applies(&p, &sc))
-			continue;
-		double x = src->x[j] + fit_step(&src->free[j], src->fd_rel, src->x[j]);
-		if (sim_set(&p, &sc, &m, src->free[j].name, x, NULL, 0) != SIM_OK ||
-		    !sim_mirror_applies(&p, &sc))
-			sim_set(&o->p, &o->sc, &o->m, "mirror", 0, NULL, 0);
 	}
 	return 0;
 }

@@ -216,12 +216,6 @@ typedef struct fit_band_source {
 	double fd_rel;                        /* the step (fit_step) */
 } fit_band_source;
 
-/* The source of a finished fit (req and the result res answering it).
- * SIM_OK, or SIM_EPARAM with the reason in msg: the fit failed, or its
- * covariance is not determined (NaN) or not finite. */
-int fit_band_source_of(const fit_request *req, const fit_result *res, fit_band_source *src,
-		       char *msg, size_t len);
-
 /* The source from `convsim fit`'s JSON result (fit_result_json's text,
  * whitespace anywhere): "parameters" (name, value, standard_error, min,
  * max, in user units), "correlation", "dof", "standard_errors_from" and
@@ -229,13 +223,15 @@ int fit_band_source_of(const fit_request *req, const fit_result *res, fit_band_s
  * fit's default. SIM_OK, or SIM_EPARAM with what is wrong in msg. */
 int fit_band_source_parse(const char *json, fit_band_source *src, char *msg, size_t len);
 
-/* Index of the source's parameter `name`, or -1. */
-int fit_band_source_find(const fit_band_source *src, const char *name);
-
-/* Set the source's fitted values on the model, except those with
- * skip[j] != 0 (a study's varied settings). SIM_OK or sim_set's code. */
-int fit_band_source_apply(const fit_band_source *src, const int *skip, sim_params *p,
-			  sim_scene *s, sim_method *m, char *msg, size_t len);
+/* Prepare a study's model for bands from src: skip[j] = 1 where the
+ * study varies parameter j (its name among the nvaried names of varied),
+ * the others' fitted values set on p, s, m, and the mirror reduction off
+ * (s->mirror = 0) where a parameter's step would break the machine's
+ * symmetry that the images' bands rely on. SIM_OK or sim_set's code with
+ * msg. */
+int fit_band_source_prepare(const fit_band_source *src, const char *const *varied, size_t nvaried,
+			    int *skip, sim_params *p, sim_scene *s, sim_method *m, char *msg,
+			    size_t len);
 
 /* The 95 % band of a study's point (thread-safe): at its measurement `at`
  * on the model p, s, m (the source's values applied, the point's

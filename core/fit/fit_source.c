@@ -1,11 +1,11 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fit_source.c - a fit's parameters with their uncertainties as the
- * source of bands on other curves (fit.h "bands on other curves"): from a
- * finished fit in memory (the daemon's fit job) or from `convsim fit`'s
- * JSON result read back (the CLI's --band-from), applied to a study's
- * model, and one study point's band by the delta method that the fit's
- * own band uses (fit_delta_half, fit_step). The reader takes the members
+ * source of bands on other curves (fit.h "bands on other curves"): read
+ * back from a fit's JSON result (`convsim fit`'s, which the CLI's
+ * --band-from names, or a fit job's, which a sweep's band_from_fit
+ * names), applied to a study's model, and one study point's band by the
+ * delta method that the fit's own band uses (fit_delta_half, fit_step). The reader takes the members
  * fit_out.c writes and skips every other; it is a reader of that result,
  * not a general JSON library.
  */
@@ -29,29 +29,6 @@ static int cov_ok(const fit_band_source *src)
 		if (!(src->cov[a * p + a] >= 0))
 			return 0;
 	return p > 0 && isfinite(src->quantile);
-}
-
-int fit_band_source_of(const fit_request *req, const fit_result *res, fit_band_source *src,
-		       char *msg, size_t len)
-{
-	memset(src, 0, sizeof *src);
-	if (res->status == FIT_FAILED || res->status == FIT_CANCELLED) {
-		snprintf(msg, len, "the fit %s: its parameters have no uncertainties",
-			 fit_status_name(res->status));
-		return SIM_EPARAM;
-	}
-	src->nfree = res->nfree;
-	memcpy(src->free, req->free, sizeof src->free);
-	memcpy(src->x, res->x, sizeof src->x);
-	memcpy(src->cov, res->cov, sizeof src->cov);
-	src->quantile = fit_band_quantile(res->sigma_given, res->dof);
-	src->fd_rel = req->fd_rel;
-	if (!cov_ok(src)) {
-		snprintf(msg, len, "the fit's covariance is not determined (a standard error is "
-				   "null): no band can be drawn from it");
-		return SIM_EPARAM;
-	}
-	return SIM_OK;
 }
 
 /* ---- the reader of fit_result_json's text ---- */
@@ -329,23 +306,34 @@ done:
 	return rc;
 }
 
-int fit_band_source_find(const fit_band_source *src, const char *name)
-{
-	for (int j = 0; j < src->nfree; j++)
-		if (strcmp(src->free[j].name, name) == 0)
-			return j;
-	return -1;
-}
-
-int fit_band_source_apply(const fit_band_source *src, const int *skip, sim_params *p,
-			  sim_scene *s, sim_method *m, char *msg, size_t len)
+int fit_band_source_prepare(const fit_band_source *src, const char *const *varied, size_t nvaried,
+			    int *skip, sim_params *p, sim_scene *s, sim_method *m, char *msg,
+			    size_t len)
 {
 	for (int j = 0; j < src->nfree; j++) {
-		if (skip && skip[j])
+		skip[j] = 0;
+		for (size_t a = 0; a < nvaried; a++)
+			skip[j] |= strcmp(varied[a], src->free[j].name) == 0;
+	}
+	for (int j = 0; j < src->nfree; j++) {
+		if (skip[j])
 			continue;
 		int rc = sim_set(p, s, m, src->free[j].name, src->x[j], msg, len);
 		if (rc != SIM_OK)
 			return rc;
+	}
+	/* the images of the mirror reduction take their sources' bands only
+	 * where every perturbed model is mirror-symmetric as well */
+	for (int j = 0; j < src->nfree; j++) {
+		sim_params pj = *p;
+		sim_scene sj = *s;
+		sim_method mj = *m;
+		if (skip[j] || !sim_mirror_applies(&pj, &sj))
+			continue;
+		double x = src->x[j] + fit_step(&src->free[j], src->fd_rel, src->x[j]);
+		if (sim_set(&pj, &sj, &mj, src->free[j].name, x, NULL, 0) != SIM_OK ||
+		    !sim_mirror_applies(&pj, &sj))
+			s->mirror = 0;
 	}
 	return SIM_OK;
 }
