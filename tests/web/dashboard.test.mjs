@@ -470,6 +470,41 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	assert.equal(csv.filter(l => l.startsWith('curve,')).length, 4);
 });
 
+test('a sweep with the last fit\'s band: the band shaded under each curve, as the daemon gives it', async () => {
+	const box = '#sweep-form input[name="band"]';
+	assert.equal(await page.$eval(box, b => b.disabled), false, 'a finished fit offers its band');
+	const fitId = /^band of fit (\S+)$/.exec(await page.textContent('#sweep-band-text'))?.[1];
+	assert.ok(fitId, await page.textContent('#sweep-band-text'));
+	await page.fill('#sweep-form input[name="vary"]', '');
+	await page.fill('#sweep-form input[name="from"]', '30');
+	await page.fill('#sweep-form input[name="to"]', '150');
+	await page.fill('#sweep-form input[name="step"]', '60');
+	await page.fill('#sweep-form input[name="t_end"]', '2');
+	await page.check(box);
+	const before = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
+	await page.click('#sweep-run');
+	/* 3 angles x 2 rotations, each a curve point and a band point */
+	await until(async () => await count('#plot-sweep') === 12 && await page.$eval('#sweep-csv', a => a.getAttribute('href')) !== before,
+		120000, 'the sweep with its bands');
+	await page.uncheck(box);
+	const href = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
+	const s = await apiGet(href.replace('?format=csv', ''));
+	await until(async () => (await apiGet(href.replace('?format=csv', ''))).state === 'done', 120000, 'done');
+	const done = await apiGet(href.replace('?format=csv', ''));
+	assert.equal(s.band.fit, fitId);
+	assert.deepEqual(done.band.parameters, ['e']);
+	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
+	for (const [rot, name] of [['cw', '95 % band cw'], ['ccw', '95 % band ccw']]) {
+		const rows = plot.filter(l => l.startsWith(`${name},`)).map(l => l.split(',').slice(1).map(Number));
+		const pts = done.points.filter(p => p.rotation === rot);
+		assert.deepEqual(rows, pts.map(p => [p.beta, p.velocity, (p.band.upper - p.band.lower) / 2]), name);
+		assert.ok(rows.every(r => r[2] > 0));
+	}
+	const legend = await page.$$eval('#plot-sweep .u-legend .u-series', rows => rows
+		.filter(r => getComputedStyle(r).display !== 'none').map(r => r.querySelector('.u-label').textContent));
+	assert.deepEqual(legend, ['95 % band cw', '95 % band ccw', 'clockwise', 'counter-clockwise']);
+});
+
 test('a β-change experiment reports its reversal time', async () => {
 	await page.fill('#experiment-form input[name="beta1"]', '38');
 	await page.fill('#experiment-form input[name="beta2"]', '128');

@@ -320,6 +320,8 @@ export function sweepPoints(results, vary = ['beta']) {
 		/* the steps it was measured with: machine step (s), feed sub-steps */
 		if (p && 'dt' in p) point.dt = num(p.dt);
 		if (p && 'substeps' in p) point.substeps = num(p.substeps);
+		/* band_from_fit: the 95 % band at the point (m/s) */
+		if (p && p.band && typeof p.band === 'object') point.band = [num(p.band.lower), num(p.band.upper)];
 		out.push(point);
 	};
 	const vOf = p => p.transport_velocity ?? p.v ?? p.velocity;

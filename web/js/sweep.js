@@ -6,7 +6,9 @@
  * bar; a study over one setting as curves over it), a study over two
  * settings as a map of v per rotation (each cell's title: v and its error
  * bar; exported beside it as a PNG and as the CSV of its points), the
- * table (v, its error bar u, steady or settling) and the CSV link.
+ * table (v, its error bar u, steady or settling) and the CSV link. With
+ * "band of the last fit" the sweep takes that fit's bands
+ * (band_from_fit), shaded under the curves as the fit's own band is.
  */
 
 import * as api from './api.js';
@@ -19,7 +21,8 @@ export async function runSweep(ev) {
 	ev.preventDefault();
 	const f = $('#sweep-form').elements;
 	const base = readSessionForm();
-	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end), vary: f.vary.value };
+	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end), vary: f.vary.value,
+		bandFit: f.band.checked ? app.lastFit : undefined };
 	const btn = $('#sweep-run');
 	const box = $('#sweep-progress');
 	busy(btn, true);
@@ -69,8 +72,7 @@ function showSweep(j) {
 	setXLabel('β / °');
 	const by = rot => j.points.filter(p => p.rotation === rot).sort((a, b) => a.beta - b.beta);
 	const cw = by('cw'), ccw = by('ccw');
-	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]],
-		[cw.map(p => p.u), ccw.map(p => p.u)]);
+	plotCurves(cw, ccw, p => p.beta);
 	const table = $('#sweep-table');
 	table.replaceChildren();
 	const head = table.createTHead().insertRow();
@@ -111,9 +113,19 @@ function showCurves(points, name) {
 	setXLabel(name);
 	const by = rot => points.filter(p => p.rotation === rot).sort((a, b) => a.at[name] - b.at[name]);
 	const cw = by('cw'), ccw = by('ccw');
-	app.plots.sweep.setData([[cw.map(p => p.at[name]), cw.map(p => p.v)], [ccw.map(p => p.at[name]), ccw.map(p => p.v)]],
-		[cw.map(p => p.u), ccw.map(p => p.u)]);
+	plotCurves(cw, ccw, p => p.at[name]);
 	showStudyTable(points, [name]);
+}
+
+/* The curves of v (with each point's error bar) over x(p), per rotation,
+ * and under them the fit's 95 % band where the sweep has one (shaded as
+ * v ± its half-width: the band is symmetric about v). */
+function plotCurves(cw, ccw, x) {
+	const banded = pts => pts.filter(p => p.band && Number.isFinite(p.band[0]) && Number.isFinite(p.band[1]));
+	const bands = [banded(cw), banded(ccw)];
+	app.plots.sweep.setData([...bands.map(b => [b.map(x), b.map(p => p.v)]),
+		[cw.map(x), cw.map(p => p.v)], [ccw.map(x), ccw.map(p => p.v)]],
+	[...bands.map(b => b.map(p => (p.band[1] - p.band[0]) / 2)), cw.map(p => p.u), ccw.map(p => p.u)]);
 }
 
 /* A study's table: the varied settings, the rotation, v, u, steady. */
