@@ -13,6 +13,7 @@
 #include <stdio.h>
 
 #include "sim.h"
+#include "study.h"
 
 #define CONVSIM_VERSION "1.0.0"
 
@@ -72,6 +73,11 @@ int cli_cmd_fit(int argc, char **argv);
 /* convsim sweep (sweep_cmd.c): exit status 0, 1 (a point failed or the
  * table could not be written) or 2 (usage). */
 int cli_cmd_sweep(int argc, char **argv);
+/* The study of sweep's options into *st (study_opts.c): --beta (default
+ * 0:180:10 when nothing is varied) and every --vary in the order given,
+ * --lhs, --seed, the senses of --rotation, planned (sim_study_plan). 0, or
+ * 2 after a message; st is the caller's to free either way. */
+int cli_plan_study(const cli_opts *o, sim_study *st);
 
 /* Output (options.c): a number as the daemon prints it (shortest round
  * trip), non-finite as `nonfinite`; whether a file is JSON (--format, else
