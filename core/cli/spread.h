@@ -29,6 +29,13 @@ void cli_spread_start(cli_spread *sp);
  * the measuring starts. One rank: rc. */
 int cli_spread_agree(const cli_spread *sp, int rc);
 
+/* Rank 0's v on every rank (a collective; alone: v). */
+int cli_spread_rank0(const cli_spread *sp, int v);
+
+/* 1 when every rank has the same v (a collective; alone: 1): the ranks
+ * check that they were started with the same options. */
+int cli_spread_same(const cli_spread *sp, unsigned long long v);
+
 /* 1 when job k of a spread map is this rank's. */
 static inline int cli_spread_mine(const cli_spread *sp, size_t k)
 {

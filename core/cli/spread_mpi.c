@@ -51,6 +51,23 @@ int cli_spread_agree(const cli_spread *sp, int rc)
 	return all;
 }
 
+int cli_spread_rank0(const cli_spread *sp, int v)
+{
+	if (sp->ranks > 1)
+		MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
+	return v;
+}
+
+int cli_spread_same(const cli_spread *sp, unsigned long long v)
+{
+	unsigned long long lo = v, hi = v;
+	if (sp->ranks > 1) {
+		MPI_Allreduce(&v, &lo, 1, MPI_UNSIGNED_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
+		MPI_Allreduce(&v, &hi, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+	}
+	return lo == hi;
+}
+
 /* Rank q's share of the jobs (k = q, q + ranks, ...). */
 static size_t share_of(int q, int ranks, size_t n)
 {

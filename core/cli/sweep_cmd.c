@@ -279,28 +279,47 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 	return 0;
 }
 
-/* Point fds 1 and 2 at /dev/null (mute) or back (saved): the ranks but
- * rank 0 parse and plan in silence, since every rank finds the same
- * usage errors and rank 0 reports them; saved holds the originals. */
-static void mute_output(int mute, int saved[2])
+/* What a rank but rank 0 says while it parses and plans: stdout to
+ * /dev/null, stderr into a scratch file, since every rank finds the same
+ * usage errors and rank 0 reports them; said after all only when this
+ * rank's outcome differs from rank 0's (quiet_end). */
+typedef struct quiet {
+	int saved[2]; /* the original fds 1 and 2, or -1 */
+	FILE *said;   /* stderr meanwhile, or NULL */
+} quiet;
+
+static void quiet_start(quiet *q)
 {
-	if (mute) {
-		int null = open("/dev/null", O_WRONLY);
-		for (int fd = 1; fd <= 2; fd++) {
-			saved[fd - 1] = dup(fd);
-			if (null >= 0)
-				dup2(null, fd);
-		}
-		if (null >= 0)
-			close(null);
-		return;
+	int null = open("/dev/null", O_WRONLY);
+	q->said = tmpfile();
+	fflush(stdout);
+	for (int fd = 1; fd <= 2; fd++) {
+		int to = fd == 2 && q->said ? fileno(q->said) : null;
+		q->saved[fd - 1] = to >= 0 ? dup(fd) : -1;
+		if (q->saved[fd - 1] >= 0)
+			dup2(to, fd);
 	}
+	if (null >= 0)
+		close(null);
+}
+
+/* Back to the original fds; with tell, what the rank said goes to stderr,
+ * each line with the rank's number. */
+static void quiet_end(quiet *q, int rank, int tell)
+{
 	fflush(stdout);
 	for (int fd = 1; fd <= 2; fd++)
-		if (saved[fd - 1] >= 0) {
-			dup2(saved[fd - 1], fd);
-			close(saved[fd - 1]);
+		if (q->saved[fd - 1] >= 0) {
+			dup2(q->saved[fd - 1], fd);
+			close(q->saved[fd - 1]);
 		}
+	if (!q->said)
+		return;
+	char line[512];
+	rewind(q->said);
+	while (tell && fgets(line, sizeof line, q->said))
+		fprintf(stderr, "(rank %d) %s", rank, line);
+	fclose(q->said);
 }
 
 /* The options parsed and checked, the study planned, --band-from read
@@ -322,20 +341,45 @@ static int prepare(int argc, char **argv, cli_opts *o, sim_study *st, fit_band_s
 	return o->band_from ? cli_band_from(o, st, band, skip) : 0;
 }
 
+/* FNV-1a over the arguments: the ranks compare their command lines. */
+static unsigned long long argv_hash(int argc, char **argv)
+{
+	unsigned long long h = 14695981039346656037ULL;
+	for (int i = 0; i < argc; i++)
+		for (const char *c = argv[i];; c++) {
+			h = (h ^ (unsigned char)*c) * 1099511628211ULL;
+			if (!*c)
+				break;
+		}
+	return h;
+}
+
 /* The sweep on this rank (spread.h): every rank parses, plans and
  * measures its share; rank 0 alone opens --out and writes the table.
- * The ranks agree on every early stop, so none waits for another. */
+ * The ranks check that they have the same options and agree on every
+ * early stop, so none waits for another. */
 static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 {
 	cli_opts o = {0};
 	sim_study st = {0};
 	fit_band_source band;
-	int saved[2] = {-1, -1}, skip[FIT_MAX_FREE] = {0}, rc;
+	int skip[FIT_MAX_FREE] = {0}, rc;
+	quiet q = {{-1, -1}, NULL};
+	if (!cli_spread_same(sp, argv_hash(argc, argv))) {
+		if (sp->rank == 0)
+			fprintf(stderr, "convsim sweep: the %d ranks were started with different "
+					"options; every rank must have the same command line\n",
+				sp->ranks);
+		return 2;
+	}
 	if (sp->rank > 0)
-		mute_output(1, saved);
+		quiet_start(&q);
 	rc = prepare(argc, argv, &o, &st, &band, skip);
+	/* a rank that fares otherwise than rank 0 (a file only rank 0 can
+	 * read, say) says why */
+	int other = cli_spread_rank0(sp, rc) != rc;
 	if (sp->rank > 0)
-		mute_output(0, saved);
+		quiet_end(&q, sp->rank, other);
 	FILE *out = stdout;
 	if (rc == 0 && sp->rank == 0 && o.out && !(out = cli_open_out(&o))) {
 		out = stdout;
@@ -349,8 +393,11 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 		fprintf(stderr, "convsim sweep: rank %d: out of memory\n", sp->rank);
 		rc = 1;
 	}
-	if ((rc = cli_spread_agree(sp, rc)) != 0 || (rc = measure_study(&o, &pl, ntasks)) != 0 ||
-	    sp->rank > 0) {
+	int mine = rc;
+	if ((rc = cli_spread_agree(sp, rc)) > 0 && mine == 0 && sp->rank == 0)
+		fprintf(stderr, "convsim sweep: another rank could not start the study (its reason "
+				"is marked with its rank); every rank stops\n");
+	if (rc != 0 || (rc = measure_study(&o, &pl, ntasks)) != 0 || sp->rank > 0) {
 		rc = rc < 0 ? 0 : rc; /* -1: help shown */
 		goto done;
 	}

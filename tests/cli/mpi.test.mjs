@@ -5,7 +5,9 @@
 // a study with the mirror reduction, a beta sweep, a Latin hypercube, an
 // uneven split over 3 ranks, one thread or two per rank, bands from a
 // fit). A usage error and an unwritable --out stop every rank with one
-// message, no hang. The build without MPI (`make NO_MPI=1`: CONVSIM_NOMPI,
+// message, no hang; so do ranks started with other options, and a rank
+// that cannot read a file rank 0 reads (its own reason, marked with its
+// rank). The build without MPI (`make NO_MPI=1`: CONVSIM_NOMPI,
 // else made here) links no MPI and writes the same bytes. CONVSIM names
 // the binary.
 import { test } from 'node:test';
@@ -109,6 +111,25 @@ test('errors end every rank with one message: a usage error (exit 2), an unwrita
   assert.equal(out.code, 1, out.err);
   assert.match(out.err, /\/nonexistent\/dir\/study\.csv/);
   assert.equal(out.out, '');
+});
+
+test('ranks that differ: other options, or a file only rank 0 can read, stop every rank with the reason (exit 2)', () => {
+  const other = spawn('mpirun', ['--oversubscribe', '-n', '1', CLI, ...STUDY, '-q', ':', '-n', '1', CLI, ...BETA, '-q']);
+  assert.equal(other.code, 2, other.err);
+  assert.match(other.err, /convsim sweep: the 2 ranks were started with different options; every rank must have the same command line/);
+  assert.equal(other.out, '');
+  // the same command line, run in two directories: fit.json is in rank 0's only
+  const [a, b] = [0, 1].map(() => mkdtempSync(join(tmpdir(), 'convsim-mpi-wdir-')));
+  writeFileSync(join(a, 'fit.json'), JSON.stringify({
+    status: 'converged', dof: 6, standard_errors_from: 'sigma',
+    parameters: [{ name: 'e', value: 0.0215, standard_error: 0.0004, min: 0.005, max: 0.04 }], correlation: [[1]],
+  }));
+  const args = [...BETA, '-q', '--band-from', 'fit.json'];
+  const r = spawn('mpirun', ['--oversubscribe', '-n', '1', '-wdir', a, CLI, ...args, ':', '-n', '1', '-wdir', b, CLI, ...args]);
+  assert.equal(r.code, 2, r.err);
+  assert.match(r.err, /\(rank 1\) convsim sweep: --band-from: cannot read 'fit\.json'/);
+  assert.match(r.err, /convsim sweep: another rank could not start the study/);
+  assert.equal(r.out, '');
 });
 
 test('the build without MPI runs the same study and the same beta sweep, the same bytes', () => {
