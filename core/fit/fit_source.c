@@ -36,7 +36,10 @@ static int cov_ok(const fit_band_source *src)
 typedef struct scan {
 	const char *s;
 	int bad;
+	int depth; /* of skip's nesting: a file nested deeper is refused */
 } scan;
+
+#define SCAN_MAX_DEPTH 64
 
 static void ws(scan *c)
 {
@@ -99,9 +102,15 @@ static void skip(scan *c)
 	}
 	if (*c->s == '[' || *c->s == '{') {
 		char close = *c->s == '[' ? ']' : '}';
-		c->s++;
-		if (eat(c, close))
+		if (++c->depth > SCAN_MAX_DEPTH) {
+			c->bad = 1;
 			return;
+		}
+		c->s++;
+		if (eat(c, close)) {
+			c->depth--;
+			return;
+		}
 		do {
 			if (close == '}') {
 				string(c, NULL, 0);
@@ -112,6 +121,7 @@ static void skip(scan *c)
 		} while (!c->bad && eat(c, ','));
 		if (!eat(c, close))
 			c->bad = 1;
+		c->depth--;
 		return;
 	}
 	const char *start = c->s;

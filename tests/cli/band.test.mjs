@@ -109,6 +109,8 @@ test('bad --band-from: exit 2, a message naming it, nothing on stdout', () => {
     [join(dir, 'missing.json'), /--band-from: cannot read '.*missing\.json'/],
     [(() => { const p = join(dir, 'not.json'); writeFileSync(p, 'beta,rotation,v\n'); return p; })(), /--band-from .*not the JSON result of convsim fit/],
     [(() => { const p = join(dir, 'nocov.json'); writeFileSync(p, JSON.stringify(noCov, null, 2)); return p; })(), /--band-from .*covariance is not determined/],
+    [(() => { const p = join(dir, 'deep.json'); writeFileSync(p, `{"x":${'['.repeat(100000)}${']'.repeat(100000)}}`); return p; })(), /--band-from .*not the JSON result of convsim fit/],
+    [(() => { const p = join(dir, 'cut.json'); writeFileSync(p, JSON.stringify(fit).slice(0, 200)); return p; })(), /--band-from .*not the JSON result of convsim fit/],
     [(() => { const p = join(dir, 'failed.json'); writeFileSync(p, JSON.stringify({ ...fit, status: 'failed' })); return p; })(), /--band-from .*the fit failed/],
   ];
   for (const [file, re] of cases) {
