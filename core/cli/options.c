@@ -98,7 +98,9 @@ static const struct {
 	 "Measure the steady transport velocity v(beta), or a study of v over any number\n"
 	 "settings (--vary, a grid or a --lhs sample): one fresh simulation per point and\n"
 	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
-	 "stderr: a bar on a terminal, plain lines otherwise."},
+	 "stderr: a bar on a terminal, plain lines otherwise. Built with MPI, under mpirun\n"
+	 "the points are spread over the ranks and rank 0 writes the table (docs/cli.md,\n"
+	 "\"On a cluster\")."},
 	{"fit", CMD_FIT, "convsim fit (--data FILE | --peaks ROT:DEG,...) --free NAME,... [OPTIONS]",
 	 "Fit free model parameters to measured v(beta) points or peak positions by\n"
 	 "Levenberg-Marquardt (GSL), each model value a steady-state measurement, the\n"
