@@ -28,10 +28,17 @@ else
 Q := @
 endif
 
-# LIGGGHTS installed: the DEM coupling (dem/, below) is built
-HAVE_LIGGGHTS := $(wildcard /usr/include/liggghts/library.h)
+# Open MPI installed (pkg-config ompi-c) and not NO_MPI=1: `convsim sweep`
+# spreads a study's points over the ranks under mpirun (core/cli/spread.h:
+# spread_mpi.c, else spread_none.c). `make NO_MPI=1 BUILD=DIR` builds
+# without MPI (and so without the DEM coupling, which needs it) where it
+# is installed; `make test` builds that too, in $(BUILD)/nompi.
+HAVE_MPI := $(if $(NO_MPI),,$(shell pkg-config --exists ompi-c 2>/dev/null && echo yes))
+# LIGGGHTS (and MPI) installed: the DEM coupling (dem/, below) is built
+HAVE_LIGGGHTS := $(if $(HAVE_MPI),$(wildcard /usr/include/liggghts/library.h))
 CORE_SRC   := $(wildcard core/*.c)
-CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),core/cli/coupled_none.c),$(wildcard core/cli/*.c))
+CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),core/cli/coupled_none.c) \
+                $(if $(HAVE_MPI),core/cli/spread_none.c,core/cli/spread_mpi.c),$(wildcard core/cli/*.c))
 FIT_SRC    := $(wildcard core/fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 SERVER_SRC := $(wildcard server/*.c)
@@ -56,9 +63,9 @@ DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem)
 # convsim's `run --set feed_model=liggghts`: the coupled runner and its
 # libraries where LIGGGHTS is installed, else a stub that says how to get it
 CLI_DEM_OBJ := $(if $(HAVE_LIGGGHTS),$(BUILD)/dem/cli/run_coupled.o $(BUILD)/libdem.a)
-CLI_DEM_LIBS = $(if $(HAVE_LIGGGHTS),-lliggghts $(MPI_LIBS))
-MPI_CFLAGS  := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --cflags ompi-c))
-MPI_LIBS    := $(if $(HAVE_LIGGGHTS),$(shell pkg-config --libs ompi-c))
+CLI_DEM_LIBS = $(if $(HAVE_LIGGGHTS),-lliggghts)
+MPI_CFLAGS  := $(if $(HAVE_MPI),$(shell pkg-config --cflags ompi-c))
+MPI_LIBS    := $(if $(HAVE_MPI),$(shell pkg-config --libs ompi-c))
 
 # Debian packages the project needs, by the file each provides: to build
 # and run (`make`, `make run`), and in addition to test (`make test`,
@@ -124,6 +131,7 @@ INC_server := -Icore -Icore/fit -Iapi -Iserver
 INC_tests  := -Icore -Icore/fit
 INC_dem    := -Icore -Icore/cli -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 $(CLI_OBJ): INC_EXTRA := -Icore/fit
+$(BUILD)/core/cli/spread_mpi.o: INC_EXTRA := -Icore/fit $(MPI_CFLAGS)
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
@@ -162,7 +170,7 @@ dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim
 
 $(BUILD)/convsim: $(CLI_OBJ) $(CLI_DEM_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(MPI_LIBS) $(LDLIBS)
 
 $(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
@@ -203,6 +211,7 @@ cluster: deps-build $(BUILD)/convsimd
 
 test: deps all
 	$(Q)$(MAKE) --no-print-directory dem-build
+	$(Q)$(MAKE) --no-print-directory NO_MPI=1 BUILD=$(BUILD)/nompi $(BUILD)/nompi/convsim
 	$(Q)BUILD=$(BUILD) bash tests/run.sh
 
 check:

@@ -9,6 +9,7 @@
 #define CONVSIM_API_JOBS_H
 
 #include "api.h"
+#include "fit.h"
 #include "study.h"
 
 /* ---- experiments --------------------------------------------------------- */
@@ -94,6 +95,13 @@ typedef struct api_sweep_req {
 	double *values;        /* nbeta x nvary user values, malloc'd by the
 				  parser (caller frees; not kept after the
 				  points are made) */
+	/* bands from a fit ("band_from_fit": its id): the parser keeps the
+	 * id; the daemon finds the fit, reads its result into band_src and
+	 * prepares spec for it (fit_band_source_prepare: band_skip) */
+	char band_fit[API_SWEEP_NAME_LEN];
+	int band;              /* 1: every point gets a band */
+	fit_band_source band_src;
+	int band_skip[FIT_MAX_FREE];
 } api_sweep_req;
 /* Default simulated time per point after scene.transient, s: after a steady
  * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
@@ -105,7 +113,8 @@ typedef struct api_sweep_req {
  * scene.transient); a study: "vary": {"NAME": {"from","to","step"} or
  * [v, ...], ...} over number settings in their user units (beta, when
  * given as "beta", the first), "lhs": N for a Latin-hypercube sample of
- * the ranges, "seed" (core/study.h). A 4xx names the field ("vary.mu")
+ * the ranges, "seed" (core/study.h); "band_from_fit": a fit's id (the
+ * daemon resolves it: req->band_fit). A 4xx names the field ("vary.mu")
  * and its range; nothing is kept then. */
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb);
@@ -123,6 +132,7 @@ typedef struct api_sweep_point {
 	char error[160];
 	double vary[SIM_STUDY_MAX_AXES]; /* the varied settings' values, user
 					    units (api_sweep_req.vary) */
+	double band[2];     /* req.band, when done: the 95 % band, m/s */
 } api_sweep_point;
 typedef struct api_sweep_view {
 	char id[24];

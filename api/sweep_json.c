@@ -19,7 +19,7 @@
 const char *const api_members_beta_range[] = {"from", "to", "step", NULL};
 const char *const api_members_sweep[] = {"preset", "params", "scene", "integrator",
 					  "beta", "rotations", "t_end", "vary", "lhs",
-					  "seed", NULL};
+					  "seed", "band_from_fit", NULL};
 
 #define T_END_MAX 600.0 /* s simulated per point, at most */
 
@@ -169,6 +169,24 @@ static api_err parse_t_end(const cJSON *te, const sim_scene *scene,
 	return API_OK;
 }
 
+/* "band_from_fit": a fit's id, a string of 1 to API_SWEEP_NAME_LEN - 1
+ * characters (whether such a fit exists is the daemon's to say). */
+static api_err parse_band_from(const cJSON *it, api_sweep_req *req, api_problem *pb)
+{
+	if (!it)
+		return API_OK;
+	if (!cJSON_IsString(it))
+		return api_fail(pb, API_TYPE, "band_from_fit",
+				"band_from_fit must be a fit's id (a string, GET /api/v1/fits)");
+	size_t n = strlen(it->valuestring);
+	if (n < 1 || n >= sizeof req->band_fit)
+		return api_fail(pb, API_INVALID, "band_from_fit",
+				"band_from_fit must be a fit's id of 1 to %d characters",
+				(int)sizeof req->band_fit - 1);
+	memcpy(req->band_fit, it->valuestring, n + 1);
+	return API_OK;
+}
+
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
@@ -194,6 +212,9 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 	if (e == API_OK)
 		e = api_parse_study(vary, cJSON_GetObjectItemCaseSensitive(root, "lhs"),
 				    cJSON_GetObjectItemCaseSensitive(root, "seed"), req, pb);
+	if (e == API_OK)
+		e = parse_band_from(cJSON_GetObjectItemCaseSensitive(root, "band_from_fit"), req,
+				    pb);
 	cJSON_Delete(root);
 	if (e != API_OK) {
 		free(req->betas);
@@ -228,6 +249,20 @@ static const char *point_state(int s)
 	return s >= 0 && s <= 3 ? names[s] : "pending";
 }
 
+/* The band's head: its level, the fit, the fit's parameters in the band
+ * and those the study varies (which leave it). */
+static void add_band_head(cJSON *o, const api_sweep_req *req)
+{
+	cJSON *band = cJSON_AddObjectToObject(o, "band");
+	api_add_number(band, "level", 0.95);
+	cJSON_AddStringToObject(band, "fit", req->band_fit);
+	cJSON *in = cJSON_AddArrayToObject(band, "parameters");
+	cJSON *out = cJSON_AddArrayToObject(band, "varied");
+	for (int j = 0; j < req->band_src.nfree; j++)
+		cJSON_AddItemToArray(req->band_skip[j] ? out : in,
+				     cJSON_CreateString(req->band_src.free[j].name));
+}
+
 static cJSON *sweep_object(const api_sweep_view *v, int points)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -253,6 +288,8 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 		api_add_number(o, "lhs", v->req->lhs);
 		api_add_number(o, "seed", v->req->seed);
 	}
+	if (v->req && v->req->band)
+		add_band_head(o, v->req);
 	if (points) {
 		/* the sweep-level reductions: the mirror reduction when it
 		 * derived any point (every point's own model reductions are a
@@ -285,6 +322,11 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 			cJSON_AddNumberToObject(po, "substeps", p->m.substeps);
 			api_add_number(po, "step_error", p->m.step_error);
 			cJSON_AddBoolToObject(po, "tol_met", p->m.tol_met);
+			if (v->req && v->req->band) {
+				cJSON *band = cJSON_AddObjectToObject(po, "band");
+				api_add_number(band, "lower", p->band[0]);
+				api_add_number(band, "upper", p->band[1]);
+			}
 		} else {
 			cJSON_AddNullToObject(po, "velocity");
 			cJSON_AddNullToObject(po, "uncertainty");
@@ -332,7 +374,9 @@ char *api_sweep_csv(const api_sweep_view *v)
 	int nvary = vary_count(v);
 	for (int a = 0; a < nvary; a++)
 		api_buf_printf(&b, "%s,", vary_name(v, a));
-	api_buf_puts(&b, SIM_SWEEP_POINT_COLUMNS "\n");
+	int band = v->req && v->req->band;
+	api_buf_puts(&b, band ? SIM_SWEEP_POINT_COLUMNS ",band_lower,band_upper\n"
+			      : SIM_SWEEP_POINT_COLUMNS "\n");
 	for (size_t i = 0; i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
 		int done = p->state == 2;
@@ -353,10 +397,16 @@ char *api_sweep_csv(const api_sweep_view *v)
 			api_buf_printf(&b, ",%d,", p->m.substeps);
 			if (isfinite(p->m.step_error))
 				api_buf_double(&b, p->m.step_error);
-			api_buf_puts(&b, p->m.tol_met ? ",true\n" : ",false\n");
+			api_buf_puts(&b, p->m.tol_met ? ",true" : ",false");
 		} else {
-			api_buf_puts(&b, ",,,\n");
+			api_buf_puts(&b, ",,,");
 		}
+		for (int k = 0; band && k < 2; k++) {
+			api_buf_put(&b, ",", 1);
+			if (done && isfinite(p->band[k]))
+				api_buf_double(&b, p->band[k]);
+		}
+		api_buf_put(&b, "\n", 1);
 	}
 	return api_buf_take(&b);
 }

@@ -363,6 +363,30 @@ static srv_entry *fit_load(void *payload, size_t len, char *why, size_t whylen)
 	return f ? &f->entry : NULL;
 }
 
+api_err srv_fit_band_source(const char *id, fit_band_source *src, api_problem *pb)
+{
+	srv_entry *en = srv_registry_get(&fits, id);
+	if (!en)
+		return api_fail(pb, API_INVALID, "band_from_fit",
+				"band_from_fit: no fit has the id '%s' (GET /api/v1/fits lists them)",
+				id);
+	srv_fit *f = fit_of(en);
+	char msg[300] = "";
+	pthread_mutex_lock(&f->lock);
+	const char *state = fit_state(f);
+	int rc = SIM_EPARAM;
+	if (!f->over || !f->json)
+		snprintf(msg, sizeof msg, "is %s; a band needs a finished fit", state);
+	else if ((rc = fit_band_source_parse(f->json, src, msg, sizeof msg)) == SIM_OK)
+		src->fd_rel = f->req.fd_rel;
+	pthread_mutex_unlock(&f->lock);
+	srv_registry_put(&fits, en);
+	if (rc != SIM_OK)
+		return api_fail(pb, API_INVALID, "band_from_fit", "band_from_fit: fit '%s' %s%s", id,
+				strncmp(msg, "is ", 3) == 0 ? "" : ": ", msg);
+	return API_OK;
+}
+
 /* A restored fit that was not over runs again from its start. */
 static void fit_resume(srv_entry *en)
 {

@@ -14,14 +14,18 @@
  * sweep's fields are guarded by its own lock. Results are served as JSON
  * or CSV and, with --data-dir, saved as CSV when done. The sweep is
  * one kind of job (job.h): srv_sweep_job below is its descriptor. The
- * mirror reduction's plan of its points is sweep_plan.c.
+ * mirror reduction's plan of its points is sweep_plan.c. With band_from_fit
+ * each point is measured again per fitted parameter (fit_band_point) for
+ * its band from the fit's covariance.
  */
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "budget.h"
+#include "fitjob.h"
 #include "job.h"
 #include "metrics.h"
 #include "pool.h"
@@ -183,11 +187,18 @@ static void run_point(void *arg)
 		if (rc == SIM_OK)
 			rc = sim_measure(&spec.params, &spec.scene, &spec.method,
 					 sw->req.t_end, &r, msg, sizeof msg);
+		double band[2] = {NAN, NAN};
+		if (rc == SIM_OK && sw->req.band)
+			rc = fit_band_point(&sw->req.band_src, sw->req.band_skip, &spec.params,
+					    &spec.scene, &spec.method, sw->req.t_end, &r, &band[0],
+					    &band[1], msg, sizeof msg);
 		pthread_mutex_lock(&sw->lock);
 		sw->running--;
 		if (rc == SIM_OK) {
 			p->state = 2;
 			p->m = r;
+			p->band[0] = band[0];
+			p->band[1] = band[1];
 			/* not shown: the record stays the same for the same sweep */
 			p->m.cpu_seconds = 0.0;
 		} else {
@@ -304,6 +315,25 @@ static int evictable(srv_entry *en)
 	return over;
 }
 
+/* band_from_fit: the fit's result as the band source and the sweep's
+ * model prepared for it (its fitted values, the varied ones skipped). */
+static api_err prepare_band(api_sweep_req *req, api_problem *pb)
+{
+	api_err e = srv_fit_band_source(req->band_fit, &req->band_src, pb);
+	if (e != API_OK)
+		return e;
+	const char *varied[SIM_STUDY_MAX_AXES];
+	for (int a = 0; a < req->nvary; a++)
+		varied[a] = req->vary[a];
+	char msg[240];
+	if (fit_band_source_prepare(&req->band_src, varied, (size_t)req->nvary, req->band_skip,
+				    &req->spec.params, &req->spec.scene, &req->spec.method, msg,
+				    sizeof msg) != SIM_OK)
+		return api_fail(pb, API_INVALID, "band_from_fit", "band_from_fit: %s", msg);
+	req->band = 1;
+	return API_OK;
+}
+
 /* A sweep for a request body with its grid of points and their place in
  * the points' budget; NULL with *pb. */
 static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
@@ -314,7 +344,8 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 		return NULL;
 	}
 	pthread_mutex_init(&sw->lock, NULL);
-	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK) {
+	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK ||
+	    (sw->req.band_fit[0] && prepare_band(&sw->req, pb) != API_OK)) {
 		sweep_free(sw);
 		return NULL;
 	}

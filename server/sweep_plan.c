@@ -80,6 +80,8 @@ void srv_sweep_fill_image(srv_sweep *sw, size_t i)
 	api_sweep_point *p = &sw->pt[j];
 	p->state = src->state;
 	sim_mirror_measurement(&src->m, &p->m);
+	p->band[0] = -src->band[1]; /* the band's image: v -> -v */
+	p->band[1] = -src->band[0];
 	if (src->state == 3)
 		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
 				   src->error);

@@ -8,6 +8,7 @@ set -u
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 export BUILD CONVSIMD="$PWD/$BUILD/convsimd" CONVSIM="$PWD/$BUILD/convsim" CONVSIM_DEM="$PWD/$BUILD/convsim-dem"
+export CONVSIM_NOMPI="$PWD/$BUILD/nompi/convsim" # the convsim of `make NO_MPI=1` (make test builds it)
 mkdir -p tests/out
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT

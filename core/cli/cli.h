@@ -13,6 +13,7 @@
 #include <stdio.h>
 
 #include "sim.h"
+#include "study.h"
 
 #define CONVSIM_VERSION "1.0.0"
 
@@ -23,7 +24,7 @@ enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
 	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_VARY,
-	OPT_LHS, OPT_SEED
+	OPT_LHS, OPT_SEED, OPT_BAND_FROM
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
@@ -50,6 +51,7 @@ typedef struct cli_opts {
 	int nvary, lhs;
 	int beta_at; /* sweep: --beta's place among the --vary (it is one) */
 	double seed;
+	const char *band_from; /* sweep: a fit's JSON result (bands on every point) */
 	/* fit */
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
@@ -71,6 +73,11 @@ int cli_cmd_fit(int argc, char **argv);
 /* convsim sweep (sweep_cmd.c): exit status 0, 1 (a point failed or the
  * table could not be written) or 2 (usage). */
 int cli_cmd_sweep(int argc, char **argv);
+/* The study of sweep's options into *st (study_opts.c): --beta (default
+ * 0:180:10 when nothing is varied) and every --vary in the order given,
+ * --lhs, --seed, the senses of --rotation, planned (sim_study_plan). 0, or
+ * 2 after a message; st is the caller's to free either way. */
+int cli_plan_study(const cli_opts *o, sim_study *st);
 
 /* Output (options.c): a number as the daemon prints it (shortest round
  * trip), non-finite as `nonfinite`; whether a file is JSON (--format, else
@@ -82,6 +89,9 @@ void cli_put_num(FILE *f, double v, const char *nonfinite);
 void cli_put_json_num(FILE *f, const char *head, double v);
 int cli_wants_json(const char *format, const char *file);
 FILE *cli_open_out(const cli_opts *o);
+/* The whole of file path (stdin for "-", at most 16 MB), malloc'd (the
+ * caller frees); NULL after "convsim CMD: --OPT: ..." on stderr. */
+char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
  * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else

@@ -68,34 +68,6 @@ static int parse_peaks(const char *list, fit_request *req)
 	return 0;
 }
 
-/* The whole of a file (or stdin for "-"), malloc'd; NULL after a message. */
-static char *slurp(const char *path)
-{
-	FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
-	if (!f) {
-		fprintf(stderr, "convsim fit: --data: cannot read '%s': %s\n", path, strerror(errno));
-		return NULL;
-	}
-	size_t len = 0, cap = 4096;
-	char *s = malloc(cap);
-	for (size_t n; s && (n = fread(s + len, 1, cap - len - 1, f)) > 0;) {
-		len += n;
-		if (len + 1 == cap) {
-			char *t = len < (16u << 20) ? realloc(s, cap *= 2) : NULL;
-			if (!t)
-				free(s);
-			s = t;
-		}
-	}
-	if (f != stdin)
-		fclose(f);
-	if (!s)
-		fprintf(stderr, "convsim fit: --data: '%s' is too large (16 MB at most)\n", path);
-	else
-		s[len] = '\0';
-	return s;
-}
-
 /* Progress on stderr: one line per iteration and phase. */
 typedef struct fit_progress_line {
 	const fit_request *req;
@@ -146,7 +118,7 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 		return 2;
 	char msg[FIT_MSG], field[48];
 	if (o->data) {
-		char *text = slurp(o->data);
+		char *text = cli_slurp("fit", "data", o->data);
 		if (!text)
 			return 2;
 		int rc = fit_parse_csv(text, points, &req->npoints, msg, sizeof msg);

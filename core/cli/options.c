@@ -53,6 +53,9 @@ static const cli_opt options[] = {
 	{CMD_SWEEP, OPT_LHS, "lhs", 0, "N", NULL, "the full grid",
 	 "a Latin-hypercube sample of N points over the --vary ranges instead of their grid"},
 	{CMD_SWEEP, OPT_SEED, "seed", 0, "S", NULL, "1", "seed of the --lhs sample, 0..4294967295"},
+	{CMD_SWEEP, OPT_BAND_FROM, "band-from", 0, "FIT.json", NULL, NULL,
+	 "the JSON result of convsim fit: its fitted values on the model and a 95 % band on every "
+	 "point from its covariance (a varied parameter takes the grid's values and leaves the band)"},
 	{CMD_SWEEP, OPT_ROTATION, "rotation", 0, "cw,ccw", NULL, "cw,ccw",
 	 "cw (the paper's clockwise, rotor speed > 0), ccw, or both"},
 	{CMD_SWEEP | CMD_FIT, OPT_THREADS, "threads", 'j', "N", NULL, "2",
@@ -95,7 +98,9 @@ static const struct {
 	 "Measure the steady transport velocity v(beta), or a study of v over any number\n"
 	 "settings (--vary, a grid or a --lhs sample): one fresh simulation per point and\n"
 	 "rotation sense, on a thread pool. The table goes to stdout (or --out), progress to\n"
-	 "stderr: a bar on a terminal, plain lines otherwise."},
+	 "stderr: a bar on a terminal, plain lines otherwise. Built with MPI, under mpirun\n"
+	 "the points are spread over the ranks and rank 0 writes the table (docs/cli.md,\n"
+	 "\"On a cluster\")."},
 	{"fit", CMD_FIT, "convsim fit (--data FILE | --peaks ROT:DEG,...) --free NAME,... [OPTIONS]",
 	 "Fit free model parameters to measured v(beta) points or peak positions by\n"
 	 "Levenberg-Marquardt (GSL), each model value a steady-state measurement, the\n"
@@ -352,4 +357,33 @@ FILE *cli_open_out(const cli_opts *o)
 			strerror(errno));
 	}
 	return f;
+}
+
+char *cli_slurp(const char *cmd, const char *opt, const char *path)
+{
+	FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
+	if (!f) {
+		fprintf(stderr, "convsim %s: --%s: cannot read '%s': %s\n", cmd, opt, path,
+			strerror(errno));
+		return NULL;
+	}
+	size_t len = 0, cap = 4096;
+	char *s = malloc(cap);
+	for (size_t n; s && (n = fread(s + len, 1, cap - len - 1, f)) > 0;) {
+		len += n;
+		if (len + 1 == cap) {
+			char *t = len < (16u << 20) ? realloc(s, cap *= 2) : NULL;
+			if (!t)
+				free(s);
+			s = t;
+		}
+	}
+	if (f != stdin)
+		fclose(f);
+	if (!s)
+		fprintf(stderr, "convsim %s: --%s: '%s' is too large (16 MB at most)\n", cmd, opt,
+			path);
+	else
+		s[len] = '\0';
+	return s;
 }

@@ -186,6 +186,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 			}
 			break;
 		case OPT_DATA: o->data = arg; break;
+		case OPT_BAND_FROM: o->band_from = arg; break;
 		case OPT_PEAKS: o->peaks = arg; break;
 		case OPT_FREE: o->free_list = arg; break;
 		case OPT_CURVE_STEP:

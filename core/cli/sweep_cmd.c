@@ -6,26 +6,32 @@
  * rotation sense, one fresh sim_measure per point and sense on the
  * library's parallel map (pmap.h), the mirror reduction's images taken
  * from their sources. The table has the varied settings' columns, then
- * the daemon's point columns (core/table.h).
+ * the daemon's point columns (core/table.h); with --band-from a band per
+ * point (band_from.h). Under mpirun the points to measure are spread
+ * over the ranks (spread.h) and rank 0 writes the table, the same bytes
+ * as one process writes. The options' study is study_opts.c's.
  */
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "band_from.h"
 #include "cli.h"
 #include "pmap.h"
 #include "sim.h"
+#include "spread.h"
 #include "study.h"
-#include "suggest.h"
 #include "table.h"
-#include "units.h"
 
 /* ---- sweep ---- */
 
 typedef struct task {
 	long source; /* -1: measured; else the task it mirrors (sim_study_mirror_plan) */
 	sim_measurement r;
+	double band[2]; /* --band-from: the 95 % band's lower and upper ends, m/s */
 	int err;
 	char msg[160];
 } task;
@@ -33,9 +39,12 @@ typedef struct task {
 typedef struct pool {
 	const cli_opts *o;
 	const sim_study *st;
+	const cli_spread *sp;
+	const fit_band_source *band; /* NULL: no bands */
+	const int *skip;             /* the band's parameters the study varies */
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
-	int n, done;
+	int n, done; /* done: of this rank's share */
 	cli_progress progress;
 } pool;
 
@@ -57,29 +66,41 @@ static const char *describe_task(const sim_study *st, size_t k, char *buf, size_
 	return buf;
 }
 
-/* Measure the k-th task to run (a job of the map). */
-static void measure_task(void *arg, size_t k)
+/* The task of this rank's j-th job: the (rank + j ranks)-th to run. */
+static size_t share_task(const pool *pl, size_t j)
+{
+	return (size_t)pl->run[(size_t)pl->sp->rank + j * (size_t)pl->sp->ranks];
+}
+
+/* Measure this rank's j-th task (a job of the map). */
+static void measure_task(void *arg, size_t j)
 {
 	pool *pl = arg;
-	size_t i = (size_t)pl->run[k];
+	size_t i = share_task(pl, j);
 	task *t = &pl->tasks[i];
 	sim_params p = pl->o->p;
 	sim_scene sc = pl->o->sc;
 	sim_method m = pl->o->m;
+	t->band[0] = t->band[1] = NAN;
 	t->err = sim_study_apply(pl->st, i, &p, &sc, &m, t->msg, sizeof t->msg);
 	if (t->err == SIM_OK)
 		t->err = sim_measure(&p, &sc, &m, pl->o->duration, &t->r, t->msg, sizeof t->msg);
+	if (t->err == SIM_OK && pl->band)
+		t->err = fit_band_point(pl->band, pl->skip, &p, &sc, &m, pl->o->duration, &t->r,
+					&t->band[0], &t->band[1], t->msg, sizeof t->msg);
 }
 
 /* The progress line after each task (the map calls it one at a time). */
-static void task_done(void *arg, size_t k, size_t done)
+static void task_done(void *arg, size_t j, size_t done)
 {
 	pool *pl = arg;
 	char what[200], detail[220];
 	pl->done = (int)done;
 	snprintf(detail, sizeof detail, " (last: %s)",
-		 describe_task(pl->st, (size_t)pl->run[k], what, sizeof what));
-	cli_progress_update(&pl->progress, pl->done, pl->n, "points", detail);
+		 describe_task(pl->st, share_task(pl, j), what, sizeof what));
+	cli_progress_update(&pl->progress, pl->done,
+			    (double)cli_spread_share(pl->sp, (size_t)pl->n),
+			    pl->sp->ranks > 1 ? "points of rank 0's share" : "points", detail);
 }
 
 /* Task k's beta in degrees: its axis value, else the model's. */
@@ -101,6 +122,8 @@ static void mirror_tasks(const pool *pl, int ntasks)
 			continue;
 		const task *src = &pl->tasks[t->source];
 		sim_mirror_measurement(&src->r, &t->r);
+		t->band[0] = -src->band[1]; /* the band's image: v -> -v */
+		t->band[1] = -src->band[0];
 		t->err = src->err;
 		if (src->err != SIM_OK)
 			sim_mirror_failure(t->msg, sizeof t->msg, task_beta(pl, (size_t)t->source),
@@ -136,6 +159,17 @@ static void print_json_head(FILE *f, const cli_opts *o, const pool *pl, int ntas
 	fputc(']', f);
 	if (st->lhs)
 		fprintf(f, ",\"lhs\":%zu,\"seed\":%.0f", st->lhs, (double)st->seed);
+	if (pl->band) { /* the band's parameters, and those the study varies */
+		fputs(",\"band\":{\"level\":0.95,\"parameters\":[", f);
+		for (int j = 0, n = 0; j < pl->band->nfree; j++)
+			if (!pl->skip[j])
+				fprintf(f, "%s\"%s\"", n++ ? "," : "", pl->band->free[j].name);
+		fputs("],\"varied\":[", f);
+		for (int j = 0, n = 0; j < pl->band->nfree; j++)
+			if (pl->skip[j])
+				fprintf(f, "%s\"%s\"", n++ ? "," : "", pl->band->free[j].name);
+		fputs("]}", f);
+	}
 	fprintf(f, ",\"reductions\":[%s],\"points\":[\n", pl->n < ntasks ? "\"mirror\"" : "");
 }
 
@@ -151,7 +185,8 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 	} else {
 		for (size_t a = 0; a < st->naxes; a++)
 			fprintf(f, "%s,", st->axis[a].setting->name);
-		fputs(SIM_SWEEP_POINT_COLUMNS "\n", f);
+		fputs(SIM_SWEEP_POINT_COLUMNS, f);
+		fputs(pl->band ? ",band_lower,band_upper\n" : "\n", f);
 	}
 	for (int i = 0; i < ntasks; i++) {
 		const task *t = &pl->tasks[i];
@@ -185,168 +220,35 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 		cli_put_num(f, t->r.dt, nf);
 		fprintf(f, json ? ",\"substeps\":%d,\"step_error\":" : ",%d,", t->r.substeps);
 		cli_put_num(f, t->r.step_error, nf);
-		fprintf(f, json ? ",\"tol_met\":%s}%s\n" : ",%s%s\n", t->r.tol_met ? "true" : "false",
-			json && i + 1 < ntasks ? "," : "");
+		fprintf(f, json ? ",\"tol_met\":%s" : ",%s", t->r.tol_met ? "true" : "false");
+		if (pl->band) {
+			fputs(json ? ",\"band\":{\"lower\":" : ",", f);
+			cli_put_num(f, t->band[0], nf);
+			fputs(json ? ",\"upper\":" : ",", f);
+			cli_put_num(f, t->band[1], nf);
+			fputs(json ? "}" : "", f);
+		}
+		fprintf(f, "%s%s\n", json ? "}" : "", json && i + 1 < ntasks ? "," : "");
 	}
 	if (json)
 		fputs("]}\n", f);
 	return failed;
 }
 
-/* --beta FROM:TO:STEP or one angle into *from, *to, *step. */
-static int parse_beta(const char *text, double *from, double *to, double *step)
-{
-	char tail;
-	int n = sscanf(text, "%lf:%lf:%lf%c", from, to, step, &tail);
-	if (n == 1 && sscanf(text, "%lf%c", from, &tail) == 1) {
-		*to = *from;
-		*step = 1;
-		n = 3;
-	}
-	if (n != 3 || !(*step > 0) || !(*from >= 0) || !(*to <= 180) || !(*to >= *from)) {
-		fprintf(stderr, "convsim sweep: --beta must be FROM:TO:STEP in degrees with 0 <= FROM "
-				"<= TO <= 180 and STEP > 0 (or one angle), got '%s'\n",
-			text);
-		return -1;
-	}
-	return 0;
-}
-
-/* One --vary NAME=FROM:TO:STEP or NAME=V1,V2,... (or NAME=V) as an axis
- * of st, checked by the study (name, range); 0 or -1 after a message. */
-static int add_vary(sim_study *st, const cli_opts *o, const char *text)
-{
-	const char *eq = strchr(text, '=');
-	char name[64], msg[240], hint[96] = "";
-	double v[3];
-	int rc = SIM_EPARAM;
-	if (!eq || eq == text || (size_t)(eq - text) >= sizeof name) {
-		fprintf(stderr, "convsim sweep: --vary needs NAME=FROM:TO:STEP or NAME=V1,V2,..., "
-				"got '%s'\n",
-			text);
-		return -1;
-	}
-	snprintf(name, sizeof name, "%.*s", (int)(eq - text), text);
-	const char *spec = eq + 1;
-	char tail;
-	if (strchr(spec, ':')) {
-		if (sscanf(spec, "%lf:%lf:%lf%c", &v[0], &v[1], &v[2], &tail) == 3)
-			rc = sim_study_add_range(st, &o->p, &o->sc, &o->m, name, v[0], v[1], v[2],
-						 msg, sizeof msg);
-		else
-			snprintf(msg, sizeof msg, "a range is FROM:TO:STEP, three numbers");
-	} else {
-		size_t n = 1;
-		for (const char *c = spec; *c; c++)
-			n += *c == ',';
-		double *list = calloc(n, sizeof(double));
-		char *copy = strdup(spec);
-		size_t k = 0;
-		int ok = list && copy;
-		char *save = NULL;
-		for (char *tok = ok ? strtok_r(copy, ",", &save) : NULL; ok && tok;
-		     tok = strtok_r(NULL, ",", &save))
-			ok = sscanf(tok, "%lf%c", &list[k++], &tail) == 1;
-		if (ok && k == n)
-			rc = sim_study_add_list(st, &o->p, &o->sc, &o->m, name, list, n, msg,
-						sizeof msg);
-		else
-			snprintf(msg, sizeof msg, "a list is numbers separated by commas");
-		free(list);
-		free(copy);
-	}
-	if (rc == SIM_OK)
-		return 0;
-	if (rc == SIM_EUNKNOWN && !sim_setting_find(name)) {
-		size_t nset;
-		const sim_setting *t = sim_settings(&nset);
-		cli_did_you_mean(hint, sizeof hint, sim_suggest(name, &t->name, nset, sizeof *t));
-	}
-	fprintf(stderr, "convsim sweep: --vary %s: %s%s; 'convsim list' shows every setting\n", text,
-		msg, hint);
-	return -1;
-}
-
-/* --rotation cw, ccw, cw,ccw (or ccw,cw) into rots; the count or -1. */
-static int parse_rotation(const char *text, int rots[2])
-{
-	static const char *const senses[] = {"cw", "ccw"};
-	int n = 0;
-	char buf[64];
-	snprintf(buf, sizeof buf, "%s", text);
-	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		int known = strcmp(tok, "cw") == 0 || strcmp(tok, "ccw") == 0;
-		int r = strcmp(tok, "cw") == 0 ? SIM_CW : SIM_CCW;
-		if (!known || n == 2 || (n == 1 && rots[0] == r)) {
-			char hint[96];
-			fprintf(stderr, "convsim sweep: --rotation takes cw, ccw or cw,ccw; '%s' is not "
-					"one%s\n",
-				tok,
-				cli_did_you_mean(hint, sizeof hint,
-						 !known ? sim_suggest(tok, senses, 2, sizeof *senses)
-						       : NULL));
-			return -1;
-		}
-		rots[n++] = r;
-	}
-	if (!n)
-		fprintf(stderr, "convsim sweep: --rotation takes cw, ccw or cw,ccw\n");
-	return n ? n : -1;
-}
-
-/* --beta TEXT as the axis beta (the shorthand's own message for a bad
- * range); 0 or -1 after a message. */
-static int add_beta(sim_study *st, const cli_opts *o, const char *text)
-{
-	double from, to, step;
-	char msg[240];
-	if (parse_beta(text, &from, &to, &step))
-		return -1;
-	if (sim_study_add_range(st, &o->p, &o->sc, &o->m, "beta", from, to, step, msg,
-				sizeof msg) != SIM_OK) {
-		fprintf(stderr, "convsim sweep: --beta %s: %s\n", text, msg);
-		return -1;
-	}
-	return 0;
-}
-
-/* The study of the options: --beta (default 0:180:10 when nothing is
- * varied) and every --vary in the order given, --lhs, --seed, the senses, planned.
- * 0, or 2 after a message. */
-static int plan_study(const cli_opts *o, sim_study *st)
-{
-	int nrot;
-	if ((nrot = parse_rotation(o->rotation, st->rotation)) < 0)
-		return 2;
-	st->nrot = (size_t)nrot;
-	st->lhs = (size_t)o->lhs;
-	st->seed = (uint64_t)o->seed;
-	const char *beta = o->beta ? o->beta : o->nvary ? NULL : "0:180:10";
-	char msg[240];
-	for (int i = 0; i <= o->nvary; i++) {
-		if (beta && i == o->beta_at && add_beta(st, o, beta))
-			return 2;
-		if (i < o->nvary && add_vary(st, o, o->vary[i]))
-			return 2;
-	}
-	if (o->lhs && !o->nvary) {
-		fprintf(stderr, "convsim sweep: --lhs samples the --vary ranges; give at least one "
-				"--vary\n");
-		return 2;
-	}
-	if (sim_study_plan(st, msg, sizeof msg) != SIM_OK) {
-		fprintf(stderr, "convsim sweep: %s\n", msg);
-		return 2;
-	}
-	return 0;
-}
-
-/* Measure the study's tasks on o->threads threads, the mirror images
- * derived after; the closing progress line. 0, or 1 out of memory. */
+/* Measure this rank's share of the study's tasks on o->threads threads,
+ * gather every rank's into point order on rank 0 (which derives the
+ * mirror images and closes the progress: rank 0 reports its own share
+ * while it runs, then the whole). 0, or 1 out of memory (before the
+ * measuring: every rank stops with it); an error in the gathering ends
+ * every rank (cli_spread_abort). */
 static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 {
 	long *source = calloc((size_t)ntasks, sizeof(long));
-	if (!source || sim_study_mirror_plan(pl->st, &o->p, &o->sc, &o->m, source) == (size_t)-1) {
+	int rc = !source || sim_study_mirror_plan(pl->st, &o->p, &o->sc, &o->m, source) ==
+				    (size_t)-1;
+	if (rc)
+		fprintf(stderr, "convsim sweep: out of memory\n");
+	if (cli_spread_agree(pl->sp, rc)) {
 		free(source);
 		return 1;
 	}
@@ -356,12 +258,20 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 			pl->run[pl->n++] = k;
 	}
 	free(source);
-	cli_progress_start(&pl->progress, "sweep", o->quiet, 0);
-	pmap_run(o->threads, (size_t)pl->n, measure_task, pl, task_done);
+	const cli_spread *sp = pl->sp;
+	cli_progress_start(&pl->progress, "sweep", o->quiet || sp->rank > 0, 0);
+	pmap_run(o->threads, cli_spread_share(sp, (size_t)pl->n), measure_task, pl, task_done);
+	if (cli_spread_gather(sp, pl->tasks, sizeof(task), pl->run, (size_t)pl->n))
+		cli_spread_abort(sp, 1);
+	if (sp->rank > 0)
+		return 0;
 	mirror_tasks(pl, ntasks);
-	char done[128];
-	snprintf(done, sizeof done, "%d/%d points in %.1f s", pl->done, pl->n,
-		 cli_now() - pl->progress.t0);
+	char done[160];
+	snprintf(done, sizeof done, "%d/%d points in %.1f s", sp->ranks > 1 ? pl->n : pl->done,
+		 pl->n, cli_now() - pl->progress.t0);
+	if (sp->ranks > 1)
+		snprintf(done + strlen(done), sizeof done - strlen(done),
+			 " on %d ranks (%d on rank 0)", sp->ranks, pl->done);
 	if (pl->n < ntasks)
 		snprintf(done + strlen(done), sizeof done - strlen(done),
 			 "; %d more as their mirror images (mirror reduction)", ntasks - pl->n);
@@ -369,46 +279,148 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 	return 0;
 }
 
-int cli_cmd_sweep(int argc, char **argv)
+/* What a rank but rank 0 says while it parses and plans: stdout to
+ * /dev/null, stderr into a scratch file, since every rank finds the same
+ * usage errors and rank 0 reports them; said after all only when this
+ * rank's outcome differs from rank 0's (quiet_end). */
+typedef struct quiet {
+	int saved[2]; /* the original fds 1 and 2, or -1 */
+	FILE *said;   /* stderr meanwhile, or NULL */
+} quiet;
+
+static void quiet_start(quiet *q)
 {
-	cli_opts o = {0};
-	int rc = cli_parse(argc, argv, CMD_SWEEP, &o);
+	int null = open("/dev/null", O_WRONLY);
+	q->said = tmpfile();
+	fflush(stdout);
+	for (int fd = 1; fd <= 2; fd++) {
+		int to = fd == 2 && q->said ? fileno(q->said) : null;
+		q->saved[fd - 1] = to >= 0 ? dup(fd) : -1;
+		if (q->saved[fd - 1] >= 0)
+			dup2(to, fd);
+	}
+	if (null >= 0)
+		close(null);
+}
+
+/* Back to the original fds; with tell, what the rank said goes to stderr,
+ * each line with the rank's number. */
+static void quiet_end(quiet *q, int rank, int tell)
+{
+	fflush(stdout);
+	for (int fd = 1; fd <= 2; fd++)
+		if (q->saved[fd - 1] >= 0) {
+			dup2(q->saved[fd - 1], fd);
+			close(q->saved[fd - 1]);
+		}
+	if (!q->said)
+		return;
+	char line[512];
+	rewind(q->said);
+	while (tell && fgets(line, sizeof line, q->said))
+		fprintf(stderr, "(rank %d) %s", rank, line);
+	fclose(q->said);
+}
+
+/* The options parsed and checked, the study planned, --band-from read
+ * into band (with skip): 0, 2 (usage, reported) or -1 (help shown). */
+static int prepare(int argc, char **argv, cli_opts *o, sim_study *st, fit_band_source *band,
+		   int *skip)
+{
+	int rc = cli_parse(argc, argv, CMD_SWEEP, o);
 	if (rc)
-		return rc < 0 ? 0 : rc;
-	if (!(o.duration > o.sc.transient)) {
+		return rc;
+	if (!(o->duration > o->sc.transient)) {
 		fprintf(stderr, "convsim sweep: --duration (%g s) must exceed the scene's transient "
 				"(%g s): v is measured over [transient, duration]\n",
-			o.duration, o.sc.transient);
+			o->duration, o->sc.transient);
 		return 2;
 	}
-	sim_study st = {0};
-	if ((rc = plan_study(&o, &st)) != 0) {
-		sim_study_free(&st);
+	if ((rc = cli_plan_study(o, st)) != 0)
 		return rc;
+	return o->band_from ? cli_band_from(o, st, band, skip) : 0;
+}
+
+/* FNV-1a over the arguments: the ranks compare their command lines. */
+static unsigned long long argv_hash(int argc, char **argv)
+{
+	unsigned long long h = 14695981039346656037ULL;
+	for (int i = 0; i < argc; i++)
+		for (const char *c = argv[i];; c++) {
+			h = (h ^ (unsigned char)*c) * 1099511628211ULL;
+			if (!*c)
+				break;
+		}
+	return h;
+}
+
+/* The sweep on this rank (spread.h): every rank parses, plans and
+ * measures its share; rank 0 alone opens --out and writes the table.
+ * The ranks check that they have the same options and agree on every
+ * early stop, so none waits for another. */
+static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
+{
+	cli_opts o = {0};
+	sim_study st = {0};
+	fit_band_source band;
+	int skip[FIT_MAX_FREE] = {0}, rc;
+	quiet q = {{-1, -1}, NULL};
+	if (!cli_spread_same(sp, argv_hash(argc, argv))) {
+		if (sp->rank == 0)
+			fprintf(stderr, "convsim sweep: the %d ranks were started with different "
+					"options; every rank must have the same command line\n",
+				sp->ranks);
+		return 2;
 	}
+	if (sp->rank > 0)
+		quiet_start(&q);
+	rc = prepare(argc, argv, &o, &st, &band, skip);
+	/* a rank that fares otherwise than rank 0 (a file only rank 0 can
+	 * read, say) says why */
+	int other = cli_spread_rank0(sp, rc) != rc;
+	if (sp->rank > 0)
+		quiet_end(&q, sp->rank, other);
 	FILE *out = stdout;
-	if (o.out && !(out = cli_open_out(&o))) {
-		sim_study_free(&st);
-		return 1;
+	if (rc == 0 && sp->rank == 0 && o.out && !(out = cli_open_out(&o))) {
+		out = stdout;
+		rc = 1;
 	}
-	int ntasks = (int)sim_study_tasks(&st);
-	pool pl = {.o = &o, .st = &st};
-	pl.tasks = calloc((size_t)ntasks, sizeof(task));
-	pl.run = calloc((size_t)ntasks, sizeof(int));
-	int failed = 0, write_failed = 0;
-	if (!pl.tasks || !pl.run || measure_study(&o, &pl, ntasks)) {
-		fprintf(stderr, "convsim sweep: out of memory\n");
-		failed = 1;
-	} else {
-		failed = print_sweep(out, &o, &pl, ntasks);
+	int ntasks = rc ? 0 : (int)sim_study_tasks(&st);
+	pool pl = {.o = &o, .st = &st, .sp = sp, .band = o.band_from ? &band : NULL, .skip = skip};
+	pl.tasks = calloc(ntasks ? (size_t)ntasks : 1, sizeof(task));
+	pl.run = calloc(ntasks ? (size_t)ntasks : 1, sizeof(int));
+	if (rc == 0 && (!pl.tasks || !pl.run)) {
+		fprintf(stderr, "convsim sweep: rank %d: out of memory\n", sp->rank);
+		rc = 1;
 	}
-	if (out != stdout) {
-		write_failed = ferror(out) | (fclose(out) != 0);
-		if (write_failed)
-			fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
+	int mine = rc;
+	if ((rc = cli_spread_agree(sp, rc)) > 0 && mine == 0 && sp->rank == 0)
+		fprintf(stderr, "convsim sweep: another rank could not start the study (its reason "
+				"is marked with its rank); every rank stops\n");
+	if (rc != 0 || (rc = measure_study(&o, &pl, ntasks)) != 0 || sp->rank > 0) {
+		rc = rc < 0 ? 0 : rc; /* -1: help shown */
+		goto done;
 	}
+	rc = print_sweep(out, &o, &pl, ntasks) ? 1 : 0;
+	if (out != stdout && (ferror(out) | (fclose(out) != 0))) {
+		fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
+		rc = 1;
+	}
+	out = stdout;
+done:
+	if (out != stdout)
+		fclose(out);
 	free(pl.tasks);
 	free(pl.run);
 	sim_study_free(&st);
-	return failed || write_failed ? 1 : 0;
+	return rc;
+}
+
+int cli_cmd_sweep(int argc, char **argv)
+{
+	cli_spread sp;
+	cli_spread_start(&sp);
+	int rc = sweep_on_rank(argc, argv, &sp);
+	cli_spread_end(&sp);
+	return rc;
 }

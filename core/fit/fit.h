@@ -186,6 +186,64 @@ double fit_normal(unsigned long long *seed);
 int fit_band_sampled(const fit_request *req, const fit_result *res, int nsamples,
 		     unsigned long long seed, double *lo, double *hi);
 
+/* The 97.5 % quantile of a band: the normal's when every datum had its
+ * sigma, Student's t with dof degrees of freedom when the covariance
+ * comes from the residual variance; NaN when dof < 1. */
+double fit_band_quantile(int sigma_given, int dof);
+
+/* The delta method's half-width at one curve point (the one piece of it
+ * that the fit's band and a study's bands share): q sqrt(g^T cov g + u^2)
+ * with g_j = (vp[j] - v) / h[j], the forward difference of v over the
+ * step h[j] of parameter j (vp[j]: v with x_j + h_j), cov p x p row-major
+ * (SI), u the point's own error bar (m/s; NaN: none). */
+double fit_delta_half(int p, const double *cov, double q, double v, const double *vp,
+		      const double *h, double u);
+
+/* The forward-difference step of parameter f at x (SI): fd_rel max(|x|,
+ * 1e-3 of its range), at most a quarter of the range, backwards where x +
+ * h passes the upper bound. The Jacobian's, the band's and a study's. */
+double fit_step(const fit_free *f, double fd_rel, double x);
+
+/* ---- bands on other curves (fit_source.c): a fit's parameters with
+ * their uncertainties, for a study over other settings ---------------- */
+
+typedef struct fit_band_source {
+	int nfree;
+	fit_free free[FIT_MAX_FREE];          /* name, bounds (SI) */
+	double x[FIT_MAX_FREE];               /* SI: the fitted values */
+	double cov[FIT_MAX_FREE * FIT_MAX_FREE]; /* SI, row-major */
+	double quantile;                      /* q of the fit's band */
+	double fd_rel;                        /* the step (fit_step) */
+} fit_band_source;
+
+/* The source from `convsim fit`'s JSON result (fit_result_json's text,
+ * whitespace anywhere): "parameters" (name, value, standard_error, min,
+ * max, in user units), "correlation", "dof", "standard_errors_from" and
+ * "status"; the covariance is corr_ab se_a se_b in SI and the step the
+ * fit's default. SIM_OK, or SIM_EPARAM with what is wrong in msg. */
+int fit_band_source_parse(const char *json, fit_band_source *src, char *msg, size_t len);
+
+/* Prepare a study's model for bands from src: skip[j] = 1 where the
+ * study varies parameter j (its name among the nvaried names of varied),
+ * the others' fitted values set on p, s, m, and the mirror reduction off
+ * (s->mirror = 0) where a parameter's step would break the machine's
+ * symmetry that the images' bands rely on. SIM_OK or sim_set's code with
+ * msg. */
+int fit_band_source_prepare(const fit_band_source *src, const char *const *varied, size_t nvaried,
+			    int *skip, sim_params *p, sim_scene *s, sim_method *m, char *msg,
+			    size_t len);
+
+/* The 95 % band of a study's point (thread-safe): at its measurement `at`
+ * on the model p, s, m (the source's values applied, the point's
+ * settings set), v is measured again with x_j + h_j for each parameter j
+ * of the source not skipped (skip[j]: the study varies it; it drops out
+ * of the covariance), and [lower, upper] = v -+ fit_delta_half. t_end as
+ * sim_measure's. SIM_OK, or the failing run's code with msg. */
+int fit_band_point(const fit_band_source *src, const int *skip, const sim_params *p,
+		   const sim_scene *s, const sim_method *m, double t_end,
+		   const sim_measurement *at, double *lower, double *upper, char *msg,
+		   size_t len);
+
 /* ---- checks and parsers (user units in messages) ---------------------- */
 
 /* The setting for a free-parameter name: a real setting of group "params"

@@ -30,13 +30,29 @@
 #include "fit_int.h"
 #include "units.h"
 
-/* 97.5 % quantile for the band: normal with sigma, t(dof) without; NaN
- * when there is no residual variance. */
+double fit_band_quantile(int sigma_given, int dof)
+{
+	if (sigma_given)
+		return gsl_cdf_ugaussian_Pinv(0.975);
+	return dof > 0 ? gsl_cdf_tdist_Pinv(0.975, dof) : NAN;
+}
+
+/* 97.5 % quantile for res's band. */
 static double band_quantile(const fit_result *res)
 {
-	if (res->sigma_given)
-		return gsl_cdf_ugaussian_Pinv(0.975);
-	return res->dof > 0 ? gsl_cdf_tdist_Pinv(0.975, res->dof) : NAN;
+	return fit_band_quantile(res->sigma_given, res->dof);
+}
+
+double fit_delta_half(int p, const double *cov, double q, double v, const double *vp,
+		      const double *h, double u)
+{
+	double g[FIT_MAX_FREE], var = 0;
+	for (int j = 0; j < p; j++)
+		g[j] = (vp[j] - v) / h[j];
+	for (int a = 0; a < p; a++)
+		for (int b = 0; b < p; b++)
+			var += g[a] * cov[a * p + b] * g[b];
+	return q * sqrt(fmax(var, 0) + (isfinite(u) ? u * u : 0));
 }
 
 /* The rotations of the data into res (in order of first use). */
@@ -67,13 +83,10 @@ static void delta_band(fit_result *res, int p, size_t total, const double *v, co
 {
 	res->band_quantile = band_quantile(res);
 	for (size_t k = 0; k < total; k++) {
-		double g[FIT_MAX_FREE], var = 0;
+		double vk[FIT_MAX_FREE];
 		for (int j = 0; j < p; j++)
-			g[j] = (vp[(size_t)j * total + k] - v[k]) / h[j];
-		for (int a = 0; a < p; a++)
-			for (int b = 0; b < p; b++)
-				var += g[a] * res->cov[a * p + b] * g[b];
-		double half = res->band_quantile * sqrt(fmax(var, 0) + (isfinite(u[k]) ? u[k] * u[k] : 0));
+			vk[j] = vp[(size_t)j * total + k];
+		double half = fit_delta_half(p, res->cov, res->band_quantile, v[k], vk, h, u[k]);
 		res->band_lo[k] = isfinite(half) ? v[k] - half : NAN;
 		res->band_hi[k] = isfinite(half) ? v[k] + half : NAN;
 	}

@@ -34,8 +34,12 @@ void fit_warn(fit_result *res, const char *fmt, ...)
 /* The step of the forward differences (the Jacobian's and the band's). */
 double fit_fd_step(const fit_ctx *c, int j, double x)
 {
-	const fit_free *f = &c->req->free[j];
-	double h = c->req->fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
+	return fit_step(&c->req->free[j], c->req->fd_rel, x);
+}
+
+double fit_step(const fit_free *f, double fd_rel, double x)
+{
+	double h = fd_rel * fmax(fabs(x), 1e-3 * (f->hi - f->lo));
 	h = fmin(h, 0.25 * (f->hi - f->lo));
 	return x + h <= f->hi ? h : -h;
 }

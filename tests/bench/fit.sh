@@ -8,15 +8,7 @@
 # (fixed seed), the fit starts at the preset (e = 0.0215 m, mu = 0.4).
 # Repeated REPEAT times (default 3: the machine is shared); the table gives
 # wall and CPU time (user + sys) of each run and what the fit found.
-set -eu
-cd "$(dirname "$0")/../.."
-BUILD=${BUILD:-build}
-out=${1:-tests/bench/results}
-repeat=${REPEAT:-3}
-mkdir -p "$out"
-cli="$BUILD/convsim"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+. "$(dirname "$0")/preamble.sh"
 "$cli" sweep --beta 15:150:15 --rotation cw,ccw --set e=0.018 --set mu=0.5 -q --threads 2 > "$work/clean.csv"
 awk -F, 'BEGIN { srand(2016); print "beta,rotation,v,sigma" }
 	NR > 1 { u1 = rand(); u2 = rand(); if (u1 < 1e-12) u1 = 1e-12

@@ -386,6 +386,22 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 			assert.match(c.bg, p.velocity > 0 ? /^rgb\(255, / : /, 255\)$/, `${rot} cell ${i}: ${c.bg} for v = ${p.velocity}`);
 		});
 	}
+	/* the map's own export: the CSV rows are the sweep's points, the PNG
+	 * an image of the map's size */
+	const mapCsv = csvLines(await download('#sweep-map + .plot-export button[data-export="csv"]'));
+	assert.equal(mapCsv[0], 'mu,beta,rotation,velocity,uncertainty,steady,dt,substeps');
+	assert.deepEqual(mapCsv.slice(1), study.points.map(p =>
+		[p.mu, p.beta, p.rotation, p.velocity, p.uncertainty, p.steady, p.dt, p.substeps].map(String).join(',')));
+	const png = await download('#sweep-map + .plot-export button[data-export="png"]');
+	assert.equal(png.name, 'sweep-map.png');
+	assert.equal(png.bytes.subarray(0, 8).toString('hex'), '89504e470d0a1a0a', 'a PNG');
+	const size = await page.$eval('#sweep-map', el => {
+		const r = el.getBoundingClientRect(), d = window.devicePixelRatio || 1;
+		return [Math.round(r.width * d), Math.round(r.height * d)];
+	});
+	assert.ok(size[0] > 100 && size[1] > 40, `map ${size}`);
+	assert.deepEqual([png.bytes.readUInt32BE(16), png.bytes.readUInt32BE(20)], size, 'the PNG has the map\'s size');
+	assert.ok(png.bytes.length > 1000, `${png.bytes.length} bytes`);
 	const rows = await page.$$eval('#sweep-table tbody tr', r => r.map(x => Array.from(x.cells, c => c.textContent)));
 	assert.equal(rows.length, 12);
 	assert.deepEqual(rows[0].slice(0, 3), ['0.3', '30', 'cw']);
@@ -396,6 +412,7 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 	await page.click('#sweep-run');
 	await until(async () => await visible('#plot-sweep') && await count('#plot-sweep') === 8, 60000, 'the curves over mu');
 	assert.equal(await visible('#sweep-map'), false);
+	assert.equal(await visible('#sweep-map + .plot-export'), false, 'no map, no map export');
 	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
 	assert.equal(plot[0], 'series,mu,transport velocity v / (m/s),error');
 	assert.deepEqual(plot.slice(1, 5).map(l => l.split(',')[1]), ['0.3', '0.6', '0.9', '1.2']);
@@ -451,6 +468,41 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	const csv = csvLines(await download('#fit-csv'));
 	assert.equal(csv[0], 'kind,name,beta,rotation,measured,sigma,model,uncertainty,residual,start,band_lower,band_upper');
 	assert.equal(csv.filter(l => l.startsWith('curve,')).length, 4);
+});
+
+test('a sweep with the last fit\'s band: the band shaded under each curve, as the daemon gives it', async () => {
+	const box = '#sweep-form input[name="band"]';
+	assert.equal(await page.$eval(box, b => b.disabled), false, 'a finished fit offers its band');
+	const fitId = /^band of fit (\S+)$/.exec(await page.textContent('#sweep-band-text'))?.[1];
+	assert.ok(fitId, await page.textContent('#sweep-band-text'));
+	await page.fill('#sweep-form input[name="vary"]', '');
+	await page.fill('#sweep-form input[name="from"]', '30');
+	await page.fill('#sweep-form input[name="to"]', '150');
+	await page.fill('#sweep-form input[name="step"]', '60');
+	await page.fill('#sweep-form input[name="t_end"]', '2');
+	await page.check(box);
+	const before = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
+	await page.click('#sweep-run');
+	/* 3 angles x 2 rotations, each a curve point and a band point */
+	await until(async () => await count('#plot-sweep') === 12 && await page.$eval('#sweep-csv', a => a.getAttribute('href')) !== before,
+		120000, 'the sweep with its bands');
+	await page.uncheck(box);
+	const href = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
+	const s = await apiGet(href.replace('?format=csv', ''));
+	await until(async () => (await apiGet(href.replace('?format=csv', ''))).state === 'done', 120000, 'done');
+	const done = await apiGet(href.replace('?format=csv', ''));
+	assert.equal(s.band.fit, fitId);
+	assert.deepEqual(done.band.parameters, ['e']);
+	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
+	for (const [rot, name] of [['cw', '95 % band cw'], ['ccw', '95 % band ccw']]) {
+		const rows = plot.filter(l => l.startsWith(`${name},`)).map(l => l.split(',').slice(1).map(Number));
+		const pts = done.points.filter(p => p.rotation === rot);
+		assert.deepEqual(rows, pts.map(p => [p.beta, p.velocity, (p.band.upper - p.band.lower) / 2]), name);
+		assert.ok(rows.every(r => r[2] > 0));
+	}
+	const legend = await page.$$eval('#plot-sweep .u-legend .u-series', rows => rows
+		.filter(r => getComputedStyle(r).display !== 'none').map(r => r.querySelector('.u-label').textContent));
+	assert.deepEqual(legend, ['95 % band cw', '95 % band ccw', 'clockwise', 'counter-clockwise']);
 });
 
 test('a β-change experiment reports its reversal time', async () => {

@@ -302,7 +302,7 @@ function stateOf(raw, F) {
 }
 
 /* v(beta) points of a sweep, flattened to [{beta, rotation, v}], with u
- * (the error bar, m/s) and steady where the daemon gives them. Accepts a
+ * (the error bar, m/s), steady, dt and substeps where the daemon gives them. Accepts a
  * list of points or an object keyed by rotation holding lists or columns.
  * A study's points (vary names other settings) carry `at`: each varied
  * setting's value by name. */
@@ -317,6 +317,11 @@ export function sweepPoints(results, vary = ['beta']) {
 		if (study && p) point.at = Object.fromEntries(vary.map(n => [n, num(p[n])]));
 		if (p && 'uncertainty' in p) point.u = num(p.uncertainty);
 		if (p && typeof p.steady === 'boolean') point.steady = p.steady;
+		/* the steps it was measured with: machine step (s), feed sub-steps */
+		if (p && 'dt' in p) point.dt = num(p.dt);
+		if (p && 'substeps' in p) point.substeps = num(p.substeps);
+		/* band_from_fit: the 95 % band at the point (m/s) */
+		if (p && p.band && typeof p.band === 'object') point.band = [num(p.band.lower), num(p.band.upper)];
 		out.push(point);
 	};
 	const vOf = p => p.transport_velocity ?? p.v ?? p.velocity;

@@ -70,7 +70,7 @@ export function parseVary(text) {
 }
 
 /* POST /sweeps: the session form's model, a beta grid (or the study of
- * the form's vary), both rotations. */
+ * the form's vary), both rotations, and a fit's bands (bandFit: its id). */
 export function sweepRequest(f) {
 	const body = jobModel(f);
 	const vary = parseVary(f.vary);
@@ -78,6 +78,7 @@ export function sweepRequest(f) {
 	else body.beta = { from: f.from, to: f.to, step: f.step };
 	body.rotations = ['cw', 'ccw'];
 	body.t_end = f.tEnd;
+	if (f.bandFit) body.band_from_fit = f.bandFit;
 	return body;
 }
 

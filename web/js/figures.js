@@ -27,8 +27,11 @@ export function makePlots() {
 	buildFeedPlot(0);
 	app.schematic = new Schematic($('#schematic'));
 	app.schematic.update({ beta: numberOf($('#session-form').elements.beta), rotation: 'cw', columns: 5, layers: 8 });
+	/* a fit's bands first (band_from_fit), under the curves */
 	app.plots.sweep = new XYPlot($('#plot-sweep'), {
-		series: [{ label: 'clockwise', color: PALETTE[0] }, { label: 'counter-clockwise', color: PALETTE[1] }],
+		series: [{ label: '95 % band cw', color: PALETTE[0], band: true, fill: 'rgba(148, 163, 184, 0.3)' },
+			{ label: '95 % band ccw', color: PALETTE[1], band: true, fill: 'rgba(203, 213, 225, 0.35)' },
+			{ label: 'clockwise', color: PALETTE[0] }, { label: 'counter-clockwise', color: PALETTE[1] }],
 		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5,
 	});
 	/* the bands first, so that the curves and data are drawn over them */

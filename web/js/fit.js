@@ -49,6 +49,7 @@ async function runFit(ev) {
 		progress(box, 0, 'started');
 		const end = await poll(api.getFit, j.id, u => progress(box, u.progress, fitProgressText(u)));
 		if (end.result) showFit(end.result);
+		if (end.state === 'done') offerBand(end.id);
 		csv.hidden = !end.result;
 		const r = end.result;
 		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${r?.error ? ': ' + r.error : ''}`);
@@ -105,4 +106,12 @@ function showFit(r) {
 	note.textContent = `standard errors from ${r.standard_errors_from}; ${fitChi2Text(r)}`;
 	const list = $('#fit-warnings');
 	list.replaceChildren(...r.warnings.map(w => Object.assign(document.createElement('li'), { textContent: w })));
+}
+
+/* A finished fit's bands for the sweep panel: its checkbox names the fit. */
+function offerBand(id) {
+	app.lastFit = id;
+	const box = $('#sweep-form').elements.band;
+	box.disabled = false;
+	$('#sweep-band-text').textContent = `band of fit ${id}`;
 }

@@ -52,9 +52,11 @@ const cell = v => (typeof v === 'number' ? (Number.isFinite(v) ? String(v) : '')
 	: /[",\n]/.test(String(v)) ? `"${String(v).replace(/"/g, '""')}"` : String(v ?? ''));
 export const csvText = rows => rows.map(r => r.map(cell).join(',')).join('\n') + '\n';
 
-/* PNG and CSV buttons under a plot's container; the plot object gives
- * csvRows() and its uPlot; named after the container (plot-rotor: rotor). */
-function addExport(owner, el) {
+/* PNG and CSV buttons under a plot's container; the owner gives csvRows()
+ * and either its uPlot (plot) or canvas(), a canvas to save (the study
+ * map's); named after the container (plot-rotor: rotor, sweep-map:
+ * sweep-map). Hidden until the owner shows it. */
+export function addExport(owner, el) {
 	const bar = document.createElement('div');
 	bar.className = 'plot-export';
 	bar.hidden = true;
@@ -68,7 +70,7 @@ function addExport(owner, el) {
 		b.title = kind === 'png' ? 'this plot as an image' : 'the data of this plot';
 		b.addEventListener('click', () => {
 			if (kind === 'csv') return saveBlob(new Blob([csvText(owner.csvRows())], { type: 'text/csv' }), `${name}.csv`);
-			const src = owner.plot.ctx.canvas;
+			const src = owner.canvas ? owner.canvas() : owner.plot.ctx.canvas;
 			const c = document.createElement('canvas');
 			c.width = src.width;
 			c.height = src.height;

@@ -5,20 +5,24 @@
  * field, follows its progress, and shows the plot (with each point's error
  * bar; a study over one setting as curves over it), a study over two
  * settings as a map of v per rotation (each cell's title: v and its error
- * bar), the table (v, its error bar u, steady or settling) and the CSV
- * link.
+ * bar; exported beside it as a PNG and as the CSV of its points), the
+ * table (v, its error bar u, steady or settling) and the CSV link. With
+ * "band of the last fit" the sweep takes that fit's bands
+ * (band_from_fit), shaded under the curves as the fit's own band is.
  */
 
 import * as api from './api.js';
 import { fmt, steadyLabel } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm } from './session.js';
+import { addExport } from './plots.js';
 
 export async function runSweep(ev) {
 	ev.preventDefault();
 	const f = $('#sweep-form').elements;
 	const base = readSessionForm();
-	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end), vary: f.vary.value };
+	const form = { ...base, from: numberOf(f.from), to: numberOf(f.to), step: numberOf(f.step), tEnd: numberOf(f.t_end), vary: f.vary.value,
+		bandFit: f.band.checked ? app.lastFit : undefined };
 	const btn = $('#sweep-run');
 	const box = $('#sweep-progress');
 	busy(btn, true);
@@ -59,13 +63,16 @@ function showSweep(j) {
 	map.hidden = vary.length !== 2;
 	$('#plot-sweep').hidden = vary.length === 2;
 	if (vary.length === 2) drawMaps(map, j.points, vary);
+	const exp = mapExport(map);
+	exp.points = vary.length === 2 ? j.points : [];
+	exp.vary = vary;
+	exp.bar.hidden = !exp.points.length;
 	if (vary.length === 1 && vary[0] !== 'beta') return showCurves(j.points, vary[0]);
 	if (vary.length !== 1) return showStudyTable(j.points, vary);
 	setXLabel('β / °');
 	const by = rot => j.points.filter(p => p.rotation === rot).sort((a, b) => a.beta - b.beta);
 	const cw = by('cw'), ccw = by('ccw');
-	app.plots.sweep.setData([[cw.map(p => p.beta), cw.map(p => p.v)], [ccw.map(p => p.beta), ccw.map(p => p.v)]],
-		[cw.map(p => p.u), ccw.map(p => p.u)]);
+	plotCurves(cw, ccw, p => p.beta);
 	const table = $('#sweep-table');
 	table.replaceChildren();
 	const head = table.createTHead().insertRow();
@@ -106,9 +113,19 @@ function showCurves(points, name) {
 	setXLabel(name);
 	const by = rot => points.filter(p => p.rotation === rot).sort((a, b) => a.at[name] - b.at[name]);
 	const cw = by('cw'), ccw = by('ccw');
-	app.plots.sweep.setData([[cw.map(p => p.at[name]), cw.map(p => p.v)], [ccw.map(p => p.at[name]), ccw.map(p => p.v)]],
-		[cw.map(p => p.u), ccw.map(p => p.u)]);
+	plotCurves(cw, ccw, p => p.at[name]);
 	showStudyTable(points, [name]);
+}
+
+/* The curves of v (with each point's error bar) over x(p), per rotation,
+ * and under them the fit's 95 % band where the sweep has one (shaded as
+ * v ± its half-width: the band is symmetric about v). */
+function plotCurves(cw, ccw, x) {
+	const banded = pts => pts.filter(p => p.band && Number.isFinite(p.band[0]) && Number.isFinite(p.band[1]));
+	const bands = [banded(cw), banded(ccw)];
+	app.plots.sweep.setData([...bands.map(b => [b.map(x), b.map(p => p.v)]),
+		[cw.map(x), cw.map(p => p.v)], [ccw.map(x), ccw.map(p => p.v)]],
+	[...bands.map(b => b.map(p => (p.band[1] - p.band[0]) / 2)), cw.map(p => p.u), ccw.map(p => p.u)]);
 }
 
 /* A study's table: the varied settings, the rotation, v, u, steady. */
@@ -169,4 +186,51 @@ function drawMaps(box, points, [rowName, colName]) {
 		}
 		box.append(grid);
 	}
+}
+
+/* The map's export buttons (PNG, CSV) beside it, made once: the owner
+ * holds the points and settings shown. */
+let mapOwner = null;
+function mapExport(box) {
+	if (mapOwner) return mapOwner;
+	mapOwner = { points: [], vary: [], csvRows: () => mapRows(mapOwner.points, mapOwner.vary), canvas: () => mapCanvas(box) };
+	mapOwner.bar = addExport(mapOwner, box);
+	return mapOwner;
+}
+
+/* The tidy rows behind the map: a header, then one row per point in the
+ * daemon's order: both varied settings, the rotation, v and its error bar
+ * (m/s), steady, and the steps it was measured with (dt in s, substeps). */
+function mapRows(points, [rowName, colName]) {
+	return [[rowName, colName, 'rotation', 'velocity', 'uncertainty', 'steady', 'dt', 'substeps'],
+		...points.map(p => [p.at?.[rowName], p.at?.[colName], p.rotation, p.v, p.u, p.steady, p.dt, p.substeps])];
+}
+
+/* The map as it is on the page, drawn onto a canvas of its size (CSS
+ * pixels times the device's pixel ratio): each cell's colour, each
+ * label's and title's text where they are. */
+function mapCanvas(box) {
+	const dpr = window.devicePixelRatio || 1;
+	const at = box.getBoundingClientRect();
+	const c = document.createElement('canvas');
+	c.width = Math.round(at.width * dpr);
+	c.height = Math.round(at.height * dpr);
+	const ctx = c.getContext('2d');
+	ctx.scale(dpr, dpr);
+	ctx.fillStyle = '#fff';
+	ctx.fillRect(0, 0, at.width, at.height);
+	for (const el of box.querySelectorAll('.cell, .label, .title')) {
+		const r = el.getBoundingClientRect(), css = getComputedStyle(el);
+		const x = r.left - at.left, y = r.top - at.top;
+		if (el.classList.contains('cell')) {
+			ctx.fillStyle = css.backgroundColor;
+			ctx.fillRect(x, y, r.width, r.height);
+			continue;
+		}
+		ctx.fillStyle = css.color;
+		ctx.font = css.font;
+		ctx.textBaseline = 'middle';
+		ctx.fillText(el.textContent, x + parseFloat(css.paddingLeft || '0'), y + r.height / 2);
+	}
+	return c;
 }

@@ -25,6 +25,7 @@ export const app = {
 	columns: 0,
 	traces: null,
 	plots: {},
+	lastFit: null,        /* the last finished fit's id: the sweep's band source */
 	dirty: false,
 	online: undefined,
 	betaEditing: false,   /* the user is dragging the slider */
