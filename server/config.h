@@ -55,6 +55,10 @@ typedef struct srv_config {
 	int max_queued_points; /* sweep points queued or running, all sweeps */
 	double cpu_probe;      /* CPU s a new session's cost is probed for
 				  (cpu_probe.c); 0: the estimate alone */
+	/* LIGGGHTS sessions (session_dem.c) */
+	const char *dem_bed;   /* --dem-bed: the bed program; NULL: convsim-bed
+				  next to the daemon's own executable */
+	int max_dem_sessions;  /* LIGGGHTS sessions at once */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

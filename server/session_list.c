@@ -79,6 +79,8 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->waiting_for_cpu = s->waiting_for_cpu;
 	v->replayed = s->rebuilt;
 	v->replay_seconds = s->replay_seconds;
+	v->has_bed = srv_dem_wanted(&s->spec);
+	v->bed = s->bed;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));
