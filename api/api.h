@@ -401,6 +401,13 @@ size_t api_record_max(int columns, int layers);
  * length. Doubles round-trip. */
 size_t api_format_record(char *buf, size_t len, const api_sample *s,
 			 unsigned fields, int ndjson);
+/* The stream's first record: the session, the id the next record will
+ * have, and the scene's feed_warning (sim_feed_validated: why its column
+ * model lies outside the domain checked against LIGGGHTS beds; NULL for
+ * none, written as null), so that a client that only streams knows it.
+ * Returns the length (0 if it does not fit). */
+size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
+			const char *feed_warning, int ndjson);
 /* Stream notices: missed samples, heartbeat, end (reason: finished,
  * deleted, failed, shutdown, limit). Return the length. */
 size_t api_format_dropped(char *buf, size_t len, uint64_t missed,

@@ -36,6 +36,11 @@ void srv_session_put(srv_session *s)
 
 /* ---- queries --------------------------------------------------------------- */
 
+const api_spec *srv_session_spec(const srv_session *s)
+{
+	return &s->spec;
+}
+
 const char *srv_session_id(const srv_session *s)
 {
 	return s->entry.id;

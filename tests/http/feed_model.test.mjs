@@ -7,7 +7,19 @@
 // nothing is created then.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, SLOW } from './lib.mjs';
+import { startDaemon, req, openStream, SLOW } from './lib.mjs';
+
+// The stream's first record (hello), NDJSON.
+async function hello(base, id) {
+  const ac = new AbortController();
+  let first;
+  for await (const rec of openStream(base, `/api/v1/sessions/${id}/stream?format=ndjson`, {}, ac.signal)) {
+    first = rec;
+    break;
+  }
+  ac.abort();
+  return first;
+}
 
 let d;
 // a daemon that finds no bed program (as one built without LIGGGHTS)
@@ -44,4 +56,10 @@ test('status.feed_warning: the preset\'s 8 soft layers lie outside the domain ch
   const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 2 }, pace: 1 });
   const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
   assert.equal(sb.feed_warning, null);
+  // the stream's first record says the same
+  const ha = await hello(d.base, a.body.id), hb = await hello(d.base, b.body.id);
+  assert.equal(ha.type, 'hello');
+  assert.equal(ha.feed_warning, sa.feed_warning);
+  assert.equal(hb.type, 'hello');
+  assert.equal(hb.feed_warning, null);
 });
