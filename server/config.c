@@ -184,13 +184,13 @@ static void usage(FILE *f, const srv_config *cfg)
 		"measured for before it is\n"
 		"                       admitted; 0: the estimate alone "
 		"(default %g)\n"
+		"LIGGGHTS sessions (scene.feed_model liggghts, docs/dem.md):\n"
+		"  --dem-bed PATH       the bed program (default: convsim-bed "
+		"next to this executable)\n"
 		"  --max-dem-sessions N  sessions with a LIGGGHTS bed at once, "
 		"each a bed process\n"
 		"                       holding a whole core (default %d; 0: "
-		"none)\n"
-		"LIGGGHTS sessions (scene.feed_model liggghts, docs/dem.md):\n"
-		"  --dem-bed PATH       the bed program (default: convsim-bed "
-		"next to this executable)\n",
+		"none)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
