@@ -49,15 +49,18 @@ struct dem_feed {
  * NULL or an MPI_Comm * (as dem_bed_new). NULL with msg on error. */
 dem_feed *dem_feed_local(const dem_bed_spec *spec, const void *comm, char *msg, size_t msglen);
 /* The bed of spec in a child process running `bed_path --serve --nice
- * nice_value` (no LIGGGHTS here: feed_remote.c). Waits for the bed to
- * settle. NULL with msg on error (the program missing, the child refusing
- * or ending). */
+ * nice_value`, or with ranks > 1 `mpirun -n ranks bed_path ...` (LIGGGHTS
+ * splits the bed over the ranks) (no LIGGGHTS here: feed_remote.c). The
+ * child leads a process group of its own, which a kill ends whole. Waits
+ * for the bed to settle. NULL with msg on error (the program missing, the
+ * child refusing or ending). */
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  char *msg, size_t msglen);
+			  int ranks, char *msg, size_t msglen);
 /* The child's process id (remote; 0 for local, NULL, or once it ended
  * and was reaped). */
 long dem_feed_pid(const dem_feed *f);
-/* Remote: end the child now (SIGKILL) if it still runs; from any thread,
+/* Remote: end the child and its process group now (SIGKILL: mpirun's
+ * ranks too) if it still runs; from any thread,
  * while another may be in an advance, which then fails. Local, NULL:
  * nothing. */
 void dem_feed_kill(const dem_feed *f);

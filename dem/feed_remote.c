@@ -6,8 +6,11 @@
  * way per coupling interval. Built without LIGGGHTS and MPI: the daemon
  * links this and never LIGGGHTS.
  *
- * The child ends with its bed: dem_feed_free kills it (SIGKILL; the bed
- * has nothing to save) and reaps it, so that no process or zombie is left.
+ * The child ends with its bed: dem_feed_free kills it and its process
+ * group (SIGKILL; the bed has nothing to save) and reaps it, so that no
+ * process or zombie is left. Under mpirun, whose ranks lead groups of
+ * their own and must be reaped by it, the end of the requests ends them
+ * first (then SIGTERM to mpirun, then SIGKILL).
  * A child that ends on its own (LIGGGHTS refused a command, a signal)
  * shows as the end of its answers: the advance fails with how it ended.
  */
@@ -22,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "bed_proto.h"
@@ -33,6 +37,7 @@ typedef struct remote {
 	dem_feed base;
 	pthread_mutex_t lock; /* pid, against a kill from another thread */
 	pid_t pid;     /* 0 once reaped */
+	int ranks;     /* > 1: pid is mpirun's */
 	int to, from;  /* our ends: its stdin, its stdout */
 	char in[DEM_PROTO_LINE];
 	size_t have;   /* bytes of in read but not yet taken */
@@ -144,14 +149,44 @@ static int remote_advance(dem_feed *f, double ax, double ay, double interval, ch
 
 static const struct dem_feed_ops remote_ops = {"remote", remote_advance, remote_free};
 
+/* Wait up to seconds for the child to end; 1 once it is reaped. */
+static int remote_wait(remote *r, double seconds)
+{
+	for (int i = 0; i <= (int)(seconds / 0.02); i++) {
+		pthread_mutex_lock(&r->lock);
+		pid_t got = r->pid ? waitpid(r->pid, NULL, WNOHANG) : r->pid;
+		if (got == r->pid || got < 0)
+			r->pid = 0;
+		int gone = r->pid == 0;
+		pthread_mutex_unlock(&r->lock);
+		if (gone)
+			return 1;
+		nanosleep(&(struct timespec){0, 20000000}, NULL);
+	}
+	return 0;
+}
+
 static void remote_free(dem_feed *f)
 {
 	remote *r = (remote *)f;
 	if (r->to >= 0)
 		close(r->to);
+	/* under mpirun, whose ranks lead process groups of their own: the
+	 * end of the requests ends every rank and then mpirun, which reaps
+	 * them; one that does not is told to (mpirun ends its ranks on
+	 * SIGTERM) before the group is killed */
+	if (r->ranks > 1 && !remote_wait(r, 3.0)) {
+		dem_feed_kill(f);
+		remote_wait(r, 5.0);
+	}
+	if (r->pid) {
+		pthread_mutex_lock(&r->lock);
+		if (r->pid)
+			kill(-r->pid, SIGKILL);
+		pthread_mutex_unlock(&r->lock);
+	}
 	if (r->from >= 0)
 		close(r->from);
-	dem_feed_kill(&r->base);
 	remote_reap(r, NULL, 0);
 	pthread_mutex_destroy(&r->lock);
 	free(r);
@@ -174,21 +209,30 @@ void dem_feed_kill(const dem_feed *f)
 		return;
 	remote *r = (remote *)(void *)(uintptr_t)f;
 	pthread_mutex_lock(&r->lock);
-	if (r->pid) /* not reaped yet: the id is still the child's */
-		kill(r->pid, SIGKILL);
+	/* not reaped yet: the id is still the child's (and its group's);
+	 * mpirun is asked, so that it ends and reaps its ranks */
+	if (r->pid)
+		kill(r->ranks > 1 ? r->pid : -r->pid, r->ranks > 1 ? SIGTERM : SIGKILL);
 	pthread_mutex_unlock(&r->lock);
 }
 
-/* Start `path --serve --nice N` with its stdin and stdout on two new
- * pipes (ours close on exec; the child keeps no other descriptor). 0 or
- * -1 with msg. */
-static int remote_spawn(remote *r, const char *path, int nice_value, char *msg, size_t msglen)
+/* Start `path --serve --nice N` (under `mpirun -n ranks` when ranks > 1)
+ * with its stdin and stdout on two new pipes (ours close on exec; the
+ * child keeps no other descriptor), leading a process group of its own.
+ * 0 or -1 with msg. */
+static int remote_spawn(remote *r, const char *path, int nice_value, int ranks, char *msg,
+			size_t msglen)
 {
 	int req[2] = {-1, -1}, ans[2] = {-1, -1};
-	char nice_arg[16];
+	char nice_arg[16], ranks_arg[16];
 	snprintf(nice_arg, sizeof nice_arg, "%d", nice_value);
-	char *argv[] = {(char *)path, "--serve", "--nice", nice_arg, NULL};
+	snprintf(ranks_arg, sizeof ranks_arg, "%d", ranks);
+	char *serial[] = {(char *)path, "--serve", "--nice", nice_arg, NULL};
+	char *parallel[] = {"mpirun", "-n", ranks_arg, (char *)path, "--serve", "--nice", nice_arg,
+			    NULL};
+	char **argv = ranks > 1 ? parallel : serial;
 	posix_spawn_file_actions_t fa;
+	posix_spawnattr_t at;
 	if (pipe2(req, O_CLOEXEC) || pipe2(ans, O_CLOEXEC)) {
 		snprintf(msg, msglen, "bed process: no pipe: %s", strerror(errno));
 		goto fail;
@@ -197,11 +241,15 @@ static int remote_spawn(remote *r, const char *path, int nice_value, char *msg, 
 	posix_spawn_file_actions_adddup2(&fa, req[0], 0);
 	posix_spawn_file_actions_adddup2(&fa, ans[1], 1);
 	posix_spawn_file_actions_addclosefrom_np(&fa, 3);
-	int rc = posix_spawn(&r->pid, path, &fa, NULL, argv, environ);
+	posix_spawnattr_init(&at);
+	posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP);
+	posix_spawnattr_setpgroup(&at, 0);
+	int rc = posix_spawnp(&r->pid, argv[0], &fa, &at, argv, environ);
 	posix_spawn_file_actions_destroy(&fa);
+	posix_spawnattr_destroy(&at);
 	if (rc) {
 		r->pid = 0;
-		snprintf(msg, msglen, "bed process: cannot start %s: %s", path, strerror(rc));
+		snprintf(msg, msglen, "bed process: cannot start %s: %s", argv[0], strerror(rc));
 		goto fail;
 	}
 	close(req[0]);
@@ -220,7 +268,7 @@ fail:
 }
 
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  char *msg, size_t msglen)
+			  int ranks, char *msg, size_t msglen)
 {
 	char req[DEM_PROTO_LINE];
 	if (spec->wiggle_period > 0) {
@@ -235,8 +283,9 @@ dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int ni
 	}
 	r->base.ops = &remote_ops;
 	r->to = r->from = -1;
+	r->ranks = ranks;
 	pthread_mutex_init(&r->lock, NULL);
-	if (remote_spawn(r, bed_path, nice_value, msg, msglen) ||
+	if (remote_spawn(r, bed_path, nice_value, ranks, msg, msglen) ||
 	    remote_exchange(r, req, dem_proto_bed_line(req, sizeof req, spec), msg, msglen)) {
 		remote_free(&r->base);
 		return NULL;

@@ -169,9 +169,9 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 					   : -1.0;
 	if (probed > s->cpu_per_s)
 		s->cpu_per_s = probed;
-	/* a bed process: a whole core a simulated second until measured */
-	if (s->dem && s->cpu_per_s < 1.0)
-		s->cpu_per_s = 1.0;
+	/* a bed process: its cores a simulated second until measured */
+	if (s->dem && s->cpu_per_s < s->dem_cores)
+		s->cpu_per_s = s->dem_cores;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -252,8 +252,8 @@ static void adopt_bed(srv_session *s)
 	srv_dem_hold();
 	s->dem_slot = 1;
 	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
-		if (s->cpu_per_s < 1.0)
-			s->cpu_per_s = 1.0;
+		if (s->cpu_per_s < s->dem_cores)
+			s->cpu_per_s = s->dem_cores;
 		return;
 	}
 	s->state = SRV_FAILED;
@@ -310,6 +310,14 @@ static void remove_session(srv_session *s, int files)
 	if (!srv_registry_remove(&sessions, &s->entry))
 		return;
 	stop_worker(s);
+	/* its bed process ends and is reaped now, and its slot is free for
+	 * the next LIGGGHTS session at once, not when the last reader lets
+	 * go of the session */
+	srv_dem_free(s);
+	if (s->dem_slot) {
+		s->dem_slot = 0;
+		srv_dem_release();
+	}
 	if (files)
 		srv_persist_remove(s); /* after the worker's last write */
 	if (files) {

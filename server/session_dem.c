@@ -12,9 +12,10 @@
  * this executable; else 422 on scene.feed_model), the method must take a
  * fixed step (422 on integrator.method), and at most --max-dem-sessions
  * run at once (429, budget "dem-sessions"). A LIGGGHTS session holds at
- * least a whole core of the paced budget while it runs paced (session_int.h
- * srv_paced_need): its bed process uses one. The worker counts the bed
- * process's CPU time as the session's.
+ * least a whole core of the paced budget while it runs paced, --dem-ranks
+ * of them under mpirun (session_int.h srv_paced_need): its bed process
+ * uses that many. The worker counts the bed process's CPU time (all its
+ * ranks') as the session's.
  *
  * Persistence: the machine is restored from its checkpoint like any
  * other; the bed is settled anew from its seed at the restored time
@@ -104,7 +105,8 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	const api_spec *sp = &s->spec;
 	dem_bed_spec bed;
 	dem_bed_spec_default(&sp->params, (double)sp->scene.layers, &bed);
-	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, msg, msglen);
+	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks, msg,
+				      msglen);
 	if (!f)
 		return -1;
 	s->dem = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
@@ -112,9 +114,11 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	if (!s->dem)
 		return -1;
 	s->bed.resettled = restored;
+	s->dem_cores = cfg->dem_ranks;
 	srv_dem_read(s, &s->st, &s->bed);
-	srv_log(SRV_LOG_INFO, "session %s: bed process %ld, %d grains%s", s->entry.id,
-		dem_feed_pid(f), bed.grains, restored ? ", settled anew at the restored time" : "");
+	srv_log(SRV_LOG_INFO, "session %s: bed process %ld, %d grains, %d rank%s%s", s->entry.id,
+		dem_feed_pid(f), bed.grains, cfg->dem_ranks, cfg->dem_ranks > 1 ? "s" : "",
+		restored ? ", settled anew at the restored time" : "");
 	return 0;
 }
 

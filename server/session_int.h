@@ -106,6 +106,7 @@ struct srv_session {
 				     freed after it ends): the coupling to the
 				     bed process; NULL for the column model */
 	int dem_slot;             /* holds one of --max-dem-sessions */
+	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
 	api_bed bed;              /* what the worker last read of it (lock) */
 };
 
@@ -142,15 +143,15 @@ void srv_dem_kill(srv_session *s);
 void srv_dem_free(srv_session *s);
 
 /* Cores a session needs from the paced budget as it is now: its CPU s per
- * simulated s times its pace while it runs paced (at least one for a
- * LIGGGHTS session), else none (lock held). */
+ * simulated s times its pace while it runs paced (at least its bed
+ * process's cores for a LIGGGHTS session), else none (lock held). */
 static inline double srv_paced_need(const srv_session *s)
 {
 	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
 		return 0;
 	double need = s->cpu_per_s * s->pace;
-	/* a LIGGGHTS session's bed process holds a whole core */
-	return s->dem && need < 1.0 ? 1.0 : need;
+	/* a LIGGGHTS session's bed process holds its cores */
+	return s->dem && need < s->dem_cores ? s->dem_cores : need;
 }
 
 /* The state control c leaves a session in, from its state, whether its
