@@ -256,7 +256,7 @@ FUZZ_BODIES  := session control experiment sweep fit
 FUZZ_NAMES   := $(FUZZ_BODIES:%=body_%) query route checkpoint store
 FUZZ_BINS    := $(FUZZ_NAMES:%=$(BUILD)/fuzz/%)
 FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))
-FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
+FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libdemlink.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 
 fuzz: deps-build
 	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
