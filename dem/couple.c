@@ -229,6 +229,16 @@ const dem_feed *dem_coupled_bed(const dem_coupled *c)
 	return c->bed;
 }
 
+void dem_coupled_restart_transport(dem_coupled *c)
+{
+	memset(&c->slope, 0, sizeof c->slope);
+	c->load_y_sum = c->load_y_n = 0;
+	if (c->transient < c->ms.t)
+		c->transient = c->ms.t;
+	if (c->ms.t >= c->transient - 1e-12 * c->H)
+		dem_slope_add(&c->slope, c->ms.t, c->bs.x_mean);
+}
+
 double dem_coupled_interval_end(const dem_coupled *c, double t)
 {
 	long k = (long)ceil(t / c->H - 1e-9);

@@ -92,6 +92,10 @@ int dem_coupled_advance(dem_coupled *c, double t_end, FILE *deck_out, char *msg,
 void dem_coupled_get(const dem_coupled *c, dem_coupled_status *st);
 /* The machine (borrowed). */
 const sim *dem_coupled_machine(const dem_coupled *c);
+/* Restart the transport velocity's estimate (and the mean vertical load)
+ * from now: the grains' mean x from here on (after a change of the
+ * machine, to measure the new steady state, as sim_restart_transport). */
+void dem_coupled_restart_transport(dem_coupled *c);
 /* The end of the first coupling interval at or after t (s): where the
  * machine stops when asked to reach t (a caller that steps to sample
  * times which are no multiple of the interval rounds up with this). */

@@ -128,6 +128,14 @@ int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen)
 				   msglen);
 }
 
+void srv_dem_controlled(srv_session *s, const sim_status *st)
+{
+	if (!s->dem_restart || st->beta != st->beta_target)
+		return;
+	s->dem_restart = 0;
+	dem_coupled_restart_transport(s->dem);
+}
+
 void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 {
 	dem_coupled_status cs;

@@ -107,6 +107,9 @@ struct srv_session {
 				     bed process; NULL for the column model */
 	int dem_slot;             /* holds one of --max-dem-sessions */
 	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
+	int dem_restart;          /* worker only: a control changed the machine;
+				     the bed's transport estimate restarts once
+				     its beta ramp is over */
 	api_bed bed;              /* what the worker last read of it (lock) */
 };
 
@@ -133,6 +136,10 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
  * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
  * process ended or failed, the machine froze). */
 int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen);
+/* Worker, lock released: a control changed the machine (restart = 1):
+ * once beta has reached its target (status st), the bed's transport
+ * estimate restarts, as the core's does. */
+void srv_dem_controlled(srv_session *s, const sim_status *st);
 /* Worker: the bed's figures into a status of the machine (transport
  * velocity, feed displacement and velocity) and into *b. */
 void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b);

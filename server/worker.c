@@ -168,6 +168,11 @@ static int apply_commands(srv_session *s)
 			rc = sim_set_drive_on(s->sim, c->motor_on);
 		if (rc == SIM_OK && cmd->restart_transport)
 			sim_restart_transport(s->sim);
+		/* a LIGGGHTS bed's estimate restarts as the core's does */
+		if (rc == SIM_OK && s->dem &&
+		    (cmd->restart_transport ||
+		     (c->set & (API_C_BETA | API_C_ROTATION | API_C_OMEGA_SS | API_C_MOTOR))))
+			s->dem_restart = 1;
 		if (rc == SIM_OK && (c->set & API_C_PACE)) {
 			s->pace = c->pace;
 			reanchor = 1;
@@ -460,8 +465,10 @@ static int step(srv_session *s, double t_next, char *why, size_t whylen)
 	else if (srv_dem_step(s, t_next, why, whylen))
 		rc = SIM_EDIVERGED;
 	sim_get_status(s->sim, &st);
-	if (s->dem)
+	if (s->dem) {
+		srv_dem_controlled(s, &st);
 		srv_dem_read(s, &st, &bed);
+	}
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	if (st.steps > s->st.steps)

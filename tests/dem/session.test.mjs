@@ -7,7 +7,8 @@
 //    `convsim run --set feed_model=liggghts` over the same 0.5 s, bit for bit
 //    (the same coupling code and sequence, the bed's numbers crossing the
 //    pipe exactly);
-//  - PATCH beta accepted; stream frames carry the bed's feed displacement;
+//  - PATCH beta accepted and v turns (its estimate restarts after the
+//    ramp); stream frames carry the bed's feed displacement;
 //  - a second one beyond --max-dem-sessions: 429 naming scene.feed_model;
 //  - the bed process killed with SIGKILL: the session fails with the signal
 //    named and the daemon answers; DELETE leaves no process and no zombie;
@@ -78,7 +79,11 @@ test('PATCH beta, stream frames with the bed\'s displacement, a second session r
   const r = await req(d.base, 'POST', '/api/v1/sessions', { ...BED, pace: 1 });
   assert.equal(r.status, 201, JSON.stringify(r.body));
   const id = r.body.id;
-  const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 137 });
+  // transport to the right at 30 deg cw, then to the left at 137 deg: the
+  // bed's estimate restarts after the control's ramp, as the core's does
+  const before = await until(async () => { const g = await get(id); return g.status.t > 0.6 && g; }, 60000 * SLOW, 't > 0.6 s');
+  assert.ok(before.status.transport_velocity > 0.05, `v ${before.status.transport_velocity} at 30 deg`);
+  const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 137, beta_rate: 1000 });
   assert.equal(p.status, 200, JSON.stringify(p.body));
   assert.equal((await get(id)).status.beta_target, 137);
   const frames = [];
@@ -94,6 +99,8 @@ test('PATCH beta, stream frames with the bed\'s displacement, a second session r
   }
   const disp = frames.map((f) => f.feed_displacement);
   assert.ok(new Set(disp).size > 10, 'the bed moves from frame to frame');
+  const after = await until(async () => { const g = await get(id); return g.status.t > p.body.t_effective + 0.8 && g; }, 60000 * SLOW, '0.8 s at 137 deg');
+  assert.ok(after.status.transport_velocity < -0.03, `v ${after.status.transport_velocity} at 137 deg`);
   const two = await req(d.base, 'POST', '/api/v1/sessions', BED);
   assert.equal(two.status, 429);
   assert.equal(two.headers.get('content-type'), 'application/problem+json');
