@@ -59,7 +59,13 @@ DEM_SRC     := $(wildcard dem/*.c)
 DEM_CLI_SRC := dem/cli/convsim_dem.c
 DEM_OBJ     := $(DEM_SRC:%.c=$(BUILD)/%.o)
 DEM_CLI_OBJ := $(DEM_CLI_SRC:%.c=$(BUILD)/%.o)
-DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem)
+DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem $(BUILD)/convsim-bed)
+# The daemon's side of a LIGGGHTS session (docs/dem.md "The bed process"):
+# the coupling and the client of the bed process, built everywhere and
+# without LIGGGHTS or MPI (convsimd never links them); the bed process,
+# convsim-bed, is built where LIGGGHTS is installed.
+DEM_LINK_SRC := dem/couple.c dem/feed_remote.c dem/bed_proto.c dem/bed_spec.c
+DEM_LINK_OBJ := $(DEM_LINK_SRC:%.c=$(BUILD)/demlink/%.o)
 # convsim's `run --set feed_model=liggghts`: the coupled runner and its
 # libraries where LIGGGHTS is installed, else a stub that says how to get it
 CLI_DEM_OBJ := $(if $(HAVE_LIGGGHTS),$(BUILD)/dem/cli/run_coupled.o $(BUILD)/libdem.a)
@@ -123,13 +129,15 @@ $(BUILD)/.deps-bench: Makefile
 # Include floors, by the top directory of the source: core/ sees only
 # core/; the fitting module core/fit/ sees core/ and GSL; the CLI core/cli/
 # sees core/ and core/fit/; api/ sees core/, core/fit/ and api/, server/
-# all of them; the unit tests see core/ and core/fit/. A header included
+# all of them and dem/'s headers (the LIGGGHTS-free client of the bed
+# process: libdemlink.a); the unit tests see core/ and core/fit/. A header included
 # across a floor fails the build.
 INC_core   := -Icore
 INC_api    := -Icore -Icore/fit -Iapi
 INC_server := -Icore -Icore/fit -Iapi -Iserver
 INC_tests  := -Icore -Icore/fit
 INC_dem    := -Icore -Icore/cli -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
+INC_server += -Idem
 $(CLI_OBJ): INC_EXTRA := -Icore/fit
 $(BUILD)/core/cli/spread_mpi.o: INC_EXTRA := -Icore/fit $(MPI_CFLAGS)
 
@@ -158,6 +166,17 @@ $(BUILD)/libapi.a: $(API_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
+# dem/'s LIGGGHTS-free part for the daemon, compiled without LIGGGHTS's or
+# MPI's include paths: a LIGGGHTS header included there fails the build
+$(BUILD)/demlink/%.o: %.c
+	@mkdir -p $(dir $@)
+	@$(if $(Q),echo "  CC      $< (daemon)")
+	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP -Icore -Idem -c $< -o $@
+
+$(BUILD)/libdemlink.a: $(DEM_LINK_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
+
 $(BUILD)/libdem.a: $(DEM_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
@@ -166,13 +185,17 @@ $(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
 
-dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim
+$(BUILD)/convsim-bed: $(BUILD)/dem/cli/convsim_bed.o $(BUILD)/libdem.a $(BUILD)/libcore.a
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(LDLIBS)
+
+dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim-bed $(BUILD)/convsim
 
 $(BUILD)/convsim: $(CLI_OBJ) $(CLI_DEM_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(MPI_LIBS) $(LDLIBS)
 
-$(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
+$(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libdemlink.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
@@ -242,7 +265,7 @@ FUZZ_BODIES  := session control experiment sweep fit
 FUZZ_NAMES   := $(FUZZ_BODIES:%=body_%) query route checkpoint store
 FUZZ_BINS    := $(FUZZ_NAMES:%=$(BUILD)/fuzz/%)
 FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))
-FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
+FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libdemlink.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 
 fuzz: deps-build
 	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
@@ -317,5 +340,6 @@ uninstall:
 clean:
 	rm -rf build build-san build-fuzz
 
--include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d) $(BUILD)/dem/cli/run_coupled.d
+-include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d) $(BUILD)/dem/cli/run_coupled.d $(BUILD)/dem/cli/convsim_bed.d \
+	$(DEM_LINK_OBJ:.o=.d)
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)

@@ -306,6 +306,22 @@ int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective);
 
 /* Everything GET /sessions/{id} shows, filled by the server. */
+/* A LIGGGHTS session's bed (feed_model liggghts, docs/dem.md): it runs in
+ * a child process of the daemon; scaled to the scene's feed. */
+typedef struct api_bed {
+	int grains;
+	long pid;              /* the bed process, 0 once it ended */
+	double interval;       /* s: the coupling interval */
+	long intervals;        /* coupling intervals since t = 0 */
+	double displacement;   /* m: the grains' mean x since the bed began */
+	double velocity;       /* m/s: their mean velocity relative to the deck */
+	double cpu_seconds;    /* the bed process's CPU time, s */
+	double weight, load_mean_y;          /* N */
+	double work_machine, work_bed, bed_energy; /* J since the bed began */
+	int resettled;         /* restored: the machine from its checkpoint,
+				  the bed settled anew from its seed */
+} api_bed;
+
 typedef struct api_view {
 	char id[24];
 	const api_spec *spec;  /* borrowed */
@@ -328,6 +344,8 @@ typedef struct api_view {
 				  (its checkpoint unusable), its control log
 				  replayed: "restored": "replayed" */
 	double replay_seconds; /* wall s the replay took; NAN while it runs */
+	int has_bed;           /* feed_model liggghts: bed is its bed */
+	api_bed bed;
 } api_view;
 
 /* Session as JSON; with_spec adds the full settings. malloc'd text. */
@@ -383,6 +401,13 @@ size_t api_record_max(int columns, int layers);
  * length. Doubles round-trip. */
 size_t api_format_record(char *buf, size_t len, const api_sample *s,
 			 unsigned fields, int ndjson);
+/* The stream's first record: the session, the id the next record will
+ * have, and the scene's feed_warning (sim_feed_validated: why its column
+ * model lies outside the domain checked against LIGGGHTS beds; NULL for
+ * none, written as null), so that a client that only streams knows it.
+ * Returns the length (0 if it does not fit). */
+size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
+			const char *feed_warning, int ndjson);
 /* Stream notices: missed samples, heartbeat, end (reason: finished,
  * deleted, failed, shutdown, limit). Return the length. */
 size_t api_format_dropped(char *buf, size_t len, uint64_t missed,

@@ -101,7 +101,8 @@ api_err api_check_members(const cJSON *obj, const char *const *names,
  * "beta" member's grid, varied first. Needs req->spec and req->nrot. */
 api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 			api_sweep_req *req, api_problem *pb);
-/* sim_validate on the spec, as a 422 problem. */
+/* sim_validate on the spec of a sweep, fit or experiment, as a 422
+ * problem: feed_model column only (a session may take liggghts). */
 api_err api_validate_spec(api_spec *spec, api_problem *pb);
 /* The settings table as a JSON array of {name, group, kind, unit,
  * min, max | choices, doc}. */

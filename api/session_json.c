@@ -296,6 +296,27 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
 	return e;
 }
 
+/* A LIGGGHTS session's bed process and the balances between it and the
+ * machine. */
+static cJSON *bed_object(const api_bed *b)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "grains", b->grains);
+	api_add_number(o, "pid", (double)b->pid);
+	api_add_number(o, "coupling_interval", b->interval);
+	api_add_number(o, "intervals", (double)b->intervals);
+	api_add_number(o, "displacement", b->displacement);
+	api_add_number(o, "velocity", b->velocity);
+	api_add_number(o, "cpu_seconds", b->cpu_seconds);
+	cJSON *bal = cJSON_AddObjectToObject(o, "balance");
+	api_add_number(bal, "weight", b->weight);
+	api_add_number(bal, "load_mean_y", b->load_mean_y);
+	api_add_number(bal, "work_machine", b->work_machine);
+	api_add_number(bal, "work_bed", b->work_bed);
+	api_add_number(bal, "bed_energy", b->bed_energy);
+	return o;
+}
+
 static cJSON *session_object(const api_view *v, int with_spec)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -326,7 +347,11 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	if (v->replayed) {
 		cJSON_AddStringToObject(o, "restored", "replayed");
 		api_add_number(o, "replay_seconds", v->replay_seconds);
+	} else if (v->has_bed && v->bed.resettled) {
+		cJSON_AddStringToObject(o, "restored", "bed_resettled");
 	}
+	if (v->has_bed)
+		cJSON_AddItemToObject(o, "bed", bed_object(&v->bed));
 	if (v->experiment[0])
 		cJSON_AddStringToObject(o, "experiment", v->experiment);
 	else

@@ -327,20 +327,10 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
 	return API_OK;
 }
 
-api_err api_validate_spec(api_spec *spec, api_problem *pb)
+/* The model's settings together (sim_validate), for a session or a job. */
+static api_err validate_model(api_spec *spec, api_problem *pb)
 {
 	char msg[256] = "";
-	/* the LIGGGHTS bed couples in the CLI built with it (dem/), not in
-	 * the daemon: refused here rather than run as a dead weight */
-	if (spec->scene.feed_model != SIM_FEED_COLUMN) {
-		api_fail(pb, API_RANGE, "scene.feed_model",
-			 "scene.feed_model must be column in the daemon; liggghts runs in `convsim run` "
-			 "built with LIGGGHTS (docs/dem.md)");
-		pb->has_range = 1;
-		pb->min = 0.0;
-		pb->max = 0.0;
-		return pb->code;
-	}
 	int rc = sim_validate(&spec->params, &spec->scene, &spec->method, msg,
 			      sizeof msg);
 	if (rc == SIM_OK)
@@ -362,6 +352,23 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb)
 	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }
 
+api_err api_validate_spec(api_spec *spec, api_problem *pb)
+{
+	/* a LIGGGHTS bed is a process of its own per session (the daemon's
+	 * bed process, docs/dem.md): sweeps, fits and experiments, which run
+	 * many scenes at once, take the column model only */
+	if (spec->scene.feed_model != SIM_FEED_COLUMN) {
+		api_fail(pb, API_RANGE, "scene.feed_model",
+			 "scene.feed_model must be column in sweeps, fits and experiments; liggghts "
+			 "runs as a session (POST /api/v1/sessions) or in `convsim run` (docs/dem.md)");
+		pb->has_range = 1;
+		pb->min = 0.0;
+		pb->max = 0.0;
+		return pb->code;
+	}
+	return validate_model(spec, pb);
+}
+
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb)
 {
@@ -372,8 +379,10 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 	api_err e = api_apply_model(root, spec, pb);
 	if (e == API_OK)
 		e = api_apply_session_extras(root, spec, pb);
+	/* a session may take feed_model liggghts: the daemon says whether it
+	 * can run its bed (server/session_dem.c) */
 	if (e == API_OK)
-		e = api_validate_spec(spec, pb);
+		e = validate_model(spec, pb);
 	cJSON_Delete(root);
 	return e;
 }
@@ -415,5 +424,5 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb)
 			    sizeof msg) != SIM_OK)
 			return api_fail(pb, API_RANGE, tab[i].name, "%s", msg);
 	}
-	return api_validate_spec(&copy, pb);
+	return validate_model(&copy, pb);
 }

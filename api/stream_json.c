@@ -209,6 +209,30 @@ size_t api_format_record(char *buf, size_t len, const api_sample *s,
 	return w.at;
 }
 
+size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
+			const char *feed_warning, int ndjson)
+{
+	api_buf b = {0};
+	api_buf_puts(&b, ndjson ? "{\"type\":\"hello\",\"session\":"
+				: "retry: 1000\nevent: hello\ndata: {\"session\":");
+	api_buf_jstr(&b, session);
+	api_buf_printf(&b, ",\"next_id\":%llu,\"feed_warning\":", (unsigned long long)next_id);
+	if (feed_warning)
+		api_buf_jstr(&b, feed_warning);
+	else
+		api_buf_puts(&b, "null");
+	api_buf_puts(&b, ndjson ? "}\n" : "}\n\n");
+	char *text = api_buf_take(&b);
+	size_t n = text ? strlen(text) : 0;
+	if (n >= len)
+		n = 0;
+	memcpy(buf, text ? text : "", n);
+	if (len)
+		buf[n] = '\0';
+	free(text);
+	return n;
+}
+
 size_t api_format_dropped(char *buf, size_t len, uint64_t missed,
 			  uint64_t next_id, int ndjson)
 {

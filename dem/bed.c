@@ -213,30 +213,6 @@ static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
 	}
 }
 
-int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth)
-{
-	long n = lround(0.6 * cell_x * cell_y * depth * d_mean / (M_PI / 6 * d_mean * d_mean * d_mean));
-	return n < 1 ? 1 : n > 1000000 ? 1000000 : (int)n;
-}
-
-void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
-{
-	double d_mean = 0.004;
-	memset(b, 0, sizeof *b);
-	b->d_min = 0.0036;
-	b->d_max = 0.0044;
-	b->density = 2500;
-	b->cell_x = 20 * d_mean;
-	b->cell_y = 4 * d_mean;
-	b->grains = dem_bed_grains(b->cell_x, b->cell_y, d_mean, depth);
-	b->k_over_m = p->k_c / p->m_n;
-	b->restitution = p->R;
-	b->mu = p->mu;
-	b->g = p->g;
-	b->seed = 1;
-	b->settle = b->grains == 1 ? 0.05 : 0.3;
-}
-
 dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size_t msglen)
 {
 	if (spec_check(spec, msg, msglen))

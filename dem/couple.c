@@ -3,7 +3,9 @@
  * couple.c - the machine and a LIGGGHTS bed, two-way coupled at the
  * machine's step (couple.h): the staggered interval, the floor's impulse
  * from the bed's momentum, the balances of momentum and energy between
- * the two sides, and the replay of a recorded deck motion.
+ * the two sides. The bed is a dem_feed (feed.h): this file builds
+ * without LIGGGHTS, so that the daemon couples a bed in a child process
+ * with the very arithmetic the CLI uses on a bed in its own.
  */
 #include <math.h>
 #include <stdio.h>
@@ -14,19 +16,20 @@
 
 struct dem_coupled {
 	sim *machine;
-	dem_bed *bed;
+	int own_machine;
+	dem_feed *bed;
 	double dt, H, scale, g, transient, weight;
 	int steps;
 	int coupled;              /* feed_coupling: the load reaches the machine */
 	sim_status ms;            /* the machine at the interval's start */
-	dem_bed_state bs, bs0;    /* the bed at the interval's start, at t = 0 */
+	dem_bed_state bs, bs0;    /* the bed at the interval's start, at attach */
 	double load[2];
 	double imp_m[2], imp_b[2], work_m, work_b;
 	double load_y_sum, load_y_n;
 	double e_bed0;
 	dem_slope slope;
-	double cpu;
-	long k;
+	double cpu0;              /* the bed's CPU at attach */
+	long k;                   /* intervals since t = 0 */
 };
 
 void dem_slope_add(dem_slope *s, double t, double x)
@@ -55,9 +58,8 @@ static double couple_bed_energy(const dem_coupled *c, const dem_bed_state *b, co
 	return c->scale * (kin + b->mass * c->g * (b->z_mean + m->deck[1]));
 }
 
-dem_coupled *dem_coupled_new(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			     const dem_bed_spec *spec, int steps, double transient, const void *comm,
-			     char *msg, size_t msglen)
+int dem_coupled_check(const sim_scene *sc, const sim_method *m, int steps, double transient,
+		      char *msg, size_t msglen)
 {
 	size_t nm;
 	const sim_method_info *const *methods = sim_methods(&nm);
@@ -65,49 +67,68 @@ dem_coupled *dem_coupled_new(const sim_params *p, const sim_scene *sc, const sim
 		if (!strcmp(methods[i]->name, m->name) && methods[i]->adaptive) {
 			snprintf(msg, msglen, "feed_model liggghts: the method must take a fixed step "
 					      "(euler, rk4 or dem), not %s", m->name);
-			return NULL;
+			return -1;
 		}
 	if (sc->feed_model != SIM_FEED_EXTERNAL || !sc->feed || steps < 1 || steps > 100000 ||
 	    !(transient >= 0)) {
 		snprintf(msg, msglen, "feed_model liggghts: needs feed = true, feed_model = liggghts, "
 				      "coupling steps in [1, 100000] and transient >= 0");
-		return NULL;
+		return -1;
 	}
+	return 0;
+}
+
+dem_coupled *dem_coupled_attach(sim *machine, int own_machine, dem_feed *bed,
+				const sim_params *p, const sim_scene *sc, int steps,
+				double transient, char *msg, size_t msglen)
+{
 	dem_coupled *c = calloc(1, sizeof *c);
-	int err = SIM_OK;
 	if (!c) {
 		snprintf(msg, msglen, "feed_model liggghts: out of memory");
+		if (own_machine)
+			sim_free(machine);
+		dem_feed_free(bed);
 		return NULL;
 	}
-	if (!(c->machine = sim_new(p, sc, m, &err, msg, msglen)))
-		goto fail;
-	if (!(c->bed = dem_bed_new(spec, comm, msg, msglen)))
-		goto fail;
+	c->machine = machine;
+	c->own_machine = own_machine;
+	c->bed = bed;
 	sim_get_status(c->machine, &c->ms);
-	dem_bed_get(c->bed, &c->bs);
-	c->bs0 = c->bs;
+	c->bs = c->bs0 = bed->state;
+	c->cpu0 = bed->cpu;
 	c->dt = c->ms.dt;
 	c->steps = steps;
 	c->H = steps * c->ms.dt;
+	/* a restored machine resumes on an interval's end, in the core's
+	 * own arithmetic for its time (k_fixed * dt) */
+	c->k = (long)llround(c->ms.t / c->H);
+	if (c->ms.t_int != c->ms.t || (double)(c->k * c->steps) * c->dt != c->ms.t) {
+		snprintf(msg, msglen, "feed_model liggghts: the machine (t = %.17g s) does not "
+				      "stand at the end of a coupling interval", c->ms.t);
+		dem_coupled_free(c);
+		return NULL;
+	}
 	c->g = p->g;
 	c->transient = transient;
 	c->coupled = sc->feed_coupling;
 	c->weight = (double)sc->columns * (double)sc->layers * p->m_n * p->g;
 	c->scale = c->weight / (p->g * c->bs.mass);
-	c->load[1] = c->coupled ? -c->weight : 0.0;
+	/* the load the machine holds: the feed's weight at t = 0, the last
+	 * bed's load on a restored machine (its checkpoint keeps it) */
+	c->load[1] = c->coupled && c->k == 0 ? -c->weight : 0.0;
 	c->e_bed0 = couple_bed_energy(c, &c->bs, &c->ms);
+	if (c->ms.t >= c->transient - 1e-12 * c->H)
+		dem_slope_add(&c->slope, c->ms.t, c->bs.x_mean);
 	return c;
-fail:
-	dem_coupled_free(c);
-	return NULL;
 }
 
 void dem_coupled_free(dem_coupled *c)
 {
 	if (!c)
 		return;
-	sim_free(c->machine);
-	dem_bed_free(c->bed);
+	if (c->own_machine)
+		sim_free(c->machine);
+	dem_feed_free(c->bed);
 	free(c);
 }
 
@@ -140,11 +161,9 @@ static int couple_interval(dem_coupled *c, FILE *deck_out, char *msg, size_t msg
 	double ay = (m1.deck_vel[1] - c->ms.deck_vel[1]) / H;
 	if (deck_out)
 		fprintf(deck_out, "%.17g %.17g\n", ax, ay);
-	double cpu0 = dem_cpu_now();
-	if (dem_bed_advance(c->bed, ax, ay, H, msg, msglen))
+	if (dem_feed_advance(c->bed, ax, ay, H, msg, msglen))
 		return -1;
-	dem_bed_get(c->bed, &b1);
-	c->cpu += dem_cpu_now() - cpu0;
+	b1 = c->bed->state;
 	/* 3. the floor's impulse on the grains, scaled: the next load */
 	double Jx = c->scale * (b1.p_x - c->bs.p_x + b1.mass * ax * H);
 	double Jy = c->scale * (b1.p_z - c->bs.p_z + b1.mass * (ay + c->g) * H);
@@ -170,8 +189,6 @@ static int couple_interval(dem_coupled *c, FILE *deck_out, char *msg, size_t msg
 
 int dem_coupled_advance(dem_coupled *c, double t_end, FILE *deck_out, char *msg, size_t msglen)
 {
-	if (c->k == 0 && c->transient <= 0)
-		dem_slope_add(&c->slope, 0.0, c->bs.x_mean);
 	while ((double)((c->k + 1) * c->steps) * c->dt <= t_end + 1e-9 * c->H)
 		if (couple_interval(c, deck_out, msg, msglen))
 			return -1;
@@ -195,7 +212,10 @@ void dem_coupled_get(const dem_coupled *c, dem_coupled_status *st)
 	st->work_bed = c->work_b;
 	st->bed_energy = couple_bed_energy(c, &c->bs, &c->ms) - c->e_bed0;
 	st->machine_residual = c->ms.e_residual;
-	st->dem_cpu_seconds = c->cpu;
+	st->dem_cpu_seconds = c->bed->cpu - c->cpu0;
+	st->displacement = c->bs.x_mean - c->bs0.x_mean;
+	st->bed_velocity = c->bs.mass > 0 ? c->bs.p_x / c->bs.mass : NAN;
+	st->grains = c->bed->grains;
 	st->intervals = c->k;
 }
 
@@ -204,24 +224,35 @@ const sim *dem_coupled_machine(const dem_coupled *c)
 	return c->machine;
 }
 
-int dem_replay(dem_bed *b, const double *a, long n, double interval, double transient,
-	       double *v, char *msg, size_t msglen)
+const dem_feed *dem_coupled_bed(const dem_coupled *c)
 {
-	dem_slope s = {0};
-	dem_bed_state st;
-	if (transient <= 0) {
-		dem_bed_get(b, &st);
-		dem_slope_add(&s, 0.0, st.x_mean);
-	}
-	for (long k = 0; k < n; k++) {
-		if (dem_bed_advance(b, a[2 * k], a[2 * k + 1], interval, msg, msglen))
-			return -1;
-		double t1 = (double)(k + 1) * interval;
-		if (t1 >= transient - 1e-12 * interval) {
-			dem_bed_get(b, &st);
-			dem_slope_add(&s, t1, st.x_mean);
-		}
-	}
-	*v = dem_slope_value(&s);
-	return 0;
+	return c->bed;
+}
+
+void dem_coupled_restart_transport(dem_coupled *c)
+{
+	memset(&c->slope, 0, sizeof c->slope);
+	c->load_y_sum = c->load_y_n = 0;
+	if (c->transient < c->ms.t)
+		c->transient = c->ms.t;
+	if (c->ms.t >= c->transient - 1e-12 * c->H)
+		dem_slope_add(&c->slope, c->ms.t, c->bs.x_mean);
+}
+
+double dem_coupled_interval_end(const dem_coupled *c, double t)
+{
+	long k = (long)ceil(t / c->H - 1e-9);
+	return (double)(k * c->steps) * c->dt;
+}
+
+int dem_feed_advance(dem_feed *f, double ax, double ay, double interval, char *msg,
+		     size_t msglen)
+{
+	return f->ops->advance(f, ax, ay, interval, msg, msglen);
+}
+
+void dem_feed_free(dem_feed *f)
+{
+	if (f)
+		f->ops->free(f);
 }

@@ -20,7 +20,16 @@
 #define CONVSIM_DEM_COUPLE_H
 
 #include "dem.h"
+#include "feed.h"
 #include "sim.h"
+
+/* The machine's step when the method's dt is 0 (the scene's default):
+ * coupled every step, the staggered scheme's energy error is about 1.3 %
+ * at 3.125e-4 s, 2.6 % at 6.25e-4 s and 4 % at the core's default
+ * 1.25e-3 s, at nearly the same cost (the DEM's step dominates); 10-ms
+ * intervals reach 78 % (docs/dem.md "Coupling interval"). The CLI and the
+ * daemon both take it, so that they couple the same sequence. */
+#define DEM_COUPLED_DT 3.125e-4
 
 typedef struct dem_coupled dem_coupled;
 
@@ -41,18 +50,38 @@ typedef struct dem_coupled_status {
 	double bed_energy;           /* J: the bed's energy change since t = 0 (kinetic, absolute
 					frame, translation and rotation, + potential; scaled) */
 	double machine_residual;     /* J: the core's energy residual (status e_residual) */
-	double dem_cpu_seconds;      /* s of the DEM's CPU in this process */
-	long intervals;
+	double dem_cpu_seconds;      /* s of the DEM's CPU since the coupling began (the
+					bed's process for a remote bed) */
+	double displacement;         /* m: the grains' mean x since the coupling began */
+	double bed_velocity;         /* m/s: their mean velocity relative to the deck */
+	int grains;
+	long intervals;              /* since t = 0 (a restored machine's before included) */
 } dem_coupled_status;
 
-/* A coupled run of p, sc (feed_model = SIM_FEED_EXTERNAL), m with the bed
- * of spec, coupled every `steps` machine steps (m's fixed step: euler,
- * rk4 or dem). comm: NULL (serial) or an MPI_Comm * for LIGGGHTS. The
- * transport velocity counts from `transient` s. NULL with msg on error. */
+/* Whether sc and m can be coupled every `steps` machine steps: feed on,
+ * feed_model liggghts, a fixed-step method (euler, rk4 or dem), steps in
+ * [1, 100000], transient >= 0. 0, or -1 with the reason in msg. */
+int dem_coupled_check(const sim_scene *sc, const sim_method *m, int steps, double transient,
+		      char *msg, size_t msglen);
+/* Couple machine (feed_model = SIM_FEED_EXTERNAL, a fixed step; borrowed,
+ * or owned when own_machine: freed with the coupling) to bed (owned from
+ * here, freed on failure too) every `steps` machine steps from the
+ * machine's time now (0, or a restored machine's, which must end a whole
+ * interval: the bed is new there). The transport velocity counts from
+ * `transient` s. The feed's size (K L m_n) is p's and sc's. NULL with
+ * msg on error. */
+dem_coupled *dem_coupled_attach(sim *machine, int own_machine, dem_feed *bed,
+				const sim_params *p, const sim_scene *sc, int steps,
+				double transient, char *msg, size_t msglen);
+/* A coupled run of p, sc, m with a bed of spec in this process
+ * (dem_feed_local: LIGGGHTS linked, feed_local.c). comm: NULL (serial) or
+ * an MPI_Comm * for LIGGGHTS. NULL with msg on error. */
 dem_coupled *dem_coupled_new(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			     const dem_bed_spec *spec, int steps, double transient, const void *comm,
 			     char *msg, size_t msglen);
 void dem_coupled_free(dem_coupled *c);
+/* The bed (borrowed). */
+const dem_feed *dem_coupled_bed(const dem_coupled *c);
 
 /* Advance whole coupling intervals while t < t_end (s). 0, or -1 with
  * msg (the machine froze, LIGGGHTS failed). Every interval's deck
@@ -63,6 +92,14 @@ int dem_coupled_advance(dem_coupled *c, double t_end, FILE *deck_out, char *msg,
 void dem_coupled_get(const dem_coupled *c, dem_coupled_status *st);
 /* The machine (borrowed). */
 const sim *dem_coupled_machine(const dem_coupled *c);
+/* Restart the transport velocity's estimate (and the mean vertical load)
+ * from now: the grains' mean x from here on (after a change of the
+ * machine, to measure the new steady state, as sim_restart_transport). */
+void dem_coupled_restart_transport(dem_coupled *c);
+/* The end of the first coupling interval at or after t (s): where the
+ * machine stops when asked to reach t (a caller that steps to sample
+ * times which are no multiple of the interval rounds up with this). */
+double dem_coupled_interval_end(const dem_coupled *c, double t);
 
 /* The transport velocity's estimator, shared with the replay so that both
  * give the same number for the same bed: a least-squares line through
@@ -73,7 +110,7 @@ typedef struct dem_slope {
 void dem_slope_add(dem_slope *s, double t, double x);
 double dem_slope_value(const dem_slope *s);
 
-/* Drive bed b with n deck accelerations a[2i], a[2i+1] (m/s^2), each over
+/* Drive bed b (in this process: feed_local.c) with n deck accelerations a[2i], a[2i+1] (m/s^2), each over
  * interval s, and measure the transport velocity from transient s as the
  * coupled run does. 0, or -1 with msg. */
 int dem_replay(dem_bed *b, const double *a, long n, double interval, double transient,

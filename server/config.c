@@ -44,6 +44,9 @@ static const srv_config defaults = {
 	.connection_timeout = 30.0,
 	.max_queued_points = 4096,
 	.cpu_probe = 0.03,
+	.dem_bed = NULL,
+	.max_dem_sessions = 1,
+	.dem_ranks = 1,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
@@ -91,6 +94,9 @@ static const opt opts[] = {
 	 F(connection_timeout)},
 	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
 	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe)},
+	{"dem-bed", OPT_STRING, 0, 0, F(dem_bed)},
+	{"max-dem-sessions", OPT_INT, 0, 1024, F(max_dem_sessions)},
+	{"dem-ranks", OPT_INT, 1, 256, F(dem_ranks)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -179,11 +185,21 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --cpu-probe S        CPU seconds a new session's cost is "
 		"measured for before it is\n"
 		"                       admitted; 0: the estimate alone "
-		"(default %g)\n",
+		"(default %g)\n"
+		"LIGGGHTS sessions (scene.feed_model liggghts, docs/dem.md):\n"
+		"  --dem-bed PATH       the bed program (default: convsim-bed "
+		"next to this executable)\n"
+		"  --max-dem-sessions N  sessions with a LIGGGHTS bed at once, "
+		"each a bed process\n"
+		"                       holding a whole core (default %d; 0: "
+		"none)\n"
+		"  --dem-ranks N        run each bed under mpirun -n N, holding N "
+		"cores (default %d)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
-		cfg->connection_timeout, cfg->max_queued_points, cfg->cpu_probe);
+		cfg->connection_timeout, cfg->max_queued_points, cfg->cpu_probe,
+		cfg->max_dem_sessions, cfg->dem_ranks);
 }
 
 /* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */

@@ -55,6 +55,12 @@ typedef struct srv_config {
 	int max_queued_points; /* sweep points queued or running, all sweeps */
 	double cpu_probe;      /* CPU s a new session's cost is probed for
 				  (cpu_probe.c); 0: the estimate alone */
+	/* LIGGGHTS sessions (session_dem.c) */
+	const char *dem_bed;   /* --dem-bed: the bed program; NULL: convsim-bed
+				  next to the daemon's own executable */
+	int max_dem_sessions;  /* LIGGGHTS sessions at once */
+	int dem_ranks;         /* --dem-ranks: a bed process's MPI ranks (under
+				  mpirun when > 1), the cores it holds */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

@@ -34,6 +34,7 @@ static const srv_config *cfg;
 void srv_sessions_init(const srv_config *config)
 {
 	cfg = config;
+	srv_dem_init(config);
 	sessions.destroy = destroy;
 	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
 }
@@ -44,6 +45,9 @@ static void session_free(srv_session *s)
 {
 	if (!s)
 		return;
+	srv_dem_free(s); /* the bed process ends before its machine */
+	if (s->dem_slot)
+		srv_dem_release();
 	sim_free(s->sim);
 	srv_budget_give(s->mem_reserved);
 	srv_budget_set_paced(&s->paced_held, 0);
@@ -75,6 +79,8 @@ static void signal_stop(srv_session *s)
 static void stop_worker(srv_session *s)
 {
 	signal_stop(s);
+	/* a worker waiting for its bed process's answer sees its stop at once */
+	srv_dem_kill(s);
 	if (s->worker_started) {
 		pthread_join(s->worker, NULL);
 		s->worker_started = 0;
@@ -145,6 +151,11 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
+	if (srv_dem_wanted(spec) && srv_dem_start(s, 0, msg, sizeof msg)) {
+		api_fail(pb, API_UNAVAILABLE, "scene.feed_model",
+			 "the LIGGGHTS bed did not start: %s", msg);
+		return -1;
+	}
 	/* what a simulated second costs: the larger of the estimate from the
 	 * integrator and a short run of a copy (cpu_probe.c; what grows with
 	 * a large feed). A threshold (the measurement only beyond twice the
@@ -158,6 +169,9 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 					   : -1.0;
 	if (probed > s->cpu_per_s)
 		s->cpu_per_s = probed;
+	/* a bed process: its cores a simulated second until measured */
+	if (s->dem && s->cpu_per_s < s->dem_cores)
+		s->cpu_per_s = s->dem_cores;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -165,9 +179,11 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
-srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
+srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 				api_problem *pb)
 {
+	api_spec copy = *request;
+	const api_spec *spec = &copy;
 	srv_session *s = calloc(1, sizeof *s);
 	if (!s) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
@@ -182,6 +198,12 @@ srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
 			 "%d sessions exist, the limit (--max-sessions); "
 			 "delete one first", cfg->max_sessions);
 		return NULL;
+	}
+	/* a LIGGGHTS bed: its program, its method and one of its slots */
+	if (srv_dem_wanted(spec)) {
+		if (srv_dem_admit(&copy, pb) != API_OK)
+			goto fail;
+		s->dem_slot = 1;
 	}
 	int feed = spec->scene.feed && spec->scene.columns > 0 &&
 		   spec->scene.layers > 0;
@@ -221,6 +243,24 @@ fail:
 	return NULL;
 }
 
+/* A restored LIGGGHTS session: its slot (even beyond --max-dem-sessions:
+ * it existed before) and a bed settled anew at the machine's restored
+ * time; without one it fails with the reason. */
+static void adopt_bed(srv_session *s)
+{
+	char msg[256];
+	srv_dem_hold();
+	s->dem_slot = 1;
+	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
+		if (s->cpu_per_s < s->dem_cores)
+			s->cpu_per_s = s->dem_cores;
+		return;
+	}
+	s->state = SRV_FAILED;
+	snprintf(s->error, sizeof s->error, "the LIGGGHTS bed did not start again: %.200s", msg);
+	srv_log(SRV_LOG_WARN, "session %s: %s", s->entry.id, s->error);
+}
+
 int srv_session_adopt(srv_session *s)
 {
 	s->last_access = s->ckpt_wall = srv_now();
@@ -238,6 +278,8 @@ int srv_session_adopt(srv_session *s)
 		 * budget: it existed before */
 		s->cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
 						       s->columns, s->layers);
+		if (srv_dem_wanted(&s->spec))
+			adopt_bed(s);
 	}
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		srv_log(SRV_LOG_WARN, "session %s not restored: --max-sessions "
@@ -268,6 +310,14 @@ static void remove_session(srv_session *s, int files)
 	if (!srv_registry_remove(&sessions, &s->entry))
 		return;
 	stop_worker(s);
+	/* its bed process ends and is reaped now, and its slot is free for
+	 * the next LIGGGHTS session at once, not when the last reader lets
+	 * go of the session */
+	srv_dem_free(s);
+	if (s->dem_slot) {
+		s->dem_slot = 0;
+		srv_dem_release();
+	}
 	if (files)
 		srv_persist_remove(s); /* after the worker's last write */
 	if (files) {

@@ -59,6 +59,8 @@ size_t srv_sessions_reap(double idle_timeout);
 size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 			    void (*put)(srv_experiment *e));
 const char *srv_session_id(const srv_session *s);
+/* Its spec (immutable; borrowed while the reference is held). */
+const api_spec *srv_session_spec(const srv_session *s);
 /* Fill a view (spec borrowed from s: keep the reference while using it). */
 void srv_session_view(srv_session *s, api_view *v);
 /* Live sessions. */

@@ -101,16 +101,64 @@ struct srv_session {
 				     creation, then measured by the worker */
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
+	/* a LIGGGHTS session (session_dem.c) */
+	struct dem_coupled *dem;  /* worker only (created before it starts,
+				     freed after it ends): the coupling to the
+				     bed process; NULL for the column model */
+	int dem_slot;             /* holds one of --max-dem-sessions */
+	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
+	int dem_restart;          /* worker only: a control changed the machine;
+				     the bed's transport estimate restarts once
+				     its beta ramp is over */
+	api_bed bed;              /* what the worker last read of it (lock) */
 };
 
+/* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
+
+/* Find the bed program (--dem-bed, or convsim-bed next to the daemon). */
+void srv_dem_init(const srv_config *cfg);
+/* The spec asks for a LIGGGHTS bed (feed on, feed_model liggghts). */
+int srv_dem_wanted(const api_spec *spec);
+/* Admit a LIGGGHTS session: the bed program exists (else 422 on
+ * scene.feed_model), a fixed-step method (a dt of 0 becomes the CLI's
+ * coupled step; else 422 on integrator.method), one of --max-dem-sessions
+ * taken (else 429): give it back with srv_dem_release. */
+api_err srv_dem_admit(api_spec *spec, api_problem *pb);
+/* A restored session's slot, taken even beyond the limit; and giving one
+ * back. */
+void srv_dem_hold(void);
+void srv_dem_release(void);
+/* Start s's bed process and couple it to s->sim (at t = 0, or at a
+ * restored machine's time: restored = 1, the bed settled anew); s->st and
+ * s->bed show it. 0, or -1 with msg (s->dem stays NULL). */
+int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
+/* Worker, lock released: advance machine and bed to the end of the
+ * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
+ * process ended or failed, the machine froze). */
+int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen);
+/* Worker, lock released: a control changed the machine (restart = 1):
+ * once beta has reached its target (status st), the bed's transport
+ * estimate restarts, as the core's does. */
+void srv_dem_controlled(srv_session *s, const sim_status *st);
+/* Worker: the bed's figures into a status of the machine (transport
+ * velocity, feed displacement and velocity) and into *b. */
+void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b);
+/* End the bed process now (any thread: a worker inside an advance then
+ * fails and sees its stop). */
+void srv_dem_kill(srv_session *s);
+/* Free the coupling, ending and reaping the bed process. */
+void srv_dem_free(srv_session *s);
+
 /* Cores a session needs from the paced budget as it is now: its CPU s per
- * simulated s times its pace while it runs paced, else none (lock
- * held). */
+ * simulated s times its pace while it runs paced (at least its bed
+ * process's cores for a LIGGGHTS session), else none (lock held). */
 static inline double srv_paced_need(const srv_session *s)
 {
 	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
 		return 0;
-	return s->cpu_per_s * s->pace;
+	double need = s->cpu_per_s * s->pace;
+	/* a LIGGGHTS session's bed process holds its cores */
+	return s->dem && need < s->dem_cores ? s->dem_cores : need;
 }
 
 /* The state control c leaves a session in, from its state, whether its

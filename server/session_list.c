@@ -36,6 +36,11 @@ void srv_session_put(srv_session *s)
 
 /* ---- queries --------------------------------------------------------------- */
 
+const api_spec *srv_session_spec(const srv_session *s)
+{
+	return &s->spec;
+}
+
 const char *srv_session_id(const srv_session *s)
 {
 	return s->entry.id;
@@ -79,6 +84,8 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->waiting_for_cpu = s->waiting_for_cpu;
 	v->replayed = s->rebuilt;
 	v->replay_seconds = s->replay_seconds;
+	v->has_bed = srv_dem_wanted(&s->spec);
+	v->bed = s->bed;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

@@ -243,13 +243,13 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				    : rv.head;
 	else
 		k->cursor = rv.head > rv.oldest ? rv.head - 1 : rv.head;
-	k->out_len = (size_t)snprintf(
-		k->out, k->out_cap,
-		k->ndjson ? "{\"type\":\"hello\",\"session\":\"%s\","
-			    "\"next_id\":%" PRIu64 "}\n"
-			  : "retry: 1000\nevent: hello\ndata: "
-			    "{\"session\":\"%s\",\"next_id\":%" PRIu64 "}\n\n",
-		srv_session_id(k->s), k->cursor);
+	/* the first record: where the stream starts, and whether the
+	 * scene's column model lies outside its validated domain */
+	char why[400];
+	const api_spec *spec = srv_session_spec(k->s);
+	int inside = sim_feed_validated(&spec->params, &spec->scene, why, sizeof why);
+	k->out_len = api_format_hello(k->out, k->out_cap, srv_session_id(k->s), k->cursor,
+				      inside ? NULL : why, k->ndjson);
 	k->last_write = srv_now();
 	struct MHD_Response *resp = MHD_create_response_from_callback(
 		MHD_SIZE_UNKNOWN, 32 * 1024, reader, k, stream_free);

@@ -168,6 +168,11 @@ static int apply_commands(srv_session *s)
 			rc = sim_set_drive_on(s->sim, c->motor_on);
 		if (rc == SIM_OK && cmd->restart_transport)
 			sim_restart_transport(s->sim);
+		/* a LIGGGHTS bed's estimate restarts as the core's does */
+		if (rc == SIM_OK && s->dem &&
+		    (cmd->restart_transport ||
+		     (c->set & (API_C_BETA | API_C_ROTATION | API_C_OMEGA_SS | API_C_MOTOR))))
+			s->dem_restart = 1;
 		if (rc == SIM_OK && (c->set & API_C_PACE)) {
 			s->pace = c->pace;
 			reanchor = 1;
@@ -355,8 +360,10 @@ static void check_cpu(srv_session *s, clocks *c)
 	if (now - c->cpu_wall < CPU_READ_EVERY)
 		return;
 	c->cpu_wall = now;
+	/* a LIGGGHTS session's bed process's CPU is the session's too */
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
-		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
+				 (s->dem ? s->bed.cpu_seconds : 0.0);
 	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
 		return;
@@ -442,19 +449,32 @@ static int pace(srv_session *s, clocks *c, double t_next)
 }
 
 /* step: advance to t_next with the lock released, then publish the status
- * and push a sample (its readers are woken once per batch: publish).
- * Returns the core's code. */
-static int step(srv_session *s, double t_next)
+ * and push a sample (its readers are woken once per batch: publish). A
+ * LIGGGHTS session advances machine and bed together to the end of the
+ * coupling interval at or after t_next (session_dem.c), its status
+ * showing the bed's feed. Returns the core's code; a bed that failed
+ * gives SIM_EDIVERGED with its reason in why. */
+static int step(srv_session *s, double t_next, char *why, size_t whylen)
 {
 	sim_status st;
+	api_bed bed = s->bed;
+	int rc = SIM_OK;
 	pthread_mutex_unlock(&s->lock);
-	int rc = sim_advance(s->sim, t_next);
+	if (!s->dem)
+		rc = sim_advance(s->sim, t_next);
+	else if (srv_dem_step(s, t_next, why, whylen))
+		rc = SIM_EDIVERGED;
 	sim_get_status(s->sim, &st);
+	if (s->dem) {
+		srv_dem_controlled(s, &st);
+		srv_dem_read(s, &st, &bed);
+	}
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
 	if (st.steps > s->st.steps)
 		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
 	s->st = st;
+	s->bed = bed;
 	srv_ring_sample(s);
 	return rc;
 }
@@ -475,15 +495,22 @@ static void run_job(srv_session *s)
 	}
 }
 
-/* failure: the core refused to go on; the session fails for good. */
-static void fail(srv_session *s, int rc)
+/* failure: the core refused to go on, or a LIGGGHTS session's bed did
+ * (why, else ""); the session fails for good. A bed ended by the
+ * session's own stop (deleted, the daemon stopping) is no failure. */
+static void fail(srv_session *s, int rc, const char *why)
 {
+	if (s->stop && why[0])
+		return;
 	s->state = SRV_FAILED;
 	s->ckpt_dirty = 1;
 	if (s->owned)
 		s->expire = 1;
-	snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
-		 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
+	if (why[0])
+		snprintf(s->error, sizeof s->error, "the LIGGGHTS bed: %.220s", why);
+	else
+		snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
+			 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
 	srv_ring_event_at(s, "failed", NULL);
 	srv_worker_detach_exp(s, s->error);
 	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
@@ -537,10 +564,11 @@ void *srv_worker_main(void *arg)
 		double t_next = next_time(s);
 		if (pace(s, &clk, t_next))
 			continue;
-		int rc = step(s, t_next);
+		char why[256] = "";
+		int rc = step(s, t_next, why, sizeof why);
 		run_job(s);
 		if (rc != SIM_OK)
-			fail(s, rc);
+			fail(s, rc, why);
 		meter(s, &clk);
 		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
 			publish(s, &clk);

@@ -13,12 +13,8 @@
  * is deterministic and cheap) and sets the same load, since the bed's
  * totals are LIGGGHTS's global reductions; rank 0 alone prints.
  *
- * dt = 0 stands for a machine step of RUN_COUPLED_DT here: coupled every
- * step, the staggered scheme's energy error (the bed's received work
- * against the machine's given work) is about 1.3 % at 3.125e-4 s, 2.6 %
- * at 6.25e-4 s and 4 % at the core's default 1.25e-3 s, at nearly the same
- * cost (the DEM's step dominates); 10 ms coupling intervals reach 78 %
- * (docs/dem.md "Coupling interval").
+ * dt = 0 stands for a machine step of DEM_COUPLED_DT (couple.h), as in
+ * the daemon.
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,8 +25,6 @@
 #include "cli.h"
 #include "couple.h"
 #include "dem.h"
-
-#define RUN_COUPLED_DT 3.125e-4
 
 static void run_summary(const cli_opts *o, const dem_coupled *c, const dem_bed_spec *spec, int ranks,
 			int failed, double cpu, double wall)
@@ -81,7 +75,7 @@ int cli_run_coupled(const cli_opts *o)
 	double w0 = cli_now(), c0 = dem_cpu_now();
 	sim_method m = o->m;
 	if (m.dt == 0.0)
-		m.dt = RUN_COUPLED_DT;
+		m.dt = DEM_COUPLED_DT;
 	dem_coupled *c = dem_coupled_new(&o->p, &o->sc, &m, &spec, o->coupling_steps,
 					 o->sc.transient, ranks > 1 ? &world : NULL, msg, sizeof msg);
 	if (!c) {

@@ -1,15 +1,29 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // scene.feed_model in the daemon: the settings list it (column|liggghts),
-// the column model is the default and runs, and liggghts, which couples a
-// LIGGGHTS bed only in `convsim run` built with it (docs/dem.md), is
-// refused with a problem naming the field and its range; nothing is
-// created then.
+// the column model is the default and runs; liggghts, whose bed runs in a
+// bed process (build/convsim-bed, tests/dem/session.test.mjs), is refused
+// with a problem naming the field and its range where the daemon finds no
+// bed program, and always in sweeps (which run many scenes at once);
+// nothing is created then.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, SLOW } from './lib.mjs';
+import { startDaemon, req, openStream, SLOW } from './lib.mjs';
+
+// The stream's first record (hello), NDJSON.
+async function hello(base, id) {
+  const ac = new AbortController();
+  let first;
+  for await (const rec of openStream(base, `/api/v1/sessions/${id}/stream?format=ndjson`, {}, ac.signal)) {
+    first = rec;
+    break;
+  }
+  ac.abort();
+  return first;
+}
 
 let d;
-before(async () => { d = await startDaemon([]); });
+// a daemon that finds no bed program (as one built without LIGGGHTS)
+before(async () => { d = await startDaemon(['--dem-bed', '/nonexistent/convsim-bed']); });
 after(async () => { await d.stop(); });
 
 test('feed_model: listed, column by default, liggghts refused with 422 and nothing created', { timeout: 20000 * SLOW }, async () => {
@@ -24,8 +38,12 @@ test('feed_model: listed, column by default, liggghts refused with 422 and nothi
   assert.equal(r.body.field, 'scene.feed_model');
   assert.equal(r.body.min, 0);
   assert.equal(r.body.max, 0);
-  assert.match(r.body.detail, /feed_model must be column in the daemon/);
+  assert.match(r.body.detail, /needs the bed program \/nonexistent\/convsim-bed, which this daemon does not find/);
   assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, n0);
+  const sw = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [30], scene: { feed_model: 'liggghts' } });
+  assert.equal(sw.status, 422);
+  assert.equal(sw.body.field, 'scene.feed_model');
+  assert.match(sw.body.detail, /must be column in sweeps, fits and experiments/);
   const ok = await req(d.base, 'POST', '/api/v1/sessions', { scene: { feed_model: 'column' }, pace: 1 });
   assert.equal(ok.status, 201);
 });
@@ -38,4 +56,10 @@ test('status.feed_warning: the preset\'s 8 soft layers lie outside the domain ch
   const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 2 }, pace: 1 });
   const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
   assert.equal(sb.feed_warning, null);
+  // the stream's first record says the same
+  const ha = await hello(d.base, a.body.id), hb = await hello(d.base, b.body.id);
+  assert.equal(ha.type, 'hello');
+  assert.equal(ha.feed_warning, sa.feed_warning);
+  assert.equal(hb.type, 'hello');
+  assert.equal(hb.feed_warning, null);
 });

@@ -160,6 +160,9 @@ test('a session starts from the form', async () => {
 	assert.equal(s.layers, 2);
 	assert.equal(s.spec.scene.start, 'steady');
 	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
+	/* two layers: inside the column model's validated domain, no note */
+	assert.equal(s.status.feed_warning, null);
+	assert.equal(await visible('#feed-warning'), false, 'no feed warning for 2 layers');
 });
 
 test('stream samples arrive and the plots grow', async () => {
@@ -598,6 +601,25 @@ test('a Kloss-drive session from the picker: the rotor plot\'s period means leav
 	const ripple = Math.max(...raw) - Math.min(...raw);
 	assert.ok(ripple > 0.5, `raw ripple ${ripple} rad/s`);
 	assert.ok(shown < ripple / 4, `the plot's rotor speed spans ${shown} rad/s over its last second, the raw ${ripple}`);
+});
+
+test('a czubak2016 session (8 soft layers) shows the feed warning; the 2-layer session does not', async () => {
+	const r = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json', ...AUTH },
+		body: JSON.stringify({ preset: 'czubak2016', scene: { drive: 'ideal', columns: 2 }, pace: 1 }) });
+	assert.equal(r.status, 201);
+	const czubak = await r.json();
+	assert.equal(czubak.layers, 8);
+	assert.match(czubak.status.feed_warning, /8 layers/);
+	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(czubak.id), 10000, 'the new session in the picker');
+	await page.selectOption('#session-select', czubak.id);
+	await until(async () => await visible('#feed-warning'), 5000, 'the feed warning shown');
+	const text = await page.$eval('#feed-warning', e => e.textContent);
+	assert.ok(text.includes(czubak.status.feed_warning), `the daemon's sentence on the page: ${text}`);
+	assert.match(text, /feed_model=liggghts/);
+	await page.selectOption('#session-select', sessionId);
+	await until(async () => !(await visible('#feed-warning')), 5000, 'the feed warning gone for the 2-layer session');
+	const del = await fetch(`${base}/api/v1/sessions/${czubak.id}`, { method: 'DELETE', headers: { 'Content-Type': 'application/json', ...AUTH } });
+	assert.equal(del.status, 204);
 });
 
 test('Delete clears the tiles and the plots', async () => {

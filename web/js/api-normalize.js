@@ -45,6 +45,7 @@ export const FIELDS = {
 		columns: ['columns', 'spec.scene.columns', 'scene.columns', 'status.columns'],
 		layers: ['layers', 'spec.scene.layers', 'scene.layers', 'status.layers'],
 		feed: ['spec.scene.feed', 'scene.feed'],
+		feedWarning: ['status.feed_warning', 'feed_warning'],
 		drive: ['spec.scene.drive', 'scene.drive'],
 		method: ['spec.integrator.method', 'integrator.method'],
 		start: ['spec.scene.start', 'scene.start'],
@@ -218,6 +219,8 @@ export function normalizeSession(raw) {
 		columns: scalar(raw, F.columns),
 		layers: scalar(raw, F.layers),
 		feed: pick(raw, F.feed),
+		/* why the column model lies outside its validated domain, or null */
+		feedWarning: typeof pick(raw, F.feedWarning) === 'string' ? pick(raw, F.feedWarning) : null,
 		drive: pick(raw, F.drive),
 		method: pick(raw, F.method),
 		start: pick(raw, F.start),

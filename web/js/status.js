@@ -4,7 +4,8 @@
  * (the daemon's transport velocity with its error bar and steady mark,
  * simulated time, rotor speed, real-time factor), the live-control card
  * (buttons, beta slider and readout, rotation, drive row) and the model
- * card with its reductions.
+ * card with its reductions, and the note when the scene's column model
+ * lies outside its validated domain.
  */
 
 import { fmt, fmtSig, fmtTime, fmtVelocityPm, steadyLabel, fmtPace, RAD_S_TO_RPM, rotationLabel,
@@ -73,6 +74,7 @@ export function showStatus(s) {
 		? ` · step ${fmtSig(1e3 * s.dt, 3)} ms, ${s.substeps} feed sub-steps` : '');
 	$('#m-pace').textContent = fmtPace(s.pace);
 	showReductions(s.reductions);
+	showFeedWarning(s.feedWarning);
 	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
 	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
 	app.dirty = true;
@@ -91,11 +93,21 @@ export function clearStatus() {
 	$('#v-steady').dataset.steady = '';
 	$('#v-tol').textContent = '';
 	$('#v-tol').dataset.tol = '';
+	showFeedWarning(null);
 	delete document.body.dataset.running;
 	const box = $('#reductions');
 	box.dataset.key = '';
 	box.replaceChildren(DASH);
 	resetTraces(0);
+}
+
+/* The note over the tiles when the scene's column model lies outside the
+ * domain checked against LIGGGHTS beds (docs/dem.md): the daemon's sentence,
+ * which names the way out. */
+function showFeedWarning(text) {
+	const note = $('#feed-warning');
+	note.hidden = !text;
+	note.textContent = text ? `Feed model outside its validated domain: ${text}` : '';
 }
 
 function showReductions(list) {
