@@ -67,7 +67,10 @@ export function openStream(id, opts, handlers) {
 		let d;
 		try { d = JSON.parse(ev.data); } catch { return; }
 		const kind = (d && typeof d === 'object' && !Array.isArray(d) && (d.type ?? d.event)) || ev.type;
-		if (/control|change|command/i.test(kind)) {
+		if (kind === 'hello') {
+			/* the stream's first record: the session and its feed_warning */
+			h.hello?.(d);
+		} else if (/control|change|command/i.test(kind)) {
 			h.control?.(normalizeControl(d.control ?? d), d);
 		} else if (/drop|miss|lag/i.test(kind)) {
 			h.dropped?.(num(d.missed ?? d.dropped ?? d.count ?? d.n));
