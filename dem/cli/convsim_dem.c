@@ -99,6 +99,15 @@ static double dem_number(const char *opt, const char *text, double lo, double hi
 	return v;
 }
 
+/* 0 for `off`, 1 for `on`, or exit 2 naming the option and both words. */
+static int dem_choice(const char *opt, const char *text, const char *off, const char *on)
+{
+	if (!strcmp(text, off) || !strcmp(text, on))
+		return !strcmp(text, on);
+	fprintf(stderr, "convsim-dem: --%s must be %s or %s, got '%s'\n", opt, off, on, text);
+	exit(2);
+}
+
 static void dem_parse(int argc, char **argv, dem_opts *o)
 {
 	int c;
@@ -149,22 +158,8 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 		case 'H': o->harmonics = (int)dem_number("harmonics", optarg, 1, DEM_MAX_HARMONICS); break;
 		case 'w': o->settle = dem_number("settle", optarg, 0, 100); break;
 		case 'C': o->column = 0; break;
-		case 'M':
-			if (strcmp(optarg, "fit") && strcmp(optarg, "machine")) {
-				fprintf(stderr, "convsim-dem: --motion must be fit or machine, got '%s'\n",
-					optarg);
-				exit(2);
-			}
-			o->motion_machine = !strcmp(optarg, "machine");
-			break;
-		case 'T':
-			if (strcmp(optarg, "spring") && strcmp(optarg, "viscous")) {
-				fprintf(stderr, "convsim-dem: --tangential must be spring or viscous, got '%s'\n",
-					optarg);
-				exit(2);
-			}
-			o->tangential_viscous = !strcmp(optarg, "viscous");
-			break;
+		case 'M': o->motion_machine = dem_choice("motion", optarg, "fit", "machine"); break;
+		case 'T': o->tangential_viscous = dem_choice("tangential", optarg, "spring", "viscous"); break;
 		case 'c': o->coupling_steps = (int)dem_number("coupling-steps", optarg, 1, 1000); break;
 		case 'F':
 			if (sscanf(optarg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
