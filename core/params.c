@@ -118,15 +118,16 @@ const char *const sim_preset_names[] = {"czubak2016", "czubak2016-fit", "liggght
 
 /* liggghts-bed4: the column model's contact fitted to a LIGGGHTS bed of 4
  * grain diameters (367 spheres 3.6-4.4 mm, the preset's contacts) on the
- * preset's deck, one-way, 18 points (9 angles, both senses) by `convsim
- * fit --data tests/bench/results/dem_bed4.csv --free k_c,R,mu --set
- * layers=4 --set feed_coupling=false` (docs/dem.md "Calibrated to a
- * bed"): R 0.181 +- 0.013, mu 0.604 +- 0.007, k_c 1.9e4 N/m, which the
- * data do not pin down (standard error 3.3e4); rms residual 0.0053 m/s
- * against the DEM, 0.036 m/s before the fit. */
-#define LIGGGHTS_BED4_K_C 18830.98
-#define LIGGGHTS_BED4_R 0.18105
-#define LIGGGHTS_BED4_MU 0.60390
+ * preset's deck, one-way, 22 points (11 angles, both senses, 3 packing
+ * seeds each) by `convsim fit -p liggghts-bed4 --data
+ * tests/bench/results/dem_bed4.csv --free k_c,R,mu --set layers=4 --set
+ * feed_coupling=false` (docs/dem.md "Calibrated to a bed"): R 0.177 +-
+ * 0.009, mu 0.623 +- 0.007, k_c 2.6e4 N/m, which the data do not pin down
+ * (standard error 3.9e4); rms residual 0.0030 m/s against the DEM, 0.0044
+ * m/s with the values fitted before the bed's restitution was fixed. */
+#define LIGGGHTS_BED4_K_C 25613.34
+#define LIGGGHTS_BED4_R 0.17732
+#define LIGGGHTS_BED4_MU 0.62285
 
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 {
