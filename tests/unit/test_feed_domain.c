@@ -2,9 +2,10 @@
 /*
  * test_feed_domain.c - sim_feed_validated: the column model's domain as
  * checked against LIGGGHTS beds (docs/dem.md): inside at 1-2 layers, at
- * up to 8 with stiff contacts and for the preset fitted to a 4-diameter
- * bed; outside beyond, with a reason that names the layers and the way
- * out; no answer without a column feed.
+ * up to 8 with stiff contacts away from the DEM bed's second peak, and for
+ * the preset fitted to a 4-diameter bed; outside beyond, with a reason
+ * that names the layers, the angle and the way out; no answer without a
+ * column feed.
  */
 #include "testutil.h"
 
@@ -31,8 +32,21 @@ static void domain_by_depth_and_stiffness(void **state)
 	assert_int_equal(validated(&u, NULL, 0), 1);
 	set(&u, "layers", "9");
 	assert_int_equal(validated(&u, NULL, 0), 0);
-	set(&u, "k_c", "9.9e6");
+	/* stiff contacts, but the DEM bed's second peak (150 cw, 30 ccw) */
 	set(&u, "layers", "8");
+	set(&u, "beta", "150");
+	assert_int_equal(validated(&u, why, sizeof why), 0);
+	assert_non_null(strstr(why, "beta 150 deg cw"));
+	set(&u, "beta", "137");
+	assert_int_equal(validated(&u, NULL, 0), 1);
+	set(&u, "rotation", "ccw");
+	set(&u, "beta", "30");
+	assert_int_equal(validated(&u, NULL, 0), 0);
+	set(&u, "beta", "60");
+	assert_int_equal(validated(&u, NULL, 0), 1);
+	set(&u, "rotation", "cw");
+	set(&u, "beta", "38");
+	set(&u, "k_c", "9.9e6");
 	assert_int_equal(validated(&u, NULL, 0), 0);
 	/* the preset fitted to a 4-diameter bed */
 	setup f;
