@@ -8,7 +8,8 @@ and sample standard deviation), the change between the last two rungs on
 seed 1, and the column model's relative error at the first and the last
 rung. Table 2: every other scene (depth, rolling friction, ...), one row
 each, seeds pooled. Then the scenes where the column model is within 5, 10
-and 30 %. Usage: dem_report.py FILE.jsonl COMMAND DATE SECONDS [NOTE]."""
+and 30 %. Usage: dem_report.py FILE.jsonl COMMAND DATE SECONDS [NOTE];
+dem_report.py --bed4-csv FILE.jsonl writes the curve's points for the fit."""
 import json
 import math
 import statistics
@@ -39,7 +40,27 @@ def cost(rs):
                             for r in rs)
 
 
+def bed4_csv(path):
+    """The curve's points for `convsim fit --data` (docs/dem.md "Calibrated
+    to a bed"): the seeds' mean v at each angle and sense, and one sigma for
+    all, the root mean square of the seeds' standard deviations."""
+    curve = {}
+    for line in open(path):
+        if line.strip():
+            r = json.loads(line)
+            if r["group"] == "curve":
+                curve.setdefault((round(r["beta"]), r["rotation"]), []).append(r["v_dem"])
+    sds = [statistics.stdev(v) for v in curve.values() if len(v) > 1]
+    sigma = math.sqrt(statistics.fmean([s * s for s in sds])) if sds else 0.0013
+    print("beta,rotation,v,sigma")
+    for beta, rot in sorted(curve, key=lambda br: (br[1] != "cw", br[0])):
+        print(f"{beta},{rot},{statistics.fmean(curve[(beta, rot)]):.6f},{sigma:.4f}")
+
+
 def main():
+    if sys.argv[1] == "--bed4-csv":
+        bed4_csv(sys.argv[2])
+        return
     path, command, date, seconds = sys.argv[1:5]
     note = sys.argv[5] if len(sys.argv) > 5 else ""
     rows = [json.loads(line) for line in open(path) if line.strip()]
@@ -63,49 +84,37 @@ def main():
     rungs = sorted({k[4] for k in scenes if k[0] == "ladder"})
     if curve:
         kom0 = next(k[4] for k in scenes if k[0] == "curve")
-        head = [f"v DEM {kom0:.0e}"] + [f"v DEM {x:.0e}" for x in rungs]
-        tail = []
-        if len(rungs) >= 2:
-            tail = [f"{rungs[-2]:.0e} → {rungs[-1]:.0e} (seed 1)"]
-        out.append("| β (°) | sense | " + " | ".join(head + tail) +
-                   f" | v column {kom0:.0e} | column − DEM {kom0:.0e}" +
-                   (f" | v column {rungs[-1]:.0e} | column − DEM {rungs[-1]:.0e}" if rungs else "") +
-                   " |")
-        out.append("|" + "---|" * (2 + len(head) + len(tail) + 2 + (2 if rungs else 0)))
+        allr = [kom0] + rungs
+        head = [f"v DEM {x:.0e}" for x in allr]
+        tail = [f"{rungs[-2]:.0e} → {rungs[-1]:.0e} (seed 1)"] if len(rungs) >= 2 else []
+        cols = [f"v column {kom0:.0e}"] + ([f"v column {rungs[-1]:.0e}"] if rungs else [])
+        diffs = [f"column − DEM {x:.0e}" for x in allr]
+        out.append("| β (°) | sense | " + " | ".join(head + tail + cols + diffs) + " |")
+        out.append("|" + "---|" * (2 + len(head) + len(tail) + len(cols) + len(diffs)))
+        seeds_at = {x: 0 for x in allr}
         for (beta, rot) in sorted(curve, key=lambda br: (br[1] != "cw", br[0])):
-            rs0 = curve[(beta, rot)]
-            m0 = pooled(rs0)
-            cells = [fmt(*m0)]
-            lad = ladder.get((beta, rot), {})
-            for x in rungs:
-                cells.append(fmt(*pooled(lad[x])) if x in lad else "")
+            by = {kom0: curve[(beta, rot)], **ladder.get((beta, rot), {})}
+            cells = [fmt(*pooled(by[x])) if x in by else "" for x in allr]
+            for x in allr:
+                seeds_at[x] = max(seeds_at[x], len(by.get(x, [])))
             if tail:
-                s1 = [next((r["v_dem"] for r in lad.get(x, []) if r["seed"] == 1), float("nan"))
+                s1 = [next((r["v_dem"] for r in by.get(x, []) if r["seed"] == 1), float("nan"))
                       for x in rungs[-2:]]
                 cells.append(f"{100 * (s1[1] - s1[0]) / abs(s1[0]):+.1f} %")
-            col0 = rs0[0]["v_column"]
-            r0 = rel(col0, m0[0])
-            cells += [f"{col0:+.4f}", f"{100 * r0:+.1f} %"]
-            classify(f"β {beta:.0f}° {rot}, 4 d, k/m {kom0:.3g}", r0)
-            if rungs:
-                for x in rungs:
-                    if x in lad:
-                        rx = rel(lad[x][0]["v_column"], pooled(lad[x])[0])
-                        classify(f"β {beta:.0f}° {rot}, 4 d, k/m {x:.3g}", rx)
-                if rungs[-1] in lad:
-                    last = lad[rungs[-1]]
-                    cells += [f"{last[0]['v_column']:+.4f}",
-                              f"{100 * rel(last[0]['v_column'], pooled(last)[0]):+.1f} %"]
-                else:
-                    cells += ["", ""]
+            cells += [f"{by[x][0]['v_column']:+.4f}" if x in by else "" for x in allr if
+                      x == kom0 or x == allr[-1]][:len(cols)]
+            for x in allr:
+                if x not in by:
+                    cells.append("")
+                    continue
+                rx = rel(by[x][0]["v_column"], pooled(by[x])[0])
+                cells.append(f"{100 * rx:+.1f} %")
+                classify(f"β {beta:.0f}° {rot}, 4 d, k/m {x:.3g}", rx)
             out.append(f"| {beta:.0f} | {rot} | " + " | ".join(cells) + " |")
-        n = {k: len(rs) for k, rs in scenes.items()}
         out.append("")
-        out.append(f"The 4-diameter bed ({next(rs[0]['grains'] for k, rs in scenes.items() if k[0] == 'curve')} "
-                   f"grains); v in m/s; ± is the standard deviation over packing seeds "
-                   f"({max(n[k] for k in n if k[0] == 'curve')} at {kom0:.0e}"
-                   + (f", {max(n[k] for k in n if k[0] == 'ladder' and k[4] == rungs[-1])} at {rungs[-1]:.0e}"
-                      if rungs else "") + "); k/m in 1/s².")
+        out.append(f"The 4-diameter bed ({curve[next(iter(curve))][0]['grains']} grains); v in m/s; "
+                   "± is the standard deviation over packing seeds ("
+                   + ", ".join(f"{seeds_at[x]} at {x:.0e}" for x in allr) + "); k/m in 1/s².")
         out.append("")
     # table 2: every other scene
     out.append("| group | β (°) | sense | depth (d) | grains | k/m (1/s²) | μ_roll | e | tangential | seeds | "
