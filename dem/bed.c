@@ -302,6 +302,10 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 		return NULL;
 	}
 	bed_cmd(b, "boundary %s", s->wiggle_period > 0 ? "f f f" : "p p f");
+	/* ranks split the cell along the deck and across, never in height:
+	 * the box is four times the bed's height, and a split there left the
+	 * upper rank empty (two ranks cost what one did) */
+	bed_cmd(b, "processors * * 1");
 	bed_cmd(b, "newton off");
 	bed_cmd(b, "communicate single vel yes");
 	bed_cmd(b, "units si");
