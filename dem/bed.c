@@ -5,9 +5,11 @@
  * coupling interval under the deck's acceleration, and the bed's totals
  * read back through equal-style variables.
  *
- * LIGGGHTS's fix gravity takes no variables, so the deck's acceleration
+ * LIGGGHTS's fix gravity takes no variables, so a held deck acceleration
  * enters as a new gravity fix at each interval ("unfix", "fix", then a run
- * with its set-up), which LIGGGHTS evaluates once per run. LIGGGHTS ends
+ * with its set-up), which LIGGGHTS evaluates once per run; a formula of
+ * time enters as a fix addforce of atom-style variables, evaluated at
+ * every step (dem_bed_advance_drive). LIGGGHTS ends
  * the process on a command it refuses, so every value is checked here
  * before it is sent.
  */

@@ -12,7 +12,8 @@
  * translating deck (docs/dem.md "Frame"). The deck's motion is held
  * constant over each coupling interval (its mean acceleration there), so
  * that the grains' velocities relative to the deck are exact at the
- * interval's ends.
+ * interval's ends; or, for a deck known ahead, given as a formula of time
+ * evaluated at every DEM step (dem_bed_advance_drive).
  *
  * Units SI. Positions and momenta are the bed's totals, in the deck frame.
  */
