@@ -5,9 +5,11 @@
  * coupling interval under the deck's acceleration, and the bed's totals
  * read back through equal-style variables.
  *
- * LIGGGHTS's fix gravity takes no variables, so the deck's acceleration
+ * LIGGGHTS's fix gravity takes no variables, so a held deck acceleration
  * enters as a new gravity fix at each interval ("unfix", "fix", then a run
- * with its set-up), which LIGGGHTS evaluates once per run. LIGGGHTS ends
+ * with its set-up), which LIGGGHTS evaluates once per run; a formula of
+ * time enters as a fix addforce of atom-style variables, evaluated at
+ * every step (dem_bed_advance_drive). LIGGGHTS ends
  * the process on a command it refuses, so every value is checked here
  * before it is sent.
  */
@@ -30,12 +32,14 @@ struct dem_bed {
 	double dt;      /* s DEM step */
 	double t;       /* s since the end of the settling */
 	double m_mean;  /* kg of the mean grain */
+	double t_zero;  /* s: LIGGGHTS's own time at the bed's t = 0 */
+	int drive;      /* 1: the deck fix is the formula's addforce, 0: a held gravity */
 };
 
 /* One LIGGGHTS command, printf-style. */
 static void bed_cmd(dem_bed *b, const char *fmt, ...)
 {
-	char line[512];
+	char line[2048];
 	va_list ap;
 	va_start(ap, fmt);
 	vsnprintf(line, sizeof line, fmt, ap);
@@ -97,6 +101,12 @@ double dem_restitution_damping(double e)
 	double lo = 0, hi = 1;
 	if (e >= 1)
 		return 0;
+	/* past critical damping (e 0.135) the grain still leaves sooner and
+	 * slower as zeta grows: widen the bracket until it holds e */
+	while (dem_restitution(hi) > e && hi < 1e3) {
+		lo = hi;
+		hi *= 2;
+	}
 	for (int i = 0; i < 50; i++) {
 		double mid = 0.5 * (lo + hi);
 		if (dem_restitution(mid) > e)
@@ -146,6 +156,9 @@ static void bed_contacts(dem_bed *b)
 	 * 2 zeta omega for the mean grain on the floor */
 	double gamman = 2 * zeta * sqrt(s->k_over_m);
 	const char *roll = s->mu_roll > 0 ? " rolling_friction cdt" : "";
+	/* history: a tangential spring capped by Coulomb; no_history: a
+	 * viscous tangential force (gammat) capped by Coulomb, no spring */
+	const char *tang = s->tangential_viscous ? "no_history" : "history";
 	bed_cmd(b, "fix m1 all property/global kn peratomtypepair 1 %.17g", kn);
 	bed_cmd(b, "fix m2 all property/global kt peratomtypepair 1 %.17g", kn * 2.0 / 7.0);
 	bed_cmd(b, "fix m3 all property/global gamman peratomtypepair 1 %.17g", gamman);
@@ -154,16 +167,16 @@ static void bed_contacts(dem_bed *b)
 	if (s->mu_roll > 0)
 		bed_cmd(b, "fix m6 all property/global coefficientRollingFriction peratomtypepair 1 %.17g",
 			s->mu_roll);
-	bed_cmd(b, "pair_style gran model hooke/stiffness tangential history%s limitForce on", roll);
+	bed_cmd(b, "pair_style gran model hooke/stiffness tangential %s%s limitForce on", tang, roll);
 	bed_cmd(b, "pair_coeff * *");
 	if (!b->stl[0]) {
-		bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
-			   "primitive type 1 zplane 0.0 limitForce on", roll);
+		bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential %s%s "
+			   "primitive type 1 zplane 0.0 limitForce on", tang, roll);
 		return;
 	}
 	bed_cmd(b, "fix cad all mesh/surface file %s type 1", b->stl);
-	bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential history%s "
-		   "mesh n_meshes 1 meshes cad limitForce on", roll);
+	bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential %s%s "
+		   "mesh n_meshes 1 meshes cad limitForce on", tang, roll);
 }
 
 /* The frame check's floor: a rectangle at z = 0, 2 mm inside the cell's
@@ -256,12 +269,21 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	}
 	bed_cmd(b, "atom_style granular");
 	bed_cmd(b, "atom_modify map array");
+	/* the moving floor's closed cell: LIGGGHTS's atom sorting finds a bin
+	 * size of 0 there with an overdamped contact and stops; one grain
+	 * needs no sorting */
+	if (s->wiggle_period > 0)
+		bed_cmd(b, "atom_modify sort 0 0.0");
 	if (s->wiggle_period > 0 && bed_floor_mesh(b)) {
 		snprintf(msg, msglen, "dem bed: the floor mesh's file could not be written");
 		dem_bed_free(b);
 		return NULL;
 	}
 	bed_cmd(b, "boundary %s", s->wiggle_period > 0 ? "f f f" : "p p f");
+	/* ranks split the cell along the deck and across, never in height:
+	 * the box is four times the bed's height, and a split there left the
+	 * upper rank empty (two ranks cost what one did) */
+	bed_cmd(b, "processors * * 1");
 	bed_cmd(b, "newton off");
 	bed_cmd(b, "communicate single vel yes");
 	bed_cmd(b, "units si");
@@ -295,6 +317,9 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 		bed_cmd(b, "fix move all move/mesh mesh cad wiggle amplitude %.17g 0 %.17g period %.17g",
 			s->wiggle_x, s->wiggle_z, s->wiggle_period);
 	}
+	bed_cmd(b, "variable now equal time");
+	b->t_zero = bed_var(b, "now");
+	bed_cmd(b, "variable t equal time-%.17g", b->t_zero);
 	b->t = 0;
 	return b;
 }
@@ -327,10 +352,50 @@ int dem_bed_advance(dem_bed *b, double ax, double ay, double interval, char *msg
 	double gmag = hypot(gx, gz);
 	bed_cmd(b, "timestep %.17g", interval / (double)n);
 	bed_cmd(b, "unfix deck");
+	b->drive = 0;
 	if (gmag > 0)
 		bed_cmd(b, "fix deck all gravity %.17g vector %.17g 0 %.17g", gmag, gx, gz);
 	else
 		bed_cmd(b, "fix deck all gravity 0 vector 0 0 -1");
+	bed_cmd(b, "run %ld post no", n);
+	b->t += interval;
+	return 0;
+}
+
+/* A formula for LIGGGHTS: numbers, v_t, + - * / ( ) . e and the names
+ * of its math functions only, so that LIGGGHTS never sees a command it
+ * refuses from here. */
+static int bed_formula_ok(const char *f)
+{
+	size_t n = f ? strlen(f) : 0;
+	if (n == 0 || n > 1500)
+		return 0;
+	for (const char *c = f; *c; c++)
+		if (!strchr("0123456789.+-*/()_ eEvtcosinqrxp", *c))
+			return 0;
+	return 1;
+}
+
+int dem_bed_advance_drive(dem_bed *b, const char *ax, const char *ay, double interval, char *msg,
+			  size_t msglen)
+{
+	if (!bed_formula_ok(ax) || !bed_formula_ok(ay) || !(interval > 0) || !isfinite(interval)) {
+		snprintf(msg, msglen, "dem bed: the deck's acceleration must be a formula of v_t "
+				      "(numbers, + - * / ( ), sin, cos, exp, sqrt) and the interval > 0");
+		return -1;
+	}
+	long n = (long)ceil(interval / b->dt * (1 - 1e-12));
+	bed_cmd(b, "timestep %.17g", interval / (double)n);
+	bed_cmd(b, "variable ax equal %s", ax);
+	bed_cmd(b, "variable ay equal %s", ay);
+	if (!b->drive) {
+		/* per grain: its mass times g_eff = (-a_x, 0, -g - a_y) */
+		bed_cmd(b, "variable fx atom -mass*v_ax");
+		bed_cmd(b, "variable fz atom -mass*(%.17g+v_ay)", b->spec.g);
+		bed_cmd(b, "unfix deck");
+		bed_cmd(b, "fix deck all addforce v_fx 0.0 v_fz");
+		b->drive = 1;
+	}
 	bed_cmd(b, "run %ld post no", n);
 	b->t += interval;
 	return 0;

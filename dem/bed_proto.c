@@ -41,23 +41,25 @@ static int proto_fits(int n, size_t len)
 
 int dem_proto_bed_line(char *buf, size_t len, const dem_bed_spec *s)
 {
-	return proto_fits(snprintf(buf, len, "bed %d %a %a %a %a %a %a %a %a %a %d %u %a %a\n",
+	return proto_fits(snprintf(buf, len, "bed %d %a %a %a %a %a %a %a %a %a %d %u %a %a %d\n",
 				   s->grains, s->d_min, s->d_max, s->density, s->cell_x, s->cell_y,
 				   s->k_over_m, s->restitution, s->mu, s->mu_roll,
-				   s->freeze_rotation, s->seed, s->g, s->settle),
+				   s->freeze_rotation, s->seed, s->g, s->settle,
+				   s->tangential_viscous),
 			  len);
 }
 
 int dem_proto_bed_parse(const char *args, dem_bed_spec *s)
 {
-	double grains, freeze, seed;
-	if (proto_numbers(args, 14, &grains, &s->d_min, &s->d_max, &s->density, &s->cell_x,
+	double grains, freeze, seed, viscous;
+	if (proto_numbers(args, 15, &grains, &s->d_min, &s->d_max, &s->density, &s->cell_x,
 			  &s->cell_y, &s->k_over_m, &s->restitution, &s->mu, &s->mu_roll, &freeze,
-			  &seed, &s->g, &s->settle) ||
+			  &seed, &s->g, &s->settle, &viscous) ||
 	    grains < 1 || grains > 1e7 || seed < 0 || seed > 4294967295.0)
 		return -1;
 	s->grains = (int)grains;
 	s->freeze_rotation = freeze != 0;
+	s->tangential_viscous = viscous != 0;
 	s->seed = (unsigned)seed;
 	s->wiggle_x = s->wiggle_z = s->wiggle_period = 0;
 	return 0;

@@ -12,7 +12,8 @@
  * translating deck (docs/dem.md "Frame"). The deck's motion is held
  * constant over each coupling interval (its mean acceleration there), so
  * that the grains' velocities relative to the deck are exact at the
- * interval's ends.
+ * interval's ends; or, for a deck known ahead, given as a formula of time
+ * evaluated at every DEM step (dem_bed_advance_drive).
  *
  * Units SI. Positions and momenta are the bed's totals, in the deck frame.
  */
@@ -27,7 +28,9 @@
  * hooke/stiffness) with the stiffness of k_over_m times the mean grain's
  * mass, a viscous normal damper calibrated so that a grain dropped on the
  * floor rebounds with `restitution` (dem_restitution_damping), Coulomb
- * friction mu with a tangential spring (2/7 of the normal one), and
+ * friction mu with a tangential spring (2/7 of the normal one; or, with
+ * tangential_viscous, no spring but a viscous tangential force of the
+ * normal damper's rate, capped by Coulomb: LIGGGHTS's no_history), and
  * rolling friction mu_roll (model cdt; 0: none). */
 typedef struct dem_bed_spec {
 	int grains;            /* number of spheres, >= 1 */
@@ -39,6 +42,7 @@ typedef struct dem_bed_spec {
 	double mu;             /* Coulomb friction, grain-grain and grain-floor */
 	double mu_roll;        /* rolling friction (cdt), 0 for none */
 	int freeze_rotation;   /* 1: grains do not rotate (fix nve, not nve/sphere) */
+	int tangential_viscous; /* 1: no tangential spring (tangential no_history) */
 	unsigned seed;         /* packing: diameters and the lattice's jitter */
 	double g;              /* m/s^2 gravity */
 	double settle;         /* s of settling under gravity before t = 0 */
@@ -81,6 +85,16 @@ double dem_bed_dt(const dem_bed *b);
  * LIGGGHTS fails. */
 int dem_bed_advance(dem_bed *b, double ax, double ay, double interval, char *msg, size_t msglen);
 
+/* Advance the bed by `interval` s (a whole number of DEM steps of at most
+ * dem_bed_dt each) with the deck's acceleration given as two formulas in
+ * LIGGGHTS's syntax of `v_t`, the bed's time (s since its t = 0): ax, ay
+ * (m/s^2, horizontal and vertical; numbers, + - * / ( ), sin, cos, exp,
+ * sqrt), evaluated at every DEM step: no staircase, for a deck whose
+ * motion is known ahead (motion.h). 0, or -1 with msg for a formula
+ * outside that syntax. */
+int dem_bed_advance_drive(dem_bed *b, const char *ax, const char *ay, double interval, char *msg,
+			  size_t msglen);
+
 /* The bed now, in the deck's frame. */
 typedef struct dem_bed_state {
 	double t;            /* s since t = 0 (the end of the settling) */
@@ -99,7 +113,8 @@ double dem_cpu_now(void);
 
 /* The viscous damping ratio of a linear contact (spring stiffness k,
  * mass m, force never attractive) that gives restitution e; found by
- * bisection on the integrated collision. In (0, 1]. */
+ * bisection on the integrated collision. >= 0, above 1 (overdamped) for
+ * e < 0.135: 1.95 for e = 0.05. */
 double dem_restitution_damping(double e);
 /* The restitution of a linear contact with damping ratio zeta (the
  * collision integrated, force never attractive). */

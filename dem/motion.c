@@ -168,14 +168,32 @@ void dem_motion_velocity(const dem_motion *mo, double t, double vel[2])
 	}
 }
 
+/* The fit's acceleration along one axis (c: a or b) as a LIGGGHTS formula
+ * of v_t: -sum (h w)^2 (c[2h-1] cos(h w t) + c[2h] sin(h w t)). */
+static void motion_formula(const dem_motion *mo, const double *c, char *f, size_t len)
+{
+	size_t used = (size_t)snprintf(f, len, "0");
+	for (int h = 1; h <= mo->harmonics && used < len; h++) {
+		double w = h * mo->omega;
+		used += (size_t)snprintf(f + used, len - used, "-(%.17g*cos(%.17g*v_t)+%.17g*sin(%.17g*v_t))",
+					 w * w * c[2 * h - 1], w, w * w * c[2 * h], w);
+	}
+}
+
 int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double transient,
 		       int intervals, dem_prescribed *out, char *msg, size_t msglen)
 {
-	if (intervals < 1 || !(mo->omega > 0) || !(t_end > transient) || !(transient >= 0)) {
-		snprintf(msg, msglen, "prescribed run: intervals >= 1 and 0 <= transient < t_end");
+	if (intervals < 0 || !(mo->omega > 0) || !(t_end > transient) || !(transient >= 0)) {
+		snprintf(msg, msglen, "prescribed run: intervals >= 0 and 0 <= transient < t_end");
 		return -1;
 	}
-	double period = 2 * M_PI / mo->omega, dt = period / intervals;
+	/* intervals 0: the fit's acceleration at every DEM step, a period a run */
+	char fx[1400], fy[1400];
+	if (intervals == 0) {
+		motion_formula(mo, mo->a, fx, sizeof fx);
+		motion_formula(mo, mo->b, fy, sizeof fy);
+	}
+	double period = 2 * M_PI / mo->omega, dt = period / (intervals ? intervals : 1);
 	long first = (long)ceil(transient / period - 1e-9), last = (long)floor(t_end / period + 1e-9);
 	if (last <= first) {
 		snprintf(msg, msglen, "prescribed run: no whole period between the transient and the end");
@@ -186,17 +204,19 @@ int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double tr
 	dem_bed_get(b, &st);
 	out->mass = st.mass;
 	out->bed_height = 2 * st.z_mean;
-	for (long k = 0; k <= last * intervals; k++) {
-		if (k % intervals == 0 && (k / intervals == first || k / intervals == last)) {
+	int per = intervals ? intervals : 1; /* runs a period */
+	for (long k = 0; k <= last * per; k++) {
+		if (k % per == 0 && (k / per == first || k / per == last)) {
 			dem_bed_get(b, &st);
-			*(k / intervals == first ? &x_first : &x_last) = st.x_mean;
+			*(k / per == first ? &x_first : &x_last) = st.x_mean;
 		}
-		if (k == last * intervals)
+		if (k == last * per)
 			break;
 		double v0[2], v1[2];
 		dem_motion_velocity(mo, k * dt, v0);
 		dem_motion_velocity(mo, (k + 1) * dt, v1);
-		if (dem_bed_advance(b, (v1[0] - v0[0]) / dt, (v1[1] - v0[1]) / dt, dt, msg, msglen))
+		if (intervals ? dem_bed_advance(b, (v1[0] - v0[0]) / dt, (v1[1] - v0[1]) / dt, dt, msg, msglen)
+			      : dem_bed_advance_drive(b, fx, fy, dt, msg, msglen))
 			return -1;
 	}
 	out->periods = (double)(last - first);

@@ -54,7 +54,9 @@ typedef struct dem_prescribed {
 
 /* Drive bed b with motion mo from its t = 0 to t_end, in coupling
  * intervals of 1/intervals of a period, each under the mean acceleration
- * of the deck over it (the velocity's change over the interval); the
+ * of the deck over it (the velocity's change over the interval), or with
+ * intervals 0 under the fit's own acceleration evaluated at every DEM
+ * step (dem_bed_advance_drive, a period a run: no staircase); the
  * transport velocity is measured over the whole periods after transient
  * (s). 0, or -1 with msg. */
 int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double transient,

@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The plot of `make bench-dem`: v from LIGGGHTS against v from the column
 model, one mark per scene of tests/bench/results/dem.jsonl (seeds pooled,
-bars: their standard deviation), the diagonal and the 10 % and 30 % bands.
+bars: their standard deviation; the ladder's rungs in one colour), the
+diagonal and the 10 % and 30 % bands.
 Writes SVG to stdout. Usage: dem_plot.py FILE.jsonl COMMAND DATE."""
 import json
 import statistics
@@ -10,8 +11,8 @@ import sys
 
 W, H, M = 560, 560, 60
 LO, HI = -0.2, 0.2
-COLOURS = {"curve": "#1f77b4", "depth": "#d62728", "stiffness": "#2ca02c", "rolling": "#9467bd",
-           "restitution": "#8c564b"}
+COLOURS = {"curve": "#1f77b4", "ladder": "#17becf", "depth": "#d62728", "stiffness": "#2ca02c",
+           "rolling": "#9467bd", "restitution": "#8c564b", "tangential": "#ff7f0e"}
 
 
 def sx(v):
@@ -29,7 +30,7 @@ def main():
         if line.strip():
             r = json.loads(line)
             key = (r["group"], r["beta"], r["rotation"], r["layers"], r["k_over_m"], r["mu_roll"],
-                   r["restitution_floor"])
+                   r["restitution_floor"], r.get("tangential", "spring"))
             scenes.setdefault(key, []).append(r)
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H + 40}" font-family="sans-serif" font-size="12">',
            f'<rect width="{W}" height="{H + 40}" fill="white"/>',
@@ -54,7 +55,7 @@ def main():
         if sd > 0:
             out.append(f'<line x1="{sx(col)}" y1="{sy(mean - sd)}" x2="{sx(col)}" y2="{sy(mean + sd)}" stroke="{c}"/>')
         out.append(f'<circle cx="{sx(col)}" cy="{sy(mean)}" r="4" fill="{c}"><title>{key[0]} beta {key[1]:.0f} {key[2]} '
-                   f'{key[3]} d: DEM {mean:+.4f}, column {col:+.4f}</title></circle>')
+                   f'{key[3]} d k/m {key[4]:.0e}: DEM {mean:+.4f}, column {col:+.4f}</title></circle>')
     y = M + 14
     for g, c in COLOURS.items():
         out.append(f'<circle cx="{M + 12}" cy="{y - 4}" r="4" fill="{c}"/><text x="{M + 22}" y="{y}">{g}</text>')

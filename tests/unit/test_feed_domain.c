@@ -2,9 +2,10 @@
 /*
  * test_feed_domain.c - sim_feed_validated: the column model's domain as
  * checked against LIGGGHTS beds (docs/dem.md): inside at 1-2 layers, at
- * up to 8 with stiff contacts and for the preset fitted to a 4-diameter
- * bed; outside beyond, with a reason that names the layers and the way
- * out; no answer without a column feed.
+ * up to 8 with stiff contacts away from the DEM bed's second peak, and for
+ * the preset fitted to a 4-diameter bed; outside beyond, with a reason
+ * that names the layers, the angle and the way out; no answer without a
+ * column feed.
  */
 #include "testutil.h"
 
@@ -31,8 +32,20 @@ static void domain_by_depth_and_stiffness(void **state)
 	assert_int_equal(validated(&u, NULL, 0), 1);
 	set(&u, "layers", "9");
 	assert_int_equal(validated(&u, NULL, 0), 0);
-	set(&u, "k_c", "9.9e6");
+	/* stiff contacts, but the DEM bed's second peak (150 cw, 30 ccw) */
+	static const struct { const char *rotation, *beta; int inside; } angles[] = {
+		{"cw", "150", 0}, {"cw", "137", 1}, {"ccw", "30", 0}, {"ccw", "60", 1}, {"cw", "38", 1}};
 	set(&u, "layers", "8");
+	for (size_t i = 0; i < sizeof angles / sizeof angles[0]; i++) {
+		set(&u, "rotation", angles[i].rotation);
+		set(&u, "beta", angles[i].beta);
+		assert_int_equal(validated(&u, why, sizeof why), angles[i].inside);
+	}
+	set(&u, "beta", "150");
+	assert_int_equal(validated(&u, why, sizeof why), 0);
+	assert_non_null(strstr(why, "beta 150 deg cw"));
+	set(&u, "beta", "38");
+	set(&u, "k_c", "9.9e6");
 	assert_int_equal(validated(&u, NULL, 0), 0);
 	/* the preset fitted to a 4-diameter bed */
 	setup f;
