@@ -52,10 +52,12 @@ dem_feed *dem_feed_local(const dem_bed_spec *spec, const void *comm, char *msg, 
  * nice_value`, or with ranks > 1 `mpirun -n ranks bed_path ...` (LIGGGHTS
  * splits the bed over the ranks) (no LIGGGHTS here: feed_remote.c). The
  * child leads a process group of its own, which a kill ends whole. Waits
- * for the bed to settle. NULL with msg on error (the program missing, the
- * child refusing or ending). */
+ * for the bed to settle. An answer (the settled bed, an interval's state)
+ * that takes longer than timeout s (0: no limit) ends the child as hung
+ * and fails the request. NULL with msg on error (the program missing, the
+ * child refusing, ending or hanging). */
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, char *msg, size_t msglen);
+			  int ranks, double timeout, char *msg, size_t msglen);
 /* The child's process id (remote; 0 for local, NULL, or once it ended
  * and was reaped). */
 long dem_feed_pid(const dem_feed *f);

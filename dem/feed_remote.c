@@ -17,6 +17,8 @@
 #define _GNU_SOURCE /* pipe2, posix_spawn_file_actions_addclosefrom_np (glibc 2.34) */
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
@@ -39,6 +41,7 @@ typedef struct remote {
 	pid_t pid;     /* 0 once reaped */
 	int ranks;     /* > 1: pid is mpirun's */
 	int to, from;  /* our ends: its stdin, its stdout */
+	double timeout; /* s an answer may take; 0: no limit */
 	char in[DEM_PROTO_LINE];
 	size_t have;   /* bytes of in read but not yet taken */
 } remote;
@@ -85,10 +88,34 @@ static int remote_send(remote *r, const char *line, size_t n)
 	return 0;
 }
 
-/* Read one answer line into line (newline dropped): 0, or -1 at the end
- * of the answers or a line too long. */
+/* Wait until the answer has bytes to read: 0, or -1 when r->timeout s
+ * pass without any (the deadline counts from the request). */
+static int remote_await(remote *r, const struct timespec *t0)
+{
+	if (!(r->timeout > 0))
+		return 0;
+	for (;;) {
+		struct timespec now;
+		clock_gettime(CLOCK_MONOTONIC, &now);
+		double left = r->timeout - ((double)(now.tv_sec - t0->tv_sec) +
+					    1e-9 * (double)(now.tv_nsec - t0->tv_nsec));
+		if (left <= 0)
+			return -1;
+		struct pollfd p = {.fd = r->from, .events = POLLIN};
+		int n = poll(&p, 1, left > 1e6 ? 1000000000 : (int)ceil(left * 1e3));
+		if (n > 0)
+			return 0;
+		if (n < 0 && errno != EINTR)
+			return 0; /* the read says what is wrong */
+	}
+}
+
+/* Read one answer line into line (newline dropped): 0, -1 at the end of
+ * the answers or a line too long, -2 when no answer came in time. */
 static int remote_receive(remote *r, char *line, size_t len)
 {
+	struct timespec t0;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
 	for (;;) {
 		char *nl = memchr(r->in, '\n', r->have);
 		if (nl) {
@@ -103,6 +130,8 @@ static int remote_receive(remote *r, char *line, size_t len)
 		}
 		if (r->have == sizeof r->in)
 			return -1;
+		if (remote_await(r, &t0))
+			return -2;
 		ssize_t got = read(r->from, r->in + r->have, sizeof r->in - r->have);
 		if (got < 0 && errno == EINTR)
 			continue;
@@ -120,9 +149,14 @@ static int remote_exchange(remote *r, const char *req, int n, char *msg, size_t 
 		snprintf(msg, msglen, "the bed process has ended");
 		return -1;
 	}
-	if (n < 0 || remote_send(r, req, (size_t)n) || remote_receive(r, line, sizeof line)) {
-		dem_feed_kill(&r->base); /* gone, or talking nonsense: make sure */
+	int rc = n < 0 || remote_send(r, req, (size_t)n) ? -1 : remote_receive(r, line, sizeof line);
+	if (rc) {
+		long pid = (long)r->pid;
+		dem_feed_kill(&r->base); /* gone, hung or talking nonsense: make sure */
 		remote_reap(r, msg, msglen);
+		if (rc == -2)
+			snprintf(msg, msglen, "the bed process (pid %ld) gave no answer within %g s "
+					      "(--dem-timeout) and was ended", pid, r->timeout);
 		return -1;
 	}
 	if (!strncmp(line, "error ", 6)) {
@@ -268,7 +302,7 @@ fail:
 }
 
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, char *msg, size_t msglen)
+			  int ranks, double timeout, char *msg, size_t msglen)
 {
 	char req[DEM_PROTO_LINE];
 	if (spec->wiggle_period > 0) {
@@ -284,6 +318,7 @@ dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int ni
 	r->base.ops = &remote_ops;
 	r->to = r->from = -1;
 	r->ranks = ranks;
+	r->timeout = timeout > 0 && isfinite(timeout) ? timeout : 0;
 	pthread_mutex_init(&r->lock, NULL);
 	if (remote_spawn(r, bed_path, nice_value, ranks, msg, msglen) ||
 	    remote_exchange(r, req, dem_proto_bed_line(req, sizeof req, spec), msg, msglen)) {

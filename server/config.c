@@ -47,6 +47,7 @@ static const srv_config defaults = {
 	.dem_bed = NULL,
 	.max_dem_sessions = 1,
 	.dem_ranks = 1,
+	.dem_timeout = 300.0,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
@@ -97,6 +98,7 @@ static const opt opts[] = {
 	{"dem-bed", OPT_STRING, 0, 0, F(dem_bed)},
 	{"max-dem-sessions", OPT_INT, 0, 1024, F(max_dem_sessions)},
 	{"dem-ranks", OPT_INT, 1, 256, F(dem_ranks)},
+	{"dem-timeout", OPT_SECONDS, 100, 86400000, F(dem_timeout)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -194,12 +196,15 @@ static void usage(FILE *f, const srv_config *cfg)
 		"                       holding a whole core (default %d; 0: "
 		"none)\n"
 		"  --dem-ranks N        run each bed under mpirun -n N, holding N "
-		"cores (default %d)\n",
+		"cores (default %d)\n"
+		"  --dem-timeout S      fail a session whose bed process gives no "
+		"answer for S seconds\n"
+		"                       (a hung bed; default %g)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
 		cfg->connection_timeout, cfg->max_queued_points, cfg->cpu_probe,
-		cfg->max_dem_sessions, cfg->dem_ranks);
+		cfg->max_dem_sessions, cfg->dem_ranks, cfg->dem_timeout);
 }
 
 /* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */

@@ -61,6 +61,8 @@ typedef struct srv_config {
 	int max_dem_sessions;  /* LIGGGHTS sessions at once */
 	int dem_ranks;         /* --dem-ranks: a bed process's MPI ranks (under
 				  mpirun when > 1), the cores it holds */
+	double dem_timeout;    /* --dem-timeout: s a bed process may take to
+				  answer before its session fails */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

@@ -105,8 +105,8 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	const api_spec *sp = &s->spec;
 	dem_bed_spec bed;
 	dem_bed_spec_default(&sp->params, (double)sp->scene.layers, &bed);
-	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks, msg,
-				      msglen);
+	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks,
+				      cfg->dem_timeout, msg, msglen);
 	if (!f)
 		return -1;
 	s->dem = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,

@@ -12,6 +12,8 @@
 //  - a second one beyond --max-dem-sessions: 429 naming scene.feed_model;
 //  - the bed process killed with SIGKILL: the session fails with the signal
 //    named and the daemon answers; DELETE leaves no process and no zombie;
+//  - a bed process that stops answering (SIGSTOP): after --dem-timeout the
+//    session fails naming it, and the process is ended and reaped;
 //  - a restart restores the machine and settles the bed anew.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -131,6 +133,28 @@ test('the bed process killed: the session fails with the signal named, the daemo
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r2.body.id}`)).status, 204);
   assert.equal(procState(pid2), null, 'no process, no zombie');
   assert.deepEqual(children(d.proc.pid), []);
+});
+
+test('a bed process that hangs: after --dem-timeout the session fails naming the timeout, the process is ended and reaped', { timeout: 120000 * SLOW }, async () => {
+  const wait = 2 * SLOW;
+  const d2 = await startDaemon(['--worker-nice', '15', '--dem-timeout', String(wait)]);
+  try {
+    const r = await req(d2.base, 'POST', '/api/v1/sessions', { ...BED, pace: 1 });
+    assert.equal(r.status, 201, JSON.stringify(r.body));
+    const id = r.body.id, pid = r.body.bed.pid;
+    const get2 = async () => (await req(d2.base, 'GET', `/api/v1/sessions/${id}`)).body;
+    await until(async () => (await get2()).status.t > 0.01, 30000 * SLOW, 't advances');
+    process.kill(pid, 'SIGSTOP'); // alive, but never answers again
+    const s = await until(async () => { const g = await get2(); return g.state === 'failed' && g; }, 30000 * SLOW, 'failed');
+    assert.match(s.error, new RegExp(`the bed process \\(pid ${pid}\\) gave no answer within ${wait} s \\(--dem-timeout\\) and was ended`));
+    assert.equal(s.bed.pid, 0, 'reaped');
+    assert.equal(procState(pid), null, 'no zombie');
+    assert.equal((await req(d2.base, 'GET', '/api/v1/health')).status, 200);
+    assert.equal((await req(d2.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
+    assert.deepEqual(children(d2.proc.pid), []);
+  } finally {
+    await d2.stop();
+  }
 });
 
 test('a restart restores the machine from its checkpoint and settles the bed anew', { timeout: 120000 * SLOW }, async () => {
