@@ -4,9 +4,10 @@
 
 Table 1: the preset's curve on the 4-diameter bed and its stiffness ladder,
 one row per angle and sense: the DEM's v at each rung (seeds pooled: mean
-and sample standard deviation), the change between the last two rungs on
-seed 1, and the column model's relative error at the first and the last
-rung. Table 2: every other scene (depth, rolling friction, ...), one row
+and sample standard deviation), the change between each two neighbouring
+rungs of the ladder on seed 1, the column model's v at the curve's rung and
+at every ladder rung but the first, and its relative error at every rung; a
+rung absent from the rows (the ladder-top part not run) drops its columns. Table 2: every other scene (depth, rolling friction, ...), one row
 each, seeds pooled. Then the scenes where the column model is within 5, 10
 and 30 %. Usage: dem_report.py FILE.jsonl COMMAND DATE SECONDS [NOTE];
 dem_report.py --bed4-csv FILE.jsonl writes the curve's points for the fit."""
@@ -86,8 +87,10 @@ def main():
         kom0 = next(k[4] for k in scenes if k[0] == "curve")
         allr = [kom0] + rungs
         head = [f"v DEM {x:.0e}" for x in allr]
-        tail = [f"{rungs[-2]:.0e} → {rungs[-1]:.0e} (seed 1)"] if len(rungs) >= 2 else []
-        cols = [f"v column {kom0:.0e}"] + ([f"v column {rungs[-1]:.0e}"] if rungs else [])
+        steps = list(zip(rungs, rungs[1:]))
+        tail = [f"{a:.0e} → {b:.0e} (seed 1)" for a, b in steps]
+        at = [kom0] + (rungs[1:] if len(rungs) >= 2 else rungs)
+        cols = [f"v column {x:.0e}" for x in at]
         diffs = [f"column − DEM {x:.0e}" for x in allr]
         out.append("| β (°) | sense | " + " | ".join(head + tail + cols + diffs) + " |")
         out.append("|" + "---|" * (2 + len(head) + len(tail) + len(cols) + len(diffs)))
@@ -97,12 +100,10 @@ def main():
             cells = [fmt(*pooled(by[x])) if x in by else "" for x in allr]
             for x in allr:
                 seeds_at[x] = max(seeds_at[x], len(by.get(x, [])))
-            if tail:
-                s1 = [next((r["v_dem"] for r in by.get(x, []) if r["seed"] == 1), float("nan"))
-                      for x in rungs[-2:]]
-                cells.append(f"{100 * (s1[1] - s1[0]) / abs(s1[0]):+.1f} %")
-            cells += [f"{by[x][0]['v_column']:+.4f}" if x in by else "" for x in allr if
-                      x == kom0 or x == allr[-1]][:len(cols)]
+            for a, b in steps:
+                s1 = [next((r["v_dem"] for r in by.get(x, []) if r["seed"] == 1), None) for x in (a, b)]
+                cells.append(f"{100 * (s1[1] - s1[0]) / abs(s1[0]):+.1f} %" if None not in s1 else "")
+            cells += [f"{by[x][0]['v_column']:+.4f}" if x in by else "" for x in at]
             for x in allr:
                 if x not in by:
                     cells.append("")
