@@ -100,7 +100,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -302,6 +302,14 @@ bench-dem: all $(BUILD)/.deps-dem
 	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem_cost.sh
+
+# The DEM reference map (tests/bench/dem_map.sh, docs/dem.md "The map"):
+# named materials, depths 1-16 grains, beta every 15 deg, two drives, three
+# seeds a point, from one build; many CPU hours, resumable, in parts
+# (DEM_MAP_PARTS="glass-shallow glass-checks"), into
+# tests/bench/results/dem_map.csv and dem_map.md.
+bench-dem-map: $(BUILD)/.deps-dem
+	$(Q)bash tests/bench/dem_map.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.

@@ -35,6 +35,8 @@ typedef struct dem_opts {
 	int grains, seed, freeze_rotation, tangential_viscous, intervals, harmonics, column;
 	int motion_machine, coupling_steps; /* --motion machine: the one-way machine's own deck */
 	double frame_amp, frame_angle;      /* --frame-check: m, deg; amplitude 0: none */
+	double youngs, poisson, density;    /* --hertz E:NU (youngs 0: none), --density */
+	double pair[3], wall[3];            /* --pair, --wall: restitution, mu, rolling mu */
 } dem_opts;
 
 static const struct option dem_long[] = {
@@ -50,6 +52,8 @@ static const struct option dem_long[] = {
 	{"settle", required_argument, 0, 'w'},     {"no-column", no_argument, 0, 'C'},
 	{"motion", required_argument, 0, 'M'},     {"coupling-steps", required_argument, 0, 'c'},
 	{"frame-check", required_argument, 0, 'F'}, {"tangential", required_argument, 0, 'T'},
+	{"hertz", required_argument, 0, 'Z'},      {"pair", required_argument, 0, 'P'},
+	{"wall", required_argument, 0, 'W'},       {"density", required_argument, 0, 'R'},
 	{"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
 
 static const char dem_usage[] =
@@ -84,7 +88,14 @@ static const char dem_usage[] =
 	"      --coupling-steps N   machine steps a coupling interval (1)\n"
 	"      --frame-check A:DEG  one grain on a floor moving A sin(omega_ss t) along DEG, as a\n"
 	"                           body force over the fixed floor and as LIGGGHTS's moving mesh\n"
-	"                           (v_body, v_mesh); no machine, no column model\n";
+	"                           (v_body, v_mesh); no machine, no column model\n"
+	"      --hertz E:NU         a named material's contacts (docs/dem.md \"The map\"): Hertz-\n"
+	"                           Mindlin with Young's modulus E (Pa, scaled; [5e6, 1e9]) and\n"
+	"                           Poisson's ratio NU, grains and deck alike; then --pair and\n"
+	"                           --wall give restitution, friction and rolling friction\n"
+	"      --pair E:MU:MUR      grain on grain (0.9:0.3:0)\n"
+	"      --wall E:MU:MUR      grain on deck (0.9:0.3:0)\n"
+	"      --density RHO        grains' density (2500 kg/m^3)\n";
 
 /* A number in [lo, hi] or exit 2 with the option's name and range. */
 static double dem_number(const char *opt, const char *text, double lo, double hi)
@@ -122,7 +133,8 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	o->duration = 2, o->transient = 0.5, o->depth = 8, o->stiffness = 1, o->seed = 1;
 	o->d_min = 0.0036, o->d_max = 0.0044, o->cell_x = 20, o->cell_y = 4, o->settle = NAN;
 	o->restitution = NAN, o->mu = NAN, o->intervals = 0, o->harmonics = 3, o->column = 1;
-	o->coupling_steps = 1;
+	o->coupling_steps = 1, o->density = 2500;
+	o->pair[0] = o->wall[0] = 0.9, o->pair[1] = o->wall[1] = 0.3;
 	while ((c = getopt_long(argc, argv, "p:s:d:t:n:D:S:k:e:u:r:fi:H:w:h", dem_long, NULL)) != -1) {
 		char msg[200], name[64];
 		const char *eq;
@@ -170,6 +182,26 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 				exit(2);
 			}
 			break;
+		case 'Z':
+			if (sscanf(optarg, "%lf:%lf", &o->youngs, &o->poisson) != 2 || !(o->youngs >= 5e6) ||
+			    !(o->youngs <= 1e9) || !(o->poisson > 0) || !(o->poisson < 0.5)) {
+				fprintf(stderr, "convsim-dem: --hertz must be E:NU with E in [5e6, 1e9] Pa "
+						"and NU in (0, 0.5), got '%s'\n", optarg);
+				exit(2);
+			}
+			break;
+		case 'P':
+		case 'W': {
+			double *t = c == 'P' ? o->pair : o->wall;
+			if (sscanf(optarg, "%lf:%lf:%lf", &t[0], &t[1], &t[2]) != 3 || !(t[0] > 0.05) ||
+			    !(t[0] <= 1) || !(t[1] >= 0) || !(t[1] <= 10) || !(t[2] >= 0) || !(t[2] <= 10)) {
+				fprintf(stderr, "convsim-dem: --%s must be E:MU:MUR with E in (0.05, 1], MU and "
+						"MUR in [0, 10], got '%s'\n", c == 'P' ? "pair" : "wall", optarg);
+				exit(2);
+			}
+			break;
+		}
+		case 'R': o->density = dem_number("density", optarg, 1, 100000); break;
 		case 'h': fputs(dem_usage, stdout); exit(0);
 		default: fputs(dem_usage, stderr); exit(2);
 		}
@@ -202,6 +234,14 @@ static void dem_spec(const dem_opts *o, dem_bed_spec *b)
 	b->tangential_viscous = o->tangential_viscous;
 	b->seed = (unsigned)o->seed;
 	b->settle = isnan(o->settle) ? (b->grains == 1 ? 0.05 : 0.3) : o->settle;
+	b->density = o->density;
+	if (o->youngs > 0) {
+		b->hertz = 1;
+		b->youngs = o->youngs;
+		b->poisson = o->poisson;
+		b->e_pp = o->pair[0], b->mu_pp = o->pair[1], b->roll_pp = o->pair[2];
+		b->e_pw = o->wall[0], b->mu_pw = o->wall[1], b->roll_pw = o->wall[2];
+	}
 }
 
 /* "  \"name\": value,\n", null where the value is not finite (JSON has no NaN). */
@@ -229,6 +269,7 @@ static int run_machine_motion(const dem_opts *o, dem_bed *bed, dem_prescribed *r
 	r->bed_height = 2 * st.z_mean;
 	r->dt = dem_bed_dt(bed);
 	r->periods = NAN;
+	r->v_first_half = r->v_second_half = r->overlap_pp = r->overlap_pw = NAN;
 	int rc = dem_replay(bed, acc, n, H, o->transient, &r->transport_velocity, msg, msglen);
 	free(acc);
 	return rc;
@@ -346,6 +387,23 @@ int main(int argc, char **argv)
 	put("v_column", col.transport_velocity, 0);
 	put("v_column_uncertainty", col.uncertainty, 0);
 	put("layers", o.sc.layers, 0);
+	printf("  \"contacts\": \"%s\",\n", spec.hertz ? "hertz" : "linear");
+	put("density", spec.density, 0);
+	put("youngs", spec.hertz ? spec.youngs : NAN, 0);
+	put("poisson", spec.hertz ? spec.poisson : NAN, 0);
+	put("e_pp", spec.hertz ? spec.e_pp : NAN, 0);
+	put("e_pw", spec.hertz ? spec.e_pw : NAN, 0);
+	put("mu_pp", spec.hertz ? spec.mu_pp : NAN, 0);
+	put("mu_pw", spec.hertz ? spec.mu_pw : NAN, 0);
+	put("roll_pp", spec.hertz ? spec.roll_pp : NAN, 0);
+	put("roll_pw", spec.hertz ? spec.roll_pw : NAN, 0);
+	put("d_mean", 0.5 * (spec.d_min + spec.d_max), 0);
+	put("cell_x", spec.cell_x, 0);
+	put("cell_y", spec.cell_y, 0);
+	put("v_first_half", r.v_first_half, 0);
+	put("v_second_half", r.v_second_half, 0);
+	put("overlap_pp_max", r.overlap_pp, 0);
+	put("overlap_pw_max", r.overlap_pw, 0);
 	put("dem_cpu_seconds", r.cpu_seconds, 1);
 	printf("}\n");
 	return 0;
