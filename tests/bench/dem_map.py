@@ -82,9 +82,15 @@ def plan():
             rows.append(point(name, "mirror", material, n, "preset", b, rotation="ccw", youngs=e_map))
         return (name, rows)
 
-    parts.append(sweep("glass-shallow", "glass", [1, 2, 4], "preset"))
-    parts.append(checks("glass-checks", "glass", [(1, 150), (2, 30), (2, 150), (4, 30), (4, 150)],
-                        [(2, 30), (2, 150)], [(2, 30), (2, 150), (4, 30)], [(2, 150), (2, 30)]))
+    # glass at the preset's drive first, one grain deep, then the checks
+    # that validate the map's stiffness and cell on it, before the deeper
+    # rows that cost more; a part may come in pieces (DEM_MAP_PARTS runs
+    # all of a part's pieces)
+    parts.append(sweep("glass-shallow", "glass", [1], "preset"))
+    parts.append(checks("glass-checks", "glass", [(1, 30), (1, 150)], [(1, 30)], [(1, 30)], [(1, 150)]))
+    parts.append(sweep("glass-shallow", "glass", [2, 4], "preset"))
+    parts.append(checks("glass-checks", "glass", [(2, 30), (2, 150), (4, 30), (4, 150)],
+                        [(2, 30)], [(2, 30), (4, 30)], [(2, 150)]))
     parts.append(sweep("glass-deep", "glass", [8, 16], "preset"))
     parts.append(checks("glass-deep-checks", "glass", [(8, 30), (16, 30)], [], [(8, 30), (16, 30)], []))
     parts.append(sweep("wheat-shallow", "wheat", [1, 2, 4], "preset"))
@@ -277,7 +283,10 @@ def main():
         wanted = set(sys.argv[2:])
         for name, points in plan():
             if not wanted or name in wanted:
-                print("%s: %d rows" % (name, len(points)))
+                print("%s: %d rows: %s" % (name, len(points), ", ".join(
+                    "%s %d %s %g%s" % (p["role"], p["layers"], p["drive"], p["beta"],
+                                       "" if p["rotation"] == "cw" else " ccw") for p in points[:6])
+                    + (" ..." if len(points) > 6 else "")))
         return
     if len(sys.argv) >= 4 and sys.argv[1] == "run":
         run(sys.argv[2], sys.argv[3], set(sys.argv[4:]))

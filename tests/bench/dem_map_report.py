@@ -1,0 +1,221 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The DEM map's report (tests/bench/results/dem_map.md) from its CSV.
+
+    dem_map_report.py [CSV]
+
+Prints Markdown: what of the planned map exists, the map's table (v and
+the seeds' spread), the convergence checks (stiffness, cell width, the
+mirror, the window's halves, the overlap), and the cost. Only reads.
+"""
+import csv
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import dem_map  # noqa: E402  (the plan and the CSV's key)
+
+TOL = 0.02    # the relative change a check allows
+OVERLAP = 0.01  # the largest overlap allowed, of a mean diameter
+
+
+def f(x):
+    return float(x)
+
+
+def rel(a, b):
+    """(a - b) / |b|, or None where b is 0."""
+    return (a - b) / abs(b) if b else None
+
+
+def pct(x):
+    return "n/a" if x is None else "%+.1f %%" % (100 * x)
+
+
+def main():
+    path = sys.argv[1] if len(sys.argv) > 1 else dem_map.CSV
+    rows = dem_map.read_rows(path)
+    mats = dem_map.materials()
+    plan = dem_map.plan()
+    by_key = {}
+    for r in rows:
+        by_key[dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
+                           r["e_scale"], r["cell_width_d"])] = r
+    out = []
+    w = out.append
+    builds = sorted({r["build"] for r in rows})
+    dates = sorted(r["date"] for r in rows)
+    w("# The DEM reference map")
+    w("")
+    w("`make bench-dem-map` (tests/bench/dem_map.sh; parts: `DEM_MAP_PARTS=\"...\"`), "
+      "report by tests/bench/dem_map_report.py on %s. Build: %s. Rows measured %s to %s, "
+      "one LIGGGHTS process at a time at nice 19 on a 2-core machine shared with other work. "
+      "Data: tests/bench/results/dem_map.csv (one row a point; the command of each row in its "
+      "`command` column)." % (time.strftime("%Y-%m-%d", time.gmtime()),
+                              ", ".join("`%s`" % b[:12] for b in builds) or "none yet",
+                              dates[0] if dates else "-", dates[-1] if dates else "-"))
+    w("")
+    # what exists
+    total = sum(len(p) for _, p in plan)
+    done_all = 0
+    w("## What exists")
+    w("")
+    w("| part | rows done | rows planned | CPU h so far |")
+    w("|---|---|---|---|")
+    map_planned = map_done = 0
+    names = []
+    for name, _ in plan:
+        if name not in names:
+            names.append(name)
+    for name in names:
+        points = [p for n, ps in plan if n == name for p in ps]
+        d = [by_key.get(dem_map.point_key(p, mats)) for p in points]
+        n = sum(1 for x in d if x)
+        done_all += n
+        cpu = sum(f(x["cpu_s"]) for x in d if x) / 3600
+        w("| %s | %d | %d | %.2f |" % (name, n, len(points), cpu))
+        for p, x in zip(points, d):
+            if p["role"] == "map":
+                map_planned += 1
+                map_done += 1 if x else 0
+    w("| all | %d | %d | %.2f |" % (done_all, total, sum(f(r["cpu_s"]) for r in rows) / 3600))
+    w("")
+    w("Map points done: %d of %d (%.0f %%); the checks' rows are the others. Each map point is "
+      "beta clockwise; the machine is mirror-symmetric (checked below), so counter-clockwise "
+      "at 180 - beta is the same speed the other way." %
+      (map_done, map_planned, 100.0 * map_done / map_planned if map_planned else 0))
+    w("")
+    # the map's tables
+    w("## The map: v (m/s), mean of 3 seeds ± their standard deviation")
+    w("")
+    maprows = [r for r in rows if r["role"] == "map"]
+    for mat in mats["materials"]:
+        for drive in dem_map.DRIVES:
+            sel = [r for r in maprows if r["material"] == mat and r["drive"] == drive]
+            if not sel:
+                continue
+            depths = sorted({int(r["layers"]) for r in sel})
+            w("### %s, drive `%s`" % (mat, drive))
+            w("")
+            w("| beta cw (deg) | " + " | ".join("%d grains deep" % d for d in depths) + " |")
+            w("|---|" + "---|" * len(depths))
+            for b in dem_map.BETAS:
+                cells = []
+                for d in depths:
+                    r = [x for x in sel if int(x["layers"]) == d and f(x["beta_deg"]) == b]
+                    cells.append("%+.4f ± %.4f" % (f(r[0]["v_dem"]), f(r[0]["v_dem_sd"])) if r else "")
+                w("| %d | %s |" % (b, " | ".join(cells)))
+            w("")
+    # checks
+    w("## Convergence checks")
+    w("")
+    w("Each check row is a map point run again with one thing changed, three seeds; the change "
+      "is (v_check - v_map) / |v_map|, the bound %.0f %%; \"seeds\" is the change in the "
+      "points' combined standard error." % (100 * TOL))
+    w("")
+    e_map = mats["map"]["youngs_map"]
+
+    def base_of(r):
+        m = mats["materials"][r["material"]]
+        return by_key.get(dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], "cw",
+                                      e_map / m["youngs_real"], dem_map.WIDTH))
+
+    for role, title, what in (("stiffness", "Stiffness", "youngs_pa"),
+                              ("cell", "Cell width across the deck", "cell_width_d")):
+        sel = [r for r in rows if r["role"] == role]
+        w("### %s" % title)
+        w("")
+        if not sel:
+            w("No rows yet.")
+            w("")
+            continue
+        w("| material | depth | beta | %s | v_map | v_check | change | seeds | overlap map / check (of d) | within %.0f %% |" %
+          ("E (Pa) map -> check" if role == "stiffness" else "width (d) map -> check", 100 * TOL))
+        w("|---|---|---|---|---|---|---|---|---|---|")
+        for r in sel:
+            b = base_of(r)
+            if not b:
+                w("| %s | %s | %s | -> %s | (map row not yet) | %+.4f | | | %s | |" %
+                  (r["material"], r["layers"], r["beta_deg"], r[what], f(r["v_dem"]), r["overlap_max_rel"]))
+                continue
+            c = rel(f(r["v_dem"]), f(b["v_dem"]))
+            se = ((f(r["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
+            z = abs(f(r["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
+            w("| %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %.1f | %s / %s | %s |" %
+              (r["material"], r["layers"], r["beta_deg"], b[what], r[what], f(b["v_dem"]),
+               f(r["v_dem"]), pct(c), z, b["overlap_max_rel"], r["overlap_max_rel"],
+               "yes" if c is not None and abs(c) < TOL else "no"))
+        w("")
+    sel = [r for r in rows if r["role"] == "mirror"]
+    w("### Mirror: counter-clockwise at beta against clockwise at 180 - beta")
+    w("")
+    if sel:
+        w("| material | depth | beta ccw | v ccw | v cw at 180 - beta | sum / mean |v| |")
+        w("|---|---|---|---|---|---|")
+        for r in sel:
+            m = mats["materials"][r["material"]]
+            b = by_key.get(dem_map.key(r["material"], r["layers"], r["drive"], 180 - f(r["beta_deg"]),
+                                       "cw", e_map / m["youngs_real"], dem_map.WIDTH))
+            if b:
+                s = f(r["v_dem"]) + f(b["v_dem"])
+                w("| %s | %s | %s | %+.4f | %+.4f | %s |" %
+                  (r["material"], r["layers"], r["beta_deg"], f(r["v_dem"]), f(b["v_dem"]),
+                   pct(s / (0.5 * (abs(f(r["v_dem"])) + abs(f(b["v_dem"])))))))
+        w("")
+    else:
+        w("No rows yet.")
+        w("")
+    w("### Steady window and overlap (every row)")
+    w("")
+    if rows:
+        steady = [r for r in rows if abs(f(r["v_second_half"]) - f(r["v_first_half"])) <=
+                  max(f(r["v_dem_sd"]), 1e-4)]
+        big = [r for r in rows if f(r["overlap_max_rel"]) > OVERLAP]
+        w("Window %s s after a 1-s transient (50 periods of the 25-Hz drive), split at its middle "
+          "period. Rows whose halves differ by no more than the seeds' standard deviation: %d of %d. "
+          "Largest overlap (grain on grain or into the deck, sampled 40 times a period over the "
+          "whole run after the settling) over all rows: %.2f %% of a mean diameter; rows above "
+          "%.0f %%: %d." % (rows[0]["window_s"], len(steady), len(rows),
+                            100 * max(f(r["overlap_max_rel"]) for r in rows), 100 * OVERLAP, len(big)))
+        w("")
+        drift = [r for r in rows if r not in steady]
+        if drift:
+            w("| material | depth | drive | beta | rotation | role | v first half | v second half | seeds' sd |")
+            w("|---|---|---|---|---|---|---|---|---|")
+            for r in drift:
+                w("| %s | %s | %s | %s | %s | %s | %+.4f | %+.4f | %.4f |" %
+                  (r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"], r["role"],
+                   f(r["v_first_half"]), f(r["v_second_half"]), f(r["v_dem_sd"])))
+            w("")
+        if big:
+            w("Rows above the overlap bound: " + ", ".join(
+                "%s %s grains %s deg %s (%s E %s: %.2f %%)" %
+                (r["material"], r["layers"], r["beta_deg"], r["rotation"], r["role"], r["youngs_pa"],
+                 100 * f(r["overlap_max_rel"])) for r in big) + ".")
+            w("")
+    # cost
+    w("## Cost")
+    w("")
+    if rows:
+        w("CPU seconds a row (three seeds, 3 s simulated each with the machine's run and the "
+          "settling), by material, depth and Young's modulus:")
+        w("")
+        w("| material | depth | grains | E (Pa) | rows | CPU s a row (median) |")
+        w("|---|---|---|---|---|---|")
+        groups = {}
+        for r in rows:
+            groups.setdefault((r["material"], int(r["layers"]), r["grains"], f(r["youngs_pa"])), []).append(f(r["cpu_s"]))
+        for (m, d, g, e), c in sorted(groups.items()):
+            w("| %s | %d | %s | %g | %d | %.0f |" % (m, d, g, e, len(c), statistics.median(c)))
+        w("")
+        w("Total so far: %.2f CPU hours for %d rows." % (sum(f(r["cpu_s"]) for r in rows) / 3600, len(rows)))
+    else:
+        w("No rows yet.")
+    w("")
+    print("\n".join(out))
+
+
+if __name__ == "__main__":
+    main()
