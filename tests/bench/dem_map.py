@@ -234,6 +234,34 @@ def row_of(p, mats, build, seeds):
     return [values[c] for c in COLUMNS]
 
 
+OVERLAP_MAX = 0.01  # of a mean diameter
+
+
+def by_key(k):
+    for r in read_rows():
+        if key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"], r["e_scale"],
+               r["cell_width_d"]) == k:
+            return r
+    return None
+
+
+def run_point(binary, build, name, p, mats, have):
+    """The point's missing seeds, then its row, appended whole."""
+    for s in SEEDS:
+        if s in have:
+            continue
+        rec = run_seed(binary, build, p, mats, s)
+        append(RUNS, json.dumps(rec, sort_keys=True) + "\n")
+        have[s] = rec
+        o = rec["out"]
+        print("dem-map: %s %s %s %d layers %s beta %g %s E %g seed %d: v %.5f m/s, overlap %.3g d, "
+              "%.0f CPU s" % (name, p["role"], p["material"], p["layers"], p["drive"], p["beta"],
+                              p["rotation"], p["youngs"], s, o["v_dem"],
+                              max(o["overlap_pp_max"], o["overlap_pw_max"]) / o["d_mean"],
+                              rec["cpu_s"]), flush=True)
+    append(CSV, csv_line(row_of(p, mats, build, have)))
+
+
 def run(binary, build, wanted):
     mats = materials()
     os.makedirs(os.path.dirname(CSV), exist_ok=True)
@@ -258,24 +286,19 @@ def run(binary, build, wanted):
         if wanted and name not in wanted:
             continue
         for p in points:
-            k = point_key(p, mats)
-            if k in done:
-                continue
-            have = seeds.setdefault(k, {})
-            for s in SEEDS:
-                if s in have:
-                    continue
-                rec = run_seed(binary, build, p, mats, s)
-                append(RUNS, json.dumps(rec, sort_keys=True) + "\n")
-                have[s] = rec
-                o = rec["out"]
-                print("dem-map: %s %s %d layers %s beta %g %s seed %d: v %.5f m/s, overlap %.3g d, "
-                      "%.0f CPU s" % (name, p["material"], p["layers"], p["drive"], p["beta"],
-                                      p["rotation"], s, o["v_dem"],
-                                      max(o["overlap_pp_max"], o["overlap_pw_max"]) / o["d_mean"],
-                                      rec["cpu_s"]), flush=True)
-            append(CSV, csv_line(row_of(p, mats, build, have)))
-            done.add(k)
+            todo = [p]
+            while todo:
+                q = todo.pop(0)
+                k = point_key(q, mats)
+                if k not in done:
+                    run_point(binary, build, name, q, mats, seeds.setdefault(k, {}))
+                    done.add(k)
+                # a map point whose overlap passed the bound gets the ladder's
+                # next rung at once: the map's value there is the softest
+                # rung within the bound (docs/dem.md "The map")
+                r = by_key(k)
+                if q["role"] == "map" and r and float(r["overlap_max_rel"]) > OVERLAP_MAX:
+                    todo.append(dict(q, role="stiffness", youngs=mats["map"]["youngs_ladder"][2]))
 
 
 def main():

@@ -34,6 +34,23 @@ def pct(x):
     return "n/a" if x is None else "%+.1f %%" % (100 * x)
 
 
+def chosen(rows, material, layers, drive, beta):
+    """A map point's value: of its rows in the map's cell, clockwise, the
+    softest whose largest overlap is within the bound, else the stiffest."""
+    rs = [r for r in rows if r["material"] == material and int(r["layers"]) == layers and
+          r["drive"] == drive and f(r["beta_deg"]) == beta and r["rotation"] == "cw" and
+          f(r["cell_width_d"]) == dem_map.WIDTH and r["role"] in ("map", "stiffness")]
+    if not any(r["role"] == "map" for r in rs):
+        return None
+    rs.sort(key=lambda r: f(r["e_scale"]))
+    ok = [r for r in rs if f(r["overlap_max_rel"]) <= OVERLAP and f(r["youngs_pa"]) >= e_map_of()]
+    return ok[0] if ok else rs[-1]
+
+
+def e_map_of():
+    return dem_map.materials()["map"]["youngs_map"]
+
+
 def main():
     path = sys.argv[1] if len(sys.argv) > 1 else dem_map.CSV
     rows = dem_map.read_rows(path)
@@ -43,6 +60,7 @@ def main():
     for r in rows:
         by_key[dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
                            r["e_scale"], r["cell_width_d"])] = r
+    e_map = mats["map"]["youngs_map"]
     out = []
     w = out.append
     builds = sorted({r["build"] for r in rows})
@@ -104,9 +122,19 @@ def main():
             for b in dem_map.BETAS:
                 cells = []
                 for d in depths:
-                    r = [x for x in sel if int(x["layers"]) == d and f(x["beta_deg"]) == b]
-                    cells.append("%+.4f ± %.4f" % (f(r[0]["v_dem"]), f(r[0]["v_dem_sd"])) if r else "")
+                    r = chosen(rows, mat, d, drive, b)
+                    if not r:
+                        cells.append("")
+                        continue
+                    mark = "" if r["role"] == "map" else " ᵏ"
+                    if f(r["overlap_max_rel"]) > OVERLAP:
+                        mark += " !"
+                    cells.append("%+.4f ± %.4f%s" % (f(r["v_dem"]), f(r["v_dem_sd"]), mark))
                 w("| %d | %s |" % (b, " | ".join(cells)))
+            w("")
+            w("ᵏ: the point's overlap passed 1 %% of a diameter at E = %g Pa, so its value is the "
+              "next rung's (%g Pa); !: the overlap passes 1 %% at every rung run." %
+              (e_map, mats["map"]["youngs_ladder"][2]))
             w("")
     # checks
     w("## Convergence checks")
@@ -115,7 +143,6 @@ def main():
       "is (v_check - v_map) / |v_map|, the bound %.0f %%; \"seeds\" is the change in the "
       "points' combined standard error." % (100 * TOL))
     w("")
-    e_map = mats["map"]["youngs_map"]
 
     def base_of(r):
         m = mats["materials"][r["material"]]
