@@ -140,8 +140,10 @@ def main():
     w("## Convergence checks")
     w("")
     w("Each check row is a map point run again with one thing changed, three seeds; the change "
-      "is (v_check - v_map) / |v_map|, the bound %.0f %%; \"seeds\" is the change in the "
-      "points' combined standard error." % (100 * TOL))
+      "is (v_check - v_map) / |v_map|, the bound %.0f %%; \"seeds\" is the change in units of the "
+      "two points' combined standard error (each point's seeds' standard deviation over the root of "
+      "3): where it is below 2 the two rows are not told apart by three seeds, whatever the "
+      "change in %%." % (100 * TOL))
     w("")
 
     def base_of(r):
@@ -158,9 +160,9 @@ def main():
             w("No rows yet.")
             w("")
             continue
-        w("| material | depth | beta | %s | v_map | v_check | change | seeds | overlap map / check (of d) | within %.0f %% |" %
+        w("| material | depth | beta | %s | v_map | v_check | change | seeds | overlap map / check (of d) | within %.0f %% | within 2 standard errors |" %
           ("E (Pa) map -> check" if role == "stiffness" else "width (d) map -> check", 100 * TOL))
-        w("|---|---|---|---|---|---|---|---|---|---|")
+        w("|---|---|---|---|---|---|---|---|---|---|---|")
         for r in sel:
             b = base_of(r)
             if not b:
@@ -170,10 +172,10 @@ def main():
             c = rel(f(r["v_dem"]), f(b["v_dem"]))
             se = ((f(r["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
             z = abs(f(r["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
-            w("| %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %.1f | %s / %s | %s |" %
+            w("| %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %.1f | %s / %s | %s | %s |" %
               (r["material"], r["layers"], r["beta_deg"], b[what], r[what], f(b["v_dem"]),
                f(r["v_dem"]), pct(c), z, b["overlap_max_rel"], r["overlap_max_rel"],
-               "yes" if c is not None and abs(c) < TOL else "no"))
+               "yes" if c is not None and abs(c) < TOL else "no", "yes" if z < 2 else "no"))
         w("")
     sel = [r for r in rows if r["role"] == "mirror"]
     w("### Mirror: counter-clockwise at beta against clockwise at 180 - beta")
