@@ -3,6 +3,7 @@
 """The DEM map's report (tests/bench/results/dem_map.md) from its CSV.
 
     dem_map_report.py [CSV]
+    dem_map_report.py --status      one paragraph of what exists (docs/dem.md)
 
 Prints Markdown: what of the planned map exists, the map's table (v and
 the seeds' spread), the convergence checks (stiffness, cell width, the
@@ -51,7 +52,29 @@ def e_map_of():
     return dem_map.materials()["map"]["youngs_map"]
 
 
+def status(rows, mats):
+    """One paragraph for docs/dem.md: what exists, from one build."""
+    plan = dem_map.plan()
+    planned = [p for _, ps in plan for p in ps]
+    keys = {dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
+                        r["e_scale"], r["cell_width_d"]) for r in rows}
+    done = [p for p in planned if dem_map.point_key(p, mats) in keys]
+    maps = [p for p in planned if p["role"] == "map"]
+    mdone = [p for p in done if p["role"] == "map"]
+    extra = len(rows) - len(done)
+    builds = sorted({r["build"][:12] for r in rows})
+    print("Status (%s, build %s): %d of the plan's %d map points and %d of its %d check rows "
+          "exist, with %d more rows at 8e+08 Pa where 2e+08 overlapped more than 1 %%; %.2f CPU "
+          "hours so far (tests/bench/results/dem_map.md)." %
+          (max(r["date"] for r in rows)[:10] if rows else "-", ", ".join(builds) or "-", len(mdone),
+           len(maps), len(done) - len(mdone), len(planned) - len(maps), extra,
+           sum(f(r["cpu_s"]) for r in rows) / 3600))
+
+
 def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--status":
+        status(dem_map.read_rows(), dem_map.materials())
+        return
     path = sys.argv[1] if len(sys.argv) > 1 else dem_map.CSV
     rows = dem_map.read_rows(path)
     mats = dem_map.materials()
@@ -201,6 +224,20 @@ def main():
     if rows:
         steady = [r for r in rows if abs(f(r["v_second_half"]) - f(r["v_first_half"])) <=
                   max(f(r["v_dem_sd"]), 1e-4)]
+        # the paired test: each seed's second half minus its first, their
+        # mean against its standard error (the runs file's seeds)
+        halves = {}
+        for rec in dem_map.finished_seeds(rows[0]["build"]).items():
+            k, by_seed = rec
+            d = [x["out"]["v_second_half"] - x["out"]["v_first_half"] for x in by_seed.values()]
+            if len(d) >= 2:
+                halves[k] = (statistics.fmean(d), statistics.stdev(d) / len(d) ** 0.5)
+
+        def paired(r):
+            return halves.get(dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"],
+                                          r["rotation"], r["e_scale"], r["cell_width_d"]))
+
+        drifting = [r for r in rows if paired(r) and abs(paired(r)[0]) > 2 * max(paired(r)[1], 1e-5)]
         big = [r for r in rows if f(r["overlap_max_rel"]) > OVERLAP]
         w("Window %s s after a 1-s transient (50 periods of the 25-Hz drive), split at its middle "
           "period. Rows whose halves differ by no more than the seeds' standard deviation: %d of %d. "
@@ -209,14 +246,21 @@ def main():
           "%.0f %%: %d." % (rows[0]["window_s"], len(steady), len(rows),
                             100 * max(f(r["overlap_max_rel"]) for r in rows), 100 * OVERLAP, len(big)))
         w("")
-        drift = [r for r in rows if r not in steady]
+        w("The halves' difference has its own noise, so the rows are also tested in pairs: each "
+          "seed's second half minus its first, the mean of the three against twice its standard "
+          "error. Rows that drift by that test: %d of %d." % (len(drifting), len(rows)))
+        w("")
+        drift = [r for r in rows if r not in steady or r in drifting]
         if drift:
-            w("| material | depth | drive | beta | rotation | role | v first half | v second half | seeds' sd |")
-            w("|---|---|---|---|---|---|---|---|---|")
+            w("| material | depth | drive | beta | rotation | role | E (Pa) | v first half | v second half | seeds' sd | within the seeds' sd | paired drift / its standard error |")
+            w("|---|---|---|---|---|---|---|---|---|---|---|---|")
             for r in drift:
-                w("| %s | %s | %s | %s | %s | %s | %+.4f | %+.4f | %.4f |" %
+                pr = paired(r)
+                w("| %s | %s | %s | %s | %s | %s | %s | %+.4f | %+.4f | %.4f | %s | %s |" %
                   (r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"], r["role"],
-                   f(r["v_first_half"]), f(r["v_second_half"]), f(r["v_dem_sd"])))
+                   r["youngs_pa"], f(r["v_first_half"]), f(r["v_second_half"]), f(r["v_dem_sd"]),
+                   "yes" if r in steady else "no",
+                   "%+.4f / %.4f" % pr if pr else "n/a"))
             w("")
         if big:
             w("Rows above the overlap bound: " + ", ".join(
