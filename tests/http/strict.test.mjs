@@ -76,6 +76,104 @@ test('a body JSON forbids is refused with 400 and its position on every route; n
   }
 });
 
+// A string whose decoded value holds U+0000 (written \u0000, which JSON
+// allows) on every route that reads a body: cJSON's C strings used to cut
+// it there, so "czubak2016\u0000x" was read as czubak2016. [method, path
+// (SID: the session's), body]; the fault is at the backslash.
+const NUL = [
+  ['POST', '/api/v1/sessions', '{"preset":"czubak2016\\u0000x"}'],
+  ['POST', '/api/v1/sessions', '{"params":{"rotation":"ccw\\u0000garbage"}}'],
+  ['POST', '/api/v1/sessions', '{"pace\\u0000x":1}'],
+  ['PATCH', '/api/v1/sessions/SID', '{"rotation":"ccw\\u0000garbage"}'],
+  ['POST', '/api/v1/sweeps', '{"rotations":["cw\\u0000x"],"t_end":0.5}'],
+  ['POST', '/api/v1/fits', '{"free":["e\\u0000x"],"peaks":[{"rotation":"cw","beta":38}]}'],
+  ['POST', '/api/v1/experiments', '{"session":{"pace":"max\\u0000"},"schedule":[{"beta":38,"until":1}]}'],
+  ['POST', '/api/v1/sessions', '{"preset":"czubak2016","scene":{"drive":"ideal\\u0000"}}'],
+];
+
+test('a string holding U+0000 (\\u0000) is 400 with its position on every route; nothing changes', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, params: { rotation: 'cw' } });
+    assert.equal(s.status, 201, s.text);
+    for (const [method, template, body] of NUL) {
+      const path = template.replace('SID', s.body.id);
+      const r = await req(d.base, method, path, body);
+      const position = Buffer.from(body).indexOf('\\u0000');
+      assert.equal(r.status, 400, `${method} ${path} ${body}: ${r.text}`);
+      assert.match(r.headers.get('content-type'), /^application\/problem\+json/);
+      assert.deepEqual(r.body, {
+        type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+        detail: 'the request body is refused: a string may not hold U+0000 (\\u0000) (no member ' +
+          `takes it; it would cut the string short) at byte ${position}`,
+        instance: path, position,
+      }, `${method} ${path} ${body}`);
+    }
+    assert.equal(NUL[0][2].indexOf('\\u0000'), 21, 'the first fault is at byte 21');
+    // nothing was created or changed
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 1);
+    for (const kind of ['sweeps', 'fits', 'experiments']) {
+      assert.equal((await req(d.base, 'GET', `/api/v1/${kind}`)).body[kind].length, 0, kind);
+    }
+    const g = await req(d.base, 'GET', `/api/v1/sessions/${s.body.id}`);
+    assert.equal(g.body.status.rotation, 'cw', 'the refused PATCH changed nothing');
+    // other escapes, \u0001 among them, still decode and reach the API
+    const one = await req(d.base, 'POST', '/api/v1/sessions', '{"preset":"czubak2016\\u0001x"}');
+    assert.equal(one.status, 422, one.text);
+    assert.equal(one.body.field, 'preset');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+// The same name twice in one object, at every depth and after many other
+// names, is refused as it was before the check became linear: the first
+// fault in the text wins, whether a duplicate or another.
+const DUP = [
+  // [body, position, field]
+  ['{"pace":1,"pace":2}', 10, 'pace'],
+  ['{"scene":{"drive":"ideal","layers":2,"drive":"ideal"}}', 37, 'drive'],
+  ['{"a":{"b":{"c":{"d":{"e":1,"f":2,"e":3}}}}}', 33, 'e'],
+  ['{"a":{"x":1,"x":2},"a":3}', 12, 'x'], // the inner one comes first
+  ['{"a":1,"b":{"x":1,"x":2},"a":3}', 18, 'x'],
+  ['{"a":1,"a":{"x":1,"x":2}}', 7, 'a'], // the outer one comes first
+  ['{"a":1,"a":01}', 7, 'a'], // before a bad number
+  ['{"a":1,"b":01,"a":1}', 11, null], // after one
+  ['{"a":1,"b":{"c":[1,{"d":1,"d":2}]},"a":2}', 26, 'd'],
+  ['{"\\u00e9":1,"\\u00E9":2}', 12, '\\u00E9'],
+  ['{"\\ud83d\\ude00":1,"\\ud83d\\ude00":2}', 18, '\\ud83d\\ude00'],
+];
+
+test('a name given twice is refused at its second place at any depth, also among 20,000 names', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const many = Array.from({ length: 20000 }, (_, i) => `"n${i}":0`);
+    const manyBody = `{"scene":{"inner":{${many.join(',')},"n12345":1}}}`;
+    const cases = [...DUP, [manyBody, manyBody.lastIndexOf('"n12345"'), 'n12345']];
+    for (const [body, position, field] of cases) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', body);
+      const shown = body.length > 80 ? `${body.slice(0, 80)}...` : body;
+      assert.equal(r.status, 400, `${shown}: ${r.text}`);
+      const why = field === null ? 'a number may not have a leading zero'
+        : `a member's name is given twice in one object ("${field}")`;
+      const want = {
+        type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+        detail: `the request body is not valid JSON (RFC 8259, I-JSON): ${why} at byte ${position}`,
+        instance: '/api/v1/sessions', position,
+      };
+      if (field !== null) want.field = field;
+      assert.deepEqual(r.body, want, shown);
+    }
+    // 20,000 distinct names pass the check (and meet the member check)
+    const distinct = await req(d.base, 'POST', '/api/v1/sessions', `{${many.join(',')}}`);
+    assert.equal(distinct.status, 422, distinct.text);
+    assert.equal(distinct.body.field, 'n0');
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
 test('a Host or Content-Length header given twice is 400 and changes nothing; 500 query parameters get 431', { timeout: 60000 * SLOW }, async () => {
   const d = await startDaemon();
   try {
