@@ -242,7 +242,7 @@ typedef struct api_spec {
 } api_spec;
 
 /* Parse a POST /sessions body (len bytes, need not be NUL-terminated; an
- * empty body means {}). Fills *spec from the preset and overrides, checks
+ * empty or blank body is refused, {} takes every default). Fills *spec from the preset and overrides, checks
  * every value with sim_set/sim_validate. Returns API_OK or the error in
  * *pb; *spec is then unspecified. */
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,

@@ -101,7 +101,7 @@ api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 0, api_members_experiment, pb);
+	cJSON *root = api_parse_body(body, len, api_members_experiment, pb);
 	if (!root)
 		return pb->code;
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");

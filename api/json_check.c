@@ -283,8 +283,8 @@ static int push_name(checker *c, size_t start, uint32_t hash)
 }
 
 /* The names of the innermost object, from `first` on (then closed). A
- * name given twice is a fault at its earliest second occurrence, unless a
- * fault before that one was found already. 0: every name once. */
+ * name given twice is a fault at its earliest second occurrence, and the
+ * first fault in the text. 0: every name once. */
 static int check_names(checker *c, size_t first)
 {
 	size_t n = c->n_names - first;
@@ -303,8 +303,8 @@ static int check_names(checker *c, size_t first)
 			again = &v[k];
 	if (!again)
 		return 0;
-	if (c->why && c->where < again->start - 1)
-		return -1;
+	/* a fault found before stopped the reading after these names were
+	 * read, so this one comes first in the text */
 	size_t at = again->start;
 	while (next_code_point(c->s, c->len, &at) >= 0)
 		;

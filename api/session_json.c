@@ -56,7 +56,7 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 			  api_control *c, api_problem *pb)
 {
 	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_body(body, len, 0, api_members_control, pb);
+	cJSON *root = api_parse_body(body, len, api_members_control, pb);
 	if (!root)
 		return pb->code;
 	api_err e = API_OK;

@@ -191,7 +191,7 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 1, api_members_sweep, pb);
+	cJSON *root = api_parse_body(body, len, api_members_sweep, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, &req->spec, pb);

@@ -7,7 +7,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { startDaemon, req, rawRequest, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, rawRequest, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 const bytes = (...parts) => Buffer.concat(parts.map((p) => (typeof p === 'string' ? Buffer.from(p, 'latin1') : Buffer.from(p))));
 
@@ -137,6 +137,8 @@ const DUP = [
   ['{"a":{"x":1,"x":2},"a":3}', 12, 'x'], // the inner one comes first
   ['{"a":1,"b":{"x":1,"x":2},"a":3}', 18, 'x'],
   ['{"a":1,"a":{"x":1,"x":2}}', 7, 'a'], // the outer one comes first
+  ['{"b":1,"a":1,"b":1,"a":1}', 13, 'b'], // two names twice: the earlier
+  ['{"a":1,"b":1,"a":1,"b":1}', 13, 'a'],
   ['{"a":1,"a":01}', 7, 'a'], // before a bad number
   ['{"a":1,"b":01,"a":1}', 11, null], // after one
   ['{"a":1,"b":{"c":[1,{"d":1,"d":2}]},"a":2}', 26, 'd'],
@@ -149,7 +151,13 @@ test('a name given twice is refused at its second place at any depth, also among
   try {
     const many = Array.from({ length: 20000 }, (_, i) => `"n${i}":0`);
     const manyBody = `{"scene":{"inner":{${many.join(',')},"n12345":1}}}`;
-    const cases = [...DUP, [manyBody, manyBody.lastIndexOf('"n12345"'), 'n12345']];
+    // ZjEppR and yjepeD have one 32-bit FNV-1a hash of their code points
+    // (tests/bench/body_parse.mjs found the pair), so only their text tells
+    // them apart; among 100 names the check sorts by hash first
+    const filler = Array.from({ length: 100 }, (_, i) => `"f${i}":0`).join(',');
+    const collide = `{${filler},"ZjEppR":1,"yjepeD":2,"ZjEppR":3}`;
+    const cases = [...DUP, [manyBody, manyBody.lastIndexOf('"n12345"'), 'n12345'],
+      [collide, collide.lastIndexOf('"ZjEppR"'), 'ZjEppR']];
     for (const [body, position, field] of cases) {
       const r = await req(d.base, 'POST', '/api/v1/sessions', body);
       const shown = body.length > 80 ? `${body.slice(0, 80)}...` : body;
@@ -213,6 +221,91 @@ test('a Host or Content-Length header given twice is 400 and changes nothing; 50
     assert.equal(few.status, 400);
     assert.equal(few.body.field, 'a');
     assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200, 'the daemon still answers');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('an empty or blank body is 400 on every route that reads one; nothing is created', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const routes = [['POST', '/api/v1/sessions'], ['POST', '/api/v1/sweeps'], ['POST', '/api/v1/fits'],
+      ['POST', '/api/v1/experiments'], ['PATCH', `/api/v1/sessions/${s.body.id}`]];
+    for (const [method, path] of routes) {
+      for (const body of ['', ' ', '\r\n\t ']) {
+        const r = await req(d.base, method, path, body);
+        assert.equal(r.status, 400, `${method} ${path} ${JSON.stringify(body)}: ${r.text}`);
+        assert.deepEqual(r.body, {
+          type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+          detail: `the request body is ${body ? 'only whitespace' : 'empty'}; a JSON object is expected ({} for no members)`,
+          instance: path,
+        }, `${method} ${path} ${JSON.stringify(body)}`);
+      }
+    }
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 1, 'no session created');
+    assert.equal((await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps.length, 0, 'no sweep started');
+    // {} still takes every default
+    assert.equal((await req(d.base, 'POST', '/api/v1/sessions', '{}')).status, 201);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('%00 in the path or the query is 400, never a shorter path; a Last-Event-ID or limit past its range is 400', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const host = `Host: 127.0.0.1:${d.port}`;
+    const get = (target, more = '') => rawRequest(d.port, `GET ${target} HTTP/1.1\r\n${host}${more}`);
+    // [target, type, field, instance (the path as libmicrohttpd decoded it), position]
+    const cases = [
+      ['/api/v1/health%00x', 'bad-request', 'path', '/api/v1/health', 14],
+      ['/index.html%00.txt', 'bad-request', 'path', '/index.html', 11],
+      ['/%00', 'bad-request', 'path', '/', 1],
+      ['/api/v1/sessions?limit=1%00x', 'bad-query', 'query', '/api/v1/sessions', 24],
+    ];
+    for (const [target, type, field, instance, position] of cases) {
+      const r = await get(target);
+      assert.equal(r.status, 400, `${target}: ${r.raw.toString('latin1')}`);
+      assert.deepEqual(JSON.parse(r.body.toString('utf8')), {
+        type: `/api/v1/problems/${type}`, title: type === 'bad-query' ? 'Bad query parameter' : 'Bad request',
+        status: 400,
+        detail: `the request target has %00 (a NUL byte) at byte ${position}; no path or query value holds one`,
+        instance, field,
+      }, target);
+    }
+    assert.equal((await get('/api/v1/health')).status, 200);
+    assert.equal((await get('/index.html')).status, 200);
+    assert.equal((await get('/api/v1/health%41')).status, 404, 'other escapes still decode');
+
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const stream = `/api/v1/sessions/${s.body.id}/stream`;
+    const idProblem = (field) => ({
+      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+      detail: 'Last-Event-ID (or since) must be a record id, an integer from 0 to 9223372036854775807',
+      instance: stream, field,
+    });
+    for (const id of ['18446744073709551616', '9223372036854775808', '99999999999999999999999', '+5', '5x', '-1']) {
+      const r = await get(stream, `\r\nLast-Event-ID: ${id}`);
+      assert.equal(r.status, 400, `Last-Event-ID ${id}: ${r.raw.toString('latin1').slice(0, 300)}`);
+      assert.deepEqual(JSON.parse(r.body.toString('utf8')), idProblem('Last-Event-ID'), id);
+    }
+    const since = await get(`${stream}?since=18446744073709551616`);
+    assert.equal(since.status, 400);
+    assert.deepEqual(JSON.parse(since.body.toString('utf8')), idProblem('since'));
+    const limit = await get(`${stream}?limit=18446744073709551616`);
+    assert.equal(limit.status, 400);
+    assert.deepEqual(JSON.parse(limit.body.toString('utf8')), {
+      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+      detail: 'limit must be a positive integer (at most 18446744073709551615)', instance: stream, field: 'limit',
+    });
+    // the largest id and limit still open a stream
+    const ok = await fetch(`${d.base}${stream}?limit=18446744073709551615`,
+      { headers: { 'Last-Event-ID': '9223372036854775807' } });
+    assert.equal(ok.status, 200);
+    await ok.body.cancel();
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
