@@ -5,6 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const CONVSIM = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 const summary = (...set) => JSON.parse(execFileSync(CONVSIM, ['run', '-q', '-d', '0.2',
