@@ -311,16 +311,18 @@ test('%00 in the path or the query is 400, never a shorter path; a Last-Event-ID
   }
 });
 
-test('docs/hardening.md: its example body gets the answer it shows', { timeout: 30000 * SLOW }, async () => {
+test('docs/hardening.md: its example bodies get the answers it shows', { timeout: 30000 * SLOW }, async () => {
   const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
-  const m = doc.match(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/);
-  assert.ok(m, 'docs/hardening.md has a json block after <!-- test:strict-example -->');
-  const example = JSON.parse(m[1]);
+  const blocks = [...doc.matchAll(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/g)];
+  assert.equal(blocks.length, 2, 'docs/hardening.md has two json blocks after <!-- test:strict-example -->');
   const d = await startDaemon();
   try {
-    const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
-    assert.equal(r.status, example.answer.status);
-    assert.deepEqual(r.body, example.answer);
+    for (const m of blocks) {
+      const example = JSON.parse(m[1]);
+      const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
+      assert.equal(r.status, example.answer.status, example.request);
+      assert.deepEqual(r.body, example.answer);
+    }
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
