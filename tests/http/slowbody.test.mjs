@@ -147,3 +147,38 @@ test('a flood of slow POST bodies from many addresses: closed at the cap or at t
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
+
+test('headers that trickle are closed at --request-timeout, a request line that trickles at --connection-timeout', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon(['--request-timeout', '1', '--heartbeat', '0.5', '--connection-timeout', '2']);
+  const socks = [];
+  // one byte every 200 ms restarts libmicrohttpd's own timeout each time
+  const trickle = (first, text) => {
+    const s = net.connect(d.port, '127.0.0.1');
+    const st = { closedAt: 0, t0: Date.now() };
+    if (first) s.write(first);
+    let i = 0;
+    const timer = setInterval(() => { if (i < text.length && s.writable) s.write(text[i++]); }, 200);
+    s.on('close', () => { clearInterval(timer); st.closedAt = Date.now(); });
+    s.on('error', () => {});
+    socks.push(s);
+    return st;
+  };
+  try {
+    // the request line at once, then the headers a byte at a time: closed
+    // --request-timeout (1 s) after the line, within the reaper's second
+    const headers = trickle(`GET /api/v1/health HTTP/1.1\r\n`, `Host: 127.0.0.1:${d.port}\r\nX-Slow: ${'a'.repeat(200)}`);
+    // the request line itself a byte at a time: closed --connection-timeout
+    // (2 s) after the connection opened
+    const line = trickle('', `GET /api/v1/health${'a'.repeat(200)}`);
+    await until(() => headers.closedAt && line.closedAt, 15000, 'both trickling sockets closed');
+    assert.ok(headers.closedAt - headers.t0 < 4000 * SLOW, `headers closed after ${headers.closedAt - headers.t0} ms`);
+    assert.ok(line.closedAt - line.t0 >= 1900, `request line closed after ${line.closedAt - line.t0} ms, not before 2 s`);
+    assert.ok(line.closedAt - line.t0 < 5000 * SLOW, `request line closed after ${line.closedAt - line.t0} ms`);
+    const m = (await req(d.base, 'GET', '/metrics')).text;
+    assert.equal(metric(m, 'convsim_connections_timed_out_total'), 2, 'both counted as timed out');
+    await healthy(d.port, '127.0.0.1', 'after');
+  } finally {
+    for (const s of socks) s.destroy();
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
