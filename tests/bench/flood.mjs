@@ -15,9 +15,9 @@
 // and measures 3 s more. Throughout, an active client from 127.0.0.4 asks
 // GET /api/v1/health back to back (20 ms apart), each on a fresh
 // connection, and counts an answer only if it is 200 with status "ok"
-// within 5 s. The active client runs in a worker thread of its own, so
-// that its times are the daemon's, not the wait for this process's event
-// loop busy with the flood. It prints one table (markdown): the active
+// within 5 s, in the phase in which it ends. The active client runs in a
+// worker thread of its own, so that its times are the daemon's, not the
+// wait for this process's event loop busy with the flood. It prints one table (markdown): the active
 // client's answers and p50 / p99 / max latency while the flood's sockets
 // connect, while they are held and after they closed, whether
 // /api/v1/health answers after it, and the daemon's counters of
