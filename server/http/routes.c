@@ -11,9 +11,9 @@
  * method (404, 405) or GET, HEAD, DELETE with a body (400). It then
  * collects the body under its deadline (conns.h: closed when slower than
  * --min-body-rate; 413 while it is read for chunked bodies), then calls
- * the one handler. A
- * path that exists with another method gets 405 with Allow; unknown paths
- * under /api/ get 404; everything else is a static file of web/. Query
+ * the one handler. A path that exists with another method gets 405 with
+ * Allow; unknown paths under /api/ get 404; everything else is a static
+ * file of web/. Query
  * parameters and the representation are checked against the API's route
  * table (api/routes.c) before the handler runs.
  * Per-request state is freed in the completion callback.
