@@ -102,7 +102,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -304,6 +304,13 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 # budget or stopped answering another client.
 load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
+
+# Connection floods on loopback (about a minute; tests/bench/flood.mjs):
+# 2,000 idle, slow-GET and slow-POST sockets from 500 addresses, an active
+# client's p50 / p99 meanwhile; fails if it or /api/v1/health went
+# unanswered.
+flood: all
+	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/flood.mjs
 
 # The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
 # process at a time, niced, into tests/bench/results/dem.md; then the

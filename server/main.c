@@ -224,11 +224,14 @@ int main(int argc, char **argv)
 		cfg.max_queued_points);
 
 	/* once a second: remove the sessions whose experiment ended and
-	 * those idle beyond --idle-timeout */
+	 * those idle beyond --idle-timeout, close the connections past
+	 * their deadline */
 	int sig = 0;
 	struct timespec tick = {1, 0};
-	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0)
+	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0) {
 		srv_sessions_reap(cfg.idle_timeout);
+		srv_conns_reap();
+	}
 	srv_log(SRV_LOG_INFO, "%s: shutting down",
 		sig == SIGINT ? "SIGINT" : "SIGTERM");
 	shut_down(d);

@@ -36,7 +36,8 @@ typedef struct srv_gauges {
 	double sweep_points;           /* queued or running */
 	double client_refused;         /* connections answered 429 */
 	double connections_dropped;    /* closed by libmicrohttpd at accept */
-	double connections_evicted;    /* idle ones closed at the cap (conns.c) */
+	double connections_evicted;    /* closed at the cap (conns.c) */
+	double connections_timed_out;  /* closed at their deadline (conns.c) */
 } srv_gauges;
 
 /* Count one response with this HTTP status. */
