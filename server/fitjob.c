@@ -28,6 +28,7 @@
 #include "fitjob.h"
 #include "job.h"
 #include "pool.h"
+#include "records.h"
 #include "registry.h"
 #include "store.h"
 #include "util.h"
@@ -126,14 +127,7 @@ static void on_progress(void *ctx, const fit_progress *pr)
 static const char *const phases[] = {"fitting", "covariance", "curve", "done"};
 #define NPHASES (sizeof phases / sizeof *phases)
 
-typedef struct fit_record {
-	char id[SRV_ID_LEN];
-	int32_t over, status, has_pr, phase; /* phase: index in phases, or -1 */
-	int32_t iteration, pad;
-	int64_t evaluations;
-	double cost, x[FIT_MAX_FREE];
-	uint64_t body_len, json_len, csv_len;
-} fit_record;
+typedef srv_fit_record fit_record; /* records.h */
 
 /* Queue fits/ID.bin (lock held). */
 static void persist_locked(const srv_fit *f)

@@ -149,11 +149,23 @@ static void restore_state(void)
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_job_restore(&srv_sweep_job);
 	size_t nf = srv_job_restore(&srv_fit_job);
-	if (ne + ns + nw + nf)
-		srv_log(SRV_LOG_INFO,
-			"restored %zu sessions, %zu experiments (%zu "
-			"interrupted), %zu sweeps, %zu fits in %.3f s",
-			ns, ne, ni, nw, nf, srv_now() - t0);
+	if (!(ne + ns + nw + nf))
+		return;
+	/* the damaged ones are listed (state "damaged") but not whole: said
+	 * apart, and the line is a warning then */
+	size_t ds = srv_store_damaged(SRV_STORE_SESSION),
+	       de = srv_store_damaged(SRV_STORE_EXPERIMENT),
+	       dw = srv_store_damaged(SRV_STORE_SWEEP), df = srv_store_damaged(SRV_STORE_FIT);
+	size_t up = srv_store_upgraded(SRV_STORE_SESSION) +
+		    srv_store_upgraded(SRV_STORE_EXPERIMENT) +
+		    srv_store_upgraded(SRV_STORE_SWEEP) + srv_store_upgraded(SRV_STORE_FIT);
+	srv_log(ds + de + dw + df ? SRV_LOG_WARN : SRV_LOG_INFO,
+		"restored %zu sessions, %zu experiments (%zu interrupted), %zu "
+		"sweeps, %zu fits in %.3f s; damaged: %zu sessions, %zu "
+		"experiments, %zu sweeps, %zu fits; %zu read from an earlier "
+		"format and written again in format %d",
+		ns - ds, ne - de, ni, nw - dw, nf - df, srv_now() - t0, ds, de, dw, df, up,
+		SRV_STORE_VERSION);
 }
 
 int main(int argc, char **argv)

@@ -90,6 +90,8 @@ struct srv_session {
 				     reaches where it was (0: not) */
 	double replay_wall, replay_seconds; /* when the replay began, how
 				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */

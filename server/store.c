@@ -46,6 +46,8 @@ static struct {
 	store_job *head, *tail;
 	int stop, started;
 	pthread_t thread;
+	/* the restore's counts, by kind (written before the daemon serves) */
+	size_t damaged[8], upgraded[8];
 } st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
 typedef struct frame_header {
@@ -252,7 +254,7 @@ int srv_store_open(const srv_config *cfg)
 	if (!st.dir)
 		return 0;
 	static const char *const subdirs[] = {"sessions", "experiments", "sweeps", "fits"};
-	for (int i = 0; i < 3; i++) {
+	for (size_t i = 0; i < sizeof subdirs / sizeof *subdirs; i++) {
 		char p[4096];
 		full_path(p, sizeof p, subdirs[i]);
 		if (mkdir(p, 0755) != 0 && errno != EEXIST) {
@@ -435,19 +437,22 @@ char *srv_store_read_text(const char *rel, size_t *len)
 	return buf;
 }
 
-void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
+void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *older,
 			const char **bad)
 {
 	frame_header h;
 	*bad = NULL;
+	*older = 0;
 	if (n < sizeof h)
 		*bad = "cut off (shorter than its header)";
 	if (!*bad) {
 		memcpy(&h, buf, sizeof h);
 		if (memcmp(h.magic, "CVSF", 4) != 0)
 			*bad = "not a convsim file (bad magic)";
-		else if (h.version != SRV_STORE_VERSION)
-			*bad = "unknown version";
+		else if (h.version > SRV_STORE_VERSION)
+			*bad = "of a newer format version than this build reads";
+		else if (h.version < SRV_STORE_OLDEST)
+			*bad = "of an unknown format version";
 		else if (h.kind != kind)
 			*bad = "a file of another kind";
 		else if (h.len > n - sizeof h)
@@ -463,19 +468,45 @@ void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
 	}
 	memmove(buf, buf + sizeof h, h.len);
 	*len = h.len;
-	return buf;
+	if (h.version == SRV_STORE_VERSION)
+		return buf;
+	*older = 1;
+	return srv_store_upgrade_v1(kind, buf, len, bad);
 }
 
-void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
-		     size_t whylen)
+void *srv_store_read(const char *rel, uint32_t kind, size_t *len, int *older,
+		     char *why, size_t whylen)
 {
 	size_t n = 0;
 	char *buf = srv_store_read_text(rel, &n);
 	const char *bad = "missing or unreadable";
-	void *payload = buf ? srv_store_unframe(buf, n, kind, len, &bad) : NULL;
+	*older = 0;
+	void *payload = buf ? srv_store_unframe(buf, n, kind, len, older, &bad) : NULL;
 	if (!payload)
 		snprintf(why, whylen, "%s: %s", rel, bad);
 	return payload;
+}
+
+void srv_store_count_damaged(uint32_t kind)
+{
+	if (kind < sizeof st.damaged / sizeof *st.damaged)
+		st.damaged[kind]++;
+}
+
+void srv_store_count_upgraded(uint32_t kind)
+{
+	if (kind < sizeof st.upgraded / sizeof *st.upgraded)
+		st.upgraded[kind]++;
+}
+
+size_t srv_store_damaged(uint32_t kind)
+{
+	return kind < sizeof st.damaged / sizeof *st.damaged ? st.damaged[kind] : 0;
+}
+
+size_t srv_store_upgraded(uint32_t kind)
+{
+	return kind < sizeof st.upgraded / sizeof *st.upgraded ? st.upgraded[kind] : 0;
 }
 
 /* Is the entry name of rel one of the kind srv_store_list_ids lists? 1
