@@ -117,6 +117,7 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 /* Stop accepting, let streams end, join every thread, free everything. */
 static void shut_down(struct MHD_Daemon *d)
 {
+	srv_store_watch(); /* the final checkpoints and records from here */
 	srv_stop();
 	MHD_socket ls = MHD_quiesce_daemon(d);
 	if (ls != MHD_INVALID_SOCKET)
@@ -244,6 +245,16 @@ int main(int argc, char **argv)
 	srv_log(SRV_LOG_INFO, "%s: shutting down",
 		sig == SIGINT ? "SIGINT" : "SIGTERM");
 	shut_down(d);
+	/* a final checkpoint or record that is not on disk is not a clean
+	 * stop: the next start would not find what was acknowledged */
+	char failed[1024];
+	size_t nfailed = srv_store_failed(failed, sizeof failed);
+	if (nfailed) {
+		srv_log(SRV_LOG_ERROR, "stopped, but %zu final write%s failed, their "
+				       "state is not on disk: %s", nfailed,
+			nfailed == 1 ? "" : "s", failed);
+		return 1;
+	}
 	srv_log(SRV_LOG_INFO, "stopped cleanly");
 	return 0;
 }

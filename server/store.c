@@ -48,6 +48,10 @@ static struct {
 	pthread_t thread;
 	/* the restore's counts, by kind (written before the daemon serves) */
 	size_t damaged[8], upgraded[8];
+	/* srv_store_watch on: the writes that failed since (lock held) */
+	int watching;
+	size_t failed;
+	char failed_what[1024];
 } st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
 typedef struct frame_header {
@@ -170,6 +174,18 @@ static void remove_path(const char *rel)
 	fsync_parent(path);
 }
 
+/* A failed write while srv_store_watch is on (writer thread). */
+static void note_failure(const char *path, const char *msg)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = strlen(st.failed_what);
+	if (st.watching && st.failed++ == 0)
+		snprintf(st.failed_what, sizeof st.failed_what, "%s", msg);
+	else if (st.watching && n + strlen(path) + 3 < sizeof st.failed_what)
+		snprintf(st.failed_what + n, sizeof st.failed_what - n, "; %s", path);
+	pthread_mutex_unlock(&st.lock);
+}
+
 static void run_job(store_job *j)
 {
 	char msg[4400] = "";
@@ -181,6 +197,7 @@ static void run_job(store_job *j)
 		if (err) {
 			atomic_fetch_add(&srv_stats.store_errors, 1);
 			srv_log(SRV_LOG_ERROR, "store: %s", msg);
+			note_failure(j->path, msg);
 		} else {
 			atomic_fetch_add(&srv_stats.store_writes, 1);
 		}
@@ -283,6 +300,22 @@ void srv_store_close(void)
 	pthread_mutex_unlock(&st.lock);
 	pthread_join(st.thread, NULL);
 	st.started = 0;
+}
+
+void srv_store_watch(void)
+{
+	pthread_mutex_lock(&st.lock);
+	st.watching = 1;
+	pthread_mutex_unlock(&st.lock);
+}
+
+size_t srv_store_failed(char *what, size_t len)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = st.failed;
+	snprintf(what, len, "%s", st.failed_what);
+	pthread_mutex_unlock(&st.lock);
+	return n;
 }
 
 int srv_store_enabled(void)

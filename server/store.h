@@ -60,6 +60,12 @@ typedef void (*srv_store_done)(void *arg, int err, const char *what);
 int srv_store_open(const srv_config *cfg);
 /* Finish every queued write and stop the writer. */
 void srv_store_close(void);
+/* From now on, note every write that fails (the shutdown's final
+ * checkpoints and records); srv_store_failed then says how many failed
+ * and names them (up to len bytes into what: the first failure's
+ * sentence, then the other files). */
+void srv_store_watch(void);
+size_t srv_store_failed(char *what, size_t len);
 /* 1 when a data directory is in use. */
 int srv_store_enabled(void);
 /* --checkpoint-interval, s of wall time. */
