@@ -37,12 +37,40 @@ typedef struct v1_method {
 	int32_t substeps, feed_events;
 } v1_method;
 
-/* sim_params and sim_scene are as c793934 laid them out (asserted: a
- * change to either needs its version-1 copy here first) */
+/* sim_params and sim_scene as c793934 laid them out: each member in its
+ * order, with its type; the same lists copy them into today's structs by
+ * name */
+#define V1_PARAMS(X)                                                                      \
+	X(double, l1) X(double, l2) X(double, h) X(double, k_x) X(double, k_y)            \
+	X(double, b_x) X(double, b_y) X(double, M_r) X(double, J_r) X(double, m)          \
+	X(double, e) X(double, J_w) X(double, w_x) X(double, w_y) X(double, b_phi)        \
+	X(double, M_load) X(double, M_ut) X(double, omega_ss) X(double, slip_ut)          \
+	X(int32_t, rotation) X(double, m1) X(double, m2) X(double, k_s1) X(double, k_s2)  \
+	X(double, b_s1) X(double, b_s2) X(double, p1_x) X(double, p1_y) X(double, p2_x)   \
+	X(double, p2_y) X(double, c) X(double, beta) X(double, beta_rate)                 \
+	X(double, beta_accel) X(double, m_n) X(double, k_c) X(double, p) X(double, R)     \
+	X(double, mu) X(double, h_d) X(double, column_span) X(double, g)                  \
+	X(double, drive_accel)
+#define V1_SCENE(X)                                                                       \
+	X(int32_t, feed) X(int32_t, columns) X(int32_t, layers) X(int32_t, drive)         \
+	X(int32_t, trough_rotation) X(int32_t, mirror) X(int32_t, feed_coupling)          \
+	X(int32_t, friction) X(double, friction_eps) X(int32_t, motor_on)                 \
+	X(double, transient) X(int32_t, start) X(double, settle)
+#define V1_MEMBER(type, name) type name;
+#define V1_COPY(type, name) to->name = from->name;
+
+typedef struct v1_params {
+	V1_PARAMS(V1_MEMBER)
+} v1_params;
+
+typedef struct v1_scene {
+	V1_SCENE(V1_MEMBER)
+} v1_scene;
+
 typedef struct v1_spec {
 	char preset[32];
-	sim_params params;
-	sim_scene scene;
+	v1_params params;
+	v1_scene scene;
 	v1_method method;
 	double pace, until, sample_rate;
 } v1_spec;
@@ -132,8 +160,7 @@ typedef struct v1_core_header {
 } v1_core_header;
 
 #if defined(__x86_64__) || defined(__aarch64__)
-static_assert(sizeof(sim_params) == 344 && sizeof(sim_scene) == 72,
-	      "sim_params or sim_scene changed: copy c793934's layout into store_v1.c first");
+static_assert(sizeof(v1_params) == 344 && sizeof(v1_scene) == 72, "c793934's settings");
 static_assert(sizeof(v1_spec_record) == 568, "c793934's spec.bin");
 static_assert(sizeof(v1_exp_record) == 4008, "c793934's experiment record");
 static_assert(sizeof(v1_sweep_record) == 616, "c793934's sweep record");
@@ -144,19 +171,29 @@ static_assert(sizeof(v1_core_header) == 48, "c793934's core checkpoint header");
 
 /* ---- conversions ------------------------------------------------------------ */
 
+static void params_from_v1(const v1_params *from, sim_params *to)
+{
+	V1_PARAMS(V1_COPY)
+}
+
+/* feed_model, a later setting, is the column model: all c793934 had */
+static void scene_from_v1(const v1_scene *from, sim_scene *to)
+{
+	V1_SCENE(V1_COPY)
+}
+
 static void spec_from_v1(const v1_spec *o, api_spec *s)
 {
 	memset(s, 0, sizeof *s);
 	memcpy(s->preset, o->preset, sizeof s->preset);
 	s->preset[sizeof s->preset - 1] = '\0';
-	sim_params p;
-	sim_scene sc;
-	/* tol and any later method setting: the preset's, as a request
-	 * without them gets */
-	if (sim_preset(s->preset, &p, &sc, &s->method) != 0)
-		sim_preset_czubak2016(&p, &sc, &s->method);
-	s->params = o->params;
-	s->scene = o->scene;
+	/* tol and any later setting: the preset's, as a request without
+	 * them gets */
+	if (sim_preset(s->preset, &s->params, &s->scene, &s->method) != 0)
+		sim_preset_czubak2016(&s->params, &s->scene, &s->method);
+	params_from_v1(&o->params, &s->params);
+	scene_from_v1(&o->scene, &s->scene);
+	s->scene.feed_model = SIM_FEED_COLUMN;
 	memcpy(s->method.name, o->method.name, sizeof s->method.name);
 	s->method.name[sizeof s->method.name - 1] = '\0';
 	s->method.dt = o->method.dt;
