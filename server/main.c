@@ -138,6 +138,13 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_conns_shutdown();
 }
 
+/* Of n restored, those not damaged (a damaged one may also have found no
+ * room, so it is not always among the n). */
+static size_t whole(size_t n, size_t damaged)
+{
+	return n > damaged ? n - damaged : 0;
+}
+
 /* Rebuild what the data directory holds: experiments first (the sessions
  * resume theirs), then sessions, then sweeps and fits (on the pool). */
 static void restore_state(void)
@@ -165,8 +172,8 @@ static void restore_state(void)
 		"sweeps, %zu fits in %.3f s; damaged: %zu sessions, %zu "
 		"experiments, %zu sweeps, %zu fits; %zu read from an earlier "
 		"format and written again in format %d",
-		ns - ds, ne - de, ni, nw - dw, nf - df, srv_now() - t0, ds, de, dw, df, up,
-		SRV_STORE_VERSION);
+		whole(ns, ds), whole(ne, de), ni, whole(nw, dw), whole(nf, df), srv_now() - t0, ds,
+		de, dw, df, up, SRV_STORE_VERSION);
 }
 
 int main(int argc, char **argv)

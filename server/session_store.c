@@ -451,7 +451,6 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
-
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	load_files(s, id, ef);
