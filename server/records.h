@@ -7,7 +7,8 @@
  * (docs/operations.md "Stored formats").
  *
  *   sessions/ID/spec.bin        srv_spec_record
- *   sessions/ID/checkpoint.bin  srv_ckpt_record (session_int.h), the
+ *   sessions/ID/checkpoint.bin  srv_ckpt_record (session_int.h, its size
+ *                               asserted in session_store.c), the
  *                               experiment's srv_exp_record and feed
  *                               velocity record, the core's checkpoint
  *                               (its own version, core/checkpoint.c),
