@@ -180,7 +180,7 @@ static void note_failure(const char *path, const char *msg)
 	pthread_mutex_lock(&st.lock);
 	size_t n = strlen(st.failed_what);
 	if (st.watching && st.failed++ == 0)
-		snprintf(st.failed_what, sizeof st.failed_what, "%s", msg);
+		snprintf(st.failed_what, sizeof st.failed_what, "%.900s", msg);
 	else if (st.watching && n + strlen(path) + 3 < sizeof st.failed_what)
 		snprintf(st.failed_what + n, sizeof st.failed_what - n, "; %s", path);
 	pthread_mutex_unlock(&st.lock);
