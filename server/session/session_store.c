@@ -137,13 +137,6 @@ void srv_persist_control(srv_session *s, const char *json)
 	queue(s, "controls.ndjson", copy, s->controls_len, 0);
 }
 
-/* checkpoint.bin's head and trailer (session_int.h) are format 2's too
- * (records.h: a change is a new format) */
-#if defined(__x86_64__) || defined(__aarch64__)
-static_assert(sizeof(srv_ckpt_record) == 320 && sizeof(srv_ckpt_trailer) == 16,
-	      "the checkpoint's head or trailer changed: a new format version");
-#endif
-
 void srv_persist_checkpoint(srv_session *s, int force)
 {
 	if (!srv_store_enabled() || !s->sim)

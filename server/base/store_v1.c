@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "records.h"
-#include "session_int.h"
+#include "sim.h"
 #include "store.h"
 
 /* ---- c793934's layouts ------------------------------------------------------ */

@@ -7,8 +7,7 @@
  * (docs/operations.md "Stored formats").
  *
  *   sessions/ID/spec.bin        srv_spec_record
- *   sessions/ID/checkpoint.bin  srv_ckpt_record (session_int.h, its size
- *                               asserted in session_store.c), the
+ *   sessions/ID/checkpoint.bin  srv_ckpt_record, the
  *                               experiment's srv_exp_record and feed
  *                               velocity record, the core's checkpoint
  *                               (its own version, core/checkpoint.c),
@@ -77,6 +76,24 @@ typedef struct srv_fit_record {
 	uint64_t body_len, json_len, csv_len;
 } srv_fit_record;
 
+/* sessions/ID/checkpoint.bin: this head, the experiment's state (exp_len
+ * bytes), the core's checkpoint (sim_len bytes), then this trailer: the
+ * length of the control log it holds, so that a restore replays what came
+ * after, and its time, so that a session re-created from its spec knows
+ * where it was (c793934's checkpoints had no trailer: store_v1.c adds it). */
+typedef struct srv_ckpt_trailer {
+	uint64_t logged;
+	double t; /* s */
+} srv_ckpt_trailer;
+#define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
+typedef struct srv_ckpt_record {
+	int32_t state, exp_started;
+	double pace, until;
+	char error[256];
+	char exp_id[SRV_ID_LEN];
+	uint64_t exp_len, sim_len;
+} srv_ckpt_record;
+
 /* Version 2's sizes (x86-64 and aarch64 Linux, where the daemon is built
  * and tested): see the top of this file before changing one. */
 #if defined(__x86_64__) || defined(__aarch64__)
@@ -85,6 +102,8 @@ static_assert(sizeof(srv_exp_record) == 4016, "the experiment record changed: a 
 static_assert(sizeof(srv_sweep_record) == 1888, "the sweep record changed: a new format version");
 static_assert(sizeof(api_sweep_point) == 352, "the sweep point changed: a new format version");
 static_assert(sizeof(srv_fit_record) == 152, "the fit record changed: a new format version");
+static_assert(sizeof(srv_ckpt_record) == 320 && sizeof(srv_ckpt_trailer) == 16,
+	      "the checkpoint's head or trailer changed: a new format version");
 #endif
 
 #endif
