@@ -253,15 +253,19 @@ typedef struct api_spec {
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb);
 
-/* A session's spec as stored (sessions/ID/spec.json): its creation time
- * (unix s), whether an experiment owns it, and the create body that makes
- * it again ("session": preset, pace, until, sample_rate and every setting
- * by group), the API's own JSON, so that another build reads it. malloc'd
- * text, NULL when out of memory. api_parse_spec_file reads it back through
- * api_parse_session (400/422 as a POST would be). */
+/* A session's spec as stored (sessions/ID/spec.json): its format
+ * ("format": API_SPEC_FILE_FORMAT), its creation time (unix s), whether an
+ * experiment owns it, and the create body that makes it again ("session":
+ * preset, pace, until, sample_rate and every setting by group), the API's
+ * own JSON, so that another build reads it. malloc'd text, NULL when out
+ * of memory. api_parse_spec_file reads it back through api_parse_session
+ * (400/422 as a POST would be), with its format in *format (1: a file
+ * without the member, as builds before format 2 wrote it); a format above
+ * API_SPEC_FILE_FORMAT (a newer build's) is refused. */
+#define API_SPEC_FILE_FORMAT 2
 char *api_spec_file(const api_spec *spec, double created, int owned);
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, api_problem *pb);
+			    double *created, int *owned, int *format, api_problem *pb);
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
  * sample_rate within the ranges the parser allows, every setting within

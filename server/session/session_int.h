@@ -11,6 +11,7 @@
 
 #include "budget.h"
 #include "budget_turns.h"
+#include "records.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"
@@ -91,6 +92,8 @@ struct srv_session {
 				     reaches where it was (0: not) */
 	double replay_wall, replay_seconds; /* when the replay began, how
 				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
@@ -238,25 +241,8 @@ typedef struct srv_exp_finder {
  * when they do not pass their checks. */
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
 
-/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
- * the core's checkpoint (sim_len bytes) follow. */
-/* A checkpoint's payload: this head, the experiment's state, the core's
- * checkpoint, then (from this build on; older ones end with the core's)
- * this trailer: the length of the control log it holds, so that a restore
- * replays what came after, and its time, so that a session re-created
- * from its spec knows where it was. */
-typedef struct srv_ckpt_trailer {
-	uint64_t logged;
-	double t; /* s */
-} srv_ckpt_trailer;
-#define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
-typedef struct srv_ckpt_record {
-	int32_t state, exp_started;
-	double pace, until;
-	char error[256];
-	char exp_id[SRV_ID_LEN];
-	uint64_t exp_len, sim_len;
-} srv_ckpt_record;
+/* checkpoint.bin's head and trailer: srv_ckpt_record, srv_ckpt_trailer
+ * (records.h, with every stored layout). */
 /* The files read back, checked without touching a session (the restore
  * uses these; so does the fuzz harness tests/fuzz/fuzz_store.c). A spec
  * file's payload (len bytes, borrowed): 0 with the spec, its creation

@@ -28,17 +28,13 @@
 
 #include "experiment.h"
 #include "metrics.h"
+#include "records.h"
 #include "session_int.h"
 #include "store.h"
 #include "util.h"
 
-/* sessions/ID/spec.bin */
-typedef struct spec_record {
-	char id[SRV_ID_LEN];
-	api_spec spec;
-	double created;
-	int32_t owned, pad;
-} spec_record;
+/* sessions/ID/spec.bin (records.h) */
+typedef srv_spec_record spec_record;
 
 static void session_dir(char *out, size_t len, const char *id,
 			const char *file)
@@ -238,8 +234,11 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 	size_t n = 0, len;
 	char *raw = srv_store_read_text(file, &n);
 	const char *bad = "missing or unreadable";
-	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &bad) : NULL;
+	int older = 0;
+	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &older, &bad) : NULL;
 	*unread = !raw;
+	if (older)
+		s->upgrade = 1; /* written again in this build's format */
 	if (!p) {
 		snprintf(why, whylen, "%s: %s", file, bad);
 		return -1;
@@ -360,20 +359,26 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 	char *text = srv_store_read_text(path, &len);
 	if (text) {
 		api_problem pb;
+		int format = 0;
 		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
-						&s->owned, &pb);
+						&s->owned, &format, &pb);
 		free(text);
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
+			s->upgrade = 1;
 		return e == API_OK ? 0 : -1;
 	}
+	/* no spec.json: a build before it (c793934) wrote only spec.bin */
 	session_dir(path, sizeof path, s->entry.id, "spec.bin");
-	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, whylen);
+	int older = 0;
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, &older, why, whylen);
 	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
 				     msg, sizeof msg)
 		   : -1;
 	if (r && rc)
 		snprintf(why, whylen, "%s: %s", path, msg);
+	s->upgrade = 1; /* spec.json (and spec.bin) in this build's format */
 	free(r);
 	return rc;
 }
@@ -395,7 +400,8 @@ static void rebuild(srv_session *s, const char *why, const char *why2)
 		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
 }
 
-void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
+/* The files of session id into s (srv_persist_load). */
+static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	char path[128], why[512] = "", why2[512] = "";
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
@@ -445,3 +451,21 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
+{
+	load_files(s, id, ef);
+	if (s->damaged) {
+		srv_store_count_damaged(SRV_STORE_SESSION);
+		return;
+	}
+	if (!s->upgrade)
+		return;
+	/* an earlier format: its spec written again at once (spec.json and
+	 * spec.bin, each atomically: store.c), its checkpoint at the next
+	 * interval, in this build's format */
+	srv_persist_spec(s);
+	s->ckpt_dirty = 1;
+	srv_store_count_upgraded(SRV_STORE_SESSION);
+	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
+			      "in format %d", s->entry.id, SRV_STORE_VERSION);
+}

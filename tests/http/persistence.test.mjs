@@ -184,7 +184,7 @@ function fullDisk() {
   return probe.status === 0;
 }
 
-test('write errors (ENOSPC) put sessions, sweeps and experiments in state "error"', { timeout: 60000 * SLOW, skip: !fullDisk() && 'unshare -m with a tmpfs is not possible here (needs root or user namespaces)' }, async () => {
+test('write errors (ENOSPC) put sessions, sweeps, experiments and fits in state "error"', { timeout: 60000 * SLOW, skip: !fullDisk() && 'unshare -m with a tmpfs is not possible here (needs root or user namespaces)' }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-full-'));
   // the daemon sees a tmpfs of 64 kB at dir, filled up but for its
   // directories; mount and daemon live in their own mount namespace
@@ -211,9 +211,21 @@ test('write errors (ENOSPC) put sessions, sweeps and experiments in state "error
       return g.state === 'error' && g;
     }, 10000, 'the experiment in state error');
     assert.match(exe.error, /No space left on device/);
+    // a fit whose record is not on disk is not "done": a restart would
+    // not find it
+    const fit = await req(d.base, 'POST', '/api/v1/fits', { ...CHEAP, t_end: 0.5, free: ['e'], curve_step: 90,
+      points: [{ beta: 20, rotation: 'cw', v: 0.07 }, { beta: 60, rotation: 'cw', v: 0.06 }] });
+    assert.equal(fit.status, 202, fit.text);
+    const fe = await until(async () => {
+      const g = (await req(d.base, 'GET', `/api/v1/fits/${fit.body.id}`)).body;
+      return g.state === 'error' && g;
+    }, 10000, 'the fit in state error');
+    assert.match(fe.error, /fits\/[0-9a-f]+\.bin: No space left on device/);
+    const listed = (await req(d.base, 'GET', '/api/v1/fits?format=csv')).text;
+    assert.ok(listed.includes(`${fit.body.id},error,`), listed);
     const m = await fetch(`${d.base}/metrics`).then((r) => r.text());
     const errors = Number((m.match(/^convsim_store_errors_total (\S+)$/m) || [])[1]);
-    assert.ok(errors >= 3, `convsim_store_errors_total ${errors}`);
+    assert.ok(errors >= 4, `convsim_store_errors_total ${errors}`);
     assert.match(d.stderr(), /store: cannot .*No space left on device/);
   } finally {
     await d.stop('SIGKILL');

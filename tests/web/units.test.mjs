@@ -37,6 +37,17 @@ test('session document maps to the page model', () => {
 	assert.deepEqual(s.reductions.map(r => r.name), ['symmetric', 'ideal_drive']);
 });
 
+test('a fit whose record could not be written ends the wait, failed with its reason', () => {
+	const f = api.normalizeFit({ id: 'f', state: 'error', error: 'cannot write fits/f.bin: No space left on device',
+		phase: 'fitting', iteration: 1, max_iter: 30, result: null });
+	assert.equal(f.done, true);
+	assert.equal(f.failed, true);
+	assert.equal(f.error, 'cannot write fits/f.bin: No space left on device');
+	const running = api.normalizeFit({ id: 'f', state: 'running', iteration: 1, max_iter: 30 });
+	assert.equal(running.done, false);
+	assert.equal(running.error, null);
+});
+
 test('a session without status yet gives NaN, not zeros', () => {
 	const s = api.normalizeSession({ id: 'b', state: 'running', status: null });
 	assert.ok(Number.isNaN(s.t));
