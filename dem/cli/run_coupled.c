@@ -7,7 +7,7 @@
  * and energy between machine and bed. The bed is dem_bed_spec_default's,
  * `layers` mean diameters deep. Linked into convsim-mpi where LIGGGHTS is
  * installed (the Makefile), to which the plain convsim hands such a run
- * (core/cli/handover.h).
+ * (cli/handover.h).
  *
  * Under `mpirun -n N` LIGGGHTS runs the bed on the N ranks (its domain
  * split along the cell); every rank integrates the same machine (the core

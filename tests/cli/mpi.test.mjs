@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `convsim sweep` under `mpirun -n N` (core/cli/spread.h): the ranks
+// `convsim sweep` under `mpirun -n N` (cli/spread.h): the ranks
 // measure their share of the points, rank 0 gathers them into point order
 // and writes the table, the very bytes one process writes (CSV and JSON,
 // a study with the mirror reduction, a beta sweep, a Latin hypercube, an
@@ -8,7 +8,7 @@
 // message, no hang; so do ranks started with other options, and a rank
 // that cannot read a file rank 0 reads (its own reason, marked with its
 // rank). The plain convsim links neither MPI nor LIGGGHTS and hands a
-// launched sweep to convsim-mpi beside it (core/cli/handover.h), which
+// launched sweep to convsim-mpi beside it (cli/handover.h), which
 // links MPI; without convsim-mpi it says so (exit 1). The build without
 // MPI (`make NO_MPI=1`: CONVSIM_NOMPI, else made here) links no MPI and
 // writes the same bytes. CONVSIM names the binary.

@@ -95,7 +95,7 @@ char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
  * LIGGGHTS bed (dem/cli/run_coupled.c, in convsim-mpi where LIGGGHTS is
- * installed; in the plain convsim core/cli/coupled_none.c, which hands
+ * installed; in the plain convsim cli/coupled_none.c, which hands
  * the run over to convsim-mpi or says how to get it). Exit status as run. */
 int cli_run_coupled(const cli_opts *o);
 
