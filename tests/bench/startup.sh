@@ -51,13 +51,15 @@ row() { # what, command, prev line, new line, unit scale, unit, target
 			t == "" ? "" : (k * nb <= t ? "met (least)" : "missed") (t == "" ? "" : (k * nm <= t ? ", met (median)" : ", missed (median)"))
 	}'
 }
+# this build's commit, and whether the sources differ from it (the results aside)
+rev="$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . ':(exclude)tests/bench/results' || echo ' with uncommitted changes')"
 {
 	echo "# Start-up and the curve: whole processes, the previous build beside this one"
 	echo
 	echo "Command: \`bash tests/bench/startup.sh\` (part of \`make bench\`), $(date -u '+%Y-%m-%d %H:%M UTC'),"
 	echo "$(nproc) cores ($(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)), load average"
 	echo "$(cut -d' ' -f1-3 /proc/loadavg) at the end: the machine was shared with other builds and runs."
-	echo "Previous build: $PREV ($prev); this build: $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . 2>/dev/null || echo ' with uncommitted changes') ($cli)."
+	echo "Previous build: $PREV ($prev); this build: $rev ($cli)."
 	echo "CPU = user + sys of the whole process (wait4), least / median of $RUNS runs ($CURVES for the"
 	echo "curve), the two builds taking turns; wall: median."
 	echo
