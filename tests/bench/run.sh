@@ -46,6 +46,8 @@ echo "bench: the machine zoo against its converged references (one core per curv
 bash tests/bench/zoo.sh "$out"
 echo "bench: the speed targets (one core)"
 bash tests/bench/targets.sh "$out"
+echo "bench: start-up and the curve, whole processes, against the previous build (one core)"
+bash tests/bench/startup.sh "$out"
 echo "bench: cost against the feed's size (one core)"
 bash tests/bench/scaling.sh "$out"
 echo "bench: a 2-parameter fit on 20 points (two threads)"
