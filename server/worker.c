@@ -196,7 +196,7 @@ static int apply_commands(srv_session *s)
 			api_control_event(json, sizeof json, c, t_eff);
 			srv_ring_event(s, "control", json);
 			if (!cmd->replay)
-				srv_persist_control(s, json);
+				cmd->logged = srv_control_log_append(s, json, cmd->waited);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
@@ -257,13 +257,13 @@ static void run_replay(srv_session *s)
 	}
 }
 
-/* caught up: a session re-created from its spec (session_store.c rebuild)
- * ran flat out to where it was, or a replayed control stopped it short of
- * that: from here on it keeps its pace. */
+/* caught up: a restored session (session_store.c catch_up) ran flat out
+ * to where it was, or a replayed control stopped it short of that, or it
+ * failed: from here on it keeps its pace and answers. */
 static void check_caught_up(srv_session *s, clocks *c)
 {
 	if (!(s->catch_up_t > 0) ||
-	    (s->st.t < s->catch_up_t &&
+	    (s->st.t < s->catch_up_t && s->state != SRV_FAILED && !s->stop &&
 	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
 		return;
 	s->catch_up_t = 0;
@@ -328,7 +328,7 @@ static void pace_down(srv_session *s, clocks *c)
 	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
 	s->pace = pace;
 	srv_ring_event(s, "control", json);
-	srv_persist_control(s, json);
+	srv_control_log_append(s, json, 0);
 	s->ckpt_dirty = 1;
 	restart_clocks(c, s);
 	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
