@@ -17,7 +17,9 @@
 /* A control of the log to apply again once the integrator reaches at. */
 typedef struct srv_replay {
 	srv_cmd cmd;
-	double at; /* its t_effective, s */
+	double at;   /* its t_effective, s */
+	int exp_own; /* sent by the experiment the checkpoint resumed: not
+			applied here, the experiment sends it again itself */
 } srv_replay;
 
 struct srv_session {
@@ -90,6 +92,9 @@ struct srv_session {
 				     again as the integrator reaches each
 				     (session_store.c loads, worker.c runs) */
 	size_t nreplay, replayed;
+	size_t exp_relogged;      /* lines of the resumed experiment in the
+				     log after its checkpoint: its commands
+				     that many times are not logged again */
 	int rebuilt;              /* re-created from its spec, its checkpoint
 				     unusable (another build): the whole log
 				     is replayed */

@@ -335,9 +335,16 @@ static void load_controls(srv_session *s, size_t logged)
 		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
 		srv_replay *rp = &s->replay[s->nreplay];
 		api_problem pb;
+		char exp[SRV_ID_LEN];
 		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
-						 &rp->at, &pb) == API_OK)
+						 &rp->at, exp, sizeof exp, &pb) == API_OK) {
+			/* the experiment resumed from the checkpoint sends its
+			 * segments' commands again: applied twice, the second
+			 * would move the estimator's restart */
+			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
+			s->exp_relogged += rp->exp_own;
 			s->nreplay++;
+		}
 		else if (n)
 			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
 					      "replayed: %s", s->entry.id, path, pb.detail);

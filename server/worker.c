@@ -139,6 +139,16 @@ static void apply_budget(srv_session *s, const srv_cmd *cmd)
 		s->cpu_paused = 0;
 }
 
+/* Append cmd's line to the control log: an experiment's names it (lock
+ * held). The log's length with it. */
+static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
+{
+	char line[API_EVENT_MAX];
+	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
+			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
+	return srv_control_log_append(s, line, cmd->waited);
+}
+
 /* Apply queued controls in order and acknowledge each (lock held).
  * Returns 1 if pacing must restart. */
 static int apply_commands(srv_session *s)
@@ -195,8 +205,10 @@ static int apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, c, t_eff);
 			srv_ring_event(s, "control", json);
-			if (!cmd->replay)
-				cmd->logged = srv_control_log_append(s, json, cmd->waited);
+			if (cmd->from_experiment && s->exp_relogged > 0)
+				s->exp_relogged--; /* in the log since before the restore */
+			else if (!cmd->replay)
+				cmd->logged = log_control(s, cmd, t_eff);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
@@ -251,9 +263,11 @@ static void run_replay(srv_session *s)
 {
 	double t = sim_effective_time(s->sim);
 	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
-		srv_cmd *cmd = &s->replay[s->replayed++].cmd;
-		cmd->replay = 1;
-		srv_worker_queue(s, cmd);
+		srv_replay *rp = &s->replay[s->replayed++];
+		if (rp->exp_own)
+			continue; /* its experiment sends it again */
+		rp->cmd.replay = 1;
+		srv_worker_queue(s, &rp->cmd);
 	}
 }
 
