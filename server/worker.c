@@ -588,6 +588,13 @@ void *srv_worker_main(void *arg)
 			publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
+		/* the log first, here: the session has left the registry, so
+		 * the store's writer can no longer find it to sync the lines
+		 * nobody waited for before the checkpoint */
+		size_t logged = s->controls_len;
+		pthread_mutex_unlock(&s->lock);
+		srv_control_log_sync(s, logged, 30.0);
+		pthread_mutex_lock(&s->lock);
 		s->ckpt_dirty = 1;
 		srv_persist_checkpoint(s, 1);
 	}
