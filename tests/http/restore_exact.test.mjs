@@ -77,11 +77,19 @@ test(`a pace-max session killed ${KILLS} times ends bit for bit as an uninterrup
       return r.status !== 200 || r.body.state === 'running';
     });
     const g = await settled(d(), `/api/v1/sessions/${id}`, (b) => b.state === 'finished', 120000);
-    return g.body.status;
+    // the trajectory's rows (since the last start, for the restored one)
+    const tr = (await req(d().base, 'GET', `/api/v1/sessions/${id}/trajectory`)).body;
+    return { status: g.body.status, fields: tr.fields, rows: tr.rows };
   });
   assert.ok(kills >= 1, `killed while running ${kills} times`);
-  assert.ok(Number.isFinite(ref.step_error), 'a shadow measured the step error');
-  assert.deepEqual(physics(got), physics(ref), `restored ${kills} times`);
+  assert.ok(Number.isFinite(ref.status.step_error), 'a shadow measured the step error');
+  assert.deepEqual(physics(got.status), physics(ref.status), `restored ${kills} times`);
+  // every row the restored run recorded is the uninterrupted run's row at
+  // that time, every column (the uncertainty's too)
+  const byT = new Map(ref.rows.map((r) => [r[0], r]));
+  const shared = got.rows.filter((r) => byT.has(r[0]));
+  assert.ok(shared.length >= 10, `${shared.length} rows at shared times`);
+  for (const r of shared) assert.deepEqual(r, byT.get(r[0]), `the row at t = ${r[0]}`);
 });
 
 test(`an experiment killed ${KILLS} times gives the uninterrupted run's CSV byte for byte`, { timeout: 180000 * SLOW }, async () => {
