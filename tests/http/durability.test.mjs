@@ -94,7 +94,7 @@ for (const delay of [0, 1]) {
   });
 }
 
-test('concurrent controls share a sync: fewer syncs than controls, each answered after its line', { timeout: 60000 * SLOW }, async () => {
+test('24 concurrent controls of one session: each in the log once when answered, no more syncs than controls', { timeout: 60000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-group-'));
   const d = await startDaemon(['--data-dir', dir]);
   try {
