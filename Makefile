@@ -109,7 +109,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: all deps deps-build run cluster test check bench bench-controls bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -315,6 +315,12 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 	@$(if $(Q),echo "  FUZZ    $@")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer $(INC_server) -o $@ \
 	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
+
+# PATCH throughput with the durable control log alone (part of `make
+# bench`; tests/bench/controls.mjs, about 20 s): OLD_CONVSIMD=path adds
+# another build's rows for comparison.
+bench-controls: all
+	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/controls.mjs
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;

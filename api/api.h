@@ -298,11 +298,13 @@ typedef struct api_control {
 			      upper bound, --max-cpu-seconds) */
 } api_control;
 
-/* Parse one line of a session's control log (the "control" event of
- * api_control_event: a PATCH body with t_effective) back into *c and
- * *t_effective (s), checked as api_parse_control checks a PATCH. */
+/* Parse one line of a session's control log (api_control_log_line: a
+ * PATCH body with t_effective, and the experiment that sent it) back into
+ * *c, *t_effective (s) and experiment (explen bytes, "" when a client
+ * sent it; may be NULL), checked as api_parse_control checks a PATCH. */
 api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
-				api_control *c, double *t_effective, api_problem *pb);
+				api_control *c, double *t_effective, char *experiment,
+				size_t explen, api_problem *pb);
 /* Parse a PATCH body against the session's spec (ranges from the settings
  * table). All or nothing: on error *c is unspecified and nothing is to be
  * applied. An empty object is a 422. */
@@ -313,6 +315,12 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
  * small). */
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective);
+/* The control as a line of the session's control log: the stream event's
+ * object, and "experiment": its id when an experiment's segment sent it
+ * (experiment may be NULL), so that a restore that resumes the
+ * experiment leaves its commands to it. Returns the length as above. */
+int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
+			 const char *experiment);
 
 /* Everything GET /sessions/{id} shows, filled by the server. */
 /* A LIGGGHTS session's bed (feed_model liggghts, docs/dem.md): it runs in

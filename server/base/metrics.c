@@ -67,6 +67,9 @@ char *srv_metrics_text(const srv_gauges *g)
 	metric(f, "convsim_store_writes_total", "counter",
 	       "Files written to the data directory.",
 	       (double)srv_stats.store_writes);
+	metric(f, "convsim_control_log_syncs_total", "counter",
+	       "Control-log syncs: each makes every control appended before it durable.",
+	       (double)srv_stats.log_syncs);
 	metric(f, "convsim_store_errors_total", "counter",
 	       "Writes to the data directory that failed (ENOSPC, EIO, ...).",
 	       (double)srv_stats.store_errors);

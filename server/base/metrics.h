@@ -19,6 +19,8 @@ typedef struct srv_metrics {
 	atomic_ullong streams_opened, dropped_samples, stream_records;
 	atomic_ullong sweep_points, experiments;
 	atomic_ullong store_writes, store_errors; /* files the writer wrote, failed */
+	atomic_ullong log_syncs;  /* fdatasyncs of control logs (one a round
+				     of group commit) */
 	atomic_ullong requests[6];       /* by status class 1xx..5xx (index 1..5) */
 } srv_metrics;
 extern srv_metrics srv_stats;

@@ -34,6 +34,8 @@ typedef struct store_job {
 	size_t len;
 	int keep_prev;
 	srv_store_done done;
+	void (*before)(void *arg); /* called just before the write */
+	void (*call)(void *arg);   /* a call in order (srv_store_call) */
 	void *arg;
 	struct store_job *next;
 } store_job;
@@ -190,9 +192,16 @@ static void run_job(store_job *j)
 {
 	char msg[4400] = "";
 	int err = 0;
+	if (j->call) {
+		j->call(j->arg);
+		free(j);
+		return;
+	}
 	if (j->notify) {
 		/* superseded: nothing to write, done says so */
 	} else if (j->buf) {
+		if (j->before)
+			j->before(j->arg);
 		err = write_atomic(j, msg, sizeof msg);
 		if (err) {
 			atomic_fetch_add(&srv_stats.store_errors, 1);
@@ -344,6 +353,12 @@ static void enqueue(store_job *j)
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg)
 {
+	srv_store_write_after(path, buf, len, keep_prev, NULL, done, arg);
+}
+
+void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
+			   void (*before)(void *arg), srv_store_done done, void *arg)
+{
 	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
 	if (!j) { /* off (callers check first) or out of memory */
 		free(buf);
@@ -354,6 +369,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 	j->len = len;
 	j->keep_prev = keep_prev;
 	j->done = done;
+	j->before = before;
 	j->arg = arg;
 	/* supersede a pending write to the same path in place */
 	store_job *old = NULL;
@@ -368,6 +384,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 			q->len = j->len;
 			q->keep_prev = j->keep_prev;
 			q->done = j->done;
+			q->before = j->before;
 			q->arg = j->arg;
 			break;
 		}
@@ -378,11 +395,51 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		free(j);
 		free(old->buf);
 		old->buf = NULL;
+		old->before = NULL;
 		old->notify = 1;
 		enqueue(old);
 		return;
 	}
 	enqueue(j);
+}
+
+void srv_store_call(void (*fn)(void *arg), void *arg)
+{
+	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
+	if (!j)
+		return;
+	j->call = fn;
+	j->arg = arg;
+	enqueue(j);
+}
+
+int srv_store_make_dir(const char *rel)
+{
+	if (!st.started)
+		return 0;
+	char path[4096];
+	full_path(path, sizeof path, rel);
+	if (mkdir(path, 0755) != 0)
+		return errno == EEXIST ? 0 : -1;
+	return fsync_parent(path);
+}
+
+int srv_store_open_log(const char *rel, uint64_t len)
+{
+	char path[4096];
+	full_path(path, sizeof path, rel);
+	int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+	if (fd < 0)
+		return -1;
+	/* what lies past len was never acknowledged (a line cut short by a
+	 * crash): cut it, and make the file's name durable */
+	if (ftruncate(fd, (off_t)len) != 0 || fsync(fd) != 0 || fsync_parent(path) != 0) {
+		int e = errno;
+		close(fd);
+		errno = e;
+		return -1;
+	}
+	return fd;
 }
 
 api_err srv_store_check_removable(const char *rel, api_problem *pb)

@@ -4,11 +4,13 @@
  * that writes every file as temporary file -> fsync -> rename -> fsync of
  * the directory, and the framed binary files it reads back at start-up.
  *
- * Nothing else writes under the data directory. Callers hand a finished
- * buffer to the writer (srv_store_write) and go on: no caller waits for a
- * disk, none writes on a worker's step path or under a registry lock. A
- * pending write to the same path is replaced by a newer one (a checkpoint
- * that could not be written in time is superseded, never queued twice).
+ * Nothing else writes under the data directory but the control logs
+ * (control_log.c: appended and synced by the thread that answers for
+ * them). Callers hand a finished buffer to the writer (srv_store_write)
+ * and go on: no caller but a control's answer waits for a disk, none
+ * writes on a worker's step path or under a registry lock. A pending
+ * write to the same path is replaced by a newer one (a checkpoint that
+ * could not be written in time is superseded, never queued twice).
  * The outcome of each write comes back through its callback, on the
  * writer thread with no lock held: 0, or the errno (ENOSPC, EIO, EACCES,
  * ...) with a sentence naming the file; failures are logged and counted
@@ -80,6 +82,25 @@ double srv_store_interval(void);
  * off, or out of memory, buf is freed and done is never called. */
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg);
+/* srv_store_write with before (may be NULL) called on the writer thread
+ * just before the file is written (not when superseded): a checkpoint
+ * makes the control log it accounts for durable first. */
+void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
+			   void (*before)(void *arg), srv_store_done done, void *arg);
+/* Call fn(arg) on the writer thread after the jobs queued before it
+ * (nothing without a data directory: fn is not called). */
+void srv_store_call(void (*fn)(void *arg), void *arg);
+/* Create the directory rel (relative; its parent exists) now, and make
+ * its name durable: 0 (also when it exists or without a data directory),
+ * or -1 with errno. */
+int srv_store_make_dir(const char *rel);
+/* Open the append-only file rel (relative; its directory exists: never
+ * created here, so a file removed with its directory is not made again)
+ * for writing with pwrite, cut to len bytes (a tail past what was made
+ * durable is dropped), its name durable: the descriptor, or -1 with
+ * errno. The control log (control_log.c) is the one file written outside
+ * the writer thread. */
+int srv_store_open_log(const char *rel, uint64_t len);
 /* Queue the removal of path (a file, or a directory and what it holds),
  * after every write queued before it. */
 void srv_store_remove(const char *path);

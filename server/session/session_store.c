@@ -8,13 +8,15 @@
  *   sessions/ID/spec.bin         the same as this build's record (framed,
  *                                store.h), for earlier builds
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
- *                                object a line with t_effective (s)
+ *                                object a line with t_effective (s);
+ *                                appended and synced before the control
+ *                                is answered (control_log.c)
  *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
  *                                until, the attached experiment's state
  *                                and the core's checkpoint (sim.h); the
  *                                one before it as checkpoint.bin.prev
  *
- * Everything is written by the store's writer (store.c); the worker only
+ * Everything else is written by the store's writer (store.c); the worker only
  * serialises, between steps, with the session lock held. A restore never
  * fails the daemon: a checkpoint that does not pass its checks falls back
  * to the previous one; a session whose spec or both checkpoints are
@@ -48,6 +50,7 @@ static void session_dir(char *out, size_t len, const char *id,
 typedef struct write_of {
 	char id[SRV_ID_LEN];
 	int spec; /* spec.json */
+	size_t logged; /* a checkpoint: the control log it accounts for */
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
@@ -79,8 +82,22 @@ static void written(void *arg, int err, const char *what)
 	srv_session_put(s);
 }
 
+/* Before a checkpoint is written: the control log up to what it accounts
+ * for is on disk first (control_log.c), so that no checkpoint holds more
+ * of the log than the file (a restore replays the log after it). */
+static void log_first(void *arg)
+{
+	write_of *w = arg;
+	srv_entry *en = srv_registry_get(&srv_sessions_registry, w->id);
+	if (!en)
+		return;
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	srv_control_log_sync(s, w->logged, 30.0);
+	srv_registry_put(&srv_sessions_registry, en);
+}
+
 static void queue(const srv_session *s, const char *file, void *buf,
-		  size_t len, int keep_prev)
+		  size_t len, int keep_prev, size_t logged)
 {
 	char path[128];
 	session_dir(path, sizeof path, s->entry.id, file);
@@ -88,8 +105,10 @@ static void queue(const srv_session *s, const char *file, void *buf,
 	if (w) {
 		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
 		w->spec = strcmp(file, "spec.json") == 0;
+		w->logged = logged;
 	}
-	srv_store_write(path, buf, len, keep_prev, w ? written : NULL, w);
+	srv_store_write_after(path, buf, len, keep_prev, w && logged ? log_first : NULL,
+			      w ? written : NULL, w);
 }
 
 void srv_persist_spec(srv_session *s)
@@ -106,35 +125,10 @@ void srv_persist_spec(srv_session *s)
 	size_t len;
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
-		queue(s, "spec.bin", buf, len, 0);
+		queue(s, "spec.bin", buf, len, 0, 0);
 	char *text = api_spec_file(&s->spec, s->created, s->owned);
 	if (text)
-		queue(s, "spec.json", text, strlen(text), 0);
-}
-
-void srv_persist_control(srv_session *s, const char *json)
-{
-	if (!srv_store_enabled())
-		return;
-	size_t add = strlen(json) + 1;
-	if (s->controls_len + add + 1 > s->controls_cap) {
-		size_t cap = s->controls_cap ? 2 * s->controls_cap : 4096;
-		while (cap < s->controls_len + add + 1)
-			cap *= 2;
-		char *nc = realloc(s->controls, cap);
-		if (!nc)
-			return;
-		s->controls = nc;
-		s->controls_cap = cap;
-	}
-	memcpy(s->controls + s->controls_len, json, add - 1);
-	s->controls_len += add;
-	s->controls[s->controls_len - 1] = '\n';
-	char *copy = malloc(s->controls_len ? s->controls_len : 1);
-	if (!copy)
-		return;
-	memcpy(copy, s->controls, s->controls_len);
-	queue(s, "controls.ndjson", copy, s->controls_len, 0);
+		queue(s, "spec.json", text, strlen(text), 0, 0);
 }
 
 void srv_persist_checkpoint(srv_session *s, int force)
@@ -177,7 +171,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
 					    &len);
 		if (buf)
-			queue(s, "checkpoint.bin", buf, len, 1);
+			queue(s, "checkpoint.bin", buf, len, 1, s->controls_len);
 	}
 	free(payload);
 	free(exp);
@@ -322,8 +316,13 @@ static void load_controls(srv_session *s, size_t logged)
 	char *text = srv_store_read_text(path, &len);
 	if (!text)
 		return;
+	/* a line a crash cut short was never acknowledged: the log ends at
+	 * its last newline (the file is cut there when it is next written) */
+	while (len > 0 && text[len - 1] != '\n')
+		len--;
 	s->controls = text;
-	s->controls_len = s->controls_cap = len;
+	s->controls_len = s->log_synced = len;
+	s->controls_cap = len + 1;
 	if (logged >= len)
 		return;
 	size_t lines = 0;
@@ -335,9 +334,16 @@ static void load_controls(srv_session *s, size_t logged)
 		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
 		srv_replay *rp = &s->replay[s->nreplay];
 		api_problem pb;
+		char exp[SRV_ID_LEN];
 		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
-						 &rp->at, &pb) == API_OK)
+						 &rp->at, exp, sizeof exp, &pb) == API_OK) {
+			/* the experiment resumed from the checkpoint sends its
+			 * segments' commands again: applied twice, the second
+			 * would move the estimator's restart */
+			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
+			s->exp_relogged += rp->exp_own;
 			s->nreplay++;
+		}
 		else if (n)
 			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
 					      "replayed: %s", s->entry.id, path, pb.detail);
@@ -383,17 +389,28 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 	return rc;
 }
 
+/* s restored at t0 with its log loaded: it runs flat out (and answers
+ * 503 meanwhile: srv_session_replaying) to the later of where a refused
+ * checkpoint said it was (rebuilt) and its last control's time, so that
+ * no client sees it before the controls it acknowledged. */
+static void catch_up(srv_session *s)
+{
+	for (size_t i = 0; i < s->nreplay; i++)
+		if (s->replay[i].at > s->catch_up_t)
+			s->catch_up_t = s->replay[i].at;
+	s->replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
+	if (!(s->catch_up_t > s->replay_t0))
+		s->catch_up_t = 0;
+	s->replay_wall = srv_now();
+}
+
 /* s was re-created from its spec because neither checkpoint could be used
  * (why, why2): its worker replays the whole control log and runs flat out
  * to where it was, the later of the time a checkpoint's trailer gave and
  * the last control's, then at its pace again (worker.c). */
 static void rebuild(srv_session *s, const char *why, const char *why2)
 {
-	for (size_t i = 0; i < s->nreplay; i++)
-		if (s->replay[i].at > s->catch_up_t)
-			s->catch_up_t = s->replay[i].at;
 	s->rebuilt = 1;
-	s->replay_wall = srv_now();
 	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
 	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
 			      "spec, %zu controls replayed to t = %g s",
@@ -420,6 +437,7 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 	int unread = 0, unread_prev = 0;
 	if (load_checkpoint(s, path, ef, &logged, &unread, why, sizeof why) == 0) {
 		load_controls(s, logged);
+		catch_up(s);
 		return;
 	}
 	char prev[160];
@@ -428,6 +446,7 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
 		load_controls(s, logged);
+		catch_up(s);
 		return;
 	}
 	/* none: created less than one interval before the crash; else both
@@ -440,10 +459,11 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 			 &err, msg, sizeof msg);
 	if (s->sim) {
 		load_controls(s, 0);
+		if (none)
+			s->catch_up_t = 0;
+		catch_up(s);
 		if (!none)
 			rebuild(s, why, why2);
-		else
-			s->catch_up_t = 0;
 		return;
 	}
 	snprintf(why, sizeof why, "its spec is refused: %s", msg);

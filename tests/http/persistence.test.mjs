@@ -13,7 +13,7 @@ import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, truncateSync, writeFileSync, statSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, untilReplayed, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, getReady, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
 
 const INTERVAL = 0.5;            // --checkpoint-interval, s
 const MARGIN = 0.8 * SLOW;       // s: scheduling slack on top of it (shared CI cores)
@@ -82,7 +82,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
       const list = await req(d.base, 'GET', '/api/v1/sessions');
       const byId = new Map(list.body.sessions.map((s) => [s.id, s]));
       for (const id of ids) {
-        const s = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+        const s = (await getReady(d.base, `/api/v1/sessions/${id}`)).body;
         assert.ok(s && byId.has(id), `round ${round}: session ${id} lost`);
         assert.equal(s.state, 'running', `round ${round}: ${id} ${s.error}`);
         const mine = acked.filter((a) => a.id === id);
@@ -110,7 +110,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
         assert.ok(e.t >= b.t, `round ${round}: experiment went back from ${b.t} to ${e.t}`);
         assert.ok(s.done >= b.done, `round ${round}: sweep went back from ${b.done} to ${s.done} points`);
       }
-      const es = (await req(d.base, 'GET', `/api/v1/sessions/${e.session}`)).body;
+      const es = (await getReady(d.base, `/api/v1/sessions/${e.session}`)).body;
       assert.equal(es.experiment, ex.body.id, `round ${round}: the experiment runs on its session again`);
       if (finished) {
         const again = await req(d.base, 'GET', `/api/v1/sweeps/${finished.id}`);
@@ -140,7 +140,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
     assert.equal(dv.restored, 'replayed');
     assert.match(d.stderr(), new RegExp(`session ${ids[2]}: .*version.*re-created from its spec`));
     assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${ids[1]}`, { beta: 30 })).status, 409);
-    assert.equal((await req(d.base, 'GET', `/api/v1/sessions/${ids[3]}`)).body.state, 'running');
+    assert.equal((await getReady(d.base, `/api/v1/sessions/${ids[3]}`)).body.state, 'running');
     // DELETE removes the files too
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ids[1]}`)).status, 204);
     await until(() => !existsSync(join(dir, 'sessions', ids[1])), 3000, 'the files to go');
