@@ -1,0 +1,152 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * cli.h - what the files of the command-line runner share: the option
+ * table (one entry per option: its names, argument, unit, default and
+ * meaning, from which both getopt_long's table and the help are made),
+ * near-miss suggestions, number parsing with specific messages, and the
+ * progress reporter. Every message starts with "convsim" and the command.
+ */
+#ifndef CONVSIM_CLI_H
+#define CONVSIM_CLI_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "sim.h"
+#include "study.h"
+
+#define CONVSIM_VERSION "1.0.0"
+
+/* Commands, as bits (an option belongs to one or more). */
+enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
+
+enum {
+	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
+	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_VARY,
+	OPT_LHS, OPT_SEED, OPT_BAND_FROM
+};
+
+/* The default measuring window (s after the transient) of run, sweep and
+ * fit: with the `steady` start, 4 s keep all 74 points of czubak2016
+ * within 1 % of the converged reference (docs/accuracy.md "Accuracy"). */
+#define MEASURE_WINDOW 4.0
+
+/* The most --vary options a sweep takes (SIM_STUDY_MAX_AXES). */
+#define CLI_MAX_VARY 8
+
+/* A command's options as parsed (parse.c): the model (preset and --set),
+ * and each command's own options. */
+typedef struct cli_opts {
+	const char *cmd;
+	sim_params p;
+	sim_scene sc;
+	sim_method m;
+	const char *preset, *out, *format, *beta, *rotation;
+	double duration, rate;
+	int threads, quiet;
+	int coupling_steps; /* feed_model liggghts: machine steps per coupling interval */
+	/* sweep: --vary NAME=SPEC in the order given, --lhs N, --seed S */
+	const char *vary[CLI_MAX_VARY];
+	int nvary, lhs;
+	int beta_at; /* sweep: --beta's place among the --vary (it is one) */
+	double seed;
+	const char *band_from; /* sweep: a fit's JSON result (bands on every point) */
+	/* fit */
+	const char *data, *peaks, *free_list;
+	double curve_step, fd_step; /* deg; relative */
+	int max_iter, starts;
+} cli_opts;
+
+/* The first pass over command cmd's options: help (shown, -1), a wrong
+ * option or an operand (reported, 2), else 0 with --preset in *preset
+ * (may be NULL for commands without one). */
+int cli_first_pass(int argc, char **argv, unsigned cmd, const char **preset);
+/* Parse command cmd's options into *o (the preset's model, --set on top,
+ * defaults). Returns 0, 2 (usage error, reported) or -1 (help shown:
+ * exit 0). */
+int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o);
+
+/* convsim fit (fit_cmd.c): exit status 0, 1 (the fit failed or a file
+ * could not be written) or 2 (usage). */
+int cli_cmd_fit(int argc, char **argv);
+/* convsim sweep (sweep_cmd.c): exit status 0, 1 (a point failed or the
+ * table could not be written) or 2 (usage). */
+int cli_cmd_sweep(int argc, char **argv);
+/* The study of sweep's options into *st (study_opts.c): --beta (default
+ * 0:180:10 when nothing is varied) and every --vary in the order given,
+ * --lhs, --seed, the senses of --rotation, planned (sim_study_plan). 0, or
+ * 2 after a message; st is the caller's to free either way. */
+int cli_plan_study(const cli_opts *o, sim_study *st);
+
+/* Output (options.c): a number as the daemon prints it (shortest round
+ * trip), non-finite as `nonfinite`; whether a file is JSON (--format, else
+ * the name's extension); --out opened for writing, or NULL with the reason
+ * on stderr. */
+void cli_put_num(FILE *f, double v, const char *nonfinite);
+/* JSON text head (a member's name and colon, with what comes before it),
+ * then v as cli_put_num writes it, null when not finite. */
+void cli_put_json_num(FILE *f, const char *head, double v);
+int cli_wants_json(const char *format, const char *file);
+FILE *cli_open_out(const cli_opts *o);
+/* The whole of file path (stdin for "-", at most 16 MB), malloc'd (the
+ * caller frees); NULL after "convsim CMD: --OPT: ..." on stderr. */
+char *cli_slurp(const char *cmd, const char *opt, const char *path);
+
+/* convsim run with feed_model = liggghts: the machine coupled to a
+ * LIGGGHTS bed (dem/cli/run_coupled.c, in convsim-mpi where LIGGGHTS is
+ * installed; in the plain convsim cli/coupled_none.c, which hands
+ * the run over to convsim-mpi or says how to get it). Exit status as run. */
+int cli_run_coupled(const cli_opts *o);
+
+typedef struct cli_opt {
+	unsigned cmds;    /* CMD_* bits: the commands that take it */
+	int id;           /* OPT_* */
+	const char *name; /* long name, without "--" */
+	char key;         /* short letter, or 0 */
+	const char *arg;  /* metavariable, NULL for a flag */
+	const char *unit; /* of the argument, or NULL */
+	const char *def;  /* the default as the help shows it, or NULL */
+	const char *doc;
+} cli_opt;
+
+/* The command bit for a command name, 0 if unknown. */
+unsigned cli_command(const char *name);
+/* Print command cmd's help (usage, every option with unit and default)
+ * on f; cmd 0 prints the overview. */
+void cli_help(FILE *f, unsigned cmd);
+/* The next option of argv for command cmd (getopt_long over the table):
+ * OPT_* with *arg set, -1 at the end, or 0 after printing a specific
+ * error (unknown option with a suggestion, missing argument). */
+int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg);
+/* Index of the first operand after the options (getopt's optind). */
+int cli_operand_index(void);
+/* Parse the same argv again from its start. */
+void cli_restart_options(void);
+
+/* " (did you mean 'X'?)" for a near miss, else "": into buf. */
+const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion);
+
+/* Parse text as a finite number in [lo, hi] (lo excluded if lo_open).
+ * On error prints "convsim CMD: --NAME must be ..., got 'text'" and
+ * returns -1. */
+int cli_number(const char *cmd, const char *opt, const char *unit, const char *text,
+	       double lo, double hi, int lo_open, double *out);
+
+/* Progress on stderr: a bar redrawn in place on a terminal, plain lines
+ * (every tenth of the work) otherwise. Reports start after min_wall
+ * seconds of wall time (0: at once). */
+typedef struct cli_progress {
+	const char *label;
+	int tty, quiet, shown, decile;
+	double t0, last, min_wall;
+} cli_progress;
+void cli_progress_start(cli_progress *p, const char *label, int quiet, double min_wall);
+/* done of total units; detail is shown after the count (may be ""). */
+void cli_progress_update(cli_progress *p, double done, double total, const char *unit,
+			 const char *detail);
+/* The closing line (always for force, else only if something was shown). */
+void cli_progress_end(cli_progress *p, const char *summary, int force);
+double cli_now(void);
+
+#endif

@@ -1,0 +1,506 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * budget.c - the daemon's resource budgets: memory reservations, the cores
+ * of paced sessions, CPU turns for pace "max" sessions, connections per
+ * client address.
+ *
+ * Memory is an estimate made before anything is allocated: the buffers the
+ * server allocates are counted exactly from their sizes (record ring,
+ * trajectory history, stream buffers); the core instance and the threads
+ * are a constant plus a cost per feed element, calibrated against the
+ * resident memory the daemon gained per session (docs/operations.md "Budgets and
+ * load" has the measurement). The cores of paced sessions are committed
+ * the same way: each session holds its need (CPU s per simulated s, first
+ * estimated from its integrator and feed, then measured by its worker,
+ * times its pace) while it runs. CPU turns are a first-come-first-served
+ * queue of at most --max-busy holders, each holding for a time slice while
+ * others wait (round robin: each gets an equal share of the cores).
+ * Connections are counted per client address in a small table sized by
+ * --max-connections (libmicrohttpd never holds more).
+ */
+#include <arpa/inet.h>
+#include <math.h>
+#include <netinet/in.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "budget.h"
+#include "budget_turns.h"
+#include "conns.h"
+#include "util.h"
+
+/* Calibration (docs/operations.md "Budgets and load"): resident bytes a session holds
+ * besides its ring and history, as base + per feed element. */
+#define SESSION_BASE_BYTES ((size_t)128 << 10)
+#define ELEMENT_BYTES ((size_t)384)
+/* A stream's connection thread and its bookkeeping. */
+#define STREAM_BASE_BYTES ((size_t)96 << 10)
+/* Retry-After of a memory refusal: sessions come and go in seconds. */
+#define MEMORY_RETRY_S 5
+/* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
+ * one macro step of the machine (four right-hand sides: RK4, or dem's
+ * macro step), of one feed sub-step per integrated column and per
+ * integrated element, and of one published sample (status, ring record,
+ * trajectory row); `build/convsim run` on this machine, the cost of 5
+ * simulated s less that of 0.01 s, and the daemon's workers. */
+#define STEP_CPU_S 0.41e-6
+#define COLUMN_SUBSTEP_CPU_S 8.0e-8
+#define ELEMENT_SUBSTEP_CPU_S 0.8e-8
+#define SAMPLE_CPU_S 7e-6
+/* and of each double of a published sample's feed record (ring, history) */
+#define RECORD_DOUBLE_CPU_S 2e-9
+/* Retry-After of a refusal for CPU: paced sessions come and go. */
+#define CPU_RETRY_S 5
+
+static const srv_config *cfg;
+static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+static size_t reserved;                 /* lock */
+static double paced;                    /* lock: cores held */
+
+void srv_budget_init(const srv_config *config)
+{
+	cfg = config;
+	srv_cpu_turns_init(config);
+}
+
+/* ---- memory ---------------------------------------------------------------- */
+
+/* Doubles per record of a feed: column displacements, xi and eta. */
+static size_t record_doubles(int columns, int layers)
+{
+	return (size_t)columns + 2 * (size_t)columns * (size_t)layers;
+}
+
+size_t srv_budget_session_need(int columns, int layers)
+{
+	size_t ring = cfg->ring > 16 ? (size_t)cfg->ring : 16;
+	size_t hist = cfg->history > 16 ? (size_t)cfg->history : 16;
+	size_t per = record_doubles(columns, layers);
+	return SESSION_BASE_BYTES +
+	       ELEMENT_BYTES * (size_t)columns * (size_t)layers +
+	       ring * (sizeof(api_sample) + per * sizeof(double)) +
+	       hist * API_HISTORY_WIDTH(columns) * sizeof(double) +
+	       per * sizeof(double);
+}
+
+size_t srv_budget_stream_need(int columns, int layers)
+{
+	/* stream.c: the record copy and 4 formatted records + 64 kB */
+	return STREAM_BASE_BYTES +
+	       record_doubles(columns, layers) * sizeof(double) +
+	       4 * api_record_max(columns, layers) + 65536;
+}
+
+size_t srv_budget_memory(void)
+{
+	return cfg->max_memory;
+}
+
+size_t srv_budget_reserved(void)
+{
+	pthread_mutex_lock(&lock);
+	size_t n = reserved;
+	pthread_mutex_unlock(&lock);
+	return n;
+}
+
+static double mib(size_t bytes)
+{
+	return (double)bytes / (1 << 20);
+}
+
+/* Add n to *pool if it stays within cap (or force); *before: the pool
+ * before. 1 if added. */
+static int reserve(size_t *pool, size_t cap, size_t n, int force,
+		   size_t *before)
+{
+	pthread_mutex_lock(&lock);
+	*before = *pool;
+	int room = force || (*pool <= cap && n <= cap - *pool);
+	if (room)
+		*pool += n;
+	pthread_mutex_unlock(&lock);
+	return room;
+}
+
+api_err srv_budget_take(size_t bytes, const char *what, int force,
+			api_problem *pb)
+{
+	size_t used;
+	if (reserve(&reserved, cfg->max_memory, bytes, force, &used))
+		return API_OK;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "%s needs %.1f MiB and %.1f MiB of the memory budget of "
+		 "%.1f MiB (--max-memory) are taken; nothing was created, "
+		 "retry when sessions or streams have ended", what, mib(bytes),
+		 mib(used), mib(cfg->max_memory));
+	return api_budget(pb, "memory", (double)cfg->max_memory,
+			  MEMORY_RETRY_S);
+}
+
+api_err srv_budget_take_session(int columns, int layers, size_t *need,
+				api_problem *pb)
+{
+	*need = srv_budget_session_need(columns, layers);
+	if (*need <= cfg->max_memory)
+		return srv_budget_take(*need, "this session", 0, pb);
+	/* alone too large: the largest feed of this shape that fits */
+	int fit = layers;
+	while (fit > 0 && srv_budget_session_need(columns, fit) > cfg->max_memory)
+		fit--;
+	const char *field = fit > 0 ? "scene.layers" : "scene.columns";
+	api_fail(pb, API_RANGE, field,
+		 "this session needs %.1f MiB (%d x %d feed, %d stream records, "
+		 "%d trajectory rows), more than the whole memory budget of "
+		 "%.1f MiB (--max-memory); %s", mib(*need), columns, layers,
+		 cfg->ring, cfg->history, mib(cfg->max_memory),
+		 fit > 0 ? "fewer layers fit" : "fewer columns fit");
+	if (fit == 0) {
+		fit = columns;
+		while (fit > 0 && srv_budget_session_need(fit, 1) > cfg->max_memory)
+			fit--;
+	}
+	pb->has_range = 1;
+	pb->min = fit > 0 ? 1 : 0;
+	pb->max = fit;
+	return api_budget(pb, "memory", (double)cfg->max_memory, 0);
+}
+
+void srv_budget_give(size_t bytes)
+{
+	pthread_mutex_lock(&lock);
+	reserved -= bytes < reserved ? bytes : reserved;
+	pthread_mutex_unlock(&lock);
+}
+
+/* ---- cores of paced sessions ------------------------------------------------ */
+
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers)
+{
+	const sim_method *m = &spec->method;
+	double dt = st->dt, evals = 1;
+	int substeps = st->substeps;
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(all[i]->name, m->name) == 0 && all[i]->adaptive) {
+			/* its steps follow the solution: guess dem's */
+			sim_method dem = *m;
+			snprintf(dem.name, sizeof dem.name, "dem");
+			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
+			substeps = sim_default_substeps(&spec->params, &spec->scene, &dem, dt);
+		}
+	if (strcmp(m->name, "euler") == 0)
+		evals = 0.25; /* one right-hand side a step, not four */
+	if (!(dt > 0))
+		dt = 1e-3;
+	if (substeps < 1)
+		substeps = 1;
+	/* the symmetric reduction integrates one representative column */
+	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
+	if (columns <= 0 || layers <= 0)
+		integrated = 0;
+	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
+			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
+	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
+}
+
+double srv_budget_sample_cpu(int columns, int layers)
+{
+	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)record_doubles(columns, layers);
+}
+
+api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
+			      const char *field, const char *verb,
+			      api_problem *pb)
+{
+	double need = cpu_per_s * pace, limit = cfg->max_paced_cores;
+	pthread_mutex_lock(&lock);
+	double others = paced - *held;
+	int fits = need <= *held || others + need <= limit * (1 + 1e-12);
+	if (fits) {
+		if (need > *held) {
+			paced = others + need;
+			*held = need;
+		}
+		pthread_mutex_unlock(&lock);
+		return API_OK;
+	}
+	pthread_mutex_unlock(&lock);
+	if (need > limit) {
+		api_fail(pb, API_RANGE, field,
+			 "this session needs %.3g cores (%.3g ms of CPU per "
+			 "simulated s at pace %g), more than the %g cores for "
+			 "paced sessions (--max-paced-cores); nothing was %s, "
+			 "lower the pace", need, 1e3 * cpu_per_s, pace, limit,
+			 verb);
+		pb->has_range = 1;
+		pb->min = 0.001; /* the least pace (api/) */
+		pb->max = limit / cpu_per_s;
+		return api_budget(pb, "cpu", limit, 0);
+	}
+	api_fail(pb, API_UNAVAILABLE, field,
+		 "this session needs %.3g cores (%.3g ms of CPU per simulated s "
+		 "at pace %g) and running paced sessions hold %.3g of the %g "
+		 "cores for paced sessions (--max-paced-cores); nothing was %s, "
+		 "retry when paced sessions have ended, paused or slowed down",
+		 need, 1e3 * cpu_per_s, pace, others, limit, verb);
+	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
+}
+
+double srv_budget_fit_pace(double *held, double cpu_per_s, double pace)
+{
+	pthread_mutex_lock(&lock);
+	double others = paced - *held, room = cfg->max_paced_cores - others;
+	double fit = pace;
+	if (cpu_per_s > 0 && cpu_per_s * pace > room * (1 + 1e-12)) {
+		fit = room / cpu_per_s; /* NaN when no room: the least pace */
+		double unit = pow(10, floor(log10(fit)) - 2);
+		fit = floor(fit / unit) * unit; /* three significant digits */
+	}
+	if (!(fit >= API_PACE_MIN))
+		fit = API_PACE_MIN;
+	if (fit > pace)
+		fit = pace;
+	*held = cpu_per_s * fit;
+	paced = others + *held;
+	pthread_mutex_unlock(&lock);
+	return fit;
+}
+
+void srv_budget_set_paced(double *held, double need)
+{
+	if (!(need >= 0))
+		need = 0;
+	pthread_mutex_lock(&lock);
+	paced += need - *held;
+	if (paced < 1e-12)
+		paced = 0; /* no drift below nothing */
+	*held = need;
+	pthread_mutex_unlock(&lock);
+}
+
+double srv_budget_paced(void)
+{
+	pthread_mutex_lock(&lock);
+	double c = paced;
+	pthread_mutex_unlock(&lock);
+	return c;
+}
+
+double srv_budget_paced_limit(void)
+{
+	return cfg->max_paced_cores;
+}
+
+/* ---- queued sweep points ------------------------------------------------------ */
+
+static size_t points;               /* lock */
+static double point_seconds = 1.0;  /* lock: mean wall time of a point */
+
+api_err srv_budget_take_points(size_t n, const char *field, int force,
+			       api_problem *pb)
+{
+	size_t cap = (size_t)cfg->max_queued_points;
+	if (n > cap && !force) {
+		api_fail(pb, API_RANGE, field,
+			 "this sweep has %zu points, more than the %zu sweep "
+			 "points that may be queued (--max-queued-points); "
+			 "split it", n, cap);
+		pb->has_range = 1;
+		pb->min = 1;
+		pb->max = (double)cap;
+		return api_budget(pb, "sweep-points", (double)cap, 0);
+	}
+	size_t queued;
+	if (reserve(&points, cap, n, force, &queued))
+		return API_OK;
+	/* the wait: the points beyond the budget, at the pool's pace */
+	pthread_mutex_lock(&lock);
+	double wait = (double)(queued + n - cap) * point_seconds /
+		      (cfg->pool_threads > 0 ? cfg->pool_threads : 1);
+	pthread_mutex_unlock(&lock);
+	api_fail(pb, API_LIMIT, NULL,
+		 "%zu sweep points are queued or running and this sweep adds "
+		 "%zu: the budget is %zu (--max-queued-points); nothing was "
+		 "queued", queued, n, cap);
+	return api_budget(pb, "sweep-points", (double)cap,
+			  wait < 1 ? 1 : wait > 3600 ? 3600 : (int)(wait + 0.999));
+}
+
+void srv_budget_point_done(double seconds)
+{
+	pthread_mutex_lock(&lock);
+	if (points)
+		points--;
+	if (seconds > 0) /* a running mean over the last few dozen points */
+		point_seconds += (seconds - point_seconds) / 32;
+	pthread_mutex_unlock(&lock);
+}
+
+void srv_budget_give_points(size_t n)
+{
+	pthread_mutex_lock(&lock);
+	points -= n < points ? n : points;
+	pthread_mutex_unlock(&lock);
+}
+
+size_t srv_budget_points(void)
+{
+	pthread_mutex_lock(&lock);
+	size_t n = points;
+	pthread_mutex_unlock(&lock);
+	return n;
+}
+
+/* ---- connections per client -------------------------------------------------------- */
+
+typedef struct client {
+	unsigned char addr[16]; /* IPv4 in the first 4 bytes */
+	int family;
+	int count;              /* lock; 0: a free entry */
+} client;
+
+/* What a connection's socket context holds. */
+typedef struct client_conn {
+	client *c;
+	int over;
+	srv_conn *live; /* conns.c: deadlines, room at the global cap */
+} client_conn;
+
+static client *clients;  /* lock; cfg->max_connections + 1 entries */
+static atomic_ullong client_refused;
+
+/* The address bytes of a connection's peer; 0 if it has none. */
+static int peer(struct MHD_Connection *conn, unsigned char addr[16],
+		int *family)
+{
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+	if (!ci || !ci->client_addr)
+		return 0;
+	memset(addr, 0, 16);
+	*family = ci->client_addr->sa_family;
+	if (*family == AF_INET)
+		memcpy(addr, &((const struct sockaddr_in *)(const void *)ci->client_addr)
+				      ->sin_addr, 4);
+	else if (*family == AF_INET6)
+		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)ci->client_addr)
+				      ->sin6_addr, 16);
+	else
+		return 0;
+	return 1;
+}
+
+/* The entry of addr, or a free one for it; NULL when full (lock held). */
+static client *find_client(const unsigned char addr[16], int family)
+{
+	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
+	client *free_one = NULL;
+	if (!clients && !(clients = calloc(n, sizeof *clients)))
+		return NULL;
+	for (size_t i = 0; i < n; i++) {
+		client *c = &clients[i];
+		if (c->count && c->family == family && memcmp(c->addr, addr, 16) == 0)
+			return c;
+		if (!c->count && !free_one)
+			free_one = c;
+	}
+	if (free_one) {
+		memcpy(free_one->addr, addr, 16);
+		free_one->family = family;
+	}
+	return free_one;
+}
+
+void srv_budget_connection(void *cls, struct MHD_Connection *conn,
+			   void **socket_context,
+			   enum MHD_ConnectionNotificationCode code)
+{
+	(void)cls;
+	client_conn *cc = *socket_context;
+	if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+		if (cc && cc->c) {
+			pthread_mutex_lock(&lock);
+			cc->c->count--;
+			pthread_mutex_unlock(&lock);
+		}
+		if (cc)
+			srv_conn_close(cc->live);
+		free(cc);
+		*socket_context = NULL;
+		return;
+	}
+	unsigned char addr[16];
+	int family;
+	cc = calloc(1, sizeof *cc);
+	if (cc)
+		cc->live = srv_conn_open(conn);
+	if (!cc || !peer(conn, addr, &family)) {
+		*socket_context = cc;
+		return;
+	}
+	pthread_mutex_lock(&lock);
+	cc->c = find_client(addr, family);
+	if (cc->c)
+		cc->over = ++cc->c->count > cfg->max_client_connections;
+	pthread_mutex_unlock(&lock);
+	*socket_context = cc;
+}
+
+srv_conn *srv_budget_live(struct MHD_Connection *conn)
+{
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+	const client_conn *cc = ci ? ci->socket_context : NULL;
+	return cc ? cc->live : NULL;
+}
+
+int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
+{
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+	const client_conn *cc = ci ? ci->socket_context : NULL;
+	if (!cc || !cc->over)
+		return 0;
+	atomic_fetch_add(&client_refused, 1);
+	api_fail(pb, API_LIMIT, NULL,
+		 "this client address has more than %d connections open, its "
+		 "budget (--max-client-connections); close some (idle ones "
+		 "close after %g s) and retry", cfg->max_client_connections,
+		 cfg->connection_timeout);
+	api_budget(pb, "connections", cfg->max_client_connections, 1);
+	pb->close = 1; /* one too many: the answer closes it */
+	return 1;
+}
+
+unsigned long long srv_budget_client_refused(void)
+{
+	return atomic_load(&client_refused);
+}
+
+static atomic_ullong connections_dropped;
+
+unsigned long long srv_budget_connections_dropped(void)
+{
+	return atomic_load(&connections_dropped);
+}
+
+void srv_budget_mhd_log(void *cls, const char *fmt, va_list ap)
+{
+	(void)cls;
+	char line[512];
+	vsnprintf(line, sizeof line, fmt, ap);
+	size_t n = strlen(line);
+	while (n && line[n - 1] == '\n')
+		line[--n] = '\0';
+	int refused = strstr(line, "connection limit") != NULL ||
+		      strstr(line, "connections from this IP") != NULL;
+	if (refused)
+		atomic_fetch_add(&connections_dropped, 1);
+	srv_log(refused ? SRV_LOG_DEBUG : SRV_LOG_WARN, "libmicrohttpd: %s",
+		line);
+}

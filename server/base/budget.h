@@ -1,0 +1,133 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * budget.h - the daemon's resource budgets, so that no one client takes the
+ * machine: memory (the need of each session and stream, estimated before it
+ * is created and reserved against --max-memory), the cores that running
+ * paced sessions need (each its CPU s per simulated s times its pace,
+ * committed against --max-paced-cores before it is created, resumed or
+ * sped up), CPU turns for pace "max" sessions (at most --max-busy step at
+ * once, taking turns in time slices, first come first served) and the
+ * open connections of each client address (counted in libmicrohttpd's
+ * connection notification). The CPU turns are in budget_turns.h.
+ *
+ * A leaf like metrics.c: it calls nothing else of server/ but util.c. Its
+ * lock is a leaf of the lock order (registry.h): nothing is taken under it
+ * (it only signals a waiting worker's condition).
+ */
+#ifndef CONVSIM_BUDGET_H
+#define CONVSIM_BUDGET_H
+
+#include <microhttpd.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include "api.h"
+#include "config.h"
+
+/* Keep cfg (borrowed for the daemon's life). */
+void srv_budget_init(const srv_config *cfg);
+
+/* ---- memory ---------------------------------------------------------------- */
+
+/* Estimated bytes of a session with this feed (0 x 0 without feed): the
+ * core instance, its worker, the record ring (--ring) and the trajectory
+ * history (--history) when full. */
+size_t srv_budget_session_need(int columns, int layers);
+/* Estimated bytes of one stream client of such a session. */
+size_t srv_budget_stream_need(int columns, int layers);
+/* Reserve a session's need: API_OK (*need set), 422 when it alone exceeds
+ * the whole budget (naming scene.layers or scene.columns with the largest
+ * value that fits) or 503 when the budget has no room now; *pb names the
+ * budget. Nothing is reserved on failure. */
+api_err srv_budget_take_session(int columns, int layers, size_t *need,
+				api_problem *pb);
+/* Reserve bytes for what (a noun for the message): API_OK or 503 with *pb.
+ * force: reserve even beyond the budget (a session restored at start-up). */
+api_err srv_budget_take(size_t bytes, const char *what, int force,
+			api_problem *pb);
+/* Give back a reservation (0 is accepted). */
+void srv_budget_give(size_t bytes);
+/* Bytes reserved now, and the budget. */
+size_t srv_budget_reserved(void);
+size_t srv_budget_memory(void);
+
+/* ---- cores of paced sessions ------------------------------------------------ */
+
+/* CPU s the server spends on one published sample of a feed of columns x
+ * layers (status, ring record, trajectory row), besides the core's. */
+double srv_budget_sample_cpu(int columns, int layers);
+/* Estimated CPU s per simulated s of a session before it has run: from
+ * its integrator (method, the step dt and the feed sub-steps in use, as
+ * sim_get_status reports them after sim_new) and the feed elements it
+ * integrates (feed: columns x layers; the symmetric reduction integrates
+ * one representative column). Calibrated on this machine (docs/operations.md "Budgets
+ * and load"); a running session's worker measures its own. */
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers);
+/* Raise what a paced session holds (*held, cores; the caller's, guarded
+ * by its lock) to need = cpu_per_s x pace. API_OK when need <= *held or
+ * the running paced sessions' sum stays within --max-paced-cores; else
+ * nothing changes and *pb is 503 (budget "cpu", Retry-After, field named)
+ * or, when need alone is more than the whole budget, 422 naming field
+ * with the largest pace that fits as max. verb: "created" or "changed",
+ * for the message. */
+api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
+			      const char *field, const char *verb,
+			      api_problem *pb);
+/* Set what a session holds to need (cores, >= 0), even beyond the budget:
+ * its worker's own measure, a pause, the end. */
+void srv_budget_set_paced(double *held, double need);
+/* The pace, at most pace, at which a running paced session that measured
+ * cpu_per_s (CPU s per simulated s) fits beside the other paced sessions'
+ * holds within --max-paced-cores (three significant digits, rounded
+ * down; at least API_PACE_MIN even where that does not fit); *held is set
+ * to its need at that pace. */
+double srv_budget_fit_pace(double *held, double cpu_per_s, double pace);
+/* Cores held by running paced sessions now, and the budget. */
+double srv_budget_paced(void);
+double srv_budget_paced_limit(void);
+
+/* ---- queued sweep points ------------------------------------------------------ */
+
+/* Reserve n sweep points (queued or running, all sweeps): API_OK, 422 when
+ * n alone exceeds --max-queued-points (naming field), or 429 with a
+ * Retry-After from the measured time per point; *pb names the budget.
+ * force: reserve beyond the budget (a sweep restored at start-up). */
+api_err srv_budget_take_points(size_t n, const char *field, int force,
+			       api_problem *pb);
+/* One point is done (or skipped) after seconds of wall time (0: skipped). */
+void srv_budget_point_done(double seconds);
+/* Give back n points that were never queued. */
+void srv_budget_give_points(size_t n);
+/* Points queued or running now. */
+size_t srv_budget_points(void);
+
+/* ---- connections per client ------------------------------------------------- */
+
+/* Connections a client may open beyond its budget that still get a 429
+ * with a body; libmicrohttpd closes any further ones at accept
+ * (MHD_OPTION_PER_IP_CONNECTION_LIMIT is the budget plus this). */
+#define SRV_CLIENT_GRACE 8
+
+/* libmicrohttpd's connection notification: counts the connections of each
+ * client address (MHD_OPTION_NOTIFY_CONNECTION, cls unused). */
+void srv_budget_connection(void *cls, struct MHD_Connection *conn,
+			   void **socket_context,
+			   enum MHD_ConnectionNotificationCode code);
+/* conn's entry in the table of open connections and their deadlines
+ * (conns.h), borrowed until libmicrohttpd closes it; NULL if it has none. */
+struct srv_conn *srv_budget_live(struct MHD_Connection *conn);
+/* 1 if conn was opened beyond its client's --max-client-connections (it
+ * gets a 429 and is closed), with *pb naming the budget. */
+int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb);
+/* Connections answered 429 by the per-client budget so far, and those
+ * libmicrohttpd closed at accept (beyond the grace or --max-connections). */
+unsigned long long srv_budget_client_refused(void);
+unsigned long long srv_budget_connections_dropped(void);
+/* libmicrohttpd's error log (MHD_OPTION_EXTERNAL_LOGGER): its refusals at
+ * the connection limits are counted and logged at debug level (thousands
+ * of idle sockets must not flood the log), the rest as warnings. */
+void srv_budget_mhd_log(void *cls, const char *fmt, va_list ap);
+
+#endif

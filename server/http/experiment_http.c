@@ -1,0 +1,177 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * experiment_http.c - the experiments as a kind of job: their registry and
+ * the descriptor the handlers of /api/v1/experiments[/{id}] use (job.c).
+ *
+ * Experiments are kept in a registry until shutdown; beyond
+ * --max-experiments the oldest finished one that no worker refers to is
+ * evicted. Creating one either creates a fresh session with the
+ * experiment attached before its first step, or attaches it to a running
+ * session; the session's worker then runs it (experiment.c).
+ */
+#include <stdlib.h>
+
+#include "experiment.h"
+#include "experiment_http.h"
+#include "job.h"
+#include "metrics.h"
+#include "session.h"
+#include "store.h"
+#include "util.h"
+
+static void destroy(srv_entry *en)
+{
+	srv_exp_free(srv_exp_from_entry(en));
+}
+
+static srv_registry experiments = SRV_REGISTRY_INIT(destroy);
+static const srv_config *cfg;
+
+void srv_experiments_init(const srv_config *config)
+{
+	cfg = config;
+	srv_job_open(&srv_experiment_job, (size_t)cfg->max_experiments);
+}
+
+static int evictable(srv_entry *en)
+{
+	return srv_exp_finished(srv_exp_from_entry(en));
+}
+
+srv_experiment *srv_experiment_get(const char *id)
+{
+	srv_entry *en = srv_registry_get(&experiments, id);
+	return en ? srv_exp_from_entry(en) : NULL;
+}
+
+void srv_experiment_put(srv_experiment *e)
+{
+	if (e)
+		srv_registry_put(&experiments, srv_exp_entry(e));
+}
+
+size_t srv_experiments_interrupt_orphans(void)
+{
+	srv_entry **all = NULL;
+	size_t n = srv_registry_snapshot(&experiments, &all), count = 0;
+	for (size_t i = 0; i < n; i++)
+		count += (size_t)srv_exp_interrupt(srv_exp_from_entry(all[i]));
+	srv_registry_release(&experiments, all, n);
+	return count;
+}
+
+/* Run e on a fresh session or attach it to the one it names; the session
+ * notes its id in e before its worker can run it. */
+static api_err start_on_session(srv_experiment *e,
+				const api_experiment_req *req, api_problem *pb)
+{
+	srv_session *s;
+	if (req->fresh) {
+		s = srv_session_create(&req->spec, e, pb);
+		if (!s)
+			return pb->code;
+	} else {
+		s = srv_session_get(req->session_id);
+		if (!s)
+			return api_fail(pb, API_NOTFOUND, "session",
+					"no session with id \"%.40s\"",
+					req->session_id);
+		if (srv_session_replaying(s, pb) != API_OK ||
+		    srv_session_attach(s, e, pb) != API_OK) {
+			srv_session_put(s);
+			return pb->code;
+		}
+	}
+	srv_session_put(s); /* it noted its id in e before its worker ran */
+	return API_OK;
+}
+
+/* The experiment as JSON, from a consistent copy of its state. */
+static char *experiment_json(srv_experiment *e, int csv)
+{
+	api_experiment_view v;
+	api_segment seg[API_EXP_MAX_SEGMENTS];
+	srv_exp_view(e, &v, seg);
+	return csv ? api_experiment_csv(&v, 1) : api_experiment_json(&v);
+}
+
+/* An experiment for a request body; NULL with *pb. */
+static srv_entry *experiment_create(const char *body, size_t len, api_problem *pb)
+{
+	api_experiment_req *req = malloc(sizeof *req);
+	if (!req) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
+	srv_experiment *e = NULL;
+	if (api_parse_experiment(body, len, req, pb) == API_OK)
+		e = srv_exp_new(req, cfg->data_dir, pb);
+	free(req);
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+static void experiment_discard(srv_entry *en)
+{
+	srv_exp_free(srv_exp_from_entry(en));
+}
+
+/* On its session (a fresh one or the one it names), then its record. */
+static api_err experiment_start(srv_entry *en, char **answer, api_problem *pb)
+{
+	srv_experiment *e = srv_exp_from_entry(en);
+	if (start_on_session(e, srv_exp_request(e), pb) != API_OK)
+		return pb->code;
+	srv_exp_persist(e);
+	atomic_fetch_add(&srv_stats.experiments, 1);
+	*answer = experiment_json(e, 0);
+	return API_OK;
+}
+
+static char *experiment_text(srv_entry *en, int csv)
+{
+	return experiment_json(srv_exp_from_entry(en), csv);
+}
+
+static void experiment_view(srv_entry *en, void *view, void *scratch)
+{
+	srv_exp_view(srv_exp_from_entry(en), view, scratch);
+}
+
+static char *experiment_list_text(const void *views, size_t n, int csv)
+{
+	return csv ? api_experiment_csv(views, n) : api_experiment_list_json(views, n);
+}
+
+static srv_entry *experiment_load(void *payload, size_t len, char *why, size_t whylen)
+{
+	srv_experiment *e = srv_exp_load(payload, len, why, whylen);
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+static srv_entry *experiment_damaged(const char *id, const char *why)
+{
+	srv_experiment *e = srv_exp_damaged(id, why);
+	return e ? srv_exp_entry(e) : NULL;
+}
+
+/* No DELETE: an experiment goes with its session's end or is pushed out. */
+const srv_job_kind srv_experiment_job = {
+	.name = "experiment",
+	.plural = "experiments",
+	.reg = &experiments,
+	.created_status = 201,
+	.limit = "experiments are running or kept (--max-experiments)",
+	.store_kind = SRV_STORE_EXPERIMENT,
+	.restore_evicts = 1,
+	.create = experiment_create,
+	.discard = experiment_discard,
+	.start = experiment_start,
+	.evictable = evictable,
+	.text = experiment_text,
+	.view_size = sizeof(api_experiment_view),
+	.scratch_size = API_EXP_MAX_SEGMENTS * sizeof(api_segment),
+	.view = experiment_view,
+	.list_text = experiment_list_text,
+	.load = experiment_load,
+	.damaged = experiment_damaged,
+};

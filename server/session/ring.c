@@ -1,0 +1,231 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * ring.c - what a session's worker writes for its readers: records into the
+ * bounded ring (samples and events, indexed by a sequence number that never
+ * repeats; the oldest is overwritten) and rows into the trajectory history
+ * (every stride, exactly on its grid; the stride doubles when it fills).
+ * Below them the readers (streams, the trajectory route): one consistent
+ * copy under the session lock, which never leaves this file, session.c and
+ * worker.c.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "session_int.h"
+#include "util.h"
+
+static api_sample *push_slot(srv_session *s)
+{
+	api_sample *slot = srv_ring_slot(s, s->head % s->ring_cap);
+	slot->index = s->head++;
+	return slot;
+}
+
+void srv_ring_event(srv_session *s, const char *type, const char *json)
+{
+	api_sample *slot = push_slot(s);
+	slot->kind = API_REC_EVENT;
+	slot->st = s->st;
+	snprintf(slot->event_type, sizeof slot->event_type, "%s", type);
+	snprintf(slot->event, sizeof slot->event, "%s", json);
+	s->event_head = s->head;
+}
+
+void srv_ring_event_at(srv_session *s, const char *type, const char *detail)
+{
+	char json[API_EVENT_MAX], t[40];
+	api_fmt_time(t, sizeof t, s->st.t);
+	snprintf(json, sizeof json, "{\"t\":%s%s%s}", t, detail ? "," : "",
+		 detail ? detail : "");
+	srv_ring_event(s, type, json);
+}
+
+/* 1 if t lies on the grid of multiples of step (to rounding). */
+static int on_grid(double t, double step)
+{
+	double m = t / step;
+	return fabs(m - floor(m + 0.5)) < 1e-6;
+}
+
+/* A trajectory row at every multiple of the stride, exactly: rows are
+ * taken at sample times on that grid (the stride is a whole number of
+ * sample intervals), so the rows lie `stride` apart as reported. */
+static void record_history(srv_session *s)
+{
+	if (!s->hist_cap || s->st.t < s->hist_next - 1e-9 * s->hist_stride ||
+	    !on_grid(s->st.t, s->hist_stride))
+		return;
+	size_t width = API_HISTORY_WIDTH(s->columns);
+	if (s->hist_n == s->hist_cap) {
+		/* full: keep the rows on the doubled grid, double the stride */
+		size_t k = 0;
+		for (size_t i = 0; i < s->hist_n; i++)
+			if (on_grid(s->hist[i * width], 2 * s->hist_stride))
+				memmove(s->hist + k++ * width, s->hist + i * width,
+					width * sizeof(double));
+		s->hist_n = k;
+		s->hist_stride *= 2;
+		if (!on_grid(s->st.t, s->hist_stride)) {
+			s->hist_next = (floor(s->st.t / s->hist_stride + 1e-6) + 1) * s->hist_stride;
+			return;
+		}
+	}
+	api_history_row(&s->st, s->scratch.column_disp, s->columns,
+			s->hist + s->hist_n * width);
+	s->hist_n++;
+	s->hist_next = (floor(s->st.t / s->hist_stride + 0.5) + 1) * s->hist_stride;
+}
+
+void srv_ring_sample(srv_session *s)
+{
+	api_sample *slot = push_slot(s);
+	slot->kind = API_REC_SAMPLE;
+	slot->st = s->st;
+	slot->event_type[0] = '\0';
+	size_t n = (size_t)s->columns +
+		   2 * (size_t)s->columns * (size_t)s->layers;
+	if (n)
+		memcpy(slot->column_disp, s->scratch.column_disp,
+		       n * sizeof(double));
+	record_history(s);
+}
+
+void srv_ring_gather(srv_session *s)
+{
+	if (!s->columns)
+		return;
+	sim_column_displacement(s->sim, s->scratch.column_disp);
+	sim_feed_state(s->sim, s->scratch.xi, s->scratch.eta);
+}
+
+/* ---- records for readers ------------------------------------------------ */
+
+int srv_sample_alloc(api_sample *rec, int columns, int layers)
+{
+	size_t n = (size_t)columns + 2 * (size_t)columns * (size_t)layers;
+	memset(rec, 0, sizeof *rec);
+	rec->column_disp = calloc(n ? n : 1, sizeof(double));
+	if (!rec->column_disp)
+		return -1;
+	rec->columns = columns;
+	rec->layers = layers;
+	rec->xi = rec->column_disp + columns;
+	rec->eta = rec->xi + (size_t)columns * (size_t)layers;
+	return 0;
+}
+
+void srv_sample_free(api_sample *rec)
+{
+	if (!rec)
+		return;
+	free(rec->column_disp);
+	rec->column_disp = rec->xi = rec->eta = NULL;
+}
+
+static void copy_record(api_sample *dst, const api_sample *src)
+{
+	size_t n = (size_t)src->columns +
+		   2 * (size_t)src->columns * (size_t)src->layers;
+	dst->index = src->index;
+	dst->kind = src->kind;
+	dst->st = src->st;
+	dst->columns = src->columns;
+	dst->layers = src->layers;
+	if (src->kind == API_REC_SAMPLE && n)
+		memcpy(dst->column_disp, src->column_disp, n * sizeof(double));
+	memcpy(dst->event_type, src->event_type, sizeof dst->event_type);
+	if (src->kind == API_REC_EVENT)
+		memcpy(dst->event, src->event, sizeof dst->event);
+}
+
+/* ---- snapshot readers ----------------------------------------------------- */
+
+/* The ring's bounds and the run state (lock held). */
+static void look(srv_session *s, srv_ring_read *rd)
+{
+	rd->head = s->head;
+	rd->oldest = s->head > s->ring_cap ? s->head - s->ring_cap : 0;
+	rd->state = s->state;
+	rd->removed = s->stop;
+	rd->t = s->st.t;
+}
+
+srv_ring_read srv_session_ring(srv_session *s)
+{
+	srv_ring_read rd;
+	pthread_mutex_lock(&s->lock);
+	look(s, &rd);
+	pthread_mutex_unlock(&s->lock);
+	return rd;
+}
+
+void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
+		      api_sample *dst, srv_ring_read *rd)
+{
+	pthread_mutex_lock(&s->lock);
+	look(s, rd);
+	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
+	/* samples before from_t are passed over here, without a copy */
+	while (idx < rd->head) {
+		const api_sample *r = &s->ring[idx % s->ring_cap];
+		if (r->kind != API_REC_SAMPLE || r->st.t >= from_t)
+			break;
+		idx++;
+	}
+	rd->next = idx;
+	if (idx < rd->head)
+		copy_record(dst, &s->ring[idx % s->ring_cap]);
+	pthread_mutex_unlock(&s->lock);
+}
+
+void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
+		      double seconds)
+{
+	pthread_mutex_lock(&s->lock);
+	/* what would wake it: an event, a sample at or past from_t, a change
+	 * of state, the deletion */
+	int news = s->event_head > rd->head ||
+		   (s->head > rd->head && s->st.t >= from_t) ||
+		   s->state != rd->state || s->stop;
+	if (!news) {
+		if (from_t < s->wake_t)
+			s->wake_t = from_t; /* the worker wakes it from then */
+		struct timespec ts = srv_deadline(seconds);
+		pthread_cond_timedwait(&s->data, &s->lock, &ts);
+	}
+	pthread_mutex_unlock(&s->lock);
+}
+
+void srv_session_stream_count(srv_session *s, int delta)
+{
+	pthread_mutex_lock(&s->lock);
+	s->streams += delta;
+	pthread_mutex_unlock(&s->lock);
+}
+
+void srv_session_feed_size(const srv_session *s, int *columns, int *layers)
+{
+	*columns = s->columns;
+	*layers = s->layers;
+}
+
+size_t srv_session_history(srv_session *s, double from, double to,
+			   double **rows, double *stride)
+{
+	pthread_mutex_lock(&s->lock);
+	size_t width = API_HISTORY_WIDTH(s->columns);
+	size_t first = 0, last = s->hist_n;
+	while (first < s->hist_n && s->hist[first * width] < from)
+		first++;
+	while (last > first && s->hist[(last - 1) * width] > to)
+		last--;
+	size_t n = last - first;
+	*rows = malloc((n ? n : 1) * width * sizeof(double));
+	if (*rows && n)
+		memcpy(*rows, s->hist + first * width, n * width * sizeof(double));
+	*stride = s->hist_stride;
+	pthread_mutex_unlock(&s->lock);
+	return *rows ? n : 0;
+}

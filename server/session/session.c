@@ -1,0 +1,583 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * session.c - sessions: lifetime (create, restore, delete, reap), the
+ * control entry point and attaching an experiment. The registry of
+ * sessions and what reads it are session_list.c; their files are
+ * session_store.c, which this file calls and which never calls back.
+ *
+ * Sessions live in a registry (registry.c) and are reference counted: the
+ * registry, each handler while it works and each stream hold one. Handlers
+ * never call the core: controls go through the worker's command queue
+ * (worker.c) and wait for its acknowledgement; everything else is read
+ * from what the worker publishes under the session lock, which never
+ * leaves this file and worker.c. Lock order: see registry.h.
+ */
+#include <errno.h>
+#include <malloc.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+
+#include "cpu_probe.h"
+#include "experiment.h"
+#include "metrics.h"
+#include "session_int.h"
+#include "store.h"
+#include "util.h"
+
+static void destroy(srv_entry *en);
+#define sessions srv_sessions_registry /* session_list.c's */
+static const srv_config *cfg;
+
+void srv_sessions_init(const srv_config *config)
+{
+	cfg = config;
+	srv_dem_init(config);
+	sessions.destroy = destroy;
+	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
+}
+
+/* ---- lifetime ---------------------------------------------------------- */
+
+/* The lock and conditions of a session fresh from calloc, and its control
+ * log not open yet. */
+static void session_locks_init(srv_session *s)
+{
+	pthread_mutex_init(&s->lock, NULL);
+	pthread_cond_init(&s->wake, NULL);
+	pthread_cond_init(&s->data, NULL);
+	pthread_cond_init(&s->log_cond, NULL);
+	s->log_fd = -1;
+}
+
+static void session_free(srv_session *s)
+{
+	if (!s)
+		return;
+	srv_dem_free(s); /* the bed process ends before its machine */
+	if (s->dem_slot)
+		srv_dem_release();
+	sim_free(s->sim);
+	srv_budget_give(s->mem_reserved);
+	srv_budget_set_paced(&s->paced_held, 0);
+	srv_sample_free(&s->scratch);
+	if (s->ring_bytes)
+		munmap(s->ring, s->ring_bytes);
+	free(s->hist);
+	srv_control_log_close(s);
+	free(s->controls);
+	free(s->replay);
+	pthread_cond_destroy(&s->log_cond);
+	pthread_mutex_destroy(&s->lock);
+	pthread_cond_destroy(&s->wake);
+	pthread_cond_destroy(&s->data);
+	free(s);
+	/* a session's buffers are megabytes: give the pages back to the
+	 * system rather than keep them in the allocator (glibc) */
+	malloc_trim(0);
+}
+
+/* Tell the worker to stop and every waiter to look again. */
+static void signal_stop(srv_session *s)
+{
+	pthread_mutex_lock(&s->lock);
+	s->stop = 1;
+	pthread_cond_broadcast(&s->wake);
+	pthread_cond_broadcast(&s->data);
+	pthread_mutex_unlock(&s->lock);
+}
+
+static void stop_worker(srv_session *s)
+{
+	signal_stop(s);
+	/* a worker waiting for its bed process's answer sees its stop at once */
+	srv_dem_kill(s);
+	if (s->worker_started) {
+		pthread_join(s->worker, NULL);
+		s->worker_started = 0;
+	}
+}
+
+static void destroy(srv_entry *en)
+{
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	stop_worker(s);
+	session_free(s);
+}
+
+static int alloc_buffers(srv_session *s)
+{
+	size_t per = (size_t)s->columns +
+		     2 * (size_t)s->columns * (size_t)s->layers;
+	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
+	/* the record ring, slots then their arrays, in one mapping whose
+	 * pages are all made now (MAP_POPULATE): the memory budget reserved
+	 * them anyway, and a worker that fills a fresh ring would otherwise
+	 * take a page fault every few samples over its first 16 s */
+	size_t bytes = s->ring_cap * (sizeof *s->ring + per * sizeof(double));
+	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
+			 MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+	if (map != MAP_FAILED) {
+		s->ring_bytes = bytes;
+		s->ring = map;
+		s->ring_store = (double *)(void *)(s->ring + s->ring_cap);
+	}
+	s->wake_t = INFINITY;
+	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
+	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
+	if (!s->ring_bytes || !s->hist ||
+	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
+		return -1;
+	/* trajectory rows every whole number of sample intervals, at least
+	 * 0.01 s apart */
+	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
+	s->hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
+	return 0;
+}
+
+/* Build s for spec: its sim instance, the initial status and the buffers
+ * (lock and conditions are initialised). 0, or -1 with *pb. */
+static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
+{
+	char msg[256] = "";
+	int err = SIM_OK;
+	s->spec = *spec;
+	s->created = srv_unix_time();
+	s->pace = spec->pace;
+	s->until = spec->until;
+	s->state = SRV_RUNNING;
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
+	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
+			 sizeof msg);
+	if (!s->sim) {
+		api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
+			 msg[0] ? msg : sim_strerror(err));
+		return -1;
+	}
+	/* the worker has not run yet: publish the initial state ourselves so
+	 * that the 201 answer shows beta, rotation and the equilibrium */
+	sim_get_status(s->sim, &s->st);
+	if (spec->scene.feed) {
+		s->columns = sim_columns(s->sim);
+		s->layers = sim_layers(s->sim);
+	}
+	if (srv_dem_wanted(spec) && srv_dem_start(s, 0, msg, sizeof msg)) {
+		api_fail(pb, API_UNAVAILABLE, "scene.feed_model",
+			 "the LIGGGHTS bed did not start: %s", msg);
+		return -1;
+	}
+	/* what a simulated second costs: the larger of the estimate from the
+	 * integrator and a short run of a copy (cpu_probe.c; what grows with
+	 * a large feed). A threshold (the measurement only beyond twice the
+	 * estimate) made a large scene's hold jump to the estimate when a
+	 * busy machine's probe fell just below it; --cpu-probe 0: the
+	 * estimate alone */
+	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
+					       s->layers);
+	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
+							   cfg->cpu_probe)
+					   : -1.0;
+	if (probed > s->cpu_per_s)
+		s->cpu_per_s = probed;
+	/* a bed process: its cores a simulated second until measured */
+	if (s->dem && s->cpu_per_s < s->dem_cores)
+		s->cpu_per_s = s->dem_cores;
+	if (alloc_buffers(s)) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return -1;
+	}
+	return 0;
+}
+
+srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
+				api_problem *pb)
+{
+	api_spec copy = *request;
+	const api_spec *spec = &copy;
+	srv_session *s = calloc(1, sizeof *s);
+	if (!s) {
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+		return NULL;
+	}
+	session_locks_init(s);
+	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
+		session_free(s);
+		api_fail(pb, API_LIMIT, NULL,
+			 "%d sessions exist, the limit (--max-sessions); "
+			 "delete one first", cfg->max_sessions);
+		return NULL;
+	}
+	/* a LIGGGHTS bed: its program, its method and one of its slots */
+	if (srv_dem_wanted(spec)) {
+		if (srv_dem_admit(&copy, pb) != API_OK)
+			goto fail;
+		s->dem_slot = 1;
+	}
+	int feed = spec->scene.feed && spec->scene.columns > 0 &&
+		   spec->scene.layers > 0;
+	if (srv_budget_take_session(feed ? spec->scene.columns : 0,
+				    feed ? spec->scene.layers : 0,
+				    &s->mem_reserved, pb) != API_OK) {
+		s->mem_reserved = 0;
+		goto fail;
+	}
+	if (session_init(s, spec, pb))
+		goto fail;
+	/* the cores it needs at its pace, before it runs */
+	if (s->pace != API_PACE_MAX &&
+	    srv_budget_take_paced(&s->paced_held, s->cpu_per_s, s->pace, "pace",
+				  "created", pb) != API_OK)
+		goto fail;
+	s->exp = exp;
+	s->owned = exp && !srv_exp_keeps_session(exp);
+	if (exp) /* before its worker can end it and write its result */
+		srv_exp_set_session(exp, s->entry.id);
+	/* its directory now: the control log is opened in it at the first
+	 * control, maybe before the writer has written the spec */
+	if (srv_store_enabled()) {
+		char dir[64];
+		snprintf(dir, sizeof dir, "sessions/%s", s->entry.id);
+		if (srv_store_make_dir(dir) != 0)
+			snprintf(s->store_error, sizeof s->store_error,
+				 "cannot create %s: %s", dir, strerror(errno));
+	}
+	s->last_access = s->ckpt_wall = srv_now();
+	s->ckpt_dirty = 1;
+	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
+		api_fail(pb, API_UNAVAILABLE, NULL,
+			 "cannot start the session's worker thread");
+		goto fail;
+	}
+	s->worker_started = 1;
+	srv_registry_publish(&sessions, &s->entry);
+	srv_persist_spec(s);
+	atomic_fetch_add(&srv_stats.sessions_created, 1);
+	srv_log(SRV_LOG_INFO, "session %s created", s->entry.id);
+	return s;
+fail:
+	srv_registry_cancel(&sessions, &s->entry);
+	session_free(s);
+	return NULL;
+}
+
+/* A restored LIGGGHTS session: its slot (even beyond --max-dem-sessions:
+ * it existed before) and a bed settled anew at the machine's restored
+ * time; without one it fails with the reason. */
+static void adopt_bed(srv_session *s)
+{
+	char msg[256];
+	srv_dem_hold();
+	s->dem_slot = 1;
+	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
+		if (s->cpu_per_s < s->dem_cores)
+			s->cpu_per_s = s->dem_cores;
+		return;
+	}
+	s->state = SRV_FAILED;
+	snprintf(s->error, sizeof s->error, "the LIGGGHTS bed did not start again: %.200s", msg);
+	srv_log(SRV_LOG_WARN, "session %s: %s", s->entry.id, s->error);
+}
+
+int srv_session_adopt(srv_session *s)
+{
+	s->last_access = s->ckpt_wall = srv_now();
+	s->cpu_limit = cfg->max_cpu_seconds;
+	s->turn.wake = &s->wake;
+	if (s->damaged) {
+		s->state = SRV_FAILED;
+	} else {
+		sim_get_status(s->sim, &s->st);
+		if (s->spec.scene.feed) {
+			s->columns = sim_columns(s->sim);
+			s->layers = sim_layers(s->sim);
+		}
+		/* its worker commits the cores it needs, even beyond the
+		 * budget: it existed before */
+		s->cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
+						       s->columns, s->layers);
+		if (srv_dem_wanted(&s->spec))
+			adopt_bed(s);
+	}
+	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
+		srv_log(SRV_LOG_WARN, "session %s not restored: --max-sessions "
+				      "reached or id taken", s->entry.id);
+		goto fail;
+	}
+	/* what it had before the restart: reserved even beyond the budget */
+	s->mem_reserved = srv_budget_session_need(s->columns, s->layers);
+	srv_budget_take(s->mem_reserved, "a restored session", 1, NULL);
+	if (alloc_buffers(s)) {
+		srv_registry_cancel(&sessions, &s->entry);
+		goto fail;
+	}
+	srv_registry_publish(&sessions, &s->entry);
+	srv_registry_put(&sessions, &s->entry); /* the registry's stays */
+	return 0;
+fail:
+	if (s->exp)
+		srv_exp_abort(s->exp, "its session could not be restored");
+	session_free(s);
+	return -1;
+}
+
+/* Unlink s and stop its worker; its files go too unless the daemon
+ * stops (then they are what the next start restores). */
+static void remove_session(srv_session *s, int files)
+{
+	if (!srv_registry_remove(&sessions, &s->entry))
+		return;
+	stop_worker(s);
+	/* its bed process ends and is reaped now, and its slot is free for
+	 * the next LIGGGHTS session at once, not when the last reader lets
+	 * go of the session */
+	srv_dem_free(s);
+	if (s->dem_slot) {
+		s->dem_slot = 0;
+		srv_dem_release();
+	}
+	if (files)
+		srv_persist_remove(s); /* after the worker's last write */
+	if (files) {
+		atomic_fetch_add(&srv_stats.sessions_deleted, 1);
+		srv_log(SRV_LOG_INFO, "session %s deleted", s->entry.id);
+	} else {
+		srv_log(SRV_LOG_INFO, "session %s closed", s->entry.id);
+	}
+}
+
+void srv_session_delete(srv_session *s)
+{
+	remove_session(s, 1);
+}
+
+void srv_sessions_shutdown(void)
+{
+	/* stop all workers first (in parallel), then remove each */
+	for (;;) {
+		srv_session **all = NULL;
+		size_t n = srv_sessions_all(&all);
+		for (size_t i = 0; i < n; i++)
+			signal_stop(all[i]);
+		for (size_t i = 0; i < n; i++)
+			remove_session(all[i], 0);
+		srv_sessions_release(all, n);
+		if (n == 0)
+			break;
+	}
+}
+
+size_t srv_sessions_start_restored(void)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), started = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (s->damaged || s->worker_started)
+			continue;
+		if (pthread_create(&s->worker, NULL, srv_worker_main, s) == 0) {
+			s->worker_started = 1;
+			started++;
+		} else {
+			pthread_mutex_lock(&s->lock);
+			s->state = SRV_FAILED;
+			snprintf(s->error, sizeof s->error,
+				 "cannot start the session's worker thread");
+			pthread_mutex_unlock(&s->lock);
+		}
+	}
+	/* the restored controls due now applied before anyone can read a
+	 * status: a GET right after the start shows the targets the session
+	 * acknowledged, not its checkpoint's (bounded: a worker that does not
+	 * get there within 5 s is read as it is) */
+	double until = srv_now() + 5.0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (!s->worker_started)
+			continue;
+		pthread_mutex_lock(&s->lock);
+		while (!s->first_applied && srv_now() < until) {
+			struct timespec ts;
+			clock_gettime(CLOCK_REALTIME, &ts);
+			ts.tv_nsec += 10000000; /* 10 ms */
+			if (ts.tv_nsec >= 1000000000) {
+				ts.tv_sec++;
+				ts.tv_nsec -= 1000000000;
+			}
+			pthread_cond_timedwait(&s->data, &s->lock, &ts);
+		}
+		pthread_mutex_unlock(&s->lock);
+	}
+	srv_sessions_release(all, n);
+	return started;
+}
+
+size_t srv_sessions_reap(double idle_timeout)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), reaped = 0;
+	double now = srv_now();
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		pthread_mutex_lock(&s->lock);
+		int idle = idle_timeout > 0 && s->streams == 0 && !s->exp &&
+			   now - s->last_access > idle_timeout;
+		int go = s->expire || idle;
+		pthread_mutex_unlock(&s->lock);
+		if (!go)
+			continue;
+		srv_log(SRV_LOG_INFO, "session %s %s", s->entry.id,
+			idle ? "expired (--idle-timeout)"
+			     : "removed: its experiment ended");
+		srv_session_delete(s);
+		reaped++;
+	}
+	srv_sessions_release(all, n);
+	return reaped;
+}
+
+/* The paced cores s needs after c: raise its hold before c is queued, or
+ * refuse (lock held). The field named is the one that raises it. */
+static api_err admit_control(srv_session *s, const api_control *c,
+			     api_problem *pb)
+{
+	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
+	if (pace == API_PACE_MAX ||
+	    srv_state_after(s->state, s->cpu_paused, s->st.t, c) != SRV_RUNNING ||
+	    s->cpu_per_s * pace <= s->paced_held)
+		return API_OK;
+	const char *field = (c->set & API_C_PACE)      ? "pace"
+			    : (c->set & API_C_RUNNING) ? "running"
+			    : (c->set & API_C_CPU)     ? "cpu_budget"
+						       : "until";
+	return srv_budget_take_paced(&s->paced_held, s->cpu_per_s, pace, field,
+				     "changed", pb);
+}
+
+api_err srv_session_control(srv_session *s, const api_control *c,
+			    double timeout_s, double *t_eff, api_problem *pb)
+{
+	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
+	pthread_mutex_lock(&s->lock);
+	api_err e = API_OK;
+	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
+		e = api_fail(pb, API_RANGE, "cpu_budget",
+			     "cpu_budget must be CPU seconds in (0, %g] "
+			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
+			     c->cpu_budget);
+		pb->has_range = 1;
+		pb->min = 0;
+		pb->max = cfg->max_cpu_seconds;
+	} else if (s->stop)
+		e = api_fail(pb, API_NOTFOUND, NULL,
+			     "the session is being deleted");
+	else if (s->state == SRV_FAILED)
+		e = api_fail(pb, API_CONFLICT, NULL,
+			     "the session has failed (%s); it takes no more "
+			     "controls", s->error);
+	else if ((c->set & API_C_UNTIL) && c->until > 0 && c->until <= s->st.t)
+		e = api_fail(pb, API_CONFLICT, "until",
+			     "until (%g s) lies in the past: the session is at "
+			     "t = %g s", c->until, s->st.t);
+	else if ((c->set & API_C_RUNNING) && c->running &&
+		 s->state == SRV_FINISHED && !(c->set & API_C_UNTIL))
+		e = api_fail(pb, API_CONFLICT, "running",
+			     "the session finished at until = %g s; raise "
+			     "until to run on", s->until);
+	else
+		e = admit_control(s, c, pb);
+	if (e != API_OK) {
+		pthread_mutex_unlock(&s->lock);
+		return e;
+	}
+	srv_worker_queue(s, &cmd);
+	struct timespec until = srv_deadline(timeout_s);
+	while (!cmd.done && !s->stop)
+		if (pthread_cond_timedwait(&s->data, &s->lock, &until) ==
+		    ETIMEDOUT)
+			break;
+	if (!cmd.done) { /* take it back: nothing changes */
+		srv_worker_unqueue(s, &cmd);
+		srv_budget_set_paced(&s->paced_held, srv_paced_need(s));
+		pthread_mutex_unlock(&s->lock);
+		return api_fail(pb, API_UNAVAILABLE, NULL,
+				"the session's worker did not take the change "
+				"within %g s; nothing was changed", timeout_s);
+	}
+	pthread_mutex_unlock(&s->lock);
+	if (cmd.rc != SIM_OK)
+		return api_fail(pb, api_from_sim(cmd.rc), NULL, "%s",
+				sim_strerror(cmd.rc));
+	/* the answer only once its line is on disk (control_log.c) */
+	int err = cmd.logged ? srv_control_log_sync(s, cmd.logged, timeout_s) : 0;
+	if (err) {
+		api_fail(pb, API_UNAVAILABLE, NULL,
+			 "the control was applied at t = %g s but its line could not be made "
+			 "durable in the control log (%s): a crash may lose it",
+			 cmd.t_eff, strerror(err));
+		pb->retry_after = 5;
+		return API_UNAVAILABLE;
+	}
+	*t_eff = cmd.t_eff;
+	return API_OK;
+}
+
+api_err srv_session_attach(srv_session *s, srv_experiment *e,
+			   api_problem *pb)
+{
+	api_err rc = API_OK;
+	pthread_mutex_lock(&s->lock);
+	if (s->stop)
+		rc = api_fail(pb, API_NOTFOUND, "session",
+			      "the session is being deleted");
+	else if (s->state == SRV_FAILED)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session has failed (%s)", s->error);
+	else if (s->exp)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session already runs experiment %s",
+			      srv_exp_id(s->exp));
+	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
+		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
+					     s->pace, "session", "attached",
+					     pb)) != API_OK)
+		; /* the experiment would run it on (worker.c extend_until)
+		     past the cores for paced sessions: nothing attached */
+	else {
+		s->exp = e;
+		s->exp_started = 0;
+		srv_exp_set_session(e, s->entry.id);
+		pthread_cond_broadcast(&s->wake);
+	}
+	pthread_mutex_unlock(&s->lock);
+	return rc;
+}
+
+size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
+			    void (*put)(srv_experiment *e))
+{
+	if (!srv_store_enabled())
+		return 0;
+	const srv_exp_finder ef = {find, put};
+	char **names = NULL;
+	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = calloc(1, sizeof *s);
+		if (s) {
+			session_locks_init(s);
+			srv_persist_load(s, names[i], &ef);
+			if (s->damaged)
+				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
+					s->error);
+			if (srv_session_adopt(s) == 0)
+				count++;
+		}
+		free(names[i]);
+	}
+	free(names);
+	/* all in first: the restore does not compete with running workers */
+	srv_sessions_start_restored();
+	return count;
+}

@@ -1,0 +1,297 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * session_int.h - the inside of a session, shared by session.c (registry,
+ * lifetime, readers) and worker.c (the thread that steps the core).
+ */
+#ifndef CONVSIM_SESSION_INT_H
+#define CONVSIM_SESSION_INT_H
+
+#include <math.h>
+#include <pthread.h>
+
+#include "budget.h"
+#include "budget_turns.h"
+#include "records.h"
+#include "registry.h"
+#include "session.h"
+#include "worker.h"
+
+/* A control of the log to apply again once the integrator reaches at. */
+typedef struct srv_replay {
+	srv_cmd cmd;
+	double at;   /* its t_effective, s */
+	int exp_own; /* sent by the experiment the checkpoint resumed: not
+			applied here, the experiment sends it again itself */
+} srv_replay;
+
+struct srv_session {
+	srv_entry entry;          /* id and references: the registry */
+	api_spec spec;            /* immutable */
+	double created;
+	int columns, layers;      /* feed size, 0 without feed */
+	sim *sim;                 /* worker only */
+	pthread_t worker;
+	int worker_started;
+	int first_applied;        /* its worker has applied what was due at its
+				     start (the controls logged after a restored
+				     checkpoint): srv_sessions_start_restored
+				     waits for it (lock) */
+	api_sample scratch;       /* worker only */
+
+	pthread_mutex_t lock;
+	pthread_cond_t wake;      /* worker: commands, stop */
+	pthread_cond_t data;      /* streams and waiting handlers */
+	/* guarded by lock */
+	int stop;
+	int state;
+	char error[256];
+	double pace, until;
+	srv_cmd *cmd_head, *cmd_tail;
+	sim_status st;
+	double steps_per_s, rtf;
+	api_sample *ring;
+	double *ring_store;
+	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
+	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
+	double *hist;
+	size_t hist_cap, hist_n;
+	double hist_stride, hist_next;
+	int streams;
+	srv_experiment *exp;
+	srv_cmd *exp_cmd;         /* the experiment's command while queued */
+	int exp_started;
+	/* lifetime and persistence (session_store.c) */
+	int damaged;              /* restored without a usable spec or
+				     checkpoint: listed, failed, no worker */
+	int owned;                /* created by an experiment that does not
+				     keep it: removed when it ends */
+	int expire;               /* remove at the next reap */
+	double last_access;       /* srv_now() of the last request */
+	char *controls;           /* every acknowledged control, one JSON
+				     line each (controls.ndjson) */
+	size_t controls_len, controls_cap;
+	/* the log on disk (control_log.c), guarded by lock */
+	pthread_cond_t log_cond;  /* a sync round ended */
+	int log_fd;               /* -1 until its first sync opens it */
+	size_t log_synced;        /* bytes of controls on disk, synced */
+	int log_syncing;          /* a thread leads a sync round */
+	int log_flush_queued;     /* a flush of lines nobody waits for is
+				     queued on the store's writer */
+	double ckpt_wall;         /* srv_now() of the last checkpoint */
+	int ckpt_dirty;           /* a control or state change since */
+	char store_error[256];    /* the last failed write, "" */
+	int spec_unwritten;       /* spec.json failed to be written: the
+				     session stays "error" until a rewrite
+				     (queued at the next write that works)
+				     is on disk */
+	int spec_retrying;        /* that rewrite is queued */
+	srv_replay *replay;       /* controls logged after the checkpoint it
+				     was restored from, in order: applied
+				     again as the integrator reaches each
+				     (session_store.c loads, worker.c runs) */
+	size_t nreplay, replayed;
+	size_t exp_relogged;      /* lines of the resumed experiment in the
+				     log after its checkpoint: its commands
+				     that many times are not logged again */
+	int rebuilt;              /* re-created from its spec, its checkpoint
+				     unusable (another build): the whole log
+				     is replayed */
+	double catch_up_t;        /* restored with controls to replay: runs
+				     flat out until its time reaches where
+				     it was (0: not; then it answers) */
+	double replay_wall, replay_seconds; /* when the replay began, how
+				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
+	double replay_t0;         /* s: the time it was restored at */
+	/* budgets (budget.c) */
+	size_t mem_reserved;      /* bytes of the memory budget it holds */
+	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
+	int waiting_for_cpu;      /* its turn has not come */
+	double cpu_seconds;       /* the worker's CPU time, s */
+	double cpu_limit;         /* pauses when cpu_seconds reaches it */
+	int cpu_paused;           /* paused because cpu_limit was reached */
+	double cpu_per_s;         /* CPU s per simulated s: estimated at
+				     creation, then measured by the worker */
+	int cpu_measured;         /* cpu_per_s is the worker's measure */
+	double paced_held;        /* cores of the paced budget it holds */
+	/* a LIGGGHTS session (session_dem.c) */
+	struct dem_coupled *dem;  /* worker only (created before it starts,
+				     freed after it ends): the coupling to the
+				     bed process; NULL for the column model */
+	int dem_slot;             /* holds one of --max-dem-sessions */
+	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
+	int dem_restart;          /* worker only: a control changed the machine;
+				     the bed's transport estimate restarts once
+				     its beta ramp is over */
+	api_bed bed;              /* what the worker last read of it (lock) */
+};
+
+/* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
+
+/* Find the bed program (--dem-bed, or convsim-bed next to the daemon). */
+void srv_dem_init(const srv_config *cfg);
+/* The spec asks for a LIGGGHTS bed (feed on, feed_model liggghts). */
+int srv_dem_wanted(const api_spec *spec);
+/* Admit a LIGGGHTS session: the bed program exists (else 422 on
+ * scene.feed_model), a fixed-step method (a dt of 0 becomes the CLI's
+ * coupled step; else 422 on integrator.method), one of --max-dem-sessions
+ * taken (else 429): give it back with srv_dem_release. */
+api_err srv_dem_admit(api_spec *spec, api_problem *pb);
+/* A restored session's slot, taken even beyond the limit; and giving one
+ * back. */
+void srv_dem_hold(void);
+void srv_dem_release(void);
+/* Start s's bed process and couple it to s->sim (at t = 0, or at a
+ * restored machine's time: restored = 1, the bed settled anew); s->st and
+ * s->bed show it. 0, or -1 with msg (s->dem stays NULL). */
+int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
+/* Worker, lock released: advance machine and bed to the end of the
+ * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
+ * process ended or failed, the machine froze). */
+int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen);
+/* Worker, lock released: a control changed the machine (restart = 1):
+ * once beta has reached its target (status st), the bed's transport
+ * estimate restarts, as the core's does. */
+void srv_dem_controlled(srv_session *s, const sim_status *st);
+/* Worker: the bed's figures into a status of the machine (transport
+ * velocity, feed displacement and velocity) and into *b. */
+void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b);
+/* End the bed process now (any thread: a worker inside an advance then
+ * fails and sees its stop). */
+void srv_dem_kill(srv_session *s);
+/* Free the coupling, ending and reaping the bed process. */
+void srv_dem_free(srv_session *s);
+
+/* Cores a session needs from the paced budget as it is now: its CPU s per
+ * simulated s times its pace while it runs paced (at least its bed
+ * process's cores for a LIGGGHTS session), else none (lock held). */
+static inline double srv_paced_need(const srv_session *s)
+{
+	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
+		return 0;
+	double need = s->cpu_per_s * s->pace;
+	/* a LIGGGHTS session's bed process holds its cores */
+	return s->dem && need < s->dem_cores ? s->dem_cores : need;
+}
+
+/* The state control c leaves a session in, from its state, whether its
+ * CPU budget paused it and its time t: until raised past t resumes a
+ * finished session, running pauses or resumes, and a new CPU budget (or
+ * running = true) resumes one its budget paused. The one rule for the
+ * worker, which applies c (worker.c apply_commands), and for admission,
+ * which must know beforehand whether the session will run paced
+ * (session.c admit_control). */
+static inline int srv_state_after(int state, int cpu_paused, double t, const api_control *c)
+{
+	if ((c->set & API_C_UNTIL) && state == SRV_FINISHED && (c->until == 0 || c->until > t))
+		state = SRV_RUNNING;
+	if ((c->set & API_C_RUNNING) && !c->running && state == SRV_RUNNING)
+		state = SRV_PAUSED;
+	else if ((c->set & API_C_RUNNING) && c->running && state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	if (((c->set & API_C_CPU) || ((c->set & API_C_RUNNING) && c->running)) && cpu_paused &&
+	    state == SRV_PAUSED)
+		state = SRV_RUNNING;
+	return state;
+}
+
+/* Slot i of the ring with its arrays pointed into ring_store (set on
+ * every use). */
+static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
+{
+	size_t per = (size_t)s->columns +
+		     2 * (size_t)s->columns * (size_t)s->layers;
+	api_sample *r = &s->ring[i];
+	r->columns = s->columns;
+	r->layers = s->layers;
+	r->column_disp = s->ring_store + i * per;
+	r->xi = r->column_disp + s->columns;
+	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
+	return r;
+}
+
+/* ---- ring.c: the worker's writers (session lock held) ----------------- */
+
+/* Push an event record: type ("control", "finished", ...) and its JSON. */
+void srv_ring_event(srv_session *s, const char *type, const char *json);
+/* Push an event {"t": now, detail...}; detail (may be NULL) is more JSON
+ * members. */
+void srv_ring_event_at(srv_session *s, const char *type, const char *detail);
+/* Push a sample of the published status and the scratch feed arrays, and
+ * a trajectory row when one is due. */
+void srv_ring_sample(srv_session *s);
+/* Copy the feed arrays out of the instance into the scratch record
+ * (worker; no lock needed). */
+void srv_ring_gather(srv_session *s);
+
+/* ---- session_store.c: the session's files (store.h) ------------------ */
+
+/* Queue the spec file (at creation). */
+void srv_persist_spec(srv_session *s);
+
+/* ---- control_log.c: the control log on disk ----------------------------- */
+
+/* Append a control's event line to s's log in memory (worker, lock held):
+ * the log's length with it, for srv_control_log_sync (0 without a data
+ * directory). waited: a handler makes it durable before it answers; else
+ * a flush is queued on the store's writer. */
+size_t srv_control_log_append(srv_session *s, const char *json, int waited);
+/* Make s's log durable up to end bytes (lock not held): by group commit,
+ * one pwrite and one fdatasync for every line appended before the round
+ * began. 0, or an errno (ETIMEDOUT after timeout_s, the write's failure,
+ * also shown in store_error). */
+int srv_control_log_sync(srv_session *s, size_t end, double timeout_s);
+/* Close the log's file (the session is freed). */
+void srv_control_log_close(srv_session *s);
+/* Queue a checkpoint now if one is due: the interval has passed, or the
+ * session stopped running with changes since the last one (worker, lock
+ * held, after the commands phase). */
+void srv_persist_checkpoint(srv_session *s, int force);
+/* Queue the removal of the session's files. */
+void srv_persist_remove(const srv_session *s);
+
+/* The experiments' registry as the restore sees it (session.h's
+ * srv_sessions_restore): a new reference by id, or NULL; put it back. */
+typedef struct srv_exp_finder {
+	srv_experiment *(*find)(const char *id);
+	void (*put)(srv_experiment *e);
+} srv_exp_finder;
+/* Build session id from its files into s (calloc'd, lock initialised):
+ * spec, checkpoint (or the previous one, or a fresh start from the spec),
+ * the experiment it ran resumed; s->damaged with the reason in s->error
+ * when they do not pass their checks. */
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
+
+/* checkpoint.bin's head and trailer: srv_ckpt_record, srv_ckpt_trailer
+ * (records.h, with every stored layout). */
+/* The files read back, checked without touching a session (the restore
+ * uses these; so does the fuzz harness tests/fuzz/fuzz_store.c). A spec
+ * file's payload (len bytes, borrowed): 0 with the spec, its creation
+ * time and whether an experiment owns it, or -1 with why (another size, a
+ * spec the API would refuse: api_check_spec). A checkpoint file's payload:
+ * 0 with its head in *r (strings terminated; the experiment's state and
+ * the core's checkpoint follow it in p), or -1 with why (cut off,
+ * inconsistent lengths, an unknown run state). */
+int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
+		    int *owned, char *why, size_t whylen);
+int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
+		    size_t whylen);
+
+/* The registry of sessions (session_list.c; session.c sets its destroy). */
+extern srv_registry srv_sessions_registry;
+
+/* session.c: publish a session built by session_store.c: s has its
+ * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
+ * buffers are allocated here. 0 or -1 (s freed). Its worker starts with
+ * srv_sessions_start_restored, once every session is in. */
+int srv_session_adopt(srv_session *s);
+/* Start the workers of the adopted sessions. Returns how many. */
+size_t srv_sessions_start_restored(void);
+
+
+#endif

@@ -1,0 +1,491 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * session_store.c - a session's files in the data directory, written and
+ * read back (docs/operations.md "Persistence"); session.c's restore calls it.
+ *
+ *   sessions/ID/spec.json        the spec as created, the API's JSON
+ *                                (api_spec_file), read first
+ *   sessions/ID/spec.bin         the same as this build's record (framed,
+ *                                store.h), for earlier builds
+ *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
+ *                                object a line with t_effective (s);
+ *                                appended and synced before the control
+ *                                is answered (control_log.c)
+ *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
+ *                                until, the attached experiment's state
+ *                                and the core's checkpoint (sim.h); the
+ *                                one before it as checkpoint.bin.prev
+ *
+ * Everything else is written by the store's writer (store.c); the worker only
+ * serialises, between steps, with the session lock held. A restore never
+ * fails the daemon: a checkpoint that does not pass its checks falls back
+ * to the previous one; a session whose spec or both checkpoints are
+ * unusable is listed as "damaged" with the reason; a session with a spec
+ * and no checkpoint yet starts again from its spec.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "experiment.h"
+#include "metrics.h"
+#include "records.h"
+#include "session_int.h"
+#include "store.h"
+#include "util.h"
+
+/* sessions/ID/spec.bin (records.h) */
+typedef srv_spec_record spec_record;
+
+static void session_dir(char *out, size_t len, const char *id,
+			const char *file)
+{
+	snprintf(out, len, "sessions/%s%s%s", id, file ? "/" : "",
+		 file ? file : "");
+}
+
+/* Which write of which session a callback is about (malloc'd, freed by
+ * written). */
+typedef struct write_of {
+	char id[SRV_ID_LEN];
+	int spec; /* spec.json */
+	size_t logged; /* a checkpoint: the control log it accounts for */
+} write_of;
+
+/* A write's outcome: a failure puts the session in state "error" with the
+ * reason. A later success clears it, unless spec.json is not on disk: the
+ * first success after its failure (space came back) queues it again, and
+ * the session reports healthy only once that rewrite is written (lock
+ * order: the session's, then the store's). */
+static void written(void *arg, int err, const char *what)
+{
+	write_of *w = arg;
+	srv_session *s = srv_session_get(w->id);
+	int spec = w->spec;
+	free(w);
+	if (!s)
+		return;
+	pthread_mutex_lock(&s->lock);
+	if (spec) {
+		s->spec_unwritten = err != 0;
+		s->spec_retrying = 0;
+	}
+	if (err)
+		snprintf(s->store_error, sizeof s->store_error, "%s", what);
+	else if (s->spec_unwritten && !s->spec_retrying) {
+		s->spec_retrying = 1;
+		srv_persist_spec(s);
+	} else if (!s->spec_unwritten && what && what[0] == '\0')
+		s->store_error[0] = '\0';
+	pthread_mutex_unlock(&s->lock);
+	srv_session_put(s);
+}
+
+/* Before a checkpoint is written: the control log up to what it accounts
+ * for is on disk first (control_log.c), so that no checkpoint holds more
+ * of the log than the file (a restore replays the log after it). */
+static void log_first(void *arg)
+{
+	write_of *w = arg;
+	srv_entry *en = srv_registry_get(&srv_sessions_registry, w->id);
+	if (!en)
+		return;
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	srv_control_log_sync(s, w->logged, 30.0);
+	srv_registry_put(&srv_sessions_registry, en);
+}
+
+static void queue(const srv_session *s, const char *file, void *buf,
+		  size_t len, int keep_prev, size_t logged)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, file);
+	write_of *w = calloc(1, sizeof *w);
+	if (w) {
+		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
+		w->spec = strcmp(file, "spec.json") == 0;
+		w->logged = logged;
+	}
+	srv_store_write_after(path, buf, len, keep_prev, w && logged ? log_first : NULL,
+			      w ? written : NULL, w);
+}
+
+void srv_persist_spec(srv_session *s)
+{
+	if (!srv_store_enabled() || s->damaged)
+		return;
+	/* spec.bin too, for an earlier build started on this directory */
+	spec_record r;
+	memset(&r, 0, sizeof r);
+	snprintf(r.id, sizeof r.id, "%s", s->entry.id);
+	r.spec = s->spec;
+	r.created = s->created;
+	r.owned = s->owned;
+	size_t len;
+	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
+	if (buf)
+		queue(s, "spec.bin", buf, len, 0, 0);
+	char *text = api_spec_file(&s->spec, s->created, s->owned);
+	if (text)
+		queue(s, "spec.json", text, strlen(text), 0, 0);
+}
+
+void srv_persist_checkpoint(srv_session *s, int force)
+{
+	if (!srv_store_enabled() || !s->sim)
+		return;
+	double now = srv_now();
+	int due = now - s->ckpt_wall >= srv_store_interval() &&
+		  (s->state == SRV_RUNNING || s->ckpt_dirty);
+	if (!due && !(force && s->ckpt_dirty))
+		return;
+	srv_ckpt_record r;
+	memset(&r, 0, sizeof r);
+	r.state = s->state;
+	r.pace = s->pace;
+	r.until = s->until;
+	snprintf(r.error, sizeof r.error, "%s", s->error);
+	void *exp = NULL;
+	if (s->exp && s->exp_started) {
+		size_t n = 0;
+		exp = srv_exp_save(s->exp, &n);
+		r.exp_len = exp ? n : 0;
+		r.exp_started = 1;
+		snprintf(r.exp_id, sizeof r.exp_id, "%s", srv_exp_id(s->exp));
+	}
+	r.sim_len = sim_checkpoint_size(s->sim);
+	/* the trailer: how much of the control log the checkpoint holds,
+	 * and its time */
+	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t};
+	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof tr;
+	char *payload = malloc(plen);
+	if (payload) {
+		memcpy(payload, &r, sizeof r);
+		if (r.exp_len)
+			memcpy(payload + sizeof r, exp, r.exp_len);
+		sim_checkpoint(s->sim, payload + sizeof r + r.exp_len,
+			       r.sim_len);
+		memcpy(payload + plen - sizeof tr, &tr, sizeof tr);
+		size_t len;
+		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
+					    &len);
+		if (buf)
+			queue(s, "checkpoint.bin", buf, len, 1, s->controls_len);
+	}
+	free(payload);
+	free(exp);
+	s->ckpt_wall = now;
+	s->ckpt_dirty = 0;
+}
+
+api_err srv_session_check_removable(const srv_session *s, api_problem *pb)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, NULL);
+	return srv_store_check_removable(path, pb);
+}
+
+void srv_persist_remove(const srv_session *s)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, NULL);
+	srv_store_remove(path);
+}
+
+/* ---- restore ------------------------------------------------------------ */
+
+int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
+		    size_t whylen)
+{
+	if (len < sizeof *r) {
+		snprintf(why, whylen, "cut off");
+		return -1;
+	}
+	memcpy(r, p, sizeof *r);
+	/* exp_len first: a length between len - sizeof *r and len wrapped
+	 * the difference below and let sim_len point past the buffer; the
+	 * core's checkpoint ends the payload or is followed by the trailer */
+	size_t left = r->exp_len <= len - sizeof *r ? len - sizeof *r - (size_t)r->exp_len : 0;
+	if (r->exp_len > len - sizeof *r ||
+	    (r->sim_len != left && !(left >= SRV_CKPT_TRAILER && r->sim_len == left - SRV_CKPT_TRAILER)) ||
+	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
+		snprintf(why, whylen, "inconsistent lengths or state");
+		return -1;
+	}
+	r->error[sizeof r->error - 1] = '\0';
+	r->exp_id[SRV_ID_LEN - 1] = '\0';
+	return 0;
+}
+
+/* The checkpoint of s from file (relative): restores s->sim, run state and
+ * the experiment (found with find, given back with put), and *logged, the
+ * bytes of the control log it holds; 0, or -1 with why and *unread set
+ * when the file could not be read at all (missing). */
+static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finder *ef,
+			   size_t *logged, int *unread, char *why, size_t whylen)
+{
+	size_t n = 0, len;
+	char *raw = srv_store_read_text(file, &n);
+	const char *bad = "missing or unreadable";
+	int older = 0;
+	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &older, &bad) : NULL;
+	*unread = !raw;
+	if (older)
+		s->upgrade = 1; /* written again in this build's format */
+	if (!p) {
+		snprintf(why, whylen, "%s: %s", file, bad);
+		return -1;
+	}
+	srv_ckpt_record r;
+	int rc = -1;
+	char msg[256] = "";
+	if (srv_ckpt_decode(p, len, &r, msg, sizeof msg) != 0) {
+		snprintf(why, whylen, "%s: %s", file, msg);
+		goto done;
+	}
+	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
+	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
+		srv_ckpt_trailer tr;
+		memcpy(&tr, p + len - sizeof tr, sizeof tr);
+		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
+		if (isfinite(tr.t) && tr.t > s->catch_up_t)
+			s->catch_up_t = tr.t; /* where it was, if the core's
+						 part is refused */
+	}
+	int err;
+	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
+			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
+			      sizeof msg);
+	if (!sm) {
+		snprintf(why, whylen, "%s: %s", file, msg);
+		goto done;
+	}
+	s->catch_up_t = 0;
+	sim_free(s->sim);
+	s->sim = sm;
+	s->state = r.state;
+	s->pace = r.pace;
+	s->until = r.until;
+	snprintf(s->error, sizeof s->error, "%s", r.error);
+	if (r.exp_started && r.exp_len) {
+		srv_experiment *e = ef->find(r.exp_id);
+		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
+			s->exp = e;
+			s->exp_started = 1;
+		}
+		if (e)
+			ef->put(e); /* the registry keeps it */
+	}
+	rc = 0;
+done:
+	free(p);
+	return rc;
+}
+
+int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
+		    int *owned, char *why, size_t whylen)
+{
+	spec_record r;
+	if (len != sizeof r) {
+		snprintf(why, whylen, "of another size");
+		return -1;
+	}
+	memcpy(&r, p, sizeof r);
+	api_problem pb;
+	if (api_check_spec(&r.spec, &pb) != API_OK) {
+		/* the reason cut to the caller's room, as snprintf would */
+		snprintf(why, whylen, "%.*s", whylen > 0 ? (int)(whylen - 1) : 0, pb.detail);
+		return -1;
+	}
+	*spec = r.spec;
+	*created = r.created;
+	*owned = r.owned != 0;
+	return 0;
+}
+
+/* The control log back into s->controls (later controls are appended to
+ * it), and the controls logged after its first `logged` bytes (what the
+ * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
+ * does not say) into s->replay, for the worker to apply again. */
+static void load_controls(srv_session *s, size_t logged)
+{
+	char path[128];
+	session_dir(path, sizeof path, s->entry.id, "controls.ndjson");
+	size_t len = 0;
+	char *text = srv_store_read_text(path, &len);
+	if (!text)
+		return;
+	/* a line a crash cut short was never acknowledged: the log ends at
+	 * its last newline (the file is cut there when it is next written) */
+	while (len > 0 && text[len - 1] != '\n')
+		len--;
+	s->controls = text;
+	s->controls_len = s->log_synced = len;
+	s->controls_cap = len + 1;
+	if (logged >= len)
+		return;
+	size_t lines = 0;
+	for (size_t i = logged; i < len; i++)
+		lines += text[i] == '\n';
+	s->replay = calloc(lines ? lines : 1, sizeof *s->replay);
+	for (size_t at = logged; s->replay && at < len;) {
+		const char *nl = memchr(text + at, '\n', len - at);
+		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
+		srv_replay *rp = &s->replay[s->nreplay];
+		api_problem pb;
+		char exp[SRV_ID_LEN];
+		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
+						 &rp->at, exp, sizeof exp, &pb) == API_OK) {
+			/* the experiment resumed from the checkpoint sends its
+			 * segments' commands again: applied twice, the second
+			 * would move the estimator's restart */
+			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
+			s->exp_relogged += rp->exp_own;
+			s->nreplay++;
+		}
+		else if (n)
+			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
+					      "replayed: %s", s->entry.id, path, pb.detail);
+		at += n + 1;
+	}
+	if (s->nreplay)
+		srv_log(SRV_LOG_INFO, "session %s: %zu controls logged after "
+				      "its checkpoint are replayed", s->entry.id,
+			s->nreplay);
+}
+
+/* The spec of s from spec.json (the API's JSON: this build on) or, when
+ * there is none, spec.bin (earlier builds); 0, or -1 with why. */
+static int load_spec(srv_session *s, char *why, size_t whylen)
+{
+	char path[128], msg[256];
+	size_t len = 0;
+	session_dir(path, sizeof path, s->entry.id, "spec.json");
+	char *text = srv_store_read_text(path, &len);
+	if (text) {
+		api_problem pb;
+		int format = 0;
+		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
+						&s->owned, &format, &pb);
+		free(text);
+		if (e != API_OK)
+			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
+			s->upgrade = 1;
+		return e == API_OK ? 0 : -1;
+	}
+	/* no spec.json: a build before it (c793934) wrote only spec.bin */
+	session_dir(path, sizeof path, s->entry.id, "spec.bin");
+	int older = 0;
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, &older, why, whylen);
+	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
+				     msg, sizeof msg)
+		   : -1;
+	if (r && rc)
+		snprintf(why, whylen, "%s: %s", path, msg);
+	s->upgrade = 1; /* spec.json (and spec.bin) in this build's format */
+	free(r);
+	return rc;
+}
+
+/* s restored at t0 with its log loaded: it runs flat out (and answers
+ * 503 meanwhile: srv_session_replaying) to the later of where a refused
+ * checkpoint said it was (rebuilt) and its last control's time, so that
+ * no client sees it before the controls it acknowledged. */
+static void catch_up(srv_session *s)
+{
+	for (size_t i = 0; i < s->nreplay; i++)
+		if (s->replay[i].at > s->catch_up_t)
+			s->catch_up_t = s->replay[i].at;
+	s->replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
+	if (!(s->catch_up_t > s->replay_t0))
+		s->catch_up_t = 0;
+	s->replay_wall = srv_now();
+}
+
+/* s was re-created from its spec because neither checkpoint could be used
+ * (why, why2): its worker replays the whole control log and runs flat out
+ * to where it was, the later of the time a checkpoint's trailer gave and
+ * the last control's, then at its pace again (worker.c). */
+static void rebuild(srv_session *s, const char *why, const char *why2)
+{
+	s->rebuilt = 1;
+	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
+	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
+			      "spec, %zu controls replayed to t = %g s",
+		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
+}
+
+/* The files of session id into s (srv_persist_load). */
+static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
+{
+	char path[128], why[512] = "", why2[512] = "";
+	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
+	s->created = srv_unix_time();
+	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
+	if (load_spec(s, why, sizeof why) != 0) {
+		s->damaged = 1;
+		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
+		return;
+	}
+	s->pace = s->spec.pace;
+	s->until = s->spec.until;
+	s->state = SRV_RUNNING;
+	session_dir(path, sizeof path, id, "checkpoint.bin");
+	size_t logged = 0;
+	int unread = 0, unread_prev = 0;
+	if (load_checkpoint(s, path, ef, &logged, &unread, why, sizeof why) == 0) {
+		load_controls(s, logged);
+		catch_up(s);
+		return;
+	}
+	char prev[160];
+	snprintf(prev, sizeof prev, "%s.prev", path);
+	if (load_checkpoint(s, prev, ef, &logged, &unread_prev, why2, sizeof why2) == 0) {
+		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
+				      "previous checkpoint", id, why);
+		load_controls(s, logged);
+		catch_up(s);
+		return;
+	}
+	/* none: created less than one interval before the crash; else both
+	 * copies are unusable (another build's, damaged): either way it
+	 * starts again from its spec and takes every control it took */
+	int none = unread && unread_prev;
+	char msg[256] = "";
+	int err;
+	s->sim = sim_new(&s->spec.params, &s->spec.scene, &s->spec.method,
+			 &err, msg, sizeof msg);
+	if (s->sim) {
+		load_controls(s, 0);
+		if (none)
+			s->catch_up_t = 0;
+		catch_up(s);
+		if (!none)
+			rebuild(s, why, why2);
+		return;
+	}
+	snprintf(why, sizeof why, "its spec is refused: %s", msg);
+	s->damaged = 1;
+	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
+}
+
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
+{
+	load_files(s, id, ef);
+	if (s->damaged) {
+		srv_store_count_damaged(SRV_STORE_SESSION);
+		return;
+	}
+	if (!s->upgrade)
+		return;
+	/* an earlier format: its spec written again at once (spec.json and
+	 * spec.bin, each atomically: store.c), its checkpoint at the next
+	 * interval, in this build's format */
+	srv_persist_spec(s);
+	s->ckpt_dirty = 1;
+	srv_store_count_upgraded(SRV_STORE_SESSION);
+	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
+			      "in format %d", s->entry.id, SRV_STORE_VERSION);
+}

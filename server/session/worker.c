@@ -1,0 +1,607 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * worker.c - a session's worker thread: the only thread that touches the
+ * session's sim instance. It runs below the request and stream threads
+ * (--worker-nice, srv_thread_background): when the sessions want more CPU
+ * than there is, they fall behind before the answers do.
+ *
+ * The loop runs a few named phases per turn, with the session lock held
+ * except while the core advances (libuv's uv_run is the model):
+ *
+ *   job start   an experiment attached since the last turn begins: its first
+ *               segment's command joins the queue
+ *   commands    queued controls (PATCH, experiment segments) are applied in
+ *               order and acknowledged, reading sim_effective_time(); each
+ *               is appended to the session's control log
+ *   checkpoint  with --data-dir, every --checkpoint-interval of wall time
+ *               (and before going idle after a change) the session's
+ *               state is serialised and handed to the store's writer
+ *               (session_store.c); no file is touched here
+ *   until       a running session that reached "until" finishes
+ *   idle        a session that is not running sleeps until woken
+ *   turn        a pace "max" session steps only while it holds one of the
+ *               --max-busy CPU slots (budget.c), giving it up after each
+ *               slice when others wait; any other session holds none
+ *   pacing      simulated time is held to pace x wall time (no catching up
+ *               after a stall; pace "max" runs flat out up to "until"): a
+ *               paced session sleeps until its next sample is due, then
+ *               steps every sample due within the next 20 ms (a batch)
+ *   step        sim_advance by one sample interval (1/sample_rate simulated
+ *               seconds, cut at "until" and at experiment boundaries), then
+ *               publish the status snapshot and a record in the bounded ring
+ *               (samples and control events, indexed by a sequence number
+ *               that never repeats) and, every stride, a trajectory row (the
+ *               stride doubles whenever the history fills); the readers are
+ *               woken once per batch (every 10 ms of a flat-out session),
+ *               and only when a record one of them waits for exists
+ *   job step    the experiment records the step and, at a segment boundary,
+ *               hands over the next segment's command
+ *   failure     a core error fails the session and aborts its experiment
+ *   cpu         the worker's CPU time is read (CLOCK_THREAD_CPUTIME_ID: the
+ *               worker steps this session only), at most every 10 ms of
+ *               wall time; a session that spent its grant (cpu_limit)
+ *               pauses with pause_reason "cpu-budget"
+ *   meter       achieved steps/s and real-time factor over half-second
+ *               windows
+ *
+ * The command queue, and the attached experiment's command in it, are
+ * worker_queue.c.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "experiment.h"
+#include "metrics.h"
+#include "session_int.h"
+#include "util.h"
+
+/* Wall-clock anchors of pacing and metering. */
+typedef struct clocks {
+	double anchor_wall, anchor_t; /* pacing: wall time at simulated t */
+	double rate_wall, rate_t;     /* metering window start */
+	uint64_t rate_steps;
+	double cpu_wall;              /* when the CPU clock was last read */
+	double publish_wall;          /* when readers were last woken */
+	double batch_end;             /* pacing: samples due by then step now */
+	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
+					 the cost window */
+} clocks;
+
+/* Restart pacing and metering from now (after a pause or a pace change). */
+static void restart_clocks(clocks *c, const srv_session *s)
+{
+	c->anchor_wall = c->rate_wall = srv_now();
+	c->anchor_t = c->rate_t = s->st.t;
+	c->rate_steps = s->st.steps;
+	c->batch_end = -INFINITY;
+}
+
+/* The CPU clock is read at most this often (s of wall time): once per
+ * batch of a paced session, every 10 ms of a flat-out one. */
+#define CPU_READ_EVERY 0.01
+/* A flat-out session wakes its readers this often (s of wall time); a
+ * paced one once per batch, before it sleeps. */
+#define PUBLISH_EVERY 0.01
+
+/* Wake the readers if a record one of them waits for was pushed since
+ * the last time: an event, or a sample at or past the earliest time a
+ * waiting stream wants (wake_t, which the streams lower before they wait).
+ * Once per batch, not once per sample: every waiting stream is a thread
+ * to wake (lock held). */
+static void publish(srv_session *s, clocks *c)
+{
+	c->publish_wall = srv_now();
+	if (s->head == s->published)
+		return;
+	if (s->event_head > s->published || s->st.t >= s->wake_t) {
+		s->wake_t = INFINITY;
+		pthread_cond_broadcast(&s->data);
+	}
+	s->published = s->head;
+}
+
+/* ---- the attached experiment (its command queue: worker_queue.c) ---------- */
+
+/* The experiment's command was applied or refused (lock held). */
+static void experiment_commanded(srv_session *s, const srv_cmd *cmd)
+{
+	if (cmd != s->exp_cmd)
+		return;
+	s->exp_cmd = NULL;
+	if (srv_exp_commanded(s->exp, cmd))
+		srv_worker_detach_exp(s, NULL);
+}
+
+/* Let the session run at least up to t_end (s): raise until, resume a
+ * finished session (lock held). */
+static void extend_until(srv_session *s, double t_end)
+{
+	if (s->until > 0 && s->until < t_end)
+		s->until = t_end;
+	if (s->state == SRV_FINISHED && s->st.t < t_end)
+		s->state = SRV_RUNNING;
+}
+
+/* The budget part of a control, after its state change
+ * (srv_state_after): a CPU grant from now, and the budget's pause flag
+ * cleared once the session runs or is paused or resumed by hand (lock
+ * held). */
+static void apply_budget(srv_session *s, const srv_cmd *cmd)
+{
+	const api_control *c = &cmd->c;
+	if (c->set & API_C_CPU)
+		s->cpu_limit = s->cpu_seconds + c->cpu_budget;
+	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
+		 cmd->cpu_grant > 0)
+		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
+	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
+		s->cpu_paused = 0;
+}
+
+/* Append cmd's line to the control log: an experiment's names it (lock
+ * held). The log's length with it. */
+static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
+{
+	char line[API_EVENT_MAX];
+	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
+			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
+	return srv_control_log_append(s, line, cmd->waited);
+}
+
+/* Apply queued controls in order and acknowledge each (lock held).
+ * Returns 1 if pacing must restart. */
+static int apply_commands(srv_session *s)
+{
+	int reanchor = 0;
+	srv_cmd *cmd;
+	while ((cmd = s->cmd_head)) {
+		s->cmd_head = cmd->next;
+		if (!s->cmd_head)
+			s->cmd_tail = NULL;
+		const api_control *c = &cmd->c;
+		double t_eff = sim_effective_time(s->sim);
+		int rc = SIM_OK;
+		if (c->set & (API_C_BETA | API_C_BETA_RATE)) {
+			/* SI from api/; a rate alone keeps the target */
+			double target = (c->set & API_C_BETA) ? c->beta.si
+							      : s->st.beta_target;
+			double rate =
+				(c->set & API_C_BETA_RATE) ? c->beta_rate.si : 0;
+			rc = sim_set_beta(s->sim, target, rate);
+		}
+		if (rc == SIM_OK && (c->set & API_C_ROTATION))
+			rc = sim_set_rotation(s->sim, c->rotation);
+		if (rc == SIM_OK && (c->set & API_C_OMEGA_SS))
+			rc = sim_set_omega_ss(s->sim, c->omega_ss);
+		if (rc == SIM_OK && (c->set & API_C_MOTOR))
+			rc = sim_set_drive_on(s->sim, c->motor_on);
+		if (rc == SIM_OK && cmd->restart_transport)
+			sim_restart_transport(s->sim);
+		/* a LIGGGHTS bed's estimate restarts as the core's does */
+		if (rc == SIM_OK && s->dem &&
+		    (cmd->restart_transport ||
+		     (c->set & (API_C_BETA | API_C_ROTATION | API_C_OMEGA_SS | API_C_MOTOR))))
+			s->dem_restart = 1;
+		if (rc == SIM_OK && (c->set & API_C_PACE)) {
+			s->pace = c->pace;
+			reanchor = 1;
+		}
+		if (rc == SIM_OK && (c->set & API_C_UNTIL))
+			s->until = c->until;
+		if (rc == SIM_OK) {
+			/* pacing restarts on running and on a resume from a
+			 * pause (not on a finished session resumed by until:
+			 * it restarts its clocks when it wakes, idle) */
+			int was = s->state;
+			s->state = srv_state_after(was, s->cpu_paused, s->st.t, c);
+			reanchor |= (c->set & API_C_RUNNING) ||
+				    (was == SRV_PAUSED && s->state != was);
+			apply_budget(s, cmd);
+		}
+		if (s->pace == API_PACE_MAX && s->until == 0)
+			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
+		if (rc == SIM_OK) {
+			char json[API_EVENT_MAX];
+			api_control_event(json, sizeof json, c, t_eff);
+			srv_ring_event(s, "control", json);
+			if (cmd->from_experiment && s->exp_relogged > 0)
+				s->exp_relogged--; /* in the log since before the restore */
+			else if (!cmd->replay)
+				cmd->logged = log_control(s, cmd, t_eff);
+			s->ckpt_dirty = 1;
+		}
+		cmd->rc = rc;
+		cmd->t_eff = t_eff;
+		cmd->done = 1;
+		if (cmd->from_experiment)
+			experiment_commanded(s, cmd);
+	}
+	/* the status shows the accepted targets at once: no step publishes
+	 * one while paused or finished, nor before the answer when running */
+	sim_get_status(s->sim, &s->st);
+	pthread_cond_broadcast(&s->data);
+	return reanchor;
+}
+
+/* Next simulated time to advance to (lock held). */
+static double next_time(srv_session *s)
+{
+	double t = s->st.t;
+	double dt = 1.0 / s->spec.sample_rate;
+	double t_next = (floor(t / dt + 1e-6) + 1) * dt;
+	if (s->until > 0 && t_next > s->until)
+		t_next = s->until;
+	if (s->exp) {
+		double b = srv_exp_boundary(s->exp);
+		if (b > t && b < t_next)
+			t_next = b;
+	}
+	return t_next;
+}
+
+/* ---- the phases --------------------------------------------------------------- */
+
+/* job start: an experiment attached since the last turn begins. */
+static void start_job(srv_session *s)
+{
+	if (!s->exp || s->exp_started || s->state == SRV_FAILED || s->stop)
+		return;
+	double t_end;
+	srv_cmd *cmd = srv_exp_begin(s->exp, &s->st, &t_end);
+	extend_until(s, t_end);
+	srv_worker_queue_exp_command(s, cmd);
+	s->exp_started = 1;
+	pthread_cond_broadcast(&s->data);
+}
+
+/* replay: the controls logged after the checkpoint the session was
+ * restored from go through the commands phase again, each once the
+ * integrator reaches its t_effective, so that no acknowledged control is
+ * lost to a crash. */
+static void run_replay(srv_session *s)
+{
+	double t = sim_effective_time(s->sim);
+	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
+		srv_replay *rp = &s->replay[s->replayed++];
+		if (rp->exp_own)
+			continue; /* its experiment sends it again */
+		rp->cmd.replay = 1;
+		srv_worker_queue(s, &rp->cmd);
+	}
+}
+
+/* caught up: a restored session (session_store.c catch_up) ran flat out
+ * to where it was, or a replayed control stopped it short of that, or it
+ * failed: from here on it keeps its pace and answers. */
+static void check_caught_up(srv_session *s, clocks *c)
+{
+	if (!(s->catch_up_t > 0) ||
+	    (s->st.t < s->catch_up_t && s->state != SRV_FAILED && !s->stop &&
+	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
+		return;
+	s->catch_up_t = 0;
+	s->replay_seconds = srv_now() - s->replay_wall;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_INFO, "session %s: replayed to t = %g s in %.3f s",
+		s->entry.id, s->st.t, s->replay_seconds);
+}
+
+/* commands: apply what is queued; pacing restarts after pace or pause. */
+static void run_commands(srv_session *s, clocks *c)
+{
+	if (s->cmd_head && apply_commands(s))
+		restart_clocks(c, s);
+}
+
+/* until: a running session that reached until finishes there. */
+static void check_until(srv_session *s, clocks *c)
+{
+	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
+		s->state = SRV_FINISHED;
+		s->ckpt_dirty = 1;
+		srv_ring_event_at(s, "finished", NULL);
+		publish(s, c);
+	}
+}
+
+/* The CPU a simulated second costs this session, over windows of 50 ms of
+ * CPU or 2 simulated s, whichever comes first; the mean of the last and
+ * this window's (a session's cost changes with its state: a run-up, a
+ * moving feed). */
+#define COST_WINDOW_CPU 0.05
+#define COST_WINDOW_T 2.0
+
+static void measure_cost(srv_session *s, clocks *c)
+{
+	double cpu = s->cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
+	if (t <= 0 || (cpu < COST_WINDOW_CPU && t < COST_WINDOW_T)) {
+		if (t < 0) /* not a window: start one */
+			c->cost_cpu = s->cpu_seconds, c->cost_t = s->st.t;
+		return;
+	}
+	double cost = cpu / t;
+	s->cpu_per_s = s->cpu_measured ? 0.5 * (s->cpu_per_s + cost) : cost;
+	s->cpu_measured = 1;
+	c->cost_cpu = s->cpu_seconds;
+	c->cost_t = s->st.t;
+}
+
+/* The session measured more than it was admitted for: it goes on at the
+ * pace that fits the cores for paced sessions (budget.c), taken as a
+ * control would be (the stream's and the control log's "control" event),
+ * so that it does not starve the others (lock held). */
+static void pace_down(srv_session *s, clocks *c)
+{
+	double was = s->pace, cost = s->cpu_per_s;
+	double pace = srv_budget_fit_pace(&s->paced_held, cost, was);
+	if (pace >= was)
+		return;
+	api_control ctl = {.set = API_C_PACE, .pace = pace};
+	char json[API_EVENT_MAX];
+	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
+	s->pace = pace;
+	srv_ring_event(s, "control", json);
+	srv_control_log_append(s, json, 0);
+	s->ckpt_dirty = 1;
+	restart_clocks(c, s);
+	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
+			      "admitted; paced down from %g to %g to fit "
+			      "--max-paced-cores", s->entry.id, cost, was, pace);
+}
+
+/* need: the session's hold on the paced cores follows what it needs now
+ * (its state, pace and measured cost), even beyond the budget: admission
+ * is checked where a request raises it (session.c). Called in the same
+ * turn as the commands phase (the lock is not let go in between), so that
+ * a hold a handler raised for its queued command is kept until the worker
+ * has applied it. */
+static void commit_need(srv_session *s, clocks *c)
+{
+	double need = srv_paced_need(s);
+	if (need > s->paced_held * (1 + 1e-9) && need > 1e-9)
+		pace_down(s, c);
+	else if (need != s->paced_held)
+		srv_budget_set_paced(&s->paced_held, need);
+}
+
+/* cpu: read the worker's CPU time; a running session that spent its
+ * grant pauses. */
+static void check_cpu(srv_session *s, clocks *c)
+{
+	double now = srv_now();
+	struct timespec ts;
+	if (now - c->cpu_wall < CPU_READ_EVERY)
+		return;
+	c->cpu_wall = now;
+	/* a LIGGGHTS session's bed process's CPU is the session's too */
+	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
+				 (s->dem ? s->bed.cpu_seconds : 0.0);
+	measure_cost(s, c);
+	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
+		return;
+	s->state = SRV_PAUSED;
+	s->cpu_paused = 1;
+	s->ckpt_dirty = 1;
+	srv_ring_event_at(s, "paused", "\"reason\":\"cpu-budget\"");
+	publish(s, c);
+	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
+			      "spent", s->entry.id, s->cpu_limit);
+}
+
+/* turn: a running pace "max" session steps only while it holds a CPU
+ * slot; any other gives its slot (or place in line) up. 1 if it must wait
+ * (the loop then starts over, so that commands are seen at once). */
+static int take_turn(srv_session *s, clocks *c)
+{
+	if (s->state != SRV_RUNNING || s->pace != API_PACE_MAX || s->stop) {
+		srv_cpu_leave(&s->turn);
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	if (srv_cpu_turn_over(&s->turn))
+		srv_cpu_leave(&s->turn); /* to the back of the line */
+	if (srv_cpu_take(&s->turn)) {
+		s->waiting_for_cpu = 0;
+		return 0;
+	}
+	s->waiting_for_cpu = 1;
+	publish(s, c);
+	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
+	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+	restart_clocks(c, s);
+	return 1;
+}
+
+/* idle: a session that is not running sleeps until woken; 1 if it slept. */
+static int idle(srv_session *s, clocks *c)
+{
+	if (s->state == SRV_RUNNING)
+		return 0;
+	srv_cpu_leave(&s->turn);
+	s->waiting_for_cpu = 0;
+	s->steps_per_s = s->rtf = 0;
+	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
+	publish(s, c);
+	pthread_cond_wait(&s->wake, &s->lock);
+	restart_clocks(c, s);
+	return 1;
+}
+
+/* A paced session steps in batches: it wakes when its next sample is due
+ * and steps every sample due within PACE_AHEAD (s of wall time) from then,
+ * so it runs at most that far ahead of its clock and wakes (and wakes its
+ * readers) once per PACE_AHEAD, not once per sample (at 250 Hz sampling,
+ * 250 wake-ups a second each, which cost more than the simulation itself
+ * with many sessions). */
+#define PACE_AHEAD 0.02
+
+/* pacing: step t_next now if it is due within the current batch, else
+ * wait until it is due and start a batch; 1 if it waited (the loop then
+ * starts over, so that commands are seen at once). */
+static int pace(srv_session *s, clocks *c, double t_next)
+{
+	if (s->pace == API_PACE_MAX || s->catch_up_t > 0)
+		return 0;
+	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
+	if (due <= c->batch_end)
+		return 0;
+	double now = srv_now();
+	if (now < due) {
+		publish(s, c); /* the batch is over */
+		struct timespec ts = srv_deadline(due - now);
+		pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+		return 1;
+	}
+	if (now - due > 0.25) { /* behind: do not catch up */
+		c->anchor_wall = now;
+		c->anchor_t = s->st.t;
+	}
+	c->batch_end = now + PACE_AHEAD;
+	return 0;
+}
+
+/* step: advance to t_next with the lock released, then publish the status
+ * and push a sample (its readers are woken once per batch: publish). A
+ * LIGGGHTS session advances machine and bed together to the end of the
+ * coupling interval at or after t_next (session_dem.c), its status
+ * showing the bed's feed. Returns the core's code; a bed that failed
+ * gives SIM_EDIVERGED with its reason in why. */
+static int step(srv_session *s, double t_next, char *why, size_t whylen)
+{
+	sim_status st;
+	api_bed bed = s->bed;
+	int rc = SIM_OK;
+	pthread_mutex_unlock(&s->lock);
+	if (!s->dem)
+		rc = sim_advance(s->sim, t_next);
+	else if (srv_dem_step(s, t_next, why, whylen))
+		rc = SIM_EDIVERGED;
+	sim_get_status(s->sim, &st);
+	if (s->dem) {
+		srv_dem_controlled(s, &st);
+		srv_dem_read(s, &st, &bed);
+	}
+	srv_ring_gather(s);
+	pthread_mutex_lock(&s->lock);
+	if (st.steps > s->st.steps)
+		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
+	s->st = st;
+	s->bed = bed;
+	srv_ring_sample(s);
+	return rc;
+}
+
+/* job step: the experiment sees the step; it may end or hand over the
+ * next segment's command. */
+static void run_job(srv_session *s)
+{
+	if (!s->exp || !s->exp_started)
+		return;
+	int over = 0;
+	srv_worker_queue_exp_command(s, srv_exp_step(s->exp, &s->st, &over));
+	if (over) {
+		srv_worker_detach_exp(s, NULL);
+		s->ckpt_dirty = 1;
+		if (s->owned) /* created by it and not kept */
+			s->expire = 1;
+	}
+}
+
+/* failure: the core refused to go on, or a LIGGGHTS session's bed did
+ * (why, else ""); the session fails for good. A bed ended by the
+ * session's own stop (deleted, the daemon stopping) is no failure. */
+static void fail(srv_session *s, int rc, const char *why)
+{
+	if (s->stop && why[0])
+		return;
+	s->state = SRV_FAILED;
+	s->ckpt_dirty = 1;
+	if (s->owned)
+		s->expire = 1;
+	if (why[0])
+		snprintf(s->error, sizeof s->error, "the LIGGGHTS bed: %.220s", why);
+	else
+		snprintf(s->error, sizeof s->error, "%s: %s", sim_strerror(rc),
+			 sim_last_error(s->sim) ? sim_last_error(s->sim) : "");
+	srv_ring_event_at(s, "failed", NULL);
+	srv_worker_detach_exp(s, s->error);
+	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
+}
+
+/* meter: steps/s and real-time factor over the last half second. */
+static void meter(srv_session *s, clocks *c)
+{
+	double now = srv_now();
+	if (now - c->rate_wall < 0.5)
+		return;
+	s->steps_per_s = (double)(s->st.steps - c->rate_steps) /
+			 (now - c->rate_wall);
+	s->rtf = (s->st.t - c->rate_t) / (now - c->rate_wall);
+	c->rate_wall = now;
+	c->rate_t = s->st.t;
+	c->rate_steps = s->st.steps;
+}
+
+void *srv_worker_main(void *arg)
+{
+	srv_session *s = arg;
+	clocks clk = {0};
+	srv_thread_background("session");
+	srv_ring_gather(s);
+	pthread_mutex_lock(&s->lock);
+	sim_get_status(s->sim, &s->st);
+	srv_ring_sample(s);
+	restart_clocks(&clk, s);
+	clk.cpu_wall = -INFINITY;
+	clk.cost_t = s->st.t; /* the thread's CPU clock starts at 0 */
+	publish(s, &clk);
+	for (;;) {
+		start_job(s);
+		run_replay(s);
+		run_commands(s, &clk);
+		if (!s->first_applied) {
+			/* what was due at the start is in: the status shows it */
+			s->first_applied = 1;
+			pthread_cond_broadcast(&s->data);
+		}
+		check_caught_up(s, &clk);
+		if (s->stop)
+			break;
+		srv_persist_checkpoint(s, 0);
+		check_until(s, &clk);
+		check_cpu(s, &clk);
+		commit_need(s, &clk);
+		if (idle(s, &clk) || take_turn(s, &clk))
+			continue;
+		double t_next = next_time(s);
+		if (pace(s, &clk, t_next))
+			continue;
+		char why[256] = "";
+		int rc = step(s, t_next, why, sizeof why);
+		run_job(s);
+		if (rc != SIM_OK)
+			fail(s, rc, why);
+		meter(s, &clk);
+		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
+			publish(s, &clk);
+	}
+	if (srv_stopping()) { /* the next start continues from here */
+		/* the log first, here: the session has left the registry, so
+		 * the store's writer can no longer find it to sync the lines
+		 * nobody waited for before the checkpoint */
+		size_t logged = s->controls_len;
+		pthread_mutex_unlock(&s->lock);
+		srv_control_log_sync(s, logged, 30.0);
+		pthread_mutex_lock(&s->lock);
+		s->ckpt_dirty = 1;
+		srv_persist_checkpoint(s, 1);
+	}
+	srv_worker_detach_exp(s, "the session was deleted or the daemon stopped");
+	srv_cpu_leave(&s->turn);
+	srv_budget_set_paced(&s->paced_held, 0);
+	pthread_cond_broadcast(&s->data);
+	pthread_mutex_unlock(&s->lock);
+	return NULL;
+}
