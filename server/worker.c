@@ -192,9 +192,15 @@ static int apply_commands(srv_session *s)
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
 		if (rc == SIM_OK) {
-			char json[API_EVENT_MAX];
+			/* the control log keeps the control; the stream's event
+			 * also carries the scene's model error after it */
+			char json[API_EVENT_MAX], ring[API_EVENT_MAX];
+			sim_model_error me;
+			sim_get_status(s->sim, &s->st);
+			api_model_check(&s->spec, &s->st, &me);
 			api_control_event(json, sizeof json, c, t_eff);
-			srv_ring_event(s, "control", json);
+			api_control_event_model(ring, sizeof ring, c, t_eff, &me);
+			srv_ring_event(s, "control", ring);
 			if (!cmd->replay)
 				srv_persist_control(s, json);
 			s->ckpt_dirty = 1;
