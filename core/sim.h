@@ -168,20 +168,6 @@ const sim_setting *sim_settings(size_t *n);
 /* The czubak2016 preset (docs/MODEL.md), default scene and default method. */
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
 
-/* Whether the column model of a scene lies inside the domain where it was
- * checked against LIGGGHTS beds (docs/dem.md, `make bench-dem`: the
- * czubak2016 machine, a 4-diameter bed at 11 angles in both senses, other
- * depths at beta = 30 deg): 1 inside; 0 outside, with the reason and what
- * to use instead written into why (len bytes); -1 where the scene has no
- * column feed (no feed, or feed_model liggghts). The rule: at most 2
- * layers (within 1 % of the DEM bed of that depth at 30 deg); or at most 8
- * layers with contacts 10x the preset's stiffness or stiffer, k_c / m_n >=
- * 2e7 s^-2, except beta in (137, 165) deg cw and (15, 45) deg ccw, the DEM
- * bed's second peak (within 10 % at 19 of the 22 angles and senses of a
- * 4-diameter bed); or the preset liggghts-bed4's contact fitted to a
- * 4-diameter bed, at most 4 layers. */
-int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len);
-
 /* How far the scene's column model is from a DEM bed (docs/dem.md "Model
  * error"), from the DEM map compiled in (tests/bench/results/
  * model_check.csv). checked: 1 when the scene's settings (all but beta,
