@@ -80,6 +80,8 @@ static api_err start_on_session(srv_experiment *e,
 			srv_session_put(s);
 			return pb->code;
 		}
+		/* the session's scene, for each segment's model error */
+		srv_exp_set_spec(e, srv_session_spec(s));
 	}
 	srv_session_put(s); /* it noted its id in e before its worker ran */
 	return API_OK;

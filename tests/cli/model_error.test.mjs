@@ -46,3 +46,19 @@ test('model_error: not checked at another depth or for the preset, the note name
   assert.equal(n.model_checked, false);
   assert.equal(n.feed_warning, null);
 });
+
+test('model_error: a fit\'s curve is checked at the fitted values, not the start\'s', () => {
+  const data = new URL('../bench/results/dem_bed4.csv', import.meta.url).pathname;
+  const out = execFileSync(CONVSIM, ['fit', '-p', 'liggghts-bed4', '--data', data, '--free', 'mu',
+    '--set', 'feed_coupling=false', '--curve-step', '15', '--threads', '1', '--max-iter', '1', '-q'], { encoding: 'utf8' });
+  const f = JSON.parse(out);
+  const mu = f.parameters[0].value;
+  assert.ok(Math.abs(mu - 0.62285) > 1e-6, `mu moved from the preset's: ${mu}`);
+  for (const rot of ['cw', 'ccw']) {
+    const c = f.curve[rot];
+    assert.equal(c.model_error.length, f.curve.beta.length);
+    assert.deepEqual(c.model_checked, f.curve.beta.map(() => false), `${rot}: the fitted mu is no map entry's`);
+    assert.ok(c.model_error.every((e) => e === null));
+    assert.equal(c.model_check_note, 'not checked against DEM with this contact (mu differs): nearest checked is 4 layers, liggghts-bed4');
+  }
+});

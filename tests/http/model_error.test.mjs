@@ -118,3 +118,28 @@ test('model_error: the preset is not checked, in one short sentence; a 2-layer c
   for (const id of [a.body.id, b.body.id])
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
+
+test('model_error: a sweep\'s points and an experiment\'s segments carry the map\'s value at their angle', { timeout: 30000 * SLOW }, async () => {
+  const sw = await req(d.base, 'POST', '/api/v1/sweeps',
+    { preset: 'liggghts-bed4', beta: [30, 150, 170], rotations: ['cw'], t_end: 1 });
+  assert.equal(sw.status, 202, sw.text);
+  const at = (beta) => sw.body.points.find((p) => p.beta === beta);
+  assert.ok(Math.abs(at(30).model_error - MAP['30,cw']) < 1e-12, `sweep at 30: ${at(30).model_error}`);
+  assert.ok(Math.abs(at(150).model_error - MAP['150,cw']) < 1e-12, `sweep at 150: ${at(150).model_error}`);
+  assert.equal(at(150).model_checked, true);
+  assert.equal(at(170).model_checked, false);
+  assert.equal(at(170).model_error, null);
+  assert.match(at(170).model_check_note, /beta 170 deg cw/);
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${sw.body.id}`)).status, 204);
+
+  const s = await req(d.base, 'POST', '/api/v1/sessions', { preset: 'liggghts-bed4', params: { beta: 30 }, pace: 1 });
+  assert.equal(s.status, 201);
+  const x = await req(d.base, 'POST', '/api/v1/experiments',
+    { session: s.body.id, schedule: [{ beta: 30, until: 0.002 }, { beta: 150, until: 0.004 }] });
+  assert.equal(x.status, 201, x.text);
+  const seg = x.body.segments;
+  assert.ok(Math.abs(seg[0].model_error - MAP['30,cw']) < 1e-12, `segment at 30: ${seg[0].model_error}`);
+  assert.ok(Math.abs(seg[1].model_error - MAP['150,cw']) < 1e-12, `segment at 150: ${seg[1].model_error}`);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${x.body.id}`)).body.state === 'done', 10000 * SLOW, 'the experiment');
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${s.body.id}`)).status, 204);
+});
