@@ -67,7 +67,7 @@ static api_err start_on_session(srv_experiment *e,
 {
 	srv_session *s;
 	if (req->fresh) {
-		s = srv_session_create(&req->spec, e, pb);
+		s = srv_session_create(&req->spec, e, -1, pb);
 		if (!s)
 			return pb->code;
 	} else {

@@ -179,7 +179,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
-srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
+srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
 	api_spec copy = *request;
@@ -189,6 +189,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
+	s->create_fd = -1;
 	pthread_mutex_init(&s->lock, NULL);
 	pthread_cond_init(&s->wake, NULL);
 	pthread_cond_init(&s->data, NULL);
@@ -213,7 +214,10 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		s->mem_reserved = 0;
 		goto fail;
 	}
-	if (session_init(s, spec, pb))
+	s->create_fd = client_fd;
+	int bad = session_init(s, spec, pb);
+	s->create_fd = -1;
+	if (bad)
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&
@@ -536,6 +540,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
+			s->create_fd = -1; /* no client waits for a restore */
 			pthread_mutex_init(&s->lock, NULL);
 			pthread_cond_init(&s->wake, NULL);
 			pthread_cond_init(&s->data, NULL);
