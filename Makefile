@@ -29,7 +29,7 @@ Q := @
 endif
 
 # Open MPI installed (pkg-config ompi-c) and not NO_MPI=1: `convsim sweep`
-# spreads a study's points over the ranks under mpirun (core/cli/spread.h:
+# spreads a study's points over the ranks under mpirun (cli/spread.h:
 # spread_mpi.c, else spread_none.c). `make NO_MPI=1 BUILD=DIR` builds
 # without MPI (and so without the DEM coupling, which needs it) where it
 # is installed; `make test` builds that too, in $(BUILD)/nompi.
@@ -37,11 +37,13 @@ HAVE_MPI := $(if $(NO_MPI),,$(shell pkg-config --exists ompi-c 2>/dev/null && ec
 # LIGGGHTS (and MPI) installed: the DEM coupling (dem/, below) is built
 HAVE_LIGGGHTS := $(if $(HAVE_MPI),$(wildcard /usr/include/liggghts/library.h))
 CORE_SRC   := $(wildcard core/*.c)
-CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),core/cli/coupled_none.c) \
-                $(if $(HAVE_MPI),core/cli/spread_none.c,core/cli/spread_mpi.c),$(wildcard core/cli/*.c))
-FIT_SRC    := $(wildcard core/fit/*.c)
+CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),cli/coupled_none.c) \
+                $(if $(HAVE_MPI),cli/spread_none.c,cli/spread_mpi.c),$(wildcard cli/*.c))
+FIT_SRC    := $(wildcard fit/*.c)
 API_SRC    := $(wildcard api/*.c)
-SERVER_SRC := $(wildcard server/*.c)
+# server/ in floors (docs/development.md "Architecture"), bottom to top
+SERVER_FLOORS := base jobs session http
+SERVER_SRC := $(foreach f,$(SERVER_FLOORS),$(wildcard server/$(f)/*.c)) server/main.c
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 
 CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/%.o)
@@ -115,7 +117,7 @@ $(BUILD)/.deps-build: Makefile
 $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze, haproxy, clang for libFuzzer, valgrind)" sh tests/apt-deps.sh
 	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ] || \
-	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ]; then \
+	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ] || [ ! -d tests/node_modules/@stoplight/prism-cli ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@
@@ -126,25 +128,34 @@ $(BUILD)/.deps-bench: Makefile
 	$(Q)NEEDS="$(DEB_BENCH)" WHY="to benchmark against the ODE peers (GSL, SUNDIALS)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 
-# Include floors, by the top directory of the source: core/ sees only
-# core/; the fitting module core/fit/ sees core/ and GSL; the CLI core/cli/
-# sees core/ and core/fit/; api/ sees core/, core/fit/ and api/, server/
-# all of them and dem/'s headers (the LIGGGHTS-free client of the bed
-# process: libdemlink.a); the unit tests see core/ and core/fit/. A header included
-# across a floor fails the build.
+# Include floors, by the directory of the source (docs/development.md
+# "Architecture"): a floor's -I flags name its own directory and the floors
+# below it, so a header included upward fails the build. core/ sees only
+# core/; fit/ (the calibration library) core/ and GSL; api/ core/ and fit/;
+# the application cli/ (convsim) core/ and fit/; server/'s floors, bottom
+# to top, base/ < jobs/ < session/ < http/ < server/main.c, each core/,
+# fit/, api/ and the floors below it (session/ and up also dem/'s headers:
+# the LIGGGHTS-free client of the bed process, libdemlink.a); dem/ core/
+# and LIGGGHTS, its programs dem/cli/ also cli/ (convsim's coupled run);
+# the unit tests core/ and fit/.
 INC_core   := -Icore
-INC_api    := -Icore -Icore/fit -Iapi
-INC_server := -Icore -Icore/fit -Iapi -Iserver
-INC_tests  := -Icore -Icore/fit
-INC_dem    := -Icore -Icore/cli -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
-INC_server += -Idem
-$(CLI_OBJ): INC_EXTRA := -Icore/fit
-$(BUILD)/core/cli/spread_mpi.o: INC_EXTRA := -Icore/fit $(MPI_CFLAGS)
+INC_fit    := -Icore -Ifit
+INC_api    := -Icore -Ifit -Iapi
+INC_cli    := -Icore -Ifit -Icli
+INC_server_base    := $(INC_api) -Iserver/base
+INC_server_jobs    := $(INC_server_base) -Iserver/jobs
+INC_server_session := $(INC_server_jobs) -Iserver/session -Idem
+INC_server_http    := $(INC_server_session) -Iserver/http
+INC_server := $(INC_server_http)
+INC_tests  := -Icore -Ifit
+INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
+INC_dem_cli := $(INC_dem) -Icli
+$(BUILD)/cli/spread_mpi.o: INC_EXTRA := $(MPI_CFLAGS)
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
-	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(firstword $(subst /, ,$*))) $(INC_EXTRA) -c $< -o $@
+	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_$(subst /,_,$(patsubst %/,%,$(dir $*)))) $(INC_EXTRA) -c $< -o $@
 
 # The OpenAPI document's response and stream schemas, api/schemas.json,
 # become one C string literal (api/openapi.c includes it).
@@ -270,7 +281,7 @@ bench-zoo-ref: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
 # libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
-# api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
+# fit/, api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
 # executions, coverage and crashes is printed. A JSON body is one more

@@ -380,7 +380,7 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 	if (e == API_OK)
 		e = api_apply_session_extras(root, spec, pb);
 	/* a session may take feed_model liggghts: the daemon says whether it
-	 * can run its bed (server/session_dem.c) */
+	 * can run its bed (server/session/session_dem.c) */
 	if (e == API_OK)
 		e = validate_model(spec, pb);
 	cJSON_Delete(root);

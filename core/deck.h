@@ -5,7 +5,7 @@
  * turned into the world frame, the deck points D_k = G + R(alpha)(d_k, h_d)
  * with their velocities and accelerations, and the generalized force of
  * forces applied there. The machine (model.c), the feed coupling
- * (dynamics.c, ode_dem.c) and the observables (sim.c) share it; it calls
+ * (dynamics.c, ode_split.c) and the observables (sim.c) share it; it calls
  * no other module. Lengths in m, angles in rad, SI throughout.
  */
 #ifndef CONVSIM_DECK_H
@@ -14,7 +14,7 @@
 #include <math.h>
 
 #include "angle.h"
-#include "sim.h"
+#include "params.h"
 
 /* Machine coordinates q = (x, y, alpha, phi, s1, s2) (docs/MODEL.md). */
 enum { Q_X, Q_Y, Q_ALPHA, Q_PHI, Q_S1, Q_S2, NQ_FULL };

@@ -14,7 +14,7 @@
  *
  * The deck's motion comes in (deck_motion, or the deck point of one
  * sub-step); the feed's forces on the deck go out. No machine function is
- * called here: dynamics.c and ode_dem.c couple the two.
+ * called here: dynamics.c and ode_split.c couple the two.
  */
 #include <math.h>
 #include <string.h>

@@ -25,7 +25,7 @@
 
 #include "deck.h"
 #include "ramp.h"
-#include "sim.h"
+#include "params.h"
 
 /* Energy accumulators (J): the drive's input, the machine's damping, the
  * feed's friction and contact work; with dem only (else zero), the feed's

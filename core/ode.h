@@ -11,6 +11,7 @@
 #define CONVSIM_ODE_H
 
 #include "dynamics.h"
+#include "errors.h"
 
 /* Classical RK4's stability region along the negative real axis: the
  * real root of 1 + z/2 + z^2/6 + z^3/24 (where |R(z)| returns to 1). */
@@ -44,7 +45,7 @@ typedef struct ode_method {
 	void (*load)(void *ws, const void *buf);
 } ode_method;
 
-extern const ode_method ode_rk4, ode_dopri5, ode_euler, ode_dem;
+extern const ode_method ode_rk4, ode_dopri5, ode_euler, ode_split;
 
 /* Method by name, NULL if unknown. */
 const ode_method *ode_find(const char *name);

@@ -10,7 +10,7 @@
 
 /* Each entry is the first member of an ode_method (ode.h). */
 static const sim_method_info *const registry[] = {&ode_rk4.info, &ode_dopri5.info,
-						  &ode_euler.info, &ode_dem.info};
+						  &ode_euler.info, &ode_split.info};
 #define N_METHODS (sizeof registry / sizeof registry[0])
 
 const ode_method *ode_find(const char *name)

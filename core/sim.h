@@ -21,133 +21,14 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Return codes: one list, expanded into the enum and sim_strerror().
- * X(name, message); no transport meaning (api/errors.c maps them). */
-#define SIM_ERRNO_MAP(X)                                                      \
-	X(OK, "ok")                                                           \
-	X(EPARAM, "parameter out of range")                                   \
-	X(EUNKNOWN, "unknown name")                                           \
-	X(ENOMEM, "out of memory")                                            \
-	X(EDIVERGED, "simulation diverged")                                   \
-	X(ESTEP, "step size underflow")                                       \
-	X(ETIME, "requested time lies in the past")                           \
-	X(ECHECKPOINT, "checkpoint damaged, cut off or of another version")
-
-typedef enum {
-#define SIM_ERR_ENUM(name, msg) SIM_##name,
-	SIM_ERRNO_MAP(SIM_ERR_ENUM)
-#undef SIM_ERR_ENUM
-	SIM_NERR
-} sim_err;
-
-/* Static text for a return code; never NULL. */
-const char *sim_strerror(int err);
+/* Return codes (sim_err, SIM_OK, ...) and sim_strerror: errors.h. */
+#include "errors.h"
 
 /* ---- parameters ------------------------------------------------------ */
 
-/* Largest feed: columns K and layers L (settings table and array sizes). */
-#define SIM_MAX_COLUMNS 64
-#define SIM_MAX_LAYERS 64
-
-/* Rotation sense of the unbalanced mass in the paper's words (docs/MODEL.md
- * "Rotation sense"): its clockwise is phi' > 0 in the model's axes
- * (clockwise seen from behind the drawing), its counter-clockwise phi' < 0.
- * The value is the sign of phi'. */
-enum { SIM_CW = 1, SIM_CCW = -1 };
-enum { SIM_DRIVE_MOTOR = 0, SIM_DRIVE_IDEAL = 1 };
-enum { SIM_FRICTION_COULOMB = 0, SIM_FRICTION_REGULARISED = 1 };
-/* How an instance starts (docs/MODEL.md "Start"): `rest`, the paper's run-up
- * from static equilibrium with the motor switched on at t = 0; `steady`,
- * the machine on its periodic forced response at the loaded motor speed
- * with the feed settled on the moving deck. */
-enum { SIM_START_REST = 0, SIM_START_STEADY = 1 };
-/* What carries the feed (scene setting `feed_model`): the paper's columns
- * of layers, integrated by the core; or a bed outside the core (the
- * setting's choice `liggghts`: dem/ couples a LIGGGHTS bed), which the
- * core sees only as a load on the deck that its caller sets each step
- * (sim_set_deck_load): no feed coordinates, the feed's weight on the deck
- * at the start. */
-enum { SIM_FEED_COLUMN = 0, SIM_FEED_EXTERNAL = 1 };
-
-/* Physical parameters, docs/MODEL.md names, SI (angles in radians). */
-typedef struct sim_params {
-	/* suspension */
-	double l1, l2, h;         /* m: spring sets at (l1,-h), (-l2,-h) */
-	double k_x, k_y;          /* N/m per spring set */
-	double b_x, b_y;          /* N s/m per spring set */
-	/* trough */
-	double M_r, J_r;          /* kg, kg m^2 */
-	/* vibrator */
-	double m, e, J_w;         /* kg, m, kg m^2 */
-	double w_x, w_y;          /* m: axle, body frame */
-	double b_phi;             /* N m s^2: bearing drag b_phi*w|w| */
-	double M_load;            /* N m: constant load torque on the rotor,
-				     against the commanded rotation */
-	/* motor (Kloss) */
-	double M_ut;              /* N m breakdown torque */
-	double omega_ss;          /* rad/s synchronous speed (>0) */
-	double slip_ut;           /* rad/s omega_ss - omega_ut */
-	int rotation;             /* SIM_CW or SIM_CCW */
-	/* eliminators */
-	double m1, m2;            /* kg */
-	double k_s1, k_s2;        /* N/m */
-	double b_s1, b_s2;        /* N s/m */
-	double p1_x, p1_y, p2_x, p2_y; /* m guide points, body frame */
-	double c;                 /* m offset of the mass along the guide */
-	double beta;              /* rad, initial guide angle */
-	double beta_rate;         /* rad/s slew rate of beta ramps */
-	double beta_accel;        /* rad/s^2 bound on beta'' in ramps */
-	/* feed */
-	double m_n;               /* kg per element */
-	double k_c;               /* contact stiffness k, N/m^p */
-	double p;                 /* contact exponent */
-	double R;                 /* restitution coefficient */
-	double mu;                /* friction coefficient */
-	double h_d;               /* m deck height above G */
-	double column_span;       /* m columns at d_k evenly in [-span, span] */
-	/* environment */
-	double g;                 /* m/s^2 */
-	double drive_accel;       /* rad/s^2 speed ramp of the ideal drive */
-} sim_params;
-
-/* Scene: what the user needs; the engine builds the cheapest model for it. */
-typedef struct sim_scene {
-	int feed;             /* 0: no feed degrees of freedom */
-	int columns, layers;  /* K, L */
-	int drive;            /* SIM_DRIVE_MOTOR (Kloss) or SIM_DRIVE_IDEAL */
-	int trough_rotation;  /* 1: integrate alpha even on a symmetric machine;
-				 0: the engine drops it there by itself */
-	int mirror;           /* 1: sweeps derive (ccw, pi - beta) from (cw,
-				 beta) where the machine allows it
-				 (sim_mirror_plan); 0: every point is run */
-	int feed_coupling;    /* 0: one-way (feed does not act on the trough) */
-	int friction;         /* SIM_FRICTION_* */
-	double friction_eps;  /* m/s, regularised friction width */
-	int motor_on;         /* drive on at t = 0 */
-	double transient;     /* s: transport velocity ignores t < transient */
-	int start;            /* SIM_START_REST or SIM_START_STEADY */
-	int feed_model;       /* SIM_FEED_COLUMN or SIM_FEED_EXTERNAL (in start's
-				 padding: the struct's size and the offsets after
-				 it stay, and a zeroed old record reads column) */
-	double settle;        /* s: `steady` start's settling before t = 0 */
-} sim_scene;
-
-/* Integrator choice. dt: fixed step (or macro step) in s, 0 for the
- * default of the scene kind (sim_default_dt); rtol/atol for adaptive
- * methods; substeps: feed sub-steps per macro step (method "dem"), 0 for
- * sim_default_substeps(); feed_events (dem): slip reversals located inside
- * the feed's sub-steps and the deck yielding to the feed within the
- * machine's step (0: the former dem). */
-typedef struct sim_method {
-	char name[24];
-	double dt;
-	double rtol, atol;
-	int substeps;
-	int feed_events;
-	double tol;   /* accuracy target of v (docs/MODEL.md's convention):
-			 the default steps scale with it and sim_measure
-			 refines until the estimated step error is within it */
-} sim_method;
+/* sim_params, sim_scene and sim_method: params.h (which the model includes
+ * without the rest of this interface). */
+#include "params.h"
 
 /* Description of one named setting, for validation, docs and OpenAPI. */
 typedef enum { SIM_KIND_REAL, SIM_KIND_INT, SIM_KIND_BOOL, SIM_KIND_ENUM } sim_kind;
@@ -244,16 +125,7 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m,
 
 /* ---- integrators ----------------------------------------------------- */
 
-typedef struct sim_method_info {
-	const char *name;
-	int order;        /* classical order on smooth problems */
-	int adaptive;     /* 1 if rtol/atol drive the step */
-	/* fixed-step methods: the largest h lambda for which a decaying mode
-	 * y' = -lambda y stays bounded (the stability region's reach along
-	 * the negative real axis); 0 for the adaptive ones */
-	double real_limit;
-	const char *doc;
-} sim_method_info;
+/* sim_method_info (one integrator's description): params.h. */
 /* Registry of integrators, built from each method's own descriptor: an
  * array of *n pointers, all static. */
 const sim_method_info *const *sim_methods(size_t *n);
@@ -348,13 +220,7 @@ int sim_place_feed(sim *s, const double *xi, const double *eta, const double *xi
 
 /* ---- observables at the observed time -------------------------------- */
 
-enum {
-	SIM_RED_NO_FEED = 1 << 0,
-	SIM_RED_SYMMETRIC = 1 << 1,
-	SIM_RED_IDEAL_DRIVE = 1 << 2,
-	SIM_RED_ONE_WAY = 1 << 3,
-	SIM_RED_MIRROR = 1 << 4, /* of a sweep, never of an instance */
-};
+/* The reductions' bits, SIM_RED_*: params.h. */
 /* Name of reduction bit i (0..4), NULL past the end. */
 const char *sim_reduction_name(int bit);
 

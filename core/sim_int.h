@@ -10,6 +10,7 @@
 
 #include "estimator.h"
 #include "ode.h"
+#include "sim.h"
 
 struct sim {
 	model md;            /* const after sim_new */

@@ -3,7 +3,7 @@
  * table.h - the tables a user takes away, as the CLI and the daemon write
  * them: one column list for trajectories, one header for v(beta) sweeps,
  * and one way to print a number. Header only (static inline, libc and
- * libm), so that core/cli (which sees only core/) and api/ share it
+ * libm), so that cli/ (which sees core/ and fit/, not api/) and api/ share it
  * without a dependency between the two.
  *
  * Numbers are the shortest of %.15g, %.16g and %.17g that strtod reads

@@ -2,12 +2,17 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """deps.py - dependency loops between the files of a module, counted by symbols.
 
-For each object file of a folder (build/server/*.o), every undefined symbol is
-looked up among the symbols the other objects of that folder define (functions
-and globals, `nm`); "a.c uses b.c" when a.o needs a symbol b.o defines. The
-strongly connected components of that file graph are the dependency loops.
+For each object file of a folder (build/server/base/*.o), every undefined
+symbol is looked up among the symbols the other objects of that folder define
+(functions and globals, `nm`); "a.c uses b.c" when a.o needs a symbol b.o
+defines. The strongly connected components of that file graph are the
+dependency loops. A folder written DIR/** is one graph of DIR and all its
+sub-folders (build/server/**: the daemon's floors together, so that no loop
+runs across floors either). Only objects whose source still exists are
+counted (a file moved or removed leaves its old object in the build).
 
-usage: tests/deps.py [BUILD/DIR ...]   (default: build/server build/api)
+usage: tests/deps.py [--max N] [BUILD/DIR ...]
+  (default: the daemon's floors, build/server/** and build/api)
 Prints, per folder, every loop of two or more files and the largest size; the
 exit status is 1 when a loop is larger than --max (default: no limit).
 """
@@ -33,11 +38,42 @@ def symbols(obj):
     return defined, needed
 
 
+def source_dir(folder):
+    """The source folder of an object folder: the shortest tail of its path
+    that is a directory here (build/nompi/server/base -> server/base)."""
+    parts = os.path.normpath(folder).split(os.sep)
+    for i in range(1, len(parts) + 1):
+        tail = os.path.join(*parts[i:]) if i < len(parts) else ""
+        if tail and os.path.isdir(tail):
+            return tail
+    return None
+
+
+def objects(folder):
+    """(name, object) of the folder's objects whose source exists; DIR/**:
+    of DIR and its sub-folders, named by their path below DIR."""
+    deep = folder.endswith("/**")
+    top = folder[:-3] if deep else folder
+    dirs = [top]
+    if deep:
+        dirs = sorted(d for d, _, _ in os.walk(top))
+    out = []
+    for d in dirs:
+        src = source_dir(d)
+        if src is None:
+            continue
+        for o in sorted(glob.glob(os.path.join(d, "*.o"))):
+            c = os.path.basename(o)[:-2] + ".c"
+            if os.path.exists(os.path.join(src, c)):
+                out.append((os.path.relpath(os.path.join(d, c), top), o))
+    return out
+
+
 def graph(folder):
-    objs = sorted(glob.glob(os.path.join(folder, "*.o")))
-    names = [os.path.basename(o)[:-2] + ".c" for o in objs]
+    pairs = objects(folder)
+    names = [n for n, _ in pairs]
     defs, needs = {}, {}
-    for n, o in zip(names, objs):
+    for n, o in pairs:
         defs[n], needs[n] = symbols(o)
     owner = {s: n for n in names for s in defs[n]}
     return {n: sorted({owner[s] for s in needs[n] if s in owner} - {n})
@@ -79,7 +115,7 @@ def main(argv):
     limit = None
     if len(argv) > 1 and argv[0] == "--max":
         limit, argv = int(argv[1]), argv[2:]
-    folders = argv or ["build/server", "build/api"]
+    folders = argv or ["build/server/**", "build/api"]
     worst = 0
     for folder in folders:
         g = graph(folder)

@@ -6,7 +6,7 @@
  * summary on stdout: the transport velocity and the balances of momentum
  * and energy between machine and bed. The bed is dem_bed_spec_default's,
  * `layers` mean diameters deep. Linked into convsim where LIGGGHTS is
- * installed (the Makefile); core/cli/coupled_none.c otherwise.
+ * installed (the Makefile); cli/coupled_none.c otherwise.
  *
  * Under `mpirun -n N` LIGGGHTS runs the bed on the N ranks (its domain
  * split along the cell); every rank integrates the same machine (the core

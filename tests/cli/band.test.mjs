@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `convsim sweep --band-from FIT.json` (core/fit/fit_source.c): a study
+// `convsim sweep --band-from FIT.json` (fit/fit_source.c): a study
 // takes a fit's result and every point gets the 95 % band from the fit's
 // covariance by the delta method the fit's own band uses. At the fit's
 // curve points (same beta, same settings) the study's bands are the

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `convsim sweep` under `mpirun -n N` (core/cli/spread.h): the ranks
+// `convsim sweep` under `mpirun -n N` (cli/spread.h): the ranks
 // measure their share of the points, rank 0 gathers them into point order
 // and writes the table, the very bytes one process writes (CSV and JSON,
 // a study with the mirror reduction, a beta sweep, a Latin hypercube, an

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * fuzz_route.c - libFuzzer harness of the daemon's path routing,
- * srv_route_resolve (server/routes.c): the route table and its "*"
+ * srv_route_resolve (server/http/routes.c): the route table and its "*"
  * segments decide, without libmicrohttpd, whether a method and a path are
  * a route (with its path arguments), a 405 with Allow, a 404 under /api,
  * or a static file.

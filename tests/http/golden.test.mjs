@@ -214,9 +214,9 @@ test('every job route answers as recorded, and the data directory holds the same
 });
 
 // docs/jobs.md's table of the descriptor names every field of
-// srv_job_kind (server/job.h), and nothing else.
-test('docs/jobs.md lists the job descriptor\'s fields as server/job.h has them', () => {
-  const header = readFileSync(fileURLToPath(new URL('../../server/job.h', import.meta.url)), 'utf8');
+// srv_job_kind (server/jobs/job.h), and nothing else.
+test('docs/jobs.md lists the job descriptor\'s fields as server/jobs/job.h has them', () => {
+  const header = readFileSync(fileURLToPath(new URL('../../server/jobs/job.h', import.meta.url)), 'utf8');
   const body = header.match(/typedef struct srv_job_kind \{([\s\S]*?)\} srv_job_kind;/)[1]
     .replace(/\/\*[\s\S]*?\*\//g, '');
   const fields = [];

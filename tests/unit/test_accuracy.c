@@ -17,7 +17,7 @@
  * converged within 0.05 % of the peak at these points. 15 and 155 deg cw
  * are where the feed's step matters most: with the sub-step's velocity
  * taken at its end instead of its middle (the leapfrog staggering of
- * ode_dem.c), the default step is 1.9 % and 1.3 % off there. */
+ * ode_split.c), the default step is 1.9 % and 1.3 % off there. */
 static const struct {
 	double beta;
 	const char *rotation;

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * test_fit.c - the fitting module (core/fit) against known answers: data
+ * test_fit.c - the fitting module (fit/) against known answers: data
  * made by the model itself from known parameters plus Gaussian noise of
  * known sigma (fixed seed) must give back those parameters within two
  * standard errors, and the standard errors must match the scatter of the

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * test_fit_source.c - a fit's result read back as the source of a study's
- * bands (core/fit/fit_source.c): the parameters, covariance and quantile
+ * bands (fit/fit_source.c): the parameters, covariance and quantile
  * read from fit_result_json's text are the fit's own (values bit for bit,
  * the covariance rebuilt from standard errors and correlation to
  * round-off); a study point at a curve point of the fit (the same beta,

@@ -7,7 +7,7 @@
  */
 #include <pthread.h>
 
-#include "budget.h"
+#include "budget_turns.h"
 #include "util.h"
 
 /* How long a pace "max" session holds its CPU slot while others wait. */

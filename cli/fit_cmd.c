@@ -2,7 +2,7 @@
 /*
  * fit_cmd.c - `convsim fit`: free parameters (--free) fitted to measured
  * points (--data, CSV) or peak positions (--peaks) by the fitting module
- * (core/fit/fit.h) on --threads threads. The result goes to stdout (or
+ * (fit/fit.h) on --threads threads. The result goes to stdout (or
  * --out) as the daemon's JSON or CSV (fit_out.c writes both); a summary,
  * the warnings and progress go to stderr. Bad input exits with 2 before
  * anything runs.

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * band_from.c - `convsim sweep --band-from FIT.json`: a fit's result (the
- * JSON of `convsim fit`) read back as a band source (core/fit/fit.h) and
+ * JSON of `convsim fit`) read back as a band source (fit/fit.h) and
  * the study's model prepared for it (fit_band_source_prepare). The
  * points' bands themselves are fit_band_point's, per task in
  * sweep_cmd.c.

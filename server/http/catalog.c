@@ -11,6 +11,7 @@
 #include <pthread.h>
 
 #include "budget.h"
+#include "budget_turns.h"
 #include "catalog.h"
 #include "conns.h"
 #include "metrics.h"

@@ -10,6 +10,7 @@
 #include <pthread.h>
 
 #include "budget.h"
+#include "budget_turns.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * ode_dem.c - split (multirate) method for the non-smooth feed, in the
+ * ode_split.c - split (multirate) method for the non-smooth feed, in the
  * manner of discrete-element codes coupled to a rigid machine:
  *
  *  1. the machine takes one classical RK4 macro step dt with the feed's
@@ -46,7 +46,9 @@
  *    sees a deck that ignores the feed's own reaction until the
  *    corrector, which costs up to 1 % of v at a 1e-3-s step (20 deg cw).
  *
- * Without feed it is exactly RK4 on the machine.
+ * Without feed it is exactly RK4 on the machine. Its user-visible name is
+ * "dem" (the `method` setting, kept for the API and the CLI); it is not the
+ * LIGGGHTS coupling of dem/.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -55,7 +57,7 @@
 #include "feed.h"
 #include "ode.h"
 
-typedef struct dem {
+typedef struct split {
 	int n, substeps, have_q;
 	int nmodes; /* feed elements with a normal and a tangential mode each */
 	int correct; /* corrector on: feed light enough (added mass) */
@@ -80,11 +82,11 @@ typedef struct dem {
 	 * same bits */
 	int have_feed_energy;
 	double feed_energy;
-} dem;
+} split;
 
-static void dem_free(void *p)
+static void split_free(void *p)
 {
-	dem *w = p;
+	split *w = p;
 	if (!w)
 		return;
 	free(w->k1);
@@ -96,9 +98,9 @@ static void dem_free(void *p)
 	free(w);
 }
 
-static void *dem_alloc(const model *md, const sim_method *cfg)
+static void *split_alloc(const model *md, const sim_method *cfg)
 {
-	dem *w = calloc(1, sizeof *w);
+	split *w = calloc(1, sizeof *w);
 	if (!w)
 		return NULL;
 	w->n = md->n;
@@ -121,7 +123,7 @@ static void *dem_alloc(const model *md, const sim_method *cfg)
 		w->yield = calloc(1, sizeof *w->yield);
 	if (!w->k1 || !w->modes || !w->deck_pos || !w->hermite || !w->cubic ||
 	    (w->couple && !w->yield)) {
-		dem_free(w);
+		split_free(w);
 		return NULL;
 	}
 	w->k2 = w->k1 + md->n;
@@ -165,7 +167,7 @@ static inline double hermite_sum(const double w[4], double p0, double v0, double
 /* One classical RK4 step of the machine's entries of y over H, with the
  * feed's reaction held at w->Qfeed; ev0 receives the start evaluation,
  * evm and ev3 (where not NULL) the third and the last stage's. */
-static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_eval *ev0,
+static void machine_rk4(split *w, dyn *sys, double t, double H, double *y, model_eval *ev0,
 			model_eval *evm, model_eval *ev3)
 {
 	const model *md = sys->md;
@@ -199,7 +201,7 @@ static void machine_rk4(dem *w, dyn *sys, double t, double H, double *y, model_e
  * middle to O(H^2) like the mean of its ends), so the corrector costs
  * back-substitutions only: no configuration, mass matrix or factorisation
  * of its own. */
-static void correct(dem *w, const model *md, double H, double *y, const double Qold[NQ_FULL],
+static void correct(split *w, const model *md, double H, double *y, const double Qold[NQ_FULL],
 		    const model_eval *evm, const deck_rot *R1)
 {
 	double Q[4][NQ_FULL], a[4][NQ_FULL];
@@ -223,9 +225,9 @@ static void correct(dem *w, const model *md, double H, double *y, const double Q
 		feed_yield_compliance(md, nb, (const double(*)[NQ_FULL])(a + 1), R1, w->yield);
 }
 
-static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
+static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
 {
-	dem *w = p;
+	split *w = p;
 	const model *md = sys->md;
 	double H = ode_fixed_step(*t, w->dt, t_max);
 	if (md->nf > 0 && !w->have_q) {
@@ -349,16 +351,16 @@ static int dem_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	return SIM_OK;
 }
 
-static void dem_reset(void *p)
+static void split_reset(void *p)
 {
-	dem *w = p;
+	split *w = p;
 	w->have_feed_energy = 0;
 }
 
 /* Carried between steps: the held reaction, the contacts' modes and, with
  * the deck yielding, its compliance and the held reaction of the K
  * integrated columns. */
-static size_t yield_size(const dem *w)
+static size_t yield_size(const split *w)
 {
 	size_t K = (size_t)w->K;
 	return w->couple ? sizeof w->have_yield + sizeof w->yield->nb + K * sizeof w->yield->T[0] +
@@ -366,9 +368,9 @@ static size_t yield_size(const dem *w)
 			 : 0;
 }
 
-static size_t dem_state_size(const void *p)
+static size_t split_state_size(const void *p)
 {
-	const dem *w = p;
+	const split *w = p;
 	return sizeof w->have_q + sizeof w->Qfeed + 2 * (size_t)w->nmodes + yield_size(w);
 }
 
@@ -383,9 +385,9 @@ static void carry(char **b, void *field, size_t n, int save)
 	*b += n;
 }
 
-/* The carried state in dem_state_size's order, saved into buf or loaded
+/* The carried state in split_state_size's order, saved into buf or loaded
  * from it (saving only reads w). */
-static void carry_state(dem *w, char *buf, int save)
+static void carry_state(split *w, char *buf, int save)
 {
 	char *b = buf;
 	carry(&b, &w->have_q, sizeof w->have_q, save);
@@ -400,30 +402,30 @@ static void carry_state(dem *w, char *buf, int save)
 	carry(&b, w->yield->F, (size_t)w->K * sizeof w->yield->F[0], save);
 }
 
-static void dem_save(const void *p, void *buf)
+static void split_save(const void *p, void *buf)
 {
-	carry_state((dem *)p, buf, 1);
+	carry_state((split *)p, buf, 1);
 }
 
-static void dem_load(void *p, const void *buf)
+static void split_load(void *p, const void *buf)
 {
 	carry_state(p, (char *)buf, 0);
-	dem_reset(p);
+	split_reset(p);
 }
 
-const ode_method ode_dem = {
+const ode_method ode_split = {
 	.info = {.name = "dem",
 		 .order = 1,
 		 .adaptive = 0,
 		 .real_limit = RK4_REAL_LIMIT,
 		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction"},
 	.dense = 0,
-	.alloc = dem_alloc,
-	.step = dem_step,
+	.alloc = split_alloc,
+	.step = split_step,
 	.interpolate = NULL,
-	.reset = dem_reset,
-	.free = dem_free,
-	.state_size = dem_state_size,
-	.save = dem_save,
-	.load = dem_load,
+	.reset = split_reset,
+	.free = split_free,
+	.state_size = split_state_size,
+	.save = split_save,
+	.load = split_load,
 };

@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "budget.h"
+#include "budget_turns.h"
 #include "conns.h"
 #include "util.h"
 

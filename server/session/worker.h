@@ -7,29 +7,16 @@
  * queue, applied by the worker between steps: a PATCH from a handler
  * (which waits for the acknowledgement) and the beta of each experiment
  * segment (which the experiment hands to the worker and nobody waits on).
- * The loop itself is described in worker.c.
+ * The loop itself is described in worker.c; the command, srv_cmd, is in
+ * jobs/cmd.h (the experiments hand it over too).
  */
 #ifndef CONVSIM_WORKER_H
 #define CONVSIM_WORKER_H
 
 #include "api.h"
+#include "cmd.h"
 
 typedef struct srv_session srv_session;
-
-typedef struct srv_cmd {
-	api_control c;           /* the changes, as PATCH parses them */
-	int restart_transport;   /* then restart the transport estimator */
-	int from_experiment;     /* sent by the attached experiment */
-	int replay;              /* taken again from the control log at a
-				    restore: applied, not logged again */
-	double cpu_grant;        /* CPU s a "running": true grants a session
-				    its CPU budget paused (0: none) */
-	/* set by the worker, under the session lock */
-	int done;                /* applied (or refused): rc and t_eff hold */
-	int rc;                  /* SIM_OK or the core's refusal */
-	double t_eff;            /* s: sim_effective_time() when applied */
-	struct srv_cmd *next;
-} srv_cmd;
 
 /* Append cmd (borrowed until done or taken back) to s's queue and wake the
  * worker. Session lock held. */

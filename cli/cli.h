@@ -95,7 +95,7 @@ char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
  * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else
- * core/cli/coupled_none.c, which says how to get it). Exit status as run. */
+ * cli/coupled_none.c, which says how to get it). Exit status as run. */
 int cli_run_coupled(const cli_opts *o);
 
 typedef struct cli_opt {

@@ -5,7 +5,7 @@
  * An experiment rides on one session's worker, which calls the hooks below
  * with the session lock held; they take the experiment's own lock inside
  * it, as the lock order (registry.h) allows. The experiment never touches the
- * simulation: each segment's beta is a command (srv_cmd, worker.h) it hands
+ * simulation: each segment's beta is a command (srv_cmd, cmd.h) it hands
  * back to the worker, which queues and applies it like a PATCH and reports
  * the outcome with srv_exp_commanded. The handlers and the registry of
  * experiments are in experiment_http.c.
@@ -15,7 +15,7 @@
 
 #include "api.h"
 #include "registry.h"
-#include "worker.h"
+#include "cmd.h"
 
 typedef struct srv_experiment srv_experiment;
 
