@@ -32,6 +32,19 @@ test('model_error: the calibrated bed at 150 deg cw carries the map\'s value the
   assert.equal(s.feed_warning, null);
 });
 
+test('model_error: the table\'s column-model v is this build\'s (make model-check computes it)', () => {
+  // tests/bench/model_check.py's run at 150 deg cw against the committed row
+  const [head, ...rows] = readFileSync(new URL('../bench/results/model_check.csv', import.meta.url), 'utf8')
+    .trim().split('\n');
+  const c = Object.fromEntries(head.split(',').map((n, i) => [n, i]));
+  const row = rows.map((l) => l.split(',')).find((r) => r[c.preset] === 'liggghts-bed4' &&
+    Number(r[c.beta_deg]) === 150 && r[c.rotation] === 'cw');
+  const v = JSON.parse(execFileSync(CONVSIM, ['run', '-p', 'liggghts-bed4', '--set', 'layers=4', '--set', 'beta=150',
+    '--set', 'rotation=cw', '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5', '-q'],
+  { encoding: 'utf8' })).transport_velocity;
+  assert.ok(Math.abs(v - Number(row[c.v_column])) < 1e-5 * Math.abs(v), `v ${v}, the table's ${row[c.v_column]}`);
+});
+
 test('model_error: not checked at another depth or for the preset, the note names the nearest checked bed', () => {
   const s = summary('liggghts-bed4', 'beta=150', 'layers=2');
   assert.equal(s.model_checked, false);

@@ -97,6 +97,11 @@ test('model_error: the calibrated bed moved from 30 to 150 deg cw takes the map\
   await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.status.rotation === 'ccw', 5000 * SLOW, 'ccw');
   st = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.status;
   assert.ok(Math.abs(st.model_error - MAP['30,ccw']) < 1e-12, `${st.model_error} at 30 deg ccw`);
+  // and the drive: another synchronous speed is not the map's machine
+  const w = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { omega_ss: 140 });
+  assert.equal(w.status, 200);
+  assert.equal(w.body.status.model_checked, false);
+  assert.match(w.body.status.model_check_note, /^not checked against DEM at omega_ss = 140 rad\/s/);
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
 
