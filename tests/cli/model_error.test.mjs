@@ -75,3 +75,14 @@ test('model_error: a fit\'s curve is checked at the fitted values, not the start
     assert.equal(c.model_check_note, 'not checked against DEM with this contact (mu differs): nearest checked is 4 layers, liggghts-bed4');
   }
 });
+
+test('model_error: convsim sweep\'s JSON points carry it at their angle', () => {
+  const s = JSON.parse(execFileSync(CONVSIM, ['sweep', '-p', 'liggghts-bed4', '--set', 'feed_coupling=false', '--beta', '150:170:20',
+    '--rotation', 'cw', '-d', '0.5', '-q', '-f', 'json'], { encoding: 'utf8' }));
+  const [a, b] = s.points;
+  assert.equal(a.beta, 150);
+  assert.ok(Math.abs(a.model_error - mapError(150, 'cw')) < 1e-12, `${a.model_error} at 150 deg cw`);
+  assert.equal(a.model_checked, true);
+  assert.equal(b.model_checked, false);
+  assert.equal(b.model_error, null);
+});
