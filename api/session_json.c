@@ -114,13 +114,19 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
 }
 
 api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
-				api_control *c, double *t_effective, api_problem *pb)
+				api_control *c, double *t_effective, char *experiment,
+				size_t explen, api_problem *pb)
 {
 	cJSON *o = cJSON_ParseWithLength(line, len);
 	cJSON *te = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "t_effective") : NULL;
-	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble);
+	cJSON *ex = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "experiment") : NULL;
+	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble) &&
+		 (!ex || cJSON_IsString(ex));
 	*t_effective = ok ? te->valuedouble : 0;
+	if (experiment && explen)
+		snprintf(experiment, explen, "%s", ok && ex ? ex->valuestring : "");
 	cJSON_Delete(te);
+	cJSON_Delete(ex);
 	char *body = ok ? api_print(o) : NULL;
 	cJSON_Delete(o);
 	if (!body)
@@ -192,7 +198,7 @@ void api_add_model_error(cJSON *o, const sim_model_error *me)
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective)
 {
-	return api_control_event_model(buf, len, c, t_effective, NULL);
+	return api_control_log_line(buf, len, c, t_effective, NULL);
 }
 
 int api_control_event_model(char *buf, size_t len, const api_control *c,
@@ -210,6 +216,19 @@ int api_control_event_model(char *buf, size_t len, const api_control *c,
 		text = api_print(o);
 	}
 	cJSON_Delete(o);
+	int n = snprintf(buf, len, "%s", text ? text : "{}");
+	free(text);
+	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
+}
+
+int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
+			 const char *experiment)
+{
+	cJSON *o = control_object(c);
+	api_add_number(o, "t_effective", sim_time_ns(t_effective));
+	if (experiment && experiment[0])
+		cJSON_AddStringToObject(o, "experiment", experiment);
+	char *text = api_print_free(o);
 	int n = snprintf(buf, len, "%s", text ? text : "{}");
 	free(text);
 	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
@@ -299,6 +318,7 @@ static void add_settings(cJSON *o, const api_spec *sp)
 char *api_spec_file(const api_spec *spec, double created, int owned)
 {
 	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "format", API_SPEC_FILE_FORMAT);
 	api_add_number(o, "created", created);
 	cJSON_AddBoolToObject(o, "owned", owned);
 	cJSON *body = cJSON_AddObjectToObject(o, "session");
@@ -314,9 +334,22 @@ char *api_spec_file(const api_spec *spec, double created, int owned)
 }
 
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, api_problem *pb)
+			    double *created, int *owned, int *format, api_problem *pb)
 {
 	cJSON *o = cJSON_ParseWithLength(text, len);
+	const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "format");
+	*format = f ? -1 : 1; /* format 1 had no member */
+	if (cJSON_IsNumber(f) && f->valuedouble == (int)f->valuedouble)
+		*format = (int)f->valuedouble;
+	if (*format < 1 || *format > API_SPEC_FILE_FORMAT) {
+		int n = *format;
+		cJSON_Delete(o);
+		if (n > API_SPEC_FILE_FORMAT)
+			return api_fail(pb, API_MALFORMED, "format", "format %d, a newer build's "
+					"(this one reads 1 to %d)", n, API_SPEC_FILE_FORMAT);
+		return api_fail(pb, API_MALFORMED, "format", "format is not a format number "
+				"(1 to %d)", API_SPEC_FILE_FORMAT);
+	}
 	const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "created");
 	const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "owned");
 	const cJSON *b = cJSON_GetObjectItemCaseSensitive(o, "session");

@@ -42,6 +42,8 @@ static const srv_config defaults = {
 	.max_client_connections = 64,
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
+	.request_timeout = 10.0,
+	.min_body_rate = 1024,
 	.max_queued_points = 4096,
 	.cpu_probe = 0.03,
 	.dem_bed = NULL,
@@ -94,6 +96,8 @@ static const opt opts[] = {
 	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
 	{"connection-timeout", OPT_SECONDS, 1000, 3600000,
 	 F(connection_timeout)},
+	{"request-timeout", OPT_SECONDS, 100, 3600000, F(request_timeout)},
+	{"min-body-rate", OPT_SIZE, 1, 1L << 30, F(min_body_rate)},
 	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
 	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe)},
 	{"dem-bed", OPT_STRING, 0, 0, F(dem_bed)},
@@ -184,6 +188,13 @@ static void usage(FILE *f, const srv_config *cfg)
 		"  --connection-timeout S  close a connection silent for S "
 		"seconds; must exceed --heartbeat\n"
 		"                       (default %g)\n"
+		"  --request-timeout S  a request's headers must all come within S "
+		"seconds of its first\n"
+		"                       line; a body gets S, then must keep up "
+		"with --min-body-rate (default %g)\n"
+		"  --min-body-rate BYTES  bytes per second a body must average "
+		"after --request-timeout;\n"
+		"                       slower ones are closed (default %zu)\n"
 		"  --max-queued-points N  sweep points queued or running, "
 		"all sweeps (default %d)\n"
 		"  --cpu-probe S        CPU seconds a new session's cost is "
@@ -209,7 +220,8 @@ static void usage(FILE *f, const srv_config *cfg)
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
-		cfg->connection_timeout, cfg->max_queued_points, cfg->cpu_probe,
+		cfg->connection_timeout, cfg->request_timeout,
+		cfg->min_body_rate, cfg->max_queued_points, cfg->cpu_probe,
 		cfg->max_dem_sessions, cfg->dem_ranks, cfg->dem_timeout, cfg->max_dem_cost);
 }
 

@@ -139,6 +139,16 @@ static void apply_budget(srv_session *s, const srv_cmd *cmd)
 		s->cpu_paused = 0;
 }
 
+/* Append cmd's line to the control log: an experiment's names it (lock
+ * held). The log's length with it. */
+static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
+{
+	char line[API_EVENT_MAX];
+	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
+			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
+	return srv_control_log_append(s, line, cmd->waited);
+}
+
 /* Apply queued controls in order and acknowledge each (lock held).
  * Returns 1 if pacing must restart. */
 static int apply_commands(srv_session *s)
@@ -192,17 +202,19 @@ static int apply_commands(srv_session *s)
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
 		if (rc == SIM_OK) {
-			/* the control log keeps the control; the stream's event
-			 * also carries the scene's model error after it */
-			char json[API_EVENT_MAX], ring[API_EVENT_MAX];
+			/* the control log keeps the control (log_control); the
+			 * stream's event also carries the scene's model error
+			 * after it */
+			char ring[API_EVENT_MAX];
 			sim_model_error me;
 			sim_get_status(s->sim, &s->st);
 			api_model_check(&s->spec, &s->st, &me);
-			api_control_event(json, sizeof json, c, t_eff);
 			api_control_event_model(ring, sizeof ring, c, t_eff, &me);
 			srv_ring_event(s, "control", ring);
-			if (!cmd->replay)
-				srv_persist_control(s, json);
+			if (cmd->from_experiment && s->exp_relogged > 0)
+				s->exp_relogged--; /* in the log since before the restore */
+			else if (!cmd->replay)
+				cmd->logged = log_control(s, cmd, t_eff);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
@@ -257,19 +269,21 @@ static void run_replay(srv_session *s)
 {
 	double t = sim_effective_time(s->sim);
 	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
-		srv_cmd *cmd = &s->replay[s->replayed++].cmd;
-		cmd->replay = 1;
-		srv_worker_queue(s, cmd);
+		srv_replay *rp = &s->replay[s->replayed++];
+		if (rp->exp_own)
+			continue; /* its experiment sends it again */
+		rp->cmd.replay = 1;
+		srv_worker_queue(s, &rp->cmd);
 	}
 }
 
-/* caught up: a session re-created from its spec (session_store.c rebuild)
- * ran flat out to where it was, or a replayed control stopped it short of
- * that: from here on it keeps its pace. */
+/* caught up: a restored session (session_store.c catch_up) ran flat out
+ * to where it was, or a replayed control stopped it short of that, or it
+ * failed: from here on it keeps its pace and answers. */
 static void check_caught_up(srv_session *s, clocks *c)
 {
 	if (!(s->catch_up_t > 0) ||
-	    (s->st.t < s->catch_up_t &&
+	    (s->st.t < s->catch_up_t && s->state != SRV_FAILED && !s->stop &&
 	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
 		return;
 	s->catch_up_t = 0;
@@ -334,7 +348,7 @@ static void pace_down(srv_session *s, clocks *c)
 	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
 	s->pace = pace;
 	srv_ring_event(s, "control", json);
-	srv_persist_control(s, json);
+	srv_control_log_append(s, json, 0);
 	s->ckpt_dirty = 1;
 	restart_clocks(c, s);
 	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
@@ -580,6 +594,13 @@ void *srv_worker_main(void *arg)
 			publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
+		/* the log first, here: the session has left the registry, so
+		 * the store's writer can no longer find it to sync the lines
+		 * nobody waited for before the checkpoint */
+		size_t logged = s->controls_len;
+		pthread_mutex_unlock(&s->lock);
+		srv_control_log_sync(s, logged, 30.0);
+		pthread_mutex_lock(&s->lock);
 		s->ckpt_dirty = 1;
 		srv_persist_checkpoint(s, 1);
 	}
