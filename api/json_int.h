@@ -109,6 +109,9 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb);
 cJSON *api_settings_array(void);
 /* Add a number member; non-finite values become null. */
 void api_add_number(cJSON *obj, const char *name, double v);
+/* Add model_error, model_error_uncertainty (m/s, null unless checked),
+ * model_checked and model_check_note (sim_model_check) to o. */
+void api_add_model_error(cJSON *o, const sim_model_error *me);
 /* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
  * ?format=csv} (a job's result, as JSON and as CSV). */
 void api_add_result_links(cJSON *obj, const char *collection, const char *id);

@@ -176,10 +176,49 @@ static cJSON *control_object(const api_control *c)
 	return o;
 }
 
+int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me)
+{
+	sim_params p = spec->params;
+	if (st) {
+		p.beta = st->beta_target;
+		p.rotation = st->rotation;
+		p.omega_ss = st->omega_ss;
+	}
+	return sim_model_check(&p, &spec->scene, me);
+}
+
+void api_add_model_error(cJSON *o, const sim_model_error *me)
+{
+	api_add_number(o, "model_error", me->checked ? me->error : NAN);
+	api_add_number(o, "model_error_uncertainty", me->checked ? me->error_uncertainty : NAN);
+	cJSON_AddBoolToObject(o, "model_checked", me->checked);
+	cJSON_AddStringToObject(o, "model_check_note", me->note);
+}
+
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective)
 {
 	return api_control_log_line(buf, len, c, t_effective, NULL);
+}
+
+int api_control_event_model(char *buf, size_t len, const api_control *c,
+			    double t_effective, const sim_model_error *me)
+{
+	cJSON *o = control_object(c);
+	api_add_number(o, "t_effective", sim_time_ns(t_effective));
+	if (me)
+		api_add_model_error(o, me);
+	char *text = api_print(o);
+	if (me && text && strlen(text) >= len) {
+		/* the note goes before the event is cut (a ring slot's size) */
+		cJSON_DeleteItemFromObjectCaseSensitive(o, "model_check_note");
+		free(text);
+		text = api_print(o);
+	}
+	cJSON_Delete(o);
+	int n = snprintf(buf, len, "%s", text ? text : "{}");
+	free(text);
+	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
 }
 
 int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
@@ -247,11 +286,14 @@ static cJSON *status_object(const api_view *v)
 		api_add_number(f, "error", r->v_error);
 		cJSON_AddItemToArray(fig, f);
 	}
-	/* the column model outside the domain checked against LIGGGHTS beds
-	 * (docs/dem.md), a property of the scene */
-	char why[400];
-	if (sim_feed_validated(&v->spec->params, &v->spec->scene, why, sizeof why) == 0)
-		cJSON_AddStringToObject(o, "feed_warning", why);
+	/* how far the column model is from a DEM bed at the scene as its
+	 * controls now stand (docs/dem.md "Model error"); feed_warning is the
+	 * note where the scene is not checked */
+	sim_model_error me;
+	int mc = api_model_check(v->spec, st, &me);
+	api_add_model_error(o, &me);
+	if (mc == 0)
+		cJSON_AddStringToObject(o, "feed_warning", me.note);
 	else
 		cJSON_AddNullToObject(o, "feed_warning");
 	cJSON *en = cJSON_AddObjectToObject(o, "energy");

@@ -242,6 +242,24 @@ static double vary_value(const api_sweep_view *v, const api_sweep_point *p, int 
 	return v->req && v->req->nvary > 0 ? p->vary[a] : p->beta.user;
 }
 
+/* A point's model error (sim_model_check): the sweep's scene with the
+ * point's varied settings and sense. */
+static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_point *p)
+{
+	if (!v->req)
+		return;
+	sim_params pr = v->req->spec.params;
+	sim_scene sc = v->req->spec.scene;
+	sim_method m = v->req->spec.method;
+	pr.beta = p->beta.si;
+	for (int a = 0; a < v->req->nvary; a++)
+		sim_set_user(&pr, &sc, &m, v->req->vary[a], p->vary[a], NULL, 0);
+	pr.rotation = p->rotation;
+	sim_model_error me;
+	sim_model_check(&pr, &sc, &me);
+	api_add_model_error(po, &me);
+}
+
 static const char *point_state(int s)
 {
 	static const char *const names[] = {"pending", "running", "done",
@@ -333,6 +351,7 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 			cJSON_AddNullToObject(po, "steady");
 		}
 		cJSON_AddBoolToObject(po, "mirrored", p->mirrored);
+		add_point_model(po, v, p);
 		if (p->error[0])
 			cJSON_AddStringToObject(po, "error", p->error);
 		cJSON_AddItemToArray(pts, po);

@@ -50,6 +50,7 @@ static const srv_config defaults = {
 	.max_dem_sessions = 1,
 	.dem_ranks = 1,
 	.dem_timeout = 300.0,
+	.max_dem_cost = 1000.0,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
@@ -103,6 +104,7 @@ static const opt opts[] = {
 	{"max-dem-sessions", OPT_INT, 0, 1024, F(max_dem_sessions)},
 	{"dem-ranks", OPT_INT, 1, 256, F(dem_ranks)},
 	{"dem-timeout", OPT_SECONDS, 100, 86400000, F(dem_timeout)},
+	{"max-dem-cost", OPT_SECONDS, 1000, 1000000000, F(max_dem_cost)},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -210,13 +212,17 @@ static void usage(FILE *f, const srv_config *cfg)
 		"cores (default %d)\n"
 		"  --dem-timeout S      fail a session whose bed process gives no "
 		"answer for S seconds\n"
-		"                       (a hung bed; default %g)\n",
+		"                       (a hung bed; default %g)\n"
+		"  --max-dem-cost S     refuse a bed expected to take more than S "
+		"CPU seconds a\n"
+		"                       simulated second (its grains over its DEM "
+		"step; default %g)\n",
 		(double)cfg->max_memory / (double)(1 << 30),
 		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
 		cfg->max_client_connections, cfg->max_connections,
 		cfg->connection_timeout, cfg->request_timeout,
 		cfg->min_body_rate, cfg->max_queued_points, cfg->cpu_probe,
-		cfg->max_dem_sessions, cfg->dem_ranks, cfg->dem_timeout);
+		cfg->max_dem_sessions, cfg->dem_ranks, cfg->dem_timeout, cfg->max_dem_cost);
 }
 
 /* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */

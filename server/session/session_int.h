@@ -124,6 +124,8 @@ struct srv_session {
 				     freed after it ends): the coupling to the
 				     bed process; NULL for the column model */
 	int dem_slot;             /* holds one of --max-dem-sessions */
+	int create_fd;            /* while created: the client's socket or -1
+				     (a bed's settling ends when it leaves) */
 	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
 	int dem_restart;          /* worker only: a control changed the machine;
 				     the bed's transport estimate restarts once
