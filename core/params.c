@@ -90,9 +90,14 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 #define GNAME_G_METHOD "integrator"
 #define ROW_PUB(grp, f, k, u, lo, hi, ch, sc, d) \
 	{#f, GNAME_##grp, SIM_KIND_##k, u, sc, lo, hi, ch, d},
-static const sim_setting table[] = {SETTINGS(ROW_PUB){"method", "integrator", SIM_KIND_ENUM, "", 1,
-						 0, 3, "rk4|dopri5|euler|dem",
-						 "integrator by name"}};
+/* the setting "method": the registry's names, in its order (ode.h) */
+#define METHOD_CHOICE(descriptor, name) "|" name
+#define METHOD_ONE(descriptor, name) +1
+static const sim_setting table[] = {SETTINGS(ROW_PUB){
+	"method", "integrator", SIM_KIND_ENUM, "", 1, 0, (0 ODE_REGISTRY(METHOD_ONE)) - 1,
+	("" ODE_REGISTRY(METHOD_CHOICE)) + 1, "integrator by name"}};
+#undef METHOD_ONE
+#undef METHOD_CHOICE
 #undef ROW_PUB
 
 typedef struct loc {
@@ -185,7 +190,7 @@ void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m)
 	s->settle = 0.6; /* docs/MODEL.md "Start": the settled orbit closes, the gate holds */
 
 	memset(m, 0, sizeof *m);
-	snprintf(m->name, sizeof m->name, "%s", "dem");
+	snprintf(m->name, sizeof m->name, "%s", sim_default_method());
 	m->dt = 0.0; /* chosen by sim_method_defaults() for the scene */
 	m->rtol = 1e-6;
 	m->atol = 1e-9;
@@ -252,12 +257,9 @@ static double two_digits(double dt)
 static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
 	int feed = s->feed && s->columns > 0 && s->layers > 0;
-	if (strcmp(m->name, "euler") == 0)
-		return feed ? 5e-6 : 1e-5;
-	if (strcmp(m->name, "rk4") == 0)
-		return feed ? 1e-5 : 1e-3;
-	if (strcmp(m->name, "dopri5") == 0)
-		return 1e-5; /* the first step */
+	const ode_method *om = ode_find(m->name);
+	if (om && om->info.dt_feed > 0)
+		return feed ? om->info.dt_feed : om->info.dt_free;
 	double dt, top;
 	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO) {
 		top = HEAVY_FEED_STEP;

@@ -188,7 +188,8 @@ int main(int argc, char **argv)
 	srv_job_open(&srv_fit_job, (size_t)cfg.max_fits);
 	srv_streams_init(&cfg);
 	srv_static_init(&cfg);
-	srv_routes_init(&cfg);
+	if (srv_routes_init(&cfg))
+		return 1;
 	if (srv_store_open(&cfg))
 		return 1;
 	if (srv_pool_start(cfg.pool_threads)) {

@@ -185,16 +185,18 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	int substeps = st->substeps;
 	size_t n;
 	const sim_method_info *const *all = sim_methods(&n);
-	for (size_t i = 0; i < n; i++)
-		if (strcmp(all[i]->name, m->name) == 0 && all[i]->adaptive) {
-			/* its steps follow the solution: guess dem's */
-			sim_method dem = *m;
-			snprintf(dem.name, sizeof dem.name, "dem");
-			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
-			substeps = sim_default_substeps(&spec->params, &spec->scene, &dem, dt);
+	for (size_t i = 0; i < n; i++) {
+		if (strcmp(all[i]->name, m->name) != 0)
+			continue;
+		evals = all[i]->cost;
+		if (all[i]->adaptive) {
+			/* its steps follow the solution: guess the default method's */
+			sim_method guess = *m;
+			snprintf(guess.name, sizeof guess.name, "%s", sim_default_method());
+			dt = sim_default_dt(&spec->params, &spec->scene, &guess);
+			substeps = sim_default_substeps(&spec->params, &spec->scene, &guess, dt);
 		}
-	if (strcmp(m->name, "euler") == 0)
-		evals = 0.25; /* one right-hand side a step, not four */
+	}
 	if (!(dt > 0))
 		dt = 1e-3;
 	if (substeps < 1)
