@@ -117,7 +117,7 @@ $(BUILD)/.deps-build: Makefile
 $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze, haproxy, clang for libFuzzer, valgrind)" sh tests/apt-deps.sh
 	$(Q)if [ ! -d tests/node_modules/playwright-core ] || [ ! -d tests/node_modules/ajv ] || \
-	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ]; then \
+	   [ ! -d tests/node_modules/@apidevtools/swagger-parser ] || [ ! -d tests/node_modules/@stoplight/prism-cli ]; then \
 	  echo "npm ci in tests/ (the test tools of tests/package.json, into tests/node_modules; no root)"; \
 	  (cd tests && npm ci --no-audit --no-fund --loglevel=error) || exit 1; fi
 	$(Q)mkdir -p $(BUILD) && touch $@

@@ -146,6 +146,11 @@ char *api_problem_json(const api_problem *pb, const char *instance);
  * the length written (buf of at least 32 bytes). */
 int api_fmt_double(char *buf, size_t len, double v);
 
+/* A time in s as answers print it (core/table.h's sim_time_ns: a time on
+ * a step or sample grid reads as k dt, 16.016 and not 16.016000000000002),
+ * as api_fmt_double. */
+int api_fmt_time(char *buf, size_t len, double t);
+
 /* ---- routes ---------------------------------------------------------------- */
 
 /* Query parameters, by bit; two share the name "format" (tables, streams). */

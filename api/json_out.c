@@ -23,6 +23,11 @@ int api_fmt_double(char *buf, size_t len, double v)
 	return sim_fmt_double(buf, len, v, "null");
 }
 
+int api_fmt_time(char *buf, size_t len, double t)
+{
+	return sim_fmt_double(buf, len, sim_time_ns(t), "null");
+}
+
 void api_buf_put(api_buf *b, const char *s, size_t n)
 {
 	if (b->failed)

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "units.h"
 
 static const char schemas_text[] =
 #include "schemas.inc"
@@ -95,6 +96,24 @@ static cJSON *group_schema(const char *group)
 	return schema;
 }
 
+/* A request member named after a number setting (a control's beta,
+ * beta_rate, omega_ss) takes that setting's range from the settings
+ * table, the range the daemon checks it against, so that the document's
+ * bounds are the daemon's. */
+static void add_setting_bounds(cJSON *member, const char *name)
+{
+	const sim_setting *st = sim_setting_find(name);
+	const cJSON *type = cJSON_GetObjectItemCaseSensitive(member, "type");
+	if (!st || (st->kind != SIM_KIND_REAL && st->kind != SIM_KIND_INT) ||
+	    !cJSON_IsString(type) ||
+	    (strcmp(type->valuestring, "number") != 0 && strcmp(type->valuestring, "integer") != 0) ||
+	    cJSON_GetObjectItemCaseSensitive(member, "minimum") ||
+	    cJSON_GetObjectItemCaseSensitive(member, "maximum"))
+		return;
+	api_add_number(member, "minimum", st->min);
+	api_add_number(member, "maximum", st->max);
+}
+
 /* A request schema: exactly the parser's members, each typed by
  * schemas.json's x-request-members; NULL if the two lists differ. */
 static cJSON *request_schema(const cJSON *types, const cJSON *required, const char *name,
@@ -115,7 +134,9 @@ static cJSON *request_schema(const cJSON *types, const cJSON *required, const ch
 			cJSON_Delete(o);
 			return NULL;
 		}
-		cJSON_AddItemToObject(props, members[i], cJSON_Duplicate(p, 1));
+		cJSON *m = cJSON_Duplicate(p, 1);
+		add_setting_bounds(m, members[i]);
+		cJSON_AddItemToObject(props, members[i], m);
 	}
 	const cJSON *req = cJSON_GetObjectItemCaseSensitive(required, name);
 	if (req)

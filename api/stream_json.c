@@ -199,7 +199,7 @@ size_t api_format_record(char *buf, size_t len, const api_sample *s,
 			w_str(&w, inner);
 		}
 	} else {
-		api_fmt_double(num, sizeof num, s->st.t);
+		api_fmt_time(num, sizeof num, s->st.t);
 		w_str(&w, ndjson ? ",\"t\":" : "\"t\":");
 		w_str(&w, num);
 		sample_body(&w, s, fields);
@@ -249,7 +249,7 @@ size_t api_format_dropped(char *buf, size_t len, uint64_t missed,
 size_t api_format_heartbeat(char *buf, size_t len, double t, int ndjson)
 {
 	char num[48];
-	api_fmt_double(num, sizeof num, t);
+	api_fmt_time(num, sizeof num, t);
 	int n = snprintf(buf, len,
 			 ndjson ? "{\"type\":\"heartbeat\",\"t\":%s}\n"
 				: ": heartbeat t=%s\n\n",

@@ -36,7 +36,7 @@ void srv_ring_event(srv_session *s, const char *type, const char *json)
 void srv_ring_event_at(srv_session *s, const char *type, const char *detail)
 {
 	char json[API_EVENT_MAX], t[40];
-	api_fmt_double(t, sizeof t, s->st.t);
+	api_fmt_time(t, sizeof t, s->st.t);
 	snprintf(json, sizeof json, "{\"t\":%s%s%s}", t, detail ? "," : "",
 		 detail ? detail : "");
 	srv_ring_event(s, type, json);

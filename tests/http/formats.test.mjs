@@ -178,3 +178,28 @@ test('numbers as the user gave them: beta in degrees as sent, times on the grid 
   }
   assert.ok(rows[1].split(',')[13] !== '', 'the beta change has its reversal time');
 });
+
+test('stream records carry times on the sample grid as k dt, in NDJSON and SSE', async () => {
+  /* 250 samples a second: every sample's t is a multiple of 0.004 s and reads so
+   * (16.016, never 16.016000000000002), as do the events' and heartbeats' */
+  const r = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 20, sample_rate: 250 });
+  assert.equal(r.status, 201, r.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body.state === 'finished', 60000 * SLOW);
+  await req(d.base, 'PATCH', `/api/v1/sessions/${r.body.id}`, { beta: 128, until: 21 });
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body.state === 'finished', 60000 * SLOW);
+  for (const [format, pattern] of [['ndjson', /"t":([^,}]+)/], ['sse', /"t":([^,}]+)/]]) {
+    const text = await (await fetch(`${d.base}/api/v1/sessions/${r.body.id}/stream?format=${format}&since=0&limit=6000`)).text();
+    let samples = 0;
+    for (const line of text.split('\n')) {
+      const m = line.match(pattern);
+      if (!m) continue;
+      const t = m[1];
+      assert.match(t, /^\d+(\.\d{1,9})?$/, `${format}: t as k dt: ${line.slice(0, 120)}`);
+      if (/"type":"sample"|^data: \{"t"/.test(line)) {
+        samples++;
+        assert.equal(Number(t), Math.round(Number(t) * 250) / 250, `${format}: t on the 250 Hz grid: ${t}`);
+      }
+    }
+    assert.ok(samples > 4000, `${format}: ${samples} samples read`);
+  }
+});

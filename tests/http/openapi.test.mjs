@@ -6,24 +6,56 @@
 // request bodies sent against their (closed) request schemas, and a body
 // with an unknown member is refused by both the schema and the daemon.
 // Besides, the document itself is validated as OpenAPI 3.1 by an external
-// validator, @apidevtools/swagger-parser.
+// validator, @apidevtools/swagger-parser, and every well-formed request of
+// the tour goes through a validating proxy, Prism (`prism proxy --errors`),
+// in front of the daemon: a request or an answer that breaks the document
+// is a violation there, and the test fails on any.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { mkdtempSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { fileURLToPath } from 'node:url';
 import Ajv2020 from 'ajv/dist/2020.js';
 import SwaggerParser from '@apidevtools/swagger-parser';
-import { startDaemon, req, until, openStream, SLOW, CHEAP } from './lib.mjs';
+import { startDaemon, req, until, openStream, freePorts, SLOW, CHEAP } from './lib.mjs';
 
 const ID = 'https://convsim.invalid/openapi.json';
 let d, doc, ajv;
 const seen = new Set();
 
+// Prism as a validating proxy in front of the daemon. It runs under a shell
+// that ends it when its standard input closes, so that it ends with this
+// process however this process ends.
+const PRISM = fileURLToPath(new URL('../node_modules/.bin/prism', import.meta.url));
+let prism, proxy, prismLog = '';
+async function startPrism(docText, target) {
+  const file = join(mkdtempSync(join(tmpdir(), 'convsim-prism-')), 'openapi.json');
+  writeFileSync(file, docText);
+  const [port] = await freePorts(1);
+  prism = spawn('sh', ['-c', '"$@" & p=$!; read _; kill $p; wait $p', 'sh',
+    PRISM, 'proxy', '--errors', '-h', '127.0.0.1', '-p', String(port), file, target],
+  { stdio: ['pipe', 'pipe', 'pipe'] });
+  const listening = new Promise((resolve, reject) => {
+    const seenText = (b) => { prismLog += b; if (/Prism is listening/.test(prismLog)) resolve(); };
+    prism.stdout.on('data', seenText);
+    prism.stderr.on('data', seenText);
+    prism.on('exit', (code) => reject(new Error(`prism exited (${code}): ${prismLog.slice(-2000)}`)));
+  });
+  await Promise.race([listening, new Promise((_, no) => setTimeout(() => no(new Error(`prism did not start: ${prismLog}`)), 60000 * SLOW))]);
+  return `http://127.0.0.1:${port}`;
+}
+
 before(async () => {
   d = await startDaemon(['--heartbeat', '0.2']);
-  doc = (await req(d.base, 'GET', '/api/v1/openapi.json')).body;
+  const r = await req(d.base, 'GET', '/api/v1/openapi.json');
+  doc = r.body;
   ajv = new Ajv2020({ strict: false, allErrors: true });
   ajv.addSchema({ ...doc, $id: ID });
+  proxy = await startPrism(r.text, d.base);
 });
-after(async () => { await d?.stop(); });
+after(async () => { prism?.stdin.end(); await d?.stop(); });
 
 test('the served document is valid OpenAPI 3.1 (swagger-parser)', async () => {
   assert.equal(doc.openapi, '3.1.0');
@@ -51,7 +83,9 @@ function valid(name, value, what) {
 }
 const deref = (o) => (o && o.$ref ? o.$ref.split('/').slice(1).reduce((a, k) => a[k], doc) : o);
 
-// call an operation as the document describes it and validate the answer
+// call an operation as the document describes it and validate the answer;
+// a request that is well-formed by the document (checkBody) goes through
+// the validating proxy, which must find nothing wrong with it or its answer
 async function call(method, template, path, body, headers, checkBody = true) {
   const op = doc.paths[template]?.[method.toLowerCase()];
   assert.ok(op, `${method} ${template} is in the document`);
@@ -59,7 +93,12 @@ async function call(method, template, path, body, headers, checkBody = true) {
     const ref = op.requestBody.content['application/json'].schema.$ref.split('/').pop();
     valid(ref, body, `${method} ${template} request`);
   }
-  const r = await req(d.base, method, path, body, headers);
+  const r = await req(checkBody ? proxy : d.base, method, path, body, headers);
+  if (checkBody) {
+    assert.equal(r.headers.get('sl-violations'), null, `${method} ${path}: Prism found violations: ${r.headers.get('sl-violations')}`);
+    assert.notEqual(r.body?.type, 'https://stoplight.io/prism/errors#VIOLATIONS',
+      `${method} ${path}: Prism found violations: ${JSON.stringify(r.body?.validation)?.slice(0, 1000)}`);
+  }
   const resp = deref(op.responses[String(r.status)]);
   assert.ok(resp, `${method} ${path}: status ${r.status} is documented (${r.text.slice(0, 200)})`);
   const ct = (r.headers.get('content-type') || '').split(';')[0];
@@ -105,6 +144,14 @@ test('every operation answers what the document says', { timeout: 120000 * SLOW 
   await call('GET', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}`);
   await call('GET', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}?format=csv`);
   await call('GET', '/api/v1/fits', '/api/v1/fits');
+  // a study over two settings and a sweep with the fit's band, through the proxy too
+  for (const body of [{ ...CHEAP, vary: { mu: [0.3, 0.9], beta: { from: 30, to: 150, step: 120 } }, rotations: ['cw'], t_end: 0.3 },
+    { ...CHEAP, beta: [30, 130], rotations: ['cw'], t_end: 0.5, band_from_fit: f.id }]) {
+    const st = (await call('POST', '/api/v1/sweeps', '/api/v1/sweeps', body)).body;
+    await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${st.id}`)).body.state === 'done', 60000 * SLOW, 'study');
+    await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${st.id}`);
+    await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${st.id}?format=csv`);
+  }
   await call('DELETE', '/api/v1/fits/{id}', `/api/v1/fits/${f.id}`, undefined, { 'Content-Type': 'application/json' });
   await call('GET', '/api/v1/presets', '/api/v1/presets');
   await call('GET', '/api/v1/health', '/api/v1/health');
@@ -112,10 +159,15 @@ test('every operation answers what the document says', { timeout: 120000 * SLOW 
   await call('GET', '/api/v1/problems/{id}', '/api/v1/problems/out-of-range');
   await call('GET', '/metrics', '/metrics');
   // problems, each validated as the documented Problem
+  // (sent past the proxy: Prism itself answers a request that breaks the document)
   await call('GET', '/api/v1/sessions/{id}', '/api/v1/sessions/none');
-  await call('GET', '/api/v1/sessions/{id}/trajectory', `/api/v1/sessions/${s.id}/trajectory?fromm=1`);
-  await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`, undefined, { Accept: 'image/png' });
+  await call('GET', '/api/v1/sessions/{id}/trajectory', `/api/v1/sessions/${s.id}/trajectory?fromm=1`, undefined, {}, false);
+  await call('GET', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`, undefined, { Accept: 'image/png' }, false);
   await call('POST', '/api/v1/sessions', '/api/v1/sessions', { params: { k_s1: -1 } }, {}, false);
+  await call('PATCH', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`, { beta: 500 }, {}, false);
+  assert.equal(schema('Control')({ beta: 500 }), false, 'the document bounds a control as the daemon does');
+  // a DELETE without the JSON type: 415, as the document says
+  assert.equal((await call('DELETE', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`, undefined, { 'Content-Type': null })).status, 415);
   await call('DELETE', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`);
   await call('DELETE', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`);
   // the stream: SSE and NDJSON records of every kind it produced
