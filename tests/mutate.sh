@@ -38,8 +38,8 @@ mutations=(
 	"the mean rotor speed one period off|core/estimator.c|s|sense \* 2.0 \* M_PI \* e->n_bound / span|sense * 2.0 * M_PI * (e->n_bound + 1) / span|"
 	"the shadow's Richardson estimate divided by r + 1, not r - 1|core/shadow.c|s|/ (r - 1.0);|/ (r + 1.0);|"
 	"the shadow as fine as its instance (no step error measured)|core/shadow.c|s|m.substeps = (s->cfg.substeps + 1) / 2;|m.substeps = s->cfg.substeps;|"
-	"the contact period without the Hertzian tangent stiffness|core/params.c|s|if (p->p != 1.0) {|if (0) {|"
-	"the default feed step blind to the contact period|core/params.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
+	"the contact period without the Hertzian tangent stiffness|core/defaults.c|s|if (p->p != 1.0) {|if (0) {|"
+	"the default feed step blind to the contact period|core/defaults.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
 	"no refinement of a measurement's steps|core/measure.c|s|^#define MEASURE_REFINEMENTS 3$|#define MEASURE_REFINEMENTS 0|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
