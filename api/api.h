@@ -263,15 +263,19 @@ typedef struct api_spec {
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb);
 
-/* A session's spec as stored (sessions/ID/spec.json): its creation time
- * (unix s), whether an experiment owns it, and the create body that makes
- * it again ("session": preset, pace, until, sample_rate and every setting
- * by group), the API's own JSON, so that another build reads it. malloc'd
- * text, NULL when out of memory. api_parse_spec_file reads it back through
- * api_parse_session (400/422 as a POST would be). */
+/* A session's spec as stored (sessions/ID/spec.json): its format
+ * ("format": API_SPEC_FILE_FORMAT), its creation time (unix s), whether an
+ * experiment owns it, and the create body that makes it again ("session":
+ * preset, pace, until, sample_rate and every setting by group), the API's
+ * own JSON, so that another build reads it. malloc'd text, NULL when out
+ * of memory. api_parse_spec_file reads it back through api_parse_session
+ * (400/422 as a POST would be), with its format in *format (1: a file
+ * without the member, as builds before format 2 wrote it); a format above
+ * API_SPEC_FILE_FORMAT (a newer build's) is refused. */
+#define API_SPEC_FILE_FORMAT 2
 char *api_spec_file(const api_spec *spec, double created, int owned);
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, api_problem *pb);
+			    double *created, int *owned, int *format, api_problem *pb);
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
  * sample_rate within the ranges the parser allows, every setting within
@@ -313,11 +317,13 @@ typedef struct api_control {
 			      upper bound, --max-cpu-seconds) */
 } api_control;
 
-/* Parse one line of a session's control log (the "control" event of
- * api_control_event: a PATCH body with t_effective) back into *c and
- * *t_effective (s), checked as api_parse_control checks a PATCH. */
+/* Parse one line of a session's control log (api_control_log_line: a
+ * PATCH body with t_effective, and the experiment that sent it) back into
+ * *c, *t_effective (s) and experiment (explen bytes, "" when a client
+ * sent it; may be NULL), checked as api_parse_control checks a PATCH. */
 api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
-				api_control *c, double *t_effective, api_problem *pb);
+				api_control *c, double *t_effective, char *experiment,
+				size_t explen, api_problem *pb);
 /* Parse a PATCH body against the session's spec (ranges from the settings
  * table). All or nothing: on error *c is unspecified and nothing is to be
  * applied. An empty object is a 422. */
@@ -328,6 +334,12 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
  * small). */
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective);
+/* The control as a line of the session's control log: the stream event's
+ * object, and "experiment": its id when an experiment's segment sent it
+ * (experiment may be NULL), so that a restore that resumes the
+ * experiment leaves its commands to it. Returns the length as above. */
+int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
+			 const char *experiment);
 
 /* Everything GET /sessions/{id} shows, filled by the server. */
 /* A LIGGGHTS session's bed (feed_model liggghts, docs/dem.md): it runs in

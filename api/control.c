@@ -205,13 +205,19 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec, ap
 }
 
 api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
-				api_control *c, double *t_effective, api_problem *pb)
+				api_control *c, double *t_effective, char *experiment,
+				size_t explen, api_problem *pb)
 {
 	cJSON *o = cJSON_ParseWithLength(line, len);
 	cJSON *te = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "t_effective") : NULL;
-	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble);
+	cJSON *ex = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "experiment") : NULL;
+	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble) &&
+		 (!ex || cJSON_IsString(ex));
 	*t_effective = ok ? te->valuedouble : 0;
+	if (experiment && explen)
+		snprintf(experiment, explen, "%s", ok && ex ? ex->valuestring : "");
 	cJSON_Delete(te);
+	cJSON_Delete(ex);
 	char *body = ok ? api_print(o) : NULL;
 	cJSON_Delete(o);
 	if (!body)
@@ -234,8 +240,16 @@ cJSON *api_control_object(const api_control *c)
 
 int api_control_event(char *buf, size_t len, const api_control *c, double t_effective)
 {
+	return api_control_log_line(buf, len, c, t_effective, NULL);
+}
+
+int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
+			 const char *experiment)
+{
 	cJSON *o = api_control_object(c);
 	api_add_number(o, "t_effective", sim_time_ns(t_effective));
+	if (experiment && experiment[0])
+		cJSON_AddStringToObject(o, "experiment", experiment);
 	char *text = api_print_free(o);
 	int n = snprintf(buf, len, "%s", text ? text : "{}");
 	free(text);

@@ -100,6 +100,7 @@ static void add_settings(cJSON *o, const api_spec *sp)
 char *api_spec_file(const api_spec *spec, double created, int owned)
 {
 	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "format", API_SPEC_FILE_FORMAT);
 	api_add_number(o, "created", created);
 	cJSON_AddBoolToObject(o, "owned", owned);
 	cJSON *body = cJSON_AddObjectToObject(o, "session");
@@ -115,9 +116,22 @@ char *api_spec_file(const api_spec *spec, double created, int owned)
 }
 
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, api_problem *pb)
+			    double *created, int *owned, int *format, api_problem *pb)
 {
 	cJSON *o = cJSON_ParseWithLength(text, len);
+	const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "format");
+	*format = f ? -1 : 1; /* format 1 had no member */
+	if (cJSON_IsNumber(f) && f->valuedouble == (int)f->valuedouble)
+		*format = (int)f->valuedouble;
+	if (*format < 1 || *format > API_SPEC_FILE_FORMAT) {
+		int n = *format;
+		cJSON_Delete(o);
+		if (n > API_SPEC_FILE_FORMAT)
+			return api_fail(pb, API_MALFORMED, "format", "format %d, a newer build's "
+					"(this one reads 1 to %d)", n, API_SPEC_FILE_FORMAT);
+		return api_fail(pb, API_MALFORMED, "format", "format is not a format number "
+				"(1 to %d)", API_SPEC_FILE_FORMAT);
+	}
 	const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "created");
 	const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "owned");
 	const cJSON *b = cJSON_GetObjectItemCaseSensitive(o, "session");

@@ -94,8 +94,9 @@ FILE *cli_open_out(const cli_opts *o);
 char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
- * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else
- * cli/coupled_none.c, which says how to get it). Exit status as run. */
+ * LIGGGHTS bed (dem/cli/run_coupled.c, in convsim-mpi where LIGGGHTS is
+ * installed; in the plain convsim cli/coupled_none.c, which hands
+ * the run over to convsim-mpi or says how to get it). Exit status as run. */
 int cli_run_coupled(const cli_opts *o);
 
 typedef struct cli_opt {

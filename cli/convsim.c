@@ -25,6 +25,7 @@
 #include <time.h>
 
 #include "cli.h"
+#include "handover.h"
 #include "sim.h"
 #include "suggest.h"
 #include "table.h"
@@ -274,6 +275,7 @@ static int unknown_command(const char *name)
 
 int main(int argc, char **argv)
 {
+	cli_handover_init(argv);
 	if (argc < 2) {
 		cli_help(stderr, 0);
 		return 2;

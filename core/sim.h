@@ -150,20 +150,22 @@ const char *sim_last_error(const sim *s);
 
 /* ---- checkpoints ------------------------------------------------------- */
 
-/* Version of the checkpoint format (checkpoint.c); a checkpoint of
- * another version is refused. */
-#define SIM_CHECKPOINT_VERSION 2
+/* Version of the checkpoint format (checkpoint.c); version 2 (without the
+ * measured step error's shadow) is still read, any other is refused. */
+#define SIM_CHECKPOINT_VERSION 3
 
 /* FNV-1a 64 of len bytes: the checkpoints' checksum, for callers that
  * frame their own files the same way. */
 uint64_t sim_checksum(const void *buf, size_t len);
 
-/* Bytes sim_checkpoint writes for this instance (fixed for its life). */
+/* Bytes sim_checkpoint writes for this instance as it is now (more while
+ * a shadow measures the step error: its checkpoint is nested). */
 size_t sim_checkpoint_size(const sim *s);
 /* Write everything that determines the instance's future (state, the
  * last step's start for the interpolant, times and step count, controls
  * with their ramps, the estimator with its records, energy baselines,
- * the integrator workspace's cached values, counters, a failure) into buf
+ * the integrator workspace's cached values, counters, a failure, the
+ * measured step error and the shadow that measures it) into buf
  * (len >= sim_checkpoint_size), framed by a magic, the version, the
  * instance's layout and a checksum. Reads only. SIM_OK or SIM_EPARAM
  * (buffer too small). */

@@ -117,6 +117,7 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 /* Stop accepting, let streams end, join every thread, free everything. */
 static void shut_down(struct MHD_Daemon *d)
 {
+	srv_store_watch(); /* the final checkpoints and records from here */
 	srv_stop();
 	MHD_socket ls = MHD_quiesce_daemon(d);
 	if (ls != MHD_INVALID_SOCKET)
@@ -137,6 +138,13 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_conns_shutdown();
 }
 
+/* Of n restored, those not damaged (a damaged one may also have found no
+ * room, so it is not always among the n). */
+static size_t whole(size_t n, size_t damaged)
+{
+	return n > damaged ? n - damaged : 0;
+}
+
 /* Rebuild what the data directory holds: experiments first (the sessions
  * resume theirs), then sessions, then sweeps and fits (on the pool). */
 static void restore_state(void)
@@ -149,11 +157,23 @@ static void restore_state(void)
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_job_restore(&srv_sweep_job);
 	size_t nf = srv_job_restore(&srv_fit_job);
-	if (ne + ns + nw + nf)
-		srv_log(SRV_LOG_INFO,
-			"restored %zu sessions, %zu experiments (%zu "
-			"interrupted), %zu sweeps, %zu fits in %.3f s",
-			ns, ne, ni, nw, nf, srv_now() - t0);
+	if (!(ne + ns + nw + nf))
+		return;
+	/* the damaged ones are listed (state "damaged") but not whole: said
+	 * apart, and the line is a warning then */
+	size_t ds = srv_store_damaged(SRV_STORE_SESSION),
+	       de = srv_store_damaged(SRV_STORE_EXPERIMENT),
+	       dw = srv_store_damaged(SRV_STORE_SWEEP), df = srv_store_damaged(SRV_STORE_FIT);
+	size_t up = srv_store_upgraded(SRV_STORE_SESSION) +
+		    srv_store_upgraded(SRV_STORE_EXPERIMENT) +
+		    srv_store_upgraded(SRV_STORE_SWEEP) + srv_store_upgraded(SRV_STORE_FIT);
+	srv_log(ds + de + dw + df ? SRV_LOG_WARN : SRV_LOG_INFO,
+		"restored %zu sessions, %zu experiments (%zu interrupted), %zu "
+		"sweeps, %zu fits in %.3f s; damaged: %zu sessions, %zu "
+		"experiments, %zu sweeps, %zu fits; %zu read from an earlier "
+		"format and written again in format %d",
+		whole(ns, ds), whole(ne, de), ni, whole(nw, dw), whole(nf, df), srv_now() - t0, ds,
+		de, dw, df, up, SRV_STORE_VERSION);
 }
 
 int main(int argc, char **argv)
@@ -225,14 +245,27 @@ int main(int argc, char **argv)
 		cfg.max_queued_points);
 
 	/* once a second: remove the sessions whose experiment ended and
-	 * those idle beyond --idle-timeout */
+	 * those idle beyond --idle-timeout, close the connections past
+	 * their deadline */
 	int sig = 0;
 	struct timespec tick = {1, 0};
-	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0)
+	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0) {
 		srv_sessions_reap(cfg.idle_timeout);
+		srv_conns_reap();
+	}
 	srv_log(SRV_LOG_INFO, "%s: shutting down",
 		sig == SIGINT ? "SIGINT" : "SIGTERM");
 	shut_down(d);
+	/* a final checkpoint or record that is not on disk is not a clean
+	 * stop: the next start would not find what was acknowledged */
+	char failed[1024];
+	size_t nfailed = srv_store_failed(failed, sizeof failed);
+	if (nfailed) {
+		srv_log(SRV_LOG_ERROR, "stopped, but %zu final write%s failed, their "
+				       "state is not on disk: %s", nfailed,
+			nfailed == 1 ? "" : "s", failed);
+		return 1;
+	}
 	srv_log(SRV_LOG_INFO, "stopped cleanly");
 	return 0;
 }

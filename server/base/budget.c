@@ -315,7 +315,7 @@ typedef struct client {
 typedef struct client_conn {
 	client *c;
 	int over;
-	srv_conn *live; /* conns.c: the idle ones closed at the global cap */
+	srv_conn *live; /* conns.c: deadlines, room at the global cap */
 } client_conn;
 
 static client *clients;  /* lock; cfg->max_connections + 1 entries */
@@ -398,13 +398,12 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 	*socket_context = cc;
 }
 
-void srv_budget_request(struct MHD_Connection *conn, int busy)
+srv_conn *srv_budget_live(struct MHD_Connection *conn)
 {
 	const union MHD_ConnectionInfo *ci =
 		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
 	const client_conn *cc = ci ? ci->socket_context : NULL;
-	if (cc)
-		srv_conn_busy(cc->live, busy);
+	return cc ? cc->live : NULL;
 }
 
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)

@@ -43,6 +43,8 @@ static const srv_config defaults = {
 	.max_client_connections = 64,
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
+	.request_timeout = 10.0,
+	.min_body_rate = 1024,
 	.max_queued_points = 4096,
 	.cpu_probe = 0.03,
 	.dem_bed = NULL,
@@ -128,6 +130,12 @@ static const opt opts[] = {
 	 "open connections, all clients (default %D)", NULL},
 	{"connection-timeout", OPT_SECONDS, 1000, 3600000, F(connection_timeout), "S",
 	 "close a connection silent for S seconds; must exceed --heartbeat\n(default %D)", NULL},
+	{"request-timeout", OPT_SECONDS, 100, 3600000, F(request_timeout), "S",
+	 "a request's headers must all come within S seconds of its first\n"
+	 "line; a body gets S, then must keep up with --min-body-rate (default %D)", NULL},
+	{"min-body-rate", OPT_SIZE, 1, 1L << 30, F(min_body_rate), "BYTES",
+	 "bytes per second a body must average after --request-timeout;\n"
+	 "slower ones are closed (default %D)", NULL},
 	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points), "N",
 	 "sweep points queued or running, all sweeps (default %D)", NULL},
 	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe), "S",

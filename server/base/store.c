@@ -34,6 +34,8 @@ typedef struct store_job {
 	size_t len;
 	int keep_prev;
 	srv_store_done done;
+	void (*before)(void *arg); /* called just before the write */
+	void (*call)(void *arg);   /* a call in order (srv_store_call) */
 	void *arg;
 	struct store_job *next;
 } store_job;
@@ -46,6 +48,12 @@ static struct {
 	store_job *head, *tail;
 	int stop, started;
 	pthread_t thread;
+	/* the restore's counts, by kind (written before the daemon serves) */
+	size_t damaged[8], upgraded[8];
+	/* srv_store_watch on: the writes that failed since (lock held) */
+	int watching;
+	size_t failed;
+	char failed_what[1024];
 } st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
 typedef struct frame_header {
@@ -168,17 +176,37 @@ static void remove_path(const char *rel)
 	fsync_parent(path);
 }
 
+/* A failed write while srv_store_watch is on (writer thread). */
+static void note_failure(const char *path, const char *msg)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = strlen(st.failed_what);
+	if (st.watching && st.failed++ == 0)
+		snprintf(st.failed_what, sizeof st.failed_what, "%.900s", msg);
+	else if (st.watching && n + strlen(path) + 3 < sizeof st.failed_what)
+		snprintf(st.failed_what + n, sizeof st.failed_what - n, "; %s", path);
+	pthread_mutex_unlock(&st.lock);
+}
+
 static void run_job(store_job *j)
 {
 	char msg[4400] = "";
 	int err = 0;
+	if (j->call) {
+		j->call(j->arg);
+		free(j);
+		return;
+	}
 	if (j->notify) {
 		/* superseded: nothing to write, done says so */
 	} else if (j->buf) {
+		if (j->before)
+			j->before(j->arg);
 		err = write_atomic(j, msg, sizeof msg);
 		if (err) {
 			atomic_fetch_add(&srv_stats.store_errors, 1);
 			srv_log(SRV_LOG_ERROR, "store: %s", msg);
+			note_failure(j->path, msg);
 		} else {
 			atomic_fetch_add(&srv_stats.store_writes, 1);
 		}
@@ -252,7 +280,7 @@ int srv_store_open(const srv_config *cfg)
 	if (!st.dir)
 		return 0;
 	static const char *const subdirs[] = {"sessions", "experiments", "sweeps", "fits"};
-	for (int i = 0; i < 3; i++) {
+	for (size_t i = 0; i < sizeof subdirs / sizeof *subdirs; i++) {
 		char p[4096];
 		full_path(p, sizeof p, subdirs[i]);
 		if (mkdir(p, 0755) != 0 && errno != EEXIST) {
@@ -283,6 +311,22 @@ void srv_store_close(void)
 	st.started = 0;
 }
 
+void srv_store_watch(void)
+{
+	pthread_mutex_lock(&st.lock);
+	st.watching = 1;
+	pthread_mutex_unlock(&st.lock);
+}
+
+size_t srv_store_failed(char *what, size_t len)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = st.failed;
+	snprintf(what, len, "%s", st.failed_what);
+	pthread_mutex_unlock(&st.lock);
+	return n;
+}
+
 int srv_store_enabled(void)
 {
 	return st.dir != NULL;
@@ -309,6 +353,12 @@ static void enqueue(store_job *j)
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg)
 {
+	srv_store_write_after(path, buf, len, keep_prev, NULL, done, arg);
+}
+
+void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
+			   void (*before)(void *arg), srv_store_done done, void *arg)
+{
 	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
 	if (!j) { /* off (callers check first) or out of memory */
 		free(buf);
@@ -319,6 +369,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 	j->len = len;
 	j->keep_prev = keep_prev;
 	j->done = done;
+	j->before = before;
 	j->arg = arg;
 	/* supersede a pending write to the same path in place */
 	store_job *old = NULL;
@@ -333,6 +384,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 			q->len = j->len;
 			q->keep_prev = j->keep_prev;
 			q->done = j->done;
+			q->before = j->before;
 			q->arg = j->arg;
 			break;
 		}
@@ -343,11 +395,51 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		free(j);
 		free(old->buf);
 		old->buf = NULL;
+		old->before = NULL;
 		old->notify = 1;
 		enqueue(old);
 		return;
 	}
 	enqueue(j);
+}
+
+void srv_store_call(void (*fn)(void *arg), void *arg)
+{
+	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
+	if (!j)
+		return;
+	j->call = fn;
+	j->arg = arg;
+	enqueue(j);
+}
+
+int srv_store_make_dir(const char *rel)
+{
+	if (!st.started)
+		return 0;
+	char path[4096];
+	full_path(path, sizeof path, rel);
+	if (mkdir(path, 0755) != 0)
+		return errno == EEXIST ? 0 : -1;
+	return fsync_parent(path);
+}
+
+int srv_store_open_log(const char *rel, uint64_t len)
+{
+	char path[4096];
+	full_path(path, sizeof path, rel);
+	int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+	if (fd < 0)
+		return -1;
+	/* what lies past len was never acknowledged (a line cut short by a
+	 * crash): cut it, and make the file's name durable */
+	if (ftruncate(fd, (off_t)len) != 0 || fsync(fd) != 0 || fsync_parent(path) != 0) {
+		int e = errno;
+		close(fd);
+		errno = e;
+		return -1;
+	}
+	return fd;
 }
 
 api_err srv_store_check_removable(const char *rel, api_problem *pb)
@@ -435,19 +527,22 @@ char *srv_store_read_text(const char *rel, size_t *len)
 	return buf;
 }
 
-void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
+void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *older,
 			const char **bad)
 {
 	frame_header h;
 	*bad = NULL;
+	*older = 0;
 	if (n < sizeof h)
 		*bad = "cut off (shorter than its header)";
 	if (!*bad) {
 		memcpy(&h, buf, sizeof h);
 		if (memcmp(h.magic, "CVSF", 4) != 0)
 			*bad = "not a convsim file (bad magic)";
-		else if (h.version != SRV_STORE_VERSION)
-			*bad = "unknown version";
+		else if (h.version > SRV_STORE_VERSION)
+			*bad = "of a newer format version than this build reads";
+		else if (h.version < SRV_STORE_OLDEST)
+			*bad = "of an unknown format version";
 		else if (h.kind != kind)
 			*bad = "a file of another kind";
 		else if (h.len > n - sizeof h)
@@ -463,19 +558,45 @@ void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
 	}
 	memmove(buf, buf + sizeof h, h.len);
 	*len = h.len;
-	return buf;
+	if (h.version == SRV_STORE_VERSION)
+		return buf;
+	*older = 1;
+	return srv_store_upgrade_v1(kind, buf, len, bad);
 }
 
-void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
-		     size_t whylen)
+void *srv_store_read(const char *rel, uint32_t kind, size_t *len, int *older,
+		     char *why, size_t whylen)
 {
 	size_t n = 0;
 	char *buf = srv_store_read_text(rel, &n);
 	const char *bad = "missing or unreadable";
-	void *payload = buf ? srv_store_unframe(buf, n, kind, len, &bad) : NULL;
+	*older = 0;
+	void *payload = buf ? srv_store_unframe(buf, n, kind, len, older, &bad) : NULL;
 	if (!payload)
 		snprintf(why, whylen, "%s: %s", rel, bad);
 	return payload;
+}
+
+void srv_store_count_damaged(uint32_t kind)
+{
+	if (kind < sizeof st.damaged / sizeof *st.damaged)
+		st.damaged[kind]++;
+}
+
+void srv_store_count_upgraded(uint32_t kind)
+{
+	if (kind < sizeof st.upgraded / sizeof *st.upgraded)
+		st.upgraded[kind]++;
+}
+
+size_t srv_store_damaged(uint32_t kind)
+{
+	return kind < sizeof st.damaged / sizeof *st.damaged ? st.damaged[kind] : 0;
+}
+
+size_t srv_store_upgraded(uint32_t kind)
+{
+	return kind < sizeof st.upgraded / sizeof *st.upgraded ? st.upgraded[kind] : 0;
 }
 
 /* Is the entry name of rel one of the kind srv_store_list_ids lists? 1

@@ -76,7 +76,8 @@ static api_err start_on_session(srv_experiment *e,
 			return api_fail(pb, API_NOTFOUND, "session",
 					"no session with id \"%.40s\"",
 					req->session_id);
-		if (srv_session_attach(s, e, pb) != API_OK) {
+		if (srv_session_replaying(s, pb) != API_OK ||
+		    srv_session_attach(s, e, pb) != API_OK) {
 			srv_session_put(s);
 			return pb->code;
 		}

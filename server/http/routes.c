@@ -7,12 +7,15 @@
  * {handler, job kind}; "*" in a pattern matches one path segment and
  * becomes a path argument. The access
  * handler first passes the request's headers through the gate (gate.c:
- * Host, Origin, token, the JSON media type of mutating requests), then
- * collects the body (refusing it with 413 before it is read when
- * Content-Length exceeds --max-body, and while it is read for chunked
- * bodies), then calls the one handler. A
- * path that exists with another method gets 405 with Allow; unknown paths
- * under /api/ get 404; everything else is a static file of web/. Query
+ * Host, Origin, token, the JSON media type of mutating requests) and
+ * answers, before any byte of a body is read, a body too large for
+ * --max-body (413) and one that would not be read: an unknown route or
+ * method (404, 405) or GET, HEAD, DELETE with a body (400). It then
+ * collects the body under its deadline (conns.h: closed when slower than
+ * --min-body-rate; 413 while it is read for chunked bodies), then calls
+ * the one handler. A path that exists with another method gets 405 with
+ * Allow; unknown paths under /api/ get 404; everything else is a static
+ * file of web/. Query
  * parameters and the representation are checked against the API's route
  * table (api/routes.c) before the handler runs.
  * Per-request state is freed in the completion callback.
@@ -24,6 +27,7 @@
 
 #include "budget.h"
 #include "catalog.h"
+#include "conns.h"
 #include "gate.h"
 #include "job.h"
 #include "routes.h"
@@ -91,6 +95,7 @@ typedef struct req_state {
 	size_t len, cap;
 	int too_large;
 	size_t query_params; /* over SRV_MAX_QUERY_PARAMS: the query was cut */
+	srv_conn *live;      /* the connection's deadlines (conns.h) */
 } req_state;
 
 /* More query parameters than any route takes (the most is a handful). */
@@ -99,7 +104,7 @@ typedef struct req_state {
 void *srv_uri_seen(void *cls, const char *uri, struct MHD_Connection *conn)
 {
 	(void)cls;
-	(void)conn;
+	srv_conn_request_line(srv_budget_live(conn));
 	req_state *st = calloc(1, sizeof *st);
 	char *query = strchr(uri, '?');
 	if (!st || !query)
@@ -247,34 +252,80 @@ static enum MHD_Result route_request(srv_req *r)
 	}
 }
 
-/* The request as first seen, headers only: the gate, then the declared
- * body size (refused before the body is read). */
-static enum MHD_Result first_look(srv_req *r)
+/* Does the request announce a body (Content-Length above 0, or
+ * Transfer-Encoding)? The header that says so goes to *field. */
+static int body_declared(srv_req *r, const char **field)
 {
-	enum MHD_Result result;
+	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
+	if (cl && strtoull(cl, NULL, 10) > 0) {
+		*field = MHD_HTTP_HEADER_CONTENT_LENGTH;
+		return 1;
+	}
+	*field = MHD_HTTP_HEADER_TRANSFER_ENCODING;
+	return srv_header(r, MHD_HTTP_HEADER_TRANSFER_ENCODING) != NULL;
+}
+
+/* A request with a body that will not be read is answered now, before
+ * any of its bytes: a route or method that does not exist (404, 405), or
+ * a method that takes none (GET, HEAD, DELETE: 400). libmicrohttpd then
+ * discards the body and closes the connection. 1 if answered. */
+static int refuse_body(srv_req *r, enum MHD_Result *result)
+{
+	const char *field;
+	if (!body_declared(r, &field))
+		return 0;
+	srv_route_match m;
+	srv_route_resolve(r->method, r->url, &m);
+	if (m.kind != SRV_ROUTE_FOUND && m.kind != SRV_ROUTE_STATIC) {
+		*result = route_request(r);
+		return 1;
+	}
+	if (strcmp(r->method, "POST") == 0 || strcmp(r->method, "PATCH") == 0)
+		return 0;
+	*result = srv_fail(r, API_BADREQUEST, field,
+			   "%s takes no body, and this request announces one "
+			   "(%s); nothing of it was read: send the request "
+			   "without it", r->method, field);
+	return 1;
+}
+
+/* The request as first seen, headers only: the client's budget, the
+ * gate, the declared body (its size, whether the route reads one), all
+ * answered before a byte of the body is read. 1 if answered (*result). */
+static int first_look(srv_req *r, enum MHD_Result *result)
+{
 	api_problem pb;
-	if (srv_budget_client_over(r->conn, &pb)) /* before anything else */
-		return srv_reply_problem(r, &pb, NULL);
-	if (((req_state *)r)->query_params)
-		return srv_fail(r, API_HEADERS, NULL,
-				"the query has %zu parameters; no route takes "
-				"more than %d", ((req_state *)r)->query_params,
-				SRV_MAX_QUERY_PARAMS);
-	if (!srv_gate_check(r, &result))
-		return result;
+	if (srv_budget_client_over(r->conn, &pb)) { /* before anything else */
+		*result = srv_reply_problem(r, &pb, NULL);
+		return 1;
+	}
+	if (((req_state *)r)->query_params) {
+		*result = srv_fail(r, API_HEADERS, NULL,
+				   "the query has %zu parameters; no route "
+				   "takes more than %d",
+				   ((req_state *)r)->query_params,
+				   SRV_MAX_QUERY_PARAMS);
+		return 1;
+	}
+	if (!srv_gate_check(r, result))
+		return 1;
 	if (srv_header_count(r, MHD_HTTP_HEADER_CONTENT_LENGTH) > 1) {
 		api_fail(&pb, API_BADREQUEST, "Content-Length",
 			 "Content-Length is given more than once (RFC 9112 "
 			 "section 6.3)");
-		return srv_reply_problem_with(r, &pb, MHD_HTTP_HEADER_CONNECTION,
-					      "close");
+		*result = srv_reply_problem_with(r, &pb,
+						 MHD_HTTP_HEADER_CONNECTION,
+						 "close");
+		return 1;
 	}
 	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
-	if (cl && strtoull(cl, NULL, 10) > cfg->max_body)
-		return srv_fail(r, API_TOOLARGE, NULL,
-				"the body has %.30s bytes; the limit is %zu "
-				"(--max-body)", cl, cfg->max_body);
-	return MHD_YES;
+	if (cl && strtoull(cl, NULL, 10) > cfg->max_body) {
+		*result = srv_fail(r, API_TOOLARGE, NULL,
+				   "the body has %.30s bytes; the limit is %zu "
+				   "(--max-body)", cl, cfg->max_body);
+		return 1;
+	}
+	return refuse_body(r, result);
 }
 
 enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
@@ -295,12 +346,21 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->r.method = method;
 		st->r.url = url;
 		st->r.body = "";
-		srv_budget_request(conn, 1);
-		return first_look(&st->r);
+		st->live = srv_budget_live(conn);
+		enum MHD_Result result = MHD_YES;
+		const char *field;
+		if (!first_look(&st->r, &result) &&
+		    body_declared(&st->r, &field))
+			srv_conn_body_start(st->live); /* under its deadline */
+		else
+			srv_conn_busy(st->live, 1); /* answered now or next */
+		return result;
 	}
 	if (*upload_data_size) {
 		size_t n = *upload_data_size;
 		*upload_data_size = 0;
+		if (!srv_conn_body_read(st->live, n))
+			return MHD_NO; /* slower than --min-body-rate: closed */
 		if (st->too_large || st->len + n > cfg->max_body) {
 			st->too_large = 1;
 			return MHD_YES;
@@ -320,6 +380,7 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 		st->body[st->len] = '\0';
 		return MHD_YES;
 	}
+	srv_conn_busy(st->live, 1); /* the body is in: answered now */
 	st->r.body = st->body ? st->body : "";
 	st->r.body_len = st->len;
 	if (st->too_large)
@@ -338,8 +399,9 @@ void srv_request_done(void *cls, struct MHD_Connection *conn,
 	(void)cls;
 	(void)toe;
 	req_state *st = *con_cls;
+	(void)conn;
 	if (st && st->r.conn)
-		srv_budget_request(conn, 0);
+		srv_conn_busy(st->live, 0);
 	if (!st)
 		return;
 	free(st->body);

@@ -63,6 +63,11 @@ enum MHD_Result srv_h_session_get(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	api_problem pb;
+	if (srv_session_replaying(s, &pb) != API_OK) {
+		srv_session_put(s);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	api_view v;
 	srv_session_view(s, &v);
 	enum MHD_Result res =
@@ -82,7 +87,8 @@ enum MHD_Result srv_h_session_patch(srv_req *r)
 	double t_eff = NAN;
 	api_view v;
 	srv_session_view(s, &v);
-	if (api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
+	if (srv_session_replaying(s, &pb) != API_OK ||
+	    api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
 		    API_OK ||
 	    srv_session_control(s, &c, CONTROL_TIMEOUT_S, &t_eff, &pb) !=
 		    API_OK) {
@@ -123,6 +129,10 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	if (srv_session_replaying(s, &pb) != API_OK) {
+		srv_session_put(s);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	int columns, layers;
 	srv_session_feed_size(s, &columns, &layers);
 	size_t n = srv_session_history(s, from, to, &rows, &stride);

@@ -208,6 +208,11 @@ enum MHD_Result srv_h_stream(srv_req *r)
 		return srv_fail(r, API_NOTFOUND, NULL,
 				"no session with id \"%.40s\"", r->arg[0]);
 	}
+	if (srv_session_replaying(k->s, &pb) != API_OK) {
+		srv_session_put(k->s);
+		free(k);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	if (atomic_fetch_add(&srv_stats.stream_clients, 1) >=
 	    cfg->max_streams) {
 		atomic_fetch_sub(&srv_stats.stream_clients, 1);

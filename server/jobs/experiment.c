@@ -26,6 +26,7 @@
 
 #include "experiment.h"
 #include "experiment_int.h"
+#include "records.h"
 #include "store.h"
 #include "util.h"
 
@@ -158,15 +159,7 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
  * progress (the record and the feed-velocity record) rides in its
  * session's checkpoint (srv_exp_save), so that both continue from the same
  * moment. */
-typedef struct exp_record {
-	char id[SRV_ID_LEN], session_id[SRV_ID_LEN];
-	api_experiment_req req;
-	int32_t state, cur;
-	char error[256];
-	double t0, t_now;
-	uint64_t seg_first, rec_n;
-	double rec_spacing;
-} exp_record;
+typedef srv_exp_record exp_record; /* records.h */
 
 static void record_of(const srv_experiment *e, exp_record *r)
 {

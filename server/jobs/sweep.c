@@ -29,6 +29,7 @@
 #include "job.h"
 #include "metrics.h"
 #include "pool.h"
+#include "records.h"
 #include "registry.h"
 #include "store.h"
 #include "sweep_int.h"
@@ -97,12 +98,7 @@ static void fill_view(const srv_sweep *sw, api_sweep_view *v)
  * creation, after each point and at a cancel (a pending write is replaced
  * by the newer one); at the end, sweep-ID.csv. A restart serves finished
  * sweeps again and queues the points that were pending or running. */
-typedef struct sweep_record {
-	char id[SRV_ID_LEN];
-	api_sweep_req req;     /* betas: NULL here, they follow */
-	uint64_t total, done;
-	int32_t cancelled, pad;
-} sweep_record;
+typedef srv_sweep_record sweep_record; /* records.h */
 
 /* A write's outcome for sweep id (malloc'd, freed here). */
 static void written(void *arg, int err, const char *what)

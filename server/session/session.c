@@ -41,6 +41,17 @@ void srv_sessions_init(const srv_config *config)
 
 /* ---- lifetime ---------------------------------------------------------- */
 
+/* The lock and conditions of a session fresh from calloc, and its control
+ * log not open yet. */
+static void session_locks_init(srv_session *s)
+{
+	pthread_mutex_init(&s->lock, NULL);
+	pthread_cond_init(&s->wake, NULL);
+	pthread_cond_init(&s->data, NULL);
+	pthread_cond_init(&s->log_cond, NULL);
+	s->log_fd = -1;
+}
+
 static void session_free(srv_session *s)
 {
 	if (!s)
@@ -55,8 +66,10 @@ static void session_free(srv_session *s)
 	if (s->ring_bytes)
 		munmap(s->ring, s->ring_bytes);
 	free(s->hist);
+	srv_control_log_close(s);
 	free(s->controls);
 	free(s->replay);
+	pthread_cond_destroy(&s->log_cond);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);
@@ -189,9 +202,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
-	pthread_mutex_init(&s->lock, NULL);
-	pthread_cond_init(&s->wake, NULL);
-	pthread_cond_init(&s->data, NULL);
+	session_locks_init(s);
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		session_free(s);
 		api_fail(pb, API_LIMIT, NULL,
@@ -224,6 +235,15 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 	s->owned = exp && !srv_exp_keeps_session(exp);
 	if (exp) /* before its worker can end it and write its result */
 		srv_exp_set_session(exp, s->entry.id);
+	/* its directory now: the control log is opened in it at the first
+	 * control, maybe before the writer has written the spec */
+	if (srv_store_enabled()) {
+		char dir[64];
+		snprintf(dir, sizeof dir, "sessions/%s", s->entry.id);
+		if (srv_store_make_dir(dir) != 0)
+			snprintf(s->store_error, sizeof s->store_error,
+				 "cannot create %s: %s", dir, strerror(errno));
+	}
 	s->last_access = s->ckpt_wall = srv_now();
 	s->ckpt_dirty = 1;
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
@@ -439,7 +459,7 @@ static api_err admit_control(srv_session *s, const api_control *c,
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
-	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds};
+	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
 	pthread_mutex_lock(&s->lock);
 	api_err e = API_OK;
 	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
@@ -490,6 +510,16 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 	if (cmd.rc != SIM_OK)
 		return api_fail(pb, api_from_sim(cmd.rc), NULL, "%s",
 				sim_strerror(cmd.rc));
+	/* the answer only once its line is on disk (control_log.c) */
+	int err = cmd.logged ? srv_control_log_sync(s, cmd.logged, timeout_s) : 0;
+	if (err) {
+		api_fail(pb, API_UNAVAILABLE, NULL,
+			 "the control was applied at t = %g s but its line could not be made "
+			 "durable in the control log (%s): a crash may lose it",
+			 cmd.t_eff, strerror(err));
+		pb->retry_after = 5;
+		return API_UNAVAILABLE;
+	}
 	*t_eff = cmd.t_eff;
 	return API_OK;
 }
@@ -536,9 +566,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
-			pthread_mutex_init(&s->lock, NULL);
-			pthread_cond_init(&s->wake, NULL);
-			pthread_cond_init(&s->data, NULL);
+			session_locks_init(s);
 			srv_persist_load(s, names[i], &ef);
 			if (s->damaged)
 				srv_log(SRV_LOG_WARN, "session %s %s", names[i],

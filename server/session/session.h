@@ -63,6 +63,12 @@ const char *srv_session_id(const srv_session *s);
 const api_spec *srv_session_spec(const srv_session *s);
 /* Fill a view (spec borrowed from s: keep the reference while using it). */
 void srv_session_view(srv_session *s, api_view *v);
+/* API_OK, or 503 in *pb with Retry-After while s, restored at a start,
+ * runs flat out through the controls of its log to where it was: until
+ * then its status would show a past the clients had already left
+ * (docs/hardening.md). GET, PATCH, its trajectory and streams and an
+ * experiment's attach answer this; the listing shows its status null. */
+api_err srv_session_replaying(srv_session *s, api_problem *pb);
 /* Live sessions. */
 size_t srv_session_count(void);
 /* Every live session, newest first, as new references in *out (malloc'd;

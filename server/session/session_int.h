@@ -11,6 +11,7 @@
 
 #include "budget.h"
 #include "budget_turns.h"
+#include "records.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"
@@ -18,7 +19,9 @@
 /* A control of the log to apply again once the integrator reaches at. */
 typedef struct srv_replay {
 	srv_cmd cmd;
-	double at; /* its t_effective, s */
+	double at;   /* its t_effective, s */
+	int exp_own; /* sent by the experiment the checkpoint resumed: not
+			applied here, the experiment sends it again itself */
 } srv_replay;
 
 struct srv_session {
@@ -71,6 +74,13 @@ struct srv_session {
 	char *controls;           /* every acknowledged control, one JSON
 				     line each (controls.ndjson) */
 	size_t controls_len, controls_cap;
+	/* the log on disk (control_log.c), guarded by lock */
+	pthread_cond_t log_cond;  /* a sync round ended */
+	int log_fd;               /* -1 until its first sync opens it */
+	size_t log_synced;        /* bytes of controls on disk, synced */
+	int log_syncing;          /* a thread leads a sync round */
+	int log_flush_queued;     /* a flush of lines nobody waits for is
+				     queued on the store's writer */
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
@@ -84,13 +94,20 @@ struct srv_session {
 				     again as the integrator reaches each
 				     (session_store.c loads, worker.c runs) */
 	size_t nreplay, replayed;
+	size_t exp_relogged;      /* lines of the resumed experiment in the
+				     log after its checkpoint: its commands
+				     that many times are not logged again */
 	int rebuilt;              /* re-created from its spec, its checkpoint
 				     unusable (another build): the whole log
 				     is replayed */
-	double catch_up_t;        /* rebuilt: runs flat out until its time
-				     reaches where it was (0: not) */
+	double catch_up_t;        /* restored with controls to replay: runs
+				     flat out until its time reaches where
+				     it was (0: not; then it answers) */
 	double replay_wall, replay_seconds; /* when the replay began, how
 				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
+	double replay_t0;         /* s: the time it was restored at */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
@@ -216,9 +233,21 @@ void srv_ring_gather(srv_session *s);
 
 /* Queue the spec file (at creation). */
 void srv_persist_spec(srv_session *s);
-/* Append an acknowledged control's event line and queue the controls
- * file (worker, lock held). */
-void srv_persist_control(srv_session *s, const char *json);
+
+/* ---- control_log.c: the control log on disk ----------------------------- */
+
+/* Append a control's event line to s's log in memory (worker, lock held):
+ * the log's length with it, for srv_control_log_sync (0 without a data
+ * directory). waited: a handler makes it durable before it answers; else
+ * a flush is queued on the store's writer. */
+size_t srv_control_log_append(srv_session *s, const char *json, int waited);
+/* Make s's log durable up to end bytes (lock not held): by group commit,
+ * one pwrite and one fdatasync for every line appended before the round
+ * began. 0, or an errno (ETIMEDOUT after timeout_s, the write's failure,
+ * also shown in store_error). */
+int srv_control_log_sync(srv_session *s, size_t end, double timeout_s);
+/* Close the log's file (the session is freed). */
+void srv_control_log_close(srv_session *s);
 /* Queue a checkpoint now if one is due: the interval has passed, or the
  * session stopped running with changes since the last one (worker, lock
  * held, after the commands phase). */
@@ -238,25 +267,8 @@ typedef struct srv_exp_finder {
  * when they do not pass their checks. */
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
 
-/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
- * the core's checkpoint (sim_len bytes) follow. */
-/* A checkpoint's payload: this head, the experiment's state, the core's
- * checkpoint, then (from this build on; older ones end with the core's)
- * this trailer: the length of the control log it holds, so that a restore
- * replays what came after, and its time, so that a session re-created
- * from its spec knows where it was. */
-typedef struct srv_ckpt_trailer {
-	uint64_t logged;
-	double t; /* s */
-} srv_ckpt_trailer;
-#define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
-typedef struct srv_ckpt_record {
-	int32_t state, exp_started;
-	double pace, until;
-	char error[256];
-	char exp_id[SRV_ID_LEN];
-	uint64_t exp_len, sim_len;
-} srv_ckpt_record;
+/* checkpoint.bin's head and trailer: srv_ckpt_record, srv_ckpt_trailer
+ * (records.h, with every stored layout). */
 /* The files read back, checked without touching a session (the restore
  * uses these; so does the fuzz harness tests/fuzz/fuzz_store.c). A spec
  * file's payload (len bytes, borrowed): 0 with the spec, its creation

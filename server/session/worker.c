@@ -151,19 +151,21 @@ static void run_replay(srv_session *s)
 {
 	double t = sim_effective_time(s->sim);
 	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
-		srv_cmd *cmd = &s->replay[s->replayed++].cmd;
-		cmd->replay = 1;
-		srv_worker_queue(s, cmd);
+		srv_replay *rp = &s->replay[s->replayed++];
+		if (rp->exp_own)
+			continue; /* its experiment sends it again */
+		rp->cmd.replay = 1;
+		srv_worker_queue(s, &rp->cmd);
 	}
 }
 
-/* caught up: a session re-created from its spec (session_store.c rebuild)
- * ran flat out to where it was, or a replayed control stopped it short of
- * that: from here on it keeps its pace. */
+/* caught up: a restored session (session_store.c catch_up) ran flat out
+ * to where it was, or a replayed control stopped it short of that, or it
+ * failed: from here on it keeps its pace and answers. */
 static void check_caught_up(srv_session *s, clocks *c)
 {
 	if (!(s->catch_up_t > 0) ||
-	    (s->st.t < s->catch_up_t &&
+	    (s->st.t < s->catch_up_t && s->state != SRV_FAILED && !s->stop &&
 	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
 		return;
 	s->catch_up_t = 0;
@@ -228,7 +230,7 @@ static void pace_down(srv_session *s, clocks *c)
 	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
 	s->pace = pace;
 	srv_ring_event(s, "control", json);
-	srv_persist_control(s, json);
+	srv_control_log_append(s, json, 0);
 	s->ckpt_dirty = 1;
 	restart_clocks(c, s);
 	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
@@ -474,6 +476,13 @@ void *srv_worker_main(void *arg)
 			publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
+		/* the log first, here: the session has left the registry, so
+		 * the store's writer can no longer find it to sync the lines
+		 * nobody waited for before the checkpoint */
+		size_t logged = s->controls_len;
+		pthread_mutex_unlock(&s->lock);
+		srv_control_log_sync(s, logged, 30.0);
+		pthread_mutex_lock(&s->lock);
 		s->ckpt_dirty = 1;
 		srv_persist_checkpoint(s, 1);
 	}

@@ -36,6 +36,16 @@ static void apply_budget(srv_session *s, const srv_cmd *cmd)
 		s->cpu_paused = 0;
 }
 
+/* Append cmd's line to the control log: an experiment's names it (lock
+ * held). The log's length with it. */
+static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
+{
+	char line[API_EVENT_MAX];
+	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
+			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
+	return srv_control_log_append(s, line, cmd->waited);
+}
+
 /* ---- the PATCH controls' apply column (api.h API_CONTROLS, by id) ---------- */
 
 /* Apply one control of cmd to the session (lock held): a SIM_* code;
@@ -158,8 +168,10 @@ int srv_worker_apply_commands(srv_session *s)
 			char json[API_EVENT_MAX];
 			api_control_event(json, sizeof json, &cmd->c, t_eff);
 			srv_ring_event(s, "control", json);
-			if (!cmd->replay)
-				srv_persist_control(s, json);
+			if (cmd->from_experiment && s->exp_relogged > 0)
+				s->exp_relogged--; /* in the log since before the restore */
+			else if (!cmd->replay)
+				cmd->logged = log_control(s, cmd, t_eff);
 			s->ckpt_dirty = 1;
 		}
 		cmd->rc = rc;

@@ -117,7 +117,7 @@ export function attach(id, initial) {
 let polls = 0;
 export async function pollStatus() {
 	const id = app.id;
-	if (!id) return;
+	if (!id || id === app.removing) return;
 	if (++polls % 10 === 0) refreshSessionList();
 	try {
 		const s = await api.getSession(id);
@@ -165,13 +165,16 @@ export async function setBeta(beta) {
 export async function removeSession() {
 	const id = app.id;
 	if (!id) return;
+	/* from here no poll asks for it (the stream's end would, and get a 404) */
+	app.removing = id;
 	try {
 		await api.deleteSession(id);
 		message('ok', `Session ${id} deleted.`);
 	} catch (err) {
-		if (!(err instanceof api.ApiError && err.status === 404)) { report(err, 'Delete'); return; }
+		if (!(err instanceof api.ApiError && err.status === 404)) { app.removing = null; report(err, 'Delete'); return; }
 	}
 	detach();
+	app.removing = null;
 	refreshSessionList();
 }
 
