@@ -131,6 +131,11 @@ struct srv_session {
 	api_bed bed;              /* what the worker last read of it (lock) */
 };
 
+/* ---- session_control.c: a control's admission and wait -------------------- */
+
+/* cfg (borrowed for the daemon's life) gives --max-cpu-seconds. */
+void srv_session_control_init(const srv_config *cfg);
+
 /* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
 
 /* Find the bed program (--dem-bed, or convsim-bed next to the daemon). */
