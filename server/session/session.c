@@ -49,8 +49,8 @@ static void session_locks_init(srv_session *s)
 	pthread_mutex_init(&s->lock, NULL);
 	pthread_cond_init(&s->wake, NULL);
 	pthread_cond_init(&s->data, NULL);
-	pthread_cond_init(&s->log_cond, NULL);
-	s->log_fd = -1;
+	pthread_cond_init(&s->log.cond, NULL);
+	s->log.fd = -1;
 }
 
 static void session_free(srv_session *s)
@@ -58,7 +58,7 @@ static void session_free(srv_session *s)
 	if (!s)
 		return;
 	srv_dem_free(s); /* the bed process ends before its machine */
-	if (s->dem_slot)
+	if (s->dem.slot)
 		srv_dem_release();
 	sim_free(s->sim);
 	srv_budget_give(s->mem_reserved);
@@ -70,7 +70,7 @@ static void session_free(srv_session *s)
 	srv_control_log_close(s);
 	free(s->controls);
 	free(s->replay);
-	pthread_cond_destroy(&s->log_cond);
+	pthread_cond_destroy(&s->log.cond);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);
@@ -184,8 +184,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	if (probed > s->cpu_per_s)
 		s->cpu_per_s = probed;
 	/* a bed process: its cores a simulated second until measured */
-	if (s->dem && s->cpu_per_s < s->dem_cores)
-		s->cpu_per_s = s->dem_cores;
+	if (s->dem.link && s->cpu_per_s < s->dem.cores)
+		s->cpu_per_s = s->dem.cores;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -215,7 +215,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 	if (srv_dem_wanted(spec)) {
 		if (srv_dem_admit(&copy, pb) != API_OK)
 			goto fail;
-		s->dem_slot = 1;
+		s->dem.slot = 1;
 	}
 	int feed = spec->scene.feed && spec->scene.columns > 0 &&
 		   spec->scene.layers > 0;
@@ -271,10 +271,10 @@ static void adopt_bed(srv_session *s)
 {
 	char msg[256];
 	srv_dem_hold();
-	s->dem_slot = 1;
+	s->dem.slot = 1;
 	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
-		if (s->cpu_per_s < s->dem_cores)
-			s->cpu_per_s = s->dem_cores;
+		if (s->cpu_per_s < s->dem.cores)
+			s->cpu_per_s = s->dem.cores;
 		return;
 	}
 	s->state = SRV_FAILED;
@@ -335,8 +335,8 @@ static void remove_session(srv_session *s, int files)
 	 * the next LIGGGHTS session at once, not when the last reader lets
 	 * go of the session */
 	srv_dem_free(s);
-	if (s->dem_slot) {
-		s->dem_slot = 0;
+	if (s->dem.slot) {
+		s->dem.slot = 0;
 		srv_dem_release();
 	}
 	if (files)

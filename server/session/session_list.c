@@ -86,7 +86,7 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->replayed = s->rebuilt;
 	v->replay_seconds = s->replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);
-	v->bed = s->bed;
+	v->bed = s->dem.bed;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

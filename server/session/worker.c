@@ -265,7 +265,7 @@ static void check_cpu(srv_session *s, clocks *c)
 	/* a LIGGGHTS session's bed process's CPU is the session's too */
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
 		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
-				 (s->dem ? s->bed.cpu_seconds : 0.0);
+				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
 	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
 		return;
@@ -359,15 +359,15 @@ static int pace(srv_session *s, clocks *c, double t_next)
 static int step(srv_session *s, double t_next, char *why, size_t whylen)
 {
 	sim_status st;
-	api_bed bed = s->bed;
+	api_bed bed = s->dem.bed;
 	int rc = SIM_OK;
 	pthread_mutex_unlock(&s->lock);
-	if (!s->dem)
+	if (!s->dem.link)
 		rc = sim_advance(s->sim, t_next);
 	else if (srv_dem_step(s, t_next, why, whylen))
 		rc = SIM_EDIVERGED;
 	sim_get_status(s->sim, &st);
-	if (s->dem) {
+	if (s->dem.link) {
 		srv_dem_controlled(s, &st);
 		srv_dem_read(s, &st, &bed);
 	}
@@ -376,7 +376,7 @@ static int step(srv_session *s, double t_next, char *why, size_t whylen)
 	if (st.steps > s->st.steps)
 		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
 	s->st = st;
-	s->bed = bed;
+	s->dem.bed = bed;
 	srv_ring_sample(s);
 	return rc;
 }

@@ -140,8 +140,8 @@ static int apply_command(srv_session *s, const srv_cmd *cmd, int *reanchor)
 		return rc;
 	if (cmd->restart_transport)
 		sim_restart_transport(s->sim);
-	if (s->dem && (cmd->restart_transport || (c->set & DEM_RESTARTS)))
-		s->dem_restart = 1;
+	if (s->dem.link && (cmd->restart_transport || (c->set & DEM_RESTARTS)))
+		s->dem.restart = 1;
 	/* pacing restarts on running and on a resume from a pause (not on a
 	 * finished session resumed by until: it restarts its clocks when it
 	 * wakes, idle) */
