@@ -257,7 +257,7 @@ typedef struct api_spec {
 } api_spec;
 
 /* Parse a POST /sessions body (len bytes, need not be NUL-terminated; an
- * empty body means {}). Fills *spec from the preset and overrides, checks
+ * empty or blank body is refused, {} takes every default). Fills *spec from the preset and overrides, checks
  * every value with sim_set/sim_validate. Returns API_OK or the error in
  * *pb; *spec is then unspecified. */
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
@@ -334,6 +334,15 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
  * small). */
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective);
+/* The same with the scene's model error after the control (me, borrowed:
+ * model_error, model_error_uncertainty, model_checked, model_check_note),
+ * the stream's form of the event; the control log keeps api_control_event's. */
+int api_control_event_model(char *buf, size_t len, const api_control *c,
+			    double t_effective, const sim_model_error *me);
+/* The model error of a session's scene now (sim_model_check): the spec's
+ * settings with the status's controls (beta_target, rotation, omega_ss)
+ * when st is not NULL. Returns sim_model_check's value. */
+int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me);
 /* The control as a line of the session's control log: the stream event's
  * object, and "experiment": its id when an experiment's segment sent it
  * (experiment may be NULL), so that a restore that resumes the
@@ -438,12 +447,13 @@ size_t api_record_max(int columns, int layers);
 size_t api_format_record(char *buf, size_t len, const api_sample *s,
 			 unsigned fields, int ndjson);
 /* The stream's first record: the session, the id the next record will
- * have, and the scene's feed_warning (sim_feed_validated: why its column
- * model lies outside the domain checked against LIGGGHTS beds; NULL for
- * none, written as null), so that a client that only streams knows it.
- * Returns the length (0 if it does not fit). */
+ * have, the scene's feed_warning (the model check's note where the scene's
+ * column model is not checked against DEM; NULL for none, written as null)
+ * and, with me (borrowed, may be NULL), its model error as the status
+ * gives it, so that a client that only streams knows it. Returns the
+ * length (0 if it does not fit). */
 size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
-			const char *feed_warning, int ndjson);
+			const char *feed_warning, const sim_model_error *me, int ndjson);
 /* Stream notices: missed samples, heartbeat, end (reason: finished,
  * deleted, failed, shutdown, limit). Return the length. */
 size_t api_format_dropped(char *buf, size_t len, uint64_t missed,

@@ -182,7 +182,7 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec, ap
 			  api_problem *pb)
 {
 	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_body(body, len, 0, api_members_control, pb);
+	cJSON *root = api_parse_body(body, len, api_members_control, pb);
 	if (!root)
 		return pb->code;
 	api_err e = API_OK;
@@ -241,6 +241,26 @@ cJSON *api_control_object(const api_control *c)
 int api_control_event(char *buf, size_t len, const api_control *c, double t_effective)
 {
 	return api_control_log_line(buf, len, c, t_effective, NULL);
+}
+
+int api_control_event_model(char *buf, size_t len, const api_control *c,
+			    double t_effective, const sim_model_error *me)
+{
+	cJSON *o = api_control_object(c);
+	api_add_number(o, "t_effective", sim_time_ns(t_effective));
+	if (me)
+		api_add_model_error(o, me);
+	char *text = api_print(o);
+	if (me && text && strlen(text) >= len) {
+		/* the note goes before the event is cut (a ring slot's size) */
+		cJSON_DeleteItemFromObjectCaseSensitive(o, "model_check_note");
+		free(text);
+		text = api_print(o);
+	}
+	cJSON_Delete(o);
+	int n = snprintf(buf, len, "%s", text ? text : "{}");
+	free(text);
+	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
 }
 
 int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,

@@ -7,6 +7,7 @@
  * table, so the document and the checks cannot drift. The values of the
  * stream's and the trajectory's parameters are parsed here too.
  */
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -191,6 +192,22 @@ api_err api_negotiate(const api_route *rt, const char *format, const char *accep
 	return API_OK;
 }
 
+/* The decimal digits of text (nothing else: no sign, no space) as a
+ * number of at most max; 0 if text is not one. */
+static int decimal(const char *text, uint64_t max, uint64_t *out)
+{
+	uint64_t n = 0;
+	if (!*text)
+		return 0;
+	for (const char *c = text; *c; c++) {
+		if (*c < '0' || *c > '9' || n > (max - (uint64_t)(*c - '0')) / 10)
+			return 0;
+		n = n * 10 + (uint64_t)(*c - '0');
+	}
+	*out = n;
+	return 1;
+}
+
 api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
 			       const char *rate, const char *limit, const char *last_event_id,
 			       const char *since, api_stream_query *q, api_problem *pb)
@@ -216,20 +233,21 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 					"rate must be a number of samples per "
 					"simulated second in (0, 100000]");
 	}
+	uint64_t n;
 	if (limit) {
-		unsigned long long n = strtoull(limit, &end, 10);
-		if (*end || n == 0 || *limit == '-')
-			return api_fail(pb, API_QUERY, "limit", "limit must be a positive integer");
+		if (!decimal(limit, UINT64_MAX, &n) || n == 0)
+			return api_fail(pb, API_QUERY, "limit",
+					"limit must be a positive integer (at most "
+					"%" PRIu64 ")", UINT64_MAX);
 		q->limit = n;
 	}
 	const char *v = last_event_id ? last_event_id : since;
 	if (v) {
-		unsigned long long id = strtoull(v, &end, 10);
-		if (*end || !*v || *v == '-')
-			return api_fail(pb, API_QUERY, "Last-Event-ID",
+		if (!decimal(v, INT64_MAX, &n))
+			return api_fail(pb, API_QUERY, last_event_id ? "Last-Event-ID" : "since",
 					"Last-Event-ID (or since) must be a record "
-					"id, a non-negative integer");
-		q->resume = (int64_t)(id > INT64_MAX - 1 ? INT64_MAX - 1 : id);
+					"id, an integer from 0 to %" PRId64, INT64_MAX);
+		q->resume = (int64_t)(n > INT64_MAX - 1 ? INT64_MAX - 1 : n);
 	}
 	return API_OK;
 }

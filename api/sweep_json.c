@@ -197,7 +197,7 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 1, api_members_sweep, pb);
+	cJSON *root = api_parse_body(body, len, api_members_sweep, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, &req->spec, pb);
@@ -246,6 +246,24 @@ static const char *vary_name(const api_sweep_view *v, int a)
 static double vary_value(const api_sweep_view *v, const api_sweep_point *p, int a)
 {
 	return v->req && v->req->nvary > 0 ? p->vary[a] : p->beta.user;
+}
+
+/* A point's model error (sim_model_check): the sweep's scene with the
+ * point's varied settings and sense. */
+static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_point *p)
+{
+	if (!v->req)
+		return;
+	sim_params pr = v->req->spec.params;
+	sim_scene sc = v->req->spec.scene;
+	sim_method m = v->req->spec.method;
+	pr.beta = p->beta.si;
+	for (int a = 0; a < v->req->nvary; a++)
+		sim_set_user(&pr, &sc, &m, v->req->vary[a], p->vary[a], NULL, 0);
+	pr.rotation = p->rotation;
+	sim_model_error me;
+	sim_model_check(&pr, &sc, &me);
+	api_add_model_error(po, &me);
 }
 
 static const char *point_state(int s)
@@ -298,6 +316,7 @@ static cJSON *point_object(const api_sweep_view *v, const api_sweep_point *p, in
 		cJSON_AddNullToObject(po, "steady");
 	}
 	cJSON_AddBoolToObject(po, "mirrored", p->mirrored);
+	add_point_model(po, v, p);
 	if (p->error[0])
 		cJSON_AddStringToObject(po, "error", p->error);
 	return po;

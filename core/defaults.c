@@ -229,28 +229,3 @@ int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m)
 	}
 	return SIM_EUNKNOWN;
 }
-
-int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len)
-{
-	if (!sc->feed || sc->feed_model != SIM_FEED_COLUMN)
-		return -1;
-	double k_over_m = p->k_c / p->m_n, beta = p->beta / RAD_PER_DEG;
-	int fitted = p->k_c == LIGGGHTS_BED4_K_C && p->R == LIGGGHTS_BED4_R &&
-		     p->mu == LIGGGHTS_BED4_MU;
-	/* the DEM bed's second peak, which the column model lacks even with
-	 * stiff contacts (150 deg cw, 30 deg ccw: 29-33 % apart) */
-	int second_peak = p->rotation == SIM_CW ? beta > 137 && beta < 165 : beta > 15 && beta < 45;
-	if (sc->layers <= 2 || (sc->layers <= 8 && k_over_m >= 2e7 && !second_peak) ||
-	    (fitted && sc->layers <= 4))
-		return 1;
-	if (why)
-		snprintf(why, len,
-			 "the column model with %d layers and k_c/m_n = %.3g 1/s^2 at beta %.0f deg %s "
-			 "lies outside the domain checked against LIGGGHTS beds (at most 2 layers; at "
-			 "most 8 with k_c/m_n >= 2e7 away from 137-165 deg cw and 15-45 deg ccw; beds "
-			 "of 4 and 8 diameters move 14 %% and 54 %% slower than the column model says "
-			 "with the preset's contacts): feed_model=liggghts couples a DEM bed "
-			 "(docs/dem.md)",
-			 sc->layers, k_over_m, beta, p->rotation == SIM_CW ? "cw" : "ccw");
-	return 0;
-}

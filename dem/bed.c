@@ -279,15 +279,8 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	double pitch = 1.05 * s->d_max;
 	int nx = (int)floor(s->cell_x / pitch), ny = (int)floor(s->cell_y / pitch);
 	int nz = (s->grains + nx * ny - 1) / (nx * ny);
-	double d_mean = 0.5 * (s->d_min + s->d_max);
-	/* the mean of d^3 over the uniform distribution of d */
-	double d3 = (pow(s->d_max, 4) - pow(s->d_min, 4)) / (4 * fmax(s->d_max - s->d_min, 1e-300));
-	if (s->d_max - s->d_min < 1e-12 * d_mean)
-		d3 = d_mean * d_mean * d_mean;
-	b->m_mean = s->density * M_PI / 6 * d3;
-	double m_min = s->density * M_PI / 6 * pow(s->d_min, 3);
-	double kn = s->k_over_m * b->m_mean;
-	b->dt = M_PI / sqrt(kn / m_min) / 50;
+	b->m_mean = dem_bed_spec_mass_mean(s);
+	b->dt = dem_bed_spec_dt(s);
 	double z_top = 4 * nz * pitch + 20 * s->d_max;
 
 	if (bed_open(b, comm, msg, msglen)) {

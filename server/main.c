@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "budget.h"
+#include "tether.h"
 #include "catalog.h"
 #include "config.h"
 #include "conns.h"
@@ -213,6 +214,7 @@ static void announce(const srv_config *config, int port)
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	srv_config cfg;
 	int parsed = srv_config_parse(&cfg, argc, argv);
 	if (parsed)

@@ -23,6 +23,7 @@
 #include "dem.h"
 #include "couple.h"
 #include "motion.h"
+#include "tether.h"
 #include "sim.h"
 #include "units.h"
 
@@ -292,6 +293,7 @@ static int frame_check(const dem_opts *o)
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	dem_opts o;
 	memset(&o, 0, sizeof o);
 	dem_parse(argc, argv, &o);

@@ -51,6 +51,7 @@ static const srv_config defaults = {
 	.max_dem_sessions = 1,
 	.dem_ranks = 1,
 	.dem_timeout = 300.0,
+	.max_dem_cost = 1000.0,
 };
 
 enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_MEMORY, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
@@ -152,6 +153,9 @@ static const opt opts[] = {
 	{"dem-timeout", OPT_SECONDS, 100, 86400000, F(dem_timeout), "S",
 	 "fail a session whose bed process gives no answer for S seconds\n"
 	 "(a hung bed; default %D)", NULL},
+	{"max-dem-cost", OPT_SECONDS, 1000, 1000000000, F(max_dem_cost), "S",
+	 "refuse a bed expected to take more than S CPU seconds a\n"
+	 "simulated second (its grains over its DEM step; default %D)", NULL},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)

@@ -96,6 +96,8 @@ typedef struct req_state {
 	int too_large;
 	size_t query_params; /* over SRV_MAX_QUERY_PARAMS: the query was cut */
 	srv_conn *live;      /* the connection's deadlines (conns.h) */
+	size_t nul_at;       /* 1 + where the target has %00; 0: nowhere */
+	int nul_in_query;    /* that %00 is in the query */
 } req_state;
 
 /* More query parameters than any route takes (the most is a handful). */
@@ -107,7 +109,17 @@ void *srv_uri_seen(void *cls, const char *uri, struct MHD_Connection *conn)
 	srv_conn_request_line(srv_budget_live(conn));
 	req_state *st = calloc(1, sizeof *st);
 	char *query = strchr(uri, '?');
-	if (!st || !query)
+	if (!st)
+		return st;
+	/* libmicrohttpd decodes %00 into a NUL that ends the path or value
+	 * there (/api/v1/health%00x would be /api/v1/health): such a target
+	 * names nothing, and first_look refuses it */
+	const char *nul = strstr(uri, "%00");
+	if (nul) {
+		st->nul_at = (size_t)(nul - uri) + 1;
+		st->nul_in_query = query && nul > query;
+	}
+	if (!query)
 		return st;
 	size_t n = 1;
 	for (const char *c = query + 1; *c; c++)
@@ -297,6 +309,15 @@ static int first_look(srv_req *r, enum MHD_Result *result)
 	api_problem pb;
 	if (srv_budget_client_over(r->conn, &pb)) { /* before anything else */
 		*result = srv_reply_problem(r, &pb, NULL);
+		return 1;
+	}
+	const req_state *st = (const req_state *)r;
+	if (st->nul_at) {
+		*result = srv_fail(r, st->nul_in_query ? API_QUERY : API_BADREQUEST,
+				   st->nul_in_query ? "query" : "path",
+				   "the request target has %%00 (a NUL byte) at "
+				   "byte %zu; no path or query value holds one",
+				   st->nul_at - 1);
 		return 1;
 	}
 	if (((req_state *)r)->query_params) {

@@ -193,7 +193,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
-srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
+srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
 	api_spec copy = *request;
@@ -203,6 +203,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
+	s->create_fd = -1;
 	session_locks_init(s);
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		session_free(s);
@@ -225,7 +226,10 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		s->mem_reserved = 0;
 		goto fail;
 	}
-	if (session_init(s, spec, pb))
+	s->create_fd = client_fd;
+	int bad = session_init(s, spec, pb);
+	s->create_fd = -1;
+	if (bad)
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&
@@ -481,6 +485,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
+			s->create_fd = -1; /* no client waits for a restore */
 			session_locks_init(s);
 			srv_persist_load(s, names[i], &ef);
 			if (s->damaged)

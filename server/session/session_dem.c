@@ -77,6 +77,26 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 	if (dem_coupled_check(&spec->scene, &spec->method, 1, spec->scene.transient, msg,
 			      sizeof msg))
 		return api_fail(pb, API_RANGE, "integrator.method", "%s", msg);
+	/* the bed's cost: its grains over its DEM step, which shrinks as the
+	 * contact stiffens (k/m = k_c / m_n); the cost grows as sqrt(k_c) */
+	dem_bed_spec bed;
+	dem_bed_spec_default(&spec->params, (double)spec->scene.layers, &bed);
+	double cost = dem_bed_spec_cost(&bed);
+	if (!(cost <= cfg->max_dem_cost)) {
+		double k_max = spec->params.k_c * (cfg->max_dem_cost / cost) *
+			       (cfg->max_dem_cost / cost);
+		const sim_setting *t = sim_setting_find("k_c");
+		api_fail(pb, API_RANGE, "params.k_c",
+			 "the LIGGGHTS bed of %d grains at k_c/m_n = %.3g 1/s^2 takes DEM steps of "
+			 "%.2g s: about %.3g CPU s a simulated second, more than --max-dem-cost %g; "
+			 "k_c at most %.3g N/m at this m_n (or fewer layers)",
+			 bed.grains, bed.k_over_m, dem_bed_spec_dt(&bed), cost, cfg->max_dem_cost,
+			 k_max);
+		pb->has_range = 1;
+		pb->min = t ? t->min : 0.0;
+		pb->max = k_max;
+		return pb->code;
+	}
 	int n = atomic_load(&live);
 	do {
 		if (n >= cfg->max_dem_sessions) {
@@ -106,7 +126,7 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	dem_bed_spec bed;
 	dem_bed_spec_default(&sp->params, (double)sp->scene.layers, &bed);
 	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks,
-				      cfg->dem_timeout, msg, msglen);
+				      cfg->dem_timeout, restored ? -1 : s->create_fd, msg, msglen);
 	if (!f)
 		return -1;
 	s->dem.link = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,

@@ -137,6 +137,8 @@ struct srv_session {
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
 	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
+	int create_fd;            /* while created: the client's socket or -1
+				     (a bed's settling ends when it leaves) */
 };
 
 /* ---- session_control.c: a control's admission and wait -------------------- */

@@ -165,9 +165,15 @@ int srv_worker_apply_commands(srv_session *s)
 		if (s->pace == API_PACE_MAX && s->until == 0)
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
 		if (rc == SIM_OK) {
-			char json[API_EVENT_MAX];
-			api_control_event(json, sizeof json, &cmd->c, t_eff);
-			srv_ring_event(s, "control", json);
+			/* the control log keeps the control (log_control); the
+			 * stream's event also carries the scene's model error
+			 * after it */
+			char ring[API_EVENT_MAX];
+			sim_model_error me;
+			sim_get_status(s->sim, &s->st);
+			api_model_check(&s->spec, &s->st, &me);
+			api_control_event_model(ring, sizeof ring, &cmd->c, t_eff, &me);
+			srv_ring_event(s, "control", ring);
 			if (cmd->from_experiment && s->exp_relogged > 0)
 				s->exp_relogged--; /* in the log since before the restore */
 			else if (!cmd->replay)

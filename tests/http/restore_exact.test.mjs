@@ -69,12 +69,14 @@ test(`a pace-max session killed ${KILLS} times ends bit for bit as an uninterrup
     const id = (await req(d().base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 2 })).body.id;
     await settled(d(), `/api/v1/sessions/${id}`, (b) => b.state === 'finished');
     // a control at a time both runs share: where until stopped it
-    const p = await req(d().base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 60, beta_rate: 30, until: 120 });
+    const p = await req(d().base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 60, beta_rate: 30, until: 600 });
     assert.equal(p.status, 200, p.text);
     assert.equal(p.body.t_effective, 2);
     await interrupt(async (dd) => {
+      // work remains until it finished at its until (not: is it "running"
+      // now, which a poll just after the control can miss)
       const r = await req(dd.base, 'GET', `/api/v1/sessions/${id}`);
-      return r.status !== 200 || r.body.state === 'running';
+      return r.status !== 200 || !(r.body.state === 'finished' && r.body.status.t >= 600);
     });
     const g = await settled(d(), `/api/v1/sessions/${id}`, (b) => b.state === 'finished', 120000);
     // the trajectory's rows (since the last start, for the restored one)

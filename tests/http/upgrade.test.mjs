@@ -13,7 +13,7 @@ import assert from 'node:assert/strict';
 import { cpSync, mkdtempSync, readdirSync, readFileSync, rmSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, SLOW } from './lib.mjs';
+import { startDaemon, req, until, getReady, SLOW } from './lib.mjs';
 
 const FIXTURES = new URL('../fixtures/datadir/', import.meta.url).pathname;
 const FORMAT = 2; // SRV_STORE_VERSION, API_SPEC_FILE_FORMAT
@@ -67,7 +67,8 @@ async function checkWhole(d, dir, exp, first) {
     // the log as the release left it, line for line
     const fixtureLog = join(FIXTURES, exp.release, 'data', 'sessions', id, 'controls.ndjson');
     assert.equal(controls, existsSync(fixtureLog) ? readFileSync(fixtureLog, 'utf8') : '', `${id}'s log`);
-    const g = (await req(d.base, 'GET', path)).body;
+    // (a session with controls to replay answers 503 until it is back where it was)
+    const g = (await getReady(d.base, path, 20000 * SLOW)).body;
     assert.equal(g.state, want.state, `${want.role} ${id}: ${JSON.stringify(g)}`);
     assert.equal(g.preset, want.preset);
     assert.equal(g.pace, want.pace);
