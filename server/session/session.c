@@ -443,37 +443,6 @@ size_t srv_sessions_reap(double idle_timeout)
 	return reaped;
 }
 
-api_err srv_session_attach(srv_session *s, srv_experiment *e,
-			   api_problem *pb)
-{
-	api_err rc = API_OK;
-	pthread_mutex_lock(&s->lock);
-	if (s->stop)
-		rc = api_fail(pb, API_NOTFOUND, "session",
-			      "the session is being deleted");
-	else if (s->state == SRV_FAILED)
-		rc = api_fail(pb, API_CONFLICT, "session",
-			      "the session has failed (%s)", s->error);
-	else if (s->exp)
-		rc = api_fail(pb, API_CONFLICT, "session",
-			      "the session already runs experiment %s",
-			      srv_exp_id(s->exp));
-	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
-		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
-					     s->pace, "session", "attached",
-					     pb)) != API_OK)
-		; /* the experiment would run it on (worker.c extend_until)
-		     past the cores for paced sessions: nothing attached */
-	else {
-		s->exp = e;
-		s->exp_started = 0;
-		srv_exp_set_session(e, s->entry.id);
-		pthread_cond_broadcast(&s->wake);
-	}
-	pthread_mutex_unlock(&s->lock);
-	return rc;
-}
-
 size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 			    void (*put)(srv_experiment *e))
 {

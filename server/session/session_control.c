@@ -4,11 +4,12 @@
  * from its admission to its answer: checked against the session's state
  * and the budgets, queued to the worker (whose commands phase applies it,
  * worker_control.c), waited for, and answered once its control-log line
- * is durable.
+ * is durable; and an experiment attached to send its segments' controls.
  */
 #include <errno.h>
 #include <string.h>
 
+#include "experiment.h"
 #include "session_int.h"
 #include "util.h"
 
@@ -103,4 +104,35 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 	}
 	*t_eff = cmd.t_eff;
 	return API_OK;
+}
+
+api_err srv_session_attach(srv_session *s, srv_experiment *e,
+			   api_problem *pb)
+{
+	api_err rc = API_OK;
+	pthread_mutex_lock(&s->lock);
+	if (s->stop)
+		rc = api_fail(pb, API_NOTFOUND, "session",
+			      "the session is being deleted");
+	else if (s->state == SRV_FAILED)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session has failed (%s)", s->error);
+	else if (s->exp)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session already runs experiment %s",
+			      srv_exp_id(s->exp));
+	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
+		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
+					     s->pace, "session", "attached",
+					     pb)) != API_OK)
+		; /* the experiment would run it on (worker.c extend_until)
+		     past the cores for paced sessions: nothing attached */
+	else {
+		s->exp = e;
+		s->exp_started = 0;
+		srv_exp_set_session(e, s->entry.id);
+		pthread_cond_broadcast(&s->wake);
+	}
+	pthread_mutex_unlock(&s->lock);
+	return rc;
 }
