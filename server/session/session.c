@@ -64,9 +64,9 @@ static void session_free(srv_session *s)
 	srv_budget_give(s->mem_reserved);
 	srv_budget_set_paced(&s->paced_held, 0);
 	srv_sample_free(&s->scratch);
-	if (s->ring_bytes)
-		munmap(s->ring, s->ring_bytes);
-	free(s->hist);
+	if (s->ring.bytes)
+		munmap(s->ring.samples, s->ring.bytes);
+	free(s->ring.hist);
 	srv_control_log_close(s);
 	free(s->controls);
 	free(s->replay);
@@ -112,29 +112,29 @@ static int alloc_buffers(srv_session *s)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
+	s->ring.cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
 	/* the record ring, slots then their arrays, in one mapping whose
 	 * pages are all made now (MAP_POPULATE): the memory budget reserved
 	 * them anyway, and a worker that fills a fresh ring would otherwise
 	 * take a page fault every few samples over its first 16 s */
-	size_t bytes = s->ring_cap * (sizeof *s->ring + per * sizeof(double));
+	size_t bytes = s->ring.cap * (sizeof *s->ring.samples + per * sizeof(double));
 	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
 			 MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
 	if (map != MAP_FAILED) {
-		s->ring_bytes = bytes;
-		s->ring = map;
-		s->ring_store = (double *)(void *)(s->ring + s->ring_cap);
+		s->ring.bytes = bytes;
+		s->ring.samples = map;
+		s->ring.store = (double *)(void *)(s->ring.samples + s->ring.cap);
 	}
-	s->wake_t = INFINITY;
-	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
-	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
-	if (!s->ring_bytes || !s->hist ||
+	s->ring.wake_t = INFINITY;
+	s->ring.hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
+	s->ring.hist = calloc(s->ring.hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
+	if (!s->ring.bytes || !s->ring.hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
 	/* trajectory rows every whole number of sample intervals, at least
 	 * 0.01 s apart */
 	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
-	s->hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
+	s->ring.hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
 	return 0;
 }
 

@@ -24,6 +24,23 @@ typedef struct srv_replay {
 			applied here, the experiment sends it again itself */
 } srv_replay;
 
+/* A session's record ring and trajectory history (ring.c: the worker's
+ * writers and the readers; session.c allocates them), guarded by the
+ * session lock. */
+typedef struct srv_session_records {
+	api_sample *samples;
+	double *store;
+	size_t cap, bytes;        /* store's mapping: bytes */
+	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
+	double *hist;
+	size_t hist_cap, hist_n;
+	double hist_stride, hist_next;
+} srv_session_records;
+
 /* The control log on disk (control_log.c), guarded by the session lock. */
 typedef struct srv_control_log {
 	pthread_cond_t cond;      /* a sync round ended */
@@ -72,17 +89,7 @@ struct srv_session {
 	srv_cmd *cmd_head, *cmd_tail;
 	sim_status st;
 	double steps_per_s, rtf;
-	api_sample *ring;
-	double *ring_store;
-	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
-	uint64_t head;
-	uint64_t event_head;      /* head after the newest event record */
-	uint64_t published;       /* head when readers were last woken */
-	double wake_t;            /* s: the earliest sample time a waiting
-				     stream wants (INFINITY: none waits) */
-	double *hist;
-	size_t hist_cap, hist_n;
-	double hist_stride, hist_next;
+	srv_session_records ring; /* records and history (ring.c) */
 	int streams;
 	srv_experiment *exp;
 	srv_cmd *exp_cmd;         /* the experiment's command while queued */
@@ -215,16 +222,16 @@ static inline int srv_state_after(int state, int cpu_paused, double t, const api
 	return state;
 }
 
-/* Slot i of the ring with its arrays pointed into ring_store (set on
+/* Slot i of the ring with its arrays pointed into ring.store (set on
  * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	api_sample *r = &s->ring[i];
+	api_sample *r = &s->ring.samples[i];
 	r->columns = s->columns;
 	r->layers = s->layers;
-	r->column_disp = s->ring_store + i * per;
+	r->column_disp = s->ring.store + i * per;
 	r->xi = r->column_disp + s->columns;
 	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
 	return r;

@@ -75,7 +75,7 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->st = s->st;
 	v->steps_per_s = s->steps_per_s;
 	v->rtf = s->rtf;
-	v->samples = s->head;
+	v->samples = s->ring.head;
 	v->streams = s->streams;
 	v->cpu_seconds = s->cpu_seconds;
 	v->cpu_limit = s->cpu_limit;

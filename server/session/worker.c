@@ -93,13 +93,13 @@ static void restart_clocks(clocks *c, const srv_session *s)
 static void publish(srv_session *s, clocks *c)
 {
 	c->publish_wall = srv_now();
-	if (s->head == s->published)
+	if (s->ring.head == s->ring.published)
 		return;
-	if (s->event_head > s->published || s->st.t >= s->wake_t) {
-		s->wake_t = INFINITY;
+	if (s->ring.event_head > s->ring.published || s->st.t >= s->ring.wake_t) {
+		s->ring.wake_t = INFINITY;
 		pthread_cond_broadcast(&s->data);
 	}
-	s->published = s->head;
+	s->ring.published = s->ring.head;
 }
 
 /* Let the session run at least up to t_end (s): raise until, resume a
