@@ -219,7 +219,7 @@ $(BUILD)/libdem.a: $(DEM_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
+$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/cli/options.o $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
 

@@ -125,6 +125,9 @@ char *api_list_json(const char *member, const void *views, size_t n, size_t size
  * very lists. */
 extern const char *const api_members_session_create[];
 extern const char *const api_members_control[];
+/* The control c as the object PATCH answers under "applied" and the
+ * control event carries (control.c; the caller owns it). */
+cJSON *api_control_object(const api_control *c);
 extern const char *const api_members_experiment[];
 extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];

@@ -40,62 +40,62 @@ static const api_query queries[] = {
 
 #define TRAJ (API_Q_FORMAT | API_Q_FROM | API_Q_TO | API_Q_STRIDE)
 #define STREAM (API_Q_STREAM_FORMAT | API_Q_FIELDS | API_Q_RATE | API_Q_LIMIT | API_Q_SINCE)
-static const api_route routes[] = {
-	{"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
+static const api_route routes[API_R_COUNT] = {
+	[API_R_SESSIONS_CREATE] = {"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
 	 "SessionCreate", 201, "Session", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sessions", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_SESSIONS_LIST] = {"GET", "/api/v1/sessions", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All sessions with live status (CSV: one summary row each)", NULL, 200, "SessionList",
 	 "400,406"},
-	{"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
+	[API_R_SESSION_GET] = {"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
 	 "One session: spec and live status (CSV: its summary row)", NULL, 200, "Session",
 	 "400,404,406,503"},
-	{"PATCH", "/api/v1/sessions/*", 0, 0,
+	[API_R_SESSION_PATCH] = {"PATCH", "/api/v1/sessions/*", 0, 0,
 	 "Change beta, beta_rate, rotation, omega_ss, motor_on, running, pace or until while it "
 	 "runs; answers the simulated time the change takes effect",
 	 "Control", 200, "ControlResult", "400,404,409,413,415,422,503"},
-	{"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
+	[API_R_SESSION_DELETE] = {"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
 	 "400,404,415"},
-	{"GET", "/api/v1/sessions/*/stream", STREAM, 0,
+	[API_R_SESSION_STREAM] = {"GET", "/api/v1/sessions/*/stream", STREAM, 0,
 	 "Server-Sent Events or NDJSON of samples and events", NULL, 200, "StreamRecord",
 	 "400,404,429,503"},
-	{"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
+	[API_R_SESSION_TRAJECTORY] = {"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
 	 "The recorded, downsampled history (the CLI's trajectory columns)", NULL, 200,
 	 "Trajectory", "400,404,406,503"},
-	{"POST", "/api/v1/experiments", 0, 0,
+	[API_R_EXPERIMENTS_CREATE] = {"POST", "/api/v1/experiments", 0, 0,
 	 "Run a beta schedule; per segment the transport velocity and the reversal time",
 	 "ExperimentCreate", 201, "Experiment", "400,404,409,413,415,422,429,503"},
-	{"GET", "/api/v1/experiments", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_EXPERIMENTS_LIST] = {"GET", "/api/v1/experiments", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All kept experiments (CSV: one row per segment)", NULL, 200, "ExperimentList", "400,406"},
-	{"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
+	[API_R_EXPERIMENT_GET] = {"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per segment)", NULL, 200, "Experiment",
 	 "400,404,406"},
-	{"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
+	[API_R_SWEEPS_CREATE] = {"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
 	 "SweepCreate", 202, "Sweep", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_SWEEPS_LIST] = {"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All kept sweeps (CSV: one row per sweep)", NULL, 200, "SweepList", "400,406"},
-	{"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
+	[API_R_SWEEP_GET] = {"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per point, the CLI's sweep columns)", NULL, 200,
 	 "Sweep", "400,404,406"},
-	{"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404,415"},
-	{"POST", "/api/v1/fits", 0, 0,
+	[API_R_SWEEP_DELETE] = {"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404,415"},
+	[API_R_FITS_CREATE] = {"POST", "/api/v1/fits", 0, 0,
 	 "Fit free parameters to measured v(beta) points or peaks (Levenberg-Marquardt) as a job",
 	 "FitCreate", 202, "Fit", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/fits", API_Q_FORMAT | API_Q_SCOPE, 1, "All kept fits with progress (CSV: one row each)",
+	[API_R_FITS_LIST] = {"GET", "/api/v1/fits", API_Q_FORMAT | API_Q_SCOPE, 1, "All kept fits with progress (CSV: one row each)",
 	 NULL, 200, "FitList", "400,406"},
-	{"GET", "/api/v1/fits/*", API_Q_FORMAT, 1,
+	[API_R_FIT_GET] = {"GET", "/api/v1/fits/*", API_Q_FORMAT, 1,
 	 "Progress and result (CSV: parameters, data with residuals, curves)", NULL, 200, "Fit",
 	 "400,404,406"},
-	{"DELETE", "/api/v1/fits/*", 0, 0, "Cancel (a running fit stops) and forget", NULL, 204, "",
+	[API_R_FIT_DELETE] = {"DELETE", "/api/v1/fits/*", 0, 0, "Cancel (a running fit stops) and forget", NULL, 204, "",
 	 "400,404,415"},
-	{"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
+	[API_R_PRESETS] = {"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
 	 "Presets", "400"},
-	{"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",
+	[API_R_HEALTH] = {"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",
 	 NULL, 200, "Health", "400"},
-	{"GET", "/api/v1/openapi.json", 0, 0, "This document", NULL, 200, "application/json",
+	[API_R_OPENAPI] = {"GET", "/api/v1/openapi.json", 0, 0, "This document", NULL, 200, "application/json",
 	 "400"},
-	{"GET", "/api/v1/problems/*", 0, 0, "What a problem type means", NULL, 200, "text/html",
+	[API_R_PROBLEM] = {"GET", "/api/v1/problems/*", 0, 0, "What a problem type means", NULL, 200, "text/html",
 	 "400,404"},
-	{"GET", "/metrics", 0, 0, "Prometheus text format", NULL, 200, "text/plain", "400"},
+	[API_R_METRICS] = {"GET", "/metrics", 0, 0, "Prometheus text format", NULL, 200, "text/plain", "400"},
 };
 
 const api_route *api_routes(size_t *n)
@@ -108,14 +108,6 @@ const api_query *api_queries(size_t *n)
 {
 	*n = sizeof queries / sizeof *queries;
 	return queries;
-}
-
-const api_route *api_route_find(const char *method, const char *pattern)
-{
-	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++)
-		if (strcmp(routes[i].method, method) == 0 && strcmp(routes[i].pattern, pattern) == 0)
-			return &routes[i];
-	return NULL;
 }
 
 api_err api_check_query(const api_route *rt, const char *name, api_problem *pb)

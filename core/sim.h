@@ -129,6 +129,9 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m,
 /* Registry of integrators, built from each method's own descriptor: an
  * array of *n pointers, all static. */
 const sim_method_info *const *sim_methods(size_t *n);
+/* The name of the default integrator (the presets'; the daemon guesses an
+ * adaptive method's steps by its). Static. */
+const char *sim_default_method(void);
 
 /* ---- instances ------------------------------------------------------- */
 

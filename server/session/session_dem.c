@@ -129,13 +129,13 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 				      cfg->dem_timeout, restored ? -1 : s->create_fd, msg, msglen);
 	if (!f)
 		return -1;
-	s->dem = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
+	s->dem.link = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
 				    sp->scene.transient, msg, msglen);
-	if (!s->dem)
+	if (!s->dem.link)
 		return -1;
-	s->bed.resettled = restored;
-	s->dem_cores = cfg->dem_ranks;
-	srv_dem_read(s, &s->st, &s->bed);
+	s->dem.bed.resettled = restored;
+	s->dem.cores = cfg->dem_ranks;
+	srv_dem_read(s, &s->st, &s->dem.bed);
 	srv_log(SRV_LOG_INFO, "session %s: bed process %ld, %d grains, %d rank%s%s", s->entry.id,
 		dem_feed_pid(f), bed.grains, cfg->dem_ranks, cfg->dem_ranks > 1 ? "s" : "",
 		restored ? ", settled anew at the restored time" : "");
@@ -144,22 +144,22 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 
 int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen)
 {
-	return dem_coupled_advance(s->dem, dem_coupled_interval_end(s->dem, t_next), NULL, msg,
+	return dem_coupled_advance(s->dem.link, dem_coupled_interval_end(s->dem.link, t_next), NULL, msg,
 				   msglen);
 }
 
 void srv_dem_controlled(srv_session *s, const sim_status *st)
 {
-	if (!s->dem_restart || st->beta != st->beta_target)
+	if (!s->dem.restart || st->beta != st->beta_target)
 		return;
-	s->dem_restart = 0;
-	dem_coupled_restart_transport(s->dem);
+	s->dem.restart = 0;
+	dem_coupled_restart_transport(s->dem.link);
 }
 
 void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 {
 	dem_coupled_status cs;
-	dem_coupled_get(s->dem, &cs);
+	dem_coupled_get(s->dem.link, &cs);
 	/* the feed's figures are the bed's: its mean x and velocity relative
 	 * to the deck, and the transport velocity fitted to its x */
 	st->transport_velocity = cs.transport_velocity;
@@ -169,12 +169,12 @@ void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 	int resettled = b->resettled;
 	*b = (api_bed){
 		.grains = cs.grains,
-		.pid = dem_feed_pid(dem_coupled_bed(s->dem)),
+		.pid = dem_feed_pid(dem_coupled_bed(s->dem.link)),
 		.interval = cs.interval,
 		.intervals = cs.intervals,
 		.displacement = cs.displacement,
 		.velocity = cs.bed_velocity,
-		.cpu_seconds = dem_coupled_bed(s->dem)->cpu,
+		.cpu_seconds = dem_coupled_bed(s->dem.link)->cpu,
 		.weight = cs.weight,
 		.load_mean_y = cs.load_mean_y,
 		.work_machine = cs.work_machine,
@@ -186,14 +186,14 @@ void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 
 void srv_dem_kill(srv_session *s)
 {
-	if (s->dem)
-		dem_feed_kill(dem_coupled_bed(s->dem));
+	if (s->dem.link)
+		dem_feed_kill(dem_coupled_bed(s->dem.link));
 }
 
 void srv_dem_free(srv_session *s)
 {
-	if (!s->dem)
+	if (!s->dem.link)
 		return;
-	dem_coupled_free(s->dem); /* kills and reaps the bed process */
-	s->dem = NULL;
+	dem_coupled_free(s->dem.link); /* kills and reaps the bed process */
+	s->dem.link = NULL;
 }
