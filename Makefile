@@ -28,17 +28,19 @@ else
 Q := @
 endif
 
-# Open MPI installed (pkg-config ompi-c) and not NO_MPI=1: `convsim sweep`
+# Open MPI installed (pkg-config ompi-c) and not NO_MPI=1: convsim-mpi is
+# built, the command line with MPI (and LIGGGHTS where installed): it
 # spreads a study's points over the ranks under mpirun (cli/spread.h:
-# spread_mpi.c, else spread_none.c). `make NO_MPI=1 BUILD=DIR` builds
-# without MPI (and so without the DEM coupling, which needs it) where it
-# is installed; `make test` builds that too, in $(BUILD)/nompi.
+# spread_mpi.c) and runs feed_model=liggghts. The plain convsim links
+# neither (spread_none.c, coupled_none.c) and hands those two over to it
+# (cli/handover.h). `make NO_MPI=1 BUILD=DIR` builds without MPI (and
+# so without the DEM coupling, which needs it) where it is installed;
+# `make test` builds that too, in $(BUILD)/nompi.
 HAVE_MPI := $(if $(NO_MPI),,$(shell pkg-config --exists ompi-c 2>/dev/null && echo yes))
 # LIGGGHTS (and MPI) installed: the DEM coupling (dem/, below) is built
 HAVE_LIGGGHTS := $(if $(HAVE_MPI),$(wildcard /usr/include/liggghts/library.h))
 CORE_SRC   := $(wildcard core/*.c)
-CLI_SRC    := $(filter-out $(if $(HAVE_LIGGGHTS),cli/coupled_none.c) \
-                $(if $(HAVE_MPI),cli/spread_none.c,cli/spread_mpi.c),$(wildcard cli/*.c))
+CLI_SRC    := $(filter-out cli/spread_mpi.c,$(wildcard cli/*.c))
 FIT_SRC    := $(wildcard fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 # server/ in floors (docs/development.md "Architecture"), bottom to top
@@ -68,10 +70,15 @@ DEM_BIN     := $(if $(HAVE_LIGGGHTS),$(BUILD)/convsim-dem $(BUILD)/convsim-bed)
 # convsim-bed, is built where LIGGGHTS is installed.
 DEM_LINK_SRC := dem/couple.c dem/feed_remote.c dem/bed_proto.c dem/bed_spec.c
 DEM_LINK_OBJ := $(DEM_LINK_SRC:%.c=$(BUILD)/demlink/%.o)
-# convsim's `run --set feed_model=liggghts`: the coupled runner and its
-# libraries where LIGGGHTS is installed, else a stub that says how to get it
+# convsim-mpi: the CLI's objects with spread_mpi.c for spread_none.c and,
+# where LIGGGHTS is installed, the coupled runner and its libraries for
+# coupled_none.c; what it has is compiled into handover.c (CLI_MPI_BUILD)
 CLI_DEM_OBJ := $(if $(HAVE_LIGGGHTS),$(BUILD)/dem/cli/run_coupled.o $(BUILD)/libdem.a)
 CLI_DEM_LIBS = $(if $(HAVE_LIGGGHTS),-lliggghts)
+CLI_MPI_OBJ := $(filter-out $(BUILD)/cli/spread_none.o $(if $(HAVE_LIGGGHTS),$(BUILD)/cli/coupled_none.o),\
+                $(CLI_OBJ)) $(BUILD)/cli/spread_mpi.o $(CLI_DEM_OBJ)
+CLI_MPI_BIN := $(if $(HAVE_MPI),$(BUILD)/convsim-mpi)
+CLI_MPI_HAS := $(if $(HAVE_MPI),$(if $(HAVE_LIGGGHTS),3,1),0)
 MPI_CFLAGS  := $(if $(HAVE_MPI),$(shell pkg-config --cflags ompi-c))
 MPI_LIBS    := $(if $(HAVE_MPI),$(shell pkg-config --libs ompi-c))
 
@@ -102,8 +109,8 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load mutate fuzz fuzz-build clean install uninstall
-all: deps-build $(BUILD)/convsim $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
+.PHONY: model-check all deps deps-build run cluster test check bench bench-controls bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
 # run as root or have sudo) and the npm test tools (tests/node_modules, no
@@ -151,6 +158,7 @@ INC_tests  := -Icore -Ifit
 INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 INC_dem_cli := $(INC_dem) -Icli
 $(BUILD)/cli/spread_mpi.o: INC_EXTRA := $(MPI_CFLAGS)
+$(BUILD)/cli/handover.o: INC_EXTRA := -DCLI_MPI_BUILD=$(CLI_MPI_HAS)
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
@@ -164,6 +172,25 @@ $(BUILD)/api/schemas.inc: api/schemas.json
 	$(Q)sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$$/\\n"/' $< > $@
 $(BUILD)/api/openapi.o: $(BUILD)/api/schemas.inc
 $(BUILD)/api/openapi.o: INC_EXTRA := -I$(BUILD)/api
+
+# The DEM map's points with the column model's v (tests/bench/model_check.py
+# writes the CSV) become rows of a C table that core/model_check.c includes:
+# the core reads no file at run time. Columns are found by their header.
+MODEL_MAP := tests/bench/results/model_check.csv
+$(BUILD)/core/model_map.inc: $(MODEL_MAP)
+	@mkdir -p $(dir $@)
+	$(Q)awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$$i] = i; next } \
+	  /^[^#]/ { printf "{\"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
+	    $$c["preset"], $$c["settings"], $$c["layers"], $$c["beta_deg"], \
+	    $$c["rotation"] == "cw" ? "SIM_CW" : "SIM_CCW", $$c["v_dem"], \
+	    $$c["v_dem_sd"] == "nan" ? "NAN" : $$c["v_dem_sd"], $$c["seeds"], $$c["v_column"] }' \
+	  $< > $@
+# `make model-check` computes the table again from the DEM data (after new
+# rows in tests/bench/results/dem_map.csv or a change of the column model).
+model-check: $(BUILD)/convsim
+	$(Q)python3 tests/bench/model_check.py $(BUILD)/convsim > $(MODEL_MAP).new && mv $(MODEL_MAP).new $(MODEL_MAP)
+$(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
+$(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
@@ -192,7 +219,7 @@ $(BUILD)/libdem.a: $(DEM_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
+$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/cli/options.o $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
 
@@ -200,9 +227,19 @@ $(BUILD)/convsim-bed: $(BUILD)/dem/cli/convsim_bed.o $(BUILD)/libdem.a $(BUILD)/
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(LDLIBS)
 
-dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim-bed $(BUILD)/convsim
+dem-build: $(BUILD)/convsim-dem $(BUILD)/convsim-bed $(BUILD)/convsim $(CLI_MPI_BIN)
 
-$(BUILD)/convsim: $(CLI_OBJ) $(CLI_DEM_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
+# the plain convsim: neither MPI nor LIGGGHTS (tests/cli/mpi.test.mjs reads
+# its ldd), and GSL from its archive where that is installed: two shared
+# libraries fewer to map at every start (about 1 ms of a short run's 7,
+# tests/bench/startup.sh)
+GSL_STATIC_LIBS := -Wl,-Bstatic $(GSL_LIBS) -Wl,-Bdynamic
+CLI_GSL_LIBS := $(if $(filter /%,$(shell $(CC) -print-file-name=libgsl.a)),$(GSL_STATIC_LIBS),$(GSL_LIBS))
+$(BUILD)/convsim: $(CLI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(CLI_GSL_LIBS) $(LDLIBS)
+
+$(BUILD)/convsim-mpi: $(CLI_MPI_OBJ) $(BUILD)/libfit.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ $(GSL_LIBS) $(CLI_DEM_LIBS) $(MPI_LIBS) $(LDLIBS)
 
@@ -298,12 +335,25 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 	$(Q)$(CC) $(CFLAGS) $(WARN) -fsanitize=fuzzer $(INC_server) -o $@ \
 	  $(filter %.c,$^) $(FUZZ_LIBS) -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
+# PATCH throughput with the durable control log alone (part of `make
+# bench`; tests/bench/controls.mjs, about 20 s): OLD_CONVSIMD=path adds
+# another build's rows for comparison.
+bench-controls: all
+	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/controls.mjs
+
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
 # prints a table and fails if the daemon crashed, went over its memory
 # budget or stopped answering another client.
 load: all
 	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/load.mjs
+
+# Connection floods on loopback (about a minute; tests/bench/flood.mjs):
+# 2,000 idle, slow-GET and slow-POST sockets from 500 addresses, an active
+# client's p50 / p99 meanwhile; fails if it or /api/v1/health went
+# unanswered.
+flood: all
+	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/flood.mjs
 
 # The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
 # process at a time, niced, into tests/bench/results/dem.md; then the
@@ -334,9 +384,9 @@ mutate: all
 # The binaries, the dashboard, the docs and a hardened systemd unit under
 # $(DESTDIR)$(PREFIX); the unit is checked with systemd-analyze verify when
 # that exists and DESTDIR is empty (the unit names the installed paths).
-install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
+install: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd
 	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR) $(DESTDIR)$(UNITDIR)
-	install -m 755 $(BUILD)/convsim $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
+	install -m 755 $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(DESTDIR)$(BINDIR)/
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
 	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
@@ -352,7 +402,7 @@ install: deps-build $(BUILD)/convsim $(BUILD)/convsimd
 	else echo "(systemd-analyze not run: DESTDIR set or systemd-analyze missing)"; fi
 
 uninstall:
-	rm -f $(DESTDIR)$(BINDIR)/convsim $(DESTDIR)$(BINDIR)/convsimd \
+	rm -f $(DESTDIR)$(BINDIR)/convsim $(DESTDIR)$(BINDIR)/convsim-mpi $(DESTDIR)$(BINDIR)/convsimd \
 	  $(DESTDIR)$(UNITDIR)/convsimd.service
 	rm -rf $(DESTDIR)$(DATADIR) $(DESTDIR)$(DOCDIR)
 
@@ -360,5 +410,6 @@ clean:
 	rm -rf build build-san build-fuzz
 
 -include $(DEM_OBJ:.o=.d) $(DEM_CLI_OBJ:.o=.d) $(BUILD)/dem/cli/run_coupled.d $(BUILD)/dem/cli/convsim_bed.d \
+	$(BUILD)/cli/spread_mpi.d \
 	$(DEM_LINK_OBJ:.o=.d)
 -include $(CORE_OBJ:.o=.d) $(API_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(FIT_OBJ:.o=.d)

@@ -62,6 +62,8 @@ typedef struct api_experiment_view {
 	double progress;        /* 0..1 */
 	int nseg;
 	const api_segment *seg; /* borrowed */
+	const api_spec *spec;   /* borrowed, may be NULL: the session's scene,
+				   each segment's model error at its beta */
 } api_experiment_view;
 char *api_experiment_json(const api_experiment_view *v);
 /* {"experiments": [...]} of n views. malloc'd text. */
@@ -183,10 +185,13 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 
 typedef struct api_fit_view {
 	char id[24];
-	const char *state;        /* queued, running, done, failed, cancelled */
+	const char *state;        /* queued, running, done, failed, cancelled,
+				     error */
 	const fit_request *req;   /* borrowed */
 	fit_progress pr;          /* the last report (phase NULL before one) */
 	const char *result;       /* fit_result_json's text when over, or NULL */
+	const char *error;        /* why "error" (its record could not be
+				     written); NULL or "" */
 } api_fit_view;
 /* One fit: progress, current values and the result (null until over). */
 char *api_fit_json(const api_fit_view *v);

@@ -205,7 +205,7 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 {
 	fit_request_init(req);
 	*points = NULL;
-	cJSON *root = api_parse_body(body, len, 0, api_members_fit, pb);
+	cJSON *root = api_parse_body(body, len, api_members_fit, pb);
 	if (!root)
 		return pb->code;
 	api_spec spec;
@@ -247,6 +247,8 @@ static cJSON *fit_object(const api_fit_view *v, int with_result)
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "id", v->id);
 	cJSON_AddStringToObject(o, "state", v->state);
+	if (v->error && v->error[0])
+		cJSON_AddStringToObject(o, "error", v->error);
 	cJSON_AddStringToObject(o, "phase", v->pr.phase ? v->pr.phase : "queued");
 	api_add_number(o, "iteration", v->pr.iteration);
 	api_add_number(o, "max_iter", v->req->max_iter);

@@ -94,8 +94,9 @@ FILE *cli_open_out(const cli_opts *o);
 char *cli_slurp(const char *cmd, const char *opt, const char *path);
 
 /* convsim run with feed_model = liggghts: the machine coupled to a
- * LIGGGHTS bed (dem/cli/run_coupled.c where LIGGGHTS is installed, else
- * cli/coupled_none.c, which says how to get it). Exit status as run. */
+ * LIGGGHTS bed (dem/cli/run_coupled.c, in convsim-mpi where LIGGGHTS is
+ * installed; in the plain convsim cli/coupled_none.c, which hands
+ * the run over to convsim-mpi or says how to get it). Exit status as run. */
 int cli_run_coupled(const cli_opts *o);
 
 typedef struct cli_opt {
@@ -108,6 +109,18 @@ typedef struct cli_opt {
 	const char *def;  /* the default as the help shows it, or NULL */
 	const char *doc;
 } cli_opt;
+
+/* The most options one table holds (convsim's, convsim-dem's). */
+#define CLI_MAX_OPTIONS 64
+
+/* The help lines of the options of table opts (n rows) that command bit
+ * cmd takes: flag, argument and text, then unit and default. */
+void cli_help_options(FILE *f, const cli_opt *opts, size_t n, unsigned cmd);
+/* The next option of argv in table opts (n rows, at most CLI_MAX_OPTIONS)
+ * for command bit cmd, as cli_next_option; messages start with who
+ * ("convsim run") and point to hint ("convsim help run"). */
+int cli_next_option_in(const cli_opt *opts, size_t n, unsigned cmd, const char *who,
+		       const char *hint, int argc, char **argv, const char **arg);
 
 /* The command bit for a command name, 0 if unknown. */
 unsigned cli_command(const char *name);

@@ -1,16 +1,20 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * coupled_none.c - `convsim run --set feed_model=liggghts` where convsim
- * was built without LIGGGHTS: says so and how to get it. Where LIGGGHTS
- * is installed the Makefile links dem/cli/run_coupled.c instead.
+ * coupled_none.c - `convsim run --set feed_model=liggghts` in a binary
+ * without LIGGGHTS: the plain convsim hands the run to convsim-mpi where
+ * that was built with LIGGGHTS (handover.h), which links
+ * dem/cli/run_coupled.c instead of this; else it says how to get it.
  */
 #include <stdio.h>
 
 #include "cli.h"
+#include "handover.h"
 
 int cli_run_coupled(const cli_opts *o)
 {
 	(void)o;
+	if (cli_handover_has(CLI_HAS_MPI | CLI_HAS_LIGGGHTS))
+		return cli_handover("run", "--set feed_model=liggghts");
 	fprintf(stderr, "convsim run: --set feed_model=liggghts: this convsim was built without "
 			"LIGGGHTS; `make deps` installs it (Debian libliggghts-dev) and `make` then "
 			"builds the coupling (docs/dem.md)\n");

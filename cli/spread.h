@@ -3,10 +3,11 @@
  * spread.h - a sweep's points spread over MPI ranks: when mpirun (or a
  * batch scheduler's launcher) starts convsim, every rank plans the same
  * study, measures the points k with k % ranks == rank, and rank 0
- * gathers the outcomes into point order and writes the table. Where
- * Open MPI was found at build time this is spread_mpi.c, else (or with
- * `make NO_MPI=1`) spread_none.c, which is always one rank. The core
- * never sees MPI; only the CLI's sweep calls these.
+ * gathers the outcomes into point order and writes the table. In
+ * convsim-mpi (built where Open MPI was found) this is spread_mpi.c; in
+ * the plain convsim spread_none.c, which is always one rank and hands a
+ * launched sweep over to convsim-mpi (handover.h). The core never sees
+ * MPI; only the CLI's sweep calls these.
  */
 #ifndef CONVSIM_SPREAD_H
 #define CONVSIM_SPREAD_H

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * spread_mpi.c - spread.h on MPI (Open MPI where the build found it):
+ * spread_mpi.c - spread.h on MPI, in convsim-mpi (built where Open MPI
+ * is found; the plain convsim hands a launched sweep over to it):
  * the ranks of MPI_COMM_WORLD when a launcher started convsim, one
  * agreement (MPI_Allreduce of the largest status) before the measuring,
  * one MPI_Gatherv of the outcomes' bytes to rank 0 after it, unpacked
@@ -16,15 +17,8 @@
 
 #include <mpi.h>
 
+#include "handover.h"
 #include "spread.h"
-
-/* 1 when a launcher started this process: Open MPI's mpirun
- * (OMPI_COMM_WORLD_SIZE), a PMIx launcher (PMIX_RANK: Open MPI 5, Slurm's
- * srun --mpi=pmix) or a PMI one (PMI_RANK). */
-static int launched(void)
-{
-	return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMIX_RANK") || getenv("PMI_RANK");
-}
 
 void cli_spread_start(cli_spread *sp)
 {
@@ -32,7 +26,7 @@ void cli_spread_start(cli_spread *sp)
 	sp->rank = 0;
 	sp->ranks = 1;
 	sp->mpi = 0;
-	if (!launched())
+	if (!cli_mpi_launched())
 		return;
 	MPI_Initialized(&on);
 	if (!on) {

@@ -1,16 +1,20 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * spread_none.c - spread.h where convsim is built without MPI (no Open
- * MPI at build time, or `make NO_MPI=1`): always rank 0 of 1, so a sweep
- * measures every point itself. Where Open MPI is found the Makefile
- * links spread_mpi.c instead.
+ * spread_none.c - spread.h in the plain convsim, which links no MPI:
+ * always rank 0 of 1, so a sweep measures every point itself. Started by
+ * an MPI launcher where Open MPI was found at build time, it hands the
+ * sweep to convsim-mpi (handover.h), which links spread_mpi.c; built
+ * without MPI (`make NO_MPI=1`) it runs the whole study on every rank.
  */
 #include <stdlib.h>
 
+#include "handover.h"
 #include "spread.h"
 
 void cli_spread_start(cli_spread *sp)
 {
+	if (cli_mpi_launched() && cli_handover_has(CLI_HAS_MPI))
+		exit(cli_handover("sweep", "a sweep started by an MPI launcher"));
 	sp->rank = 0;
 	sp->ranks = 1;
 	sp->mpi = 0;

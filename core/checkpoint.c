@@ -15,7 +15,15 @@
  *            steps, rhs_evals, failed, error; the controls (model_ctl,
  *            ramps included); the estimator (records included); energy
  *            baselines e0, kin0, pot0, elastic0; feed origins X0, X0k;
- *            the workspace's state (ode_method.save)
+ *            the workspace's state (ode_method.save); from version 3 on,
+ *            the measured step error (shadow.c): step_error,
+ *            shadow_until, shadow_window and the running shadow's own
+ *            checkpoint (none: length 0), so that a restore in the middle
+ *            of a shadow's window gives the same error bar at its end
+ *
+ * Version 2 (without the step error's part) is still read: its instance
+ * keeps the calibrated step term until its next estimate starts, as it
+ * did.
  *
  * The core's structs are plain data (no pointers), so they are copied
  * whole; the sizes in the header refuse a buffer of a build whose structs
@@ -30,6 +38,8 @@
 #include "sim_int.h"
 
 #define CKPT_MAGIC "CVSCKPT1"
+/* The last version without the step error's part (read as it was). */
+#define CKPT_VERSION_NO_SHADOW 2
 
 typedef struct ckpt_header {
 	char magic[8];
@@ -48,6 +58,13 @@ typedef struct ckpt_scalars {
 	char error[160];
 	double e0, kin0, pot0, elastic0, X0;
 } ckpt_scalars;
+
+/* The measured step error (version 3 on), after the workspace's state;
+ * the shadow's checkpoint (shadow_len bytes) follows it. */
+typedef struct ckpt_shadow {
+	double step_error, shadow_until, shadow_window;
+	uint64_t shadow_len;
+} ckpt_shadow;
 
 /* FNV-1a, 64 bits (Fowler, Noll, Vo): enough to tell a torn or flipped
  * buffer from a whole one; not a defence against a forger. */
@@ -72,11 +89,17 @@ static size_t columns_of(const sim *s)
 	return (size_t)(s->md.dk.K > 0 ? s->md.dk.K : 1);
 }
 
-/* The payload's length for instance s. */
-static size_t payload_size(const sim *s)
+/* The length of the payload's part that every version holds. */
+static size_t base_size(const sim *s)
 {
 	return 3 * sizeof(double) * (size_t)s->md.n + sizeof(ckpt_scalars) + sizeof(model_ctl) +
 	       sizeof(estimator) + sizeof(double) * columns_of(s) + ws_state_size(s);
+}
+
+/* The payload's length for instance s (its shadow's checkpoint too). */
+static size_t payload_size(const sim *s)
+{
+	return base_size(s) + sizeof(ckpt_shadow) + (s->shadow ? sim_checkpoint_size(s->shadow) : 0);
 }
 
 static ckpt_header header_of(const sim *s)
@@ -143,10 +166,20 @@ int sim_checkpoint(const sim *s, void *buf, size_t len)
 	put(&at, s->X0k, sizeof(double) * columns_of(s));
 	if (h.ws_size)
 		s->ode->save(s->ws, at);
+	at += h.ws_size;
+	ckpt_shadow sh = {s->step_error, s->shadow_until, s->shadow_window,
+			  s->shadow ? sim_checkpoint_size(s->shadow) : 0};
+	put(&at, &sh, sizeof sh);
+	if (sh.shadow_len)
+		sim_checkpoint(s->shadow, at, sh.shadow_len);
 	h.checksum = sim_checksum(payload, h.payload);
 	memcpy(buf, &h, sizeof h);
 	return SIM_OK;
 }
+
+static sim *restore_depth(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			  const void *buf, size_t len, int depth, int *err, char *msg,
+			  size_t msglen);
 
 /* Refuse with a reason (msg) and SIM_ECHECKPOINT. */
 static int refuse(char *msg, size_t msglen, const char *why)
@@ -166,10 +199,13 @@ static int check_frame(const sim *s, const void *buf, size_t len, char *msg, siz
 	memcpy(&h, buf, sizeof h);
 	if (memcmp(h.magic, CKPT_MAGIC, sizeof h.magic) != 0)
 		return refuse(msg, msglen, "not a checkpoint (bad magic)");
-	if (h.version != SIM_CHECKPOINT_VERSION)
+	if (h.version != SIM_CHECKPOINT_VERSION && h.version != CKPT_VERSION_NO_SHADOW)
 		return refuse(msg, msglen, "unknown version");
+	size_t base = base_size(s);
 	if (h.n != want.n || h.columns != want.columns || h.ctl_size != want.ctl_size ||
-	    h.est_size != want.est_size || h.ws_size != want.ws_size || h.payload != want.payload)
+	    h.est_size != want.est_size || h.ws_size != want.ws_size ||
+	    (h.version == CKPT_VERSION_NO_SHADOW ? h.payload != base
+						  : h.payload < base + sizeof(ckpt_shadow)))
 		return refuse(msg, msglen, "layout differs from this session's model or build");
 	if (len - sizeof h < h.payload)
 		return refuse(msg, msglen, "cut off");
@@ -178,8 +214,49 @@ static int check_frame(const sim *s, const void *buf, size_t len, char *msg, siz
 	return SIM_OK;
 }
 
+/* The step error's part of a version 3 payload at at (left bytes to the
+ * payload's end): the shadow restored (a shadow of a shadow is refused:
+ * depth). SIM_OK or SIM_ECHECKPOINT with msg. */
+static int restore_shadow(sim *s, const char *at, size_t left, int depth, char *msg,
+			  size_t msglen)
+{
+	ckpt_shadow sh;
+	if (left < sizeof sh)
+		return refuse(msg, msglen, "cut off");
+	get(&at, &sh, sizeof sh);
+	if (sh.shadow_len != left - sizeof sh || (sh.shadow_len && depth > 0) ||
+	    !(isnan(sh.step_error) || sh.step_error >= 0.0) || !isfinite(sh.shadow_until) ||
+	    !(sh.shadow_window > 0.0) || !isfinite(sh.shadow_window))
+		return refuse(msg, msglen, "the measured step error's part is inconsistent");
+	s->step_error = sh.step_error;
+	s->shadow_until = sh.shadow_until;
+	s->shadow_window = sh.shadow_window;
+	if (!sh.shadow_len)
+		return SIM_OK;
+	/* as shadow_begin made it: the same method with fewer sub-steps */
+	sim_method m = s->cfg;
+	m.substeps = (s->cfg.substeps + 1) / 2;
+	char why[160] = "";
+	int e;
+	s->shadow = restore_depth(&s->md.p, &s->md.sc, &m, at, sh.shadow_len, depth + 1, &e, why,
+				  sizeof why);
+	if (!s->shadow) {
+		if (msg)
+			snprintf(msg, msglen, "its shadow: %s", why);
+		return SIM_ECHECKPOINT;
+	}
+	return SIM_OK;
+}
+
 sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, const void *buf,
 		 size_t len, int *err, char *msg, size_t msglen)
+{
+	return restore_depth(p, sc, m, buf, len, 0, err, msg, msglen);
+}
+
+static sim *restore_depth(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			  const void *buf, size_t len, int depth, int *err, char *msg,
+			  size_t msglen)
 {
 	sim *s = sim_alloc(p, sc, m, err, msg, msglen);
 	if (!s)
@@ -187,6 +264,8 @@ sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, 
 	int e = check_frame(s, buf, len, msg, msglen);
 	if (e != SIM_OK)
 		goto fail;
+	ckpt_header h;
+	memcpy(&h, buf, sizeof h);
 	size_t vec = sizeof(double) * (size_t)s->md.n;
 	ckpt_scalars scl;
 	const char *at = (const char *)buf + sizeof(ckpt_header);
@@ -199,6 +278,12 @@ sim *sim_restore(const sim_params *p, const sim_scene *sc, const sim_method *m, 
 	get(&at, s->X0k, sizeof(double) * columns_of(s));
 	if (ws_state_size(s))
 		s->ode->load(s->ws, at);
+	at += ws_state_size(s);
+	if (h.version != CKPT_VERSION_NO_SHADOW) {
+		e = restore_shadow(s, at, h.payload - base_size(s), depth, msg, msglen);
+		if (e != SIM_OK)
+			goto fail;
+	}
 	s->t_int = scl.t_int;
 	s->t_obs = scl.t_obs;
 	s->t_prev = scl.t_prev;

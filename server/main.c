@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "budget.h"
+#include "tether.h"
 #include "catalog.h"
 #include "config.h"
 #include "conns.h"
@@ -117,6 +118,7 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 /* Stop accepting, let streams end, join every thread, free everything. */
 static void shut_down(struct MHD_Daemon *d)
 {
+	srv_store_watch(); /* the final checkpoints and records from here */
 	srv_stop();
 	MHD_socket ls = MHD_quiesce_daemon(d);
 	if (ls != MHD_INVALID_SOCKET)
@@ -137,6 +139,13 @@ static void shut_down(struct MHD_Daemon *d)
 	srv_conns_shutdown();
 }
 
+/* Of n restored, those not damaged (a damaged one may also have found no
+ * room, so it is not always among the n). */
+static size_t whole(size_t n, size_t damaged)
+{
+	return n > damaged ? n - damaged : 0;
+}
+
 /* Rebuild what the data directory holds: experiments first (the sessions
  * resume theirs), then sessions, then sweeps and fits (on the pool). */
 static void restore_state(void)
@@ -149,15 +158,63 @@ static void restore_state(void)
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_job_restore(&srv_sweep_job);
 	size_t nf = srv_job_restore(&srv_fit_job);
-	if (ne + ns + nw + nf)
-		srv_log(SRV_LOG_INFO,
-			"restored %zu sessions, %zu experiments (%zu "
-			"interrupted), %zu sweeps, %zu fits in %.3f s",
-			ns, ne, ni, nw, nf, srv_now() - t0);
+	if (!(ne + ns + nw + nf))
+		return;
+	/* the damaged ones are listed (state "damaged") but not whole: said
+	 * apart, and the line is a warning then */
+	size_t ds = srv_store_damaged(SRV_STORE_SESSION),
+	       de = srv_store_damaged(SRV_STORE_EXPERIMENT),
+	       dw = srv_store_damaged(SRV_STORE_SWEEP), df = srv_store_damaged(SRV_STORE_FIT);
+	size_t up = srv_store_upgraded(SRV_STORE_SESSION) +
+		    srv_store_upgraded(SRV_STORE_EXPERIMENT) +
+		    srv_store_upgraded(SRV_STORE_SWEEP) + srv_store_upgraded(SRV_STORE_FIT);
+	srv_log(ds + de + dw + df ? SRV_LOG_WARN : SRV_LOG_INFO,
+		"restored %zu sessions, %zu experiments (%zu interrupted), %zu "
+		"sweeps, %zu fits in %.3f s; damaged: %zu sessions, %zu "
+		"experiments, %zu sweeps, %zu fits; %zu read from an earlier "
+		"format and written again in format %d",
+		whole(ns, ds), whole(ne, de), ni, whole(nw, dw), whole(nf, df), srv_now() - t0, ds,
+		de, dw, df, up, SRV_STORE_VERSION);
+}
+
+/* The floors' services, each given the options (before the store opens). */
+static void open_services(srv_config *config)
+{
+	raise_nofile(config);
+	srv_budget_init(config);
+	srv_conns_init(config);
+	srv_catalog_init(config);
+	srv_sessions_init(config);
+	srv_experiments_init(config);
+	srv_job_open(&srv_sweep_job, (size_t)config->max_sweeps);
+	srv_job_open(&srv_fit_job, (size_t)config->max_fits);
+	srv_streams_init(config);
+	srv_static_init(config);
+}
+
+/* The address it listens on (stdout, for scripts) and its budgets (log). */
+static void announce(const srv_config *config, int port)
+{
+	if (strchr(config->listen, ':'))
+		printf("listening on http://[%s]:%d\n", config->listen, port);
+	else
+		printf("listening on http://%s:%d\n", config->listen, port);
+	fflush(stdout);
+	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
+			      "budgets: %.1f GiB memory, %g CPU s per session, "
+			      "%g cores for paced sessions, %d pace-max at once, "
+			      "%d connections per client (%d in all), %d queued "
+			      "sweep points",
+		config->web_root, config->max_sessions, config->max_streams,
+		(double)config->max_memory / (1 << 30), config->max_cpu_seconds,
+		config->max_paced_cores, config->max_busy, config->max_client_connections,
+		config->max_connections,
+		config->max_queued_points);
 }
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	srv_config cfg;
 	int parsed = srv_config_parse(&cfg, argc, argv);
 	if (parsed)
@@ -178,17 +235,9 @@ int main(int argc, char **argv)
 	    srv_peers_init(&cfg))
 		return 2;
 
-	raise_nofile(&cfg);
-	srv_budget_init(&cfg);
-	srv_conns_init(&cfg);
-	srv_catalog_init(&cfg);
-	srv_sessions_init(&cfg);
-	srv_experiments_init(&cfg);
-	srv_job_open(&srv_sweep_job, (size_t)cfg.max_sweeps);
-	srv_job_open(&srv_fit_job, (size_t)cfg.max_fits);
-	srv_streams_init(&cfg);
-	srv_static_init(&cfg);
-	srv_routes_init(&cfg);
+	open_services(&cfg);
+	if (srv_routes_init(&cfg))
+		return 1;
 	if (srv_store_open(&cfg))
 		return 1;
 	if (srv_pool_start(cfg.pool_threads)) {
@@ -207,31 +256,30 @@ int main(int argc, char **argv)
 		MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
 	int port = info ? info->port : cfg.port;
 	srv_gate_set_port(port);
-	if (strchr(cfg.listen, ':'))
-		printf("listening on http://[%s]:%d\n", cfg.listen, port);
-	else
-		printf("listening on http://%s:%d\n", cfg.listen, port);
-	fflush(stdout);
-	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
-			      "budgets: %.1f GiB memory, %g CPU s per session, "
-			      "%g cores for paced sessions, %d pace-max at once, "
-			      "%d connections per client (%d in all), %d queued "
-			      "sweep points",
-		cfg.web_root, cfg.max_sessions, cfg.max_streams,
-		(double)cfg.max_memory / (1 << 30), cfg.max_cpu_seconds,
-		cfg.max_paced_cores, cfg.max_busy, cfg.max_client_connections,
-		cfg.max_connections,
-		cfg.max_queued_points);
+	announce(&cfg, port);
 
 	/* once a second: remove the sessions whose experiment ended and
-	 * those idle beyond --idle-timeout */
+	 * those idle beyond --idle-timeout, close the connections past
+	 * their deadline */
 	int sig = 0;
 	struct timespec tick = {1, 0};
-	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0)
+	while ((sig = sigtimedwait(&sigs, NULL, &tick)) < 0) {
 		srv_sessions_reap(cfg.idle_timeout);
+		srv_conns_reap();
+	}
 	srv_log(SRV_LOG_INFO, "%s: shutting down",
 		sig == SIGINT ? "SIGINT" : "SIGTERM");
 	shut_down(d);
+	/* a final checkpoint or record that is not on disk is not a clean
+	 * stop: the next start would not find what was acknowledged */
+	char failed[1024];
+	size_t nfailed = srv_store_failed(failed, sizeof failed);
+	if (nfailed) {
+		srv_log(SRV_LOG_ERROR, "stopped, but %zu final write%s failed, their "
+				       "state is not on disk: %s", nfailed,
+			nfailed == 1 ? "" : "s", failed);
+		return 1;
+	}
 	srv_log(SRV_LOG_INFO, "stopped cleanly");
 	return 0;
 }

@@ -5,8 +5,9 @@
  * --coupling-steps machine steps, with progress on stderr and a JSON
  * summary on stdout: the transport velocity and the balances of momentum
  * and energy between machine and bed. The bed is dem_bed_spec_default's,
- * `layers` mean diameters deep. Linked into convsim where LIGGGHTS is
- * installed (the Makefile); cli/coupled_none.c otherwise.
+ * `layers` mean diameters deep. Linked into convsim-mpi where LIGGGHTS is
+ * installed (the Makefile), to which the plain convsim hands such a run
+ * (cli/handover.h).
  *
  * Under `mpirun -n N` LIGGGHTS runs the bed on the N ranks (its domain
  * split along the cell); every rank integrates the same machine (the core

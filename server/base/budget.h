@@ -54,8 +54,11 @@ size_t srv_budget_memory(void);
 
 /* ---- cores of paced sessions ------------------------------------------------ */
 
-/* CPU s the server spends on one published sample of a feed of columns x
- * layers (status, ring record, trajectory row), besides the core's. */
+/* The cost model (budget_cost.c): doubles per record of a feed (column
+ * displacements, xi and eta); CPU s the server spends on one published
+ * sample of a feed of columns x layers (status, ring record, trajectory
+ * row), besides the core's. */
+size_t srv_budget_record_doubles(int columns, int layers);
 double srv_budget_sample_cpu(int columns, int layers);
 /* Estimated CPU s per simulated s of a session before it has run: from
  * its integrator (method, the step dt and the feed sub-steps in use, as
@@ -115,10 +118,9 @@ size_t srv_budget_points(void);
 void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			   void **socket_context,
 			   enum MHD_ConnectionNotificationCode code);
-/* A request reached the access handler (busy 1) or completed (busy 0) on
- * conn: a connection with none in flight may be closed at the global cap
- * (conns.h). */
-void srv_budget_request(struct MHD_Connection *conn, int busy);
+/* conn's entry in the table of open connections and their deadlines
+ * (conns.h), borrowed until libmicrohttpd closes it; NULL if it has none. */
+struct srv_conn *srv_budget_live(struct MHD_Connection *conn);
 /* 1 if conn was opened beyond its client's --max-client-connections (it
  * gets a 429 and is closed), with *pb naming the budget. */
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb);

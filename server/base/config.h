@@ -52,6 +52,9 @@ typedef struct srv_config {
 	int max_client_connections; /* open connections per client address */
 	int max_connections;   /* open connections, all clients */
 	double connection_timeout; /* s a connection may stay silent */
+	double request_timeout; /* s from a request line to its last header,
+				   and a body's start (conns.c) */
+	size_t min_body_rate;  /* bytes/s a body must keep up after that */
 	int max_queued_points; /* sweep points queued or running, all sweeps */
 	double cpu_probe;      /* CPU s a new session's cost is probed for
 				  (cpu_probe.c); 0: the estimate alone */
@@ -63,6 +66,9 @@ typedef struct srv_config {
 				  mpirun when > 1), the cores it holds */
 	double dem_timeout;    /* --dem-timeout: s a bed process may take to
 				  answer before its session fails */
+	double max_dem_cost;   /* --max-dem-cost: CPU s a bed may be expected
+				  to take per simulated second (its DEM step
+				  and grains), beyond which it is refused */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

@@ -1,19 +1,35 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * conns.c - the open connections and the idle ones closed at the global
- * cap (see conns.h).
+ * conns.c - the open connections, their deadlines, and the ones closed
+ * to make room at the global cap (see conns.h).
  *
- * A connection is idle from its last activity (accepted, a request ended)
- * until a request reaches the access handler, and busy until that request
- * is complete: streams are busy for their whole life and are never
- * closed here; a socket that sends nothing, or only part of a request's
- * headers, is idle, unless bytes of a request wait on its socket. The
- * idlest is the one idle longest. Closing is a
- * shutdown(2) of the socket under the lock: libmicrohttpd notifies the
- * close (srv_conn_close, which takes the lock) before it closes the
- * descriptor, so a descriptor in the list is never another's. The list is
- * a doubly linked list scanned at each eviction (a thousand entries at
- * most, and only beyond the cap).
+ * A connection is in one of four states; each but "busy" has a progress
+ * time (how far it has come) and a deadline (when it is cut):
+ *
+ *   idle  accepted, or between requests: progress = since then,
+ *         deadline = progress + --connection-timeout;
+ *   head  a request line came (libmicrohttpd saw its URI), its headers
+ *         not yet all: progress = then, deadline = progress +
+ *         --request-timeout;
+ *   body  the headers passed the gate, the body is being read: progress =
+ *         its start + bytes read / --min-body-rate, deadline = progress +
+ *         --request-timeout (a body slower than the rate falls behind);
+ *   busy  the request is being answered (a stream for its whole life):
+ *         never closed here.
+ *
+ * Two binary min-heaps hold the connections that are not busy, one by
+ * progress and one by deadline, so that each change is O(log n) under
+ * the lock and nothing is ever scanned. Beyond --max-connections each new
+ * connection closes the one with the oldest progress; an idle one whose
+ * request bytes already wait unread on its socket (accepted just before
+ * a burst of others, its thread not yet run) is a request arriving: it
+ * goes to "head" with progress now instead; after SRV_CONN_PEEKS of those
+ * for one new connection the oldest is closed whatever waits on it, so
+ * the listen thread's work per connection is bounded. Once a
+ * second srv_conns_reap closes every connection past its deadline.
+ * Closing is a shutdown(2) of the socket under the lock: libmicrohttpd
+ * notifies the close (srv_conn_close, which takes the lock) before it
+ * closes the descriptor, so a descriptor here is never another's.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -23,59 +39,177 @@
 #include "conns.h"
 #include "util.h"
 
+/* Idle connections with request bytes waiting that one new connection
+ * passes over (each to the back) before it closes the oldest anyway. */
+#define SRV_CONN_PEEKS 16
+
+enum { BY_PROGRESS, BY_DEADLINE, HEAPS };
+enum conn_state { CONN_IDLE, CONN_HEAD, CONN_BODY, CONN_BUSY, CONN_CLOSING };
+
 struct srv_conn {
-	srv_conn *prev, *next;
 	int fd;
-	int busy;       /* a request in flight */
-	int closing;    /* shut down here, not yet closed by libmicrohttpd */
-	double last;    /* srv_now() of the last activity */
+	enum conn_state state;
+	double key[HEAPS];   /* progress and deadline, srv_now() seconds */
+	size_t at[HEAPS];    /* index in each heap; NOWHERE when out */
+	double body_start;   /* state body: when the headers passed */
+	size_t body_bytes;   /* state body: bytes read so far */
 };
 
+#define NOWHERE ((size_t)-1)
+
+typedef struct heap {
+	srv_conn **v;
+	size_t n, cap;
+} heap;
+
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
-static srv_conn *head;   /* lock */
-static int open_count;   /* lock: in the list and not closing */
+static heap heaps[HEAPS];  /* lock */
+static int open_count;     /* lock: registered and not closing */
 static const srv_config *cfg;
-static atomic_ullong evicted;
+static atomic_ullong evicted, timed_out;
 
 void srv_conns_init(const srv_config *config)
 {
 	cfg = config;
 }
 
-/* The idle connection with the oldest activity other than skip, or NULL
- * (lock held). */
-static srv_conn *idlest(const srv_conn *skip)
+/* ---- the heaps (lock held) ------------------------------------------------- */
+
+static int before(int h, const srv_conn *a, const srv_conn *b)
 {
-	srv_conn *best = NULL;
-	for (srv_conn *c = head; c; c = c->next)
-		if (c != skip && !c->busy && !c->closing &&
-		    (!best || c->last < best->last))
-			best = c;
-	return best;
+	return a->key[h] < b->key[h];
 }
 
-/* Bytes are waiting on c's socket: a request on its way that
- * libmicrohttpd has not read yet (a client that connected just before a
- * burst of others), so c is not idle. */
+static void place(int h, size_t i, srv_conn *c)
+{
+	heaps[h].v[i] = c;
+	c->at[h] = i;
+}
+
+static void sift_up(int h, size_t i)
+{
+	srv_conn *c = heaps[h].v[i];
+	while (i > 0) {
+		size_t parent = (i - 1) / 2;
+		if (!before(h, c, heaps[h].v[parent]))
+			break;
+		place(h, i, heaps[h].v[parent]);
+		i = parent;
+	}
+	place(h, i, c);
+}
+
+static void sift_down(int h, size_t i)
+{
+	heap *hp = &heaps[h];
+	srv_conn *c = hp->v[i];
+	for (;;) {
+		size_t child = 2 * i + 1;
+		if (child >= hp->n)
+			break;
+		if (child + 1 < hp->n && before(h, hp->v[child + 1], hp->v[child]))
+			child++;
+		if (!before(h, hp->v[child], c))
+			break;
+		place(h, i, hp->v[child]);
+		i = child;
+	}
+	place(h, i, c);
+}
+
+/* Add c to heap h; -1 when out of memory. */
+static int heap_add(int h, srv_conn *c)
+{
+	heap *hp = &heaps[h];
+	if (hp->n == hp->cap) {
+		size_t cap = hp->cap ? 2 * hp->cap : 1024;
+		srv_conn **v = realloc(hp->v, cap * sizeof *v);
+		if (!v)
+			return -1;
+		hp->v = v;
+		hp->cap = cap;
+	}
+	place(h, hp->n++, c);
+	sift_up(h, hp->n - 1);
+	return 0;
+}
+
+static void heap_remove(int h, srv_conn *c)
+{
+	heap *hp = &heaps[h];
+	size_t i = c->at[h];
+	if (i == NOWHERE)
+		return;
+	c->at[h] = NOWHERE;
+	srv_conn *last = hp->v[--hp->n];
+	if (last == c)
+		return;
+	place(h, i, last);
+	sift_up(h, i);
+	sift_down(h, last->at[h]);
+}
+
+/* ---- states (lock held) ---------------------------------------------------- */
+
+/* Out of both heaps. */
+static void unlist(srv_conn *c)
+{
+	heap_remove(BY_PROGRESS, c);
+	heap_remove(BY_DEADLINE, c);
+}
+
+/* c in state s with this progress time; its deadline follows from it.
+ * Out of memory for the heaps: c stays unlisted (not closed here). */
+static void set_state(srv_conn *c, enum conn_state s, double progress)
+{
+	unlist(c);
+	c->state = s;
+	if (s == CONN_BUSY || s == CONN_CLOSING)
+		return;
+	c->key[BY_PROGRESS] = progress;
+	c->key[BY_DEADLINE] = progress + (s == CONN_IDLE
+						  ? cfg->connection_timeout
+						  : cfg->request_timeout);
+	if (heap_add(BY_PROGRESS, c) == 0 && heap_add(BY_DEADLINE, c) != 0)
+		heap_remove(BY_PROGRESS, c);
+}
+
+/* Close c: shut its socket down; libmicrohttpd then closes it as a peer
+ * that left and notifies srv_conn_close. */
+static void cut(srv_conn *c)
+{
+	set_state(c, CONN_CLOSING, 0);
+	open_count--;
+	shutdown(c->fd, SHUT_RDWR);
+}
+
+/* Bytes wait unread on c's socket: a request on its way. */
 static int request_waiting(const srv_conn *c)
 {
 	char byte;
 	return recv(c->fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT) > 0;
 }
 
-/* Close the idlest connection but keep; 0 if none is idle (lock held). */
-static int close_idlest(const srv_conn *keep, double now)
+/* Close the connection with the oldest progress; 0 if none is listed.
+ * An idle one with request bytes waiting goes to the back as a request
+ * arriving; after SRV_CONN_PEEKS of those the oldest is closed whatever
+ * waits on it, so that the cap holds and the work stays bounded. */
+static int evict_one(double now)
 {
-	srv_conn *victim;
-	while ((victim = idlest(keep)) && request_waiting(victim))
-		victim->last = now;
-	if (!victim)
-		return 0;
-	victim->closing = 1;
-	open_count--;
-	shutdown(victim->fd, SHUT_RDWR);
-	return 1;
+	for (int peeks = 0; heaps[BY_PROGRESS].n; peeks++) {
+		srv_conn *victim = heaps[BY_PROGRESS].v[0];
+		if (peeks < SRV_CONN_PEEKS && victim->state == CONN_IDLE &&
+		    request_waiting(victim)) {
+			set_state(victim, CONN_HEAD, now);
+			continue;
+		}
+		cut(victim);
+		return 1;
+	}
+	return 0;
 }
+
+/* ---- the interface ---------------------------------------------------------- */
 
 srv_conn *srv_conn_open(struct MHD_Connection *conn)
 {
@@ -85,22 +219,19 @@ srv_conn *srv_conn_open(struct MHD_Connection *conn)
 	if (!c)
 		return NULL;
 	c->fd = ci->connect_fd;
-	c->last = srv_now();
+	c->at[BY_PROGRESS] = c->at[BY_DEADLINE] = NOWHERE;
+	double now = srv_now();
 	int closed = 0;
 	pthread_mutex_lock(&lock);
-	c->next = head;
-	if (head)
-		head->prev = c;
-	head = c;
-	open_count++;
-	while (cfg && open_count > cfg->max_connections &&
-	       close_idlest(c, c->last))
+	while (cfg && open_count >= cfg->max_connections && evict_one(now))
 		closed++;
+	open_count++;
+	set_state(c, CONN_IDLE, now);
 	pthread_mutex_unlock(&lock);
 	if (closed) {
 		atomic_fetch_add(&evicted, (unsigned long long)closed);
 		srv_log(SRV_LOG_DEBUG, "at the cap of %d connections: closed "
-				       "%d idle", cfg->max_connections, closed);
+				       "%d", cfg->max_connections, closed);
 	}
 	return c;
 }
@@ -110,16 +241,56 @@ void srv_conn_close(srv_conn *c)
 	if (!c)
 		return;
 	pthread_mutex_lock(&lock);
-	if (c->prev)
-		c->prev->next = c->next;
-	else
-		head = c->next;
-	if (c->next)
-		c->next->prev = c->prev;
-	if (!c->closing)
+	if (c->state != CONN_CLOSING)
 		open_count--;
+	unlist(c);
 	pthread_mutex_unlock(&lock);
 	free(c);
+}
+
+void srv_conn_request_line(srv_conn *c)
+{
+	if (!c)
+		return;
+	pthread_mutex_lock(&lock);
+	if (c->state == CONN_IDLE || c->state == CONN_HEAD)
+		set_state(c, CONN_HEAD, srv_now());
+	pthread_mutex_unlock(&lock);
+}
+
+void srv_conn_body_start(srv_conn *c)
+{
+	if (!c)
+		return;
+	pthread_mutex_lock(&lock);
+	if (c->state != CONN_CLOSING) {
+		c->body_start = srv_now();
+		c->body_bytes = 0;
+		set_state(c, CONN_BODY, c->body_start);
+	}
+	pthread_mutex_unlock(&lock);
+}
+
+int srv_conn_body_read(srv_conn *c, size_t n)
+{
+	if (!c)
+		return 1;
+	double now = srv_now();
+	int keep = 0, late = 0;
+	pthread_mutex_lock(&lock);
+	if (c->state == CONN_BODY && now > c->key[BY_DEADLINE]) {
+		late = 1;
+	} else if (c->state == CONN_BODY) {
+		c->body_bytes += n;
+		set_state(c, CONN_BODY,
+			  c->body_start + (double)c->body_bytes /
+						  (double)cfg->min_body_rate);
+		keep = 1;
+	}
+	pthread_mutex_unlock(&lock);
+	if (late)
+		atomic_fetch_add(&timed_out, 1);
+	return keep;
 }
 
 void srv_conn_busy(srv_conn *c, int busy)
@@ -127,9 +298,26 @@ void srv_conn_busy(srv_conn *c, int busy)
 	if (!c)
 		return;
 	pthread_mutex_lock(&lock);
-	c->busy = busy;
-	c->last = srv_now();
+	if (c->state != CONN_CLOSING)
+		set_state(c, busy ? CONN_BUSY : CONN_IDLE, srv_now());
 	pthread_mutex_unlock(&lock);
+}
+
+void srv_conns_reap(void)
+{
+	double now = srv_now();
+	unsigned long long n = 0;
+	pthread_mutex_lock(&lock);
+	while (heaps[BY_DEADLINE].n && heaps[BY_DEADLINE].v[0]->key[BY_DEADLINE] < now) {
+		cut(heaps[BY_DEADLINE].v[0]);
+		n++;
+	}
+	pthread_mutex_unlock(&lock);
+	if (n) {
+		atomic_fetch_add(&timed_out, n);
+		srv_log(SRV_LOG_DEBUG, "closed %llu connections past their "
+				       "deadline", n);
+	}
 }
 
 unsigned long long srv_conns_evicted(void)
@@ -137,13 +325,17 @@ unsigned long long srv_conns_evicted(void)
 	return atomic_load(&evicted);
 }
 
+unsigned long long srv_conns_timed_out(void)
+{
+	return atomic_load(&timed_out);
+}
+
 void srv_conns_shutdown(void)
 {
 	pthread_mutex_lock(&lock);
-	while (head) {
-		srv_conn *c = head;
-		head = c->next;
-		free(c);
+	for (int h = 0; h < HEAPS; h++) {
+		free(heaps[h].v);
+		heaps[h] = (heap){0};
 	}
 	open_count = 0;
 	pthread_mutex_unlock(&lock);

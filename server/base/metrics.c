@@ -30,13 +30,9 @@ static void metric(FILE *f, const char *name, const char *type,
 		type, name, value);
 }
 
-char *srv_metrics_text(const srv_gauges *g)
+/* The counters and gauges of sessions, steps, streams, jobs and the store. */
+static void activity_metrics(FILE *f, const srv_gauges *g)
 {
-	char *text = NULL;
-	size_t len = 0;
-	FILE *f = open_memstream(&text, &len);
-	if (!f)
-		return NULL;
 	metric(f, "convsim_sessions", "gauge", "Live simulation sessions.",
 	       g->sessions);
 	metric(f, "convsim_sessions_created_total", "counter",
@@ -67,12 +63,20 @@ char *srv_metrics_text(const srv_gauges *g)
 	metric(f, "convsim_store_writes_total", "counter",
 	       "Files written to the data directory.",
 	       (double)srv_stats.store_writes);
+	metric(f, "convsim_control_log_syncs_total", "counter",
+	       "Control-log syncs: each makes every control appended before it durable.",
+	       (double)srv_stats.log_syncs);
 	metric(f, "convsim_store_errors_total", "counter",
 	       "Writes to the data directory that failed (ENOSPC, EIO, ...).",
 	       (double)srv_stats.store_errors);
 	metric(f, "convsim_pool_queued", "gauge",
 	       "Sweep jobs waiting for a pool thread.",
 	       g->pool_queued);
+}
+
+/* The budgets' use and limits, and the connections refused or closed. */
+static void budget_metrics(FILE *f, const srv_gauges *g)
+{
 	const struct {
 		const char *name, *type, *help;
 		double value;
@@ -98,13 +102,29 @@ char *srv_metrics_text(const srv_gauges *g)
 		{"convsim_connections_dropped_total", "counter", "Connections closed "
 		 "at accept: beyond a client's budget and its grace, or beyond "
 		 "--max-connections.", g->connections_dropped},
-		{"convsim_connections_evicted_total", "counter", "Idle connections "
-		 "(no request in flight) closed to make room at --max-connections.",
-		 g->connections_evicted},
+		{"convsim_connections_evicted_total", "counter", "Connections "
+		 "closed to make room at --max-connections: the one with the "
+		 "least progress (idle longest, headers or body furthest "
+		 "behind), never one being answered.", g->connections_evicted},
+		{"convsim_connections_timed_out_total", "counter", "Connections "
+		 "closed at their deadline: idle beyond --connection-timeout, "
+		 "headers not all in within --request-timeout, a body slower "
+		 "than --min-body-rate.", g->connections_timed_out},
 	};
 	for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
 		metric(f, budgets[i].name, budgets[i].type, budgets[i].help,
 		       budgets[i].value);
+}
+
+char *srv_metrics_text(const srv_gauges *g)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f)
+		return NULL;
+	activity_metrics(f, g);
+	budget_metrics(f, g);
 	fprintf(f, "# HELP convsim_http_requests_total HTTP responses by "
 		   "status.\n# TYPE convsim_http_requests_total counter\n");
 	for (int s = 100; s < 600; s++) {

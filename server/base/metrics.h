@@ -19,6 +19,8 @@ typedef struct srv_metrics {
 	atomic_ullong streams_opened, dropped_samples, stream_records;
 	atomic_ullong sweep_points, experiments;
 	atomic_ullong store_writes, store_errors; /* files the writer wrote, failed */
+	atomic_ullong log_syncs;  /* fdatasyncs of control logs (one a round
+				     of group commit) */
 	atomic_ullong requests[6];       /* by status class 1xx..5xx (index 1..5) */
 } srv_metrics;
 extern srv_metrics srv_stats;
@@ -36,7 +38,8 @@ typedef struct srv_gauges {
 	double sweep_points;           /* queued or running */
 	double client_refused;         /* connections answered 429 */
 	double connections_dropped;    /* closed by libmicrohttpd at accept */
-	double connections_evicted;    /* idle ones closed at the cap (conns.c) */
+	double connections_evicted;    /* closed at the cap (conns.c) */
+	double connections_timed_out;  /* closed at their deadline (conns.c) */
 } srv_gauges;
 
 /* Count one response with this HTTP status. */

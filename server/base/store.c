@@ -9,7 +9,8 @@
  * path -> path.prev] -> rename(path.tmp, path) -> fsync of the directory;
  * on any failure the temporary file is removed and the file it would have
  * replaced stays as it was. So a reader finds the old file or the new
- * one, whole, never a mixture, whatever moment the daemon dies.
+ * one, whole, never a mixture, whatever moment the daemon dies. The
+ * framed files read back and the listings are store_read.c's.
  */
 #define _GNU_SOURCE /* pthread_setname_np: the writer shows as "store" */
 #include <dirent.h>
@@ -34,6 +35,8 @@ typedef struct store_job {
 	size_t len;
 	int keep_prev;
 	srv_store_done done;
+	void (*before)(void *arg); /* called just before the write */
+	void (*call)(void *arg);   /* a call in order (srv_store_call) */
 	void *arg;
 	struct store_job *next;
 } store_job;
@@ -46,15 +49,13 @@ static struct {
 	store_job *head, *tail;
 	int stop, started;
 	pthread_t thread;
+	/* srv_store_watch on: the writes that failed since (lock held) */
+	int watching;
+	size_t failed;
+	char failed_what[1024];
 } st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
-typedef struct frame_header {
-	char magic[4];
-	uint32_t version, kind, pad;
-	uint64_t len, checksum;
-} frame_header;
-
-static void full_path(char *out, size_t len, const char *rel)
+void srv_store_path(char *out, size_t len, const char *rel)
 {
 	snprintf(out, len, "%s/%s", st.dir, rel);
 }
@@ -95,7 +96,7 @@ static int fsync_parent(const char *p)
 static int write_atomic(const store_job *j, char *msg, size_t msglen)
 {
 	char path[4096], tmp[4200], prev[4200];
-	full_path(path, sizeof path, j->path);
+	srv_store_path(path, sizeof path, j->path);
 	snprintf(tmp, sizeof tmp, "%s.tmp", path);
 	snprintf(prev, sizeof prev, "%s.prev", path);
 	const char *step = "create the directory of";
@@ -150,7 +151,7 @@ fail:
 static void remove_path(const char *rel)
 {
 	char path[4096];
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	DIR *d = opendir(path);
 	if (d) {
 		struct dirent *de;
@@ -168,17 +169,37 @@ static void remove_path(const char *rel)
 	fsync_parent(path);
 }
 
+/* A failed write while srv_store_watch is on (writer thread). */
+static void note_failure(const char *path, const char *msg)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = strlen(st.failed_what);
+	if (st.watching && st.failed++ == 0)
+		snprintf(st.failed_what, sizeof st.failed_what, "%.900s", msg);
+	else if (st.watching && n + strlen(path) + 3 < sizeof st.failed_what)
+		snprintf(st.failed_what + n, sizeof st.failed_what - n, "; %s", path);
+	pthread_mutex_unlock(&st.lock);
+}
+
 static void run_job(store_job *j)
 {
 	char msg[4400] = "";
 	int err = 0;
+	if (j->call) {
+		j->call(j->arg);
+		free(j);
+		return;
+	}
 	if (j->notify) {
 		/* superseded: nothing to write, done says so */
 	} else if (j->buf) {
+		if (j->before)
+			j->before(j->arg);
 		err = write_atomic(j, msg, sizeof msg);
 		if (err) {
 			atomic_fetch_add(&srv_stats.store_errors, 1);
 			srv_log(SRV_LOG_ERROR, "store: %s", msg);
+			note_failure(j->path, msg);
 		} else {
 			atomic_fetch_add(&srv_stats.store_writes, 1);
 		}
@@ -220,7 +241,7 @@ static void *writer_main(void *arg)
 static int check_node_id(const char *node_id)
 {
 	char p[4096], held[64] = "";
-	full_path(p, sizeof p, "node-id");
+	srv_store_path(p, sizeof p, "node-id");
 	FILE *f = fopen(p, "r");
 	if (f) {
 		if (!fgets(held, sizeof held, f))
@@ -252,9 +273,9 @@ int srv_store_open(const srv_config *cfg)
 	if (!st.dir)
 		return 0;
 	static const char *const subdirs[] = {"sessions", "experiments", "sweeps", "fits"};
-	for (int i = 0; i < 3; i++) {
+	for (size_t i = 0; i < sizeof subdirs / sizeof *subdirs; i++) {
 		char p[4096];
-		full_path(p, sizeof p, subdirs[i]);
+		srv_store_path(p, sizeof p, subdirs[i]);
 		if (mkdir(p, 0755) != 0 && errno != EEXIST) {
 			fprintf(stderr, "convsimd: cannot create %s: %s\n", p,
 				strerror(errno));
@@ -283,6 +304,22 @@ void srv_store_close(void)
 	st.started = 0;
 }
 
+void srv_store_watch(void)
+{
+	pthread_mutex_lock(&st.lock);
+	st.watching = 1;
+	pthread_mutex_unlock(&st.lock);
+}
+
+size_t srv_store_failed(char *what, size_t len)
+{
+	pthread_mutex_lock(&st.lock);
+	size_t n = st.failed;
+	snprintf(what, len, "%s", st.failed_what);
+	pthread_mutex_unlock(&st.lock);
+	return n;
+}
+
 int srv_store_enabled(void)
 {
 	return st.dir != NULL;
@@ -309,6 +346,12 @@ static void enqueue(store_job *j)
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg)
 {
+	srv_store_write_after(path, buf, len, keep_prev, NULL, done, arg);
+}
+
+void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
+			   void (*before)(void *arg), srv_store_done done, void *arg)
+{
 	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
 	if (!j) { /* off (callers check first) or out of memory */
 		free(buf);
@@ -319,6 +362,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 	j->len = len;
 	j->keep_prev = keep_prev;
 	j->done = done;
+	j->before = before;
 	j->arg = arg;
 	/* supersede a pending write to the same path in place */
 	store_job *old = NULL;
@@ -333,6 +377,7 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 			q->len = j->len;
 			q->keep_prev = j->keep_prev;
 			q->done = j->done;
+			q->before = j->before;
 			q->arg = j->arg;
 			break;
 		}
@@ -343,11 +388,51 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		free(j);
 		free(old->buf);
 		old->buf = NULL;
+		old->before = NULL;
 		old->notify = 1;
 		enqueue(old);
 		return;
 	}
 	enqueue(j);
+}
+
+void srv_store_call(void (*fn)(void *arg), void *arg)
+{
+	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
+	if (!j)
+		return;
+	j->call = fn;
+	j->arg = arg;
+	enqueue(j);
+}
+
+int srv_store_make_dir(const char *rel)
+{
+	if (!st.started)
+		return 0;
+	char path[4096];
+	srv_store_path(path, sizeof path, rel);
+	if (mkdir(path, 0755) != 0)
+		return errno == EEXIST ? 0 : -1;
+	return fsync_parent(path);
+}
+
+int srv_store_open_log(const char *rel, uint64_t len)
+{
+	char path[4096];
+	srv_store_path(path, sizeof path, rel);
+	int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+	if (fd < 0)
+		return -1;
+	/* what lies past len was never acknowledged (a line cut short by a
+	 * crash): cut it, and make the file's name durable */
+	if (ftruncate(fd, (off_t)len) != 0 || fsync(fd) != 0 || fsync_parent(path) != 0) {
+		int e = errno;
+		close(fd);
+		errno = e;
+		return -1;
+	}
+	return fd;
 }
 
 api_err srv_store_check_removable(const char *rel, api_problem *pb)
@@ -356,7 +441,7 @@ api_err srv_store_check_removable(const char *rel, api_problem *pb)
 		return API_OK;
 	char path[4096];
 	struct stat sb;
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
 	/* its directory (the entry goes), and the entry's own when it is
 	 * one (its files go) */
@@ -388,162 +473,4 @@ void srv_store_remove(const char *path)
 		return;
 	snprintf(j->path, sizeof j->path, "%s", path);
 	enqueue(j);
-}
-
-void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
-		      size_t *len)
-{
-	frame_header h = {{'C', 'V', 'S', 'F'}, SRV_STORE_VERSION, kind, 0,
-			  plen, sim_checksum(payload, plen)};
-	char *buf = malloc(sizeof h + plen);
-	if (!buf)
-		return NULL;
-	memcpy(buf, &h, sizeof h);
-	memcpy(buf + sizeof h, payload, plen);
-	*len = sizeof h + plen;
-	return buf;
-}
-
-char *srv_store_read_text(const char *rel, size_t *len)
-{
-	char path[4096];
-	full_path(path, sizeof path, rel);
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	char *buf = NULL;
-	size_t n = 0, cap = 0;
-	for (;;) {
-		if (n + 4096 + 1 > cap) {
-			cap = cap ? 2 * cap : 8192;
-			char *nb = realloc(buf, cap);
-			if (!nb) {
-				free(buf);
-				fclose(f);
-				return NULL;
-			}
-			buf = nb;
-		}
-		size_t r = fread(buf + n, 1, 4096, f);
-		n += r;
-		if (r < 4096)
-			break;
-	}
-	fclose(f);
-	buf[n] = '\0';
-	*len = n;
-	return buf;
-}
-
-void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
-			const char **bad)
-{
-	frame_header h;
-	*bad = NULL;
-	if (n < sizeof h)
-		*bad = "cut off (shorter than its header)";
-	if (!*bad) {
-		memcpy(&h, buf, sizeof h);
-		if (memcmp(h.magic, "CVSF", 4) != 0)
-			*bad = "not a convsim file (bad magic)";
-		else if (h.version != SRV_STORE_VERSION)
-			*bad = "unknown version";
-		else if (h.kind != kind)
-			*bad = "a file of another kind";
-		else if (h.len > n - sizeof h)
-			*bad = "cut off";
-		else if (h.len < n - sizeof h)
-			*bad = "longer than its header says";
-		else if (sim_checksum(buf + sizeof h, h.len) != h.checksum)
-			*bad = "checksum mismatch";
-	}
-	if (*bad) {
-		free(buf);
-		return NULL;
-	}
-	memmove(buf, buf + sizeof h, h.len);
-	*len = h.len;
-	return buf;
-}
-
-void *srv_store_read(const char *rel, uint32_t kind, size_t *len, char *why,
-		     size_t whylen)
-{
-	size_t n = 0;
-	char *buf = srv_store_read_text(rel, &n);
-	const char *bad = "missing or unreadable";
-	void *payload = buf ? srv_store_unframe(buf, n, kind, len, &bad) : NULL;
-	if (!payload)
-		snprintf(why, whylen, "%s: %s", rel, bad);
-	return payload;
-}
-
-/* Is the entry name of rel one of the kind srv_store_list_ids lists? 1
- * yes, 0 the store's own leftovers (.tmp, .prev: skipped silently), -1
- * junk (the reason in *why). */
-static int stored_entry(const char *rel, const char *name, int dirs,
-			const char **why)
-{
-	size_t n = strlen(name);
-	if (n > 4 && (strcmp(name + n - 4, ".tmp") == 0 ||
-		      strcmp(name + n - 5, ".prev") == 0))
-		return 0;
-	char path[4096];
-	struct stat sb;
-	snprintf(path, sizeof path, "%s/%s/%s", st.dir, rel, name);
-	size_t idlen = dirs ? n : n > 4 && strcmp(name + n - 4, ".bin") == 0 ? n - 4 : 0;
-	if (lstat(path, &sb) != 0)
-		*why = strerror(errno);
-	else if (dirs ? !S_ISDIR(sb.st_mode) : !S_ISREG(sb.st_mode))
-		*why = dirs ? "not a directory" : "not a regular file";
-	else if (!srv_id_valid(name, idlen))
-		*why = dirs ? "not named by an id" : "not named ID.bin";
-	else
-		return 1;
-	return -1;
-}
-
-size_t srv_store_list_ids(const char *rel, int dirs, char ***names)
-{
-	size_t n = srv_store_list(rel, names), kept = 0;
-	for (size_t i = 0; i < n; i++) {
-		const char *why = NULL;
-		int ok = stored_entry(rel, (*names)[i], dirs, &why);
-		if (ok < 0)
-			srv_log(SRV_LOG_WARN, "data dir: ignored %s/%.100s: %s",
-				rel, (*names)[i], why);
-		if (ok > 0)
-			(*names)[kept++] = (*names)[i];
-		else
-			free((*names)[i]);
-	}
-	return kept;
-}
-
-size_t srv_store_list(const char *rel, char ***names)
-{
-	char path[4096];
-	full_path(path, sizeof path, rel);
-	*names = NULL;
-	DIR *d = opendir(path);
-	if (!d)
-		return 0;
-	size_t n = 0, cap = 0;
-	struct dirent *de;
-	while ((de = readdir(d))) {
-		if (de->d_name[0] == '.')
-			continue;
-		if (n == cap) {
-			cap = cap ? 2 * cap : 64;
-			char **nn = realloc(*names, cap * sizeof *nn);
-			if (!nn)
-				break;
-			*names = nn;
-		}
-		(*names)[n] = strdup(de->d_name);
-		if ((*names)[n])
-			n++;
-	}
-	closedir(d);
-	return n;
 }

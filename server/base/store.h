@@ -4,19 +4,23 @@
  * that writes every file as temporary file -> fsync -> rename -> fsync of
  * the directory, and the framed binary files it reads back at start-up.
  *
- * Nothing else writes under the data directory. Callers hand a finished
- * buffer to the writer (srv_store_write) and go on: no caller waits for a
- * disk, none writes on a worker's step path or under a registry lock. A
- * pending write to the same path is replaced by a newer one (a checkpoint
- * that could not be written in time is superseded, never queued twice).
+ * Nothing else writes under the data directory but the control logs
+ * (control_log.c: appended and synced by the thread that answers for
+ * them). Callers hand a finished buffer to the writer (srv_store_write)
+ * and go on: no caller but a control's answer waits for a disk, none
+ * writes on a worker's step path or under a registry lock. A pending
+ * write to the same path is replaced by a newer one (a checkpoint that
+ * could not be written in time is superseded, never queued twice).
  * The outcome of each write comes back through its callback, on the
  * writer thread with no lock held: 0, or the errno (ENOSPC, EIO, EACCES,
  * ...) with a sentence naming the file; failures are logged and counted
  * (convsim_store_errors_total).
  *
  * Framed files: a header (magic "CVSF", format version, kind, payload
- * length, FNV-1a 64 checksum of the payload, sim_checksum) and the payload. Reading one
- * checks all of it and says what is wrong.
+ * length, FNV-1a 64 checksum of the payload, sim_checksum) and the payload
+ * (records.h: the layouts). Reading one checks all of it and says what is
+ * wrong; a file of an earlier format version is upgraded to this one's
+ * layout as it is read (store_v1.c), and its reader writes it back.
  *
  * Lock order: the store's queue lock is a leaf (registry.h): callbacks run
  * after it is released.
@@ -30,7 +34,15 @@
 #include "api.h"
 #include "config.h"
 
-#define SRV_STORE_VERSION 1
+/* The format this build writes; it reads every one from
+ * SRV_STORE_OLDEST on (docs/operations.md "Stored formats"):
+ *   1  c793934 and the builds up to c3bc9a1: no word of the layout
+ *      beyond the frame's version, two layouts under the same number
+ *      (told apart by the records' sizes, store_v1.c)
+ *   2  this build: the layouts of records.h, their sizes asserted at
+ *      build time; spec.json says "format": 2 */
+#define SRV_STORE_VERSION 2
+#define SRV_STORE_OLDEST 1
 
 /* Kinds of framed files. */
 enum {
@@ -50,8 +62,16 @@ typedef void (*srv_store_done)(void *arg, int err, const char *what);
 int srv_store_open(const srv_config *cfg);
 /* Finish every queued write and stop the writer. */
 void srv_store_close(void);
+/* From now on, note every write that fails (the shutdown's final
+ * checkpoints and records); srv_store_failed then says how many failed
+ * and names them (up to len bytes into what: the first failure's
+ * sentence, then the other files). */
+void srv_store_watch(void);
+size_t srv_store_failed(char *what, size_t len);
 /* 1 when a data directory is in use. */
 int srv_store_enabled(void);
+/* The absolute path of rel (relative to the data directory) into out. */
+void srv_store_path(char *out, size_t len, const char *rel);
 /* --checkpoint-interval, s of wall time. */
 double srv_store_interval(void);
 
@@ -64,6 +84,25 @@ double srv_store_interval(void);
  * off, or out of memory, buf is freed and done is never called. */
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg);
+/* srv_store_write with before (may be NULL) called on the writer thread
+ * just before the file is written (not when superseded): a checkpoint
+ * makes the control log it accounts for durable first. */
+void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
+			   void (*before)(void *arg), srv_store_done done, void *arg);
+/* Call fn(arg) on the writer thread after the jobs queued before it
+ * (nothing without a data directory: fn is not called). */
+void srv_store_call(void (*fn)(void *arg), void *arg);
+/* Create the directory rel (relative; its parent exists) now, and make
+ * its name durable: 0 (also when it exists or without a data directory),
+ * or -1 with errno. */
+int srv_store_make_dir(const char *rel);
+/* Open the append-only file rel (relative; its directory exists: never
+ * created here, so a file removed with its directory is not made again)
+ * for writing with pwrite, cut to len bytes (a tail past what was made
+ * durable is dropped), its name durable: the descriptor, or -1 with
+ * errno. The control log (control_log.c) is the one file written outside
+ * the writer thread. */
+int srv_store_open_log(const char *rel, uint64_t len);
 /* Queue the removal of path (a file, or a directory and what it holds),
  * after every write queued before it. */
 void srv_store_remove(const char *path);
@@ -78,18 +117,33 @@ api_err srv_store_check_removable(const char *rel, api_problem *pb);
  * in *len; NULL when out of memory. */
 void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
 		      size_t *len);
-/* Read path (relative) as a framed file of kind: the payload (malloc'd,
- * caller frees) and its length, or NULL with the reason in why (missing,
- * cut off, checksum, unknown version, ...). */
-void *srv_store_read(const char *path, uint32_t kind, size_t *len, char *why,
-		     size_t whylen);
+/* Read path (relative) as a framed file of kind: the payload in this
+ * build's layout (malloc'd, caller frees) and its length, *older set when
+ * the file is of an earlier format (upgraded: the caller writes it back),
+ * or NULL with the reason in why (missing, cut off, checksum, a newer
+ * format, a layout no release wrote, ...). */
+void *srv_store_read(const char *path, uint32_t kind, size_t *len, int *older,
+		     char *why, size_t whylen);
 /* The payload of a framed file of kind held in buf (n bytes, malloc'd,
- * taken): buf again with the payload moved to its start and its length in
- * *len, or NULL (buf freed) with the reason in *bad (static text). No file
- * system: srv_store_read reads, this checks (and the fuzz harness
+ * taken): the payload in this build's layout (malloc'd; buf or another
+ * buffer) and its length in *len, *older as above, or NULL (buf freed)
+ * with the reason in *bad (static text). No file system: srv_store_read
+ * reads, this checks and upgrades (and the fuzz harness
  * tests/fuzz/fuzz_store.c calls it). */
-void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len,
+void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *older,
 			const char **bad);
+/* A version-1 payload of kind (taken) in version 2's layout (store_v1.c):
+ * the payload (malloc'd; p itself when already in it) and *len, or NULL
+ * (p freed) with the reason in *bad. */
+void *srv_store_upgrade_v1(uint32_t kind, void *p, size_t *len, const char **bad);
+
+/* What a start-up restore found, by kind (SRV_STORE_SESSION for sessions,
+ * else a job kind's store_kind): a record listed damaged, and one read
+ * from an earlier format and written back in this one. */
+void srv_store_count_damaged(uint32_t kind);
+void srv_store_count_upgraded(uint32_t kind);
+size_t srv_store_damaged(uint32_t kind);
+size_t srv_store_upgraded(uint32_t kind);
 /* Read a whole plain file (relative path); malloc'd with a final NUL,
  * NULL if missing. */
 char *srv_store_read_text(const char *path, size_t *len);

@@ -98,6 +98,7 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.client_refused = (double)srv_budget_client_refused(),
 		.connections_dropped = (double)srv_budget_connections_dropped(),
 		.connections_evicted = (double)srv_conns_evicted(),
+		.connections_timed_out = (double)srv_conns_timed_out(),
 	};
 	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
 			 srv_metrics_text(&g), NULL, NULL);

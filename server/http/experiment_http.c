@@ -67,7 +67,7 @@ static api_err start_on_session(srv_experiment *e,
 {
 	srv_session *s;
 	if (req->fresh) {
-		s = srv_session_create(&req->spec, e, pb);
+		s = srv_session_create(&req->spec, e, -1, pb);
 		if (!s)
 			return pb->code;
 	} else {
@@ -76,10 +76,13 @@ static api_err start_on_session(srv_experiment *e,
 			return api_fail(pb, API_NOTFOUND, "session",
 					"no session with id \"%.40s\"",
 					req->session_id);
-		if (srv_session_attach(s, e, pb) != API_OK) {
+		if (srv_session_replaying(s, pb) != API_OK ||
+		    srv_session_attach(s, e, pb) != API_OK) {
 			srv_session_put(s);
 			return pb->code;
 		}
+		/* the session's scene, for each segment's model error */
+		srv_exp_set_spec(e, srv_session_spec(s));
 	}
 	srv_session_put(s); /* it noted its id in e before its worker ran */
 	return API_OK;

@@ -31,7 +31,10 @@ enum MHD_Result srv_h_sessions_create(srv_req *r)
 	api_problem pb;
 	if (api_parse_session(r->body, r->body_len, &spec, &pb) != API_OK)
 		return srv_reply_problem(r, &pb, NULL);
-	srv_session *s = srv_session_create(&spec, NULL, &pb);
+	/* the client's socket: a LIGGGHTS bed stops settling when it leaves */
+	const union MHD_ConnectionInfo *ci =
+		MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+	srv_session *s = srv_session_create(&spec, NULL, ci ? ci->connect_fd : -1, &pb);
 	if (!s)
 		return srv_reply_problem(r, &pb, NULL);
 	api_view v;
@@ -63,6 +66,11 @@ enum MHD_Result srv_h_session_get(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	api_problem pb;
+	if (srv_session_replaying(s, &pb) != API_OK) {
+		srv_session_put(s);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	api_view v;
 	srv_session_view(s, &v);
 	enum MHD_Result res =
@@ -82,7 +90,8 @@ enum MHD_Result srv_h_session_patch(srv_req *r)
 	double t_eff = NAN;
 	api_view v;
 	srv_session_view(s, &v);
-	if (api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
+	if (srv_session_replaying(s, &pb) != API_OK ||
+	    api_parse_control(r->body, r->body_len, v.spec, &c, &pb) !=
 		    API_OK ||
 	    srv_session_control(s, &c, CONTROL_TIMEOUT_S, &t_eff, &pb) !=
 		    API_OK) {
@@ -123,6 +132,10 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
 		return not_found(r, r->arg[0]);
+	if (srv_session_replaying(s, &pb) != API_OK) {
+		srv_session_put(s);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	int columns, layers;
 	srv_session_feed_size(s, &columns, &layers);
 	size_t n = srv_session_history(s, from, to, &rows, &stride);

@@ -22,6 +22,9 @@ typedef struct srv_cmd {
 	int done;                /* applied (or refused): rc and t_eff hold */
 	int rc;                  /* SIM_OK or the core's refusal */
 	double t_eff;            /* s: sim_effective_time() when applied */
+	size_t logged;           /* the control log's length with its line
+				    (0: not logged): durable before a 200 */
+	int waited;              /* a handler waits for it (a PATCH) */
 	struct srv_cmd *next;
 } srv_cmd;
 

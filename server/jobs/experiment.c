@@ -26,6 +26,7 @@
 
 #include "experiment.h"
 #include "experiment_int.h"
+#include "records.h"
 #include "store.h"
 #include "util.h"
 
@@ -106,6 +107,13 @@ int srv_exp_keeps_session(const srv_experiment *e)
 	return e->req.keep_session || !e->req.fresh;
 }
 
+void srv_exp_set_spec(srv_experiment *e, const api_spec *spec)
+{
+	pthread_mutex_lock(&e->lock);
+	e->req.spec = *spec;
+	pthread_mutex_unlock(&e->lock);
+}
+
 void srv_exp_set_session(srv_experiment *e, const char *session_id)
 {
 	pthread_mutex_lock(&e->lock);
@@ -149,6 +157,7 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 	v->progress = e->state == EXP_DONE ? 1 : p < 0 ? 0 : p > 1 ? 1 : p;
 	v->nseg = e->req.nseg;
 	v->seg = e->req.seg;
+	v->spec = &e->req.spec; /* set at creation, never changed after */
 }
 
 /* ---- persistence (store.h) ---------------------------------------------
@@ -158,15 +167,7 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
  * progress (the record and the feed-velocity record) rides in its
  * session's checkpoint (srv_exp_save), so that both continue from the same
  * moment. */
-typedef struct exp_record {
-	char id[SRV_ID_LEN], session_id[SRV_ID_LEN];
-	api_experiment_req req;
-	int32_t state, cur;
-	char error[256];
-	double t0, t_now;
-	uint64_t seg_first, rec_n;
-	double rec_spacing;
-} exp_record;
+typedef srv_exp_record exp_record; /* records.h */
 
 static void record_of(const srv_experiment *e, exp_record *r)
 {

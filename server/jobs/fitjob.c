@@ -28,6 +28,7 @@
 #include "fitjob.h"
 #include "job.h"
 #include "pool.h"
+#include "records.h"
 #include "registry.h"
 #include "store.h"
 #include "util.h"
@@ -46,6 +47,8 @@ typedef struct srv_fit {
 	int has_pr;
 	fit_result res;
 	char *json, *csv;      /* the result's text once over */
+	char store_error[256]; /* its record's last write failed: why (state
+				  "error": a restart would not find it) */
 } srv_fit;
 
 static void destroy(srv_entry *en);
@@ -80,6 +83,8 @@ static void destroy(srv_entry *en)
 
 static const char *fit_state(const srv_fit *f)
 {
+	if (f->store_error[0])
+		return "error";
 	if (f->over)
 		return f->res.status == FIT_FAILED      ? "failed"
 		       : f->res.status == FIT_CANCELLED ? "cancelled"
@@ -99,6 +104,7 @@ static void fill_view(const srv_fit *f, api_fit_view *v)
 	if (!f->has_pr)
 		v->pr.phase = NULL, v->pr.cost = NAN;
 	v->result = f->json;
+	v->error = f->store_error;
 }
 
 static int is_cancelled(void *ctx)
@@ -126,14 +132,27 @@ static void on_progress(void *ctx, const fit_progress *pr)
 static const char *const phases[] = {"fitting", "covariance", "curve", "done"};
 #define NPHASES (sizeof phases / sizeof *phases)
 
-typedef struct fit_record {
-	char id[SRV_ID_LEN];
-	int32_t over, status, has_pr, phase; /* phase: index in phases, or -1 */
-	int32_t iteration, pad;
-	int64_t evaluations;
-	double cost, x[FIT_MAX_FREE];
-	uint64_t body_len, json_len, csv_len;
-} fit_record;
+typedef srv_fit_record fit_record; /* records.h */
+
+/* A write's outcome for fit id (malloc'd, freed here): a failure puts the
+ * fit in state "error" with the reason; a later write that lands clears
+ * it (its record is on disk again). */
+static void written(void *arg, int err, const char *what)
+{
+	char *id = arg;
+	srv_entry *en = srv_registry_get(&fits, id);
+	free(id);
+	if (!en)
+		return;
+	srv_fit *f = fit_of(en);
+	pthread_mutex_lock(&f->lock);
+	if (err)
+		snprintf(f->store_error, sizeof f->store_error, "%s", what);
+	else if (what && what[0] == '\0')
+		f->store_error[0] = '\0';
+	pthread_mutex_unlock(&f->lock);
+	srv_registry_put(&fits, en);
+}
 
 /* Queue fits/ID.bin (lock held). */
 static void persist_locked(const srv_fit *f)
@@ -167,7 +186,9 @@ static void persist_locked(const srv_fit *f)
 		memcpy(p + sizeof r + r.body_len, f->json, r.json_len);
 	if (r.csv_len)
 		memcpy(p + sizeof r + r.body_len + r.json_len, f->csv, r.csv_len);
-	srv_job_save(&srv_fit_job, f->entry.id, p, n, NULL, NULL);
+	char *id = strdup(f->entry.id);
+	if (id && srv_job_save(&srv_fit_job, f->entry.id, p, n, written, id) != 0)
+		free(id);
 	free(p);
 }
 

@@ -45,7 +45,13 @@ static size_t restore_one(const srv_job_kind *kind, const char *name)
 	char path[300], why[300];
 	snprintf(path, sizeof path, "%s/%s", kind->plural, name);
 	size_t len = 0;
-	void *payload = srv_store_read(path, kind->store_kind, &len, why, sizeof why);
+	int older = 0;
+	void *payload = srv_store_read(path, kind->store_kind, &len, &older, why, sizeof why);
+	/* an earlier format, upgraded as it was read: written back in this
+	 * build's once its job loads (atomically: store.c) */
+	void *again = older && payload ? malloc(len ? len : 1) : NULL;
+	if (again)
+		memcpy(again, payload, len);
 	srv_entry *e = NULL;
 	if (payload) {
 		char reason[200];
@@ -54,7 +60,18 @@ static size_t restore_one(const srv_job_kind *kind, const char *name)
 			snprintf(why, sizeof why, "%.90s: %.190s", path, reason);
 	}
 	int damaged = !e;
+	if (!damaged && again) {
+		char id[64];
+		snprintf(id, sizeof id, "%.*s", (int)(strlen(name) - 4), name);
+		if (srv_job_save(kind, id, again, len, NULL, NULL) == 0) {
+			srv_store_count_upgraded(kind->store_kind);
+			srv_log(SRV_LOG_INFO, "%s %s: read from an earlier format, written again "
+					      "in format %d", kind->name, id, SRV_STORE_VERSION);
+		}
+	}
+	free(again);
 	if (damaged) {
+		srv_store_count_damaged(kind->store_kind);
 		srv_log(SRV_LOG_WARN, "%s not restored: %s", kind->name, why);
 		if (!kind->damaged)
 			return 0;

@@ -29,6 +29,7 @@
 #include "job.h"
 #include "metrics.h"
 #include "pool.h"
+#include "records.h"
 #include "registry.h"
 #include "store.h"
 #include "sweep_int.h"
@@ -97,12 +98,7 @@ static void fill_view(const srv_sweep *sw, api_sweep_view *v)
  * creation, after each point and at a cancel (a pending write is replaced
  * by the newer one); at the end, sweep-ID.csv. A restart serves finished
  * sweeps again and queues the points that were pending or running. */
-typedef struct sweep_record {
-	char id[SRV_ID_LEN];
-	api_sweep_req req;     /* betas: NULL here, they follow */
-	uint64_t total, done;
-	int32_t cancelled, pad;
-} sweep_record;
+typedef srv_sweep_record sweep_record; /* records.h */
 
 /* A write's outcome for sweep id (malloc'd, freed here). */
 static void written(void *arg, int err, const char *what)
@@ -315,25 +311,6 @@ static int evictable(srv_entry *en)
 	return over;
 }
 
-/* band_from_fit: the fit's result as the band source and the sweep's
- * model prepared for it (its fitted values, the varied ones skipped). */
-static api_err prepare_band(api_sweep_req *req, api_problem *pb)
-{
-	api_err e = srv_fit_band_source(req->band_fit, &req->band_src, pb);
-	if (e != API_OK)
-		return e;
-	const char *varied[SIM_STUDY_MAX_AXES];
-	for (int a = 0; a < req->nvary; a++)
-		varied[a] = req->vary[a];
-	char msg[240];
-	if (fit_band_source_prepare(&req->band_src, varied, (size_t)req->nvary, req->band_skip,
-				    &req->spec.params, &req->spec.scene, &req->spec.method, msg,
-				    sizeof msg) != SIM_OK)
-		return api_fail(pb, API_INVALID, "band_from_fit", "band_from_fit: %s", msg);
-	req->band = 1;
-	return API_OK;
-}
-
 /* A sweep for a request body with its grid of points and their place in
  * the points' budget; NULL with *pb. */
 static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
@@ -345,7 +322,7 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 	}
 	pthread_mutex_init(&sw->lock, NULL);
 	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK ||
-	    (sw->req.band_fit[0] && prepare_band(&sw->req, pb) != API_OK)) {
+	    (sw->req.band_fit[0] && srv_sweep_prepare_band(&sw->req, pb) != API_OK)) {
 		sweep_free(sw);
 		return NULL;
 	}

@@ -32,9 +32,11 @@ void srv_sessions_shutdown(void);
 
 /* Create a session from spec (copied) and start its worker, with exp
  * (may be NULL; borrowed, must outlive the attachment) attached before
- * the first step. Returns a new reference or NULL with *pb set (429 at
- * --max-sessions, 422 when the core refuses the spec, 503). */
-srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp,
+ * the first step. client_fd: -1, or the creating client's socket: a
+ * LIGGGHTS bed's settling is cancelled (503, nothing kept) when the client
+ * leaves before it ends. Returns a new reference or NULL with *pb set (429
+ * at --max-sessions, 422 when the core refuses the spec, 503). */
+srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp, int client_fd,
 				api_problem *pb);
 /* Look up by id; returns a new reference or NULL. */
 srv_session *srv_session_get(const char *id);
@@ -63,6 +65,12 @@ const char *srv_session_id(const srv_session *s);
 const api_spec *srv_session_spec(const srv_session *s);
 /* Fill a view (spec borrowed from s: keep the reference while using it). */
 void srv_session_view(srv_session *s, api_view *v);
+/* API_OK, or 503 in *pb with Retry-After while s, restored at a start,
+ * runs flat out through the controls of its log to where it was: until
+ * then its status would show a past the clients had already left
+ * (docs/hardening.md). GET, PATCH, its trajectory and streams and an
+ * experiment's attach answer this; the listing shows its status null. */
+api_err srv_session_replaying(srv_session *s, api_problem *pb);
 /* Live sessions. */
 size_t srv_session_count(void);
 /* Every live session, newest first, as new references in *out (malloc'd;

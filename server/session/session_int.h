@@ -11,6 +11,7 @@
 
 #include "budget.h"
 #include "budget_turns.h"
+#include "records.h"
 #include "registry.h"
 #include "session.h"
 #include "worker.h"
@@ -18,8 +19,50 @@
 /* A control of the log to apply again once the integrator reaches at. */
 typedef struct srv_replay {
 	srv_cmd cmd;
-	double at; /* its t_effective, s */
+	double at;   /* its t_effective, s */
+	int exp_own; /* sent by the experiment the checkpoint resumed: not
+			applied here, the experiment sends it again itself */
 } srv_replay;
+
+/* A session's record ring and trajectory history (ring.c: the worker's
+ * writers and the readers; session.c allocates them), guarded by the
+ * session lock. */
+typedef struct srv_session_records {
+	api_sample *samples;
+	double *store;
+	size_t cap, bytes;        /* store's mapping: bytes */
+	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
+	double *hist;
+	size_t hist_cap, hist_n;
+	double hist_stride, hist_next;
+} srv_session_records;
+
+/* The control log on disk (control_log.c), guarded by the session lock. */
+typedef struct srv_control_log {
+	pthread_cond_t cond;      /* a sync round ended */
+	int fd;                   /* -1 until its first sync opens it */
+	size_t synced;            /* bytes of controls on disk, synced */
+	int syncing;              /* a thread leads a sync round */
+	int flush_queued;         /* a flush of lines nobody waits for is
+				     queued on the store's writer */
+} srv_control_log;
+
+/* A LIGGGHTS session's bed (session_dem.c). */
+typedef struct srv_session_dem {
+	struct dem_coupled *link; /* worker only (created before it starts,
+				     freed after it ends): the coupling to the
+				     bed process; NULL for the column model */
+	int slot;                 /* holds one of --max-dem-sessions */
+	double cores;             /* cores its bed process holds (--dem-ranks) */
+	int restart;              /* worker only: a control changed the machine;
+				     the bed's transport estimate restarts once
+				     its beta ramp is over */
+	api_bed bed;              /* what the worker last read of it (lock) */
+} srv_session_dem;
 
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
@@ -46,17 +89,7 @@ struct srv_session {
 	srv_cmd *cmd_head, *cmd_tail;
 	sim_status st;
 	double steps_per_s, rtf;
-	api_sample *ring;
-	double *ring_store;
-	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
-	uint64_t head;
-	uint64_t event_head;      /* head after the newest event record */
-	uint64_t published;       /* head when readers were last woken */
-	double wake_t;            /* s: the earliest sample time a waiting
-				     stream wants (INFINITY: none waits) */
-	double *hist;
-	size_t hist_cap, hist_n;
-	double hist_stride, hist_next;
+	srv_session_records ring; /* records and history (ring.c) */
 	int streams;
 	srv_experiment *exp;
 	srv_cmd *exp_cmd;         /* the experiment's command while queued */
@@ -71,6 +104,7 @@ struct srv_session {
 	char *controls;           /* every acknowledged control, one JSON
 				     line each (controls.ndjson) */
 	size_t controls_len, controls_cap;
+	srv_control_log log;      /* the log on disk (control_log.c), lock */
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
@@ -84,13 +118,20 @@ struct srv_session {
 				     again as the integrator reaches each
 				     (session_store.c loads, worker.c runs) */
 	size_t nreplay, replayed;
+	size_t exp_relogged;      /* lines of the resumed experiment in the
+				     log after its checkpoint: its commands
+				     that many times are not logged again */
 	int rebuilt;              /* re-created from its spec, its checkpoint
 				     unusable (another build): the whole log
 				     is replayed */
-	double catch_up_t;        /* rebuilt: runs flat out until its time
-				     reaches where it was (0: not) */
+	double catch_up_t;        /* restored with controls to replay: runs
+				     flat out until its time reaches where
+				     it was (0: not; then it answers) */
 	double replay_wall, replay_seconds; /* when the replay began, how
 				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
+	double replay_t0;         /* s: the time it was restored at */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
@@ -102,17 +143,15 @@ struct srv_session {
 				     creation, then measured by the worker */
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
-	/* a LIGGGHTS session (session_dem.c) */
-	struct dem_coupled *dem;  /* worker only (created before it starts,
-				     freed after it ends): the coupling to the
-				     bed process; NULL for the column model */
-	int dem_slot;             /* holds one of --max-dem-sessions */
-	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
-	int dem_restart;          /* worker only: a control changed the machine;
-				     the bed's transport estimate restarts once
-				     its beta ramp is over */
-	api_bed bed;              /* what the worker last read of it (lock) */
+	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
+	int create_fd;            /* while created: the client's socket or -1
+				     (a bed's settling ends when it leaves) */
 };
+
+/* ---- session_control.c: a control's admission and wait -------------------- */
+
+/* cfg (borrowed for the daemon's life) gives --max-cpu-seconds. */
+void srv_session_control_init(const srv_config *cfg);
 
 /* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
 
@@ -131,7 +170,7 @@ void srv_dem_hold(void);
 void srv_dem_release(void);
 /* Start s's bed process and couple it to s->sim (at t = 0, or at a
  * restored machine's time: restored = 1, the bed settled anew); s->st and
- * s->bed show it. 0, or -1 with msg (s->dem stays NULL). */
+ * s->dem.bed show it. 0, or -1 with msg (s->dem.link stays NULL). */
 int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
 /* Worker, lock released: advance machine and bed to the end of the
  * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
@@ -159,7 +198,7 @@ static inline double srv_paced_need(const srv_session *s)
 		return 0;
 	double need = s->cpu_per_s * s->pace;
 	/* a LIGGGHTS session's bed process holds its cores */
-	return s->dem && need < s->dem_cores ? s->dem_cores : need;
+	return s->dem.link && need < s->dem.cores ? s->dem.cores : need;
 }
 
 /* The state control c leaves a session in, from its state, whether its
@@ -183,16 +222,16 @@ static inline int srv_state_after(int state, int cpu_paused, double t, const api
 	return state;
 }
 
-/* Slot i of the ring with its arrays pointed into ring_store (set on
+/* Slot i of the ring with its arrays pointed into ring.store (set on
  * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	api_sample *r = &s->ring[i];
+	api_sample *r = &s->ring.samples[i];
 	r->columns = s->columns;
 	r->layers = s->layers;
-	r->column_disp = s->ring_store + i * per;
+	r->column_disp = s->ring.store + i * per;
 	r->xi = r->column_disp + s->columns;
 	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
 	return r;
@@ -216,9 +255,21 @@ void srv_ring_gather(srv_session *s);
 
 /* Queue the spec file (at creation). */
 void srv_persist_spec(srv_session *s);
-/* Append an acknowledged control's event line and queue the controls
- * file (worker, lock held). */
-void srv_persist_control(srv_session *s, const char *json);
+
+/* ---- control_log.c: the control log on disk ----------------------------- */
+
+/* Append a control's event line to s's log in memory (worker, lock held):
+ * the log's length with it, for srv_control_log_sync (0 without a data
+ * directory). waited: a handler makes it durable before it answers; else
+ * a flush is queued on the store's writer. */
+size_t srv_control_log_append(srv_session *s, const char *json, int waited);
+/* Make s's log durable up to end bytes (lock not held): by group commit,
+ * one pwrite and one fdatasync for every line appended before the round
+ * began. 0, or an errno (ETIMEDOUT after timeout_s, the write's failure,
+ * also shown in store_error). */
+int srv_control_log_sync(srv_session *s, size_t end, double timeout_s);
+/* Close the log's file (the session is freed). */
+void srv_control_log_close(srv_session *s);
 /* Queue a checkpoint now if one is due: the interval has passed, or the
  * session stopped running with changes since the last one (worker, lock
  * held, after the commands phase). */
@@ -238,25 +289,8 @@ typedef struct srv_exp_finder {
  * when they do not pass their checks. */
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
 
-/* The head of checkpoint.bin; the experiment's state (exp_len bytes) and
- * the core's checkpoint (sim_len bytes) follow. */
-/* A checkpoint's payload: this head, the experiment's state, the core's
- * checkpoint, then (from this build on; older ones end with the core's)
- * this trailer: the length of the control log it holds, so that a restore
- * replays what came after, and its time, so that a session re-created
- * from its spec knows where it was. */
-typedef struct srv_ckpt_trailer {
-	uint64_t logged;
-	double t; /* s */
-} srv_ckpt_trailer;
-#define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
-typedef struct srv_ckpt_record {
-	int32_t state, exp_started;
-	double pace, until;
-	char error[256];
-	char exp_id[SRV_ID_LEN];
-	uint64_t exp_len, sim_len;
-} srv_ckpt_record;
+/* checkpoint.bin's head and trailer: srv_ckpt_record, srv_ckpt_trailer
+ * (records.h, with every stored layout). */
 /* The files read back, checked without touching a session (the restore
  * uses these; so does the fuzz harness tests/fuzz/fuzz_store.c). A spec
  * file's payload (len bytes, borrowed): 0 with the spec, its creation

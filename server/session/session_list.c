@@ -5,6 +5,7 @@
  * last access; session.c owns their lifetime (it sets the registry's
  * destroy function at start-up).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,11 +71,11 @@ void srv_session_view(srv_session *s, api_view *v)
 		 s->store_error[0] && !s->damaged ? s->store_error : s->error);
 	v->pace = s->pace;
 	v->until = s->until;
-	v->has_status = 1;
+	v->has_status = !(s->catch_up_t > 0); /* a past the clients left */
 	v->st = s->st;
 	v->steps_per_s = s->steps_per_s;
 	v->rtf = s->rtf;
-	v->samples = s->head;
+	v->samples = s->ring.head;
 	v->streams = s->streams;
 	v->cpu_seconds = s->cpu_seconds;
 	v->cpu_limit = s->cpu_limit;
@@ -85,11 +86,35 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->replayed = s->rebuilt;
 	v->replay_seconds = s->replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);
-	v->bed = s->bed;
+	v->bed = s->dem.bed;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));
 	pthread_mutex_unlock(&s->lock);
+}
+
+/* The 503 for a session that replays (lock held). */
+static api_err replaying(const srv_session *s, api_problem *pb)
+{
+	if (!(s->catch_up_t > 0))
+		return API_OK;
+	double now = srv_now(), done = s->st.t - s->replay_t0;
+	double rate = now > s->replay_wall && done > 0 ? done / (now - s->replay_wall) : 0;
+	double left = rate > 0 ? (s->catch_up_t - s->st.t) / rate : 1;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "session %s is replaying its control log after a restart: at t = %.6g s of "
+		 "%.6g s; it answers once it is back where it was",
+		 s->entry.id, s->st.t, s->catch_up_t);
+	pb->retry_after = left < 1 ? 1 : left > 60 ? 60 : (int)ceil(left);
+	return API_UNAVAILABLE;
+}
+
+api_err srv_session_replaying(srv_session *s, api_problem *pb)
+{
+	pthread_mutex_lock(&s->lock);
+	api_err e = replaying(s, pb);
+	pthread_mutex_unlock(&s->lock);
+	return e;
 }
 
 size_t srv_session_count(void)

@@ -8,13 +8,15 @@
  *   sessions/ID/spec.bin         the same as this build's record (framed,
  *                                store.h), for earlier builds
  *   sessions/ID/controls.ndjson  every acknowledged control, one JSON
- *                                object a line with t_effective (s)
+ *                                object a line with t_effective (s);
+ *                                appended and synced before the control
+ *                                is answered (control_log.c)
  *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
  *                                until, the attached experiment's state
  *                                and the core's checkpoint (sim.h); the
  *                                one before it as checkpoint.bin.prev
  *
- * Everything is written by the store's writer (store.c); the worker only
+ * Everything else is written by the store's writer (store.c); the worker only
  * serialises, between steps, with the session lock held. A restore never
  * fails the daemon: a checkpoint that does not pass its checks falls back
  * to the previous one; a session whose spec or both checkpoints are
@@ -28,17 +30,13 @@
 
 #include "experiment.h"
 #include "metrics.h"
+#include "records.h"
 #include "session_int.h"
 #include "store.h"
 #include "util.h"
 
-/* sessions/ID/spec.bin */
-typedef struct spec_record {
-	char id[SRV_ID_LEN];
-	api_spec spec;
-	double created;
-	int32_t owned, pad;
-} spec_record;
+/* sessions/ID/spec.bin (records.h) */
+typedef srv_spec_record spec_record;
 
 static void session_dir(char *out, size_t len, const char *id,
 			const char *file)
@@ -52,6 +50,7 @@ static void session_dir(char *out, size_t len, const char *id,
 typedef struct write_of {
 	char id[SRV_ID_LEN];
 	int spec; /* spec.json */
+	size_t logged; /* a checkpoint: the control log it accounts for */
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
@@ -83,8 +82,22 @@ static void written(void *arg, int err, const char *what)
 	srv_session_put(s);
 }
 
+/* Before a checkpoint is written: the control log up to what it accounts
+ * for is on disk first (control_log.c), so that no checkpoint holds more
+ * of the log than the file (a restore replays the log after it). */
+static void log_first(void *arg)
+{
+	write_of *w = arg;
+	srv_entry *en = srv_registry_get(&srv_sessions_registry, w->id);
+	if (!en)
+		return;
+	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
+	srv_control_log_sync(s, w->logged, 30.0);
+	srv_registry_put(&srv_sessions_registry, en);
+}
+
 static void queue(const srv_session *s, const char *file, void *buf,
-		  size_t len, int keep_prev)
+		  size_t len, int keep_prev, size_t logged)
 {
 	char path[128];
 	session_dir(path, sizeof path, s->entry.id, file);
@@ -92,8 +105,10 @@ static void queue(const srv_session *s, const char *file, void *buf,
 	if (w) {
 		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
 		w->spec = strcmp(file, "spec.json") == 0;
+		w->logged = logged;
 	}
-	srv_store_write(path, buf, len, keep_prev, w ? written : NULL, w);
+	srv_store_write_after(path, buf, len, keep_prev, w && logged ? log_first : NULL,
+			      w ? written : NULL, w);
 }
 
 void srv_persist_spec(srv_session *s)
@@ -110,35 +125,10 @@ void srv_persist_spec(srv_session *s)
 	size_t len;
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
-		queue(s, "spec.bin", buf, len, 0);
+		queue(s, "spec.bin", buf, len, 0, 0);
 	char *text = api_spec_file(&s->spec, s->created, s->owned);
 	if (text)
-		queue(s, "spec.json", text, strlen(text), 0);
-}
-
-void srv_persist_control(srv_session *s, const char *json)
-{
-	if (!srv_store_enabled())
-		return;
-	size_t add = strlen(json) + 1;
-	if (s->controls_len + add + 1 > s->controls_cap) {
-		size_t cap = s->controls_cap ? 2 * s->controls_cap : 4096;
-		while (cap < s->controls_len + add + 1)
-			cap *= 2;
-		char *nc = realloc(s->controls, cap);
-		if (!nc)
-			return;
-		s->controls = nc;
-		s->controls_cap = cap;
-	}
-	memcpy(s->controls + s->controls_len, json, add - 1);
-	s->controls_len += add;
-	s->controls[s->controls_len - 1] = '\n';
-	char *copy = malloc(s->controls_len ? s->controls_len : 1);
-	if (!copy)
-		return;
-	memcpy(copy, s->controls, s->controls_len);
-	queue(s, "controls.ndjson", copy, s->controls_len, 0);
+		queue(s, "spec.json", text, strlen(text), 0, 0);
 }
 
 void srv_persist_checkpoint(srv_session *s, int force)
@@ -181,7 +171,7 @@ void srv_persist_checkpoint(srv_session *s, int force)
 		void *buf = srv_store_frame(SRV_STORE_CHECKPOINT, payload, plen,
 					    &len);
 		if (buf)
-			queue(s, "checkpoint.bin", buf, len, 1);
+			queue(s, "checkpoint.bin", buf, len, 1, s->controls_len);
 	}
 	free(payload);
 	free(exp);
@@ -238,8 +228,11 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 	size_t n = 0, len;
 	char *raw = srv_store_read_text(file, &n);
 	const char *bad = "missing or unreadable";
-	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &bad) : NULL;
+	int older = 0;
+	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &older, &bad) : NULL;
 	*unread = !raw;
+	if (older)
+		s->upgrade = 1; /* written again in this build's format */
 	if (!p) {
 		snprintf(why, whylen, "%s: %s", file, bad);
 		return -1;
@@ -323,8 +316,13 @@ static void load_controls(srv_session *s, size_t logged)
 	char *text = srv_store_read_text(path, &len);
 	if (!text)
 		return;
+	/* a line a crash cut short was never acknowledged: the log ends at
+	 * its last newline (the file is cut there when it is next written) */
+	while (len > 0 && text[len - 1] != '\n')
+		len--;
 	s->controls = text;
-	s->controls_len = s->controls_cap = len;
+	s->controls_len = s->log.synced = len;
+	s->controls_cap = len + 1;
 	if (logged >= len)
 		return;
 	size_t lines = 0;
@@ -336,9 +334,16 @@ static void load_controls(srv_session *s, size_t logged)
 		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
 		srv_replay *rp = &s->replay[s->nreplay];
 		api_problem pb;
+		char exp[SRV_ID_LEN];
 		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
-						 &rp->at, &pb) == API_OK)
+						 &rp->at, exp, sizeof exp, &pb) == API_OK) {
+			/* the experiment resumed from the checkpoint sends its
+			 * segments' commands again: applied twice, the second
+			 * would move the estimator's restart */
+			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
+			s->exp_relogged += rp->exp_own;
 			s->nreplay++;
+		}
 		else if (n)
 			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
 					      "replayed: %s", s->entry.id, path, pb.detail);
@@ -360,22 +365,43 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 	char *text = srv_store_read_text(path, &len);
 	if (text) {
 		api_problem pb;
+		int format = 0;
 		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
-						&s->owned, &pb);
+						&s->owned, &format, &pb);
 		free(text);
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
+			s->upgrade = 1;
 		return e == API_OK ? 0 : -1;
 	}
+	/* no spec.json: a build before it (c793934) wrote only spec.bin */
 	session_dir(path, sizeof path, s->entry.id, "spec.bin");
-	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, why, whylen);
+	int older = 0;
+	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, &older, why, whylen);
 	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
 				     msg, sizeof msg)
 		   : -1;
 	if (r && rc)
 		snprintf(why, whylen, "%s: %s", path, msg);
+	s->upgrade = 1; /* spec.json (and spec.bin) in this build's format */
 	free(r);
 	return rc;
+}
+
+/* s restored at t0 with its log loaded: it runs flat out (and answers
+ * 503 meanwhile: srv_session_replaying) to the later of where a refused
+ * checkpoint said it was (rebuilt) and its last control's time, so that
+ * no client sees it before the controls it acknowledged. */
+static void catch_up(srv_session *s)
+{
+	for (size_t i = 0; i < s->nreplay; i++)
+		if (s->replay[i].at > s->catch_up_t)
+			s->catch_up_t = s->replay[i].at;
+	s->replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
+	if (!(s->catch_up_t > s->replay_t0))
+		s->catch_up_t = 0;
+	s->replay_wall = srv_now();
 }
 
 /* s was re-created from its spec because neither checkpoint could be used
@@ -384,18 +410,15 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
  * the last control's, then at its pace again (worker.c). */
 static void rebuild(srv_session *s, const char *why, const char *why2)
 {
-	for (size_t i = 0; i < s->nreplay; i++)
-		if (s->replay[i].at > s->catch_up_t)
-			s->catch_up_t = s->replay[i].at;
 	s->rebuilt = 1;
-	s->replay_wall = srv_now();
 	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
 	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
 			      "spec, %zu controls replayed to t = %g s",
 		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
 }
 
-void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
+/* The files of session id into s (srv_persist_load). */
+static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	char path[128], why[512] = "", why2[512] = "";
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
@@ -414,6 +437,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	int unread = 0, unread_prev = 0;
 	if (load_checkpoint(s, path, ef, &logged, &unread, why, sizeof why) == 0) {
 		load_controls(s, logged);
+		catch_up(s);
 		return;
 	}
 	char prev[160];
@@ -422,6 +446,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
 				      "previous checkpoint", id, why);
 		load_controls(s, logged);
+		catch_up(s);
 		return;
 	}
 	/* none: created less than one interval before the crash; else both
@@ -434,10 +459,11 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 			 &err, msg, sizeof msg);
 	if (s->sim) {
 		load_controls(s, 0);
+		if (none)
+			s->catch_up_t = 0;
+		catch_up(s);
 		if (!none)
 			rebuild(s, why, why2);
-		else
-			s->catch_up_t = 0;
 		return;
 	}
 	snprintf(why, sizeof why, "its spec is refused: %s", msg);
@@ -445,3 +471,21 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
 }
 
+void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
+{
+	load_files(s, id, ef);
+	if (s->damaged) {
+		srv_store_count_damaged(SRV_STORE_SESSION);
+		return;
+	}
+	if (!s->upgrade)
+		return;
+	/* an earlier format: its spec written again at once (spec.json and
+	 * spec.bin, each atomically: store.c), its checkpoint at the next
+	 * interval, in this build's format */
+	srv_persist_spec(s);
+	s->ckpt_dirty = 1;
+	srv_store_count_upgraded(SRV_STORE_SESSION);
+	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
+			      "in format %d", s->entry.id, SRV_STORE_VERSION);
+}

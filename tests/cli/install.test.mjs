@@ -9,6 +9,7 @@ import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 
@@ -42,4 +43,9 @@ test('make install PREFIX=... installs a working daemon and a verified, hardened
     assert.match(await page.text(), /<script type="module"/);
   } finally { d.kill('SIGTERM'); }
   assert.match(spawnSync(join(prefix, 'bin/convsim'), ['--version'], { encoding: 'utf8' }).stdout, /^convsim /);
+  // convsim-mpi beside it where it was built (Open MPI installed): the hand-over finds it
+  if (existsSync(join(ROOT, process.env.BUILD || 'build', 'convsim-mpi'))) {
+    assert.ok(existsSync(join(prefix, 'bin/convsim-mpi')), 'bin/convsim-mpi');
+    assert.match(spawnSync(join(prefix, 'bin/convsim-mpi'), ['--version'], { encoding: 'utf8' }).stdout, /^convsim /);
+  }
 });

@@ -7,15 +7,18 @@
 // fit). A usage error and an unwritable --out stop every rank with one
 // message, no hang; so do ranks started with other options, and a rank
 // that cannot read a file rank 0 reads (its own reason, marked with its
-// rank). The build without MPI (`make NO_MPI=1`: CONVSIM_NOMPI,
-// else made here) links no MPI and writes the same bytes. CONVSIM names
-// the binary.
+// rank). The plain convsim links neither MPI nor LIGGGHTS and hands a
+// launched sweep to convsim-mpi beside it (cli/handover.h), which
+// links MPI; without convsim-mpi it says so (exit 1). The build without
+// MPI (`make NO_MPI=1`: CONVSIM_NOMPI, else made here) links no MPI and
+// writes the same bytes. CONVSIM names the binary.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { existsSync, mkdtempSync, writeFileSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join } from 'node:path';
+import { dirname, join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 const BUILD = process.env.BUILD || 'build';
@@ -38,15 +41,30 @@ const STUDY = ['sweep', '--vary', 'mu=0.2:0.6:0.2', '--beta', '0:180:30', '--rot
 const BETA = ['sweep', '--beta', '0:180:10', '--rotation', 'cw,ccw', '--set', 'h=0.02', '--duration', '0.6'];
 const LHS = ['sweep', '--vary', 'mu=0.2:1.0:0.1', '--vary', 'beta=10:170:10', '--lhs', '9', '--seed', '7', '--duration', '0.6'];
 
-test('the convsim under test links MPI, the NO_MPI build does not', () => {
+test('the plain convsim links neither MPI nor LIGGGHTS, convsim-mpi beside it links MPI, the NO_MPI build none', () => {
   // built here (make: up to date, or made again) unless CONVSIM_NOMPI names one
   if (!process.env.CONVSIM_NOMPI || !existsSync(NOMPI)) {
     const b = spawnSync('make', ['-j2', 'NO_MPI=1', `BUILD=${BUILD}/nompi`, `${BUILD}/nompi/convsim`],
       { cwd: ROOT, encoding: 'utf8', timeout: 600000 });
     assert.equal(b.status, 0, b.stderr);
   }
-  assert.match(spawnSync('ldd', [CLI], { encoding: 'utf8' }).stdout, /libmpi\.so/);
-  assert.doesNotMatch(spawnSync('ldd', [NOMPI], { encoding: 'utf8' }).stdout, /libmpi/);
+  const ldd = (bin) => { const r = spawnSync('ldd', [bin], { encoding: 'utf8' }); assert.equal(r.status, 0, r.stderr); return r.stdout; };
+  assert.match(ldd(CLI), /libc\.so/);
+  assert.doesNotMatch(ldd(CLI), /libmpi|liggghts|libopen-|libpmix|libvtk/);
+  assert.match(ldd(join(dirname(CLI), 'convsim-mpi')), /libmpi\.so/);
+  assert.doesNotMatch(ldd(NOMPI), /libmpi/);
+});
+
+test('under mpirun a convsim without convsim-mpi beside it says what it needs and stops (exit 1), no table', () => {
+  const lone = join(mkdtempSync(join(tmpdir(), 'convsim-lone-')), 'convsim');
+  copyFileSync(CLI, lone);
+  const r = mpirun(1, [...BETA, '-q'], lone);
+  assert.equal(r.code, 1, r.err);
+  assert.match(r.err, /convsim sweep: a sweep started by an MPI launcher needs convsim-mpi .*cannot run '.*convsim-lone-.*\/convsim-mpi': No such file or directory/);
+  assert.equal(r.out, '');
+  // alone it needs nothing
+  const one = alone([...BETA, '-q'], lone);
+  assert.equal(one.code, 0, one.err);
 });
 
 test('a study (mu x beta, both senses, mirror reduction): mpirun -n 2 writes the one-process CSV and JSON bit for bit', () => {

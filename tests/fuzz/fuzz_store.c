@@ -39,7 +39,8 @@ static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, si
 		fuzz_fix_checksum(buf, n, FRAME_LEN, FRAME_CHECKSUM, FRAME_SIZE);
 	char *copy = fuzz_exact((const uint8_t *)buf, n);
 	const char *bad = NULL;
-	char *payload = srv_store_unframe(buf, n, kind, plen, &bad);
+	int older = 0;
+	char *payload = srv_store_unframe(buf, n, kind, plen, &older, &bad);
 	if (!payload) {
 		FUZZ_CHECK(bad && bad[0], "a frame refused without a reason");
 		fuzz_refused("srv_store_unframe", bad);
@@ -48,8 +49,10 @@ static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, si
 	}
 	size_t len;
 	memset(copy + FRAME_PAD, 0, 4);
-	char *again = srv_store_frame(kind, payload, *plen, &len);
-	FUZZ_CHECK(again && len == n && memcmp(again, copy, n) == 0,
+	/* an earlier format comes back upgraded (store_v1.c): framed again,
+	 * it is this build's */
+	char *again = older ? NULL : srv_store_frame(kind, payload, *plen, &len);
+	FUZZ_CHECK(older || (again && len == n && memcmp(again, copy, n) == 0),
 		   "an accepted file framed again differs");
 	free(again);
 	free(copy);

@@ -182,6 +182,41 @@ test('a full disk: the session stays "error" until its spec is on disk; read-onl
   }
 });
 
+// SIGTERM writes every session's final checkpoint: when the data
+// directory went read-only, that is no clean stop.
+test('a read-only data directory: a fit is "error", and SIGTERM exits 1 naming the final writes that failed', { timeout: 60000 * SLOW, skip: NS_SKIP }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-rostop-'));
+  const script = `mount -t tmpfs -o size=1m tmpfs "${dir}" && exec "${BIN}" "$@"`;
+  const d = await startDaemon([], { wrap: ['unshare', '-m', 'sh', '-c', script, 'sh'], tail: ['--data-dir', dir, '--checkpoint-interval', '3600', '--log-level', 'info'] });
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const id = s.body.id;
+    // (no control first: a session's control log stays open for writing,
+    // and a file system with a file open for writing cannot be remounted
+    // read-only by hand: "mount point is busy")
+    await until(async () => existsSync(`/proc/${d.proc.pid}/root${dir}/sessions/${id}/spec.json`), 5000, 'the spec on disk');
+    const ro = spawnSync('nsenter', ['-t', String(d.proc.pid), '-m', 'mount', '-o', 'remount,ro', dir], { encoding: 'utf8' });
+    assert.equal(ro.status, 0, ro.stderr);
+    // a fit posted now cannot be kept: state "error", never "done"
+    const fit = await req(d.base, 'POST', '/api/v1/fits', { ...CHEAP, t_end: 0.5, free: ['e'], curve_step: 90,
+      points: [{ beta: 20, rotation: 'cw', v: 0.07 }, { beta: 60, rotation: 'cw', v: 0.06 }] });
+    assert.equal(fit.status, 202, fit.text);
+    const fe = await until(async () => {
+      const g = (await req(d.base, 'GET', `/api/v1/fits/${fit.body.id}`)).body;
+      return g.state === 'error' && g;
+    }, 10000, 'the fit in state error');
+    assert.match(fe.error, new RegExp(`fits/${fit.body.id}\\.bin: Read-only file system`));
+    const r = await d.stop();
+    assert.equal(r.code, 1, d.stderr());
+    assert.match(d.stderr(), new RegExp(`stopped, but 1 final write failed, their state is not on disk: cannot create sessions/${id}/checkpoint\\.bin: Read-only file system`));
+    assert.doesNotMatch(d.stderr(), /stopped cleanly/);
+  } finally {
+    await d.stop('SIGKILL');
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
 test('starting on a read-only data directory exits 2 with a message', { timeout: 30000 * SLOW, skip: NS_SKIP }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-ro-'));
   try {

@@ -8,6 +8,7 @@ import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import '../tether.mjs'; // nothing started here outlives the test
 
 export const BIN = process.env.CONVSIMD ||
   fileURLToPath(new URL('../../build/convsimd', import.meta.url));
@@ -96,9 +97,19 @@ export function reframe(buf) {
 // unusable) once its replay is over: its document.
 export async function untilReplayed(base, id, ms = 20000) {
   return until(async () => {
-    const b = (await req(base, 'GET', `/api/v1/sessions/${id}`)).body;
-    return b.replay_seconds !== null && b;
+    const r = await req(base, 'GET', `/api/v1/sessions/${id}`);
+    return r.status === 200 && r.body.replay_seconds !== null && r.body;
   }, ms, `session ${id}'s replay over`);
+}
+
+// GET path once it is not 503: a session restored with controls to
+// replay answers 503 (Retry-After) until it is back where it was
+// (docs/hardening.md). The answer {status, headers, body, text}.
+export async function getReady(base, path, ms = 20000) {
+  return until(async () => {
+    const r = await req(base, 'GET', path);
+    return r.status !== 503 && r;
+  }, ms, `${path} answering`);
 }
 
 // |actual - expected| <= tol, with both in the message.

@@ -13,7 +13,7 @@ import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, truncateSync, writeFileSync, statSync, existsSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, untilReplayed, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
+import { startDaemon, req, until, untilReplayed, getReady, sleep, CHEAP, NO_FEED, SLOW, BIN, WEB_ROOT } from './lib.mjs';
 
 const INTERVAL = 0.5;            // --checkpoint-interval, s
 const MARGIN = 0.8 * SLOW;       // s: scheduling slack on top of it (shared CI cores)
@@ -82,7 +82,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
       const list = await req(d.base, 'GET', '/api/v1/sessions');
       const byId = new Map(list.body.sessions.map((s) => [s.id, s]));
       for (const id of ids) {
-        const s = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
+        const s = (await getReady(d.base, `/api/v1/sessions/${id}`)).body;
         assert.ok(s && byId.has(id), `round ${round}: session ${id} lost`);
         assert.equal(s.state, 'running', `round ${round}: ${id} ${s.error}`);
         const mine = acked.filter((a) => a.id === id);
@@ -110,7 +110,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
         assert.ok(e.t >= b.t, `round ${round}: experiment went back from ${b.t} to ${e.t}`);
         assert.ok(s.done >= b.done, `round ${round}: sweep went back from ${b.done} to ${s.done} points`);
       }
-      const es = (await req(d.base, 'GET', `/api/v1/sessions/${e.session}`)).body;
+      const es = (await getReady(d.base, `/api/v1/sessions/${e.session}`)).body;
       assert.equal(es.experiment, ex.body.id, `round ${round}: the experiment runs on its session again`);
       if (finished) {
         const again = await req(d.base, 'GET', `/api/v1/sweeps/${finished.id}`);
@@ -140,7 +140,7 @@ test('SIGKILL at random moments loses nothing beyond one checkpoint interval', {
     assert.equal(dv.restored, 'replayed');
     assert.match(d.stderr(), new RegExp(`session ${ids[2]}: .*version.*re-created from its spec`));
     assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${ids[1]}`, { beta: 30 })).status, 409);
-    assert.equal((await req(d.base, 'GET', `/api/v1/sessions/${ids[3]}`)).body.state, 'running');
+    assert.equal((await getReady(d.base, `/api/v1/sessions/${ids[3]}`)).body.state, 'running');
     // DELETE removes the files too
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ids[1]}`)).status, 204);
     await until(() => !existsSync(join(dir, 'sessions', ids[1])), 3000, 'the files to go');
@@ -184,7 +184,7 @@ function fullDisk() {
   return probe.status === 0;
 }
 
-test('write errors (ENOSPC) put sessions, sweeps and experiments in state "error"', { timeout: 60000 * SLOW, skip: !fullDisk() && 'unshare -m with a tmpfs is not possible here (needs root or user namespaces)' }, async () => {
+test('write errors (ENOSPC) put sessions, sweeps, experiments and fits in state "error"', { timeout: 60000 * SLOW, skip: !fullDisk() && 'unshare -m with a tmpfs is not possible here (needs root or user namespaces)' }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsimd-full-'));
   // the daemon sees a tmpfs of 64 kB at dir, filled up but for its
   // directories; mount and daemon live in their own mount namespace
@@ -211,9 +211,21 @@ test('write errors (ENOSPC) put sessions, sweeps and experiments in state "error
       return g.state === 'error' && g;
     }, 10000, 'the experiment in state error');
     assert.match(exe.error, /No space left on device/);
+    // a fit whose record is not on disk is not "done": a restart would
+    // not find it
+    const fit = await req(d.base, 'POST', '/api/v1/fits', { ...CHEAP, t_end: 0.5, free: ['e'], curve_step: 90,
+      points: [{ beta: 20, rotation: 'cw', v: 0.07 }, { beta: 60, rotation: 'cw', v: 0.06 }] });
+    assert.equal(fit.status, 202, fit.text);
+    const fe = await until(async () => {
+      const g = (await req(d.base, 'GET', `/api/v1/fits/${fit.body.id}`)).body;
+      return g.state === 'error' && g;
+    }, 10000, 'the fit in state error');
+    assert.match(fe.error, /fits\/[0-9a-f]+\.bin: No space left on device/);
+    const listed = (await req(d.base, 'GET', '/api/v1/fits?format=csv')).text;
+    assert.ok(listed.includes(`${fit.body.id},error,`), listed);
     const m = await fetch(`${d.base}/metrics`).then((r) => r.text());
     const errors = Number((m.match(/^convsim_store_errors_total (\S+)$/m) || [])[1]);
-    assert.ok(errors >= 3, `convsim_store_errors_total ${errors}`);
+    assert.ok(errors >= 4, `convsim_store_errors_total ${errors}`);
     assert.match(d.stderr(), /store: cannot .*No space left on device/);
   } finally {
     await d.stop('SIGKILL');

@@ -132,3 +132,57 @@ test('the spec is read from spec.json, the API\'s JSON: a spec.bin of another la
     rmSync(dir, { recursive: true, force: true });
   }
 });
+
+test('a session replayed from its spec answers 503 until it is back where it was: no GET shows the past', { timeout: 120000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-replay-visible-'));
+  const args = ['--data-dir', dir, '--checkpoint-interval', '0.2'];
+  let d = await startDaemon(args);
+  let id, seen;
+  try {
+    id = (await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 20 })).body.id;
+    await until(async () => (await get(d, id)).state === 'finished', 30000, 'finished at 20 s');
+    assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 130, until: 80 })).status, 200);
+    seen = await until(async () => { const b = await get(d, id); return b.state === 'finished' && b; }, 60000, 'finished at 80 s');
+    assert.equal(seen.status.t, 80);
+    assert.equal(seen.status.beta_target, 130);
+    await sleep(500); // its last checkpoint written
+  } finally {
+    await d.stop('SIGKILL');
+  }
+  for (const f of ['checkpoint.bin', 'checkpoint.bin.prev']) { // another build's core
+    const path = join(dir, 'sessions', id, f);
+    const b = readFileSync(path);
+    const at = FRAME + CKPT_RECORD + Number(b.readBigUInt64LE(FRAME + 304)) + 8;
+    b.writeUInt32LE(b.readUInt32LE(at) + 1, at);
+    writeFileSync(path, reframe(b));
+  }
+  d = await startDaemon(args);
+  try {
+    // from the first moment: every answer is the present or a 503
+    let refused = 0, answered = 0;
+    for (;;) {
+      const r = await req(d.base, 'GET', `/api/v1/sessions/${id}`);
+      if (r.status === 503) {
+        refused++;
+        assert.equal(r.body.type, '/api/v1/problems/unavailable');
+        assert.match(r.body.detail, /replaying its control log/);
+        assert.ok(Number(r.headers.get('retry-after')) >= 1, 'Retry-After');
+        const l = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.find((s) => s.id === id);
+        assert.ok(l.status === null || l.status.t >= 80, `the listing shows t ${l.status && l.status.t}`);
+        continue;
+      }
+      assert.equal(r.status, 200, r.text);
+      answered++;
+      assert.equal(r.body.status.t, 80, 'where the client left it');
+      assert.equal(r.body.status.beta_target, 130);
+      assert.equal(r.body.state, 'finished');
+      assert.equal(r.body.restored, 'replayed');
+      if (answered >= 3) break;
+    }
+    console.log(`${refused} GETs answered 503 during the replay`);
+    assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { until: 81 })).status, 200);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});

@@ -105,6 +105,44 @@ static void dem_continues(void **state)
 	continues_bit_for_bit(&u, 0.3137, 0.6);
 }
 
+/* A checkpoint taken while the shadow measures the step error (shadow.c:
+ * the first 40 periods after an estimate's start), restored and run on
+ * past the shadow's window: the error bar at its end is the same to the
+ * bit (the shadow is in the checkpoint). Without it the restored instance
+ * kept the calibrated term: another transport_velocity_uncertainty. */
+static void dem_shadow_continues(void **state)
+{
+	(void)state;
+	setup u = small("dem");
+	sim *a = make(&u);
+	advance(a, 0.3);
+	assert_non_null(a->shadow); /* measuring */
+	double until = a->shadow_until;
+	size_t len;
+	void *buf = checkpoint_of(a, &len);
+	sim *b = restore(&u, buf, len);
+	assert_non_null(b->shadow);
+	assert_same(a, b);
+	double t_end = until + 0.5;
+	for (double t = 0.3; t < t_end;) {
+		t = fmin(t_end, t + 0.25);
+		advance(a, t);
+		advance(b, t);
+		if (t < until) { /* a checkpoint of the restored one, nested again */
+			free(buf);
+			buf = checkpoint_of(b, &len);
+			sim_free(b);
+			b = restore(&u, buf, len);
+		}
+	}
+	assert_null(a->shadow); /* its window is over: the error measured */
+	assert_true(isfinite(status(a).step_error));
+	assert_same(a, b);
+	free(buf);
+	sim_free(a);
+	sim_free(b);
+}
+
 static void rk4_continues(void **state)
 {
 	(void)state;
@@ -295,6 +333,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(dem_continues),
+		cmocka_unit_test(dem_shadow_continues),
 		cmocka_unit_test(rk4_continues),
 		cmocka_unit_test(euler_continues),
 		cmocka_unit_test(dopri5_continues),

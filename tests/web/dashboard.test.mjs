@@ -9,7 +9,7 @@
 // (--token-file) and the page is opened as `make run` prints it, with
 // #token=... in the fragment: every request, the stream and the downloads
 // below carry it.
-import { test, before, after } from 'node:test';
+import { test, before, after, beforeEach } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import { randomBytes } from 'node:crypto';
@@ -18,6 +18,7 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from '../node_modules/playwright-core/index.mjs';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const DAEMON = path.resolve(ROOT, process.env.CONVSIMD || 'build/convsimd');
@@ -27,6 +28,11 @@ const PACE = process.env.DASHBOARD_PACE || '2';
 
 let daemon, base, browser, page;
 const pageErrors = [];
+/* console errors of the whole tour (a 404 of a poll after Delete, ...):
+ * the tour ends with none but those a test provokes on purpose */
+const consoleErrors = [];
+let currentTest = '';
+beforeEach((t) => { currentTest = t.name; });
 const TOKEN = randomBytes(20).toString('hex');
 const AUTH = { Authorization: `Bearer ${TOKEN}` };
 const TOKEN_FILE = path.join(mkdtempSync(path.join(tmpdir(), 'convsim-dash-')), 'token');
@@ -114,6 +120,7 @@ before(async () => {
 	});
 	page = await browser.newPage({ viewport: { width: 1600, height: 1300 } });
 	page.on('pageerror', e => pageErrors.push(e.message));
+	page.on('console', m => { if (m.type() === 'error') consoleErrors.push(`${m.text()} (${m.location().url}) in "${currentTest}"`); });
 });
 
 after(async () => {
@@ -160,9 +167,12 @@ test('a session starts from the form', async () => {
 	assert.equal(s.layers, 2);
 	assert.equal(s.spec.scene.start, 'steady');
 	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
-	/* two layers: inside the column model's validated domain, no note */
-	assert.equal(s.status.feed_warning, null);
-	assert.equal(await visible('#feed-warning'), false, 'no feed warning for 2 layers');
+	/* czubak2016's contacts are not checked against DEM: one short line
+	 * under the velocity, no banner */
+	assert.equal(s.status.model_checked, false);
+	await until(async () => await page.$eval('#v-model', e => e.textContent) ===
+		"czubak2016's column model is not checked against DEM", 5000, 'the model check line');
+	assert.equal(await page.$('#feed-warning'), null, 'no banner');
 });
 
 test('stream samples arrive and the plots grow', async () => {
@@ -603,36 +613,87 @@ test('a Kloss-drive session from the picker: the rotor plot\'s period means leav
 	assert.ok(shown < ripple / 4, `the plot's rotor speed spans ${shown} rad/s over its last second, the raw ${ripple}`);
 });
 
-test('a czubak2016 session (8 soft layers) shows the feed warning; the 2-layer session does not', async () => {
+test('the rotor plot\'s ticks: every one with the decimals of its step', async () => {
+	const ticks = await until(async () => {
+		const t = await page.$eval('#plot-rotor', e => e.dataset.yTicks || '');
+		return t.split(' ').filter(Boolean).length >= 3 ? t.split(' ') : null;
+	}, 10000, 'the rotor plot\'s ticks');
+	const decimals = new Set(ticks.map(x => (x.split('.')[1] || '').length));
+	assert.equal(decimals.size, 1, `one number of decimals: ${ticks.join(' ')}`);
+	const v = ticks.map(Number);
+	const steps = v.slice(1).map((x, i) => x - v[i]);
+	for (const st of steps) assert.ok(Math.abs(st - steps[0]) <= 1e-9 * Math.abs(v[0]), `evenly spaced as written: ${ticks.join(' ')}`);
+});
+
+test('a liggghts-bed4 session shows its DEM check in plain words, and the new one after a β change', async () => {
 	const r = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json', ...AUTH },
-		body: JSON.stringify({ preset: 'czubak2016', scene: { drive: 'ideal', columns: 2 }, pace: 1 }) });
+		body: JSON.stringify({ preset: 'liggghts-bed4', params: { beta: 30 }, scene: { drive: 'ideal', columns: 2 }, pace: 1 }) });
 	assert.equal(r.status, 201);
-	const czubak = await r.json();
-	assert.equal(czubak.layers, 8);
-	assert.match(czubak.status.feed_warning, /8 layers/);
-	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(czubak.id), 10000, 'the new session in the picker');
-	await page.selectOption('#session-select', czubak.id);
-	await until(async () => await visible('#feed-warning'), 5000, 'the feed warning shown');
-	const text = await page.$eval('#feed-warning', e => e.textContent);
-	assert.ok(text.includes(czubak.status.feed_warning), `the daemon's sentence on the page: ${text}`);
-	assert.match(text, /feed_model=liggghts/);
+	const bed = await r.json();
+	assert.equal(bed.status.model_checked, true);
+	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(bed.id), 10000, 'the new session in the picker');
+	await page.selectOption('#session-select', bed.id);
+	const want = e => `DEM check: within ±${e.toFixed(3)} m/s here`;
+	await until(async () => await page.$eval('#v-model', e => e.textContent) === want(bed.status.model_error), 5000,
+		`${want(bed.status.model_error)} on the page`);
+	assert.equal(await page.$eval('#v-model', e => e.dataset.checked), 'true');
+	const p = await fetch(`${base}/api/v1/sessions/${bed.id}`, { method: 'PATCH', headers: { 'Content-Type': 'application/json', ...AUTH },
+		body: JSON.stringify({ beta: 150 }) });
+	assert.equal(p.status, 200);
+	const at150 = (await p.json()).status.model_error;
+	assert.ok(at150 > bed.status.model_error, `${at150} at 150 deg, ${bed.status.model_error} at 30`);
+	await until(async () => await page.$eval('#v-model', e => e.textContent) === want(at150), 5000, `${want(at150)} after the β change`);
 	await page.selectOption('#session-select', sessionId);
-	await until(async () => !(await visible('#feed-warning')), 5000, 'the feed warning gone for the 2-layer session');
-	const del = await fetch(`${base}/api/v1/sessions/${czubak.id}`, { method: 'DELETE', headers: { 'Content-Type': 'application/json', ...AUTH } });
+	/* the first session, its omega_ss changed by the drive row: not checked */
+	await until(async () => /not checked against DEM/.test(await page.$eval('#v-model', e => e.textContent)), 5000,
+		'the first session\'s line again');
+	assert.equal(await page.$eval('#v-model', e => e.dataset.checked), 'false');
+	const del = await fetch(`${base}/api/v1/sessions/${bed.id}`, { method: 'DELETE', headers: { 'Content-Type': 'application/json', ...AUTH } });
 	assert.equal(del.status, 204);
 });
 
 test('Delete clears the tiles and the plots', async () => {
+	const gone = await page.$eval('body', b => b.dataset.sessionId);
+	const after = [];
+	const seen = r => { if (r.url().includes(gone)) after.push(`${r.method()} ${r.url()}`); };
 	await page.click('#delete');
+	page.on('request', seen);
 	await until(async () => !(await page.$eval('body', b => b.dataset.sessionId)), 5000, 'the session detached');
 	await until(async () => await page.$eval('#state-now', e => e.textContent) === 'no session', 5000, 'no session shown');
 	for (const sel of ['#t-now', '#rotor-now', '#rtf-now', '#v-value', '#v-daemon'])
 		assert.equal(await page.$eval(sel, e => e.textContent), '–', sel);
 	for (const sel of ['#plot-rotor', '#plot-feed', '#plot-orbit', '#plot-strokes', '#plot-trough'])
 		assert.equal(await count(sel), 0, `${sel} emptied`);
-	/* and it stays so: no poll brings the deleted session back */
-	await new Promise(r => setTimeout(r, 1500));
+	/* and it stays so: no poll brings the deleted session back, and none
+	 * asks for it (each would be a 404 in the console) */
+	after.length = 0;
+	await new Promise(r => setTimeout(r, 2500));
+	page.off('request', seen);
 	assert.equal(await page.$eval('#state-now', e => e.textContent), 'no session');
+	assert.deepEqual(after, [], 'no request for the deleted session');
+	/* the tour's refusals on purpose: 422s (a refused input, a refused CSV) and a 400 (pace "abc") */
+	const provoked = e => /status of 422 .* in "(a refused input|the calibration panel)/.test(e) || /status of 400 .* in "the drive row/.test(e);
+	assert.deepEqual(consoleErrors.filter(e => !provoked(e)), [], 'no console error in the whole tour but those provoked');
+});
+
+test('a phone (390 px): one column, no sideways scroll; one h1', async () => {
+	await page.setViewportSize({ width: 390, height: 844 });
+	try {
+		await until(async () => await page.evaluate(() => document.documentElement.scrollWidth) <= 390, 5000, 'no sideways scroll');
+		const wide = await page.evaluate(() => [...document.querySelectorAll('main *, header *')]
+			.filter(e => { const b = e.getBoundingClientRect(); return b.width > 0 && b.right > 391; })
+			.map(e => `${e.tagName}#${e.id}.${e.className}`).slice(0, 5));
+		assert.deepEqual(wide, [], 'nothing reaches past the screen');
+		for (const sel of ['#sweep-run', '#conn'])
+			if (await page.$(sel)) {
+				const b = await page.$eval(sel, e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; });
+				assert.ok(b[0] >= 0 && b[1] <= 390, `${sel} on screen: ${b}`);
+			}
+	} finally {
+		await page.setViewportSize({ width: 1600, height: 1300 });
+	}
+	assert.equal(await page.$$eval('h1', h => h.length), 1);
+	assert.match(await page.$eval('h1', h => h.textContent), /convsim/);
 });
 
 test('problem pages are rendered: code as code, no raw backticks', async () => {

@@ -6,7 +6,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import * as api from '../../web/js/api.js';
 import { Trace, slope, recentVelocity } from '../../web/js/series.js';
-import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText } from '../../web/js/format.js';
+import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText, tickText } from '../../web/js/format.js';
 import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
 
 const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
@@ -35,6 +35,17 @@ test('session document maps to the page model', () => {
 	assert.equal(s.realTimeFactor, 4.5);
 	assert.equal(s.columns, 5);
 	assert.deepEqual(s.reductions.map(r => r.name), ['symmetric', 'ideal_drive']);
+});
+
+test('a fit whose record could not be written ends the wait, failed with its reason', () => {
+	const f = api.normalizeFit({ id: 'f', state: 'error', error: 'cannot write fits/f.bin: No space left on device',
+		phase: 'fitting', iteration: 1, max_iter: 30, result: null });
+	assert.equal(f.done, true);
+	assert.equal(f.failed, true);
+	assert.equal(f.error, 'cannot write fits/f.bin: No space left on device');
+	const running = api.normalizeFit({ id: 'f', state: 'running', iteration: 1, max_iter: 30 });
+	assert.equal(running.done, false);
+	assert.equal(running.error, null);
 });
 
 test('a session without status yet gives NaN, not zeros', () => {
@@ -252,4 +263,13 @@ test('fit panel: χ² with its unit and the reduced χ², at three significant d
 		'done · iteration 3 · 40 evaluations · e = 0.01812');
 	assert.equal(fitProgressText({ state: 'running', phase: 'covariance', iteration: 2, evaluations: 9, values: {} }),
 		'running · covariance · iteration 2 · 9 evaluations');
+});
+
+test('axis ticks carry the decimals of their step', () => {
+	assert.deepEqual([157.025, 157.0275, 157.03].map(v => tickText(v, 0.0025)), ['157.0250', '157.0275', '157.0300']);
+	assert.deepEqual([-0.5, 0, 0.5].map(v => tickText(v, 0.5)), ['-0.5', '0.0', '0.5']);
+	assert.deepEqual([0, 500, 1000].map(v => tickText(v, 500)), ['0', '500', '1000']);
+	assert.equal(tickText(-1e-17, 0.1), '0.0');
+	assert.deepEqual([0.1 + 0.2, 0.4].map(v => tickText(v, 0.1)), ['0.3', '0.4']);
+	assert.equal(tickText(3, NaN), '3');
 });

@@ -170,8 +170,9 @@ export function normalizeFit(raw) {
 		id: r.id, state: r.state, phase: r.phase, iteration: r.iteration ?? 0,
 		maxIter: r.max_iter ?? 1, evaluations: r.evaluations ?? 0, values: r.values || {},
 		result: r.result || null,
-		done: ['done', 'failed', 'cancelled'].includes(r.state),
-		failed: r.state === 'failed' || r.state === 'cancelled',
+		error: r.error || null, /* state "error": its record could not be written */
+		done: ['done', 'failed', 'cancelled', 'error'].includes(r.state),
+		failed: ['failed', 'cancelled', 'error'].includes(r.state),
 		progress: r.state === 'done' ? 1 : Math.min(1, (r.iteration ?? 0) / (r.max_iter || 1)),
 	};
 }

@@ -52,7 +52,8 @@ async function runFit(ev) {
 		if (end.state === 'done') offerBand(end.id);
 		csv.hidden = !end.result;
 		const r = end.result;
-		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${r?.error ? ': ' + r.error : ''}`);
+		const why = end.error || r?.error;
+		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${why ? ': ' + why : ''}`);
 		else message(r.warnings.length ? 'warn' : 'ok', `Fit ${end.id} ${r.status} after ${r.iterations} iterations, ` +
 			`${r.evaluations} evaluations` + (r.warnings.length ? `: ${r.warnings.length} warning(s) below` : ''));
 	} catch (err) {

@@ -119,3 +119,14 @@ export function fitChi2Text(r) {
 	const reduced = r.dof > 0 && Number.isFinite(r.chi2) ? `; reduced χ²/dof = ${fmtSig(r.chi2 / r.dof, 3)}${unit}` : '';
 	return `χ² = ${fmtSig(r.chi2, 3)}${unit} with ${r.dof} degrees of freedom${reduced}`;
 }
+
+/* An axis tick's text: every tick of an axis with as many decimals as its
+ * step needs (a 0.0025 step: 157.0250, 157.0275, never 157.028 beside
+ * 157.03), and 0 never written -0. */
+export function tickText(v, step) {
+	let d = 0;
+	if (Number.isFinite(step) && step > 0)
+		while (d < 12 && Math.abs(Math.round(step * 10 ** d) - step * 10 ** d) > 1e-6 * 10 ** d * step) d++;
+	const x = Number.isFinite(step) && Math.abs(v) < step / 2 ? 0 : v;
+	return x.toFixed(d);
+}

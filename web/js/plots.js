@@ -14,6 +14,7 @@
  */
 
 import uPlot from '../vendor/uplot/uPlot.esm.js';
+import { tickText } from './format.js';
 
 export const PALETTE = ['#2563eb', '#dc2626', '#059669', '#d97706', '#7c3aed',
 	'#0891b2', '#db2777', '#65a30d', '#475569', '#b45309'];
@@ -24,6 +25,9 @@ const AXIS = {
 	ticks: { stroke: '#cbd5e1', width: 1 },
 	font: '11px system-ui, sans-serif',
 	labelFont: '600 11px system-ui, sans-serif',
+	/* every tick with the decimals its step needs (uPlot's own text keeps
+	 * at most three, so a 0.0025 step read 157.028, 157.03, 157.033) */
+	values: (u, splits, axisIdx, space, step) => splits.map(v => (v == null ? '' : tickText(v, step))),
 };
 
 function axis(label, extra = {}) {
@@ -115,7 +119,13 @@ export class TimePlot {
 		scales.y = { range: yRange ?? autoRange };
 		if (y2Label) scales.y2 = { range: y2Range ?? autoRange };
 		this.labels = [xLabel, ...series.map(d => d.label)];
-		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })];
+		/* the left axis's ticks as drawn, on the container (the browser test reads them) */
+		const yValues = (u, splits, ai, space, step) => {
+			const t = AXIS.values(u, splits, ai, space, step);
+			el.dataset.yTicks = t.join(' ');
+			return t;
+		};
+		const axes = [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24, values: yValues })];
 		if (y2Label) axes.push(axis(y2Label, { scale: 'y2', side: 1, size: 50, space: 24, grid: { show: false } }));
 		this.plot = new uPlot({
 			width: s.width,

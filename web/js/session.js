@@ -11,7 +11,7 @@ import * as api from './api.js';
 import { fmt, fmtTime, rotationLabel, parsePace } from './format.js';
 import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
 import { resetTraces, onSample, onControl } from './live.js';
-import { showStatus, clearStatus, sessionLabel } from './status.js';
+import { showStatus, clearStatus, sessionLabel, showModelCheck } from './status.js';
 
 const STATUS_MS = 500;
 
@@ -99,7 +99,13 @@ export function attach(id, initial) {
 	app.stream = api.openStream(id, { since: 0 }, {
 		open: () => { setOnline(true); $('#live-state').textContent = `stream: open (${id})`; },
 		sample: onSample,
-		control: onControl,
+		control: (c, raw) => {
+			onControl(c);
+			/* each control's record carries the scene's model error anew */
+			if (typeof raw?.model_checked === 'boolean')
+				showModelCheck({ feed: app.session?.feed, modelChecked: raw.model_checked,
+					modelError: raw.model_error, modelCheckNote: raw.model_check_note ?? '' });
+		},
 		dropped: n => { if (n > 0) app.dropped += n; },
 		end: d => {
 			$('#live-state').textContent = `stream: ended${d?.reason ? ` (${d.reason})` : ''}`;
@@ -117,7 +123,7 @@ export function attach(id, initial) {
 let polls = 0;
 export async function pollStatus() {
 	const id = app.id;
-	if (!id) return;
+	if (!id || id === app.removing) return;
 	if (++polls % 10 === 0) refreshSessionList();
 	try {
 		const s = await api.getSession(id);
@@ -165,13 +171,16 @@ export async function setBeta(beta) {
 export async function removeSession() {
 	const id = app.id;
 	if (!id) return;
+	/* from here no poll asks for it (the stream's end would, and get a 404) */
+	app.removing = id;
 	try {
 		await api.deleteSession(id);
 		message('ok', `Session ${id} deleted.`);
 	} catch (err) {
-		if (!(err instanceof api.ApiError && err.status === 404)) { report(err, 'Delete'); return; }
+		if (!(err instanceof api.ApiError && err.status === 404)) { app.removing = null; report(err, 'Delete'); return; }
 	}
 	detach();
+	app.removing = null;
 	refreshSessionList();
 }
 
