@@ -192,7 +192,7 @@ void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 	if (!news) {
 		if (from_t < s->wake_t)
 			s->wake_t = from_t; /* the worker wakes it from then */
-		if (from_t < s->plan_t - 1e-6)
+		if (s->plan_t < INFINITY && from_t < s->plan_t - 1e-6)
 			pthread_cond_signal(&s->wake); /* a paced worker sleeps past it */
 		struct timespec ts = srv_deadline(seconds);
 		pthread_cond_timedwait(&s->data, &s->lock, &ts);
