@@ -24,8 +24,9 @@
  *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
  *               after a stall; pace "max" runs flat out up to "until"): a
- *               paced session sleeps until its next sample is due, then
- *               steps every sample due within the next 20 ms (a batch)
+ *               paced session steps every sample due when it wakes (a
+ *               batch), then sleeps until the sample a stream waits for
+ *               is due or 0.1 s (pace())
  *   step        sim_advance by one sample interval (1/sample_rate simulated
  *               seconds, cut at "until" and at experiment boundaries), then
  *               publish the status snapshot and a record in the bounded ring
