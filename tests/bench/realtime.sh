@@ -34,7 +34,7 @@ N=${REALTIME_N:-200 600}
 	echo "Command: \`bash tests/bench/realtime.sh\` (part of \`make bench\`; \`node tests/bench/realtime.mjs $N\`"
 	echo "with BASELINE), $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores"
 	echo "($(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //')), load average $(cut -d' ' -f1-3 /proc/loadavg) before."
-	echo "Previous build: $PREV ($prev); this build: $rev ($BUILD/convsimd)."
+	echo "Previous build: $PREV; this build: $rev."
 	echo
 	CONVSIMD="$BUILD/convsimd" BASELINE="$prev" node tests/bench/realtime.mjs $N | sed -n '/^|/p'
 	echo
