@@ -109,7 +109,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: all deps deps-build run cluster test check bench bench-controls bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: model-check all deps deps-build run cluster test check bench bench-controls bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -173,6 +173,25 @@ $(BUILD)/api/schemas.inc: api/schemas.json
 $(BUILD)/api/openapi.o: $(BUILD)/api/schemas.inc
 $(BUILD)/api/openapi.o: INC_EXTRA := -I$(BUILD)/api
 
+# The DEM map's points with the column model's v (tests/bench/model_check.py
+# writes the CSV) become rows of a C table that core/model_check.c includes:
+# the core reads no file at run time. Columns are found by their header.
+MODEL_MAP := tests/bench/results/model_check.csv
+$(BUILD)/core/model_map.inc: $(MODEL_MAP)
+	@mkdir -p $(dir $@)
+	$(Q)awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$$i] = i; next } \
+	  /^[^#]/ { printf "{\"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
+	    $$c["preset"], $$c["settings"], $$c["layers"], $$c["beta_deg"], \
+	    $$c["rotation"] == "cw" ? "SIM_CW" : "SIM_CCW", $$c["v_dem"], \
+	    $$c["v_dem_sd"] == "nan" ? "NAN" : $$c["v_dem_sd"], $$c["seeds"], $$c["v_column"] }' \
+	  $< > $@
+# `make model-check` computes the table again from the DEM data (after new
+# rows in tests/bench/results/dem_map.csv or a change of the column model).
+model-check: $(BUILD)/convsim
+	$(Q)python3 tests/bench/model_check.py $(BUILD)/convsim > $(MODEL_MAP).new && mv $(MODEL_MAP).new $(MODEL_MAP)
+$(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
+$(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
+
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
@@ -200,7 +219,7 @@ $(BUILD)/libdem.a: $(DEM_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/libdem.a $(BUILD)/libcore.a
+$(BUILD)/convsim-dem: $(DEM_CLI_OBJ) $(BUILD)/cli/options.o $(BUILD)/libdem.a $(BUILD)/libcore.a
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lliggghts $(MPI_LIBS) $(GSL_LIBS) $(LDLIBS)
 

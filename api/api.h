@@ -165,6 +165,17 @@ typedef struct api_query {
 	const char *schema; /* JSON Schema text */
 	const char *doc;
 } api_query;
+/* The routes, by their row in the one route table (api/routes.c); the
+ * server's handlers are indexed by the same ids (server/http/routes.c). */
+typedef enum {
+	API_R_SESSIONS_CREATE, API_R_SESSIONS_LIST, API_R_SESSION_GET, API_R_SESSION_PATCH,
+	API_R_SESSION_DELETE, API_R_SESSION_STREAM, API_R_SESSION_TRAJECTORY,
+	API_R_EXPERIMENTS_CREATE, API_R_EXPERIMENTS_LIST, API_R_EXPERIMENT_GET,
+	API_R_SWEEPS_CREATE, API_R_SWEEPS_LIST, API_R_SWEEP_GET, API_R_SWEEP_DELETE,
+	API_R_FITS_CREATE, API_R_FITS_LIST, API_R_FIT_GET, API_R_FIT_DELETE,
+	API_R_PRESETS, API_R_HEALTH, API_R_OPENAPI, API_R_PROBLEM, API_R_METRICS,
+	API_R_COUNT
+} api_route_id;
 /* One route: "*" in the pattern is one path segment ({id}). */
 typedef struct api_route {
 	const char *method, *pattern;
@@ -177,11 +188,10 @@ typedef struct api_route {
 				 type ("text/html", ...) for other bodies */
 	const char *problems; /* the problem statuses it may answer, "400,404" */
 } api_route;
-/* The route table and the query parameters (static). */
+/* The route table (API_R_COUNT rows, in api_route_id order) and the query
+ * parameters (static). */
 const api_route *api_routes(size_t *n);
 const api_query *api_queries(size_t *n);
-/* The route of method and pattern, or NULL. */
-const api_route *api_route_find(const char *method, const char *pattern);
 /* API_OK if route rt takes query parameter name, else a 400 bad-query
  * problem naming the parameters it takes (and the nearest one). */
 api_err api_check_query(const api_route *rt, const char *name, api_problem *pb);
@@ -247,7 +257,7 @@ typedef struct api_spec {
 } api_spec;
 
 /* Parse a POST /sessions body (len bytes, need not be NUL-terminated; an
- * empty body means {}). Fills *spec from the preset and overrides, checks
+ * empty or blank body is refused, {} takes every default). Fills *spec from the preset and overrides, checks
  * every value with sim_set/sim_validate. Returns API_OK or the error in
  * *pb; *spec is then unspecified. */
 api_err api_parse_session(const char *body, size_t len, api_spec *spec,
@@ -272,18 +282,27 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
  * its range, and the set passes sim_validate. API_OK or the problem (nothing is changed). */
 api_err api_check_spec(const api_spec *spec, api_problem *pb);
 
-/* Control changes of PATCH /sessions/{id}; set has API_C_* bits. */
-enum {
-	API_C_BETA = 1 << 0,
-	API_C_BETA_RATE = 1 << 1,
-	API_C_ROTATION = 1 << 2,
-	API_C_OMEGA_SS = 1 << 3,
-	API_C_RUNNING = 1 << 4,
-	API_C_PACE = 1 << 5,
-	API_C_UNTIL = 1 << 6,
-	API_C_MOTOR = 1 << 7,
-	API_C_CPU = 1 << 8,
-};
+/* The controls of PATCH /sessions/{id}, one row each, in the order they
+ * are parsed, echoed in the control event and listed in messages and the
+ * OpenAPI document: X(ID, member, API_C_ID bit, function suffix). The
+ * rest of each row is api/control.c's (parse, echo) and
+ * server/session/worker.c's (apply), both indexed by API_CTL_ID. */
+#define API_CONTROLS(X)                                                                    \
+	X(BETA, "beta", 1u << 0, beta)                                                      \
+	X(BETA_RATE, "beta_rate", 1u << 1, beta_rate)                                       \
+	X(ROTATION, "rotation", 1u << 2, rotation)                                          \
+	X(OMEGA_SS, "omega_ss", 1u << 3, omega_ss)                                          \
+	X(RUNNING, "running", 1u << 4, running)                                             \
+	X(MOTOR, "motor_on", 1u << 7, motor)                                                \
+	X(PACE, "pace", 1u << 5, pace)                                                      \
+	X(UNTIL, "until", 1u << 6, until)                                                   \
+	X(CPU, "cpu_budget", 1u << 8, cpu)
+#define API_C_BIT_(id, member, bit, fn) API_C_##id = bit,
+enum { API_CONTROLS(API_C_BIT_) }; /* the bits of api_control.set */
+#undef API_C_BIT_
+#define API_CTL_ID_(id, member, bit, fn) API_CTL_##id,
+typedef enum { API_CONTROLS(API_CTL_ID_) API_CTL_COUNT } api_control_id;
+#undef API_CTL_ID_
 typedef struct api_control {
 	unsigned set;
 	api_value beta;      /* rad (deg as sent) */
@@ -315,6 +334,15 @@ api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
  * small). */
 int api_control_event(char *buf, size_t len, const api_control *c,
 		      double t_effective);
+/* The same with the scene's model error after the control (me, borrowed:
+ * model_error, model_error_uncertainty, model_checked, model_check_note),
+ * the stream's form of the event; the control log keeps api_control_event's. */
+int api_control_event_model(char *buf, size_t len, const api_control *c,
+			    double t_effective, const sim_model_error *me);
+/* The model error of a session's scene now (sim_model_check): the spec's
+ * settings with the status's controls (beta_target, rotation, omega_ss)
+ * when st is not NULL. Returns sim_model_check's value. */
+int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me);
 /* The control as a line of the session's control log: the stream event's
  * object, and "experiment": its id when an experiment's segment sent it
  * (experiment may be NULL), so that a restore that resumes the
@@ -419,12 +447,13 @@ size_t api_record_max(int columns, int layers);
 size_t api_format_record(char *buf, size_t len, const api_sample *s,
 			 unsigned fields, int ndjson);
 /* The stream's first record: the session, the id the next record will
- * have, and the scene's feed_warning (sim_feed_validated: why its column
- * model lies outside the domain checked against LIGGGHTS beds; NULL for
- * none, written as null), so that a client that only streams knows it.
- * Returns the length (0 if it does not fit). */
+ * have, the scene's feed_warning (the model check's note where the scene's
+ * column model is not checked against DEM; NULL for none, written as null)
+ * and, with me (borrowed, may be NULL), its model error as the status
+ * gives it, so that a client that only streams knows it. Returns the
+ * length (0 if it does not fit). */
 size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
-			const char *feed_warning, int ndjson);
+			const char *feed_warning, const sim_model_error *me, int ndjson);
 /* Stream notices: missed samples, heartbeat, end (reason: finished,
  * deleted, failed, shutdown, limit). Return the length. */
 size_t api_format_dropped(char *buf, size_t len, uint64_t missed,

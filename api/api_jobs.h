@@ -62,6 +62,8 @@ typedef struct api_experiment_view {
 	double progress;        /* 0..1 */
 	int nseg;
 	const api_segment *seg; /* borrowed */
+	const api_spec *spec;   /* borrowed, may be NULL: the session's scene,
+				   each segment's model error at its beta */
 } api_experiment_view;
 char *api_experiment_json(const api_experiment_view *v);
 /* {"experiments": [...]} of n views. malloc'd text. */

@@ -11,20 +11,19 @@
 
 #include "json_int.h"
 
-/* Parse len bytes as one JSON object (empty or blank text gives {} when
- * empty_ok). Returns the tree or NULL with *pb set (400). */
-static cJSON *parse_object(const char *body, size_t len, int empty_ok,
-			  api_problem *pb)
+/* Parse len bytes as one JSON object. Empty or blank text is no JSON
+ * (RFC 8259) and refused as such on every route; {} is the body that takes
+ * every default. Returns the tree or NULL with *pb set (400). */
+static cJSON *parse_object(const char *body, size_t len, api_problem *pb)
 {
 	size_t i = 0;
 	while (i < len && (body[i] == ' ' || body[i] == '\t' ||
 			   body[i] == '\n' || body[i] == '\r'))
 		i++;
 	if (i == len) {
-		if (empty_ok)
-			return cJSON_CreateObject();
-		api_fail(pb, API_MALFORMED, NULL, "the request body is empty; "
-			 "a JSON object is expected");
+		api_fail(pb, API_MALFORMED, NULL, "the request body is %s; a JSON "
+			 "object is expected ({} for no members)",
+			 len ? "only whitespace" : "empty");
 		return NULL;
 	}
 	if (api_json_check(body, len, pb) != API_OK)
@@ -84,10 +83,10 @@ api_err api_check_members(const cJSON *obj, const char *const *names,
 	return API_OK;
 }
 
-cJSON *api_parse_body(const char *body, size_t len, int empty_ok,
-		      const char *const *members, api_problem *pb)
+cJSON *api_parse_body(const char *body, size_t len, const char *const *members,
+		      api_problem *pb)
 {
-	cJSON *root = parse_object(body, len, empty_ok, pb);
+	cJSON *root = parse_object(body, len, pb);
 	if (root && api_check_members(root, members, "", pb) != API_OK) {
 		cJSON_Delete(root);
 		return NULL;

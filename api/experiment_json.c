@@ -101,7 +101,7 @@ api_err api_parse_experiment(const char *body, size_t len,
 			     api_experiment_req *req, api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 0, api_members_experiment, pb);
+	cJSON *root = api_parse_body(body, len, api_members_experiment, pb);
 	if (!root)
 		return pb->code;
 	const cJSON *sess = cJSON_GetObjectItemCaseSensitive(root, "session");
@@ -179,6 +179,14 @@ static cJSON *experiment_object(const api_experiment_view *v)
 		else
 			cJSON_AddNullToObject(so, "steady");
 		api_add_number(so, "reversal_time", sim_time_ns(s->reversal_time));
+		if (v->spec) {
+			/* the scene's model error at the segment's beta */
+			sim_params p = v->spec->params;
+			sim_model_error me;
+			p.beta = s->beta.si;
+			sim_model_check(&p, &v->spec->scene, &me);
+			api_add_model_error(so, &me);
+		}
 		cJSON_AddItemToArray(arr, so);
 	}
 	cJSON *links = cJSON_AddObjectToObject(o, "links");

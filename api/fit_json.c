@@ -205,7 +205,7 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 {
 	fit_request_init(req);
 	*points = NULL;
-	cJSON *root = api_parse_body(body, len, 0, api_members_fit, pb);
+	cJSON *root = api_parse_body(body, len, api_members_fit, pb);
 	if (!root)
 		return pb->code;
 	api_spec spec;

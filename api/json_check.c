@@ -8,7 +8,15 @@
  * and the rules of I-JSON, RFC 7493 (UTF-8 only, no unpaired surrogate
  * escapes, no two members of one object with the same name after their
  * escapes are decoded), so that what JSON forbids is refused with the byte
- * where it starts and cJSON only ever reads valid text.
+ * where it starts and cJSON only ever reads valid text. One thing JSON
+ * allows is refused too: a string whose decoded value holds U+0000
+ * (written `\u0000`), which cJSON's C strings would cut there.
+ *
+ * The check is linear in the body: to find the same name given twice,
+ * the names of an object are sorted by the hash of their code points
+ * (radix passes), then names of one hash by their code points (merge
+ * sort), so that no choice of names, colliding hashes included, costs
+ * more than n log n comparisons.
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -19,20 +27,24 @@
 /* Deeper than any body the API reads (a fit's points are two levels). */
 #define CHECK_DEPTH 64
 
+/* A member's name inside an object: where its text starts (after the
+ * quote) and the hash of its decoded code points. */
+typedef struct seen_name {
+	uint32_t start, hash;
+} seen_name;
+
 typedef struct checker {
 	const unsigned char *s;
 	size_t len, at;
 	const char *why; /* what is wrong at `where`; NULL while valid */
 	size_t where;
+	int json_ok;   /* the fault is one JSON allows (U+0000) */
 	char name[48]; /* the duplicated member's name, cut */
+	/* the names of the open objects, innermost last, and room as large
+	 * for sorting them (one allocation, freed at the end) */
+	seen_name *names, *sorted;
+	size_t n_names, cap_names;
 } checker;
-
-/* A member's name inside an object: where its text starts (after the
- * quote) and the hash of its decoded code points. */
-typedef struct seen_name {
-	size_t start;
-	uint32_t hash;
-} seen_name;
 
 static int fail_at(checker *c, size_t where, const char *why)
 {
@@ -133,6 +145,12 @@ static int check_string(checker *c, uint32_t *hash)
 				if (u < 0)
 					return fail_at(c, here, "\\u needs four "
 								"hex digits");
+				if (u == 0) {
+					fail_at(c, here, "a string may not hold "
+							 "U+0000 (\\u0000)");
+					c->json_ok = 1;
+					return -1;
+				}
 				if (u >= 0xdc00 && u <= 0xdfff)
 					return fail_at(c, here, "an unpaired "
 								"surrogate escape");
@@ -161,18 +179,144 @@ static int check_string(checker *c, uint32_t *hash)
 	return 0;
 }
 
-/* Do the two checked strings starting at a and b (past their quotes)
- * decode to the same code points? */
-static int same_name(const checker *c, size_t a, size_t b)
+/* The order of the code points of two checked strings starting at a and
+ * b (past their quotes): <0, 0 (the same name) or >0. */
+static int code_point_order(const checker *c, size_t a, size_t b)
 {
 	for (;;) {
 		long x = next_code_point(c->s, c->len, &a);
 		long y = next_code_point(c->s, c->len, &b);
 		if (x != y)
-			return 0;
+			return x < y ? -1 : 1;
 		if (x < 0)
-			return 1;
+			return 0;
 	}
+}
+
+/* The order of two names: by hash, then by code points, then by place. */
+static int name_order(const checker *c, const seen_name *a, const seen_name *b)
+{
+	if (a->hash != b->hash)
+		return a->hash < b->hash ? -1 : 1;
+	int o = code_point_order(c, a->start, b->start);
+	if (o)
+		return o;
+	return a->start < b->start ? -1 : a->start > b->start;
+}
+
+/* Sort n names (tmp: room for n more) bottom-up by name_order: n log n
+ * comparisons whatever the names. */
+static void merge_sort_names(const checker *c, seen_name *v, seen_name *tmp, size_t n)
+{
+	seen_name *from = v, *to = tmp;
+	for (size_t width = 1; width < n; width *= 2) {
+		for (size_t lo = 0; lo < n; lo += 2 * width) {
+			size_t mid = lo + width < n ? lo + width : n;
+			size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
+			size_t i = lo, j = mid, k = lo;
+			while (i < mid && j < hi)
+				to[k++] = name_order(c, &from[j], &from[i]) < 0
+						  ? from[j++]
+						  : from[i++];
+			while (i < mid)
+				to[k++] = from[i++];
+			while (j < hi)
+				to[k++] = from[j++];
+		}
+		seen_name *t = from;
+		from = to;
+		to = t;
+	}
+	if (from != v)
+		memcpy(v, from, n * sizeof *v);
+}
+
+/* Sort n names (tmp: room for n more) by name_order: by hash in four
+ * stable passes of 8 bits (the names arrive by place), then each run of
+ * one hash by merge sort. Linear unless hashes collide, n log n if all
+ * do. */
+static void sort_names(const checker *c, seen_name *v, seen_name *tmp, size_t n)
+{
+	if (n < 64) {
+		merge_sort_names(c, v, tmp, n);
+		return;
+	}
+	seen_name *from = v, *to = tmp;
+	for (unsigned shift = 0; shift < 32; shift += 8) {
+		size_t count[257] = {0};
+		for (size_t k = 0; k < n; k++)
+			count[((from[k].hash >> shift) & 0xff) + 1]++;
+		for (size_t d = 0; d < 256; d++)
+			count[d + 1] += count[d];
+		for (size_t k = 0; k < n; k++)
+			to[count[(from[k].hash >> shift) & 0xff]++] = from[k];
+		seen_name *t = from;
+		from = to;
+		to = t;
+	}
+	/* four passes: the names are back in v */
+	for (size_t lo = 0, hi; lo < n; lo = hi) {
+		for (hi = lo + 1; hi < n && v[hi].hash == v[lo].hash; hi++)
+			;
+		if (hi - lo > 1)
+			merge_sort_names(c, v + lo, tmp, hi - lo);
+	}
+}
+
+/* Add a name to the innermost open object; -1 out of memory. The room
+ * is taken once, for as many names as the body can hold (a member takes
+ * at least 5 bytes, `"":0,`), so that nothing is copied as it fills. */
+static int push_name(checker *c, size_t start, uint32_t hash)
+{
+	if (!c->names) {
+		size_t cap = c->len / 5 + 2;
+		c->names = malloc(2 * cap * sizeof *c->names);
+		if (!c->names)
+			return -1;
+		c->sorted = c->names + cap;
+		c->cap_names = cap;
+	}
+	if (c->n_names == c->cap_names) /* cannot happen: the room is the most */
+		return -1;
+	c->names[c->n_names++] = (seen_name){(uint32_t)start, hash};
+	return 0;
+}
+
+/* The names of the innermost object, from `first` on (then closed). A
+ * name given twice is a fault at its earliest second occurrence, and the
+ * first fault in the text. 0: every name once. */
+static int check_names(checker *c, size_t first)
+{
+	size_t n = c->n_names - first;
+	c->n_names = first;
+	if (n < 2)
+		return 0;
+	seen_name *v = c->names + first;
+	sort_names(c, v, c->sorted, n);
+	const seen_name *again = NULL;
+	for (size_t k = 1; k < n; k++)
+		/* the same name sorts together, by place: v[k] is a second
+		 * occurrence when v[k - 1] is the same name */
+		if (v[k].hash == v[k - 1].hash &&
+		    (!again || v[k].start < again->start) &&
+		    code_point_order(c, v[k - 1].start, v[k].start) == 0)
+			again = &v[k];
+	if (!again)
+		return 0;
+	/* a fault found before stopped the reading after these names were
+	 * read, so this one comes first in the text */
+	size_t at = again->start;
+	while (next_code_point(c->s, c->len, &at) >= 0)
+		;
+	size_t len = at - again->start;
+	if (len >= sizeof c->name)
+		len = sizeof c->name - 1;
+	memcpy(c->name, c->s + again->start, len);
+	c->name[len] = '\0';
+	c->why = "a member's name is given twice in one object";
+	c->where = again->start - 1;
+	c->json_ok = 0;
+	return -1;
 }
 
 /* RFC 8259 section 6: -? (0 | [1-9][0-9]*) (. [0-9]+)? ([eE][+-]?[0-9]+)? */
@@ -220,11 +364,12 @@ static int next_item(checker *c, unsigned char close)
 					      : "',' or ']' is expected");
 }
 
-/* An object: members with distinct names (RFC 7493 section 2.3). */
+/* An object: members with distinct names (RFC 7493 section 2.3), checked
+ * once its members are read or a fault stopped the reading (a name given
+ * twice before that fault is the first fault). */
 static int check_object(checker *c, int depth)
 {
-	seen_name *seen = NULL;
-	size_t n = 0, cap = 0;
+	size_t first = c->n_names;
 	int rc = 0;
 	c->at++;
 	skip_ws(c);
@@ -243,28 +388,10 @@ static int check_object(checker *c, int depth)
 		uint32_t hash;
 		if ((rc = check_string(c, &hash)) != 0)
 			break;
-		for (size_t k = 0; k < n && !rc; k++)
-			if (seen[k].hash == hash && same_name(c, seen[k].start, start)) {
-				size_t len = c->at - 1 - start;
-				if (len >= sizeof c->name)
-					len = sizeof c->name - 1;
-				memcpy(c->name, c->s + start, len);
-				c->name[len] = '\0';
-				rc = fail_at(c, start - 1, "a member's name is given "
-							   "twice in one object");
-			}
-		if (rc)
+		if (push_name(c, start, hash) != 0) {
+			rc = fail_at(c, start, "out of memory");
 			break;
-		if (n == cap) {
-			cap = cap ? 2 * cap : 8;
-			seen_name *grown = realloc(seen, cap * sizeof *seen);
-			if (!grown) {
-				rc = fail_at(c, start, "out of memory");
-				break;
-			}
-			seen = grown;
 		}
-		seen[n++] = (seen_name){start, hash};
 		skip_ws(c);
 		if (c->at >= c->len || c->s[c->at] != ':') {
 			rc = fail_at(c, c->at, "':' is expected after a member's "
@@ -280,7 +407,8 @@ static int check_object(checker *c, int depth)
 			break;
 		}
 	}
-	free(seen);
+	if (check_names(c, first) != 0)
+		rc = -1;
 	return rc;
 }
 
@@ -329,17 +457,26 @@ static int check_value(checker *c, int depth)
 api_err api_json_check(const char *text, size_t len, api_problem *pb)
 {
 	checker c = {.s = (const unsigned char *)text, .len = len};
-	if (check_value(&c, 0) == 0) {
+	if (len > UINT32_MAX) /* a name's place is kept in 32 bits */
+		fail_at(&c, 0, "the body is larger than 4 GiB");
+	else if (check_value(&c, 0) == 0) {
 		skip_ws(&c);
 		if (c.at < c.len)
 			fail_at(&c, c.at, "unexpected text after the JSON value");
 	}
+	free(c.names);
 	if (!c.why)
 		return API_OK;
-	api_fail(pb, API_MALFORMED, c.name[0] ? c.name : NULL,
-		 "the request body is not valid JSON (RFC 8259, I-JSON): %s%s%s%s "
-		 "at byte %zu", c.why, c.name[0] ? " (\"" : "", c.name,
-		 c.name[0] ? "\")" : "", c.where);
+	if (c.json_ok)
+		api_fail(pb, API_MALFORMED, NULL,
+			 "the request body is refused: %s (no member takes it; "
+			 "it would cut the string short) at byte %zu", c.why,
+			 c.where);
+	else
+		api_fail(pb, API_MALFORMED, c.name[0] ? c.name : NULL,
+			 "the request body is not valid JSON (RFC 8259, I-JSON): "
+			 "%s%s%s%s at byte %zu", c.why, c.name[0] ? " (\"" : "",
+			 c.name, c.name[0] ? "\")" : "", c.where);
 	pb->has_position = 1;
 	pb->position = c.where;
 	return API_MALFORMED;

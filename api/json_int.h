@@ -36,11 +36,11 @@ char *api_print(const cJSON *item);
 char *api_print_free(cJSON *item);
 
 /* The prologue of every body parser (body.c): parse len bytes as one JSON
- * object (empty or blank text gives {} when empty_ok) whose members are all
- * among the NULL-terminated names. Returns the tree (caller deletes it) or
- * NULL with *pb set: 400 malformed or not an object, 422 unknown member. */
-cJSON *api_parse_body(const char *body, size_t len, int empty_ok,
-		      const char *const *members, api_problem *pb);
+ * object whose members are all among the NULL-terminated names. Returns
+ * the tree (caller deletes it) or NULL with *pb set: 400 empty, blank,
+ * malformed or not an object, 422 unknown member. */
+cJSON *api_parse_body(const char *body, size_t len, const char *const *members,
+		      api_problem *pb);
 
 /* Length of the valid UTF-8 sequence at s of at most avail bytes (RFC
  * 3629: no overlong forms, no surrogates, nothing above U+10FFFF), 0 if
@@ -109,6 +109,9 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb);
 cJSON *api_settings_array(void);
 /* Add a number member; non-finite values become null. */
 void api_add_number(cJSON *obj, const char *name, double v);
+/* Add model_error, model_error_uncertainty (m/s, null unless checked),
+ * model_checked and model_check_note (sim_model_check) to o. */
+void api_add_model_error(cJSON *o, const sim_model_error *me);
 /* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
  * ?format=csv} (a job's result, as JSON and as CSV). */
 void api_add_result_links(cJSON *obj, const char *collection, const char *id);
@@ -122,6 +125,9 @@ char *api_list_json(const char *member, const void *views, size_t n, size_t size
  * very lists. */
 extern const char *const api_members_session_create[];
 extern const char *const api_members_control[];
+/* The control c as the object PATCH answers under "applied" and the
+ * control event carries (control.c; the caller owns it). */
+cJSON *api_control_object(const api_control *c);
 extern const char *const api_members_experiment[];
 extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];

@@ -190,12 +190,12 @@ static cJSON *content(const char *media, cJSON *schema)
 }
 
 /* The operation object of route rt. */
-static cJSON *operation(const api_route *rt)
+/* The route's parameters: the path's id, its query parameters, and
+ * Last-Event-ID where it resumes. */
+static void add_parameters(cJSON *op, const api_route *rt)
 {
 	size_t nq;
 	const api_query *q = api_queries(&nq);
-	cJSON *op = cJSON_CreateObject();
-	cJSON_AddStringToObject(op, "summary", rt->summary);
 	cJSON *params = cJSON_AddArrayToObject(op, "parameters");
 	if (strchr(rt->pattern, '*'))
 		cJSON_AddItemToArray(params, ref("parameters", "Id"));
@@ -216,13 +216,11 @@ static cJSON *operation(const api_route *rt)
 		cJSON_AddItemToObject(p, "schema", cJSON_Parse("{\"type\":\"integer\",\"minimum\":0}"));
 		cJSON_AddItemToArray(params, p);
 	}
-	if (rt->request) {
-		cJSON *body = cJSON_AddObjectToObject(op, "requestBody");
-		cJSON_AddBoolToObject(body, "required", 1);
-		cJSON_AddItemToObject(body, "content",
-				      content("application/json", ref("schemas", rt->request)));
-	}
-	cJSON *responses = cJSON_AddObjectToObject(op, "responses");
+}
+
+/* The success answer of the route and its media types into responses. */
+static void add_success(cJSON *responses, const api_route *rt)
+{
 	char status[8];
 	snprintf(status, sizeof status, "%d", rt->status);
 	cJSON *ok = cJSON_AddObjectToObject(responses, status);
@@ -250,6 +248,21 @@ static cJSON *operation(const api_route *rt)
 							  "\"description\":\"CSV with a header line\"}}"));
 		cJSON_AddItemToObject(ok, "content", c);
 	}
+}
+
+static cJSON *operation(const api_route *rt)
+{
+	cJSON *op = cJSON_CreateObject();
+	cJSON_AddStringToObject(op, "summary", rt->summary);
+	add_parameters(op, rt);
+	if (rt->request) {
+		cJSON *body = cJSON_AddObjectToObject(op, "requestBody");
+		cJSON_AddBoolToObject(body, "required", 1);
+		cJSON_AddItemToObject(body, "content",
+				      content("application/json", ref("schemas", rt->request)));
+	}
+	cJSON *responses = cJSON_AddObjectToObject(op, "responses");
+	add_success(responses, rt);
 	if (strcmp(rt->response, "Health") == 0) {
 		cJSON *down = cJSON_AddObjectToObject(responses, "503");
 		cJSON_AddStringToObject(down, "description", "shutting down");

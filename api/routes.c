@@ -7,6 +7,7 @@
  * table, so the document and the checks cannot drift. The values of the
  * stream's and the trajectory's parameters are parsed here too.
  */
+#include <inttypes.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,62 +40,62 @@ static const api_query queries[] = {
 
 #define TRAJ (API_Q_FORMAT | API_Q_FROM | API_Q_TO | API_Q_STRIDE)
 #define STREAM (API_Q_STREAM_FORMAT | API_Q_FIELDS | API_Q_RATE | API_Q_LIMIT | API_Q_SINCE)
-static const api_route routes[] = {
-	{"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
+static const api_route routes[API_R_COUNT] = {
+	[API_R_SESSIONS_CREATE] = {"POST", "/api/v1/sessions", 0, 0, "Create a session and start its worker",
 	 "SessionCreate", 201, "Session", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sessions", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_SESSIONS_LIST] = {"GET", "/api/v1/sessions", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All sessions with live status (CSV: one summary row each)", NULL, 200, "SessionList",
 	 "400,406"},
-	{"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
+	[API_R_SESSION_GET] = {"GET", "/api/v1/sessions/*", API_Q_FORMAT, 1,
 	 "One session: spec and live status (CSV: its summary row)", NULL, 200, "Session",
 	 "400,404,406,503"},
-	{"PATCH", "/api/v1/sessions/*", 0, 0,
+	[API_R_SESSION_PATCH] = {"PATCH", "/api/v1/sessions/*", 0, 0,
 	 "Change beta, beta_rate, rotation, omega_ss, motor_on, running, pace or until while it "
 	 "runs; answers the simulated time the change takes effect",
 	 "Control", 200, "ControlResult", "400,404,409,413,415,422,503"},
-	{"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
+	[API_R_SESSION_DELETE] = {"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
 	 "400,404,415"},
-	{"GET", "/api/v1/sessions/*/stream", STREAM, 0,
+	[API_R_SESSION_STREAM] = {"GET", "/api/v1/sessions/*/stream", STREAM, 0,
 	 "Server-Sent Events or NDJSON of samples and events", NULL, 200, "StreamRecord",
 	 "400,404,429,503"},
-	{"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
+	[API_R_SESSION_TRAJECTORY] = {"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
 	 "The recorded, downsampled history (the CLI's trajectory columns)", NULL, 200,
 	 "Trajectory", "400,404,406,503"},
-	{"POST", "/api/v1/experiments", 0, 0,
+	[API_R_EXPERIMENTS_CREATE] = {"POST", "/api/v1/experiments", 0, 0,
 	 "Run a beta schedule; per segment the transport velocity and the reversal time",
 	 "ExperimentCreate", 201, "Experiment", "400,404,409,413,415,422,429,503"},
-	{"GET", "/api/v1/experiments", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_EXPERIMENTS_LIST] = {"GET", "/api/v1/experiments", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All kept experiments (CSV: one row per segment)", NULL, 200, "ExperimentList", "400,406"},
-	{"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
+	[API_R_EXPERIMENT_GET] = {"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per segment)", NULL, 200, "Experiment",
 	 "400,404,406"},
-	{"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
+	[API_R_SWEEPS_CREATE] = {"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
 	 "SweepCreate", 202, "Sweep", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
+	[API_R_SWEEPS_LIST] = {"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
 	 "All kept sweeps (CSV: one row per sweep)", NULL, 200, "SweepList", "400,406"},
-	{"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
+	[API_R_SWEEP_GET] = {"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per point, the CLI's sweep columns)", NULL, 200,
 	 "Sweep", "400,404,406"},
-	{"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404,415"},
-	{"POST", "/api/v1/fits", 0, 0,
+	[API_R_SWEEP_DELETE] = {"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404,415"},
+	[API_R_FITS_CREATE] = {"POST", "/api/v1/fits", 0, 0,
 	 "Fit free parameters to measured v(beta) points or peaks (Levenberg-Marquardt) as a job",
 	 "FitCreate", 202, "Fit", "400,413,415,422,429,503"},
-	{"GET", "/api/v1/fits", API_Q_FORMAT | API_Q_SCOPE, 1, "All kept fits with progress (CSV: one row each)",
+	[API_R_FITS_LIST] = {"GET", "/api/v1/fits", API_Q_FORMAT | API_Q_SCOPE, 1, "All kept fits with progress (CSV: one row each)",
 	 NULL, 200, "FitList", "400,406"},
-	{"GET", "/api/v1/fits/*", API_Q_FORMAT, 1,
+	[API_R_FIT_GET] = {"GET", "/api/v1/fits/*", API_Q_FORMAT, 1,
 	 "Progress and result (CSV: parameters, data with residuals, curves)", NULL, 200, "Fit",
 	 "400,404,406"},
-	{"DELETE", "/api/v1/fits/*", 0, 0, "Cancel (a running fit stops) and forget", NULL, 204, "",
+	[API_R_FIT_DELETE] = {"DELETE", "/api/v1/fits/*", 0, 0, "Cancel (a running fit stops) and forget", NULL, 204, "",
 	 "400,404,415"},
-	{"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
+	[API_R_PRESETS] = {"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
 	 "Presets", "400"},
-	{"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",
+	[API_R_HEALTH] = {"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",
 	 NULL, 200, "Health", "400"},
-	{"GET", "/api/v1/openapi.json", 0, 0, "This document", NULL, 200, "application/json",
+	[API_R_OPENAPI] = {"GET", "/api/v1/openapi.json", 0, 0, "This document", NULL, 200, "application/json",
 	 "400"},
-	{"GET", "/api/v1/problems/*", 0, 0, "What a problem type means", NULL, 200, "text/html",
+	[API_R_PROBLEM] = {"GET", "/api/v1/problems/*", 0, 0, "What a problem type means", NULL, 200, "text/html",
 	 "400,404"},
-	{"GET", "/metrics", 0, 0, "Prometheus text format", NULL, 200, "text/plain", "400"},
+	[API_R_METRICS] = {"GET", "/metrics", 0, 0, "Prometheus text format", NULL, 200, "text/plain", "400"},
 };
 
 const api_route *api_routes(size_t *n)
@@ -107,14 +108,6 @@ const api_query *api_queries(size_t *n)
 {
 	*n = sizeof queries / sizeof *queries;
 	return queries;
-}
-
-const api_route *api_route_find(const char *method, const char *pattern)
-{
-	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++)
-		if (strcmp(routes[i].method, method) == 0 && strcmp(routes[i].pattern, pattern) == 0)
-			return &routes[i];
-	return NULL;
 }
 
 api_err api_check_query(const api_route *rt, const char *name, api_problem *pb)
@@ -199,6 +192,22 @@ api_err api_negotiate(const api_route *rt, const char *format, const char *accep
 	return API_OK;
 }
 
+/* The decimal digits of text (nothing else: no sign, no space) as a
+ * number of at most max; 0 if text is not one. */
+static int decimal(const char *text, uint64_t max, uint64_t *out)
+{
+	uint64_t n = 0;
+	if (!*text)
+		return 0;
+	for (const char *c = text; *c; c++) {
+		if (*c < '0' || *c > '9' || n > (max - (uint64_t)(*c - '0')) / 10)
+			return 0;
+		n = n * 10 + (uint64_t)(*c - '0');
+	}
+	*out = n;
+	return 1;
+}
+
 api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
 			       const char *rate, const char *limit, const char *last_event_id,
 			       const char *since, api_stream_query *q, api_problem *pb)
@@ -224,20 +233,21 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 					"rate must be a number of samples per "
 					"simulated second in (0, 100000]");
 	}
+	uint64_t n;
 	if (limit) {
-		unsigned long long n = strtoull(limit, &end, 10);
-		if (*end || n == 0 || *limit == '-')
-			return api_fail(pb, API_QUERY, "limit", "limit must be a positive integer");
+		if (!decimal(limit, UINT64_MAX, &n) || n == 0)
+			return api_fail(pb, API_QUERY, "limit",
+					"limit must be a positive integer (at most "
+					"%" PRIu64 ")", UINT64_MAX);
 		q->limit = n;
 	}
 	const char *v = last_event_id ? last_event_id : since;
 	if (v) {
-		unsigned long long id = strtoull(v, &end, 10);
-		if (*end || !*v || *v == '-')
-			return api_fail(pb, API_QUERY, "Last-Event-ID",
+		if (!decimal(v, INT64_MAX, &n))
+			return api_fail(pb, API_QUERY, last_event_id ? "Last-Event-ID" : "since",
 					"Last-Event-ID (or since) must be a record "
-					"id, a non-negative integer");
-		q->resume = (int64_t)(id > INT64_MAX - 1 ? INT64_MAX - 1 : id);
+					"id, an integer from 0 to %" PRId64, INT64_MAX);
+		q->resume = (int64_t)(n > INT64_MAX - 1 ? INT64_MAX - 1 : n);
 	}
 	return API_OK;
 }

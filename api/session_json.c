@@ -1,13 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * session_json.c - sessions in JSON: the PATCH control body and the
- * session document (spec and live status) that GET, POST and PATCH answer.
- *
- * Controls are validated against the session's own settings with sim_set
- * on a scratch copy, so the messages and ranges are the core's; a control
- * is all or nothing. Angles are converted to SI once, where they are
- * parsed (api_parse_user_value), and leave here in degrees, as users type
- * them: the "applied" echo shows what was sent.
+ * session_json.c - sessions in JSON: the session document (spec and live
+ * status) that GET, POST and PATCH answer. The PATCH body is control.c's.
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,127 +11,6 @@
 #include "json_int.h"
 #include "table.h"
 
-const char *const api_members_control[] = {"beta", "beta_rate", "rotation", "omega_ss",
-					    "running", "motor_on", "pace", "until",
-					    "cpu_budget", NULL};
-
-
-/* A number member for a setting in its user unit (beta in deg), converted
- * once to SI; sets the bit. */
-static api_err parse_value(const cJSON *root, const api_spec *spec,
-			   const char *name, unsigned bit, api_value *out,
-			   api_control *c, api_problem *pb)
-{
-	const cJSON *it = cJSON_GetObjectItemCaseSensitive(root, name);
-	if (!it)
-		return API_OK;
-	api_err e = api_parse_user_value(spec, name, it, name, out, pb);
-	if (e == API_OK)
-		c->set |= bit;
-	return e;
-}
-
-/* A boolean member: sets *out and the bit, or fails with a type error. */
-static api_err parse_bool(const cJSON *root, const char *name, unsigned bit,
-			  int *out, api_control *c, api_problem *pb)
-{
-	const cJSON *it = cJSON_GetObjectItemCaseSensitive(root, name);
-	if (!it)
-		return API_OK;
-	if (!cJSON_IsBool(it))
-		return api_fail(pb, API_TYPE, name, "%s must be true or false",
-				name);
-	*out = cJSON_IsTrue(it);
-	c->set |= bit;
-	return API_OK;
-}
-
-api_err api_parse_control(const char *body, size_t len, const api_spec *spec,
-			  api_control *c, api_problem *pb)
-{
-	memset(c, 0, sizeof *c);
-	cJSON *root = api_parse_body(body, len, 0, api_members_control, pb);
-	if (!root)
-		return pb->code;
-	api_err e = API_OK;
-	const cJSON *it;
-	if (!root->child)
-		e = api_fail(pb, API_INVALID, NULL,
-			     "no change given; expected any of beta, "
-			     "beta_rate, rotation, omega_ss, running, "
-			     "motor_on, pace, until, cpu_budget");
-	api_value omega_ss = {0, 0};
-	if (e == API_OK)
-		e = parse_value(root, spec, "beta", API_C_BETA, &c->beta, c, pb);
-	if (e == API_OK)
-		e = parse_value(root, spec, "beta_rate", API_C_BETA_RATE,
-				&c->beta_rate, c, pb);
-	if (e == API_OK)
-		e = parse_value(root, spec, "omega_ss", API_C_OMEGA_SS,
-				&omega_ss, c, pb);
-	c->omega_ss = omega_ss.si;
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "rotation"))) {
-		if (!cJSON_IsString(it)) {
-			e = api_fail(pb, API_TYPE, "rotation",
-				     "rotation must be \"cw\" or \"ccw\"");
-		} else if (strcmp(it->valuestring, "cw") == 0) {
-			c->rotation = SIM_CW;
-			c->set |= API_C_ROTATION;
-		} else if (strcmp(it->valuestring, "ccw") == 0) {
-			c->rotation = SIM_CCW;
-			c->set |= API_C_ROTATION;
-		} else {
-			e = api_fail(pb, API_RANGE, "rotation",
-				     "rotation must be \"cw\" or \"ccw\"");
-			snprintf(pb->choices, sizeof pb->choices, "cw|ccw");
-		}
-	}
-	if (e == API_OK)
-		e = parse_bool(root, "running", API_C_RUNNING, &c->running, c, pb);
-	if (e == API_OK)
-		e = parse_bool(root, "motor_on", API_C_MOTOR, &c->motor_on, c, pb);
-	if (e == API_OK && (it = cJSON_GetObjectItemCaseSensitive(root, "pace")) &&
-	    (e = api_parse_pace(it, "pace", &c->pace, pb)) == API_OK)
-		c->set |= API_C_PACE;
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "until")) &&
-	    (e = api_parse_real(it, "until", 1e-6, 1e6, 1, &c->until, pb)) ==
-		    API_OK)
-		c->set |= API_C_UNTIL;
-	if (e == API_OK &&
-	    (it = cJSON_GetObjectItemCaseSensitive(root, "cpu_budget")) &&
-	    (e = api_parse_real(it, "cpu_budget", 1e-3, 1e9, 0, &c->cpu_budget, pb)) == API_OK)
-		c->set |= API_C_CPU;
-	cJSON_Delete(root);
-	return e;
-}
-
-api_err api_parse_control_event(const char *line, size_t len, const api_spec *spec,
-				api_control *c, double *t_effective, char *experiment,
-				size_t explen, api_problem *pb)
-{
-	cJSON *o = cJSON_ParseWithLength(line, len);
-	cJSON *te = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "t_effective") : NULL;
-	cJSON *ex = o ? cJSON_DetachItemFromObjectCaseSensitive(o, "experiment") : NULL;
-	int ok = cJSON_IsObject(o) && cJSON_IsNumber(te) && isfinite(te->valuedouble) &&
-		 (!ex || cJSON_IsString(ex));
-	*t_effective = ok ? te->valuedouble : 0;
-	if (experiment && explen)
-		snprintf(experiment, explen, "%s", ok && ex ? ex->valuestring : "");
-	cJSON_Delete(te);
-	cJSON_Delete(ex);
-	char *body = ok ? api_print(o) : NULL;
-	cJSON_Delete(o);
-	if (!body)
-		return api_fail(pb, API_MALFORMED, NULL,
-				"a control log line is not a control event "
-				"with t_effective");
-	api_err e = api_parse_control(body, strlen(body), spec, c, pb);
-	free(body);
-	return e;
-}
-
 static void put_pace(cJSON *o, const char *name, double pace)
 {
 	if (pace == API_PACE_MAX)
@@ -146,53 +19,23 @@ static void put_pace(cJSON *o, const char *name, double pace)
 		api_add_number(o, name, pace);
 }
 
-static cJSON *control_object(const api_control *c)
+int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me)
 {
-	cJSON *o = cJSON_CreateObject();
-	/* angles as the user sent them */
-	if (c->set & API_C_BETA)
-		api_add_number(o, "beta", c->beta.user);
-	if (c->set & API_C_BETA_RATE)
-		api_add_number(o, "beta_rate", c->beta_rate.user);
-	if (c->set & API_C_ROTATION)
-		cJSON_AddStringToObject(o, "rotation",
-					c->rotation == SIM_CW ? "cw" : "ccw");
-	if (c->set & API_C_OMEGA_SS)
-		api_add_number(o, "omega_ss", c->omega_ss);
-	if (c->set & API_C_RUNNING)
-		cJSON_AddBoolToObject(o, "running", c->running);
-	if (c->set & API_C_MOTOR)
-		cJSON_AddBoolToObject(o, "motor_on", c->motor_on);
-	if (c->set & API_C_PACE)
-		put_pace(o, "pace", c->pace);
-	if (c->set & API_C_UNTIL) {
-		if (c->until > 0)
-			api_add_number(o, "until", c->until);
-		else
-			cJSON_AddNullToObject(o, "until");
+	sim_params p = spec->params;
+	if (st) {
+		p.beta = st->beta_target;
+		p.rotation = st->rotation;
+		p.omega_ss = st->omega_ss;
 	}
-	if (c->set & API_C_CPU)
-		api_add_number(o, "cpu_budget", c->cpu_budget);
-	return o;
+	return sim_model_check(&p, &spec->scene, me);
 }
 
-int api_control_event(char *buf, size_t len, const api_control *c,
-		      double t_effective)
+void api_add_model_error(cJSON *o, const sim_model_error *me)
 {
-	return api_control_log_line(buf, len, c, t_effective, NULL);
-}
-
-int api_control_log_line(char *buf, size_t len, const api_control *c, double t_effective,
-			 const char *experiment)
-{
-	cJSON *o = control_object(c);
-	api_add_number(o, "t_effective", sim_time_ns(t_effective));
-	if (experiment && experiment[0])
-		cJSON_AddStringToObject(o, "experiment", experiment);
-	char *text = api_print_free(o);
-	int n = snprintf(buf, len, "%s", text ? text : "{}");
-	free(text);
-	return n < 0 ? 0 : n >= (int)len ? (int)len - 1 : n;
+	api_add_number(o, "model_error", me->checked ? me->error : NAN);
+	api_add_number(o, "model_error_uncertainty", me->checked ? me->error_uncertainty : NAN);
+	cJSON_AddBoolToObject(o, "model_checked", me->checked);
+	cJSON_AddStringToObject(o, "model_check_note", me->note);
 }
 
 static cJSON *status_object(const api_view *v)
@@ -247,11 +90,14 @@ static cJSON *status_object(const api_view *v)
 		api_add_number(f, "error", r->v_error);
 		cJSON_AddItemToArray(fig, f);
 	}
-	/* the column model outside the domain checked against LIGGGHTS beds
-	 * (docs/dem.md), a property of the scene */
-	char why[400];
-	if (sim_feed_validated(&v->spec->params, &v->spec->scene, why, sizeof why) == 0)
-		cJSON_AddStringToObject(o, "feed_warning", why);
+	/* how far the column model is from a DEM bed at the scene as its
+	 * controls now stand (docs/dem.md "Model error"); feed_warning is the
+	 * note where the scene is not checked */
+	sim_model_error me;
+	int mc = api_model_check(v->spec, st, &me);
+	api_add_model_error(o, &me);
+	if (mc == 0)
+		cJSON_AddStringToObject(o, "feed_warning", me.note);
 	else
 		cJSON_AddNullToObject(o, "feed_warning");
 	cJSON *en = cJSON_AddObjectToObject(o, "energy");
@@ -420,7 +266,7 @@ char *api_control_result_json(const api_view *v, const api_control *c,
 			      int acked, double t_effective)
 {
 	cJSON *o = session_object(v, 0);
-	cJSON_AddItemToObject(o, "applied", control_object(c));
+	cJSON_AddItemToObject(o, "applied", api_control_object(c));
 	cJSON_AddBoolToObject(o, "acknowledged", acked);
 	if (acked)
 		api_add_number(o, "t_effective", sim_time_ns(t_effective));

@@ -373,7 +373,7 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 			  api_problem *pb)
 {
 	memset(spec, 0, sizeof *spec);
-	cJSON *root = api_parse_body(body, len, 1, api_members_session_create, pb);
+	cJSON *root = api_parse_body(body, len, api_members_session_create, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, spec, pb);

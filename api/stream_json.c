@@ -210,7 +210,7 @@ size_t api_format_record(char *buf, size_t len, const api_sample *s,
 }
 
 size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t next_id,
-			const char *feed_warning, int ndjson)
+			const char *feed_warning, const sim_model_error *me, int ndjson)
 {
 	api_buf b = {0};
 	api_buf_puts(&b, ndjson ? "{\"type\":\"hello\",\"session\":"
@@ -221,6 +221,16 @@ size_t api_format_hello(char *buf, size_t len, const char *session, uint64_t nex
 		api_buf_jstr(&b, feed_warning);
 	else
 		api_buf_puts(&b, "null");
+	if (me) {
+		char num[40];
+		api_fmt_double(num, sizeof num, me->checked ? me->error : NAN);
+		api_buf_printf(&b, ",\"model_error\":%s", num);
+		api_fmt_double(num, sizeof num, me->checked ? me->error_uncertainty : NAN);
+		api_buf_printf(&b, ",\"model_error_uncertainty\":%s,\"model_checked\":%s,"
+				   "\"model_check_note\":",
+			       num, me->checked ? "true" : "false");
+		api_buf_jstr(&b, me->note);
+	}
 	api_buf_puts(&b, ndjson ? "}\n" : "}\n\n");
 	char *text = api_buf_take(&b);
 	size_t n = text ? strlen(text) : 0;

@@ -23,6 +23,32 @@ const char *const api_members_sweep[] = {"preset", "params", "scene", "integrato
 
 #define T_END_MAX 600.0 /* s simulated per point, at most */
 
+/* beta as an array of angles (deg) into req->betas. */
+static api_err parse_beta_list(const cJSON *it, api_sweep_req *req, api_problem *pb)
+{
+	char field[32];
+	int n = cJSON_GetArraySize(it);
+	if (n < 1 || n > API_SWEEP_MAX_POINTS / 2)
+		return api_fail(pb, API_RANGE, "beta",
+				"beta must list 1 to %d angles",
+				API_SWEEP_MAX_POINTS / 2);
+	req->betas = malloc((size_t)n * sizeof *req->betas);
+	if (!req->betas)
+		return api_fail(pb, API_UNAVAILABLE, NULL,
+				"out of memory");
+	int i = 0;
+	for (const cJSON *b = it->child; b; b = b->next, i++) {
+		snprintf(field, sizeof field, "beta[%d]", i);
+		api_err e = api_parse_user_value(&req->spec, "beta", b,
+						 field, &req->betas[i],
+						 pb);
+		if (e != API_OK)
+			return e;
+	}
+	req->nbeta = n;
+	return API_OK;
+}
+
 static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 			  api_problem *pb)
 {
@@ -42,28 +68,8 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 		}
 		return API_OK;
 	}
-	if (cJSON_IsArray(it)) {
-		int n = cJSON_GetArraySize(it);
-		if (n < 1 || n > API_SWEEP_MAX_POINTS / 2)
-			return api_fail(pb, API_RANGE, "beta",
-					"beta must list 1 to %d angles",
-					API_SWEEP_MAX_POINTS / 2);
-		req->betas = malloc((size_t)n * sizeof *req->betas);
-		if (!req->betas)
-			return api_fail(pb, API_UNAVAILABLE, NULL,
-					"out of memory");
-		int i = 0;
-		for (const cJSON *b = it->child; b; b = b->next, i++) {
-			snprintf(field, sizeof field, "beta[%d]", i);
-			api_err e = api_parse_user_value(&req->spec, "beta", b,
-							 field, &req->betas[i],
-							 pb);
-			if (e != API_OK)
-				return e;
-		}
-		req->nbeta = n;
-		return API_OK;
-	}
+	if (cJSON_IsArray(it))
+		return parse_beta_list(it, req, pb);
 	if (!cJSON_IsObject(it))
 		return api_fail(pb, API_TYPE, "beta",
 				"beta must be {\"from\",\"to\",\"step\"} or an "
@@ -191,7 +197,7 @@ api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
 			api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
-	cJSON *root = api_parse_body(body, len, 1, api_members_sweep, pb);
+	cJSON *root = api_parse_body(body, len, api_members_sweep, pb);
 	if (!root)
 		return pb->code;
 	api_err e = api_apply_model(root, &req->spec, pb);
@@ -242,6 +248,24 @@ static double vary_value(const api_sweep_view *v, const api_sweep_point *p, int 
 	return v->req && v->req->nvary > 0 ? p->vary[a] : p->beta.user;
 }
 
+/* A point's model error (sim_model_check): the sweep's scene with the
+ * point's varied settings and sense. */
+static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_point *p)
+{
+	if (!v->req)
+		return;
+	sim_params pr = v->req->spec.params;
+	sim_scene sc = v->req->spec.scene;
+	sim_method m = v->req->spec.method;
+	pr.beta = p->beta.si;
+	for (int a = 0; a < v->req->nvary; a++)
+		sim_set_user(&pr, &sc, &m, v->req->vary[a], p->vary[a], NULL, 0);
+	pr.rotation = p->rotation;
+	sim_model_error me;
+	sim_model_check(&pr, &sc, &me);
+	api_add_model_error(po, &me);
+}
+
 static const char *point_state(int s)
 {
 	static const char *const names[] = {"pending", "running", "done",
@@ -261,6 +285,41 @@ static void add_band_head(cJSON *o, const api_sweep_req *req)
 	for (int j = 0; j < req->band_src.nfree; j++)
 		cJSON_AddItemToArray(req->band_skip[j] ? out : in,
 				     cJSON_CreateString(req->band_src.free[j].name));
+}
+
+/* One point of sweep v as its object: the varied settings, the rotation,
+ * the state and, once measured, v with its bar, steps and band. */
+static cJSON *point_object(const api_sweep_view *v, const api_sweep_point *p, int nvary)
+{
+	cJSON *po = cJSON_CreateObject();
+	for (int a = 0; a < nvary; a++)
+		api_add_number(po, vary_name(v, a), vary_value(v, p, a));
+	cJSON_AddStringToObject(po, "rotation",
+				p->rotation == SIM_CW ? "cw" : "ccw");
+	cJSON_AddStringToObject(po, "state", point_state(p->state));
+	if (p->state == 2) {
+		api_add_number(po, "velocity", p->m.transport_velocity);
+		api_add_number(po, "uncertainty", p->m.uncertainty);
+		cJSON_AddBoolToObject(po, "steady", p->m.steady);
+		api_add_number(po, "dt", p->m.dt);
+		cJSON_AddNumberToObject(po, "substeps", p->m.substeps);
+		api_add_number(po, "step_error", p->m.step_error);
+		cJSON_AddBoolToObject(po, "tol_met", p->m.tol_met);
+		if (v->req && v->req->band) {
+			cJSON *band = cJSON_AddObjectToObject(po, "band");
+			api_add_number(band, "lower", p->band[0]);
+			api_add_number(band, "upper", p->band[1]);
+		}
+	} else {
+		cJSON_AddNullToObject(po, "velocity");
+		cJSON_AddNullToObject(po, "uncertainty");
+		cJSON_AddNullToObject(po, "steady");
+	}
+	cJSON_AddBoolToObject(po, "mirrored", p->mirrored);
+	add_point_model(po, v, p);
+	if (p->error[0])
+		cJSON_AddStringToObject(po, "error", p->error);
+	return po;
 }
 
 static cJSON *sweep_object(const api_sweep_view *v, int points)
@@ -308,33 +367,7 @@ static cJSON *sweep_object(const api_sweep_view *v, int points)
 	cJSON *ccw = points ? cJSON_AddArrayToObject(series, "ccw") : NULL;
 	for (size_t i = 0; points && i < v->total; i++) {
 		const api_sweep_point *p = &v->pt[i];
-		cJSON *po = cJSON_CreateObject();
-		for (int a = 0; a < nvary; a++)
-			api_add_number(po, vary_name(v, a), vary_value(v, p, a));
-		cJSON_AddStringToObject(po, "rotation",
-					p->rotation == SIM_CW ? "cw" : "ccw");
-		cJSON_AddStringToObject(po, "state", point_state(p->state));
-		if (p->state == 2) {
-			api_add_number(po, "velocity", p->m.transport_velocity);
-			api_add_number(po, "uncertainty", p->m.uncertainty);
-			cJSON_AddBoolToObject(po, "steady", p->m.steady);
-			api_add_number(po, "dt", p->m.dt);
-			cJSON_AddNumberToObject(po, "substeps", p->m.substeps);
-			api_add_number(po, "step_error", p->m.step_error);
-			cJSON_AddBoolToObject(po, "tol_met", p->m.tol_met);
-			if (v->req && v->req->band) {
-				cJSON *band = cJSON_AddObjectToObject(po, "band");
-				api_add_number(band, "lower", p->band[0]);
-				api_add_number(band, "upper", p->band[1]);
-			}
-		} else {
-			cJSON_AddNullToObject(po, "velocity");
-			cJSON_AddNullToObject(po, "uncertainty");
-			cJSON_AddNullToObject(po, "steady");
-		}
-		cJSON_AddBoolToObject(po, "mirrored", p->mirrored);
-		if (p->error[0])
-			cJSON_AddStringToObject(po, "error", p->error);
+		cJSON *po = point_object(v, p, nvary);
 		cJSON_AddItemToArray(pts, po);
 		if (p->state == 2) {
 			cJSON *pair = cJSON_CreateArray();

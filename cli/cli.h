@@ -110,6 +110,18 @@ typedef struct cli_opt {
 	const char *doc;
 } cli_opt;
 
+/* The most options one table holds (convsim's, convsim-dem's). */
+#define CLI_MAX_OPTIONS 64
+
+/* The help lines of the options of table opts (n rows) that command bit
+ * cmd takes: flag, argument and text, then unit and default. */
+void cli_help_options(FILE *f, const cli_opt *opts, size_t n, unsigned cmd);
+/* The next option of argv in table opts (n rows, at most CLI_MAX_OPTIONS)
+ * for command bit cmd, as cli_next_option; messages start with who
+ * ("convsim run") and point to hint ("convsim help run"). */
+int cli_next_option_in(const cli_opt *opts, size_t n, unsigned cmd, const char *who,
+		       const char *hint, int argc, char **argv, const char **arg);
+
 /* The command bit for a command name, 0 if unknown. */
 unsigned cli_command(const char *name);
 /* Print command cmd's help (usage, every option with unit and default)

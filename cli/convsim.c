@@ -28,6 +28,7 @@
 #include "handover.h"
 #include "sim.h"
 #include "suggest.h"
+#include "tether.h"
 #include "table.h"
 #include "units.h"
 
@@ -118,15 +119,21 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 			first = 0;
 		}
 	fputc(']', f);
-	/* the column model outside the domain checked against a DEM bed */
-	char why[400];
+	/* how far the column model is from a DEM bed here (docs/dem.md
+	 * "Model error"); feed_warning is the note where it is not checked */
+	sim_model_error me;
+	int mc = sim_model_check(&o->p, &o->sc, &me);
 	fputs(",\n  \"feed_warning\": ", f);
-	if (sim_feed_validated(&o->p, &o->sc, why, sizeof why) == 0)
-		fprintf(f, "\"%s\"", why);
+	if (mc == 0)
+		fprintf(f, "\"%s\"", me.note);
 	else
 		fputs("null", f);
 	NUM("transport_velocity", st->transport_velocity);
 	NUM("transport_velocity_uncertainty", st->transport_velocity_uncertainty);
+	NUM("model_error", me.checked ? me.error : NAN);
+	NUM("model_error_uncertainty", me.checked ? me.error_uncertainty : NAN);
+	fprintf(f, ",\n  \"model_checked\": %s,\n  \"model_check_note\": \"%s\"",
+		me.checked ? "true" : "false", me.note);
 	fprintf(f, ",\n  \"steady\": %s", st->steady ? "true" : "false");
 	NUM("step_error", st->step_error);
 	NUM("tol", st->tol);
@@ -275,6 +282,7 @@ static int unknown_command(const char *name)
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	cli_handover_init(argv);
 	if (argc < 2) {
 		cli_help(stderr, 0);

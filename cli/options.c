@@ -84,6 +84,7 @@ static const cli_opt options[] = {
 	{ALL, OPT_HELP, "help", 'h', NULL, NULL, NULL, "show this help on stdout and exit"},
 };
 #define NOPTIONS (sizeof options / sizeof *options)
+_Static_assert(NOPTIONS <= CLI_MAX_OPTIONS, "convsim's options fit CLI_MAX_OPTIONS");
 
 static const struct {
 	const char *name;
@@ -128,6 +129,24 @@ static const char *command_name(unsigned cmd)
 	return "";
 }
 
+void cli_help_options(FILE *f, const cli_opt *opts, size_t n, unsigned cmd)
+{
+	for (size_t i = 0; i < n; i++) {
+		const cli_opt *o = &opts[i];
+		if (!(o->cmds & cmd))
+			continue;
+		char flag[64];
+		snprintf(flag, sizeof flag, "%c%c%s--%s%s%s", o->key ? '-' : ' ',
+			 o->key ? o->key : ' ', o->key ? ", " : "  ", o->name, o->arg ? " " : "",
+			 o->arg ? o->arg : "");
+		fprintf(f, "  %-26s %s\n", flag, o->doc);
+		if (o->unit || o->def)
+			fprintf(f, "  %-26s %s%s%s%s%s\n", "", o->unit ? "unit: " : "",
+				o->unit ? o->unit : "", o->unit && o->def ? "; " : "",
+				o->def ? "default: " : "", o->def ? o->def : "");
+	}
+}
+
 void cli_help(FILE *f, unsigned cmd)
 {
 	if (!cmd) {
@@ -150,21 +169,10 @@ void cli_help(FILE *f, unsigned cmd)
 	size_t c = 0;
 	while (c < NCOMMANDS && commands[c].cmd != cmd)
 		c++;
+	if (c == NCOMMANDS)
+		return;
 	fprintf(f, "usage: %s\n\n%s\n\noptions:\n", commands[c].synopsis, commands[c].about);
-	for (size_t i = 0; i < NOPTIONS; i++) {
-		const cli_opt *o = &options[i];
-		if (!(o->cmds & cmd))
-			continue;
-		char flag[64];
-		snprintf(flag, sizeof flag, "%c%c%s--%s%s%s", o->key ? '-' : ' ',
-			 o->key ? o->key : ' ', o->key ? ", " : "  ", o->name, o->arg ? " " : "",
-			 o->arg ? o->arg : "");
-		fprintf(f, "  %-26s %s\n", flag, o->doc);
-		if (o->unit || o->def)
-			fprintf(f, "  %-26s %s%s%s%s%s\n", "", o->unit ? "unit: " : "",
-				o->unit ? o->unit : "", o->unit && o->def ? "; " : "",
-				o->def ? "default: " : "", o->def ? o->def : "");
-	}
+	cli_help_options(f, options, NOPTIONS, cmd);
 	if (cmd & (CMD_RUN | CMD_SWEEP | CMD_FIT))
 		fprintf(f, "\nsettings for --set: 'convsim list' (for example --set beta=30 "
 			   "--set rotation=ccw\n--set method=rk4 --set dt=1e-5 --set "
@@ -180,14 +188,15 @@ const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion)
 	return buf;
 }
 
-int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
+int cli_next_option_in(const cli_opt *opts, size_t nopts, unsigned cmd, const char *who,
+		       const char *hint, int argc, char **argv, const char **arg)
 {
-	struct option longopts[NOPTIONS + 1];
-	char shortopts[2 * NOPTIONS + 2] = ":";
-	const char *names[NOPTIONS];
+	struct option longopts[CLI_MAX_OPTIONS + 1];
+	char shortopts[2 * CLI_MAX_OPTIONS + 2] = ":";
+	const char *names[CLI_MAX_OPTIONS];
 	size_t n = 0, at = 1;
-	for (size_t i = 0; i < NOPTIONS; i++) {
-		const cli_opt *o = &options[i];
+	for (size_t i = 0; i < nopts && i < CLI_MAX_OPTIONS; i++) {
+		const cli_opt *o = &opts[i];
 		if (!(o->cmds & cmd))
 			continue;
 		longopts[n] = (struct option){o->name, o->arg ? required_argument : no_argument,
@@ -206,10 +215,9 @@ int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
 	*arg = optarg;
 	if (c == -1)
 		return -1;
-	const char *cname = command_name(cmd);
 	if (c == ':' || c == '?') {
 		const char *bad = argv[optind - 1];
-		char word[64], hint[96];
+		char word[64], near[96];
 		if (optopt && optopt < 256) {
 			snprintf(word, sizeof word, "-%c", optopt);
 		} else {
@@ -219,8 +227,8 @@ int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
 				*eq = '\0';
 		}
 		if (c == ':') {
-			fprintf(stderr, "convsim %s: option %s needs an argument (see 'convsim help %s')\n",
-				cname, word, cname);
+			fprintf(stderr, "%s: option %s needs an argument (see '%s')\n", who, word,
+				hint);
 			return 0;
 		}
 		const char *plain = word;
@@ -230,16 +238,23 @@ int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
 		char full[80];
 		if (s)
 			snprintf(full, sizeof full, "--%s", s);
-		fprintf(stderr, "convsim %s: unknown or ambiguous option '%s'%s; 'convsim help %s' "
-				"lists them\n",
-			cname, word, cli_did_you_mean(hint, sizeof hint, s ? full : NULL), cname);
+		fprintf(stderr, "%s: unknown or ambiguous option '%s'%s; '%s' lists them\n", who,
+			word, cli_did_you_mean(near, sizeof near, s ? full : NULL), hint);
 		return 0;
 	}
 	/* a short letter maps to its entry's id */
-	for (size_t i = 0; i < NOPTIONS; i++)
-		if (options[i].key == c && (options[i].cmds & cmd))
-			return options[i].id;
+	for (size_t i = 0; i < nopts; i++)
+		if (opts[i].key == c && (opts[i].cmds & cmd))
+			return opts[i].id;
 	return c;
+}
+
+int cli_next_option(int argc, char **argv, unsigned cmd, const char **arg)
+{
+	char who[64], hint[64];
+	snprintf(who, sizeof who, "convsim %s", command_name(cmd));
+	snprintf(hint, sizeof hint, "convsim help %s", command_name(cmd));
+	return cli_next_option_in(options, NOPTIONS, cmd, who, hint, argc, argv, arg);
 }
 
 int cli_operand_index(void)

@@ -104,6 +104,91 @@ static int whole(const char *cmd, const char *opt, const char *arg, double hi, i
 	return 0;
 }
 
+/* The model of --preset into *o: 0, or 2 after naming the presets. */
+static int load_preset(cli_opts *o)
+{
+	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
+		char hint[96];
+		size_t n = 0;
+		while (sim_preset_names[n])
+			n++;
+		fprintf(stderr, "convsim %s: --preset: unknown preset '%s'%s; known:", o->cmd,
+			o->preset,
+			cli_did_you_mean(hint, sizeof hint,
+					 sim_suggest(o->preset, sim_preset_names, n,
+						     sizeof *sim_preset_names)));
+		for (size_t i = 0; i < n; i++)
+			fprintf(stderr, "%s %s", i ? "," : "", sim_preset_names[i]);
+		fputc('\n', stderr);
+		return 2;
+	}
+	return 0;
+}
+
+/* One option of command cmd (its id, its argument) into *o: 0, or 1
+ * after a message. */
+static int apply_option(cli_opts *o, unsigned cmd, int id, const char *arg)
+{
+	int bad = 0;
+	switch (id) {
+	case OPT_SET: bad = apply_set(o, arg); break;
+	case OPT_DURATION:
+		bad = cli_number(o->cmd, "duration", "seconds", arg, 0, 1e5, 1, &o->duration);
+		break;
+	case OPT_RATE:
+		bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
+		break;
+	case OPT_THREADS: bad = whole(o->cmd, "threads", arg, 64, &o->threads); break;
+	case OPT_COUPLING_STEPS:
+		bad = whole(o->cmd, "coupling-steps", arg, 1000, &o->coupling_steps);
+		break;
+	case OPT_OUT: o->out = arg; break;
+	case OPT_FORMAT: o->format = arg; break;
+	case OPT_BETA:
+	case OPT_ROTATION: /* run: one setting, as --set; sweep: a range, a list */
+		if (cmd == CMD_RUN)
+			bad = set_option(o, id == OPT_BETA ? "beta" : "rotation", arg);
+		else
+			*(id == OPT_BETA ? &o->beta : &o->rotation) = arg;
+		if (id == OPT_BETA)
+			o->beta_at = o->nvary;
+		break;
+	case OPT_QUIET: o->quiet = 1; break;
+	case OPT_VARY:
+		if (o->nvary == CLI_MAX_VARY) {
+			fprintf(stderr, "convsim %s: --vary: at most %d settings are varied\n",
+				o->cmd, CLI_MAX_VARY);
+			bad = 1;
+		} else {
+			o->vary[o->nvary++] = arg;
+		}
+		break;
+	case OPT_LHS: bad = whole(o->cmd, "lhs", arg, 10000, &o->lhs); break;
+	case OPT_SEED:
+		bad = cli_number(o->cmd, "seed", NULL, arg, 0, 4294967295.0, 0, &o->seed);
+		if (!bad && o->seed != floor(o->seed)) {
+			fprintf(stderr, "convsim %s: --seed must be a whole number, got '%s'\n",
+				o->cmd, arg);
+			bad = 1;
+		}
+		break;
+	case OPT_DATA: o->data = arg; break;
+	case OPT_BAND_FROM: o->band_from = arg; break;
+	case OPT_PEAKS: o->peaks = arg; break;
+	case OPT_FREE: o->free_list = arg; break;
+	case OPT_CURVE_STEP:
+		bad = cli_number(o->cmd, "curve-step", "deg", arg, 0, 90, 0, &o->curve_step);
+		break;
+	case OPT_FD_STEP:
+		bad = cli_number(o->cmd, "fd-step", NULL, arg, 0, 0.5, 1, &o->fd_step);
+		break;
+	case OPT_MAX_ITER: bad = whole(o->cmd, "max-iter", arg, 1000, &o->max_iter); break;
+	case OPT_STARTS: bad = whole(o->cmd, "starts", arg, FIT_MAX_STARTS, &o->starts); break;
+	default: break;
+	}
+	return bad;
+}
+
 int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 {
 	o->cmd = argv[0];
@@ -125,83 +210,12 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 		return rc;
 	const char *arg;
 	int id;
-	if (sim_preset(o->preset, &o->p, &o->sc, &o->m) != SIM_OK) {
-		char hint[96];
-		size_t n = 0;
-		while (sim_preset_names[n])
-			n++;
-		fprintf(stderr, "convsim %s: --preset: unknown preset '%s'%s; known:", o->cmd,
-			o->preset,
-			cli_did_you_mean(hint, sizeof hint,
-					 sim_suggest(o->preset, sim_preset_names, n,
-						     sizeof *sim_preset_names)));
-		for (size_t i = 0; i < n; i++)
-			fprintf(stderr, "%s %s", i ? "," : "", sim_preset_names[i]);
-		fputc('\n', stderr);
+	if (load_preset(o))
 		return 2;
-	}
 	cli_restart_options();
-	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1) {
-		int bad = 0;
-		switch (id) {
-		case OPT_SET: bad = apply_set(o, arg); break;
-		case OPT_DURATION:
-			bad = cli_number(o->cmd, "duration", "seconds", arg, 0, 1e5, 1, &o->duration);
-			break;
-		case OPT_RATE:
-			bad = cli_number(o->cmd, "sample-rate", "Hz", arg, 0, 1e6, 1, &o->rate);
-			break;
-		case OPT_THREADS: bad = whole(o->cmd, "threads", arg, 64, &o->threads); break;
-		case OPT_COUPLING_STEPS:
-			bad = whole(o->cmd, "coupling-steps", arg, 1000, &o->coupling_steps);
-			break;
-		case OPT_OUT: o->out = arg; break;
-		case OPT_FORMAT: o->format = arg; break;
-		case OPT_BETA:
-		case OPT_ROTATION: /* run: one setting, as --set; sweep: a range, a list */
-			if (cmd == CMD_RUN)
-				bad = set_option(o, id == OPT_BETA ? "beta" : "rotation", arg);
-			else
-				*(id == OPT_BETA ? &o->beta : &o->rotation) = arg;
-			if (id == OPT_BETA)
-				o->beta_at = o->nvary;
-			break;
-		case OPT_QUIET: o->quiet = 1; break;
-		case OPT_VARY:
-			if (o->nvary == CLI_MAX_VARY) {
-				fprintf(stderr, "convsim %s: --vary: at most %d settings are varied\n",
-					o->cmd, CLI_MAX_VARY);
-				bad = 1;
-			} else {
-				o->vary[o->nvary++] = arg;
-			}
-			break;
-		case OPT_LHS: bad = whole(o->cmd, "lhs", arg, 10000, &o->lhs); break;
-		case OPT_SEED:
-			bad = cli_number(o->cmd, "seed", NULL, arg, 0, 4294967295.0, 0, &o->seed);
-			if (!bad && o->seed != floor(o->seed)) {
-				fprintf(stderr, "convsim %s: --seed must be a whole number, got '%s'\n",
-					o->cmd, arg);
-				bad = 1;
-			}
-			break;
-		case OPT_DATA: o->data = arg; break;
-		case OPT_BAND_FROM: o->band_from = arg; break;
-		case OPT_PEAKS: o->peaks = arg; break;
-		case OPT_FREE: o->free_list = arg; break;
-		case OPT_CURVE_STEP:
-			bad = cli_number(o->cmd, "curve-step", "deg", arg, 0, 90, 0, &o->curve_step);
-			break;
-		case OPT_FD_STEP:
-			bad = cli_number(o->cmd, "fd-step", NULL, arg, 0, 0.5, 1, &o->fd_step);
-			break;
-		case OPT_MAX_ITER: bad = whole(o->cmd, "max-iter", arg, 1000, &o->max_iter); break;
-		case OPT_STARTS: bad = whole(o->cmd, "starts", arg, FIT_MAX_STARTS, &o->starts); break;
-		default: break;
-		}
-		if (bad)
+	while ((id = cli_next_option(argc, argv, cmd, &arg)) != -1)
+		if (apply_option(o, cmd, id, arg))
 			return 2;
-	}
 	if (o->format && strcmp(o->format, "csv") != 0 && strcmp(o->format, "json") != 0) {
 		fprintf(stderr, "convsim %s: --format must be csv or json, got '%s'\n", o->cmd,
 			o->format);

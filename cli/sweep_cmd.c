@@ -221,6 +221,20 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 		fprintf(f, json ? ",\"substeps\":%d,\"step_error\":" : ",%d,", t->r.substeps);
 		cli_put_num(f, t->r.step_error, nf);
 		fprintf(f, json ? ",\"tol_met\":%s" : ",%s", t->r.tol_met ? "true" : "false");
+		if (json) { /* the point's model error (docs/dem.md "Model error") */
+			sim_params p = o->p;
+			sim_scene sc = o->sc;
+			sim_method m = o->m;
+			sim_model_error me;
+			if (sim_study_apply(st, (size_t)i, &p, &sc, &m, NULL, 0) == SIM_OK) {
+				sim_model_check(&p, &sc, &me);
+				cli_put_json_num(f, ",\"model_error\":", me.checked ? me.error : NAN);
+				cli_put_json_num(f, ",\"model_error_uncertainty\":",
+						 me.checked ? me.error_uncertainty : NAN);
+				fprintf(f, ",\"model_checked\":%s,\"model_check_note\":\"%s\"",
+					me.checked ? "true" : "false", me.note);
+			}
+		}
 		if (pl->band) {
 			fputs(json ? ",\"band\":{\"lower\":" : ",", f);
 			cli_put_num(f, t->band[0], nf);

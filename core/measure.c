@@ -53,7 +53,8 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	sim_status st;
 	int err;
 	/* the steps are the engine's to choose only where the user left them */
-	int own_steps = m->dt == 0.0 && m->substeps == 0 && strcmp(m->name, "dem") == 0;
+	const ode_method *om = ode_find(m->name);
+	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
 	for (int attempt = 0;; attempt++) {
 		err = measure_once(p, sc, &run, t_end, &st, msg, msglen);

@@ -47,6 +47,15 @@ typedef struct ode_method {
 
 extern const ode_method ode_rk4, ode_dopri5, ode_euler, ode_split;
 
+/* The registry: every integrator, in the order sim_methods lists them and
+ * the setting "method" numbers them, as X(descriptor, name); each name is
+ * its descriptor's own (ode_registry.c and params.c read this list alone;
+ * test_params checks the names). */
+#define ODE_REGISTRY(X) X(ode_rk4, "rk4") X(ode_dopri5, "dopri5") X(ode_euler, "euler") \
+	X(ode_split, "dem")
+/* The default integrator (the presets'). */
+#define ODE_DEFAULT ode_split
+
 /* Method by name, NULL if unknown. */
 const ode_method *ode_find(const char *name);
 

@@ -247,7 +247,10 @@ const ode_method ode_dopri5 = {
 	.info = {.name = "dopri5",
 		 .order = 5,
 		 .adaptive = 1,
-		 .doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step"},
+		 .doc = "Dormand-Prince 5(4), PI step control, dense output; dt is the first step",
+		 .dt_feed = 1e-5, /* the first step */
+		 .dt_free = 1e-5,
+		 .cost = 1},
 	.dense = 1,
 	.alloc = dp_alloc,
 	.step = dp_step,

@@ -225,47 +225,17 @@ static void correct(split *w, const model *md, double H, double *y, const double
 		feed_yield_compliance(md, nb, (const double(*)[NQ_FULL])(a + 1), R1, w->yield);
 }
 
-static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
+/* The deck's motion over the step for the feed's sub-steps: each column's
+ * deck point at the sub-steps' starts (w->deck_pos) and its velocity at
+ * their middles (w->deck_vel), from the cubic Hermite of the step's ends
+ * ev0, ev1; the end's rotation into *R1. */
+static void deck_track(split *w, const model *md, double H, const model_eval *e_0,
+		       const model_eval *e_1, deck_rot *R1_out)
 {
-	split *w = p;
-	const model *md = sys->md;
-	double H = ode_fixed_step(*t, w->dt, t_max);
-	if (md->nf > 0 && !w->have_q) {
-		/* first step: the feed's reaction from the smooth law now */
-		memset(w->Qfeed, 0, sizeof w->Qfeed);
-		dynamics_feed_reaction(md, sys->ctl, *t, y, w->tmp, w->Qfeed);
-		w->have_q = 1;
-	}
 	const int ns = w->substeps;
-	/* 1. machine RK4 with the feed force held */
-	model_eval ev0, evm, ev1;
-	machine_rk4(w, sys, *t, H, y, &ev0, w->correct ? &evm : NULL, w->events ? &ev1 : NULL);
-	double t1 = (H == t_max - *t) ? t_max : *t + H;
-	if (md->nf == 0) {
-		*t = t1;
-		return SIM_OK;
-	}
-	/* 2. the feed along the interpolated deck motion (the machine's end
-	 * acceleration completes the deck velocity's interpolant), staggered
-	 * as leapfrog: a sub-step's impulses come from the compressions at
-	 * its start, and the velocities it solves for are those of its middle
-	 * (against the deck's velocity there), with which the positions
-	 * advance. Free flight is then exact, and a layer riding on the deck
-	 * follows the deck's displacement to O(h^3) per sub-step instead of
-	 * drifting by h^2 a / 2 (which moved lift-off by O(h)). */
-	if (w->events) {
-		/* the end's accelerations from RK4's last stage (at t1, on the
-		 * state y + H k3): they enter the deck velocity's cubic only,
-		 * whose error is O(H^4) either way; the end's positions and
-		 * velocities are the step's own */
-		model_full_coords(md, sys->ctl, t1, y, ev1.q, ev1.qd);
-	} else {
-		dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
-	}
-	const double h = H / ns;
-	double F[SIM_MAX_COLUMNS][2], impulse[SIM_MAX_COLUMNS][2];
 	const deck *dk = &md->dk;
-	deck_rot R0 = ev0.R, R1 = w->events ? deck_rotation(ev1.q) : ev1.R;
+	deck_rot R0 = e_0->R, R1 = w->events ? deck_rotation(e_1->q) : e_1->R;
+	*R1_out = R1;
 	/* the cubic's four weights at each sub-step's start (positions) and
 	 * middle (velocities), the same for every column: ode_hermite's
 	 * terms, operation for operation */
@@ -283,8 +253,8 @@ static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	 * of columns; where the deck does not turn the rate is (1, 0) in
 	 * position and 0 in velocity throughout, and one cubic does */
 	double e0[3][2][2], e1[3][2][2];
-	deck_point_affine(dk, &R0, ev0.q, ev0.qd, ev0.qdd, e0);
-	deck_point_affine(dk, &R1, ev1.q, ev1.qd, ev1.qdd, e1);
+	deck_point_affine(dk, &R0, e_0->q, e_0->qd, e_0->qdd, e0);
+	deck_point_affine(dk, &R1, e_1->q, e_1->qd, e_1->qdd, e1);
 	const int turns = !md->alpha_fixed;
 	double(*cp)[2][2] = w->cubic, (*cv)[2][2] = w->cubic + ns;
 	for (int b = 0; b <= turns; b++)
@@ -312,6 +282,18 @@ static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
 			vel[i][1] = cv[i][0][1] + (turns ? d * cv[i][1][1] : 0.0);
 		}
 	}
+}
+
+/* The feed's sub-steps along the tracked deck (feed_dem_step): the
+ * impulses over the step as forces F, the work and the energy they moved
+ * booked in y's accumulators (docs/energy.md). */
+static void feed_substeps(split *w, const model *md, double H, double *y,
+			  double F[SIM_MAX_COLUMNS][2])
+{
+	const int ns = w->substeps;
+	const double h = H / ns;
+	const deck *dk = &md->dk;
+	double impulse[SIM_MAX_COLUMNS][2];
 	feed_work work = {0.0, 0.0, 0.0};
 	double kin, pot, before = w->feed_energy;
 	if (!w->have_feed_energy) {
@@ -334,19 +316,71 @@ static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
 	acc[ACC_CONTACT] += md->col_weight * work.contact;
 	acc[ACC_DECK] += md->col_weight * work.deck;
 	acc[ACC_FEED] += w->feed_energy - before;
+}
+
+/* The feed's reaction on the machine for the next step (w->Qfeed, from
+ * the forces F at the end's rotation R1), the corrector, and what the
+ * deck yields to (w->yield). */
+static void feed_reaction(split *w, const model *md, double H, double *y,
+			  double F[SIM_MAX_COLUMNS][2], const model_eval *evm, const deck_rot *R1)
+{
+	const deck *dk = &md->dk;
 	double Qold[NQ_FULL];
 	memcpy(Qold, w->Qfeed, sizeof Qold);
 	memset(w->Qfeed, 0, sizeof w->Qfeed);
 	if (md->sc.feed_coupling)
-		deck_forces(dk, &R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
+		deck_forces(dk, R1, (const double(*)[2])F, md->col_weight, w->Qfeed);
 	if (w->correct)
-		correct(w, md, H, y, Qold, &evm, &R1);
+		correct(w, md, H, y, Qold, evm, R1);
 	if (w->couple) {
 		for (int k = 0; k < dk->K; k++)
 			for (int c = 0; c < 2; c++)
 				w->yield->F[k][c] = md->sc.feed_coupling ? F[k][c] : 0.0;
 		w->have_yield = 1;
 	}
+}
+
+static int split_step(void *p, dyn *sys, double *t, double *y, double t_max)
+{
+	split *w = p;
+	const model *md = sys->md;
+	double H = ode_fixed_step(*t, w->dt, t_max);
+	if (md->nf > 0 && !w->have_q) {
+		/* first step: the feed's reaction from the smooth law now */
+		memset(w->Qfeed, 0, sizeof w->Qfeed);
+		dynamics_feed_reaction(md, sys->ctl, *t, y, w->tmp, w->Qfeed);
+		w->have_q = 1;
+	}
+	/* 1. machine RK4 with the feed force held */
+	model_eval ev0, evm, ev1;
+	machine_rk4(w, sys, *t, H, y, &ev0, w->correct ? &evm : NULL, w->events ? &ev1 : NULL);
+	double t1 = (H == t_max - *t) ? t_max : *t + H;
+	if (md->nf == 0) {
+		*t = t1;
+		return SIM_OK;
+	}
+	/* 2. the feed along the interpolated deck motion (the machine's end
+	 * acceleration completes the deck velocity's interpolant), staggered
+	 * as leapfrog: a sub-step's impulses come from the compressions at
+	 * its start, and the velocities it solves for are those of its middle
+	 * (against the deck's velocity there), with which the positions
+	 * advance. Free flight is then exact, and a layer riding on the deck
+	 * follows the deck's displacement to O(h^3) per sub-step instead of
+	 * drifting by h^2 a / 2 (which moved lift-off by O(h)). */
+	if (w->events) {
+		/* the end's accelerations from RK4's last stage (at t1, on the
+		 * state y + H k3): they enter the deck velocity's cubic only,
+		 * whose error is O(H^4) either way; the end's positions and
+		 * velocities are the step's own */
+		model_full_coords(md, sys->ctl, t1, y, ev1.q, ev1.qd);
+	} else {
+		dyn_machine_rhs(sys, t1, y, w->Qfeed, w->k4, &ev1);
+	}
+	deck_rot R1;
+	double F[SIM_MAX_COLUMNS][2];
+	deck_track(w, md, H, &ev0, &ev1, &R1);
+	feed_substeps(w, md, H, y, F);
+	feed_reaction(w, md, H, y, F, &evm, &R1);
 	*t = t1;
 	return SIM_OK;
 }
@@ -418,7 +452,12 @@ const ode_method ode_split = {
 		 .order = 1,
 		 .adaptive = 0,
 		 .real_limit = RK4_REAL_LIMIT,
-		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction"},
+		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction",
+		 .substeps = 1,
+		 .shadow = 1,
+		 .dt_feed = 0, /* from the scene's time scales */
+		 .dt_free = 0,
+		 .cost = 1},
 	.dense = 0,
 	.alloc = split_alloc,
 	.step = split_step,

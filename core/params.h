@@ -135,6 +135,18 @@ typedef struct sim_method_info {
 	 * the negative real axis); 0 for the adaptive ones */
 	double real_limit;
 	const char *doc;
+	/* What the method can do; generic code asks these, never its name. */
+	int substeps; /* steps the feed apart in sub-steps of the machine step
+			 (sim_method.substeps): its energy is booked apart, its
+			 step error modelled, the symmetric machine settles reduced */
+	int shadow;   /* a shadow run at half the sub-steps measures the feed
+			 step's error (shadow.c) */
+	double dt_feed, dt_free; /* the default step with a feed and without,
+				    s; 0: from the scene's time scales
+				    (sim_default_dt), refined by sim_measure
+				    until tol holds */
+	double cost;  /* right-hand sides a step relative to RK4's four (the
+			 daemon's CPU estimate) */
 } sim_method_info;
 
 #endif

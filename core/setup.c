@@ -94,6 +94,52 @@ static void preload(const sim_params *p, double F0[2])
 	F0[1] = W - F0[0];
 }
 
+/* The reduced coordinates of md (T, nq, col, ncol): the symmetric machine
+ * drops alpha, the ideal drive phi. */
+static void reduce_coordinates(model *md, int sym, int ideal)
+{
+	/* reduced coordinates: each full coordinate that is integrated gets a
+	 * column; under the ideal drive phi follows alpha's column */
+	int r = 0, col_alpha = -1;
+	for (int i = 0; i < NQ_FULL; i++) {
+		if (i == Q_ALPHA && sym)
+			continue;
+		if (i == Q_PHI && ideal)
+			continue;
+		if (i == Q_ALPHA)
+			col_alpha = r;
+		md->T[i][r++] = 1.0;
+	}
+	if (ideal && col_alpha >= 0)
+		md->T[Q_PHI][col_alpha] = 1.0;
+	md->nq = r;
+	for (int c = 0; c < r; c++)
+		for (int i = 0; i < NQ_FULL; i++)
+			if (md->T[i][c] != 0.0)
+				md->col[c][md->ncol[c]++] = i;
+}
+
+/* The feed's columns on the deck (one representative column of weight
+ * columns on the symmetric machine) and its coordinates' count. */
+static void place_columns(model *md, const sim_params *p, const sim_scene *sc, int sym)
+{
+	deck *dk = &md->dk;
+	md->L = sc->layers;
+	if (sym) {
+		dk->K = 1;
+		md->col_weight = (double)sc->columns;
+		dk->d[0] = 0.0;
+	} else {
+		dk->K = sc->columns;
+		md->col_weight = 1.0;
+		for (int k = 0; k < dk->K; k++)
+			dk->d[k] = dk->K == 1 ? 0.0
+					      : p->column_span *
+						    (-1.0 + 2.0 * (double)k / (double)(dk->K - 1));
+	}
+	md->nf = dk->K * md->L;
+}
+
 void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene *sc)
 {
 	memset(md, 0, sizeof *md);
@@ -121,47 +167,14 @@ void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene 
 	if (feed && !sc->feed_coupling)
 		md->reductions |= SIM_RED_ONE_WAY;
 
-	/* reduced coordinates: each full coordinate that is integrated gets a
-	 * column; under the ideal drive phi follows alpha's column */
-	int r = 0, col_alpha = -1;
-	for (int i = 0; i < NQ_FULL; i++) {
-		if (i == Q_ALPHA && sym)
-			continue;
-		if (i == Q_PHI && ideal)
-			continue;
-		if (i == Q_ALPHA)
-			col_alpha = r;
-		md->T[i][r++] = 1.0;
-	}
-	if (ideal && col_alpha >= 0)
-		md->T[Q_PHI][col_alpha] = 1.0;
-	md->nq = r;
-	for (int c = 0; c < r; c++)
-		for (int i = 0; i < NQ_FULL; i++)
-			if (md->T[i][c] != 0.0)
-				md->col[c][md->ncol[c]++] = i;
+	reduce_coordinates(md, sym, ideal);
 	md->alpha_fixed = sym;
 	md->phi_prescribed = ideal;
 	model_solve_layout(md);
 
 	md->dk.h_d = p->h_d;
-	if (feed) {
-		deck *dk = &md->dk;
-		md->L = sc->layers;
-		if (sym) {
-			dk->K = 1;
-			md->col_weight = (double)sc->columns;
-			dk->d[0] = 0.0;
-		} else {
-			dk->K = sc->columns;
-			md->col_weight = 1.0;
-			for (int k = 0; k < dk->K; k++)
-				dk->d[k] = dk->K == 1 ? 0.0
-						      : p->column_span *
-							    (-1.0 + 2.0 * (double)k / (double)(dk->K - 1));
-		}
-		md->nf = dk->K * md->L;
-	}
+	if (feed)
+		place_columns(md, p, sc, sym);
 	md->npos = md->nq + 2 * md->nf;
 	md->n = 2 * md->npos + ACC_N;
 

@@ -54,7 +54,7 @@ void shadow_stop(sim *s)
 void shadow_begin(sim *s)
 {
 	shadow_stop(s);
-	if (s->ode != &ode_split || !s->cfg.feed_events || s->md.nf == 0 || s->cfg.substeps < 3 ||
+	if (!s->ode->info.shadow || !s->cfg.feed_events || s->md.nf == 0 || s->cfg.substeps < 3 ||
 	    s->failed)
 		return;
 	sim_method m = s->cfg;

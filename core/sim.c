@@ -118,7 +118,7 @@ static int settle_reduced(sim *s)
 	const model *md = &s->md;
 	if (!(md->sc.settle > 0.0) || md->nf == 0 || md->alpha_fixed ||
 	    md->layout != MODEL_LAYOUT_TROUGH3 || !model_machine_symmetric(&md->p) ||
-	    strcmp(s->cfg.name, "dem") != 0)
+	    !s->ode->info.substeps)
 		return -1;
 	sim_scene rsc = md->sc;
 	rsc.trough_rotation = 0;

@@ -49,19 +49,28 @@ const sim_setting *sim_settings(size_t *n);
 /* The czubak2016 preset (docs/MODEL.md), default scene and default method. */
 void sim_preset_czubak2016(sim_params *p, sim_scene *s, sim_method *m);
 
-/* Whether the column model of a scene lies inside the domain where it was
- * checked against LIGGGHTS beds (docs/dem.md, `make bench-dem`: the
- * czubak2016 machine, a 4-diameter bed at 11 angles in both senses, other
- * depths at beta = 30 deg): 1 inside; 0 outside, with the reason and what
- * to use instead written into why (len bytes); -1 where the scene has no
- * column feed (no feed, or feed_model liggghts). The rule: at most 2
- * layers (within 1 % of the DEM bed of that depth at 30 deg); or at most 8
- * layers with contacts 10x the preset's stiffness or stiffer, k_c / m_n >=
- * 2e7 s^-2, except beta in (137, 165) deg cw and (15, 45) deg ccw, the DEM
- * bed's second peak (within 10 % at 19 of the 22 angles and senses of a
- * 4-diameter bed); or the preset liggghts-bed4's contact fitted to a
- * 4-diameter bed, at most 4 layers. */
-int sim_feed_validated(const sim_params *p, const sim_scene *sc, char *why, size_t len);
+/* How far the scene's column model is from a DEM bed (docs/dem.md "Model
+ * error"), from the DEM map compiled in (tests/bench/results/
+ * model_check.csv). checked: 1 when the scene's settings (all but beta,
+ * rotation and the ramps) are those of a map entry's calibrated column
+ * model with its depth, and (beta, rotation), or its mirror image on a
+ * symmetric machine, lies within the angles the entry measured in that
+ * sense (bounds included). error (m/s): the expected |v - v_DEM| there,
+ * |v_column - v_DEM| interpolated linearly in beta between the entry's
+ * two nearest points plus the DEM's seed spread there; error_uncertainty
+ * (m/s): that spread plus, between points, up to half the change of
+ * |v_column - v_DEM| across them; both NaN unless checked. note: one plain
+ * sentence, "DEM check: within +-E m/s here (...)" or why not checked and
+ * the nearest checked point. */
+typedef struct sim_model_error {
+	int checked;
+	double error, error_uncertainty;
+	char note[200];
+} sim_model_error;
+/* Fill *out for the scene. Returns 1 checked, 0 not checked, -1 no column
+ * model to check (no feed, or a LIGGGHTS feed; the note says so). Pure:
+ * no I/O, no allocation. */
+int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *out);
 
 /* Names of known presets, NULL-terminated, static. Fill by name. */
 extern const char *const sim_preset_names[];
@@ -120,6 +129,9 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m,
 /* Registry of integrators, built from each method's own descriptor: an
  * array of *n pointers, all static. */
 const sim_method_info *const *sim_methods(size_t *n);
+/* The name of the default integrator (the presets'; the daemon guesses an
+ * adaptive method's steps by its). Static. */
+const char *sim_default_method(void);
 
 /* ---- instances ------------------------------------------------------- */
 

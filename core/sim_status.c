@@ -46,10 +46,10 @@ static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 	 * deck. With one-way coupling the machine gives nothing and the deck's
 	 * work on the feed is an input of its own. */
 	double input = acc[ACC_IN], coupling = 0.0;
-	if (s->ode == &ode_split && md->nf > 0 && md->sc.feed_coupling) {
+	if (s->ode->info.substeps && md->nf > 0 && md->sc.feed_coupling) {
 		double machine_change = kin + pot - s->e0 - acc[ACC_FEED];
 		coupling = acc[ACC_IN] - acc[ACC_DAMP] - machine_change - acc[ACC_DECK];
-	} else if (s->ode == &ode_split && md->nf > 0) {
+	} else if (s->ode->info.substeps && md->nf > 0) {
 		input += acc[ACC_DECK];
 	}
 	double dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + acc[ACC_CONTACT] + coupling;
@@ -127,7 +127,7 @@ static void step_error(const sim *s, double v, double stat, sim_status *st)
 {
 	st->tol = s->cfg.tol;
 	st->machine_error = st->step_error = 0.0;
-	if (s->ode == &ode_split && s->md.nf > 0) {
+	if (s->ode->info.substeps && s->md.nf > 0) {
 		st->machine_error = machine_step_error(s, v);
 		st->step_error = isnan(s->step_error) ? calibrated_step_error(s, v)
 						      : s->step_error + st->machine_error;

@@ -227,6 +227,44 @@ static void bed_grains(dem_bed *b, double pitch, int nx, int ny)
 	}
 }
 
+/* LIGGGHTS opened for bed b, on communicator comm or without MPI: 0, or
+ * -1 with msg (b is the caller's to free). */
+static int bed_open(dem_bed *b, const void *comm, char *msg, size_t msglen)
+{
+	const dem_bed_spec *s = &b->spec;
+	/* CONVSIM_DEM_LOG names a file for LIGGGHTS's own output (its error
+	 * messages among it): the one way to see why it ended the process */
+	const char *screen = getenv("CONVSIM_DEM_LOG");
+	/* the mesh reader writes to the screen unasked: /dev/null, not none */
+	if (!screen)
+		screen = s->wiggle_period > 0 ? "/dev/null" : "none";
+	char *args[] = {"liggghts", "-log", "none", "-screen", (char *)screen, NULL};
+	if (comm)
+		lammps_open(5, args, *(const MPI_Comm *)comm, &b->lmp);
+	else
+		lammps_open_no_mpi(5, args, &b->lmp);
+	if (!b->lmp) {
+		snprintf(msg, msglen, "dem bed: LIGGGHTS did not open");
+		return -1;
+	}
+	return 0;
+}
+
+/* What the bed reports: its mass, centre, momentum and energies as
+ * LIGGGHTS variables (bed_var). */
+static void bed_observers(dem_bed *b)
+{
+	bed_cmd(b, "compute ke all ke update_on_run_end yes");
+	bed_cmd(b, "variable m equal mass(all)");
+	bed_cmd(b, "variable xm equal xcm(all,x)");
+	bed_cmd(b, "variable zm equal xcm(all,z)");
+	bed_cmd(b, "variable px equal mass(all)*vcm(all,x)");
+	bed_cmd(b, "variable pz equal mass(all)*vcm(all,z)");
+	bed_cmd(b, "variable ke equal c_ke");
+	bed_cmd(b, "compute rke all erotate/sphere update_on_run_end yes");
+	bed_cmd(b, "variable rke equal c_rke");
+}
+
 dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size_t msglen)
 {
 	if (spec_check(spec, msg, msglen))
@@ -241,30 +279,11 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	double pitch = 1.05 * s->d_max;
 	int nx = (int)floor(s->cell_x / pitch), ny = (int)floor(s->cell_y / pitch);
 	int nz = (s->grains + nx * ny - 1) / (nx * ny);
-	double d_mean = 0.5 * (s->d_min + s->d_max);
-	/* the mean of d^3 over the uniform distribution of d */
-	double d3 = (pow(s->d_max, 4) - pow(s->d_min, 4)) / (4 * fmax(s->d_max - s->d_min, 1e-300));
-	if (s->d_max - s->d_min < 1e-12 * d_mean)
-		d3 = d_mean * d_mean * d_mean;
-	b->m_mean = s->density * M_PI / 6 * d3;
-	double m_min = s->density * M_PI / 6 * pow(s->d_min, 3);
-	double kn = s->k_over_m * b->m_mean;
-	b->dt = M_PI / sqrt(kn / m_min) / 50;
+	b->m_mean = dem_bed_spec_mass_mean(s);
+	b->dt = dem_bed_spec_dt(s);
 	double z_top = 4 * nz * pitch + 20 * s->d_max;
 
-	/* CONVSIM_DEM_LOG names a file for LIGGGHTS's own output (its error
-	 * messages among it): the one way to see why it ended the process */
-	const char *screen = getenv("CONVSIM_DEM_LOG");
-	/* the mesh reader writes to the screen unasked: /dev/null, not none */
-	if (!screen)
-		screen = s->wiggle_period > 0 ? "/dev/null" : "none";
-	char *args[] = {"liggghts", "-log", "none", "-screen", (char *)screen, NULL};
-	if (comm)
-		lammps_open(5, args, *(const MPI_Comm *)comm, &b->lmp);
-	else
-		lammps_open_no_mpi(5, args, &b->lmp);
-	if (!b->lmp) {
-		snprintf(msg, msglen, "dem bed: LIGGGHTS did not open");
+	if (bed_open(b, comm, msg, msglen)) {
 		free(b);
 		return NULL;
 	}
@@ -299,15 +318,7 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	bed_grains(b, pitch, nx, ny);
 	bed_cmd(b, "fix deck all gravity %.17g vector 0 0 -1", s->g);
 	bed_cmd(b, "fix step all %s", s->freeze_rotation ? "nve" : "nve/sphere");
-	bed_cmd(b, "compute ke all ke update_on_run_end yes");
-	bed_cmd(b, "variable m equal mass(all)");
-	bed_cmd(b, "variable xm equal xcm(all,x)");
-	bed_cmd(b, "variable zm equal xcm(all,z)");
-	bed_cmd(b, "variable px equal mass(all)*vcm(all,x)");
-	bed_cmd(b, "variable pz equal mass(all)*vcm(all,z)");
-	bed_cmd(b, "variable ke equal c_ke");
-	bed_cmd(b, "compute rke all erotate/sphere update_on_run_end yes");
-	bed_cmd(b, "variable rke equal c_rke");
+	bed_observers(b);
 	if (s->settle > 0)
 		bed_cmd(b, "run %ld", (long)ceil(s->settle / b->dt));
 	else

@@ -16,6 +16,28 @@ int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth)
 	return n < 1 ? 1 : n > 1000000 ? 1000000 : (int)n;
 }
 
+double dem_bed_spec_mass_mean(const dem_bed_spec *s)
+{
+	double d_mean = 0.5 * (s->d_min + s->d_max);
+	/* the mean of d^3 over the uniform distribution of d */
+	double d3 = (pow(s->d_max, 4) - pow(s->d_min, 4)) / (4 * fmax(s->d_max - s->d_min, 1e-300));
+	if (s->d_max - s->d_min < 1e-12 * d_mean)
+		d3 = d_mean * d_mean * d_mean;
+	return s->density * M_PI / 6 * d3;
+}
+
+double dem_bed_spec_dt(const dem_bed_spec *s)
+{
+	double m_min = s->density * M_PI / 6 * pow(s->d_min, 3);
+	double kn = s->k_over_m * dem_bed_spec_mass_mean(s);
+	return M_PI / sqrt(kn / m_min) / 50;
+}
+
+double dem_bed_spec_cost(const dem_bed_spec *s)
+{
+	return DEM_CPU_PER_GRAIN_STEP * s->grains / dem_bed_spec_dt(s);
+}
+
 void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b)
 {
 	double d_mean = 0.004;

@@ -60,6 +60,20 @@ typedef struct dem_bed_spec {
  * model's contact numbers: k_c/m_n, R, mu; no rolling friction; seed 1;
  * settled 0.3 s (0.05 s for one grain). */
 void dem_bed_spec_default(const sim_params *p, double depth, dem_bed_spec *b);
+/* The mean grain's mass (kg) of a bed of spec s. */
+double dem_bed_spec_mass_mean(const dem_bed_spec *s);
+/* The DEM step (s) of a bed of spec s: a fiftieth of the floor contact's
+ * period for the lightest grain, pi / sqrt(k / m_min) / 50 with k the
+ * stiffness k_over_m gives the mean grain (dem_bed_dt is this). */
+double dem_bed_spec_dt(const dem_bed_spec *s);
+/* CPU seconds one grain's DEM step costs, measured: a coupled bed of 367
+ * grains at k/m = 2e6 1/s^2 (DEM step 3.77e-5 s) took 3.15 CPU s a
+ * simulated second (docs/dem.md "Admission and cost"; 92 grains 0.77,
+ * 1467 grains 15.2, where this gives 0.78 and 12.5). */
+#define DEM_CPU_PER_GRAIN_STEP 3.2e-7
+/* The bed's expected CPU seconds per simulated second: grains / DEM step
+ * times DEM_CPU_PER_GRAIN_STEP (one rank). */
+double dem_bed_spec_cost(const dem_bed_spec *s);
 /* Grains of mean diameter d_mean (m) that fill a cell_x x cell_y cell
  * (m) `depth` mean diameters deep at packing 0.6; at least 1. */
 int dem_bed_grains(double cell_x, double cell_y, double d_mean, double depth);

@@ -54,10 +54,13 @@ dem_feed *dem_feed_local(const dem_bed_spec *spec, const void *comm, char *msg, 
  * child leads a process group of its own, which a kill ends whole. Waits
  * for the bed to settle. An answer (the settled bed, an interval's state)
  * that takes longer than timeout s (0: no limit) ends the child as hung
- * and fails the request. NULL with msg on error (the program missing, the
- * child refusing, ending or hanging). */
+ * and fails the request. watch_fd: -1, or a socket (the creating client's)
+ * whose peer's leaving while the bed settles ends the child and fails the
+ * request, so that an abandoned create holds nothing. NULL with msg on
+ * error (the program missing, the child refusing, ending or hanging, the
+ * client gone). */
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, double timeout, char *msg, size_t msglen);
+			  int ranks, double timeout, int watch_fd, char *msg, size_t msglen);
 /* The child's process id (remote; 0 for local, NULL, or once it ended
  * and was reaped). */
 long dem_feed_pid(const dem_feed *f);

@@ -19,6 +19,7 @@
 #include <fcntl.h>
 #include <math.h>
 #include <poll.h>
+#include <sys/socket.h>
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
@@ -42,6 +43,8 @@ typedef struct remote {
 	int ranks;     /* > 1: pid is mpirun's */
 	int to, from;  /* our ends: its stdin, its stdout */
 	double timeout; /* s an answer may take; 0: no limit */
+	int watch;     /* -1, or a socket whose peer's leaving cancels the
+			  settling (the first answer) */
 	char in[DEM_PROTO_LINE];
 	size_t have;   /* bytes of in read but not yet taken */
 } remote;
@@ -88,30 +91,54 @@ static int remote_send(remote *r, const char *line, size_t n)
 	return 0;
 }
 
-/* Wait until the answer has bytes to read: 0, or -1 when r->timeout s
- * pass without any (the deadline counts from the request). */
+/* 1 when the watched socket's peer has gone (hung up, or the end of its
+ * data); data from it ends the watch (it is still there). */
+static int watch_gone(remote *r, short revents)
+{
+	if (revents & (POLLHUP | POLLERR | POLLNVAL))
+		return 1;
+	if (!(revents & POLLIN))
+		return 0;
+	char c;
+	ssize_t n = recv(r->watch, &c, 1, MSG_PEEK | MSG_DONTWAIT);
+	if (n == 0)
+		return 1;
+	if (n > 0)
+		r->watch = -1; /* a pipelined request: the client is there */
+	return 0;
+}
+
+/* Wait until the answer has bytes to read: 0, -1 when r->timeout s pass
+ * without any (the deadline counts from the request), -2 when the
+ * watched socket's peer leaves. */
 static int remote_await(remote *r, const struct timespec *t0)
 {
-	if (!(r->timeout > 0))
+	if (!(r->timeout > 0) && r->watch < 0)
 		return 0;
 	for (;;) {
 		struct timespec now;
 		clock_gettime(CLOCK_MONOTONIC, &now);
-		double left = r->timeout - ((double)(now.tv_sec - t0->tv_sec) +
-					    1e-9 * (double)(now.tv_nsec - t0->tv_nsec));
+		double left = r->timeout > 0 ? r->timeout - ((double)(now.tv_sec - t0->tv_sec) +
+							     1e-9 * (double)(now.tv_nsec - t0->tv_nsec))
+					     : 1e9;
 		if (left <= 0)
 			return -1;
-		struct pollfd p = {.fd = r->from, .events = POLLIN};
-		int n = poll(&p, 1, left > 1e6 ? 1000000000 : (int)ceil(left * 1e3));
-		if (n > 0)
+		struct pollfd p[2] = {{.fd = r->from, .events = POLLIN},
+				      {.fd = r->watch, .events = POLLIN}};
+		int n = poll(p, r->watch >= 0 ? 2 : 1,
+			     left > 1e6 ? 1000000000 : (int)ceil(left * 1e3));
+		if (n > 0 && (p[0].revents & (POLLIN | POLLHUP | POLLERR)))
 			return 0;
+		if (n > 0 && r->watch >= 0 && watch_gone(r, p[1].revents))
+			return -2;
 		if (n < 0 && errno != EINTR)
 			return 0; /* the read says what is wrong */
 	}
 }
 
 /* Read one answer line into line (newline dropped): 0, -1 at the end of
- * the answers or a line too long, -2 when no answer came in time. */
+ * the answers or a line too long, -2 when no answer came in time, -3 when
+ * the watched socket's peer left. */
 static int remote_receive(remote *r, char *line, size_t len)
 {
 	struct timespec t0;
@@ -130,8 +157,9 @@ static int remote_receive(remote *r, char *line, size_t len)
 		}
 		if (r->have == sizeof r->in)
 			return -1;
-		if (remote_await(r, &t0))
-			return -2;
+		int w = remote_await(r, &t0);
+		if (w)
+			return w == -2 ? -3 : -2;
 		ssize_t got = read(r->from, r->in + r->have, sizeof r->in - r->have);
 		if (got < 0 && errno == EINTR)
 			continue;
@@ -157,6 +185,9 @@ static int remote_exchange(remote *r, const char *req, int n, char *msg, size_t 
 		if (rc == -2)
 			snprintf(msg, msglen, "the bed process (pid %ld) gave no answer within %g s "
 					      "(--dem-timeout) and was ended", pid, r->timeout);
+		if (rc == -3)
+			snprintf(msg, msglen, "the client went away while the bed settled: the bed "
+					      "process (pid %ld) was ended", pid);
 		return -1;
 	}
 	if (!strncmp(line, "error ", 6)) {
@@ -302,7 +333,7 @@ fail:
 }
 
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, double timeout, char *msg, size_t msglen)
+			  int ranks, double timeout, int watch_fd, char *msg, size_t msglen)
 {
 	char req[DEM_PROTO_LINE];
 	if (spec->wiggle_period > 0) {
@@ -319,11 +350,13 @@ dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int ni
 	r->to = r->from = -1;
 	r->ranks = ranks;
 	r->timeout = timeout > 0 && isfinite(timeout) ? timeout : 0;
+	r->watch = watch_fd;
 	pthread_mutex_init(&r->lock, NULL);
 	if (remote_spawn(r, bed_path, nice_value, ranks, msg, msglen) ||
 	    remote_exchange(r, req, dem_proto_bed_line(req, sizeof req, spec), msg, msglen)) {
 		remote_free(&r->base);
 		return NULL;
 	}
+	r->watch = -1; /* settled: the session lives on without its creator */
 	return &r->base;
 }

@@ -25,6 +25,41 @@ static void motion_basis(double omega, int harmonics, double t, double *phi)
 	}
 }
 
+/* The harmonic series of the deck's motion (dx, dy at t, n samples, the
+ * rotor's mean speed omega) by least squares for x and y on the same
+ * basis (GSL's SVD solver) into out's coefficients. 1 when out of memory
+ * or singular. */
+static int fit_series(const double *t, const double *dx, const double *dy, long n, double omega,
+		      int harmonics, dem_motion *out)
+{
+	int nb = 2 * harmonics + 1;
+	double phi[2 * DEM_MAX_HARMONICS + 1], chisq;
+	memset(out, 0, sizeof *out);
+	gsl_matrix *X = gsl_matrix_alloc((size_t)n, (size_t)nb);
+	gsl_vector *obs = gsl_vector_alloc((size_t)n), *coef = gsl_vector_alloc((size_t)nb);
+	gsl_matrix *cov = gsl_matrix_alloc((size_t)nb, (size_t)nb);
+	gsl_multifit_linear_workspace *ws = gsl_multifit_linear_alloc((size_t)n, (size_t)nb);
+	int bad = !X || !obs || !coef || !cov || !ws;
+	for (long i = 0; i < n && !bad; i++) {
+		motion_basis(omega, harmonics, t[i], phi);
+		for (int r = 0; r < nb; r++)
+			gsl_matrix_set(X, (size_t)i, (size_t)r, phi[r]);
+	}
+	for (int axis = 0; axis < 2 && !bad; axis++) {
+		for (long i = 0; i < n; i++)
+			gsl_vector_set(obs, (size_t)i, axis ? dy[i] : dx[i]);
+		bad = gsl_multifit_linear(X, obs, coef, cov, &chisq, ws) != GSL_SUCCESS;
+		for (int r = 0; r < nb && !bad; r++)
+			(axis ? out->b : out->a)[r] = gsl_vector_get(coef, (size_t)r);
+	}
+	gsl_multifit_linear_free(ws);
+	gsl_matrix_free(cov);
+	gsl_vector_free(coef);
+	gsl_vector_free(obs);
+	gsl_matrix_free(X);
+	return bad;
+}
+
 int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m, double t0,
 		   double t1, int harmonics, dem_motion *out, char *msg, size_t msglen)
 {
@@ -63,31 +98,8 @@ int dem_motion_fit(const sim_params *p, const sim_scene *sc, const sim_method *m
 		omega += fabs(st.rotor_speed) / (double)n;
 	}
 	int nb = 2 * harmonics + 1;
-	double phi[2 * DEM_MAX_HARMONICS + 1], chisq;
-	memset(out, 0, sizeof *out);
-	/* least squares for x and y on the same basis (GSL's SVD solver) */
-	gsl_matrix *X = gsl_matrix_alloc((size_t)n, (size_t)nb);
-	gsl_vector *obs = gsl_vector_alloc((size_t)n), *coef = gsl_vector_alloc((size_t)nb);
-	gsl_matrix *cov = gsl_matrix_alloc((size_t)nb, (size_t)nb);
-	gsl_multifit_linear_workspace *ws = gsl_multifit_linear_alloc((size_t)n, (size_t)nb);
-	int bad = !X || !obs || !coef || !cov || !ws;
-	for (long i = 0; i < n && !bad; i++) {
-		motion_basis(omega, harmonics, t[i], phi);
-		for (int r = 0; r < nb; r++)
-			gsl_matrix_set(X, (size_t)i, (size_t)r, phi[r]);
-	}
-	for (int axis = 0; axis < 2 && !bad; axis++) {
-		for (long i = 0; i < n; i++)
-			gsl_vector_set(obs, (size_t)i, axis ? dy[i] : dx[i]);
-		bad = gsl_multifit_linear(X, obs, coef, cov, &chisq, ws) != GSL_SUCCESS;
-		for (int r = 0; r < nb && !bad; r++)
-			(axis ? out->b : out->a)[r] = gsl_vector_get(coef, (size_t)r);
-	}
-	gsl_multifit_linear_free(ws);
-	gsl_matrix_free(cov);
-	gsl_vector_free(coef);
-	gsl_vector_free(obs);
-	gsl_matrix_free(X);
+	double phi[2 * DEM_MAX_HARMONICS + 1];
+	int bad = fit_series(t, dx, dy, n, omega, harmonics, out);
 	if (bad) {
 		snprintf(msg, msglen, "deck motion: the fit failed (out of memory or singular)");
 		err = SIM_ENOMEM;

@@ -5,10 +5,8 @@
  * residuals r_i = (model_i - data_i) / sigma_i (sigma_i = 1 when the data
  * give none).
  *
- * Bounds by a smooth transform: each free parameter x in [lo, hi] is
- * x = lo + (hi - lo) (1 + sin z) / 2 over an unbounded z (on log x when
- * lo > 0 and hi / lo >= 1000, so that a stiffness spanning decades moves
- * in proportion); the solver works in z and never leaves the bounds.
+ * Bounds by a smooth transform (fit_setup.c): the solver works in an
+ * unbounded z and never leaves the bounds.
  *
  * Jacobian by forward differences in x, all columns in one parallel batch:
  * step h_j = fd_rel * max(|x_j|, 1e-3 (hi_j - lo_j)) (5 % by default),
@@ -46,46 +44,10 @@
  * measure's jitter and the iterate stands */
 #define MAX_TRIALS 8
 
-static int log_scale(const fit_free *f)
-{
-	return f->lo > 0 && f->hi / f->lo >= 1000;
-}
-
-/* x at u in [0, 1] across the bounds (in log x on a log scale). */
-static double x_of_u(const fit_free *f, double u)
-{
-	if (log_scale(f))
-		return exp(log(f->lo) + u * (log(f->hi) - log(f->lo)));
-	return f->lo + u * (f->hi - f->lo);
-}
-
-static double x_of_z(const fit_free *f, double z)
-{
-	return x_of_u(f, 0.5 * (1 + sin(z)));
-}
-
-static double dx_dz(const fit_free *f, double z)
-{
-	double du = 0.5 * cos(z);
-	if (log_scale(f))
-		return x_of_z(f, z) * (log(f->hi) - log(f->lo)) * du;
-	return (f->hi - f->lo) * du;
-}
-
-/* z of x; a start on a bound moves BOUND_NEAR of the width inside, where
- * dx/dz is not zero. */
-static double z_of_x(const fit_free *f, double x)
-{
-	double u = log_scale(f) ? (log(x) - log(f->lo)) / (log(f->hi) - log(f->lo))
-				: (x - f->lo) / (f->hi - f->lo);
-	u = fmin(fmax(u, BOUND_NEAR), 1 - BOUND_NEAR);
-	return asin(2 * u - 1);
-}
-
 static void xs_of(const fit_ctx *c, const gsl_vector *z, double *x)
 {
 	for (int j = 0; j < c->p; j++)
-		x[j] = x_of_z(&c->req->free[j], gsl_vector_get(z, (size_t)j));
+		x[j] = fit_x_of_z(&c->req->free[j], gsl_vector_get(z, (size_t)j));
 }
 
 static void report(fit_ctx *c, const char *phase, const double *x, double cost)
@@ -214,7 +176,7 @@ static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 		for (int j = 0; j < c->p; j++)
 			gsl_matrix_set(J, i, (size_t)j,
 				       c->jac_x[i * (size_t)c->p + (size_t)j] *
-					       dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
+					       fit_dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
 	return GSL_SUCCESS;
 }
 
@@ -223,54 +185,6 @@ static double wall_now(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* The data, weights and result arrays of c; -1 when out of memory. */
-static int prepare(fit_ctx *c, const fit_request *r, fit_result *res)
-{
-	c->req = r;
-	c->res = res;
-	c->p = r->nfree;
-	if (fit_eval_init(&c->ev, r) != 0)
-		return -1;
-	c->n = c->ev.ndata;
-	size_t n = c->n;
-	c->w = malloc(sizeof(double) * n);
-	c->data = malloc(sizeof(double) * n);
-	c->fmodel = malloc(sizeof(double) * n);
-	c->fmodel_u = malloc(sizeof(double) * n);
-	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
-	c->jmodel = malloc(sizeof(double) * n);
-	c->jmodel_u = malloc(sizeof(double) * n);
-	c->best_model = malloc(sizeof(double) * n);
-	c->best_model_u = malloc(sizeof(double) * n);
-	c->best_cost = INFINITY;
-	res->ndata = n;
-	res->model = malloc(sizeof(double) * n);
-	res->model_u = malloc(sizeof(double) * n);
-	res->model_start = malloc(sizeof(double) * n);
-	if (!c->w || !c->data || !c->fmodel || !c->fmodel_u || !c->jac_x || !c->jmodel ||
-	    !c->jmodel_u || !c->best_model || !c->best_model_u || !res->model || !res->model_u ||
-	    !res->model_start)
-		return -1;
-	for (int j = 0; j < FIT_MAX_FREE * FIT_MAX_FREE; j++)
-		res->cov[j] = res->corr[j] = NAN;
-	for (int j = 0; j < FIT_MAX_FREE; j++)
-		res->se[j] = NAN;
-	res->chi2 = res->s2 = res->cond = NAN;
-	res->sigma_given = 1;
-	for (size_t i = 0; i < n; i++) {
-		res->model[i] = res->model_u[i] = NAN;
-		double s = r->npoints ? r->points[i].sigma : r->peaks[i].sigma;
-		c->data[i] = r->npoints ? r->points[i].v : r->peaks[i].beta;
-		c->w[i] = isnan(s) ? 1 : s;
-		res->sigma_given &= !isnan(s);
-		res->model_start[i] = NAN;
-	}
-	res->nfree = c->p;
-	for (int j = 0; j < c->p; j++)
-		res->x0[j] = res->x[j] = r->free[j].start;
-	return 0;
 }
 
 /* Rough standard errors (SI) from the last Jacobian and the cost at the
@@ -379,7 +293,7 @@ static void solve(fit_ctx *c, const double *x0, fit_start *run)
 		goto done;
 	}
 	for (int j = 0; j < p; j++)
-		gsl_vector_set(z0, (size_t)j, z_of_x(&c->req->free[j], x0[j]));
+		gsl_vector_set(z0, (size_t)j, fit_z_of_x(&c->req->free[j], x0[j]));
 	int rc = gsl_multifit_nlinear_init(z0, &fdf, w);
 	if (rc == GSL_SUCCESS && run == &c->res->starts[0])
 		memcpy(c->res->model_start, c->fmodel, sizeof(double) * c->n);
@@ -401,23 +315,6 @@ done:
 	gsl_vector_free(z0);
 }
 
-/* Start k of a multi-start fit: the request's start, then the points of a
- * Halton sequence (bases 2, 3, 5, ...) across the bounds, in the solver's
- * scale (log x on a log scale). */
-static void start_point(const fit_ctx *c, int k, double *x0)
-{
-	static const int base[FIT_MAX_FREE] = {2, 3, 5, 7, 11, 13, 17, 19};
-	for (int j = 0; j < c->p; j++) {
-		const fit_free *f = &c->req->free[j];
-		double u = 0, scale = 1;
-		for (int i = k; i > 0; i /= base[j]) {
-			scale /= base[j];
-			u += scale * (i % base[j]);
-		}
-		x0[j] = k == 0 ? f->start : x_of_u(f, u);
-	}
-}
-
 /* Every run of the request; the result is the run of the lowest cost,
  * with its warnings (a failed run counts only when all failed: then the
  * status is FIT_FAILED with the best point seen, the last reason and the
@@ -430,7 +327,7 @@ static int multistart(fit_ctx *c)
 	res->nstarts = 0;
 	for (int k = 0; k < n; k++) {
 		double x0[FIT_MAX_FREE];
-		start_point(c, k, x0);
+		fit_start_point(c, k, x0);
 		fit_start *run = &res->starts[res->nstarts++];
 		res->nwarn = 0;
 		solve(c, x0, run);
@@ -514,7 +411,7 @@ int fit_run(const fit_request *req, fit_result *res)
 	double w0 = wall_now();
 	fit_ctx c;
 	memset(&c, 0, sizeof c);
-	if (prepare(&c, req, res) != 0) {
+	if (fit_prepare(&c, req, res) != 0) {
 		res->status = FIT_FAILED;
 		snprintf(res->error, FIT_MSG, "out of memory");
 		goto done;

@@ -78,6 +78,20 @@ int fit_evaluate(fit_ctx *c, size_t nsets, const double *xs, double *out, double
 /* (fit_cov.c) The forward-difference step of parameter j at x (signed: backwards
  * when x + h passes the upper bound). */
 double fit_fd_step(const fit_ctx *c, int j, double x);
+
+/* The context of request r with its result res (fit_setup.c): data,
+ * weights and every buffer allocated, the result's fields set to NaN or
+ * the start; -1 when out of memory (the caller frees either way). */
+int fit_prepare(fit_ctx *c, const fit_request *r, fit_result *res);
+/* The bounds' transform (fit_setup.c): x at u in [0, 1] across free
+ * parameter f's bounds (in log x on a log scale), x at z and dx/dz, and z
+ * of x (a start on a bound moves BOUND_NEAR of the width inside); start k
+ * of a multi-start fit into x0. */
+double fit_x_of_u(const fit_free *f, double u);
+double fit_x_of_z(const fit_free *f, double z);
+double fit_dx_dz(const fit_free *f, double z);
+double fit_z_of_x(const fit_free *f, double x);
+void fit_start_point(const fit_ctx *c, int k, double *x0);
 /* The curves at the fit and at the start on the grid, per rotation of the
  * data, and the fitted curve's 95 % band from res->cov (fit_band.c).
  * 0, or -1 (c->ev.failed says why). */

@@ -163,7 +163,40 @@ static void json_data(text *t, const fit_request *q, const fit_result *r)
 	put(t, "]");
 }
 
-static void json_curve(text *t, const fit_result *r)
+/* The model error of the fitted curve's scene at each grid angle, per
+ * rotation (sim_model_check: the request's scene with the fitted values):
+ * "model_error" and "model_checked" arrays, and the note at the first
+ * angle not checked ("" when all are). */
+static void json_curve_model(text *t, const fit_request *q, const fit_result *r, int ro)
+{
+	sim_params p = q->p;
+	sim_scene sc = q->sc;
+	sim_method m = q->m;
+	for (int j = 0; j < r->nfree; j++)
+		sim_set(&p, &sc, &m, q->free[j].name, r->x[j], NULL, 0);
+	p.rotation = r->rotations[ro];
+	char note[sizeof ((sim_model_error *)0)->note] = "";
+	for (int a = 0; a < 2; a++) {
+		put(t, ",\"%s\":[", a ? "model_checked" : "model_error");
+		for (size_t k = 0; k < r->ncurve; k++) {
+			sim_model_error me;
+			p.beta = r->curve_beta[k];
+			sim_model_check(&p, &sc, &me);
+			put(t, "%s", k ? "," : "");
+			if (a)
+				put(t, "%s", me.checked ? "true" : "false");
+			else
+				num(t, me.checked ? me.error : NAN, "null");
+			if (!me.checked && !note[0])
+				snprintf(note, sizeof note, "%s", me.note);
+		}
+		put(t, "]");
+	}
+	put(t, ",\"model_check_note\":");
+	jstr(t, note);
+}
+
+static void json_curve(text *t, const fit_request *q, const fit_result *r)
 {
 	put(t, ",\"curve\":");
 	if (!r->ncurve) {
@@ -191,7 +224,9 @@ static void json_curve(text *t, const fit_result *r)
 			}
 			put(t, "]");
 		}
-		put(t, "}}");
+		put(t, "}");
+		json_curve_model(t, q, r, ro);
+		put(t, "}");
 	}
 	put(t, "}");
 }
@@ -250,7 +285,7 @@ char *fit_result_json(const fit_request *q, const fit_result *r)
 	put(&t, ",\"rejected\":%d", r->rejected);
 	json_starts(&t, q, r, k2);
 	json_data(&t, q, r);
-	json_curve(&t, r);
+	json_curve(&t, q, r);
 	put(&t, ",\"warnings\":[");
 	for (int w = 0; w < r->nwarn; w++) {
 		put(&t, "%s", w ? "," : "");

@@ -165,6 +165,12 @@ run() {
 	}
 	trap 'stop; exit 0' INT TERM
 	trap stop EXIT
+	# CONVSIM_TETHER (set by the test suite, core/tether.c): the replicas
+	# end with that process; HAProxy and this script stop with it too
+	if [ -n "${CONVSIM_TETHER:-}" ]; then
+		(while kill -0 "$CONVSIM_TETHER" 2>/dev/null; do sleep 0.5; done; kill -TERM $$) &
+		pids+=($!)
+	fi
 	for r in "${REPLICA_LIST[@]}"; do
 		replica "${r%%=*}" &
 		pids+=($!)

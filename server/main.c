@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "budget.h"
+#include "tether.h"
 #include "catalog.h"
 #include "config.h"
 #include "conns.h"
@@ -176,8 +177,44 @@ static void restore_state(void)
 		de, dw, df, up, SRV_STORE_VERSION);
 }
 
+/* The floors' services, each given the options (before the store opens). */
+static void open_services(srv_config *config)
+{
+	raise_nofile(config);
+	srv_budget_init(config);
+	srv_conns_init(config);
+	srv_catalog_init(config);
+	srv_sessions_init(config);
+	srv_experiments_init(config);
+	srv_job_open(&srv_sweep_job, (size_t)config->max_sweeps);
+	srv_job_open(&srv_fit_job, (size_t)config->max_fits);
+	srv_streams_init(config);
+	srv_static_init(config);
+}
+
+/* The address it listens on (stdout, for scripts) and its budgets (log). */
+static void announce(const srv_config *config, int port)
+{
+	if (strchr(config->listen, ':'))
+		printf("listening on http://[%s]:%d\n", config->listen, port);
+	else
+		printf("listening on http://%s:%d\n", config->listen, port);
+	fflush(stdout);
+	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
+			      "budgets: %.1f GiB memory, %g CPU s per session, "
+			      "%g cores for paced sessions, %d pace-max at once, "
+			      "%d connections per client (%d in all), %d queued "
+			      "sweep points",
+		config->web_root, config->max_sessions, config->max_streams,
+		(double)config->max_memory / (1 << 30), config->max_cpu_seconds,
+		config->max_paced_cores, config->max_busy, config->max_client_connections,
+		config->max_connections,
+		config->max_queued_points);
+}
+
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	srv_config cfg;
 	int parsed = srv_config_parse(&cfg, argc, argv);
 	if (parsed)
@@ -198,17 +235,9 @@ int main(int argc, char **argv)
 	    srv_peers_init(&cfg))
 		return 2;
 
-	raise_nofile(&cfg);
-	srv_budget_init(&cfg);
-	srv_conns_init(&cfg);
-	srv_catalog_init(&cfg);
-	srv_sessions_init(&cfg);
-	srv_experiments_init(&cfg);
-	srv_job_open(&srv_sweep_job, (size_t)cfg.max_sweeps);
-	srv_job_open(&srv_fit_job, (size_t)cfg.max_fits);
-	srv_streams_init(&cfg);
-	srv_static_init(&cfg);
-	srv_routes_init(&cfg);
+	open_services(&cfg);
+	if (srv_routes_init(&cfg))
+		return 1;
 	if (srv_store_open(&cfg))
 		return 1;
 	if (srv_pool_start(cfg.pool_threads)) {
@@ -227,21 +256,7 @@ int main(int argc, char **argv)
 		MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
 	int port = info ? info->port : cfg.port;
 	srv_gate_set_port(port);
-	if (strchr(cfg.listen, ':'))
-		printf("listening on http://[%s]:%d\n", cfg.listen, port);
-	else
-		printf("listening on http://%s:%d\n", cfg.listen, port);
-	fflush(stdout);
-	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
-			      "budgets: %.1f GiB memory, %g CPU s per session, "
-			      "%g cores for paced sessions, %d pace-max at once, "
-			      "%d connections per client (%d in all), %d queued "
-			      "sweep points",
-		cfg.web_root, cfg.max_sessions, cfg.max_streams,
-		(double)cfg.max_memory / (1 << 30), cfg.max_cpu_seconds,
-		cfg.max_paced_cores, cfg.max_busy, cfg.max_client_connections,
-		cfg.max_connections,
-		cfg.max_queued_points);
+	announce(&cfg, port);
 
 	/* once a second: remove the sessions whose experiment ended and
 	 * those idle beyond --idle-timeout, close the connections past

@@ -6,7 +6,10 @@
 # the test groups until the first one fails (FAIL_FAST). A mutation that no
 # test notices "survives" and makes this script exit 1. Loopback only,
 # bounded (each copy's tests stop at the first failing group). Prints a
-# table: mutation, where, the first failing group.
+# table: mutation, where, the first failing group. A fault that does not
+# apply (its text moved) stops the script with exit 2: it would test
+# nothing. `tests/mutate.sh --check` checks that every fault applies
+# without building; ONLY=N tests/mutate.sh runs the N-th alone.
 set -u
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -14,6 +17,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # name | file | sed expression (must change the file)
 mutations=(
+	"the feed's position read at the step's end, not at the boundary|core/estimator.c|s|on_boundary(e, t0 + u \\* H, ode_hermite(e->X_prev, e->Xd_prev, X, Xd, H, u),|on_boundary(e, t0 + u * H, X,|"
 	"transport velocity scaled by 1.5|core/estimator.c|s|out->transport_velocity = (e->Xb_last - e->Xb_first) / span;|out->transport_velocity = 1.5 * (e->Xb_last - e->Xb_first) / span;|"
 	"feed's moment applied at G, not at the deck points|core/deck.c|s|Q\[Q_ALPHA\] += -Rd\[1\] \* F\[0\] + Rd\[0\] \* F\[1\];|Q[Q_ALPHA] += 0.0 * (-Rd[1] * F[0] + Rd[0] * F[1]);|"
 	"friction ignored|core/feed.c|s|mu = md->p.mu, R2|mu = 0.0 * md->p.mu, R2|"
@@ -28,32 +32,56 @@ mutations=(
 	"the vertical spring using k_x|core/model.c|s|double Fy = -p->k_y \* u\[1\]|double Fy = -p->k_x * u[1]|"
 	"friction measured against the deck, not the layer below (the feed's right-hand side)|core/feed.c|s|prev_xid = xid\[e\];|prev_xid = dvel[0];|"
 	"the regularised law's friction measured against the deck, not the layer below (dem)|core/feed.c|s|double below = j == 0 ? dv1\[0\] : xid\[j - 1\];|double below = dv1[0];|"
-	"the eliminator offset c ignored in the eliminators' geometry|core/model.c|s|double cs = md->p.c + q\[qs\]|double cs = q[qs]|"
+	"the eliminator offset c ignored in the eliminators' geometry|core/model_points.h|s|double cs = md->p.c + q\[qs\]|double cs = q[qs]|"
 	"the eliminator offset c ignored in the preload|core/setup.c|s|(p->c + s\([12]\))|(0.0 + s\1)|"
 	"the lever arm h with the wrong sign|core/model.c|s|double Pb\[2\] = {i == 0 ? p->l1 : -p->l2, -p->h};|double Pb[2] = {i == 0 ? p->l1 : -p->l2, p->h};|"
 	"the mean rotor speed one period off|core/estimator.c|s|sense \* 2.0 \* M_PI \* e->n_bound / span|sense * 2.0 * M_PI * (e->n_bound + 1) / span|"
 	"the shadow's Richardson estimate divided by r + 1, not r - 1|core/shadow.c|s|/ (r - 1.0);|/ (r + 1.0);|"
 	"the shadow as fine as its instance (no step error measured)|core/shadow.c|s|m.substeps = (s->cfg.substeps + 1) / 2;|m.substeps = s->cfg.substeps;|"
-	"the contact period without the Hertzian tangent stiffness|core/params.c|s|if (p->p != 1.0) {|if (0) {|"
-	"the default feed step blind to the contact period|core/params.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
+	"the contact period without the Hertzian tangent stiffness|core/defaults.c|s|if (p->p != 1.0) {|if (0) {|"
+	"the default feed step blind to the contact period|core/defaults.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
 	"no refinement of a measurement's steps|core/measure.c|s|^#define MEASURE_REFINEMENTS 3$|#define MEASURE_REFINEMENTS 0|"
 )
+# --check: only that every fault applies (each to a copy of its file), no
+# builds; ONLY=N: run the N-th mutation (1-based) alone.
+check=0
+[ "${1:-}" = "--check" ] && check=1
+# A fault whose text is no longer in its file tests nothing: stop loudly.
+apply_fault() { # file-in-a-copy from to name
+	local before
+	before=$(sha1sum "$1")
+	sed -i "s|$2|$3|" "$1"
+	if [ "$(sha1sum "$1")" = "$before" ]; then
+		printf 'mutate: the fault "%s" does not apply to %s: its text is not there; re-aim it\n' \
+			"$4" "${1#"$work"/tree/}" >&2
+		exit 2
+	fi
+}
+if [ "$check" = 1 ]; then
+	mkdir -p "$work/tree"
+	for m in "${mutations[@]}"; do
+		IFS='|' read -r name file _ from to _ <<<"$m"
+		mkdir -p "$work/tree/$(dirname "$file")"
+		cp "$file" "$work/tree/$file"
+		apply_fault "$work/tree/$file" "$from" "$to" "$name"
+		printf 'applies: %s (%s)\n' "$name" "$file"
+	done
+	echo "mutate --check: all ${#mutations[@]} faults apply"
+	exit 0
+fi
 printf '| mutation | file | first failing test group | verdict |\n|---|---|---|---|\n'
 survived=0
+i=0
 for m in "${mutations[@]}"; do
+	i=$((i + 1))
+	[ -n "${ONLY:-}" ] && [ "$ONLY" != "$i" ] && continue
 	IFS='|' read -r name file _ from to _ <<<"$m"
 	dir="$work/tree"
 	rm -rf "$dir"
 	mkdir -p "$dir"
 	git ls-files -z | xargs -0 cp --parents -t "$dir"
 	ln -s "$root/tests/node_modules" "$dir/tests/node_modules"
-	before=$(sha1sum "$dir/$file")
-	sed -i "s|$from|$to|" "$dir/$file"
-	if [ "$(sha1sum "$dir/$file")" = "$before" ]; then
-		printf '| %s | %s | (the fault did not apply: update tests/mutate.sh) | error |\n' "$name" "$file"
-		survived=$((survived + 1))
-		continue
-	fi
+	apply_fault "$dir/$file" "$from" "$to" "$name"
 	if ! (cd "$dir" && make -s -j2 BUILD=build-mut build-mut/convsim build-mut/convsimd \
 		$(cd "$dir" && ls tests/unit/test_*.c | sed 's|tests/unit/\(.*\)\.c|build-mut/tests/\1|') \
 		>"$work/build.log" 2>&1); then

@@ -26,6 +26,7 @@
 
 #include "bed_proto.h"
 #include "dem.h"
+#include "tether.h"
 
 /* The ranks (1 without mpirun: MPI is then left to LIGGGHTS). */
 static int bed_rank, bed_ranks = 1;
@@ -130,6 +131,7 @@ static int bed_serve(FILE *in, FILE *out)
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	int serve = 0;
 	for (int i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--serve")) {

@@ -13,15 +13,17 @@
  * the model's own numbers unless told otherwise: stiffness over mass
  * k_c/m_n (times --stiffness), restitution R, friction mu.
  */
-#include <getopt.h>
+#include <getopt.h> /* optind */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "dem.h"
 #include "couple.h"
 #include "motion.h"
+#include "tether.h"
 #include "sim.h"
 #include "units.h"
 
@@ -37,54 +39,64 @@ typedef struct dem_opts {
 	double frame_amp, frame_angle;      /* --frame-check: m, deg; amplitude 0: none */
 } dem_opts;
 
-static const struct option dem_long[] = {
-	{"preset", required_argument, 0, 'p'},     {"set", required_argument, 0, 's'},
-	{"duration", required_argument, 0, 'd'},   {"transient", required_argument, 0, 't'},
-	{"grains", required_argument, 0, 'n'},     {"depth", required_argument, 0, 'D'},
-	{"seed", required_argument, 0, 'S'},       {"stiffness", required_argument, 0, 'k'},
-	{"d-min", required_argument, 0, 'a'},      {"d-max", required_argument, 0, 'b'},
-	{"cell", required_argument, 0, 'x'},       {"width", required_argument, 0, 'y'},
-	{"restitution", required_argument, 0, 'e'}, {"mu", required_argument, 0, 'u'},
-	{"mu-roll", required_argument, 0, 'r'},    {"freeze-rotation", no_argument, 0, 'f'},
-	{"intervals", required_argument, 0, 'i'},  {"harmonics", required_argument, 0, 'H'},
-	{"settle", required_argument, 0, 'w'},     {"no-column", no_argument, 0, 'C'},
-	{"motion", required_argument, 0, 'M'},     {"coupling-steps", required_argument, 0, 'c'},
-	{"frame-check", required_argument, 0, 'F'}, {"tangential", required_argument, 0, 'T'},
-	{"help", no_argument, 0, 'h'},             {0, 0, 0, 0}};
+enum {
+	D_PRESET = 256, D_SET, D_DURATION, D_TRANSIENT, D_GRAINS, D_DEPTH, D_SEED, D_STIFFNESS,
+	D_D_MIN, D_D_MAX, D_CELL, D_WIDTH, D_RESTITUTION, D_MU, D_MU_ROLL, D_FREEZE, D_TANGENTIAL,
+	D_INTERVALS, D_HARMONICS, D_SETTLE, D_NO_COLUMN, D_MOTION, D_COUPLING_STEPS,
+	D_FRAME_CHECK, D_HELP
+};
 
-static const char dem_usage[] =
-	"usage: convsim-dem [OPTIONS]\n"
-	"The column model's transport velocity against a LIGGGHTS bed on the same deck motion.\n"
-	"  -p, --preset NAME        model preset (czubak2016)\n"
-	"  -s, --set NAME=VALUE     a setting as `convsim list` shows it; repeatable\n"
-	"  -d, --duration S         simulated time (2)\n"
-	"  -t, --transient S        the transport velocity ignores t < S (0.5)\n"
-	"  -n, --grains N           number of grains (overrides --depth)\n"
-	"  -D, --depth D            bed depth in mean diameters at packing 0.6 (8)\n"
-	"  -S, --seed N             packing seed (1)\n"
-	"  -k, --stiffness F        contact stiffness over mass = F k_c/m_n (1)\n"
-	"      --d-min M, --d-max M grain diameters, uniform (0.0036, 0.0044 m)\n"
-	"      --cell X, --width Y  periodic cell in mean diameters (20 x 4)\n"
-	"  -e, --restitution E      grain on the floor (the model's R)\n"
-	"  -u, --mu MU              Coulomb friction (the model's mu)\n"
-	"  -r, --mu-roll MU         rolling friction, 0 for none (0)\n"
-	"  -f, --freeze-rotation    grains do not rotate\n"
-	"      --tangential spring|viscous  friction with a tangential spring (the default) or\n"
-	"                           without one, viscous up to Coulomb (LIGGGHTS's no_history)\n"
-	"  -i, --intervals N        coupling intervals a period, the deck's acceleration held over\n"
-	"                           each; 0 (the default): the fit's acceleration at every DEM step\n"
-	"  -H, --harmonics H        harmonics of the deck motion's fit (3)\n"
-	"  -w, --settle S           settling before t = 0 (0.3 s; 0.05 s for one grain)\n"
-	"      --no-column          skip the column model's run\n"
-	"      --motion fit|machine fit: the deck's harmonic fit, in --intervals a period (the\n"
-	"                           default); machine: the one-way machine's deck itself, its\n"
-	"                           mean acceleration over every --coupling-steps machine steps, as\n"
-	"                           `convsim run --set feed_model=liggghts` couples it (v from t = 0\n"
-	"                           or --transient, least squares)\n"
-	"      --coupling-steps N   machine steps a coupling interval (1)\n"
-	"      --frame-check A:DEG  one grain on a floor moving A sin(omega_ss t) along DEG, as a\n"
-	"                           body force over the fixed floor and as LIGGGHTS's moving mesh\n"
-	"                           (v_body, v_mesh); no machine, no column model\n";
+/* The options as convsim's are (cli.h cli_opt): getopt_long's table and
+ * the help are made from it. */
+static const cli_opt dem_options[] = {
+	{1, D_PRESET, "preset", 'p', "NAME", NULL, "czubak2016", "model preset"},
+	{1, D_SET, "set", 's', "NAME=VALUE", NULL, NULL,
+	 "a setting as `convsim list` shows it; repeatable"},
+	{1, D_DURATION, "duration", 'd', "S", "s", "2", "simulated time"},
+	{1, D_TRANSIENT, "transient", 't', "S", "s", "0.5", "the transport velocity ignores t < S"},
+	{1, D_GRAINS, "grains", 'n', "N", NULL, NULL, "number of grains (overrides --depth)"},
+	{1, D_DEPTH, "depth", 'D', "D", "mean diameters", "8", "bed depth at packing 0.6"},
+	{1, D_SEED, "seed", 'S', "N", NULL, "1", "packing seed"},
+	{1, D_STIFFNESS, "stiffness", 'k', "F", NULL, "1",
+	 "contact stiffness over mass = F k_c/m_n"},
+	{1, D_D_MIN, "d-min", 0, "M", "m", "0.0036", "smallest grain diameter (uniform)"},
+	{1, D_D_MAX, "d-max", 0, "M", "m", "0.0044", "largest grain diameter (uniform)"},
+	{1, D_CELL, "cell", 0, "X", "mean diameters", "20", "periodic cell along the deck"},
+	{1, D_WIDTH, "width", 0, "Y", "mean diameters", "4", "periodic cell across the deck"},
+	{1, D_RESTITUTION, "restitution", 'e', "E", NULL, "the model's R", "grain on the floor"},
+	{1, D_MU, "mu", 'u', "MU", NULL, "the model's mu", "Coulomb friction"},
+	{1, D_MU_ROLL, "mu-roll", 'r', "MU", NULL, "0", "rolling friction, 0 for none"},
+	{1, D_FREEZE, "freeze-rotation", 'f', NULL, NULL, NULL, "grains do not rotate"},
+	{1, D_TANGENTIAL, "tangential", 0, "spring|viscous", NULL, "spring",
+	 "friction with a tangential spring, or without one, viscous up to Coulomb "
+	 "(LIGGGHTS's no_history)"},
+	{1, D_INTERVALS, "intervals", 'i', "N", NULL, "0",
+	 "coupling intervals a period, the deck's acceleration held over each; 0: the fit's "
+	 "acceleration at every DEM step"},
+	{1, D_HARMONICS, "harmonics", 'H', "H", NULL, "3", "harmonics of the deck motion's fit"},
+	{1, D_SETTLE, "settle", 'w', "S", "s", "0.3; 0.05 for one grain", "settling before t = 0"},
+	{1, D_NO_COLUMN, "no-column", 0, NULL, NULL, NULL, "skip the column model's run"},
+	{1, D_MOTION, "motion", 0, "fit|machine", NULL, "fit",
+	 "fit: the deck's harmonic fit, in --intervals a period; machine: the one-way "
+	 "machine's deck itself, its mean acceleration over every --coupling-steps machine "
+	 "steps, as `convsim run --set feed_model=liggghts` couples it (v from t = 0 or "
+	 "--transient, least squares)"},
+	{1, D_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
+	 "machine steps a coupling interval"},
+	{1, D_FRAME_CHECK, "frame-check", 0, "A:DEG", NULL, NULL,
+	 "one grain on a floor moving A sin(omega_ss t) along DEG, as a body force over the "
+	 "fixed floor and as LIGGGHTS's moving mesh (v_body, v_mesh); no machine, no column "
+	 "model"},
+	{1, D_HELP, "help", 'h', NULL, NULL, NULL, "show this help on stdout and exit"},
+};
+#define DEM_NOPTIONS (sizeof dem_options / sizeof *dem_options)
+
+static void dem_help(FILE *f)
+{
+	fputs("usage: convsim-dem [OPTIONS]\n\nThe column model's transport velocity against a "
+	      "LIGGGHTS bed on the same deck motion.\n\noptions:\n", f);
+	cli_help_options(f, dem_options, DEM_NOPTIONS, 1);
+}
 
 /* A number in [lo, hi] or exit 2 with the option's name and range. */
 static double dem_number(const char *opt, const char *text, double lo, double hi)
@@ -123,55 +135,57 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	o->d_min = 0.0036, o->d_max = 0.0044, o->cell_x = 20, o->cell_y = 4, o->settle = NAN;
 	o->restitution = NAN, o->mu = NAN, o->intervals = 0, o->harmonics = 3, o->column = 1;
 	o->coupling_steps = 1;
-	while ((c = getopt_long(argc, argv, "p:s:d:t:n:D:S:k:e:u:r:fi:H:w:h", dem_long, NULL)) != -1) {
+	const char *arg;
+	while ((c = cli_next_option_in(dem_options, DEM_NOPTIONS, 1, "convsim-dem",
+				       "convsim-dem --help", argc, argv, &arg)) != -1) {
 		char msg[200], name[64];
 		const char *eq;
 		switch (c) {
-		case 'p': break;
-		case 's':
-			eq = strchr(optarg, '=');
-			if (!eq || eq == optarg) {
-				fprintf(stderr, "convsim-dem: --set needs NAME=VALUE, got '%s'\n", optarg);
+		case D_PRESET: break;
+		case D_SET:
+			eq = strchr(arg, '=');
+			if (!eq || eq == arg) {
+				fprintf(stderr, "convsim-dem: --set needs NAME=VALUE, got '%s'\n", arg);
 				exit(2);
 			}
-			snprintf(name, sizeof name, "%.*s", (int)(eq - optarg), optarg);
+			snprintf(name, sizeof name, "%.*s", (int)(eq - arg), arg);
 			if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg)) {
-				fprintf(stderr, "convsim-dem: --set %s: %s\n", optarg, msg);
+				fprintf(stderr, "convsim-dem: --set %s: %s\n", arg, msg);
 				exit(2);
 			}
 			break;
-		case 'd': o->duration = dem_number("duration", optarg, 0.01, 1000); break;
-		case 't': o->transient = dem_number("transient", optarg, 0, 1000); break;
-		case 'n': o->grains = (int)dem_number("grains", optarg, 1, 1e6); break;
-		case 'D': o->depth = dem_number("depth", optarg, 0.1, 1000); break;
-		case 'S': o->seed = (int)dem_number("seed", optarg, 0, 1e9); break;
-		case 'k': o->stiffness = dem_number("stiffness", optarg, 1e-3, 1e6); break;
-		case 'a': o->d_min = dem_number("d-min", optarg, 1e-6, 0.5); break;
-		case 'b': o->d_max = dem_number("d-max", optarg, 1e-6, 0.5); break;
-		case 'x': o->cell_x = dem_number("cell", optarg, 2, 1000); break;
-		case 'y': o->cell_y = dem_number("width", optarg, 2, 1000); break;
-		case 'e': o->restitution = dem_number("restitution", optarg, 1e-3, 1); break;
-		case 'u': o->mu = dem_number("mu", optarg, 0, 10); break;
-		case 'r': o->mu_roll = dem_number("mu-roll", optarg, 0, 10); break;
-		case 'f': o->freeze_rotation = 1; break;
-		case 'i': o->intervals = (int)dem_number("intervals", optarg, 0, 100000); break;
-		case 'H': o->harmonics = (int)dem_number("harmonics", optarg, 1, DEM_MAX_HARMONICS); break;
-		case 'w': o->settle = dem_number("settle", optarg, 0, 100); break;
-		case 'C': o->column = 0; break;
-		case 'M': o->motion_machine = dem_choice("motion", optarg, "fit", "machine"); break;
-		case 'T': o->tangential_viscous = dem_choice("tangential", optarg, "spring", "viscous"); break;
-		case 'c': o->coupling_steps = (int)dem_number("coupling-steps", optarg, 1, 1000); break;
-		case 'F':
-			if (sscanf(optarg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
+		case D_DURATION: o->duration = dem_number("duration", arg, 0.01, 1000); break;
+		case D_TRANSIENT: o->transient = dem_number("transient", arg, 0, 1000); break;
+		case D_GRAINS: o->grains = (int)dem_number("grains", arg, 1, 1e6); break;
+		case D_DEPTH: o->depth = dem_number("depth", arg, 0.1, 1000); break;
+		case D_SEED: o->seed = (int)dem_number("seed", arg, 0, 1e9); break;
+		case D_STIFFNESS: o->stiffness = dem_number("stiffness", arg, 1e-3, 1e6); break;
+		case D_D_MIN: o->d_min = dem_number("d-min", arg, 1e-6, 0.5); break;
+		case D_D_MAX: o->d_max = dem_number("d-max", arg, 1e-6, 0.5); break;
+		case D_CELL: o->cell_x = dem_number("cell", arg, 2, 1000); break;
+		case D_WIDTH: o->cell_y = dem_number("width", arg, 2, 1000); break;
+		case D_RESTITUTION: o->restitution = dem_number("restitution", arg, 1e-3, 1); break;
+		case D_MU: o->mu = dem_number("mu", arg, 0, 10); break;
+		case D_MU_ROLL: o->mu_roll = dem_number("mu-roll", arg, 0, 10); break;
+		case D_FREEZE: o->freeze_rotation = 1; break;
+		case D_INTERVALS: o->intervals = (int)dem_number("intervals", arg, 0, 100000); break;
+		case D_HARMONICS: o->harmonics = (int)dem_number("harmonics", arg, 1, DEM_MAX_HARMONICS); break;
+		case D_SETTLE: o->settle = dem_number("settle", arg, 0, 100); break;
+		case D_NO_COLUMN: o->column = 0; break;
+		case D_MOTION: o->motion_machine = dem_choice("motion", arg, "fit", "machine"); break;
+		case D_TANGENTIAL: o->tangential_viscous = dem_choice("tangential", arg, "spring", "viscous"); break;
+		case D_COUPLING_STEPS: o->coupling_steps = (int)dem_number("coupling-steps", arg, 1, 1000); break;
+		case D_FRAME_CHECK:
+			if (sscanf(arg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
 			    !(o->frame_amp > 0) || !(o->frame_amp <= 0.01) || !(o->frame_angle >= 0) ||
 			    !(o->frame_angle <= 180)) {
 				fprintf(stderr, "convsim-dem: --frame-check must be A:DEG with A in (0, 0.01] m "
-						"and DEG in [0, 180], got '%s'\n", optarg);
+						"and DEG in [0, 180], got '%s'\n", arg);
 				exit(2);
 			}
 			break;
-		case 'h': fputs(dem_usage, stdout); exit(0);
-		default: fputs(dem_usage, stderr); exit(2);
+		case D_HELP: dem_help(stdout); exit(0);
+		default: exit(2); /* cli_next_option_in said why */
 		}
 	}
 	if (optind < argc || o->d_min > o->d_max || o->transient >= o->duration) {
@@ -279,6 +293,7 @@ static int frame_check(const dem_opts *o)
 
 int main(int argc, char **argv)
 {
+	sim_tether_from_env(); /* the test suite's: end with the test */
 	dem_opts o;
 	memset(&o, 0, sizeof o);
 	dem_parse(argc, argv, &o);

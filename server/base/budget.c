@@ -16,7 +16,8 @@
  * queue of at most --max-busy holders, each holding for a time slice while
  * others wait (round robin: each gets an equal share of the cores).
  * Connections are counted per client address in a small table sized by
- * --max-connections (libmicrohttpd never holds more).
+ * --max-connections (libmicrohttpd never holds more). The CPU estimate of
+ * a session is budget_cost.c's.
  */
 #include <arpa/inet.h>
 #include <math.h>
@@ -39,18 +40,6 @@
 #define STREAM_BASE_BYTES ((size_t)96 << 10)
 /* Retry-After of a memory refusal: sessions come and go in seconds. */
 #define MEMORY_RETRY_S 5
-/* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
- * one macro step of the machine (four right-hand sides: RK4, or dem's
- * macro step), of one feed sub-step per integrated column and per
- * integrated element, and of one published sample (status, ring record,
- * trajectory row); `build/convsim run` on this machine, the cost of 5
- * simulated s less that of 0.01 s, and the daemon's workers. */
-#define STEP_CPU_S 0.41e-6
-#define COLUMN_SUBSTEP_CPU_S 8.0e-8
-#define ELEMENT_SUBSTEP_CPU_S 0.8e-8
-#define SAMPLE_CPU_S 7e-6
-/* and of each double of a published sample's feed record (ring, history) */
-#define RECORD_DOUBLE_CPU_S 2e-9
 /* Retry-After of a refusal for CPU: paced sessions come and go. */
 #define CPU_RETRY_S 5
 
@@ -67,17 +56,11 @@ void srv_budget_init(const srv_config *config)
 
 /* ---- memory ---------------------------------------------------------------- */
 
-/* Doubles per record of a feed: column displacements, xi and eta. */
-static size_t record_doubles(int columns, int layers)
-{
-	return (size_t)columns + 2 * (size_t)columns * (size_t)layers;
-}
-
 size_t srv_budget_session_need(int columns, int layers)
 {
 	size_t ring = cfg->ring > 16 ? (size_t)cfg->ring : 16;
 	size_t hist = cfg->history > 16 ? (size_t)cfg->history : 16;
-	size_t per = record_doubles(columns, layers);
+	size_t per = srv_budget_record_doubles(columns, layers);
 	return SESSION_BASE_BYTES +
 	       ELEMENT_BYTES * (size_t)columns * (size_t)layers +
 	       ring * (sizeof(api_sample) + per * sizeof(double)) +
@@ -89,7 +72,7 @@ size_t srv_budget_stream_need(int columns, int layers)
 {
 	/* stream.c: the record copy and 4 formatted records + 64 kB */
 	return STREAM_BASE_BYTES +
-	       record_doubles(columns, layers) * sizeof(double) +
+	       srv_budget_record_doubles(columns, layers) * sizeof(double) +
 	       4 * api_record_max(columns, layers) + 65536;
 }
 
@@ -176,42 +159,6 @@ void srv_budget_give(size_t bytes)
 }
 
 /* ---- cores of paced sessions ------------------------------------------------ */
-
-double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
-			       int columns, int layers)
-{
-	const sim_method *m = &spec->method;
-	double dt = st->dt, evals = 1;
-	int substeps = st->substeps;
-	size_t n;
-	const sim_method_info *const *all = sim_methods(&n);
-	for (size_t i = 0; i < n; i++)
-		if (strcmp(all[i]->name, m->name) == 0 && all[i]->adaptive) {
-			/* its steps follow the solution: guess dem's */
-			sim_method dem = *m;
-			snprintf(dem.name, sizeof dem.name, "dem");
-			dt = sim_default_dt(&spec->params, &spec->scene, &dem);
-			substeps = sim_default_substeps(&spec->params, &spec->scene, &dem, dt);
-		}
-	if (strcmp(m->name, "euler") == 0)
-		evals = 0.25; /* one right-hand side a step, not four */
-	if (!(dt > 0))
-		dt = 1e-3;
-	if (substeps < 1)
-		substeps = 1;
-	/* the symmetric reduction integrates one representative column */
-	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
-	if (columns <= 0 || layers <= 0)
-		integrated = 0;
-	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
-			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
-	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
-}
-
-double srv_budget_sample_cpu(int columns, int layers)
-{
-	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)record_doubles(columns, layers);
-}
 
 api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			      const char *field, const char *verb,

@@ -54,8 +54,11 @@ size_t srv_budget_memory(void);
 
 /* ---- cores of paced sessions ------------------------------------------------ */
 
-/* CPU s the server spends on one published sample of a feed of columns x
- * layers (status, ring record, trajectory row), besides the core's. */
+/* The cost model (budget_cost.c): doubles per record of a feed (column
+ * displacements, xi and eta); CPU s the server spends on one published
+ * sample of a feed of columns x layers (status, ring record, trajectory
+ * row), besides the core's. */
+size_t srv_budget_record_doubles(int columns, int layers);
 double srv_budget_sample_cpu(int columns, int layers);
 /* Estimated CPU s per simulated s of a session before it has run: from
  * its integrator (method, the step dt and the feed sub-steps in use, as

@@ -3,8 +3,9 @@
  * config.c - the daemon's options: defaults, the command line and the
  * checks of what it names (web root guess, writable data directory).
  *
- * Options are a table {flag, kind, range, field}: one loop parses them all
- * and each kind checks its range with one message.
+ * Options are a table {flag, kind, range, field, help}: one loop parses
+ * them all, each kind checks its range with one message, and --help is
+ * printed from the same rows with the defaults' values.
  */
 #include <getopt.h>
 #include <stdio.h>
@@ -50,59 +51,111 @@ static const srv_config defaults = {
 	.max_dem_sessions = 1,
 	.dem_ranks = 1,
 	.dem_timeout = 300.0,
+	.max_dem_cost = 1000.0,
 };
 
-enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
+enum { OPT_STRING, OPT_INT, OPT_SIZE, OPT_MEMORY, OPT_SECONDS, OPT_CORES, OPT_LEVEL,
        OPT_FLAG, OPT_LIST };
 
+/* One option: its flag, kind, range, field, and its line of --help: the
+ * argument's name, the text ("%D" is the default, from the field; "\n"
+ * starts a continuation line) and a heading printed above it. */
 typedef struct opt {
 	const char *name;
 	int kind;
 	long lo, hi;
 	size_t field; /* offsetof(srv_config, ...) */
+	const char *arg, *doc, *heading;
 } opt;
 
 #define F(member) offsetof(srv_config, member)
 static const opt opts[] = {
-	{"listen", OPT_STRING, 0, 0, F(listen)},
-	{"port", OPT_INT, 0, 65535, F(port)},
-	{"max-sessions", OPT_INT, 1, 100000, F(max_sessions)},
-	{"max-streams", OPT_INT, 1, 100000, F(max_streams)},
-	{"max-body", OPT_SIZE, 64, 1L << 30, F(max_body)},
-	{"data-dir", OPT_STRING, 0, 0, F(data_dir)},
-	{"web-root", OPT_STRING, 0, 0, F(web_root)},
-	{"log-level", OPT_LEVEL, 0, 0, F(log_level)},
-	{"ring", OPT_INT, 16, 1 << 22, F(ring)},
-	{"history", OPT_INT, 16, 1 << 24, F(history)},
-	{"pool-threads", OPT_INT, 1, 256, F(pool_threads)},
-	{"worker-nice", OPT_INT, 0, 19, F(worker_nice)},
-	{"heartbeat", OPT_SECONDS, 50, 3600000, F(heartbeat)},
-	{"checkpoint-interval", OPT_SECONDS, 50, 3600000,
-	 F(checkpoint_interval)},
-	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout)},
-	{"token-file", OPT_STRING, 0, 0, F(token_file)},
-	{"insecure", OPT_FLAG, 0, 0, F(insecure)},
-	{"allow-origin", OPT_LIST, 0, 0, F(allow_origins)},
-	{"server-name", OPT_LIST, 0, 0, F(server_names)},
-	{"node-id", OPT_STRING, 0, 0, F(node_id)},
-	{"peers", OPT_STRING, 0, 0, F(peers)},
-	{"max-memory", OPT_SIZE, 1L << 20, 1L << 50, F(max_memory)},
-	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds)},
-	{"max-busy", OPT_INT, 1, 1024, F(max_busy)},
-	{"max-paced-cores", OPT_CORES, 10, 4096000000L, F(max_paced_cores)},
-	{"max-client-connections", OPT_INT, 1, 100000,
-	 F(max_client_connections)},
-	{"max-connections", OPT_INT, 16, 100000, F(max_connections)},
-	{"connection-timeout", OPT_SECONDS, 1000, 3600000,
-	 F(connection_timeout)},
-	{"request-timeout", OPT_SECONDS, 100, 3600000, F(request_timeout)},
-	{"min-body-rate", OPT_SIZE, 1, 1L << 30, F(min_body_rate)},
-	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points)},
-	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe)},
-	{"dem-bed", OPT_STRING, 0, 0, F(dem_bed)},
-	{"max-dem-sessions", OPT_INT, 0, 1024, F(max_dem_sessions)},
-	{"dem-ranks", OPT_INT, 1, 256, F(dem_ranks)},
-	{"dem-timeout", OPT_SECONDS, 100, 86400000, F(dem_timeout)},
+	{"listen", OPT_STRING, 0, 0, F(listen), "ADDR", "address to bind (default %D)", NULL},
+	{"port", OPT_INT, 0, 65535, F(port), "N", "TCP port, 0 = ephemeral (default %D)", NULL},
+	{"max-sessions", OPT_INT, 1, 100000, F(max_sessions), "N", "live sessions (default %D)",
+	 NULL},
+	{"max-streams", OPT_INT, 1, 100000, F(max_streams), "N",
+	 "open stream clients (default %D)", NULL},
+	{"max-body", OPT_SIZE, 64, 1L << 30, F(max_body), "BYTES",
+	 "request body limit (default %D)", NULL},
+	{"data-dir", OPT_STRING, 0, 0, F(data_dir), "DIR",
+	 "save sessions, experiments, sweeps and fits here", NULL},
+	{"web-root", OPT_STRING, 0, 0, F(web_root), "DIR",
+	 "static files served at / (default web)", NULL},
+	{"log-level", OPT_LEVEL, 0, 0, F(log_level), "L", "error|warn|info|debug (default %D)",
+	 NULL},
+	{"ring", OPT_INT, 16, 1 << 22, F(ring), "N", "stream records kept per session (default %D)",
+	 NULL},
+	{"history", OPT_INT, 16, 1 << 24, F(history), "N",
+	 "trajectory rows kept per session (default %D)", NULL},
+	{"pool-threads", OPT_INT, 1, 256, F(pool_threads), "N",
+	 "sweep worker threads (default %D)", NULL},
+	{"worker-nice", OPT_INT, 0, 19, F(worker_nice), "N",
+	 "nice value (0-19) of session workers and sweep threads, below\n"
+	 "the request and stream threads' 0 (default %D)", NULL},
+	{"heartbeat", OPT_SECONDS, 50, 3600000, F(heartbeat), "S",
+	 "seconds between stream heartbeats (default %D)", NULL},
+	{"checkpoint-interval", OPT_SECONDS, 50, 3600000, F(checkpoint_interval), "S",
+	 "wall seconds between session checkpoints (default %D)", NULL},
+	{"idle-timeout", OPT_SECONDS, 0, 864000000, F(idle_timeout), "S",
+	 "remove sessions with no client and no request for S seconds (default %D: never)",
+	 NULL},
+	{"token-file", OPT_STRING, 0, 0, F(token_file), "FILE",
+	 "require Authorization: Bearer with the token in FILE\n"
+	 "(mode 0600 or stricter) on every route but / files and /health", NULL},
+	{"insecure", OPT_FLAG, 0, 0, F(insecure), "",
+	 "allow a non-loopback --listen without --token-file", NULL},
+	{"allow-origin", OPT_LIST, 0, 0, F(allow_origins), "ORIG",
+	 "one more browser origin allowed to call (repeatable, max 16)", NULL},
+	{"server-name", OPT_LIST, 0, 0, F(server_names), "NAME",
+	 "one more Host name the daemon answers to (repeatable, max 16)", NULL},
+	{"node-id", OPT_STRING, 0, 0, F(node_id), "NAME",
+	 "this replica's name (1-10 of a-z 0-9 -): every id it makes starts NAME-", NULL},
+	{"peers", OPT_STRING, 0, 0, F(peers), "URL,...",
+	 "other replicas (http://HOST:PORT); lists gather theirs", NULL},
+	{"max-memory", OPT_MEMORY, 1L << 20, 1L << 50, F(max_memory), "BYTES",
+	 "estimated memory of all sessions and streams; K, M, G suffixes\n"
+	 "(default %D: 3/4 of this machine's memory)",
+	 "budgets (429/503 with Retry-After when spent; see docs/operations.md \"Budgets and "
+	 "load\"):"},
+	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds), "S",
+	 "CPU seconds a session may use before it pauses, per grant\n(default %D)", NULL},
+	{"max-busy", OPT_INT, 1, 1024, F(max_busy), "N",
+	 "pace \"max\" sessions stepping at once, in turns (default %D: the cores)", NULL},
+	{"max-paced-cores", OPT_CORES, 10, 4096000000L, F(max_paced_cores), "C",
+	 "cores the running paced sessions may need together: each its CPU s\n"
+	 "per simulated s times its pace (default %D: half the cores)", NULL},
+	{"max-client-connections", OPT_INT, 1, 100000, F(max_client_connections), "N",
+	 "open connections per client address (default %D)", NULL},
+	{"max-connections", OPT_INT, 16, 100000, F(max_connections), "N",
+	 "open connections, all clients (default %D)", NULL},
+	{"connection-timeout", OPT_SECONDS, 1000, 3600000, F(connection_timeout), "S",
+	 "close a connection silent for S seconds; must exceed --heartbeat\n(default %D)", NULL},
+	{"request-timeout", OPT_SECONDS, 100, 3600000, F(request_timeout), "S",
+	 "a request's headers must all come within S seconds of its first\n"
+	 "line; a body gets S, then must keep up with --min-body-rate (default %D)", NULL},
+	{"min-body-rate", OPT_SIZE, 1, 1L << 30, F(min_body_rate), "BYTES",
+	 "bytes per second a body must average after --request-timeout;\n"
+	 "slower ones are closed (default %D)", NULL},
+	{"max-queued-points", OPT_INT, 1, 10000000, F(max_queued_points), "N",
+	 "sweep points queued or running, all sweeps (default %D)", NULL},
+	{"cpu-probe", OPT_SECONDS, 0, 1000, F(cpu_probe), "S",
+	 "CPU seconds a new session's cost is measured for before it is\n"
+	 "admitted; 0: the estimate alone (default %D)", NULL},
+	{"dem-bed", OPT_STRING, 0, 0, F(dem_bed), "PATH",
+	 "the bed program (default: convsim-bed next to this executable)",
+	 "LIGGGHTS sessions (scene.feed_model liggghts, docs/dem.md):"},
+	{"max-dem-sessions", OPT_INT, 0, 1024, F(max_dem_sessions), "N",
+	 "sessions with a LIGGGHTS bed at once, each a bed process\n"
+	 "holding a whole core (default %D; 0: none)", NULL},
+	{"dem-ranks", OPT_INT, 1, 256, F(dem_ranks), "N",
+	 "run each bed under mpirun -n N, holding N cores (default %D)", NULL},
+	{"dem-timeout", OPT_SECONDS, 100, 86400000, F(dem_timeout), "S",
+	 "fail a session whose bed process gives no answer for S seconds\n"
+	 "(a hung bed; default %D)", NULL},
+	{"max-dem-cost", OPT_SECONDS, 1000, 1000000000, F(max_dem_cost), "S",
+	 "refuse a bed expected to take more than S CPU seconds a\n"
+	 "simulated second (its grains over its DEM step; default %D)", NULL},
 };
 #undef F
 #define NOPTS (sizeof opts / sizeof *opts)
@@ -123,100 +176,52 @@ static void machine_defaults(srv_config *cfg)
 	cfg->max_paced_cores = 0.5 * (cores > 0 ? (double)cores : 1.0);
 }
 
+static const char *const levels[] = {"error", "warn", "info", "debug"};
+
+/* The value of option o in cfg as --help shows a default. */
+static void print_default(FILE *f, const opt *o, const srv_config *cfg)
+{
+	const char *at = (const char *)cfg + o->field;
+	switch (o->kind) {
+	case OPT_STRING: fputs(*(const char *const *)(const void *)at, f); break;
+	case OPT_INT: fprintf(f, "%d", *(const int *)(const void *)at); break;
+	case OPT_SIZE: fprintf(f, "%zu", *(const size_t *)(const void *)at); break;
+	case OPT_MEMORY:
+		fprintf(f, "%.1f GiB",
+			(double)*(const size_t *)(const void *)at / (double)(1 << 30));
+		break;
+	case OPT_SECONDS:
+	case OPT_CORES: fprintf(f, "%g", *(const double *)(const void *)at); break;
+	case OPT_LEVEL: fputs(levels[*(const int *)(const void *)at], f); break;
+	default: break;
+	}
+}
+
+/* The help, from the option table and the defaults in cfg: the flag and
+ * its argument, then the text from column 23 (or two spaces past a
+ * longer flag), its continuation lines indented as far. */
 static void usage(FILE *f, const srv_config *cfg)
 {
-	fprintf(f,
-		"usage: convsimd [options]\n"
-		"  --listen ADDR        address to bind (default 127.0.0.1)\n"
-		"  --port N             TCP port, 0 = ephemeral (default 8080)\n"
-		"  --max-sessions N     live sessions (default 64)\n"
-		"  --max-streams N      open stream clients (default 256)\n"
-		"  --max-body BYTES     request body limit (default 1048576)\n"
-		"  --data-dir DIR       save sessions, experiments, sweeps and fits here\n"
-		"  --web-root DIR       static files served at / (default web)\n"
-		"  --log-level L        error|warn|info|debug (default info)\n"
-		"  --ring N             stream records kept per session "
-		"(default 4096)\n"
-		"  --history N          trajectory rows kept per session "
-		"(default 20000)\n"
-		"  --pool-threads N     sweep worker threads (default 2)\n"
-		"  --worker-nice N      nice value (0-19) of session workers and "
-		"sweep threads, below\n"
-		"                       the request and stream threads' 0 "
-		"(default 5)\n"
-		"  --heartbeat S        seconds between stream heartbeats "
-		"(default 15)\n"
-		"  --checkpoint-interval S  wall seconds between session "
-		"checkpoints (default 10)\n"
-		"  --idle-timeout S     remove sessions with no client and no "
-		"request for S seconds (default 0: never)\n"
-		"  --token-file FILE    require Authorization: Bearer with the "
-		"token in FILE\n"
-		"                       (mode 0600 or stricter) on every route "
-		"but / files and /health\n"
-		"  --insecure           allow a non-loopback --listen without "
-		"--token-file\n"
-		"  --allow-origin ORIG  one more browser origin allowed to call "
-		"(repeatable, max 16)\n"
-		"  --server-name NAME   one more Host name the daemon answers to "
-		"(repeatable, max 16)\n"
-		"  --node-id NAME       this replica's name (1-10 of a-z 0-9 -): "
-		"every id it makes starts NAME-\n"
-		"  --peers URL,...      other replicas (http://HOST:PORT); lists "
-		"gather theirs\n"
-		"budgets (429/503 with Retry-After when spent; see docs/operations.md "
-		"\"Budgets and load\"):\n"
-		"  --max-memory BYTES   estimated memory of all sessions and "
-		"streams; K, M, G suffixes\n"
-		"                       (default %.1f GiB: 3/4 of this "
-		"machine's memory)\n"
-		"  --max-cpu-seconds S  CPU seconds a session may use before "
-		"it pauses, per grant\n"
-		"                       (default %g)\n"
-		"  --max-busy N         pace \"max\" sessions stepping at once, "
-		"in turns (default %d: the cores)\n"
-		"  --max-paced-cores C  cores the running paced sessions may "
-		"need together: each its CPU s\n"
-		"                       per simulated s times its pace (default "
-		"%g: half the cores)\n"
-		"  --max-client-connections N  open connections per client "
-		"address (default %d)\n"
-		"  --max-connections N  open connections, all clients "
-		"(default %d)\n"
-		"  --connection-timeout S  close a connection silent for S "
-		"seconds; must exceed --heartbeat\n"
-		"                       (default %g)\n"
-		"  --request-timeout S  a request's headers must all come within S "
-		"seconds of its first\n"
-		"                       line; a body gets S, then must keep up "
-		"with --min-body-rate (default %g)\n"
-		"  --min-body-rate BYTES  bytes per second a body must average "
-		"after --request-timeout;\n"
-		"                       slower ones are closed (default %zu)\n"
-		"  --max-queued-points N  sweep points queued or running, "
-		"all sweeps (default %d)\n"
-		"  --cpu-probe S        CPU seconds a new session's cost is "
-		"measured for before it is\n"
-		"                       admitted; 0: the estimate alone "
-		"(default %g)\n"
-		"LIGGGHTS sessions (scene.feed_model liggghts, docs/dem.md):\n"
-		"  --dem-bed PATH       the bed program (default: convsim-bed "
-		"next to this executable)\n"
-		"  --max-dem-sessions N  sessions with a LIGGGHTS bed at once, "
-		"each a bed process\n"
-		"                       holding a whole core (default %d; 0: "
-		"none)\n"
-		"  --dem-ranks N        run each bed under mpirun -n N, holding N "
-		"cores (default %d)\n"
-		"  --dem-timeout S      fail a session whose bed process gives no "
-		"answer for S seconds\n"
-		"                       (a hung bed; default %g)\n",
-		(double)cfg->max_memory / (double)(1 << 30),
-		cfg->max_cpu_seconds, cfg->max_busy, cfg->max_paced_cores,
-		cfg->max_client_connections, cfg->max_connections,
-		cfg->connection_timeout, cfg->request_timeout,
-		cfg->min_body_rate, cfg->max_queued_points, cfg->cpu_probe,
-		cfg->max_dem_sessions, cfg->dem_ranks, cfg->dem_timeout);
+	enum { COLUMN = 23 };
+	fputs("usage: convsimd [options]\n", f);
+	for (size_t i = 0; i < NOPTS; i++) {
+		const opt *o = &opts[i];
+		if (o->heading)
+			fprintf(f, "%s\n", o->heading);
+		int w = fprintf(f, "  --%s%s%s", o->name, *o->arg ? " " : "", o->arg);
+		fprintf(f, "%*s", w < COLUMN - 1 ? COLUMN - w : 2, "");
+		for (const char *c = o->doc; *c; c++) {
+			if (c[0] == '%' && c[1] == 'D') {
+				print_default(f, o, cfg);
+				c++;
+			} else if (*c == '\n') {
+				fprintf(f, "\n%*s", COLUMN, "");
+			} else {
+				fputc(*c, f);
+			}
+		}
+		fputc('\n', f);
+	}
 }
 
 /* An integer in [lo, hi]; sizes (binary) may end in K, M, G or T. */
@@ -243,7 +248,6 @@ static int parse_int(const char *arg, const char *name, long lo, long hi,
 /* Set one option of cfg from its argument; -1 with a message if bad. */
 static int set_option(srv_config *cfg, const opt *o, const char *arg)
 {
-	static const char *const levels[] = {"error", "warn", "info", "debug"};
 	char *at = (char *)cfg + o->field, flag[40], *end;
 	long v;
 	snprintf(flag, sizeof flag, "--%s", o->name);
@@ -262,7 +266,8 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	}
 	case OPT_INT:
 	case OPT_SIZE:
-		if (parse_int(arg, flag, o->lo, o->hi, o->kind == OPT_SIZE, &v))
+	case OPT_MEMORY:
+		if (parse_int(arg, flag, o->lo, o->hi, o->kind != OPT_INT, &v))
 			return -1;
 		if (o->kind == OPT_INT)
 			*(int *)(void *)at = (int)v;

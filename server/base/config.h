@@ -66,6 +66,9 @@ typedef struct srv_config {
 				  mpirun when > 1), the cores it holds */
 	double dem_timeout;    /* --dem-timeout: s a bed process may take to
 				  answer before its session fails */
+	double max_dem_cost;   /* --max-dem-cost: CPU s a bed may be expected
+				  to take per simulated second (its DEM step
+				  and grains), beyond which it is refused */
 } srv_config;
 
 /* Longest --node-id: "NODE-" and 12 hex digits fit in an id (SRV_ID_LEN). */

@@ -30,13 +30,9 @@ static void metric(FILE *f, const char *name, const char *type,
 		type, name, value);
 }
 
-char *srv_metrics_text(const srv_gauges *g)
+/* The counters and gauges of sessions, steps, streams, jobs and the store. */
+static void activity_metrics(FILE *f, const srv_gauges *g)
 {
-	char *text = NULL;
-	size_t len = 0;
-	FILE *f = open_memstream(&text, &len);
-	if (!f)
-		return NULL;
 	metric(f, "convsim_sessions", "gauge", "Live simulation sessions.",
 	       g->sessions);
 	metric(f, "convsim_sessions_created_total", "counter",
@@ -76,6 +72,11 @@ char *srv_metrics_text(const srv_gauges *g)
 	metric(f, "convsim_pool_queued", "gauge",
 	       "Sweep jobs waiting for a pool thread.",
 	       g->pool_queued);
+}
+
+/* The budgets' use and limits, and the connections refused or closed. */
+static void budget_metrics(FILE *f, const srv_gauges *g)
+{
 	const struct {
 		const char *name, *type, *help;
 		double value;
@@ -113,6 +114,17 @@ char *srv_metrics_text(const srv_gauges *g)
 	for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
 		metric(f, budgets[i].name, budgets[i].type, budgets[i].help,
 		       budgets[i].value);
+}
+
+char *srv_metrics_text(const srv_gauges *g)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	if (!f)
+		return NULL;
+	activity_metrics(f, g);
+	budget_metrics(f, g);
 	fprintf(f, "# HELP convsim_http_requests_total HTTP responses by "
 		   "status.\n# TYPE convsim_http_requests_total counter\n");
 	for (int s = 100; s < 600; s++) {

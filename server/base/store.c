@@ -9,7 +9,8 @@
  * path -> path.prev] -> rename(path.tmp, path) -> fsync of the directory;
  * on any failure the temporary file is removed and the file it would have
  * replaced stays as it was. So a reader finds the old file or the new
- * one, whole, never a mixture, whatever moment the daemon dies.
+ * one, whole, never a mixture, whatever moment the daemon dies. The
+ * framed files read back and the listings are store_read.c's.
  */
 #define _GNU_SOURCE /* pthread_setname_np: the writer shows as "store" */
 #include <dirent.h>
@@ -48,21 +49,13 @@ static struct {
 	store_job *head, *tail;
 	int stop, started;
 	pthread_t thread;
-	/* the restore's counts, by kind (written before the daemon serves) */
-	size_t damaged[8], upgraded[8];
 	/* srv_store_watch on: the writes that failed since (lock held) */
 	int watching;
 	size_t failed;
 	char failed_what[1024];
 } st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
-typedef struct frame_header {
-	char magic[4];
-	uint32_t version, kind, pad;
-	uint64_t len, checksum;
-} frame_header;
-
-static void full_path(char *out, size_t len, const char *rel)
+void srv_store_path(char *out, size_t len, const char *rel)
 {
 	snprintf(out, len, "%s/%s", st.dir, rel);
 }
@@ -103,7 +96,7 @@ static int fsync_parent(const char *p)
 static int write_atomic(const store_job *j, char *msg, size_t msglen)
 {
 	char path[4096], tmp[4200], prev[4200];
-	full_path(path, sizeof path, j->path);
+	srv_store_path(path, sizeof path, j->path);
 	snprintf(tmp, sizeof tmp, "%s.tmp", path);
 	snprintf(prev, sizeof prev, "%s.prev", path);
 	const char *step = "create the directory of";
@@ -158,7 +151,7 @@ fail:
 static void remove_path(const char *rel)
 {
 	char path[4096];
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	DIR *d = opendir(path);
 	if (d) {
 		struct dirent *de;
@@ -248,7 +241,7 @@ static void *writer_main(void *arg)
 static int check_node_id(const char *node_id)
 {
 	char p[4096], held[64] = "";
-	full_path(p, sizeof p, "node-id");
+	srv_store_path(p, sizeof p, "node-id");
 	FILE *f = fopen(p, "r");
 	if (f) {
 		if (!fgets(held, sizeof held, f))
@@ -282,7 +275,7 @@ int srv_store_open(const srv_config *cfg)
 	static const char *const subdirs[] = {"sessions", "experiments", "sweeps", "fits"};
 	for (size_t i = 0; i < sizeof subdirs / sizeof *subdirs; i++) {
 		char p[4096];
-		full_path(p, sizeof p, subdirs[i]);
+		srv_store_path(p, sizeof p, subdirs[i]);
 		if (mkdir(p, 0755) != 0 && errno != EEXIST) {
 			fprintf(stderr, "convsimd: cannot create %s: %s\n", p,
 				strerror(errno));
@@ -418,7 +411,7 @@ int srv_store_make_dir(const char *rel)
 	if (!st.started)
 		return 0;
 	char path[4096];
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	if (mkdir(path, 0755) != 0)
 		return errno == EEXIST ? 0 : -1;
 	return fsync_parent(path);
@@ -427,7 +420,7 @@ int srv_store_make_dir(const char *rel)
 int srv_store_open_log(const char *rel, uint64_t len)
 {
 	char path[4096];
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	int fd = open(path, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
 	if (fd < 0)
 		return -1;
@@ -448,7 +441,7 @@ api_err srv_store_check_removable(const char *rel, api_problem *pb)
 		return API_OK;
 	char path[4096];
 	struct stat sb;
-	full_path(path, sizeof path, rel);
+	srv_store_path(path, sizeof path, rel);
 	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
 	/* its directory (the entry goes), and the entry's own when it is
 	 * one (its files go) */
@@ -480,191 +473,4 @@ void srv_store_remove(const char *path)
 		return;
 	snprintf(j->path, sizeof j->path, "%s", path);
 	enqueue(j);
-}
-
-void *srv_store_frame(uint32_t kind, const void *payload, size_t plen,
-		      size_t *len)
-{
-	frame_header h = {{'C', 'V', 'S', 'F'}, SRV_STORE_VERSION, kind, 0,
-			  plen, sim_checksum(payload, plen)};
-	char *buf = malloc(sizeof h + plen);
-	if (!buf)
-		return NULL;
-	memcpy(buf, &h, sizeof h);
-	memcpy(buf + sizeof h, payload, plen);
-	*len = sizeof h + plen;
-	return buf;
-}
-
-char *srv_store_read_text(const char *rel, size_t *len)
-{
-	char path[4096];
-	full_path(path, sizeof path, rel);
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	char *buf = NULL;
-	size_t n = 0, cap = 0;
-	for (;;) {
-		if (n + 4096 + 1 > cap) {
-			cap = cap ? 2 * cap : 8192;
-			char *nb = realloc(buf, cap);
-			if (!nb) {
-				free(buf);
-				fclose(f);
-				return NULL;
-			}
-			buf = nb;
-		}
-		size_t r = fread(buf + n, 1, 4096, f);
-		n += r;
-		if (r < 4096)
-			break;
-	}
-	fclose(f);
-	buf[n] = '\0';
-	*len = n;
-	return buf;
-}
-
-void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *older,
-			const char **bad)
-{
-	frame_header h;
-	*bad = NULL;
-	*older = 0;
-	if (n < sizeof h)
-		*bad = "cut off (shorter than its header)";
-	if (!*bad) {
-		memcpy(&h, buf, sizeof h);
-		if (memcmp(h.magic, "CVSF", 4) != 0)
-			*bad = "not a convsim file (bad magic)";
-		else if (h.version > SRV_STORE_VERSION)
-			*bad = "of a newer format version than this build reads";
-		else if (h.version < SRV_STORE_OLDEST)
-			*bad = "of an unknown format version";
-		else if (h.kind != kind)
-			*bad = "a file of another kind";
-		else if (h.len > n - sizeof h)
-			*bad = "cut off";
-		else if (h.len < n - sizeof h)
-			*bad = "longer than its header says";
-		else if (sim_checksum(buf + sizeof h, h.len) != h.checksum)
-			*bad = "checksum mismatch";
-	}
-	if (*bad) {
-		free(buf);
-		return NULL;
-	}
-	memmove(buf, buf + sizeof h, h.len);
-	*len = h.len;
-	if (h.version == SRV_STORE_VERSION)
-		return buf;
-	*older = 1;
-	return srv_store_upgrade_v1(kind, buf, len, bad);
-}
-
-void *srv_store_read(const char *rel, uint32_t kind, size_t *len, int *older,
-		     char *why, size_t whylen)
-{
-	size_t n = 0;
-	char *buf = srv_store_read_text(rel, &n);
-	const char *bad = "missing or unreadable";
-	*older = 0;
-	void *payload = buf ? srv_store_unframe(buf, n, kind, len, older, &bad) : NULL;
-	if (!payload)
-		snprintf(why, whylen, "%s: %s", rel, bad);
-	return payload;
-}
-
-void srv_store_count_damaged(uint32_t kind)
-{
-	if (kind < sizeof st.damaged / sizeof *st.damaged)
-		st.damaged[kind]++;
-}
-
-void srv_store_count_upgraded(uint32_t kind)
-{
-	if (kind < sizeof st.upgraded / sizeof *st.upgraded)
-		st.upgraded[kind]++;
-}
-
-size_t srv_store_damaged(uint32_t kind)
-{
-	return kind < sizeof st.damaged / sizeof *st.damaged ? st.damaged[kind] : 0;
-}
-
-size_t srv_store_upgraded(uint32_t kind)
-{
-	return kind < sizeof st.upgraded / sizeof *st.upgraded ? st.upgraded[kind] : 0;
-}
-
-/* Is the entry name of rel one of the kind srv_store_list_ids lists? 1
- * yes, 0 the store's own leftovers (.tmp, .prev: skipped silently), -1
- * junk (the reason in *why). */
-static int stored_entry(const char *rel, const char *name, int dirs,
-			const char **why)
-{
-	size_t n = strlen(name);
-	if (n > 4 && (strcmp(name + n - 4, ".tmp") == 0 ||
-		      strcmp(name + n - 5, ".prev") == 0))
-		return 0;
-	char path[4096];
-	struct stat sb;
-	snprintf(path, sizeof path, "%s/%s/%s", st.dir, rel, name);
-	size_t idlen = dirs ? n : n > 4 && strcmp(name + n - 4, ".bin") == 0 ? n - 4 : 0;
-	if (lstat(path, &sb) != 0)
-		*why = strerror(errno);
-	else if (dirs ? !S_ISDIR(sb.st_mode) : !S_ISREG(sb.st_mode))
-		*why = dirs ? "not a directory" : "not a regular file";
-	else if (!srv_id_valid(name, idlen))
-		*why = dirs ? "not named by an id" : "not named ID.bin";
-	else
-		return 1;
-	return -1;
-}
-
-size_t srv_store_list_ids(const char *rel, int dirs, char ***names)
-{
-	size_t n = srv_store_list(rel, names), kept = 0;
-	for (size_t i = 0; i < n; i++) {
-		const char *why = NULL;
-		int ok = stored_entry(rel, (*names)[i], dirs, &why);
-		if (ok < 0)
-			srv_log(SRV_LOG_WARN, "data dir: ignored %s/%.100s: %s",
-				rel, (*names)[i], why);
-		if (ok > 0)
-			(*names)[kept++] = (*names)[i];
-		else
-			free((*names)[i]);
-	}
-	return kept;
-}
-
-size_t srv_store_list(const char *rel, char ***names)
-{
-	char path[4096];
-	full_path(path, sizeof path, rel);
-	*names = NULL;
-	DIR *d = opendir(path);
-	if (!d)
-		return 0;
-	size_t n = 0, cap = 0;
-	struct dirent *de;
-	while ((de = readdir(d))) {
-		if (de->d_name[0] == '.')
-			continue;
-		if (n == cap) {
-			cap = cap ? 2 * cap : 64;
-			char **nn = realloc(*names, cap * sizeof *nn);
-			if (!nn)
-				break;
-			*names = nn;
-		}
-		(*names)[n] = strdup(de->d_name);
-		if ((*names)[n])
-			n++;
-	}
-	closedir(d);
-	return n;
 }

@@ -70,6 +70,8 @@ void srv_store_watch(void);
 size_t srv_store_failed(char *what, size_t len);
 /* 1 when a data directory is in use. */
 int srv_store_enabled(void);
+/* The absolute path of rel (relative to the data directory) into out. */
+void srv_store_path(char *out, size_t len, const char *rel);
 /* --checkpoint-interval, s of wall time. */
 double srv_store_interval(void);
 

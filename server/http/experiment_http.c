@@ -67,7 +67,7 @@ static api_err start_on_session(srv_experiment *e,
 {
 	srv_session *s;
 	if (req->fresh) {
-		s = srv_session_create(&req->spec, e, pb);
+		s = srv_session_create(&req->spec, e, -1, pb);
 		if (!s)
 			return pb->code;
 	} else {
@@ -81,6 +81,8 @@ static api_err start_on_session(srv_experiment *e,
 			srv_session_put(s);
 			return pb->code;
 		}
+		/* the session's scene, for each segment's model error */
+		srv_exp_set_spec(e, srv_session_spec(s));
 	}
 	srv_session_put(s); /* it noted its id in e before its worker ran */
 	return API_OK;

@@ -146,9 +146,14 @@ static int split_host(const char *host, char *name, size_t cap, long *port)
 	name[n] = '\0';
 	*port = 80;
 	if (colon) {
-		char *stop;
-		*port = strtol(colon + 1, &stop, 10);
-		if (stop == colon + 1 || *stop || *port < 0 || *port > 65535)
+		/* 1 to 5 digits without a leading zero, as clients write a
+		 * port: no sign, no space, no 032100 */
+		const char *digits = colon + 1;
+		size_t k = strspn(digits, "0123456789");
+		if (k == 0 || k > 5 || digits[k] || (digits[0] == '0' && k > 1))
+			return 0;
+		*port = strtol(digits, NULL, 10);
+		if (*port > 65535)
 			return 0;
 	}
 	return 1;

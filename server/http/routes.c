@@ -2,8 +2,10 @@
 /*
  * routes.c - the route table and the libmicrohttpd access handler.
  *
- * Routes are a static table {method, pattern, handler}; "*" in a pattern
- * matches one path segment and becomes a path argument. The access
+ * Routes are one static table: the API's rows {method, pattern, query
+ * parameters, ...} (api/routes.c) and, by the same id, this file's
+ * {handler, job kind}; "*" in a pattern matches one path segment and
+ * becomes a path argument. The access
  * handler first passes the request's headers through the gate (gate.c:
  * Host, Origin, token, the JSON media type of mutating requests) and
  * answers, before any byte of a body is read, a body too large for
@@ -34,44 +36,57 @@
 #include "stream.h"
 #include "util.h"
 
+/* The server's half of the one route table: the handler (and a job
+ * route's kind, job.h) of each row of the API's table (api/routes.c), by
+ * its id. Method, path, query parameters and representations are the
+ * API's; a row without a handler stops the daemon at start-up. */
 typedef struct route {
-	const char *method;
-	const char *pattern;
 	srv_handler handler;
-	const srv_job_kind *job; /* a job route's kind (job.h) */
+	const srv_job_kind *job;
 } route;
 
-static const route routes[] = {
-	{"POST", "/api/v1/sessions", srv_h_sessions_create, NULL},
-	{"GET", "/api/v1/sessions", srv_h_sessions_list, NULL},
-	{"GET", "/api/v1/sessions/*", srv_h_session_get, NULL},
-	{"PATCH", "/api/v1/sessions/*", srv_h_session_patch, NULL},
-	{"DELETE", "/api/v1/sessions/*", srv_h_session_delete, NULL},
-	{"GET", "/api/v1/sessions/*/stream", srv_h_stream, NULL},
-	{"GET", "/api/v1/sessions/*/trajectory", srv_h_trajectory, NULL},
-	{"POST", "/api/v1/experiments", srv_h_job_create, &srv_experiment_job},
-	{"GET", "/api/v1/experiments", srv_h_job_list, &srv_experiment_job},
-	{"GET", "/api/v1/experiments/*", srv_h_job_get, &srv_experiment_job},
-	{"POST", "/api/v1/sweeps", srv_h_job_create, &srv_sweep_job},
-	{"GET", "/api/v1/sweeps", srv_h_job_list, &srv_sweep_job},
-	{"GET", "/api/v1/sweeps/*", srv_h_job_get, &srv_sweep_job},
-	{"DELETE", "/api/v1/sweeps/*", srv_h_job_delete, &srv_sweep_job},
-	{"POST", "/api/v1/fits", srv_h_job_create, &srv_fit_job},
-	{"GET", "/api/v1/fits", srv_h_job_list, &srv_fit_job},
-	{"GET", "/api/v1/fits/*", srv_h_job_get, &srv_fit_job},
-	{"DELETE", "/api/v1/fits/*", srv_h_job_delete, &srv_fit_job},
-	{"GET", "/api/v1/presets", srv_h_presets, NULL},
-	{"GET", "/api/v1/health", srv_h_health, NULL},
-	{"GET", "/api/v1/openapi.json", srv_h_openapi, NULL},
-	{"GET", "/api/v1/problems/*", srv_h_problem, NULL},
-	{"GET", "/metrics", srv_h_metrics, NULL},
+static const route routes[API_R_COUNT] = {
+	[API_R_SESSIONS_CREATE] = {srv_h_sessions_create, NULL},
+	[API_R_SESSIONS_LIST] = {srv_h_sessions_list, NULL},
+	[API_R_SESSION_GET] = {srv_h_session_get, NULL},
+	[API_R_SESSION_PATCH] = {srv_h_session_patch, NULL},
+	[API_R_SESSION_DELETE] = {srv_h_session_delete, NULL},
+	[API_R_SESSION_STREAM] = {srv_h_stream, NULL},
+	[API_R_SESSION_TRAJECTORY] = {srv_h_trajectory, NULL},
+	[API_R_EXPERIMENTS_CREATE] = {srv_h_job_create, &srv_experiment_job},
+	[API_R_EXPERIMENTS_LIST] = {srv_h_job_list, &srv_experiment_job},
+	[API_R_EXPERIMENT_GET] = {srv_h_job_get, &srv_experiment_job},
+	[API_R_SWEEPS_CREATE] = {srv_h_job_create, &srv_sweep_job},
+	[API_R_SWEEPS_LIST] = {srv_h_job_list, &srv_sweep_job},
+	[API_R_SWEEP_GET] = {srv_h_job_get, &srv_sweep_job},
+	[API_R_SWEEP_DELETE] = {srv_h_job_delete, &srv_sweep_job},
+	[API_R_FITS_CREATE] = {srv_h_job_create, &srv_fit_job},
+	[API_R_FITS_LIST] = {srv_h_job_list, &srv_fit_job},
+	[API_R_FIT_GET] = {srv_h_job_get, &srv_fit_job},
+	[API_R_FIT_DELETE] = {srv_h_job_delete, &srv_fit_job},
+	[API_R_PRESETS] = {srv_h_presets, NULL},
+	[API_R_HEALTH] = {srv_h_health, NULL},
+	[API_R_OPENAPI] = {srv_h_openapi, NULL},
+	[API_R_PROBLEM] = {srv_h_problem, NULL},
+	[API_R_METRICS] = {srv_h_metrics, NULL},
 };
 
 static const srv_config *cfg;
 
-void srv_routes_init(const srv_config *config)
+int srv_routes_init(const srv_config *config)
 {
 	cfg = config;
+	size_t n;
+	const api_route *rt = api_routes(&n);
+	int bad = n != API_R_COUNT;
+	for (size_t i = 0; i < n && i < API_R_COUNT; i++)
+		if (!rt[i].method || !routes[i].handler) {
+			fprintf(stderr, "convsimd: route %zu (%s %s) has no %s\n", i, rt[i].method ? rt[i].method : "?",
+				rt[i].pattern ? rt[i].pattern : "?",
+				rt[i].method ? "handler" : "row in the API's route table");
+			bad = 1;
+		}
+	return bad ? -1 : 0;
 }
 
 typedef struct req_state {
@@ -81,6 +96,8 @@ typedef struct req_state {
 	int too_large;
 	size_t query_params; /* over SRV_MAX_QUERY_PARAMS: the query was cut */
 	srv_conn *live;      /* the connection's deadlines (conns.h) */
+	size_t nul_at;       /* 1 + where the target has %00; 0: nowhere */
+	int nul_in_query;    /* that %00 is in the query */
 } req_state;
 
 /* More query parameters than any route takes (the most is a handful). */
@@ -92,7 +109,17 @@ void *srv_uri_seen(void *cls, const char *uri, struct MHD_Connection *conn)
 	srv_conn_request_line(srv_budget_live(conn));
 	req_state *st = calloc(1, sizeof *st);
 	char *query = strchr(uri, '?');
-	if (!st || !query)
+	if (!st)
+		return st;
+	/* libmicrohttpd decodes %00 into a NUL that ends the path or value
+	 * there (/api/v1/health%00x would be /api/v1/health): such a target
+	 * names nothing, and first_look refuses it */
+	const char *nul = strstr(uri, "%00");
+	if (nul) {
+		st->nul_at = (size_t)(nul - uri) + 1;
+		st->nul_in_query = query && nul > query;
+	}
+	if (!query)
 		return st;
 	size_t n = 1;
 	for (const char *c = query + 1; *c; c++)
@@ -153,20 +180,18 @@ static enum MHD_Result check_one_query(void *cls, enum MHD_ValueKind kind, const
 /* The checks the API's route table asks for before a handler runs: every
  * query parameter known to the route, the representation (r->csv) of a
  * result route. */
-static enum MHD_Result call_route(srv_req *r, const route *ro)
+static enum MHD_Result call_route(srv_req *r, size_t id)
 {
-	const api_route *rt = api_route_find(ro->method, ro->pattern);
+	size_t n;
+	const api_route *rt = &api_routes(&n)[id];
 	api_problem pb;
-	if (rt) {
-		query_check qc = {rt, &pb, 0};
-		MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, check_one_query, &qc);
-		if (qc.bad ||
-		    api_negotiate(rt, rt->tables ? srv_query(r, "format") : NULL,
-				  srv_header(r, MHD_HTTP_HEADER_ACCEPT), &r->csv, &pb) != API_OK)
-			return srv_reply_problem(r, &pb, NULL);
-	}
-	r->job = ro->job;
-	return ro->handler(r);
+	query_check qc = {rt, &pb, 0};
+	MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, check_one_query, &qc);
+	if (qc.bad || api_negotiate(rt, rt->tables ? srv_query(r, "format") : NULL,
+				    srv_header(r, MHD_HTTP_HEADER_ACCEPT), &r->csv, &pb) != API_OK)
+		return srv_reply_problem(r, &pb, NULL);
+	r->job = routes[id].job;
+	return routes[id].handler(r);
 }
 
 void srv_route_resolve(const char *method, const char *url, srv_route_match *m)
@@ -175,7 +200,9 @@ void srv_route_resolve(const char *method, const char *url, srv_route_match *m)
 	if (strcmp(method, "HEAD") == 0)
 		method = "GET";
 	int path_known = 0;
-	for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
+	size_t n;
+	const api_route *routes = api_routes(&n);
+	for (size_t i = 0; i < n; i++) {
 		char arg[2][64];
 		if (!match(routes[i].pattern, url, arg))
 			continue;
@@ -218,7 +245,7 @@ static enum MHD_Result route_request(srv_req *r)
 	switch (m.kind) {
 	case SRV_ROUTE_FOUND:
 		memcpy(r->arg, m.arg, sizeof m.arg);
-		return call_route(r, &routes[m.index]);
+		return call_route(r, m.index);
 	case SRV_ROUTE_METHOD:
 		api_fail(&pb, API_METHOD, NULL,
 			 "%s is not allowed on %s; allowed: %s", r->method,
@@ -282,6 +309,15 @@ static int first_look(srv_req *r, enum MHD_Result *result)
 	api_problem pb;
 	if (srv_budget_client_over(r->conn, &pb)) { /* before anything else */
 		*result = srv_reply_problem(r, &pb, NULL);
+		return 1;
+	}
+	const req_state *st = (const req_state *)r;
+	if (st->nul_at) {
+		*result = srv_fail(r, st->nul_in_query ? API_QUERY : API_BADREQUEST,
+				   st->nul_in_query ? "query" : "path",
+				   "the request target has %%00 (a NUL byte) at "
+				   "byte %zu; no path or query value holds one",
+				   st->nul_at - 1);
 		return 1;
 	}
 	if (((req_state *)r)->query_params) {

@@ -8,8 +8,10 @@
 #include "config.h"
 #include "reply.h"
 
-/* cfg (borrowed for the daemon's life) gives --max-body. */
-void srv_routes_init(const srv_config *cfg);
+/* cfg (borrowed for the daemon's life) gives --max-body. Checks that
+ * every row of the API's route table has its handler: -1 (each missing
+ * one told on stderr) if not, the daemon does not start. */
+int srv_routes_init(const srv_config *cfg);
 /* The access handler and completion callback given to MHD. */
 enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 			     const char *url, const char *method,
@@ -26,7 +28,7 @@ void srv_request_done(void *cls, struct MHD_Connection *conn,
  * alone (no libmicrohttpd, no state: the access handler acts on it, the
  * fuzz harness tests/fuzz/fuzz_route.c checks it). HEAD is GET. */
 typedef enum {
-	SRV_ROUTE_FOUND,         /* routes' entry index, with its path arguments */
+	SRV_ROUTE_FOUND,         /* the route's api_route_id, with its path arguments */
 	SRV_ROUTE_METHOD,        /* 405: the path exists with the methods in allow */
 	SRV_ROUTE_NOT_FOUND,     /* 404: an unknown path under /api */
 	SRV_ROUTE_STATIC_METHOD, /* 405: a static file asked for with another method */
@@ -34,7 +36,7 @@ typedef enum {
 } srv_route_kind;
 typedef struct srv_route_match {
 	srv_route_kind kind;
-	size_t index;                /* FOUND: the entry of the table */
+	size_t index;                /* FOUND: the route's api_route_id */
 	const char *method, *pattern; /* FOUND: the entry's (static) */
 	char arg[2][64];             /* FOUND: the "*" segments */
 	char allow[96];              /* METHOD: the Allow header */

@@ -248,13 +248,20 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				    : rv.head;
 	else
 		k->cursor = rv.head > rv.oldest ? rv.head - 1 : rv.head;
-	/* the first record: where the stream starts, and whether the
-	 * scene's column model lies outside its validated domain */
-	char why[400];
-	const api_spec *spec = srv_session_spec(k->s);
-	int inside = sim_feed_validated(&spec->params, &spec->scene, why, sizeof why);
+	/* the first record: where the stream starts, and the scene's model
+	 * error as its controls stand now (each control event carries it
+	 * anew) */
+	api_view *view = calloc(1, sizeof *view);
+	if (!view) {
+		stream_free(k);
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	}
+	srv_session_view(k->s, view);
+	sim_model_error me;
+	int mc = api_model_check(srv_session_spec(k->s), view->has_status ? &view->st : NULL, &me);
+	free(view);
 	k->out_len = api_format_hello(k->out, k->out_cap, srv_session_id(k->s), k->cursor,
-				      inside ? NULL : why, k->ndjson);
+				      mc == 0 ? me.note : NULL, &me, k->ndjson);
 	k->last_write = srv_now();
 	struct MHD_Response *resp = MHD_create_response_from_callback(
 		MHD_SIZE_UNKNOWN, 32 * 1024, reader, k, stream_free);

@@ -107,6 +107,13 @@ int srv_exp_keeps_session(const srv_experiment *e)
 	return e->req.keep_session || !e->req.fresh;
 }
 
+void srv_exp_set_spec(srv_experiment *e, const api_spec *spec)
+{
+	pthread_mutex_lock(&e->lock);
+	e->req.spec = *spec;
+	pthread_mutex_unlock(&e->lock);
+}
+
 void srv_exp_set_session(srv_experiment *e, const char *session_id)
 {
 	pthread_mutex_lock(&e->lock);
@@ -150,6 +157,7 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 	v->progress = e->state == EXP_DONE ? 1 : p < 0 ? 0 : p > 1 ? 1 : p;
 	v->nseg = e->req.nseg;
 	v->seg = e->req.seg;
+	v->spec = &e->req.spec; /* set at creation, never changed after */
 }
 
 /* ---- persistence (store.h) ---------------------------------------------

@@ -37,6 +37,9 @@ const api_experiment_req *srv_exp_request(const srv_experiment *e);
 int srv_exp_keeps_session(const srv_experiment *e);
 /* Note the session it runs on. */
 void srv_exp_set_session(srv_experiment *e, const char *session_id);
+/* Note the scene of an existing session it is attached to (copied): each
+ * segment's model error is the scene's at the segment's beta. */
+void srv_exp_set_spec(srv_experiment *e, const api_spec *spec);
 /* 1 when it is over and no worker refers to it (it may be evicted). */
 int srv_exp_finished(srv_experiment *e);
 /* A consistent copy of its state: *v, with v->seg pointing at seg (room

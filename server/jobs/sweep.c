@@ -311,25 +311,6 @@ static int evictable(srv_entry *en)
 	return over;
 }
 
-/* band_from_fit: the fit's result as the band source and the sweep's
- * model prepared for it (its fitted values, the varied ones skipped). */
-static api_err prepare_band(api_sweep_req *req, api_problem *pb)
-{
-	api_err e = srv_fit_band_source(req->band_fit, &req->band_src, pb);
-	if (e != API_OK)
-		return e;
-	const char *varied[SIM_STUDY_MAX_AXES];
-	for (int a = 0; a < req->nvary; a++)
-		varied[a] = req->vary[a];
-	char msg[240];
-	if (fit_band_source_prepare(&req->band_src, varied, (size_t)req->nvary, req->band_skip,
-				    &req->spec.params, &req->spec.scene, &req->spec.method, msg,
-				    sizeof msg) != SIM_OK)
-		return api_fail(pb, API_INVALID, "band_from_fit", "band_from_fit: %s", msg);
-	req->band = 1;
-	return API_OK;
-}
-
 /* A sweep for a request body with its grid of points and their place in
  * the points' budget; NULL with *pb. */
 static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
@@ -341,7 +322,7 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 	}
 	pthread_mutex_init(&sw->lock, NULL);
 	if (api_parse_sweep(body, len, &sw->req, pb) != API_OK ||
-	    (sw->req.band_fit[0] && prepare_band(&sw->req, pb) != API_OK)) {
+	    (sw->req.band_fit[0] && srv_sweep_prepare_band(&sw->req, pb) != API_OK)) {
 		sweep_free(sw);
 		return NULL;
 	}

@@ -41,5 +41,10 @@ int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, si
 /* Point i is over (done or failed): its mirror image, if it has one, is
  * too (lock held). */
 void srv_sweep_fill_image(srv_sweep *sw, size_t i);
+/* band_from_fit (sweep_plan.c): the fit's result as the band source and
+ * the request's model prepared for it (its fitted values, the varied ones
+ * skipped); API_OK or the problem (srv_fit_band_source's, or a 422
+ * naming band_from_fit). */
+api_err srv_sweep_prepare_band(api_sweep_req *req, api_problem *pb);
 
 #endif

@@ -3,12 +3,14 @@
  * sweep_plan.c - the mirror reduction of a sweep's points
  * (sim_study_mirror_plan): a point that is the mirror image of another is
  * no job of its own, and is filled, velocity negated, when the other is
- * over; and a point's varied settings applied to its model.
+ * over; a point's varied settings applied to its model; and the band
+ * source of a sweep with band_from_fit.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "fitjob.h"
 #include "study.h"
 #include "sweep_int.h"
 #include "units.h"
@@ -86,4 +88,23 @@ void srv_sweep_fill_image(srv_sweep *sw, size_t i)
 		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
 				   src->error);
 	sw->done++;
+}
+
+/* band_from_fit: the fit's result as the band source and the sweep's
+ * model prepared for it (its fitted values, the varied ones skipped). */
+api_err srv_sweep_prepare_band(api_sweep_req *req, api_problem *pb)
+{
+	api_err e = srv_fit_band_source(req->band_fit, &req->band_src, pb);
+	if (e != API_OK)
+		return e;
+	const char *varied[SIM_STUDY_MAX_AXES];
+	for (int a = 0; a < req->nvary; a++)
+		varied[a] = req->vary[a];
+	char msg[240];
+	if (fit_band_source_prepare(&req->band_src, varied, (size_t)req->nvary, req->band_skip,
+				    &req->spec.params, &req->spec.scene, &req->spec.method, msg,
+				    sizeof msg) != SIM_OK)
+		return api_fail(pb, API_INVALID, "band_from_fit", "band_from_fit: %s", msg);
+	req->band = 1;
+	return API_OK;
 }

@@ -63,32 +63,32 @@ int srv_control_log_sync(srv_session *s, size_t end, double timeout_s)
 	int rc = 0;
 	struct timespec until = srv_deadline(timeout_s);
 	pthread_mutex_lock(&s->lock);
-	while (s->log_synced < end) {
-		if (s->log_syncing) { /* a leader is at it: its round may hold ours */
-			if (pthread_cond_timedwait(&s->log_cond, &s->lock, &until) == ETIMEDOUT) {
+	while (s->log.synced < end) {
+		if (s->log.syncing) { /* a leader is at it: its round may hold ours */
+			if (pthread_cond_timedwait(&s->log.cond, &s->lock, &until) == ETIMEDOUT) {
 				rc = ETIMEDOUT;
 				break;
 			}
 			continue;
 		}
 		/* lead a round: everything appended so far */
-		size_t from = s->log_synced, to = s->controls_len;
+		size_t from = s->log.synced, to = s->controls_len;
 		char *copy = malloc(to - from);
 		if (!copy) {
 			rc = ENOMEM;
 			break;
 		}
 		memcpy(copy, s->controls + from, to - from);
-		s->log_syncing = 1;
-		int fd = s->log_fd;
+		s->log.syncing = 1;
+		int fd = s->log.fd;
 		pthread_mutex_unlock(&s->lock);
 		int err = write_durable(s, &fd, copy, to - from, from);
 		free(copy);
 		pthread_mutex_lock(&s->lock);
-		s->log_fd = fd;
-		s->log_syncing = 0;
+		s->log.fd = fd;
+		s->log.syncing = 0;
 		if (!err) {
-			s->log_synced = to;
+			s->log.synced = to;
 			atomic_fetch_add(&srv_stats.log_syncs, 1);
 		} else {
 			snprintf(s->store_error, sizeof s->store_error,
@@ -96,7 +96,7 @@ int srv_control_log_sync(srv_session *s, size_t end, double timeout_s)
 				 strerror(err));
 			atomic_fetch_add(&srv_stats.store_errors, 1);
 		}
-		pthread_cond_broadcast(&s->log_cond);
+		pthread_cond_broadcast(&s->log.cond);
 		if (err) {
 			rc = err;
 			break;
@@ -116,7 +116,7 @@ static void flush(void *arg)
 		return;
 	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
 	pthread_mutex_lock(&s->lock);
-	s->log_flush_queued = 0;
+	s->log.flush_queued = 0;
 	size_t end = s->controls_len;
 	pthread_mutex_unlock(&s->lock);
 	int err = srv_control_log_sync(s, end, 30.0);
@@ -144,10 +144,10 @@ size_t srv_control_log_append(srv_session *s, const char *json, int waited)
 	memcpy(s->controls + s->controls_len, json, add - 1);
 	s->controls_len += add;
 	s->controls[s->controls_len - 1] = '\n';
-	if (!waited && !s->log_flush_queued) {
+	if (!waited && !s->log.flush_queued) {
 		char *id = strdup(s->entry.id);
 		if (id) {
-			s->log_flush_queued = 1;
+			s->log.flush_queued = 1;
 			srv_store_call(flush, id);
 		}
 	}
@@ -156,7 +156,7 @@ size_t srv_control_log_append(srv_session *s, const char *json, int waited)
 
 void srv_control_log_close(srv_session *s)
 {
-	if (s->log_fd >= 0)
-		close(s->log_fd);
-	s->log_fd = -1;
+	if (s->log.fd >= 0)
+		close(s->log.fd);
+	s->log.fd = -1;
 }

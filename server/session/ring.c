@@ -18,8 +18,8 @@
 
 static api_sample *push_slot(srv_session *s)
 {
-	api_sample *slot = srv_ring_slot(s, s->head % s->ring_cap);
-	slot->index = s->head++;
+	api_sample *slot = srv_ring_slot(s, s->ring.head % s->ring.cap);
+	slot->index = s->ring.head++;
 	return slot;
 }
 
@@ -30,7 +30,7 @@ void srv_ring_event(srv_session *s, const char *type, const char *json)
 	slot->st = s->st;
 	snprintf(slot->event_type, sizeof slot->event_type, "%s", type);
 	snprintf(slot->event, sizeof slot->event, "%s", json);
-	s->event_head = s->head;
+	s->ring.event_head = s->ring.head;
 }
 
 void srv_ring_event_at(srv_session *s, const char *type, const char *detail)
@@ -54,28 +54,28 @@ static int on_grid(double t, double step)
  * sample intervals), so the rows lie `stride` apart as reported. */
 static void record_history(srv_session *s)
 {
-	if (!s->hist_cap || s->st.t < s->hist_next - 1e-9 * s->hist_stride ||
-	    !on_grid(s->st.t, s->hist_stride))
+	if (!s->ring.hist_cap || s->st.t < s->ring.hist_next - 1e-9 * s->ring.hist_stride ||
+	    !on_grid(s->st.t, s->ring.hist_stride))
 		return;
 	size_t width = API_HISTORY_WIDTH(s->columns);
-	if (s->hist_n == s->hist_cap) {
+	if (s->ring.hist_n == s->ring.hist_cap) {
 		/* full: keep the rows on the doubled grid, double the stride */
 		size_t k = 0;
-		for (size_t i = 0; i < s->hist_n; i++)
-			if (on_grid(s->hist[i * width], 2 * s->hist_stride))
-				memmove(s->hist + k++ * width, s->hist + i * width,
+		for (size_t i = 0; i < s->ring.hist_n; i++)
+			if (on_grid(s->ring.hist[i * width], 2 * s->ring.hist_stride))
+				memmove(s->ring.hist + k++ * width, s->ring.hist + i * width,
 					width * sizeof(double));
-		s->hist_n = k;
-		s->hist_stride *= 2;
-		if (!on_grid(s->st.t, s->hist_stride)) {
-			s->hist_next = (floor(s->st.t / s->hist_stride + 1e-6) + 1) * s->hist_stride;
+		s->ring.hist_n = k;
+		s->ring.hist_stride *= 2;
+		if (!on_grid(s->st.t, s->ring.hist_stride)) {
+			s->ring.hist_next = (floor(s->st.t / s->ring.hist_stride + 1e-6) + 1) * s->ring.hist_stride;
 			return;
 		}
 	}
 	api_history_row(&s->st, s->scratch.column_disp, s->columns,
-			s->hist + s->hist_n * width);
-	s->hist_n++;
-	s->hist_next = (floor(s->st.t / s->hist_stride + 0.5) + 1) * s->hist_stride;
+			s->ring.hist + s->ring.hist_n * width);
+	s->ring.hist_n++;
+	s->ring.hist_next = (floor(s->st.t / s->ring.hist_stride + 0.5) + 1) * s->ring.hist_stride;
 }
 
 void srv_ring_sample(srv_session *s)
@@ -145,8 +145,8 @@ static void copy_record(api_sample *dst, const api_sample *src)
 /* The ring's bounds and the run state (lock held). */
 static void look(srv_session *s, srv_ring_read *rd)
 {
-	rd->head = s->head;
-	rd->oldest = s->head > s->ring_cap ? s->head - s->ring_cap : 0;
+	rd->head = s->ring.head;
+	rd->oldest = s->ring.head > s->ring.cap ? s->ring.head - s->ring.cap : 0;
 	rd->state = s->state;
 	rd->removed = s->stop;
 	rd->t = s->st.t;
@@ -169,14 +169,14 @@ void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
 	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
 	/* samples before from_t are passed over here, without a copy */
 	while (idx < rd->head) {
-		const api_sample *r = &s->ring[idx % s->ring_cap];
+		const api_sample *r = &s->ring.samples[idx % s->ring.cap];
 		if (r->kind != API_REC_SAMPLE || r->st.t >= from_t)
 			break;
 		idx++;
 	}
 	rd->next = idx;
 	if (idx < rd->head)
-		copy_record(dst, &s->ring[idx % s->ring_cap]);
+		copy_record(dst, &s->ring.samples[idx % s->ring.cap]);
 	pthread_mutex_unlock(&s->lock);
 }
 
@@ -186,13 +186,13 @@ void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 	pthread_mutex_lock(&s->lock);
 	/* what would wake it: an event, a sample at or past from_t, a change
 	 * of state, the deletion */
-	int news = s->event_head > rd->head ||
-		   (s->head > rd->head && s->st.t >= from_t) ||
+	int news = s->ring.event_head > rd->head ||
+		   (s->ring.head > rd->head && s->st.t >= from_t) ||
 		   s->state != rd->state || s->stop;
 	if (!news) {
-		if (from_t < s->wake_t)
-			s->wake_t = from_t; /* the worker wakes it from then */
-		if (s->plan_t < INFINITY && from_t < s->plan_t - 1e-6)
+		if (from_t < s->ring.wake_t)
+			s->ring.wake_t = from_t; /* the worker wakes it from then */
+		if (s->ring.plan_t < INFINITY && from_t < s->ring.plan_t - 1e-6)
 			pthread_cond_signal(&s->wake); /* a paced worker sleeps past it */
 		struct timespec ts = srv_deadline(seconds);
 		pthread_cond_timedwait(&s->data, &s->lock, &ts);
@@ -218,16 +218,16 @@ size_t srv_session_history(srv_session *s, double from, double to,
 {
 	pthread_mutex_lock(&s->lock);
 	size_t width = API_HISTORY_WIDTH(s->columns);
-	size_t first = 0, last = s->hist_n;
-	while (first < s->hist_n && s->hist[first * width] < from)
+	size_t first = 0, last = s->ring.hist_n;
+	while (first < s->ring.hist_n && s->ring.hist[first * width] < from)
 		first++;
-	while (last > first && s->hist[(last - 1) * width] > to)
+	while (last > first && s->ring.hist[(last - 1) * width] > to)
 		last--;
 	size_t n = last - first;
 	*rows = malloc((n ? n : 1) * width * sizeof(double));
 	if (*rows && n)
-		memcpy(*rows, s->hist + first * width, n * width * sizeof(double));
-	*stride = s->hist_stride;
+		memcpy(*rows, s->ring.hist + first * width, n * width * sizeof(double));
+	*stride = s->ring.hist_stride;
 	pthread_mutex_unlock(&s->lock);
 	return *rows ? n : 0;
 }

@@ -35,6 +35,7 @@ void srv_sessions_init(const srv_config *config)
 {
 	cfg = config;
 	srv_dem_init(config);
+	srv_session_control_init(config);
 	sessions.destroy = destroy;
 	srv_registry_open(&sessions, (size_t)cfg->max_sessions);
 }
@@ -48,8 +49,8 @@ static void session_locks_init(srv_session *s)
 	pthread_mutex_init(&s->lock, NULL);
 	pthread_cond_init(&s->wake, NULL);
 	pthread_cond_init(&s->data, NULL);
-	pthread_cond_init(&s->log_cond, NULL);
-	s->log_fd = -1;
+	pthread_cond_init(&s->log.cond, NULL);
+	s->log.fd = -1;
 }
 
 static void session_free(srv_session *s)
@@ -57,19 +58,19 @@ static void session_free(srv_session *s)
 	if (!s)
 		return;
 	srv_dem_free(s); /* the bed process ends before its machine */
-	if (s->dem_slot)
+	if (s->dem.slot)
 		srv_dem_release();
 	sim_free(s->sim);
 	srv_budget_give(s->mem_reserved);
 	srv_budget_set_paced(&s->paced_held, 0);
 	srv_sample_free(&s->scratch);
-	if (s->ring_bytes)
-		munmap(s->ring, s->ring_bytes);
-	free(s->hist);
+	if (s->ring.bytes)
+		munmap(s->ring.samples, s->ring.bytes);
+	free(s->ring.hist);
 	srv_control_log_close(s);
 	free(s->controls);
 	free(s->replay);
-	pthread_cond_destroy(&s->log_cond);
+	pthread_cond_destroy(&s->log.cond);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
 	pthread_cond_destroy(&s->data);
@@ -111,7 +112,7 @@ static int alloc_buffers(srv_session *s)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	s->ring_cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
+	s->ring.cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
 	/* the record ring, slots then their arrays, in one mapping whose
 	 * pages are all made now: the memory budget reserved them anyway,
 	 * and a worker that fills a fresh ring would otherwise take a page
@@ -120,7 +121,7 @@ static int alloc_buffers(srv_session *s)
 	 * few samples, and with hundreds of sessions each such write missed
 	 * the TLB (a fifth of the daemon's CPU in a profile:
 	 * docs/performance.md) */
-	size_t bytes = s->ring_cap * (sizeof *s->ring + per * sizeof(double));
+	size_t bytes = s->ring.cap * (sizeof *s->ring.samples + per * sizeof(double));
 	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
 			 MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
 	if (map != MAP_FAILED) {
@@ -131,21 +132,21 @@ static int alloc_buffers(srv_session *s)
 		if (madvise(map, bytes, MADV_POPULATE_WRITE) != 0)
 #endif
 			memset(map, 0, bytes);
-		s->ring_bytes = bytes;
-		s->ring = map;
-		s->ring_store = (double *)(void *)(s->ring + s->ring_cap);
+		s->ring.bytes = bytes;
+		s->ring.samples = map;
+		s->ring.store = (double *)(void *)(s->ring.samples + s->ring.cap);
 	}
-	s->wake_t = INFINITY;
-	s->plan_t = INFINITY;
-	s->hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
-	s->hist = calloc(s->hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
-	if (!s->ring_bytes || !s->hist ||
+	s->ring.wake_t = INFINITY;
+	s->ring.plan_t = INFINITY;
+	s->ring.hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
+	s->ring.hist = calloc(s->ring.hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
+	if (!s->ring.bytes || !s->ring.hist ||
 	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
 		return -1;
 	/* trajectory rows every whole number of sample intervals, at least
 	 * 0.01 s apart */
 	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
-	s->hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
+	s->ring.hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
 	return 0;
 }
 
@@ -195,8 +196,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	if (probed > s->cpu_per_s)
 		s->cpu_per_s = probed;
 	/* a bed process: its cores a simulated second until measured */
-	if (s->dem && s->cpu_per_s < s->dem_cores)
-		s->cpu_per_s = s->dem_cores;
+	if (s->dem.link && s->cpu_per_s < s->dem.cores)
+		s->cpu_per_s = s->dem.cores;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -204,7 +205,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
-srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
+srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
 	api_spec copy = *request;
@@ -214,6 +215,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
+	s->create_fd = -1;
 	session_locks_init(s);
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		session_free(s);
@@ -226,7 +228,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 	if (srv_dem_wanted(spec)) {
 		if (srv_dem_admit(&copy, pb) != API_OK)
 			goto fail;
-		s->dem_slot = 1;
+		s->dem.slot = 1;
 	}
 	int feed = spec->scene.feed && spec->scene.columns > 0 &&
 		   spec->scene.layers > 0;
@@ -236,7 +238,10 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp,
 		s->mem_reserved = 0;
 		goto fail;
 	}
-	if (session_init(s, spec, pb))
+	s->create_fd = client_fd;
+	int bad = session_init(s, spec, pb);
+	s->create_fd = -1;
+	if (bad)
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&
@@ -282,10 +287,10 @@ static void adopt_bed(srv_session *s)
 {
 	char msg[256];
 	srv_dem_hold();
-	s->dem_slot = 1;
+	s->dem.slot = 1;
 	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
-		if (s->cpu_per_s < s->dem_cores)
-			s->cpu_per_s = s->dem_cores;
+		if (s->cpu_per_s < s->dem.cores)
+			s->cpu_per_s = s->dem.cores;
 		return;
 	}
 	s->state = SRV_FAILED;
@@ -346,8 +351,8 @@ static void remove_session(srv_session *s, int files)
 	 * the next LIGGGHTS session at once, not when the last reader lets
 	 * go of the session */
 	srv_dem_free(s);
-	if (s->dem_slot) {
-		s->dem_slot = 0;
+	if (s->dem.slot) {
+		s->dem.slot = 0;
 		srv_dem_release();
 	}
 	if (files)
@@ -450,123 +455,6 @@ size_t srv_sessions_reap(double idle_timeout)
 	return reaped;
 }
 
-/* The paced cores s needs after c: raise its hold before c is queued, or
- * refuse (lock held). The field named is the one that raises it. */
-static api_err admit_control(srv_session *s, const api_control *c,
-			     api_problem *pb)
-{
-	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
-	if (pace == API_PACE_MAX ||
-	    srv_state_after(s->state, s->cpu_paused, s->st.t, c) != SRV_RUNNING ||
-	    s->cpu_per_s * pace <= s->paced_held)
-		return API_OK;
-	const char *field = (c->set & API_C_PACE)      ? "pace"
-			    : (c->set & API_C_RUNNING) ? "running"
-			    : (c->set & API_C_CPU)     ? "cpu_budget"
-						       : "until";
-	return srv_budget_take_paced(&s->paced_held, s->cpu_per_s, pace, field,
-				     "changed", pb);
-}
-
-api_err srv_session_control(srv_session *s, const api_control *c,
-			    double timeout_s, double *t_eff, api_problem *pb)
-{
-	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
-	pthread_mutex_lock(&s->lock);
-	api_err e = API_OK;
-	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
-		e = api_fail(pb, API_RANGE, "cpu_budget",
-			     "cpu_budget must be CPU seconds in (0, %g] "
-			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
-			     c->cpu_budget);
-		pb->has_range = 1;
-		pb->min = 0;
-		pb->max = cfg->max_cpu_seconds;
-	} else if (s->stop)
-		e = api_fail(pb, API_NOTFOUND, NULL,
-			     "the session is being deleted");
-	else if (s->state == SRV_FAILED)
-		e = api_fail(pb, API_CONFLICT, NULL,
-			     "the session has failed (%s); it takes no more "
-			     "controls", s->error);
-	else if ((c->set & API_C_UNTIL) && c->until > 0 && c->until <= s->st.t)
-		e = api_fail(pb, API_CONFLICT, "until",
-			     "until (%g s) lies in the past: the session is at "
-			     "t = %g s", c->until, s->st.t);
-	else if ((c->set & API_C_RUNNING) && c->running &&
-		 s->state == SRV_FINISHED && !(c->set & API_C_UNTIL))
-		e = api_fail(pb, API_CONFLICT, "running",
-			     "the session finished at until = %g s; raise "
-			     "until to run on", s->until);
-	else
-		e = admit_control(s, c, pb);
-	if (e != API_OK) {
-		pthread_mutex_unlock(&s->lock);
-		return e;
-	}
-	srv_worker_queue(s, &cmd);
-	struct timespec until = srv_deadline(timeout_s);
-	while (!cmd.done && !s->stop)
-		if (pthread_cond_timedwait(&s->data, &s->lock, &until) ==
-		    ETIMEDOUT)
-			break;
-	if (!cmd.done) { /* take it back: nothing changes */
-		srv_worker_unqueue(s, &cmd);
-		srv_budget_set_paced(&s->paced_held, srv_paced_need(s));
-		pthread_mutex_unlock(&s->lock);
-		return api_fail(pb, API_UNAVAILABLE, NULL,
-				"the session's worker did not take the change "
-				"within %g s; nothing was changed", timeout_s);
-	}
-	pthread_mutex_unlock(&s->lock);
-	if (cmd.rc != SIM_OK)
-		return api_fail(pb, api_from_sim(cmd.rc), NULL, "%s",
-				sim_strerror(cmd.rc));
-	/* the answer only once its line is on disk (control_log.c) */
-	int err = cmd.logged ? srv_control_log_sync(s, cmd.logged, timeout_s) : 0;
-	if (err) {
-		api_fail(pb, API_UNAVAILABLE, NULL,
-			 "the control was applied at t = %g s but its line could not be made "
-			 "durable in the control log (%s): a crash may lose it",
-			 cmd.t_eff, strerror(err));
-		pb->retry_after = 5;
-		return API_UNAVAILABLE;
-	}
-	*t_eff = cmd.t_eff;
-	return API_OK;
-}
-
-api_err srv_session_attach(srv_session *s, srv_experiment *e,
-			   api_problem *pb)
-{
-	api_err rc = API_OK;
-	pthread_mutex_lock(&s->lock);
-	if (s->stop)
-		rc = api_fail(pb, API_NOTFOUND, "session",
-			      "the session is being deleted");
-	else if (s->state == SRV_FAILED)
-		rc = api_fail(pb, API_CONFLICT, "session",
-			      "the session has failed (%s)", s->error);
-	else if (s->exp)
-		rc = api_fail(pb, API_CONFLICT, "session",
-			      "the session already runs experiment %s",
-			      srv_exp_id(s->exp));
-	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
-		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
-					     s->pace, "session", "attached",
-					     pb)) != API_OK)
-		; /* the experiment would run it on (worker.c extend_until)
-		     past the cores for paced sessions: nothing attached */
-	else {
-		s->exp = e;
-		s->exp_started = 0;
-		srv_exp_set_session(e, s->entry.id);
-		pthread_cond_broadcast(&s->wake);
-	}
-	pthread_mutex_unlock(&s->lock);
-	return rc;
-}
-
 size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 			    void (*put)(srv_experiment *e))
 {
@@ -578,6 +466,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 	for (size_t i = 0; i < n; i++) {
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
+			s->create_fd = -1; /* no client waits for a restore */
 			session_locks_init(s);
 			srv_persist_load(s, names[i], &ef);
 			if (s->damaged)

@@ -77,6 +77,26 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 	if (dem_coupled_check(&spec->scene, &spec->method, 1, spec->scene.transient, msg,
 			      sizeof msg))
 		return api_fail(pb, API_RANGE, "integrator.method", "%s", msg);
+	/* the bed's cost: its grains over its DEM step, which shrinks as the
+	 * contact stiffens (k/m = k_c / m_n); the cost grows as sqrt(k_c) */
+	dem_bed_spec bed;
+	dem_bed_spec_default(&spec->params, (double)spec->scene.layers, &bed);
+	double cost = dem_bed_spec_cost(&bed);
+	if (!(cost <= cfg->max_dem_cost)) {
+		double k_max = spec->params.k_c * (cfg->max_dem_cost / cost) *
+			       (cfg->max_dem_cost / cost);
+		const sim_setting *t = sim_setting_find("k_c");
+		api_fail(pb, API_RANGE, "params.k_c",
+			 "the LIGGGHTS bed of %d grains at k_c/m_n = %.3g 1/s^2 takes DEM steps of "
+			 "%.2g s: about %.3g CPU s a simulated second, more than --max-dem-cost %g; "
+			 "k_c at most %.3g N/m at this m_n (or fewer layers)",
+			 bed.grains, bed.k_over_m, dem_bed_spec_dt(&bed), cost, cfg->max_dem_cost,
+			 k_max);
+		pb->has_range = 1;
+		pb->min = t ? t->min : 0.0;
+		pb->max = k_max;
+		return pb->code;
+	}
 	int n = atomic_load(&live);
 	do {
 		if (n >= cfg->max_dem_sessions) {
@@ -106,16 +126,16 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	dem_bed_spec bed;
 	dem_bed_spec_default(&sp->params, (double)sp->scene.layers, &bed);
 	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks,
-				      cfg->dem_timeout, msg, msglen);
+				      cfg->dem_timeout, restored ? -1 : s->create_fd, msg, msglen);
 	if (!f)
 		return -1;
-	s->dem = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
+	s->dem.link = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
 				    sp->scene.transient, msg, msglen);
-	if (!s->dem)
+	if (!s->dem.link)
 		return -1;
-	s->bed.resettled = restored;
-	s->dem_cores = cfg->dem_ranks;
-	srv_dem_read(s, &s->st, &s->bed);
+	s->dem.bed.resettled = restored;
+	s->dem.cores = cfg->dem_ranks;
+	srv_dem_read(s, &s->st, &s->dem.bed);
 	srv_log(SRV_LOG_INFO, "session %s: bed process %ld, %d grains, %d rank%s%s", s->entry.id,
 		dem_feed_pid(f), bed.grains, cfg->dem_ranks, cfg->dem_ranks > 1 ? "s" : "",
 		restored ? ", settled anew at the restored time" : "");
@@ -124,22 +144,22 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 
 int srv_dem_step(srv_session *s, double t_next, char *msg, size_t msglen)
 {
-	return dem_coupled_advance(s->dem, dem_coupled_interval_end(s->dem, t_next), NULL, msg,
+	return dem_coupled_advance(s->dem.link, dem_coupled_interval_end(s->dem.link, t_next), NULL, msg,
 				   msglen);
 }
 
 void srv_dem_controlled(srv_session *s, const sim_status *st)
 {
-	if (!s->dem_restart || st->beta != st->beta_target)
+	if (!s->dem.restart || st->beta != st->beta_target)
 		return;
-	s->dem_restart = 0;
-	dem_coupled_restart_transport(s->dem);
+	s->dem.restart = 0;
+	dem_coupled_restart_transport(s->dem.link);
 }
 
 void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 {
 	dem_coupled_status cs;
-	dem_coupled_get(s->dem, &cs);
+	dem_coupled_get(s->dem.link, &cs);
 	/* the feed's figures are the bed's: its mean x and velocity relative
 	 * to the deck, and the transport velocity fitted to its x */
 	st->transport_velocity = cs.transport_velocity;
@@ -149,12 +169,12 @@ void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 	int resettled = b->resettled;
 	*b = (api_bed){
 		.grains = cs.grains,
-		.pid = dem_feed_pid(dem_coupled_bed(s->dem)),
+		.pid = dem_feed_pid(dem_coupled_bed(s->dem.link)),
 		.interval = cs.interval,
 		.intervals = cs.intervals,
 		.displacement = cs.displacement,
 		.velocity = cs.bed_velocity,
-		.cpu_seconds = dem_coupled_bed(s->dem)->cpu,
+		.cpu_seconds = dem_coupled_bed(s->dem.link)->cpu,
 		.weight = cs.weight,
 		.load_mean_y = cs.load_mean_y,
 		.work_machine = cs.work_machine,
@@ -166,14 +186,14 @@ void srv_dem_read(const srv_session *s, sim_status *st, api_bed *b)
 
 void srv_dem_kill(srv_session *s)
 {
-	if (s->dem)
-		dem_feed_kill(dem_coupled_bed(s->dem));
+	if (s->dem.link)
+		dem_feed_kill(dem_coupled_bed(s->dem.link));
 }
 
 void srv_dem_free(srv_session *s)
 {
-	if (!s->dem)
+	if (!s->dem.link)
 		return;
-	dem_coupled_free(s->dem); /* kills and reaps the bed process */
-	s->dem = NULL;
+	dem_coupled_free(s->dem.link); /* kills and reaps the bed process */
+	s->dem.link = NULL;
 }

@@ -24,6 +24,50 @@ typedef struct srv_replay {
 			applied here, the experiment sends it again itself */
 } srv_replay;
 
+/* A session's record ring and trajectory history (ring.c: the worker's
+ * writers and the readers; session.c allocates them), guarded by the
+ * session lock. */
+typedef struct srv_session_records {
+	api_sample *samples;
+	double *store;
+	size_t cap, bytes;        /* store's mapping: bytes */
+	uint64_t head;
+	uint64_t event_head;      /* head after the newest event record */
+	uint64_t published;       /* head when readers were last woken */
+	double wake_t;            /* s: the earliest sample time a waiting
+				     stream wants (INFINITY: none waits) */
+	double plan_t;            /* s: the simulated time a paced worker
+				     sleeps until (INFINITY: it does not);
+				     a stream that wants an earlier sample
+				     wakes it (worker.c pace) */
+	double *hist;
+	size_t hist_cap, hist_n;
+	double hist_stride, hist_next;
+} srv_session_records;
+
+/* The control log on disk (control_log.c), guarded by the session lock. */
+typedef struct srv_control_log {
+	pthread_cond_t cond;      /* a sync round ended */
+	int fd;                   /* -1 until its first sync opens it */
+	size_t synced;            /* bytes of controls on disk, synced */
+	int syncing;              /* a thread leads a sync round */
+	int flush_queued;         /* a flush of lines nobody waits for is
+				     queued on the store's writer */
+} srv_control_log;
+
+/* A LIGGGHTS session's bed (session_dem.c). */
+typedef struct srv_session_dem {
+	struct dem_coupled *link; /* worker only (created before it starts,
+				     freed after it ends): the coupling to the
+				     bed process; NULL for the column model */
+	int slot;                 /* holds one of --max-dem-sessions */
+	double cores;             /* cores its bed process holds (--dem-ranks) */
+	int restart;              /* worker only: a control changed the machine;
+				     the bed's transport estimate restarts once
+				     its beta ramp is over */
+	api_bed bed;              /* what the worker last read of it (lock) */
+} srv_session_dem;
+
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
@@ -49,21 +93,7 @@ struct srv_session {
 	srv_cmd *cmd_head, *cmd_tail;
 	sim_status st;
 	double steps_per_s, rtf;
-	api_sample *ring;
-	double *ring_store;
-	size_t ring_cap, ring_bytes; /* ring_store's mapping: ring_bytes */
-	uint64_t head;
-	uint64_t event_head;      /* head after the newest event record */
-	uint64_t published;       /* head when readers were last woken */
-	double wake_t;            /* s: the earliest sample time a waiting
-				     stream wants (INFINITY: none waits) */
-	double plan_t;            /* s: the simulated time a paced worker
-				     sleeps until (INFINITY: it does not);
-				     a stream that wants an earlier sample
-				     wakes it (worker.c pace) */
-	double *hist;
-	size_t hist_cap, hist_n;
-	double hist_stride, hist_next;
+	srv_session_records ring; /* records and history (ring.c) */
 	int streams;
 	srv_experiment *exp;
 	srv_cmd *exp_cmd;         /* the experiment's command while queued */
@@ -78,13 +108,7 @@ struct srv_session {
 	char *controls;           /* every acknowledged control, one JSON
 				     line each (controls.ndjson) */
 	size_t controls_len, controls_cap;
-	/* the log on disk (control_log.c), guarded by lock */
-	pthread_cond_t log_cond;  /* a sync round ended */
-	int log_fd;               /* -1 until its first sync opens it */
-	size_t log_synced;        /* bytes of controls on disk, synced */
-	int log_syncing;          /* a thread leads a sync round */
-	int log_flush_queued;     /* a flush of lines nobody waits for is
-				     queued on the store's writer */
+	srv_control_log log;      /* the log on disk (control_log.c), lock */
 	double ckpt_wall;         /* srv_now() of the last checkpoint */
 	int ckpt_dirty;           /* a control or state change since */
 	char store_error[256];    /* the last failed write, "" */
@@ -123,17 +147,15 @@ struct srv_session {
 				     creation, then measured by the worker */
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
-	/* a LIGGGHTS session (session_dem.c) */
-	struct dem_coupled *dem;  /* worker only (created before it starts,
-				     freed after it ends): the coupling to the
-				     bed process; NULL for the column model */
-	int dem_slot;             /* holds one of --max-dem-sessions */
-	double dem_cores;         /* cores its bed process holds (--dem-ranks) */
-	int dem_restart;          /* worker only: a control changed the machine;
-				     the bed's transport estimate restarts once
-				     its beta ramp is over */
-	api_bed bed;              /* what the worker last read of it (lock) */
+	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
+	int create_fd;            /* while created: the client's socket or -1
+				     (a bed's settling ends when it leaves) */
 };
+
+/* ---- session_control.c: a control's admission and wait -------------------- */
+
+/* cfg (borrowed for the daemon's life) gives --max-cpu-seconds. */
+void srv_session_control_init(const srv_config *cfg);
 
 /* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
 
@@ -152,7 +174,7 @@ void srv_dem_hold(void);
 void srv_dem_release(void);
 /* Start s's bed process and couple it to s->sim (at t = 0, or at a
  * restored machine's time: restored = 1, the bed settled anew); s->st and
- * s->bed show it. 0, or -1 with msg (s->dem stays NULL). */
+ * s->dem.bed show it. 0, or -1 with msg (s->dem.link stays NULL). */
 int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
 /* Worker, lock released: advance machine and bed to the end of the
  * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
@@ -180,7 +202,7 @@ static inline double srv_paced_need(const srv_session *s)
 		return 0;
 	double need = s->cpu_per_s * s->pace;
 	/* a LIGGGHTS session's bed process holds its cores */
-	return s->dem && need < s->dem_cores ? s->dem_cores : need;
+	return s->dem.link && need < s->dem.cores ? s->dem.cores : need;
 }
 
 /* The state control c leaves a session in, from its state, whether its
@@ -204,16 +226,16 @@ static inline int srv_state_after(int state, int cpu_paused, double t, const api
 	return state;
 }
 
-/* Slot i of the ring with its arrays pointed into ring_store (set on
+/* Slot i of the ring with its arrays pointed into ring.store (set on
  * every use). */
 static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	api_sample *r = &s->ring[i];
+	api_sample *r = &s->ring.samples[i];
 	r->columns = s->columns;
 	r->layers = s->layers;
-	r->column_disp = s->ring_store + i * per;
+	r->column_disp = s->ring.store + i * per;
 	r->xi = r->column_disp + s->columns;
 	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
 	return r;

@@ -75,7 +75,7 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->st = s->st;
 	v->steps_per_s = s->steps_per_s;
 	v->rtf = s->rtf;
-	v->samples = s->head;
+	v->samples = s->ring.head;
 	v->streams = s->streams;
 	v->cpu_seconds = s->cpu_seconds;
 	v->cpu_limit = s->cpu_limit;
@@ -86,7 +86,7 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->replayed = s->rebuilt;
 	v->replay_seconds = s->replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);
-	v->bed = s->bed;
+	v->bed = s->dem.bed;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

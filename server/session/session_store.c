@@ -321,7 +321,7 @@ static void load_controls(srv_session *s, size_t logged)
 	while (len > 0 && text[len - 1] != '\n')
 		len--;
 	s->controls = text;
-	s->controls_len = s->log_synced = len;
+	s->controls_len = s->log.synced = len;
 	s->controls_cap = len + 1;
 	if (logged >= len)
 		return;

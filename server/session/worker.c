@@ -46,7 +46,8 @@
  *               windows
  *
  * The command queue, and the attached experiment's command in it, are
- * worker_queue.c.
+ * worker_queue.c; the commands phase, the PATCH controls' apply column,
+ * worker_control.c.
  */
 #include <math.h>
 #include <stdio.h>
@@ -97,14 +98,14 @@ static int publish_wakes(srv_session *s, clocks *c)
 {
 	int wake = 0;
 	c->publish_wall = srv_now();
-	if (s->head == s->published)
+	if (s->ring.head == s->ring.published)
 		return 0;
-	if (s->event_head > s->published || s->st.t >= s->wake_t) {
-		c->want_all = s->wake_t == -INFINITY;
-		s->wake_t = INFINITY;
+	if (s->ring.event_head > s->ring.published || s->st.t >= s->ring.wake_t) {
+		c->want_all = s->ring.wake_t == -INFINITY;
+		s->ring.wake_t = INFINITY;
 		wake = 1;
 	}
-	s->published = s->head;
+	s->ring.published = s->ring.head;
 	return wake;
 }
 
@@ -129,18 +130,6 @@ static void publish_batch(srv_session *s, clocks *c)
 	pthread_mutex_lock(&s->lock);
 }
 
-/* ---- the attached experiment (its command queue: worker_queue.c) ---------- */
-
-/* The experiment's command was applied or refused (lock held). */
-static void experiment_commanded(srv_session *s, const srv_cmd *cmd)
-{
-	if (cmd != s->exp_cmd)
-		return;
-	s->exp_cmd = NULL;
-	if (srv_exp_commanded(s->exp, cmd))
-		srv_worker_detach_exp(s, NULL);
-}
-
 /* Let the session run at least up to t_end (s): raise until, resume a
  * finished session (lock held). */
 static void extend_until(srv_session *s, double t_end)
@@ -149,107 +138,6 @@ static void extend_until(srv_session *s, double t_end)
 		s->until = t_end;
 	if (s->state == SRV_FINISHED && s->st.t < t_end)
 		s->state = SRV_RUNNING;
-}
-
-/* The budget part of a control, after its state change
- * (srv_state_after): a CPU grant from now, and the budget's pause flag
- * cleared once the session runs or is paused or resumed by hand (lock
- * held). */
-static void apply_budget(srv_session *s, const srv_cmd *cmd)
-{
-	const api_control *c = &cmd->c;
-	if (c->set & API_C_CPU)
-		s->cpu_limit = s->cpu_seconds + c->cpu_budget;
-	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
-		 cmd->cpu_grant > 0)
-		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
-	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
-		s->cpu_paused = 0;
-}
-
-/* Append cmd's line to the control log: an experiment's names it (lock
- * held). The log's length with it. */
-static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
-{
-	char line[API_EVENT_MAX];
-	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
-			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
-	return srv_control_log_append(s, line, cmd->waited);
-}
-
-/* Apply queued controls in order and acknowledge each (lock held).
- * Returns 1 if pacing must restart. */
-static int apply_commands(srv_session *s)
-{
-	int reanchor = 0;
-	srv_cmd *cmd;
-	while ((cmd = s->cmd_head)) {
-		s->cmd_head = cmd->next;
-		if (!s->cmd_head)
-			s->cmd_tail = NULL;
-		const api_control *c = &cmd->c;
-		double t_eff = sim_effective_time(s->sim);
-		int rc = SIM_OK;
-		if (c->set & (API_C_BETA | API_C_BETA_RATE)) {
-			/* SI from api/; a rate alone keeps the target */
-			double target = (c->set & API_C_BETA) ? c->beta.si
-							      : s->st.beta_target;
-			double rate =
-				(c->set & API_C_BETA_RATE) ? c->beta_rate.si : 0;
-			rc = sim_set_beta(s->sim, target, rate);
-		}
-		if (rc == SIM_OK && (c->set & API_C_ROTATION))
-			rc = sim_set_rotation(s->sim, c->rotation);
-		if (rc == SIM_OK && (c->set & API_C_OMEGA_SS))
-			rc = sim_set_omega_ss(s->sim, c->omega_ss);
-		if (rc == SIM_OK && (c->set & API_C_MOTOR))
-			rc = sim_set_drive_on(s->sim, c->motor_on);
-		if (rc == SIM_OK && cmd->restart_transport)
-			sim_restart_transport(s->sim);
-		/* a LIGGGHTS bed's estimate restarts as the core's does */
-		if (rc == SIM_OK && s->dem &&
-		    (cmd->restart_transport ||
-		     (c->set & (API_C_BETA | API_C_ROTATION | API_C_OMEGA_SS | API_C_MOTOR))))
-			s->dem_restart = 1;
-		if (rc == SIM_OK && (c->set & API_C_PACE)) {
-			s->pace = c->pace;
-			reanchor = 1;
-		}
-		if (rc == SIM_OK && (c->set & API_C_UNTIL))
-			s->until = c->until;
-		if (rc == SIM_OK) {
-			/* pacing restarts on running and on a resume from a
-			 * pause (not on a finished session resumed by until:
-			 * it restarts its clocks when it wakes, idle) */
-			int was = s->state;
-			s->state = srv_state_after(was, s->cpu_paused, s->st.t, c);
-			reanchor |= (c->set & API_C_RUNNING) ||
-				    (was == SRV_PAUSED && s->state != was);
-			apply_budget(s, cmd);
-		}
-		if (s->pace == API_PACE_MAX && s->until == 0)
-			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
-		if (rc == SIM_OK) {
-			char json[API_EVENT_MAX];
-			api_control_event(json, sizeof json, c, t_eff);
-			srv_ring_event(s, "control", json);
-			if (cmd->from_experiment && s->exp_relogged > 0)
-				s->exp_relogged--; /* in the log since before the restore */
-			else if (!cmd->replay)
-				cmd->logged = log_control(s, cmd, t_eff);
-			s->ckpt_dirty = 1;
-		}
-		cmd->rc = rc;
-		cmd->t_eff = t_eff;
-		cmd->done = 1;
-		if (cmd->from_experiment)
-			experiment_commanded(s, cmd);
-	}
-	/* the status shows the accepted targets at once: no step publishes
-	 * one while paused or finished, nor before the answer when running */
-	sim_get_status(s->sim, &s->st);
-	pthread_cond_broadcast(&s->data);
-	return reanchor;
 }
 
 /* Next simulated time to advance to (lock held). */
@@ -318,7 +206,7 @@ static void check_caught_up(srv_session *s, clocks *c)
 /* commands: apply what is queued; pacing restarts after pace or pause. */
 static void run_commands(srv_session *s, clocks *c)
 {
-	if (s->cmd_head && apply_commands(s))
+	if (s->cmd_head && srv_worker_apply_commands(s))
 		restart_clocks(c, s);
 }
 
@@ -418,7 +306,7 @@ static void check_cpu(srv_session *s, clocks *c)
 	/* a LIGGGHTS session's bed process's CPU is the session's too */
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
 		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
-				 (s->dem ? s->bed.cpu_seconds : 0.0);
+				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
 	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
 		return;
@@ -527,8 +415,8 @@ static int pace(srv_session *s, clocks *c, double t_next)
 	double plan = due_at(s, c, tick);
 	if (c->batch_start + PACE_TICK < plan)
 		plan = c->batch_start + PACE_TICK;
-	if (s->wake_t < INFINITY && due_at(s, c, s->wake_t) < plan)
-		plan = due_at(s, c, s->wake_t);
+	if (s->ring.wake_t < INFINITY && due_at(s, c, s->ring.wake_t) < plan)
+		plan = due_at(s, c, s->ring.wake_t);
 	if (c->want_all && c->batch_start + PACE_MIN < plan)
 		plan = c->batch_start + PACE_MIN;
 	if (plan < c->batch_start + PACE_MIN)
@@ -537,10 +425,10 @@ static int pace(srv_session *s, clocks *c, double t_next)
 		plan = due;
 	double now = srv_now();
 	if (now < plan) {
-		s->plan_t = c->anchor_t + (plan - c->anchor_wall) * s->pace;
+		s->ring.plan_t = c->anchor_t + (plan - c->anchor_wall) * s->pace;
 		struct timespec ts = srv_deadline(plan - now);
 		pthread_cond_timedwait(&s->wake, &s->lock, &ts);
-		s->plan_t = INFINITY;
+		s->ring.plan_t = INFINITY;
 		return 1;
 	}
 	if (now - due > 0.25 + PACE_TICK) { /* behind: do not catch up */
@@ -560,15 +448,15 @@ static int pace(srv_session *s, clocks *c, double t_next)
 static int step(srv_session *s, double t_next, char *why, size_t whylen)
 {
 	sim_status st;
-	api_bed bed = s->bed;
+	api_bed bed = s->dem.bed;
 	int rc = SIM_OK;
 	pthread_mutex_unlock(&s->lock);
-	if (!s->dem)
+	if (!s->dem.link)
 		rc = sim_advance(s->sim, t_next);
 	else if (srv_dem_step(s, t_next, why, whylen))
 		rc = SIM_EDIVERGED;
 	sim_get_status(s->sim, &st);
-	if (s->dem) {
+	if (s->dem.link) {
 		srv_dem_controlled(s, &st);
 		srv_dem_read(s, &st, &bed);
 	}
@@ -577,7 +465,7 @@ static int step(srv_session *s, double t_next, char *why, size_t whylen)
 	if (st.steps > s->st.steps)
 		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
 	s->st = st;
-	s->bed = bed;
+	s->dem.bed = bed;
 	srv_ring_sample(s);
 	return rc;
 }

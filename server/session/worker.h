@@ -27,6 +27,10 @@ int srv_worker_unqueue(srv_session *s, srv_cmd *cmd);
 /* The worker thread's body; arg is the srv_session. Returns when the
  * session's stop flag is set. */
 void *srv_worker_main(void *arg);
+/* The worker's commands phase (worker_control.c): apply the queued
+ * controls in order and acknowledge each (lock held). 1 if pacing must
+ * restart. */
+int srv_worker_apply_commands(srv_session *s);
 
 /* worker_queue.c, for the worker's phases (session lock held): queue the
  * experiment's command, if it handed one over (the one still queued is

@@ -12,6 +12,7 @@ import { spawn } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // the daemons end with this script, however it ends
 
 const NEW = process.env.CONVSIMD || 'build/convsimd';
 const OLD = process.env.OLD || '';

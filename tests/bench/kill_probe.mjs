@@ -14,6 +14,7 @@ import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // the daemons end with this script, however it ends
 
 const BIN = process.env.CONVSIMD || 'build/convsimd';
 const ROUNDS = Number(process.env.ROUNDS || 100);

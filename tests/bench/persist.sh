@@ -15,7 +15,8 @@ dir=$(mktemp -d)
 trap 'kill -9 $pid 2>/dev/null || true; rm -rf "$dir"' EXIT
 
 start() { # args...; sets pid, base
-	"$BIN" --port 0 --log-level "${LOGLEVEL:-warn}" "$@" >"$dir/out" 2>"$dir/err" &
+	# CONVSIM_TETHER: the daemon ends with this script, however it ends
+	CONVSIM_TETHER=$$ "$BIN" --port 0 --log-level "${LOGLEVEL:-warn}" "$@" >"$dir/out" 2>"$dir/err" &
 	pid=$!
 	for _ in $(seq 200); do grep -q listening "$dir/out" 2>/dev/null && break; sleep 0.01; done
 	base="http://127.0.0.1:$(grep -o '[0-9]*$' "$dir/out")/api/v1"

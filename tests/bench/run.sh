@@ -58,4 +58,6 @@ echo "bench: paced default sessions held in real time, against the previous buil
 bash tests/bench/realtime.sh "$out"
 echo "bench: PATCH throughput with the durable control log (loopback, a temporary data directory)"
 CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs | tee "$out/controls.md"
+echo "bench: the request body check: CPU per 1 MiB body of many names (one daemon)"
+CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs >"$out/body_parse.md"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

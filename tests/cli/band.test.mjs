@@ -15,6 +15,7 @@ import { spawnSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 const run = (...args) => {

@@ -9,6 +9,7 @@ import { spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 

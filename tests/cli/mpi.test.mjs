@@ -18,6 +18,7 @@ import { spawnSync } from 'node:child_process';
 import { copyFileSync, existsSync, mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 const BUILD = process.env.BUILD || 'build';

@@ -10,6 +10,7 @@ import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = new URL('../..', import.meta.url).pathname;
 

@@ -10,6 +10,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 const run = (...args) => {

@@ -8,6 +8,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const BUILD = process.env.BUILD || 'build';
 const ROOT = new URL('../..', import.meta.url).pathname;

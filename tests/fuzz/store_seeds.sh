@@ -16,7 +16,8 @@ BUILD=${BUILD:-build}
 out=tests/fuzz/corpus/store
 data=$(mktemp -d)
 log=$data.log
-"$BUILD/convsimd" --port 0 --data-dir "$data" --checkpoint-interval 0.5 >"$log" 2>&1 &
+# CONVSIM_TETHER: the daemon ends with this script, however it ends
+CONVSIM_TETHER=$$ "$BUILD/convsimd" --port 0 --data-dir "$data" --checkpoint-interval 0.5 >"$log" 2>&1 &
 pid=$!
 trap 'kill "$pid" 2>/dev/null || true; rm -rf "$data" "$log"' EXIT
 url=

@@ -48,18 +48,21 @@ test('feed_model: listed, column by default, liggghts refused with 422 and nothi
   assert.equal(ok.status, 201);
 });
 
-test('status.feed_warning: the preset\'s 8 soft layers lie outside the domain checked against LIGGGHTS, 2 layers inside', { timeout: 20000 * SLOW }, async () => {
+test('status.feed_warning: the model check\'s short sentence where the scene is not checked against DEM, null where it is', { timeout: 20000 * SLOW }, async () => {
   const a = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1 });
   assert.equal(a.status, 201);
   const sa = (await req(d.base, 'GET', `/api/v1/sessions/${a.body.id}`)).body.status;
-  assert.match(sa.feed_warning, /8 layers/);
-  const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 2 }, pace: 1 });
+  assert.equal(sa.feed_warning, "czubak2016's column model is not checked against DEM (checked: 4 layers, liggghts-bed4)");
+  const b = await req(d.base, 'POST', '/api/v1/sessions', { preset: 'liggghts-bed4', pace: 1 });
   const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
   assert.equal(sb.feed_warning, null);
+  assert.equal(sb.model_checked, true);
   // the stream's first record says the same
   const ha = await hello(d.base, a.body.id), hb = await hello(d.base, b.body.id);
   assert.equal(ha.type, 'hello');
   assert.equal(ha.feed_warning, sa.feed_warning);
+  assert.equal(ha.model_checked, false);
   assert.equal(hb.type, 'hello');
   assert.equal(hb.feed_warning, null);
+  assert.equal(hb.model_error, sb.model_error);
 });

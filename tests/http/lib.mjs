@@ -8,6 +8,7 @@ import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
+import '../tether.mjs'; // nothing started here outlives the test
 
 export const BIN = process.env.CONVSIMD ||
   fileURLToPath(new URL('../../build/convsimd', import.meta.url));

@@ -11,7 +11,7 @@
 // reversal time).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startDaemon, req, until, sleep, CHEAP, SLOW } from './lib.mjs';
@@ -24,6 +24,12 @@ const settled = (d, path, ok, ms = 60000) => until(async () => {
   const r = await req(d.base, 'GET', path);
   return r.status === 200 && ok(r.body) && r;
 }, ms, `${path} settled`);
+
+// Whether a session in the data directory dir has written a checkpoint.
+const checkpointed = (dir) => {
+  const sessions = join(dir, 'sessions');
+  return existsSync(sessions) && readdirSync(sessions).some((id) => existsSync(join(sessions, id, 'checkpoint.bin')));
+};
 
 // Run the same requests uninterrupted (d, no data directory) and with
 // KILLS kills at random moments while work runs; what each ends with.
@@ -46,6 +52,9 @@ async function bothWays(steps, interval = 0.05) {
       // directory
       while (kills < KILLS && await running(d)) {
         await sleep((interval * 1000 + 50 + Math.random() * 300) * SLOW);
+        // not before the first checkpoint (on a loaded machine it can come
+        // later than the sleep): without one an experiment is not resumed
+        await until(async () => checkpointed(dir), 30000 * SLOW, 'a first checkpoint');
         if (!(await running(d))) break;
         d.proc.kill('SIGKILL');
         await d.exited;
@@ -99,7 +108,7 @@ test(`an experiment killed ${KILLS} times gives the uninterrupted run's CSV byte
     const d = () => cur();
     const ex = await req(d().base, 'POST', '/api/v1/experiments', {
       session: { ...CHEAP, pace: 'max' },
-      schedule: [{ beta: 40, until: 60 }, { beta: 120, until: 140 }, { beta: 20, until: 220 }],
+      schedule: [{ beta: 40, until: 240 }, { beta: 120, until: 560 }, { beta: 20, until: 880 }],
     });
     assert.equal(ex.status, 201, ex.text);
     const path = `/api/v1/experiments/${ex.body.id}`;

@@ -7,7 +7,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { startDaemon, req, rawRequest, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, rawRequest, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 const bytes = (...parts) => Buffer.concat(parts.map((p) => (typeof p === 'string' ? Buffer.from(p, 'latin1') : Buffer.from(p))));
 
@@ -76,6 +76,112 @@ test('a body JSON forbids is refused with 400 and its position on every route; n
   }
 });
 
+// A string whose decoded value holds U+0000 (written \u0000, which JSON
+// allows) on every route that reads a body: cJSON's C strings used to cut
+// it there, so "czubak2016\u0000x" was read as czubak2016. [method, path
+// (SID: the session's), body]; the fault is at the backslash.
+const NUL = [
+  ['POST', '/api/v1/sessions', '{"preset":"czubak2016\\u0000x"}'],
+  ['POST', '/api/v1/sessions', '{"params":{"rotation":"ccw\\u0000garbage"}}'],
+  ['POST', '/api/v1/sessions', '{"pace\\u0000x":1}'],
+  ['PATCH', '/api/v1/sessions/SID', '{"rotation":"ccw\\u0000garbage"}'],
+  ['POST', '/api/v1/sweeps', '{"rotations":["cw\\u0000x"],"t_end":0.5}'],
+  ['POST', '/api/v1/fits', '{"free":["e\\u0000x"],"peaks":[{"rotation":"cw","beta":38}]}'],
+  ['POST', '/api/v1/experiments', '{"session":{"pace":"max\\u0000"},"schedule":[{"beta":38,"until":1}]}'],
+  ['POST', '/api/v1/sessions', '{"preset":"czubak2016","scene":{"drive":"ideal\\u0000"}}'],
+];
+
+test('a string holding U+0000 (\\u0000) is 400 with its position on every route; nothing changes', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1, params: { rotation: 'cw' } });
+    assert.equal(s.status, 201, s.text);
+    for (const [method, template, body] of NUL) {
+      const path = template.replace('SID', s.body.id);
+      const r = await req(d.base, method, path, body);
+      const position = Buffer.from(body).indexOf('\\u0000');
+      assert.equal(r.status, 400, `${method} ${path} ${body}: ${r.text}`);
+      assert.match(r.headers.get('content-type'), /^application\/problem\+json/);
+      assert.deepEqual(r.body, {
+        type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+        detail: 'the request body is refused: a string may not hold U+0000 (\\u0000) (no member ' +
+          `takes it; it would cut the string short) at byte ${position}`,
+        instance: path, position,
+      }, `${method} ${path} ${body}`);
+    }
+    assert.equal(NUL[0][2].indexOf('\\u0000'), 21, 'the first fault is at byte 21');
+    // nothing was created or changed
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 1);
+    for (const kind of ['sweeps', 'fits', 'experiments']) {
+      assert.equal((await req(d.base, 'GET', `/api/v1/${kind}`)).body[kind].length, 0, kind);
+    }
+    const g = await req(d.base, 'GET', `/api/v1/sessions/${s.body.id}`);
+    assert.equal(g.body.status.rotation, 'cw', 'the refused PATCH changed nothing');
+    // other escapes, \u0001 among them, still decode and reach the API
+    const one = await req(d.base, 'POST', '/api/v1/sessions', '{"preset":"czubak2016\\u0001x"}');
+    assert.equal(one.status, 422, one.text);
+    assert.equal(one.body.field, 'preset');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+// The same name twice in one object, at every depth and after many other
+// names, is refused as it was before the check became linear: the first
+// fault in the text wins, whether a duplicate or another.
+const DUP = [
+  // [body, position, field]
+  ['{"pace":1,"pace":2}', 10, 'pace'],
+  ['{"scene":{"drive":"ideal","layers":2,"drive":"ideal"}}', 37, 'drive'],
+  ['{"a":{"b":{"c":{"d":{"e":1,"f":2,"e":3}}}}}', 33, 'e'],
+  ['{"a":{"x":1,"x":2},"a":3}', 12, 'x'], // the inner one comes first
+  ['{"a":1,"b":{"x":1,"x":2},"a":3}', 18, 'x'],
+  ['{"a":1,"a":{"x":1,"x":2}}', 7, 'a'], // the outer one comes first
+  ['{"b":1,"a":1,"b":1,"a":1}', 13, 'b'], // two names twice: the earlier
+  ['{"a":1,"b":1,"a":1,"b":1}', 13, 'a'],
+  ['{"a":1,"a":01}', 7, 'a'], // before a bad number
+  ['{"a":1,"b":01,"a":1}', 11, null], // after one
+  ['{"a":1,"b":{"c":[1,{"d":1,"d":2}]},"a":2}', 26, 'd'],
+  ['{"\\u00e9":1,"\\u00E9":2}', 12, '\\u00E9'],
+  ['{"\\ud83d\\ude00":1,"\\ud83d\\ude00":2}', 18, '\\ud83d\\ude00'],
+];
+
+test('a name given twice is refused at its second place at any depth, also among 20,000 names', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const many = Array.from({ length: 20000 }, (_, i) => `"n${i}":0`);
+    const manyBody = `{"scene":{"inner":{${many.join(',')},"n12345":1}}}`;
+    // ZjEppR and yjepeD have one 32-bit FNV-1a hash of their code points
+    // (tests/bench/body_parse.mjs found the pair), so only their text tells
+    // them apart; among 100 names the check sorts by hash first
+    const filler = Array.from({ length: 100 }, (_, i) => `"f${i}":0`).join(',');
+    const collide = `{${filler},"ZjEppR":1,"yjepeD":2,"ZjEppR":3}`;
+    const cases = [...DUP, [manyBody, manyBody.lastIndexOf('"n12345"'), 'n12345'],
+      [collide, collide.lastIndexOf('"ZjEppR"'), 'ZjEppR']];
+    for (const [body, position, field] of cases) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', body);
+      const shown = body.length > 80 ? `${body.slice(0, 80)}...` : body;
+      assert.equal(r.status, 400, `${shown}: ${r.text}`);
+      const why = field === null ? 'a number may not have a leading zero'
+        : `a member's name is given twice in one object ("${field}")`;
+      const want = {
+        type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+        detail: `the request body is not valid JSON (RFC 8259, I-JSON): ${why} at byte ${position}`,
+        instance: '/api/v1/sessions', position,
+      };
+      if (field !== null) want.field = field;
+      assert.deepEqual(r.body, want, shown);
+    }
+    // 20,000 distinct names pass the check (and meet the member check)
+    const distinct = await req(d.base, 'POST', '/api/v1/sessions', `{${many.join(',')}}`);
+    assert.equal(distinct.status, 422, distinct.text);
+    assert.equal(distinct.body.field, 'n0');
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
 test('a Host or Content-Length header given twice is 400 and changes nothing; 500 query parameters get 431', { timeout: 60000 * SLOW }, async () => {
   const d = await startDaemon();
   try {
@@ -120,16 +226,103 @@ test('a Host or Content-Length header given twice is 400 and changes nothing; 50
   }
 });
 
-test('docs/hardening.md: its example body gets the answer it shows', { timeout: 30000 * SLOW }, async () => {
-  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
-  const m = doc.match(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/);
-  assert.ok(m, 'docs/hardening.md has a json block after <!-- test:strict-example -->');
-  const example = JSON.parse(m[1]);
+test('an empty or blank body is 400 on every route that reads one; nothing is created', { timeout: 60000 * SLOW }, async () => {
   const d = await startDaemon();
   try {
-    const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
-    assert.equal(r.status, example.answer.status);
-    assert.deepEqual(r.body, example.answer);
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const routes = [['POST', '/api/v1/sessions'], ['POST', '/api/v1/sweeps'], ['POST', '/api/v1/fits'],
+      ['POST', '/api/v1/experiments'], ['PATCH', `/api/v1/sessions/${s.body.id}`]];
+    for (const [method, path] of routes) {
+      for (const body of ['', ' ', '\r\n\t ']) {
+        const r = await req(d.base, method, path, body);
+        assert.equal(r.status, 400, `${method} ${path} ${JSON.stringify(body)}: ${r.text}`);
+        assert.deepEqual(r.body, {
+          type: '/api/v1/problems/malformed-json', title: 'Malformed JSON', status: 400,
+          detail: `the request body is ${body ? 'only whitespace' : 'empty'}; a JSON object is expected ({} for no members)`,
+          instance: path,
+        }, `${method} ${path} ${JSON.stringify(body)}`);
+      }
+    }
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 1, 'no session created');
+    assert.equal((await req(d.base, 'GET', '/api/v1/sweeps')).body.sweeps.length, 0, 'no sweep started');
+    // {} still takes every default
+    assert.equal((await req(d.base, 'POST', '/api/v1/sessions', '{}')).status, 201);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('%00 in the path or the query is 400, never a shorter path; a Last-Event-ID or limit past its range is 400', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon();
+  try {
+    const host = `Host: 127.0.0.1:${d.port}`;
+    const get = (target, more = '') => rawRequest(d.port, `GET ${target} HTTP/1.1\r\n${host}${more}`);
+    // [target, type, field, instance (the path as libmicrohttpd decoded it), position]
+    const cases = [
+      ['/api/v1/health%00x', 'bad-request', 'path', '/api/v1/health', 14],
+      ['/index.html%00.txt', 'bad-request', 'path', '/index.html', 11],
+      ['/%00', 'bad-request', 'path', '/', 1],
+      ['/api/v1/sessions?limit=1%00x', 'bad-query', 'query', '/api/v1/sessions', 24],
+    ];
+    for (const [target, type, field, instance, position] of cases) {
+      const r = await get(target);
+      assert.equal(r.status, 400, `${target}: ${r.raw.toString('latin1')}`);
+      assert.deepEqual(JSON.parse(r.body.toString('utf8')), {
+        type: `/api/v1/problems/${type}`, title: type === 'bad-query' ? 'Bad query parameter' : 'Bad request',
+        status: 400,
+        detail: `the request target has %00 (a NUL byte) at byte ${position}; no path or query value holds one`,
+        instance, field,
+      }, target);
+    }
+    assert.equal((await get('/api/v1/health')).status, 200);
+    assert.equal((await get('/index.html')).status, 200);
+    assert.equal((await get('/api/v1/health%41')).status, 404, 'other escapes still decode');
+
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const stream = `/api/v1/sessions/${s.body.id}/stream`;
+    const idProblem = (field) => ({
+      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+      detail: 'Last-Event-ID (or since) must be a record id, an integer from 0 to 9223372036854775807',
+      instance: stream, field,
+    });
+    for (const id of ['18446744073709551616', '9223372036854775808', '99999999999999999999999', '+5', '5x', '-1']) {
+      const r = await get(stream, `\r\nLast-Event-ID: ${id}`);
+      assert.equal(r.status, 400, `Last-Event-ID ${id}: ${r.raw.toString('latin1').slice(0, 300)}`);
+      assert.deepEqual(JSON.parse(r.body.toString('utf8')), idProblem('Last-Event-ID'), id);
+    }
+    const since = await get(`${stream}?since=18446744073709551616`);
+    assert.equal(since.status, 400);
+    assert.deepEqual(JSON.parse(since.body.toString('utf8')), idProblem('since'));
+    const limit = await get(`${stream}?limit=18446744073709551616`);
+    assert.equal(limit.status, 400);
+    assert.deepEqual(JSON.parse(limit.body.toString('utf8')), {
+      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+      detail: 'limit must be a positive integer (at most 18446744073709551615)', instance: stream, field: 'limit',
+    });
+    // the largest id and limit still open a stream
+    const ok = await fetch(`${d.base}${stream}?limit=18446744073709551615`,
+      { headers: { 'Last-Event-ID': '9223372036854775807' } });
+    assert.equal(ok.status, 200);
+    await ok.body.cancel();
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('docs/hardening.md: its example bodies get the answers it shows', { timeout: 30000 * SLOW }, async () => {
+  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
+  const blocks = [...doc.matchAll(/<!-- test:strict-example -->\s*```json\n([\s\S]*?)\n```/g)];
+  assert.equal(blocks.length, 2, 'docs/hardening.md has two json blocks after <!-- test:strict-example -->');
+  const d = await startDaemon();
+  try {
+    for (const m of blocks) {
+      const example = JSON.parse(m[1]);
+      const r = await req(d.base, 'POST', '/api/v1/sessions', example.request);
+      assert.equal(r.status, example.answer.status, example.request);
+      assert.deepEqual(r.body, example.answer);
+    }
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }

@@ -109,6 +109,34 @@ static void every_setting_is_described(void **state)
 	assert_int_equal(mi[1]->adaptive, 1);
 }
 
+/* The setting "method" offers the registry's integrators, in its order
+ * (the list is ODE_REGISTRY's, the names the descriptors'); the default is
+ * one of them, and only the split method takes sub-steps and a shadow. */
+static void method_choices_are_the_registry(void **state)
+{
+	(void)state;
+	size_t n, nm;
+	const sim_setting *t = sim_settings(&n);
+	const sim_method_info *const *mi = sim_methods(&nm);
+	const sim_setting *method = NULL;
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(t[i].name, "method") == 0)
+			method = &t[i];
+	assert_non_null(method);
+	char want[128] = "";
+	for (size_t i = 0; i < nm; i++) {
+		size_t at = strlen(want);
+		snprintf(want + at, sizeof want - at, "%s%s", i ? "|" : "", mi[i]->name);
+		assert_int_equal(mi[i]->substeps, strcmp(mi[i]->name, "dem") == 0);
+		assert_int_equal(mi[i]->shadow, strcmp(mi[i]->name, "dem") == 0);
+		assert_true(mi[i]->cost > 0);
+	}
+	assert_string_equal(method->choices, want);
+	assert_string_equal(want, "rk4|dopri5|euler|dem");
+	assert_true(method->min == 0 && method->max == (double)nm - 1);
+	assert_string_equal(sim_default_method(), "dem");
+}
+
 static void errors_have_text(void **state)
 {
 	(void)state;
@@ -126,6 +154,7 @@ int main(void)
 		cmocka_unit_test(sim_new_refuses_invalid_sets),
 		cmocka_unit_test(every_setting_is_described),
 		cmocka_unit_test(errors_have_text),
+		cmocka_unit_test(method_choices_are_the_registry),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -18,6 +18,7 @@ import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from '../node_modules/playwright-core/index.mjs';
+import '../tether.mjs'; // nothing started here outlives the test
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const DAEMON = path.resolve(ROOT, process.env.CONVSIMD || 'build/convsimd');
@@ -166,9 +167,12 @@ test('a session starts from the form', async () => {
 	assert.equal(s.layers, 2);
 	assert.equal(s.spec.scene.start, 'steady');
 	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
-	/* two layers: inside the column model's validated domain, no note */
-	assert.equal(s.status.feed_warning, null);
-	assert.equal(await visible('#feed-warning'), false, 'no feed warning for 2 layers');
+	/* czubak2016's contacts are not checked against DEM: one short line
+	 * under the velocity, no banner */
+	assert.equal(s.status.model_checked, false);
+	await until(async () => await page.$eval('#v-model', e => e.textContent) ===
+		"czubak2016's column model is not checked against DEM", 5000, 'the model check line');
+	assert.equal(await page.$('#feed-warning'), null, 'no banner');
 });
 
 test('stream samples arrive and the plots grow', async () => {
@@ -621,22 +625,30 @@ test('the rotor plot\'s ticks: every one with the decimals of its step', async (
 	for (const st of steps) assert.ok(Math.abs(st - steps[0]) <= 1e-9 * Math.abs(v[0]), `evenly spaced as written: ${ticks.join(' ')}`);
 });
 
-test('a czubak2016 session (8 soft layers) shows the feed warning; the 2-layer session does not', async () => {
+test('a liggghts-bed4 session shows its DEM check in plain words, and the new one after a β change', async () => {
 	const r = await fetch(base + '/api/v1/sessions', { method: 'POST', headers: { 'Content-Type': 'application/json', ...AUTH },
-		body: JSON.stringify({ preset: 'czubak2016', scene: { drive: 'ideal', columns: 2 }, pace: 1 }) });
+		body: JSON.stringify({ preset: 'liggghts-bed4', params: { beta: 30 }, scene: { drive: 'ideal', columns: 2 }, pace: 1 }) });
 	assert.equal(r.status, 201);
-	const czubak = await r.json();
-	assert.equal(czubak.layers, 8);
-	assert.match(czubak.status.feed_warning, /8 layers/);
-	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(czubak.id), 10000, 'the new session in the picker');
-	await page.selectOption('#session-select', czubak.id);
-	await until(async () => await visible('#feed-warning'), 5000, 'the feed warning shown');
-	const text = await page.$eval('#feed-warning', e => e.textContent);
-	assert.ok(text.includes(czubak.status.feed_warning), `the daemon's sentence on the page: ${text}`);
-	assert.match(text, /feed_model=liggghts/);
+	const bed = await r.json();
+	assert.equal(bed.status.model_checked, true);
+	await until(async () => (await page.$$eval('#session-select option', o => o.map(x => x.value))).includes(bed.id), 10000, 'the new session in the picker');
+	await page.selectOption('#session-select', bed.id);
+	const want = e => `DEM check: within ±${e.toFixed(3)} m/s here`;
+	await until(async () => await page.$eval('#v-model', e => e.textContent) === want(bed.status.model_error), 5000,
+		`${want(bed.status.model_error)} on the page`);
+	assert.equal(await page.$eval('#v-model', e => e.dataset.checked), 'true');
+	const p = await fetch(`${base}/api/v1/sessions/${bed.id}`, { method: 'PATCH', headers: { 'Content-Type': 'application/json', ...AUTH },
+		body: JSON.stringify({ beta: 150 }) });
+	assert.equal(p.status, 200);
+	const at150 = (await p.json()).status.model_error;
+	assert.ok(at150 > bed.status.model_error, `${at150} at 150 deg, ${bed.status.model_error} at 30`);
+	await until(async () => await page.$eval('#v-model', e => e.textContent) === want(at150), 5000, `${want(at150)} after the β change`);
 	await page.selectOption('#session-select', sessionId);
-	await until(async () => !(await visible('#feed-warning')), 5000, 'the feed warning gone for the 2-layer session');
-	const del = await fetch(`${base}/api/v1/sessions/${czubak.id}`, { method: 'DELETE', headers: { 'Content-Type': 'application/json', ...AUTH } });
+	/* the first session, its omega_ss changed by the drive row: not checked */
+	await until(async () => /not checked against DEM/.test(await page.$eval('#v-model', e => e.textContent)), 5000,
+		'the first session\'s line again');
+	assert.equal(await page.$eval('#v-model', e => e.dataset.checked), 'false');
+	const del = await fetch(`${base}/api/v1/sessions/${bed.id}`, { method: 'DELETE', headers: { 'Content-Type': 'application/json', ...AUTH } });
 	assert.equal(del.status, 204);
 });
 

@@ -68,7 +68,7 @@ export function openStream(id, opts, handlers) {
 		try { d = JSON.parse(ev.data); } catch { return; }
 		const kind = (d && typeof d === 'object' && !Array.isArray(d) && (d.type ?? d.event)) || ev.type;
 		if (kind === 'hello') {
-			/* the stream's first record: the session and its feed_warning */
+			/* the stream's first record: the session and its model error */
 			h.hello?.(d);
 		} else if (/control|change|command/i.test(kind)) {
 			h.control?.(normalizeControl(d.control ?? d), d);

@@ -11,7 +11,7 @@ import * as api from './api.js';
 import { fmt, fmtTime, rotationLabel, parsePace } from './format.js';
 import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
 import { resetTraces, onSample, onControl } from './live.js';
-import { showStatus, clearStatus, sessionLabel } from './status.js';
+import { showStatus, clearStatus, sessionLabel, showModelCheck } from './status.js';
 
 const STATUS_MS = 500;
 
@@ -99,7 +99,13 @@ export function attach(id, initial) {
 	app.stream = api.openStream(id, { since: 0 }, {
 		open: () => { setOnline(true); $('#live-state').textContent = `stream: open (${id})`; },
 		sample: onSample,
-		control: onControl,
+		control: (c, raw) => {
+			onControl(c);
+			/* each control's record carries the scene's model error anew */
+			if (typeof raw?.model_checked === 'boolean')
+				showModelCheck({ feed: app.session?.feed, modelChecked: raw.model_checked,
+					modelError: raw.model_error, modelCheckNote: raw.model_check_note ?? '' });
+		},
 		dropped: n => { if (n > 0) app.dropped += n; },
 		end: d => {
 			$('#live-state').textContent = `stream: ended${d?.reason ? ` (${d.reason})` : ''}`;

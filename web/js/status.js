@@ -74,7 +74,7 @@ export function showStatus(s) {
 		? ` · step ${fmtSig(1e3 * s.dt, 3)} ms, ${s.substeps} feed sub-steps` : '');
 	$('#m-pace').textContent = fmtPace(s.pace);
 	showReductions(s.reductions);
-	showFeedWarning(s.feedWarning);
+	showModelCheck(s);
 	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
 	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
 	app.dirty = true;
@@ -93,7 +93,7 @@ export function clearStatus() {
 	$('#v-steady').dataset.steady = '';
 	$('#v-tol').textContent = '';
 	$('#v-tol').dataset.tol = '';
-	showFeedWarning(null);
+	showModelCheck(null);
 	delete document.body.dataset.running;
 	const box = $('#reductions');
 	box.dataset.key = '';
@@ -101,13 +101,24 @@ export function clearStatus() {
 	resetTraces(0);
 }
 
-/* The note over the tiles when the scene's column model lies outside the
- * domain checked against LIGGGHTS beds (docs/dem.md): the daemon's sentence,
- * which names the way out. */
-function showFeedWarning(text) {
-	const note = $('#feed-warning');
-	note.hidden = !text;
-	note.textContent = text ? `Feed model outside its validated domain: ${text}` : '';
+/* The model error in plain words under the transport velocity (docs/dem.md
+ * "Model error"): "DEM check: within ±E m/s here" where the scene is
+ * checked against the DEM map, else the daemon's note up to its details
+ * ("not checked against DEM for 16-layer beds"); the whole note as the
+ * line's title. Nothing without a feed. */
+export function showModelCheck(s) {
+	const line = $('#v-model');
+	const note = s?.feed === false ? '' : (s?.modelCheckNote ?? '');
+	let text = '';
+	if (s?.modelChecked && Number.isFinite(s.modelError))
+		text = `DEM check: within ±${s.modelError.toFixed(3)} m/s here`;
+	else if (note) {
+		const cut = note.search(/: | \(/);
+		text = cut > 0 ? note.slice(0, cut) : note;
+	}
+	line.textContent = text;
+	line.title = note;
+	line.dataset.checked = s?.modelChecked ? 'true' : 'false';
 }
 
 function showReductions(list) {

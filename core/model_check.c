@@ -1,0 +1,305 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later
+ *
+ * model_check.c - how far the column model is from a DEM bed for a scene:
+ * the model error of every v (docs/dem.md "Model error").
+ *
+ * The DEM map's points with the column model's v at each (computed once by
+ * tests/bench/model_check.py and committed as
+ * tests/bench/results/model_check.csv) are compiled in: the build turns the
+ * CSV into model_map.inc, rows of map_point. Consecutive rows with the same
+ * preset, settings and layers are one entry: a calibrated column model and
+ * the bed it was checked against. A scene is checked when its settings are
+ * an entry's (every machine and feed setting but the controls beta and
+ * rotation) and its (beta, sense), or their mirror image on a symmetric
+ * machine, lies within the angles the entry measured in that sense. No file
+ * is read at run time.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+#include "units.h"
+
+typedef struct map_point {
+	const char *preset;   /* the calibrated column model's preset */
+	const char *settings; /* its changes, "name=value;..." in user units */
+	int layers;
+	double beta_deg;
+	int rotation;         /* SIM_CW or SIM_CCW */
+	double v_dem, v_dem_sd; /* m/s: the seeds' mean and spread */
+	int seeds;
+	double v_column;      /* m/s: the column model's v at the point */
+} map_point;
+
+static const map_point map[] = {
+#include "model_map.inc"
+	{NULL, NULL, 0, 0, 0, 0, 0, 0, 0} /* the end (the table may be empty) */
+};
+
+/* Settings that are controls, not part of a scene's check: the angle and
+ * the sense are interpolated over, the ramps only decide how a control is
+ * reached. */
+static int is_control(const char *name)
+{
+	static const char *const controls[] = {"beta", "rotation", "beta_rate", "beta_accel",
+					       "drive_accel"};
+	for (size_t i = 0; i < sizeof controls / sizeof *controls; i++)
+		if (strcmp(name, controls[i]) == 0)
+			return 1;
+	return 0;
+}
+
+/* The settings of entry point e: its preset with its changes applied.
+ * 0 on success. */
+static int entry_settings(const map_point *e, sim_params *p, sim_scene *sc)
+{
+	sim_method m;
+	if (sim_preset(e->preset, p, sc, &m) != SIM_OK)
+		return -1;
+	const char *at = e->settings;
+	while (at && *at) {
+		char item[80];
+		size_t n = strcspn(at, ";");
+		if (n >= sizeof item)
+			return -1;
+		memcpy(item, at, n);
+		item[n] = '\0';
+		at += n + (at[n] == ';');
+		char *eq = strchr(item, '=');
+		if (!eq)
+			return -1;
+		*eq = '\0';
+		char *end;
+		double v = strtod(eq + 1, &end);
+		int rc = *end ? sim_set_user_str(p, sc, &m, item, eq + 1, NULL, 0)
+			      : sim_set_user(p, sc, &m, item, v, NULL, 0);
+		if (rc != SIM_OK)
+			return -1;
+	}
+	sc->layers = e->layers;
+	return 0;
+}
+
+static int same(double a, double b)
+{
+	return a == b || fabs(a - b) <= 1e-9 * fmax(fabs(a), fabs(b));
+}
+
+/* The first parameter (not a control) in which p differs from q, or NULL. */
+static const char *first_difference(const sim_params *p, const sim_scene *s,
+				    const sim_params *q, const sim_scene *t)
+{
+	/* the common answer first: the same bytes once the controls are
+	 * copied (padding that differs only sends it the long way) */
+	sim_params same_controls = *q;
+	same_controls.beta = p->beta;
+	same_controls.rotation = p->rotation;
+	same_controls.beta_rate = p->beta_rate;
+	same_controls.beta_accel = p->beta_accel;
+	same_controls.drive_accel = p->drive_accel;
+	if (!memcmp(&same_controls, p, sizeof *p) && s->friction == t->friction)
+		return NULL;
+	size_t n;
+	const sim_setting *tab = sim_settings(&n);
+	for (size_t i = 0; i < n; i++) {
+		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name))
+			continue;
+		double a, b;
+		if (sim_get(p, s, NULL, tab[i].name, &a) == SIM_OK &&
+		    sim_get(q, t, NULL, tab[i].name, &b) == SIM_OK && !same(a, b))
+			return tab[i].name;
+	}
+	if (s->friction != t->friction)
+		return "friction";
+	return NULL;
+}
+
+/* A setting of the feed (its contact) rather than of the machine. */
+static int is_feed_setting(const char *name)
+{
+	static const char *const feed[] = {"m_n", "k_c", "p", "R", "mu", "h_d", "column_span",
+					   "friction"};
+	for (size_t i = 0; i < sizeof feed / sizeof *feed; i++)
+		if (strcmp(name, feed[i]) == 0)
+			return 1;
+	return 0;
+}
+
+/* The angle range [lo, hi] (deg) entry [first, end) measured in a sense. */
+static int entry_range(size_t first, size_t end, int rotation, double *lo, double *hi)
+{
+	*lo = INFINITY;
+	*hi = -INFINITY;
+	for (size_t i = first; i < end; i++)
+		if (map[i].rotation == rotation) {
+			*lo = fmin(*lo, map[i].beta_deg);
+			*hi = fmax(*hi, map[i].beta_deg);
+		}
+	return *lo <= *hi;
+}
+
+/* Interpolate the entry [first, end) at (beta_deg, rotation): 1 inside
+ * its measured angles, with *err and *unc filled. */
+static int interpolate(size_t first, size_t end, double beta_deg, int rotation, double *err,
+		       double *unc)
+{
+	const map_point *lo = NULL, *hi = NULL;
+	for (size_t i = first; i < end; i++) {
+		const map_point *q = &map[i];
+		if (q->rotation != rotation)
+			continue;
+		if (q->beta_deg <= beta_deg + 1e-9 && (!lo || q->beta_deg > lo->beta_deg))
+			lo = q;
+		if (q->beta_deg >= beta_deg - 1e-9 && (!hi || q->beta_deg < hi->beta_deg))
+			hi = q;
+	}
+	if (!lo || !hi)
+		return 0;
+	double w = hi->beta_deg > lo->beta_deg
+			   ? (beta_deg - lo->beta_deg) / (hi->beta_deg - lo->beta_deg)
+			   : 0.0;
+	w = fmin(1.0, fmax(0.0, w));
+	double d_lo = fabs(lo->v_column - lo->v_dem), d_hi = fabs(hi->v_column - hi->v_dem);
+	double sd_lo = isfinite(lo->v_dem_sd) ? lo->v_dem_sd : 0.0;
+	double sd_hi = isfinite(hi->v_dem_sd) ? hi->v_dem_sd : 0.0;
+	double d = (1 - w) * d_lo + w * d_hi, sd = (1 - w) * sd_lo + w * sd_hi;
+	*err = d + sd;
+	/* between two points the curve is not measured: half the change of
+	 * the error across them, growing from 0 at a point to its full share
+	 * midway */
+	*unc = sd + 2.0 * fmin(w, 1.0 - w) * 0.5 * fabs(d_hi - d_lo);
+	return 1;
+}
+
+static const char *sense_name(int rotation)
+{
+	return rotation == SIM_CW ? "cw" : "ccw";
+}
+
+/* How well the scene matches entry [first, end): 0 settings and layers
+ * match, 1 layers differ, 2 a machine setting differs, 3 a feed setting
+ * differs. *diff receives the first differing setting. */
+static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
+		       const char **diff)
+{
+	sim_params q;
+	sim_scene t;
+	*diff = NULL;
+	if (entry_settings(&map[first], &q, &t) != 0)
+		return 4;
+	*diff = first_difference(p, sc, &q, &t);
+	if (*diff)
+		return is_feed_setting(*diff) ? 3 : 2;
+	return sc->layers == map[first].layers ? 0 : 1;
+}
+
+int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *out)
+{
+	out->checked = 0;
+	out->error = NAN;
+	out->error_uncertainty = NAN;
+	out->note[0] = '\0';
+	if (!sc->feed) {
+		snprintf(out->note, sizeof out->note, "no feed: nothing to check against DEM");
+		return -1;
+	}
+	if (sc->feed_model != SIM_FEED_COLUMN) {
+		snprintf(out->note, sizeof out->note,
+			 "the feed is a LIGGGHTS bed: the DEM itself, no column model to check");
+		return -1;
+	}
+	double beta = p->beta / RAD_PER_DEG;
+	sim_scene mirrored = *sc;
+	mirrored.mirror = 1;
+	int can_mirror = sim_mirror_applies(p, &mirrored);
+	/* the best entry: fewest differences, then the nearest depth */
+	size_t best = SIZE_MAX, best_end = 0;
+	int best_rank = 5;
+	const char *best_diff = NULL;
+	for (size_t first = 0, end; map[first].preset; first = end) {
+		for (end = first + 1; map[end].preset && map[end].layers == map[first].layers &&
+				      strcmp(map[end].preset, map[first].preset) == 0 &&
+				      strcmp(map[end].settings, map[first].settings) == 0;
+		     end++)
+			;
+		const char *diff;
+		int rank = entry_match(first, p, sc, &diff);
+		if (rank == 0) {
+			double err, unc;
+			int inside = interpolate(first, end, beta, p->rotation, &err, &unc) ||
+				     (can_mirror &&
+				      interpolate(first, end, 180.0 - beta, -p->rotation, &err, &unc));
+			if (inside) {
+				out->checked = 1;
+				out->error = err;
+				out->error_uncertainty = unc;
+				snprintf(out->note, sizeof out->note,
+					 "DEM check: within ±%.3f m/s here (%s, %d layers)",
+					 err, map[first].preset, map[first].layers);
+				return 1;
+			}
+		}
+		if (rank < best_rank ||
+		    (rank == best_rank && rank == 1 &&
+		     abs(map[first].layers - sc->layers) < abs(map[best].layers - sc->layers))) {
+			best = first;
+			best_end = end;
+			best_rank = rank;
+			best_diff = diff;
+		}
+	}
+	if (best == SIZE_MAX) {
+		snprintf(out->note, sizeof out->note, "not checked against DEM: no DEM map entry");
+		return 0;
+	}
+	const map_point *e = &map[best];
+	char where[96];
+	snprintf(where, sizeof where, "%d layers, %s", e->layers, e->preset);
+	/* a scene that is another preset as it stands: say so plainly */
+	const char *named = NULL;
+	for (size_t i = 0; best_rank >= 2 && sim_preset_names[i] && !named; i++) {
+		sim_params q;
+		sim_scene t;
+		sim_method m;
+		if (sim_preset(sim_preset_names[i], &q, &t, &m) == SIM_OK &&
+		    !first_difference(p, sc, &q, &t))
+			named = sim_preset_names[i];
+	}
+	if (named) {
+		snprintf(out->note, sizeof out->note,
+			 "%s's column model is not checked against DEM (checked: %s)", named,
+			 where);
+	} else if (best_rank == 0) {
+		double lo, hi;
+		if (entry_range(best, best_end, p->rotation, &lo, &hi))
+			snprintf(out->note, sizeof out->note,
+				 "not checked against DEM at beta %.0f deg %s: checked %.0f-%.0f deg "
+				 "%s (%s)",
+				 beta, sense_name(p->rotation), lo, hi, sense_name(p->rotation),
+				 where);
+		else
+			snprintf(out->note, sizeof out->note,
+				 "not checked against DEM turning %s (%s)", sense_name(p->rotation),
+				 where);
+	} else if (best_rank == 1) {
+		snprintf(out->note, sizeof out->note,
+			 "not checked against DEM for %d-layer beds: nearest checked bed is %s",
+			 sc->layers, where);
+	} else if (best_rank == 2) {
+		double v = NAN;
+		sim_get_user(p, sc, NULL, best_diff, &v);
+		const sim_setting *t = sim_setting_find(best_diff);
+		snprintf(out->note, sizeof out->note,
+			 "not checked against DEM at %s = %g%s%s: the DEM map's machine is %s's (%s)",
+			 best_diff, v, t && *t->unit ? " " : "", t ? t->unit : "", e->preset, where);
+	} else {
+		snprintf(out->note, sizeof out->note,
+			 "not checked against DEM with this contact (%s differs): nearest "
+			 "checked is %s",
+			 best_diff, where);
+	}
+	return 0;
+}

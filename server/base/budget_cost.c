@@ -1,0 +1,68 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * budget_cost.c - the CPU cost model of a session: CPU s per simulated s
+ * estimated from its integrator's descriptor (cost, default steps) and
+ * its feed before it runs, and the cost of a published sample. The cores
+ * of paced sessions (budget.c) are committed from it until the worker
+ * has measured the session's own.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "budget.h"
+
+/* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
+ * one macro step of the machine (four right-hand sides: RK4, or dem's
+ * macro step), of one feed sub-step per integrated column and per
+ * integrated element, and of one published sample (status, ring record,
+ * trajectory row); `build/convsim run` on this machine, the cost of 5
+ * simulated s less that of 0.01 s, and the daemon's workers. */
+#define STEP_CPU_S 0.41e-6
+#define COLUMN_SUBSTEP_CPU_S 8.0e-8
+#define ELEMENT_SUBSTEP_CPU_S 0.8e-8
+#define SAMPLE_CPU_S 7e-6
+/* and of each double of a published sample's feed record (ring, history) */
+#define RECORD_DOUBLE_CPU_S 2e-9
+/* Doubles per record of a feed: column displacements, xi and eta. */
+size_t srv_budget_record_doubles(int columns, int layers)
+{
+	return (size_t)columns + 2 * (size_t)columns * (size_t)layers;
+}
+
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers)
+{
+	const sim_method *m = &spec->method;
+	double dt = st->dt, evals = 1;
+	int substeps = st->substeps;
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	for (size_t i = 0; i < n; i++) {
+		if (strcmp(all[i]->name, m->name) != 0)
+			continue;
+		evals = all[i]->cost;
+		if (all[i]->adaptive) {
+			/* its steps follow the solution: guess the default method's */
+			sim_method guess = *m;
+			snprintf(guess.name, sizeof guess.name, "%s", sim_default_method());
+			dt = sim_default_dt(&spec->params, &spec->scene, &guess);
+			substeps = sim_default_substeps(&spec->params, &spec->scene, &guess, dt);
+		}
+	}
+	if (!(dt > 0))
+		dt = 1e-3;
+	if (substeps < 1)
+		substeps = 1;
+	/* the symmetric reduction integrates one representative column */
+	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
+	if (columns <= 0 || layers <= 0)
+		integrated = 0;
+	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
+			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
+	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
+}
+
+double srv_budget_sample_cpu(int columns, int layers)
+{
+	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)srv_budget_record_doubles(columns, layers);
+}

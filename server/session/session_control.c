@@ -1,0 +1,138 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * session_control.c - a control (PATCH, session.h srv_session_control)
+ * from its admission to its answer: checked against the session's state
+ * and the budgets, queued to the worker (whose commands phase applies it,
+ * worker_control.c), waited for, and answered once its control-log line
+ * is durable; and an experiment attached to send its segments' controls.
+ */
+#include <errno.h>
+#include <string.h>
+
+#include "experiment.h"
+#include "session_int.h"
+#include "util.h"
+
+static const srv_config *cfg;
+
+void srv_session_control_init(const srv_config *config)
+{
+	cfg = config;
+}
+
+/* The paced cores s needs after c: raise its hold before c is queued, or
+ * refuse (lock held). The field named is the one that raises it. */
+static api_err admit_control(srv_session *s, const api_control *c,
+			     api_problem *pb)
+{
+	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
+	if (pace == API_PACE_MAX ||
+	    srv_state_after(s->state, s->cpu_paused, s->st.t, c) != SRV_RUNNING ||
+	    s->cpu_per_s * pace <= s->paced_held)
+		return API_OK;
+	const char *field = (c->set & API_C_PACE)      ? "pace"
+			    : (c->set & API_C_RUNNING) ? "running"
+			    : (c->set & API_C_CPU)     ? "cpu_budget"
+						       : "until";
+	return srv_budget_take_paced(&s->paced_held, s->cpu_per_s, pace, field,
+				     "changed", pb);
+}
+
+api_err srv_session_control(srv_session *s, const api_control *c,
+			    double timeout_s, double *t_eff, api_problem *pb)
+{
+	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
+	pthread_mutex_lock(&s->lock);
+	api_err e = API_OK;
+	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
+		e = api_fail(pb, API_RANGE, "cpu_budget",
+			     "cpu_budget must be CPU seconds in (0, %g] "
+			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
+			     c->cpu_budget);
+		pb->has_range = 1;
+		pb->min = 0;
+		pb->max = cfg->max_cpu_seconds;
+	} else if (s->stop)
+		e = api_fail(pb, API_NOTFOUND, NULL,
+			     "the session is being deleted");
+	else if (s->state == SRV_FAILED)
+		e = api_fail(pb, API_CONFLICT, NULL,
+			     "the session has failed (%s); it takes no more "
+			     "controls", s->error);
+	else if ((c->set & API_C_UNTIL) && c->until > 0 && c->until <= s->st.t)
+		e = api_fail(pb, API_CONFLICT, "until",
+			     "until (%g s) lies in the past: the session is at "
+			     "t = %g s", c->until, s->st.t);
+	else if ((c->set & API_C_RUNNING) && c->running &&
+		 s->state == SRV_FINISHED && !(c->set & API_C_UNTIL))
+		e = api_fail(pb, API_CONFLICT, "running",
+			     "the session finished at until = %g s; raise "
+			     "until to run on", s->until);
+	else
+		e = admit_control(s, c, pb);
+	if (e != API_OK) {
+		pthread_mutex_unlock(&s->lock);
+		return e;
+	}
+	srv_worker_queue(s, &cmd);
+	struct timespec until = srv_deadline(timeout_s);
+	while (!cmd.done && !s->stop)
+		if (pthread_cond_timedwait(&s->data, &s->lock, &until) ==
+		    ETIMEDOUT)
+			break;
+	if (!cmd.done) { /* take it back: nothing changes */
+		srv_worker_unqueue(s, &cmd);
+		srv_budget_set_paced(&s->paced_held, srv_paced_need(s));
+		pthread_mutex_unlock(&s->lock);
+		return api_fail(pb, API_UNAVAILABLE, NULL,
+				"the session's worker did not take the change "
+				"within %g s; nothing was changed", timeout_s);
+	}
+	pthread_mutex_unlock(&s->lock);
+	if (cmd.rc != SIM_OK)
+		return api_fail(pb, api_from_sim(cmd.rc), NULL, "%s",
+				sim_strerror(cmd.rc));
+	/* the answer only once its line is on disk (control_log.c) */
+	int err = cmd.logged ? srv_control_log_sync(s, cmd.logged, timeout_s) : 0;
+	if (err) {
+		api_fail(pb, API_UNAVAILABLE, NULL,
+			 "the control was applied at t = %g s but its line could not be made "
+			 "durable in the control log (%s): a crash may lose it",
+			 cmd.t_eff, strerror(err));
+		pb->retry_after = 5;
+		return API_UNAVAILABLE;
+	}
+	*t_eff = cmd.t_eff;
+	return API_OK;
+}
+
+api_err srv_session_attach(srv_session *s, srv_experiment *e,
+			   api_problem *pb)
+{
+	api_err rc = API_OK;
+	pthread_mutex_lock(&s->lock);
+	if (s->stop)
+		rc = api_fail(pb, API_NOTFOUND, "session",
+			      "the session is being deleted");
+	else if (s->state == SRV_FAILED)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session has failed (%s)", s->error);
+	else if (s->exp)
+		rc = api_fail(pb, API_CONFLICT, "session",
+			      "the session already runs experiment %s",
+			      srv_exp_id(s->exp));
+	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
+		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
+					     s->pace, "session", "attached",
+					     pb)) != API_OK)
+		; /* the experiment would run it on (worker.c extend_until)
+		     past the cores for paced sessions: nothing attached */
+	else {
+		s->exp = e;
+		s->exp_started = 0;
+		srv_exp_set_session(e, s->entry.id);
+		pthread_cond_broadcast(&s->wake);
+	}
+	pthread_mutex_unlock(&s->lock);
+	return rc;
+}

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The DEM map's points with the column model's v beside them: the data of
+every number's `model_error` (docs/dem.md "Model error").
+
+Writes tests/bench/results/model_check.csv, one row per DEM point that has a
+calibrated column model, which the build compiles into the core
+(core/model_check.c includes the table the Makefile generates from it):
+
+  preset,settings,material,layers,drive,beta_deg,rotation,v_dem,v_dem_sd,
+  seeds,v_column,source
+
+Sources, in this order:
+  1. the 4-diameter bed's curve at the preset's contacts (dem.jsonl, group
+     "curve": 11 angles, both senses, three packing seeds each), the data
+     the preset liggghts-bed4 was fitted to;
+  2. every row of tests/bench/results/dem_map.csv (the DEM map, one row per
+     point) whose material and drive have a calibrated column model in
+     tests/bench/model_presets.csv (material,drive,preset,settings: a new
+     material or drive is one line there once its preset exists).
+A map row without such a line is left out and named on stderr.
+
+v_column is the column model's v at the point: `convsim run -p PRESET
+[--set SETTING]... --set layers=L --set beta=B --set rotation=R --set
+feed_coupling=false -d 2 --set transient=0.5` (one-way, as the DEM bed is
+driven: 2 s from the steady start, v over the whole periods after 0.5 s).
+settings is PRESET's changes, `name=value;...` in user units; empty for the
+preset itself.
+
+Usage: tests/bench/model_check.py [CONVSIM] > tests/bench/results/model_check.csv
+(CONVSIM defaults to build/convsim; `make model-check` runs it)."""
+import csv
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+PRESETS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "model_presets.csv")
+COLUMNS = ["preset", "settings", "material", "layers", "drive", "beta_deg", "rotation",
+           "v_dem", "v_dem_sd", "seeds", "v_column", "source"]
+
+
+def bed4_points():
+    """The 4-diameter bed's curve, seeds pooled: mean and sample sd."""
+    curve = {}
+    for line in open(os.path.join(RESULTS, "dem.jsonl")):
+        if line.strip():
+            r = json.loads(line)
+            if r["group"] == "curve" and r["layers"] == 4 and r["k_over_m"] == 2e6:
+                curve.setdefault((round(r["beta"]), r["rotation"]), []).append(r["v_dem"])
+    for (beta, rot), v in sorted(curve.items(), key=lambda kv: (kv[0][1] != "cw", kv[0][0])):
+        yield {"preset": "liggghts-bed4", "settings": "", "material": "preset-contacts",
+               "layers": 4, "drive": "preset", "beta_deg": beta, "rotation": rot,
+               "v_dem": statistics.fmean(v),
+               "v_dem_sd": statistics.stdev(v) if len(v) > 1 else float("nan"),
+               "seeds": len(v), "source": "dem.jsonl curve"}
+
+
+def map_points():
+    """The DEM map's rows that have a calibrated column model."""
+    path = os.path.join(RESULTS, "dem_map.csv")
+    if not os.path.exists(path):
+        return
+    presets = {}
+    if os.path.exists(PRESETS):
+        for r in csv.DictReader(line for line in open(PRESETS) if not line.startswith("#")):
+            presets[(r["material"], r["drive"])] = (r["preset"], r["settings"])
+    for r in csv.DictReader(open(path)):
+        key = (r["material"], r["drive"])
+        if key not in presets:
+            print(f"model_check.py: no calibrated column model for material {key[0]}, "
+                  f"drive {key[1]} (tests/bench/model_presets.csv): row left out",
+                  file=sys.stderr)
+            continue
+        preset, settings = presets[key]
+        sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
+        yield {"preset": preset, "settings": settings, "material": r["material"],
+               "layers": int(r["layers"]), "drive": r["drive"],
+               "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
+               "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
+               "source": "dem_map.csv " + r.get("build", "")}
+
+
+def v_column(convsim, p):
+    args = [convsim, "run", "-p", p["preset"]]
+    for s in filter(None, p["settings"].split(";")):
+        args += ["--set", s]
+    args += ["--set", f"layers={p['layers']}", "--set", f"beta={p['beta_deg']:g}",
+             "--set", f"rotation={p['rotation']}", "--set", "feed_coupling=false",
+             "-d", "2", "--set", "transient=0.5", "-q"]
+    out = subprocess.run(args, check=True, capture_output=True, text=True).stdout
+    return json.loads(out)["transport_velocity"]
+
+
+def num(x, digits):
+    return "nan" if isinstance(x, float) and math.isnan(x) else f"{x:.{digits}g}"
+
+
+def main():
+    convsim = sys.argv[1] if len(sys.argv) > 1 else "build/convsim"
+    w = csv.writer(sys.stdout, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for p in list(bed4_points()) + list(map_points()):
+        p["v_column"] = v_column(convsim, p)
+        w.writerow([p["preset"], p["settings"], p["material"], p["layers"], p["drive"],
+                    num(float(p["beta_deg"]), 6), p["rotation"], num(p["v_dem"], 6),
+                    num(p["v_dem_sd"], 3), p["seeds"], num(p["v_column"], 6), p["source"]])
+
+
+if __name__ == "__main__":
+    main()

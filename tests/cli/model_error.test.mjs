@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// convsim run's summary carries the model error of its scene (docs/dem.md
+// "Model error"): at a point of the DEM map the map's |v_column - v_DEM|
+// plus the DEM's seed spread (tests/bench/results/model_check.csv); where
+// the scene is not checked, null, model_checked false and a note naming the
+// nearest checked point, which feed_warning repeats.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { readFileSync } from 'node:fs';
+import '../tether.mjs'; // nothing started here outlives the test
+
+const CONVSIM = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
+const summary = (preset, ...set) => JSON.parse(execFileSync(CONVSIM, ['run', '-q', '-d', '0.2',
+  ...(preset ? ['-p', preset] : []), ...set.flatMap((s) => ['--set', s])], { encoding: 'utf8' }));
+
+// liggghts-bed4's row at beta, rotation: the expected model error
+function mapError(beta, rotation) {
+  const [head, ...rows] = readFileSync(new URL('../bench/results/model_check.csv', import.meta.url), 'utf8')
+    .trim().split('\n');
+  const c = Object.fromEntries(head.split(',').map((n, i) => [n, i]));
+  const r = rows.map((l) => l.split(',')).find((r) => r[c.preset] === 'liggghts-bed4' &&
+    Number(r[c.beta_deg]) === beta && r[c.rotation] === rotation);
+  return Math.abs(Number(r[c.v_column]) - Number(r[c.v_dem])) + Number(r[c.v_dem_sd]);
+}
+
+test('model_error: the calibrated bed at 150 deg cw carries the map\'s value there', () => {
+  const s = summary('liggghts-bed4', 'beta=150');
+  assert.equal(s.model_checked, true);
+  assert.ok(Math.abs(s.model_error - mapError(150, 'cw')) < 1e-12, `${s.model_error} against ${mapError(150, 'cw')}`);
+  assert.ok(s.model_error_uncertainty > 0 && s.model_error_uncertainty < s.model_error);
+  assert.match(s.model_check_note, /^DEM check: within ±0\.008 m\/s here \(liggghts-bed4, 4 layers\)$/);
+  assert.equal(s.feed_warning, null);
+});
+
+test('model_error: the table\'s column-model v is this build\'s (make model-check computes it)', () => {
+  // tests/bench/model_check.py's run at 150 deg cw against the committed row
+  const [head, ...rows] = readFileSync(new URL('../bench/results/model_check.csv', import.meta.url), 'utf8')
+    .trim().split('\n');
+  const c = Object.fromEntries(head.split(',').map((n, i) => [n, i]));
+  const row = rows.map((l) => l.split(',')).find((r) => r[c.preset] === 'liggghts-bed4' &&
+    Number(r[c.beta_deg]) === 150 && r[c.rotation] === 'cw');
+  const v = JSON.parse(execFileSync(CONVSIM, ['run', '-p', 'liggghts-bed4', '--set', 'layers=4', '--set', 'beta=150',
+    '--set', 'rotation=cw', '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5', '-q'],
+  { encoding: 'utf8' })).transport_velocity;
+  assert.ok(Math.abs(v - Number(row[c.v_column])) < 1e-5 * Math.abs(v), `v ${v}, the table's ${row[c.v_column]}`);
+});
+
+test('model_error: not checked at another depth or for the preset, the note names the nearest checked bed', () => {
+  const s = summary('liggghts-bed4', 'beta=150', 'layers=2');
+  assert.equal(s.model_checked, false);
+  assert.equal(s.model_error, null);
+  assert.equal(s.model_error_uncertainty, null);
+  assert.equal(s.model_check_note, 'not checked against DEM for 2-layer beds: nearest checked bed is 4 layers, liggghts-bed4');
+  assert.equal(s.feed_warning, s.model_check_note);
+  const p = summary(null, 'beta=150', 'layers=2');
+  assert.equal(p.model_checked, false);
+  assert.equal(p.model_check_note, "czubak2016's column model is not checked against DEM (checked: 4 layers, liggghts-bed4)");
+  const n = summary(null, 'feed=false');
+  assert.equal(n.model_checked, false);
+  assert.equal(n.feed_warning, null);
+});
+
+test('model_error: a fit\'s curve is checked at the fitted values, not the start\'s', () => {
+  const data = new URL('../bench/results/dem_bed4.csv', import.meta.url).pathname;
+  const out = execFileSync(CONVSIM, ['fit', '-p', 'liggghts-bed4', '--data', data, '--free', 'mu',
+    '--set', 'feed_coupling=false', '--curve-step', '15', '--threads', '1', '--max-iter', '1', '-q'], { encoding: 'utf8' });
+  const f = JSON.parse(out);
+  const mu = f.parameters[0].value;
+  assert.ok(Math.abs(mu - 0.62285) > 1e-6, `mu moved from the preset's: ${mu}`);
+  for (const rot of ['cw', 'ccw']) {
+    const c = f.curve[rot];
+    assert.equal(c.model_error.length, f.curve.beta.length);
+    assert.deepEqual(c.model_checked, f.curve.beta.map(() => false), `${rot}: the fitted mu is no map entry's`);
+    assert.ok(c.model_error.every((e) => e === null));
+    assert.equal(c.model_check_note, 'not checked against DEM with this contact (mu differs): nearest checked is 4 layers, liggghts-bed4');
+  }
+});
+
+test('model_error: convsim sweep\'s JSON points carry it at their angle', () => {
+  const s = JSON.parse(execFileSync(CONVSIM, ['sweep', '-p', 'liggghts-bed4', '--set', 'feed_coupling=false', '--beta', '150:170:20',
+    '--rotation', 'cw', '-d', '0.5', '-q', '-f', 'json'], { encoding: 'utf8' }));
+  const [a, b] = s.points;
+  assert.equal(a.beta, 150);
+  assert.ok(Math.abs(a.model_error - mapError(150, 'cw')) < 1e-12, `${a.model_error} at 150 deg cw`);
+  assert.equal(a.model_checked, true);
+  assert.equal(b.model_checked, false);
+  assert.equal(b.model_error, null);
+});

@@ -1,0 +1,82 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * test_estimator.c - a known answer of the transport estimator: its v is
+ * the mean feed position's change over the time between its first and
+ * last period boundaries, each boundary placed on the step's cubic
+ * Hermite of the rotor's phase and the position read from the Hermite of
+ * the position at that moment. The test steps an instance one machine
+ * step at a time, keeps the ends of every step (phase, position and
+ * their rates, from the estimator's own probe), places the boundaries by
+ * bisection (not the estimator's Newton) and compares.
+ */
+#include <math.h>
+
+#include "testutil.h"
+
+#include "ode.h"     /* ode_hermite */
+#include "sim_int.h" /* the estimator's probe of each step's end */
+
+/* u in [0, 1] where the phase's Hermite passes target, by bisection. */
+static double bisect(double p0, double v0, double p1, double v1, double H, double target)
+{
+	int up = p1 > p0;
+	double lo = 0.0, hi = 1.0;
+	for (int it = 0; it < 200 && hi - lo > 1e-17; it++) {
+		double mid = 0.5 * (lo + hi);
+		if ((ode_hermite(p0, v0, p1, v1, H, mid) < target) == up)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return 0.5 * (lo + hi);
+}
+
+static void v_is_dX_over_dt_between_its_crossings(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	sim *s = make(&u);
+	const estimator *e = &s->est;
+	double dt = s->cfg.dt, start = e->start;
+	double t_first = NAN, X_first = NAN, t_last = NAN, X_last = NAN;
+	int n = 0;
+	for (long k = 1; k <= (long)(1.2 / dt); k++) {
+		double t0 = s->t_int, psi0 = e->psi_prev, psid0 = e->psid_prev;
+		double X0 = e->X_prev, Xd0 = e->Xd_prev;
+		advance(s, (double)k * dt); /* one fixed machine step */
+		double H = s->t_int - t0, psi1 = e->psi_prev, psid1 = e->psid_prev;
+		double n0 = floor(psi0 / (2 * M_PI)), n1 = floor(psi1 / (2 * M_PI));
+		assert_true(fabs(n1 - n0) <= 1); /* the preset's steps pass one at most */
+		if (n0 == n1)
+			continue;
+		double nb = n1 > n0 ? n1 : n0;
+		double w = bisect(psi0, psid0, psi1, psid1, H, nb * 2 * M_PI);
+		double t = t0 + w * H;
+		double X = ode_hermite(X0, Xd0, e->X_prev, e->Xd_prev, H, w);
+		if (t < start - 1e-12)
+			continue;
+		if (n++ == 0) {
+			t_first = t;
+			X_first = X;
+		}
+		t_last = t;
+		X_last = X;
+	}
+	assert_true(n >= 25); /* 25 Hz over 1.2 s */
+	double v = (X_last - X_first) / (t_last - t_first);
+	sim_status st = status(s);
+	assert_int_equal((int)st.transport_periods, n - 1);
+	if (!(fabs(st.transport_velocity - v) <= 1e-9 * fabs(v)))
+		fail_msg("v %.17g, dX/dt between the crossings %.17g (relative %.3g)",
+			 st.transport_velocity, v, (st.transport_velocity - v) / v);
+	assert_true(fabs(v) > 1e-3); /* the preset moves its feed */
+	sim_free(s);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(v_is_dX_over_dt_between_its_crossings),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
