@@ -104,6 +104,8 @@ static int publish_wakes(srv_session *s, clocks *c)
 		c->want_all = s->ring.wake_t == -INFINITY;
 		s->ring.wake_t = INFINITY;
 		wake = 1;
+	} else {
+		c->want_all = 0; /* no stream waited for these */
 	}
 	s->ring.published = s->ring.head;
 	return wake;
