@@ -109,7 +109,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: model-check all deps deps-build run cluster test check bench bench-controls bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: model-check all deps deps-build run cluster test check bench bench-controls bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
@@ -363,6 +363,14 @@ bench-dem: all $(BUILD)/.deps-dem
 	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem_cost.sh
+
+# The DEM reference map (tests/bench/dem_map.sh, docs/dem.md "The map"):
+# named materials, depths 1-16 grains, beta every 15 deg, two drives, three
+# seeds a point, from one build; many CPU hours, resumable, in parts
+# (DEM_MAP_PARTS="glass-shallow glass-checks"), into
+# tests/bench/results/dem_map.csv and dem_map.md.
+bench-dem-map: $(BUILD)/.deps-dem
+	$(Q)bash tests/bench/dem_map.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.
