@@ -88,7 +88,9 @@ MPI_LIBS    := $(if $(HAVE_MPI),$(shell pkg-config --libs ompi-c))
 DEB_BUILD := /usr/include/microhttpd.h:libmicrohttpd-dev \
              /usr/include/cjson/cJSON.h:libcjson-dev \
              /usr/include/gsl/gsl_multifit_nlinear.h:libgsl-dev
-DEB_TEST  := /usr/include/cmocka.h:libcmocka-dev \
+# and to build the unit tests (`make` builds them)
+DEB_UNIT  := /usr/include/cmocka.h:libcmocka-dev
+DEB_TEST  := $(DEB_UNIT) \
              /usr/bin/curl:curl \
              /usr/bin/python3:python3 \
              /usr/bin/node:nodejs \
@@ -109,8 +111,10 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: model-check all deps deps-build run cluster test check bench bench-controls bench-dem dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
-all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
+.PHONY: model-check all deps deps-build deps-unit run cluster test check bench bench-controls bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+# `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
+# as what building and running need.
+all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
 
 # Install what is missing: Debian packages (with apt-get, which needs root:
 # run as root or have sudo) and the npm test tools (tests/node_modules, no
@@ -118,8 +122,12 @@ all: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(
 # that building and running need.
 deps: deps-build $(BUILD)/.deps $(BUILD)/.deps-dem
 deps-build: $(BUILD)/.deps-build
+deps-unit: $(BUILD)/.deps-unit
 $(BUILD)/.deps-build: Makefile
 	$(Q)NEEDS="$(DEB_BUILD)" WHY="to build and run convsim" sh tests/apt-deps.sh
+	$(Q)mkdir -p $(BUILD) && touch $@
+$(BUILD)/.deps-unit: Makefile
+	$(Q)NEEDS="$(DEB_UNIT)" WHY="to build the unit tests that make builds" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@
 $(BUILD)/.deps: Makefile tests/package.json tests/package-lock.json
 	$(Q)NEEDS="$(DEB_TEST)" WHY="to run the tests (cmocka, node, chromium, systemd-analyze, haproxy, clang for libFuzzer, valgrind)" sh tests/apt-deps.sh
@@ -247,7 +255,7 @@ $(BUILD)/convsimd: $(SERVER_OBJ) $(BUILD)/libapi.a $(BUILD)/libdemlink.a $(BUILD
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(CFLAGS) -o $@ $^ -lmicrohttpd -lcjson $(GSL_LIBS) $(LDLIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a
+$(BUILD)/tests/%: tests/unit/%.c $(BUILD)/libapi.a $(BUILD)/libfit.a $(BUILD)/libcore.a | $(BUILD)/.deps-unit
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
 	$(Q)$(CC) $(CFLAGS) $(WARN) -MMD -MP $(INC_tests) -o $@ $^ -lcmocka -lcjson $(GSL_LIBS) $(LDLIBS)
@@ -363,6 +371,14 @@ bench-dem: all $(BUILD)/.deps-dem
 	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem.sh
 	$(Q)BUILD=$(BUILD) bash tests/bench/dem_cost.sh
+
+# The DEM reference map (tests/bench/dem_map.sh, docs/dem.md "The map"):
+# named materials, depths 1-16 grains, beta every 15 deg, two drives, three
+# seeds a point, from one build; many CPU hours, resumable, in parts
+# (DEM_MAP_PARTS="glass-shallow glass-checks"), into
+# tests/bench/results/dem_map.csv and dem_map.md.
+bench-dem-map: $(BUILD)/.deps-dem
+	$(Q)bash tests/bench/dem_map.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.

@@ -150,7 +150,7 @@ static void summary(const fit_request *req, const fit_result *res)
 		const sim_setting *t = sim_setting_find(req->free[j].name);
 		fprintf(stderr, "  %s = %.6g +- %.2g %s (start %.6g)\n", req->free[j].name,
 			sim_setting_from_si(t, res->x[j]), sim_setting_from_si(t, res->se[j]),
-			t->unit, sim_setting_from_si(t, res->x0[j]));
+			sim_unit_shown(t), sim_setting_from_si(t, res->x0[j]));
 	}
 	/* costs in the data's unit, as the JSON's chi2 (peaks: deg^2) */
 	int peaks_deg = !req->npoints && !res->sigma_given;

@@ -24,7 +24,7 @@
 
 static const cli_opt options[] = {
 	{RS, OPT_PRESET, "preset", 'p', "NAME", NULL, "czubak2016",
-	 "starting values for every setting (known: czubak2016, czubak2016-fit)"},
+	 "starting values for every setting"},
 	{RS, OPT_SET, "set", 's', "NAME=VALUE", NULL, NULL,
 	 "set one setting, in the unit `convsim list` shows; repeatable"},
 	{CMD_RUN, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
@@ -139,7 +139,12 @@ void cli_help_options(FILE *f, const cli_opt *opts, size_t n, unsigned cmd)
 		snprintf(flag, sizeof flag, "%c%c%s--%s%s%s", o->key ? '-' : ' ',
 			 o->key ? o->key : ' ', o->key ? ", " : "  ", o->name, o->arg ? " " : "",
 			 o->arg ? o->arg : "");
-		fprintf(f, "  %-26s %s\n", flag, o->doc);
+		fprintf(f, "  %-26s %s", flag, o->doc);
+		int preset = o->id == OPT_PRESET && strcmp(o->name, "preset") == 0;
+		if (preset) /* the names from their table */
+			for (const char *const *p = sim_preset_names; *p; p++)
+				fprintf(f, "%s%s", p == sim_preset_names ? " (known: " : ", ", *p);
+		fprintf(f, "%s\n", preset ? ")" : "");
 		if (o->unit || o->def)
 			fprintf(f, "  %-26s %s%s%s%s%s\n", "", o->unit ? "unit: " : "",
 				o->unit ? o->unit : "", o->unit && o->def ? "; " : "",

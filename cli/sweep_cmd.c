@@ -57,8 +57,8 @@ static const char *describe_task(const sim_study *st, size_t k, char *buf, size_
 	for (size_t a = 0; a < st->naxes && at < len; a++) {
 		const sim_setting *t = st->axis[a].setting;
 		at += (size_t)snprintf(buf + at, len - at, "%s=%g%s%s, ", t->name,
-				       sim_study_value(st, k % st->npoints, a), *t->unit ? " " : "",
-				       t->unit);
+				       sim_study_value(st, k % st->npoints, a),
+				       *sim_unit_shown(t) ? " " : "", sim_unit_shown(t));
 	}
 	if (at < len)
 		snprintf(buf + at, len - at, "%s",

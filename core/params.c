@@ -58,9 +58,9 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, beta_accel, REAL, "deg/s^2", 1, 1e6, NULL, RAD_PER_DEG, "acceleration bound of beta ramps") \
 	X(G_PARAM, m_n, REAL, "kg", 1e-4, 100, NULL, 1, "feed element mass")                   \
 	X(G_PARAM, k_c, REAL, "N/m^p", 100, 1e10, NULL, 1, "contact stiffness k")              \
-	X(G_PARAM, p, REAL, "", 1, 2, NULL, 1, "contact exponent")                             \
-	X(G_PARAM, R, REAL, "", 0.001, 1, NULL, 1, "restitution coefficient")                  \
-	X(G_PARAM, mu, REAL, "", 0, 2, NULL, 1, "friction coefficient")                        \
+	X(G_PARAM, p, REAL, "1", 1, 2, NULL, 1, "contact exponent")                             \
+	X(G_PARAM, R, REAL, "1", 0.001, 1, NULL, 1, "restitution coefficient")                  \
+	X(G_PARAM, mu, REAL, "1", 0, 2, NULL, 1, "friction coefficient")                        \
 	X(G_PARAM, h_d, REAL, "m", -1, 1, NULL, 1, "deck height above G")                      \
 	X(G_PARAM, column_span, REAL, "m", 0, 5, NULL, 1, "columns at d_k evenly in [-span, span]") \
 	X(G_PARAM, g, REAL, "m/s^2", 0, 100, NULL, 1, "gravity")                               \
@@ -80,11 +80,11 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_SCENE, start, ENUM, "", 0, 1, "rest|steady", 1, "rest: run-up from static equilibrium (the paper's scene); steady: on the forced response at the loaded speed") \
 	X(G_SCENE, settle, REAL, "s", 0, 100, NULL, 1, "steady start: simulated settling before t = 0 (added suspension damping, faded out)") \
 	X(G_METHOD, dt, REAL, "s", 0, 1e-2, NULL, 1, "fixed (macro) step, or first step; 0 = the default for the scene kind") \
-	X(G_METHOD, rtol, REAL, "", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
+	X(G_METHOD, rtol, REAL, "1", 1e-13, 0.1, NULL, 1, "relative tolerance (adaptive)")      \
 	X(G_METHOD, atol, REAL, "", 1e-15, 1, NULL, 1, "absolute tolerance (adaptive)")        \
 	X(G_METHOD, substeps, INT, "", 0, 1000, NULL, 1, "feed sub-steps per macro step (dem); 0 = keep the feed step <= 2.5e-4 s (6.25e-5 s without feed_events)") \
 	X(G_METHOD, feed_events, BOOL, "", 0, 1, NULL, 1, "dem: locate slip reversals inside the feed's sub-steps and let the deck yield to the feed's impulses within the machine step; false: the former dem") \
-	X(G_METHOD, tol, REAL, "", 1e-3, 0.2, NULL, 1, "accuracy target of the transport velocity (docs/MODEL.md's convention): the default steps scale with it, a measurement refines its steps until its estimated step error is within it")
+	X(G_METHOD, tol, REAL, "1", 1e-3, 0.2, NULL, 1, "accuracy target of the transport velocity (docs/MODEL.md's convention): the default steps scale with it, a measurement refines its steps until its estimated step error is within it")
 
 #define GNAME_G_PARAM "params"
 #define GNAME_G_SCENE "scene"

@@ -45,6 +45,13 @@ static inline double sim_setting_from_si(const sim_setting *t, double si)
 	return user;
 }
 
+/* The unit as written after a number: "N/m", or "" for a setting without
+ * one or a dimensionless one (unit "1": 0.3, not "0.3 1"). */
+static inline const char *sim_unit_shown(const sim_setting *t)
+{
+	return t->unit && !(t->unit[0] == '1' && !t->unit[1]) ? t->unit : "";
+}
+
 /* 1 if the SI value lies in setting t's range (finite, [min, max] scaled). */
 int sim_setting_check(const sim_setting *t, double si);
 

@@ -142,6 +142,17 @@ static int spec_check(const dem_bed_spec *s, char *msg, size_t msglen)
 		 (s->wiggle_period > 0 &&
 		  (s->grains != 1 || fabs(s->wiggle_x) > 0.01 || fabs(s->wiggle_z) > 0.01)))
 		bad = "the moving floor takes one grain and amplitudes of at most 0.01 m";
+	else if (s->hertz &&
+		 (!(s->youngs >= 5e6) || !(s->youngs <= 1e9) || !(s->poisson > 0) || !(s->poisson < 0.5) ||
+		  s->wiggle_period > 0))
+		bad = "hertz contacts take Young's modulus in [5e6, 1e9] Pa (LIGGGHTS's bounds), "
+		      "Poisson's ratio in (0, 0.5) and no moving floor";
+	else if (s->hertz && (!(s->e_pp > 0.05) || !(s->e_pp <= 1) || !(s->e_pw > 0.05) || !(s->e_pw <= 1)))
+		bad = "hertz restitution must be in (0.05, 1] (LIGGGHTS's bounds)";
+	else if (s->hertz && (!(s->mu_pp >= 0) || !(s->mu_pp <= 10) || !(s->mu_pw >= 0) ||
+			      !(s->mu_pw <= 10) || !(s->roll_pp >= 0) || !(s->roll_pp <= 10) ||
+			      !(s->roll_pw >= 0) || !(s->roll_pw <= 10)))
+		bad = "hertz friction and rolling friction must be in [0, 10]";
 	if (bad)
 		snprintf(msg, msglen, "dem bed: %s", bad);
 	return bad ? -1 : 0;
@@ -178,6 +189,59 @@ static void bed_contacts(dem_bed *b)
 	bed_cmd(b, "fix cad all mesh/surface file %s type 1", b->stl);
 	bed_cmd(b, "fix floor all wall/gran model hooke/stiffness tangential %s%s "
 		   "mesh n_meshes 1 meshes cad limitForce on", tang, roll);
+}
+
+/* A named material's contacts (dem.h, hertz): atom type 1 the grains,
+ * type 2 the deck's plane, each pair's restitution, friction and rolling
+ * friction in LIGGGHTS's type-pair tables (the 2-2 entry is never used);
+ * the overlaps of every contact (compute pair/gran/local delta) and of
+ * every grain into the plane z = 0 reduced to their maxima. */
+static void bed_contacts_hertz(dem_bed *b)
+{
+	const dem_bed_spec *s = &b->spec;
+	int roll = s->roll_pp > 0 || s->roll_pw > 0;
+	const char *rf = roll ? " rolling_friction epsd2" : "";
+	bed_cmd(b, "fix m1 all property/global youngsModulus peratomtype %.17g %.17g", s->youngs,
+		s->youngs);
+	bed_cmd(b, "fix m2 all property/global poissonsRatio peratomtype %.17g %.17g", s->poisson,
+		s->poisson);
+	bed_cmd(b, "fix m3 all property/global coefficientRestitution peratomtypepair 2 "
+		   "%.17g %.17g %.17g %.17g", s->e_pp, s->e_pw, s->e_pw, s->e_pw);
+	bed_cmd(b, "fix m4 all property/global coefficientFriction peratomtypepair 2 "
+		   "%.17g %.17g %.17g %.17g", s->mu_pp, s->mu_pw, s->mu_pw, s->mu_pw);
+	if (roll)
+		bed_cmd(b, "fix m5 all property/global coefficientRollingFriction peratomtypepair 2 "
+			   "%.17g %.17g %.17g %.17g", s->roll_pp, s->roll_pw, s->roll_pw, s->roll_pw);
+	bed_cmd(b, "pair_style gran model hertz tangential history%s", rf);
+	bed_cmd(b, "pair_coeff * *");
+	bed_cmd(b, "fix floor all wall/gran model hertz tangential history%s primitive type 2 "
+		   "zplane 0.0", rf);
+}
+
+/* The overlap computes of a hertz bed (after its grains exist). */
+static void bed_overlap_computes(dem_bed *b)
+{
+	bed_cmd(b, "compute ovl all pair/gran/local delta");
+	bed_cmd(b, "compute ovpp all reduce max c_ovl[1]");
+	bed_cmd(b, "variable ovpp equal c_ovpp");
+	bed_cmd(b, "compute rad all property/atom radius");
+	bed_cmd(b, "variable gap atom c_rad-z");
+	bed_cmd(b, "compute ovpw all reduce max v_gap");
+	bed_cmd(b, "variable ovpw equal c_ovpw");
+	/* compute reduce takes no update_on_run_end: the thermo output,
+	 * written at every run's last step (to no screen), keeps both
+	 * current for their reading between runs */
+	bed_cmd(b, "thermo_style custom step v_ovpp v_ovpw");
+}
+
+void dem_bed_overlap(const dem_bed *b, double *pp, double *pw)
+{
+	*pp = *pw = NAN;
+	if (!b->spec.hertz)
+		return;
+	/* no contact at all: the reduction's max is -1e20 or so; none is 0 */
+	*pp = fmax(0, bed_var(b, "ovpp"));
+	*pw = fmax(0, bed_var(b, "ovpw"));
 }
 
 /* The frame check's floor: a rectangle at z = 0, 2 mm inside the cell's
@@ -310,12 +374,17 @@ dem_bed *dem_bed_new(const dem_bed_spec *spec, const void *comm, char *msg, size
 	/* below the floor: room for the moving floor's mesh */
 	bed_cmd(b, "region cell block 0 %.17g 0 %.17g %.17g %.17g units box", s->cell_x, s->cell_y,
 		s->wiggle_period > 0 ? -0.02 : 0.0, z_top);
-	bed_cmd(b, "create_box 1 cell");
+	bed_cmd(b, "create_box %d cell", s->hertz ? 2 : 1);
 	bed_cmd(b, "neighbor %.17g bin", 0.2 * s->d_max);
 	bed_cmd(b, "neigh_modify delay 0");
-	bed_contacts(b);
+	if (s->hertz)
+		bed_contacts_hertz(b);
+	else
+		bed_contacts(b);
 	bed_cmd(b, "timestep %.17g", b->dt);
 	bed_grains(b, pitch, nx, ny);
+	if (s->hertz)
+		bed_overlap_computes(b);
 	bed_cmd(b, "fix deck all gravity %.17g vector 0 0 -1", s->g);
 	bed_cmd(b, "fix step all %s", s->freeze_rotation ? "nve" : "nve/sphere");
 	bed_observers(b);

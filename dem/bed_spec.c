@@ -26,8 +26,24 @@ double dem_bed_spec_mass_mean(const dem_bed_spec *s)
 	return s->density * M_PI / 6 * d3;
 }
 
+/* The step of a hertz bed: the smaller of a tenth of the lightest
+ * grain's Rayleigh time and a fortieth of its Hertz contact on the deck
+ * (same modulus) at an approach of 1 m/s. */
+static double spec_dt_hertz(const dem_bed_spec *s)
+{
+	double r = 0.5 * s->d_min, nu = s->poisson;
+	double shear = s->youngs / (2 * (1 + nu));
+	double t_r = M_PI * r * sqrt(s->density / shear) / (0.1631 * nu + 0.8766);
+	double m = s->density * M_PI / 6 * pow(s->d_min, 3);
+	double e_star = s->youngs / (2 * (1 - nu * nu));
+	double t_c = 2.87 * pow(m * m / (r * e_star * e_star * 1.0), 0.2);
+	return fmin(0.1 * t_r, t_c / 40);
+}
+
 double dem_bed_spec_dt(const dem_bed_spec *s)
 {
+	if (s->hertz)
+		return spec_dt_hertz(s);
 	double m_min = s->density * M_PI / 6 * pow(s->d_min, 3);
 	double kn = s->k_over_m * dem_bed_spec_mass_mean(s);
 	return M_PI / sqrt(kn / m_min) / 50;

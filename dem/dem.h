@@ -52,6 +52,18 @@ typedef struct dem_bed_spec {
 	 * grain then starts with the floor's velocity), the cell closed in x
 	 * and y; the bed's frame is then the lab's (advance with a = 0) */
 	double wiggle_x, wiggle_z, wiggle_period;
+	/* A named material's contacts (hertz 1; docs/dem.md "The map"):
+	 * Hertz-Mindlin (LIGGGHTS's hertz, tangential history) with Young's
+	 * modulus `youngs` (Pa, the scaled one) and Poisson's ratio for the
+	 * grains and the deck alike; restitution, Coulomb friction and
+	 * rolling friction (model epsd2; 0: none) grain on grain (_pp) and
+	 * grain on deck (_pw). Then k_over_m, restitution, mu and mu_roll
+	 * are not used, and the step is the smaller of a tenth of the
+	 * lightest grain's Rayleigh time and a fortieth of its Hertz contact
+	 * on the deck at 1 m/s. */
+	int hertz;
+	double youngs, poisson;
+	double e_pp, e_pw, mu_pp, mu_pw, roll_pp, roll_pw;
 } dem_bed_spec;
 
 /* The bed this project uses unless told otherwise: spheres 3.6-4.4 mm of
@@ -120,6 +132,10 @@ typedef struct dem_bed_state {
 	double kinetic_rot;  /* J: the grains' rotational kinetic energy */
 } dem_bed_state;
 void dem_bed_get(const dem_bed *b, dem_bed_state *st);
+
+/* The largest overlap now (m) between two grains (*pp) and of a grain
+ * into the deck (*pw); NaN for a bed without hertz contacts. */
+void dem_bed_overlap(const dem_bed *b, double *pp, double *pw);
 
 /* CPU seconds of this process so far (CLOCK_PROCESS_CPUTIME_ID): the
  * cost figures of dem/ and its tools. */

@@ -205,22 +205,36 @@ int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double tr
 		motion_formula(mo, mo->a, fx, sizeof fx);
 		motion_formula(mo, mo->b, fy, sizeof fy);
 	}
-	double period = 2 * M_PI / mo->omega, dt = period / (intervals ? intervals : 1);
+	/* a hertz bed's overlaps: sampled after each of 40 runs a period */
+	double ov_pp, ov_pw;
+	dem_bed_overlap(b, &ov_pp, &ov_pw);
+	int sampled = intervals == 0 && !isnan(ov_pp);
+	int per = intervals ? intervals : sampled ? 40 : 1; /* runs a period */
+	double period = 2 * M_PI / mo->omega, dt = period / per;
 	long first = (long)ceil(transient / period - 1e-9), last = (long)floor(t_end / period + 1e-9);
 	if (last <= first) {
 		snprintf(msg, msglen, "prescribed run: no whole period between the transient and the end");
 		return -1;
 	}
-	double cpu0 = dem_cpu_now(), x_first = 0, x_last = 0;
+	long mid = first + (last - first) / 2;
+	double cpu0 = dem_cpu_now(), x_first = 0, x_mid = 0, x_last = 0;
 	dem_bed_state st;
 	dem_bed_get(b, &st);
 	out->mass = st.mass;
 	out->bed_height = 2 * st.z_mean;
-	int per = intervals ? intervals : 1; /* runs a period */
+	out->overlap_pp = out->overlap_pw = NAN;
+	if (sampled)
+		out->overlap_pp = out->overlap_pw = 0;
 	for (long k = 0; k <= last * per; k++) {
-		if (k % per == 0 && (k / per == first || k / per == last)) {
+		long n = k / per;
+		if (k % per == 0 && (n == first || n == mid || n == last)) {
 			dem_bed_get(b, &st);
-			*(k / per == first ? &x_first : &x_last) = st.x_mean;
+			*(n == first ? &x_first : n == mid ? &x_mid : &x_last) = st.x_mean;
+		}
+		if (sampled && k > 0) {
+			dem_bed_overlap(b, &ov_pp, &ov_pw);
+			out->overlap_pp = fmax(out->overlap_pp, ov_pp);
+			out->overlap_pw = fmax(out->overlap_pw, ov_pw);
 		}
 		if (k == last * per)
 			break;
@@ -233,6 +247,8 @@ int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double tr
 	}
 	out->periods = (double)(last - first);
 	out->transport_velocity = (x_last - x_first) / (out->periods * period);
+	out->v_first_half = (x_mid - x_first) / ((double)(mid - first) * period);
+	out->v_second_half = (x_last - x_mid) / ((double)(last - mid) * period);
 	out->cpu_seconds = dem_cpu_now() - cpu0;
 	out->dt = dem_bed_dt(b);
 	return 0;

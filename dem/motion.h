@@ -50,6 +50,12 @@ typedef struct dem_prescribed {
 	double dt;                 /* s DEM step */
 	double mass;               /* kg of the bed */
 	double bed_height;         /* m: twice the mean height of the grains at t = 0 */
+	/* m/s: the transport velocity over the first and the second half of
+	 * the measured periods (the middle period's start splits them) */
+	double v_first_half, v_second_half;
+	/* m: the largest overlaps grain on grain and grain into the deck
+	 * from t = 0 on, sampled 40 times a period (hertz beds; else NaN) */
+	double overlap_pp, overlap_pw;
 } dem_prescribed;
 
 /* Drive bed b with motion mo from its t = 0 to t_end, in coupling
@@ -58,7 +64,9 @@ typedef struct dem_prescribed {
  * intervals 0 under the fit's own acceleration evaluated at every DEM
  * step (dem_bed_advance_drive, a period a run: no staircase); the
  * transport velocity is measured over the whole periods after transient
- * (s). 0, or -1 with msg. */
+ * (s), and over each half of them. A bed with hertz contacts runs a
+ * period in 40 runs (intervals 0) and samples its overlaps after each.
+ * 0, or -1 with msg. */
 int dem_run_prescribed(dem_bed *b, const dem_motion *mo, double t_end, double transient,
 		       int intervals, dem_prescribed *out, char *msg, size_t msglen);
 

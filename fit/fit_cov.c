@@ -145,7 +145,8 @@ void fit_bound_warnings(fit_ctx *c)
 			fit_warn(res, "'%s' ends at its %s bound %g %s: the data want it beyond; widen "
 				  "the bound or question the model", f->name,
 			     res->at_bound[j] < 0 ? "lower" : "upper",
-			     sim_setting_from_si(t, res->at_bound[j] < 0 ? f->lo : f->hi), t->unit);
+			     sim_setting_from_si(t, res->at_bound[j] < 0 ? f->lo : f->hi),
+			     sim_unit_shown(t));
 		else if (res->se[j] >= fabs(res->x[j]))
 			fit_warn(res, "'%s' is not identifiable: its standard error (%g) is as large as "
 				  "its value (%g)", f->name, sim_setting_from_si(t, res->se[j]),

@@ -92,7 +92,7 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 	double lo = isnan(lo_user) ? t->min : lo_user, hi = isnan(hi_user) ? t->max : hi_user;
 	if (!(lo >= t->min && hi <= t->max && lo < hi)) {
 		snprintf(msg, mlen, "the bounds of '%s' must satisfy %g <= min < max <= %g %s", name,
-			 t->min, t->max, t->unit);
+			 t->min, t->max, sim_unit_shown(t));
 		return SIM_EPARAM;
 	}
 	fit_free *f = &req->free[req->nfree++];

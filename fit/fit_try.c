@@ -23,7 +23,8 @@ static void describe_x(const fit_ctx *c, const double *x, char *buf, size_t len)
 	for (int j = 0; j < c->p && at < len; j++) {
 		const sim_setting *t = sim_setting_find(c->req->free[j].name);
 		at += (size_t)snprintf(buf + at, len - at, "%s%s = %.6g%s%s", j ? ", " : "", t->name,
-				       sim_setting_from_si(t, x[j]), t->unit[0] ? " " : "", t->unit);
+				       sim_setting_from_si(t, x[j]), *sim_unit_shown(t) ? " " : "",
+				       sim_unit_shown(t));
 	}
 }
 

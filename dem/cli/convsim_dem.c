@@ -37,13 +37,15 @@ typedef struct dem_opts {
 	int grains, seed, freeze_rotation, tangential_viscous, intervals, harmonics, column;
 	int motion_machine, coupling_steps; /* --motion machine: the one-way machine's own deck */
 	double frame_amp, frame_angle;      /* --frame-check: m, deg; amplitude 0: none */
+	double youngs, poisson, density;    /* --hertz E:NU (youngs 0: none), --density */
+	double pair[3], wall[3];            /* --pair, --wall: restitution, mu, rolling mu */
 } dem_opts;
 
 enum {
 	D_PRESET = 256, D_SET, D_DURATION, D_TRANSIENT, D_GRAINS, D_DEPTH, D_SEED, D_STIFFNESS,
 	D_D_MIN, D_D_MAX, D_CELL, D_WIDTH, D_RESTITUTION, D_MU, D_MU_ROLL, D_FREEZE, D_TANGENTIAL,
 	D_INTERVALS, D_HARMONICS, D_SETTLE, D_NO_COLUMN, D_MOTION, D_COUPLING_STEPS,
-	D_FRAME_CHECK, D_HELP
+	D_FRAME_CHECK, D_HERTZ, D_PAIR, D_WALL, D_DENSITY, D_HELP
 };
 
 /* The options as convsim's are (cli.h cli_opt): getopt_long's table and
@@ -87,6 +89,13 @@ static const cli_opt dem_options[] = {
 	 "one grain on a floor moving A sin(omega_ss t) along DEG, as a body force over the "
 	 "fixed floor and as LIGGGHTS's moving mesh (v_body, v_mesh); no machine, no column "
 	 "model"},
+	{1, D_HERTZ, "hertz", 0, "E:NU", NULL, NULL,
+	 "a named material's contacts (docs/dem.md \"The map\"): Hertz-Mindlin with Young's "
+	 "modulus E (Pa, scaled; [5e6, 1e9]) and Poisson's ratio NU, grains and deck alike; then "
+	 "--pair and --wall give restitution, friction and rolling friction"},
+	{1, D_PAIR, "pair", 0, "E:MU:MUR", NULL, "0.9:0.3:0", "grain on grain, with --hertz"},
+	{1, D_WALL, "wall", 0, "E:MU:MUR", NULL, "0.9:0.3:0", "grain on deck, with --hertz"},
+	{1, D_DENSITY, "density", 0, "RHO", "kg/m^3", "2500", "the grains' density"},
 	{1, D_HELP, "help", 'h', NULL, NULL, NULL, "show this help on stdout and exit"},
 };
 #define DEM_NOPTIONS (sizeof dem_options / sizeof *dem_options)
@@ -134,7 +143,8 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	o->duration = 2, o->transient = 0.5, o->depth = 8, o->stiffness = 1, o->seed = 1;
 	o->d_min = 0.0036, o->d_max = 0.0044, o->cell_x = 20, o->cell_y = 4, o->settle = NAN;
 	o->restitution = NAN, o->mu = NAN, o->intervals = 0, o->harmonics = 3, o->column = 1;
-	o->coupling_steps = 1;
+	o->coupling_steps = 1, o->density = 2500;
+	o->pair[0] = o->wall[0] = 0.9, o->pair[1] = o->wall[1] = 0.3;
 	const char *arg;
 	while ((c = cli_next_option_in(dem_options, DEM_NOPTIONS, 1, "convsim-dem",
 				       "convsim-dem --help", argc, argv, &arg)) != -1) {
@@ -184,6 +194,26 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 				exit(2);
 			}
 			break;
+		case D_HERTZ:
+			if (sscanf(arg, "%lf:%lf", &o->youngs, &o->poisson) != 2 || !(o->youngs >= 5e6) ||
+			    !(o->youngs <= 1e9) || !(o->poisson > 0) || !(o->poisson < 0.5)) {
+				fprintf(stderr, "convsim-dem: --hertz must be E:NU with E in [5e6, 1e9] Pa "
+						"and NU in (0, 0.5), got '%s'\n", arg);
+				exit(2);
+			}
+			break;
+		case D_PAIR:
+		case D_WALL: {
+			double *t = c == D_PAIR ? o->pair : o->wall;
+			if (sscanf(arg, "%lf:%lf:%lf", &t[0], &t[1], &t[2]) != 3 || !(t[0] > 0.05) ||
+			    !(t[0] <= 1) || !(t[1] >= 0) || !(t[1] <= 10) || !(t[2] >= 0) || !(t[2] <= 10)) {
+				fprintf(stderr, "convsim-dem: --%s must be E:MU:MUR with E in (0.05, 1], MU and "
+						"MUR in [0, 10], got '%s'\n", c == D_PAIR ? "pair" : "wall", arg);
+				exit(2);
+			}
+			break;
+		}
+		case D_DENSITY: o->density = dem_number("density", arg, 1, 100000); break;
 		case D_HELP: dem_help(stdout); exit(0);
 		default: exit(2); /* cli_next_option_in said why */
 		}
@@ -216,6 +246,14 @@ static void dem_spec(const dem_opts *o, dem_bed_spec *b)
 	b->tangential_viscous = o->tangential_viscous;
 	b->seed = (unsigned)o->seed;
 	b->settle = isnan(o->settle) ? (b->grains == 1 ? 0.05 : 0.3) : o->settle;
+	b->density = o->density;
+	if (o->youngs > 0) {
+		b->hertz = 1;
+		b->youngs = o->youngs;
+		b->poisson = o->poisson;
+		b->e_pp = o->pair[0], b->mu_pp = o->pair[1], b->roll_pp = o->pair[2];
+		b->e_pw = o->wall[0], b->mu_pw = o->wall[1], b->roll_pw = o->wall[2];
+	}
 }
 
 /* "  \"name\": value,\n", null where the value is not finite (JSON has no NaN). */
@@ -243,6 +281,7 @@ static int run_machine_motion(const dem_opts *o, dem_bed *bed, dem_prescribed *r
 	r->bed_height = 2 * st.z_mean;
 	r->dt = dem_bed_dt(bed);
 	r->periods = NAN;
+	r->v_first_half = r->v_second_half = r->overlap_pp = r->overlap_pw = NAN;
 	int rc = dem_replay(bed, acc, n, H, o->transient, &r->transport_velocity, msg, msglen);
 	free(acc);
 	return rc;
@@ -361,6 +400,23 @@ int main(int argc, char **argv)
 	put("v_column", col.transport_velocity, 0);
 	put("v_column_uncertainty", col.uncertainty, 0);
 	put("layers", o.sc.layers, 0);
+	printf("  \"contacts\": \"%s\",\n", spec.hertz ? "hertz" : "linear");
+	put("density", spec.density, 0);
+	put("youngs", spec.hertz ? spec.youngs : NAN, 0);
+	put("poisson", spec.hertz ? spec.poisson : NAN, 0);
+	put("e_pp", spec.hertz ? spec.e_pp : NAN, 0);
+	put("e_pw", spec.hertz ? spec.e_pw : NAN, 0);
+	put("mu_pp", spec.hertz ? spec.mu_pp : NAN, 0);
+	put("mu_pw", spec.hertz ? spec.mu_pw : NAN, 0);
+	put("roll_pp", spec.hertz ? spec.roll_pp : NAN, 0);
+	put("roll_pw", spec.hertz ? spec.roll_pw : NAN, 0);
+	put("d_mean", 0.5 * (spec.d_min + spec.d_max), 0);
+	put("cell_x", spec.cell_x, 0);
+	put("cell_y", spec.cell_y, 0);
+	put("v_first_half", r.v_first_half, 0);
+	put("v_second_half", r.v_second_half, 0);
+	put("overlap_pp_max", r.overlap_pp, 0);
+	put("overlap_pw_max", r.overlap_pw, 0);
 	put("dem_cpu_seconds", r.cpu_seconds, 1);
 	printf("}\n");
 	return 0;

@@ -464,6 +464,11 @@ int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 		abort_locked(e, why);
 	} else {
 		seg->t_command = cmd->t_eff;
+		/* a control acts at the end of the integrator's step: the
+		 * segment before ran its beta up to this command, not only to
+		 * its boundary's observation inside that step */
+		if (e->cur > 0)
+			e->req.seg[e->cur - 1].t_end = cmd->t_eff;
 	}
 	pthread_mutex_unlock(&e->lock);
 	return refused;

@@ -6,7 +6,8 @@
  * mean velocity from the restarted estimator, the steady velocity as the
  * mean feed velocity over the segment's second half, and the reversal time
  * from the command until the feed velocity first reaches 90 % of that
- * steady value.
+ * steady value, before that second half begins (else none: the segment
+ * was too short for the feed to settle).
  */
 #include <math.h>
 #include <string.h>
@@ -61,7 +62,11 @@ void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
 			if (e->rec_t[i] >= seg->t_command &&
 			    (steady > 0 ? v >= 0.9 * steady
 					: v <= 0.9 * steady)) {
-				seg->reversal_time = e->rec_t[i] - seg->t_command;
+				/* reached only inside the half it is averaged
+				 * over: the segment ended before the feed
+				 * settled, there is no reversal time to tell */
+				if (e->rec_t[i] < half)
+					seg->reversal_time = e->rec_t[i] - seg->t_command;
 				break;
 			}
 		}

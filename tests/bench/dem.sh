@@ -21,7 +21,7 @@ mkdir -p "$out"
 jl="$out/dem.jsonl"
 # DEM_GROUPS="p1 p2": run those parts only, in place of their rows in
 # dem.jsonl (the others kept); default: every part afresh, in this order
-parts=${DEM_GROUPS:-curve ladder ladder-top depth ladder-seeds stiffness rolling restitution tangential}
+parts=${DEM_GROUPS:-curve ladder ladder-top depth ladder-seeds stiffness rolling restitution tangential one-grain}
 want() { case " $parts " in *" $1 "*) return 0;; esac; return 1; }
 if [ -n "${DEM_GROUPS:-}" ] && [ -f "$jl" ]; then
 	python3 - "$jl" $parts <<'PY'
@@ -98,6 +98,15 @@ want restitution && run restitution --depth 8 --set layers=8 --set beta=30 --res
 part=tangential
 want tangential && for seed in $seeds; do
 	run tangential --depth 4 --set layers=4 --set beta=30 --tangential viscous --seed $seed
+done
+# one grain of 4 mm, rotation frozen, the preset's contacts at 30 deg
+# clockwise: the formula drive against the acceleration held over 32
+# intervals a period and over 4 and 1 DEM steps (225 and 901 intervals;
+# docs/dem.md "Coupling interval")
+part=one-grain
+want one-grain && for n in 0 32 225 901; do
+	run one-grain --grains 1 --d-min 0.004 --d-max 0.004 --freeze-rotation --set layers=1 \
+		--set beta=30 --intervals $n --seed 1
 done
 python3 tests/bench/dem_plot.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" > "$out/dem.svg"
 python3 tests/bench/dem_report.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" \

@@ -29,6 +29,8 @@ def main():
     for line in open(path):
         if line.strip():
             r = json.loads(line)
+            if r["group"] == "one-grain":  # the drive's check, not a scene of the plot
+                continue
             key = (r["group"], r["beta"], r["rotation"], r["layers"], r["k_over_m"], r["mu_roll"],
                    r["restitution_floor"], r.get("tangential", "spring"))
             scenes.setdefault(key, []).append(r)

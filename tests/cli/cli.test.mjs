@@ -38,6 +38,9 @@ test('help CMD and CMD --help list every option with default and unit on stdout'
   assert.match(h, /--duration S[\s\S]*unit: s; default: transient \+ 4/);
   assert.match(h, /--threads N[\s\S]*default: 2/);
   assert.match(run('help', 'run').out, /--sample-rate HZ[\s\S]*unit: Hz; default: 1000/);
+  // every preset --preset takes (liggghts-bed4 was left out)
+  for (const cmd of ['run', 'sweep', 'fit'])
+    assert.match(run('help', cmd).out, /--preset NAME +starting values for every setting \(known: czubak2016, czubak2016-fit, liggghts-bed4\)\n/, cmd);
   for (const args of [['help'], ['--help'], ['-h']]) {
     const r = run(...args);
     assert.equal(r.code, 0);

@@ -120,3 +120,47 @@ test('frame check: the deck as a body force and as a moving mesh give one v', ()
     assert.ok(Math.abs(r.v_body - r.v_mesh) < 0.01 * Math.abs(r.v_mesh), `${spec}: body ${r.v_body}, mesh ${r.v_mesh}`);
   }
 });
+
+// A named material's contacts (convsim-dem --hertz, docs/dem.md "The
+// map"): one 4-mm grain of 2500 kg/m^3 at rest on a still deck (the
+// unbalance's eccentricity 0, the rotor turning) sinks into it by the Hertz
+// static overlap of its weight, delta = (3 m g / (4 E* sqrt(R)))^(2/3) with
+// E* = E / (2 (1 - nu^2)) (grain and deck of one modulus): 2.99e-6 m at
+// E = 5e6 Pa, nu = 0.25. The grain-on-deck restitution is low (0.1) so that
+// the settling's bounce is gone; the largest overlap sampled over the run
+// is within 2 % of it. A modulus or Poisson's ratio that does not reach the
+// wall, or a linear contact, misses it by far.
+test('hertz contacts: one grain at rest sinks into the deck by the Hertz overlap of its weight', () => {
+  const r = dem(['--grains', '1', '--d-min', '0.004', '--d-max', '0.004', '--set', 'e=0',
+    '--hertz', '5e6:0.25', '--wall', '0.1:0.3:0', '--pair', '0.1:0.3:0', '--duration', '0.3',
+    '--transient', '0.1', '--no-column']);
+  assert.equal(r.contacts, 'hertz');
+  assert.equal(r.youngs, 5e6);
+  assert.equal(r.e_pw, 0.1);
+  const m = 2500 * Math.PI / 6 * 0.004 ** 3, g = 9.81;
+  const eStar = 5e6 / (2 * (1 - 0.25 * 0.25));
+  const delta = (3 * m * g / (4 * eStar * Math.sqrt(0.002))) ** (2 / 3);
+  const rel = Math.abs(r.overlap_pw_max - delta) / delta;
+  assert.ok(rel < 0.02, `overlap ${r.overlap_pw_max} m, Hertz ${delta} m (${(100 * rel).toFixed(2)} %)`);
+  assert.equal(r.overlap_pp_max, 0);
+  assert.equal(r.v_dem, 0);
+});
+
+test('convsim-dem --hertz, --pair, --wall: out-of-range values exit 2 naming the option and its range', () => {
+  for (const [args, text] of [
+    [['--hertz', '1e5:0.25'], '--hertz must be E:NU with E in [5e6, 1e9] Pa and NU in (0, 0.5)'],
+    [['--hertz', '1e8:0.5'], '--hertz must be E:NU with E in [5e6, 1e9] Pa and NU in (0, 0.5)'],
+    [['--pair', '0.01:0.3:0'], '--pair must be E:MU:MUR with E in (0.05, 1], MU and MUR in [0, 10]'],
+    [['--wall', '0.9:0.3'], '--wall must be E:MU:MUR with E in (0.05, 1], MU and MUR in [0, 10]'],
+  ]) {
+    let err;
+    try {
+      execFileSync(DEM, args, { encoding: 'utf8', env: ENV, stdio: ['ignore', 'pipe', 'pipe'] });
+    } catch (e) {
+      err = e;
+    }
+    assert.ok(err, `${args.join(' ')} was accepted`);
+    assert.equal(err.status, 2);
+    assert.ok(err.stderr.includes(text), err.stderr);
+  }
+});

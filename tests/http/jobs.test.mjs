@@ -58,6 +58,30 @@ test('experiment on a fresh session: 38 -> 128 deg reverses the feed', { timeout
     3000, 'the experiment\'s session to be removed');
 });
 
+test('experiment: a segment too short to settle has no reversal time; the next one starts where it ended', { timeout: 60000 * SLOW }, async () => {
+  // 0.052 s is not on the default step grid (a command acts at a step's end)
+  const r = await req(d.base, 'POST', '/api/v1/experiments',
+    { schedule: [{ beta: 30, until: 0.052 }, { beta: 150, until: 0.104 }] });
+  assert.equal(r.status, 201, r.text);
+  const done = await until(async () => {
+    const g = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`);
+    return g.body.state === 'done' && g.body;
+  }, 40000, 'the experiment');
+  const [a, b] = done.segments;
+  // the feed reaches 90 % of its 'steady' value only inside the half that
+  // value is averaged over: nothing to time (was 0.052, the whole segment)
+  assert.equal(a.reversal_time, null);
+  assert.equal(b.reversal_time, null);
+  // one time for the boundary: the command's, on the step grid
+  assert.ok(b.t_command >= 0.052 && b.t_command < 0.06, `second command ${b.t_command}`);
+  assert.equal(a.t_end, b.t_command);
+  const csv = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}?format=csv`);
+  const rows = csv.text.trim().split('\n').map((l) => l.split(','));
+  const col = (name) => rows[0].indexOf(name);
+  assert.equal(rows[1][col('t_end')], rows[2][col('t_command')]);
+  assert.equal(rows[1][col('reversal_time')], '');
+});
+
 test('experiment on an existing session; a second one is 409', { timeout: 60000 * SLOW }, async () => {
   const c = await req(d.base, 'POST', '/api/v1/sessions', { scene, pace: 'max', until: 1 });
   const id = c.body.id;

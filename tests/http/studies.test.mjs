@@ -42,7 +42,7 @@ test('a 2-D study (mu x beta): the daemon\'s table is the CLI\'s, bit for bit, t
   const body = { ...CHEAP, vary: { mu: [0.3, 0.9], beta: { from: 30, to: 150, step: 60 } }, rotations: ['cw', 'ccw'], t_end: 0.4 };
   const r = await req(d.base, 'POST', '/api/v1/sweeps', body);
   assert.equal(r.status, 202, r.text);
-  assert.deepEqual(r.body.vary, [{ name: 'mu', unit: '' }, { name: 'beta', unit: 'deg' }]);
+  assert.deepEqual(r.body.vary, [{ name: 'mu', unit: '1' }, { name: 'beta', unit: 'deg' }]);
   const s = await done(d, r.body.id);
   valid('SweepCreate', body);
   valid('Sweep', s);

@@ -103,6 +103,8 @@ async function download(sel) {
 	const [dl] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.click(sel)]);
 	return { name: dl.suggestedFilename(), bytes: readFileSync(await dl.path()) };
 }
+/* a time's text on the nanosecond grid (at most 9 decimals, no float noise) */
+const onNsGrid = c => /^\d+(\.\d{1,9})?$/.test(c);
 const csvLines = d => d.bytes.toString('utf8').trim().split('\n');
 const TRAJ_HEAD = 't,beta,beta_target,x,y,alpha,s1,s2,deck_x,deck_y,rotor_speed,motor_torque,power,' +
 	'feed_displacement,feed_velocity,transport_velocity,transport_velocity_uncertainty,e_input,e_dissipated,e_residual';
@@ -203,6 +205,12 @@ test('every live plot exports PNG and CSV; the trajectory downloads as CSV and J
 		const width = lines[0].split(',').length;
 		assert.ok(lines.every(l => l.split(',').length === width), `${name}.csv is rectangular`);
 		assert.ok(lines.slice(1).every(l => l.split(',').every(c => c === '' || Number.isFinite(Number(c))) || name === 'orbit'), `${name}.csv numbers`);
+		/* times on the daemon's grid as it writes them: k·dt (0.022, not the
+		 * period midpoint's 0.022000000000000002) */
+		if (name !== 'orbit') {
+			const noisy = lines.slice(1).map(l => l.split(',')[0]).filter(c => !onNsGrid(c));
+			assert.deepEqual(noisy.slice(0, 3), [], `${name}.csv: times with at most 9 decimals`);
+		}
 	}
 	assert.equal(csvLines(await download('#plot-rotor + .plot-export button[data-export="csv"]'))[0], 't / s,rotor speed / (rad/s),β / °');
 	assert.equal(csvLines(await download('#plot-orbit + .plot-export button[data-export="csv"]'))[0],
@@ -211,6 +219,29 @@ test('every live plot exports PNG and CSV; the trajectory downloads as CSV and J
 	assert.ok(await visible('#feed-note'));
 	assert.match(await page.$eval('#feed-note', e => e.textContent), /All 5 columns move identically/);
 	assert.equal(csvLines(await download('#plot-feed + .plot-export button[data-export="csv"]'))[0], 't / s,columns 1–5 (identical)');
+	/* the note under a plot starts below its export bar (it overlapped it) */
+	const gap = await page.evaluate(() => {
+		const bar = document.querySelector('#plot-feed + .plot-export').getBoundingClientRect();
+		return document.querySelector('#feed-note').getBoundingClientRect().top - bar.bottom;
+	});
+	assert.ok(gap >= 0, `#feed-note starts ${gap} px into the export bar`);
+	/* each plot's text alternative: named, and a data table reached by the keyboard */
+	for (const name of ['orbit', 'feed', 'rotor', 'strokes', 'trough']) {
+		assert.equal(await page.$eval(`#plot-${name}`, e => e.getAttribute('role')), 'img');
+		assert.ok((await page.$eval(`#plot-${name}`, e => e.getAttribute('aria-label'))).length > 5);
+		const summary = page.locator(`#plot-${name} + .plot-export .plot-data summary`);
+		await summary.focus();
+		assert.equal(await summary.evaluate(e => e === document.activeElement && e.tabIndex >= 0), true, `${name}: the summary takes focus`);
+		await page.keyboard.press('Enter');
+		const t = await until(() => page.$eval(`#plot-${name} + .plot-export .plot-data`, d => d.open && {
+			label: d.querySelector('table').getAttribute('aria-label'),
+			head: Array.from(d.querySelectorAll('th')).map(h => h.textContent).join(','),
+			rows: d.querySelectorAll('tbody tr').length }), 3000, `${name}'s data table`);
+		assert.match(t.label, /: data$/);
+		assert.equal(t.head, csvLines(await download(`#plot-${name} + .plot-export button[data-export="csv"]`))[0]);
+		assert.ok(t.rows > 5, `${name}: ${t.rows} rows`);
+		await page.keyboard.press('Enter');
+	}
 	/* the recorded trajectory, with the CLI's columns */
 	assert.ok(await visible('#session-downloads'));
 	const traj = await download('#traj-csv');
@@ -271,6 +302,18 @@ test('identical strokes: one line, said so, as for the feed\'s columns', async (
 
 test('moving the β slider turns the session to 128° and reverses the shown direction', async () => {
 	await page.locator('#beta-slider').fill('128');
+	/* one β per moment: the readout and the drawing from the same sample
+	 * during the ramp (the readout followed the polled status, the drawing
+	 * the stream: 93.6° beside 97.6°) */
+	const pairs = [];
+	for (let k = 0; k < 25; k++) {
+		pairs.push(await page.evaluate(() => [document.querySelector('#beta-now').textContent,
+			document.querySelector('#schematic .sch-beta').textContent]));
+		await page.waitForTimeout(40);
+	}
+	const differ = pairs.filter(([now, drawn]) => now.replace(' °', '') !== (drawn.match(/^β = (-?[\d.]+)°/) || [])[1]);
+	assert.deepEqual(differ, [], 'β now and the drawing\'s β');
+	assert.ok(new Set(pairs.map(p => p[0])).size > 1, `β moved while sampled: ${pairs.map(p => p[0])}`);
 	const s = await until(async () => {
 		const j = await apiGet(`/api/v1/sessions/${sessionId}`);
 		return j.status && Math.abs(j.status.beta_target - 128) < 1e-9 ? j : null;
@@ -346,6 +389,13 @@ test('a refused input shows the daemon\'s problem detail', async () => {
 
 test('a sweep draws v(β) for both rotations', async () => {
 	assert.equal(await visible('#sweep-csv'), false, 'no sweep CSV link before a sweep');
+	/* an empty plot lists no series (it drew 4 and 8 entries) and spans β 0…180 (was −1…1) */
+	for (const name of ['sweep', 'fit']) {
+		const shown = await page.$$eval(`#plot-${name} .u-legend .u-series`, rows => rows
+			.filter(r => getComputedStyle(r).display !== 'none').map(r => r.textContent));
+		assert.deepEqual(shown, [], `${name}: legend of an empty plot`);
+		assert.deepEqual(await page.evaluate(n => { const x = window.convsim.plots[n].plot.scales.x; return [x.min, x.max]; }, name), [0, 180]);
+	}
 	await page.fill('#sweep-form input[name="from"]', '30');
 	await page.fill('#sweep-form input[name="to"]', '130');
 	await page.fill('#sweep-form input[name="step"]', '50');
@@ -383,6 +433,14 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 		c => c.map(x => ({ title: x.title, v: Number(x.dataset.v), bg: x.style.background })));
 	await until(async () => (await page.$$eval('#sweep-map .cell[data-v]', c => c.length)) === 12, 60000, 'a map of 2 x 3 points per rotation');
 	assert.equal(await visible('#plot-sweep'), false, 'the map in place of the curves');
+	/* no stray export bar of the hidden curves; a colour scale with its unit */
+	assert.equal(await visible('#plot-sweep + .plot-export'), false, 'the curves\' export bar beside the map');
+	const scale = await page.$eval('#sweep-map .colour-scale', e => ({ title: e.querySelector('.title').textContent,
+		ticks: Array.from(e.querySelectorAll('.ticks .label')).map(l => Number(l.textContent)), h: e.getBoundingClientRect().height }));
+	assert.equal(scale.title, 'v / (m/s)');
+	assert.equal(scale.ticks.length, 3);
+	assert.ok(scale.ticks[0] < 0 && scale.ticks[1] === 0 && scale.ticks[2] === -scale.ticks[0], `ticks ${scale.ticks}`);
+	assert.ok(scale.h > 10);
 	/* the cells are the daemon's points: mu down, beta across */
 	const href = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
 	const study = (await (await fetch(base + href.replace('?format=csv', ''), { headers: AUTH })).json());
@@ -520,8 +578,9 @@ test('a sweep with the last fit\'s band: the band shaded under each curve, as th
 
 test('a β-change experiment reports its reversal time', async () => {
 	await page.fill('#experiment-form input[name="beta1"]', '38');
-	await page.fill('#experiment-form input[name="beta2"]', '128');
-	await page.fill('#experiment-form input[name="t_switch"]', '1.5');
+	/* settings shown as given: 121.9 (was "122°" on the plot), 1.55 (was "1.55" but 0.052 "0.05") */
+	await page.fill('#experiment-form input[name="beta2"]', '121.9');
+	await page.fill('#experiment-form input[name="t_switch"]', '1.55');
 	await page.fill('#experiment-form input[name="t_end"]', '4');
 	await page.uncheck('#experiment-form input[name="watch"]');
 	/* the experiment's fresh session takes the form's start: the run-up */
@@ -551,7 +610,22 @@ test('a β-change experiment reports its reversal time', async () => {
 	assert.equal(seg[0], 'experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,' +
 		'steady_velocity,mean_velocity,uncertainty,steady,reversal_time');
 	assert.equal(seg.length, 3);
-	assert.deepEqual(seg.slice(1).map(l => l.split(',')[3]), ['38', '128']);
+	assert.deepEqual(seg.slice(1).map(l => l.split(',')[3]), ['38', '121.9']);
+	/* the table stays inside its card ("reversal / s" stood past the border at 1440 px) */
+	await page.setViewportSize({ width: 1440, height: 1300 });
+	await page.waitForTimeout(200);
+	const spill = await page.evaluate(() => {
+		const card = document.querySelector('#experiment-card').getBoundingClientRect();
+		const t = document.querySelector('#experiment-table');
+		const box = (t.closest('.table-scroll') ?? t).getBoundingClientRect();
+		return [box.left - card.left, card.right - box.right];
+	});
+	await page.setViewportSize({ width: 1600, height: 1300 });
+	assert.ok(spill[0] >= 0 && spill[1] >= 0, `experiment table: ${spill} px inside the card's left and right`);
+	assert.deepEqual(await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[1].textContent)), ['38', '121.9']);
+	assert.equal(await page.$eval('#experiment-table tbody tr:nth-child(2)', r => r.cells[2].textContent), seg[2].split(',')[6]);
+	assert.deepEqual(await page.evaluate(() => window.convsim.plots.experiment.markers.map(m => m.label).filter(l => l.startsWith('β'))),
+		['β → 121.9°']);
 	/* the first segment commands the β the session already has: nothing reverses, no time */
 	assert.deepEqual(seg.slice(1).map(l => l.split(',')[13] !== ''), [false, true], seg.join('\n'));
 	const reversals = await page.$$eval('#experiment-table tbody tr', r => r.map(x => x.cells[5].textContent));
@@ -562,6 +636,7 @@ test('a β-change experiment reports its reversal time', async () => {
 	assert.ok(Number(et[et.length - 1].split(',')[0]) >= 3.9, 'the trajectory covers the experiment');
 	const ep = csvLines(await download('#plot-experiment + .plot-export button[data-export="csv"]'));
 	assert.equal(ep[0], 't / s,feed velocity / (m/s),β / °');
+	assert.deepEqual(ep.slice(1).map(l => l.split(',')[0]).filter(c => !onNsGrid(c)).slice(0, 3), [], 'experiment.csv: times on the grid');
 	await page.selectOption('select[name="scene_start"]', 'steady');
 });
 
@@ -684,6 +759,10 @@ test('a phone (390 px): one column, no sideways scroll; one h1', async () => {
 			.filter(e => { const b = e.getBoundingClientRect(); return b.width > 0 && b.right > 391; })
 			.map(e => `${e.tagName}#${e.id}.${e.className}`).slice(0, 5));
 		assert.deepEqual(wide, [], 'nothing reaches past the screen');
+		/* the picker shows the session it is on, not only its arrow */
+		const pick = await page.$eval('#session-select', e => ({ w: e.getBoundingClientRect().width, text: e.selectedOptions[0]?.textContent }));
+		assert.ok(pick.w >= 200, `the picker is ${pick.w} px wide`);
+		assert.ok(pick.text.length > 3, pick.text);
 		for (const sel of ['#sweep-run', '#conn'])
 			if (await page.$(sel)) {
 				const b = await page.$eval(sel, e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; });

@@ -6,7 +6,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import * as api from '../../web/js/api.js';
 import { Trace, slope, recentVelocity } from '../../web/js/series.js';
-import { fmt, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText, tickText } from '../../web/js/format.js';
+import { fmt, fmtGiven, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText, tickText } from '../../web/js/format.js';
 import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
 
 const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
@@ -272,4 +272,16 @@ test('axis ticks carry the decimals of their step', () => {
 	assert.equal(tickText(-1e-17, 0.1), '0.0');
 	assert.deepEqual([0.1 + 0.2, 0.4].map(v => tickText(v, 0.1)), ['0.3', '0.4']);
 	assert.equal(tickText(3, NaN), '3');
+});
+
+test('numbers as a person wrote them: no float noise, settings as given', () => {
+	assert.equal(fmtGiven(0.022000000000000002), '0.022');
+	assert.equal(fmtGiven(16.016000000000002), '16.016');
+	assert.equal(fmtGiven(31.487812499999997), '31.4878125');
+	assert.equal(fmtGiven(121.9), '121.9');
+	assert.equal(fmtGiven(0.052, 's'), '0.052 s');
+	assert.equal(fmtGiven(38), '38');
+	assert.equal(fmtGiven(-1.5e-7), '-1.5e-7');
+	assert.equal(fmtGiven(0.15039742644948292), '0.150397426449483');
+	assert.equal(fmtGiven(NaN), '–');
 });

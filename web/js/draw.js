@@ -5,7 +5,7 @@
  * page is dirty.
  */
 
-import { fmtVelocity, direction, ARROW } from './format.js';
+import { fmt, fmtVelocity, direction, ARROW } from './format.js';
 import { app, $, numberOf } from './ui.js';
 import { currentVelocity, MM } from './live.js';
 import { buildFeedPlot, buildStrokesPlot } from './figures.js';
@@ -57,8 +57,12 @@ function draw() {
 		const v = strokes[c].filter(Number.isFinite);
 		return v.length ? [Math.min(...v) / MM, Math.max(...v) / MM] : null;
 	}) : undefined;
+	/* one β per moment: the readout shows the drawing's (the latest
+	 * sample's, else the polled status's) */
+	const beta = Number.isFinite(last?.beta) ? last.beta : s?.beta ?? numberOf($('#session-form').elements.beta);
+	if (s || Number.isFinite(last?.beta)) $('#beta-now').textContent = fmt(beta, 1, '°');
 	app.schematic.update({
-		beta: Number.isFinite(last?.beta) ? last.beta : s?.beta ?? numberOf($('#session-form').elements.beta),
+		beta,
 		betaTarget: s?.betaTarget,
 		rotation: last?.rotation ?? s?.rotation ?? $('#session-form').elements.rotation.value,
 		strokes: last?.strokes,

@@ -8,7 +8,7 @@
 
 import * as api from './api.js';
 import { Trace } from './series.js';
-import { fmt, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direction, ARROW, DASH } from './format.js';
+import { fmt, fmtGiven, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direction, ARROW, DASH } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm, attach } from './session.js';
 
@@ -72,8 +72,8 @@ function showExperiment(j, form, traj) {
 	j.segments.forEach((s, i) => {
 		const row = body.insertRow();
 		row.insertCell().textContent = String(i + 1);
-		row.insertCell().textContent = fmt(s.beta, 1);
-		row.insertCell().textContent = fmt(s.tStart, 2);
+		row.insertCell().textContent = fmtGiven(s.beta);
+		row.insertCell().textContent = fmtGiven(s.tStart);
 		const vc = row.insertCell();
 		vc.textContent = `${fmtVelocity(s.v).replace(' m/s', '')} ${ARROW[direction(s.v)]}`;
 		/* the daemon's estimate over the segment, its error bar, and whether
@@ -112,7 +112,7 @@ function showExperiment(j, form, traj) {
 	const marks = [];
 	j.segments.forEach((s, i) => {
 		if (i === 0 || !Number.isFinite(s.tStart)) return;
-		marks.push({ x: s.tStart, label: `β → ${fmt(s.beta, 0)}°`, color: '#d97706' });
+		marks.push({ x: s.tStart, label: `β → ${fmtGiven(s.beta)}°`, color: '#d97706' });
 		if (Number.isFinite(s.reversalTime))
 			marks.push({ x: s.tStart + s.reversalTime, label: `90 % after ${fmt(s.reversalTime, 3)} s`, color: '#7c3aed', row: 1 });
 	});

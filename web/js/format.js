@@ -15,6 +15,24 @@ export function fmt(v, digits = 3, unit = '') {
 	return unit ? `${z} ${unit}` : z;
 }
 
+/* A time the page derives from the daemon's (a period's midpoint) on the
+ * daemon's nanosecond grid, as the daemon writes times: k·dt reads 0.022,
+ * not 0.022000000000000002. */
+export function onGrid(t) {
+	return Math.round(t * 1e9) / 1e9;
+}
+
+/* A number as a person wrote it: the shortest text of at most 15
+ * significant digits (every decimal of up to 15 digits comes back from a
+ * double as written), so a time on the step grid reads 0.022, not
+ * 0.022000000000000002, a ramp's beta 31.4878125, and a setting as given
+ * (121.9, not 122; 0.052, not 0.05). A dash for a missing value. */
+export function fmtGiven(v, unit = '') {
+	if (!Number.isFinite(v)) return DASH;
+	const s = String(Number(v.toPrecision(15)));
+	return unit ? `${s} ${unit}` : s;
+}
+
 /* Significant-digit text for values of any magnitude (steps/s, speed-ups). */
 export function fmtSig(v, sig = 3, unit = '') {
 	if (!Number.isFinite(v)) return DASH;

@@ -7,7 +7,7 @@
  */
 
 import { Trace, recentVelocity } from './series.js';
-import { fmt, fmtTime, rotationLabel } from './format.js';
+import { fmt, fmtTime, rotationLabel, onGrid } from './format.js';
 import { app, $ } from './ui.js';
 import { buildFeedPlot } from './figures.js';
 
@@ -69,7 +69,7 @@ function pushRotor(tr, t, speed, beta, omega) {
 	p.t = t;
 	const period = omega > 1 ? Math.min(0.1, 2 * Math.PI / omega) : 0.1;
 	if (t - p.t0 >= period * (1 - 1e-9)) {
-		tr.rotor.push((p.t0 + t) / 2, [p.sum / p.n, beta]);
+		tr.rotor.push(onGrid((p.t0 + t) / 2), [p.sum / p.n, beta]);
 		Object.assign(p, { t0: t, sum: 0, n: 0 });
 	}
 }

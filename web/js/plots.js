@@ -52,6 +52,8 @@ export function saveBlob(blob, name) {
 	setTimeout(() => URL.revokeObjectURL(a.href), 5000);
 }
 
+/* numbers as the daemon sent them (the shortest text that reads back as
+ * the same double); the page's own times are on its grid (onGrid) */
 const cell = v => (typeof v === 'number' ? (Number.isFinite(v) ? String(v) : '')
 	: /[",\n]/.test(String(v)) ? `"${String(v).replace(/"/g, '""')}"` : String(v ?? ''));
 export const csvText = rows => rows.map(r => r.map(cell).join(',')).join('\n') + '\n';
@@ -87,8 +89,41 @@ export function addExport(owner, el) {
 		bar.append(b);
 	}
 	bar.prepend(Object.assign(document.createElement('span'), { textContent: 'Export: ' }));
+	bar.append(dataTable(owner, el));
 	el.after(bar);
 	return bar;
+}
+
+/* The text alternative of a plot's canvas: the plot named after its card's
+ * title (role img), and a "Data table" disclosure (keyboard-reachable
+ * through its summary) whose table, of the same rows as the CSV (the last
+ * 500), is filled each time it opens. */
+const DATA_ROWS = 500;
+function dataTable(owner, el) {
+	const title = el.closest('.card')?.querySelector('h3')?.firstChild?.textContent?.trim() || el.id;
+	el.setAttribute('role', 'img');
+	el.setAttribute('aria-label', `${title} (plot; its data: the Data table below)`);
+	const d = document.createElement('details');
+	d.className = 'plot-data';
+	d.append(Object.assign(document.createElement('summary'), { textContent: 'Data table' }));
+	const wrap = Object.assign(document.createElement('div'), { className: 'table-scroll' });
+	const table = Object.assign(document.createElement('table'), { className: 'table' });
+	table.setAttribute('aria-label', `${title}: data`);
+	wrap.append(table);
+	d.append(wrap);
+	d.addEventListener('toggle', () => {
+		if (!d.open) return;
+		const [head = [], ...rows] = owner.csvRows();
+		table.replaceChildren();
+		const tr = table.createTHead().insertRow();
+		for (const h of head) tr.append(Object.assign(document.createElement('th'), { textContent: h, scope: 'col' }));
+		const body = table.createTBody();
+		for (const r of rows.slice(-DATA_ROWS)) {
+			const row = body.insertRow();
+			for (const c of r) row.insertCell().textContent = typeof c === 'number' ? (Number.isFinite(c) ? String(c) : '') : String(c ?? '');
+		}
+	});
+	return d;
 }
 
 function sizeOf(el, aspect) {
@@ -330,10 +365,11 @@ export class XYPlot {
 	 * equal: keep aspect 1:1 in data units; markers: draw a dot per point;
 	 * zeroLine: draw y = 0. The legend lists only the series that have
 	 * points. */
-	constructor(el, { series, xLabel, yLabel, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange }) {
+	constructor(el, { series, xLabel, yLabel, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange, emptyX }) {
 		this.el = el;
 		this.equal = equal;
 		this.xRange = xRange;
+		this.emptyX = emptyX; /* the x axis of an empty plot (β: 0…180), not −1…1 */
 		this.errs = [];
 		this.labels = [xLabel, yLabel, series.map(d => d.label)];
 		this.legend = series.length > 1;
@@ -350,6 +386,7 @@ export class XYPlot {
 			}
 			if (axisKey === 'x' && self.xRange) return self.xRange;
 			const e = self.ext;
+			if (axisKey === 'x' && self.emptyX && !Number.isFinite(e.x0)) return self.emptyX;
 			return axisKey === 'x' ? padRange(e.x0, e.x1, 0.05) : padRange(Math.min(e.y0, zeroLine ? 0 : e.y0), Math.max(e.y1, zeroLine ? 0 : e.y1));
 		};
 		const hooks = {};
@@ -388,6 +425,7 @@ export class XYPlot {
 				points: { show: false },
 			}))],
 		}, [null, ...series.map(() => [[], []])], el);
+		if (this.legend) this.showLegend(series.map(() => false));
 		this.ro = observe(el, this.plot, aspect, legendRoom);
 		el.dataset.points = '0';
 		el.classList.add('empty');
@@ -427,14 +465,13 @@ export class XYPlot {
 		this.bar.hidden = n === 0;
 	}
 
-	/* The legend's entry of each series only while it has points (an empty
-	 * plot lists them all, as a key of what will come). */
+	/* The legend's entry of each series only while it has points: an empty
+	 * plot lists none (it draws none). */
 	showLegend(shown) {
-		const any = shown.some(Boolean);
 		const names = this.labels[2];
 		for (const row of this.plot.root.querySelectorAll('.u-legend .u-series')) {
 			const k = names.indexOf(row.querySelector('.u-label')?.textContent);
-			if (k >= 0) row.style.display = !any || shown[k] ? '' : 'none';
+			if (k >= 0) row.style.display = shown[k] ? '' : 'none';
 		}
 	}
 

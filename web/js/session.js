@@ -8,7 +8,7 @@
  */
 
 import * as api from './api.js';
-import { fmt, fmtTime, rotationLabel, parsePace } from './format.js';
+import { fmt, fmtGiven, fmtTime, rotationLabel, parsePace } from './format.js';
 import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
 import { resetTraces, onSample, onControl } from './live.js';
 import { showStatus, clearStatus, sessionLabel, showModelCheck } from './status.js';
@@ -46,7 +46,7 @@ export async function startSession(ev) {
 	try {
 		const s = await api.createSession(form);
 		setOnline(true);
-		message('ok', `Session ${s.id} started (${form.preset}, β = ${fmt(form.beta, 1)}°, ${rotationLabel(form.rotation)}).`);
+		message('ok', `Session ${s.id} started (${form.preset}, β = ${fmtGiven(form.beta)}°, ${rotationLabel(form.rotation)}).`);
 		/* the POST answer's status is that of t = 0 before the first step:
 		 * let the first poll fill the tiles */
 		attach(s.id, null);
@@ -87,7 +87,12 @@ export function attach(id, initial) {
 	document.body.dataset.sessionId = id;
 	history.replaceState(null, '', `#session=${encodeURIComponent(id)}`);
 	$('#session-label').textContent = `session ${id}`;
-	$('#session-select').value = id;
+	/* the picker names the session at once, before the next list refresh
+	 * brings it (it stood blank for a refresh's time after "Run experiment") */
+	const sel = $('#session-select');
+	if (!Array.from(sel.options).some(o => o.value === id))
+		sel.append(new Option(initial ? sessionLabel(initial) : id, id));
+	sel.value = id;
 	setControlsEnabled(true);
 	for (const format of ['csv', 'json']) {
 		const a = $(`#traj-${format}`);
@@ -163,7 +168,7 @@ export async function setBeta(beta) {
 	const r = await patch(body, 'β change');
 	if (r) {
 		const t = r.control.t;
-		message('ok', `β → ${fmt(beta, 1)}°` + (Number.isFinite(t) ? ` from t = ${fmtTime(t)}` : '') + '.');
+		message('ok', `β → ${fmtGiven(beta)}°` + (Number.isFinite(t) ? ` from t = ${fmtTime(t)}` : '') + '.');
 	}
 	return r;
 }

@@ -36,7 +36,9 @@ export function showStatus(s) {
 		(Number.isFinite(s.omegaSs) ? ` · ω_ss ${fmt(s.omegaSs, 2)} rad/s` : '') : DASH;
 	$('#rtf-now').textContent = Number.isFinite(s.realTimeFactor) ? `${fmtSig(s.realTimeFactor, 3)}×` : DASH;
 	$('#sps-now').textContent = `${fmtSig(s.stepsPerSecond, 3, 'steps/s')} · pace ${fmtPace(s.pace)}`;
-	$('#beta-now').textContent = fmt(s.beta, 1, '°');
+	/* β now: the stream's latest sample where there is one (draw.js), so
+	 * that the readout and the drawing agree */
+	if (!Number.isFinite(app.lastSample?.beta)) $('#beta-now').textContent = fmt(s.beta, 1, '°');
 	$('#beta-target').textContent = fmt(Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta, 1, '°');
 	$('#rotation-now').textContent = rotationLabel(s.rotation);
 	$('#drive-now').textContent = s.driveOn === false ? 'off' : s.driveOn ? 'on' : DASH;

@@ -67,6 +67,8 @@ function showSweep(j) {
 	exp.points = vary.length === 2 ? j.points : [];
 	exp.vary = vary;
 	exp.bar.hidden = !exp.points.length;
+	/* the curves' export goes with the curves: none beside the map */
+	if (vary.length === 2) app.plots.sweep.bar.hidden = true;
 	if (vary.length === 1 && vary[0] !== 'beta') return showCurves(j.points, vary[0]);
 	if (vary.length !== 1) return showStudyTable(j.points, vary);
 	setXLabel('β / °');
@@ -186,6 +188,21 @@ function drawMaps(box, points, [rowName, colName]) {
 		}
 		box.append(grid);
 	}
+	box.append(colourScale(vmax));
+}
+
+/* The map's colour scale: −vmax (blue) through 0 (white) to +vmax (red),
+ * in m/s, the colours of colourOf. */
+function colourScale(vmax) {
+	const scale = Object.assign(document.createElement('div'), { className: 'colour-scale' });
+	scale.setAttribute('role', 'img');
+	scale.setAttribute('aria-label', `colour scale: blue ${fmt(-vmax, 3)} m/s (feed moves left), white 0, red ${fmt(vmax, 3)} m/s (right)`);
+	const bar = Object.assign(document.createElement('div'), { className: 'bar' });
+	bar.style.background = `linear-gradient(to right, ${colourOf(-vmax, vmax)}, ${colourOf(0, vmax)}, ${colourOf(vmax, vmax)})`;
+	const ticks = Object.assign(document.createElement('div'), { className: 'ticks' });
+	for (const v of [-vmax, 0, vmax]) ticks.append(Object.assign(document.createElement('span'), { className: 'label', textContent: fmt(v, 3) }));
+	scale.append(Object.assign(document.createElement('div'), { className: 'title', textContent: 'v / (m/s)' }), bar, ticks);
+	return scale;
 }
 
 /* The map's export buttons (PNG, CSV) beside it, made once: the owner

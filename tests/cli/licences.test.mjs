@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Licences that cannot drift: docs/third-party.md's table of shared
+// libraries names every Debian package `ldd` shows for each built program,
+// with that program, and no package none of them loads; every file the
+// project wrote says its licence in an SPDX line near its top.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { existsSync, readFileSync, realpathSync } from 'node:fs';
+import { join } from 'node:path';
+
+const ROOT = new URL('../..', import.meta.url).pathname;
+const BUILD = join(ROOT, process.env.BUILD || 'build');
+const PROGRAMS = ['convsim', 'convsim-mpi', 'convsimd', 'convsim-dem', 'convsim-bed'];
+
+// The table between <!-- ldd: packages --> and <!-- /ldd -->: package ->
+// the programs its row names.
+function lddTable(md) {
+  const from = md.indexOf('<!-- ldd: packages -->'), to = md.indexOf('<!-- /ldd -->');
+  assert.ok(from >= 0 && to > from, 'docs/third-party.md has its ldd table');
+  const rows = new Map();
+  for (const line of md.slice(from, to).split('\n')) {
+    const m = line.match(/^\| `([^`]+)` \|[^|]*\| ([^|]*) \|/);
+    if (m) rows.set(m[1], new Set(m[2].split(',').map((s) => s.trim()).filter(Boolean)));
+  }
+  return rows;
+}
+
+// The Debian package of each shared library a program loads.
+function packagesOf(bin) {
+  const ldd = spawnSync('ldd', [bin], { encoding: 'utf8' });
+  assert.equal(ldd.status, 0, ldd.stderr);
+  const pkgs = new Set();
+  for (const m of ldd.stdout.matchAll(/=> (\/\S+)/g)) {
+    let p = null;
+    for (const f of [m[1], realpathSync(m[1])]) {
+      const q = spawnSync('dpkg', ['-S', f], { encoding: 'utf8' });
+      if (q.status === 0) { p = q.stdout.split(':')[0].split(',')[0].trim(); break; }
+    }
+    assert.ok(p, `${bin}: no Debian package provides ${m[1]}`);
+    pkgs.add(p);
+  }
+  return pkgs;
+}
+
+const hasDpkg = spawnSync('sh', ['-c', 'command -v dpkg && command -v ldd']).status === 0;
+
+test('docs/third-party.md lists every shared library of every built program', { skip: !hasDpkg && 'no dpkg or ldd' }, () => {
+  const rows = lddTable(readFileSync(join(ROOT, 'docs/third-party.md'), 'utf8'));
+  const seen = new Set();
+  let built = 0;
+  for (const prog of PROGRAMS) {
+    const bin = join(BUILD, prog);
+    if (!existsSync(bin)) continue;
+    built++;
+    for (const p of packagesOf(bin)) {
+      seen.add(p);
+      assert.ok(rows.has(p), `docs/third-party.md: no row for \`${p}\` (ldd ${prog})`);
+      assert.ok(rows.get(p).has(prog), `docs/third-party.md: \`${p}\`'s row does not name ${prog}`);
+    }
+  }
+  assert.ok(built >= 2, 'convsim and convsimd are built');
+  // with every program built, no row for a package none loads
+  if (built === PROGRAMS.length)
+    for (const p of rows.keys()) assert.ok(seen.has(p), `docs/third-party.md: \`${p}\` is loaded by no program`);
+});
+
+// Files that cannot carry a comment, or are not the project's text.
+const NO_SPDX = [
+  [/^LICENSE$/, 'the licence itself'],
+  [/^web\/vendor\//, 'vendored: its own LICENSE beside it'],
+  [/\.(json|png|bin|ndjson|csv)$/, 'JSON and data: no comment syntax'],
+  [/^tests\/fuzz\/corpus\//, 'fuzz inputs: a comment would change them'],
+  [/^tests\/fixtures\//, 'data directories written by older builds, as they wrote them'],
+  [/^tests\/bench\/results\//, 'benchmark output, as the benchmarks wrote it'],
+  [/^tests\/bench\/zoo\/ref\.tsv$/, 'a reference table its readers parse whole'],
+];
+
+test('every file the project wrote carries an SPDX line near its top', () => {
+  const ls = spawnSync('git', ['ls-files'], { cwd: ROOT, encoding: 'utf8' });
+  if (ls.status !== 0) return; // not a git checkout (a release tarball)
+  const missing = [];
+  let checked = 0;
+  for (const f of ls.stdout.split('\n').filter(Boolean)) {
+    if (NO_SPDX.some(([re]) => re.test(f)) || !existsSync(join(ROOT, f))) continue;
+    checked++;
+    const head = readFileSync(join(ROOT, f), 'utf8').split('\n').slice(0, 5).join('\n');
+    if (!/SPDX-License-Identifier: GPL-3\.0-or-later/.test(head)) missing.push(f);
+  }
+  assert.deepEqual(missing, []);
+  assert.ok(checked > 100, `${checked} files checked`);
+});
