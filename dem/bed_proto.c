@@ -52,6 +52,10 @@ int dem_proto_bed_line(char *buf, size_t len, const dem_bed_spec *s)
 int dem_proto_bed_parse(const char *args, dem_bed_spec *s)
 {
 	double grains, freeze, seed, viscous;
+	/* what the line does not carry (a named material's contacts, the
+	 * frame check's wiggle) is off: a bed process's spec is never what
+	 * its stack held before */
+	*s = (dem_bed_spec){0};
 	if (proto_numbers(args, 15, &grains, &s->d_min, &s->d_max, &s->density, &s->cell_x,
 			  &s->cell_y, &s->k_over_m, &s->restitution, &s->mu, &s->mu_roll, &freeze,
 			  &seed, &s->g, &s->settle, &viscous) ||
@@ -61,7 +65,6 @@ int dem_proto_bed_parse(const char *args, dem_bed_spec *s)
 	s->freeze_rotation = freeze != 0;
 	s->tangential_viscous = viscous != 0;
 	s->seed = (unsigned)seed;
-	s->wiggle_x = s->wiggle_z = s->wiggle_period = 0;
 	return 0;
 }
 

@@ -192,6 +192,8 @@ void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 	if (!news) {
 		if (from_t < s->ring.wake_t)
 			s->ring.wake_t = from_t; /* the worker wakes it from then */
+		if (s->ring.plan_t < INFINITY && from_t < s->ring.plan_t - 1e-6)
+			pthread_cond_signal(&s->wake); /* a paced worker sleeps past it */
 		struct timespec ts = srv_deadline(seconds);
 		pthread_cond_timedwait(&s->data, &s->lock, &ts);
 	}

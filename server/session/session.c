@@ -114,18 +114,30 @@ static int alloc_buffers(srv_session *s)
 		     2 * (size_t)s->columns * (size_t)s->layers;
 	s->ring.cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
 	/* the record ring, slots then their arrays, in one mapping whose
-	 * pages are all made now (MAP_POPULATE): the memory budget reserved
-	 * them anyway, and a worker that fills a fresh ring would otherwise
-	 * take a page fault every few samples over its first 16 s */
+	 * pages are all made now: the memory budget reserved them anyway,
+	 * and a worker that fills a fresh ring would otherwise take a page
+	 * fault every few samples over its first 16 s. Huge pages where the
+	 * kernel has them: a sample's record lands on a fresh 4-KiB page every
+	 * few samples, and with hundreds of sessions each such write missed
+	 * the TLB (a fifth of the daemon's CPU in a profile:
+	 * docs/performance.md) */
 	size_t bytes = s->ring.cap * (sizeof *s->ring.samples + per * sizeof(double));
 	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
-			 MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+			 MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
 	if (map != MAP_FAILED) {
+#ifdef MADV_HUGEPAGE
+		(void)madvise(map, bytes, MADV_HUGEPAGE);
+#endif
+#ifdef MADV_POPULATE_WRITE
+		if (madvise(map, bytes, MADV_POPULATE_WRITE) != 0)
+#endif
+			memset(map, 0, bytes);
 		s->ring.bytes = bytes;
 		s->ring.samples = map;
 		s->ring.store = (double *)(void *)(s->ring.samples + s->ring.cap);
 	}
 	s->ring.wake_t = INFINITY;
+	s->ring.plan_t = INFINITY;
 	s->ring.hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
 	s->ring.hist = calloc(s->ring.hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
 	if (!s->ring.bytes || !s->ring.hist ||

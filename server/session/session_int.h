@@ -36,6 +36,10 @@ typedef struct srv_session_records {
 	uint64_t published;       /* head when readers were last woken */
 	double wake_t;            /* s: the earliest sample time a waiting
 				     stream wants (INFINITY: none waits) */
+	double plan_t;            /* s: the simulated time a paced worker
+				     sleeps until (INFINITY: it does not);
+				     a stream that wants an earlier sample
+				     wakes it (worker.c pace) */
 	double *hist;
 	size_t hist_cap, hist_n;
 	double hist_stride, hist_next;

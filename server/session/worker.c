@@ -24,8 +24,9 @@
  *               slice when others wait; any other session holds none
  *   pacing      simulated time is held to pace x wall time (no catching up
  *               after a stall; pace "max" runs flat out up to "until"): a
- *               paced session sleeps until its next sample is due, then
- *               steps every sample due within the next 20 ms (a batch)
+ *               paced session steps every sample due when it wakes (a
+ *               batch), then sleeps until the sample a stream waits for
+ *               is due or 0.1 s (pace())
  *   step        sim_advance by one sample interval (1/sample_rate simulated
  *               seconds, cut at "until" and at experiment boundaries), then
  *               publish the status snapshot and a record in the bounded ring
@@ -64,7 +65,10 @@ typedef struct clocks {
 	uint64_t rate_steps;
 	double cpu_wall;              /* when the CPU clock was last read */
 	double publish_wall;          /* when readers were last woken */
+	double batch_start;           /* pacing: when the last batch began */
 	double batch_end;             /* pacing: samples due by then step now */
+	int want_all;                 /* pacing: a stream waited for every
+					 sample at the last wake-up */
 	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
 					 the cost window */
 } clocks;
@@ -75,7 +79,7 @@ static void restart_clocks(clocks *c, const srv_session *s)
 	c->anchor_wall = c->rate_wall = srv_now();
 	c->anchor_t = c->rate_t = s->st.t;
 	c->rate_steps = s->st.steps;
-	c->batch_end = -INFINITY;
+	c->batch_start = c->batch_end = -INFINITY;
 }
 
 /* The CPU clock is read at most this often (s of wall time): once per
@@ -90,16 +94,42 @@ static void restart_clocks(clocks *c, const srv_session *s)
  * waiting stream wants (wake_t, which the streams lower before they wait).
  * Once per batch, not once per sample: every waiting stream is a thread
  * to wake (lock held). */
-static void publish(srv_session *s, clocks *c)
+static int publish_wakes(srv_session *s, clocks *c)
 {
+	int wake = 0;
 	c->publish_wall = srv_now();
 	if (s->ring.head == s->ring.published)
-		return;
+		return 0;
 	if (s->ring.event_head > s->ring.published || s->st.t >= s->ring.wake_t) {
+		c->want_all = s->ring.wake_t == -INFINITY;
 		s->ring.wake_t = INFINITY;
-		pthread_cond_broadcast(&s->data);
+		wake = 1;
+	} else {
+		c->want_all = 0; /* no stream waited for these */
 	}
 	s->ring.published = s->ring.head;
+	return wake;
+}
+
+static void publish(srv_session *s, clocks *c)
+{
+	if (publish_wakes(s, c))
+		pthread_cond_broadcast(&s->data);
+}
+
+/* The same at the end of a paced batch, with the lock let go while the
+ * readers are woken: a reader woken while the worker holds the lock
+ * would wake only to sleep on the lock, then be woken again by its
+ * release (two context switches instead of one, a tenth of the CPU of a
+ * daemon of paced sessions). Whatever happened meanwhile (a command, a
+ * stream that waits) is seen by the caller after it. */
+static void publish_batch(srv_session *s, clocks *c)
+{
+	if (!publish_wakes(s, c))
+		return;
+	pthread_mutex_unlock(&s->lock);
+	pthread_cond_broadcast(&s->data);
+	pthread_mutex_lock(&s->lock);
 }
 
 /* Let the session run at least up to t_end (s): raise until, resume a
@@ -238,16 +268,29 @@ static void pace_down(srv_session *s, clocks *c)
 			      "--max-paced-cores", s->entry.id, cost, was, pace);
 }
 
+/* A running session is paced down only when it measures more than this
+ * times what it holds: a scene whose estimate was far off (a restored one
+ * is admitted by the estimate alone, without the probe; a 16 x 64 feed
+ * measured 12 times its estimate). A default session's measure differs
+ * from its estimate by up to 2.6 times on this machine (a lone paced
+ * session's wake-ups from an idle core cost it 4-7 ms of CPU per
+ * simulated s, hundreds of them 2.4 ms each, the estimate says 2.65), and
+ * an admitted session keeps its pace through that: the budget's excess
+ * then refuses the next session instead. */
+#define PACE_DOWN_OVER 4.0
+
 /* need: the session's hold on the paced cores follows what it needs now
  * (its state, pace and measured cost), even beyond the budget: admission
- * is checked where a request raises it (session.c). Called in the same
+ * is checked where a request raises it (session.c), so that the sessions
+ * admitted keep their pace and the next one is refused; only a measure
+ * PACE_DOWN_OVER times its hold with no room left paces it down. Called in the same
  * turn as the commands phase (the lock is not let go in between), so that
  * a hold a handler raised for its queued command is kept until the worker
  * has applied it. */
 static void commit_need(srv_session *s, clocks *c)
 {
 	double need = srv_paced_need(s);
-	if (need > s->paced_held * (1 + 1e-9) && need > 1e-9)
+	if (need > PACE_DOWN_OVER * s->paced_held && need > 1e-9)
 		pace_down(s, c);
 	else if (need != s->paced_held)
 		srv_budget_set_paced(&s->paced_held, need);
@@ -317,36 +360,84 @@ static int idle(srv_session *s, clocks *c)
 	return 1;
 }
 
-/* A paced session steps in batches: it wakes when its next sample is due
- * and steps every sample due within PACE_AHEAD (s of wall time) from then,
- * so it runs at most that far ahead of its clock and wakes (and wakes its
- * readers) once per PACE_AHEAD, not once per sample (at 250 Hz sampling,
- * 250 wake-ups a second each, which cost more than the simulation itself
- * with many sessions). */
-#define PACE_AHEAD 0.02
+/* meter: steps/s and real-time factor over the last half second, as of
+ * wall time now: a paced session's is taken at the end of a batch as of
+ * its start (it stepped what was due by then; a thread put off the CPU
+ * while it stepped has not fallen behind for that). */
+static void meter(srv_session *s, clocks *c, double now)
+{
+	if (now - c->rate_wall < 0.5)
+		return;
+	s->steps_per_s = (double)(s->st.steps - c->rate_steps) /
+			 (now - c->rate_wall);
+	s->rtf = (s->st.t - c->rate_t) / (now - c->rate_wall);
+	c->rate_wall = now;
+	c->rate_t = s->st.t;
+	c->rate_steps = s->st.steps;
+}
+
+/* A paced session steps in batches, each of every sample due by the time
+ * it wakes, and sleeps in between until the first of:
+ *   - the next sample a waiting stream wants is due (wake_t; a stream that
+ *     starts waiting for an earlier one than the worker sleeps to, plan_t,
+ *     wakes it: ring.c), so that a stream's samples leave on time, not
+ *     early nor late by a batch;
+ *   - the next PACE_TICK of simulated time is due, or PACE_TICK of wall
+ *     time has passed: the status and the CPU measure stay that fresh;
+ * and never sooner than PACE_MIN after the batch before (a stream of every
+ * sample gets them in batches of that). Waking costs more than the
+ * simulation of a default session (a context switch of a thread among
+ * hundreds): at 250 Hz sampling one wake-up a sample was 250 a second,
+ * batches of 20 ms ahead 50, a 10-Hz stream now 10. */
+#define PACE_TICK 0.1
+#define PACE_MIN 0.02
+
+/* The wall time of simulated time t at the session's pace. */
+static double due_at(const srv_session *s, const clocks *c, double t)
+{
+	return c->anchor_wall + (t - c->anchor_t) / s->pace;
+}
 
 /* pacing: step t_next now if it is due within the current batch, else
- * wait until it is due and start a batch; 1 if it waited (the loop then
+ * sleep until the next batch and start it; 1 if it slept (the loop then
  * starts over, so that commands are seen at once). */
 static int pace(srv_session *s, clocks *c, double t_next)
 {
 	if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
 		return 0;
-	double due = c->anchor_wall + (t_next - c->anchor_t) / s->pace;
+	double due = due_at(s, c, t_next);
 	if (due <= c->batch_end)
 		return 0;
+	publish_batch(s, c); /* the batch is over */
+	if (s->cmd_head || s->stop)
+		return 1; /* came while the lock was let go */
+	if (c->batch_start > c->rate_wall)
+		meter(s, c, c->batch_start); /* as of when it began */
+	double tick = (floor(s->st.t / PACE_TICK + 1e-6) + 1) * PACE_TICK;
+	double plan = due_at(s, c, tick);
+	if (c->batch_start + PACE_TICK < plan)
+		plan = c->batch_start + PACE_TICK;
+	if (s->ring.wake_t < INFINITY && due_at(s, c, s->ring.wake_t) < plan)
+		plan = due_at(s, c, s->ring.wake_t);
+	if (c->want_all && c->batch_start + PACE_MIN < plan)
+		plan = c->batch_start + PACE_MIN;
+	if (plan < c->batch_start + PACE_MIN)
+		plan = c->batch_start + PACE_MIN;
+	if (plan < due)
+		plan = due;
 	double now = srv_now();
-	if (now < due) {
-		publish(s, c); /* the batch is over */
-		struct timespec ts = srv_deadline(due - now);
+	if (now < plan) {
+		s->ring.plan_t = c->anchor_t + (plan - c->anchor_wall) * s->pace;
+		struct timespec ts = srv_deadline(plan - now);
 		pthread_cond_timedwait(&s->wake, &s->lock, &ts);
+		s->ring.plan_t = INFINITY;
 		return 1;
 	}
-	if (now - due > 0.25) { /* behind: do not catch up */
+	if (now - due > 0.25 + PACE_TICK) { /* behind: do not catch up */
 		c->anchor_wall = now;
 		c->anchor_t = s->st.t;
 	}
-	c->batch_end = now + PACE_AHEAD;
+	c->batch_start = c->batch_end = now;
 	return 0;
 }
 
@@ -418,20 +509,6 @@ static void fail(srv_session *s, int rc, const char *why)
 	srv_log(SRV_LOG_WARN, "session %s failed: %s", s->entry.id, s->error);
 }
 
-/* meter: steps/s and real-time factor over the last half second. */
-static void meter(srv_session *s, clocks *c)
-{
-	double now = srv_now();
-	if (now - c->rate_wall < 0.5)
-		return;
-	s->steps_per_s = (double)(s->st.steps - c->rate_steps) /
-			 (now - c->rate_wall);
-	s->rtf = (s->st.t - c->rate_t) / (now - c->rate_wall);
-	c->rate_wall = now;
-	c->rate_t = s->st.t;
-	c->rate_steps = s->st.steps;
-}
-
 void *srv_worker_main(void *arg)
 {
 	srv_session *s = arg;
@@ -443,7 +520,12 @@ void *srv_worker_main(void *arg)
 	srv_ring_sample(s);
 	restart_clocks(&clk, s);
 	clk.cpu_wall = -INFINITY;
-	clk.cost_t = s->st.t; /* the thread's CPU clock starts at 0 */
+	/* the thread's CPU clock starts at 0; a LIGGGHTS bed's settling, done
+	 * before the first step, is no cost of simulated time (counted, it
+	 * made a 92-grain bed's first window 25 CPU s a simulated second and
+	 * paced the session down to 0.04) */
+	clk.cost_t = s->st.t;
+	clk.cost_cpu = s->dem.link ? s->dem.bed.cpu_seconds : 0.0;
 	publish(s, &clk);
 	for (;;) {
 		start_job(s);
@@ -471,7 +553,8 @@ void *srv_worker_main(void *arg)
 		run_job(s);
 		if (rc != SIM_OK)
 			fail(s, rc, why);
-		meter(s, &clk);
+		if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
+			meter(s, &clk, srv_now()); /* paced: pace() */
 		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
 			publish(s, &clk);
 	}

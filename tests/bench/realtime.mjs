@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // How many default sessions one daemon holds in real time on this machine
-// (`node tests/bench/realtime.mjs [N ...]`, not part of `make bench`: about
+// (`node tests/bench/realtime.mjs [N ...]`; `make bench` runs it through
+// realtime.sh, against the previous build: about
 // half a minute per N, loopback only, bounded). For each N it starts N
 // sessions of the czubak2016 defaults at pace 1 on a fresh daemon, each with
 // one NDJSON stream client (trough fields, 10 samples per simulated second),
@@ -14,6 +15,10 @@
 // session was admitted and kept real time and the lag's p99 is under 50
 // ms. tests/bench/cluster.mjs runs the same measurement (heldInRealTime)
 // through HAProxy in front of replicas. More daemon flags: DAEMON_FLAGS.
+// BASELINE=path/to/another/convsimd runs each N on that build first, in
+// the same minutes, for a row to compare with. The daemon's CPU per
+// session-second (its user + sys time over the simulated seconds of all
+// its sessions) is what the machine's other load distorts least.
 import http from 'node:http';
 import { pathToFileURL } from 'node:url';
 import { startDaemon } from '../http/lib.mjs';
@@ -62,19 +67,25 @@ if (import.meta.url === pathToFileURL(process.argv[1]).href) {
     '` (czubak2016 defaults, pace 1, one NDJSON stream each, 10 s of wall time, 2 cores)\n');
   const flags = (process.env.DAEMON_FLAGS || '').split(/\s+/).filter(Boolean);
   if (flags.length) console.log(`Daemon flags: ${flags.join(' ')}\n`);
-  console.log('| sessions | admitted (refused: 503 cpu) | at >= 0.95 of real time | slowest rtf | median rtf | stream lag p50 / p99, ms | daemon CPU, cores | holds (all admitted, in real time, p99 < 50 ms) |');
-  console.log('|---|---|---|---|---|---|---|---|');
+  const builds = process.env.BASELINE ? [['baseline', process.env.BASELINE], ['this build', undefined]]
+    : [['', undefined]];
+  console.log('| build | sessions | admitted (refused: 503 cpu) | at >= 0.95 of real time | slowest rtf | median rtf | stream lag p50 / p99, ms | daemon CPU, cores | daemon CPU per session-second, ms | holds (all admitted, in real time, p99 < 50 ms) |');
+  console.log('|---|---|---|---|---|---|---|---|---|---|');
   for (const N of Ns) {
-    const d = await startDaemon(['--max-sessions', String(Math.max(64, N)),
-      '--max-streams', String(Math.max(256, N + 16)), '--max-client-connections', String(N + 64), ...flags]);
-    const cpu0 = procUsage(d.proc.pid).cpu;
-    const t0 = Date.now();
-    const { admitted, refused, ok, min, median, lags } = await heldInRealTime(d.base, N);
-    const cpu = procUsage(d.proc.pid).cpu - cpu0;
-    const p99 = quantile(lags, 0.99);
-    const holds = admitted === N && ok === N && p99 < 50;
-    console.log(`| ${N} | ${admitted} (${refused}) | ${ok} | ${fmt(min, 2)} | ${fmt(median, 2)} | ` +
-      `${fmt(quantile(lags, 0.5))} / ${fmt(p99)} | ${fmt(cpu / ((Date.now() - t0) / 1000), 2)} | ${holds ? 'yes' : 'no'} |`);
-    await d.stop();
+    for (const [name, bin] of builds) {
+      const d = await startDaemon(['--max-sessions', String(Math.max(64, N)),
+        '--max-streams', String(Math.max(256, N + 16)), '--max-client-connections', String(N + 64), ...flags],
+      bin ? { wrap: [bin] } : {});
+      const cpu0 = procUsage(d.proc.pid).cpu;
+      const t0 = Date.now();
+      const { admitted, refused, ok, min, median, lags, simulated } = await heldInRealTime(d.base, N);
+      const cpu = procUsage(d.proc.pid).cpu - cpu0;
+      const p99 = quantile(lags, 0.99);
+      const holds = admitted === N && ok === admitted && p99 < 50;
+      console.log(`| ${name} | ${N} | ${admitted} (${refused}) | ${ok} | ${fmt(min, 2)} | ${fmt(median, 2)} | ` +
+        `${fmt(quantile(lags, 0.5))} / ${fmt(p99)} | ${fmt(cpu / ((Date.now() - t0) / 1000), 2)} | ` +
+        `${fmt(1e3 * cpu / simulated, 2)} | ${holds ? 'yes' : `no${admitted < N && ok === admitted && p99 < 50 ? ': the admitted in real time, the rest 503' : ''}`} |`);
+      await d.stop();
+    }
   }
 }

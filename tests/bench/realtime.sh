@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+# Paced default sessions held in real time by one daemon, the previous
+# build beside this one in the same minutes (part of `make bench`; a few
+# minutes): tests/bench/realtime.mjs for each N of REALTIME_N (default
+# "200 600": within the default --max-paced-cores, and beyond it, where the
+# admitted must keep real time and the rest get 503). The previous build
+# is commit PREV (default: main at the branch point of the admission's and
+# the pacing's changes, 1b75a01), exported with git archive and built once
+# into $BUILD/prev-PREV (`make build/convsimd`); PREV_CONVSIMD names a
+# built one instead. Writes $1/realtime.md.
+set -eu
+cd "$(dirname "$0")/../.."
+BUILD=${BUILD:-build}
+out=${1:-tests/bench/results}
+PREV=${PREV:-1b75a01}
+prev=${PREV_CONVSIMD:-}
+if [ -z "$prev" ]; then
+	prev_dir="$BUILD/prev-$PREV"
+	prev="$prev_dir/src/build/convsimd"
+	if [ ! -x "$prev" ]; then
+		echo "realtime: building the previous build ($PREV) in $prev_dir"
+		mkdir -p "$prev_dir/src"
+		[ -f "$prev_dir/src/Makefile" ] || git archive "$PREV" | tar -x -C "$prev_dir/src"
+		make -C "$prev_dir/src" --no-print-directory -j2 build/convsimd > "$prev_dir/make.log" 2>&1 ||
+			{ tail -20 "$prev_dir/make.log"; exit 1; }
+	fi
+fi
+rev=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+N=${REALTIME_N:-200 600}
+{
+	echo "# Paced default sessions in real time: the previous build beside this one"
+	echo
+	echo "Command: \`bash tests/bench/realtime.sh\` (part of \`make bench\`; \`node tests/bench/realtime.mjs $N\`"
+	echo "with BASELINE), $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc) cores"
+	echo "($(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //')), load average $(cut -d' ' -f1-3 /proc/loadavg) before."
+	echo "Previous build: $PREV; this build: $rev."
+	echo
+	CONVSIMD="$BUILD/convsimd" BASELINE="$prev" node tests/bench/realtime.mjs $N | sed -n '/^|/p'
+	echo
+	echo "Load average $(cut -d' ' -f1-3 /proc/loadavg) after. Daemon CPU per session-second: its user +"
+	echo "sys time from before the first creation to after the last deletion over the simulated seconds"
+	echo "of all its sessions; the figure the machine's other load distorts least."
+} | tee "$out/realtime.md"

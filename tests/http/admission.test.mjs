@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Admission keeps its word (docs/operations.md "Budgets and load"): with
+// the cores for paced sessions full, the next session is refused with 503
+// and a problem body naming the budget, and the sessions already running
+// keep their pace: not the newest refused and everyone slowed down. Holds
+// are the estimate from the scene (--cpu-probe 0) until the workers have
+// measured, so the refusal's numbers are known in advance.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { startDaemon, req, metric, until, sleep, SLOW } from './lib.mjs';
+
+// printf's %.3g for the magnitudes here (1e-4 .. 1e3)
+const g3 = (x) => String(Number(x.toPrecision(3)));
+
+test('paced budget full: the next session gets 503 with the budget named, the running ones keep pace 1', { timeout: 90000 * SLOW }, async () => {
+  const limit = 0.01;
+  const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
+  const held = async () => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+  try {
+    // the first one tells the estimate (CPU s per simulated s at pace 1)
+    const first = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(first.status, 201, first.text);
+    const cost = await held();
+    assert.ok(cost > 1e-4 && cost < limit / 2, `a default session's estimate: ${cost}`);
+    const fit = Math.floor(limit / cost);
+    const ids = [first.body.id];
+    while (ids.length < fit) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+      assert.equal(r.status, 201, `session ${ids.length + 1} of ${fit} fits: ${r.text}`);
+      ids.push(r.body.id);
+    }
+    const before = (await req(d.base, 'GET', '/metrics')).text;
+    const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(r.status, 503, r.text);
+    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    assert.equal(r.headers.get('retry-after'), '5');
+    // the holds summed as the daemon sums them, in the order they came
+    let sum = 0;
+    for (let i = 0; i < fit; i++) sum += cost;
+    assert.deepEqual(r.body, {
+      type: '/api/v1/problems/unavailable',
+      title: 'Service unavailable',
+      status: 503,
+      detail: `this session needs ${g3(cost)} cores (${g3(1e3 * cost)} ms of CPU per simulated s at pace 1) ` +
+        `and running paced sessions hold ${g3(sum)} of the ${limit} cores for paced sessions ` +
+        '(--max-paced-cores); nothing was created, retry when paced sessions have ended, paused or slowed down',
+      instance: '/api/v1/sessions',
+      field: 'pace',
+      budget: 'cpu',
+      limit,
+    });
+    const after = (await req(d.base, 'GET', '/metrics')).text;
+    for (const k of ['convsim_sessions', 'convsim_sessions_created_total', 'convsim_paced_cpu_cores']) {
+      assert.equal(metric(after, k), metric(before, k), `${k}: nothing created or held`);
+    }
+    // the running ones are untouched: pace 1 and running, also once their
+    // workers have measured them (2 simulated s) and their holds follow
+    // the measure, which may exceed the estimate: none is paced down
+    // (sanitizer builds measure several times the estimate: there only
+    // what the refusal itself changed is checked)
+    const list = async () => (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
+    if (SLOW === 1) await until(async () => (await list()).every((s) => s.status.t > 3), 30000, 'the sessions measured');
+    else await sleep(500);
+    const now = await list();
+    assert.equal(now.length, fit);
+    for (const s of now) {
+      assert.equal(s.state, 'running', s.id);
+      assert.equal(s.pace, 1, `${s.id} keeps pace 1`);
+    }
+    assert.doesNotMatch(d.stderr(), /paced down/);
+    // and still nothing more is admitted
+    const again = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(again.status, 503, again.text);
+    assert.equal(again.body.budget, 'cpu');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
