@@ -196,27 +196,20 @@ static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
 	return sc->layers == map[first].layers ? 0 : 1;
 }
 
-int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *out)
+/* The map's entry nearest the scene, when none checks it. */
+typedef struct {
+	size_t first, end; /* first == SIZE_MAX: no entry */
+	int rank;          /* entry_match's */
+	const char *diff;  /* the first differing setting */
+} nearest_entry;
+
+/* Walk the map's entries: 1 with *out filled where an entry matching the
+ * scene covers its angle (beta in degrees, or its mirror); else 0 and *best
+ * the nearest entry: fewest differences, then the nearest depth. */
+static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, int can_mirror,
+			sim_model_error *out, nearest_entry *best)
 {
-	out->checked = 0;
-	out->error = NAN;
-	out->error_uncertainty = NAN;
-	out->note[0] = '\0';
-	if (!sc->feed) {
-		snprintf(out->note, sizeof out->note, "no feed: nothing to check against DEM");
-		return -1;
-	}
-	if (sc->feed_model != SIM_FEED_COLUMN) {
-		snprintf(out->note, sizeof out->note,
-			 "the feed is a LIGGGHTS bed: the DEM itself, no column model to check");
-		return -1;
-	}
-	double beta = p->beta / RAD_PER_DEG;
-	sim_scene mirrored = *sc;
-	mirrored.mirror = 1;
-	int can_mirror = sim_mirror_applies(p, &mirrored);
-	/* the best entry: fewest differences, then the nearest depth */
-	size_t best = SIZE_MAX, best_end = 0;
+	size_t best_first = SIZE_MAX, best_end = 0;
 	int best_rank = 5;
 	const char *best_diff = NULL;
 	for (size_t first = 0, end; map[first].preset; first = end) {
@@ -244,23 +237,26 @@ int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *o
 		}
 		if (rank < best_rank ||
 		    (rank == best_rank && rank == 1 &&
-		     abs(map[first].layers - sc->layers) < abs(map[best].layers - sc->layers))) {
-			best = first;
+		     abs(map[first].layers - sc->layers) < abs(map[best_first].layers - sc->layers))) {
+			best_first = first;
 			best_end = end;
 			best_rank = rank;
 			best_diff = diff;
 		}
 	}
-	if (best == SIZE_MAX) {
-		snprintf(out->note, sizeof out->note, "not checked against DEM: no DEM map entry");
-		return 0;
-	}
-	const map_point *e = &map[best];
-	char where[96];
-	snprintf(where, sizeof where, "%d layers, %s", e->layers, e->preset);
-	/* a scene that is another preset as it stands: say so plainly */
+	best->first = best_first;
+	best->end = best_end;
+	best->rank = best_rank;
+	best->diff = best_diff;
+	return 0;
+}
+
+/* The preset the scene is as it stands, when its nearest entry differs in
+ * a setting (rank >= 2); NULL if none. */
+static const char *scene_preset(const sim_params *p, const sim_scene *sc, int rank)
+{
 	const char *named = NULL;
-	for (size_t i = 0; best_rank >= 2 && sim_preset_names[i] && !named; i++) {
+	for (size_t i = 0; rank >= 2 && sim_preset_names[i] && !named; i++) {
 		sim_params q;
 		sim_scene t;
 		sim_method m;
@@ -268,6 +264,21 @@ int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *o
 		    !first_difference(p, sc, &q, &t))
 			named = sim_preset_names[i];
 	}
+	return named;
+}
+
+/* The note of a scene not checked, naming its nearest entry b. */
+static void note_unchecked(const sim_params *p, const sim_scene *sc, double beta,
+			   const nearest_entry *b, sim_model_error *out)
+{
+	size_t best = b->first, best_end = b->end;
+	int best_rank = b->rank;
+	const char *best_diff = b->diff;
+	const map_point *e = &map[best];
+	char where[96];
+	snprintf(where, sizeof where, "%d layers, %s", e->layers, e->preset);
+	/* a scene that is another preset as it stands: say so plainly */
+	const char *named = scene_preset(p, sc, best_rank);
 	if (named) {
 		snprintf(out->note, sizeof out->note,
 			 "%s's column model is not checked against DEM (checked: %s)", named,
@@ -301,5 +312,34 @@ int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *o
 			 "checked is %s",
 			 best_diff, where);
 	}
+}
+
+int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *out)
+{
+	out->checked = 0;
+	out->error = NAN;
+	out->error_uncertainty = NAN;
+	out->note[0] = '\0';
+	if (!sc->feed) {
+		snprintf(out->note, sizeof out->note, "no feed: nothing to check against DEM");
+		return -1;
+	}
+	if (sc->feed_model != SIM_FEED_COLUMN) {
+		snprintf(out->note, sizeof out->note,
+			 "the feed is a LIGGGHTS bed: the DEM itself, no column model to check");
+		return -1;
+	}
+	double beta = p->beta / RAD_PER_DEG;
+	sim_scene mirrored = *sc;
+	mirrored.mirror = 1;
+	int can_mirror = sim_mirror_applies(p, &mirrored);
+	nearest_entry best;
+	if (scan_entries(p, sc, beta, can_mirror, out, &best))
+		return 1;
+	if (best.first == SIZE_MAX) {
+		snprintf(out->note, sizeof out->note, "not checked against DEM: no DEM map entry");
+		return 0;
+	}
+	note_unchecked(p, sc, beta, &best, out);
 	return 0;
 }

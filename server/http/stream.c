@@ -190,57 +190,53 @@ static int parse_options(srv_req *r, stream *k, int64_t *resume,
 	return 1;
 }
 
-enum MHD_Result srv_h_stream(srv_req *r)
+/* Admit a stream of session r->arg[0]: 1 with the session held in k->s, a
+ * stream client counted, its memory taken and the feed's size in *columns,
+ * *layers; else 0, k freed and the answer in *res. */
+static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Result *res)
 {
 	api_problem pb;
-	int64_t resume;
-	stream *k = calloc(1, sizeof *k);
-	if (!k)
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	if (!parse_options(r, k, &resume, &pb)) {
-		free(k);
-		return srv_reply_problem(r, &pb, NULL);
-	}
-	k->heartbeat = cfg->heartbeat;
 	k->s = srv_session_get(r->arg[0]);
 	if (!k->s) {
 		free(k);
-		return srv_fail(r, API_NOTFOUND, NULL,
+		*res = srv_fail(r, API_NOTFOUND, NULL,
 				"no session with id \"%.40s\"", r->arg[0]);
+		return 0;
 	}
 	if (srv_session_replaying(k->s, &pb) != API_OK) {
 		srv_session_put(k->s);
 		free(k);
-		return srv_reply_problem(r, &pb, NULL);
+		*res = srv_reply_problem(r, &pb, NULL);
+		return 0;
 	}
 	if (atomic_fetch_add(&srv_stats.stream_clients, 1) >=
 	    cfg->max_streams) {
 		atomic_fetch_sub(&srv_stats.stream_clients, 1);
 		srv_session_put(k->s);
 		free(k);
-		return srv_fail(r, API_LIMIT, NULL,
+		*res = srv_fail(r, API_LIMIT, NULL,
 				"%d stream clients are connected, the limit "
 				"(--max-streams)", cfg->max_streams);
+		return 0;
 	}
-	int columns, layers;
-	srv_session_feed_size(k->s, &columns, &layers);
-	size_t need = srv_budget_stream_need(columns, layers);
+	srv_session_feed_size(k->s, columns, layers);
+	size_t need = srv_budget_stream_need(*columns, *layers);
 	if (srv_budget_take(need, "this stream", 0, &pb) != API_OK) {
 		atomic_fetch_sub(&srv_stats.stream_clients, 1);
 		srv_session_put(k->s);
 		free(k);
-		return srv_reply_problem(r, &pb, NULL);
+		*res = srv_reply_problem(r, &pb, NULL);
+		return 0;
 	}
 	k->mem_reserved = need;
 	srv_session_stream_count(k->s, 1);
 	atomic_fetch_add(&srv_stats.streams_opened, 1);
-	k->rec_max = api_record_max(columns, layers);
-	k->out_cap = 4 * k->rec_max + 65536;
-	k->out = malloc(k->out_cap);
-	if (!k->out || srv_sample_alloc(&k->rec, columns, layers)) {
-		stream_free(k);
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	}
+	return 1;
+}
+
+/* The cursor where the stream starts: after record resume, or the newest. */
+static void start_cursor(stream *k, int64_t resume)
+{
 	srv_ring_read rv = srv_session_ring(k->s);
 	if (resume >= 0)
 		k->cursor = (uint64_t)resume + 1 < rv.head
@@ -248,21 +244,28 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				    : rv.head;
 	else
 		k->cursor = rv.head > rv.oldest ? rv.head - 1 : rv.head;
-	/* the first record: where the stream starts, and the scene's model
-	 * error as its controls stand now (each control event carries it
-	 * anew) */
+}
+
+/* The first record into k->out: where the stream starts, and the scene's
+ * model error as its controls stand now (each control event carries it
+ * anew); 0 out of memory. */
+static int put_hello(stream *k)
+{
 	api_view *view = calloc(1, sizeof *view);
-	if (!view) {
-		stream_free(k);
-		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
-	}
+	if (!view)
+		return 0;
 	srv_session_view(k->s, view);
 	sim_model_error me;
 	int mc = api_model_check(srv_session_spec(k->s), view->has_status ? &view->st : NULL, &me);
 	free(view);
 	k->out_len = api_format_hello(k->out, k->out_cap, srv_session_id(k->s), k->cursor,
 				      mc == 0 ? me.note : NULL, &me, k->ndjson);
-	k->last_write = srv_now();
+	return 1;
+}
+
+/* Answer 200 with the stream k as the body, read by reader. */
+static enum MHD_Result respond(srv_req *r, stream *k)
+{
 	struct MHD_Response *resp = MHD_create_response_from_callback(
 		MHD_SIZE_UNKNOWN, 32 * 1024, reader, k, stream_free);
 	if (!resp) {
@@ -276,4 +279,36 @@ enum MHD_Result srv_h_stream(srv_req *r)
 				"no-store");
 	MHD_add_response_header(resp, "X-Accel-Buffering", "no");
 	return srv_queue(r, 200, resp);
+}
+
+enum MHD_Result srv_h_stream(srv_req *r)
+{
+	api_problem pb;
+	int64_t resume;
+	stream *k = calloc(1, sizeof *k);
+	if (!k)
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	if (!parse_options(r, k, &resume, &pb)) {
+		free(k);
+		return srv_reply_problem(r, &pb, NULL);
+	}
+	k->heartbeat = cfg->heartbeat;
+	enum MHD_Result res;
+	int columns, layers;
+	if (!admit(r, k, &columns, &layers, &res))
+		return res;
+	k->rec_max = api_record_max(columns, layers);
+	k->out_cap = 4 * k->rec_max + 65536;
+	k->out = malloc(k->out_cap);
+	if (!k->out || srv_sample_alloc(&k->rec, columns, layers)) {
+		stream_free(k);
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	}
+	start_cursor(k, resume);
+	if (!put_hello(k)) {
+		stream_free(k);
+		return srv_fail(r, API_UNAVAILABLE, NULL, "out of memory");
+	}
+	k->last_write = srv_now();
+	return respond(r, k);
 }

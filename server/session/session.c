@@ -69,7 +69,7 @@ static void session_free(srv_session *s)
 	free(s->ring.hist);
 	srv_control_log_close(s);
 	free(s->controls);
-	free(s->replay);
+	free(s->restore.replay);
 	pthread_cond_destroy(&s->log.cond);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->wake);
@@ -288,7 +288,7 @@ static void adopt_bed(srv_session *s)
 	char msg[256];
 	srv_dem_hold();
 	s->dem.slot = 1;
-	if (srv_dem_start(s, !s->rebuilt, msg, sizeof msg) == 0) {
+	if (srv_dem_start(s, !s->restore.rebuilt, msg, sizeof msg) == 0) {
 		if (s->cpu_per_s < s->dem.cores)
 			s->cpu_per_s = s->dem.cores;
 		return;

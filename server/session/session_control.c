@@ -20,10 +20,82 @@ void srv_session_control_init(const srv_config *config)
 	cfg = config;
 }
 
+/* ---- the PATCH controls' admit column (api.h API_CONTROLS, by id) ---------- */
+
+/* An admit: 0 (API_OK) if control c's member may go to s, else the error
+ * with *pb filled (lock held). */
+typedef api_err (*control_admit)(const srv_session *s, const api_control *c,
+				 api_problem *pb);
+
+static api_err admit_cpu_limit(const srv_session *s, const api_control *c,
+			       api_problem *pb)
+{
+	(void)s;
+	if (!(c->cpu_budget > cfg->max_cpu_seconds))
+		return API_OK;
+	api_err e = api_fail(pb, API_RANGE, "cpu_budget",
+			     "cpu_budget must be CPU seconds in (0, %g] "
+			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
+			     c->cpu_budget);
+	pb->has_range = 1;
+	pb->min = 0;
+	pb->max = cfg->max_cpu_seconds;
+	return e;
+}
+
+static api_err admit_until(const srv_session *s, const api_control *c,
+			   api_problem *pb)
+{
+	if (c->until > 0 && c->until <= s->st.t)
+		return api_fail(pb, API_CONFLICT, "until",
+				"until (%g s) lies in the past: the session is at "
+				"t = %g s", c->until, s->st.t);
+	return API_OK;
+}
+
+static api_err admit_running(const srv_session *s, const api_control *c,
+			     api_problem *pb)
+{
+	if (c->running && s->state == SRV_FINISHED && !(c->set & API_C_UNTIL))
+		return api_fail(pb, API_CONFLICT, "running",
+				"the session finished at until = %g s; raise "
+				"until to run on", s->until);
+	return API_OK;
+}
+
+/* The column in two passes: `limit` checks a member against the daemon's
+ * options, before the session's state (a cpu_budget past --max-cpu-seconds
+ * is a 422 even for a session being deleted); `state` against the session,
+ * after it. A member without an entry is admitted as parsed. */
+static const struct {
+	control_admit limit, state;
+} control_admits[API_CTL_COUNT] = {
+	[API_CTL_RUNNING] = {NULL, admit_running},
+	[API_CTL_UNTIL] = {NULL, admit_until},
+	[API_CTL_CPU] = {admit_cpu_limit, NULL},
+};
+
+#define CONTROL_BIT(id, member, bit, fn) [API_CTL_##id] = bit,
+static const unsigned control_bits[API_CTL_COUNT] = {API_CONTROLS(CONTROL_BIT)};
+#undef CONTROL_BIT
+
+/* The session's state: one taking no more controls refuses any. */
+static api_err admit_session(const srv_session *s, api_problem *pb)
+{
+	if (s->stop)
+		return api_fail(pb, API_NOTFOUND, NULL,
+				"the session is being deleted");
+	if (s->state == SRV_FAILED)
+		return api_fail(pb, API_CONFLICT, NULL,
+				"the session has failed (%s); it takes no more "
+				"controls", s->error);
+	return API_OK;
+}
+
 /* The paced cores s needs after c: raise its hold before c is queued, or
  * refuse (lock held). The field named is the one that raises it. */
-static api_err admit_control(srv_session *s, const api_control *c,
-			     api_problem *pb)
+static api_err admit_paced(srv_session *s, const api_control *c,
+			   api_problem *pb)
 {
 	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
 	if (pace == API_PACE_MAX ||
@@ -38,38 +110,33 @@ static api_err admit_control(srv_session *s, const api_control *c,
 				     "changed", pb);
 }
 
+/* Admit c to s, the first refusal winning, in this fixed order: the
+ * members' limits (table order), the session's state, the members against
+ * the session (table order; until's and running's never both apply: running's
+ * needs until absent), the paced cores (lock held). */
+static api_err admit_control(srv_session *s, const api_control *c,
+			     api_problem *pb)
+{
+	api_err e;
+	for (size_t i = 0; i < API_CTL_COUNT; i++)
+		if ((c->set & control_bits[i]) && control_admits[i].limit &&
+		    (e = control_admits[i].limit(s, c, pb)) != API_OK)
+			return e;
+	if ((e = admit_session(s, pb)) != API_OK)
+		return e;
+	for (size_t i = 0; i < API_CTL_COUNT; i++)
+		if ((c->set & control_bits[i]) && control_admits[i].state &&
+		    (e = control_admits[i].state(s, c, pb)) != API_OK)
+			return e;
+	return admit_paced(s, c, pb);
+}
+
 api_err srv_session_control(srv_session *s, const api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
 	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
 	pthread_mutex_lock(&s->lock);
-	api_err e = API_OK;
-	if ((c->set & API_C_CPU) && c->cpu_budget > cfg->max_cpu_seconds) {
-		e = api_fail(pb, API_RANGE, "cpu_budget",
-			     "cpu_budget must be CPU seconds in (0, %g] "
-			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
-			     c->cpu_budget);
-		pb->has_range = 1;
-		pb->min = 0;
-		pb->max = cfg->max_cpu_seconds;
-	} else if (s->stop)
-		e = api_fail(pb, API_NOTFOUND, NULL,
-			     "the session is being deleted");
-	else if (s->state == SRV_FAILED)
-		e = api_fail(pb, API_CONFLICT, NULL,
-			     "the session has failed (%s); it takes no more "
-			     "controls", s->error);
-	else if ((c->set & API_C_UNTIL) && c->until > 0 && c->until <= s->st.t)
-		e = api_fail(pb, API_CONFLICT, "until",
-			     "until (%g s) lies in the past: the session is at "
-			     "t = %g s", c->until, s->st.t);
-	else if ((c->set & API_C_RUNNING) && c->running &&
-		 s->state == SRV_FINISHED && !(c->set & API_C_UNTIL))
-		e = api_fail(pb, API_CONFLICT, "running",
-			     "the session finished at until = %g s; raise "
-			     "until to run on", s->until);
-	else
-		e = admit_control(s, c, pb);
+	api_err e = admit_control(s, c, pb);
 	if (e != API_OK) {
 		pthread_mutex_unlock(&s->lock);
 		return e;

@@ -68,6 +68,31 @@ typedef struct srv_session_dem {
 	api_bed bed;              /* what the worker last read of it (lock) */
 } srv_session_dem;
 
+/* A restored session's replay of the controls logged after its checkpoint:
+ * session_store.c fills it at the restore; the worker (worker.c) applies
+ * the controls and ends the catch-up; guarded by the session's lock. */
+typedef struct srv_session_restore {
+	srv_replay *replay;       /* controls logged after the checkpoint it
+				     was restored from, in order: applied
+				     again as the integrator reaches each
+				     (session_store.c loads, worker.c runs) */
+	size_t nreplay, replayed;
+	size_t exp_relogged;      /* lines of the resumed experiment in the
+				     log after its checkpoint: its commands
+				     that many times are not logged again */
+	int rebuilt;              /* re-created from its spec, its checkpoint
+				     unusable (another build): the whole log
+				     is replayed */
+	double catch_up_t;        /* restored with controls to replay: runs
+				     flat out until its time reaches where
+				     it was (0: not; then it answers) */
+	double replay_wall, replay_seconds; /* when the replay began, how
+				     long it took (NAN until over) */
+	int upgrade;              /* restore: a file of an earlier format
+				     (store.h), written again in this one */
+	double replay_t0;         /* s: the time it was restored at */
+} srv_session_restore;
+
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
@@ -117,25 +142,7 @@ struct srv_session {
 				     (queued at the next write that works)
 				     is on disk */
 	int spec_retrying;        /* that rewrite is queued */
-	srv_replay *replay;       /* controls logged after the checkpoint it
-				     was restored from, in order: applied
-				     again as the integrator reaches each
-				     (session_store.c loads, worker.c runs) */
-	size_t nreplay, replayed;
-	size_t exp_relogged;      /* lines of the resumed experiment in the
-				     log after its checkpoint: its commands
-				     that many times are not logged again */
-	int rebuilt;              /* re-created from its spec, its checkpoint
-				     unusable (another build): the whole log
-				     is replayed */
-	double catch_up_t;        /* restored with controls to replay: runs
-				     flat out until its time reaches where
-				     it was (0: not; then it answers) */
-	double replay_wall, replay_seconds; /* when the replay began, how
-				     long it took (NAN until over) */
-	int upgrade;              /* restore: a file of an earlier format
-				     (store.h), written again in this one */
-	double replay_t0;         /* s: the time it was restored at */
+	srv_session_restore restore; /* a restored session's replay (session_store.c) */
 	/* budgets (budget.c) */
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */

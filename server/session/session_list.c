@@ -71,7 +71,7 @@ void srv_session_view(srv_session *s, api_view *v)
 		 s->store_error[0] && !s->damaged ? s->store_error : s->error);
 	v->pace = s->pace;
 	v->until = s->until;
-	v->has_status = !(s->catch_up_t > 0); /* a past the clients left */
+	v->has_status = !(s->restore.catch_up_t > 0); /* a past the clients left */
 	v->st = s->st;
 	v->steps_per_s = s->steps_per_s;
 	v->rtf = s->rtf;
@@ -83,8 +83,8 @@ void srv_session_view(srv_session *s, api_view *v)
 			  : s->cpu_paused      ? "cpu-budget"
 					       : "client";
 	v->waiting_for_cpu = s->waiting_for_cpu;
-	v->replayed = s->rebuilt;
-	v->replay_seconds = s->replay_seconds;
+	v->replayed = s->restore.rebuilt;
+	v->replay_seconds = s->restore.replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);
 	v->bed = s->dem.bed;
 	if (s->exp)
@@ -96,15 +96,15 @@ void srv_session_view(srv_session *s, api_view *v)
 /* The 503 for a session that replays (lock held). */
 static api_err replaying(const srv_session *s, api_problem *pb)
 {
-	if (!(s->catch_up_t > 0))
+	if (!(s->restore.catch_up_t > 0))
 		return API_OK;
-	double now = srv_now(), done = s->st.t - s->replay_t0;
-	double rate = now > s->replay_wall && done > 0 ? done / (now - s->replay_wall) : 0;
-	double left = rate > 0 ? (s->catch_up_t - s->st.t) / rate : 1;
+	double now = srv_now(), done = s->st.t - s->restore.replay_t0;
+	double rate = now > s->restore.replay_wall && done > 0 ? done / (now - s->restore.replay_wall) : 0;
+	double left = rate > 0 ? (s->restore.catch_up_t - s->st.t) / rate : 1;
 	api_fail(pb, API_UNAVAILABLE, NULL,
 		 "session %s is replaying its control log after a restart: at t = %.6g s of "
 		 "%.6g s; it answers once it is back where it was",
-		 s->entry.id, s->st.t, s->catch_up_t);
+		 s->entry.id, s->st.t, s->restore.catch_up_t);
 	pb->retry_after = left < 1 ? 1 : left > 60 ? 60 : (int)ceil(left);
 	return API_UNAVAILABLE;
 }

@@ -232,7 +232,7 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &older, &bad) : NULL;
 	*unread = !raw;
 	if (older)
-		s->upgrade = 1; /* written again in this build's format */
+		s->restore.upgrade = 1; /* written again in this build's format */
 	if (!p) {
 		snprintf(why, whylen, "%s: %s", file, bad);
 		return -1;
@@ -249,8 +249,8 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 		srv_ckpt_trailer tr;
 		memcpy(&tr, p + len - sizeof tr, sizeof tr);
 		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
-		if (isfinite(tr.t) && tr.t > s->catch_up_t)
-			s->catch_up_t = tr.t; /* where it was, if the core's
+		if (isfinite(tr.t) && tr.t > s->restore.catch_up_t)
+			s->restore.catch_up_t = tr.t; /* where it was, if the core's
 						 part is refused */
 	}
 	int err;
@@ -261,7 +261,7 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 		snprintf(why, whylen, "%s: %s", file, msg);
 		goto done;
 	}
-	s->catch_up_t = 0;
+	s->restore.catch_up_t = 0;
 	sim_free(s->sim);
 	s->sim = sm;
 	s->state = r.state;
@@ -307,7 +307,7 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 /* The control log back into s->controls (later controls are appended to
  * it), and the controls logged after its first `logged` bytes (what the
  * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
- * does not say) into s->replay, for the worker to apply again. */
+ * does not say) into s->restore.replay, for the worker to apply again. */
 static void load_controls(srv_session *s, size_t logged)
 {
 	char path[128];
@@ -328,11 +328,11 @@ static void load_controls(srv_session *s, size_t logged)
 	size_t lines = 0;
 	for (size_t i = logged; i < len; i++)
 		lines += text[i] == '\n';
-	s->replay = calloc(lines ? lines : 1, sizeof *s->replay);
-	for (size_t at = logged; s->replay && at < len;) {
+	s->restore.replay = calloc(lines ? lines : 1, sizeof *s->restore.replay);
+	for (size_t at = logged; s->restore.replay && at < len;) {
 		const char *nl = memchr(text + at, '\n', len - at);
 		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
-		srv_replay *rp = &s->replay[s->nreplay];
+		srv_replay *rp = &s->restore.replay[s->restore.nreplay];
 		api_problem pb;
 		char exp[SRV_ID_LEN];
 		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
@@ -341,18 +341,18 @@ static void load_controls(srv_session *s, size_t logged)
 			 * segments' commands again: applied twice, the second
 			 * would move the estimator's restart */
 			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
-			s->exp_relogged += rp->exp_own;
-			s->nreplay++;
+			s->restore.exp_relogged += rp->exp_own;
+			s->restore.nreplay++;
 		}
 		else if (n)
 			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
 					      "replayed: %s", s->entry.id, path, pb.detail);
 		at += n + 1;
 	}
-	if (s->nreplay)
+	if (s->restore.nreplay)
 		srv_log(SRV_LOG_INFO, "session %s: %zu controls logged after "
 				      "its checkpoint are replayed", s->entry.id,
-			s->nreplay);
+			s->restore.nreplay);
 }
 
 /* The spec of s from spec.json (the API's JSON: this build on) or, when
@@ -372,7 +372,7 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);
 		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
-			s->upgrade = 1;
+			s->restore.upgrade = 1;
 		return e == API_OK ? 0 : -1;
 	}
 	/* no spec.json: a build before it (c793934) wrote only spec.bin */
@@ -384,7 +384,7 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 		   : -1;
 	if (r && rc)
 		snprintf(why, whylen, "%s: %s", path, msg);
-	s->upgrade = 1; /* spec.json (and spec.bin) in this build's format */
+	s->restore.upgrade = 1; /* spec.json (and spec.bin) in this build's format */
 	free(r);
 	return rc;
 }
@@ -395,13 +395,13 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
  * no client sees it before the controls it acknowledged. */
 static void catch_up(srv_session *s)
 {
-	for (size_t i = 0; i < s->nreplay; i++)
-		if (s->replay[i].at > s->catch_up_t)
-			s->catch_up_t = s->replay[i].at;
-	s->replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
-	if (!(s->catch_up_t > s->replay_t0))
-		s->catch_up_t = 0;
-	s->replay_wall = srv_now();
+	for (size_t i = 0; i < s->restore.nreplay; i++)
+		if (s->restore.replay[i].at > s->restore.catch_up_t)
+			s->restore.catch_up_t = s->restore.replay[i].at;
+	s->restore.replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
+	if (!(s->restore.catch_up_t > s->restore.replay_t0))
+		s->restore.catch_up_t = 0;
+	s->restore.replay_wall = srv_now();
 }
 
 /* s was re-created from its spec because neither checkpoint could be used
@@ -410,11 +410,11 @@ static void catch_up(srv_session *s)
  * the last control's, then at its pace again (worker.c). */
 static void rebuild(srv_session *s, const char *why, const char *why2)
 {
-	s->rebuilt = 1;
-	s->replay_seconds = s->catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
+	s->restore.rebuilt = 1;
+	s->restore.replay_seconds = s->restore.catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
 	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
 			      "spec, %zu controls replayed to t = %g s",
-		s->entry.id, why, why2, s->nreplay, s->catch_up_t);
+		s->entry.id, why, why2, s->restore.nreplay, s->restore.catch_up_t);
 }
 
 /* The files of session id into s (srv_persist_load). */
@@ -460,7 +460,7 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 	if (s->sim) {
 		load_controls(s, 0);
 		if (none)
-			s->catch_up_t = 0;
+			s->restore.catch_up_t = 0;
 		catch_up(s);
 		if (!none)
 			rebuild(s, why, why2);
@@ -478,7 +478,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 		srv_store_count_damaged(SRV_STORE_SESSION);
 		return;
 	}
-	if (!s->upgrade)
+	if (!s->restore.upgrade)
 		return;
 	/* an earlier format: its spec written again at once (spec.json and
 	 * spec.bin, each atomically: store.c), its checkpoint at the next

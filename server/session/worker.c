@@ -180,8 +180,8 @@ static void start_job(srv_session *s)
 static void run_replay(srv_session *s)
 {
 	double t = sim_effective_time(s->sim);
-	while (s->replayed < s->nreplay && s->replay[s->replayed].at <= t) {
-		srv_replay *rp = &s->replay[s->replayed++];
+	while (s->restore.replayed < s->restore.nreplay && s->restore.replay[s->restore.replayed].at <= t) {
+		srv_replay *rp = &s->restore.replay[s->restore.replayed++];
 		if (rp->exp_own)
 			continue; /* its experiment sends it again */
 		rp->cmd.replay = 1;
@@ -194,15 +194,15 @@ static void run_replay(srv_session *s)
  * failed: from here on it keeps its pace and answers. */
 static void check_caught_up(srv_session *s, clocks *c)
 {
-	if (!(s->catch_up_t > 0) ||
-	    (s->st.t < s->catch_up_t && s->state != SRV_FAILED && !s->stop &&
-	     (s->replayed < s->nreplay || s->state == SRV_RUNNING)))
+	if (!(s->restore.catch_up_t > 0) ||
+	    (s->st.t < s->restore.catch_up_t && s->state != SRV_FAILED && !s->stop &&
+	     (s->restore.replayed < s->restore.nreplay || s->state == SRV_RUNNING)))
 		return;
-	s->catch_up_t = 0;
-	s->replay_seconds = srv_now() - s->replay_wall;
+	s->restore.catch_up_t = 0;
+	s->restore.replay_seconds = srv_now() - s->restore.replay_wall;
 	restart_clocks(c, s);
 	srv_log(SRV_LOG_INFO, "session %s: replayed to t = %g s in %.3f s",
-		s->entry.id, s->st.t, s->replay_seconds);
+		s->entry.id, s->st.t, s->restore.replay_seconds);
 }
 
 /* commands: apply what is queued; pacing restarts after pace or pause. */
@@ -403,7 +403,7 @@ static double due_at(const srv_session *s, const clocks *c, double t)
  * starts over, so that commands are seen at once). */
 static int pace(srv_session *s, clocks *c, double t_next)
 {
-	if (s->pace == API_PACE_MAX || s->catch_up_t > 0)
+	if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
 		return 0;
 	double due = due_at(s, c, t_next);
 	if (due <= c->batch_end)
@@ -553,7 +553,7 @@ void *srv_worker_main(void *arg)
 		run_job(s);
 		if (rc != SIM_OK)
 			fail(s, rc, why);
-		if (s->pace == API_PACE_MAX || s->catch_up_t > 0)
+		if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
 			meter(s, &clk, srv_now()); /* paced: pace() */
 		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
 			publish(s, &clk);

@@ -174,8 +174,8 @@ int srv_worker_apply_commands(srv_session *s)
 			api_model_check(&s->spec, &s->st, &me);
 			api_control_event_model(ring, sizeof ring, &cmd->c, t_eff, &me);
 			srv_ring_event(s, "control", ring);
-			if (cmd->from_experiment && s->exp_relogged > 0)
-				s->exp_relogged--; /* in the log since before the restore */
+			if (cmd->from_experiment && s->restore.exp_relogged > 0)
+				s->restore.exp_relogged--; /* in the log since before the restore */
 			else if (!cmd->replay)
 				cmd->logged = log_control(s, cmd, t_eff);
 			s->ckpt_dirty = 1;
