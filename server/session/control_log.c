@@ -91,7 +91,7 @@ int srv_control_log_sync(srv_session *s, size_t end, double timeout_s)
 			s->log.synced = to;
 			atomic_fetch_add(&srv_stats.log_syncs, 1);
 		} else {
-			snprintf(s->store_error, sizeof s->store_error,
+			snprintf(s->persist.store_error, sizeof s->persist.store_error,
 				 "cannot write sessions/%s/controls.ndjson: %s", s->entry.id,
 				 strerror(err));
 			atomic_fetch_add(&srv_stats.store_errors, 1);

@@ -61,8 +61,8 @@ static void session_free(srv_session *s)
 	if (s->dem.slot)
 		srv_dem_release();
 	sim_free(s->sim);
-	srv_budget_give(s->mem_reserved);
-	srv_budget_set_paced(&s->paced_held, 0);
+	srv_budget_give(s->budget.mem_reserved);
+	srv_budget_set_paced(&s->budget.paced_held, 0);
 	srv_sample_free(&s->scratch);
 	if (s->ring.bytes)
 		munmap(s->ring.samples, s->ring.bytes);
@@ -161,8 +161,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->pace = spec->pace;
 	s->until = spec->until;
 	s->state = SRV_RUNNING;
-	s->cpu_limit = cfg->max_cpu_seconds;
-	s->turn.wake = &s->wake;
+	s->budget.cpu_limit = cfg->max_cpu_seconds;
+	s->budget.turn.wake = &s->wake;
 	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
 			 sizeof msg);
 	if (!s->sim) {
@@ -188,16 +188,16 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	 * estimate) made a large scene's hold jump to the estimate when a
 	 * busy machine's probe fell just below it; --cpu-probe 0: the
 	 * estimate alone */
-	s->cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
+	s->budget.cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
 	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
 							   cfg->cpu_probe)
 					   : -1.0;
-	if (probed > s->cpu_per_s)
-		s->cpu_per_s = probed;
+	if (probed > s->budget.cpu_per_s)
+		s->budget.cpu_per_s = probed;
 	/* a bed process: its cores a simulated second until measured */
-	if (s->dem.link && s->cpu_per_s < s->dem.cores)
-		s->cpu_per_s = s->dem.cores;
+	if (s->dem.link && s->budget.cpu_per_s < s->dem.cores)
+		s->budget.cpu_per_s = s->dem.cores;
 	if (alloc_buffers(s)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
@@ -234,8 +234,8 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		   spec->scene.layers > 0;
 	if (srv_budget_take_session(feed ? spec->scene.columns : 0,
 				    feed ? spec->scene.layers : 0,
-				    &s->mem_reserved, pb) != API_OK) {
-		s->mem_reserved = 0;
+				    &s->budget.mem_reserved, pb) != API_OK) {
+		s->budget.mem_reserved = 0;
 		goto fail;
 	}
 	s->create_fd = client_fd;
@@ -245,7 +245,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&
-	    srv_budget_take_paced(&s->paced_held, s->cpu_per_s, s->pace, "pace",
+	    srv_budget_take_paced(&s->budget.paced_held, s->budget.cpu_per_s, s->pace, "pace",
 				  "created", pb) != API_OK)
 		goto fail;
 	s->exp = exp;
@@ -258,11 +258,11 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		char dir[64];
 		snprintf(dir, sizeof dir, "sessions/%s", s->entry.id);
 		if (srv_store_make_dir(dir) != 0)
-			snprintf(s->store_error, sizeof s->store_error,
+			snprintf(s->persist.store_error, sizeof s->persist.store_error,
 				 "cannot create %s: %s", dir, strerror(errno));
 	}
-	s->last_access = s->ckpt_wall = srv_now();
-	s->ckpt_dirty = 1;
+	s->last_access = s->persist.ckpt_wall = srv_now();
+	s->persist.ckpt_dirty = 1;
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
 		api_fail(pb, API_UNAVAILABLE, NULL,
 			 "cannot start the session's worker thread");
@@ -289,8 +289,8 @@ static void adopt_bed(srv_session *s)
 	srv_dem_hold();
 	s->dem.slot = 1;
 	if (srv_dem_start(s, !s->restore.rebuilt, msg, sizeof msg) == 0) {
-		if (s->cpu_per_s < s->dem.cores)
-			s->cpu_per_s = s->dem.cores;
+		if (s->budget.cpu_per_s < s->dem.cores)
+			s->budget.cpu_per_s = s->dem.cores;
 		return;
 	}
 	s->state = SRV_FAILED;
@@ -300,9 +300,9 @@ static void adopt_bed(srv_session *s)
 
 int srv_session_adopt(srv_session *s)
 {
-	s->last_access = s->ckpt_wall = srv_now();
-	s->cpu_limit = cfg->max_cpu_seconds;
-	s->turn.wake = &s->wake;
+	s->last_access = s->persist.ckpt_wall = srv_now();
+	s->budget.cpu_limit = cfg->max_cpu_seconds;
+	s->budget.turn.wake = &s->wake;
 	if (s->damaged) {
 		s->state = SRV_FAILED;
 	} else {
@@ -313,7 +313,7 @@ int srv_session_adopt(srv_session *s)
 		}
 		/* its worker commits the cores it needs, even beyond the
 		 * budget: it existed before */
-		s->cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
+		s->budget.cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
 						       s->columns, s->layers);
 		if (srv_dem_wanted(&s->spec))
 			adopt_bed(s);
@@ -324,8 +324,8 @@ int srv_session_adopt(srv_session *s)
 		goto fail;
 	}
 	/* what it had before the restart: reserved even beyond the budget */
-	s->mem_reserved = srv_budget_session_need(s->columns, s->layers);
-	srv_budget_take(s->mem_reserved, "a restored session", 1, NULL);
+	s->budget.mem_reserved = srv_budget_session_need(s->columns, s->layers);
+	srv_budget_take(s->budget.mem_reserved, "a restored session", 1, NULL);
 	if (alloc_buffers(s)) {
 		srv_registry_cancel(&sessions, &s->entry);
 		goto fail;

@@ -99,14 +99,14 @@ static api_err admit_paced(srv_session *s, const api_control *c,
 {
 	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
 	if (pace == API_PACE_MAX ||
-	    srv_state_after(s->state, s->cpu_paused, s->st.t, c) != SRV_RUNNING ||
-	    s->cpu_per_s * pace <= s->paced_held)
+	    srv_state_after(s->state, s->budget.cpu_paused, s->st.t, c) != SRV_RUNNING ||
+	    s->budget.cpu_per_s * pace <= s->budget.paced_held)
 		return API_OK;
 	const char *field = (c->set & API_C_PACE)      ? "pace"
 			    : (c->set & API_C_RUNNING) ? "running"
 			    : (c->set & API_C_CPU)     ? "cpu_budget"
 						       : "until";
-	return srv_budget_take_paced(&s->paced_held, s->cpu_per_s, pace, field,
+	return srv_budget_take_paced(&s->budget.paced_held, s->budget.cpu_per_s, pace, field,
 				     "changed", pb);
 }
 
@@ -149,7 +149,7 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 			break;
 	if (!cmd.done) { /* take it back: nothing changes */
 		srv_worker_unqueue(s, &cmd);
-		srv_budget_set_paced(&s->paced_held, srv_paced_need(s));
+		srv_budget_set_paced(&s->budget.paced_held, srv_paced_need(s));
 		pthread_mutex_unlock(&s->lock);
 		return api_fail(pb, API_UNAVAILABLE, NULL,
 				"the session's worker did not take the change "
@@ -189,7 +189,7 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 			      "the session already runs experiment %s",
 			      srv_exp_id(s->exp));
 	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
-		 (rc = srv_budget_take_paced(&s->paced_held, s->cpu_per_s,
+		 (rc = srv_budget_take_paced(&s->budget.paced_held, s->budget.cpu_per_s,
 					     s->pace, "session", "attached",
 					     pb)) != API_OK)
 		; /* the experiment would run it on (worker.c extend_until)

@@ -93,6 +93,39 @@ typedef struct srv_session_restore {
 	double replay_t0;         /* s: the time it was restored at */
 } srv_session_restore;
 
+/* What a session holds of the daemon's budgets (budget.c keeps the
+ * totals) and the CPU it measures: worker.c owns it (its CPU clock, the
+ * cost measure, the hold on the paced cores, its CPU turn at pace max);
+ * session.c only takes the memory at creation and gives all back at the
+ * end. Guarded by the session's lock but for turn (worker only). */
+typedef struct srv_session_budget {
+	size_t mem_reserved;      /* bytes of the memory budget it holds */
+	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
+	int waiting_for_cpu;      /* its turn has not come */
+	double cpu_seconds;       /* the worker's CPU time, s */
+	double cpu_limit;         /* pauses when cpu_seconds reaches it */
+	int cpu_paused;           /* paused because cpu_limit was reached */
+	double cpu_per_s;         /* CPU s per simulated s: estimated at
+				     creation, then measured by the worker */
+	int cpu_measured;         /* cpu_per_s is the worker's measure */
+	double paced_held;        /* cores of the paced budget it holds */
+} srv_session_budget;
+
+/* The state of a session's files: session_store.c owns it (writes the
+ * checkpoints and the spec, keeps the last failure); the worker and the
+ * control handlers only mark a change (ckpt_dirty) and the control log
+ * reports its failures into store_error. Guarded by the session's lock. */
+typedef struct srv_session_persist {
+	double ckpt_wall;         /* srv_now() of the last checkpoint */
+	int ckpt_dirty;           /* a control or state change since */
+	char store_error[256];    /* the last failed write, "" */
+	int spec_unwritten;       /* spec.json failed to be written: the
+				     session stays "error" until a rewrite
+				     (queued at the next write that works)
+				     is on disk */
+	int spec_retrying;        /* that rewrite is queued */
+} srv_session_persist;
+
 struct srv_session {
 	srv_entry entry;          /* id and references: the registry */
 	api_spec spec;            /* immutable */
@@ -134,26 +167,9 @@ struct srv_session {
 				     line each (controls.ndjson) */
 	size_t controls_len, controls_cap;
 	srv_control_log log;      /* the log on disk (control_log.c), lock */
-	double ckpt_wall;         /* srv_now() of the last checkpoint */
-	int ckpt_dirty;           /* a control or state change since */
-	char store_error[256];    /* the last failed write, "" */
-	int spec_unwritten;       /* spec.json failed to be written: the
-				     session stays "error" until a rewrite
-				     (queued at the next write that works)
-				     is on disk */
-	int spec_retrying;        /* that rewrite is queued */
+	srv_session_persist persist; /* its files' state (session_store.c) */
 	srv_session_restore restore; /* a restored session's replay (session_store.c) */
-	/* budgets (budget.c) */
-	size_t mem_reserved;      /* bytes of the memory budget it holds */
-	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
-	int waiting_for_cpu;      /* its turn has not come */
-	double cpu_seconds;       /* the worker's CPU time, s */
-	double cpu_limit;         /* pauses when cpu_seconds reaches it */
-	int cpu_paused;           /* paused because cpu_limit was reached */
-	double cpu_per_s;         /* CPU s per simulated s: estimated at
-				     creation, then measured by the worker */
-	int cpu_measured;         /* cpu_per_s is the worker's measure */
-	double paced_held;        /* cores of the paced budget it holds */
+	srv_session_budget budget; /* what it holds of the budgets (worker.c) */
 	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
 	int create_fd;            /* while created: the client's socket or -1
 				     (a bed's settling ends when it leaves) */
@@ -207,7 +223,7 @@ static inline double srv_paced_need(const srv_session *s)
 {
 	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
 		return 0;
-	double need = s->cpu_per_s * s->pace;
+	double need = s->budget.cpu_per_s * s->pace;
 	/* a LIGGGHTS session's bed process holds its cores */
 	return s->dem.link && need < s->dem.cores ? s->dem.cores : need;
 }

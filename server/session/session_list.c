@@ -64,11 +64,11 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->layers = s->layers;
 	pthread_mutex_lock(&s->lock);
 	v->state = s->damaged ? "damaged"
-		   : s->store_error[0] && s->state != SRV_FAILED
+		   : s->persist.store_error[0] && s->state != SRV_FAILED
 			   ? "error"
 			   : state_name(s->state);
 	snprintf(v->error, sizeof v->error, "%s",
-		 s->store_error[0] && !s->damaged ? s->store_error : s->error);
+		 s->persist.store_error[0] && !s->damaged ? s->persist.store_error : s->error);
 	v->pace = s->pace;
 	v->until = s->until;
 	v->has_status = !(s->restore.catch_up_t > 0); /* a past the clients left */
@@ -77,12 +77,12 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->rtf = s->rtf;
 	v->samples = s->ring.head;
 	v->streams = s->streams;
-	v->cpu_seconds = s->cpu_seconds;
-	v->cpu_limit = s->cpu_limit;
+	v->cpu_seconds = s->budget.cpu_seconds;
+	v->cpu_limit = s->budget.cpu_limit;
 	v->pause_reason = s->state != SRV_PAUSED ? NULL
-			  : s->cpu_paused      ? "cpu-budget"
+			  : s->budget.cpu_paused      ? "cpu-budget"
 					       : "client";
-	v->waiting_for_cpu = s->waiting_for_cpu;
+	v->waiting_for_cpu = s->budget.waiting_for_cpu;
 	v->replayed = s->restore.rebuilt;
 	v->replay_seconds = s->restore.replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);

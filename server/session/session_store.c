@@ -68,16 +68,16 @@ static void written(void *arg, int err, const char *what)
 		return;
 	pthread_mutex_lock(&s->lock);
 	if (spec) {
-		s->spec_unwritten = err != 0;
-		s->spec_retrying = 0;
+		s->persist.spec_unwritten = err != 0;
+		s->persist.spec_retrying = 0;
 	}
 	if (err)
-		snprintf(s->store_error, sizeof s->store_error, "%s", what);
-	else if (s->spec_unwritten && !s->spec_retrying) {
-		s->spec_retrying = 1;
+		snprintf(s->persist.store_error, sizeof s->persist.store_error, "%s", what);
+	else if (s->persist.spec_unwritten && !s->persist.spec_retrying) {
+		s->persist.spec_retrying = 1;
 		srv_persist_spec(s);
-	} else if (!s->spec_unwritten && what && what[0] == '\0')
-		s->store_error[0] = '\0';
+	} else if (!s->persist.spec_unwritten && what && what[0] == '\0')
+		s->persist.store_error[0] = '\0';
 	pthread_mutex_unlock(&s->lock);
 	srv_session_put(s);
 }
@@ -136,9 +136,9 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	if (!srv_store_enabled() || !s->sim)
 		return;
 	double now = srv_now();
-	int due = now - s->ckpt_wall >= srv_store_interval() &&
-		  (s->state == SRV_RUNNING || s->ckpt_dirty);
-	if (!due && !(force && s->ckpt_dirty))
+	int due = now - s->persist.ckpt_wall >= srv_store_interval() &&
+		  (s->state == SRV_RUNNING || s->persist.ckpt_dirty);
+	if (!due && !(force && s->persist.ckpt_dirty))
 		return;
 	srv_ckpt_record r;
 	memset(&r, 0, sizeof r);
@@ -175,8 +175,8 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	}
 	free(payload);
 	free(exp);
-	s->ckpt_wall = now;
-	s->ckpt_dirty = 0;
+	s->persist.ckpt_wall = now;
+	s->persist.ckpt_dirty = 0;
 }
 
 api_err srv_session_check_removable(const srv_session *s, api_problem *pb)
@@ -484,7 +484,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	 * spec.bin, each atomically: store.c), its checkpoint at the next
 	 * interval, in this build's format */
 	srv_persist_spec(s);
-	s->ckpt_dirty = 1;
+	s->persist.ckpt_dirty = 1;
 	srv_store_count_upgraded(SRV_STORE_SESSION);
 	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
 			      "in format %d", s->entry.id, SRV_STORE_VERSION);

@@ -217,7 +217,7 @@ static void check_until(srv_session *s, clocks *c)
 {
 	if (s->state == SRV_RUNNING && s->until > 0 && s->st.t >= s->until) {
 		s->state = SRV_FINISHED;
-		s->ckpt_dirty = 1;
+		s->persist.ckpt_dirty = 1;
 		srv_ring_event_at(s, "finished", NULL);
 		publish(s, c);
 	}
@@ -232,16 +232,16 @@ static void check_until(srv_session *s, clocks *c)
 
 static void measure_cost(srv_session *s, clocks *c)
 {
-	double cpu = s->cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
+	double cpu = s->budget.cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
 	if (t <= 0 || (cpu < COST_WINDOW_CPU && t < COST_WINDOW_T)) {
 		if (t < 0) /* not a window: start one */
-			c->cost_cpu = s->cpu_seconds, c->cost_t = s->st.t;
+			c->cost_cpu = s->budget.cpu_seconds, c->cost_t = s->st.t;
 		return;
 	}
 	double cost = cpu / t;
-	s->cpu_per_s = s->cpu_measured ? 0.5 * (s->cpu_per_s + cost) : cost;
-	s->cpu_measured = 1;
-	c->cost_cpu = s->cpu_seconds;
+	s->budget.cpu_per_s = s->budget.cpu_measured ? 0.5 * (s->budget.cpu_per_s + cost) : cost;
+	s->budget.cpu_measured = 1;
+	c->cost_cpu = s->budget.cpu_seconds;
 	c->cost_t = s->st.t;
 }
 
@@ -251,8 +251,8 @@ static void measure_cost(srv_session *s, clocks *c)
  * so that it does not starve the others (lock held). */
 static void pace_down(srv_session *s, clocks *c)
 {
-	double was = s->pace, cost = s->cpu_per_s;
-	double pace = srv_budget_fit_pace(&s->paced_held, cost, was);
+	double was = s->pace, cost = s->budget.cpu_per_s;
+	double pace = srv_budget_fit_pace(&s->budget.paced_held, cost, was);
 	if (pace >= was)
 		return;
 	api_control ctl = {.set = API_C_PACE, .pace = pace};
@@ -261,7 +261,7 @@ static void pace_down(srv_session *s, clocks *c)
 	s->pace = pace;
 	srv_ring_event(s, "control", json);
 	srv_control_log_append(s, json, 0);
-	s->ckpt_dirty = 1;
+	s->persist.ckpt_dirty = 1;
 	restart_clocks(c, s);
 	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
 			      "admitted; paced down from %g to %g to fit "
@@ -290,10 +290,10 @@ static void pace_down(srv_session *s, clocks *c)
 static void commit_need(srv_session *s, clocks *c)
 {
 	double need = srv_paced_need(s);
-	if (need > PACE_DOWN_OVER * s->paced_held && need > 1e-9)
+	if (need > PACE_DOWN_OVER * s->budget.paced_held && need > 1e-9)
 		pace_down(s, c);
-	else if (need != s->paced_held)
-		srv_budget_set_paced(&s->paced_held, need);
+	else if (need != s->budget.paced_held)
+		srv_budget_set_paced(&s->budget.paced_held, need);
 }
 
 /* cpu: read the worker's CPU time; a running session that spent its
@@ -307,18 +307,18 @@ static void check_cpu(srv_session *s, clocks *c)
 	c->cpu_wall = now;
 	/* a LIGGGHTS session's bed process's CPU is the session's too */
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
-		s->cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
+		s->budget.cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
 				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
 	measure_cost(s, c);
-	if (s->state != SRV_RUNNING || s->cpu_seconds < s->cpu_limit)
+	if (s->state != SRV_RUNNING || s->budget.cpu_seconds < s->budget.cpu_limit)
 		return;
 	s->state = SRV_PAUSED;
-	s->cpu_paused = 1;
-	s->ckpt_dirty = 1;
+	s->budget.cpu_paused = 1;
+	s->persist.ckpt_dirty = 1;
 	srv_ring_event_at(s, "paused", "\"reason\":\"cpu-budget\"");
 	publish(s, c);
 	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
-			      "spent", s->entry.id, s->cpu_limit);
+			      "spent", s->entry.id, s->budget.cpu_limit);
 }
 
 /* turn: a running pace "max" session steps only while it holds a CPU
@@ -327,17 +327,17 @@ static void check_cpu(srv_session *s, clocks *c)
 static int take_turn(srv_session *s, clocks *c)
 {
 	if (s->state != SRV_RUNNING || s->pace != API_PACE_MAX || s->stop) {
-		srv_cpu_leave(&s->turn);
-		s->waiting_for_cpu = 0;
+		srv_cpu_leave(&s->budget.turn);
+		s->budget.waiting_for_cpu = 0;
 		return 0;
 	}
-	if (srv_cpu_turn_over(&s->turn))
-		srv_cpu_leave(&s->turn); /* to the back of the line */
-	if (srv_cpu_take(&s->turn)) {
-		s->waiting_for_cpu = 0;
+	if (srv_cpu_turn_over(&s->budget.turn))
+		srv_cpu_leave(&s->budget.turn); /* to the back of the line */
+	if (srv_cpu_take(&s->budget.turn)) {
+		s->budget.waiting_for_cpu = 0;
 		return 0;
 	}
-	s->waiting_for_cpu = 1;
+	s->budget.waiting_for_cpu = 1;
 	publish(s, c);
 	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
 	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
@@ -350,8 +350,8 @@ static int idle(srv_session *s, clocks *c)
 {
 	if (s->state == SRV_RUNNING)
 		return 0;
-	srv_cpu_leave(&s->turn);
-	s->waiting_for_cpu = 0;
+	srv_cpu_leave(&s->budget.turn);
+	s->budget.waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	publish(s, c);
@@ -482,7 +482,7 @@ static void run_job(srv_session *s)
 	srv_worker_queue_exp_command(s, srv_exp_step(s->exp, &s->st, &over));
 	if (over) {
 		srv_worker_detach_exp(s, NULL);
-		s->ckpt_dirty = 1;
+		s->persist.ckpt_dirty = 1;
 		if (s->owned) /* created by it and not kept */
 			s->expire = 1;
 	}
@@ -496,7 +496,7 @@ static void fail(srv_session *s, int rc, const char *why)
 	if (s->stop && why[0])
 		return;
 	s->state = SRV_FAILED;
-	s->ckpt_dirty = 1;
+	s->persist.ckpt_dirty = 1;
 	if (s->owned)
 		s->expire = 1;
 	if (why[0])
@@ -566,12 +566,12 @@ void *srv_worker_main(void *arg)
 		pthread_mutex_unlock(&s->lock);
 		srv_control_log_sync(s, logged, 30.0);
 		pthread_mutex_lock(&s->lock);
-		s->ckpt_dirty = 1;
+		s->persist.ckpt_dirty = 1;
 		srv_persist_checkpoint(s, 1);
 	}
 	srv_worker_detach_exp(s, "the session was deleted or the daemon stopped");
-	srv_cpu_leave(&s->turn);
-	srv_budget_set_paced(&s->paced_held, 0);
+	srv_cpu_leave(&s->budget.turn);
+	srv_budget_set_paced(&s->budget.paced_held, 0);
 	pthread_cond_broadcast(&s->data);
 	pthread_mutex_unlock(&s->lock);
 	return NULL;

@@ -28,12 +28,12 @@ static void apply_budget(srv_session *s, const srv_cmd *cmd)
 {
 	const api_control *c = &cmd->c;
 	if (c->set & API_C_CPU)
-		s->cpu_limit = s->cpu_seconds + c->cpu_budget;
-	else if ((c->set & API_C_RUNNING) && c->running && s->cpu_paused &&
+		s->budget.cpu_limit = s->budget.cpu_seconds + c->cpu_budget;
+	else if ((c->set & API_C_RUNNING) && c->running && s->budget.cpu_paused &&
 		 cmd->cpu_grant > 0)
-		s->cpu_limit = s->cpu_seconds + cmd->cpu_grant;
+		s->budget.cpu_limit = s->budget.cpu_seconds + cmd->cpu_grant;
 	if (s->state != SRV_PAUSED || (c->set & API_C_RUNNING))
-		s->cpu_paused = 0;
+		s->budget.cpu_paused = 0;
 }
 
 /* Append cmd's line to the control log: an experiment's names it (lock
@@ -146,7 +146,7 @@ static int apply_command(srv_session *s, const srv_cmd *cmd, int *reanchor)
 	 * finished session resumed by until: it restarts its clocks when it
 	 * wakes, idle) */
 	int was = s->state;
-	s->state = srv_state_after(was, s->cpu_paused, s->st.t, c);
+	s->state = srv_state_after(was, s->budget.cpu_paused, s->st.t, c);
 	*reanchor |= (c->set & API_C_RUNNING) || (was == SRV_PAUSED && s->state != was);
 	apply_budget(s, cmd);
 	return SIM_OK;
@@ -178,7 +178,7 @@ int srv_worker_apply_commands(srv_session *s)
 				s->restore.exp_relogged--; /* in the log since before the restore */
 			else if (!cmd->replay)
 				cmd->logged = log_control(s, cmd, t_eff);
-			s->ckpt_dirty = 1;
+			s->persist.ckpt_dirty = 1;
 		}
 		cmd->rc = rc;
 		cmd->t_eff = t_eff;
