@@ -5,8 +5,9 @@
  *
  * The writer takes jobs from one FIFO queue: writes (superseding a
  * pending write to the same path in place) and removals. A write is
- * open(path.tmp) -> write all -> fsync -> close (each checked) -> [rename
- * path -> path.prev] -> rename(path.tmp, path) -> fsync of the directory;
+ * open(path.tmp) -> write all -> fsync -> close (each checked) -> [path.prev
+ * made a second name of path] -> rename(path.tmp, path) -> fsync of the
+ * directory;
  * on any failure the temporary file is removed and the file it would have
  * replaced stays as it was. So a reader finds the old file or the new
  * one, whole, never a mixture, whatever moment the daemon dies. The
@@ -127,8 +128,13 @@ static int write_atomic(const store_job *j, char *msg, size_t msglen)
 	fd = -1;
 	if (c != 0)
 		goto fail;
+	/* the previous version as a second name of the current file, so that
+	 * path names a whole file at every moment (a rename of path to
+	 * path.prev left none between the two renames: a kill there lost the
+	 * latest checkpoint's name) */
 	step = "keep the previous version of";
-	if (j->keep_prev && rename(path, prev) != 0 && errno != ENOENT)
+	if (j->keep_prev && ((unlink(prev) != 0 && errno != ENOENT) ||
+			     (link(path, prev) != 0 && errno != ENOENT)))
 		goto fail;
 	step = "rename into place";
 	if (rename(tmp, path) != 0)
