@@ -19,25 +19,6 @@ static void put_pace(cJSON *o, const char *name, double pace)
 		api_add_number(o, name, pace);
 }
 
-int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me)
-{
-	sim_params p = spec->params;
-	if (st) {
-		p.beta = st->beta_target;
-		p.rotation = st->rotation;
-		p.omega_ss = st->omega_ss;
-	}
-	return sim_model_check(&p, &spec->scene, me);
-}
-
-void api_add_model_error(cJSON *o, const sim_model_error *me)
-{
-	api_add_number(o, "model_error", me->checked ? me->error : NAN);
-	api_add_number(o, "model_error_uncertainty", me->checked ? me->error_uncertainty : NAN);
-	cJSON_AddBoolToObject(o, "model_checked", me->checked);
-	cJSON_AddStringToObject(o, "model_check_note", me->note);
-}
-
 static cJSON *status_object(const api_view *v)
 {
 	const sim_status *st = &v->st;

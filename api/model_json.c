@@ -1,0 +1,30 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * model_json.c - the DEM check of a scene's column model (core's
+ * sim_model_check) as the members every answer that reports a v carries:
+ * model_error, model_error_uncertainty, model_checked, model_check_note.
+ * Its own file, so that the session, control, sweep and experiment
+ * writers all use it without using each other.
+ */
+#include <math.h>
+
+#include "json_int.h"
+
+int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me)
+{
+	sim_params p = spec->params;
+	if (st) {
+		p.beta = st->beta_target;
+		p.rotation = st->rotation;
+		p.omega_ss = st->omega_ss;
+	}
+	return sim_model_check(&p, &spec->scene, me);
+}
+
+void api_add_model_error(cJSON *o, const sim_model_error *me)
+{
+	api_add_number(o, "model_error", me->checked ? me->error : NAN);
+	api_add_number(o, "model_error_uncertainty", me->checked ? me->error_uncertainty : NAN);
+	cJSON_AddBoolToObject(o, "model_checked", me->checked);
+	cJSON_AddStringToObject(o, "model_check_note", me->note);
+}
