@@ -237,7 +237,8 @@ test('every live plot exports PNG and CSV; the trajectory downloads as CSV and J
 		await summary.focus();
 		assert.equal(await summary.evaluate(e => e === document.activeElement && e.tabIndex >= 0), true, `${name}: the summary takes focus`);
 		await page.keyboard.press('Enter');
-		const t = await until(() => page.$eval(`#plot-${name} + .plot-export .plot-data`, d => d.open && {
+		/* the table is filled by the toggle event, which comes after open is set */
+		const t = await until(() => page.$eval(`#plot-${name} + .plot-export .plot-data`, d => d.open && d.querySelector('th') && {
 			label: d.querySelector('table').getAttribute('aria-label'),
 			head: Array.from(d.querySelectorAll('th')).map(h => h.textContent).join(','),
 			rows: d.querySelectorAll('tbody tr').length }), 3000, `${name}'s data table`);
