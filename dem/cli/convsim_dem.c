@@ -120,6 +120,55 @@ static double dem_number(const char *opt, const char *text, double lo, double hi
 	return v;
 }
 
+/* The options whose argument has parts: NAME=VALUE, A:DEG, E:NU, E:MU:MUR. */
+static void dem_parse_compound(int c, const char *arg, dem_opts *o)
+{
+	char msg[200], name[64];
+	const char *eq;
+	switch (c) {
+	case D_SET:
+		eq = strchr(arg, '=');
+		if (!eq || eq == arg) {
+			fprintf(stderr, "convsim-dem: --set needs NAME=VALUE, got '%s'\n", arg);
+			exit(2);
+		}
+		snprintf(name, sizeof name, "%.*s", (int)(eq - arg), arg);
+		if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg)) {
+			fprintf(stderr, "convsim-dem: --set %s: %s\n", arg, msg);
+			exit(2);
+		}
+		break;
+	case D_FRAME_CHECK:
+		if (sscanf(arg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
+		    !(o->frame_amp > 0) || !(o->frame_amp <= 0.01) || !(o->frame_angle >= 0) ||
+		    !(o->frame_angle <= 180)) {
+			fprintf(stderr, "convsim-dem: --frame-check must be A:DEG with A in (0, 0.01] m "
+					"and DEG in [0, 180], got '%s'\n", arg);
+			exit(2);
+		}
+		break;
+	case D_HERTZ:
+		if (sscanf(arg, "%lf:%lf", &o->youngs, &o->poisson) != 2 || !(o->youngs >= 5e6) ||
+		    !(o->youngs <= 1e9) || !(o->poisson > 0) || !(o->poisson < 0.5)) {
+			fprintf(stderr, "convsim-dem: --hertz must be E:NU with E in [5e6, 1e9] Pa "
+					"and NU in (0, 0.5), got '%s'\n", arg);
+			exit(2);
+		}
+		break;
+	case D_PAIR:
+	case D_WALL: {
+		double *t = c == D_PAIR ? o->pair : o->wall;
+		if (sscanf(arg, "%lf:%lf:%lf", &t[0], &t[1], &t[2]) != 3 || !(t[0] > 0.05) ||
+		    !(t[0] <= 1) || !(t[1] >= 0) || !(t[1] <= 10) || !(t[2] >= 0) || !(t[2] <= 10)) {
+			fprintf(stderr, "convsim-dem: --%s must be E:MU:MUR with E in (0.05, 1], MU and "
+					"MUR in [0, 10], got '%s'\n", c == D_PAIR ? "pair" : "wall", arg);
+			exit(2);
+		}
+		break;
+	}
+	}
+}
+
 /* 0 for `off`, 1 for `on`, or exit 2 naming the option and both words. */
 static int dem_choice(const char *opt, const char *text, const char *off, const char *on)
 {
@@ -148,22 +197,13 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 	const char *arg;
 	while ((c = cli_next_option_in(dem_options, DEM_NOPTIONS, 1, "convsim-dem",
 				       "convsim-dem --help", argc, argv, &arg)) != -1) {
-		char msg[200], name[64];
-		const char *eq;
 		switch (c) {
 		case D_PRESET: break;
 		case D_SET:
-			eq = strchr(arg, '=');
-			if (!eq || eq == arg) {
-				fprintf(stderr, "convsim-dem: --set needs NAME=VALUE, got '%s'\n", arg);
-				exit(2);
-			}
-			snprintf(name, sizeof name, "%.*s", (int)(eq - arg), arg);
-			if (sim_set_user_str(&o->p, &o->sc, &o->m, name, eq + 1, msg, sizeof msg)) {
-				fprintf(stderr, "convsim-dem: --set %s: %s\n", arg, msg);
-				exit(2);
-			}
-			break;
+		case D_FRAME_CHECK:
+		case D_HERTZ:
+		case D_PAIR:
+		case D_WALL: dem_parse_compound(c, arg, o); break;
 		case D_DURATION: o->duration = dem_number("duration", arg, 0.01, 1000); break;
 		case D_TRANSIENT: o->transient = dem_number("transient", arg, 0, 1000); break;
 		case D_GRAINS: o->grains = (int)dem_number("grains", arg, 1, 1e6); break;
@@ -185,34 +225,6 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 		case D_MOTION: o->motion_machine = dem_choice("motion", arg, "fit", "machine"); break;
 		case D_TANGENTIAL: o->tangential_viscous = dem_choice("tangential", arg, "spring", "viscous"); break;
 		case D_COUPLING_STEPS: o->coupling_steps = (int)dem_number("coupling-steps", arg, 1, 1000); break;
-		case D_FRAME_CHECK:
-			if (sscanf(arg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
-			    !(o->frame_amp > 0) || !(o->frame_amp <= 0.01) || !(o->frame_angle >= 0) ||
-			    !(o->frame_angle <= 180)) {
-				fprintf(stderr, "convsim-dem: --frame-check must be A:DEG with A in (0, 0.01] m "
-						"and DEG in [0, 180], got '%s'\n", arg);
-				exit(2);
-			}
-			break;
-		case D_HERTZ:
-			if (sscanf(arg, "%lf:%lf", &o->youngs, &o->poisson) != 2 || !(o->youngs >= 5e6) ||
-			    !(o->youngs <= 1e9) || !(o->poisson > 0) || !(o->poisson < 0.5)) {
-				fprintf(stderr, "convsim-dem: --hertz must be E:NU with E in [5e6, 1e9] Pa "
-						"and NU in (0, 0.5), got '%s'\n", arg);
-				exit(2);
-			}
-			break;
-		case D_PAIR:
-		case D_WALL: {
-			double *t = c == D_PAIR ? o->pair : o->wall;
-			if (sscanf(arg, "%lf:%lf:%lf", &t[0], &t[1], &t[2]) != 3 || !(t[0] > 0.05) ||
-			    !(t[0] <= 1) || !(t[1] >= 0) || !(t[1] <= 10) || !(t[2] >= 0) || !(t[2] <= 10)) {
-				fprintf(stderr, "convsim-dem: --%s must be E:MU:MUR with E in (0.05, 1], MU and "
-						"MUR in [0, 10], got '%s'\n", c == D_PAIR ? "pair" : "wall", arg);
-				exit(2);
-			}
-			break;
-		}
 		case D_DENSITY: o->density = dem_number("density", arg, 1, 100000); break;
 		case D_HELP: dem_help(stdout); exit(0);
 		default: exit(2); /* cli_next_option_in said why */
@@ -330,6 +342,55 @@ static int frame_check(const dem_opts *o)
 	return 0;
 }
 
+/* The run's JSON report on stdout. */
+static void dem_report(const dem_opts *o, const dem_bed_spec *spec, const dem_motion *mo,
+		       const dem_prescribed *r, const sim_measurement *col)
+{
+	double zeta = dem_restitution_damping(spec->restitution);
+	printf("{\n  \"beta\": %.17g,\n  \"rotation\": \"%s\",\n", o->p.beta / RAD_PER_DEG,
+	       o->p.rotation == SIM_CW ? "cw" : "ccw");
+	printf("  \"motion\": \"%s\",\n  \"grains\": %d,\n", o->motion_machine ? "machine" : "fit",
+	       spec->grains);
+	put("bed_height", r->bed_height, 0);
+	put("bed_mass", r->mass, 0);
+	put("k_over_m", spec->k_over_m, 0);
+	put("restitution_floor", spec->restitution, 0);
+	put("restitution_pair", dem_restitution(zeta / sqrt(2)), 0);
+	put("mu", spec->mu, 0);
+	put("mu_roll", spec->mu_roll, 0);
+	printf("  \"tangential\": \"%s\",\n", spec->tangential_viscous ? "viscous" : "spring");
+	put("seed", o->seed, 0);
+	put("deck_omega", mo->omega, 0);
+	put("deck_fit_residual", mo->residual, 0);
+	put("deck_amplitude", mo->amplitude, 0);
+	put("dem_dt", r->dt, 0);
+	put("intervals", o->motion_machine ? NAN : o->intervals, 0);
+	put("periods", r->periods, 0);
+	put("v_dem", r->transport_velocity, 0);
+	put("v_column", col->transport_velocity, 0);
+	put("v_column_uncertainty", col->uncertainty, 0);
+	put("layers", o->sc.layers, 0);
+	printf("  \"contacts\": \"%s\",\n", spec->hertz ? "hertz" : "linear");
+	put("density", spec->density, 0);
+	put("youngs", spec->hertz ? spec->youngs : NAN, 0);
+	put("poisson", spec->hertz ? spec->poisson : NAN, 0);
+	put("e_pp", spec->hertz ? spec->e_pp : NAN, 0);
+	put("e_pw", spec->hertz ? spec->e_pw : NAN, 0);
+	put("mu_pp", spec->hertz ? spec->mu_pp : NAN, 0);
+	put("mu_pw", spec->hertz ? spec->mu_pw : NAN, 0);
+	put("roll_pp", spec->hertz ? spec->roll_pp : NAN, 0);
+	put("roll_pw", spec->hertz ? spec->roll_pw : NAN, 0);
+	put("d_mean", 0.5 * (spec->d_min + spec->d_max), 0);
+	put("cell_x", spec->cell_x, 0);
+	put("cell_y", spec->cell_y, 0);
+	put("v_first_half", r->v_first_half, 0);
+	put("v_second_half", r->v_second_half, 0);
+	put("overlap_pp_max", r->overlap_pp, 0);
+	put("overlap_pw_max", r->overlap_pw, 0);
+	put("dem_cpu_seconds", r->cpu_seconds, 1);
+	printf("}\n");
+}
+
 int main(int argc, char **argv)
 {
 	sim_tether_from_env(); /* the test suite's: end with the test */
@@ -376,48 +437,6 @@ int main(int argc, char **argv)
 	if (o.motion_machine)
 		r.cpu_seconds = dem_cpu_now() - cpu0;
 	dem_bed_free(bed);
-	double zeta = dem_restitution_damping(spec.restitution);
-	printf("{\n  \"beta\": %.17g,\n  \"rotation\": \"%s\",\n", o.p.beta / RAD_PER_DEG,
-	       o.p.rotation == SIM_CW ? "cw" : "ccw");
-	printf("  \"motion\": \"%s\",\n  \"grains\": %d,\n", o.motion_machine ? "machine" : "fit",
-	       spec.grains);
-	put("bed_height", r.bed_height, 0);
-	put("bed_mass", r.mass, 0);
-	put("k_over_m", spec.k_over_m, 0);
-	put("restitution_floor", spec.restitution, 0);
-	put("restitution_pair", dem_restitution(zeta / sqrt(2)), 0);
-	put("mu", spec.mu, 0);
-	put("mu_roll", spec.mu_roll, 0);
-	printf("  \"tangential\": \"%s\",\n", spec.tangential_viscous ? "viscous" : "spring");
-	put("seed", o.seed, 0);
-	put("deck_omega", mo.omega, 0);
-	put("deck_fit_residual", mo.residual, 0);
-	put("deck_amplitude", mo.amplitude, 0);
-	put("dem_dt", r.dt, 0);
-	put("intervals", o.motion_machine ? NAN : o.intervals, 0);
-	put("periods", r.periods, 0);
-	put("v_dem", r.transport_velocity, 0);
-	put("v_column", col.transport_velocity, 0);
-	put("v_column_uncertainty", col.uncertainty, 0);
-	put("layers", o.sc.layers, 0);
-	printf("  \"contacts\": \"%s\",\n", spec.hertz ? "hertz" : "linear");
-	put("density", spec.density, 0);
-	put("youngs", spec.hertz ? spec.youngs : NAN, 0);
-	put("poisson", spec.hertz ? spec.poisson : NAN, 0);
-	put("e_pp", spec.hertz ? spec.e_pp : NAN, 0);
-	put("e_pw", spec.hertz ? spec.e_pw : NAN, 0);
-	put("mu_pp", spec.hertz ? spec.mu_pp : NAN, 0);
-	put("mu_pw", spec.hertz ? spec.mu_pw : NAN, 0);
-	put("roll_pp", spec.hertz ? spec.roll_pp : NAN, 0);
-	put("roll_pw", spec.hertz ? spec.roll_pw : NAN, 0);
-	put("d_mean", 0.5 * (spec.d_min + spec.d_max), 0);
-	put("cell_x", spec.cell_x, 0);
-	put("cell_y", spec.cell_y, 0);
-	put("v_first_half", r.v_first_half, 0);
-	put("v_second_half", r.v_second_half, 0);
-	put("overlap_pp_max", r.overlap_pp, 0);
-	put("overlap_pw_max", r.overlap_pw, 0);
-	put("dem_cpu_seconds", r.cpu_seconds, 1);
-	printf("}\n");
+	dem_report(&o, &spec, &mo, &r, &col);
 	return 0;
 }

@@ -47,7 +47,8 @@
  *
  * The command queue, and the attached experiment's command in it, are
  * worker_queue.c; the commands phase, the PATCH controls' apply column,
- * worker_control.c.
+ * worker_control.c; the budget's phases (turn, need, cpu),
+ * worker_budget.c.
  */
 #include <math.h>
 #include <stdio.h>
@@ -56,81 +57,12 @@
 #include "experiment.h"
 #include "metrics.h"
 #include "session_int.h"
+#include "worker_int.h"
 #include "util.h"
 
-/* Wall-clock anchors of pacing and metering. */
-typedef struct clocks {
-	double anchor_wall, anchor_t; /* pacing: wall time at simulated t */
-	double rate_wall, rate_t;     /* metering window start */
-	uint64_t rate_steps;
-	double cpu_wall;              /* when the CPU clock was last read */
-	double publish_wall;          /* when readers were last woken */
-	double batch_start;           /* pacing: when the last batch began */
-	double batch_end;             /* pacing: samples due by then step now */
-	int want_all;                 /* pacing: a stream waited for every
-					 sample at the last wake-up */
-	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
-					 the cost window */
-} clocks;
-
-/* Restart pacing and metering from now (after a pause or a pace change). */
-static void restart_clocks(clocks *c, const srv_session *s)
-{
-	c->anchor_wall = c->rate_wall = srv_now();
-	c->anchor_t = c->rate_t = s->st.t;
-	c->rate_steps = s->st.steps;
-	c->batch_start = c->batch_end = -INFINITY;
-}
-
-/* The CPU clock is read at most this often (s of wall time): once per
- * batch of a paced session, every 10 ms of a flat-out one. */
-#define CPU_READ_EVERY 0.01
 /* A flat-out session wakes its readers this often (s of wall time); a
  * paced one once per batch, before it sleeps. */
 #define PUBLISH_EVERY 0.01
-
-/* Wake the readers if a record one of them waits for was pushed since
- * the last time: an event, or a sample at or past the earliest time a
- * waiting stream wants (wake_t, which the streams lower before they wait).
- * Once per batch, not once per sample: every waiting stream is a thread
- * to wake (lock held). */
-static int publish_wakes(srv_session *s, clocks *c)
-{
-	int wake = 0;
-	c->publish_wall = srv_now();
-	if (s->ring.head == s->ring.published)
-		return 0;
-	if (s->ring.event_head > s->ring.published || s->st.t >= s->ring.wake_t) {
-		c->want_all = s->ring.wake_t == -INFINITY;
-		s->ring.wake_t = INFINITY;
-		wake = 1;
-	} else {
-		c->want_all = 0; /* no stream waited for these */
-	}
-	s->ring.published = s->ring.head;
-	return wake;
-}
-
-static void publish(srv_session *s, clocks *c)
-{
-	if (publish_wakes(s, c))
-		pthread_cond_broadcast(&s->data);
-}
-
-/* The same at the end of a paced batch, with the lock let go while the
- * readers are woken: a reader woken while the worker holds the lock
- * would wake only to sleep on the lock, then be woken again by its
- * release (two context switches instead of one, a tenth of the CPU of a
- * daemon of paced sessions). Whatever happened meanwhile (a command, a
- * stream that waits) is seen by the caller after it. */
-static void publish_batch(srv_session *s, clocks *c)
-{
-	if (!publish_wakes(s, c))
-		return;
-	pthread_mutex_unlock(&s->lock);
-	pthread_cond_broadcast(&s->data);
-	pthread_mutex_lock(&s->lock);
-}
 
 /* Let the session run at least up to t_end (s): raise until, resume a
  * finished session (lock held). */
@@ -200,7 +132,7 @@ static void check_caught_up(srv_session *s, clocks *c)
 		return;
 	s->restore.catch_up_t = 0;
 	s->restore.replay_seconds = srv_now() - s->restore.replay_wall;
-	restart_clocks(c, s);
+	srv_worker_restart_clocks(c, s);
 	srv_log(SRV_LOG_INFO, "session %s: replayed to t = %g s in %.3f s",
 		s->entry.id, s->st.t, s->restore.replay_seconds);
 }
@@ -209,7 +141,7 @@ static void check_caught_up(srv_session *s, clocks *c)
 static void run_commands(srv_session *s, clocks *c)
 {
 	if (s->cmd_head && srv_worker_apply_commands(s))
-		restart_clocks(c, s);
+		srv_worker_restart_clocks(c, s);
 }
 
 /* until: a running session that reached until finishes there. */
@@ -219,130 +151,8 @@ static void check_until(srv_session *s, clocks *c)
 		s->state = SRV_FINISHED;
 		s->persist.ckpt_dirty = 1;
 		srv_ring_event_at(s, "finished", NULL);
-		publish(s, c);
+		srv_worker_publish(s, c);
 	}
-}
-
-/* The CPU a simulated second costs this session, over windows of 50 ms of
- * CPU or 2 simulated s, whichever comes first; the mean of the last and
- * this window's (a session's cost changes with its state: a run-up, a
- * moving feed). */
-#define COST_WINDOW_CPU 0.05
-#define COST_WINDOW_T 2.0
-
-static void measure_cost(srv_session *s, clocks *c)
-{
-	double cpu = s->budget.cpu_seconds - c->cost_cpu, t = s->st.t - c->cost_t;
-	if (t <= 0 || (cpu < COST_WINDOW_CPU && t < COST_WINDOW_T)) {
-		if (t < 0) /* not a window: start one */
-			c->cost_cpu = s->budget.cpu_seconds, c->cost_t = s->st.t;
-		return;
-	}
-	double cost = cpu / t;
-	s->budget.cpu_per_s = s->budget.cpu_measured ? 0.5 * (s->budget.cpu_per_s + cost) : cost;
-	s->budget.cpu_measured = 1;
-	c->cost_cpu = s->budget.cpu_seconds;
-	c->cost_t = s->st.t;
-}
-
-/* The session measured more than it was admitted for: it goes on at the
- * pace that fits the cores for paced sessions (budget.c), taken as a
- * control would be (the stream's and the control log's "control" event),
- * so that it does not starve the others (lock held). */
-static void pace_down(srv_session *s, clocks *c)
-{
-	double was = s->pace, cost = s->budget.cpu_per_s;
-	double pace = srv_budget_fit_pace(&s->budget.paced_held, cost, was);
-	if (pace >= was)
-		return;
-	api_control ctl = {.set = API_C_PACE, .pace = pace};
-	char json[API_EVENT_MAX];
-	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
-	s->pace = pace;
-	srv_ring_event(s, "control", json);
-	srv_control_log_append(s, json, 0);
-	s->persist.ckpt_dirty = 1;
-	restart_clocks(c, s);
-	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "
-			      "admitted; paced down from %g to %g to fit "
-			      "--max-paced-cores", s->entry.id, cost, was, pace);
-}
-
-/* A running session is paced down only when it measures more than this
- * times what it holds: a scene whose estimate was far off (a restored one
- * is admitted by the estimate alone, without the probe; a 16 x 64 feed
- * measured 12 times its estimate). A default session's measure differs
- * from its estimate by up to 2.6 times on this machine (a lone paced
- * session's wake-ups from an idle core cost it 4-7 ms of CPU per
- * simulated s, hundreds of them 2.4 ms each, the estimate says 2.65), and
- * an admitted session keeps its pace through that: the budget's excess
- * then refuses the next session instead. */
-#define PACE_DOWN_OVER 4.0
-
-/* need: the session's hold on the paced cores follows what it needs now
- * (its state, pace and measured cost), even beyond the budget: admission
- * is checked where a request raises it (session.c), so that the sessions
- * admitted keep their pace and the next one is refused; only a measure
- * PACE_DOWN_OVER times its hold with no room left paces it down. Called in the same
- * turn as the commands phase (the lock is not let go in between), so that
- * a hold a handler raised for its queued command is kept until the worker
- * has applied it. */
-static void commit_need(srv_session *s, clocks *c)
-{
-	double need = srv_paced_need(s);
-	if (need > PACE_DOWN_OVER * s->budget.paced_held && need > 1e-9)
-		pace_down(s, c);
-	else if (need != s->budget.paced_held)
-		srv_budget_set_paced(&s->budget.paced_held, need);
-}
-
-/* cpu: read the worker's CPU time; a running session that spent its
- * grant pauses. */
-static void check_cpu(srv_session *s, clocks *c)
-{
-	double now = srv_now();
-	struct timespec ts;
-	if (now - c->cpu_wall < CPU_READ_EVERY)
-		return;
-	c->cpu_wall = now;
-	/* a LIGGGHTS session's bed process's CPU is the session's too */
-	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
-		s->budget.cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
-				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
-	measure_cost(s, c);
-	if (s->state != SRV_RUNNING || s->budget.cpu_seconds < s->budget.cpu_limit)
-		return;
-	s->state = SRV_PAUSED;
-	s->budget.cpu_paused = 1;
-	s->persist.ckpt_dirty = 1;
-	srv_ring_event_at(s, "paused", "\"reason\":\"cpu-budget\"");
-	publish(s, c);
-	srv_log(SRV_LOG_INFO, "session %s paused: its CPU budget of %g s is "
-			      "spent", s->entry.id, s->budget.cpu_limit);
-}
-
-/* turn: a running pace "max" session steps only while it holds a CPU
- * slot; any other gives its slot (or place in line) up. 1 if it must wait
- * (the loop then starts over, so that commands are seen at once). */
-static int take_turn(srv_session *s, clocks *c)
-{
-	if (s->state != SRV_RUNNING || s->pace != API_PACE_MAX || s->stop) {
-		srv_cpu_leave(&s->budget.turn);
-		s->budget.waiting_for_cpu = 0;
-		return 0;
-	}
-	if (srv_cpu_turn_over(&s->budget.turn))
-		srv_cpu_leave(&s->budget.turn); /* to the back of the line */
-	if (srv_cpu_take(&s->budget.turn)) {
-		s->budget.waiting_for_cpu = 0;
-		return 0;
-	}
-	s->budget.waiting_for_cpu = 1;
-	publish(s, c);
-	struct timespec ts = srv_deadline(0.05); /* a missed signal costs 50 ms */
-	pthread_cond_timedwait(&s->wake, &s->lock, &ts);
-	restart_clocks(c, s);
-	return 1;
 }
 
 /* idle: a session that is not running sleeps until woken; 1 if it slept. */
@@ -354,9 +164,9 @@ static int idle(srv_session *s, clocks *c)
 	s->budget.waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
-	publish(s, c);
+	srv_worker_publish(s, c);
 	pthread_cond_wait(&s->wake, &s->lock);
-	restart_clocks(c, s);
+	srv_worker_restart_clocks(c, s);
 	return 1;
 }
 
@@ -408,7 +218,7 @@ static int pace(srv_session *s, clocks *c, double t_next)
 	double due = due_at(s, c, t_next);
 	if (due <= c->batch_end)
 		return 0;
-	publish_batch(s, c); /* the batch is over */
+	srv_worker_publish_batch(s, c); /* the batch is over */
 	if (s->cmd_head || s->stop)
 		return 1; /* came while the lock was let go */
 	if (c->batch_start > c->rate_wall)
@@ -518,7 +328,7 @@ void *srv_worker_main(void *arg)
 	pthread_mutex_lock(&s->lock);
 	sim_get_status(s->sim, &s->st);
 	srv_ring_sample(s);
-	restart_clocks(&clk, s);
+	srv_worker_restart_clocks(&clk, s);
 	clk.cpu_wall = -INFINITY;
 	/* the thread's CPU clock starts at 0; a LIGGGHTS bed's settling, done
 	 * before the first step, is no cost of simulated time (counted, it
@@ -526,7 +336,7 @@ void *srv_worker_main(void *arg)
 	 * paced the session down to 0.04) */
 	clk.cost_t = s->st.t;
 	clk.cost_cpu = s->dem.link ? s->dem.bed.cpu_seconds : 0.0;
-	publish(s, &clk);
+	srv_worker_publish(s, &clk);
 	for (;;) {
 		start_job(s);
 		run_replay(s);
@@ -541,9 +351,9 @@ void *srv_worker_main(void *arg)
 			break;
 		srv_persist_checkpoint(s, 0);
 		check_until(s, &clk);
-		check_cpu(s, &clk);
-		commit_need(s, &clk);
-		if (idle(s, &clk) || take_turn(s, &clk))
+		srv_worker_check_cpu(s, &clk);
+		srv_worker_commit_need(s, &clk);
+		if (idle(s, &clk) || srv_worker_take_turn(s, &clk))
 			continue;
 		double t_next = next_time(s);
 		if (pace(s, &clk, t_next))
@@ -556,7 +366,7 @@ void *srv_worker_main(void *arg)
 		if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
 			meter(s, &clk, srv_now()); /* paced: pace() */
 		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
-			publish(s, &clk);
+			srv_worker_publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
 		/* the log first, here: the session has left the registry, so
