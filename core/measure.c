@@ -39,18 +39,23 @@ static int refine_asks(const sim_status *st, double last)
 	       st->substeps >= 1;
 }
 
-#define MEASURE_EARLY_SCATTER 0.25
-
 /* A bar met early enough to stop on: within tol, steady, and its scatter
  * and drift at most MEASURE_EARLY_SCATTER of what tol allows. A short
  * window's scatter is read from few batches, and where the feed's motion
  * is correlated over many periods it is read low (a 1.2-s window of the
  * zoo's `stiffer` machine said 0.31 % at 140 deg cw where its v was 0.97 %
- * off): a scatter that small a share of tol holds even read low. */
+ * off): a scatter that small a share of tol holds even read low. And a
+ * window of MEASURE_EARLY_PERIODS whole periods at least: the preset's
+ * shadow spans 29 of them (30 % of 4 s at its loaded 24.5 Hz); a shorter
+ * --duration shortens the shadow, and a measurement stopped with it (0.6
+ * s at --duration 2) put 2 of the 74 points outside their bars. */
+#define MEASURE_EARLY_SCATTER 0.25
+#define MEASURE_EARLY_PERIODS 28
 static int early_met(const sim_status *st)
 {
 	double scatter = st->transport_velocity_uncertainty - st->step_error;
-	return st->tol_met && st->steady && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed;
+	return st->tol_met && st->steady && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed &&
+	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
 /* One run of sim_measure: a fresh instance to t_end at most, its shadow

@@ -327,8 +327,9 @@ typedef struct sim_measurement {
  * where undefined); msg as sim_new, or the failure's cause. Where a
  * shadow measures the step error (dem with feed events), the run stops
  * before t_end at the first check after the shadow's window whose bar is
- * within tol, steady and at most a quarter scatter (out->periods says how
- * long it measured), or whose step error alone is beyond tol. Where the
+ * within tol, steady, at most a quarter scatter and 28 whole periods long
+ * (out->periods says how long it measured), or whose step error alone is
+ * beyond tol. Where the
  * steps are the engine's (dem, dt = 0 and substeps = 0) and the
  * uncertainty is beyond what m->tol allows because of the steps' error,
  * the run is repeated at finer steps (at most 3 times; *out says which
