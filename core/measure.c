@@ -8,6 +8,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -58,6 +59,42 @@ static int early_met(const sim_status *st)
 	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
+/* The first run's instance as it starts (settled, at t = 0, its shadow
+ * begun), kept for the refinements: a checkpoint of it restored with
+ * finer steps starts them where the first run started, without settling
+ * again (the settling at the first run's steps: the state at t = 0 is a
+ * start like any other, and the estimate and its bar come from the finer
+ * steps alone). buf NULL: none kept (yet). */
+typedef struct settled_start {
+	void *buf;
+	size_t len;
+} settled_start;
+
+/* A run's instance: the first one fresh (its start kept in *start where
+ * start is not NULL), a refinement's restored from *start with its own
+ * steps (its shadow too), or fresh where no start could be kept. */
+static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			   double t_end, settled_start *start, int *err, char *msg, size_t msglen)
+{
+	if (start && start->buf) {
+		sim *s = sim_restore(p, sc, m, start->buf, start->len, err, NULL, 0);
+		if (s)
+			return s;
+	}
+	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
+	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, err, msg, msglen);
+	if (s && start && !start->buf) {
+		size_t len = sim_checkpoint_size(s);
+		start->buf = malloc(len);
+		start->len = len;
+		if (start->buf && sim_checkpoint(s, start->buf, len) != SIM_OK) {
+			free(start->buf);
+			start->buf = NULL;
+		}
+	}
+	return s;
+}
+
 /* One run of sim_measure: a fresh instance to t_end at most, its shadow
  * over the first SHADOW_MEASURE_SHARE of the window; *st its final
  * status. With a shadow, the run stops early at the first check after the
@@ -70,14 +107,13 @@ static int early_met(const sim_status *st)
  * whose room a longer window's smaller scatter may yet make is left to
  * the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, int may_refine, double last, sim_status *st, char *msg,
-			size_t msglen)
+			double t_end, int may_refine, double last, settled_start *start,
+			sim_status *st, char *msg, size_t msglen)
 {
 	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
 			   .rotor_speed_mean = NAN, .step_error = NAN, .tol_allowed = NAN};
 	int err;
-	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
-	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, &err, msg, msglen);
+	sim *s = start_instance(p, sc, m, t_end, start, &err, msg, msglen);
 	if (!s)
 		return err;
 	/* the first check at the shadow's end (just past it: the shadow
@@ -114,9 +150,11 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	const ode_method *om = ode_find(m->name);
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
+	settled_start start = {NULL, 0};
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
-		err = measure_once(p, sc, &run, t_end, may_refine, last, &st, msg, msglen);
+		err = measure_once(p, sc, &run, t_end, may_refine, last, own_steps ? &start : NULL,
+				   &st, msg, msglen);
 		out->refinements = attempt;
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a
@@ -139,6 +177,7 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 		if (run.substeps > 1000)
 			break;
 	}
+	free(start.buf);
 	out->transport_velocity = st.transport_velocity;
 	out->uncertainty = st.transport_velocity_uncertainty;
 	out->steady = st.steady;
