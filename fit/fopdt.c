@@ -212,3 +212,15 @@ int fopdt_fit(const double *t, const double *y, size_t n, const double *ts,
 	r->ok = 1;
 	return 0;
 }
+
+void fopdt_simc(const fopdt_result *r, double tau_c, double *kp, double *ki)
+{
+	double k = fabs(r->k);
+	if (!(k > 0) || !(r->t > 0) || !(tau_c + r->l > 0)) {
+		*kp = *ki = NAN;
+		return;
+	}
+	*kp = r->t / (k * (tau_c + r->l));
+	double ti = fmin(r->t, 4 * (tau_c + r->l));
+	*ki = *kp / ti;
+}

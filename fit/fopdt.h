@@ -41,4 +41,10 @@ int fopdt_fit(const double *t, const double *y, size_t n, const double *ts,
 double fopdt_eval(const fopdt_result *r, const double *ts, const double *d, size_t m,
 		  double t);
 
+/* PI gains by Skogestad's SIMC rule (J. Process Control 13 (2003) 291)
+ * for the model r with closed-loop time constant tau_c (s): *kp = T / (|K|
+ * (tau_c + L)) and *ki = *kp / min(T, 4 (tau_c + L)), in the inverse of K's
+ * unit (and per s). NaN when the model has no gain. */
+void fopdt_simc(const fopdt_result *r, double tau_c, double *kp, double *ki);
+
 #endif
