@@ -27,7 +27,7 @@
 #define CURVES 4
 #define CURVE_WINDOW 2.0 /* s measured per point after the transient */
 #define DEG (M_PI / 180)
-#define SIMC_TAU_L 8.0 /* "auto": tau_c = 8 L unless given */
+#define SIMC_TAU_L 3.0 /* "auto": tau_c = 3 L unless given */
 
 typedef struct curve_key {
 	sim_params p; /* beta and beta_rate zeroed: they do not change v */
@@ -182,10 +182,11 @@ static api_err check_setpoints(srv_experiment *e, api_problem *pb)
 			snprintf(field, sizeof field, "control.setpoint[%d].v", i);
 			api_fail(pb, API_RANGE, field,
 				 "%s = %g m/s is outside the machine's reachable range (%.4g, %.4g) "
-				 "m/s: the v(beta) curve between its peaks at %g and %g deg",
+				 "m/s: the v(beta) curve between its minimum at %g deg and its maximum "
+				 "at %g deg",
 				 field, v, x->v_lo, x->v_hi,
-				 ((x->branch_sign < 0 ? x->beta_lo : x->beta_hi) / DEG),
-				 ((x->branch_sign < 0 ? x->beta_hi : x->beta_lo) / DEG));
+				 (x->branch_sign < 0 ? x->beta_hi : x->beta_lo) / DEG,
+				 (x->branch_sign < 0 ? x->beta_lo : x->beta_hi) / DEG);
 			pb->has_range = 1, pb->min = x->v_lo, pb->max = x->v_hi;
 			return API_RANGE;
 		}
@@ -211,7 +212,7 @@ static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *
 				"model (%s); give kp and ki", m->beta0, msg);
 	/* SIMC's tight tau_c = L leaves the preset's loop in a limit cycle
 	 * (the feed rings after each beta change, which a first-order model
-	 * does not hold: docs/control.md); smooth tuning by default */
+	 * does not hold: docs/control.md); tau_c = 3 L by default */
 	double tau = x->tau_c > 0 ? x->tau_c : SIMC_TAU_L * m->l;
 	fopdt_result r = {.k = m->k, .t = m->t, .l = m->l};
 	fopdt_simc(&r, tau, &x->kp, &x->ki);
