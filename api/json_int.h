@@ -132,7 +132,7 @@ extern const char *const api_members_experiment[];
 extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];
 extern const char *const api_members_identify[];
-extern const char *const api_members_control[];
+extern const char *const api_members_exp_control[];
 extern const char *const api_members_setpoint[];
 extern const char *const api_members_controller[];
 extern const char *const api_members_disturbance[];
