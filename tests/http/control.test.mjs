@@ -155,3 +155,42 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
   // nothing was created
   assert.equal((await req(d.base, 'GET', '/api/v1/experiments')).body.experiments.length, before);
 });
+
+test('a closed loop killed mid-run resumes from its checkpoint and ends; an identification is served again', { timeout: 120000 * SLOW }, async () => {
+  const { mkdtempSync, rmSync } = await import('node:fs');
+  const { tmpdir } = await import('node:os');
+  const { join } = await import('node:path');
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-control-'));
+  const args = ['--data-dir', dir, '--checkpoint-interval', '0.5'];
+  let k = await startDaemon(args);
+  try {
+    const id = (await req(k.base, 'POST', '/api/v1/experiments', { identify: { beta: 60, hold: 0.5 } })).body;
+    const idDone = await until(async () => {
+      const g = await req(k.base, 'GET', `/api/v1/experiments/${id.id}`);
+      return g.body.state === 'done' && g;
+    }, 30000 * SLOW, 'identification');
+    const r = await req(k.base, 'POST', '/api/v1/experiments', {
+      session: { pace: 1 },
+      control: { setpoint: [{ v: 0.1, until: 1.5 }, { v: -0.05, until: 4 }], controller: { kp: 2, ki: 800 } },
+    });
+    assert.equal(r.status, 201, r.text);
+    await until(async () => (await req(k.base, 'GET', `/api/v1/experiments/${r.body.id}`)).body.t - r.body.t_start > 2,
+      20000, 'two simulated seconds');
+    k.proc.kill('SIGKILL');
+    await k.exited;
+    k = await startDaemon(args);
+    const again = await req(k.base, 'GET', `/api/v1/experiments/${id.id}`);
+    assert.equal(again.text, idDone.text, 'a finished identification is served byte for byte');
+    const e = await until(async () => {
+      const g = await req(k.base, 'GET', `/api/v1/experiments/${r.body.id}`);
+      return g.status === 200 && g.body.state !== 'running' && g.body;
+    }, 30000 * SLOW, 'the resumed closed loop');
+    assert.equal(e.state, 'done', e.error);
+    assert.equal(e.kind, 'control');
+    assert.deepEqual(e.control.controller, { tuning: 'given', kp: 2, ki: 800 });
+    for (const sp of e.control.setpoints) assert.ok(sp.steady_error < 0.01, JSON.stringify(sp));
+  } finally {
+    await k.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
