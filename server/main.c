@@ -154,7 +154,9 @@ static void restore_state(void)
 		return;
 	double t0 = srv_now();
 	size_t ne = srv_job_restore(&srv_experiment_job);
-	size_t ns = srv_sessions_restore(srv_experiment_get, srv_experiment_put);
+	const srv_exp_finder ef = {srv_experiment_get, srv_experiment_put,
+				   srv_experiments_readopt};
+	size_t ns = srv_sessions_restore(&ef);
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_job_restore(&srv_sweep_job);
 	size_t nf = srv_job_restore(&srv_fit_job);
