@@ -109,8 +109,11 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 		MHD_OPTION_SOCK_ADDR, la->addr,
 		MHD_OPTION_CONNECTION_LIMIT,
 		(unsigned)(cfg->max_connections + SRV_CONN_HEADROOM),
+		/* a backstop only: conns.c holds the per-address cap by
+		 * closing that address's idle or slow connections, which
+		 * libmicrohttpd still counts until their threads close them */
 		MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE),
+		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE + SRV_CONN_HEADROOM),
 		MHD_OPTION_CONNECTION_TIMEOUT,
 		(unsigned)(cfg->connection_timeout + 0.5), MHD_OPTION_END);
 }
