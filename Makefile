@@ -345,9 +345,9 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 
 # PATCH throughput with the durable control log alone (part of `make
 # bench`; tests/bench/controls.mjs, about 20 s): OLD_CONVSIMD=path adds
-# another build's rows for comparison.
+# another build's rows for comparison; CLIENT=fetch,lean both clients.
 bench-controls: all
-	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/controls.mjs
+	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" CLIENT="$(or $(CLIENT),lean)" node tests/bench/controls.mjs
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
