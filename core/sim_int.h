@@ -25,6 +25,8 @@ struct sim {
 	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
 					    start of the last step */
 	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
+	double e_disturb;    /* J: the stored energy's jumps at the feed's
+				disturbances (disturb.c), booked as input */
 	uint64_t steps;
 	int failed;
 	char error[160];
