@@ -12,7 +12,8 @@
  * safe. The one derived choice that depends on m_n, the split method's
  * corrected coupling of a light feed (feed mass at most
  * MODEL_CORRECTOR_MAX_RATIO of the machine's), is kept on its side by
- * sim_feed_mass_range.
+ * sim_feed_mass_range (instance.c, where the method is resolved as
+ * sim_alloc resolves it).
  */
 #include <math.h>
 #include <string.h>
@@ -20,39 +21,6 @@
 #include "feed.h"
 #include "sim_int.h"
 #include "units.h"
-
-/* The machine's mass that the corrector's ratio divides by (setup.c's
- * model_feed_mass_ratio). */
-static double machine_mass(const sim_params *p)
-{
-	return p->M_r + p->m + p->m1 + p->m2;
-}
-
-void sim_feed_mass_range(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			 double *lo, double *hi)
-{
-	const sim_setting *set = sim_setting_find("m_n");
-	*lo = set->min;
-	*hi = set->max;
-	const ode_method *ode = ode_find(m->name);
-	if (!ode || !ode->info.substeps || !sc->feed || !sc->feed_coupling ||
-	    sc->feed_model != SIM_FEED_COLUMN || sc->columns < 1 || sc->layers < 1)
-		return;
-	/* the sub-steps as sim_alloc resolves them */
-	sim_method r = *m;
-	if (r.dt == 0.0)
-		r.dt = sim_default_dt(p, sc, m);
-	if (r.substeps == 0)
-		r.substeps = sim_default_substeps(p, sc, &r, r.dt);
-	if (r.substeps <= 1)
-		return;
-	double edge = MODEL_CORRECTOR_MAX_RATIO * machine_mass(p) /
-		      ((double)sc->columns * (double)sc->layers);
-	if (model_feed_mass_ratio(p, sc) <= MODEL_CORRECTOR_MAX_RATIO)
-		*hi = fmin(*hi, edge);
-	else
-		*lo = fmax(*lo, nextafter(edge, INFINITY));
-}
 
 /* Scale the contacts of state vector y at time t by factor (the deck
  * points where y puts them). */
