@@ -89,6 +89,8 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(en, "potential", st->e_potential);
 	api_add_number(en, "dissipated", st->e_dissipated);
 	api_add_number(en, "residual", st->e_residual);
+	/* the part of input the feed's disturbances brought (sim_set_feed) */
+	api_add_number(en, "disturbance", st->e_disturb);
 	return o;
 }
 

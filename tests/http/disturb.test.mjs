@@ -54,6 +54,9 @@ test('PATCH m_n and mu: applied, in the status and the stream; out of range a 42
     assert.equal(ev.m_n, 0.75);
     assert.equal(ev.t_effective, p.body.t_effective);
     assert.equal('mu' in ev, false, 'the event holds what was sent');
+    // the stored energy's jump is input, booked apart as the disturbance's
+    const e0 = p.body.status.energy;
+    assert.ok(e0.disturbance > 0 && e0.disturbance < e0.input, JSON.stringify(e0));
 
     const q = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { mu: 0.6, beta: 40 });
     assert.equal(q.status, 200, q.text);
@@ -61,6 +64,12 @@ test('PATCH m_n and mu: applied, in the status and the stream; out of range a 42
     let st = (await get(d, id)).status;
     assert.equal(st.m_n, 0.75);
     assert.equal(st.mu, 0.6);
+    // the books close after both changes; mu brought no energy
+    await sleep(500);
+    const e = (await get(d, id)).status.energy;
+    assert.equal(e.disturbance, e0.disturbance);
+    assert.ok(Math.abs(e.kinetic + e.potential + e.dissipated - e.input - e.residual) <= 1e-9 * e.input);
+    assert.ok(Math.abs(e.residual) <= 1e-3 * e.input, JSON.stringify(e));
 
     // out of the settings table's range: 422 out-of-range with the range
     const bad = [
