@@ -377,7 +377,7 @@ bench-dem: all $(BUILD)/.deps-dem
 # seeds a point, from one build; many CPU hours, resumable, in parts
 # (DEM_MAP_PARTS="glass-shallow glass-checks"), into
 # tests/bench/results/dem_map.csv and dem_map.md.
-bench-dem-map: $(BUILD)/.deps-dem
+bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
