@@ -13,7 +13,9 @@
 #include "sim.h"
 
 struct sim {
-	model md;            /* const after sim_new */
+	model md;            /* const after sim_new, but for the feed's m_n
+				and mu, which sim_set_feed changes between
+				steps (disturb.c) */
 	model_ctl ctl;       /* changed by the sim_set_* controls */
 	dyn sys;             /* what the integrator steps: &md, &ctl, rhs_evals */
 	sim_method cfg;
