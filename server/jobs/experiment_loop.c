@@ -298,10 +298,15 @@ void srv_exp_control_results(srv_experiment *e)
 	sp->iae = iae;
 	double mean = nq ? sum / (double)nq : NAN;
 	sp->steady_error = fabs(mean - r) / (fabs(r) > 1e-9 ? fabs(r) : 1);
+	/* each disturbance's recovery, up to the next one or the end */
 	for (int k = 0; k < x->ndist; k++) {
 		api_disturbance *d = &x->dist[k];
-		if (d->applied && d->t_applied >= t_a && d->t_applied < t_b)
-			d->recovery_time = settle_after(e, e->seg_first, i1, d->t_applied, r,
-							&d->max_deviation);
+		if (!d->applied || d->t_applied < t_a || d->t_applied >= t_b)
+			continue;
+		size_t ik = e->seg_first;
+		double t_next = k + 1 < x->ndist && x->dist[k + 1].applied ? x->dist[k + 1].t_applied : t_b;
+		while (ik < i1 && e->rec_t[ik] < t_next)
+			ik++;
+		d->recovery_time = settle_after(e, e->seg_first, ik, d->t_applied, r, &d->max_deviation);
 	}
 }

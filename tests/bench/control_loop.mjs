@@ -5,7 +5,8 @@
 // -> +0.05 m/s under the feedforward alone and under PI controllers, each
 // setpoint's 2 % settling time against the open-loop reversal time of the
 // same beta change (a schedule of the feedforward's betas); disturbances
-// of omega_ss under a setpoint of +0.10 m/s. Markdown tables on stdout.
+// of omega_ss, the feed's load and its friction under a setpoint of +0.10
+// m/s. Markdown tables on stdout.
 // One daemon on loopback, pace "max", about half a minute.
 //
 //   CONVSIMD=build/convsimd node tests/bench/control_loop.mjs
@@ -75,7 +76,8 @@ try {
   console.log('| disturbance | largest deviation (m/s) | recovery (s) | steady error after |');
   console.log('|---|---|---|---|');
   for (const [name, set] of [['omega_ss −4.5 % (150 rad/s)', { omega_ss: 150 }],
-    ['omega_ss −10 % (141.4 rad/s)', { omega_ss: 141.4 }], ['omega_ss +5 % (165 rad/s)', { omega_ss: 165 }]]) {
+    ['omega_ss −10 % (141.4 rad/s)', { omega_ss: 141.4 }], ['omega_ss +5 % (165 rad/s)', { omega_ss: 165 }],
+    ['load m_n +50 % (0.75 kg)', { m_n: 0.75 }], ['friction mu −20 % (0.32)', { mu: 0.32 }]]) {
     const e = await done((await post({
       control: { setpoint: [{ v: 0.10, until: 8 }], controller: { kp: 2, ki: 800 } },
       disturbances: [{ at: 3, set }],

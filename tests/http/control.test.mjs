@@ -56,10 +56,11 @@ test('identification: the gain is the slope of v(beta) within its standard error
 test('closed loop: setpoints held with a small steady error, a disturbance applied', { timeout: 120000 * SLOW }, async () => {
   const r = await req(d.base, 'POST', '/api/v1/experiments', {
     control: {
-      setpoint: [{ v: -0.08, until: 2.5 }, { v: 0.10, until: 7 }],
+      setpoint: [{ v: -0.08, until: 2.5 }, { v: 0.10, until: 10 }],
       controller: { kp: 2, ki: 800 },
     },
-    disturbances: [{ at: 4.5, set: { omega_ss: 150 } }],
+    // the feed's load (a control of the PATCH table like any other) after the supply
+    disturbances: [{ at: 4.5, set: { omega_ss: 150 } }, { at: 7.5, set: { m_n: 0.75 } }],
     keep_session: true,
   });
   assert.equal(r.status, 201, r.text);
@@ -78,13 +79,17 @@ test('closed loop: setpoints held with a small steady error, a disturbance appli
     assert.ok(sp.settling_time > 0 && sp.settling_time < 2.5, `setpoint ${i}: settling ${sp.settling_time}`);
     assert.ok(sp.iae > 0, `iae ${sp.iae}`);
   }
-  const [dist] = e.control.disturbances;
+  const [dist, load] = e.control.disturbances;
   assert.deepEqual(dist.set, { omega_ss: 150 });
   // applied at the end of the integrator's step at or after 4.5 s
   assert.ok(dist.t_applied >= e.t_start + 4.5 && dist.t_applied < e.t_start + 4.51, `${dist.t_applied}`);
   // -4.5 % omega_ss knocks v down by a third of the setpoint; the loop brings it back
   assert.ok(dist.max_deviation > 0.02, JSON.stringify(dist));
   assert.ok(dist.recovery_time > 0 && dist.recovery_time < 2.5, JSON.stringify(dist));
+  // +50 % load: a smaller knock, recovered before the end
+  assert.deepEqual(load.set, { m_n: 0.75 });
+  assert.ok(load.t_applied >= e.t_start + 7.5 && load.t_applied < e.t_start + 7.51, `${load.t_applied}`);
+  assert.ok(load.max_deviation > 0.002 && load.recovery_time > 0, JSON.stringify(load));
   // through the session's control path: its status has the new omega_ss
   const s = await req(d.base, 'GET', `/api/v1/sessions/${e.session}`);
   assert.equal(s.body.status.omega_ss, 150);
@@ -138,6 +143,10 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
   assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
     'disturbances[0].set: omega_ss must be a finite number in [1, 1000] rad/s',
     'disturbances[0].set.omega_ss', { min: 1, max: 1000 }));
+  r = await post({ control: ctl, disturbances: [{ at: 1, set: { m_n: 0 } }] });
+  assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
+    'disturbances[0].set: m_n must be a finite number in [0.0001, 100] kg',
+    'disturbances[0].set.m_n', { min: 0.0001, max: 100 }));
   r = await post({ control: ctl, disturbances: [{ at: 1, set: { beta: 50 } }] });
   assert.deepEqual(r.body, problem('invalid-value', 'Invalid value',
     'disturbances[0].set.beta: a disturbance changes the machine, not beta (the controller\'s) nor the session\'s run',
