@@ -228,6 +228,12 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 {
 	api_exp_ext *x = &e->ext;
 	char msg[200] = "";
+	/* the samples are the engine's feed displacement: a scene without a
+	 * feed, or whose feed is a LIGGGHTS bed, has none to control */
+	if (!spec->scene.feed || spec->scene.feed_model == SIM_FEED_EXTERNAL)
+		return api_fail(pb, API_INVALID, "session",
+				"%s needs a session whose feed is the engine's own (scene.feed true, not "
+				"a LIGGGHTS bed)", x->kind == API_EXP_IDENTIFY ? "identify" : "control");
 	if (x->kind == API_EXP_IDENTIFY) {
 		for (int i = 0; i < x->npoints; i++) {
 			api_fopdt *m = &x->model[i];

@@ -157,6 +157,9 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
   r = await post({ schedule: [{ beta: 30, until: 1 }], disturbances: [] });
   assert.deepEqual(r.body, problem('invalid-value', 'Invalid value',
     'disturbances belong to a closed-loop experiment ("control")', 'disturbances'));
+  r = await post({ session: { scene: { feed: false } }, identify: { beta: 60 } });
+  assert.deepEqual(r.body, problem('invalid-value', 'Invalid value',
+    'identify needs a session whose feed is the engine\'s own (scene.feed true, not a LIGGGHTS bed)', 'session'));
   r = await post({ identify: { beta: 178 } });
   assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
     'identify.beta[0] -+ identify.step (178 -+ 4 deg) must lie within the range of beta, [0, 180] deg',
