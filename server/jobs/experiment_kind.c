@@ -161,10 +161,12 @@ static int identify_scratch(const api_spec *spec, double beta0, double d, double
 			k++;
 		}
 	}
-	if (rc == 0 && k == 5)
+	if (rc == 0 && k == 5) {
 		srv_exp_fit(t, v, n, 0.5 * h, ts, dd, 4, h, m);
-	else
+		m->t_from = 0.5 * h; /* s after the scratch run's start */
+	} else {
 		snprintf(msg, len, "the identification run failed");
+	}
 	free(t);
 	free(v);
 	sim_free(s);
@@ -203,8 +205,9 @@ static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *
 	char msg[200] = "";
 	double b0 = e->req.seg[0].beta.si, rate = e->req.beta_rate.si;
 	api_fopdt *m = &x->tuned;
-	m->beta0 = ((b0) / DEG);
+	m->beta0 = b0 / DEG;
 	m->step = 4;
+	m->slope = NAN; /* no secant measured for it */
 	if (identify_scratch(spec, b0, m->step, 1.5, rate > 0 ? rate : spec->params.beta_rate, m,
 			     msg, sizeof msg) != 0)
 		return api_fail(pb, API_INVALID, "control.controller",
@@ -259,6 +262,7 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 		err = auto_gains(e, spec, pb);
 	x->integ = 0;
 	x->t_sample = 0;
+	x->period = NAN; /* measured from the start */
 	return err;
 }
 
