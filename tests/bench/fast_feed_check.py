@@ -32,6 +32,7 @@ arguments and the binary's modification time).
 """
 import csv
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -48,9 +49,9 @@ ROOT = dem_map.ROOT
 RESULTS = os.path.join(HERE, "results")
 CACHE = os.path.join(ROOT, "build", "fast_feed_cache.json")
 TOL = 0.05  # of the depth's DEM peak |v|
-GRID_R = (0.05, 0.15, 0.3, 0.45, 0.6, 0.75)
-GRID_MU = (0.2, 0.3, 0.4, 0.5)
-GRID_K = (1e5, 1e6, 1e7)
+GRID_R = (0.05, 0.15, 0.3, 0.4, 0.5, 0.6, 0.75)
+GRID_MU = (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.65)
+GRID_K = (3e2, 5e2, 1e3, 2e3, 5e3, 1e4, 1e5, 1e6, 1e7)
 LAYER_RULES = ("depth", "one")
 PAPER = {"Rs": (0.05,), "mu": 0.4, "k_c": 1e6, "layers": "depth"}
 FAMILIES = ("closure", "ensemble")
@@ -101,8 +102,13 @@ class Runner:
         return self.stamp + " " + " ".join(args[1:])
 
     def one(self, args):
-        out = subprocess.run(args, check=True, capture_output=True, text=True).stdout
-        s = json.loads(out)
+        """[v, CPU s] of one run; NaN for a run convsim refuses or that
+        diverges (a contact too soft for the element's weight): such a
+        candidate misses every point it failed at."""
+        res = subprocess.run(args, capture_output=True, text=True)
+        if res.returncode != 0:
+            return [math.nan, math.nan]
+        s = json.loads(res.stdout)
         return [s["transport_velocity"], s["cpu_seconds"]]
 
     def run_all(self, jobs):
@@ -166,10 +172,15 @@ def name_of(c):
         "= depth" if c["layers"] == "depth" else "1")
 
 
+def rel_err(v, p, peak):
+    """|v - v_DEM| / the peak; infinite where the run failed."""
+    e = abs(v - p["v_dem"]) / peak[(p["material"], p["drive"], p["depth"])]
+    return e if math.isfinite(e) else math.inf
+
+
 def score(run, cand, pts, peak):
     """(points within TOL, -worst) of cand over pts: larger is better."""
-    errs = [abs(run.get(cand, p)[0] - p["v_dem"]) / peak[(p["material"], p["drive"], p["depth"])]
-            for p in pts]
+    errs = [rel_err(run.get(cand, p)[0], p, peak) for p in pts]
     return (sum(e <= TOL for e in errs), -max(errs))
 
 
