@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -206,6 +206,12 @@ bench-dem-calibrate: $(BUILD)/convsim
 	$(Q)python3 tests/bench/dem_calibrate.py $(BUILD)/convsim > /dev/null
 	$(Q)$(MAKE) --no-print-directory model-check
 $(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
+# `make fast-feed-check`: reduced feed models against the DEM map, leave one
+# depth out (tests/bench/fast_feed_check.py, docs/feed-models.md), into
+# tests/bench/results/fast_feed.md and .csv; the docs' tables follow.
+fast-feed-check: $(BUILD)/convsim
+	$(Q)python3 tests/bench/fast_feed_check.py $(BUILD)/convsim
+	$(Q)python3 tests/docs_bench.py
 $(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
