@@ -17,6 +17,8 @@ int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error 
 		p.beta = st->beta_target;
 		p.rotation = st->rotation;
 		p.omega_ss = st->omega_ss;
+		p.m_n = st->m_n;
+		p.mu = st->mu;
 	}
 	return sim_model_check(&p, &spec->scene, me);
 }
@@ -27,4 +29,19 @@ void api_add_model_error(cJSON *o, const sim_model_error *me)
 	api_add_number(o, "model_error_uncertainty", me->checked ? me->error_uncertainty : NAN);
 	cJSON_AddBoolToObject(o, "model_checked", me->checked);
 	cJSON_AddStringToObject(o, "model_check_note", me->note);
+}
+
+void api_buf_model_error(api_buf *b, const sim_model_error *me)
+{
+	if (!me) {
+		api_buf_puts(b, ",,,");
+		return;
+	}
+	api_buf_put(b, ",", 1);
+	if (me->checked && isfinite(me->error))
+		api_buf_double(b, me->error);
+	api_buf_put(b, ",", 1);
+	if (me->checked && isfinite(me->error_uncertainty))
+		api_buf_double(b, me->error_uncertainty);
+	api_buf_puts(b, me->checked ? ",true" : ",false");
 }

@@ -10,6 +10,8 @@
  * was too short for the feed to settle).
  */
 #include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "experiment_int.h"
@@ -25,6 +27,16 @@ srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st)
 		cmd->c.set |= API_C_BETA_RATE;
 		cmd->c.beta_rate = e->req.beta_rate;
 	}
+	if (e->ext.kind == API_EXP_CONTROL) {
+		/* the new setpoint's feedforward with the integral carried over */
+		api_exp_ext *x = &e->ext;
+		double b = seg->beta.si + x->branch_sign * x->integ * (M_PI / 180);
+		b = b < x->beta_lo ? x->beta_lo : b > x->beta_hi ? x->beta_hi : b;
+		cmd->c.beta = (api_value){b, b * 180 / M_PI};
+	}
+	e->beta_sent = cmd->c.beta.si;
+	e->cmd_starts = 1;
+	e->dist_from = e->dist_to = 0;
 	cmd->restart_transport = 1;
 	cmd->from_experiment = 1;
 	seg->start_velocity = st->feed_velocity;
@@ -71,4 +83,55 @@ void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
 			}
 		}
 	seg->state = 2;
+	srv_exp_control_results(e);
+	srv_exp_identify_results(e);
+}
+
+double srv_exp_segment_end(const srv_experiment *e)
+{
+	return e->state == EXP_RUNNING ? e->t0 + e->req.seg[e->cur].until : INFINITY;
+}
+
+double srv_exp_boundary(const srv_experiment *e)
+{
+	return fmin(srv_exp_segment_end(e), srv_exp_control_boundary(e));
+}
+
+/* ---- a new start after a restart (experiment.h srv_exp_readopt) ----------- */
+
+int srv_exp_readopt(srv_experiment *e, const char *session_id)
+{
+	pthread_mutex_lock(&e->lock);
+	int hit = !e->attached && (e->state == EXP_RUNNING || e->state == EXP_WAITING) &&
+		  strcmp(e->session_id, session_id) == 0 && e->req.nseg >= 1;
+	if (hit && !e->rec_t) {
+		e->rec_t = malloc(EXP_RECORDS * sizeof(double));
+		e->rec_v = malloc(EXP_RECORDS * sizeof(double));
+	}
+	if (hit && e->rec_t && e->rec_v) {
+		/* every segment as the request left it, then its start */
+		for (int i = 0; i < e->req.nseg; i++) {
+			api_segment *seg = &e->req.seg[i];
+			api_value beta = seg->beta;
+			double until = seg->until;
+			memset(seg, 0, sizeof *seg);
+			seg->beta = beta;
+			seg->until = until;
+			seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
+			seg->reversal_time = seg->start_velocity = NAN;
+			seg->t_command = seg->t_end = NAN;
+		}
+		e->rec_cap = EXP_RECORDS;
+		e->rec_n = e->seg_first = 0;
+		e->rec_spacing = e->req.seg[e->req.nseg - 1].until / EXP_RECORDS;
+		e->state = EXP_WAITING;
+		e->cur = 0;
+		e->t0 = e->t_now = 0;
+		e->error[0] = '\0';
+		e->attached = 1;
+	} else {
+		hit = 0;
+	}
+	pthread_mutex_unlock(&e->lock);
+	return hit;
 }
