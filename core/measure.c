@@ -1,10 +1,11 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * measure.c - sim_measure: one measurement of the transport velocity, a
- * fresh instance run to a time at most with its shadow (shadow.c) over the
- * first part of the window, stopped early once its bar is met with little
- * scatter, repeated at finer steps where the measured step error is
- * beyond what the accuracy target tol allows.
+ * fresh instance run to a time with its shadow (shadow.c) over the first
+ * part of the window, repeated at finer steps where the measured step
+ * error is beyond what the accuracy target tol allows; sim_measure_point,
+ * a sweep's point: the same, stopped early once its bar is met with little
+ * scatter.
  */
 #include <math.h>
 #include <stdio.h>
@@ -97,7 +98,7 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 
 /* One run of sim_measure: a fresh instance to t_end at most, its shadow
  * over the first SHADOW_MEASURE_SHARE of the window; *st its final
- * status. With a shadow, the run stops early at the first check after the
+ * status. If early (sim_measure_point) and with a shadow, the run stops early at the first check after the
  * shadow has finished where the bar is within tol and the estimate steady
  * (the rest of the window would only shrink a bar already met), or, if
  * may_refine, where a refinement is asked (refine_asks with last) with
@@ -107,7 +108,7 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
  * whose room a longer window's smaller scatter may yet make is left to
  * the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, int may_refine, double last, settled_start *start,
+			double t_end, int early, int may_refine, double last, settled_start *start,
 			sim_status *st, char *msg, size_t msglen)
 {
 	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
@@ -118,7 +119,7 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 		return err;
 	/* the first check at the shadow's end (just past it: the shadow
 	 * finishes once the instance is asked beyond it) */
-	double t = s->shadow ? fmin(t_end, nextafter(s->shadow_until, INFINITY)) : t_end;
+	double t = early && s->shadow ? fmin(t_end, nextafter(s->shadow_until, INFINITY)) : t_end;
 	for (;;) {
 		err = sim_advance(s, t);
 		if (err != SIM_OK || t >= t_end)
@@ -136,8 +137,11 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 	return err;
 }
 
-int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
-		sim_measurement *out, char *msg, size_t msglen)
+/* sim_measure, and sim_measure_point if early: its runs stop once their
+ * bar is met, and its refinements start from the first run's settled
+ * start. */
+static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
+		   int early, sim_measurement *out, char *msg, size_t msglen)
 {
 	struct timespec c0, c1;
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
@@ -153,8 +157,8 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	settled_start start = {NULL, 0};
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
-		err = measure_once(p, sc, &run, t_end, may_refine, last, own_steps ? &start : NULL,
-				   &st, msg, msglen);
+		err = measure_once(p, sc, &run, t_end, early, may_refine, last,
+				   early && own_steps ? &start : NULL, &st, msg, msglen);
 		out->refinements = attempt;
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a
@@ -190,4 +194,16 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
 	out->cpu_seconds = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
 	return err;
+}
+
+int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
+		sim_measurement *out, char *msg, size_t msglen)
+{
+	return measure(p, sc, m, t_end, 0, out, msg, msglen);
+}
+
+int sim_measure_point(const sim_params *p, const sim_scene *sc, const sim_method *m,
+		      double t_end, sim_measurement *out, char *msg, size_t msglen)
+{
+	return measure(p, sc, m, t_end, 1, out, msg, msglen);
 }
