@@ -398,8 +398,9 @@ install: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
 	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
-	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/log
 	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
+	install -m 644 docs/log/*.md $(DESTDIR)$(DOCDIR)/docs/log/
 	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
 	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service

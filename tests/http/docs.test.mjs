@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The documents cannot drift from the program: every sh and python block of
-// README.md and docs/*.md runs against the real daemon (started with a
+// README.md, docs/*.md and docs/log/*.md runs against the real daemon (started with a
 // token, as `make run` starts it), every `<!-- output -->` block is compared
 // with what its example printed, figures in examples' comments are elided,
 // and every relative link between the documents resolves to a file and a
-// heading. The conventions are written down in docs/development.md
+// heading. The conventions are written down in docs/testing.md
 // ("Examples in the documentation").
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -23,9 +23,13 @@ const AUTH = { Authorization: `Bearer ${TOKEN}` };
 const run = promisify(execFile);
 
 // README.md and every page of docs/, as [path relative to ROOT, text]
+// (docs/log/, the measurement logs, included)
 export function documents(root = ROOT) {
-  const names = ['README.md', ...readdirSync(join(root, 'docs')).filter((f) => f.endsWith('.md')).sort()
-    .map((f) => `docs/${f}`)];
+  const names = ['README.md'];
+  for (const dir of ['docs', 'docs/log']) {
+    if (!existsSync(join(root, dir))) continue;
+    names.push(...readdirSync(join(root, dir)).filter((f) => f.endsWith('.md')).sort().map((f) => `${dir}/${f}`));
+  }
   return names.map((n) => [n, readFileSync(join(root, n), 'utf8')]);
 }
 
@@ -214,9 +218,9 @@ test('every relative link between the documents resolves (file and #anchor)', ()
   assert.deepEqual(bad, []);
 });
 
-// Operations of the OpenAPI document that docs/api.md does not name (the
-// method on a line with the path, a path parameter as any word), and
-// operations docs/api.md names that the document lacks.
+// Operations of the OpenAPI document that the API pages (API_PAGES) do not
+// name (the method on a line with the path, a path parameter as any word),
+// and operations they name that the document lacks.
 export function apiDrift(doc, text) {
   const ops = Object.entries(doc.paths).flatMap(([p, item]) => Object.keys(item).map((m) => [m.toUpperCase(), p]));
   const re = (p) => new RegExp(p.replace(/[.*+?^$()|[\]\\]/g, '\\$&').replace(/\{[^}]+\}/g, '[A-Za-z0-9_-]+') + '(?![A-Za-z0-9_/-])');
@@ -229,9 +233,12 @@ export function apiDrift(doc, text) {
   return { missing, named };
 }
 
-test('docs/api.md and the served OpenAPI document name the same operations', async () => {
+// The API reference: docs/api.md and the pages it is split into.
+export const API_PAGES = ['docs/api.md', 'docs/api-streams.md', 'docs/api-jobs.md'];
+
+test('the API pages and the served OpenAPI document name the same operations', async () => {
   const doc = (await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH)).body;
-  const text = readFileSync(join(ROOT, 'docs/api.md'), 'utf8');
+  const text = API_PAGES.map((p) => readFileSync(join(ROOT, p), 'utf8')).join('\n');
   assert.deepEqual(apiDrift(doc, text), { missing: [], named: [] });
   /* and it can fail both ways */
   const less = apiDrift(doc, text.replace(/PATCH/g, 'PUT'));
