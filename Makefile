@@ -306,7 +306,7 @@ bench: all $(BUILD)/.deps-bench
 bench-zoo-ref: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
-# libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
+# libFuzzer harnesses (tests/fuzz/, docs/fuzzing.md "Fuzzing"): clang builds core/,
 # fit/, api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
