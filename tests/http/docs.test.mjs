@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The documents cannot drift from the program: every sh and python block of
-// README.md, docs/*.md and docs/log/*.md runs against the real daemon (started with a
-// token, as `make run` starts it), every `<!-- output -->` block is compared
-// with what its example printed, figures in examples' comments are elided,
-// and every relative link between the documents resolves to a file and a
-// heading. The conventions are written down in docs/testing.md
+// README.md, docs/*.md and docs/log/*.md runs against the real daemon
+// (started with a token, as `make run` starts it) through a validating
+// proxy (Prism: a request or an answer that breaks the OpenAPI document
+// fails the example), every `<!-- output -->` block is compared with what
+// its example printed, figures in examples' comments are elided, and every
+// relative link between the documents resolves to a file and a heading.
+// The conventions are written down in docs/testing.md
 // ("Examples in the documentation").
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -15,6 +17,7 @@ import { dirname, join, relative, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
 import { startDaemon, tokenFile, req, until, SLOW } from './lib.mjs';
+import { startPrism } from './prism.mjs';
 
 const ROOT = fileURLToPath(new URL('../..', import.meta.url));
 const BUILD = resolve(ROOT, process.env.BUILD || 'build');
@@ -67,7 +70,10 @@ export function examples(name, text) {
       out[out.length - 1].output = b.code;
       continue;
     }
-    if (['sh', 'bash', 'python'].includes(b.lang)) out.push({ ...b, where });
+    if (b.mark && /example:\s*direct/.test(b.mark))
+      assert.match(b.mark, /example:\s*direct\s*\(\S[^)]*\)/, `${where}: a direct example says why: <!-- example: direct (REASON) -->`);
+    const direct = Boolean(b.mark && /example:\s*direct/.test(b.mark));
+    if (['sh', 'bash', 'python'].includes(b.lang)) out.push({ ...b, where, direct });
   }
   return out;
 }
@@ -131,13 +137,23 @@ export function brokenLinks(name, text, root = ROOT) {
   return bad;
 }
 
-let d, base, hostport;
+// The examples reach the daemon through Prism, a validating proxy
+// (prism.mjs): a request or an answer of an example that breaks the
+// OpenAPI document is a violation, which fails the example. An example
+// that must reach the daemon itself (a request the document refuses on
+// purpose, a stream Prism would hold until it ends) says why, right
+// before it: <!-- example: direct (REASON) -->.
+let d, base, prism, viaProxy, direct;
 before(async () => {
   d = await startDaemon(['--token-file', tokenFile(TOKEN)]);
   base = d.base;
-  hostport = base.replace(/^http:\/\//, '');
+  direct = base.replace(/^http:\/\//, '');
+  const doc = await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH);
+  assert.equal(doc.status, 200);
+  prism = await startPrism(doc.text, base);
+  viaProxy = prism.url.replace(/^http:\/\//, '');
 });
-after(async () => { await d?.stop(); });
+after(async () => { prism?.stop(); await d?.stop(); });
 
 async function finished(path, done, ms) {
   let last;
@@ -177,7 +193,7 @@ const MAKE = {
   },
 };
 
-async function prepare(code) {
+async function prepare(code, hostport) {
   let text = code.replace(/\b(localhost|127\.0\.0\.1):8080\b/g, hostport);
   const kinds = { sessions: 'ID', experiments: 'EID', sweeps: 'SID', fits: 'FID' };
   for (const [route, word] of Object.entries(kinds)) {
@@ -199,9 +215,10 @@ function workdir() {
 }
 
 async function runExample(ex) {
-  const code = await prepare(ex.code);
+  const hostport = ex.direct ? direct : viaProxy;
+  const code = await prepare(ex.code, hostport);
   const cwd = workdir();
-  const env = { ...process.env, CONVSIM_URL: base, CONVSIM_TOKEN: TOKEN, AUTH: `Authorization: Bearer ${TOKEN}` };
+  const env = { ...process.env, CONVSIM_URL: `http://${hostport}`, CONVSIM_TOKEN: TOKEN, AUTH: `Authorization: Bearer ${TOKEN}` };
   const opts = { cwd, env, timeout: 240000 * SLOW, maxBuffer: 64 << 20 };
   if (ex.lang === 'python') {
     writeFileSync(join(cwd, 'example.py'), code);
@@ -261,6 +278,13 @@ test('the link checker sees a missing file and a missing anchor', () => {
   assert.ok(anchors('## The 1 % gate\n## Load: `make load`\n## A\n## A').has('the-1--gate'));
   assert.ok(anchors('## Load: `make load`').has('load-make-load'));
   assert.ok(anchors('## A\n## A').has('a-1'));
+});
+
+test('an example goes through the validating proxy unless marked direct, with a reason', () => {
+  const fence = (mark) => `${mark}\n\`\`\`sh\ncurl -s localhost:8080/api/v1/health\n\`\`\`\n`;
+  assert.equal(examples('x.md', fence(''))[0].direct, false);
+  assert.equal(examples('x.md', fence('<!-- example: direct (a request the document refuses) -->'))[0].direct, true);
+  assert.throws(() => examples('x.md', fence('<!-- example: direct -->')), /a direct example says why/);
 });
 
 test('output blocks and elided figures: the rules can fail', () => {
