@@ -345,9 +345,9 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 
 # PATCH throughput with the durable control log alone (part of `make
 # bench`; tests/bench/controls.mjs, about 20 s): OLD_CONVSIMD=path adds
-# another build's rows for comparison.
+# another build's rows for comparison; CLIENT=fetch,lean both clients.
 bench-controls: all
-	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/controls.mjs
+	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" CLIENT="$(or $(CLIENT),lean)" node tests/bench/controls.mjs
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
@@ -377,7 +377,7 @@ bench-dem: all $(BUILD)/.deps-dem
 # seeds a point, from one build; many CPU hours, resumable, in parts
 # (DEM_MAP_PARTS="glass-shallow glass-checks"), into
 # tests/bench/results/dem_map.csv and dem_map.md.
-bench-dem-map: $(BUILD)/.deps-dem
+bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
@@ -398,10 +398,11 @@ install: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
 	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
-	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/log
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/log $(DESTDIR)$(DOCDIR)/docs/examples
 	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
 	install -m 644 docs/log/*.md $(DESTDIR)$(DOCDIR)/docs/log/
 	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
+	install -m 644 docs/examples/*.py $(DESTDIR)$(DOCDIR)/docs/examples/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
 	  server/convsimd.service.in > $(DESTDIR)$(UNITDIR)/convsimd.service
 	chmod 644 $(DESTDIR)$(UNITDIR)/convsimd.service

@@ -286,12 +286,17 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb);
  * are parsed, echoed in the control event and listed in messages and the
  * OpenAPI document: X(ID, member, API_C_ID bit, function suffix). The
  * rest of each row is api/control.c's (parse, echo) and
- * server/session/worker.c's (apply), both indexed by API_CTL_ID. */
+ * server/session/worker_control.c's (apply), both indexed by API_CTL_ID.
+ * m_n and mu are disturbances of a column feed (sim_set_feed); whatever
+ * sends a control (a PATCH, the control log's replay, an experiment's
+ * schedule) parses it with api_parse_control against the session's spec. */
 #define API_CONTROLS(X)                                                                    \
 	X(BETA, "beta", 1u << 0, beta)                                                      \
 	X(BETA_RATE, "beta_rate", 1u << 1, beta_rate)                                       \
 	X(ROTATION, "rotation", 1u << 2, rotation)                                          \
 	X(OMEGA_SS, "omega_ss", 1u << 3, omega_ss)                                          \
+	X(M_N, "m_n", 1u << 9, m_n)                                                         \
+	X(MU, "mu", 1u << 10, mu)                                                           \
 	X(RUNNING, "running", 1u << 4, running)                                             \
 	X(MOTOR, "motor_on", 1u << 7, motor)                                                \
 	X(PACE, "pace", 1u << 5, pace)                                                      \
@@ -309,6 +314,8 @@ typedef struct api_control {
 	api_value beta_rate; /* rad/s (deg/s as sent) */
 	int rotation;     /* SIM_CW / SIM_CCW */
 	double omega_ss;  /* rad/s */
+	double m_n;       /* kg: the column feed's element mass (a disturbance) */
+	double mu;        /* the column feed's friction coefficient (one too) */
 	int running;
 	int motor_on;     /* drive switched on (motor or ideal drive) */
 	double pace;      /* API_PACE_MAX for "max" */
@@ -340,7 +347,8 @@ int api_control_event(char *buf, size_t len, const api_control *c,
 int api_control_event_model(char *buf, size_t len, const api_control *c,
 			    double t_effective, const sim_model_error *me);
 /* The model error of a session's scene now (sim_model_check): the spec's
- * settings with the status's controls (beta_target, rotation, omega_ss)
+ * settings with the status's controls (beta_target, rotation, omega_ss,
+ * m_n, mu)
  * when st is not NULL. Returns sim_model_check's value. */
 int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error *me);
 /* The control as a line of the session's control log: the stream event's

@@ -54,6 +54,63 @@ static api_err parse_omega_ss(const cJSON *it, const api_spec *spec, const char 
 	return e;
 }
 
+/* A disturbance of the column feed (m_n, mu): only a session whose feed is
+ * the column model takes one (a LIGGGHTS bed's grains are set at its
+ * start; without a feed there is none to change). */
+static api_err feed_disturbable(const api_spec *spec, const char *name, api_problem *pb)
+{
+	if (!spec->scene.feed)
+		return api_fail(pb, API_INVALID, name,
+				"%s changes the feed of a running session; this session has "
+				"no feed (feed = false)", name);
+	if (spec->scene.feed_model != SIM_FEED_COLUMN)
+		return api_fail(pb, API_INVALID, name,
+				"%s changes the column model's feed of a running session; this "
+				"session's feed_model is liggghts, whose bed keeps the grains it "
+				"started with", name);
+	return API_OK;
+}
+
+static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name,
+			 api_control *c, api_problem *pb)
+{
+	api_value v = {0, 0};
+	api_err e = api_parse_user_value(spec, name, it, name, &v, pb);
+	if (e == API_OK)
+		e = feed_disturbable(spec, name, pb);
+	if (e != API_OK)
+		return e;
+	double lo, hi;
+	sim_feed_mass_range(&spec->params, &spec->scene, &spec->method, &lo, &hi);
+	if (v.si < lo || v.si > hi) {
+		/* narrowed from the table's range: the coupling's side */
+		int light = hi < sim_setting_find(name)->max;
+		e = api_fail(pb, API_RANGE, name,
+			     "m_n must lie in [%.6g, %.6g] kg in this session; got %g: its "
+			     "integrator (dem with sub-steps) couples a feed of %s 0.2 of "
+			     "the machine's mass %s, and keeps it so", lo, hi, v.si,
+			     light ? "at most" : "more than",
+			     light ? "with its corrector" : "without it");
+		pb->has_range = 1;
+		pb->min = lo;
+		pb->max = hi;
+		return e;
+	}
+	c->m_n = v.si;
+	return API_OK;
+}
+
+static api_err parse_mu(const cJSON *it, const api_spec *spec, const char *name,
+			api_control *c, api_problem *pb)
+{
+	api_value v = {0, 0};
+	api_err e = api_parse_user_value(spec, name, it, name, &v, pb);
+	if (e == API_OK)
+		e = feed_disturbable(spec, name, pb);
+	c->mu = v.si;
+	return e;
+}
+
 static api_err parse_rotation(const cJSON *it, const api_spec *spec, const char *name,
 			      api_control *c, api_problem *pb)
 {
@@ -133,6 +190,16 @@ static void put_rotation(cJSON *o, const char *name, const api_control *c)
 static void put_omega_ss(cJSON *o, const char *name, const api_control *c)
 {
 	api_add_number(o, name, c->omega_ss);
+}
+
+static void put_m_n(cJSON *o, const char *name, const api_control *c)
+{
+	api_add_number(o, name, c->m_n);
+}
+
+static void put_mu(cJSON *o, const char *name, const api_control *c)
+{
+	api_add_number(o, name, c->mu);
 }
 
 static void put_running(cJSON *o, const char *name, const api_control *c)

@@ -17,6 +17,8 @@ int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error 
 		p.beta = st->beta_target;
 		p.rotation = st->rotation;
 		p.omega_ss = st->omega_ss;
+		p.m_n = st->m_n;
+		p.mu = st->mu;
 	}
 	return sim_model_check(&p, &spec->scene, me);
 }

@@ -50,8 +50,8 @@ static const api_route routes[API_R_COUNT] = {
 	 "One session: spec and live status (CSV: its summary row)", NULL, 200, "Session",
 	 "400,404,406,503"},
 	[API_R_SESSION_PATCH] = {"PATCH", "/api/v1/sessions/*", 0, 0,
-	 "Change beta, beta_rate, rotation, omega_ss, motor_on, running, pace or until while it "
-	 "runs; answers the simulated time the change takes effect",
+	 "Change beta, beta_rate, rotation, omega_ss, the feed's m_n or mu, motor_on, running, "
+	 "pace or until while it runs; answers the simulated time the change takes effect",
 	 "Control", 200, "ControlResult", "400,404,409,413,415,422,503"},
 	[API_R_SESSION_DELETE] = {"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
 	 "400,404,415"},

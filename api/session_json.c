@@ -32,6 +32,8 @@ static cJSON *status_object(const api_view *v)
 				st->rotation == SIM_CW ? "cw" : "ccw");
 	cJSON_AddBoolToObject(o, "drive_on", st->drive_on);
 	api_add_number(o, "omega_ss", st->omega_ss);
+	api_add_number(o, "m_n", st->m_n);
+	api_add_number(o, "mu", st->mu);
 	api_add_number(o, "rotor_speed", st->rotor_speed);
 	api_add_number(o, "motor_torque", st->motor_torque);
 	api_add_number(o, "power", st->power);
@@ -87,6 +89,8 @@ static cJSON *status_object(const api_view *v)
 	api_add_number(en, "potential", st->e_potential);
 	api_add_number(en, "dissipated", st->e_dissipated);
 	api_add_number(en, "residual", st->e_residual);
+	/* the part of input the feed's disturbances brought (sim_set_feed) */
+	api_add_number(en, "disturbance", st->e_disturb);
 	return o;
 }
 

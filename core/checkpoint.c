@@ -19,11 +19,15 @@
  *            the measured step error (shadow.c): step_error,
  *            shadow_until, shadow_window and the running shadow's own
  *            checkpoint (none: length 0), so that a restore in the middle
- *            of a shadow's window gives the same error bar at its end
+ *            of a shadow's window gives the same error bar at its end;
+ *            from version 4 on, between the workspace's state and the
+ *            step error's part, the feed's disturbances (sim_set_feed):
+ *            m_n, mu and the energy they brought
  *
- * Version 2 (without the step error's part) is still read: its instance
- * keeps the calibrated step term until its next estimate starts, as it
- * did.
+ * Versions 2 (without the step error's part) and 3 (without the
+ * disturbances' part) are still read: a version 2 instance keeps the
+ * calibrated step term until its next estimate starts, as it did; a
+ * version 3 one has the m_n and mu it was created with.
  *
  * The core's structs are plain data (no pointers), so they are copied
  * whole; the sizes in the header refuse a buffer of a build whose structs
@@ -36,10 +40,13 @@
 #include <string.h>
 
 #include "sim_int.h"
+#include "units.h"
 
 #define CKPT_MAGIC "CVSCKPT1"
-/* The last version without the step error's part (read as it was). */
+/* The last version without the step error's part, and the last without
+ * the disturbances' part (each read as it was). */
 #define CKPT_VERSION_NO_SHADOW 2
+#define CKPT_VERSION_NO_DISTURB 3
 
 typedef struct ckpt_header {
 	char magic[8];
@@ -65,6 +72,11 @@ typedef struct ckpt_shadow {
 	double step_error, shadow_until, shadow_window;
 	uint64_t shadow_len;
 } ckpt_shadow;
+
+/* The feed's disturbances (version 4 on), before the step error's part. */
+typedef struct ckpt_disturb {
+	double m_n, mu, e_disturb;
+} ckpt_disturb;
 
 /* FNV-1a, 64 bits (Fowler, Noll, Vo): enough to tell a torn or flipped
  * buffer from a whole one; not a defence against a forger. */
@@ -99,7 +111,7 @@ static size_t base_size(const sim *s)
 /* The payload's length for instance s (its shadow's checkpoint too). */
 static size_t payload_size(const sim *s)
 {
-	return base_size(s) + sizeof(ckpt_shadow) + (s->shadow ? sim_checkpoint_size(s->shadow) : 0);
+	return base_size(s) + sizeof(ckpt_disturb) + sizeof(ckpt_shadow) + (s->shadow ? sim_checkpoint_size(s->shadow) : 0);
 }
 
 static ckpt_header header_of(const sim *s)
@@ -167,6 +179,8 @@ int sim_checkpoint(const sim *s, void *buf, size_t len)
 	if (h.ws_size)
 		s->ode->save(s->ws, at);
 	at += h.ws_size;
+	ckpt_disturb di = {s->md.p.m_n, s->md.p.mu, s->e_disturb};
+	put(&at, &di, sizeof di);
 	ckpt_shadow sh = {s->step_error, s->shadow_until, s->shadow_window,
 			  s->shadow ? sim_checkpoint_size(s->shadow) : 0};
 	put(&at, &sh, sizeof sh);
@@ -189,6 +203,31 @@ static int refuse(char *msg, size_t msglen, const char *why)
 	return SIM_ECHECKPOINT;
 }
 
+/* The disturbances' part's length in a payload of version v. */
+static size_t disturb_size(uint32_t version)
+{
+	return version > CKPT_VERSION_NO_DISTURB ? sizeof(ckpt_disturb) : 0;
+}
+
+/* The disturbances' part at *at (version 4 on; moved past it) into s,
+ * checked against the ranges a running instance takes. SIM_OK or
+ * SIM_ECHECKPOINT with msg. */
+static int restore_disturb(sim *s, const char **at, char *msg, size_t msglen)
+{
+	ckpt_disturb di;
+	get(at, &di, sizeof di);
+	double lo, hi;
+	sim_feed_mass_range(&s->md.p, &s->md.sc, &s->cfg, &lo, &hi);
+	if (!(di.m_n >= lo && di.m_n <= hi) ||
+	    !sim_setting_check(sim_setting_find("mu"), di.mu) || !isfinite(di.e_disturb) ||
+	    (s->md.nf == 0 && (di.m_n != s->md.p.m_n || di.mu != s->md.p.mu)))
+		return refuse(msg, msglen, "the feed's disturbances' part is out of range");
+	s->md.p.m_n = di.m_n;
+	s->md.p.mu = di.mu;
+	s->e_disturb = di.e_disturb;
+	return SIM_OK;
+}
+
 /* Check buf against instance s (built for the same set): the frame, the
  * layout and the checksum. SIM_OK or SIM_ECHECKPOINT with msg. */
 static int check_frame(const sim *s, const void *buf, size_t len, char *msg, size_t msglen)
@@ -199,13 +238,15 @@ static int check_frame(const sim *s, const void *buf, size_t len, char *msg, siz
 	memcpy(&h, buf, sizeof h);
 	if (memcmp(h.magic, CKPT_MAGIC, sizeof h.magic) != 0)
 		return refuse(msg, msglen, "not a checkpoint (bad magic)");
-	if (h.version != SIM_CHECKPOINT_VERSION && h.version != CKPT_VERSION_NO_SHADOW)
+	if (h.version != SIM_CHECKPOINT_VERSION && h.version != CKPT_VERSION_NO_SHADOW &&
+	    h.version != CKPT_VERSION_NO_DISTURB)
 		return refuse(msg, msglen, "unknown version");
 	size_t base = base_size(s);
 	if (h.n != want.n || h.columns != want.columns || h.ctl_size != want.ctl_size ||
 	    h.est_size != want.est_size || h.ws_size != want.ws_size ||
 	    (h.version == CKPT_VERSION_NO_SHADOW ? h.payload != base
-						  : h.payload < base + sizeof(ckpt_shadow)))
+						  : h.payload < base + disturb_size(h.version) +
+									sizeof(ckpt_shadow)))
 		return refuse(msg, msglen, "layout differs from this session's model or build");
 	if (len - sizeof h < h.payload)
 		return refuse(msg, msglen, "cut off");
@@ -279,8 +320,11 @@ static sim *restore_depth(const sim_params *p, const sim_scene *sc, const sim_me
 	if (ws_state_size(s))
 		s->ode->load(s->ws, at);
 	at += ws_state_size(s);
+	if (disturb_size(h.version) && (e = restore_disturb(s, &at, msg, msglen)) != SIM_OK)
+		goto fail;
 	if (h.version != CKPT_VERSION_NO_SHADOW) {
-		e = restore_shadow(s, at, h.payload - base_size(s), depth, msg, msglen);
+		e = restore_shadow(s, at, h.payload - base_size(s) - disturb_size(h.version), depth,
+				   msg, msglen);
 		if (e != SIM_OK)
 			goto fail;
 	}

@@ -179,6 +179,22 @@ void feed_settle(const model *md, double *y, const deck_motion *dm)
 	}
 }
 
+void feed_scale_contacts(const model *md, double *y, const deck_motion *dm, double factor)
+{
+	double *eta = ETA(md, y);
+	for (int k = 0; k < md->dk.K; k++) {
+		/* the old level below each layer and where it now stands */
+		double below_old = dm->pos[k][1], below_new = dm->pos[k][1];
+		for (int j = 0; j < md->L; j++) {
+			int e = k * md->L + j;
+			double delta = below_old - eta[e];
+			below_old = eta[e];
+			eta[e] = below_new - (delta > 0.0 ? factor * delta : delta);
+			below_new = eta[e];
+		}
+	}
+}
+
 double feed_mean_xi(const model *md, const double *y, int k)
 {
 	const double *xi = XI(md, y);

@@ -35,6 +35,14 @@ double feed_contact_energy(const model *md, const double *y, const deck_motion *
 /* Place the feed settled at rest on the deck points dm->pos. */
 void feed_settle(const model *md, double *y, const deck_motion *dm);
 
+/* Scale every closed contact's compression (delta > 0, the deck's
+ * included, deck points dm->pos) by factor, moving each layer with the
+ * contacts below it; open gaps are kept as they are, and horizontal
+ * positions and all velocities untouched. With factor (m_new /
+ * m_old)^(1/p) a column settled under elements of mass m_old is settled
+ * under m_new (sim_set_feed, docs/MODEL.md "Disturbances"). */
+void feed_scale_contacts(const model *md, double *y, const deck_motion *dm, double factor);
+
 /* Mean horizontal position (m) of column k's elements (all columns: k = -1). */
 double feed_mean_xi(const model *md, const double *y, int k);
 /* Mean horizontal velocity (m/s) of all elements; 0 without feed. */

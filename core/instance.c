@@ -4,13 +4,16 @@
  * set (the model, the controls, the state vectors, the integrator's
  * workspace), released with everything it owns. Shared by sim.c (a new
  * instance), checkpoint.c (a restored one) and shadow.c (the measured
- * step error's second instance).
+ * step error's second instance). Also the feed masses a running instance
+ * takes (sim_feed_mass_range), which depend on the method as sim_alloc
+ * resolves it.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "sim_int.h"
+#include "units.h"
 
 sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err,
 	       char *msg, size_t msglen)
@@ -66,4 +69,37 @@ void sim_free(sim *s)
 	free(s->y);
 	free(s->X0k);
 	free(s);
+}
+
+/* The machine's mass that the corrector's ratio divides by (setup.c's
+ * model_feed_mass_ratio). */
+static double machine_mass(const sim_params *p)
+{
+	return p->M_r + p->m + p->m1 + p->m2;
+}
+
+void sim_feed_mass_range(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			 double *lo, double *hi)
+{
+	const sim_setting *set = sim_setting_find("m_n");
+	*lo = set->min;
+	*hi = set->max;
+	const ode_method *ode = ode_find(m->name);
+	if (!ode || !ode->info.substeps || !sc->feed || !sc->feed_coupling ||
+	    sc->feed_model != SIM_FEED_COLUMN || sc->columns < 1 || sc->layers < 1)
+		return;
+	/* the sub-steps as sim_alloc resolves them */
+	sim_method r = *m;
+	if (r.dt == 0.0)
+		r.dt = sim_default_dt(p, sc, m);
+	if (r.substeps == 0)
+		r.substeps = sim_default_substeps(p, sc, &r, r.dt);
+	if (r.substeps <= 1)
+		return;
+	double edge = MODEL_CORRECTOR_MAX_RATIO * machine_mass(p) /
+		      ((double)sc->columns * (double)sc->layers);
+	if (model_feed_mass_ratio(p, sc) <= MODEL_CORRECTOR_MAX_RATIO)
+		*hi = fmin(*hi, edge);
+	else
+		*lo = fmax(*lo, nextafter(edge, INFINITY));
 }

@@ -84,6 +84,7 @@ static void zero_observers(sim *s, int origins)
 	double *acc = s->y + 2 * md->npos;
 	for (int a = 0; a < ACC_N; a++)
 		acc[a] = 0.0;
+	s->e_disturb = 0.0;
 	memcpy(s->y_obs, s->y, sizeof(double) * (size_t)md->n);
 	memcpy(s->y_prev, s->y, sizeof(double) * (size_t)md->n);
 	s->t_obs = s->t_prev = s->t_int;

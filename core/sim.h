@@ -159,9 +159,10 @@ const char *sim_last_error(const sim *s);
 
 /* ---- checkpoints ------------------------------------------------------- */
 
-/* Version of the checkpoint format (checkpoint.c); version 2 (without the
- * measured step error's shadow) is still read, any other is refused. */
-#define SIM_CHECKPOINT_VERSION 3
+/* Version of the checkpoint format (checkpoint.c); versions 2 (without the
+ * measured step error's shadow) and 3 (without the feed's disturbances)
+ * are still read, any other is refused. */
+#define SIM_CHECKPOINT_VERSION 4
 
 /* FNV-1a 64 of len bytes: the checkpoints' checksum, for callers that
  * frame their own files the same way. */
@@ -200,6 +201,27 @@ int sim_set_beta(sim *s, double beta, double rate);
 int sim_set_rotation(sim *s, int rotation);
 /* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
 int sim_set_omega_ss(sim *s, double omega_ss);
+/* Disturb the column feed mid-run (docs/MODEL.md "Disturbances"): its
+ * element mass m_n (kg) and friction coefficient mu from
+ * sim_effective_time() on; NaN keeps either. Every element keeps its
+ * horizontal position and its velocities; where m_n changes, each closed
+ * contact's compression is scaled by (m_n / m_n_before)^(1/p), the
+ * layers above moving with it, so that a settled column stays settled
+ * under the new load (open gaps kept). The stored energy's jump this
+ * makes is booked as input (status e_input), so the balance closes
+ * across it; the transport estimate starts over. The steps stay those of
+ * the start. SIM_EPARAM (nothing changed) without a column feed (no feed,
+ * feed_model external), on a failed instance, or for a value outside its
+ * range: the settings table's, for m_n narrowed by sim_feed_mass_range. */
+int sim_set_feed(sim *s, double m_n, double mu);
+/* The m_n (kg) a running instance of p, sc, m takes (lo, hi written,
+ * closed): the settings table's range, narrowed where the split method
+ * with sub-steps couples a light feed with its corrector (feed mass at
+ * most 0.2 of the machine's, docs/MODEL.md "Integrators") to the masses
+ * that keep it light, and where it couples a heavy feed without, to
+ * those that keep it heavy. */
+void sim_feed_mass_range(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			 double *lo, double *hi);
 /* Switch the drive on (on != 0) or off; always SIM_OK. */
 int sim_set_drive_on(sim *s, int on);
 /* An external feed's load on the deck (feed_model = SIM_FEED_EXTERNAL):
@@ -251,6 +273,8 @@ typedef struct sim_status {
 	int rotation;             /* SIM_CW / SIM_CCW commanded */
 	int drive_on;
 	double omega_ss;          /* rad/s commanded */
+	double m_n, mu;           /* the feed's element mass (kg) and friction
+				     coefficient now (sim_set_feed) */
 	double q[6], qd[6];       /* x y alpha phi s1 s2 and rates */
 	double rotor_speed;       /* rad/s, phi' - alpha' */
 	double motor_torque;      /* N m on the rotor */
@@ -293,6 +317,8 @@ typedef struct sim_status {
 	double period;            /* s: length of the last whole period */
 	double e_input, e_kinetic, e_potential, e_dissipated; /* J */
 	double e_residual;        /* J: stored change + dissipated - input */
+	double e_disturb;         /* J: the part of e_input that the feed's
+				     disturbances brought (sim_set_feed) */
 	uint64_t steps, rhs_evals;
 	double dt;                /* s: the integrator's (first) step in use */
 	int substeps;             /* feed sub-steps per step in use (dem) */

@@ -13,7 +13,9 @@
 #include "sim.h"
 
 struct sim {
-	model md;            /* const after sim_new */
+	model md;            /* const after sim_new, but for the feed's m_n
+				and mu, which sim_set_feed changes between
+				steps (disturb.c) */
 	model_ctl ctl;       /* changed by the sim_set_* controls */
 	dyn sys;             /* what the integrator steps: &md, &ctl, rhs_evals */
 	sim_method cfg;
@@ -25,6 +27,8 @@ struct sim {
 	double *y, *y_obs, *dy, *y_prev; /* y_prev: the state at t_prev, the
 					    start of the last step */
 	double e0, kin0, pot0, elastic0; /* energies at t = 0 */
+	double e_disturb;    /* J: the stored energy's jumps at the feed's
+				disturbances (disturb.c), booked as input */
 	uint64_t steps;
 	int failed;
 	char error[160];

@@ -53,7 +53,10 @@ static void status_energy(const sim *s, const model_eval *ev, sim_status *st)
 		input += acc[ACC_DECK];
 	}
 	double dissipated = acc[ACC_DAMP] + acc[ACC_FRIC] + acc[ACC_CONTACT] + coupling;
+	/* the feed's disturbances: the stored energy's jumps (disturb.c) */
+	input += s->e_disturb;
 	st->e_input = input;
+	st->e_disturb = s->e_disturb;
 	st->e_kinetic = kin - s->kin0;
 	st->e_potential = (pot - s->pot0) + (elastic - s->elastic0);
 	st->e_dissipated = dissipated - (elastic - s->elastic0);
@@ -170,6 +173,8 @@ void sim_update_status(sim *s)
 	st->rotation = ctl->rotation;
 	st->drive_on = ctl->drive_on;
 	st->omega_ss = ctl->omega_ss;
+	st->m_n = md->p.m_n;
+	st->mu = md->p.mu;
 	memcpy(st->q, ev.q, sizeof st->q);
 	memcpy(st->qd, ev.qd, sizeof st->qd);
 	st->rotor_speed = ev.rotor_speed;

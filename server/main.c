@@ -109,8 +109,11 @@ static struct MHD_Daemon *start_http(const srv_config *cfg,
 		MHD_OPTION_SOCK_ADDR, la->addr,
 		MHD_OPTION_CONNECTION_LIMIT,
 		(unsigned)(cfg->max_connections + SRV_CONN_HEADROOM),
+		/* a backstop only: conns.c holds the per-address cap by
+		 * closing that address's idle or slow connections, which
+		 * libmicrohttpd still counts until their threads close them */
 		MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE),
+		(unsigned)(cfg->max_client_connections + SRV_CLIENT_GRACE + SRV_CONN_HEADROOM),
 		MHD_OPTION_CONNECTION_TIMEOUT,
 		(unsigned)(cfg->connection_timeout + 0.5), MHD_OPTION_END);
 }
@@ -154,7 +157,9 @@ static void restore_state(void)
 		return;
 	double t0 = srv_now();
 	size_t ne = srv_job_restore(&srv_experiment_job);
-	size_t ns = srv_sessions_restore(srv_experiment_get, srv_experiment_put);
+	const srv_exp_finder ef = {srv_experiment_get, srv_experiment_put,
+				   srv_experiments_readopt};
+	size_t ns = srv_sessions_restore(&ef);
 	size_t ni = srv_experiments_interrupt_orphans();
 	size_t nw = srv_job_restore(&srv_sweep_job);
 	size_t nf = srv_job_restore(&srv_fit_job);

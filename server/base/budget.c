@@ -309,6 +309,8 @@ typedef struct client {
 	unsigned char addr[16]; /* IPv4 in the first 4 bytes */
 	int family;
 	int count;              /* lock; 0: a free entry */
+	srv_conn_group *group;  /* its connections (conns.c), kept for the
+				   next address the entry serves */
 } client;
 
 /* What a connection's socket context holds. */
@@ -319,7 +321,7 @@ typedef struct client_conn {
 } client_conn;
 
 static client *clients;  /* lock; cfg->max_connections + 1 entries */
-static atomic_ullong client_refused;
+static atomic_ullong client_refused, connections_dropped;
 
 /* The address bytes of a connection's peer; 0 if it has none. */
 static int peer(struct MHD_Connection *conn, unsigned char addr[16],
@@ -356,6 +358,10 @@ static client *find_client(const unsigned char addr[16], int family)
 		if (!c->count && !free_one)
 			free_one = c;
 	}
+	if (free_one && !free_one->group)
+		free_one->group = srv_conn_group_new();
+	if (free_one && !free_one->group)
+		return NULL;
 	if (free_one) {
 		memcpy(free_one->addr, addr, 16);
 		free_one->family = family;
@@ -370,31 +376,37 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 	(void)cls;
 	client_conn *cc = *socket_context;
 	if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
+		if (cc) /* out of its group before the entry can go */
+			srv_conn_close(cc->live);
 		if (cc && cc->c) {
 			pthread_mutex_lock(&lock);
 			cc->c->count--;
 			pthread_mutex_unlock(&lock);
 		}
-		if (cc)
-			srv_conn_close(cc->live);
 		free(cc);
 		*socket_context = NULL;
 		return;
 	}
 	unsigned char addr[16];
-	int family;
+	int family, over = SRV_CONN_OK;
 	cc = calloc(1, sizeof *cc);
-	if (cc)
-		cc->live = srv_conn_open(conn);
-	if (!cc || !peer(conn, addr, &family)) {
-		*socket_context = cc;
+	if (!cc) {
+		*socket_context = NULL;
 		return;
 	}
-	pthread_mutex_lock(&lock);
-	cc->c = find_client(addr, family);
-	if (cc->c)
-		cc->over = ++cc->c->count > cfg->max_client_connections;
-	pthread_mutex_unlock(&lock);
+	if (peer(conn, addr, &family)) {
+		pthread_mutex_lock(&lock);
+		cc->c = find_client(addr, family);
+		if (cc->c)
+			cc->c->count++; /* the entry stays its address's */
+		pthread_mutex_unlock(&lock);
+	}
+	/* room at the caps: the least progressing connection, of all or of
+	 * this address, is closed; over only when its others are all busy */
+	cc->live = srv_conn_open(conn, cc->c ? cc->c->group : NULL, &over);
+	cc->over = over != SRV_CONN_OK;
+	if (over == SRV_CONN_DROPPED)
+		atomic_fetch_add(&connections_dropped, 1);
 	*socket_context = cc;
 }
 
@@ -416,9 +428,9 @@ int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
 	atomic_fetch_add(&client_refused, 1);
 	api_fail(pb, API_LIMIT, NULL,
 		 "this client address has more than %d connections open, its "
-		 "budget (--max-client-connections); close some (idle ones "
-		 "close after %g s) and retry", cfg->max_client_connections,
-		 cfg->connection_timeout);
+		 "budget (--max-client-connections), and every other one is "
+		 "being answered (an idle or slow one would have been closed to "
+		 "make room); close some and retry", cfg->max_client_connections);
 	api_budget(pb, "connections", cfg->max_client_connections, 1);
 	pb->close = 1; /* one too many: the answer closes it */
 	return 1;
@@ -428,8 +440,6 @@ unsigned long long srv_budget_client_refused(void)
 {
 	return atomic_load(&client_refused);
 }
-
-static atomic_ullong connections_dropped;
 
 unsigned long long srv_budget_connections_dropped(void)
 {

@@ -108,11 +108,6 @@ size_t srv_budget_points(void);
 
 /* ---- connections per client ------------------------------------------------- */
 
-/* Connections a client may open beyond its budget that still get a 429
- * with a body; libmicrohttpd closes any further ones at accept
- * (MHD_OPTION_PER_IP_CONNECTION_LIMIT is the budget plus this). */
-#define SRV_CLIENT_GRACE 8
-
 /* libmicrohttpd's connection notification: counts the connections of each
  * client address (MHD_OPTION_NOTIFY_CONNECTION, cls unused). */
 void srv_budget_connection(void *cls, struct MHD_Connection *conn,
@@ -121,11 +116,14 @@ void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 /* conn's entry in the table of open connections and their deadlines
  * (conns.h), borrowed until libmicrohttpd closes it; NULL if it has none. */
 struct srv_conn *srv_budget_live(struct MHD_Connection *conn);
-/* 1 if conn was opened beyond its client's --max-client-connections (it
- * gets a 429 and is closed), with *pb naming the budget. */
+/* 1 if conn was opened beyond its client's --max-client-connections
+ * while every other connection of that client was being answered (none
+ * could be closed to make room: conns.h), with *pb naming the budget: it
+ * gets a 429 and is closed. */
 int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb);
 /* Connections answered 429 by the per-client budget so far, and those
- * libmicrohttpd closed at accept (beyond the grace or --max-connections). */
+ * closed without an answer (beyond the 429s' grace: conns.h; or
+ * libmicrohttpd's own limits at accept). */
 unsigned long long srv_budget_client_refused(void);
 unsigned long long srv_budget_connections_dropped(void);
 /* libmicrohttpd's error log (MHD_OPTION_EXTERNAL_LOGGER): its refusals at

@@ -126,7 +126,8 @@ static const opt opts[] = {
 	 "cores the running paced sessions may need together: each its CPU s\n"
 	 "per simulated s times its pace (default %D: half the cores)", NULL},
 	{"max-client-connections", OPT_INT, 1, 100000, F(max_client_connections), "N",
-	 "open connections per client address (default %D)", NULL},
+	 "open connections per client address (default %D); beyond, each\n"
+	 "closes the address's least progressing one", NULL},
 	{"max-connections", OPT_INT, 16, 100000, F(max_connections), "N",
 	 "open connections, all clients (default %D)", NULL},
 	{"connection-timeout", OPT_SECONDS, 1000, 3600000, F(connection_timeout), "S",

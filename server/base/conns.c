@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * conns.c - the open connections, their deadlines, and the ones closed
- * to make room at the global cap (see conns.h).
+ * to make room at the global cap and at each address's (see conns.h).
  *
  * A connection is in one of four states; each but "busy" has a progress
  * time (how far it has come) and a deadline (when it is cut):
@@ -25,7 +25,13 @@
  * a burst of others, its thread not yet run) is a request arriving: it
  * goes to "head" with progress now instead; after SRV_CONN_PEEKS of those
  * for one new connection the oldest is closed whatever waits on it, so
- * the listen thread's work per connection is bounded. Once a
+ * the listen thread's work per connection is bounded. Each client
+ * address's connections (a group, budget.c's entry for the address) sit
+ * in a third heap by progress, its own: beyond --max-client-connections
+ * a new connection closes the oldest of its group by the same rule; a
+ * group whose every connection is busy makes the new one "over" (a 429,
+ * counted apart; beyond SRV_CLIENT_GRACE of those it is closed at once).
+ * Once a
  * second srv_conns_reap closes every connection past its deadline.
  * Closing is a shutdown(2) of the socket under the lock: libmicrohttpd
  * notifies the close (srv_conn_close, which takes the lock) before it
@@ -43,24 +49,37 @@
  * passes over (each to the back) before it closes the oldest anyway. */
 #define SRV_CONN_PEEKS 16
 
-enum { BY_PROGRESS, BY_DEADLINE, HEAPS };
+/* The heaps a connection sits in: the global ones by progress and by
+ * deadline, and its client address's own by progress (BY_GROUP, keyed as
+ * BY_PROGRESS). */
+enum { BY_PROGRESS, BY_DEADLINE, BY_GROUP, SLOTS };
+enum { HEAPS = BY_GROUP };
 enum conn_state { CONN_IDLE, CONN_HEAD, CONN_BODY, CONN_BUSY, CONN_CLOSING };
-
-struct srv_conn {
-	int fd;
-	enum conn_state state;
-	double key[HEAPS];   /* progress and deadline, srv_now() seconds */
-	size_t at[HEAPS];    /* index in each heap; NOWHERE when out */
-	double body_start;   /* state body: when the headers passed */
-	size_t body_bytes;   /* state body: bytes read so far */
-};
-
-#define NOWHERE ((size_t)-1)
 
 typedef struct heap {
 	srv_conn **v;
 	size_t n, cap;
 } heap;
+
+/* A client address's connections (budget.c keeps one an address). */
+struct srv_conn_group {
+	heap by_progress;    /* lock: its listed connections */
+	int open;            /* lock: registered, not closing, not over */
+	int over;            /* lock: open beyond the cap, all others busy */
+};
+
+struct srv_conn {
+	int fd;
+	enum conn_state state;
+	srv_conn_group *group; /* NULL: no address (not capped per client) */
+	int over;            /* counted in group->over, not in open */
+	double key[SLOTS];   /* progress, deadline, progress; srv_now() s */
+	size_t at[SLOTS];    /* index in each heap; NOWHERE when out */
+	double body_start;   /* state body: when the headers passed */
+	size_t body_bytes;   /* state body: bytes read so far */
+};
+
+#define NOWHERE ((size_t)-1)
 
 static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static heap heaps[HEAPS];  /* lock */
@@ -80,28 +99,27 @@ static int before(int h, const srv_conn *a, const srv_conn *b)
 	return a->key[h] < b->key[h];
 }
 
-static void place(int h, size_t i, srv_conn *c)
+static void place(heap *hp, int h, size_t i, srv_conn *c)
 {
-	heaps[h].v[i] = c;
+	hp->v[i] = c;
 	c->at[h] = i;
 }
 
-static void sift_up(int h, size_t i)
+static void sift_up(heap *hp, int h, size_t i)
 {
-	srv_conn *c = heaps[h].v[i];
+	srv_conn *c = hp->v[i];
 	while (i > 0) {
 		size_t parent = (i - 1) / 2;
-		if (!before(h, c, heaps[h].v[parent]))
+		if (!before(h, c, hp->v[parent]))
 			break;
-		place(h, i, heaps[h].v[parent]);
+		place(hp, h, i, hp->v[parent]);
 		i = parent;
 	}
-	place(h, i, c);
+	place(hp, h, i, c);
 }
 
-static void sift_down(int h, size_t i)
+static void sift_down(heap *hp, int h, size_t i)
 {
-	heap *hp = &heaps[h];
 	srv_conn *c = hp->v[i];
 	for (;;) {
 		size_t child = 2 * i + 1;
@@ -111,32 +129,30 @@ static void sift_down(int h, size_t i)
 			child++;
 		if (!before(h, hp->v[child], c))
 			break;
-		place(h, i, hp->v[child]);
+		place(hp, h, i, hp->v[child]);
 		i = child;
 	}
-	place(h, i, c);
+	place(hp, h, i, c);
 }
 
-/* Add c to heap h; -1 when out of memory. */
-static int heap_add(int h, srv_conn *c)
+/* Add c to heap hp in slot h; -1 when out of memory. */
+static int heap_add(heap *hp, int h, srv_conn *c)
 {
-	heap *hp = &heaps[h];
 	if (hp->n == hp->cap) {
-		size_t cap = hp->cap ? 2 * hp->cap : 1024;
+		size_t cap = hp->cap ? 2 * hp->cap : 16;
 		srv_conn **v = realloc(hp->v, cap * sizeof *v);
 		if (!v)
 			return -1;
 		hp->v = v;
 		hp->cap = cap;
 	}
-	place(h, hp->n++, c);
-	sift_up(h, hp->n - 1);
+	place(hp, h, hp->n++, c);
+	sift_up(hp, h, hp->n - 1);
 	return 0;
 }
 
-static void heap_remove(int h, srv_conn *c)
+static void heap_remove(heap *hp, int h, srv_conn *c)
 {
-	heap *hp = &heaps[h];
 	size_t i = c->at[h];
 	if (i == NOWHERE)
 		return;
@@ -144,18 +160,39 @@ static void heap_remove(int h, srv_conn *c)
 	srv_conn *last = hp->v[--hp->n];
 	if (last == c)
 		return;
-	place(h, i, last);
-	sift_up(h, i);
-	sift_down(h, last->at[h]);
+	place(hp, h, i, last);
+	sift_up(hp, h, i);
+	sift_down(hp, h, last->at[h]);
 }
 
 /* ---- states (lock held) ---------------------------------------------------- */
 
-/* Out of both heaps. */
+/* Out of every heap. */
 static void unlist(srv_conn *c)
 {
-	heap_remove(BY_PROGRESS, c);
-	heap_remove(BY_DEADLINE, c);
+	heap_remove(&heaps[BY_PROGRESS], BY_PROGRESS, c);
+	heap_remove(&heaps[BY_DEADLINE], BY_DEADLINE, c);
+	if (c->group)
+		heap_remove(&c->group->by_progress, BY_GROUP, c);
+}
+
+/* Into every heap it belongs to; out of all when out of memory. */
+static void list(srv_conn *c)
+{
+	if (heap_add(&heaps[BY_PROGRESS], BY_PROGRESS, c) != 0 ||
+	    heap_add(&heaps[BY_DEADLINE], BY_DEADLINE, c) != 0 ||
+	    (c->group && !c->over && heap_add(&c->group->by_progress, BY_GROUP, c) != 0))
+		unlist(c);
+}
+
+/* c leaves the counts of open connections (closing or closed). */
+static void uncount(srv_conn *c)
+{
+	open_count--;
+	if (c->group && c->over)
+		c->group->over--;
+	else if (c->group)
+		c->group->open--;
 }
 
 /* c in state s with this progress time; its deadline follows from it.
@@ -166,12 +203,11 @@ static void set_state(srv_conn *c, enum conn_state s, double progress)
 	c->state = s;
 	if (s == CONN_BUSY || s == CONN_CLOSING)
 		return;
-	c->key[BY_PROGRESS] = progress;
+	c->key[BY_PROGRESS] = c->key[BY_GROUP] = progress;
 	c->key[BY_DEADLINE] = progress + (s == CONN_IDLE
 						  ? cfg->connection_timeout
 						  : cfg->request_timeout);
-	if (heap_add(BY_PROGRESS, c) == 0 && heap_add(BY_DEADLINE, c) != 0)
-		heap_remove(BY_PROGRESS, c);
+	list(c);
 }
 
 /* Close c: shut its socket down; libmicrohttpd then closes it as a peer
@@ -179,7 +215,7 @@ static void set_state(srv_conn *c, enum conn_state s, double progress)
 static void cut(srv_conn *c)
 {
 	set_state(c, CONN_CLOSING, 0);
-	open_count--;
+	uncount(c);
 	shutdown(c->fd, SHUT_RDWR);
 }
 
@@ -190,14 +226,15 @@ static int request_waiting(const srv_conn *c)
 	return recv(c->fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT) > 0;
 }
 
-/* Close the connection with the oldest progress; 0 if none is listed.
- * An idle one with request bytes waiting goes to the back as a request
- * arriving; after SRV_CONN_PEEKS of those the oldest is closed whatever
- * waits on it, so that the cap holds and the work stays bounded. */
-static int evict_one(double now)
+/* Close the connection with the oldest progress in hp (slot h); 0 if
+ * none is listed. An idle one with request bytes waiting goes to the back
+ * as a request arriving; after SRV_CONN_PEEKS of those the oldest is
+ * closed whatever waits on it, so that the cap holds and the work stays
+ * bounded. */
+static int evict_one(heap *hp, double now)
 {
-	for (int peeks = 0; heaps[BY_PROGRESS].n; peeks++) {
-		srv_conn *victim = heaps[BY_PROGRESS].v[0];
+	for (int peeks = 0; hp->n; peeks++) {
+		srv_conn *victim = hp->v[0];
 		if (peeks < SRV_CONN_PEEKS && victim->state == CONN_IDLE &&
 		    request_waiting(victim)) {
 			set_state(victim, CONN_HEAD, now);
@@ -211,27 +248,68 @@ static int evict_one(double now)
 
 /* ---- the interface ---------------------------------------------------------- */
 
-srv_conn *srv_conn_open(struct MHD_Connection *conn)
+srv_conn_group *srv_conn_group_new(void)
+{
+	return calloc(1, sizeof(srv_conn_group));
+}
+
+void srv_conn_group_free(srv_conn_group *g)
+{
+	if (g)
+		free(g->by_progress.v);
+	free(g);
+}
+
+/* Room for c (lock held): beyond --max-connections the connection with
+ * the least progress is closed, beyond its address's cap its address's
+ * own; when every one of its address's is busy c is over (a 429) or,
+ * beyond the grace, closed at once. How many were closed to make room. */
+static int make_room(srv_conn *c, double now, int *over)
+{
+	int closed = 0;
+	while (open_count >= cfg->max_connections && evict_one(&heaps[BY_PROGRESS], now))
+		closed++;
+	srv_conn_group *g = c->group;
+	*over = SRV_CONN_OK;
+	while (g && g->open >= cfg->max_client_connections && evict_one(&g->by_progress, now))
+		closed++;
+	if (g && g->open >= cfg->max_client_connections) {
+		c->over = 1;
+		*over = g->over >= SRV_CLIENT_GRACE ? SRV_CONN_DROPPED : SRV_CONN_OVER;
+	}
+	return closed;
+}
+
+srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *over)
 {
 	const union MHD_ConnectionInfo *ci =
 		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
 	srv_conn *c = ci ? calloc(1, sizeof *c) : NULL;
+	*over = SRV_CONN_OK;
 	if (!c)
 		return NULL;
 	c->fd = ci->connect_fd;
-	c->at[BY_PROGRESS] = c->at[BY_DEADLINE] = NOWHERE;
+	c->group = g;
+	c->at[BY_PROGRESS] = c->at[BY_DEADLINE] = c->at[BY_GROUP] = NOWHERE;
 	double now = srv_now();
 	int closed = 0;
 	pthread_mutex_lock(&lock);
-	while (cfg && open_count >= cfg->max_connections && evict_one(now))
-		closed++;
+	if (cfg)
+		closed = make_room(c, now, over);
 	open_count++;
+	if (g && c->over)
+		g->over++;
+	else if (g)
+		g->open++;
 	set_state(c, CONN_IDLE, now);
+	if (*over == SRV_CONN_DROPPED)
+		cut(c);
 	pthread_mutex_unlock(&lock);
 	if (closed) {
 		atomic_fetch_add(&evicted, (unsigned long long)closed);
-		srv_log(SRV_LOG_DEBUG, "at the cap of %d connections: closed "
-				       "%d", cfg->max_connections, closed);
+		srv_log(SRV_LOG_DEBUG, "at the cap of %d connections or of %d from one "
+				       "address: closed %d", cfg->max_connections,
+			cfg->max_client_connections, closed);
 	}
 	return c;
 }
@@ -242,7 +320,7 @@ void srv_conn_close(srv_conn *c)
 		return;
 	pthread_mutex_lock(&lock);
 	if (c->state != CONN_CLOSING)
-		open_count--;
+		uncount(c);
 	unlist(c);
 	pthread_mutex_unlock(&lock);
 	free(c);

@@ -60,6 +60,18 @@ size_t srv_experiments_interrupt_orphans(void)
 	return count;
 }
 
+srv_experiment *srv_experiments_readopt(const char *session_id)
+{
+	srv_entry **all = NULL;
+	size_t n = srv_registry_snapshot(&experiments, &all);
+	srv_experiment *hit = NULL;
+	for (size_t i = 0; i < n && !hit; i++)
+		if (srv_exp_readopt(srv_exp_from_entry(all[i]), session_id))
+			hit = srv_exp_from_entry(all[i]);
+	srv_registry_release(&experiments, all, n);
+	return hit;
+}
+
 /* Run e on a fresh session or attach it to the one it names; the session
  * notes its id in e before its worker can run it. */
 static api_err start_on_session(srv_experiment *e,

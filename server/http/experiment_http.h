@@ -15,6 +15,11 @@
 void srv_experiments_init(const srv_config *cfg);
 typedef struct srv_experiment srv_experiment;
 
+/* At the restore, before the sessions' workers start: the experiment
+ * whose record says it ran on session_id, still running or waiting and
+ * not resumed by a checkpoint, attached again from its first segment
+ * (srv_exp_readopt; the registry keeps it), or NULL. */
+srv_experiment *srv_experiments_readopt(const char *session_id);
 /* After the sessions are restored: mark the running experiments no
  * session resumed "interrupted". Returns how many. */
 size_t srv_experiments_interrupt_orphans(void);

@@ -30,8 +30,6 @@
 #include "store.h"
 #include "util.h"
 
-#define EXP_RECORDS 50000
-
 static double exp_end(const srv_experiment *e)
 {
 	return e->req.seg[e->req.nseg - 1].until;

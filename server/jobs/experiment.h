@@ -86,9 +86,17 @@ srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen
  * session is; a session checkpoint that carries its progress still
  * resumes it (srv_exp_resume). NULL when out of memory. */
 srv_experiment *srv_exp_damaged(const char *id, const char *why);
-/* Still running but no session resumed it: "interrupted", its finished
- * segments kept. Returns 1 if it was. */
+/* Still running but no session resumed it nor took it again
+ * (srv_exp_readopt): "interrupted", its finished segments kept. Returns
+ * 1 if it was. */
 int srv_exp_interrupt(srv_experiment *e);
+/* Running or waiting when the daemon died, on session session_id, but no
+ * checkpoint of it carried the experiment (it began after the last one,
+ * or the session had none yet): attached again from its first segment,
+ * every result cleared, to begin when its session's worker next starts a
+ * job (srv_session's restore decides when). 1 if it was; 0 (nothing
+ * changed) when e is not such an experiment or out of memory. */
+int srv_exp_readopt(srv_experiment *e, const char *session_id);
 /* A result or record could not be written: state "error" with what. */
 void srv_exp_write_failed(srv_experiment *e, const char *what);
 

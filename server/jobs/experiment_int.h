@@ -10,6 +10,9 @@
 
 #include "experiment.h"
 
+/* Feed-velocity records an experiment keeps at most. */
+#define EXP_RECORDS 50000
+
 enum {
 	EXP_WAITING,
 	EXP_RUNNING,

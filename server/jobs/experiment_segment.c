@@ -10,6 +10,8 @@
  * was too short for the feed to settle).
  */
 #include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "experiment_int.h"
@@ -71,4 +73,43 @@ void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
 			}
 		}
 	seg->state = 2;
+}
+
+/* ---- a new start after a restart (experiment.h srv_exp_readopt) ----------- */
+
+int srv_exp_readopt(srv_experiment *e, const char *session_id)
+{
+	pthread_mutex_lock(&e->lock);
+	int hit = !e->attached && (e->state == EXP_RUNNING || e->state == EXP_WAITING) &&
+		  strcmp(e->session_id, session_id) == 0 && e->req.nseg >= 1;
+	if (hit && !e->rec_t) {
+		e->rec_t = malloc(EXP_RECORDS * sizeof(double));
+		e->rec_v = malloc(EXP_RECORDS * sizeof(double));
+	}
+	if (hit && e->rec_t && e->rec_v) {
+		/* every segment as the request left it, then its start */
+		for (int i = 0; i < e->req.nseg; i++) {
+			api_segment *seg = &e->req.seg[i];
+			api_value beta = seg->beta;
+			double until = seg->until;
+			memset(seg, 0, sizeof *seg);
+			seg->beta = beta;
+			seg->until = until;
+			seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
+			seg->reversal_time = seg->start_velocity = NAN;
+			seg->t_command = seg->t_end = NAN;
+		}
+		e->rec_cap = EXP_RECORDS;
+		e->rec_n = e->seg_first = 0;
+		e->rec_spacing = e->req.seg[e->req.nseg - 1].until / EXP_RECORDS;
+		e->state = EXP_WAITING;
+		e->cur = 0;
+		e->t0 = e->t_now = 0;
+		e->error[0] = '\0';
+		e->attached = 1;
+	} else {
+		hit = 0;
+	}
+	pthread_mutex_unlock(&e->lock);
+	return hit;
 }

@@ -455,12 +455,10 @@ size_t srv_sessions_reap(double idle_timeout)
 	return reaped;
 }
 
-size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
-			    void (*put)(srv_experiment *e))
+size_t srv_sessions_restore(const srv_exp_finder *ef)
 {
 	if (!srv_store_enabled())
 		return 0;
-	const srv_exp_finder ef = {find, put};
 	char **names = NULL;
 	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
 	for (size_t i = 0; i < n; i++) {
@@ -468,7 +466,7 @@ size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
 		if (s) {
 			s->create_fd = -1; /* no client waits for a restore */
 			session_locks_init(s);
-			srv_persist_load(s, names[i], &ef);
+			srv_persist_load(s, names[i], ef);
 			if (s->damaged)
 				srv_log(SRV_LOG_WARN, "session %s %s", names[i],
 					s->error);

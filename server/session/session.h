@@ -53,13 +53,20 @@ api_err srv_session_check_removable(const srv_session *s, api_problem *pb);
  * and, with idle_timeout > 0 (s), those with no stream client, no
  * experiment and no request for that long. Returns how many. */
 size_t srv_sessions_reap(double idle_timeout);
+/* The experiments' registry as the restore sees it (passed in, so that
+ * sessions do not depend on it): find, a new reference by id, or NULL,
+ * and put to give it back; readopt, the experiment whose record says it
+ * ran on session_id and that no checkpoint resumed, attached again
+ * (srv_exp_readopt), or NULL. */
+typedef struct srv_exp_finder {
+	srv_experiment *(*find)(const char *id);
+	void (*put)(srv_experiment *e);
+	srv_experiment *(*readopt)(const char *session_id);
+} srv_exp_finder;
 /* Rebuild the sessions of the data directory (session_store.c); the
- * experiments must be restored first: find (a new reference by id, or
- * NULL) and put give the running ones back to their sessions (passed in,
- * so that sessions do not depend on the experiments' registry). Returns
- * how many. */
-size_t srv_sessions_restore(srv_experiment *(*find)(const char *id),
-			    void (*put)(srv_experiment *e));
+ * experiments must be restored first: ef gives the running ones back to
+ * their sessions. Returns how many. */
+size_t srv_sessions_restore(const srv_exp_finder *ef);
 const char *srv_session_id(const srv_session *s);
 /* Its spec (immutable; borrowed while the reference is held). */
 const api_spec *srv_session_spec(const srv_session *s);

@@ -203,3 +203,46 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	pthread_mutex_unlock(&s->lock);
 	return rc;
 }
+
+/* Whether e, attached again to s as restored, begins where it began
+ * before: created with s, which came back from its spec at t = 0; or s
+ * stood still at its checkpoint (finished or paused) and nothing but e's
+ * own commands came after it, so that e began right there. */
+static int begins_as_before(const srv_session *s, const srv_experiment *e)
+{
+	if (srv_exp_request(e)->fresh && sim_effective_time(s->sim) == 0)
+		return 1;
+	if (s->state == SRV_RUNNING)
+		return 0;
+	for (size_t i = 0; i < s->restore.nreplay; i++)
+		if (strcmp(s->restore.replay[i].exp, srv_exp_id(e)) != 0)
+			return 0;
+	return 1;
+}
+
+void srv_session_readopt(srv_session *s, const srv_exp_finder *ef)
+{
+	if (s->exp || !s->sim || s->state == SRV_FAILED || !ef || !ef->readopt)
+		return;
+	srv_experiment *e = ef->readopt(s->entry.id);
+	if (!e)
+		return;
+	s->exp = e;
+	s->exp_started = 0;
+	/* it runs again exactly as it ran: its logged segment commands are
+	 * left to it (sent again at the same times, not logged twice) */
+	int same = begins_as_before(s, e);
+	size_t own = 0;
+	for (size_t i = 0; same && i < s->restore.nreplay; i++) {
+		srv_replay *rp = &s->restore.replay[i];
+		rp->exp_own = strcmp(rp->exp, srv_exp_id(e)) == 0;
+		own += (size_t)rp->exp_own;
+	}
+	s->restore.exp_relogged = own;
+	/* else where it began is not known: it begins again where the
+	 * session is back (its logged commands replayed as controls) */
+	s->restore.exp_after_catch_up = !same;
+	srv_log(SRV_LOG_INFO, "session %s: experiment %s, which no checkpoint "
+			      "carried, runs again from its first segment %s",
+		s->entry.id, srv_exp_id(e), same ? "where it began" : "once the session is back");
+}

@@ -22,6 +22,7 @@ typedef struct srv_replay {
 	double at;   /* its t_effective, s */
 	int exp_own; /* sent by the experiment the checkpoint resumed: not
 			applied here, the experiment sends it again itself */
+	char exp[SRV_ID_LEN]; /* the experiment that sent it, or "" */
 } srv_replay;
 
 /* A session's record ring and trajectory history (ring.c: the worker's
@@ -91,6 +92,9 @@ typedef struct srv_session_restore {
 	int upgrade;              /* restore: a file of an earlier format
 				     (store.h), written again in this one */
 	double replay_t0;         /* s: the time it was restored at */
+	int exp_after_catch_up;   /* its experiment, attached again at the
+				     restore, begins once it is back where
+				     it was (srv_session_readopt) */
 } srv_session_restore;
 
 /* What a session holds of the daemon's budgets (budget.c keeps the
@@ -304,12 +308,11 @@ void srv_persist_checkpoint(srv_session *s, int force);
 /* Queue the removal of the session's files. */
 void srv_persist_remove(const srv_session *s);
 
-/* The experiments' registry as the restore sees it (session.h's
- * srv_sessions_restore): a new reference by id, or NULL; put it back. */
-typedef struct srv_exp_finder {
-	srv_experiment *(*find)(const char *id);
-	void (*put)(srv_experiment *e);
-} srv_exp_finder;
+/* An experiment no checkpoint of s carried but whose record names s
+ * (ef->readopt), attached again from its first segment at the restore,
+ * before the worker starts (session_control.c): see docs/operations.md
+ * "What a crash can lose". */
+void srv_session_readopt(srv_session *s, const srv_exp_finder *ef);
 /* Build session id from its files into s (calloc'd, lock initialised):
  * spec, checkpoint (or the previous one, or a fresh start from the spec),
  * the experiment it ran resumed; s->damaged with the reason in s->error

@@ -340,6 +340,7 @@ static void load_controls(srv_session *s, size_t logged)
 			/* the experiment resumed from the checkpoint sends its
 			 * segments' commands again: applied twice, the second
 			 * would move the estimator's restart */
+			snprintf(rp->exp, sizeof rp->exp, "%s", exp);
 			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
 			s->restore.exp_relogged += rp->exp_own;
 			s->restore.nreplay++;
@@ -478,6 +479,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 		srv_store_count_damaged(SRV_STORE_SESSION);
 		return;
 	}
+	srv_session_readopt(s, ef);
 	if (!s->restore.upgrade)
 		return;
 	/* an earlier format: its spec written again at once (spec.json and

@@ -95,7 +95,8 @@ static double next_time(srv_session *s)
 /* job start: an experiment attached since the last turn begins. */
 static void start_job(srv_session *s)
 {
-	if (!s->exp || s->exp_started || s->state == SRV_FAILED || s->stop)
+	if (!s->exp || s->exp_started || s->state == SRV_FAILED || s->stop ||
+	    (s->restore.exp_after_catch_up && s->restore.catch_up_t > 0))
 		return;
 	double t_end;
 	srv_cmd *cmd = srv_exp_begin(s->exp, &s->st, &t_end);

@@ -5,6 +5,8 @@
  * a row of the one PATCH table (api.h API_CONTROLS: member, bit; parse
  * and echo in api/control.c); its apply column is here, by the same id.
  */
+#include <math.h>
+
 #include "experiment.h"
 #include "session_int.h"
 
@@ -74,6 +76,19 @@ static int apply_omega_ss(srv_session *s, const srv_cmd *cmd, int *reanchor)
 	return sim_set_omega_ss(s->sim, cmd->c.omega_ss);
 }
 
+/* The column feed's disturbances (sim_set_feed; NaN keeps the other). */
+static int apply_m_n(srv_session *s, const srv_cmd *cmd, int *reanchor)
+{
+	(void)reanchor;
+	return sim_set_feed(s->sim, cmd->c.m_n, NAN);
+}
+
+static int apply_mu(srv_session *s, const srv_cmd *cmd, int *reanchor)
+{
+	(void)reanchor;
+	return sim_set_feed(s->sim, NAN, cmd->c.mu);
+}
+
 static int apply_motor(srv_session *s, const srv_cmd *cmd, int *reanchor)
 {
 	(void)reanchor;
@@ -110,6 +125,8 @@ static const control_apply control_applies[API_CTL_COUNT] = {
 	[API_CTL_BETA_RATE] = apply_later, /* with beta */
 	[API_CTL_ROTATION] = apply_rotation,
 	[API_CTL_OMEGA_SS] = apply_omega_ss,
+	[API_CTL_M_N] = apply_m_n,
+	[API_CTL_MU] = apply_mu,
 	[API_CTL_RUNNING] = apply_later,
 	[API_CTL_MOTOR] = apply_motor,
 	[API_CTL_PACE] = apply_pace,

@@ -9,36 +9,25 @@
 // acknowledged. Prints one table row. Loopback and a temporary directory
 // only; bounded (ROUNDS x about 1 s).
 //
-//   CONVSIMD=build/convsimd [ROUNDS=100] [SESSIONS=8] [INFLIGHT=2] node tests/bench/kill_probe.mjs
-import { spawn } from 'node:child_process';
+// CLIENT=lean (patch_client.mjs, the default) or fetch.
+//
+//   CONVSIMD=build/convsimd [ROUNDS=100] [SESSIONS=8] [INFLIGHT=2] [CLIENT=lean] node tests/bench/kill_probe.mjs
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import '../tether.mjs'; // the daemons end with this script, however it ends
+import { join, resolve } from 'node:path';
+import { startDaemon } from '../http/lib.mjs'; // its tether: the daemons end with this script
+import { client } from './patch_client.mjs';
 
 const BIN = process.env.CONVSIMD || 'build/convsimd';
 const ROUNDS = Number(process.env.ROUNDS || 100);
 const SESSIONS = Number(process.env.SESSIONS || 8);
 const INFLIGHT = Number(process.env.INFLIGHT || 2);
+const KIND = process.env.CLIENT || 'lean';
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
-async function start(dir) {
-  const p = spawn(BIN, ['--port', '0', '--log-level', 'warn', '--data-dir', dir,
-    '--checkpoint-interval', '0.5'], { stdio: ['ignore', 'pipe', 'ignore'] });
-  const port = await new Promise((resolve, reject) => {
-    let out = '';
-    const t = setTimeout(() => reject(new Error('no port')), 30000);
-    p.stdout.on('data', (d) => {
-      out += d;
-      const m = out.match(/listening on http:\/\/\S+:(\d+)/);
-      if (m) { clearTimeout(t); resolve(Number(m[1])); }
-    });
-    p.on('exit', (c) => reject(new Error(`exited ${c}`)));
-  });
-  return { p, base: `http://127.0.0.1:${port}/api/v1` };
-}
+const start = (dir) => startDaemon(['--data-dir', dir, '--checkpoint-interval', '0.5'],
+  { wrap: [resolve(BIN)] });
 
-const json = (method, body) => ({ method, headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) });
 const logged = (dir, id) => {
   let text = '';
   try { text = readFileSync(join(dir, 'sessions', id, 'controls.ndjson'), 'utf8'); } catch { /* none */ }
@@ -52,22 +41,22 @@ const t0 = Date.now();
 try {
   for (let round = 0; round < ROUNDS; round++) {
     const d = await start(dir);
+    const c0 = client(d.port, KIND);
     try {
       if (round === 0) {
         for (let i = 0; i < SESSIONS; i++) {
-          const r = await fetch(`${d.base}/sessions`, json('POST', { pace: 1, scene: { drive: 'ideal', columns: 1, layers: 2 } }));
-          const id = (await r.json()).id;
+          const r = await c0.request('POST', '/api/v1/sessions', { pace: 1, scene: { drive: 'ideal', columns: 1, layers: 2 } });
+          const id = JSON.parse(r.body).id;
           ids.push(id);
           acked[id] = [];
-          if (i % 4 === 0) await (await fetch(`${d.base}/sessions/${id}`, json('PATCH', { running: false }))).arrayBuffer();
+          if (i % 4 === 0) await c0.request('PATCH', `/api/v1/sessions/${id}`, { running: false });
         }
       } else {
         for (const id of ids) {
           let g;
           for (let k = 0; k < 600; k++) {
-            const r = await fetch(`${d.base}/sessions/${id}`);
-            const b = await r.json();
-            if (r.status === 200) { g = b; break; }
+            const r = await c0.request('GET', `/api/v1/sessions/${id}`);
+            if (r.status === 200) { g = JSON.parse(r.body); break; }
             await sleep(50);
           }
           const want = acked[id], log = logged(dir, id).slice(logBase[id] || 0);
@@ -90,33 +79,34 @@ try {
       // back-to-back PATCHes, killed at a random moment
       let killed = false, ok = 0;
       const loadStart = Date.now();
-      const client = async (id) => {
+      const patcher = async (id) => {
+        const c = client(d.port, KIND);
         while (!killed) {
           const beta = (2000 + (n++ % 4000)) / 100; // two decimals, printed as sent
           try {
-            const r = await fetch(`${d.base}/sessions/${id}`, json('PATCH', { beta }));
-            await r.arrayBuffer();
+            const r = await c.request('PATCH', `/api/v1/sessions/${id}`, { beta });
             if (r.status === 200) { acked[id].push(beta); ok++; }
-          } catch { return; /* cut by the kill: not acknowledged */ }
+          } catch { break; /* cut by the kill: not acknowledged */ }
         }
+        c.close();
       };
-      const clients = ids.flatMap((id) => Array.from({ length: INFLIGHT }, () => client(id)));
+      const clients = ids.flatMap((id) => Array.from({ length: INFLIGHT }, () => patcher(id)));
       await sleep(150 + Math.random() * 250);
       killed = true;
-      d.p.kill('SIGKILL');
+      d.proc.kill('SIGKILL');
       loadSeconds += (Date.now() - loadStart) / 1000;
       await Promise.all(clients);
       ackTotal += ok;
       rounds++;
     } finally {
-      d.p.kill('SIGKILL');
-      await new Promise((r) => (d.p.exitCode !== null || d.p.signalCode !== null ? r() : d.p.on('exit', r)));
+      c0.close();
+      await d.stop('SIGKILL');
     }
   }
 } finally {
   rmSync(dir, { recursive: true, force: true });
 }
-console.log(`    CONVSIMD=${BIN} ROUNDS=${ROUNDS} SESSIONS=${SESSIONS} INFLIGHT=${INFLIGHT} node tests/bench/kill_probe.mjs\n`);
+console.log(`    CONVSIMD=${BIN} ROUNDS=${ROUNDS} SESSIONS=${SESSIONS} INFLIGHT=${INFLIGHT} CLIENT=${KIND} node tests/bench/kill_probe.mjs\n`);
 console.log('| kill -9 rounds | sessions | PATCH/s under load (acknowledged / s of load) | controls acknowledged | acknowledged lost | wrong target after restart | GET showing an unlogged target | wall s |');
 console.log('|---|---|---|---|---|---|---|---|');
 console.log(`| ${rounds} | ${SESSIONS} | ${(ackTotal / loadSeconds).toFixed(0)} | ${ackTotal} | ${lost} | ${wrong} | ${past} | ${((Date.now() - t0) / 1000).toFixed(0)} |`);

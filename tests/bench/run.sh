@@ -60,4 +60,6 @@ echo "bench: PATCH throughput with the durable control log (loopback, a temporar
 CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs | tee "$out/controls.md"
 echo "bench: the request body check: CPU per 1 MiB body of many names (one daemon)"
 CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs >"$out/body_parse.md"
+echo "bench: the PI loop closed from a client at pace 1, with 0, 100 and 200 ms added, and open loop (one daemon, ~2 min)"
+python3 tests/bench/remote_loop.py "$BUILD/convsimd" >"$out/remote_loop.md"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

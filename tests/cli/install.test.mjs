@@ -19,7 +19,7 @@ test('make install PREFIX=... installs a working daemon and a verified, hardened
     { cwd: ROOT, encoding: 'utf8', timeout: 280000 });
   assert.equal(r.status, 0, r.stdout + r.stderr);
   for (const f of ['bin/convsim', 'bin/convsimd', 'share/convsim/web/index.html', 'share/doc/convsim/README.md',
-    'share/doc/convsim/docs/MODEL.md', 'share/doc/convsim/docs/api.md', 'share/doc/convsim/LICENSE', 'lib/systemd/system/convsimd.service']) assert.ok(existsSync(join(prefix, f)), f);
+    'share/doc/convsim/docs/MODEL.md', 'share/doc/convsim/docs/api.md', 'share/doc/convsim/docs/examples/remote_pi.py', 'share/doc/convsim/LICENSE', 'lib/systemd/system/convsimd.service']) assert.ok(existsSync(join(prefix, f)), f);
   const unit = readFileSync(join(prefix, 'lib/systemd/system/convsimd.service'), 'utf8');
   assert.ok(unit.includes(`ExecStart=${prefix}/bin/convsimd `), 'the unit names the installed binary');
   assert.ok(unit.includes(`--web-root ${prefix}/share/convsim/web`));

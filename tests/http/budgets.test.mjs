@@ -7,9 +7,10 @@
 // paced sessions by the cores they need: 503 + Retry-After or 422, nothing
 // created or changed), queued sweep points
 // (--max-queued-points: 422 / 429 + Retry-After) and the connections of one
-// client address (--max-client-connections: 429 with a body, then closed at
-// accept; idle sockets closed after --connection-timeout, live streams
-// kept). After each refusal another client is still served.
+// client address (--max-client-connections: its own least active one closed
+// to make room; 429 with a body only while all its others are answered,
+// then closed at once; idle sockets closed after --connection-timeout, live
+// streams kept). After each refusal another client is still served.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
@@ -389,14 +390,50 @@ test('sweep points: 422 beyond the whole budget, 429 + Retry-After when queued p
   }
 });
 
-test('connections: a client beyond its budget gets 429 then is closed at accept; others are served; streams outlive the idle timeout', { timeout: 60000 * SLOW }, async () => {
+// A stream of path from localAddress, kept open: .beats counts its
+// heartbeats, .closed says whether the daemon ended it; close() ends it.
+function streamFrom(base, path, localAddress) {
+  return new Promise((resolve, reject) => {
+    const r = http.get(base + path, { localAddress, agent: false }, (res) => {
+      const st = { status: res.statusCode, beats: 0, closed: false, close: () => r.destroy() };
+      res.setEncoding('utf8');
+      res.on('data', (c) => { st.beats += (c.match(/"heartbeat"/g) || []).length; });
+      res.on('close', () => { st.closed = true; });
+      resolve(st);
+    });
+    r.on('error', reject);
+  });
+}
+
+test('connections: beyond its budget a client\'s own least active connection is closed; 429 only while all its others are answered, then closed at once; streams outlive the idle timeout', { timeout: 60000 * SLOW }, async () => {
   const cap = 3;
   const d = await startDaemon(['--max-client-connections', String(cap), '--connection-timeout', '2',
     '--heartbeat', '0.5']);
   const socks = [];
+  const streams = [];
   try {
-    socks.push(...await idleSockets(d.port, cap, '127.0.0.2'));
+    // cap idle sockets: one more connection closes the oldest of them (not
+    // another address's, not a newer one) and is answered
+    const idle = await idleSockets(d.port, cap, '127.0.0.2');
+    socks.push(...idle);
+    for (const k of idle) k.closedAt.then(() => { k.gone = true; });
     await sleep(100);
+    const served = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
+    assert.equal(served.status, 200, JSON.stringify(served));
+    await sleep(200);
+    assert.deepEqual(idle.map((k) => !!k.gone), [true, false, false], 'the oldest idle socket was closed');
+    assert.ok(metric(await metrics(d.base), 'convsim_connections_evicted_total') >= 1);
+    for (const k of idle) k.destroy();
+    await sleep(100);
+
+    // cap streams (being answered): nothing of the address can be closed,
+    // so the next connection is over its budget: 429 with a body
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
+    assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${s.body.id}`, { running: false })).status, 200);
+    for (let i = 0; i < cap; i++) {
+      streams.push(await streamFrom(d.base, `/api/v1/sessions/${s.body.id}/stream?format=ndjson`, '127.0.0.2'));
+      assert.equal(streams[i].status, 200);
+    }
     const over = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
     assert.equal(over.status, 429, JSON.stringify(over));
     assert.equal(over.headers['retry-after'], '1');
@@ -405,7 +442,7 @@ test('connections: a client beyond its budget gets 429 then is closed at accept;
     assert.equal(over.body.type, '/api/v1/problems/limit-reached');
     assert.equal(over.body.budget, 'connections');
     assert.equal(over.body.limit, cap);
-    assert.match(over.body.detail, /more than 3 connections open.*--max-client-connections/);
+    assert.match(over.body.detail, /more than 3 connections open.*--max-client-connections.*every other one is being answered/);
     // a POST beyond the budget creates nothing
     const post = await new Promise((resolve) => {
       const r = http.request(d.base + '/api/v1/sessions', { method: 'POST', localAddress: '127.0.0.2',
@@ -414,10 +451,10 @@ test('connections: a client beyond its budget gets 429 then is closed at accept;
       r.end('{}');
     });
     assert.equal(post, 429);
-    assert.equal(metric(await metrics(d.base), 'convsim_sessions'), 0);
+    assert.equal(metric(await metrics(d.base), 'convsim_sessions'), 1);
     // another client address is served
     await healthy(d.base);
-    // beyond the grace (8 more), libmicrohttpd closes the socket at accept
+    // beyond the grace (8 more waiting for their 429), the next is closed at once
     socks.push(...await idleSockets(d.port, 8, '127.0.0.2'));
     await sleep(100);
     const dropped = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
@@ -425,22 +462,23 @@ test('connections: a client beyond its budget gets 429 then is closed at accept;
     assert.ok(metric(await metrics(d.base), 'convsim_connections_dropped_total') >= 1);
     await healthy(d.base);
 
-    // a stream of a paused session (heartbeats only) outlives the 2-s idle
-    // timeout, while the idle sockets are closed by it
-    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
-    assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${s.body.id}`, { running: false })).status, 200);
+    // the streams of the paused session (heartbeats only) outlive the 2-s
+    // idle timeout, while the idle sockets are closed by it
     const t0 = Date.now();
-    let beats = 0;
-    for await (const rec of openStream(d.base, `/api/v1/sessions/${s.body.id}/stream?format=ndjson`)) {
-      if (rec.type === 'heartbeat') beats++;
-      if (Date.now() - t0 > 4000) break;
-    }
-    assert.ok(beats >= 5, `the stream stayed open with ${beats} heartbeats`);
-    const when = await Promise.all(socks.map((k) => k.closedAt));
+    const beats0 = streams.map((k) => k.beats);
+    await sleep(4000);
+    streams.forEach((k, i) => {
+      assert.ok(!k.closed, `stream ${i} stayed open`);
+      assert.ok(k.beats - beats0[i] >= 5, `stream ${i}: ${k.beats - beats0[i]} heartbeats`);
+    });
+    const when = await Promise.all(socks.slice(cap).map((k) => k.closedAt));
     assert.ok(when.every((t) => t - t0 < 4000 * SLOW), 'idle sockets were closed by --connection-timeout');
-    const back = await getFrom(d.base, '/api/v1/health', '127.0.0.2');
-    assert.equal(back.status, 200, 'the client is served again once its sockets are gone');
+    // closed by the client: the daemon sees it at its next heartbeat
+    for (const k of streams) k.close();
+    await until(async () => (await getFrom(d.base, '/api/v1/health', '127.0.0.2')).status === 200,
+      5000, 'the client served again once its streams are gone');
   } finally {
+    for (const k of streams) k.close();
     for (const k of socks) k.destroy();
     assert.equal((await d.stop()).code, 0, d.stderr());
   }

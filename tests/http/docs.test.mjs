@@ -209,6 +209,7 @@ async function prepare(code, hostport) {
 function workdir() {
   const dir = mkdtempSync(join(tmpdir(), 'convsim-docs-'));
   symlinkSync(BUILD, join(dir, 'build'));
+  symlinkSync(join(ROOT, 'docs'), join(dir, 'docs')); // the examples' scripts (docs/examples/)
   mkdirSync(join(dir, 'var'));
   writeFileSync(join(dir, 'var', 'token'), TOKEN + '\n', { mode: 0o600 });
   return dir;

@@ -11,7 +11,7 @@
 // reversal time).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { existsSync, mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startDaemon, req, until, sleep, CHEAP, SLOW } from './lib.mjs';
@@ -48,12 +48,13 @@ async function bothWays(steps, interval = 0.05) {
   try {
     got = await steps(d, async (running) => {
       // while running: kill at a random moment after its first checkpoint
-      // (none yet: an experiment is not resumed), start again on the
-      // directory
+      // (none yet: the experiment runs again from its start, the test
+      // below), start again on the directory
       while (kills < KILLS && await running(d)) {
         await sleep((interval * 1000 + 50 + Math.random() * 300) * SLOW);
         // not before the first checkpoint (on a loaded machine it can come
-        // later than the sleep): without one an experiment is not resumed
+        // later than the sleep): without one the experiment is run again,
+        // not resumed
         await until(async () => checkpointed(dir), 30000 * SLOW, 'a first checkpoint');
         if (!(await running(d))) break;
         d.proc.kill('SIGKILL');
@@ -121,4 +122,112 @@ test(`an experiment killed ${KILLS} times gives the uninterrupted run's CSV byte
   }, 0.3); // segments begin between a checkpoint and the kill: replayed from the log
   assert.ok(kills >= 1, `killed while running ${kills} times`);
   assert.equal(got, ref, `restored ${kills} times`);
+});
+
+// An experiment killed before its session's first checkpoint (none
+// carries it) runs again from its first segment on the session that comes
+// back from its spec at t = 0: done, the uninterrupted run's CSV byte for
+// byte (docs/operations.md "What a crash can lose"). Before, it was listed
+// `interrupted` with no segment done.
+test('an experiment killed before its session\'s first checkpoint runs again from its start, byte for byte', { timeout: 180000 * SLOW }, async () => {
+  const body = {
+    session: { ...CHEAP, pace: 'max' },
+    schedule: [{ beta: 40, until: 240 }, { beta: 120, until: 560 }, { beta: 20, until: 880 }],
+  };
+  const run = async (d, ex) => {
+    const path = `/api/v1/experiments/${ex.id}`;
+    const e = await settled(d, path, (b) => !['waiting', 'running'].includes(b.state), 120000);
+    assert.equal(e.body.state, 'done', JSON.stringify(e.body));
+    const csv = (await req(d.base, 'GET', `${path}?format=csv`)).text;
+    return csv.split(ex.id).join('ID').split(ex.session).join('SESSION');
+  };
+  let d = await startDaemon([]);
+  let ref;
+  try {
+    const ex = await req(d.base, 'POST', '/api/v1/experiments', body);
+    assert.equal(ex.status, 201, ex.text);
+    ref = await run(d, ex.body);
+  } finally {
+    await d.stop();
+  }
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-exp0-'));
+  // no checkpoint within the run: the session has none when it dies
+  const args = ['--data-dir', dir, '--checkpoint-interval', '3600'];
+  d = await startDaemon(args);
+  try {
+    const ex = await req(d.base, 'POST', '/api/v1/experiments', body);
+    assert.equal(ex.status, 201, ex.text);
+    const { id, session } = ex.body;
+    // killed as soon as its record and its session's spec are on disk
+    const files = [join(dir, 'experiments', `${id}.bin`), join(dir, 'sessions', session, 'spec.json')];
+    const end = Date.now() + 10000 * SLOW;
+    while (!files.every((f) => existsSync(f)) && Date.now() < end) await sleep(1);
+    d.proc.kill('SIGKILL');
+    await d.exited;
+    assert.ok(files.every((f) => existsSync(f)), 'the records were on disk');
+    assert.ok(!existsSync(join(dir, 'sessions', session, 'checkpoint.bin')), 'no checkpoint before the kill');
+    assert.ok(!existsSync(join(dir, `experiment-${id}.json`)), 'killed before it ended');
+    d = await startDaemon(args);
+    const got = await run(d, ex.body);
+    assert.equal(got, ref);
+  } finally {
+    await d.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+// The same for an experiment attached to a session that had finished
+// (its checkpoint, written when it stopped, does not carry the
+// experiment): it begins again where the session stood, as it did.
+test('an experiment attached to a finished session, killed before a checkpoint carried it, runs again byte for byte', { timeout: 180000 * SLOW }, async () => {
+  const schedule = [{ beta: 40, until: 200 }, { beta: 120, until: 500 }];
+  const once = async (d, dir, kill) => {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 50 });
+    assert.equal(s.status, 201, s.text);
+    const sid = s.body.id;
+    await settled(d, `/api/v1/sessions/${sid}`, (b) => b.state === 'finished');
+    const ex = await req(d.base, 'POST', '/api/v1/experiments', { session: sid, schedule });
+    assert.equal(ex.status, 201, ex.text);
+    const id = ex.body.id;
+    if (kill) d = await kill(id, sid);
+    const path = `/api/v1/experiments/${id}`;
+    const e = await settled(d, path, (b) => !['waiting', 'running'].includes(b.state), 120000);
+    assert.equal(e.body.state, 'done', JSON.stringify(e.body));
+    assert.equal(e.body.t_start, 50);
+    const csv = (await req(d.base, 'GET', `${path}?format=csv`)).text;
+    return { d, csv: csv.split(id).join('ID').split(sid).join('SESSION') };
+  };
+  let d = await startDaemon([]);
+  let ref;
+  try {
+    ({ csv: ref } = await once(d, null, null));
+  } finally {
+    await d.stop();
+  }
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-exp1-'));
+  const args = ['--data-dir', dir, '--checkpoint-interval', '3600'];
+  d = await startDaemon(args);
+  try {
+    const got = await once(d, dir, async (id, sid) => {
+      // once its record and its first command's line are on disk: the
+      // restore must leave that line to the experiment, not replay it
+      const rec = join(dir, 'experiments', `${id}.bin`);
+      const log = join(dir, 'sessions', sid, 'controls.ndjson');
+      const ready = () => existsSync(rec) && existsSync(log) && readFileSync(log, 'utf8').includes(id);
+      const end = Date.now() + 10000 * SLOW;
+      while (!ready() && Date.now() < end) await sleep(1);
+      d.proc.kill('SIGKILL');
+      await d.exited;
+      assert.ok(ready(), 'its record and first command were on disk');
+      assert.ok(existsSync(join(dir, 'sessions', sid, 'checkpoint.bin')), 'the session\'s checkpoint of its stop');
+      assert.ok(!existsSync(join(dir, `experiment-${id}.json`)), 'killed before it ended');
+      d = await startDaemon(args);
+      return d;
+    });
+    d = got.d;
+    assert.equal(got.csv, ref);
+  } finally {
+    await d.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
 });

@@ -102,7 +102,7 @@ test('the status at t = 0: new fields typed, undefined ones null, energy changes
     assert.equal(c.body.spec.scene.start, start);
     const st = c.body.status;
     assert.equal(st.t, 0);
-    assert.deepEqual(st.energy, { input: 0, kinetic: 0, potential: 0, dissipated: 0, residual: 0 });
+    assert.deepEqual(st.energy, { input: 0, kinetic: 0, potential: 0, dissipated: 0, residual: 0, disturbance: 0 });
     for (const k of ['transport_velocity', 'transport_velocity_uncertainty', 'rotor_speed_mean',
       'motor_torque_mean', 'power_mean', 'feed_velocity']) {
       assert.ok(k in st, k);

@@ -4,7 +4,8 @@
 // byte of it (GET, HEAD, DELETE with a body: 400; a route or method that
 // does not exist: 404, 405; no token: 401), and a body slower than
 // --min-body-rate is closed after --request-timeout. Meanwhile and after,
-// /api/v1/health answers. Bounded: at most 300 sockets from 100 addresses
+// /api/v1/health answers, also to the flooding address itself: beyond
+// --max-client-connections its own least progressed connection is closed. Bounded: at most 300 sockets from 100 addresses
 // 127.3.x.y against a cap of 32, on loopback only.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -141,6 +142,33 @@ test('a flood of slow POST bodies from many addresses: closed at the cap or at t
     assert.ok(timedOut >= 32 - 6, `those under the cap were cut at their deadline (${timedOut})`);
     assert.equal(metric(m, 'convsim_connections_dropped_total'), 0, 'none closed at accept');
     // no session was created by a cut body
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0);
+  } finally {
+    if (st) closeFlood(st);
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('a flood of slow POST bodies from one address: beyond its --max-client-connections its own least progressed are closed, not refused; it is still answered', { timeout: 90000 * SLOW }, async () => {
+  const cap = 8;
+  const d = await startDaemon(['--max-client-connections', String(cap), '--request-timeout', '30']);
+  let st = null;
+  try {
+    // 60 slow bodies from 127.3.0.1 alone
+    st = await openFlood(d.port, 'slow-post', 60, 1, '127.3');
+    assert.equal(st.connected, 60, 'the flood connected');
+    // beyond the cap each new one closed that address's oldest
+    await until(() => st.closedByDaemon >= 60 - cap, 10000, 'the address held at its cap');
+    // the same address is answered during its own flood: its new
+    // connection closes its least progressed one, no 429, no refusal
+    await healthy(d.port, '127.3.0.1', 'the flooding address itself');
+    await healthy(d.port, '127.0.0.1', 'another address');
+    const m = (await req(d.base, 'GET', '/metrics')).text;
+    const evicted = metric(m, 'convsim_connections_evicted_total');
+    assert.ok(evicted >= 60 - cap + 1, `beyond the cap its least progressed were closed (${evicted})`);
+    assert.equal(metric(m, 'convsim_client_connections_refused_total'), 0, 'no 429');
+    assert.equal(metric(m, 'convsim_connections_dropped_total'), 0, 'none closed at accept');
+    assert.equal(st.answered, 0, 'no slow body got an answer (none was complete)');
     assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0);
   } finally {
     if (st) closeFlood(st);
