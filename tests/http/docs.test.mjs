@@ -252,7 +252,7 @@ export function apiDrift(doc, text) {
 }
 
 // The API reference: docs/api.md and the pages it is split into.
-export const API_PAGES = ['docs/api.md', 'docs/api-streams.md', 'docs/api-jobs.md'];
+export const API_PAGES = ['docs/api.md', 'docs/api-errors.md', 'docs/api-streams.md', 'docs/api-jobs.md'];
 
 test('the API pages and the served OpenAPI document name the same operations', async () => {
   const doc = (await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH)).body;
