@@ -69,10 +69,11 @@ char *api_experiment_json(const api_experiment_view *v);
 /* {"experiments": [...]} of n views. malloc'd text. */
 char *api_experiment_list_json(const api_experiment_view *v, size_t n);
 /* The segments of n experiments as CSV, one row each (API_EXPERIMENT_CSV
- * columns). malloc'd text. */
+ * columns; the model error's cells empty where the view has no spec).
+ * malloc'd text. */
 #define API_EXPERIMENT_CSV                                                            \
 	"experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,"   \
-	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time"
+	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time," SIM_MODEL_ERROR_COLUMNS
 char *api_experiment_csv(const api_experiment_view *v, size_t n);
 
 /* ---- sweeps --------------------------------------------------------------- */

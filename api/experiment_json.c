@@ -145,6 +145,18 @@ api_err api_parse_experiment(const char *body, size_t len,
 	return e;
 }
 
+/* The scene's model error at segment s's beta (sim_model_check); 0 where
+ * the session's scene is not known. */
+static int segment_model(const api_experiment_view *v, const api_segment *s, sim_model_error *me)
+{
+	if (!v->spec)
+		return 0;
+	sim_params p = v->spec->params;
+	p.beta = s->beta.si;
+	sim_model_check(&p, &v->spec->scene, me);
+	return 1;
+}
+
 static cJSON *experiment_object(const api_experiment_view *v)
 {
 	static const char *const seg_state[] = {"pending", "running", "done"};
@@ -179,14 +191,9 @@ static cJSON *experiment_object(const api_experiment_view *v)
 		else
 			cJSON_AddNullToObject(so, "steady");
 		api_add_number(so, "reversal_time", sim_time_ns(s->reversal_time));
-		if (v->spec) {
-			/* the scene's model error at the segment's beta */
-			sim_params p = v->spec->params;
-			sim_model_error me;
-			p.beta = s->beta.si;
-			sim_model_check(&p, &v->spec->scene, &me);
+		sim_model_error me;
+		if (segment_model(v, s, &me))
 			api_add_model_error(so, &me);
-		}
 		cJSON_AddItemToArray(arr, so);
 	}
 	cJSON *links = cJSON_AddObjectToObject(o, "links");
@@ -242,6 +249,8 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n)
 			csv_num(&b, done ? g->uncertainty : NAN);
 			api_buf_puts(&b, !done ? "," : g->steady ? ",true" : ",false");
 			csv_num(&b, done ? sim_time_ns(g->reversal_time) : NAN);
+			sim_model_error me;
+			api_buf_model_error(&b, segment_model(&v[i], g, &me) ? &me : NULL);
 			api_buf_put(&b, "\n", 1);
 		}
 	return api_buf_take(&b);

@@ -112,6 +112,9 @@ void api_add_number(cJSON *obj, const char *name, double v);
 /* Add model_error, model_error_uncertainty (m/s, null unless checked),
  * model_checked and model_check_note (sim_model_check) to o. */
 void api_add_model_error(cJSON *o, const sim_model_error *me);
+/* The same as CSV cells (SIM_MODEL_ERROR_COLUMNS), each after a comma;
+ * three empty cells where me is NULL (not known). */
+void api_buf_model_error(api_buf *b, const sim_model_error *me);
 /* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
  * ?format=csv} (a job's result, as JSON and as CSV). */
 void api_add_result_links(cJSON *obj, const char *collection, const char *id);
