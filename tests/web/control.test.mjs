@@ -72,6 +72,10 @@ async function dataTable(name) {
 	assert.equal(t.head, csv.text.split('\n')[0]);
 	assert.ok(t.rows > 100, `${name}: ${t.rows} rows`);
 	await page.keyboard.press('Enter');
+	const png = await download(page, `#plot-${name} + .plot-export button[data-export="png"]`);
+	assert.equal(png.name, `${name}.png`);
+	assert.ok(png.bytes.subarray(0, 8).equals(Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a])), 'a PNG');
+	assert.match(await page.getAttribute(`#plot-${name}`, 'aria-label'), /against time \(plot; its data: the Data table below\)$/);
 }
 
 test('a closed loop from the form: v, setpoint and beta on one axis, the per-setpoint table', { timeout: 90000 }, async () => {
@@ -156,6 +160,23 @@ test('an identification from the form: K, T, L with their standard errors, the f
 	await page.locator('#loop-card').screenshot({ path: `${OUT}/control-identify.png` });
 });
 
+test('a setpoint out of the machine\'s reach: the daemon\'s 422 on the page, the setpoints field marked, nothing started', async () => {
+	const before = (await apiGet(d, '/api/v1/experiments')).experiments.length;
+	await page.selectOption('#loop-form select[name="kind"]', 'control');
+	await page.fill('#loop-form input[name="setpoints"]', '0.10:1, 0.5:2');
+	await page.fill('#loop-form input[name="disturbances"]', '');
+	const answered = page.waitForResponse(r => r.url().endsWith('/api/v1/experiments') && r.request().method() === 'POST');
+	await page.click('#loop-run');
+	const res = await answered;
+	assert.equal(res.status(), 422);
+	const problem = await res.json();
+	assert.equal(problem.field, 'control.setpoint[1].v');
+	await until(async () => (await page.textContent('#messages')).includes(problem.detail), 5000, 'the detail on the page');
+	assert.equal(await page.getAttribute('#loop-form input[name="setpoints"]', 'aria-invalid'), 'true');
+	assert.equal(await page.getAttribute('#loop-form input[name="setpoints"]', 'title'), problem.detail);
+	assert.equal((await apiGet(d, '/api/v1/experiments')).experiments.length, before);
+});
+
 test('a phone (390 px): the panel without sideways scroll; no console errors', async () => {
 	await page.setViewportSize({ width: 390, height: 844 });
 	await until(async () => await page.evaluate(() => document.documentElement.scrollWidth) <= 390, 5000, 'no sideways scroll');
@@ -164,5 +185,7 @@ test('a phone (390 px): the panel without sideways scroll; no console errors', a
 		.map(e => `${e.tagName}#${e.id}.${e.className}`).slice(0, 5));
 	assert.deepEqual(wide, [], 'nothing of the panel reaches past the screen');
 	assert.deepEqual(ui.pageErrors, []);
-	assert.deepEqual(ui.consoleErrors, []);
+	/* but the refused request's, provoked above */
+	assert.deepEqual(ui.consoleErrors.filter(e => !/status of 422/.test(e)), []);
+	assert.equal(ui.consoleErrors.length, 1, ui.consoleErrors.join('\n'));
 });

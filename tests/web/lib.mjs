@@ -90,8 +90,10 @@ export async function until(fn, ms, what) {
 	throw new Error(`timed out after ${ms} ms waiting for ${what} (last: ${JSON.stringify(last)})`);
 }
 
-/* Click sel on page and take the download it starts: its name and text. */
+/* Click sel on page and take the download it starts: its name, bytes and
+ * text. */
 export async function download(page, sel) {
 	const [dl] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.click(sel)]);
-	return { name: dl.suggestedFilename(), text: readFileSync(await dl.path(), 'utf8') };
+	const bytes = readFileSync(await dl.path());
+	return { name: dl.suggestedFilename(), bytes, text: bytes.toString('utf8') };
 }

@@ -59,6 +59,9 @@ export function makePlots() {
 			{ label: 'β / °', color: PALETTE[3], scale: 'y2' }],
 		yLabel: 'v / (m/s)', y2Label: 'β / °', aspect: 0.5,
 	});
+	/* the two share a card: each named for what it draws */
+	$('#plot-loop').setAttribute('aria-label', 'Closed loop: v, setpoint and β against time (plot; its data: the Data table below)');
+	$('#plot-ident').setAttribute('aria-label', 'Identification: measured and fitted v against time (plot; its data: the Data table below)');
 }
 
 /* The strokes plot; alike: both eliminators move the same (the symmetric
