@@ -398,6 +398,7 @@ typedef struct api_view {
 				  replayed: "restored": "replayed" */
 	double replay_seconds; /* wall s the replay took; NAN while it runs */
 	int has_bed;           /* feed_model liggghts: bed is its bed */
+	const sim_feed_choice *pick; /* feed_model auto's pick, or NULL */
 	api_bed bed;
 } api_view;
 

@@ -211,6 +211,13 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	}
 	if (v->has_bed)
 		cJSON_AddItemToObject(o, "bed", bed_object(&v->bed));
+	if (v->pick) { /* feed_model auto: what it took and why */
+		cJSON *k = cJSON_AddObjectToObject(o, "feed_model_pick");
+		cJSON_AddStringToObject(k, "model", v->pick->model == SIM_FEED_EXTERNAL ? "liggghts"
+											: "column");
+		cJSON_AddStringToObject(k, "why", v->pick->why);
+		api_add_number(k, "expected_cpu_s_per_s", v->pick->expected_cpu_s_per_s);
+	}
 	if (v->experiment[0])
 		cJSON_AddStringToObject(o, "experiment", v->experiment);
 	else
