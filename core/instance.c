@@ -25,8 +25,8 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
 	if (sc->feed_model == SIM_FEED_AUTO) { /* the caller's to resolve */
 		e = SIM_EPARAM;
 		if (msg)
-			snprintf(msg, msglen, "feed_model auto is resolved before a run starts "
-					      "(sim_feed_pick)");
+			snprintf(msg, msglen, "feed_model auto picks the model of one run "
+					      "(convsim run, a session): give column here");
 		goto fail;
 	}
 	e = SIM_ENOMEM;
