@@ -9,6 +9,9 @@
 // The LIGGGHTS pick with a real bed process is tests/dem/feed_auto.test.mjs.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { startDaemon, req, until, SLOW } from './lib.mjs';
 
 let d;
@@ -84,4 +87,32 @@ test('feed_model auto: model_tol out of range is refused naming it', { timeout: 
   assert.equal(r.body.field, 'scene.model_tol');
   assert.equal(r.body.min, 0);
   assert.equal(r.body.max, 1);
+});
+
+test('feed_model auto: a restart keeps the model and the pick (spec.json), it does not pick again', { timeout: 30000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-auto-'));
+  const args = ['--data-dir', dir, '--dem-bed', '/nonexistent/convsim-bed'];
+  let e = await startDaemon(args);
+  try {
+    const r = await req(e.base, 'POST', '/api/v1/sessions',
+      { preset: 'liggghts-bed4', pace: 1, params: { beta: 137 }, scene: { feed_model: 'auto', model_tol: 0.003 } });
+    assert.equal(r.status, 201);
+    const pick = r.body.feed_model_pick;
+    const specFile = join(dir, 'sessions', r.body.id, 'spec.json');
+    await until(() => existsSync(specFile), 5000 * SLOW, 'spec.json');
+    const file = JSON.parse(readFileSync(specFile, 'utf8'));
+    assert.deepEqual(file.feed_model_pick, pick);
+    assert.equal(file.session.scene.feed_model, 'column');
+    assert.equal(file.session.scene.model_tol, 0.003);
+    // moved outside model_tol before the restart: auto would not pick column here
+    assert.equal((await req(e.base, 'PATCH', `/api/v1/sessions/${r.body.id}`, { beta: 150 })).status, 200);
+    await e.stop();
+    e = await startDaemon(args);
+    const b = (await req(e.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
+    assert.equal(b.spec.scene.feed_model, 'column');
+    assert.deepEqual(b.feed_model_pick, pick);
+  } finally {
+    await e.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
 });
