@@ -69,6 +69,11 @@ test('feed_model auto: no model within model_tol, 422 on scene.model_tol with wh
   assert.equal(c.body.field, 'scene.model_tol');
   assert.ok(c.body.min > 0.005 && c.body.min < 0.02, `min ${c.body.min}`);
   assert.match(c.body.detail, /^no feed model within model_tol 0\.005 m\/s here: the column model: DEM check: within ±0\.008 m\/s here \(liggghts-bed4, 4 layers\), uncertain by ±0\.002 m\/s; a LIGGGHTS bed cannot run/);
+  // model_error 0.008 alone is within 0.009; with its uncertainty it is not
+  const u = await req(d.base, 'POST', '/api/v1/sessions',
+    { preset: 'liggghts-bed4', pace: 1, params: { beta: 150 }, scene: { feed_model: 'auto', model_tol: 0.009 } });
+  assert.equal(u.status, 422);
+  assert.ok(u.body.min > 0.009, `min ${u.body.min}`);
   // auto without model_tol
   const z = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, scene: { feed_model: 'auto' } });
   assert.equal(z.status, 422);
