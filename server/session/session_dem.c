@@ -111,8 +111,9 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 	return API_OK;
 }
 
-api_err srv_dem_pick(api_spec *spec, sim_feed_choice *pick, api_problem *pb)
+api_err srv_dem_pick(srv_session *s, api_spec *spec, api_problem *pb)
 {
+	sim_feed_choice *pick = &s->pick;
 	dem_bed_spec bed;
 	dem_bed_spec_default(&spec->params, (double)spec->scene.layers, &bed);
 	sim_feed_liggghts lg = {
@@ -131,6 +132,8 @@ api_err srv_dem_pick(api_spec *spec, sim_feed_choice *pick, api_problem *pb)
 		return pb->code;
 	}
 	spec->scene.feed_model = pick->model;
+	s->picked = 1;
+	srv_log(SRV_LOG_INFO, "session %s: feed_model auto: %s", s->entry.id, pick->why);
 	return API_OK;
 }
 

@@ -198,10 +198,11 @@ int srv_dem_wanted(const api_spec *spec);
  * taken (else 429): give it back with srv_dem_release. */
 api_err srv_dem_admit(api_spec *spec, api_problem *pb);
 /* feed_model auto (sim_feed_pick, docs/feed-models.md "feed_model=auto"):
- * the spec's feed model becomes the pick, which *pick says, a LIGGGHTS bed
- * offered where its program exists and its expected cost is within
- * --max-dem-cost; none fits: 422 on scene.model_tol with the why. */
-api_err srv_dem_pick(api_spec *spec, sim_feed_choice *pick, api_problem *pb);
+ * the spec's feed model becomes the pick, which s->pick says (s->picked
+ * 1, logged), a LIGGGHTS bed offered where its program exists and its
+ * expected cost is within --max-dem-cost; none fits: 422 on
+ * scene.model_tol with the why. */
+api_err srv_dem_pick(srv_session *s, api_spec *spec, api_problem *pb);
 /* A restored session's slot, taken even beyond the limit; and giving one
  * back. */
 void srv_dem_hold(void);
