@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -320,7 +320,7 @@ bench: all $(BUILD)/.deps-bench
 bench-zoo-ref: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
-# libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
+# libFuzzer harnesses (tests/fuzz/, docs/fuzzing.md "Fuzzing"): clang builds core/,
 # fit/, api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
@@ -362,6 +362,12 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 # another build's rows for comparison; CLIENT=fetch,lean both clients.
 bench-controls: all
 	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" CLIENT="$(or $(CLIENT),lean)" node tests/bench/controls.mjs
+
+# The conveyor as a control system (part of `make bench`;
+# tests/bench/control_loop.mjs, about 10 s): identification, setpoint steps
+# and disturbances on the preset, into tests/bench/results/control_loop.md.
+bench-control-loop: all
+	$(Q)CONVSIMD=$(BUILD)/convsimd node tests/bench/control_loop.mjs | tee tests/bench/results/control_loop.md
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
@@ -412,8 +418,9 @@ install: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
 	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
-	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/examples
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/log $(DESTDIR)$(DOCDIR)/docs/examples
 	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
+	install -m 644 docs/log/*.md $(DESTDIR)$(DOCDIR)/docs/log/
 	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
 	install -m 644 docs/examples/*.py $(DESTDIR)$(DOCDIR)/docs/examples/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
