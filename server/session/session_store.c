@@ -126,7 +126,7 @@ void srv_persist_spec(srv_session *s)
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
 		queue(s, "spec.bin", buf, len, 0, 0);
-	char *text = api_spec_file(&s->spec, s->created, s->owned);
+	char *text = api_spec_file(&s->spec, s->created, s->owned, s->picked ? &s->pick : NULL);
 	if (text)
 		queue(s, "spec.json", text, strlen(text), 0, 0);
 }
@@ -368,7 +368,7 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 		api_problem pb;
 		int format = 0;
 		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
-						&s->owned, &format, &pb);
+						&s->owned, &format, &s->pick, &s->picked, &pb);
 		free(text);
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);

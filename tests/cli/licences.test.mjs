@@ -44,8 +44,11 @@ function packagesOf(bin) {
 }
 
 const hasDpkg = spawnSync('sh', ['-c', 'command -v dpkg && command -v ldd']).status === 0;
+// `make check`'s build loads the sanitizers' runtimes and what they need
+// (libasan, libubsan, libgcc_s): not what is shipped, which `make test` checks
+const sanitized = hasDpkg && /libasan|libubsan/.test(spawnSync('ldd', [join(BUILD, 'convsim')], { encoding: 'utf8' }).stdout || '');
 
-test('docs/third-party.md lists every shared library of every built program', { skip: !hasDpkg && 'no dpkg or ldd' }, () => {
+test('docs/third-party.md lists every shared library of every built program', { skip: (!hasDpkg && 'no dpkg or ldd') || (sanitized && 'a sanitizer build') }, () => {
   const rows = lddTable(readFileSync(join(ROOT, 'docs/third-party.md'), 'utf8'));
   const seen = new Set();
   let built = 0;
