@@ -39,6 +39,7 @@ typedef struct store_job {
 	void (*before)(void *arg); /* called just before the write */
 	void (*call)(void *arg);   /* a call in order (srv_store_call) */
 	void *arg;
+	uint64_t seq;         /* its place in the queue (srv_store_settle) */
 	struct store_job *next;
 } store_job;
 
@@ -47,14 +48,19 @@ static struct {
 	double interval;
 	pthread_mutex_t lock;
 	pthread_cond_t wake;
+	pthread_cond_t settled; /* a job done: done_seq moved */
 	store_job *head, *tail;
+	/* the last job queued and the last one done, in queue order (a
+	 * superseded write keeps its place and its number) */
+	uint64_t queued_seq, done_seq;
 	int stop, started;
 	pthread_t thread;
 	/* srv_store_watch on: the writes that failed since (lock held) */
 	int watching;
 	size_t failed;
 	char failed_what[1024];
-} st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
+} st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER,
+      .settled = PTHREAD_COND_INITIALIZER};
 
 void srv_store_path(char *out, size_t len, const char *rel)
 {
@@ -232,10 +238,15 @@ static void *writer_main(void *arg)
 		st.head = j->next;
 		if (!st.head)
 			st.tail = NULL;
+		uint64_t seq = j->seq;
 		pthread_mutex_unlock(&st.lock);
-		run_job(j);
+		run_job(j); /* its callback too: the waiter sees its outcome */
 		pthread_mutex_lock(&st.lock);
+		st.done_seq = seq;
+		pthread_cond_broadcast(&st.settled);
 	}
+	st.done_seq = st.queued_seq; /* stopped: nobody waits for more */
+	pthread_cond_broadcast(&st.settled);
 	pthread_mutex_unlock(&st.lock);
 	return NULL;
 }
@@ -340,6 +351,7 @@ static void enqueue(store_job *j)
 {
 	pthread_mutex_lock(&st.lock);
 	j->next = NULL;
+	j->seq = ++st.queued_seq;
 	if (st.tail)
 		st.tail->next = j;
 	else
@@ -402,6 +414,33 @@ void srv_store_write_after(const char *path, void *buf, size_t len, int keep_pre
 	enqueue(j);
 }
 
+int srv_store_settle(double timeout_s)
+{
+	if (!st.started)
+		return 0;
+	struct timespec until = srv_deadline(timeout_s);
+	int rc = 0;
+	pthread_mutex_lock(&st.lock);
+	uint64_t target = st.queued_seq;
+	while (st.done_seq < target && rc == 0)
+		rc = pthread_cond_timedwait(&st.settled, &st.lock, &until);
+	rc = st.done_seq < target ? ETIMEDOUT : 0;
+	pthread_mutex_unlock(&st.lock);
+	return rc;
+}
+
+api_err srv_store_durable(const char *what, const char *id, api_problem *pb)
+{
+	if (srv_store_settle(SRV_STORE_SETTLE_S) == 0)
+		return API_OK;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "%s %s was created, but its record is not on disk after %g s (the data "
+		 "directory does not keep up): a crash may lose it; GET shows it meanwhile",
+		 what, id, SRV_STORE_SETTLE_S);
+	pb->retry_after = 5;
+	return API_UNAVAILABLE;
+}
+
 void srv_store_call(void (*fn)(void *arg), void *arg)
 {
 	store_job *j = st.started ? calloc(1, sizeof *j) : NULL;
@@ -439,35 +478,6 @@ int srv_store_open_log(const char *rel, uint64_t len)
 		return -1;
 	}
 	return fd;
-}
-
-api_err srv_store_check_removable(const char *rel, api_problem *pb)
-{
-	if (!st.started)
-		return API_OK;
-	char path[4096];
-	struct stat sb;
-	srv_store_path(path, sizeof path, rel);
-	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
-	/* its directory (the entry goes), and the entry's own when it is
-	 * one (its files go) */
-	char *slash = strrchr(path, '/');
-	int err = 0;
-	if (slash) {
-		*slash = '\0';
-		err = access(path, W_OK) != 0 && errno != ENOENT ? errno : 0;
-		*slash = '/';
-	}
-	if (!err && is_dir && access(path, W_OK) != 0 && errno != ENOENT)
-		err = errno;
-	if (!err)
-		return API_OK;
-	api_fail(pb, API_UNAVAILABLE, NULL,
-		 "the data directory cannot be changed (%s): %s cannot be "
-		 "removed; nothing was deleted, retry once it is writable",
-		 strerror(err), rel);
-	pb->retry_after = 30;
-	return API_UNAVAILABLE;
 }
 
 void srv_store_remove(const char *path)

@@ -7,8 +7,9 @@
  * Nothing else writes under the data directory but the control logs
  * (control_log.c: appended and synced by the thread that answers for
  * them). Callers hand a finished buffer to the writer (srv_store_write)
- * and go on: no caller but a control's answer waits for a disk, none
- * writes on a worker's step path or under a registry lock. A pending
+ * and go on: no caller but the answer to a control or a creation waits
+ * for a disk (srv_store_settle), none writes on a worker's step path or
+ * under a registry lock. A pending
  * write to the same path is replaced by a newer one (a checkpoint that
  * could not be written in time is superseded, never queued twice).
  * The outcome of each write comes back through its callback, on the
@@ -89,6 +90,18 @@ void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
  * makes the control log it accounts for durable first. */
 void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
 			   void (*before)(void *arg), srv_store_done done, void *arg);
+/* Wait until every job queued so far is done, its callback run (so that
+ * its outcome shows in the object it wrote): 0 (also without a data
+ * directory), or ETIMEDOUT after timeout_s. The caller holds no lock a
+ * callback takes. */
+int srv_store_settle(double timeout_s);
+/* How long a creation waits for its record. */
+#define SRV_STORE_SETTLE_S 30.0
+/* A creation's answer waits for its record: srv_store_settle, then
+ * API_OK, or 503 in *pb saying that what (a "session", ...) id exists
+ * but is not on disk yet. A write that failed (a full disk) is API_OK
+ * here: the object shows state "error" with the reason in its answer. */
+api_err srv_store_durable(const char *what, const char *id, api_problem *pb);
 /* Call fn(arg) on the writer thread after the jobs queued before it
  * (nothing without a data directory: fn is not called). */
 void srv_store_call(void (*fn)(void *arg), void *arg);
@@ -150,6 +163,9 @@ char *srv_store_read_text(const char *path, size_t *len);
 /* Entries of a directory (relative path), malloc'd array of malloc'd
  * names (free each and the array); the count, 0 if none. */
 size_t srv_store_list(const char *path, char ***names);
+/* 1 when the directory rel holds no file but the store's temporary ones
+ * (a record whose first write a crash cut short). */
+int srv_store_dir_unwritten(const char *rel);
 /* The same for the entries of one kind of record under rel: directories
  * named by an id (dirs) or regular files ID.bin. Anything else is skipped
  * with one log line each (the store's own .tmp and .prev files without). */

@@ -162,6 +162,13 @@ enum MHD_Result srv_h_job_create(srv_req *r)
 		srv_registry_put(kind->reg, e);
 		return srv_reply_problem(r, &pb, NULL);
 	}
+	/* the answer only once its record (and a fresh session's spec) is
+	 * on disk: a crash after it keeps the job (docs/hardening.md) */
+	if (srv_store_durable(kind->name, e->id, &pb) != API_OK) {
+		free(text);
+		srv_registry_put(kind->reg, e);
+		return srv_reply_problem(r, &pb, NULL);
+	}
 	char prefix[48];
 	snprintf(prefix, sizeof prefix, "/api/v1/%s", kind->plural);
 	enum MHD_Result res = srv_reply_created(r, kind->created_status, text, prefix, e->id);

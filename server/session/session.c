@@ -462,6 +462,17 @@ size_t srv_sessions_restore(const srv_exp_finder *ef)
 	char **names = NULL;
 	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
 	for (size_t i = 0; i < n; i++) {
+		char dir[64];
+		snprintf(dir, sizeof dir, "sessions/%.40s", names[i]);
+		/* no file in it: the daemon died creating it, before its spec
+		 * was on disk, so before its 201 (which waits for the spec) */
+		if (srv_store_dir_unwritten(dir)) {
+			srv_log(SRV_LOG_INFO, "session %s: created but never answered (no spec "
+					      "on disk); its empty directory is removed", names[i]);
+			srv_store_remove(dir);
+			free(names[i]);
+			continue;
+		}
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
 			s->create_fd = -1; /* no client waits for a restore */
