@@ -39,7 +39,6 @@ typedef struct store_job {
 	void (*before)(void *arg); /* called just before the write */
 	void (*call)(void *arg);   /* a call in order (srv_store_call) */
 	void *arg;
-	uint64_t seq;         /* its place in the queue (srv_store_settle) */
 	struct store_job *next;
 } store_job;
 
@@ -48,19 +47,14 @@ static struct {
 	double interval;
 	pthread_mutex_t lock;
 	pthread_cond_t wake;
-	pthread_cond_t settled; /* a job done: done_seq moved */
 	store_job *head, *tail;
-	/* the last job queued and the last one done, in queue order (a
-	 * superseded write keeps its place and its number) */
-	uint64_t queued_seq, done_seq;
 	int stop, started;
 	pthread_t thread;
 	/* srv_store_watch on: the writes that failed since (lock held) */
 	int watching;
 	size_t failed;
 	char failed_what[1024];
-} st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER,
-      .settled = PTHREAD_COND_INITIALIZER};
+} st = {.lock = PTHREAD_MUTEX_INITIALIZER, .wake = PTHREAD_COND_INITIALIZER};
 
 void srv_store_path(char *out, size_t len, const char *rel)
 {
@@ -99,12 +93,13 @@ static int fsync_parent(const char *p)
 	return rc;
 }
 
-/* The atomic write of one job: 0, or an errno with what in msg. */
-static int write_atomic(const store_job *j, char *msg, size_t msglen)
+/* The atomic write of one job through path + tmp_ext: 0, or an errno
+ * with what in msg. */
+static int write_atomic(const store_job *j, const char *tmp_ext, char *msg, size_t msglen)
 {
 	char path[4096], tmp[4200], prev[4200];
 	srv_store_path(path, sizeof path, j->path);
-	snprintf(tmp, sizeof tmp, "%s.tmp", path);
+	snprintf(tmp, sizeof tmp, "%s%s", path, tmp_ext);
 	snprintf(prev, sizeof prev, "%s.prev", path);
 	const char *step = "create the directory of";
 	int fd = -1, err = 0;
@@ -193,6 +188,32 @@ static void note_failure(const char *path, const char *msg)
 	pthread_mutex_unlock(&st.lock);
 }
 
+/* A write's outcome counted and logged (err 0: written). */
+static void note_write(const char *path, int err, const char *msg)
+{
+	if (err) {
+		atomic_fetch_add(&srv_stats.store_errors, 1);
+		srv_log(SRV_LOG_ERROR, "store: %s", msg);
+		note_failure(path, msg);
+	} else {
+		atomic_fetch_add(&srv_stats.store_writes, 1);
+	}
+}
+
+int srv_store_write_now(const char *path, const void *buf, size_t len, char *msg,
+			size_t msglen)
+{
+	if (!st.started)
+		return 0;
+	store_job j = {.buf = (void *)buf, .len = len};
+	snprintf(j.path, sizeof j.path, "%s", path);
+	/* a temporary file of its own: the writer may be at the same path
+	 * (an experiment that ended at once), and the later rename wins */
+	int err = write_atomic(&j, ".now.tmp", msg, msglen);
+	note_write(path, err, msg);
+	return err;
+}
+
 static void run_job(store_job *j)
 {
 	char msg[4400] = "";
@@ -207,14 +228,8 @@ static void run_job(store_job *j)
 	} else if (j->buf) {
 		if (j->before)
 			j->before(j->arg);
-		err = write_atomic(j, msg, sizeof msg);
-		if (err) {
-			atomic_fetch_add(&srv_stats.store_errors, 1);
-			srv_log(SRV_LOG_ERROR, "store: %s", msg);
-			note_failure(j->path, msg);
-		} else {
-			atomic_fetch_add(&srv_stats.store_writes, 1);
-		}
+		err = write_atomic(j, ".tmp", msg, sizeof msg);
+		note_write(j->path, err, msg);
 	} else {
 		remove_path(j->path);
 	}
@@ -238,15 +253,10 @@ static void *writer_main(void *arg)
 		st.head = j->next;
 		if (!st.head)
 			st.tail = NULL;
-		uint64_t seq = j->seq;
 		pthread_mutex_unlock(&st.lock);
-		run_job(j); /* its callback too: the waiter sees its outcome */
+		run_job(j);
 		pthread_mutex_lock(&st.lock);
-		st.done_seq = seq;
-		pthread_cond_broadcast(&st.settled);
 	}
-	st.done_seq = st.queued_seq; /* stopped: nobody waits for more */
-	pthread_cond_broadcast(&st.settled);
 	pthread_mutex_unlock(&st.lock);
 	return NULL;
 }
@@ -351,7 +361,6 @@ static void enqueue(store_job *j)
 {
 	pthread_mutex_lock(&st.lock);
 	j->next = NULL;
-	j->seq = ++st.queued_seq;
 	if (st.tail)
 		st.tail->next = j;
 	else
@@ -412,33 +421,6 @@ void srv_store_write_after(const char *path, void *buf, size_t len, int keep_pre
 		return;
 	}
 	enqueue(j);
-}
-
-int srv_store_settle(double timeout_s)
-{
-	if (!st.started)
-		return 0;
-	struct timespec until = srv_deadline(timeout_s);
-	int rc = 0;
-	pthread_mutex_lock(&st.lock);
-	uint64_t target = st.queued_seq;
-	while (st.done_seq < target && rc == 0)
-		rc = pthread_cond_timedwait(&st.settled, &st.lock, &until);
-	rc = st.done_seq < target ? ETIMEDOUT : 0;
-	pthread_mutex_unlock(&st.lock);
-	return rc;
-}
-
-api_err srv_store_durable(const char *what, const char *id, api_problem *pb)
-{
-	if (srv_store_settle(SRV_STORE_SETTLE_S) == 0)
-		return API_OK;
-	api_fail(pb, API_UNAVAILABLE, NULL,
-		 "%s %s was created, but its record is not on disk after %g s (the data "
-		 "directory does not keep up): a crash may lose it; GET shows it meanwhile",
-		 what, id, SRV_STORE_SETTLE_S);
-	pb->retry_after = 5;
-	return API_UNAVAILABLE;
 }
 
 void srv_store_call(void (*fn)(void *arg), void *arg)

@@ -6,11 +6,12 @@
  *
  * Nothing else writes under the data directory but the control logs
  * (control_log.c: appended and synced by the thread that answers for
- * them). Callers hand a finished buffer to the writer (srv_store_write)
+ * them) and a new record (a session's spec.json, a job's record: written
+ * by the thread that creates it, srv_store_write_now, so that its 201
+ * follows it). Callers hand a finished buffer to the writer (srv_store_write)
  * and go on: no caller but the answer to a control or a creation waits
- * for a disk (srv_store_settle), none writes on a worker's step path or
- * under a registry lock. A pending
- * write to the same path is replaced by a newer one (a checkpoint that
+ * for a disk, none writes on a worker's step path or under a registry
+ * lock. A pending write to the same path is replaced by a newer one (a checkpoint that
  * could not be written in time is superseded, never queued twice).
  * The outcome of each write comes back through its callback, on the
  * writer thread with no lock held: 0, or the errno (ENOSPC, EIO, EACCES,
@@ -85,23 +86,22 @@ double srv_store_interval(void);
  * off, or out of memory, buf is freed and done is never called. */
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg);
+/* Write buf (len bytes, borrowed) to path now, on the calling thread, as
+ * the writer would (temporary file, fsync, rename, fsync of the
+ * directory): 0 (also without a data directory), or the errno with a
+ * sentence in msg; counted and logged as the writer's writes are. Only
+ * for a record's first version (its creation, before the answer): a
+ * session's spec.json before its worker runs, a job's record under the
+ * job's lock. Its temporary file is path.now.tmp, so that a queued write
+ * of the same path (an experiment that ended at once) cannot mix with
+ * it. */
+int srv_store_write_now(const char *path, const void *buf, size_t len, char *msg,
+			size_t msglen);
 /* srv_store_write with before (may be NULL) called on the writer thread
  * just before the file is written (not when superseded): a checkpoint
  * makes the control log it accounts for durable first. */
 void srv_store_write_after(const char *path, void *buf, size_t len, int keep_prev,
 			   void (*before)(void *arg), srv_store_done done, void *arg);
-/* Wait until every job queued so far is done, its callback run (so that
- * its outcome shows in the object it wrote): 0 (also without a data
- * directory), or ETIMEDOUT after timeout_s. The caller holds no lock a
- * callback takes. */
-int srv_store_settle(double timeout_s);
-/* How long a creation waits for its record. */
-#define SRV_STORE_SETTLE_S 30.0
-/* A creation's answer waits for its record: srv_store_settle, then
- * API_OK, or 503 in *pb saying that what (a "session", ...) id exists
- * but is not on disk yet. A write that failed (a full disk) is API_OK
- * here: the object shows state "error" with the reason in its answer. */
-api_err srv_store_durable(const char *what, const char *id, api_problem *pb);
 /* Call fn(arg) on the writer thread after the jobs queued before it
  * (nothing without a data directory: fn is not called). */
 void srv_store_call(void (*fn)(void *arg), void *arg);

@@ -204,9 +204,10 @@ static void queue_write(srv_experiment *e, const char *path, void *buf,
 	srv_store_write(path, buf, len, 0, written, e);
 }
 
-/* Queue experiments/ID.bin (lock held). Not while the daemon stops: an
- * experiment its session's worker lets go then is resumed next time. */
-static void persist_locked(srv_experiment *e)
+/* Queue experiments/ID.bin (lock held); now: write it on this thread
+ * (its creation: on disk before the answer). Not while the daemon stops:
+ * an experiment its session's worker lets go then is resumed next time. */
+static void persist_locked(srv_experiment *e, int now)
 {
 	if (!e->data_dir || srv_stopping())
 		return;
@@ -216,14 +217,23 @@ static void persist_locked(srv_experiment *e)
 	void *buf = srv_store_frame(SRV_STORE_EXPERIMENT, &r, sizeof r, &len);
 	char path[64];
 	snprintf(path, sizeof path, "experiments/%s.bin", e->entry.id);
-	if (buf)
+	char msg[sizeof e->error];
+	if (buf && now) { /* a failure is logged, and shown as a queued write's */
+		if (srv_store_write_now(path, buf, len, msg, sizeof msg) &&
+		    e->state != EXP_RUNNING && e->state != EXP_WAITING) {
+			e->state = EXP_ERROR;
+			snprintf(e->error, sizeof e->error, "%s", msg);
+		}
+		free(buf);
+	} else if (buf) {
 		queue_write(e, path, buf, len);
+	}
 }
 
 void srv_exp_persist(srv_experiment *e)
 {
 	pthread_mutex_lock(&e->lock);
-	persist_locked(e);
+	persist_locked(e, 1);
 	pthread_mutex_unlock(&e->lock);
 }
 
@@ -352,7 +362,7 @@ int srv_exp_interrupt(srv_experiment *e)
 		snprintf(e->error, sizeof e->error,
 			 "the daemon stopped before it ended and its session "
 			 "could not resume it; the segments done are kept");
-		persist_locked(e);
+		persist_locked(e, 0);
 	}
 	pthread_mutex_unlock(&e->lock);
 	return hit;
@@ -363,7 +373,7 @@ static void save_results(srv_experiment *e)
 {
 	if (!e->data_dir)
 		return;
-	persist_locked(e);
+	persist_locked(e, 0);
 	api_experiment_view v;
 	fill_view(e, &v);
 	char *text = api_experiment_json(&v);
@@ -445,7 +455,7 @@ static void abort_locked(srv_experiment *e, const char *why)
 	}
 	e->attached = 0;
 	drop_record(e);
-	persist_locked(e);
+	persist_locked(e, 0);
 }
 
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
