@@ -301,9 +301,9 @@ static api_err fitjob_start(srv_entry *en, char **answer, api_problem *pb)
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
 	pthread_mutex_lock(&f->lock);
+	persist_locked(f, 1); /* the answer shows a failure */
 	fill_view(f, &v);
 	char *text = api_fit_json(&v);
-	persist_locked(f, 1);
 	pthread_mutex_unlock(&f->lock);
 	if (start_driver(f) != 0) {
 		free(text);

@@ -54,10 +54,11 @@ typedef struct write_of {
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
- * reason. A later success clears it, unless spec.json is not on disk: the
- * first success after its failure (space came back) queues it again, and
- * the session reports healthy only once that rewrite is written (lock
- * order: the session's, then the store's). */
+ * reason (while spec.json is not on disk, its own). A later success clears
+ * it, unless spec.json is not on disk: the first success after its failure
+ * (space came back) queues it again, and the session reports healthy only
+ * once that rewrite is written (lock order: the session's, then the
+ * store's). */
 static void written(void *arg, int err, const char *what)
 {
 	write_of *w = arg;
@@ -71,9 +72,9 @@ static void written(void *arg, int err, const char *what)
 		s->persist.spec_unwritten = err != 0;
 		s->persist.spec_retrying = 0;
 	}
-	if (err)
+	if (err && (spec || !s->persist.spec_unwritten)) /* the spec's failure shown */
 		snprintf(s->persist.store_error, sizeof s->persist.store_error, "%s", what);
-	else if (s->persist.spec_unwritten && !s->persist.spec_retrying) {
+	else if (!err && s->persist.spec_unwritten && !s->persist.spec_retrying) {
 		s->persist.spec_retrying = 1;
 		srv_persist_spec(s, 0);
 	} else if (!s->persist.spec_unwritten && what && what[0] == '\0')
