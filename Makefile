@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: model-check all deps deps-build deps-unit run cluster test check bench bench-controls bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -185,11 +185,11 @@ $(BUILD)/api/openapi.o: INC_EXTRA := -I$(BUILD)/api
 # writes the CSV) become rows of a C table that core/model_check.c includes:
 # the core reads no file at run time. Columns are found by their header.
 MODEL_MAP := tests/bench/results/model_check.csv
-$(BUILD)/core/model_map.inc: $(MODEL_MAP)
+$(BUILD)/core/model_map.inc: $(MODEL_MAP) Makefile
 	@mkdir -p $(dir $@)
 	$(Q)awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$$i] = i; next } \
-	  /^[^#]/ { printf "{\"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
-	    $$c["preset"], $$c["settings"], $$c["layers"], $$c["beta_deg"], \
+	  /^[^#]/ { printf "{\"%s\", \"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
+	    $$c["preset"], $$c["settings"], $$c["material"], $$c["layers"], $$c["beta_deg"], \
 	    $$c["rotation"] == "cw" ? "SIM_CW" : "SIM_CCW", $$c["v_dem"], \
 	    $$c["v_dem_sd"] == "nan" ? "NAN" : $$c["v_dem_sd"], $$c["seeds"], $$c["v_column"] }' \
 	  $< > $@
@@ -197,7 +197,21 @@ $(BUILD)/core/model_map.inc: $(MODEL_MAP)
 # rows in tests/bench/results/dem_map.csv or a change of the column model).
 model-check: $(BUILD)/convsim
 	$(Q)python3 tests/bench/model_check.py $(BUILD)/convsim > $(MODEL_MAP).new && mv $(MODEL_MAP).new $(MODEL_MAP)
+# `make bench-dem-calibrate` calibrates the column model on three points of
+# each bed of the DEM map and predicts the rest (tests/bench/dem_calibrate.py:
+# tests/bench/results/dem_calibration.md, tests/bench/model_presets.csv),
+# then computes the table above again. Minutes; not part of `make bench`
+# (it changes the table the build compiles in).
+bench-dem-calibrate: $(BUILD)/convsim
+	$(Q)python3 tests/bench/dem_calibrate.py $(BUILD)/convsim > /dev/null
+	$(Q)$(MAKE) --no-print-directory model-check
 $(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
+# `make fast-feed-check`: reduced feed models against the DEM map, leave one
+# depth out (tests/bench/fast_feed_check.py, docs/feed-models.md), into
+# tests/bench/results/fast_feed.md and .csv; the docs' tables follow.
+fast-feed-check: $(BUILD)/convsim
+	$(Q)python3 tests/bench/fast_feed_check.py $(BUILD)/convsim
+	$(Q)python3 tests/docs_bench.py
 $(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
@@ -348,6 +362,12 @@ $(BUILD)/fuzz/%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.c $(FUZZ_LIBS)
 # another build's rows for comparison; CLIENT=fetch,lean both clients.
 bench-controls: all
 	$(Q)CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" CLIENT="$(or $(CLIENT),lean)" node tests/bench/controls.mjs
+
+# The conveyor as a control system (part of `make bench`;
+# tests/bench/control_loop.mjs, about 10 s): identification, setpoint steps
+# and disturbances on the preset, into tests/bench/results/control_loop.md.
+bench-control-loop: all
+	$(Q)CONVSIMD=$(BUILD)/convsimd node tests/bench/control_loop.mjs | tee tests/bench/results/control_loop.md
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;

@@ -44,13 +44,87 @@ typedef struct api_experiment_req {
 	api_segment seg[API_EXP_MAX_SEGMENTS];
 } api_experiment_req;
 
+/* An experiment's kind beyond its schedule (docs/control.md): an
+ * identification (steps of beta around operating points, a first-order-
+ * plus-dead-time model fitted per point) or a closed loop (a PI controller
+ * on beta holding transport-velocity setpoints), with disturbances
+ * scheduled on the session. Kept beside api_experiment_req, whose layout
+ * the stored records copy (server/base/records.h): a record of a plain
+ * schedule is what it was. */
+enum { API_EXP_SCHEDULE, API_EXP_IDENTIFY, API_EXP_CONTROL };
+#define API_EXP_MAX_POINTS 4    /* operating points of an identification */
+#define API_EXP_ID_SEGS 5       /* segments per point: settle, +d, 0, -d, 0 */
+#define API_EXP_MAX_DIST 8
+#define API_EXP_DIST_LEN 200    /* a disturbance's "set" object as sent */
+#define API_FF_NODES 73         /* the v(beta) curve: 0..180 deg by 2.5 */
+typedef struct api_fopdt {
+	double beta0, step;     /* deg: the operating point and the step */
+	double k, k_se;         /* m/s per deg */
+	double t, t_se;         /* s: time constant */
+	double l, l_se;         /* s: dead time */
+	double v0, rms;         /* m/s: velocity at beta0, residual */
+	double slope;           /* m/s per deg: the v(beta) curve's secant
+				   over beta0 -+ step (NaN: no curve) */
+	double t_from;          /* s after the start: the first step */
+	int n, ok;              /* samples fitted; 0: no model */
+} api_fopdt;
+typedef struct api_setpoint {
+	double v;               /* m/s */
+	double settling_time;   /* s from the segment start until v stays
+				   within 2 % of the setpoint; NaN: never */
+	double overshoot;       /* beyond the setpoint, a fraction of the
+				   step (0 without one) */
+	double iae;             /* m: integral of |setpoint - v| dt */
+	double steady_error;    /* |mean v over the last quarter - setpoint|
+				   / |setpoint| */
+} api_setpoint;
+typedef struct api_disturbance {
+	double at;              /* s after the experiment start */
+	char set[API_EXP_DIST_LEN]; /* the "set" object as a PATCH body */
+	double t_applied;       /* s simulated; NaN before */
+	double recovery_time;   /* s from t_applied until v stays within 2 %
+				   of the setpoint again; NaN: never */
+	double max_deviation;   /* m/s: the largest |setpoint - v| after it */
+	int applied;
+	int pad;
+} api_disturbance;
+typedef struct api_exp_ext {
+	int kind;               /* API_EXP_* */
+	int npoints;            /* identify: operating points */
+	double id_step, id_hold; /* deg, s */
+	api_fopdt model[API_EXP_MAX_POINTS];
+	/* control */
+	int auto_gains;         /* "controller": "auto" (SIMC) */
+	int branch_sign;        /* sign of dv/dbeta on the branch */
+	double kp, ki;          /* deg per m/s, deg per m */
+	double tau_c;           /* s: SIMC's closed-loop time constant */
+	api_fopdt tuned;        /* the identification behind "auto" */
+	api_setpoint sp[API_EXP_MAX_SEGMENTS];
+	int ndist;
+	int nff;                /* nodes of the branch's v(beta) curve */
+	api_disturbance dist[API_EXP_MAX_DIST];
+	double ff_beta[API_FF_NODES], ff_v[API_FF_NODES]; /* rad, m/s */
+	double v_lo, v_hi;      /* m/s: the branch's reachable range */
+	double beta_lo, beta_hi; /* rad: the branch's ends */
+	/* the sampler's and the controller's state (the server's, kept for a
+	 * restore): one sample per excitation period, the mean feed velocity
+	 * over the period since the last one */
+	double period;          /* s: the last period, the next sample's wait */
+	double last_t, last_x, last_psi; /* the last sample: s, m, rad (the
+				   rotor's phi - alpha); last_t < 0: none */
+	double integ;           /* deg */
+	double t_sample;        /* s after the start: the next sample */
+	int next_dist, pad;
+} api_exp_ext;
+
 /* Parse POST /experiments: {"session": ID} or {"session": {create body}}
  * (or none: a fresh czubak2016 session at pace "max"), "schedule":
  * [{"beta": DEG, "until": S}, ...] with increasing until, optional
  * "beta_rate" and "keep_session" (a fresh session is removed when the
  * experiment ends unless true). Returns API_OK or the error in *pb. */
 api_err api_parse_experiment(const char *body, size_t len,
-			     api_experiment_req *req, api_problem *pb);
+			     api_experiment_req *req, api_exp_ext *ext, api_problem *pb);
+
 
 typedef struct api_experiment_view {
 	char id[24];
@@ -64,15 +138,23 @@ typedef struct api_experiment_view {
 	const api_segment *seg; /* borrowed */
 	const api_spec *spec;   /* borrowed, may be NULL: the session's scene,
 				   each segment's model error at its beta */
+	const api_exp_ext *ext; /* borrowed, may be NULL: a plain schedule */
 } api_experiment_view;
 char *api_experiment_json(const api_experiment_view *v);
 /* {"experiments": [...]} of n views. malloc'd text. */
 char *api_experiment_list_json(const api_experiment_view *v, size_t n);
 /* The segments of n experiments as CSV, one row each (API_EXPERIMENT_CSV
- * columns). malloc'd text. */
+ * columns; the model error's cells empty where the view has no spec).
+ * malloc'd text. */
 #define API_EXPERIMENT_CSV                                                            \
 	"experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,"   \
-	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time"
+	"steady_velocity,mean_velocity,uncertainty,steady,reversal_time," SIM_MODEL_ERROR_COLUMNS
+/* Experiments that are all identifications add the operating point's model
+ * to each of its segments' rows, all closed loops each setpoint's
+ * results (a mixed list has the plain columns). */
+#define API_EXPERIMENT_CSV_IDENTIFY \
+	",operating_point,gain,gain_se,time_constant,time_constant_se,dead_time,dead_time_se"
+#define API_EXPERIMENT_CSV_CONTROL ",setpoint,settling_time,overshoot,iae,steady_error"
 char *api_experiment_csv(const api_experiment_view *v, size_t n);
 
 /* ---- sweeps --------------------------------------------------------------- */

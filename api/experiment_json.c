@@ -18,8 +18,8 @@
 const char *const api_members_segment[] = {"beta", "until", NULL};
 const char *const api_members_experiment_session[] = {"preset", "params", "scene", "integrator",
 						       "pace", "sample_rate", NULL};
-const char *const api_members_experiment[] = {"session", "schedule", "beta_rate", "keep_session",
-					       NULL};
+const char *const api_members_experiment[] = {"session",      "schedule", "identify", "control",
+					       "disturbances", "beta_rate", "keep_session", NULL};
 
 static api_err parse_segment(const cJSON *it, int i, double prev,
 			     const api_spec *spec, api_segment *seg,
@@ -98,9 +98,10 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 }
 
 api_err api_parse_experiment(const char *body, size_t len,
-			     api_experiment_req *req, api_problem *pb)
+			     api_experiment_req *req, api_exp_ext *ext, api_problem *pb)
 {
 	memset(req, 0, sizeof *req);
+	memset(ext, 0, sizeof *ext);
 	cJSON *root = api_parse_body(body, len, api_members_experiment, pb);
 	if (!root)
 		return pb->code;
@@ -117,6 +118,14 @@ api_err api_parse_experiment(const char *body, size_t len,
 	if (e == API_OK && rate && !cJSON_IsNull(rate))
 		e = api_parse_user_value(&req->spec, "beta_rate", rate,
 					 "beta_rate", &req->beta_rate, pb);
+	if (e == API_OK)
+		e = api_parse_experiment_kind(root, req, ext, pb);
+	if (e == API_OK && ext->kind != API_EXP_SCHEDULE) {
+		if (req->fresh)
+			req->spec.until = req->seg[req->nseg - 1].until;
+		cJSON_Delete(root);
+		return API_OK;
+	}
 	if (e == API_OK && !cJSON_IsArray(sched))
 		e = api_fail(pb, sched ? API_TYPE : API_INVALID, "schedule",
 			     "schedule must be an array of {\"beta\": DEG, "
@@ -143,6 +152,18 @@ api_err api_parse_experiment(const char *body, size_t len,
 	}
 	cJSON_Delete(root);
 	return e;
+}
+
+/* The scene's model error at segment s's beta (sim_model_check); 0 where
+ * the session's scene is not known. */
+static int segment_model(const api_experiment_view *v, const api_segment *s, sim_model_error *me)
+{
+	if (!v->spec)
+		return 0;
+	sim_params p = v->spec->params;
+	p.beta = s->beta.si;
+	sim_model_check(&p, &v->spec->scene, me);
+	return 1;
 }
 
 static cJSON *experiment_object(const api_experiment_view *v)
@@ -179,16 +200,12 @@ static cJSON *experiment_object(const api_experiment_view *v)
 		else
 			cJSON_AddNullToObject(so, "steady");
 		api_add_number(so, "reversal_time", sim_time_ns(s->reversal_time));
-		if (v->spec) {
-			/* the scene's model error at the segment's beta */
-			sim_params p = v->spec->params;
-			sim_model_error me;
-			p.beta = s->beta.si;
-			sim_model_check(&p, &v->spec->scene, &me);
+		sim_model_error me;
+		if (segment_model(v, s, &me))
 			api_add_model_error(so, &me);
-		}
 		cJSON_AddItemToArray(arr, so);
 	}
+	api_add_experiment_kind(o, v->ext, v->nseg);
 	cJSON *links = cJSON_AddObjectToObject(o, "links");
 	snprintf(link, sizeof link, "/api/v1/experiments/%s", v->id);
 	cJSON_AddStringToObject(links, "self", link);
@@ -221,11 +238,41 @@ static void csv_num(api_buf *b, double v)
 		api_buf_double(b, v);
 }
 
+/* The kind all n views share (API_EXP_SCHEDULE when they differ). */
+static int csv_kind(const api_experiment_view *v, size_t n)
+{
+	int kind = n && v[0].ext ? v[0].ext->kind : API_EXP_SCHEDULE;
+	for (size_t i = 1; i < n; i++)
+		if (!v[i].ext || v[i].ext->kind != kind)
+			return API_EXP_SCHEDULE;
+	return kind;
+}
+
+/* The kind's columns of segment k (API_EXPERIMENT_CSV_IDENTIFY or
+ * _CONTROL). */
+static void csv_kind_cells(api_buf *b, const api_exp_ext *ext, int k)
+{
+	if (ext->kind == API_EXP_IDENTIFY) {
+		const api_fopdt *m = &ext->model[k / API_EXP_ID_SEGS];
+		double cells[] = {m->beta0, m->k, m->k_se, m->t, m->t_se, m->l, m->l_se};
+		for (size_t c = 0; c < sizeof cells / sizeof *cells; c++)
+			csv_num(b, cells[c]);
+	} else if (ext->kind == API_EXP_CONTROL) {
+		const api_setpoint *s = &ext->sp[k];
+		double cells[] = {s->v, s->settling_time, s->overshoot, s->iae, s->steady_error};
+		for (size_t c = 0; c < sizeof cells / sizeof *cells; c++)
+			csv_num(b, cells[c]);
+	}
+}
+
 char *api_experiment_csv(const api_experiment_view *v, size_t n)
 {
 	static const char *const seg_state[] = {"pending", "running", "done"};
 	api_buf b = {0};
-	api_buf_puts(&b, API_EXPERIMENT_CSV "\n");
+	int kind = csv_kind(v, n);
+	api_buf_puts(&b, kind == API_EXP_IDENTIFY  ? API_EXPERIMENT_CSV API_EXPERIMENT_CSV_IDENTIFY "\n"
+			 : kind == API_EXP_CONTROL ? API_EXPERIMENT_CSV API_EXPERIMENT_CSV_CONTROL "\n"
+						   : API_EXPERIMENT_CSV "\n");
 	for (size_t i = 0; i < n; i++)
 		for (int k = 0; k < v[i].nseg; k++) {
 			const api_segment *g = &v[i].seg[k];
@@ -242,6 +289,10 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n)
 			csv_num(&b, done ? g->uncertainty : NAN);
 			api_buf_puts(&b, !done ? "," : g->steady ? ",true" : ",false");
 			csv_num(&b, done ? sim_time_ns(g->reversal_time) : NAN);
+			sim_model_error me;
+			api_buf_model_error(&b, segment_model(&v[i], g, &me) ? &me : NULL);
+			if (kind != API_EXP_SCHEDULE)
+				csv_kind_cells(&b, v[i].ext, k);
 			api_buf_put(&b, "\n", 1);
 		}
 	return api_buf_take(&b);

@@ -112,6 +112,9 @@ void api_add_number(cJSON *obj, const char *name, double v);
 /* Add model_error, model_error_uncertainty (m/s, null unless checked),
  * model_checked and model_check_note (sim_model_check) to o. */
 void api_add_model_error(cJSON *o, const sim_model_error *me);
+/* The same as CSV cells (SIM_MODEL_ERROR_COLUMNS), each after a comma;
+ * three empty cells where me is NULL (not known). */
+void api_buf_model_error(api_buf *b, const sim_model_error *me);
 /* Add "links": {"self": "/api/v1/COLLECTION/ID", "csv": the same with
  * ?format=csv} (a job's result, as JSON and as CSV). */
 void api_add_result_links(cJSON *obj, const char *collection, const char *id);
@@ -131,6 +134,20 @@ cJSON *api_control_object(const api_control *c);
 extern const char *const api_members_experiment[];
 extern const char *const api_members_experiment_session[];
 extern const char *const api_members_segment[];
+extern const char *const api_members_identify[];
+extern const char *const api_members_exp_control[];
+extern const char *const api_members_setpoint[];
+extern const char *const api_members_controller[];
+extern const char *const api_members_disturbance[];
+/* The kind members of an experiment body (experiment_kind_json.c):
+ * "identify", or "control" with "disturbances", into *ext and the schedule
+ * they make in *req (identify: API_EXP_ID_SEGS segments per point; control:
+ * one per setpoint, its beta filled by the server from the v(beta) curve).
+ * API_OK with ext->kind API_EXP_SCHEDULE when root has neither. */
+api_err api_parse_experiment_kind(const cJSON *root, api_experiment_req *req,
+				  api_exp_ext *ext, api_problem *pb);
+/* The kind's results into the experiment's JSON object o. */
+void api_add_experiment_kind(cJSON *o, const api_exp_ext *ext, int nseg);
 extern const char *const api_members_sweep[];
 extern const char *const api_members_beta_range[];
 extern const char *const api_members_fit[];

@@ -30,3 +30,18 @@ void api_add_model_error(cJSON *o, const sim_model_error *me)
 	cJSON_AddBoolToObject(o, "model_checked", me->checked);
 	cJSON_AddStringToObject(o, "model_check_note", me->note);
 }
+
+void api_buf_model_error(api_buf *b, const sim_model_error *me)
+{
+	if (!me) {
+		api_buf_puts(b, ",,,");
+		return;
+	}
+	api_buf_put(b, ",", 1);
+	if (me->checked && isfinite(me->error))
+		api_buf_double(b, me->error);
+	api_buf_put(b, ",", 1);
+	if (me->checked && isfinite(me->error_uncertainty))
+		api_buf_double(b, me->error_uncertainty);
+	api_buf_puts(b, me->checked ? ",true" : ",false");
+}

@@ -249,11 +249,12 @@ static double vary_value(const api_sweep_view *v, const api_sweep_point *p, int 
 }
 
 /* A point's model error (sim_model_check): the sweep's scene with the
- * point's varied settings and sense. */
-static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_point *p)
+ * point's varied settings and sense. 0 where the sweep's request is not
+ * known. */
+static int point_model(const api_sweep_view *v, const api_sweep_point *p, sim_model_error *me)
 {
 	if (!v->req)
-		return;
+		return 0;
 	sim_params pr = v->req->spec.params;
 	sim_scene sc = v->req->spec.scene;
 	sim_method m = v->req->spec.method;
@@ -261,9 +262,15 @@ static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_
 	for (int a = 0; a < v->req->nvary; a++)
 		sim_set_user(&pr, &sc, &m, v->req->vary[a], p->vary[a], NULL, 0);
 	pr.rotation = p->rotation;
+	sim_model_check(&pr, &sc, me);
+	return 1;
+}
+
+static void add_point_model(cJSON *po, const api_sweep_view *v, const api_sweep_point *p)
+{
 	sim_model_error me;
-	sim_model_check(&pr, &sc, &me);
-	api_add_model_error(po, &me);
+	if (point_model(v, p, &me))
+		api_add_model_error(po, &me);
 }
 
 static const char *point_state(int s)
@@ -434,6 +441,8 @@ char *api_sweep_csv(const api_sweep_view *v)
 		} else {
 			api_buf_puts(&b, ",,,");
 		}
+		sim_model_error me;
+		api_buf_model_error(&b, point_model(v, p, &me) ? &me : NULL);
 		for (int k = 0; band && k < 2; k++) {
 			api_buf_put(&b, ",", 1);
 			if (done && isfinite(p->band[k]))

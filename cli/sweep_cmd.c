@@ -173,8 +173,37 @@ static void print_json_head(FILE *f, const cli_opts *o, const pool *pl, int ntas
 	fprintf(f, ",\"reductions\":[%s],\"points\":[\n", pl->n < ntasks ? "\"mirror\"" : "");
 }
 
+/* Point i's model error (docs/dem.md "Model error"): its JSON members,
+ * or its CSV cells (SIM_MODEL_ERROR_COLUMNS, each after a comma; empty
+ * where the point's settings do not apply). */
+static void put_model(FILE *f, const cli_opts *o, const sim_study *st, size_t i, int json)
+{
+	sim_params p = o->p;
+	sim_scene sc = o->sc;
+	sim_method m = o->m;
+	sim_model_error me;
+	if (sim_study_apply(st, i, &p, &sc, &m, NULL, 0) != SIM_OK) {
+		fputs(json ? "" : ",,,", f);
+		return;
+	}
+	sim_model_check(&p, &sc, &me);
+	if (json) {
+		cli_put_json_num(f, ",\"model_error\":", me.checked ? me.error : NAN);
+		cli_put_json_num(f, ",\"model_error_uncertainty\":",
+				 me.checked ? me.error_uncertainty : NAN);
+		fprintf(f, ",\"model_checked\":%s,\"model_check_note\":\"%s\"",
+			me.checked ? "true" : "false", me.note);
+		return;
+	}
+	fputc(',', f);
+	cli_put_num(f, me.checked ? me.error : NAN, "");
+	fputc(',', f);
+	cli_put_num(f, me.checked ? me.error_uncertainty : NAN, "");
+	fputs(me.checked ? ",true" : ",false", f);
+}
+
 /* The sweep's table (CSV: the varied settings, then the daemon's point
- * columns; or JSON with the daemon's point members, the varied settings
+ * columns, the model error's among them; or JSON with the daemon's point members, the varied settings
  * first) on f; failures on stderr. Returns the number of failed points. */
 static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 {
@@ -221,20 +250,7 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 		fprintf(f, json ? ",\"substeps\":%d,\"step_error\":" : ",%d,", t->r.substeps);
 		cli_put_num(f, t->r.step_error, nf);
 		fprintf(f, json ? ",\"tol_met\":%s" : ",%s", t->r.tol_met ? "true" : "false");
-		if (json) { /* the point's model error (docs/dem.md "Model error") */
-			sim_params p = o->p;
-			sim_scene sc = o->sc;
-			sim_method m = o->m;
-			sim_model_error me;
-			if (sim_study_apply(st, (size_t)i, &p, &sc, &m, NULL, 0) == SIM_OK) {
-				sim_model_check(&p, &sc, &me);
-				cli_put_json_num(f, ",\"model_error\":", me.checked ? me.error : NAN);
-				cli_put_json_num(f, ",\"model_error_uncertainty\":",
-						 me.checked ? me.error_uncertainty : NAN);
-				fprintf(f, ",\"model_checked\":%s,\"model_check_note\":\"%s\"",
-					me.checked ? "true" : "false", me.note);
-			}
-		}
+		put_model(f, o, st, (size_t)i, json);
 		if (pl->band) {
 			fputs(json ? ",\"band\":{\"lower\":" : ",", f);
 			cli_put_num(f, t->band[0], nf);

@@ -26,6 +26,7 @@
 typedef struct map_point {
 	const char *preset;   /* the calibrated column model's preset */
 	const char *settings; /* its changes, "name=value;..." in user units */
+	const char *material; /* the DEM bed's material */
 	int layers;
 	double beta_deg;
 	int rotation;         /* SIM_CW or SIM_CCW */
@@ -36,7 +37,7 @@ typedef struct map_point {
 
 static const map_point map[] = {
 #include "model_map.inc"
-	{NULL, NULL, 0, 0, 0, 0, 0, 0, 0} /* the end (the table may be empty) */
+	{NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0} /* the end (the table may be empty) */
 };
 
 /* Settings that are controls, not part of a scene's check: the angle and
@@ -81,6 +82,16 @@ static int entry_settings(const map_point *e, sim_params *p, sim_scene *sc)
 	}
 	sc->layers = e->layers;
 	return 0;
+}
+
+/* The column model of entry e as a user knows it: its preset, or where
+ * the entry changes the preset, "PRESET calibrated to MATERIAL". */
+static const char *entry_name(const map_point *e, char *buf, size_t n)
+{
+	if (!e->settings[0])
+		return e->preset;
+	snprintf(buf, n, "%s calibrated to %s", e->preset, e->material);
+	return buf;
 }
 
 static int same(double a, double b)
@@ -229,9 +240,10 @@ static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, i
 				out->checked = 1;
 				out->error = err;
 				out->error_uncertainty = unc;
+				char name[64];
 				snprintf(out->note, sizeof out->note,
-					 "DEM check: within ±%.3f m/s here (%s, %d layers)",
-					 err, map[first].preset, map[first].layers);
+					 "DEM check: within ±%.3f m/s here (%s, %d layers)", err,
+					 entry_name(&map[first], name, sizeof name), map[first].layers);
 				return 1;
 			}
 		}
@@ -275,8 +287,8 @@ static void note_unchecked(const sim_params *p, const sim_scene *sc, double beta
 	int best_rank = b->rank;
 	const char *best_diff = b->diff;
 	const map_point *e = &map[best];
-	char where[96];
-	snprintf(where, sizeof where, "%d layers, %s", e->layers, e->preset);
+	char where[96], name[64];
+	snprintf(where, sizeof where, "%d layers, %s", e->layers, entry_name(e, name, sizeof name));
 	/* a scene that is another preset as it stands: say so plainly */
 	const char *named = scene_preset(p, sc, best_rank);
 	if (named) {

@@ -120,11 +120,18 @@ static inline void sim_trajectory_row(const sim_status *st, double *row)
  * state queued|running|done|failed|cancelled; then the steps the point
  * was measured with (dt in s, feed sub-steps), the steps' share of the
  * uncertainty (step_error, m/s) and whether the uncertainty is within
- * the accuracy target tol (tol_met true|false). A study over other
+ * the accuracy target tol (tol_met true|false); then the point's model
+ * error (SIM_MODEL_ERROR_COLUMNS). A study over other
  * settings has their columns in place of beta (SIM_SWEEP_POINT_COLUMNS
  * after them). */
 #define SIM_SWEEP_POINT_COLUMNS \
-	"rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met"
+	"rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met," \
+	SIM_MODEL_ERROR_COLUMNS
+/* A v's DEM check in a CSV row (sim_model_check, docs/dem.md "Model
+ * error"): model_error and model_error_uncertainty in m/s, empty where not
+ * checked, and model_checked true|false (the note, a sentence, is in the
+ * JSON only). */
+#define SIM_MODEL_ERROR_COLUMNS "model_error,model_error_uncertainty,model_checked"
 #define SIM_SWEEP_CSV_HEADER "beta," SIM_SWEEP_POINT_COLUMNS
 
 #endif

@@ -137,10 +137,7 @@ void fit_bound_warnings(fit_ctx *c)
 	for (int j = 0; j < c->p; j++) {
 		const fit_free *f = &c->req->free[j];
 		const sim_setting *t = sim_setting_find(f->name);
-		double w = f->hi - f->lo;
-		res->at_bound[j] = res->x[j] <= f->lo + 2 * BOUND_NEAR * w   ? -1
-				   : res->x[j] >= f->hi - 2 * BOUND_NEAR * w ? 1
-									     : 0;
+		res->at_bound[j] = fit_bound_side(f, res->x[j]);
 		if (res->at_bound[j])
 			fit_warn(res, "'%s' ends at its %s bound %g %s: the data want it beyond; widen "
 				  "the bound or question the model", f->name,

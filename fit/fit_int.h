@@ -88,6 +88,10 @@ int fit_prepare(fit_ctx *c, const fit_request *r, fit_result *res);
  * of x (a start on a bound moves BOUND_NEAR of the width inside); start k
  * of a multi-start fit into x0. */
 double fit_x_of_u(const fit_free *f, double u);
+double fit_u_of_x(const fit_free *f, double x);
+/* -1 at free parameter f's lower bound, 1 at its upper, 0 between (within
+ * 2 BOUND_NEAR of the width in the solver's scale, log x on a log scale). */
+int fit_bound_side(const fit_free *f, double x);
 double fit_x_of_z(const fit_free *f, double z);
 double fit_dx_dz(const fit_free *f, double z);
 double fit_z_of_x(const fit_free *f, double x);

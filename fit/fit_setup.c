@@ -25,6 +25,23 @@ double fit_x_of_u(const fit_free *f, double u)
 	return f->lo + u * (f->hi - f->lo);
 }
 
+/* u in [0, 1] of x across the bounds (in log x on a log scale). */
+double fit_u_of_x(const fit_free *f, double x)
+{
+	if (log_scale(f))
+		return (log(x) - log(f->lo)) / (log(f->hi) - log(f->lo));
+	return (x - f->lo) / (f->hi - f->lo);
+}
+
+/* -1 where x lies within 2 BOUND_NEAR of the width from its lower bound,
+ * 1 from its upper, else 0; the width in the solver's scale (a stiffness
+ * over decades at 1e5 in [1e3, 1e8] is not at its lower bound). */
+int fit_bound_side(const fit_free *f, double x)
+{
+	double u = fit_u_of_x(f, x);
+	return u <= 2 * BOUND_NEAR ? -1 : u >= 1 - 2 * BOUND_NEAR ? 1 : 0;
+}
+
 double fit_x_of_z(const fit_free *f, double z)
 {
 	return fit_x_of_u(f, 0.5 * (1 + sin(z)));
@@ -42,8 +59,7 @@ double fit_dx_dz(const fit_free *f, double z)
  * dx/dz is not zero. */
 double fit_z_of_x(const fit_free *f, double x)
 {
-	double u = log_scale(f) ? (log(x) - log(f->lo)) / (log(f->hi) - log(f->lo))
-				: (x - f->lo) / (f->hi - f->lo);
+	double u = fit_u_of_x(f, x);
 	u = fmin(fmax(u, BOUND_NEAR), 1 - BOUND_NEAR);
 	return asin(2 * u - 1);
 }

@@ -9,10 +9,13 @@
  *   sessions/ID/spec.bin        srv_spec_record
  *   sessions/ID/checkpoint.bin  srv_ckpt_record, the
  *                               experiment's srv_exp_record and feed
- *                               velocity record, the core's checkpoint
+ *                               velocity record (and its kind's api_exp_ext), the core's checkpoint
  *                               (its own version, core/checkpoint.c),
  *                               srv_ckpt_trailer
- *   experiments/ID.bin          srv_exp_record
+ *   experiments/ID.bin          srv_exp_record, and for an identification
+ *                               or a closed loop its api_exp_ext (a plain
+ *                               schedule's record has no tail: builds
+ *                               before the kinds read it as they wrote it)
  *   sweeps/ID.bin               srv_sweep_record, api_value[nbeta],
  *                               api_sweep_point[total]
  *   fits/ID.bin                 srv_fit_record, the request body, the
@@ -99,6 +102,7 @@ typedef struct srv_ckpt_record {
 #if defined(__x86_64__) || defined(__aarch64__)
 static_assert(sizeof(srv_spec_record) == 576, "spec.bin's layout changed: a new format version");
 static_assert(sizeof(srv_exp_record) == 4016, "the experiment record changed: a new format version");
+static_assert(sizeof(api_exp_ext) == 5040, "an experiment kind's tail changed: a new format version");
 static_assert(sizeof(srv_sweep_record) == 1888, "the sweep record changed: a new format version");
 static_assert(sizeof(api_sweep_point) == 352, "the sweep point changed: a new format version");
 static_assert(sizeof(srv_fit_record) == 152, "the fit record changed: a new format version");

@@ -104,9 +104,13 @@ static api_err start_on_session(srv_experiment *e,
 static char *experiment_json(srv_experiment *e, int csv)
 {
 	api_experiment_view v;
-	api_segment seg[API_EXP_MAX_SEGMENTS];
-	srv_exp_view(e, &v, seg);
-	return csv ? api_experiment_csv(&v, 1) : api_experiment_json(&v);
+	srv_exp_scratch *sc = malloc(sizeof *sc);
+	if (!sc)
+		return NULL;
+	srv_exp_view(e, &v, sc);
+	char *text = csv ? api_experiment_csv(&v, 1) : api_experiment_json(&v);
+	free(sc);
+	return text;
 }
 
 /* An experiment for a request body; NULL with *pb. */
@@ -117,9 +121,23 @@ static srv_entry *experiment_create(const char *body, size_t len, api_problem *p
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return NULL;
 	}
+	api_exp_ext *ext = malloc(sizeof *ext);
 	srv_experiment *e = NULL;
-	if (api_parse_experiment(body, len, req, pb) == API_OK)
-		e = srv_exp_new(req, cfg->data_dir, pb);
+	if (!ext)
+		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+	else if (api_parse_experiment(body, len, req, ext, pb) == API_OK)
+		e = srv_exp_new(req, ext, cfg->data_dir, pb);
+	/* an identification or a closed loop measures the scene it will run
+	 * on first: the fresh session's, or the named one's (a missing one
+	 * is start's 404) */
+	srv_session *s = e && !req->fresh ? srv_session_get(req->session_id) : NULL;
+	if (e && srv_exp_ready(e, s ? srv_session_spec(s) : &req->spec, pb) != API_OK) {
+		srv_exp_free(e);
+		e = NULL;
+	}
+	if (s)
+		srv_session_put(s);
+	free(ext);
 	free(req);
 	return e ? srv_exp_entry(e) : NULL;
 }
@@ -183,7 +201,7 @@ const srv_job_kind srv_experiment_job = {
 	.evictable = evictable,
 	.text = experiment_text,
 	.view_size = sizeof(api_experiment_view),
-	.scratch_size = API_EXP_MAX_SEGMENTS * sizeof(api_segment),
+	.scratch_size = sizeof(srv_exp_scratch),
 	.view = experiment_view,
 	.list_text = experiment_list_text,
 	.load = experiment_load,

@@ -35,7 +35,7 @@ static double exp_end(const srv_experiment *e)
 	return e->req.seg[e->req.nseg - 1].until;
 }
 
-srv_experiment *srv_exp_new(const api_experiment_req *req,
+srv_experiment *srv_exp_new(const api_experiment_req *req, const api_exp_ext *ext,
 			    const char *data_dir, api_problem *pb)
 {
 	srv_experiment *e = calloc(1, sizeof *e);
@@ -44,6 +44,9 @@ srv_experiment *srv_exp_new(const api_experiment_req *req,
 		return NULL;
 	}
 	e->req = *req;
+	if (ext)
+		e->ext = *ext;
+	e->beta_sent = INFINITY;
 	e->data_dir = data_dir && srv_store_enabled() ? data_dir : NULL;
 	e->attached = 1;
 	pthread_mutex_init(&e->lock, NULL);
@@ -139,9 +142,8 @@ static void drop_record(srv_experiment *e)
 /* The view of e (lock held); v->seg borrows e's segments. */
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
-	static const char *const names[EXP_NSTATES] = {
-		"waiting", "running", "done", "aborted", "interrupted", "error",
-		"damaged"};
+	static const char *const names[EXP_NSTATES] = {"waiting", "running", "done",     "aborted",
+							"interrupted", "error", "damaged"};
 	memset(v, 0, sizeof *v);
 	snprintf(v->id, sizeof v->id, "%s", e->entry.id);
 	snprintf(v->session_id, sizeof v->session_id, "%s", e->session_id);
@@ -149,13 +151,12 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
 	snprintf(v->error, sizeof v->error, "%s", e->error);
 	v->t_start = e->t0;
 	v->t_now = e->t_now;
-	double p = e->state == EXP_WAITING || e->req.nseg < 1
-			   ? 0
-			   : (e->t_now - e->t0) / exp_end(e);
+	double p = e->state == EXP_WAITING || e->req.nseg < 1 ? 0 : (e->t_now - e->t0) / exp_end(e);
 	v->progress = e->state == EXP_DONE ? 1 : p < 0 ? 0 : p > 1 ? 1 : p;
 	v->nseg = e->req.nseg;
 	v->seg = e->req.seg;
 	v->spec = &e->req.spec; /* set at creation, never changed after */
+	v->ext = &e->ext;
 }
 
 /* ---- persistence (store.h) ---------------------------------------------
@@ -166,6 +167,7 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
  * session's checkpoint (srv_exp_save), so that both continue from the same
  * moment. */
 typedef srv_exp_record exp_record; /* records.h */
+
 
 static void record_of(const srv_experiment *e, exp_record *r)
 {
@@ -204,26 +206,26 @@ static void queue_write(srv_experiment *e, const char *path, void *buf,
 	srv_store_write(path, buf, len, 0, written, e);
 }
 
-/* Queue experiments/ID.bin (lock held); now: write it on this thread
- * (its creation: on disk before the answer). Not while the daemon stops:
- * an experiment its session's worker lets go then is resumed next time. */
+/* experiments/ID.bin (lock held): queued, or now (its creation) written here. Not while the
+ * daemon stops: an experiment its session's worker lets go then is resumed next time. */
 static void persist_locked(srv_experiment *e, int now)
 {
 	if (!e->data_dir || srv_stopping())
 		return;
+	size_t tail = srv_exp_tail_len(e), len;
+	char *rec = malloc(sizeof(exp_record) + tail);
+	if (!rec)
+		return;
 	exp_record r;
 	record_of(e, &r);
-	size_t len;
-	void *buf = srv_store_frame(SRV_STORE_EXPERIMENT, &r, sizeof r, &len);
-	char path[64];
+	memcpy(rec, &r, sizeof r);
+	memcpy(rec + sizeof r, &e->ext, tail);
+	void *buf = srv_store_frame(SRV_STORE_EXPERIMENT, rec, sizeof r + tail, &len);
+	free(rec);
+	char path[64], msg[256];
 	snprintf(path, sizeof path, "experiments/%s.bin", e->entry.id);
-	char msg[sizeof e->error];
-	if (buf && now) { /* a failure is logged, and shown as a queued write's */
-		if (srv_store_write_now(path, buf, len, msg, sizeof msg) &&
-		    e->state != EXP_RUNNING && e->state != EXP_WAITING) {
-			e->state = EXP_ERROR;
-			snprintf(e->error, sizeof e->error, "%s", msg);
-		}
+	if (buf && now) { /* a failure is logged (store.c); its end's write says it */
+		srv_store_write_now(path, buf, len, msg, sizeof msg);
 		free(buf);
 	} else if (buf) {
 		queue_write(e, path, buf, len);
@@ -256,15 +258,16 @@ void *srv_exp_save(srv_experiment *e, size_t *len)
 	pthread_mutex_lock(&e->lock);
 	exp_record r;
 	record_of(e, &r);
-	size_t vec = e->rec_n * sizeof(double);
-	char *buf = malloc(sizeof r + 2 * vec);
+	size_t vec = e->rec_n * sizeof(double), tail = srv_exp_tail_len(e);
+	char *buf = malloc(sizeof r + 2 * vec + tail);
 	if (buf) {
 		memcpy(buf, &r, sizeof r);
 		if (vec) {
 			memcpy(buf + sizeof r, e->rec_t, vec);
 			memcpy(buf + sizeof r + vec, e->rec_v, vec);
 		}
-		*len = sizeof r + 2 * vec;
+		memcpy(buf + sizeof r + 2 * vec, &e->ext, tail);
+		*len = sizeof r + 2 * vec + tail;
 	}
 	pthread_mutex_unlock(&e->lock);
 	return buf;
@@ -276,7 +279,8 @@ int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
 	if (len < sizeof r)
 		return -1;
 	memcpy(&r, buf, sizeof r);
-	if (r.rec_n > EXP_RECORDS || len != sizeof r + 2 * r.rec_n * sizeof(double) ||
+	size_t head = sizeof r + 2 * r.rec_n * sizeof(double);
+	if (r.rec_n > EXP_RECORDS || len < head || srv_exp_tail_ok((const char *)buf + head, len - head) ||
 	    r.state != EXP_RUNNING || r.cur < 0 || r.cur >= r.req.nseg ||
 	    r.req.nseg < 1 || r.req.nseg > API_EXP_MAX_SEGMENTS ||
 	    r.seg_first > r.rec_n)
@@ -297,6 +301,8 @@ int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
 		e->seg_first = r.seg_first;
 		e->rec_spacing = r.rec_spacing;
 		e->req = r.req;
+		if (len > head)
+			memcpy(&e->ext, (const char *)buf + head, sizeof e->ext);
 		e->state = EXP_RUNNING;
 		e->cur = r.cur;
 		e->t0 = r.t0;
@@ -324,7 +330,8 @@ srv_experiment *srv_exp_damaged(const char *id, const char *why)
 srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen)
 {
 	exp_record *r = payload;
-	if (len != sizeof *r || r->state < 0 || r->state >= EXP_NSTATES || r->req.nseg < 1 ||
+	if (len < sizeof *r || srv_exp_tail_ok((const char *)payload + sizeof *r, len - sizeof *r) ||
+	    r->state < 0 || r->state >= EXP_NSTATES || r->req.nseg < 1 ||
 	    r->req.nseg > API_EXP_MAX_SEGMENTS) {
 		free(r);
 		snprintf(why, whylen, "inconsistent");
@@ -333,7 +340,10 @@ srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen
 	r->id[SRV_ID_LEN - 1] = r->session_id[SRV_ID_LEN - 1] = '\0';
 	r->error[sizeof r->error - 1] = '\0';
 	api_problem pb;
-	srv_experiment *e = srv_exp_new(&r->req, srv_store_enabled() ? "" : NULL, &pb);
+	api_exp_ext *ext = NULL;
+	if (len > sizeof *r)
+		ext = (api_exp_ext *)((char *)payload + sizeof *r); /* copied by srv_exp_new */
+	srv_experiment *e = srv_exp_new(&r->req, ext, srv_store_enabled() ? "" : NULL, &pb);
 	if (e) {
 		snprintf(e->entry.id, sizeof e->entry.id, "%s", r->id);
 		snprintf(e->session_id, sizeof e->session_id, "%s",
@@ -389,14 +399,15 @@ static void save_results(srv_experiment *e)
 	free(text);
 }
 
-void srv_exp_view(srv_experiment *e, api_experiment_view *v,
-		  api_segment *seg)
+void srv_exp_view(srv_experiment *e, api_experiment_view *v, srv_exp_scratch *sc)
 {
 	pthread_mutex_lock(&e->lock);
 	fill_view(e, v);
-	memcpy(seg, e->req.seg, (size_t)e->req.nseg * sizeof *seg);
+	memcpy(sc->seg, e->req.seg, (size_t)e->req.nseg * sizeof *sc->seg);
+	sc->ext = e->ext;
 	pthread_mutex_unlock(&e->lock);
-	v->seg = seg;
+	v->seg = sc->seg;
+	v->ext = &sc->ext;
 }
 
 srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
@@ -406,17 +417,13 @@ srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 	e->t0 = e->t_now = st->t;
 	e->state = EXP_RUNNING;
 	*t_end = e->t0 + exp_end(e);
+	if (e->ext.kind != API_EXP_SCHEDULE)
+		srv_exp_clock_start(e, st);
 	srv_cmd *cmd = srv_exp_start_segment(e, 0, st);
 	pthread_mutex_unlock(&e->lock);
 	return cmd;
 }
 
-double srv_exp_boundary(const srv_experiment *e)
-{
-	if (e->state != EXP_RUNNING)
-		return INFINITY;
-	return e->t0 + e->req.seg[e->cur].until;
-}
 
 srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 {
@@ -424,13 +431,9 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 	*over = 0;
 	pthread_mutex_lock(&e->lock);
 	e->t_now = st->t;
-	if (isfinite(st->feed_velocity) && e->rec_n < e->rec_cap &&
-	    (e->rec_n == 0 ||
-	     st->t - e->rec_t[e->rec_n - 1] >= e->rec_spacing)) {
-		e->rec_t[e->rec_n] = st->t;
-		e->rec_v[e->rec_n++] = st->feed_velocity;
-	}
-	if (st->t >= srv_exp_boundary(e) - 1e-9) {
+	double y;
+	int sampled = srv_exp_sample(e, st, &y);
+	if (st->t >= srv_exp_segment_end(e) - 1e-9) {
 		srv_exp_finish_segment(e, st);
 		if (e->cur + 1 < e->req.nseg) {
 			cmd = srv_exp_start_segment(e, e->cur + 1, st);
@@ -441,6 +444,8 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 			save_results(e);
 			*over = 1;
 		}
+	} else {
+		cmd = srv_exp_control(e, st, sampled, y);
 	}
 	pthread_mutex_unlock(&e->lock);
 	return cmd;
@@ -465,12 +470,16 @@ int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 	int refused = cmd->rc != SIM_OK;
 	if (refused) {
 		char why[200];
-		snprintf(why, sizeof why,
-			 "segment %d: the session refused beta = %g deg: %s",
-			 e->cur, seg->beta.user, sim_strerror(cmd->rc));
+		if (e->dist_to > e->dist_from)
+			snprintf(why, sizeof why, "disturbances[%d]: the session refused it: %s",
+				 e->dist_from, sim_strerror(cmd->rc));
+		else
+			snprintf(why, sizeof why,
+				 "segment %d: the session refused beta = %g deg: %s", e->cur,
+				 cmd->c.beta.user, sim_strerror(cmd->rc));
 		srv_log(SRV_LOG_WARN, "experiment %s: %s", e->entry.id, why);
 		abort_locked(e, why);
-	} else {
+	} else if (e->cmd_starts) {
 		seg->t_command = cmd->t_eff;
 		/* a control acts at the end of the integrator's step: the
 		 * segment before ran its beta up to this command, not only to
@@ -478,6 +487,7 @@ int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 		if (e->cur > 0)
 			e->req.seg[e->cur - 1].t_end = cmd->t_eff;
 	}
+	srv_exp_dist_commanded(e, cmd, refused);
 	pthread_mutex_unlock(&e->lock);
 	return refused;
 }

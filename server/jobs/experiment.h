@@ -19,11 +19,17 @@
 
 typedef struct srv_experiment srv_experiment;
 
-/* A new experiment for the parsed request (copied), saving its results
- * under data_dir (borrowed; NULL: not saved). NULL with *pb (503) when out
- * of memory. Free with srv_exp_free (NULL accepted). */
-srv_experiment *srv_exp_new(const api_experiment_req *req,
+/* A new experiment for the parsed request and its kind (both copied; ext
+ * NULL: a plain schedule), saving its results under data_dir (borrowed;
+ * NULL: not saved). NULL with *pb (503) when out of memory. Free with
+ * srv_exp_free (NULL accepted). */
+srv_experiment *srv_exp_new(const api_experiment_req *req, const api_exp_ext *ext,
 			    const char *data_dir, api_problem *pb);
+/* An identification or a closed loop measures what it needs on spec (its
+ * session's scene) before it starts (experiment_kind.c): API_OK, or the
+ * problem (a setpoint out of the machine's reach: 422). A plain schedule:
+ * API_OK at once. */
+api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb);
 void srv_exp_free(srv_experiment *e);
 /* Its registry entry (the id), and back. */
 srv_entry *srv_exp_entry(srv_experiment *e);
@@ -42,10 +48,14 @@ void srv_exp_set_session(srv_experiment *e, const char *session_id);
 void srv_exp_set_spec(srv_experiment *e, const api_spec *spec);
 /* 1 when it is over and no worker refers to it (it may be evicted). */
 int srv_exp_finished(srv_experiment *e);
-/* A consistent copy of its state: *v, with v->seg pointing at seg (room
- * for API_EXP_MAX_SEGMENTS, filled here). */
-void srv_exp_view(srv_experiment *e, api_experiment_view *v,
-		  api_segment *seg);
+/* Room for a view's copies. */
+typedef struct srv_exp_scratch {
+	api_segment seg[API_EXP_MAX_SEGMENTS];
+	api_exp_ext ext;
+} srv_exp_scratch;
+/* A consistent copy of its state: *v, with v->seg and v->ext pointing into
+ * sc (filled here). */
+void srv_exp_view(srv_experiment *e, api_experiment_view *v, srv_exp_scratch *sc);
 
 /* ---- worker hooks (session lock held) ---------------------------------- */
 

@@ -40,6 +40,12 @@ struct srv_experiment {
 	size_t rec_n, rec_cap, seg_first;
 	double rec_spacing;      /* s between records, at least */
 	srv_cmd cmd;             /* the running segment's command */
+	int cmd_starts;          /* cmd starts a segment (else a controller
+				    sample or a disturbance) */
+	int dist_from, dist_to;  /* cmd carries disturbances [from, to) */
+	double beta_sent;        /* rad: the last beta commanded */
+	api_exp_ext ext;         /* identify or control (experiment_kind.c,
+				    experiment_loop.c) */
 	int writes;              /* queued store writes (they refer to e) */
 	int freed;               /* srv_exp_free came while writes > 0 */
 };
@@ -49,5 +55,57 @@ srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st);
 /* The running segment ends at status st (lock held): its mean and steady
  * velocity and its reversal time from the feed-velocity record. */
 void srv_exp_finish_segment(srv_experiment *e, const sim_status *st);
+
+/* The running segment's end (s, simulated; INFINITY when not running). */
+double srv_exp_segment_end(const srv_experiment *e);
+/* The bytes of e's kind that follow its stored record (0 for a plain
+ * schedule: its record is what it was before there were kinds), and a
+ * tail read back checked: 0 when it is one (or len is 0). */
+size_t srv_exp_tail_len(const srv_experiment *e);
+int srv_exp_tail_ok(const void *tail, size_t len);
+/* The disturbances e's command carried were applied (unless refused). */
+void srv_exp_dist_commanded(srv_experiment *e, const srv_cmd *cmd, int refused);
+
+/* ---- identify and control (experiment_kind.c, experiment_loop.c) ---- */
+
+/* Before the experiment runs (the request's thread, spec: its session's
+ * scene): the v(beta) curve and its branch, the setpoints checked and
+ * their feedforward beta, "auto" gains; an identification's comparison
+ * slopes. API_OK or the problem (422 naming the field). */
+api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb);
+/* The feedforward beta (rad) of velocity v on the branch (clamped to its
+ * ends). */
+double srv_exp_feedforward(const api_exp_ext *ext, double v);
+/* A FOPDT model of the per-period feed velocity record (t, v: n samples,
+ * one value held per period; NaN skipped) from t_from on, for m steps at
+ * ts of d deg, span the hold (s): into *out (gain, time constant, dead
+ * time, their errors, v0, rms, samples, ok). */
+void srv_exp_fit(const double *t, const double *v, size_t n, double t_from, const double *ts,
+		 const double *d, int m, double span, api_fopdt *out);
+/* The period clock of identify and control (experiment_loop.c): the
+ * excitation period of status st (s); one tick: the mean feed velocity
+ * since the last tick last[0..2] (t s, feed displacement m, rotor phase
+ * rad; last[0] < 0: none, NaN returned), *period re-measured, last
+ * updated. */
+double srv_exp_period_of(const sim_status *st);
+double srv_exp_clock_tick(double *period, double *last, const sim_status *st);
+/* The clock starts at the experiment's start (lock held). */
+void srv_exp_clock_start(srv_experiment *e, const sim_status *st);
+/* After each advance (lock held): a schedule records the core's feed
+ * velocity (0); identify and control at a sample time: 1, the sample in
+ * *v and in the record. */
+int srv_exp_sample(srv_experiment *e, const sim_status *st, double *v);
+/* The controller at status st (lock held), y the sample when sampled: the
+ * command to send (beta, with a disturbance due) or NULL. */
+srv_cmd *srv_exp_control(srv_experiment *e, const sim_status *st, int sampled, double y);
+/* The next time (s, simulated) a sample or a disturbance needs the worker
+ * to stop at, or INFINITY. */
+double srv_exp_control_boundary(const srv_experiment *e);
+/* A segment of a closed loop ends (lock held): its setpoint's results and
+ * those of the disturbances applied within it. */
+void srv_exp_control_results(srv_experiment *e);
+/* An identification's operating point whose last segment just ended (lock
+ * held): its model. */
+void srv_exp_identify_results(srv_experiment *e);
 
 #endif

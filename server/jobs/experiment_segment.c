@@ -27,6 +27,16 @@ srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st)
 		cmd->c.set |= API_C_BETA_RATE;
 		cmd->c.beta_rate = e->req.beta_rate;
 	}
+	if (e->ext.kind == API_EXP_CONTROL) {
+		/* the new setpoint's feedforward with the integral carried over */
+		api_exp_ext *x = &e->ext;
+		double b = seg->beta.si + x->branch_sign * x->integ * (M_PI / 180);
+		b = b < x->beta_lo ? x->beta_lo : b > x->beta_hi ? x->beta_hi : b;
+		cmd->c.beta = (api_value){b, b * 180 / M_PI};
+	}
+	e->beta_sent = cmd->c.beta.si;
+	e->cmd_starts = 1;
+	e->dist_from = e->dist_to = 0;
 	cmd->restart_transport = 1;
 	cmd->from_experiment = 1;
 	seg->start_velocity = st->feed_velocity;
@@ -73,6 +83,18 @@ void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
 			}
 		}
 	seg->state = 2;
+	srv_exp_control_results(e);
+	srv_exp_identify_results(e);
+}
+
+double srv_exp_segment_end(const srv_experiment *e)
+{
+	return e->state == EXP_RUNNING ? e->t0 + e->req.seg[e->cur].until : INFINITY;
+}
+
+double srv_exp_boundary(const srv_experiment *e)
+{
+	return fmin(srv_exp_segment_end(e), srv_exp_control_boundary(e));
 }
 
 /* ---- a new start after a restart (experiment.h srv_exp_readopt) ----------- */

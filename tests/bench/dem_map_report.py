@@ -17,9 +17,9 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dem_map  # noqa: E402  (the plan and the CSV's key)
+from dem_points import OVERLAP, chosen  # noqa: E402  (which row is a point's value)
 
 TOL = 0.02    # the relative change a check allows
-OVERLAP = 0.01  # the largest overlap allowed, of a mean diameter
 
 
 def f(x):
@@ -33,23 +33,6 @@ def rel(a, b):
 
 def pct(x):
     return "n/a" if x is None else "%+.1f %%" % (100 * x)
-
-
-def chosen(rows, material, layers, drive, beta):
-    """A map point's value: of its rows in the map's cell, clockwise, the
-    softest whose largest overlap is within the bound, else the stiffest."""
-    rs = [r for r in rows if r["material"] == material and int(r["layers"]) == layers and
-          r["drive"] == drive and f(r["beta_deg"]) == beta and r["rotation"] == "cw" and
-          f(r["cell_width_d"]) == dem_map.WIDTH and r["role"] in ("map", "stiffness")]
-    if not any(r["role"] == "map" for r in rs):
-        return None
-    rs.sort(key=lambda r: f(r["e_scale"]))
-    ok = [r for r in rs if f(r["overlap_max_rel"]) <= OVERLAP and f(r["youngs_pa"]) >= e_map_of()]
-    return ok[0] if ok else rs[-1]
-
-
-def e_map_of():
-    return dem_map.materials()["map"]["youngs_map"]
 
 
 def status(rows, mats):

@@ -14,11 +14,14 @@ Sources, in this order:
   1. the 4-diameter bed's curve at the preset's contacts (dem.jsonl, group
      "curve": 11 angles, both senses, three packing seeds each), the data
      the preset liggghts-bed4 was fitted to;
-  2. every row of tests/bench/results/dem_map.csv (the DEM map, one row per
-     point) whose material and drive have a calibrated column model in
-     tests/bench/model_presets.csv (material,drive,preset,settings: a new
-     material or drive is one line there once its preset exists).
-A map row without such a line is left out and named on stderr.
+  2. every point of the DEM map (tests/bench/results/dem_map.csv), its
+     value taken from its rows by the map report's rule (dem_points.py:
+     the map's cell, the softest modulus within the overlap bound; the
+     mirror rows counter-clockwise), whose material, depth and drive have
+     a calibrated column model in tests/bench/model_presets.csv
+     (material,layers,drive,preset,settings; an empty layers is every
+     depth; tests/bench/dem_calibrate.py writes the lines).
+A map bed without such a line is left out and named on stderr.
 
 v_column is the column model's v at the point: `convsim run -p PRESET
 [--set SETTING]... --set layers=L --set beta=B --set rotation=R --set
@@ -37,8 +40,14 @@ import statistics
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import dem_map  # noqa: E402  (the map's materials)
+import dem_points  # noqa: E402  (which row is a point's value)
+
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
 PRESETS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "model_presets.csv")
+# the column model's measure at a point: one-way, as the DEM bed is driven
+MEASURE = ["-d", "2", "--set", "transient=0.5"]
 COLUMNS = ["preset", "settings", "material", "layers", "drive", "beta_deg", "rotation",
            "v_dem", "v_dem_sd", "seeds", "v_column", "source"]
 
@@ -59,29 +68,41 @@ def bed4_points():
                "seeds": len(v), "source": "dem.jsonl curve"}
 
 
+def read_presets(path=PRESETS):
+    """tests/bench/model_presets.csv: (material, layers, drive) -> (preset,
+    settings); an empty layers is every depth of that material and drive."""
+    presets = {}
+    if os.path.exists(path):
+        for r in csv.DictReader(line for line in open(path) if not line.startswith("#")):
+            layers = int(r["layers"]) if r.get("layers") else None
+            presets[(r["material"], layers, r["drive"])] = (r["preset"], r["settings"])
+    return presets
+
+
 def map_points():
-    """The DEM map's rows that have a calibrated column model."""
+    """The DEM map's points that have a calibrated column model, each
+    point's value taken by the map's rule (dem_points.py)."""
     path = os.path.join(RESULTS, "dem_map.csv")
     if not os.path.exists(path):
         return
-    presets = {}
-    if os.path.exists(PRESETS):
-        for r in csv.DictReader(line for line in open(PRESETS) if not line.startswith("#")):
-            presets[(r["material"], r["drive"])] = (r["preset"], r["settings"])
-    for r in csv.DictReader(open(path)):
-        key = (r["material"], r["drive"])
-        if key not in presets:
-            print(f"model_check.py: no calibrated column model for material {key[0]}, "
-                  f"drive {key[1]} (tests/bench/model_presets.csv): row left out",
-                  file=sys.stderr)
+    rows = dem_map.read_rows(path)
+    presets = read_presets()
+    mats = dem_map.materials()
+    for material, layers, drive in dem_points.beds(rows):
+        found = presets.get((material, layers, drive)) or presets.get((material, None, drive))
+        if not found:
+            print(f"model_check.py: no calibrated column model for material {material}, "
+                  f"{layers} grains deep, drive {drive} (tests/bench/model_presets.csv): "
+                  "its points left out", file=sys.stderr)
             continue
-        preset, settings = presets[key]
-        sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
-        yield {"preset": preset, "settings": settings, "material": r["material"],
-               "layers": int(r["layers"]), "drive": r["drive"],
-               "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
-               "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
-               "source": "dem_map.csv " + r.get("build", "")}
+        preset, settings = found
+        for r in dem_points.points(rows, material, layers, drive, mats):
+            sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
+            yield {"preset": preset, "settings": settings, "material": material,
+                   "layers": layers, "drive": drive,
+                   "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
+                   "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
+                   "source": "dem_map.csv " + r.get("build", "")}
 
 
 def v_column(convsim, p):
@@ -90,7 +111,7 @@ def v_column(convsim, p):
         args += ["--set", s]
     args += ["--set", f"layers={p['layers']}", "--set", f"beta={p['beta_deg']:g}",
              "--set", f"rotation={p['rotation']}", "--set", "feed_coupling=false",
-             "-d", "2", "--set", "transient=0.5", "-q"]
+             "-q"] + MEASURE
     out = subprocess.run(args, check=True, capture_output=True, text=True).stdout
     return json.loads(out)["transport_velocity"]
 

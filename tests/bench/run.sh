@@ -62,4 +62,6 @@ echo "bench: the request body check: CPU per 1 MiB body of many names (one daemo
 CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs >"$out/body_parse.md"
 echo "bench: the PI loop closed from a client at pace 1, with 0, 100 and 200 ms added, and open loop (one daemon, ~2 min)"
 python3 tests/bench/remote_loop.py "$BUILD/convsimd" >"$out/remote_loop.md"
+echo "bench: the conveyor as a control system: identification, setpoint steps, disturbances (loopback, pace max)"
+CONVSIMD="$BUILD/convsimd" node tests/bench/control_loop.mjs | tee "$out/control_loop.md"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

@@ -94,13 +94,13 @@ test('a varied fitted parameter takes the grid\'s values and leaves the band; th
 
 test('the CSV has band_lower,band_upper only with bands', () => {
   const plain = run('sweep', ...CHEAP, '--beta', '30', '--rotation', 'cw', '-q');
-  assert.equal(plain.out.split('\n')[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+  assert.equal(plain.out.split('\n')[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
   const banded = run('sweep', ...CHEAP, '--beta', '30', '--rotation', 'cw', '--band-from', FIT, '-q');
   const [head, row] = banded.out.trim().split('\n');
-  assert.equal(head, 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,band_lower,band_upper');
+  assert.equal(head, 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked,band_lower,band_upper');
   const cells = row.split(',');
-  assert.equal(Number(cells[10]), fit.curve.cw.band.lower[1]);
-  assert.equal(Number(cells[11]), fit.curve.cw.band.upper[1]);
+  assert.equal(Number(cells[13]), fit.curve.cw.band.lower[1]);
+  assert.equal(Number(cells[14]), fit.curve.cw.band.upper[1]);
 });
 
 test('bad --band-from: exit 2, a message naming it, nothing on stdout', () => {

@@ -87,3 +87,54 @@ test('model_error: convsim sweep\'s JSON points carry it at their angle', () => 
   assert.equal(b.model_checked, false);
   assert.equal(b.model_error, null);
 });
+
+// The committed CSV as rows of objects by column name.
+function csvObjects(rel) {
+  const [head, ...rows] = readFileSync(new URL(rel, import.meta.url), 'utf8').split('\n')
+    .filter((l) => l && !l.startsWith('#'));
+  const names = head.split(',');
+  return rows.map((l) => Object.fromEntries(l.split(',').map((x, i) => [names[i], x])));
+}
+
+test('model_error: each DEM map bed with a calibrated column model is checked at its settings, with the map\'s value', () => {
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv'));
+  const presets = csvObjects('../bench/model_presets.csv');
+  assert.ok(table.length > 0, 'the map has calibrated beds (make bench-dem-calibrate)');
+  const beds = new Map();
+  for (const r of table) beds.set(`${r.material},${r.layers},${r.drive}`, beds.get(`${r.material},${r.layers},${r.drive}`) || r);
+  for (const [key, r] of beds) {
+    const line = presets.find((p) => `${p.material},${p.layers},${p.drive}` === key);
+    assert.ok(line, `${key}: its line in model_presets.csv`);
+    assert.equal(r.settings, line.settings, `${key}: the table is the presets' (make model-check)`);
+    // one point of each sense and angle: the report's rule picks one row a point
+    const at = table.filter((x) => `${x.material},${x.layers},${x.drive}` === key).map((x) => `${Number(x.beta_deg)},${x.rotation}`);
+    assert.equal(new Set(at).size, at.length, `${key}: one row a point`);
+    const s = summary(r.preset, ...r.settings.split(';'), `layers=${r.layers}`, `beta=${r.beta_deg}`, `rotation=${r.rotation}`);
+    const want = Math.abs(Number(r.v_column) - Number(r.v_dem)) + Number(r.v_dem_sd);
+    assert.equal(s.model_checked, true, `${key} at ${r.beta_deg}: ${s.model_check_note}`);
+    assert.ok(Math.abs(s.model_error - want) < 1e-12, `${key} at ${r.beta_deg}: ${s.model_error} against ${want}`);
+    assert.match(s.model_check_note, new RegExp(`\\(${r.preset} calibrated to ${r.material}, ${r.layers} layers\\)$`));
+    // the table's v_column is this build's column model, one-way as model_check.py runs it
+    const v = JSON.parse(execFileSync(CONVSIM, ['run', '-p', r.preset, ...r.settings.split(';').flatMap((x) => ['--set', x]),
+      '--set', `layers=${r.layers}`, '--set', `beta=${r.beta_deg}`, '--set', `rotation=${r.rotation}`,
+      '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5', '-q'], { encoding: 'utf8' })).transport_velocity;
+    assert.ok(Math.abs(v - Number(r.v_column)) < 1e-5 * Math.abs(v), `${key}: v ${v}, the table's ${r.v_column}`);
+  }
+});
+
+test('model_error: a map point\'s value is the report\'s row: the map\'s cell, the softest modulus within the overlap bound', () => {
+  // glass one grain deep at 45 deg cw: 2e8 Pa overlaps 1.045 % of a
+  // diameter, so the point is the 8e8 Pa row's (dem_map_report.py's rule)
+  const rows = csvObjects('../bench/results/dem_map.csv').filter((r) => r.material === 'glass' && r.layers === '1' &&
+    r.drive === 'preset' && Number(r.beta_deg) === 45 && r.rotation === 'cw' && Number(r.cell_width_d) === 4);
+  const soft = rows.find((r) => Number(r.youngs_pa) === 2e8), stiff = rows.find((r) => Number(r.youngs_pa) === 8e8);
+  assert.ok(Number(soft.overlap_max_rel) > 0.01 && Number(stiff.overlap_max_rel) <= 0.01);
+  const point = csvObjects('../bench/results/model_check.csv').filter((r) => r.material === 'glass' && r.layers === '1' &&
+    Number(r.beta_deg) === 45 && r.rotation === 'cw');
+  assert.equal(point.length, 1);
+  assert.equal(Number(point[0].v_dem), Number(stiff.v_dem));
+  // and at 30 deg, where 2e8 Pa is within the bound, the 2e8 row (not the 8e8 check nor the wider cell)
+  const p30 = csvObjects('../bench/results/model_check.csv').find((r) => r.material === 'glass' && r.layers === '1' &&
+    Number(r.beta_deg) === 30 && r.rotation === 'cw');
+  assert.equal(p30.v_dem, '0.0978932');
+});

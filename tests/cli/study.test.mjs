@@ -56,7 +56,7 @@ test('the CSV: the varied settings by name, then rotation and the point columns,
   assert.equal(r.code, 0, r.err);
   const lines = r.out.trim().split('\n');
   // --beta is --vary beta=... in its place
-  assert.equal(lines[0], 'e,k_c,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+  assert.equal(lines[0], 'e,k_c,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
   assert.deepEqual(lines.slice(1).map((l) => l.split(',').slice(0, 4).join(',')),
     ['0.01,100000,60,ccw', '0.01,200000,60,ccw', '0.02,100000,60,ccw', '0.02,200000,60,ccw']);
   // a range's values are the decimals a user means

@@ -129,8 +129,9 @@ static char *experiment_text(const api_experiment_req *req)
 static void experiment_body(const char *body, size_t len)
 {
 	static api_experiment_req req, again;
+	static api_exp_ext ext, ext_again;
 	api_problem pb;
-	api_err e = api_parse_experiment(body, len, &req, &pb);
+	api_err e = api_parse_experiment(body, len, &req, &ext, &pb);
 	if (e != API_OK) {
 		fuzz_check_problem(e, &pb);
 		return;
@@ -140,7 +141,7 @@ static void experiment_body(const char *body, size_t len)
 		FUZZ_CHECK(req.seg[i].until > (i ? req.seg[i - 1].until : 0),
 			   "segment %d ends at %g", i, req.seg[i].until);
 	char *text = experiment_text(&req);
-	e = api_parse_experiment(text, strlen(text), &again, &pb);
+	e = api_parse_experiment(text, strlen(text), &again, &ext_again, &pb);
 	FUZZ_CHECK(e == API_OK, "experiment written back is refused: %s\n%s", pb.detail, text);
 	FUZZ_CHECK(again.fresh == req.fresh && again.nseg == req.nseg &&
 			   again.keep_session == req.keep_session &&

@@ -40,7 +40,7 @@ const results = () => [
   ['/api/v1/experiments', 'experiment,session,segment,beta,until'],
   [`/api/v1/experiments/${eid}`, 'experiment,session,segment,beta,until'],
   ['/api/v1/sweeps', 'sweep,state,done,total,t_end'],
-  [`/api/v1/sweeps/${wid}`, 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met'],
+  [`/api/v1/sweeps/${wid}`, 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked'],
 ];
 
 test('every result route answers JSON or CSV, by Accept and by ?format=', async () => {

@@ -80,6 +80,8 @@ test('experiment: a segment too short to settle has no reversal time; the next o
   const col = (name) => rows[0].indexOf(name);
   assert.equal(rows[1][col('t_end')], rows[2][col('t_command')]);
   assert.equal(rows[1][col('reversal_time')], '');
+  // the preset's scene is not checked against DEM: empty error, false
+  assert.deepEqual(rows.slice(1).map((r) => r.slice(col('model_error'))), [['', '', 'false'], ['', '', 'false']]);
 });
 
 test('experiment on an existing session; a second one is 409', { timeout: 60000 * SLOW }, async () => {
@@ -131,12 +133,15 @@ test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, as
   const csv = await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`);
   assert.equal(csv.headers.get('content-type'), 'text/csv');
   const lines = csv.text.trim().split('\n');
-  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
   assert.equal(lines.length, 5);
   const first = lines[1].split(',');
   const p0 = done.points[0];
   assert.deepEqual(first, [String(p0.beta), p0.rotation, String(p0.velocity), String(p0.uncertainty),
-    String(p0.steady), 'done', String(p0.dt), String(p0.substeps), String(p0.step_error), String(p0.tol_met)]);
+    String(p0.steady), 'done', String(p0.dt), String(p0.substeps), String(p0.step_error), String(p0.tol_met),
+    // the cheap scene is not the DEM map's: no model error, not checked
+    '', '', 'false']);
+  assert.equal(p0.model_checked, false);
   for (const p of done.points) {
     assert.ok(p.dt > 0 && p.dt <= 1.25e-3, `dt ${p.dt}`);
     assert.ok(Number.isInteger(p.substeps) && p.substeps >= 5, `substeps ${p.substeps}`);

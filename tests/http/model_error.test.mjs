@@ -24,6 +24,15 @@ const MAP = (() => {
   return m;
 })();
 
+// A CSV answer's rows as objects by column name; a JSON number as its cell.
+async function csvRows(path) {
+  const r = await req(d.base, 'GET', path);
+  assert.equal(r.status, 200, r.text);
+  const [head, ...rows] = r.text.trim().split('\n').map((l) => l.split(','));
+  return rows.map((cells) => Object.fromEntries(head.map((n, i) => [n, cells[i]])));
+}
+const cell = (x) => (x === null ? '' : String(x));
+
 let d;
 before(async () => { d = await startDaemon(); });
 after(async () => { await d.stop(); });
@@ -124,7 +133,7 @@ test('model_error: the preset is not checked, in one short sentence; a 2-layer c
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
 
-test('model_error: a sweep\'s points and an experiment\'s segments carry the map\'s value at their angle', { timeout: 30000 * SLOW }, async () => {
+test('model_error: a sweep\'s points and an experiment\'s segments carry the map\'s value at their angle, in JSON and CSV', { timeout: 30000 * SLOW }, async () => {
   const sw = await req(d.base, 'POST', '/api/v1/sweeps',
     { preset: 'liggghts-bed4', beta: [30, 150, 170], rotations: ['cw'], t_end: 1 });
   assert.equal(sw.status, 202, sw.text);
@@ -135,6 +144,12 @@ test('model_error: a sweep\'s points and an experiment\'s segments carry the map
   assert.equal(at(170).model_checked, false);
   assert.equal(at(170).model_error, null);
   assert.match(at(170).model_check_note, /beta 170 deg cw/);
+  // the CSV export carries the same: model_error, its uncertainty, model_checked
+  const csv = await csvRows(`/api/v1/sweeps/${sw.body.id}?format=csv`);
+  assert.deepEqual(csv.map((r) => [r.beta, r.model_error, r.model_error_uncertainty, r.model_checked]),
+    [30, 150, 170].map((b) => [String(b), cell(at(b).model_error), cell(at(b).model_error_uncertainty),
+      String(at(b).model_checked)]));
+  assert.equal(csv[2].model_error, '');
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${sw.body.id}`)).status, 204);
 
   const s = await req(d.base, 'POST', '/api/v1/sessions', { preset: 'liggghts-bed4', params: { beta: 30 }, pace: 1 });
@@ -146,5 +161,8 @@ test('model_error: a sweep\'s points and an experiment\'s segments carry the map
   assert.ok(Math.abs(seg[0].model_error - MAP['30,cw']) < 1e-12, `segment at 30: ${seg[0].model_error}`);
   assert.ok(Math.abs(seg[1].model_error - MAP['150,cw']) < 1e-12, `segment at 150: ${seg[1].model_error}`);
   await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${x.body.id}`)).body.state === 'done', 10000 * SLOW, 'the experiment');
+  const xcsv = await csvRows(`/api/v1/experiments/${x.body.id}?format=csv`);
+  assert.deepEqual(xcsv.map((r) => [r.beta, r.model_error, r.model_error_uncertainty, r.model_checked]),
+    seg.map((g) => [String(g.beta), cell(g.model_error), cell(g.model_error_uncertainty), 'true']));
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${s.body.id}`)).status, 204);
 });

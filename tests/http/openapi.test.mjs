@@ -131,6 +131,14 @@ test('every operation answers what the document says', { timeout: 120000 * SLOW 
     { session: { ...CHEAP, pace: 'max' }, schedule: [{ beta: 38, until: 0.3 }, { beta: 128, until: 0.6 }], beta_rate: 90 })).body;
   await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${e.id}`)).body.state === 'done', 30000 * SLOW, 'experiment');
   await call('GET', '/api/v1/experiments/{id}', `/api/v1/experiments/${e.id}`);
+  // the kinds: an identification and a closed loop with a disturbance (docs/control.md)
+  for (const body of [{ identify: { beta: 60, step: 4, hold: 0.5 } },
+    { control: { setpoint: [{ v: 0.05, until: 0.5 }], controller: { kp: 1, ki: 100 } },
+      disturbances: [{ at: 0.25, set: { omega_ss: 155 } }] }]) {
+    const k = (await call('POST', '/api/v1/experiments', '/api/v1/experiments', body)).body;
+    await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${k.id}`)).body.state === 'done', 30000 * SLOW, k.kind);
+    await call('GET', '/api/v1/experiments/{id}', `/api/v1/experiments/${k.id}`);
+  }
   await call('GET', '/api/v1/experiments', '/api/v1/experiments');
   const w = (await call('POST', '/api/v1/sweeps', '/api/v1/sweeps',
     { ...CHEAP, beta: { from: 30, to: 60, step: 30 }, rotations: ['cw', 'ccw'], t_end: 0.3 })).body;

@@ -15,7 +15,7 @@ const LARGE = { scene: { columns: 16, layers: 64 } };
 const LIMIT = 0.3;
 const paced = async (d) => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
 
-test('a large scene is admitted by its measured cost: alone too much at pace 1 (422), two at 0.6 of what fits do not fit (503)', { timeout: 120000 * SLOW }, async () => {
+test('a large scene is admitted by its measured cost: alone too much at pace 1 (422), two at 0.7 of what fits do not fit (503)', { timeout: 120000 * SLOW }, async () => {
   const d = await startDaemon(['--max-paced-cores', String(LIMIT)]);
   try {
     const one = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: 1 });
@@ -24,7 +24,10 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
     // the largest pace that fits: about 0.6 here (0.5 CPU s per simulated
     // s), less under the sanitizers; the estimate alone said 7
     assert.ok(one.body.max > 0.01 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
-    const pace = Math.round(0.6 * one.body.max * 1000) / 1000;
+    // 0.7: the second fits only if its copy measures under 0.43 of what
+    // the first's did, the first is refused only above 1.43 (a machine
+    // under load measures the same scene 1.5 times apart)
+    const pace = Math.round(0.7 * one.body.max * 1000) / 1000;
     const a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
     assert.equal(a.status, 201, a.text);
     const held = await paced(d);

@@ -58,7 +58,7 @@ test('a 2-D study (mu x beta): the daemon\'s table is the CLI\'s, bit for bit, t
   assert.equal(ccw.velocity, -cw.velocity);
   assert.notEqual(s.points[0].velocity, s.points[3].velocity, 'mu changes v');
   const csv = (await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`)).text;
-  assert.equal(csv.split('\n')[0], 'mu,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+  assert.equal(csv.split('\n')[0], 'mu,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
   assert.equal(csv, cli('--vary', 'mu=0.3,0.9', '--vary', 'beta=30:150:60', '--duration', '0.4'));
   // a point alone, on the CLI, is the same point
   const alone = cli('--vary', 'mu=0.9', '--beta', '90', '--rotation', 'cw', '--duration', '0.4').split('\n')[1];

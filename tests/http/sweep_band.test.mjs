@@ -67,7 +67,7 @@ test('a beta sweep with band_from_fit: the fit\'s own band at its curve points, 
   const file = join(mkdtempSync(join(tmpdir(), 'convsim-sweep-band-')), 'fit.json');
   writeFileSync(file, JSON.stringify(fit));
   const csv = (await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`)).text;
-  assert.match(csv.split('\n')[0], /,tol_met,band_lower,band_upper$/);
+  assert.match(csv.split('\n')[0], /,tol_met,model_error,model_error_uncertainty,model_checked,band_lower,band_upper$/);
   assert.equal(csv, cli('--beta', '0:180:30', '--rotation', 'cw', '--duration', '2', '--band-from', file));
 });
 
@@ -90,7 +90,7 @@ test('a study varying a fitted parameter: the grid\'s values, that parameter out
   const ps = await finished('sweeps', plain.body.id);
   assert.equal(ps.band, undefined);
   assert.equal(ps.points[0].band, undefined);
-  assert.match((await req(d.base, 'GET', `/api/v1/sweeps/${plain.body.id}?format=csv`)).text.split('\n')[0], /,tol_met$/);
+  assert.match((await req(d.base, 'GET', `/api/v1/sweeps/${plain.body.id}?format=csv`)).text.split('\n')[0], /,tol_met,model_error,model_error_uncertainty,model_checked$/);
 });
 
 test('bad band_from_fit: a 4xx naming it, nothing started', { timeout: 60000 * SLOW }, async () => {

@@ -5,7 +5,8 @@
  * a rejected step, not the end of the fit; a fit that fails reports why
  * and its best point with undetermined (not zero) standard errors; the
  * peak scan follows a peak that lies beyond it; multi-start runs from a
- * Halton design and keeps the lowest cost. The cheap scene of
+ * Halton design and keeps the lowest cost; a bound is reached in the
+ * solver's scale. The cheap scene of
  * fit_fixture.h keeps it to seconds.
  */
 #include <math.h>
@@ -185,6 +186,25 @@ static void multistart_keeps_the_lowest_cost(void **state)
 	assert_string_equal(field, "starts");
 }
 
+/* A bound is reached in the solver's scale: a stiffness over five decades
+ * at 1.1e5 in [1e3, 1e8] is mid-range (u = 0.41), not at its lower bound
+ * (linear nearness called everything below 2e5 "lower"); on a linear
+ * scale the width is linear. */
+static void bound_side_in_the_solvers_scale(void **state)
+{
+	(void)state;
+	fit_free k = {"k_c", 1e3, 1e8, 2.56e4}, r = {"R", 0.01, 0.6, 0.18};
+	assert_int_equal(fit_bound_side(&k, 1.1e5), 0);
+	assert_int_equal(fit_bound_side(&k, 1.9e5), 0);
+	assert_int_equal(fit_bound_side(&k, 1.01e3), -1);
+	assert_int_equal(fit_bound_side(&k, 1.03e3), 0);
+	assert_int_equal(fit_bound_side(&k, 0.99e8), 1);
+	assert_true(fabs(fit_u_of_x(&k, 1e5) - 0.4) < 1e-12);
+	assert_int_equal(fit_bound_side(&r, 0.0111), -1);
+	assert_int_equal(fit_bound_side(&r, 0.0113), 0);
+	assert_int_equal(fit_bound_side(&r, 0.5989), 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -192,6 +212,7 @@ int main(void)
 		cmocka_unit_test(failed_fit_reports_best_point),
 		cmocka_unit_test(peak_scan_follows_the_peak),
 		cmocka_unit_test(multistart_keeps_the_lowest_cost),
+		cmocka_unit_test(bound_side_in_the_solvers_scale),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -422,7 +422,7 @@ test('a sweep draws v(β) for both rotations', async () => {
 	assert.equal((await fetch(base + href)).status, 401, 'the link alone is not enough');
 	const csv = (await (await fetch(base + href, { headers: AUTH })).text()).trim().split('\n');
 	assert.equal(csv.length, 7, csv.join('\n'));
-	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+	assert.equal(csv[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
 	const got = csvLines(await download('#sweep-csv'));
 	assert.deepEqual(got, csv);
 	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
@@ -482,7 +482,7 @@ test('a study over two settings draws a map of v per rotation, its bars on hover
 	assert.equal(rows.length, 12);
 	assert.deepEqual(rows[0].slice(0, 3), ['0.3', '30', 'cw']);
 	const csv = (await (await fetch(base + href, { headers: AUTH })).text()).split('\n');
-	assert.equal(csv[0], 'mu,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met');
+	assert.equal(csv[0], 'mu,beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
 	/* one setting: v against it, a curve per rotation */
 	await page.fill('#sweep-form input[name="vary"]', 'mu=0.3,0.6,0.9,1.2');
 	await page.click('#sweep-run');
@@ -613,7 +613,7 @@ test('a β-change experiment reports its reversal time', async () => {
 	await until(() => visible('#experiment-downloads'), 10000, 'the experiment downloads');
 	const seg = csvLines(await download('#experiment-csv'));
 	assert.equal(seg[0], 'experiment,session,segment,beta,until,state,t_command,t_end,start_velocity,' +
-		'steady_velocity,mean_velocity,uncertainty,steady,reversal_time');
+		'steady_velocity,mean_velocity,uncertainty,steady,reversal_time,model_error,model_error_uncertainty,model_checked');
 	assert.equal(seg.length, 3);
 	assert.deepEqual(seg.slice(1).map(l => l.split(',')[3]), ['38', '121.9']);
 	/* the table stays inside its card ("reversal / s" stood past the border at 1440 px) */

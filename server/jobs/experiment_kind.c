@@ -1,0 +1,299 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
+/*
+ * experiment_kind.c - what an identification or a closed-loop experiment
+ * needs before its session runs it (docs/control.md), computed once in
+ * the request's thread with the core's measure function:
+ *
+ *  - the machine's v(beta) curve for the scene and rotation sense (73
+ *    points, 0 to 180 deg by 2.5, each a sim_measure of API_CURVE_WINDOW
+ *    s), cached per scene (the last CURVES scenes), and its monotonic
+ *    branch between the two peaks: the feedforward, the controller's beta
+ *    range and the reachable setpoints;
+ *  - each setpoint checked against that range (422 naming it);
+ *  - "auto" gains: an identification run on a scratch instance at the
+ *    first setpoint's feedforward beta, tuned by SIMC;
+ *  - an identification's comparison slope: the v(beta) secant over
+ *    beta0 -+ step.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "experiment_int.h"
+#include "fopdt.h"
+
+#define CURVES 4
+#define CURVE_WINDOW 2.0 /* s measured per point after the transient */
+#define DEG (M_PI / 180)
+#define SIMC_TAU_L 3.0 /* "auto": tau_c = 3 L unless given */
+
+typedef struct curve_key {
+	sim_params p; /* beta and beta_rate zeroed: they do not change v */
+	sim_scene s;
+	sim_method m;
+} curve_key;
+
+static struct {
+	pthread_mutex_t lock;
+	int n, next;
+	curve_key key[CURVES];
+	double v[CURVES][API_FF_NODES];
+} cache = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+static void key_of(const api_spec *spec, curve_key *k)
+{
+	memset(k, 0, sizeof *k);
+	memcpy(&k->p, &spec->params, sizeof k->p);
+	memcpy(&k->s, &spec->scene, sizeof k->s);
+	memcpy(&k->m, &spec->method, sizeof k->m);
+	k->p.beta = k->p.beta_rate = 0;
+}
+
+/* v at beta (rad) on spec's scene: a steady measurement. */
+static int measure_at(const api_spec *spec, double beta, double *v, char *msg, size_t len)
+{
+	sim_params p = spec->params;
+	p.beta = beta;
+	sim_measurement out;
+	int rc = sim_measure(&p, &spec->scene, &spec->method, spec->scene.transient + CURVE_WINDOW,
+			     &out, msg, len);
+	*v = out.transport_velocity;
+	return rc == SIM_OK && isfinite(*v) ? 0 : -1;
+}
+
+/* The curve of spec's scene, from the cache or measured (unlocked while
+ * measuring: two requests for a new scene measure it twice). */
+static int curve_of(const api_spec *spec, double *v, char *msg, size_t len)
+{
+	curve_key k;
+	key_of(spec, &k);
+	pthread_mutex_lock(&cache.lock);
+	for (int i = 0; i < cache.n; i++)
+		if (memcmp(&cache.key[i], &k, sizeof k) == 0) {
+			memcpy(v, cache.v[i], sizeof cache.v[i]);
+			pthread_mutex_unlock(&cache.lock);
+			return 0;
+		}
+	pthread_mutex_unlock(&cache.lock);
+	for (int i = 0; i < API_FF_NODES; i++)
+		if (measure_at(spec, 2.5 * i * DEG, &v[i], msg, len) != 0)
+			return -1;
+	pthread_mutex_lock(&cache.lock);
+	int at = cache.next;
+	cache.next = (cache.next + 1) % CURVES;
+	if (cache.n < CURVES)
+		cache.n++;
+	cache.key[at] = k;
+	memcpy(cache.v[at], v, sizeof cache.v[at]);
+	pthread_mutex_unlock(&cache.lock);
+	return 0;
+}
+
+/* The branch between the curve's highest and lowest points into ext:
+ * nodes in rising beta, its sign, range and ends. -1 when it is not
+ * monotonic. */
+static int branch_of(const double *v, api_exp_ext *ext)
+{
+	int hi = 0, lo = 0;
+	for (int i = 1; i < API_FF_NODES; i++) {
+		if (v[i] > v[hi])
+			hi = i;
+		if (v[i] < v[lo])
+			lo = i;
+	}
+	int a = hi < lo ? hi : lo, b = hi < lo ? lo : hi;
+	ext->branch_sign = hi < lo ? -1 : 1;
+	ext->nff = b - a + 1;
+	for (int i = a; i <= b; i++) {
+		ext->ff_beta[i - a] = 2.5 * i * DEG;
+		ext->ff_v[i - a] = v[i];
+		if (i > a && (v[i] - v[i - 1]) * ext->branch_sign <= 0)
+			return -1;
+	}
+	ext->v_lo = v[lo];
+	ext->v_hi = v[hi];
+	ext->beta_lo = ext->ff_beta[0];
+	ext->beta_hi = ext->ff_beta[ext->nff - 1];
+	return ext->nff >= 2 ? 0 : -1;
+}
+
+
+/* An identification on a scratch instance of spec at beta0 (rad): the
+ * schedule an "identify" experiment runs (settle, +d, back, -d, back, each
+ * h long), sampled by the same period clock. */
+static int identify_scratch(const api_spec *spec, double beta0, double d, double h,
+			    double rate, api_fopdt *m, char *msg, size_t len)
+{
+	sim_params p = spec->params;
+	p.beta = beta0;
+	int err;
+	sim *s = sim_new(&p, &spec->scene, &spec->method, &err, msg, len);
+	if (!s)
+		return -1;
+	sim_status st;
+	sim_get_status(s, &st);
+	double period = srv_exp_period_of(&st), last[3] = {-1, 0, 0};
+	size_t cap = (size_t)(5 * h / (0.5 * period)) + 16, n = 0;
+	double *t = malloc(cap * sizeof *t), *v = malloc(cap * sizeof *v);
+	const double steps[4] = {d, 0, -d, 0};
+	double ts[4], dd[4];
+	int rc = t && v ? 0 : -1, k = 1;
+	srv_exp_clock_tick(&period, last, &st);
+	double t_next = st.t + period;
+	while (rc == 0 && n < cap) {
+		double t_step = h * k, target = fmin(t_next, t_step);
+		rc = sim_advance(s, target) == SIM_OK ? 0 : -1;
+		sim_get_status(s, &st);
+		if (rc == 0 && target == t_next) {
+			double vk = srv_exp_clock_tick(&period, last, &st);
+			if (isfinite(vk))
+				t[n] = st.t, v[n++] = vk;
+			t_next = st.t + period;
+		}
+		if (rc == 0 && target == t_step) {
+			if (k == 5)
+				break;
+			ts[k - 1] = sim_effective_time(s);
+			dd[k - 1] = steps[k - 1] - (k > 1 ? steps[k - 2] : 0);
+			rc = sim_set_beta(s, beta0 + steps[k - 1] * DEG, rate) == SIM_OK ? 0 : -1;
+			k++;
+		}
+	}
+	if (rc == 0 && k == 5) {
+		srv_exp_fit(t, v, n, 0.5 * h, ts, dd, 4, h, m);
+		m->t_from = 0.5 * h; /* s after the scratch run's start */
+	} else {
+		snprintf(msg, len, "the identification run failed");
+	}
+	free(t);
+	free(v);
+	sim_free(s);
+	return rc == 0 && m->ok ? 0 : -1;
+}
+
+/* Each setpoint within the branch's range, its beta the feedforward's. */
+static api_err check_setpoints(srv_experiment *e, api_problem *pb)
+{
+	api_exp_ext *x = &e->ext;
+	for (int i = 0; i < e->req.nseg; i++) {
+		double v = x->sp[i].v;
+		if (!(v > x->v_lo && v < x->v_hi)) {
+			char field[48];
+			snprintf(field, sizeof field, "control.setpoint[%d].v", i);
+			api_fail(pb, API_RANGE, field,
+				 "%s = %g m/s is outside the machine's reachable range (%.4g, %.4g) "
+				 "m/s: the v(beta) curve between its minimum at %g deg and its maximum "
+				 "at %g deg",
+				 field, v, x->v_lo, x->v_hi,
+				 (x->branch_sign < 0 ? x->beta_hi : x->beta_lo) / DEG,
+				 (x->branch_sign < 0 ? x->beta_lo : x->beta_hi) / DEG);
+			pb->has_range = 1, pb->min = x->v_lo, pb->max = x->v_hi;
+			return API_RANGE;
+		}
+		double b = srv_exp_feedforward(x, v);
+		e->req.seg[i].beta = (api_value){b, ((b) / DEG)};
+	}
+	return API_OK;
+}
+
+/* "auto": SIMC gains from an identification at the first setpoint. */
+static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *pb)
+{
+	api_exp_ext *x = &e->ext;
+	char msg[200] = "";
+	double b0 = e->req.seg[0].beta.si, rate = e->req.beta_rate.si;
+	api_fopdt *m = &x->tuned;
+	m->beta0 = b0 / DEG;
+	m->step = 4;
+	m->slope = NAN; /* no secant measured for it */
+	if (identify_scratch(spec, b0, m->step, 1.5, rate > 0 ? rate : spec->params.beta_rate, m,
+			     msg, sizeof msg) != 0)
+		return api_fail(pb, API_INVALID, "control.controller",
+				"control.controller \"auto\": the identification at %g deg gave no "
+				"model (%s); give kp and ki", m->beta0, msg);
+	/* SIMC's tight tau_c = L leaves the preset's loop in a limit cycle
+	 * (the feed rings after each beta change, which a first-order model
+	 * does not hold: docs/control.md); tau_c = 3 L by default */
+	double tau = x->tau_c > 0 ? x->tau_c : SIMC_TAU_L * m->l;
+	fopdt_result r = {.k = m->k, .t = m->t, .l = m->l};
+	fopdt_simc(&r, tau, &x->kp, &x->ki);
+	x->tau_c = tau;
+	return isfinite(x->kp) && isfinite(x->ki)
+		       ? API_OK
+		       : api_fail(pb, API_INVALID, "control.controller",
+				  "control.controller \"auto\": the identified gain is zero; give kp "
+				  "and ki");
+}
+
+api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb)
+{
+	api_exp_ext *x = &e->ext;
+	char msg[200] = "";
+	/* the samples are the engine's feed displacement: a scene without a
+	 * feed, or whose feed is a LIGGGHTS bed, has none to control */
+	if (!spec->scene.feed || spec->scene.feed_model == SIM_FEED_EXTERNAL)
+		return api_fail(pb, API_INVALID, "session",
+				"%s needs a session whose feed is the engine's own (scene.feed true, not "
+				"a LIGGGHTS bed)", x->kind == API_EXP_IDENTIFY ? "identify" : "control");
+	if (x->kind == API_EXP_IDENTIFY) {
+		for (int i = 0; i < x->npoints; i++) {
+			api_fopdt *m = &x->model[i];
+			double a, b;
+			if (measure_at(spec, (m->beta0 - m->step) * DEG, &a, msg, sizeof msg) == 0 &&
+			    measure_at(spec, (m->beta0 + m->step) * DEG, &b, msg, sizeof msg) == 0)
+				m->slope = (b - a) / (2 * m->step);
+		}
+		return API_OK;
+	}
+	if (x->kind != API_EXP_CONTROL)
+		return API_OK;
+	double v[API_FF_NODES];
+	if (curve_of(spec, v, msg, sizeof msg) != 0)
+		return api_fail(pb, API_INVALID, "control",
+				"control: the machine's v(beta) curve could not be measured (%s)", msg);
+	if (branch_of(v, x) != 0)
+		return api_fail(pb, API_INVALID, "control",
+				"control: the machine's v(beta) curve is not monotonic between its "
+				"peaks; a controller needs a branch it can invert");
+	api_err err = check_setpoints(e, pb);
+	if (err == API_OK && x->auto_gains)
+		err = auto_gains(e, spec, pb);
+	x->integ = 0;
+	x->t_sample = 0;
+	x->period = NAN; /* measured from the start */
+	return err;
+}
+
+api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
+{
+	return e->ext.kind == API_EXP_SCHEDULE ? API_OK : srv_exp_prepare(e, spec, pb);
+}
+
+/* ---- the kind in the stored record (experiment.c) ---- */
+
+/* The bytes of e's kind that follow its record (an identification's or a
+ * closed loop's api_exp_ext; none for a plain schedule, whose record is
+ * what it was before there were kinds). */
+size_t srv_exp_tail_len(const srv_experiment *e)
+{
+	return e->ext.kind == API_EXP_SCHEDULE ? 0 : sizeof e->ext;
+}
+
+/* A tail read back: 0 when it is one (or none, tail 0). */
+int srv_exp_tail_ok(const void *tail, size_t len)
+{
+	if (len == 0)
+		return 0;
+	api_exp_ext x;
+	if (len != sizeof x)
+		return -1;
+	memcpy(&x, tail, sizeof x);
+	return (x.kind == API_EXP_IDENTIFY || x.kind == API_EXP_CONTROL) &&
+			       x.npoints >= 0 && x.npoints <= API_EXP_MAX_POINTS && x.ndist >= 0 &&
+			       x.ndist <= API_EXP_MAX_DIST && x.nff >= 0 && x.nff <= API_FF_NODES &&
+			       x.next_dist >= 0 && x.next_dist <= x.ndist
+		       ? 0
+		       : -1;
+}
