@@ -320,7 +320,7 @@ bench: all $(BUILD)/.deps-bench
 bench-zoo-ref: all
 	$(Q)BUILD=$(BUILD) bash tests/bench/zoo_ref.sh tests/bench/zoo/ref.tsv $(ZOO)
 
-# libFuzzer harnesses (tests/fuzz/, docs/development.md "Fuzzing"): clang builds core/,
+# libFuzzer harnesses (tests/fuzz/, docs/fuzzing.md "Fuzzing"): clang builds core/,
 # fit/, api/ and server/ into build-fuzz/ with coverage and ASan+UBSan, each
 # harness runs FUZZ_SECONDS on its committed corpus (new inputs go to
 # build-fuzz/corpus/, crashes to build-fuzz/crashes/) and a table of
@@ -418,8 +418,9 @@ install: deps-build $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd
 	rm -rf $(DESTDIR)$(DATADIR)/web && cp -R web $(DESTDIR)$(DATADIR)/web
 	chmod -R u=rwX,go=rX $(DESTDIR)$(DATADIR)/web
 	install -m 644 README.md LICENSE $(DESTDIR)$(DOCDIR)/
-	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/examples
+	install -d $(DESTDIR)$(DOCDIR)/docs $(DESTDIR)$(DOCDIR)/docs/img $(DESTDIR)$(DOCDIR)/docs/log $(DESTDIR)$(DOCDIR)/docs/examples
 	install -m 644 docs/*.md $(DESTDIR)$(DOCDIR)/docs/
+	install -m 644 docs/log/*.md $(DESTDIR)$(DOCDIR)/docs/log/
 	install -m 644 docs/img/*.png $(DESTDIR)$(DOCDIR)/docs/img/
 	install -m 644 docs/examples/*.py $(DESTDIR)$(DOCDIR)/docs/examples/
 	sed -e 's|@BINDIR@|$(BINDIR)|g' -e 's|@WEBDIR@|$(DATADIR)/web|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "json_int.h"
+#include "table.h"
 
 const char *const api_members_session_create[] = {"preset", "params", "scene", "integrator",
 						   "pace", "until", "sample_rate", NULL};
@@ -160,18 +161,7 @@ api_err api_parse_user_value(const api_spec *spec, const char *name,
 
 double api_user_of(const char *name, double si)
 {
-	const sim_setting *set = sim_setting_find(name);
-	if (!set)
-		return si;
-	double user = sim_setting_from_si(set, si);
-	if (set->scale == 1 || !isfinite(user))
-		return user;
-	/* the division leaves noise in the last bits (60 deg comes back as
-	 * 59.99999999999999): 15 significant digits, what a double carried
-	 * through a scale and back keeps, so that what was sent is shown */
-	char text[32];
-	snprintf(text, sizeof text, "%.15g", user);
-	return strtod(text, NULL);
+	return sim_table_user(name, si); /* rounded as the trajectories are */
 }
 
 api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)

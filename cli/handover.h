@@ -7,7 +7,7 @@
  * run with feed_model=liggghts (cli_run_coupled). The hand-over is an
  * exec of that binary with the same arguments: the same process, its
  * launcher's environment, its streams and its exit status
- * (docs/cli.md "Two binaries").
+ * (docs/mpi.md "Two binaries").
  */
 #ifndef CONVSIM_HANDOVER_H
 #define CONVSIM_HANDOVER_H

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * defaults.c - the presets (czubak2016, docs/MODEL.md "Parameters", and the
+ * defaults.c - the presets (czubak2016, docs/model-numerics.md "Parameters", and the
  * fitted ones) and a scene's default steps, from its own time scales and
  * the method's descriptor (dt_feed, dt_free; sim_default_dt).
  */

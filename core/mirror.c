@@ -5,7 +5,7 @@
  *
  * On a machine symmetric about the vertical through G, the clockwise
  * motion at beta and the counter-clockwise motion at 180 deg - beta are
- * mirror images (docs/MODEL.md "Checks with known answers"): mirroring x
+ * mirror images (docs/accuracy.md "Checks with known answers"): mirroring x
  * maps phi to pi - phi (the rotor turns the other way, hanging down at the
  * same angle), the guide direction u(beta) to -u(pi - beta) (so the
  * eliminators swap and their strokes change sign; with c != 0 the masses
@@ -23,8 +23,9 @@
  * off (sin(pi - beta) is not bit for bit sin(beta)), which the feed's
  * hopping amplifies, and the estimator's period boundaries, which fall
  * half a period later on the mirrored run (phi - alpha crosses 2 pi k where
- * the original's crosses pi + 2 pi k). docs/MODEL.md "Model reductions" gives the
- * measured difference over the 74 points.
+ * the original's crosses pi + 2 pi k). docs/model-numerics.md ("Modelling
+ * only what a scene needs") gives the measured difference over the 74
+ * points.
  */
 #include <math.h>
 #include <stdio.h>

@@ -129,7 +129,7 @@ static inline void model_add_reduced(const model *md, const double *qr, double f
 			full[md->col[r][a]] += qr[r];
 }
 
-/* Largest ratio for which dem corrects its coupling (docs/MODEL.md "Integrators"). */
+/* Largest ratio for which dem corrects its coupling (docs/integrators.md "Integrators"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 
 /* The decay rate (1/s) of the Kloss motor's slip mode, the machine's

@@ -114,7 +114,7 @@ double sim_contact_period(const sim_params *p, const sim_scene *s);
 /* The largest fixed step (s) method m keeps stable on the machine's
  * stiffest mode, the Kloss motor's slip (its real_limit over the slip
  * mode's decay rate); INFINITY for an adaptive method or the ideal drive.
- * Above it the run blows up within a few seconds (docs/MODEL.md "Stability"). */
+ * Above it the run blows up within a few seconds (docs/integrators.md "Stability"). */
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt within
@@ -217,7 +217,7 @@ int sim_set_feed(sim *s, double m_n, double mu);
 /* The m_n (kg) a running instance of p, sc, m takes (lo, hi written,
  * closed): the settings table's range, narrowed where the split method
  * with sub-steps couples a light feed with its corrector (feed mass at
- * most 0.2 of the machine's, docs/MODEL.md "Integrators") to the masses
+ * most 0.2 of the machine's, docs/integrators.md "Integrators") to the masses
  * that keep it light, and where it couples a heavy feed without, to
  * those that keep it heavy. */
 void sim_feed_mass_range(const sim_params *p, const sim_scene *sc, const sim_method *m,
@@ -365,7 +365,7 @@ int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, do
  * and a machine symmetric about the vertical through G (h = 0, l1 = l2,
  * the axle at G, mirrored eliminators, c = 0; the columns are mirrored by
  * construction). Then (ccw, pi - beta) moves as the mirror image of (cw,
- * beta) (docs/MODEL.md "Checks with known answers"): x, alpha and phi'
+ * beta) (docs/accuracy.md "Checks with known answers"): x, alpha and phi'
  * change sign, y stays, the eliminators swap with their strokes negated,
  * and the transport velocity changes sign. */
 int sim_mirror_applies(const sim_params *p, const sim_scene *sc);

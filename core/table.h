@@ -49,11 +49,24 @@ static inline double sim_time_ns(double t)
 }
 
 /* A user-unit value of a setting from SI (beta: rad to deg), by the
- * settings table's scale, as the API converts it. */
+ * settings table's scale; the API, the CLI and the trajectories all
+ * convert with it. sim_setting_from_si gives a value a user sent back as
+ * sent; a value the model made (a beta in mid-ramp) it leaves as the
+ * plain quotient, with noise in its last digits (31.487812499999997):
+ * 15 significant digits, what a double carried through a scale and back
+ * keeps. A name that is no setting, a scale of 1 or a value not finite
+ * pass unchanged. */
 static inline double sim_table_user(const char *setting, double si)
 {
 	const sim_setting *t = sim_setting_find(setting);
-	return t ? sim_setting_from_si(t, si) : si;
+	if (!t)
+		return si;
+	double user = sim_setting_from_si(t, si);
+	if (t->scale == 1 || !isfinite(user))
+		return user;
+	char text[32];
+	snprintf(text, sizeof text, "%.15g", user);
+	return strtod(text, NULL);
 }
 
 /*

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Benchmark tables in the documents come from `make bench`'s output files.
 
-A table in README.md or docs/*.md that stands between
+A table in README.md, docs/*.md or docs/log/*.md that stands between
 
     <!-- bench: tests/bench/results/FILE.md table N -->
     ...
@@ -71,7 +71,7 @@ def sync(path, check):
 
 def main():
     check = '--check' in sys.argv[1:]
-    docs = [ROOT / 'README.md'] + sorted((ROOT / 'docs').glob('*.md'))
+    docs = [ROOT / 'README.md'] + sorted((ROOT / 'docs').glob('*.md')) + sorted((ROOT / 'docs' / 'log').glob('*.md'))
     bad = [b for p in docs for b in sync(p, check)]
     for b in bad:
         print(b)

@@ -5,7 +5,7 @@
 It reads a session's NDJSON stream, turns beta with PATCH, and prints per setpoint
 segment the settling time, overshoot, IAE and steady error, and the loop's latency
 (a sample line received -> the PATCH's 200). Standard library only; see
-docs/control.md ("The loop closed from your own code"). Run it next to `make run`:
+docs/control-remote.md ("The loop closed from your own code"). Run it next to `make run`:
 
     python3 docs/examples/remote_pi.py --setpoints 0.10:8,-0.08:8 [--pace 1] [--delay 0]
 """

@@ -8,7 +8,7 @@
  * server allocates are counted exactly from their sizes (record ring,
  * trajectory history, stream buffers); the core instance and the threads
  * are a constant plus a cost per feed element, calibrated against the
- * resident memory the daemon gained per session (docs/operations.md "Budgets and
+ * resident memory the daemon gained per session (docs/budgets.md "Budgets and
  * load" has the measurement). The cores of paced sessions are committed
  * the same way: each session holds its need (CPU s per simulated s, first
  * estimated from its integrator and feed, then measured by its worker,
@@ -32,7 +32,7 @@
 #include "conns.h"
 #include "util.h"
 
-/* Calibration (docs/operations.md "Budgets and load"): resident bytes a session holds
+/* Calibration (docs/budgets.md "Budgets and load"): resident bytes a session holds
  * besides its ring and history, as base + per feed element. */
 #define SESSION_BASE_BYTES ((size_t)128 << 10)
 #define ELEMENT_BYTES ((size_t)384)

@@ -64,7 +64,7 @@ double srv_budget_sample_cpu(int columns, int layers);
  * its integrator (method, the step dt and the feed sub-steps in use, as
  * sim_get_status reports them after sim_new) and the feed elements it
  * integrates (feed: columns x layers; the symmetric reduction integrates
- * one representative column). Calibrated on this machine (docs/operations.md "Budgets
+ * one representative column). Calibrated on this machine (docs/budgets.md "Budgets
  * and load"); a running session's worker measures its own. */
 double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			       int columns, int layers);

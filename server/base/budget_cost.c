@@ -11,7 +11,7 @@
 
 #include "budget.h"
 
-/* Calibration of the CPU estimate (docs/operations.md "Budgets and load"): CPU s of
+/* Calibration of the CPU estimate (docs/budgets.md "Budgets and load"): CPU s of
  * one macro step of the machine (four right-hand sides: RK4, or dem's
  * macro step), of one feed sub-step per integrated column and per
  * integrated element, and of one published sample (status, ring record,

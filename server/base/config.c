@@ -116,7 +116,7 @@ static const opt opts[] = {
 	{"max-memory", OPT_MEMORY, 1L << 20, 1L << 50, F(max_memory), "BYTES",
 	 "estimated memory of all sessions and streams; K, M, G suffixes\n"
 	 "(default %D: 3/4 of this machine's memory)",
-	 "budgets (429/503 with Retry-After when spent; see docs/operations.md \"Budgets and "
+	 "budgets (429/503 with Retry-After when spent; see docs/budgets.md \"Budgets and "
 	 "load\"):"},
 	{"max-cpu-seconds", OPT_SECONDS, 100, 864000000, F(max_cpu_seconds), "S",
 	 "CPU seconds a session may use before it pauses, per grant\n(default %D)", NULL},

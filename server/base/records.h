@@ -4,7 +4,7 @@
  * format version SRV_STORE_VERSION (store.h), in one place: what a build
  * writes and, through the upgraders of earlier versions (store_v1.c), what
  * it hands its readers whatever version the file says
- * (docs/operations.md "Stored formats").
+ * (docs/formats.md "Stored formats").
  *
  *   sessions/ID/spec.bin        srv_spec_record
  *   sessions/ID/checkpoint.bin  srv_ckpt_record, the

@@ -37,7 +37,7 @@
 #include "config.h"
 
 /* The format this build writes; it reads every one from
- * SRV_STORE_OLDEST on (docs/operations.md "Stored formats"):
+ * SRV_STORE_OLDEST on (docs/formats.md "Stored formats"):
  *   1  c793934 and the builds up to c3bc9a1: no word of the layout
  *      beyond the frame's version, two layouts under the same number
  *      (told apart by the records' sizes, store_v1.c)

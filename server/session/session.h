@@ -75,7 +75,7 @@ void srv_session_view(srv_session *s, api_view *v);
 /* API_OK, or 503 in *pb with Retry-After while s, restored at a start,
  * runs flat out through the controls of its log to where it was: until
  * then its status would show a past the clients had already left
- * (docs/hardening.md). GET, PATCH, its trajectory and streams and an
+ * (docs/durability.md). GET, PATCH, its trajectory and streams and an
  * experiment's attach answer this; the listing shows its status null. */
 api_err srv_session_replaying(srv_session *s, api_problem *pb);
 /* Live sessions. */

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The figures of docs/operations.md "Running on several machines" (not part of `make
+// The figures of docs/cluster.md "Running on several machines" (not part of `make
 // bench`; loopback only, bounded: about 1 minute for latency, 20 s per
 // count and replica number for capacity). Replicas behind HAProxy are
 // started as `make cluster` starts them (server/cluster.sh run).

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // How long a creation takes to be answered on a data directory
-// (docs/hardening.md "A 201 on a creation means its record is on
+// (docs/durability.md "A 201 on a creation means its record is on
 // disk"): COUNT creations of each kind one after another, GAP ms apart
 // (each deleted before the next where the API allows; at most 12 fits),
 // latency p50 / p99 / max, on an idle daemon and beside BUSY paced

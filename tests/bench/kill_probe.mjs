@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The durability probe (docs/hardening.md), run by hand: ROUNDS rounds of
+// The durability probe (docs/durability.md), run by hand: ROUNDS rounds of
 // SESSIONS sessions (one in four paused) under back-to-back PATCHes
 // (INFLIGHT clients each), the daemon killed with SIGKILL at a random
 // moment of each round (150 to 400 ms in) while PATCHes are in flight.

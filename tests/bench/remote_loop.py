@@ -4,7 +4,7 @@
 0, 100 and 200 ms added before each command, and the same beta steps open loop (the
 feedforward alone, one step each): settling, overshoot, IAE and steady error per
 setpoint segment and the loop's latency, as a Markdown table (part of `make bench`;
-docs/control.md quotes it).
+docs/control-remote.md quotes it).
 
     python3 tests/bench/remote_loop.py [build/convsimd] > tests/bench/results/remote_loop.md
 """

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# The speed targets of the 1 % gate (part of `make bench`; docs/accuracy.md
+# The speed targets of the 1 % gate (part of `make bench`; docs/speed.md
 # "Targets"), measured with the defaults the gate scores, on one core but the daemon:
 #  - the real-time factor of a 20-s run of czubak2016 at beta = 30 deg
 #    (the `real_time_factor` of `convsim run`'s summary: the steady start's

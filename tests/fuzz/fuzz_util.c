@@ -26,7 +26,7 @@ void fuzz_refused(const char *what, const char *why)
 {
 	if (getenv("FUZZ_MUST_ACCEPT"))
 		fuzz_fail("a committed seed is refused (%s: %s): the seeds are stale, make them "
-			  "again (docs/development.md \"Fuzzing\")",
+			  "again (docs/fuzzing.md \"Fuzzing\")",
 			  what, why);
 }
 

@@ -26,7 +26,7 @@ void fuzz_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2), noretu
 /* A reader refused the input (what: which, why: its reason). Under
  * FUZZ_MUST_ACCEPT (tests/fuzz/run.sh, on the committed real seeds before
  * fuzzing) that fails the oracle: the seeds no longer match the formats
- * and must be made again (docs/development.md "Fuzzing"); otherwise nothing. */
+ * and must be made again (docs/fuzzing.md "Fuzzing"); otherwise nothing. */
 void fuzz_refused(const char *what, const char *why);
 
 /* The input as an exact-size heap buffer with no terminating NUL, so that

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Runs each libFuzzer harness of tests/fuzz/ for FUZZ_SECONDS (make fuzz;
-# docs/development.md "Fuzzing") on its committed seeds (tests/fuzz/corpus/NAME, read
+# docs/fuzzing.md "Fuzzing") on its committed seeds (tests/fuzz/corpus/NAME, read
 # only) and its working corpus ($FUZZ_BUILD/corpus/NAME, where new inputs
 # go), with its dictionary, at nice 10, and prints a table: executions,
 # exec/s, coverage (cov: edges, ft: features), CPU seconds (user+sys; the

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Makes the real seeds of the `store` fuzz harness again (docs/development.md
+# Makes the real seeds of the `store` fuzz harness again (docs/fuzzing.md
 # "Fuzzing"): runs the daemon ($BUILD/convsimd, from `make`) on a fresh
 # --data-dir with two sessions, a running default one and a finished rk4
 # one without feed (`until` 1 s at pace "max"), stops it with SIGTERM once

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Admission keeps its word (docs/operations.md "Budgets and load"): with
+// Admission keeps its word (docs/budgets.md "Budgets and load"): with
 // the cores for paced sessions full, the next session is refused with 503
 // and a problem body naming the budget, and the sessions already running
 // keep their pace: not the newest refused and everyone slowed down. Holds

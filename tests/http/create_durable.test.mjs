@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// A 201 (202) on a creation means its record is on disk (docs/hardening.md
+// A 201 (202) on a creation means its record is on disk (docs/durability.md
 // "A 201 on a creation means its record is on disk"): a session's
 // spec.json, an experiment's, a sweep's and a fit's record. The daemon is
 // killed with SIGKILL at once (0 ms) and about 1 ms after the answer, one

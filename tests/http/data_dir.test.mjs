@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The data directory as an operator leaves it (docs/hardening.md): junk
+// The data directory as an operator leaves it (docs/formats.md "The data directory"): junk
 // beside the stored records is ignored with one log line each and never
 // listed; a read-only or full data directory is reported, never taken for
 // success.

@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The documents cannot drift from the program: every sh and python block of
-// README.md and docs/*.md runs against the real daemon (started with a
-// token, as `make run` starts it), every `<!-- output -->` block is compared
-// with what its example printed, figures in examples' comments are elided,
-// and every relative link between the documents resolves to a file and a
-// heading. The conventions are written down in docs/development.md
+// README.md, docs/*.md and docs/log/*.md runs against the real daemon
+// (started with a token, as `make run` starts it) through a validating
+// proxy (Prism: a request or an answer that breaks the OpenAPI document
+// fails the example), every `<!-- output -->` block is compared with what
+// its example printed, figures in examples' comments are elided, and every
+// relative link between the documents resolves to a file and a heading.
+// The conventions are written down in docs/testing.md
 // ("Examples in the documentation").
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -15,6 +17,7 @@ import { dirname, join, relative, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
 import { startDaemon, tokenFile, req, until, SLOW } from './lib.mjs';
+import { startPrism } from './prism.mjs';
 
 const ROOT = fileURLToPath(new URL('../..', import.meta.url));
 const BUILD = resolve(ROOT, process.env.BUILD || 'build');
@@ -23,9 +26,13 @@ const AUTH = { Authorization: `Bearer ${TOKEN}` };
 const run = promisify(execFile);
 
 // README.md and every page of docs/, as [path relative to ROOT, text]
+// (docs/log/, the measurement logs, included)
 export function documents(root = ROOT) {
-  const names = ['README.md', ...readdirSync(join(root, 'docs')).filter((f) => f.endsWith('.md')).sort()
-    .map((f) => `docs/${f}`)];
+  const names = ['README.md'];
+  for (const dir of ['docs', 'docs/log']) {
+    if (!existsSync(join(root, dir))) continue;
+    names.push(...readdirSync(join(root, dir)).filter((f) => f.endsWith('.md')).sort().map((f) => `${dir}/${f}`));
+  }
   return names.map((n) => [n, readFileSync(join(root, n), 'utf8')]);
 }
 
@@ -63,7 +70,10 @@ export function examples(name, text) {
       out[out.length - 1].output = b.code;
       continue;
     }
-    if (['sh', 'bash', 'python'].includes(b.lang)) out.push({ ...b, where });
+    if (b.mark && /example:\s*direct/.test(b.mark))
+      assert.match(b.mark, /example:\s*direct\s*\(\S[^)]*\)/, `${where}: a direct example says why: <!-- example: direct (REASON) -->`);
+    const direct = Boolean(b.mark && /example:\s*direct/.test(b.mark));
+    if (['sh', 'bash', 'python'].includes(b.lang)) out.push({ ...b, where, direct });
   }
   return out;
 }
@@ -127,13 +137,23 @@ export function brokenLinks(name, text, root = ROOT) {
   return bad;
 }
 
-let d, base, hostport;
+// The examples reach the daemon through Prism, a validating proxy
+// (prism.mjs): a request or an answer of an example that breaks the
+// OpenAPI document is a violation, which fails the example. An example
+// that must reach the daemon itself (a request the document refuses on
+// purpose, a stream Prism would hold until it ends) says why, right
+// before it: <!-- example: direct (REASON) -->.
+let d, base, prism, viaProxy, direct;
 before(async () => {
   d = await startDaemon(['--token-file', tokenFile(TOKEN)]);
   base = d.base;
-  hostport = base.replace(/^http:\/\//, '');
+  direct = base.replace(/^http:\/\//, '');
+  const doc = await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH);
+  assert.equal(doc.status, 200);
+  prism = await startPrism(doc.text, base);
+  viaProxy = prism.url.replace(/^http:\/\//, '');
 });
-after(async () => { await d?.stop(); });
+after(async () => { prism?.stop(); await d?.stop(); });
 
 async function finished(path, done, ms) {
   let last;
@@ -173,7 +193,7 @@ const MAKE = {
   },
 };
 
-async function prepare(code) {
+async function prepare(code, hostport) {
   let text = code.replace(/\b(localhost|127\.0\.0\.1):8080\b/g, hostport);
   const kinds = { sessions: 'ID', experiments: 'EID', sweeps: 'SID', fits: 'FID' };
   for (const [route, word] of Object.entries(kinds)) {
@@ -196,9 +216,10 @@ function workdir() {
 }
 
 async function runExample(ex) {
-  const code = await prepare(ex.code);
+  const hostport = ex.direct ? direct : viaProxy;
+  const code = await prepare(ex.code, hostport);
   const cwd = workdir();
-  const env = { ...process.env, CONVSIM_URL: base, CONVSIM_TOKEN: TOKEN, AUTH: `Authorization: Bearer ${TOKEN}` };
+  const env = { ...process.env, CONVSIM_URL: `http://${hostport}`, CONVSIM_TOKEN: TOKEN, AUTH: `Authorization: Bearer ${TOKEN}` };
   const opts = { cwd, env, timeout: 240000 * SLOW, maxBuffer: 64 << 20 };
   if (ex.lang === 'python') {
     writeFileSync(join(cwd, 'example.py'), code);
@@ -215,9 +236,9 @@ test('every relative link between the documents resolves (file and #anchor)', ()
   assert.deepEqual(bad, []);
 });
 
-// Operations of the OpenAPI document that docs/api.md does not name (the
-// method on a line with the path, a path parameter as any word), and
-// operations docs/api.md names that the document lacks.
+// Operations of the OpenAPI document that the API pages (API_PAGES) do not
+// name (the method on a line with the path, a path parameter as any word),
+// and operations they name that the document lacks.
 export function apiDrift(doc, text) {
   const ops = Object.entries(doc.paths).flatMap(([p, item]) => Object.keys(item).map((m) => [m.toUpperCase(), p]));
   const re = (p) => new RegExp(p.replace(/[.*+?^$()|[\]\\]/g, '\\$&').replace(/\{[^}]+\}/g, '[A-Za-z0-9_-]+') + '(?![A-Za-z0-9_/-])');
@@ -230,9 +251,12 @@ export function apiDrift(doc, text) {
   return { missing, named };
 }
 
-test('docs/api.md and the served OpenAPI document name the same operations', async () => {
+// The API reference: docs/api.md and the pages it is split into.
+export const API_PAGES = ['docs/api.md', 'docs/api-errors.md', 'docs/api-streams.md', 'docs/api-jobs.md'];
+
+test('the API pages and the served OpenAPI document name the same operations', async () => {
   const doc = (await req(base, 'GET', '/api/v1/openapi.json', undefined, AUTH)).body;
-  const text = readFileSync(join(ROOT, 'docs/api.md'), 'utf8');
+  const text = API_PAGES.map((p) => readFileSync(join(ROOT, p), 'utf8')).join('\n');
   assert.deepEqual(apiDrift(doc, text), { missing: [], named: [] });
   /* and it can fail both ways */
   const less = apiDrift(doc, text.replace(/PATCH/g, 'PUT'));
@@ -255,6 +279,13 @@ test('the link checker sees a missing file and a missing anchor', () => {
   assert.ok(anchors('## The 1 % gate\n## Load: `make load`\n## A\n## A').has('the-1--gate'));
   assert.ok(anchors('## Load: `make load`').has('load-make-load'));
   assert.ok(anchors('## A\n## A').has('a-1'));
+});
+
+test('an example goes through the validating proxy unless marked direct, with a reason', () => {
+  const fence = (mark) => `${mark}\n\`\`\`sh\ncurl -s localhost:8080/api/v1/health\n\`\`\`\n`;
+  assert.equal(examples('x.md', fence(''))[0].direct, false);
+  assert.equal(examples('x.md', fence('<!-- example: direct (a request the document refuses) -->'))[0].direct, true);
+  assert.throws(() => examples('x.md', fence('<!-- example: direct -->')), /a direct example says why/);
 });
 
 test('output blocks and elided figures: the rules can fail', () => {

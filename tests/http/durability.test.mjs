@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A 200 on a control means its line is in the control log on disk
-// (docs/hardening.md): the daemon is killed with SIGKILL at once (0 ms)
+// (docs/durability.md): the daemon is killed with SIGKILL at once (0 ms)
 // and about 1 ms after a PATCH is answered, round after round, and after
 // each restart every acknowledged control is in controls.ndjson and in
 // force (beta_target), on running and on paused sessions alike.

@@ -3,7 +3,8 @@
 // or ?format=, 406 for an Accept naming neither, 400 for unknown query
 // parameters on every route; the trajectory's rows exactly `stride` apart;
 // the CLI and the daemon write the same trajectory and sweep columns and
-// the same numbers; every problem type URI serves a page.
+// the same numbers; beta in mid-ramp with 15 significant digits at most;
+// every problem type URI serves a page.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
@@ -167,9 +168,17 @@ test('numbers as the user gave them: beta in degrees as sent, times on the grid 
     assert.equal(target, '121.9', line);
     assert.match(t, /^\d+(\.\d{1,9})?$/, `t on the grid: ${line}`);
   }
-  const e = await req(d.base, 'POST', '/api/v1/experiments', { session: CHEAP, schedule: [{ beta: 38, until: 0.6 }, { beta: 128, until: 1.2 }] });
+  const e = await req(d.base, 'POST', '/api/v1/experiments', { session: CHEAP, schedule: [{ beta: 38, until: 0.6 }, { beta: 128, until: 1.2 }],
+    keep_session: true });
   assert.equal(e.status, 201, e.text);
   await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${e.body.id}`)).body.state === 'done', 60000);
+  /* beta in mid-ramp, which the model made: 15 significant digits at most
+   * (31.4878125, never 31.487812499999997), in the trajectory's CSV */
+  const sess = (await req(d.base, 'GET', `/api/v1/experiments/${e.body.id}`)).body.session;
+  const traj = (await req(d.base, 'GET', `/api/v1/sessions/${sess}/trajectory?format=csv`)).text.trim().split('\n').slice(1);
+  const ramp = traj.map((l) => l.split(',')[1]).filter((b) => b !== '38' && b !== '128');
+  assert.ok(ramp.length >= 5, `rows in mid-ramp: ${ramp.length}`);
+  for (const b of ramp) assert.ok(b.replace(/^-?0*\.?0*/, '').replace('.', '').length <= 15, `beta ${b}`);
   const rows = (await req(d.base, 'GET', `/api/v1/experiments/${e.body.id}?format=csv`)).text.trim().split('\n').slice(1);
   assert.equal(rows.length, 2);
   for (const row of rows) {

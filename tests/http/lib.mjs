@@ -104,7 +104,7 @@ export async function untilReplayed(base, id, ms = 20000) {
 
 // GET path once it is not 503: a session restored with controls to
 // replay answers 503 (Retry-After) until it is back where it was
-// (docs/hardening.md). The answer {status, headers, body, text}.
+// (docs/durability.md). The answer {status, headers, body, text}.
 export async function getReady(base, path, ms = 20000) {
   return until(async () => {
     const r = await req(base, 'GET', path);

@@ -12,40 +12,16 @@
 // is a violation there, and the test fails on any.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { mkdtempSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { fileURLToPath } from 'node:url';
 import Ajv2020 from 'ajv/dist/2020.js';
 import SwaggerParser from '@apidevtools/swagger-parser';
-import { startDaemon, req, until, openStream, freePorts, SLOW, CHEAP } from './lib.mjs';
+import { startDaemon, req, until, openStream, SLOW, CHEAP } from './lib.mjs';
+import { startPrism } from './prism.mjs';
 
 const ID = 'https://convsim.invalid/openapi.json';
 let d, doc, ajv;
 const seen = new Set();
 
-// Prism as a validating proxy in front of the daemon. It runs under a shell
-// that ends it when its standard input closes, so that it ends with this
-// process however this process ends.
-const PRISM = fileURLToPath(new URL('../node_modules/.bin/prism', import.meta.url));
-let prism, proxy, prismLog = '';
-async function startPrism(docText, target) {
-  const file = join(mkdtempSync(join(tmpdir(), 'convsim-prism-')), 'openapi.json');
-  writeFileSync(file, docText);
-  const [port] = await freePorts(1);
-  prism = spawn('sh', ['-c', '"$@" & p=$!; read _; kill $p; wait $p', 'sh',
-    PRISM, 'proxy', '--errors', '-h', '127.0.0.1', '-p', String(port), file, target],
-  { stdio: ['pipe', 'pipe', 'pipe'] });
-  const listening = new Promise((resolve, reject) => {
-    const seenText = (b) => { prismLog += b; if (/Prism is listening/.test(prismLog)) resolve(); };
-    prism.stdout.on('data', seenText);
-    prism.stderr.on('data', seenText);
-    prism.on('exit', (code) => reject(new Error(`prism exited (${code}): ${prismLog.slice(-2000)}`)));
-  });
-  await Promise.race([listening, new Promise((_, no) => setTimeout(() => no(new Error(`prism did not start: ${prismLog}`)), 60000 * SLOW))]);
-  return `http://127.0.0.1:${port}`;
-}
+let prism, proxy;
 
 before(async () => {
   d = await startDaemon(['--heartbeat', '0.2']);
@@ -53,9 +29,10 @@ before(async () => {
   doc = r.body;
   ajv = new Ajv2020({ strict: false, allErrors: true });
   ajv.addSchema({ ...doc, $id: ID });
-  proxy = await startPrism(r.text, d.base);
+  prism = await startPrism(r.text, d.base);
+  proxy = prism.url;
 });
-after(async () => { prism?.stdin.end(); await d?.stop(); });
+after(async () => { prism?.stop(); await d?.stop(); });
 
 test('the served document is valid OpenAPI 3.1 (swagger-parser)', async () => {
   assert.equal(doc.openapi, '3.1.0');

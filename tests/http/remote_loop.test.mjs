@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The PI loop closed from the user's own code (docs/examples/remote_pi.py,
-// docs/control.md "The loop closed from your own code") against the real
+// docs/control-remote.md "The loop closed from your own code") against the real
 // daemon with a token: the branch it picks is the CLI's v(beta) curve between
 // its peaks, every setpoint segment settles with a steady error within 2 %,
 // the latency figures are positive, finite and ordered, the session is gone

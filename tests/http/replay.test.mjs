@@ -3,7 +3,7 @@
 // the checkpoint a session is restored from (all of them when it had none
 // yet) are applied again as its integrator reaches each one's
 // t_effective, and the control log goes on from where it was
-// (docs/hardening.md).
+// (docs/durability.md).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// A restore continues bit for bit (docs/hardening.md): a pace-max session
+// A restore continues bit for bit (docs/durability.md): a pace-max session
 // with a control on the way and an experiment, each killed with SIGKILL
 // three times while running and restored, end with the same status and
 // the same CSV, byte for byte, as an uninterrupted run of the same

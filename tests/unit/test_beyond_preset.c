@@ -60,7 +60,7 @@ static setup free_machine(void)
 /* A column of L layers settled on a deck held still (one-way coupling,
  * motor off): contact j (between layer j-1, or the deck, and layer j,
  * bottom first) carries the weight above it, W_j = (L - j) m_n g, so its
- * compression is (W_j / k)^(1/p) (docs/MODEL.md "Checks with known
+ * compression is (W_j / k)^(1/p) (docs/accuracy.md "Checks with known
  * answers"). The start places the stack so; the integrators must then
  * hold it there: the contact law's force at those compressions is the
  * weight above only if it is k delta^p. R = 1 (no unloading branch), so a

@@ -6,6 +6,7 @@
  * message naming the setting and its range, and change nothing.
  */
 #include "testutil.h"
+#include "table.h"
 
 static void refuses_out_of_range_with_range_in_message(void **state)
 {
@@ -60,6 +61,35 @@ static void converts_units_and_enums(void **state)
 	assert_close(v, 128.0, 1e-12);
 	assert_int_equal(sim_get(&u.p, &u.sc, &u.m, "rotation", &v), SIM_OK);
 	assert_close(v, 1.0, 0.0);
+}
+
+/* Degrees as a person reads them: what goes to SI and comes back through
+ * sim_table_user (the trajectories, the CLI, the API) is the number sent,
+ * and a beta the model made in mid-ramp (an SI value one ulp off a short
+ * decimal's, which the plain quotient shows as 31.48781250000000x) reads
+ * with 15 significant digits; a setting without a scale passes untouched. */
+static void user_units_come_back_as_written(void **state)
+{
+	(void)state;
+	const double deg[] = {60, 31.4878125, 59.99, 121.9, 0.1, 17.3, 179.999, 1e-7};
+	const sim_setting *beta = sim_setting_find("beta");
+	assert_non_null(beta);
+	int noisy = 0;
+	for (size_t i = 0; i < sizeof deg / sizeof deg[0]; i++) {
+		double si = sim_setting_to_si(beta, deg[i]);
+		assert_true(sim_table_user("beta", si) == deg[i]);
+	}
+	for (size_t i = 0; i < sizeof deg / sizeof deg[0] - 1; i++) {
+		double ramp = nextafter(sim_setting_to_si(beta, deg[i]), 10.0);
+		if (sim_setting_from_si(beta, ramp) == deg[i])
+			continue; /* one ulp that does not show in degrees */
+		assert_true(sim_table_user("beta", ramp) == deg[i]);
+		noisy++;
+	}
+	assert_true(noisy >= 3); /* the rounding is what makes them clean */
+	const double e = 0.021500000000000002; /* metres: scale 1, not rounded */
+	assert_true(sim_table_user("e", e) == e);
+	assert_true(sim_table_user("no_such_setting", 0.1 + 0.2) == 0.1 + 0.2);
 }
 
 static void sim_new_refuses_invalid_sets(void **state)
@@ -151,6 +181,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(refuses_out_of_range_with_range_in_message),
 		cmocka_unit_test(converts_units_and_enums),
+		cmocka_unit_test(user_units_come_back_as_written),
 		cmocka_unit_test(sim_new_refuses_invalid_sets),
 		cmocka_unit_test(every_setting_is_described),
 		cmocka_unit_test(errors_have_text),

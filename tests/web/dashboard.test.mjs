@@ -773,6 +773,25 @@ test('a phone (390 px): one column, no sideways scroll; one h1', async () => {
 				const b = await page.$eval(sel, e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; });
 				assert.ok(b[0] >= 0 && b[1] <= 390, `${sel} on screen: ${b}`);
 			}
+		/* an empty plot's text sits in the plotting area, clear of the axes'
+		 * tick labels (it covered the left axis's labels at this width):
+		 * each plot shown as empty for a moment */
+		const boxes = await page.$$eval('.plot', ps => ps.filter(p => p.offsetParent && p.querySelector('.u-over')).map(p => {
+			const was = p.classList.contains('empty');
+			p.classList.add('empty');
+			const a = getComputedStyle(p, '::after');
+			const r = p.getBoundingClientRect(), q = p.querySelector('.u-over').getBoundingClientRect();
+			const box = { id: p.id, text: a.content, after: [a.left, a.top, a.width, a.height].map(parseFloat),
+				over: [q.left - r.left, q.top - r.top, q.width, q.height] };
+			p.classList.toggle('empty', was);
+			return box;
+		}));
+		assert.ok(boxes.length >= 8, `plots shown: ${boxes.map(b => b.id)}`);
+		for (const b of boxes) {
+			assert.notEqual(b.text, 'none', `${b.id}: the empty text is shown`);
+			b.after.forEach((v, i) => assert.ok(Math.abs(v - b.over[i]) <= 1.5,
+				`${b.id}: the empty text's box ${b.after} is the plotting area ${b.over}`));
+		}
 	} finally {
 		await page.setViewportSize({ width: 1600, height: 1300 });
 	}

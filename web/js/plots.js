@@ -132,12 +132,26 @@ function sizeOf(el, aspect) {
 	return { width: w, height: h };
 }
 
+/* The plotting area's box on the container, as CSS variables: an empty
+ * plot's text (.plot.empty::after) sits there, inside the axes, so that it
+ * never covers a tick label however narrow the plot. */
+function placeEmpty(el, plot) {
+	const r = el.getBoundingClientRect(), o = plot.over.getBoundingClientRect();
+	if (!o.width) return;
+	el.style.setProperty('--over-left', `${o.left - r.left}px`);
+	el.style.setProperty('--over-top', `${o.top - r.top}px`);
+	el.style.setProperty('--over-width', `${o.width}px`);
+	el.style.setProperty('--over-height', `${o.height}px`);
+}
+
 function observe(el, plot, aspect, legendRoom) {
 	const ro = new ResizeObserver(() => {
 		const s = sizeOf(el, aspect);
 		if (Math.abs(s.width - plot.width) > 2) plot.setSize({ width: s.width, height: s.height - legendRoom });
+		requestAnimationFrame(() => placeEmpty(el, plot));
 	});
 	ro.observe(el);
+	requestAnimationFrame(() => placeEmpty(el, plot));
 	return ro;
 }
 
