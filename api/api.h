@@ -271,11 +271,17 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
  * of memory. api_parse_spec_file reads it back through api_parse_session
  * (400/422 as a POST would be), with its format in *format (1: a file
  * without the member, as builds before format 2 wrote it); a format above
- * API_SPEC_FILE_FORMAT (a newer build's) is refused. */
+ * API_SPEC_FILE_FORMAT (a newer build's) is refused. A session that asked
+ * for feed_model auto also keeps its pick ("feed_model_pick", as the
+ * status shows it; pick NULL: none), read back into *pick with *picked 1
+ * (0 where the file has none or one this build cannot read; a build
+ * before it ignores the member). */
 #define API_SPEC_FILE_FORMAT 2
-char *api_spec_file(const api_spec *spec, double created, int owned);
+char *api_spec_file(const api_spec *spec, double created, int owned,
+		    const sim_feed_choice *pick);
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, int *format, api_problem *pb);
+			    double *created, int *owned, int *format, sim_feed_choice *pick,
+			    int *picked, api_problem *pb);
 /* Check a spec that did not come from api_parse_session (a file read
  * back): its strings are terminated, the preset known, pace, until and
  * sample_rate within the ranges the parser allows, every setting within
@@ -398,6 +404,7 @@ typedef struct api_view {
 				  replayed: "restored": "replayed" */
 	double replay_seconds; /* wall s the replay took; NAN while it runs */
 	int has_bed;           /* feed_model liggghts: bed is its bed */
+	const sim_feed_choice *pick; /* feed_model auto's pick, or NULL */
 	api_bed bed;
 } api_view;
 

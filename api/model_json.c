@@ -7,6 +7,8 @@
  * writers all use it without using each other.
  */
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 #include "json_int.h"
 
@@ -20,7 +22,14 @@ int api_model_check(const api_spec *spec, const sim_status *st, sim_model_error 
 		p.m_n = st->m_n;
 		p.mu = st->mu;
 	}
-	return sim_model_check(&p, &spec->scene, me);
+	int rc = sim_model_check(&p, &spec->scene, me);
+	/* a model_tol given (feed_model auto picked at creation, the pick
+	 * kept): say where the scene as it stands now leaves it */
+	double tol = spec->scene.model_tol;
+	size_t n = strlen(me->note);
+	if (rc >= 0 && tol > 0 && !(me->checked && me->error + me->error_uncertainty <= tol))
+		snprintf(me->note + n, sizeof me->note - n, "; outside model_tol %g m/s", tol);
+	return rc;
 }
 
 void api_add_model_error(cJSON *o, const sim_model_error *me)

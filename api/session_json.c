@@ -104,7 +104,38 @@ static void add_settings(cJSON *o, const api_spec *sp)
 							  &sp->method, groups[g]));
 }
 
-char *api_spec_file(const api_spec *spec, double created, int owned)
+/* feed_model auto's pick: {model, why, expected_cpu_s_per_s}. */
+static cJSON *pick_object(const sim_feed_choice *k)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "model", k->model == SIM_FEED_EXTERNAL ? "liggghts" : "column");
+	cJSON_AddStringToObject(o, "why", k->why);
+	api_add_number(o, "expected_cpu_s_per_s", k->expected_cpu_s_per_s);
+	return o;
+}
+
+/* pick_object's member of o back into *k: 1, or 0 if absent or not one. */
+static int read_pick(const cJSON *o, sim_feed_choice *k)
+{
+	const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "feed_model_pick");
+	const cJSON *m = cJSON_GetObjectItemCaseSensitive(p, "model");
+	const cJSON *w = cJSON_GetObjectItemCaseSensitive(p, "why");
+	const cJSON *c = cJSON_GetObjectItemCaseSensitive(p, "expected_cpu_s_per_s");
+	if (!cJSON_IsString(m) || !cJSON_IsString(w) || !(cJSON_IsNumber(c) || cJSON_IsNull(c)))
+		return 0;
+	int column = strcmp(m->valuestring, "column") == 0;
+	if (!column && strcmp(m->valuestring, "liggghts") != 0)
+		return 0;
+	memset(k, 0, sizeof *k);
+	k->model = column ? SIM_FEED_COLUMN : SIM_FEED_EXTERNAL;
+	k->min = NAN;
+	k->expected_cpu_s_per_s = cJSON_IsNumber(c) ? c->valuedouble : NAN;
+	snprintf(k->why, sizeof k->why, "%s", w->valuestring);
+	return 1;
+}
+
+char *api_spec_file(const api_spec *spec, double created, int owned,
+		    const sim_feed_choice *pick)
 {
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddNumberToObject(o, "format", API_SPEC_FILE_FORMAT);
@@ -119,11 +150,14 @@ char *api_spec_file(const api_spec *spec, double created, int owned)
 		cJSON_AddNullToObject(body, "until");
 	api_add_number(body, "sample_rate", spec->sample_rate);
 	add_settings(body, spec);
+	if (pick)
+		cJSON_AddItemToObject(o, "feed_model_pick", pick_object(pick));
 	return api_print_free(o);
 }
 
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
-			    double *created, int *owned, int *format, api_problem *pb)
+			    double *created, int *owned, int *format, sim_feed_choice *pick,
+			    int *picked, api_problem *pb)
 {
 	cJSON *o = cJSON_ParseWithLength(text, len);
 	const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "format");
@@ -146,6 +180,7 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
 									  : NULL;
 	*created = cJSON_IsNumber(c) ? c->valuedouble : 0;
 	*owned = cJSON_IsTrue(w);
+	*picked = read_pick(o, pick);
 	cJSON_Delete(o);
 	if (!body)
 		return api_fail(pb, API_MALFORMED, NULL, "not a session's spec "
@@ -211,6 +246,8 @@ static cJSON *session_object(const api_view *v, int with_spec)
 	}
 	if (v->has_bed)
 		cJSON_AddItemToObject(o, "bed", bed_object(&v->bed));
+	if (v->pick) /* feed_model auto: what it took and why */
+		cJSON_AddItemToObject(o, "feed_model_pick", pick_object(v->pick));
 	if (v->experiment[0])
 		cJSON_AddStringToObject(o, "experiment", v->experiment);
 	else

@@ -350,7 +350,8 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb)
 	if (spec->scene.feed_model != SIM_FEED_COLUMN) {
 		api_fail(pb, API_RANGE, "scene.feed_model",
 			 "scene.feed_model must be column in sweeps, fits and experiments; liggghts "
-			 "runs as a session (POST /api/v1/sessions) or in `convsim run` (docs/dem.md)");
+			 "and auto run as a session (POST /api/v1/sessions) or in `convsim run` "
+			 "(docs/dem.md, docs/feed-models.md)");
 		pb->has_range = 1;
 		pb->min = 0.0;
 		pb->max = 0.0;

@@ -23,7 +23,7 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
-	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_VARY,
+	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_MAX_DEM_COST, OPT_VARY,
 	OPT_LHS, OPT_SEED, OPT_BAND_FROM
 };
 
@@ -56,6 +56,10 @@ typedef struct cli_opts {
 	const char *data, *peaks, *free_list;
 	double curve_step, fd_step; /* deg; relative */
 	int max_iter, starts;
+	/* run --set feed_model=auto: the pick (feed_auto.c), picked 1 */
+	sim_feed_choice pick;
+	int picked;
+	double max_dem_cost; /* run --max-dem-cost: CPU s a simulated second, INFINITY none */
 } cli_opts;
 
 /* The first pass over command cmd's options: help (shown, -1), a wrong
@@ -98,6 +102,16 @@ char *cli_slurp(const char *cmd, const char *opt, const char *path);
  * installed; in the plain convsim cli/coupled_none.c, which hands
  * the run over to convsim-mpi or says how to get it). Exit status as run. */
 int cli_run_coupled(const cli_opts *o);
+/* What this binary knows of a LIGGGHTS bed for o's scene (sim_feed_pick):
+ * convsim-mpi with LIGGGHTS its cost (dem_bed_spec_cost), the plain
+ * convsim whether it can hand the run to one; the limit --max-dem-cost. */
+void cli_liggghts_here(const cli_opts *o, sim_feed_liggghts *lg);
+/* run's feed_model auto (feed_auto.c): pick, set o->sc.feed_model, say
+ * the pick on stderr. 0, or 2 after the refusal on stderr. */
+int cli_feed_auto(cli_opts *o);
+/* The summary's member ",\n  \"feed_model_pick\": {...}" where auto
+ * picked, else nothing. */
+void cli_put_feed_pick(FILE *f, const cli_opts *o);
 
 typedef struct cli_opt {
 	unsigned cmds;    /* CMD_* bits: the commands that take it */

@@ -134,6 +134,7 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 	NUM("model_error_uncertainty", me.checked ? me.error_uncertainty : NAN);
 	fprintf(f, ",\n  \"model_checked\": %s,\n  \"model_check_note\": \"%s\"",
 		me.checked ? "true" : "false", me.note);
+	cli_put_feed_pick(f, o);
 	fprintf(f, ",\n  \"steady\": %s", st->steady ? "true" : "false");
 	NUM("step_error", st->step_error);
 	NUM("tol", st->tol);
@@ -169,6 +170,8 @@ static int cmd_run(int argc, char **argv)
 	int rc = cli_parse(argc, argv, CMD_RUN, &o);
 	if (rc)
 		return rc < 0 ? 0 : rc;
+	if (o.sc.feed_model == SIM_FEED_AUTO && cli_feed_auto(&o) != 0)
+		return 2;
 	if (o.sc.feed_model == SIM_FEED_EXTERNAL)
 		return cli_run_coupled(&o);
 	char msg[200];

@@ -45,6 +45,9 @@ static const cli_opt options[] = {
 	 "cw (the paper's clockwise, rotor speed > 0) or ccw; the same as --set rotation=..."},
 	{CMD_RUN, OPT_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
 	 "feed_model=liggghts: machine steps per coupling interval with the bed (docs/dem.md)"},
+	{CMD_RUN, OPT_MAX_DEM_COST, "max-dem-cost", 0, "S", "CPU s per simulated s", "none",
+	 "feed_model=auto: a LIGGGHTS bed expected to cost more is not picked "
+	 "(docs/feed-models.md)"},
 	{CMD_SWEEP, OPT_BETA, "beta", 'b', "FROM:TO:STEP", "deg", "0:180:10",
 	 "guide angles in [0, 180], or one angle; the same as --vary beta=FROM:TO:STEP"},
 	{CMD_SWEEP, OPT_VARY, "vary", 'V', "NAME=FROM:TO:STEP|NAME=V1,V2,...", NULL, NULL,

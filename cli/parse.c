@@ -142,6 +142,10 @@ static int apply_option(cli_opts *o, unsigned cmd, int id, const char *arg)
 	case OPT_COUPLING_STEPS:
 		bad = whole(o->cmd, "coupling-steps", arg, 1000, &o->coupling_steps);
 		break;
+	case OPT_MAX_DEM_COST:
+		bad = cli_number(o->cmd, "max-dem-cost", "CPU seconds", arg, 0, 1e9, 1,
+				 &o->max_dem_cost);
+		break;
 	case OPT_OUT: o->out = arg; break;
 	case OPT_FORMAT: o->format = arg; break;
 	case OPT_BETA:
@@ -197,6 +201,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 	o->rate = 1000.0;
 	o->threads = 2;
 	o->coupling_steps = 1;
+	o->max_dem_cost = INFINITY;
 	o->rotation = "cw,ccw";
 	o->seed = 1;
 	o->curve_step = 5;

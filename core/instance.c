@@ -22,6 +22,13 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
 	sim *s = NULL;
 	if (e != SIM_OK)
 		goto fail;
+	if (sc->feed_model == SIM_FEED_AUTO) { /* the caller's to resolve */
+		e = SIM_EPARAM;
+		if (msg)
+			snprintf(msg, msglen, "feed_model auto picks the model of one run "
+					      "(convsim run, a session): give column here");
+		goto fail;
+	}
 	e = SIM_ENOMEM;
 	s = calloc(1, sizeof *s);
 	if (!s)

@@ -72,7 +72,8 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_SCENE, trough_rotation, BOOL, "", 0, 1, NULL, 1, "true: integrate alpha even on a symmetric machine; false: the engine drops it there") \
 	X(G_SCENE, mirror, BOOL, "", 0, 1, NULL, 1, "true: a sweep or fit over both senses of a mirror-symmetric machine takes (ccw, 180 - beta) as the mirror image of (cw, beta); false: it integrates every point") \
 	X(G_SCENE, feed_coupling, BOOL, "", 0, 1, NULL, 1, "false: the feed does not act on the trough") \
-	X(G_SCENE, feed_model, ENUM, "", 0, 1, "column|liggghts", 1, "column: the paper's columns of layers; liggghts: a LIGGGHTS bed coupled at the machine step (convsim built with LIGGGHTS, docs/dem.md)") \
+	X(G_SCENE, feed_model, ENUM, "", 0, 2, "column|liggghts|auto", 1, "column: the paper's columns of layers; liggghts: a LIGGGHTS bed coupled at the machine step (convsim built with LIGGGHTS, docs/dem.md); auto: the cheapest of the two whose model error is within model_tol, picked at creation (docs/feed-models.md)") \
+	X(G_SCENE, model_tol, REAL, "m/s", 0, 1, NULL, 1, "feed_model auto: the largest model error (model_error plus its uncertainty) the feed model may have; 0: none given") \
 	X(G_SCENE, friction, ENUM, "", 0, 1, "coulomb|regularised", 1, "friction law")          \
 	X(G_SCENE, friction_eps, REAL, "m/s", 1e-6, 1, NULL, 1, "regularised friction width")  \
 	X(G_SCENE, motor_on, BOOL, "", 0, 1, NULL, 1, "drive switched on at t = 0")            \
@@ -104,12 +105,16 @@ static const sim_setting table[] = {SETTINGS(ROW_PUB){
 typedef struct loc {
 	int group;
 	size_t off;
+	size_t size; /* a REAL of sizeof(float) is a float (model_tol) */
 } loc;
 #define OFF_G_PARAM(f) offsetof(sim_params, f)
 #define OFF_G_SCENE(f) offsetof(sim_scene, f)
 #define OFF_G_METHOD(f) offsetof(sim_method, f)
-#define ROW_LOC(grp, f, k, u, lo, hi, ch, sc, d) {grp, OFF_##grp(f)},
-static const loc locs[] = {SETTINGS(ROW_LOC){G_METHOD, 0}};
+#define SIZE_G_PARAM(f) sizeof(((sim_params *)0)->f)
+#define SIZE_G_SCENE(f) sizeof(((sim_scene *)0)->f)
+#define SIZE_G_METHOD(f) sizeof(((sim_method *)0)->f)
+#define ROW_LOC(grp, f, k, u, lo, hi, ch, sc, d) {grp, OFF_##grp(f), SIZE_##grp(f)},
+static const loc locs[] = {SETTINGS(ROW_LOC){G_METHOD, 0, 0}};
 #undef ROW_LOC
 
 #define N_SETTINGS (sizeof table / sizeof table[0])
@@ -126,6 +131,20 @@ static void *field(sim_params *p, sim_scene *s, sim_method *m, size_t i)
 		     : locs[i].group == G_SCENE ? (char *)s
 						 : (char *)m;
 	return base + locs[i].off;
+}
+
+/* A float setting's value as the shortest decimal that is that float
+ * (0.005, not 0.004999999888), so that it reads back as it was set. */
+static double float_value(float f)
+{
+	char buf[32];
+	for (int prec = 1; prec < 9; prec++) {
+		snprintf(buf, sizeof buf, "%.*g", prec, (double)f);
+		double v = strtod(buf, NULL);
+		if ((float)v == f)
+			return v;
+	}
+	return (double)f;
 }
 
 static int find(const char *name)
@@ -190,6 +209,8 @@ int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name, double
 	void *f = field(p, s, m, (size_t)i);
 	if (strcmp(t->name, "rotation") == 0)
 		*(int *)f = value == 0 ? SIM_CW : SIM_CCW;
+	else if (t->kind == SIM_KIND_REAL && locs[i].size == sizeof(float))
+		*(float *)f = (float)value;
 	else if (t->kind == SIM_KIND_REAL)
 		*(double *)f = value;
 	else
@@ -284,6 +305,8 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const 
 	const void *f = field((sim_params *)p, (sim_scene *)s, (sim_method *)m, (size_t)i);
 	if (strcmp(t->name, "rotation") == 0)
 		*value = *(const int *)f == SIM_CW ? 0 : 1;
+	else if (t->kind == SIM_KIND_REAL && locs[i].size == sizeof(float))
+		*value = float_value(*(const float *)f);
 	else if (t->kind == SIM_KIND_REAL)
 		*value = *(const double *)f;
 	else

@@ -35,6 +35,10 @@ enum { SIM_START_REST = 0, SIM_START_STEADY = 1 };
  * (sim_set_deck_load): no feed coordinates, the feed's weight on the deck
  * at the start. */
 enum { SIM_FEED_COLUMN = 0, SIM_FEED_EXTERNAL = 1 };
+/* The setting's third choice, `auto`: a request, never a running model.
+ * The caller resolves it to one of the two (sim_feed_pick) before an
+ * instance is made; sim_new refuses it. */
+enum { SIM_FEED_AUTO = 2 };
 
 /* Physical parameters, docs/MODEL.md names, SI (angles in radians). */
 typedef struct sim_params {
@@ -91,6 +95,9 @@ typedef struct sim_scene {
 	int friction;         /* SIM_FRICTION_* */
 	double friction_eps;  /* m/s, regularised friction width */
 	int motor_on;         /* drive on at t = 0 */
+	float model_tol;      /* m/s: feed_model auto's bound on the model error
+				 (sim_feed_pick), 0 none; a float in motor_on's
+				 padding, so the struct's size and offsets stay */
 	double transient;     /* s: transport velocity ignores t < transient */
 	int start;            /* SIM_START_REST or SIM_START_STEADY */
 	int feed_model;       /* SIM_FEED_COLUMN or SIM_FEED_EXTERNAL (in start's

@@ -72,6 +72,38 @@ typedef struct sim_model_error {
  * no I/O, no allocation. */
 int sim_model_check(const sim_params *p, const sim_scene *sc, sim_model_error *out);
 
+/* feed_model auto (docs/feed-models.md "feed_model=auto"): the cheapest
+ * feed model whose model error is within the scene's model_tol. What the
+ * caller knows of a LIGGGHTS bed here: whether one can run (else
+ * `unavailable` says why, a clause), its expected cost in CPU s a
+ * simulated second (NaN: not known to this caller, no limit checked) and
+ * the caller's limit on it (INFINITY: none; `limit` names it). */
+typedef struct sim_feed_liggghts {
+	int available;
+	const char *unavailable;
+	double cost, max_cost;
+	const char *limit;
+} sim_feed_liggghts;
+/* The pick: model SIM_FEED_COLUMN or SIM_FEED_EXTERNAL, or -1 when none
+ * fits (field then names the setting to change, "model_tol"; min the
+ * smallest model_tol the column model would meet here, NaN if none);
+ * expected_cpu_s_per_s the LIGGGHTS bed's cost (NaN for column); why one
+ * plain sentence, which model and why. */
+typedef struct sim_feed_choice {
+	int model;
+	const char *field;
+	double min;
+	double expected_cpu_s_per_s;
+	char why[480];
+} sim_feed_choice;
+/* Pick for the scene (its feed_model need not be auto): column where its
+ * DEM check (sim_model_check) is within model_tol, model_error plus its
+ * uncertainty; else LIGGGHTS where lg says one can run within its limit;
+ * else none. Without a feed the pick is column; model_tol 0 picks none.
+ * Returns 0 picked, -1 none. Pure: no I/O, no allocation. */
+int sim_feed_pick(const sim_params *p, const sim_scene *sc, const sim_feed_liggghts *lg,
+		  sim_feed_choice *out);
+
 /* Names of known presets, NULL-terminated, static. Fill by name. */
 extern const char *const sim_preset_names[];
 int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m);

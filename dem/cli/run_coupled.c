@@ -54,7 +54,9 @@ static void run_summary(const cli_opts *o, const dem_coupled *c, const dem_bed_s
 	       ms.e_input);
 	printf("  \"intervals\": %ld,\n  \"dem_cpu_seconds\": %.17g,\n", st.intervals, st.dem_cpu_seconds);
 	printf("  \"cpu_seconds\": %.17g,\n  \"wall_seconds\": %.17g,\n", cpu, wall);
-	printf("  \"error\": %s\n}\n", failed ? "true" : "null");
+	printf("  \"error\": %s", failed ? "true" : "null");
+	cli_put_feed_pick(stdout, o);
+	printf("\n}\n");
 }
 
 int cli_run_coupled(const cli_opts *o)
@@ -121,4 +123,16 @@ int cli_run_coupled(const cli_opts *o)
 	dem_coupled_free(c);
 	MPI_Finalize();
 	return failed ? 1 : 0;
+}
+
+void cli_liggghts_here(const cli_opts *o, sim_feed_liggghts *lg)
+{
+	dem_bed_spec bed;
+	dem_bed_spec_default(&o->p, (double)o->sc.layers, &bed);
+	*lg = (sim_feed_liggghts){
+		.available = 1,
+		.cost = dem_bed_spec_cost(&bed),
+		.max_cost = o->max_dem_cost,
+		.limit = "--max-dem-cost",
+	};
 }

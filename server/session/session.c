@@ -224,6 +224,9 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 			 "delete one first", cfg->max_sessions);
 		return NULL;
 	}
+	/* feed_model auto: the model the session runs, picked once here */
+	if (copy.scene.feed_model == SIM_FEED_AUTO && srv_dem_pick(s, &copy, pb) != API_OK)
+		goto fail;
 	/* a LIGGGHTS bed: its program, its method and one of its slots */
 	if (srv_dem_wanted(spec)) {
 		if (srv_dem_admit(&copy, pb) != API_OK)

@@ -23,6 +23,7 @@
  * balances count from there.
  */
 #include <limits.h>
+#include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
@@ -107,6 +108,32 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 			return api_budget(pb, "dem-sessions", cfg->max_dem_sessions, 5);
 		}
 	} while (!atomic_compare_exchange_weak(&live, &n, n + 1));
+	return API_OK;
+}
+
+api_err srv_dem_pick(srv_session *s, api_spec *spec, api_problem *pb)
+{
+	sim_feed_choice *pick = &s->pick;
+	dem_bed_spec bed;
+	dem_bed_spec_default(&spec->params, (double)spec->scene.layers, &bed);
+	sim_feed_liggghts lg = {
+		.available = bed_path[0] && access(bed_path, X_OK) == 0,
+		.unavailable = "this daemon does not find its bed program convsim-bed (built "
+			       "where LIGGGHTS is installed, or --dem-bed PATH)",
+		.cost = dem_bed_spec_cost(&bed),
+		.max_cost = cfg->max_dem_cost,
+		.limit = "--max-dem-cost",
+	};
+	if (sim_feed_pick(&spec->params, &spec->scene, &lg, pick) != 0) {
+		api_fail(pb, API_RANGE, "scene.model_tol", "%s", pick->why);
+		pb->has_range = 1;
+		pb->min = isfinite(pick->min) ? pick->min : 0.0;
+		pb->max = 1.0;
+		return pb->code;
+	}
+	spec->scene.feed_model = pick->model;
+	s->picked = 1;
+	srv_log(SRV_LOG_INFO, "session %s: feed_model auto: %s", s->entry.id, pick->why);
 	return API_OK;
 }
 

@@ -175,6 +175,8 @@ struct srv_session {
 	srv_session_restore restore; /* a restored session's replay (session_store.c) */
 	srv_session_budget budget; /* what it holds of the budgets (worker.c) */
 	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
+	sim_feed_choice pick;     /* feed_model auto's pick (srv_dem_pick) */
+	int picked;               /* 1: auto was asked and pick holds it */
 	int create_fd;            /* while created: the client's socket or -1
 				     (a bed's settling ends when it leaves) */
 };
@@ -195,6 +197,12 @@ int srv_dem_wanted(const api_spec *spec);
  * coupled step; else 422 on integrator.method), one of --max-dem-sessions
  * taken (else 429): give it back with srv_dem_release. */
 api_err srv_dem_admit(api_spec *spec, api_problem *pb);
+/* feed_model auto (sim_feed_pick, docs/feed-models.md "feed_model=auto"):
+ * the spec's feed model becomes the pick, which s->pick says (s->picked
+ * 1, logged), a LIGGGHTS bed offered where its program exists and its
+ * expected cost is within --max-dem-cost; none fits: 422 on
+ * scene.model_tol with the why. */
+api_err srv_dem_pick(srv_session *s, api_spec *spec, api_problem *pb);
 /* A restored session's slot, taken even beyond the limit; and giving one
  * back. */
 void srv_dem_hold(void);

@@ -87,6 +87,7 @@ void srv_session_view(srv_session *s, api_view *v)
 	v->replay_seconds = s->restore.replay_seconds;
 	v->has_bed = srv_dem_wanted(&s->spec);
 	v->bed = s->dem.bed;
+	v->pick = s->picked ? &s->pick : NULL;
 	if (s->exp)
 		snprintf(v->experiment, sizeof v->experiment, "%s",
 			 srv_exp_id(s->exp));

@@ -54,11 +54,10 @@ typedef struct write_of {
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
- * reason (while spec.json is not on disk, its own). A later success clears
- * it, unless spec.json is not on disk: the first success after its failure
+ * reason (spec.json's while it is not on disk). A later success clears it,
+ * unless spec.json is not on disk: the first success after its failure
  * (space came back) queues it again, and the session reports healthy only
- * once that rewrite is written (lock order: the session's, then the
- * store's). */
+ * once that rewrite is written (lock order: the session's, the store's). */
 static void written(void *arg, int err, const char *what)
 {
 	write_of *w = arg;
@@ -116,7 +115,8 @@ void srv_persist_spec(srv_session *s, int now)
 {
 	if (!srv_store_enabled() || s->damaged)
 		return;
-	char *text = api_spec_file(&s->spec, s->created, s->owned), path[128];
+	char *text = api_spec_file(&s->spec, s->created, s->owned, s->picked ? &s->pick : NULL),
+	     path[128];
 	session_dir(path, sizeof path, s->entry.id, "spec.json");
 	if (text && now) /* a creation: answered once it is on disk */
 		s->persist.spec_unwritten = srv_store_write_now(path, text, strlen(text),
@@ -375,7 +375,7 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 		api_problem pb;
 		int format = 0;
 		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
-						&s->owned, &format, &pb);
+						&s->owned, &format, &s->pick, &s->picked, &pb);
 		free(text);
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);

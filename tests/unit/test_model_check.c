@@ -7,6 +7,9 @@
  * interpolated in beta; the measured angles' bounds are inside, beyond them
  * is not checked; another depth, machine or contact is not checked and the
  * note names the nearest checked point; no column feed, no check.
+ * sim_feed_pick (feed_model auto): column where that error plus its
+ * uncertainty is within model_tol, bounds included; else LIGGGHTS within
+ * its limit; else none, naming model_tol and the smallest that fits.
  */
 #include "testutil.h"
 
@@ -120,6 +123,57 @@ static void no_column_feed(void **state)
 	assert_non_null(strstr(me.note, "LIGGGHTS"));
 }
 
+static void pick_at(setup *u, double tol, const sim_feed_liggghts *lg, sim_feed_choice *k,
+		    int expect)
+{
+	char v[32];
+	snprintf(v, sizeof v, "%.9g", tol);
+	set(u, "model_tol", v);
+	assert_int_equal(sim_feed_pick(&u->p, &u->sc, lg, k), expect);
+}
+
+static void feed_pick_rule(void **state)
+{
+	(void)state;
+	sim_feed_choice k;
+	setup u = bed4();
+	set(&u, "beta", "150");
+	set(&u, "feed_model", "auto");
+	/* at a map point the uncertainty is the seeds' spread */
+	double bound = D150 + SD150 + SD150;
+	sim_feed_liggghts cheap = {.available = 1, .cost = 1.0, .max_cost = 10.0, .limit = "L"};
+	sim_feed_liggghts dear = {.available = 1, .cost = 20.0, .max_cost = 10.0, .limit = "L"};
+	pick_at(&u, bound + 1e-6, &cheap, &k, 0);
+	assert_int_equal(k.model, SIM_FEED_COLUMN);
+	assert_true(isnan(k.expected_cpu_s_per_s));
+	assert_non_null(strstr(k.why, "column: DEM check within ±0.008 m/s here"));
+	pick_at(&u, bound - 1e-6, &cheap, &k, 0);
+	assert_int_equal(k.model, SIM_FEED_EXTERNAL);
+	assert_true(k.expected_cpu_s_per_s == 1.0);
+	pick_at(&u, bound - 1e-6, &dear, &k, -1);
+	assert_string_equal(k.field, "model_tol");
+	assert_true(fabs(k.min - bound) < 1e-12);
+	assert_non_null(strstr(k.why, "would cost about 20 CPU s a simulated second, over L 10"));
+	pick_at(&u, bound - 1e-6, NULL, &k, -1);
+	/* the bound is a float: it reads back as written */
+	double tol;
+	set(&u, "model_tol", "0.005");
+	assert_int_equal(sim_get_user(&u.p, &u.sc, &u.m, "model_tol", &tol), SIM_OK);
+	assert_true(tol == 0.005);
+	/* no bound, no pick; no feed, nothing to pick */
+	pick_at(&u, 0, &cheap, &k, -1);
+	assert_string_equal(k.field, "model_tol");
+	set(&u, "feed", "false");
+	pick_at(&u, 0, &cheap, &k, 0);
+	assert_int_equal(k.model, SIM_FEED_COLUMN);
+	/* auto is never an instance's model */
+	set(&u, "feed", "true");
+	int err = SIM_OK;
+	char msg[160];
+	assert_null(sim_new(&u.p, &u.sc, &u.m, &err, msg, sizeof msg));
+	assert_int_equal(err, SIM_EPARAM);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -127,6 +181,7 @@ int main(void)
 		cmocka_unit_test(bounds_included_and_beyond),
 		cmocka_unit_test(other_scenes_name_the_nearest),
 		cmocka_unit_test(no_column_feed),
+		cmocka_unit_test(feed_pick_rule),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

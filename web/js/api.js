@@ -20,12 +20,14 @@
  * NetworkError. This module touches no DOM and runs under node:test.
  */
 
+import { loopRequest, normalizeLoop } from './api-loop.js';
 import { BASE, authHeaders, sessionRequest, sweepRequest, experimentRequest, fitRequest } from './api-requests.js';
 import { normalizeSession, normalizeControl, normalizeSweep, normalizeExperiment,
 	normalizePresets, normalizeMethods, trajectoryColumns, methodEnum } from './api-normalize.js';
 
 export * from './api-normalize.js';
 export * from './api-requests.js';
+export * from './api-loop.js';
 export { openStream } from './api-stream.js';
 
 /* ---- errors ------------------------------------------------------------ */
@@ -154,6 +156,15 @@ export async function createExperiment(form) {
 }
 export async function getExperiment(id) {
 	return normalizeExperiment((await request('GET', `/experiments/${enc(id)}`)).data);
+}
+/* A closed loop or an identification (api-loop.js): the experiment as
+ * normalizeExperiment gives it, with its kind, control and identify. */
+const loopExperiment = d => ({ ...normalizeExperiment(d), ...normalizeLoop(d) });
+export async function createLoopExperiment(form) {
+	return loopExperiment((await request('POST', '/experiments', loopRequest(form))).data);
+}
+export async function getLoopExperiment(id) {
+	return loopExperiment((await request('GET', `/experiments/${enc(id)}`)).data);
 }
 
 export async function integratorNames() {

@@ -47,6 +47,21 @@ export function makePlots() {
 		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],
 		yLabel: 'v / (m/s)', y2Label: 'β / °', y2Range: [0, 180], aspect: 0.5,
 	});
+	/* a closed loop: v and its setpoint on the left axis, β on the right */
+	app.plots.loop = new TimePlot($('#plot-loop'), {
+		series: [{ label: 'v / (m/s)', color: PALETTE[0] }, { label: 'setpoint / (m/s)', color: PALETTE[1], dash: [6, 3] },
+			{ label: 'β / °', color: PALETTE[3], scale: 'y2' }],
+		yLabel: 'v / (m/s)', y2Label: 'β / °', aspect: 0.5,
+	});
+	/* an identification: the measured response and the fitted model over it */
+	app.plots.ident = new TimePlot($('#plot-ident'), {
+		series: [{ label: 'measured v / (m/s)', color: PALETTE[0] }, { label: 'fitted FOPDT / (m/s)', color: PALETTE[1], width: 2 },
+			{ label: 'β / °', color: PALETTE[3], scale: 'y2' }],
+		yLabel: 'v / (m/s)', y2Label: 'β / °', aspect: 0.5,
+	});
+	/* the two share a card: each named for what it draws */
+	$('#plot-loop').setAttribute('aria-label', 'Closed loop: v, setpoint and β against time (plot; its data: the Data table below)');
+	$('#plot-ident').setAttribute('aria-label', 'Identification: measured and fitted v against time (plot; its data: the Data table below)');
 }
 
 /* The strokes plot; alike: both eliminators move the same (the symmetric

@@ -148,3 +148,14 @@ export function tickText(v, step) {
 	const x = Number.isFinite(step) && Math.abs(v) < step / 2 ? 0 : v;
 	return x.toFixed(d);
 }
+
+/* A value with its standard error: the error at two significant digits
+ * and the value to the same decimal place, "-0.00385 ± 0.00020"; without
+ * a finite positive error the value at three significant digits. */
+export function fmtPm(v, se, unit = '') {
+	if (!Number.isFinite(v)) return DASH;
+	if (!(Number.isFinite(se) && se > 0)) return fmtSig(v, 3, unit);
+	const d = Math.min(12, Math.max(0, 1 - Math.floor(Math.log10(se))));
+	const s = `${fmt(v, d)} ± ${se.toFixed(d)}`;
+	return unit ? `${s} ${unit}` : s;
+}

@@ -9,7 +9,8 @@
  * traces (live.js), its polled status the tiles and controls (status.js),
  * and draw.js redraws at most every animation frame. ui.js holds the state
  * they share; figures.js says which plot shows what; controls.js wires the
- * live-control card; sweep.js, experiment.js and fit.js are the job panels.
+ * live-control card; sweep.js, experiment.js, loop.js and fit.js are the
+ * job panels.
  * api.js (with api-normalize.js, api-requests.js, api-stream.js) is the
  * one link to the daemon; auth.js gives it the token from the URL's
  * fragment (#token=...).
@@ -25,6 +26,7 @@ import { wireControls } from './controls.js';
 import { runSweep } from './sweep.js';
 import { wireFit } from './fit.js';
 import { runExperiment } from './experiment.js';
+import { wireLoop } from './loop.js';
 
 const HEALTH_MS = 3000;
 
@@ -48,6 +50,7 @@ function wire() {
 	$('#sweep-form').addEventListener('submit', runSweep);
 	wireFit();
 	$('#experiment-form').addEventListener('submit', runExperiment);
+	wireLoop();
 }
 
 let presetList = [];
