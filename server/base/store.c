@@ -93,12 +93,13 @@ static int fsync_parent(const char *p)
 	return rc;
 }
 
-/* The atomic write of one job: 0, or an errno with what in msg. */
-static int write_atomic(const store_job *j, char *msg, size_t msglen)
+/* The atomic write of one job through path + tmp_ext: 0, or an errno
+ * with what in msg. */
+static int write_atomic(const store_job *j, const char *tmp_ext, char *msg, size_t msglen)
 {
 	char path[4096], tmp[4200], prev[4200];
 	srv_store_path(path, sizeof path, j->path);
-	snprintf(tmp, sizeof tmp, "%s.tmp", path);
+	snprintf(tmp, sizeof tmp, "%s%s", path, tmp_ext);
 	snprintf(prev, sizeof prev, "%s.prev", path);
 	const char *step = "create the directory of";
 	int fd = -1, err = 0;
@@ -187,6 +188,32 @@ static void note_failure(const char *path, const char *msg)
 	pthread_mutex_unlock(&st.lock);
 }
 
+/* A write's outcome counted and logged (err 0: written). */
+static void note_write(const char *path, int err, const char *msg)
+{
+	if (err) {
+		atomic_fetch_add(&srv_stats.store_errors, 1);
+		srv_log(SRV_LOG_ERROR, "store: %s", msg);
+		note_failure(path, msg);
+	} else {
+		atomic_fetch_add(&srv_stats.store_writes, 1);
+	}
+}
+
+int srv_store_write_now(const char *path, const void *buf, size_t len, char *msg,
+			size_t msglen)
+{
+	if (!st.started)
+		return 0;
+	store_job j = {.buf = (void *)buf, .len = len};
+	snprintf(j.path, sizeof j.path, "%s", path);
+	/* a temporary file of its own: the writer may be at the same path
+	 * (an experiment that ended at once), and the later rename wins */
+	int err = write_atomic(&j, ".now.tmp", msg, msglen);
+	note_write(path, err, msg);
+	return err;
+}
+
 static void run_job(store_job *j)
 {
 	char msg[4400] = "";
@@ -201,14 +228,8 @@ static void run_job(store_job *j)
 	} else if (j->buf) {
 		if (j->before)
 			j->before(j->arg);
-		err = write_atomic(j, msg, sizeof msg);
-		if (err) {
-			atomic_fetch_add(&srv_stats.store_errors, 1);
-			srv_log(SRV_LOG_ERROR, "store: %s", msg);
-			note_failure(j->path, msg);
-		} else {
-			atomic_fetch_add(&srv_stats.store_writes, 1);
-		}
+		err = write_atomic(j, ".tmp", msg, sizeof msg);
+		note_write(j->path, err, msg);
 	} else {
 		remove_path(j->path);
 	}
@@ -439,35 +460,6 @@ int srv_store_open_log(const char *rel, uint64_t len)
 		return -1;
 	}
 	return fd;
-}
-
-api_err srv_store_check_removable(const char *rel, api_problem *pb)
-{
-	if (!st.started)
-		return API_OK;
-	char path[4096];
-	struct stat sb;
-	srv_store_path(path, sizeof path, rel);
-	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
-	/* its directory (the entry goes), and the entry's own when it is
-	 * one (its files go) */
-	char *slash = strrchr(path, '/');
-	int err = 0;
-	if (slash) {
-		*slash = '\0';
-		err = access(path, W_OK) != 0 && errno != ENOENT ? errno : 0;
-		*slash = '/';
-	}
-	if (!err && is_dir && access(path, W_OK) != 0 && errno != ENOENT)
-		err = errno;
-	if (!err)
-		return API_OK;
-	api_fail(pb, API_UNAVAILABLE, NULL,
-		 "the data directory cannot be changed (%s): %s cannot be "
-		 "removed; nothing was deleted, retry once it is writable",
-		 strerror(err), rel);
-	pb->retry_after = 30;
-	return API_UNAVAILABLE;
 }
 
 void srv_store_remove(const char *path)

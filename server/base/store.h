@@ -6,10 +6,12 @@
  *
  * Nothing else writes under the data directory but the control logs
  * (control_log.c: appended and synced by the thread that answers for
- * them). Callers hand a finished buffer to the writer (srv_store_write)
- * and go on: no caller but a control's answer waits for a disk, none
- * writes on a worker's step path or under a registry lock. A pending
- * write to the same path is replaced by a newer one (a checkpoint that
+ * them) and a new record (a session's spec.json, a job's record: written
+ * by the thread that creates it, srv_store_write_now, so that its 201
+ * follows it). Callers hand a finished buffer to the writer (srv_store_write)
+ * and go on: no caller but the answer to a control or a creation waits
+ * for a disk, none writes on a worker's step path or under a registry
+ * lock. A pending write to the same path is replaced by a newer one (a checkpoint that
  * could not be written in time is superseded, never queued twice).
  * The outcome of each write comes back through its callback, on the
  * writer thread with no lock held: 0, or the errno (ENOSPC, EIO, EACCES,
@@ -84,6 +86,17 @@ double srv_store_interval(void);
  * off, or out of memory, buf is freed and done is never called. */
 void srv_store_write(const char *path, void *buf, size_t len, int keep_prev,
 		     srv_store_done done, void *arg);
+/* Write buf (len bytes, borrowed) to path now, on the calling thread, as
+ * the writer would (temporary file, fsync, rename, fsync of the
+ * directory): 0 (also without a data directory), or the errno with a
+ * sentence in msg; counted and logged as the writer's writes are. Only
+ * for a record's first version (its creation, before the answer): a
+ * session's spec.json before its worker runs, a job's record under the
+ * job's lock. Its temporary file is path.now.tmp, so that a queued write
+ * of the same path (an experiment that ended at once) cannot mix with
+ * it. */
+int srv_store_write_now(const char *path, const void *buf, size_t len, char *msg,
+			size_t msglen);
 /* srv_store_write with before (may be NULL) called on the writer thread
  * just before the file is written (not when superseded): a checkpoint
  * makes the control log it accounts for durable first. */
@@ -150,6 +163,9 @@ char *srv_store_read_text(const char *path, size_t *len);
 /* Entries of a directory (relative path), malloc'd array of malloc'd
  * names (free each and the array); the count, 0 if none. */
 size_t srv_store_list(const char *path, char ***names);
+/* 1 when the directory rel holds no file but the store's temporary ones
+ * (a record whose first write a crash cut short). */
+int srv_store_dir_unwritten(const char *rel);
 /* The same for the entries of one kind of record under rel: directories
  * named by an id (dirs) or regular files ID.bin. Anything else is skipped
  * with one log line each (the store's own .tmp and .prev files without). */

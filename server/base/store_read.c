@@ -3,7 +3,8 @@
  * store_read.c - the framed files of the data directory (store.h): a
  * payload framed with its magic, format version, kind, length and
  * checksum, read back and checked; the restore's counts of damaged and
- * upgraded files by kind; the listings of stored ids.
+ * upgraded files by kind; the listings of stored ids; whether a record
+ * could be removed now (a DELETE's check).
  */
 #include <dirent.h>
 #include <errno.h>
@@ -190,6 +191,19 @@ size_t srv_store_list_ids(const char *rel, int dirs, char ***names)
 	return kept;
 }
 
+int srv_store_dir_unwritten(const char *rel)
+{
+	char **names = NULL;
+	size_t n = srv_store_list(rel, &names), files = 0;
+	for (size_t i = 0; i < n; i++) {
+		size_t l = strlen(names[i]);
+		files += !(l > 4 && strcmp(names[i] + l - 4, ".tmp") == 0);
+		free(names[i]);
+	}
+	free(names);
+	return files == 0;
+}
+
 size_t srv_store_list(const char *rel, char ***names)
 {
 	char path[4096];
@@ -216,4 +230,33 @@ size_t srv_store_list(const char *rel, char ***names)
 	}
 	closedir(d);
 	return n;
+}
+
+api_err srv_store_check_removable(const char *rel, api_problem *pb)
+{
+	if (!srv_store_enabled())
+		return API_OK;
+	char path[4096];
+	struct stat sb;
+	srv_store_path(path, sizeof path, rel);
+	int is_dir = stat(path, &sb) == 0 && S_ISDIR(sb.st_mode);
+	/* its directory (the entry goes), and the entry's own when it is
+	 * one (its files go) */
+	char *slash = strrchr(path, '/');
+	int err = 0;
+	if (slash) {
+		*slash = '\0';
+		err = access(path, W_OK) != 0 && errno != ENOENT ? errno : 0;
+		*slash = '/';
+	}
+	if (!err && is_dir && access(path, W_OK) != 0 && errno != ENOENT)
+		err = errno;
+	if (!err)
+		return API_OK;
+	api_fail(pb, API_UNAVAILABLE, NULL,
+		 "the data directory cannot be changed (%s): %s cannot be "
+		 "removed; nothing was deleted, retry once it is writable",
+		 strerror(err), rel);
+	pb->retry_after = 30;
+	return API_UNAVAILABLE;
 }

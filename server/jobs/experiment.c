@@ -206,9 +206,9 @@ static void queue_write(srv_experiment *e, const char *path, void *buf,
 	srv_store_write(path, buf, len, 0, written, e);
 }
 
-/* Queue experiments/ID.bin (lock held). Not while the daemon stops: an
- * experiment its session's worker lets go then is resumed next time. */
-static void persist_locked(srv_experiment *e)
+/* experiments/ID.bin (lock held): queued, or now (its creation) written here. Not while the
+ * daemon stops: an experiment its session's worker lets go then is resumed next time. */
+static void persist_locked(srv_experiment *e, int now)
 {
 	if (!e->data_dir || srv_stopping())
 		return;
@@ -222,16 +222,20 @@ static void persist_locked(srv_experiment *e)
 	memcpy(rec + sizeof r, &e->ext, tail);
 	void *buf = srv_store_frame(SRV_STORE_EXPERIMENT, rec, sizeof r + tail, &len);
 	free(rec);
-	char path[64];
+	char path[64], msg[256];
 	snprintf(path, sizeof path, "experiments/%s.bin", e->entry.id);
-	if (buf)
+	if (buf && now) { /* a failure is logged (store.c); its end's write says it */
+		srv_store_write_now(path, buf, len, msg, sizeof msg);
+		free(buf);
+	} else if (buf) {
 		queue_write(e, path, buf, len);
+	}
 }
 
 void srv_exp_persist(srv_experiment *e)
 {
 	pthread_mutex_lock(&e->lock);
-	persist_locked(e);
+	persist_locked(e, 1);
 	pthread_mutex_unlock(&e->lock);
 }
 
@@ -368,7 +372,7 @@ int srv_exp_interrupt(srv_experiment *e)
 		snprintf(e->error, sizeof e->error,
 			 "the daemon stopped before it ended and its session "
 			 "could not resume it; the segments done are kept");
-		persist_locked(e);
+		persist_locked(e, 0);
 	}
 	pthread_mutex_unlock(&e->lock);
 	return hit;
@@ -379,7 +383,7 @@ static void save_results(srv_experiment *e)
 {
 	if (!e->data_dir)
 		return;
-	persist_locked(e);
+	persist_locked(e, 0);
 	api_experiment_view v;
 	fill_view(e, &v);
 	char *text = api_experiment_json(&v);
@@ -456,7 +460,7 @@ static void abort_locked(srv_experiment *e, const char *why)
 	}
 	e->attached = 0;
 	drop_record(e);
-	persist_locked(e);
+	persist_locked(e, 0);
 }
 
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)

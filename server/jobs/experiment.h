@@ -78,7 +78,8 @@ void srv_exp_abort(srv_experiment *e, const char *why);
 
 /* ---- persistence (store.h) ---------------------------------------------- */
 
-/* Queue experiments/ID.bin (at creation; the end writes it by itself). */
+/* Write experiments/ID.bin now, on this thread (at creation, before the
+ * answer; the end queues it by itself). */
 void srv_exp_persist(srv_experiment *e);
 /* The running state (record and feed-velocity record) for the session's
  * checkpoint: malloc'd, its length in *len; NULL when out of memory.

@@ -154,8 +154,9 @@ static void written(void *arg, int err, const char *what)
 	srv_registry_put(&fits, en);
 }
 
-/* Queue fits/ID.bin (lock held). */
-static void persist_locked(const srv_fit *f)
+/* Queue fits/ID.bin (lock held); now: write it on this thread (its
+ * creation: on disk before the answer). */
+static void persist_locked(srv_fit *f, int now)
 {
 	if (!srv_store_enabled())
 		return;
@@ -186,8 +187,11 @@ static void persist_locked(const srv_fit *f)
 		memcpy(p + sizeof r + r.body_len, f->json, r.json_len);
 	if (r.csv_len)
 		memcpy(p + sizeof r + r.body_len + r.json_len, f->csv, r.csv_len);
-	char *id = strdup(f->entry.id);
-	if (id && srv_job_save(&srv_fit_job, f->entry.id, p, n, written, id) != 0)
+	char *id = now ? NULL : strdup(f->entry.id);
+	if (now)
+		srv_job_save_now(&srv_fit_job, f->entry.id, p, n, f->store_error,
+				 sizeof f->store_error);
+	else if (id && srv_job_save(&srv_fit_job, f->entry.id, p, n, written, id) != 0)
 		free(id);
 	free(p);
 }
@@ -209,7 +213,7 @@ static void *driver(void *arg)
 	f->over = 1;
 	/* not when deleted, nor when the daemon stops it: it runs again */
 	if (!f->cancelled && !srv_stopping())
-		persist_locked(f);
+		persist_locked(f, 0);
 	pthread_mutex_unlock(&f->lock);
 	srv_log(SRV_LOG_INFO, "fit %s: %s after %d iterations, %ld evaluations", f->entry.id,
 		fit_status_name(res.status), res.iterations, res.evaluations);
@@ -297,9 +301,9 @@ static api_err fitjob_start(srv_entry *en, char **answer, api_problem *pb)
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
 	pthread_mutex_lock(&f->lock);
+	persist_locked(f, 1); /* the answer shows a failure */
 	fill_view(f, &v);
 	char *text = api_fit_json(&v);
-	persist_locked(f);
 	pthread_mutex_unlock(&f->lock);
 	if (start_driver(f) != 0) {
 		free(text);

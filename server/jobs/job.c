@@ -5,6 +5,7 @@
  * merge, the restore of {kind}/ID.bin and the files a deleted job leaves.
  * What differs between kinds is in their descriptors' hooks.
  */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +38,24 @@ int srv_job_save(const srv_job_kind *kind, const char *id, const void *payload, 
 	snprintf(path, sizeof path, "%s/%s.bin", kind->plural, id);
 	srv_store_write(path, buf, framed, 0, done, arg);
 	return 0;
+}
+
+int srv_job_save_now(const srv_job_kind *kind, const char *id, const void *payload, size_t len,
+		     char *msg, size_t msglen)
+{
+	if (!srv_store_enabled())
+		return 0;
+	size_t framed;
+	void *buf = srv_store_frame(kind->store_kind, payload, len, &framed);
+	char path[64];
+	snprintf(path, sizeof path, "%s/%s.bin", kind->plural, id);
+	if (!buf) {
+		snprintf(msg, msglen, "cannot write %s: out of memory", path);
+		return ENOMEM;
+	}
+	int err = srv_store_write_now(path, buf, framed, msg, msglen);
+	free(buf);
+	return err;
 }
 
 /* One file of {plural}/: 1 when its job is back. */

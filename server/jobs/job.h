@@ -87,6 +87,11 @@ size_t srv_job_restore(const srv_job_kind *kind);
  * will be called), -1 when not (store off, out of memory). */
 int srv_job_save(const srv_job_kind *kind, const char *id, const void *payload, size_t len,
 		  void (*done)(void *arg, int err, const char *what), void *arg);
+/* The same written now, on this thread (srv_store_write_now): a job's
+ * record at its creation, under its lock, before its answer. 0 (also
+ * without a data directory), or the errno with the sentence in msg. */
+int srv_job_save_now(const srv_job_kind *kind, const char *id, const void *payload, size_t len,
+		     char *msg, size_t msglen);
 
 /* The handlers; r->job names the kind (the route table's). */
 enum MHD_Result srv_h_job_create(srv_req *r);

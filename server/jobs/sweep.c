@@ -115,8 +115,9 @@ static void written(void *arg, int err, const char *what)
 	srv_registry_put(&sweeps, en);
 }
 
-/* Queue sweeps/ID.bin (lock held). */
-static void persist_locked(const srv_sweep *sw)
+/* Queue sweeps/ID.bin (lock held); now: write it on this thread (its
+ * creation: on disk before the answer). */
+static void persist_locked(srv_sweep *sw, int now)
 {
 	if (!srv_store_enabled())
 		return;
@@ -137,8 +138,11 @@ static void persist_locked(const srv_sweep *sw)
 	memcpy(p, &r, sizeof r);
 	memcpy(p + sizeof r, sw->req.betas, nb);
 	memcpy(p + sizeof r + nb, sw->pt, np);
-	char *id = strdup(sw->entry.id);
-	if (id && srv_job_save(&srv_sweep_job, id, p, sizeof r + nb + np, written, id) != 0)
+	char *id = now ? NULL : strdup(sw->entry.id);
+	if (now)
+		srv_job_save_now(&srv_sweep_job, sw->entry.id, p, sizeof r + nb + np,
+				 sw->store_error, sizeof sw->store_error);
+	else if (id && srv_job_save(&srv_sweep_job, id, p, sizeof r + nb + np, written, id) != 0)
 		free(id);
 	free(p);
 }
@@ -209,7 +213,7 @@ static void run_point(void *arg)
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
 		/* a deleted sweep's files are gone: none are written again */
 		if (!sw->cancelled) {
-			persist_locked(sw);
+			persist_locked(sw, 0);
 			if (sw->done == sw->total)
 				save_results(sw);
 		}
@@ -405,7 +409,7 @@ static api_err sweep_start(srv_entry *en, char **answer, api_problem *pb)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */
 	/* jobs wait for the lock: the answer shows the sweep as queued */
 	pthread_mutex_lock(&sw->lock);
-	persist_locked(sw);
+	persist_locked(sw, 1);
 	size_t unused = submit_points(sw);
 	api_sweep_view v;
 	fill_view(sw, &v);

@@ -255,8 +255,8 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	s->owned = exp && !srv_exp_keeps_session(exp);
 	if (exp) /* before its worker can end it and write its result */
 		srv_exp_set_session(exp, s->entry.id);
-	/* its directory now: the control log is opened in it at the first
-	 * control, maybe before the writer has written the spec */
+	/* its directory now, its name durable: the spec is written in it
+	 * below, the control log at the first control */
 	if (srv_store_enabled()) {
 		char dir[64];
 		snprintf(dir, sizeof dir, "sessions/%s", s->entry.id);
@@ -266,14 +266,17 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	}
 	s->last_access = s->persist.ckpt_wall = srv_now();
 	s->persist.ckpt_dirty = 1;
+	/* its spec on disk before it runs and before its 201: a crash after
+	 * the answer keeps it (written here, beside the store's queue) */
+	srv_persist_spec(s, 1);
 	if (pthread_create(&s->worker, NULL, srv_worker_main, s) != 0) {
 		api_fail(pb, API_UNAVAILABLE, NULL,
 			 "cannot start the session's worker thread");
+		srv_persist_remove(s); /* never answered: not restored either */
 		goto fail;
 	}
 	s->worker_started = 1;
 	srv_registry_publish(&sessions, &s->entry);
-	srv_persist_spec(s);
 	atomic_fetch_add(&srv_stats.sessions_created, 1);
 	srv_log(SRV_LOG_INFO, "session %s created", s->entry.id);
 	return s;
@@ -465,6 +468,17 @@ size_t srv_sessions_restore(const srv_exp_finder *ef)
 	char **names = NULL;
 	size_t n = srv_store_list_ids("sessions", 1, &names), count = 0;
 	for (size_t i = 0; i < n; i++) {
+		char dir[64];
+		snprintf(dir, sizeof dir, "sessions/%.40s", names[i]);
+		/* no file in it: the daemon died creating it, before its spec
+		 * was on disk, so before its 201 (which waits for the spec) */
+		if (srv_store_dir_unwritten(dir)) {
+			srv_log(SRV_LOG_INFO, "session %s: created but never answered (no spec "
+					      "on disk); its empty directory is removed", names[i]);
+			srv_store_remove(dir);
+			free(names[i]);
+			continue;
+		}
 		srv_session *s = calloc(1, sizeof *s);
 		if (s) {
 			s->create_fd = -1; /* no client waits for a restore */

@@ -292,8 +292,11 @@ void srv_ring_gather(srv_session *s);
 
 /* ---- session_store.c: the session's files (store.h) ------------------ */
 
-/* Queue the spec file (at creation). */
-void srv_persist_spec(srv_session *s);
+/* Write the spec files: spec.json now, on this thread (now: a creation,
+ * before its worker runs; its answer follows it, and a failure puts it in
+ * store_error), or queued (an upgrade, a rewrite after a failure); then
+ * spec.bin queued. */
+void srv_persist_spec(srv_session *s, int now);
 
 /* ---- control_log.c: the control log on disk ----------------------------- */
 

@@ -54,10 +54,10 @@ typedef struct write_of {
 } write_of;
 
 /* A write's outcome: a failure puts the session in state "error" with the
- * reason. A later success clears it, unless spec.json is not on disk: the
- * first success after its failure (space came back) queues it again, and
- * the session reports healthy only once that rewrite is written (lock
- * order: the session's, then the store's). */
+ * reason (spec.json's while it is not on disk). A later success clears it,
+ * unless spec.json is not on disk: the first success after its failure
+ * (space came back) queues it again, and the session reports healthy only
+ * once that rewrite is written (lock order: the session's, the store's). */
 static void written(void *arg, int err, const char *what)
 {
 	write_of *w = arg;
@@ -71,11 +71,11 @@ static void written(void *arg, int err, const char *what)
 		s->persist.spec_unwritten = err != 0;
 		s->persist.spec_retrying = 0;
 	}
-	if (err)
+	if (err && (spec || !s->persist.spec_unwritten)) /* the spec's failure shown */
 		snprintf(s->persist.store_error, sizeof s->persist.store_error, "%s", what);
-	else if (s->persist.spec_unwritten && !s->persist.spec_retrying) {
+	else if (!err && s->persist.spec_unwritten && !s->persist.spec_retrying) {
 		s->persist.spec_retrying = 1;
-		srv_persist_spec(s);
+		srv_persist_spec(s, 0);
 	} else if (!s->persist.spec_unwritten && what && what[0] == '\0')
 		s->persist.store_error[0] = '\0';
 	pthread_mutex_unlock(&s->lock);
@@ -111,10 +111,20 @@ static void queue(const srv_session *s, const char *file, void *buf,
 			      w ? written : NULL, w);
 }
 
-void srv_persist_spec(srv_session *s)
+void srv_persist_spec(srv_session *s, int now)
 {
 	if (!srv_store_enabled() || s->damaged)
 		return;
+	char *text = api_spec_file(&s->spec, s->created, s->owned, s->picked ? &s->pick : NULL),
+	     path[128];
+	session_dir(path, sizeof path, s->entry.id, "spec.json");
+	if (text && now) /* a creation: answered once it is on disk */
+		s->persist.spec_unwritten = srv_store_write_now(path, text, strlen(text),
+			s->persist.store_error, sizeof s->persist.store_error) != 0;
+	if (text && now)
+		free(text);
+	else if (text)
+		queue(s, "spec.json", text, strlen(text), 0, 0);
 	/* spec.bin too, for an earlier build started on this directory */
 	spec_record r;
 	memset(&r, 0, sizeof r);
@@ -126,9 +136,6 @@ void srv_persist_spec(srv_session *s)
 	void *buf = srv_store_frame(SRV_STORE_SESSION, &r, sizeof r, &len);
 	if (buf)
 		queue(s, "spec.bin", buf, len, 0, 0);
-	char *text = api_spec_file(&s->spec, s->created, s->owned, s->picked ? &s->pick : NULL);
-	if (text)
-		queue(s, "spec.json", text, strlen(text), 0, 0);
 }
 
 void srv_persist_checkpoint(srv_session *s, int force)
@@ -485,7 +492,7 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	/* an earlier format: its spec written again at once (spec.json and
 	 * spec.bin, each atomically: store.c), its checkpoint at the next
 	 * interval, in this build's format */
-	srv_persist_spec(s);
+	srv_persist_spec(s, 0);
 	s->persist.ckpt_dirty = 1;
 	srv_store_count_upgraded(SRV_STORE_SESSION);
 	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
