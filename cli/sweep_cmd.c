@@ -83,8 +83,11 @@ static void measure_task(void *arg, size_t j)
 	sim_method m = pl->o->m;
 	t->band[0] = t->band[1] = NAN;
 	t->err = sim_study_apply(pl->st, i, &p, &sc, &m, t->msg, sizeof t->msg);
+	/* a point stops once its bar is met; with a band its v is the
+	 * centre of the band's finite differences, which run the whole window */
 	if (t->err == SIM_OK)
-		t->err = sim_measure(&p, &sc, &m, pl->o->duration, &t->r, t->msg, sizeof t->msg);
+		t->err = (pl->band ? sim_measure : sim_measure_point)(&p, &sc, &m, pl->o->duration,
+								       &t->r, t->msg, sizeof t->msg);
 	if (t->err == SIM_OK && pl->band)
 		t->err = fit_band_point(pl->band, pl->skip, &p, &sc, &m, pl->o->duration, &t->r,
 					&t->band[0], &t->band[1], t->msg, sizeof t->msg);

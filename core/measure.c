@@ -3,10 +3,13 @@
  * measure.c - sim_measure: one measurement of the transport velocity, a
  * fresh instance run to a time with its shadow (shadow.c) over the first
  * part of the window, repeated at finer steps where the measured step
- * error is beyond what the accuracy target tol allows.
+ * error is beyond what the accuracy target tol allows; sim_measure_point,
+ * a sweep's point: the same, stopped early once its bar is met with little
+ * scatter.
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -22,19 +25,111 @@
  * first-order error asks for, within [1/4, 3/5]. */
 #define MEASURE_REFINEMENTS 3
 
-/* One run of sim_measure: a fresh instance to t_end, its shadow over the
- * first SHADOW_MEASURE_SHARE of the window; *st its final status. */
+/* How often a measurement with a shadow checks its bar once the shadow
+ * has finished (the first check at its end): a fortieth of the preset's
+ * 4-s window, two and a half of its periods. */
+#define MEASURE_CHECK 0.1
+
+/* Whether sim_measure would refine after a run whose status is st: its
+ * step error beyond what tol leaves the steps (the bar less its scatter
+ * and drift, which finer steps cannot shrink), and shrunk as a
+ * first-order one shrinks (by 0.8 at least) since the last run's, last. */
+static int refine_asks(const sim_status *st, double last)
+{
+	double room = st->tol_allowed - (st->transport_velocity_uncertainty - st->step_error);
+	return room > 0.0 && st->step_error > room && st->step_error < 0.8 * last &&
+	       st->substeps >= 1;
+}
+
+/* A bar met early enough to stop on: within tol, steady, and its scatter
+ * and drift at most MEASURE_EARLY_SCATTER of what tol allows. A short
+ * window's scatter is read from few batches, and where the feed's motion
+ * is correlated over many periods it is read low (a 1.2-s window of the
+ * zoo's `stiffer` machine said 0.31 % at 140 deg cw where its v was 0.97 %
+ * off): a scatter that small a share of tol holds even read low. And a
+ * window of MEASURE_EARLY_PERIODS whole periods at least: the preset's
+ * shadow spans 29 of them (30 % of 4 s at its loaded 24.5 Hz); a shorter
+ * --duration shortens the shadow, and a measurement stopped with it (0.6
+ * s at --duration 2) put 2 of the 74 points outside their bars. */
+#define MEASURE_EARLY_SCATTER 0.25
+#define MEASURE_EARLY_PERIODS 28
+static int early_met(const sim_status *st)
+{
+	double scatter = st->transport_velocity_uncertainty - st->step_error;
+	return st->tol_met && st->steady && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed &&
+	       st->transport_periods >= MEASURE_EARLY_PERIODS;
+}
+
+/* The first run's instance as it starts (settled, at t = 0, its shadow
+ * begun), kept for the refinements: a checkpoint of it restored with
+ * finer steps starts them where the first run started, without settling
+ * again (the settling at the first run's steps: the state at t = 0 is a
+ * start like any other, and the estimate and its bar come from the finer
+ * steps alone). buf NULL: none kept (yet). */
+typedef struct settled_start {
+	void *buf;
+	size_t len;
+} settled_start;
+
+/* A run's instance: the first one fresh (its start kept in *start where
+ * start is not NULL), a refinement's restored from *start with its own
+ * steps (its shadow too), or fresh where no start could be kept. */
+static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			   double t_end, settled_start *start, int *err, char *msg, size_t msglen)
+{
+	if (start && start->buf) {
+		sim *s = sim_restore(p, sc, m, start->buf, start->len, err, NULL, 0);
+		if (s)
+			return s;
+	}
+	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
+	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, err, msg, msglen);
+	if (s && start && !start->buf) {
+		size_t len = sim_checkpoint_size(s);
+		start->buf = malloc(len);
+		start->len = len;
+		if (start->buf && sim_checkpoint(s, start->buf, len) != SIM_OK) {
+			free(start->buf);
+			start->buf = NULL;
+		}
+	}
+	return s;
+}
+
+/* One run of sim_measure: a fresh instance to t_end at most, its shadow
+ * over the first SHADOW_MEASURE_SHARE of the window; *st its final
+ * status. If early (sim_measure_point) and with a shadow, the run stops early at the first check after the
+ * shadow has finished where the bar is within tol and the estimate steady
+ * (the rest of the window would only shrink a bar already met), or, if
+ * may_refine, where a refinement is asked (refine_asks with last) with
+ * the step error alone beyond tol: the step error does not change after
+ * the shadow and no longer window makes room for it, so the refinement
+ * the whole window would ask for is asked now. A step error within tol
+ * whose room a longer window's smaller scatter may yet make is left to
+ * the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, sim_status *st, char *msg, size_t msglen)
+			double t_end, int early, int may_refine, double last, settled_start *start,
+			sim_status *st, char *msg, size_t msglen)
 {
 	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
 			   .rotor_speed_mean = NAN, .step_error = NAN, .tol_allowed = NAN};
 	int err;
-	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
-	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, &err, msg, msglen);
+	sim *s = start_instance(p, sc, m, t_end, start, &err, msg, msglen);
 	if (!s)
 		return err;
-	err = sim_advance(s, t_end);
+	/* the first check at the shadow's end (just past it: the shadow
+	 * finishes once the instance is asked beyond it) */
+	double t = early && s->shadow ? fmin(t_end, nextafter(s->shadow_until, INFINITY)) : t_end;
+	for (;;) {
+		err = sim_advance(s, t);
+		if (err != SIM_OK || t >= t_end)
+			break;
+		if (!s->shadow && (early_met(&s->st) ||
+				   (may_refine && s->st.step_error > s->st.tol_allowed &&
+				    refine_asks(&s->st, last))))
+			break;
+		t = fmin(t_end, t + MEASURE_CHECK);
+	}
 	if (err != SIM_OK && msg)
 		snprintf(msg, msglen, "%s", s->error);
 	*st = s->st;
@@ -42,8 +137,11 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 	return err;
 }
 
-int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
-		sim_measurement *out, char *msg, size_t msglen)
+/* sim_measure, and sim_measure_point if early: its runs stop once their
+ * bar is met, and its refinements start from the first run's settled
+ * start. */
+static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
+		   int early, sim_measurement *out, char *msg, size_t msglen)
 {
 	struct timespec c0, c1;
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
@@ -56,20 +154,18 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	const ode_method *om = ode_find(m->name);
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
+	settled_start start = {NULL, 0};
 	for (int attempt = 0;; attempt++) {
-		err = measure_once(p, sc, &run, t_end, &st, msg, msglen);
+		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
+		err = measure_once(p, sc, &run, t_end, early, may_refine, last,
+				   early && own_steps ? &start : NULL, &st, msg, msglen);
 		out->refinements = attempt;
-		/* what the steps may take of tol: the bar less its scatter and
-		 * drift, which finer steps cannot shrink */
-		double room = st.tol_allowed - (st.transport_velocity_uncertainty - st.step_error);
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a
-		 * first-order one shrinks (by 0.6 at least): what remains is not
-		 * the steps' */
-		if (err != SIM_OK || !own_steps || st.tol_met || attempt == MEASURE_REFINEMENTS ||
-		    !(room > 0.0) || !(st.step_error > room) || !(st.step_error < 0.8 * last) ||
-		    st.substeps < 1)
+		 * first-order one shrinks: what remains is not the steps' */
+		if (err != SIM_OK || !may_refine || st.tol_met || !refine_asks(&st, last))
 			break;
+		double room = st.tol_allowed - (st.transport_velocity_uncertainty - st.step_error);
 		last = st.step_error;
 		/* first order in both steps: the step whose term is the larger
 		 * shrinks by the factor asked (the machine step with the feed
@@ -85,6 +181,7 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 		if (run.substeps > 1000)
 			break;
 	}
+	free(start.buf);
 	out->transport_velocity = st.transport_velocity;
 	out->uncertainty = st.transport_velocity_uncertainty;
 	out->steady = st.steady;
@@ -97,4 +194,16 @@ int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, d
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
 	out->cpu_seconds = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
 	return err;
+}
+
+int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
+		sim_measurement *out, char *msg, size_t msglen)
+{
+	return measure(p, sc, m, t_end, 0, out, msg, msglen);
+}
+
+int sim_measure_point(const sim_params *p, const sim_scene *sc, const sim_method *m,
+		      double t_end, sim_measurement *out, char *msg, size_t msglen)
+{
+	return measure(p, sc, m, t_end, 1, out, msg, msglen);
 }

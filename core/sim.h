@@ -387,9 +387,20 @@ typedef struct sim_measurement {
  * uncertainty is beyond what m->tol allows because of the steps' error,
  * the run is repeated at finer steps (at most 3 times; *out says which
  * steps and how many repeats). Returns sim_new's or sim_advance's code.
- * For sweeps (thread-safe). */
+ * v is smooth in the parameters (the window is fixed): for fits and their
+ * bands' finite differences. For sweeps (thread-safe). */
 int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen);
+/* A sweep's point: sim_measure, but where a shadow measures the step
+ * error (dem with feed events) each run stops before t_end at the first
+ * check after the shadow's window whose bar is within tol, steady, at most
+ * a quarter scatter and 28 whole periods long (out->periods says how long
+ * it measured), or whose step error alone is beyond tol; a refinement
+ * starts from the first run's settled start. About half the cost of
+ * sim_measure at czubak2016's defaults; v then depends on where the run
+ * stopped, a step in the parameters, so fits keep sim_measure. */
+int sim_measure_point(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
+		      sim_measurement *out, char *msg, size_t msglen);
 
 /* ---- sweeps: the mirror reduction (mirror.c) ------------------------- */
 

@@ -180,9 +180,11 @@ static void run_point(void *arg)
 		/* beta was checked and converted to SI by api/, the other
 		 * varied settings checked there */
 		int rc = srv_sweep_apply(sw, job_i, &spec, msg, sizeof msg);
+		/* as the command line's sweep: with a band, the whole window */
 		if (rc == SIM_OK)
-			rc = sim_measure(&spec.params, &spec.scene, &spec.method,
-					 sw->req.t_end, &r, msg, sizeof msg);
+			rc = (sw->req.band ? sim_measure : sim_measure_point)(
+				&spec.params, &spec.scene, &spec.method, sw->req.t_end, &r, msg,
+				sizeof msg);
 		double band[2] = {NAN, NAN};
 		if (rc == SIM_OK && sw->req.band)
 			rc = fit_band_point(&sw->req.band_src, sw->req.band_skip, &spec.params,
