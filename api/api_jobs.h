@@ -114,7 +114,10 @@ typedef struct api_exp_ext {
 				   rotor's phi - alpha); last_t < 0: none */
 	double integ;           /* deg */
 	double t_sample;        /* s after the start: the next sample */
-	int next_dist, pad;
+	int next_dist;
+	int curve_changes;      /* new v(beta) curves taken up while running
+				   (rotation or omega_ss changed; was padding:
+				   0 in records from before) */
 } api_exp_ext;
 
 /* Parse POST /experiments: {"session": ID} or {"session": {create body}}

@@ -357,6 +357,7 @@ static void add_control(cJSON *o, const api_exp_ext *ext, int nseg)
 	api_add_number(r, "v_max", ext->v_hi);
 	api_add_number(r, "beta_min", ext->nff ? api_user_of("beta", ext->beta_lo) : NAN);
 	api_add_number(r, "beta_max", ext->nff ? api_user_of("beta", ext->beta_hi) : NAN);
+	cJSON_AddNumberToObject(c, "curve_changes", ext->curve_changes);
 	cJSON *arr = cJSON_AddArrayToObject(c, "setpoints");
 	for (int i = 0; i < nseg; i++) {
 		const api_setpoint *s = &ext->sp[i];

@@ -113,6 +113,21 @@ static char *experiment_json(srv_experiment *e, int csv)
 	return text;
 }
 
+/* s's spec with its rotation and omega_ss as they are now (a PATCH may
+ * have changed them since its creation), in req->spec's room (the
+ * experiment took its own copy). */
+static const api_spec *now_spec(srv_session *s, api_experiment_req *req)
+{
+	api_view v;
+	srv_session_view(s, &v);
+	req->spec = *srv_session_spec(s);
+	if (v.has_status) {
+		req->spec.params.rotation = v.st.rotation;
+		req->spec.params.omega_ss = v.st.omega_ss;
+	}
+	return &req->spec;
+}
+
 /* An experiment for a request body; NULL with *pb. */
 static srv_entry *experiment_create(const char *body, size_t len, api_problem *pb)
 {
@@ -131,7 +146,7 @@ static srv_entry *experiment_create(const char *body, size_t len, api_problem *p
 	 * on first: the fresh session's, or the named one's (a missing one
 	 * is start's 404) */
 	srv_session *s = e && !req->fresh ? srv_session_get(req->session_id) : NULL;
-	if (e && srv_exp_ready(e, s ? srv_session_spec(s) : &req->spec, pb) != API_OK) {
+	if (e && srv_exp_ready(e, s ? now_spec(s, req) : &req->spec, pb) != API_OK) {
 		srv_exp_free(e);
 		e = NULL;
 	}

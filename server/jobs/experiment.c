@@ -433,6 +433,7 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 	e->t_now = st->t;
 	double y;
 	int sampled = srv_exp_sample(e, st, &y);
+	srv_exp_follow_curve(e, st);
 	if (st->t >= srv_exp_segment_end(e) - 1e-9) {
 		srv_exp_finish_segment(e, st);
 		if (e->cur + 1 < e->req.nseg) {

@@ -46,6 +46,9 @@ struct srv_experiment {
 	double beta_sent;        /* rad: the last beta commanded */
 	api_exp_ext ext;         /* identify or control (experiment_kind.c,
 				    experiment_loop.c) */
+	int curve_rot;           /* control: the rotation and omega_ss (rad/s) */
+	double curve_omega;      /* ext's v(beta) curve is for (0 after a
+				    restore: looked up at the next step) */
 	int writes;              /* queued store writes (they refer to e) */
 	int freed;               /* srv_exp_free came while writes > 0 */
 };
@@ -73,6 +76,11 @@ void srv_exp_dist_commanded(srv_experiment *e, const srv_cmd *cmd, int refused);
  * their feedforward beta, "auto" gains; an identification's comparison
  * slopes. API_OK or the problem (422 naming the field). */
 api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb);
+/* A closed loop whose session's rotation or omega_ss (status st) is no
+ * longer its curve's (lock held): the curve of the scene as it is now,
+ * from the cache or measured, its branch taken up (the integral reset,
+ * the pending setpoints' feedforward redone). */
+void srv_exp_follow_curve(srv_experiment *e, const sim_status *st);
 /* The feedforward beta (rad) of velocity v on the branch (clamped to its
  * ends). */
 double srv_exp_feedforward(const api_exp_ext *ext, double v);

@@ -23,6 +23,7 @@
 
 #include "experiment_int.h"
 #include "fopdt.h"
+#include "util.h"
 
 #define CURVES 4
 #define CURVE_WINDOW 2.0 /* s measured per point after the transient */
@@ -63,20 +64,28 @@ static int measure_at(const api_spec *spec, double beta, double *v, char *msg, s
 	return rc == SIM_OK && isfinite(*v) ? 0 : -1;
 }
 
+/* The curve of key k from the cache into v: 0, or -1 when not there. */
+static int cached(const curve_key *k, double *v)
+{
+	int rc = -1;
+	pthread_mutex_lock(&cache.lock);
+	for (int i = 0; rc && i < cache.n; i++)
+		if (memcmp(&cache.key[i], k, sizeof *k) == 0) {
+			memcpy(v, cache.v[i], sizeof cache.v[i]);
+			rc = 0;
+		}
+	pthread_mutex_unlock(&cache.lock);
+	return rc;
+}
+
 /* The curve of spec's scene, from the cache or measured (unlocked while
  * measuring: two requests for a new scene measure it twice). */
 static int curve_of(const api_spec *spec, double *v, char *msg, size_t len)
 {
 	curve_key k;
 	key_of(spec, &k);
-	pthread_mutex_lock(&cache.lock);
-	for (int i = 0; i < cache.n; i++)
-		if (memcmp(&cache.key[i], &k, sizeof k) == 0) {
-			memcpy(v, cache.v[i], sizeof cache.v[i]);
-			pthread_mutex_unlock(&cache.lock);
-			return 0;
-		}
-	pthread_mutex_unlock(&cache.lock);
+	if (cached(&k, v) == 0)
+		return 0;
 	for (int i = 0; i < API_FF_NODES; i++)
 		if (measure_at(spec, 2.5 * i * DEG, &v[i], msg, len) != 0)
 			return -1;
@@ -89,6 +98,51 @@ static int curve_of(const api_spec *spec, double *v, char *msg, size_t len)
 	memcpy(cache.v[at], v, sizeof cache.v[at]);
 	pthread_mutex_unlock(&cache.lock);
 	return 0;
+}
+
+/* A curve measured for a running loop, in a thread of its own: measuring
+ * in the session's worker would stall it for a second and count against
+ * its CPU (the pacing would slow the session down). One at a time. */
+static int measuring; /* guarded by cache.lock */
+
+static void *measure_thread(void *arg)
+{
+	api_spec *spec = arg;
+	double v[API_FF_NODES];
+	char msg[200];
+	if (curve_of(spec, v, msg, sizeof msg) != 0)
+		srv_log(SRV_LOG_WARN, "no v(beta) curve at omega_ss %g rad/s: %s",
+			spec->params.omega_ss, msg);
+	free(spec);
+	pthread_mutex_lock(&cache.lock);
+	measuring = 0;
+	pthread_mutex_unlock(&cache.lock);
+	return NULL;
+}
+
+static void measure_later(const api_spec *spec)
+{
+	pthread_mutex_lock(&cache.lock);
+	int busy = measuring;
+	measuring = 1;
+	pthread_mutex_unlock(&cache.lock);
+	api_spec *copy = busy ? NULL : malloc(sizeof *copy);
+	pthread_t th;
+	pthread_attr_t at;
+	if (copy) {
+		*copy = *spec;
+		pthread_attr_init(&at);
+		pthread_attr_setdetachstate(&at, PTHREAD_CREATE_DETACHED);
+		if (pthread_create(&th, &at, measure_thread, copy) == 0)
+			copy = NULL;
+		pthread_attr_destroy(&at);
+	}
+	if (!busy && copy) { /* the thread did not start */
+		free(copy);
+		pthread_mutex_lock(&cache.lock);
+		measuring = 0;
+		pthread_mutex_unlock(&cache.lock);
+	}
 }
 
 /* The branch between the curve's highest and lowest points into ext:
@@ -117,6 +171,93 @@ static int branch_of(const double *v, api_exp_ext *ext)
 	ext->beta_lo = ext->ff_beta[0];
 	ext->beta_hi = ext->ff_beta[ext->nff - 1];
 	return ext->nff >= 2 ? 0 : -1;
+}
+
+/* Curve v's branch into x's branch fields: 0, or -2 (x unchanged) when
+ * it is not monotonic between its peaks. */
+static int curve_into(api_exp_ext *x, const double *v)
+{
+	api_exp_ext *b = malloc(sizeof *b);
+	if (!b)
+		return -1;
+	int rc = branch_of(v, b) == 0 ? 0 : -2;
+	if (rc == 0) {
+		x->branch_sign = b->branch_sign, x->nff = b->nff;
+		memcpy(x->ff_beta, b->ff_beta, sizeof x->ff_beta);
+		memcpy(x->ff_v, b->ff_v, sizeof x->ff_v);
+		x->v_lo = b->v_lo, x->v_hi = b->v_hi;
+		x->beta_lo = b->beta_lo, x->beta_hi = b->beta_hi;
+	}
+	free(b);
+	return rc;
+}
+
+/* The curves the scheduled disturbances of rotation or omega_ss lead to,
+ * measured now into the cache (the request's thread), so that the worker
+ * finds them there when the session gets there. */
+static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
+{
+	api_spec *at = malloc(sizeof *at);
+	if (!at)
+		return;
+	*at = *spec;
+	for (int k = 0; k < x->ndist; k++) {
+		api_control c;
+		api_problem pb;
+		const char *set = x->dist[k].set;
+		if (api_parse_control(set, strlen(set), spec, &c, &pb) != API_OK ||
+		    !(c.set & (API_C_ROTATION | API_C_OMEGA_SS)))
+			continue;
+		if (c.set & API_C_ROTATION)
+			at->params.rotation = c.rotation;
+		if (c.set & API_C_OMEGA_SS)
+			at->params.omega_ss = c.omega_ss;
+		double v[API_FF_NODES];
+		char msg[200];
+		curve_of(at, v, msg, sizeof msg);
+	}
+	free(at);
+}
+
+void srv_exp_follow_curve(srv_experiment *e, const sim_status *st)
+{
+	api_exp_ext *x = &e->ext;
+	if (x->kind != API_EXP_CONTROL || e->state != EXP_RUNNING ||
+	    (st->rotation == e->curve_rot && st->omega_ss == e->curve_omega))
+		return;
+	if (e->curve_omega == 0) { /* restored: its curve is the scene's */
+		e->curve_rot = st->rotation, e->curve_omega = st->omega_ss;
+		return;
+	}
+	api_spec *spec = malloc(sizeof *spec);
+	if (!spec)
+		return;
+	*spec = e->req.spec;
+	spec->params.rotation = st->rotation;
+	spec->params.omega_ss = st->omega_ss;
+	curve_key k;
+	key_of(spec, &k);
+	double v[API_FF_NODES];
+	int rc = cached(&k, v);
+	if (rc != 0)
+		measure_later(spec); /* the old curve until then */
+	free(spec);
+	if (rc != 0)
+		return;
+	e->curve_rot = st->rotation, e->curve_omega = st->omega_ss;
+	if (curve_into(x, v) != 0) {
+		srv_log(SRV_LOG_WARN, "experiment %s: the v(beta) curve at omega_ss %g rad/s is not "
+			"monotonic between its peaks; the controller keeps its last one",
+			e->entry.id, st->omega_ss);
+		return;
+	}
+	x->integ = 0; /* it made up for the old curve */
+	x->curve_changes++;
+	/* the setpoints still to come start from the new feedforward */
+	for (int i = e->cur + 1; i < e->req.nseg; i++) {
+		double b = srv_exp_feedforward(x, x->sp[i].v);
+		e->req.seg[i].beta = (api_value){b, b / DEG};
+	}
 }
 
 
@@ -253,13 +394,17 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 	if (curve_of(spec, v, msg, sizeof msg) != 0)
 		return api_fail(pb, API_INVALID, "control",
 				"control: the machine's v(beta) curve could not be measured (%s)", msg);
-	if (branch_of(v, x) != 0)
+	if (curve_into(x, v) != 0)
 		return api_fail(pb, API_INVALID, "control",
 				"control: the machine's v(beta) curve is not monotonic between its "
 				"peaks; a controller needs a branch it can invert");
+	e->curve_rot = spec->params.rotation, e->curve_omega = spec->params.omega_ss;
+	x->curve_changes = 0;
 	api_err err = check_setpoints(e, pb);
 	if (err == API_OK && x->auto_gains)
 		err = auto_gains(e, spec, pb);
+	if (err == API_OK)
+		prefetch_curves(x, spec);
 	x->integ = 0;
 	x->t_sample = 0;
 	x->period = NAN; /* measured from the start */

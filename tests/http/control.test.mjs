@@ -103,6 +103,38 @@ test('closed loop: setpoints held with a small steady error, a disturbance appli
   await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
 });
 
+test('a change of omega_ss mid-run: the controller takes up the new scene\'s v(beta) curve', { timeout: 120000 * SLOW }, async () => {
+  // the feedforward alone (a proportional term of 1e-4 deg per m/s) so that
+  // the beta commanded is the curve's inverse at the setpoint
+  const control = { setpoint: [{ v: 0.10, until: 1.5 }, { v: 0.06, until: 3 }], controller: { kp: 0.0001, ki: 0 } };
+  const r = await req(d.base, 'POST', '/api/v1/experiments',
+    { control, disturbances: [{ at: 1, set: { omega_ss: 141.4 } }], keep_session: true });
+  assert.equal(r.status, 201, r.text);
+  const e = await done(r.body.id);
+  assert.equal(e.state, 'done', e.error);
+  assert.equal(e.control.curve_changes, 1);
+  // the same setpoints on that session now, at 141.4 rad/s: its curve from the start
+  const r2 = await req(d.base, 'POST', '/api/v1/experiments', { session: e.session, control });
+  assert.equal(r2.status, 201, r2.text);
+  const e2 = await done(r2.body.id);
+  assert.equal(e2.state, 'done', e2.error);
+  assert.equal(e2.control.curve_changes, 0);
+  assert.deepEqual(e.control.reachable, e2.control.reachable, 'the curve in use at the end is the new scene\'s');
+  const [b0, b1] = e.segments.map((s) => s.beta);
+  const [n0, n1] = e2.segments.map((s) => s.beta);
+  // -10 % omega_ss: the feedforward at 0.10 m/s moves by degrees
+  assert.ok(Math.abs(b0 - n0) > 2, `0.10 m/s: ${b0} deg at 157 rad/s, ${n0} at 141.4`);
+  // the setpoint after the change started from the new curve's feedforward
+  assert.ok(Math.abs(b1 - n1) < 1e-9, `0.06 m/s: ${b1} vs ${n1}`);
+  // and the controller's last command is the new curve's inverse at 0.06 m/s
+  const s = await req(d.base, 'GET', `/api/v1/sessions/${e.session}`);
+  assert.equal(s.body.status.omega_ss, 141.4);
+  assert.ok(Math.abs(s.body.status.beta_target - n1) < 0.01, `${s.body.status.beta_target} vs ${n1}`);
+  // which holds the setpoint on the new scene with the feedforward alone
+  assert.ok(e.control.setpoints[1].steady_error < 0.02, JSON.stringify(e.control.setpoints[1]));
+  await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
+});
+
 const post = (body) => req(d.base, 'POST', '/api/v1/experiments', body);
 const problem = (type, title, detail, field, extra = {}) => ({
   type: `/api/v1/problems/${type}`, title, status: 422, detail,
