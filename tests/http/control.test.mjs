@@ -135,6 +135,37 @@ test('a change of omega_ss mid-run: the controller takes up the new scene\'s v(b
   await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
 });
 
+test('a PATCH of omega_ss while a closed loop runs: its curve, measured aside, taken up', { timeout: 120000 * SLOW }, async () => {
+  const control = { setpoint: [{ v: 0.06, until: 5 }], controller: { kp: 0.0001, ki: 0 } };
+  // at pace 1 (real time), so that the PATCH lands mid-run; 141.9 rad/s: a
+  // scene no other test measured (not in the daemon's cache)
+  const r = await req(d.base, 'POST', '/api/v1/experiments', { session: { pace: 1 }, control, keep_session: true });
+  assert.equal(r.status, 201, r.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`)).body.t - r.body.t_start > 1,
+    20000 * SLOW, 'a simulated second');
+  const p = await req(d.base, 'PATCH', `/api/v1/sessions/${r.body.session}`, { omega_ss: 141.9 });
+  assert.equal(p.status, 200, p.text);
+  const e = await done(r.body.id);
+  assert.equal(e.state, 'done', e.error);
+  assert.equal(e.control.curve_changes, 1);
+  // the loop's last command: the session keeps it after the end
+  const s = await req(d.base, 'GET', `/api/v1/sessions/${e.session}`);
+  assert.equal(s.body.status.omega_ss, 141.9);
+  // the same setpoint on that session now: the new scene's curve from the start
+  const r2 = await req(d.base, 'POST', '/api/v1/experiments',
+    { session: e.session, control: { ...control, setpoint: [{ v: 0.06, until: 0.5 }] } });
+  assert.equal(r2.status, 201, r2.text);
+  assert.equal(r2.body.control.curve_changes, 0);
+  assert.deepEqual(e.control.reachable, r2.body.control.reachable);
+  const n0 = r2.body.segments[0].beta;
+  // -9.6 % omega_ss moves the feedforward at 0.06 m/s by about a degree
+  assert.ok(Math.abs(e.segments[0].beta - n0) > 0.5, `${e.segments[0].beta} vs ${n0}`);
+  // the command after the PATCH is the new curve's inverse at 0.06 m/s
+  assert.ok(Math.abs(s.body.status.beta_target - n0) < 0.01, `${s.body.status.beta_target} vs ${n0}`);
+  assert.equal((await done(r2.body.id)).state, 'done');
+  await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
+});
+
 const post = (body) => req(d.base, 'POST', '/api/v1/experiments', body);
 const problem = (type, title, detail, field, extra = {}) => ({
   type: `/api/v1/problems/${type}`, title, status: 422, detail,
