@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -368,6 +368,14 @@ bench-controls: all
 # and disturbances on the preset, into tests/bench/results/control_loop.md.
 bench-control-loop: all
 	$(Q)CONVSIMD=$(BUILD)/convsimd node tests/bench/control_loop.mjs | tee tests/bench/results/control_loop.md
+
+# Does shaping the beta command settle the feed faster (part of `make bench`;
+# tests/bench/control_shaping.c on the core alone, about 10 s)? Into
+# tests/bench/results/control_shaping.md.
+bench-control-shaping: all
+	$(Q)$(CC) $(CFLAGS) $(WARN) $(INC_core) -o $(BUILD)/control_shaping tests/bench/control_shaping.c \
+		$(BUILD)/libcore.a $(LDLIBS)
+	$(Q)$(BUILD)/control_shaping | tee tests/bench/results/control_shaping.md
 
 # A bounded load run on loopback (about two minutes; tests/bench/load.mjs):
 # 200 sessions, 500 streams, PATCH beta, 2,000 idle sockets from one client;
