@@ -19,7 +19,7 @@ KEY; the figure is the last number before the comment (after any earlier
 comment on the line). `python3 tests/docs_bench.py` writes every such block
 and figure again from its file (after `make bench`); `--check` only compares
 and exits 1 naming each block or figure that differs (tests/http/docs.test.mjs
-runs it).
+runs it, and `--self-test`, which shows that a wrong figure fails).
 """
 import pathlib
 import re
@@ -121,7 +121,35 @@ def sync(path, check, counts=None):
     return bad
 
 
+def self_test():
+    """The figure check can fail: a right figure passes and is kept, a wrong
+    one, a missing key or number, and a mark with no figure are named."""
+    src = 'tests/bench/results/scaling.md'
+    key = 'Machine alone at the same step'
+    want, err = source_figure(src, key, 1)
+    mark = f'<!-- from {src} "{key}" -->'
+    cases = [
+        (f'alone {want}{mark} CPU s', f'alone {want}{mark} CPU s', 0),
+        (f'alone 0.5 CPU s{mark}', f'alone {want} CPU s{mark}', 1),
+        (f'alone 7 {mark.replace(key, "no such line")}', None, 1),
+        (f'alone 7 {mark.replace(" -->", " 99 -->")}', None, 1),
+        (f'alone {mark}', None, 1),
+        (f'1 2 {want}{mark} and 3', f'1 2 {want}{mark} and 3', 0),
+    ]
+    ok = 0
+    for line, out, nbad in cases:
+        got, count, bad = figures(line, 'x.md:1')
+        if err is None and count == 1 and len(bad) == nbad and (out is None or got == out):
+            ok += 1
+        else:
+            print(f'self-test: {line!r} gave {got!r}, {bad}')
+    print(f'docs_bench self-test: {ok} of {len(cases)}')
+    return 0 if ok == len(cases) else 1
+
+
 def main():
+    if '--self-test' in sys.argv[1:]:
+        return self_test()
     check = '--check' in sys.argv[1:]
     docs = [ROOT / 'README.md'] + sorted((ROOT / 'docs').glob('*.md')) + sorted((ROOT / 'docs' / 'log').glob('*.md'))
     counts = {'figures': 0}
