@@ -9,9 +9,17 @@ A table in README.md, docs/*.md or docs/log/*.md that stands between
     <!-- /bench -->
 
 is the N-th Markdown table (1 = the first) of that results file, line for
-line. `python3 tests/docs_bench.py` writes every such block again from its
-file (after `make bench`); `--check` only compares and exits 1 naming each
-block that differs (tests/http/docs.test.mjs runs it).
+line. A figure in prose is marked the same way by a comment after it on its
+line:
+
+    ... 0.085<!-- from tests/bench/results/FILE.md "KEY" N --> CPU s ...
+
+is the N-th number (1 = the first) of the first line of FILE that contains
+KEY; the figure is the last number before the comment (after any earlier
+comment on the line). `python3 tests/docs_bench.py` writes every such block
+and figure again from its file (after `make bench`); `--check` only compares
+and exits 1 naming each block or figure that differs (tests/http/docs.test.mjs
+runs it, and `--self-test`, which shows that a wrong figure fails).
 """
 import pathlib
 import re
@@ -20,6 +28,8 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 MARK = re.compile(r'^<!-- bench: (\S+) table (\d+) -->$')
 END = '<!-- /bench -->'
+FIGURE = re.compile(r'<!-- from (\S+) "([^"]+)"(?: (\d+))? -->')
+NUMBER = re.compile(r'(?<![\w.])\d+(?:,\d{3})*(?:\.\d+)?(?:e[-+]?\d+)?')
 
 
 def tables(text):
@@ -36,15 +46,57 @@ def tables(text):
     return out
 
 
-def sync(path, check):
+def source_figure(src, key, n):
+    """The n-th number of the first line of src containing key, or an error."""
+    path = ROOT / src
+    if not path.exists():
+        return None, f'no file {src}'
+    for line in path.read_text().splitlines():
+        if key in line:
+            nums = NUMBER.findall(line)
+            if not 1 <= n <= len(nums):
+                return None, f'the line of {src} with "{key}" has no number {n}'
+            return nums[n - 1], None
+    return None, f'{src} has no line with "{key}"'
+
+
+def figures(line, where):
+    """line with each marked figure written from its source, the number of
+    marks, and [problems]: (new line, count, bad)."""
+    out, bad, last, count = [], [], 0, 0
+    for m in FIGURE.finditer(line):
+        count += 1
+        seg = line[last:m.start()]
+        nums = list(NUMBER.finditer(seg))
+        want, err = source_figure(m.group(1), m.group(2), int(m.group(3) or 1))
+        if not nums:
+            bad.append(f'{where}: no figure before the mark {m.group(0)}')
+        elif err:
+            bad.append(f'{where}: {err}')
+        elif nums[-1].group(0) != want:
+            bad.append(f'{where}: {nums[-1].group(0)} but {m.group(1)} says {want} ("{m.group(2)}")')
+        if nums and want is not None:
+            seg = seg[:nums[-1].start()] + want + seg[nums[-1].end():]
+        out.append(seg + m.group(0))
+        last = m.end()
+    out.append(line[last:])
+    return ''.join(out), count, bad
+
+
+def sync(path, check, counts=None):
     lines = path.read_text().splitlines()
     out, bad, i = [], [], 0
     while i < len(lines):
         m = MARK.match(lines[i].strip())
-        out.append(lines[i])
         if not m:
+            line, n, fbad = figures(lines[i], f'{path.relative_to(ROOT)}:{i + 1}')
+            out.append(line)
+            bad.extend(fbad)
+            if counts is not None:
+                counts['figures'] += n
             i += 1
             continue
+        out.append(lines[i])
         j = i + 1
         while j < len(lines) and lines[j].strip() != END:
             j += 1
@@ -69,15 +121,45 @@ def sync(path, check):
     return bad
 
 
+def self_test():
+    """The figure check can fail: a right figure passes and is kept, a wrong
+    one, a missing key or number, and a mark with no figure are named."""
+    src = 'tests/bench/results/scaling.md'
+    key = 'Machine alone at the same step'
+    want, err = source_figure(src, key, 1)
+    mark = f'<!-- from {src} "{key}" -->'
+    cases = [
+        (f'alone {want}{mark} CPU s', f'alone {want}{mark} CPU s', 0),
+        (f'alone 0.5 CPU s{mark}', f'alone {want} CPU s{mark}', 1),
+        (f'alone 7 {mark.replace(key, "no such line")}', None, 1),
+        (f'alone 7 {mark.replace(" -->", " 99 -->")}', None, 1),
+        (f'alone {mark}', None, 1),
+        (f'1 2 {want}{mark} and 3', f'1 2 {want}{mark} and 3', 0),
+    ]
+    ok = 0
+    for line, out, nbad in cases:
+        got, count, bad = figures(line, 'x.md:1')
+        if err is None and count == 1 and len(bad) == nbad and (out is None or got == out):
+            ok += 1
+        else:
+            print(f'self-test: {line!r} gave {got!r}, {bad}')
+    print(f'docs_bench self-test: {ok} of {len(cases)}')
+    return 0 if ok == len(cases) else 1
+
+
 def main():
+    if '--self-test' in sys.argv[1:]:
+        return self_test()
     check = '--check' in sys.argv[1:]
     docs = [ROOT / 'README.md'] + sorted((ROOT / 'docs').glob('*.md')) + sorted((ROOT / 'docs' / 'log').glob('*.md'))
-    bad = [b for p in docs for b in sync(p, check)]
+    counts = {'figures': 0}
+    bad = [b for p in docs for b in sync(p, check, counts)]
     for b in bad:
         print(b)
     blocks = sum(1 for p in docs for l in p.read_text().splitlines() if MARK.match(l.strip()))
-    print(f'docs_bench: {blocks} tables from the bench results, {len(bad)} differ' if check
-          else f'docs_bench: {blocks} tables written from the bench results')
+    what = f'{blocks} tables and {counts["figures"]} figures'
+    print(f'docs_bench: {what} from the bench results, {len(bad)} differ' if check
+          else f'docs_bench: {what} written from the bench results')
     return 1 if check and bad else 0
 
 

@@ -265,12 +265,17 @@ test('the API pages and the served OpenAPI document name the same operations', a
 });
 
 // Benchmark tables between <!-- bench: FILE table N --> and <!-- /bench -->
-// are the N-th table of `make bench`'s output file, line for line
-// (tests/docs_bench.py writes them, --check compares).
-test('benchmark tables in the documents are those of the bench results', async () => {
+// are the N-th table of `make bench`'s output file, line for line, and a
+// figure marked <!-- from FILE "KEY" N --> is the N-th number of FILE's line
+// with KEY (tests/docs_bench.py writes them, --check compares; --self-test
+// shows that a wrong figure, key or number fails).
+test('benchmark tables and marked figures in the documents are those of the bench results', async () => {
   const r = await run('python3', [join(ROOT, 'tests/docs_bench.py'), '--check']).catch((e) => e);
   assert.equal(r.code ?? 0, 0, `${r.stdout}${r.stderr ?? ''}`);
-  assert.match(r.stdout, /docs_bench: [1-9]\d* tables from the bench results, 0 differ/);
+  assert.match(r.stdout, /docs_bench: [1-9]\d* tables and [1-9]\d* figures from the bench results, 0 differ/);
+  const t = await run('python3', [join(ROOT, 'tests/docs_bench.py'), '--self-test']).catch((e) => e);
+  assert.equal(t.code ?? 0, 0, `${t.stdout}${t.stderr ?? ''}`);
+  assert.match(t.stdout, /docs_bench self-test: 6 of 6/);
 });
 
 test('the link checker sees a missing file and a missing anchor', () => {
