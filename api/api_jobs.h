@@ -44,6 +44,10 @@ typedef struct api_experiment_req {
 	api_segment seg[API_EXP_MAX_SEGMENTS];
 } api_experiment_req;
 
+/* seg as a request leaves it: beta (rad, deg as sent) until s, its
+ * results not measured yet (NaN, state pending). */
+void api_segment_reset(api_segment *seg, api_value beta, double until);
+
 /* An experiment's kind beyond its schedule (docs/control.md): an
  * identification (steps of beta around operating points, a first-order-
  * plus-dead-time model fitted per point) or a closed loop (a PI controller

@@ -53,12 +53,7 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 		pb->has_range = 1, pb->min = prev, pb->max = 1e4;
 		return API_RANGE;
 	}
-	memset(seg, 0, sizeof *seg);
-	seg->beta = beta_si;
-	seg->until = until->valuedouble;
-	seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
-	seg->reversal_time = seg->start_velocity = NAN;
-	seg->t_command = seg->t_end = NAN;
+	api_segment_reset(seg, beta_si, until->valuedouble);
 	return API_OK;
 }
 

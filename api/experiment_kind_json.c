@@ -49,16 +49,20 @@ static api_err number_in(const cJSON *obj, const char *name, const char *field, 
 	return API_OK;
 }
 
-/* Append a segment (beta in SI and as sent, until) to req. */
-static void add_segment(api_experiment_req *req, api_value beta, double until)
+void api_segment_reset(api_segment *seg, api_value beta, double until)
 {
-	api_segment *seg = &req->seg[req->nseg++];
 	memset(seg, 0, sizeof *seg);
 	seg->beta = beta;
 	seg->until = until;
 	seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
 	seg->reversal_time = seg->start_velocity = NAN;
 	seg->t_command = seg->t_end = NAN;
+}
+
+/* Append a segment (beta in SI and as sent, until) to req. */
+static void add_segment(api_experiment_req *req, api_value beta, double until)
+{
+	api_segment_reset(&req->seg[req->nseg++], beta, until);
 }
 
 /* One operating point's segments: settle at beta0, +step, back, -step,

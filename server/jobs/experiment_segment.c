@@ -112,14 +112,7 @@ int srv_exp_readopt(srv_experiment *e, const char *session_id)
 		/* every segment as the request left it, then its start */
 		for (int i = 0; i < e->req.nseg; i++) {
 			api_segment *seg = &e->req.seg[i];
-			api_value beta = seg->beta;
-			double until = seg->until;
-			memset(seg, 0, sizeof *seg);
-			seg->beta = beta;
-			seg->until = until;
-			seg->steady_velocity = seg->mean_velocity = seg->uncertainty = NAN;
-			seg->reversal_time = seg->start_velocity = NAN;
-			seg->t_command = seg->t_end = NAN;
+			api_segment_reset(seg, seg->beta, seg->until);
 		}
 		e->rec_cap = EXP_RECORDS;
 		e->rec_n = e->seg_first = 0;
