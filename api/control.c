@@ -71,13 +71,20 @@ static api_err feed_disturbable(const api_spec *spec, const char *name, api_prob
 	return API_OK;
 }
 
+/* A feed control's value (into v) and whether the session's feed takes
+ * it. */
+static api_err feed_value(const cJSON *it, const api_spec *spec, const char *name, api_value *v,
+			  api_problem *pb)
+{
+	api_err e = api_parse_user_value(spec, name, it, name, v, pb);
+	return e == API_OK ? feed_disturbable(spec, name, pb) : e;
+}
+
 static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name,
 			 api_control *c, api_problem *pb)
 {
 	api_value v = {0, 0};
-	api_err e = api_parse_user_value(spec, name, it, name, &v, pb);
-	if (e == API_OK)
-		e = feed_disturbable(spec, name, pb);
+	api_err e = feed_value(it, spec, name, &v, pb);
 	if (e != API_OK)
 		return e;
 	double lo, hi;
@@ -104,9 +111,7 @@ static api_err parse_mu(const cJSON *it, const api_spec *spec, const char *name,
 			api_control *c, api_problem *pb)
 {
 	api_value v = {0, 0};
-	api_err e = api_parse_user_value(spec, name, it, name, &v, pb);
-	if (e == API_OK)
-		e = feed_disturbable(spec, name, pb);
+	api_err e = feed_value(it, spec, name, &v, pb);
 	c->mu = v.si;
 	return e;
 }
