@@ -42,13 +42,20 @@ static void data(double sigma, double *t, double *y)
 	}
 }
 
+/* The fit of the N samples with noise of sigma, which must succeed. */
+static fopdt_result fit_of(double sigma)
+{
+	double t[N], y[N];
+	data(sigma, t, y);
+	fopdt_result r;
+	assert_int_equal(fopdt_fit(t, y, N, ts, d, 4, 2, &r), 0);
+	return r;
+}
+
 static void exact_without_noise(void **state)
 {
 	(void)state;
-	double t[N], y[N];
-	data(0, t, y);
-	fopdt_result r;
-	assert_int_equal(fopdt_fit(t, y, N, ts, d, 4, 2, &r), 0);
+	fopdt_result r = fit_of(0);
 	assert_true(fabs(r.k + 0.0032) < 1e-9);
 	assert_true(fabs(r.t - 0.35) < 1e-6);
 	assert_true(fabs(r.l - 0.12) < 1e-6);
@@ -58,10 +65,7 @@ static void exact_without_noise(void **state)
 static void within_standard_errors(void **state)
 {
 	(void)state;
-	double t[N], y[N];
-	data(0.0005, t, y);
-	fopdt_result r;
-	assert_int_equal(fopdt_fit(t, y, N, ts, d, 4, 2, &r), 0);
+	fopdt_result r = fit_of(0.0005);
 	assert_true(r.ok && r.k_se > 0 && r.t_se > 0 && r.l_se > 0);
 	assert_true(fabs(r.k + 0.0032) < 3 * r.k_se);
 	assert_true(fabs(r.t - 0.35) < 3 * r.t_se);
