@@ -11,27 +11,9 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, openStream, until, sleep, CHEAP, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, streamUntil, until, sleep, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 const get = async (d, id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
-
-// The first record of the session's NDJSON stream that pick returns.
-async function streamUntil(base, id, pick, ms = 10000 * SLOW) {
-  const ac = new AbortController();
-  const timer = setTimeout(() => ac.abort(), ms);
-  try {
-    for await (const r of openStream(base, `/api/v1/sessions/${id}/stream?format=ndjson`, {}, ac.signal)) {
-      const hit = pick(r);
-      if (hit) return hit;
-    }
-  } catch (e) {
-    if (!ac.signal.aborted) throw e;
-  } finally {
-    clearTimeout(timer);
-    ac.abort();
-  }
-  assert.fail('no such record');
-}
 
 test('PATCH m_n and mu: applied, in the status and the stream; out of range a 422 that changes nothing', { timeout: 60000 * SLOW }, async () => {
   const d = await startDaemon();

@@ -3,6 +3,7 @@
 // talk JSON to it, and read its SSE / NDJSON streams record by record.
 // CONVSIMD names the binary (build/convsimd or build-san/convsimd); the
 // sanitizer build is slower, so timeouts scale with SLOW.
+import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -170,6 +171,27 @@ export async function* openStream(base, path, headers = {}, signal) {
       yield ndjson ? JSON.parse(block) : parseSse(block);
     }
   }
+}
+
+// The first record of the session id's NDJSON stream that pick(record,
+// records so far) returns; fails after ms, naming the first records.
+export async function streamUntil(base, id, pick, ms = 10000 * SLOW) {
+  const ac = new AbortController();
+  const timer = setTimeout(() => ac.abort(), ms);
+  const seen = [];
+  try {
+    for await (const rec of openStream(base, `/api/v1/sessions/${id}/stream?format=ndjson`, {}, ac.signal)) {
+      seen.push(rec);
+      const hit = pick(rec, seen);
+      if (hit) return hit;
+    }
+  } catch (e) {
+    if (!ac.signal.aborted) throw e;
+  } finally {
+    clearTimeout(timer);
+    ac.abort();
+  }
+  assert.fail(`no such record in ${JSON.stringify(seen.slice(0, 5))}`);
 }
 
 // Value of one Prometheus sample, e.g. metric(text, 'convsim_sessions') or

@@ -8,7 +8,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { startDaemon, req, openStream, until, SLOW } from './lib.mjs';
+import { startDaemon, req, streamUntil, until, SLOW } from './lib.mjs';
 
 // The map's rows for liggghts-bed4 (4 layers), by "beta,rotation".
 const MAP = (() => {
@@ -36,26 +36,6 @@ const cell = (x) => (x === null ? '' : String(x));
 let d;
 before(async () => { d = await startDaemon(); });
 after(async () => { await d.stop(); });
-
-// The stream's records, NDJSON, until pick returns a record (or the time runs out).
-async function streamUntil(base, id, pick, ms = 10000 * SLOW) {
-  const ac = new AbortController();
-  const timer = setTimeout(() => ac.abort(), ms);
-  const seen = [];
-  try {
-    for await (const rec of openStream(base, `/api/v1/sessions/${id}/stream?format=ndjson`, {}, ac.signal)) {
-      seen.push(rec);
-      const hit = pick(rec, seen);
-      if (hit) return hit;
-    }
-  } catch (e) {
-    if (!ac.signal.aborted) throw e;
-  } finally {
-    clearTimeout(timer);
-    ac.abort();
-  }
-  assert.fail(`no such record in ${JSON.stringify(seen.slice(0, 5))}`);
-}
 
 test('model_error: the calibrated bed moved from 30 to 150 deg cw takes the map\'s value there, then is not checked at 170', { timeout: 30000 * SLOW }, async () => {
   assert.ok(MAP['30,cw'] > 0 && MAP['150,cw'] > MAP['30,cw'], 'the map has the two points');
