@@ -93,3 +93,12 @@ cJSON *api_parse_body(const char *body, size_t len, const char *const *members,
 	}
 	return root;
 }
+
+api_err api_check_object(const cJSON *obj, const char *field, const char *prefix,
+			 const char *expected, const char *const *names, api_problem *pb)
+{
+	if (!cJSON_IsObject(obj))
+		return api_fail(pb, API_TYPE, field, "%.*s must be %s", (int)strlen(prefix) - 1,
+				prefix, expected);
+	return api_check_members(obj, names, prefix, pb);
+}

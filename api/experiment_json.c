@@ -27,11 +27,8 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 {
 	char prefix[40], field[48];
 	snprintf(prefix, sizeof prefix, "schedule[%d].", i);
-	if (!cJSON_IsObject(it))
-		return api_fail(pb, API_TYPE, prefix,
-				"schedule[%d] must be an object {\"beta\": "
-				"DEG, \"until\": S}", i);
-	api_err e = api_check_members(it, api_members_segment, prefix, pb);
+	api_err e = api_check_object(it, prefix, prefix, "an object {\"beta\": DEG, \"until\": S}",
+				     api_members_segment, pb);
 	if (e != API_OK)
 		return e;
 	const cJSON *beta = cJSON_GetObjectItemCaseSensitive(it, "beta");

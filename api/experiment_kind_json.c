@@ -104,11 +104,9 @@ static api_err identify_point(const cJSON *it, int i, api_experiment_req *req, a
 static api_err parse_identify(const cJSON *id, api_experiment_req *req, api_exp_ext *ext,
 			      api_problem *pb)
 {
-	if (!cJSON_IsObject(id))
-		return api_fail(pb, API_TYPE, "identify",
-				"identify must be an object {\"beta\": DEG or [DEG, ...], \"step\": "
-				"DEG, \"hold\": S}");
-	api_err e = api_check_members(id, api_members_identify, "identify.", pb);
+	api_err e = api_check_object(id, "identify", "identify.",
+				     "an object {\"beta\": DEG or [DEG, ...], \"step\": DEG, "
+				     "\"hold\": S}", api_members_identify, pb);
 	if (e == API_OK)
 		e = number_in(id, "step", "identify.step", 0.1, 30, 4, "deg", &ext->id_step, pb);
 	if (e == API_OK)
@@ -138,11 +136,9 @@ static api_err parse_controller(const cJSON *c, api_exp_ext *ext, api_problem *p
 		ext->auto_gains = 1;
 		return API_OK;
 	}
-	if (!cJSON_IsObject(c))
-		return api_fail(pb, API_TYPE, "control.controller",
-				"control.controller must be \"auto\" or {\"kp\": DEG_PER_M_S, "
-				"\"ki\": DEG_PER_M}");
-	api_err e = api_check_members(c, api_members_controller, "control.controller.", pb);
+	api_err e = api_check_object(c, "control.controller", "control.controller.",
+				     "\"auto\" or {\"kp\": DEG_PER_M_S, \"ki\": DEG_PER_M}",
+				     api_members_controller, pb);
 	if (e == API_OK)
 		e = number_in(c, "kp", "control.controller.kp", 0, 1e4, NAN, "deg per m/s",
 			      &ext->kp, pb);
@@ -161,10 +157,8 @@ static api_err parse_setpoint(const cJSON *it, int i, api_experiment_req *req, a
 {
 	char prefix[40], field[48];
 	snprintf(prefix, sizeof prefix, "control.setpoint[%d].", i);
-	if (!cJSON_IsObject(it))
-		return api_fail(pb, API_TYPE, prefix, "control.setpoint[%d] must be an object "
-				"{\"v\": M_S, \"until\": S}", i);
-	api_err e = api_check_members(it, api_members_setpoint, prefix, pb);
+	api_err e = api_check_object(it, prefix, prefix, "an object {\"v\": M_S, \"until\": S}",
+				     api_members_setpoint, pb);
 	double prev = req->nseg ? req->seg[req->nseg - 1].until : 0, v, until;
 	snprintf(field, sizeof field, "%sv", prefix);
 	if (e == API_OK)
@@ -194,11 +188,10 @@ static api_err parse_setpoint(const cJSON *it, int i, api_experiment_req *req, a
 static api_err parse_control(const cJSON *c, api_experiment_req *req, api_exp_ext *ext,
 			     api_problem *pb)
 {
-	if (!cJSON_IsObject(c))
-		return api_fail(pb, API_TYPE, "control",
-				"control must be an object {\"setpoint\": [{\"v\": M_S, \"until\": "
-				"S}, ...], \"controller\": \"auto\" or {\"kp\", \"ki\"}}");
-	api_err e = api_check_members(c, api_members_exp_control, "control.", pb);
+	api_err e = api_check_object(c, "control", "control.",
+				     "an object {\"setpoint\": [{\"v\": M_S, \"until\": S}, ...], "
+				     "\"controller\": \"auto\" or {\"kp\", \"ki\"}}",
+				     api_members_exp_control, pb);
 	if (e == API_OK)
 		e = number_in(c, "tau_c", "control.tau_c", 0, 100, 0, "s", &ext->tau_c, pb);
 	if (e == API_OK)
@@ -236,10 +229,9 @@ static api_err parse_disturbance(const cJSON *it, int i, const api_experiment_re
 {
 	char prefix[40], field[64];
 	snprintf(prefix, sizeof prefix, "disturbances[%d].", i);
-	if (!cJSON_IsObject(it))
-		return api_fail(pb, API_TYPE, prefix, "disturbances[%d] must be an object "
-				"{\"at\": S, \"set\": {CONTROL: VALUE}}", i);
-	api_err e = api_check_members(it, api_members_disturbance, prefix, pb);
+	api_err e = api_check_object(it, prefix, prefix,
+				     "an object {\"at\": S, \"set\": {CONTROL: VALUE}}",
+				     api_members_disturbance, pb);
 	double end = req->seg[req->nseg - 1].until;
 	snprintf(field, sizeof field, "%sat", prefix);
 	if (e == API_OK)

@@ -95,6 +95,11 @@ api_err api_apply_session_extras(const cJSON *root, api_spec *spec,
  * naming prefix + member otherwise). body.c. */
 api_err api_check_members(const cJSON *obj, const char *const *names,
 			  const char *prefix, api_problem *pb);
+/* obj must be an object (else a 400 for field: "NAME must be expected",
+ * NAME being prefix without its final dot) of the names, as
+ * api_check_members. body.c. */
+api_err api_check_object(const cJSON *obj, const char *field, const char *prefix,
+			 const char *expected, const char *const *names, api_problem *pb);
 /* The varied settings of a sweep request (study_json.c): "vary", "lhs"
  * and "seed" members (each may be NULL) into req's points (nbeta,
  * betas, nvary, vary, values, lhs, seed); req->betas, when set, is the

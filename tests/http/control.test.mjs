@@ -3,8 +3,9 @@
 // gain against the slope of v(beta) from a sweep, a closed loop's results
 // and a disturbance applied through the PATCH controls, and the 422s that
 // name the field (a setpoint out of reach with the range, gains that make
-// no sense, a disturbance outside a setting's range). On the czubak2016
-// preset at pace "max", a few simulated seconds each.
+// no sense, a disturbance outside a setting's range), and the 400s of a
+// kind or an entry that is not an object. On the czubak2016 preset at
+// pace "max", a few simulated seconds each.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, until, SLOW } from './lib.mjs';
@@ -231,6 +232,22 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
     'identify.step'));
   // nothing was created
   assert.equal((await req(d.base, 'GET', '/api/v1/experiments')).body.experiments.length, before);
+});
+
+test('400: a kind, or an entry of one, that is not an object names it and the shape it takes', async () => {
+  const wrong = (detail, field) => problem('wrong-type', 'Wrong type', detail, field, { status: 400 });
+  const sp = [{ v: 0.1, until: 1 }];
+  const cases = [
+    [{ identify: 5 }, 'identify must be an object {"beta": DEG or [DEG, ...], "step": DEG, "hold": S}', 'identify'],
+    [{ control: [] }, 'control must be an object {"setpoint": [{"v": M_S, "until": S}, ...], "controller": "auto" or {"kp", "ki"}}', 'control'],
+    [{ control: { setpoint: sp, controller: 7 } }, 'control.controller must be "auto" or {"kp": DEG_PER_M_S, "ki": DEG_PER_M}', 'control.controller'],
+    [{ control: { setpoint: [...sp, 3] } }, 'control.setpoint[1] must be an object {"v": M_S, "until": S}', 'control.setpoint[1].'],
+    [{ control: { setpoint: sp }, disturbances: [{ at: 0.5, set: { m_n: 1 } }, 'x'] },
+      'disturbances[1] must be an object {"at": S, "set": {CONTROL: VALUE}}', 'disturbances[1].'],
+    [{ schedule: [{ beta: 30, until: 1 }, []] }, 'schedule[1] must be an object {"beta": DEG, "until": S}', 'schedule[1].'],
+  ];
+  for (const [body, detail, field] of cases)
+    assert.deepEqual((await post(body)).body, wrong(detail, field), JSON.stringify(body));
 });
 
 test('a closed loop killed mid-run resumes from its checkpoint and ends; an identification is served again', { timeout: 120000 * SLOW }, async () => {
