@@ -11,76 +11,22 @@
 // below carry it.
 import { test, before, after, beforeEach } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { randomBytes } from 'node:crypto';
-import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { mkdirSync, readFileSync } from 'node:fs';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { chromium } from '../node_modules/playwright-core/index.mjs';
-import '../tether.mjs'; // nothing started here outlives the test
+import { ROOT, startDaemon, stopDaemon, launchChromium, apiGet, until } from './lib.mjs';
 
-const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
-const DAEMON = path.resolve(ROOT, process.env.CONVSIMD || 'build/convsimd');
 const OUT = path.join(ROOT, 'tests/out');
-const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 const PACE = process.env.DASHBOARD_PACE || '2';
 
-let daemon, base, browser, page;
+/* the daemon of lib.mjs's startDaemon, its base URL, token and header */
+let daemon, base, TOKEN, AUTH;
+let browser, page;
 const pageErrors = [];
 /* console errors of the whole tour (a 404 of a poll after Delete, ...):
  * the tour ends with none but those a test provokes on purpose */
 const consoleErrors = [];
 let currentTest = '';
 beforeEach((t) => { currentTest = t.name; });
-const TOKEN = randomBytes(20).toString('hex');
-const AUTH = { Authorization: `Bearer ${TOKEN}` };
-const TOKEN_FILE = path.join(mkdtempSync(path.join(tmpdir(), 'convsim-dash-')), 'token');
-writeFileSync(TOKEN_FILE, TOKEN + '\n', { mode: 0o600 });
-
-function startDaemon() {
-	return new Promise((resolve, reject) => {
-		const p = spawn(DAEMON, ['--port', '0', '--token-file', TOKEN_FILE], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
-		let out = '';
-		const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`no "listening on" line from ${DAEMON} in 15 s:\n${out}`)); }, 15000);
-		const scan = chunk => {
-			out += chunk;
-			const m = /listening on (http:\/\/[^\s]+)/.exec(out);
-			if (m) { clearTimeout(timer); resolve({ proc: p, url: m[1].replace(/\/$/, '') }); }
-		};
-		p.stdout.setEncoding('utf8').on('data', scan);
-		p.stderr.setEncoding('utf8').on('data', scan);
-		p.on('error', e => { clearTimeout(timer); reject(e); });
-		p.on('exit', code => { clearTimeout(timer); reject(new Error(`${DAEMON} exited (${code}) before listening:\n${out}`)); });
-	});
-}
-
-async function stopDaemon() {
-	if (!daemon || daemon.exitCode !== null || daemon.signalCode) return;
-	const exited = new Promise(r => daemon.once('exit', r));
-	daemon.kill('SIGTERM');
-	const t = setTimeout(() => daemon.kill('SIGKILL'), 5000);
-	await exited;
-	clearTimeout(t);
-}
-
-async function apiGet(p) {
-	const res = await fetch(base + p, { headers: AUTH });
-	assert.equal(res.status, 200, `GET ${p}`);
-	return res.json();
-}
-
-/* Poll fn until it returns a truthy value or ms pass. */
-async function until(fn, ms, what) {
-	const end = Date.now() + ms;
-	let last;
-	while (Date.now() < end) {
-		last = await fn();
-		if (last) return last;
-		await new Promise(r => setTimeout(r, 200));
-	}
-	throw new Error(`timed out after ${ms} ms waiting for ${what} (last: ${JSON.stringify(last)})`);
-}
 
 const attr = (sel, name) => page.$eval(sel, (e, n) => e.dataset[n], name);
 const count = async sel => Number(await attr(sel, 'points'));
@@ -115,15 +61,9 @@ const TRAJ_HEAD = 't,beta,beta_target,x,y,alpha,s1,s2,deck_x,deck_y,rotor_speed,
 
 before(async () => {
 	mkdirSync(OUT, { recursive: true });
-	const d = await startDaemon();
-	daemon = d.proc;
-	daemon.removeAllListeners('exit');
-	base = d.url.replace('0.0.0.0', '127.0.0.1');
-	browser = await chromium.launch({
-		executablePath: CHROMIUM,
-		args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-			'--disable-background-networking', '--disable-component-update', '--disable-sync'],
-	});
+	daemon = await startDaemon();
+	({ base, token: TOKEN, auth: AUTH } = daemon);
+	browser = await launchChromium();
 	page = await browser.newPage({ viewport: { width: 1600, height: 1300 } });
 	page.on('pageerror', e => pageErrors.push(e.message));
 	page.on('console', m => { if (m.type() === 'error') consoleErrors.push(`${m.text()} (${m.location().url}) in "${currentTest}"`); });
@@ -131,7 +71,7 @@ before(async () => {
 
 after(async () => {
 	await browser?.close();
-	await stopDaemon();
+	await stopDaemon(daemon?.proc);
 });
 
 let sessionId;
@@ -167,7 +107,7 @@ test('a session starts from the form', async () => {
 	await page.fill('input[name="rate"]', '500');
 	await page.click('#start');
 	sessionId = await until(() => page.$eval('body', b => b.dataset.sessionId), 10000, 'a session id on the page');
-	const s = await apiGet(`/api/v1/sessions/${sessionId}`);
+	const s = await apiGet(daemon, `/api/v1/sessions/${sessionId}`);
 	assert.equal(s.id, sessionId);
 	assert.equal(s.columns, 5);
 	assert.equal(s.layers, 2);
@@ -271,11 +211,11 @@ test('β = 38°, clockwise: the page shows transport to the right', async () => 
 		return /^\+0\.\d{3} ± 0\.\d{3} m\/s$/.test(d) && mark === 'steady' ? { d, mark } : null;
 	}, 30000, 'the daemon estimate ± its error bar, steady');
 	assert.equal(await page.$eval('#v-steady', e => e.textContent), 'steady');
-	const st = (await apiGet(`/api/v1/sessions/${sessionId}`)).status;
+	const st = (await apiGet(daemon, `/api/v1/sessions/${sessionId}`)).status;
 	/* the bar against the accuracy target, as the status says, and the
 	 * steps the engine chose for the scene */
 	const tol = await until(async () => await page.$eval('#v-tol', e => e.dataset.tol) || null, 10000, 'the tol mark');
-	const now = (await apiGet(`/api/v1/sessions/${sessionId}`)).status;
+	const now = (await apiGet(daemon, `/api/v1/sessions/${sessionId}`)).status;
 	assert.ok(tol === 'within' || tol === 'beyond', `tol mark ${tol}`);
 	assert.equal(typeof now.tol_met, 'boolean');
 	assert.equal(now.tol, 0.01);
@@ -320,12 +260,12 @@ test('moving the β slider turns the session to 128° and reverses the shown dir
 	assert.deepEqual(differ, [], 'β now and the drawing\'s β');
 	assert.ok(new Set(pairs.map(p => p[0])).size > 1, `β moved while sampled: ${pairs.map(p => p[0])}`);
 	const s = await until(async () => {
-		const j = await apiGet(`/api/v1/sessions/${sessionId}`);
+		const j = await apiGet(daemon, `/api/v1/sessions/${sessionId}`);
 		return j.status && Math.abs(j.status.beta_target - 128) < 1e-9 ? j : null;
 	}, 5000, 'beta_target = 128 in the API');
 	assert.ok(s.status.beta_target === 128);
 	await until(async () => {
-		const j = await apiGet(`/api/v1/sessions/${sessionId}`);
+		const j = await apiGet(daemon, `/api/v1/sessions/${sessionId}`);
 		return Math.abs(j.status.beta - 128) < 1e-6;
 	}, 30000, 'beta to reach 128 in the API');
 	assert.equal(await page.$eval('#beta-number', e => e.value), '128');
@@ -338,15 +278,15 @@ test('moving the β slider turns the session to 128° and reverses the shown dir
 test('the drive row changes omega_ss and switches the drive, checked through the API', async () => {
 	await page.locator('#omega-ss').fill('150');
 	await page.locator('#omega-ss').press('Enter');
-	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.omega_ss === 150,
+	await until(async () => (await apiGet(daemon, `/api/v1/sessions/${sessionId}`)).status.omega_ss === 150,
 		5000, 'omega_ss = 150 in the API');
 	await page.locator('#motor').click();
-	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.drive_on === false,
+	await until(async () => (await apiGet(daemon, `/api/v1/sessions/${sessionId}`)).status.drive_on === false,
 		5000, 'drive_on = false in the API');
 	await until(async () => await page.$eval('#drive-now', e => e.textContent) === 'off', 5000, 'drive shown off');
 	assert.equal(await page.$eval('#motor', e => e.textContent), 'Switch on');
 	await page.locator('#motor').click();
-	await until(async () => (await apiGet(`/api/v1/sessions/${sessionId}`)).status.drive_on === true,
+	await until(async () => (await apiGet(daemon, `/api/v1/sessions/${sessionId}`)).status.drive_on === true,
 		5000, 'drive_on = true again');
 	await page.locator('#pace-live').fill('abc');
 	await page.locator('#pace-live').press('Enter');
@@ -386,7 +326,7 @@ test('a refused input shows the daemon\'s problem detail', async () => {
 	}
 	await page.evaluate(() => window.scrollTo(0, 0));
 	/* nothing else was created, and the page still follows the same session */
-	const list = await apiGet('/api/v1/sessions');
+	const list = await apiGet(daemon, '/api/v1/sessions');
 	assert.equal(list.sessions.length, 1);
 	assert.equal(await page.$eval('body', b => b.dataset.sessionId), sessionId);
 	await page.fill('input[name="layers"]', '2');
@@ -502,7 +442,7 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	await page.click('#fit-run');
 	const msg = await page.waitForSelector('#messages .msg.error >> text=/column \'rotation\' is missing/', { timeout: 20000 });
 	assert.match(await msg.textContent(), /422/);
-	assert.deepEqual((await apiGet('/api/v1/fits')).fits, []);
+	assert.deepEqual((await apiGet(daemon, '/api/v1/fits')).fits, []);
 	await page.fill('#fit-form textarea[name="csv"]', 'beta,rotation,v,sigma\n20,cw,0.05,0.005\n60,cw,0.05,0.005\n' +
 		'110,cw,-0.05,0.005\n150,cw,-0.05,0.005\n');
 	await page.fill('#fit-form input[name="free"]', 'e');
@@ -515,7 +455,7 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	const href = await page.$eval('#fit-csv', a => a.hidden ? null : a.getAttribute('href'));
 	assert.match(href, /^\/api\/v1\/fits\/[^/?]+\?format=csv$/);
 	const id = href.split('/').pop().split('?')[0];
-	const fit = await apiGet(`/api/v1/fits/${id}`);
+	const fit = await apiGet(daemon, `/api/v1/fits/${id}`);
 	assert.equal(fit.state, 'done');
 	const e = fit.result.parameters[0];
 	const row = await page.$$eval('#fit-table tr[data-name="e"] td', c => c.map(x => x.textContent));
@@ -564,9 +504,9 @@ test('a sweep with the last fit\'s band: the band shaded under each curve, as th
 		120000, 'the sweep with its bands');
 	await page.uncheck(box);
 	const href = await page.$eval('#sweep-csv', a => a.getAttribute('href'));
-	const s = await apiGet(href.replace('?format=csv', ''));
-	await until(async () => (await apiGet(href.replace('?format=csv', ''))).state === 'done', 120000, 'done');
-	const done = await apiGet(href.replace('?format=csv', ''));
+	const s = await apiGet(daemon, href.replace('?format=csv', ''));
+	await until(async () => (await apiGet(daemon, href.replace('?format=csv', ''))).state === 'done', 120000, 'done');
+	const done = await apiGet(daemon, href.replace('?format=csv', ''));
 	assert.equal(s.band.fit, fitId);
 	assert.deepEqual(done.band.parameters, ['e']);
 	const plot = csvLines(await download('#plot-sweep + .plot-export button[data-export="csv"]'));
@@ -685,7 +625,7 @@ test('a Kloss-drive session from the picker: the rotor plot\'s period means leav
 		return Math.max(...ws) - Math.min(...ws);
 	});
 	/* the raw rotor speed ripples at the excitation frequency */
-	const traj = await apiGet(`/api/v1/sessions/${id}/trajectory?from=1`);
+	const traj = await apiGet(daemon, `/api/v1/sessions/${id}/trajectory?from=1`);
 	const k = traj.fields.indexOf('rotor_speed');
 	const raw = traj.rows.map(row => row[k]);
 	const ripple = Math.max(...raw) - Math.min(...raw);
@@ -813,7 +753,7 @@ test('problem pages are rendered: code as code, no raw backticks', async () => {
 });
 
 test('the page says so when the daemon goes away', async () => {
-	await stopDaemon();
+	await stopDaemon(daemon?.proc);
 	await page.waitForSelector('#conn[data-state="offline"]', { timeout: 10000 });
 	const text = await page.$eval('#messages', e => e.textContent);
 	assert.match(text, /does not answer/);

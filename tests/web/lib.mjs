@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// What a browser test of the dashboard needs (the set-up of
-// dashboard.test.mjs, for the test files beside it): $CONVSIMD (default
-// build/convsimd) on port 0 with a token file, Debian's chromium through
-// playwright-core, the page opened as `make run` prints it (#token=...),
-// its page and console errors collected, and a poll helper.
+// What a browser test of the dashboard needs (dashboard.test.mjs and the
+// test files beside it): $CONVSIMD (default build/convsimd) on port 0 with
+// a token file, Debian's chromium through playwright-core, the page opened
+// as `make run` prints it (#token=...), its page and console errors
+// collected, and a poll helper.
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import { randomBytes } from 'node:crypto';
@@ -25,12 +25,16 @@ export function startDaemon() {
 	writeFileSync(file, token + '\n', { mode: 0o600 });
 	return new Promise((resolve, reject) => {
 		const p = spawn(DAEMON, ['--port', '0', '--token-file', file], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
-		let out = '';
+		let out = '', up = false;
 		const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`no "listening on" line from ${DAEMON} in 15 s:\n${out}`)); }, 15000);
+		/* once up, later output (the daemon's words at a SIGTERM) leaves
+		 * the 'exit' listeners alone: stopDaemon waits on one */
 		const scan = chunk => {
+			if (up) return;
 			out += chunk;
 			const m = /listening on (http:\/\/[^\s]+)/.exec(out);
 			if (!m) return;
+			up = true;
 			clearTimeout(timer);
 			p.removeAllListeners('exit');
 			resolve({ proc: p, base: m[1].replace(/\/$/, '').replace('0.0.0.0', '127.0.0.1'), token, auth: { Authorization: `Bearer ${token}` } });
@@ -53,14 +57,19 @@ export async function stopDaemon(proc) {
 	return code;
 }
 
-/* Chromium and a page of width x height on the daemon d's dashboard, ready;
- * {browser, page, pageErrors, consoleErrors}. */
-export async function openDashboard(d, width = 1600, height = 1300) {
-	const browser = await chromium.launch({
+/* Headless chromium ($CHROMIUM, default Debian's), quiet on the network. */
+export function launchChromium() {
+	return chromium.launch({
 		executablePath: CHROMIUM,
 		args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
 			'--disable-background-networking', '--disable-component-update', '--disable-sync'],
 	});
+}
+
+/* Chromium and a page of width x height on the daemon d's dashboard, ready;
+ * {browser, page, pageErrors, consoleErrors}. */
+export async function openDashboard(d, width = 1600, height = 1300) {
+	const browser = await launchChromium();
 	const page = await browser.newPage({ viewport: { width, height } });
 	const pageErrors = [], consoleErrors = [];
 	page.on('pageerror', e => pageErrors.push(e.message));
