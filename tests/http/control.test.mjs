@@ -242,7 +242,7 @@ test('400: a kind, or an entry of one, that is not an object names it and the sh
     [{ control: [] }, 'control must be an object {"setpoint": [{"v": M_S, "until": S}, ...], "controller": "auto" or {"kp", "ki"}}', 'control'],
     [{ control: { setpoint: sp, controller: 7 } }, 'control.controller must be "auto" or {"kp": DEG_PER_M_S, "ki": DEG_PER_M}', 'control.controller'],
     [{ control: { setpoint: [...sp, 3] } }, 'control.setpoint[1] must be an object {"v": M_S, "until": S}', 'control.setpoint[1].'],
-    [{ control: { setpoint: sp }, disturbances: [{ at: 0.5, set: { m_n: 1 } }, 'x'] },
+    [{ control: { setpoint: sp }, disturbances: [{ at: 0.5, set: { omega_ss: 150 } }, 'x'] },
       'disturbances[1] must be an object {"at": S, "set": {CONTROL: VALUE}}', 'disturbances[1].'],
     [{ schedule: [{ beta: 30, until: 1 }, []] }, 'schedule[1] must be an object {"beta": DEG, "until": S}', 'schedule[1].'],
   ];
