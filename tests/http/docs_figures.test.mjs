@@ -96,6 +96,8 @@ export const SPEC = [
   ['docs/machine-zoo.md', 'differ by more\nthan 0.1 % of the peak also'],
   /* tests/tether.mjs's poll */
   ['docs/testing.md', 'ends itself within 250 ms of its runner'],
+  /* tests/web/picker.test.mjs's sampling */
+  ['docs/testing.md', 'sampled every 100 ms for 3 s'],
 ];
 
 // The unmarked measured-looking figures of one page: ["page:line: text"].
