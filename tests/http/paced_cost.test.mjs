@@ -34,13 +34,26 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
     assert.ok(held > 0.3 * LIMIT && held <= LIMIT, `16 x 64 at pace ${pace} holds ${held} cores`);
     // the second asks for 1.5 times the room left, at the cost per unit of
     // pace the first holds (at most 0.9 of the budget, so that alone it
-    // would fit): refused only by the first's hold (a copy measures the
-    // same scene up to 1.5 times apart on a loaded machine, more under
-    // the sanitizers, so a pace fixed in advance can fit beside it)
-    const room = LIMIT - held;
-    const paceB = Math.round(Math.min(1.5 * room, 0.9 * LIMIT) / (held / pace) * 1000) / 1000;
-    const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: paceB });
-    assert.equal(b.status, 503, `a second one at pace ${paceB} does not fit beside ${held} cores held: ${b.text}`);
+    // would fit). The first's hold follows what its worker measures, and a
+    // copy measures the same scene up to 2 times apart on a loaded machine
+    // (more under the sanitizers): a second admitted because the room grew
+    // meanwhile must still leave the holds within the budget, and is taken
+    // away before the next try; one of 4 tries must be refused
+    const tries = [];
+    for (let i = 0; i < 4 && !tries.includes(503); i++) {
+      const now = await paced(d);
+      const paceB = Math.round(Math.min(1.5 * (LIMIT - now), 0.9 * LIMIT) / (held / pace) * 1000) / 1000;
+      const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: paceB });
+      tries.push(b.status);
+      if (b.status === 503) {
+        assert.equal(b.body.budget, 'cpu', b.text);
+        continue;
+      }
+      assert.equal(b.status, 201, b.text);
+      assert.ok(await paced(d) <= LIMIT * (1 + 1e-9), `admitted beside ${now} cores held, the holds stay within the budget`);
+      assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${b.body.id}`)).status, 204);
+    }
+    assert.ok(tries.includes(503), `a second one does not fit beside the first: ${tries.join(', ')}`);
     assert.ok(await paced(d) <= LIMIT, 'the holds stay within the budget');
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
