@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Measured figures on the pages of a newcomer's path come from a result
-// file or are not there. On README.md, docs/getting-started.md and the task
-// pages below, a figure of a narrow, reliable kind (a number followed by
+// Measured figures on the task pages come from a result file or are not
+// there. On README.md and every page of docs/ (not docs/log/, the
+// measurement logs the pages link), a figure of a narrow, reliable kind (a number followed by
 // ms, µs, CPU s, PATCH/s, "% of the peak" or "× real time") is either
 // - marked: a `<!-- from tests/bench/results/FILE.md "KEY" N -->` comment
 //   follows it on its line with no other number between (tests/docs_bench.py
@@ -15,15 +15,15 @@
 // ("Examples in the documentation").
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { readFileSync } from 'node:fs';
+import { readFileSync, readdirSync } from 'node:fs';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const ROOT = fileURLToPath(new URL('../..', import.meta.url));
 
-export const PAGES = ['README.md', 'docs/getting-started.md', 'docs/accuracy.md', 'docs/speed.md',
-  'docs/feed-models.md', 'docs/dem.md', 'docs/control.md', 'docs/hardening.md', 'docs/durability.md',
-  'docs/load.md'];
+// README.md and docs/*.md; docs/log/*.md are measurement logs and are not read
+export const PAGES = ['README.md', ...readdirSync(join(ROOT, 'docs')).filter((f) => f.endsWith('.md'))
+  .sort().map((f) => `docs/${f}`)];
 
 const NUM = String.raw`(?<![\w.])\d+(?:,\d{3})*(?:\.\d+)?(?:e[-+]?\d+)?`;
 // a number, optionally a range "16 to 49" / "5–7", then the unit
@@ -60,6 +60,44 @@ export const SPEC = [
   ['docs/durability.md', '(0 ms) and about 1 ms after a 200'],
   ['docs/durability.md', 'missing from the log at 0 ms'],
   ['docs/durability.md', 'at 1 ms).'],
+  /* the task pages beyond the newcomer's path */
+  ['docs/benchmarks.md', 'cut at 60 CPU s each'],
+  ['docs/cli.md', '[The curve\nat 0.1 CPU s]'],
+  /* the budgets' clocks: CPU_READ_EVERY, COST_WINDOW_CPU, COST_WINDOW_T (server/session/session_int.h) */
+  ['docs/budgets.md', '(at most every 10 ms), so a session pauses at most 10 ms of CPU past its grant'],
+  ['docs/budgets.md', 'over windows of 50 ms\nof CPU or 2 simulated seconds'],
+  ['docs/budgets.md', 'first\nwindow (50 ms of CPU) replaces it'],
+  /* a sample's interval at the stream's rate */
+  ['docs/cluster.md', 'the next sample (about 100 ms at `rate=10`'],
+  /* the latencies the bench adds, and the sample interval of the example's stream */
+  ['docs/control-remote.md', 'with 100 and 200 ms added before each command'],
+  ['docs/control-remote.md', 'the dead time is about one sample, 40 ms'],
+  ['docs/control-remote.md', 'ms for 100 ms added'],
+  ['docs/control-remote.md', 'ms for 200 ms added'],
+  ['docs/control-remote.md', 'Up to 200 ms the loop'],
+  ['docs/control-remote.md', 'more than 100 ms of delay'],
+  ['docs/control-remote.md', 'one sample interval (40 ms here)'],
+  ['docs/control-remote.md', 'for every 40 ms beyond'],
+  /* PACE_MIN and PUBLISH_EVERY (server/session/worker.c) */
+  ['docs/development.md', '`PACE_MIN` (20 ms)'],
+  ['docs/development.md', 'session every 10 ms'],
+  ['docs/performance.md', 'woke every 20 ms (batches of samples due within the next 20 ms)'],
+  ['docs/performance.md', 'and at least 20 ms'],
+  ['docs/performance.md', 'not up to 20 ms early'],
+  /* contact periods the step rule computes: 2 pi sqrt(m_n / k_c) (the Hertzian one at its tangent stiffness) */
+  ['docs/machine-zoo.md', 'm_n = 0.5 kg) | 4.4 ms'],
+  ['docs/machine-zoo.md', '| k_c = 1e7 | 1.4 ms'],
+  ['docs/machine-zoo.md', '| k_c = 3e7 | 0.81 ms'],
+  ['docs/machine-zoo.md', '| k_c = 1e8 | 0.44 ms'],
+  ['docs/machine-zoo.md', '(8 layers) | 3.6 ms'],
+  ['docs/machine-zoo.md', 'M_ut = 80) | 4.4 ms'],
+  ['docs/machine-zoo.md', '| tol = 0.005 | 4.4 ms'],
+  /* the references' convergence threshold (tests/bench/zoo_ref.sh) */
+  ['docs/machine-zoo.md', 'differ by more\nthan 0.1 % of the peak also'],
+  /* tests/tether.mjs's poll */
+  ['docs/testing.md', 'ends itself within 250 ms of its runner'],
+  /* tests/web/picker.test.mjs's sampling */
+  ['docs/testing.md', 'sampled every 100 ms for 3 s'],
 ];
 
 // The unmarked measured-looking figures of one page: ["page:line: text"].
@@ -93,7 +131,7 @@ export function unmarkedFigures(name, text, spec = SPEC) {
   return bad;
 }
 
-test('measured figures on the newcomer\'s pages are marked with their result file or are specification values', () => {
+test('measured figures on the task pages are marked with their result file or are specification values', () => {
   const bad = PAGES.flatMap((p) => unmarkedFigures(p, readFileSync(join(ROOT, p), 'utf8')));
   assert.deepEqual(bad, []);
 });

@@ -24,23 +24,43 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
     // the largest pace that fits: about 0.6 here (0.5 CPU s per simulated
     // s), less under the sanitizers; the estimate alone said 7
     assert.ok(one.body.max > 0.01 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
-    // 0.7: the second fits only if its copy measures under 0.43 of what
-    // the first's did, the first is refused only above 1.43 (a machine
-    // under load measures the same scene 1.5 times apart)
-    const pace = Math.round(0.7 * one.body.max * 1000) / 1000;
-    const a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
+    // 0.8 of what fits: the first holds most of the budget
+    const pace = Math.round(0.8 * one.body.max * 1000) / 1000;
+    // copies of one scene measure up to 2 times apart on a loaded machine:
+    // the first may be refused by its own copy's measure; tried 3 times
+    let a;
+    for (let i = 0; i < 3 && a?.status !== 201; i++)
+      a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
     assert.equal(a.status, 201, a.text);
     const held = await paced(d);
     assert.ok(held > 0.3 * LIMIT && held <= LIMIT, `16 x 64 at pace ${pace} holds ${held} cores`);
-    // the second asks for 1.5 times the room left, at the cost per unit of
-    // pace the first holds (at most 0.9 of the budget, so that alone it
-    // would fit): refused only by the first's hold (a copy measures the
-    // same scene up to 1.5 times apart on a loaded machine, more under
-    // the sanitizers, so a pace fixed in advance can fit beside it)
-    const room = LIMIT - held;
-    const paceB = Math.round(Math.min(1.5 * room, 0.9 * LIMIT) / (held / pace) * 1000) / 1000;
-    const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: paceB });
-    assert.equal(b.status, 503, `a second one at pace ${paceB} does not fit beside ${held} cores held: ${b.text}`);
+    // the second asks for halfway between the room left and the whole
+    // budget, at the cost per unit of pace the first held at admission (so
+    // that it fits beside the first only if its copy measures it cheaper,
+    // and alone it would fit). The first's hold follows what its worker measures, and a
+    // copy measures the same scene up to 2 times apart on a loaded machine
+    // (more under the sanitizers): a second admitted because the room grew
+    // meanwhile must still leave the holds within the budget, and is taken
+    // away before the next try; one of 6 tries must be refused by the room
+    const tries = [];
+    for (let i = 0; i < 6 && !tries.includes(503); i++) {
+      const now = await paced(d);
+      const paceB = Math.round((LIMIT - now / 2) / (held / pace) * 1000) / 1000;
+      const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: paceB });
+      tries.push(b.status);
+      if (b.status === 503) {
+        assert.equal(b.body.budget, 'cpu', b.text);
+        continue;
+      }
+      if (b.status === 422) { /* its copy measured it beyond the whole budget */
+        assert.equal(b.body.budget, 'cpu', b.text);
+        continue;
+      }
+      assert.equal(b.status, 201, b.text);
+      assert.ok(await paced(d) <= LIMIT * (1 + 1e-9), `admitted beside ${now} cores held, the holds stay within the budget`);
+      assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${b.body.id}`)).status, 204);
+    }
+    assert.ok(tries.includes(503), `a second one does not fit beside the first: ${tries.join(', ')}`);
     assert.ok(await paced(d) <= LIMIT, 'the holds stay within the budget');
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
