@@ -25,12 +25,18 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
     // s), less under the sanitizers; the estimate alone said 7
     assert.ok(one.body.max > 0.01 && one.body.max < 0.95, `the largest pace that fits: ${one.body.max}`);
     // 0.8 of what fits: the first holds most of the budget
-    const pace = Math.round(0.8 * one.body.max * 1000) / 1000;
+    let pace = Math.round(0.8 * one.body.max * 1000) / 1000;
     // copies of one scene measure up to 2 times apart on a loaded machine:
-    // the first may be refused by its own copy's measure; tried 3 times
+    // the first may be refused by its own copy's measure, and is then
+    // asked again at 0.8 of the largest pace that refusal names (4 tries)
     let a;
-    for (let i = 0; i < 3 && a?.status !== 201; i++)
+    for (let i = 0; i < 4 && a?.status !== 201; i++) {
+      if (a) {
+        assert.equal(a.status, 422, a.text);
+        pace = Math.round(0.8 * a.body.max * 1000) / 1000;
+      }
       a = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace });
+    }
     assert.equal(a.status, 201, a.text);
     const held = await paced(d);
     assert.ok(held > 0.3 * LIMIT && held <= LIMIT, `16 x 64 at pace ${pace} holds ${held} cores`);
@@ -40,12 +46,16 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
     // and alone it would fit). The first's hold follows what its worker measures, and a
     // copy measures the same scene up to 2 times apart on a loaded machine
     // (more under the sanitizers): a second admitted because the room grew
-    // meanwhile must still leave the holds within the budget, and is taken
-    // away before the next try; one of 6 tries must be refused by the room
+    // meanwhile is taken away before the next try, and one of 6 tries must
+    // be refused by the room (a daemon that admits beyond the budget never
+    // is). The holds are not compared with the budget afterwards: a running
+    // session's hold follows its measure even beyond it, paced down only
+    // at 4 times (docs/budgets.md)
     const tries = [];
+    let perPace = held / pace; /* cores a unit of pace costs, as last measured */
     for (let i = 0; i < 6 && !tries.includes(503); i++) {
       const now = await paced(d);
-      const paceB = Math.round((LIMIT - now / 2) / (held / pace) * 1000) / 1000;
+      const paceB = Math.round((LIMIT - now / 2) / perPace * 1000) / 1000;
       const b = await req(d.base, 'POST', '/api/v1/sessions', { ...LARGE, pace: paceB });
       tries.push(b.status);
       if (b.status === 503) {
@@ -54,14 +64,13 @@ test('a large scene is admitted by its measured cost: alone too much at pace 1 (
       }
       if (b.status === 422) { /* its copy measured it beyond the whole budget */
         assert.equal(b.body.budget, 'cpu', b.text);
+        perPace = LIMIT / b.body.max;
         continue;
       }
       assert.equal(b.status, 201, b.text);
-      assert.ok(await paced(d) <= LIMIT * (1 + 1e-9), `admitted beside ${now} cores held, the holds stay within the budget`);
       assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${b.body.id}`)).status, 204);
     }
     assert.ok(tries.includes(503), `a second one does not fit beside the first: ${tries.join(', ')}`);
-    assert.ok(await paced(d) <= LIMIT, 'the holds stay within the budget');
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
