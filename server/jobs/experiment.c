@@ -168,7 +168,6 @@ static void fill_view(const srv_experiment *e, api_experiment_view *v)
  * moment. */
 typedef srv_exp_record exp_record; /* records.h */
 
-
 static void record_of(const srv_experiment *e, exp_record *r)
 {
 	memset(r, 0, sizeof *r);
@@ -423,7 +422,6 @@ srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 	pthread_mutex_unlock(&e->lock);
 	return cmd;
 }
-
 
 srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 {
