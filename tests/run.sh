@@ -48,6 +48,8 @@ run "dependency loops" sh -c "python3 tests/deps.py --max 1 $BUILD/core $BUILD/f
 # the fast feed model's harness: its leave-one-depth-out never fits on the
 # depth it predicts (no convsim runs; `make fast-feed-check` measures)
 run "fast feed check (self-test)" python3 tests/bench/fast_feed_check.py --self-test
+# the size rule: files of at most 500 lines, functions of at most 80
+run "file and function sizes" sh -c "python3 tests/size.py --self-test && python3 tests/size.py && echo '# pass 1'"
 for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/web/*.test.mjs; do
 	[ -e "$f" ] || continue
 	run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
