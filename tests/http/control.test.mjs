@@ -137,7 +137,7 @@ test('a change of omega_ss mid-run: the controller takes up the new scene\'s v(b
 });
 
 test('a PATCH of omega_ss while a closed loop runs: its curve, measured aside, taken up', { timeout: 120000 * SLOW }, async () => {
-  const control = { setpoint: [{ v: 0.06, until: 5 }], controller: { kp: 0.0001, ki: 0 } };
+  const control = { setpoint: [{ v: 0.06, until: 30 }], controller: { kp: 0.0001, ki: 0 } };
   // at pace 1 (real time), so that the PATCH lands mid-run; 141.9 rad/s: a
   // scene no other test measured (not in the daemon's cache)
   const r = await req(d.base, 'POST', '/api/v1/experiments', { session: { pace: 1 }, control, keep_session: true });
@@ -146,6 +146,11 @@ test('a PATCH of omega_ss while a closed loop runs: its curve, measured aside, t
     20000 * SLOW, 'a simulated second');
   const p = await req(d.base, 'PATCH', `/api/v1/sessions/${r.body.session}`, { omega_ss: 141.9 });
   assert.equal(p.status, 200, p.text);
+  // the new curve is measured aside (about a CPU second, far more under the
+  // sanitizers); once the loop has taken it up, the rest runs flat out
+  await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}`)).body.control.curve_changes === 1,
+    25000, 'the new curve taken up');
+  assert.equal((await req(d.base, 'PATCH', `/api/v1/sessions/${r.body.session}`, { pace: 'max' })).status, 200);
   const e = await done(r.body.id);
   assert.equal(e.state, 'done', e.error);
   assert.equal(e.control.curve_changes, 1);
