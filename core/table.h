@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "sim.h"
 #include "units.h"
@@ -64,9 +65,20 @@ static inline double sim_table_user(const char *setting, double si)
 	double user = sim_setting_from_si(t, si);
 	if (t->scale == 1 || !isfinite(user))
 		return user;
+	/* the last conversion of this thread, kept: a trajectory row converts
+	 * beta and its target 100 times a simulated second, and they rarely
+	 * change (the text round trip was a tenth of a paced session's
+	 * overhead). The same setting and the same bits give the same answer */
+	static _Thread_local const sim_setting *memo_t;
+	static _Thread_local double memo_si, memo_user;
+	if (memo_t == t && memcmp(&memo_si, &si, sizeof si) == 0)
+		return memo_user;
 	char text[32];
 	snprintf(text, sizeof text, "%.15g", user);
-	return strtod(text, NULL);
+	memo_t = t;
+	memo_si = si;
+	memo_user = strtod(text, NULL);
+	return memo_user;
 }
 
 /*

@@ -20,7 +20,7 @@ void srv_cpu_turns_init(const srv_config *cfg);
  * worker owns it. */
 typedef struct srv_cpu_turn {
 	pthread_cond_t *wake;   /* signalled when its turn may have come */
-	int holding, queued;    /* budget lock */
+	int holding, queued;    /* budget lock; written by its owner only */
 	double since;           /* srv_now() when it took its slot */
 	struct srv_cpu_turn *next;
 } srv_cpu_turn;

@@ -6,30 +6,97 @@
  * (every stride, exactly on its grid; the stride doubles when it fills).
  * Below them the readers (streams, the trajectory route): one consistent
  * copy under the session lock, which never leaves this file, session.c and
- * worker.c.
+ * worker.c. Above them the ring's memory: slots (a status each), their
+ * feed arrays and, apart, the events' text.
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "session_int.h"
 #include "util.h"
 
-static api_sample *push_slot(srv_session *s)
+/* ---- the ring's memory --------------------------------------------------- */
+
+int srv_ring_alloc(srv_session *s, int ring, int history)
 {
-	api_sample *slot = srv_ring_slot(s, s->ring.head % s->ring.cap);
+	size_t per = (size_t)s->columns +
+		     2 * (size_t)s->columns * (size_t)s->layers;
+	s->ring.cap = ring > 16 ? (size_t)ring : 16;
+	/* the record ring, slots then their arrays, in one mapping whose
+	 * pages are all made now: the memory budget reserved them anyway,
+	 * and a worker that fills a fresh ring would otherwise take a page
+	 * fault every few samples over its first 16 s. Huge pages where the
+	 * kernel has them: a sample's record lands on a fresh 4-KiB page every
+	 * few samples, and with hundreds of sessions each such write missed
+	 * the TLB (a fifth of the daemon's CPU in a profile:
+	 * docs/performance.md). Making them is most of a session's creation
+	 * (the kernel zeroes them), so a slot holds the status alone; the
+	 * events' text, 528 bytes a slot and written a few times a session,
+	 * is in a mapping of its own whose pages are made as events land */
+	size_t bytes = s->ring.cap * (sizeof *s->ring.slots + per * sizeof(double));
+	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
+			 MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+	if (map != MAP_FAILED) {
+#ifdef MADV_HUGEPAGE
+		(void)madvise(map, bytes, MADV_HUGEPAGE);
+#endif
+#ifdef MADV_POPULATE_WRITE
+		if (madvise(map, bytes, MADV_POPULATE_WRITE) != 0)
+#endif
+			memset(map, 0, bytes);
+		s->ring.bytes = bytes;
+		s->ring.slots = map;
+		s->ring.store = (double *)(void *)(s->ring.slots + s->ring.cap);
+	}
+	size_t ev_bytes = s->ring.cap * sizeof *s->ring.events;
+	map = mmap(NULL, ev_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+	if (map != MAP_FAILED) {
+		s->ring.ev_bytes = ev_bytes;
+		s->ring.events = map;
+	}
+	s->ring.wake_t = INFINITY;
+	s->ring.plan_t = INFINITY;
+	s->ring.hist_cap = history > 16 ? (size_t)history : 16;
+	s->ring.hist = calloc(s->ring.hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
+	if (!s->ring.bytes || !s->ring.ev_bytes || !s->ring.hist ||
+	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
+		return -1;
+	/* trajectory rows every whole number of sample intervals, at least
+	 * 0.01 s apart */
+	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
+	s->ring.hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
+	return 0;
+}
+
+void srv_ring_free(srv_session *s)
+{
+	if (s->ring.bytes)
+		munmap(s->ring.slots, s->ring.bytes);
+	if (s->ring.ev_bytes)
+		munmap(s->ring.events, s->ring.ev_bytes);
+	free(s->ring.hist);
+}
+
+/* ---- the worker's writers -------------------------------------------------- */
+
+static srv_slot *push_slot(srv_session *s)
+{
+	srv_slot *slot = &s->ring.slots[s->ring.head % s->ring.cap];
 	slot->index = s->ring.head++;
 	return slot;
 }
 
 void srv_ring_event(srv_session *s, const char *type, const char *json)
 {
-	api_sample *slot = push_slot(s);
+	srv_slot_event *ev = &s->ring.events[s->ring.head % s->ring.cap];
+	srv_slot *slot = push_slot(s);
 	slot->kind = API_REC_EVENT;
 	slot->st = s->st;
-	snprintf(slot->event_type, sizeof slot->event_type, "%s", type);
-	snprintf(slot->event, sizeof slot->event, "%s", json);
+	snprintf(ev->type, sizeof ev->type, "%s", type);
+	snprintf(ev->json, sizeof ev->json, "%s", json);
 	s->ring.event_head = s->ring.head;
 }
 
@@ -80,15 +147,14 @@ static void record_history(srv_session *s)
 
 void srv_ring_sample(srv_session *s)
 {
-	api_sample *slot = push_slot(s);
+	double *feed = srv_ring_feed(s, s->ring.head % s->ring.cap);
+	srv_slot *slot = push_slot(s);
 	slot->kind = API_REC_SAMPLE;
 	slot->st = s->st;
-	slot->event_type[0] = '\0';
 	size_t n = (size_t)s->columns +
 		   2 * (size_t)s->columns * (size_t)s->layers;
 	if (n)
-		memcpy(slot->column_disp, s->scratch.column_disp,
-		       n * sizeof(double));
+		memcpy(feed, s->scratch.column_disp, n * sizeof(double));
 	record_history(s);
 }
 
@@ -124,20 +190,26 @@ void srv_sample_free(api_sample *rec)
 	rec->column_disp = rec->xi = rec->eta = NULL;
 }
 
-static void copy_record(api_sample *dst, const api_sample *src)
+/* Record idx of the ring into dst (lock held). */
+static void copy_record(srv_session *s, api_sample *dst, uint64_t idx)
 {
-	size_t n = (size_t)src->columns +
-		   2 * (size_t)src->columns * (size_t)src->layers;
+	size_t i = idx % s->ring.cap;
+	const srv_slot *src = &s->ring.slots[i];
+	size_t n = (size_t)s->columns +
+		   2 * (size_t)s->columns * (size_t)s->layers;
 	dst->index = src->index;
 	dst->kind = src->kind;
 	dst->st = src->st;
-	dst->columns = src->columns;
-	dst->layers = src->layers;
+	dst->columns = s->columns;
+	dst->layers = s->layers;
 	if (src->kind == API_REC_SAMPLE && n)
-		memcpy(dst->column_disp, src->column_disp, n * sizeof(double));
-	memcpy(dst->event_type, src->event_type, sizeof dst->event_type);
-	if (src->kind == API_REC_EVENT)
-		memcpy(dst->event, src->event, sizeof dst->event);
+		memcpy(dst->column_disp, srv_ring_feed(s, i), n * sizeof(double));
+	if (src->kind == API_REC_EVENT) {
+		memcpy(dst->event_type, s->ring.events[i].type, sizeof dst->event_type);
+		memcpy(dst->event, s->ring.events[i].json, sizeof dst->event);
+	} else {
+		dst->event_type[0] = '\0';
+	}
 }
 
 /* ---- snapshot readers ----------------------------------------------------- */
@@ -169,14 +241,14 @@ void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
 	uint64_t idx = cursor > rd->oldest ? cursor : rd->oldest;
 	/* samples before from_t are passed over here, without a copy */
 	while (idx < rd->head) {
-		const api_sample *r = &s->ring.samples[idx % s->ring.cap];
+		const srv_slot *r = &s->ring.slots[idx % s->ring.cap];
 		if (r->kind != API_REC_SAMPLE || r->st.t >= from_t)
 			break;
 		idx++;
 	}
 	rd->next = idx;
 	if (idx < rd->head)
-		copy_record(dst, &s->ring.samples[idx % s->ring.cap]);
+		copy_record(s, dst, idx);
 	pthread_mutex_unlock(&s->lock);
 }
 

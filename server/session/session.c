@@ -18,7 +18,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include "cpu_probe.h"
 #include "experiment.h"
@@ -64,9 +63,7 @@ static void session_free(srv_session *s)
 	srv_budget_give(s->budget.mem_reserved);
 	srv_budget_set_paced(&s->budget.paced_held, 0);
 	srv_sample_free(&s->scratch);
-	if (s->ring.bytes)
-		munmap(s->ring.samples, s->ring.bytes);
-	free(s->ring.hist);
+	srv_ring_free(s);
 	srv_control_log_close(s);
 	free(s->controls);
 	free(s->restore.replay);
@@ -106,48 +103,6 @@ static void destroy(srv_entry *en)
 	srv_session *s = SRV_CONTAINER(en, srv_session, entry);
 	stop_worker(s);
 	session_free(s);
-}
-
-static int alloc_buffers(srv_session *s)
-{
-	size_t per = (size_t)s->columns +
-		     2 * (size_t)s->columns * (size_t)s->layers;
-	s->ring.cap = cfg->ring > 16 ? (size_t)cfg->ring : 16;
-	/* the record ring, slots then their arrays, in one mapping whose
-	 * pages are all made now: the memory budget reserved them anyway,
-	 * and a worker that fills a fresh ring would otherwise take a page
-	 * fault every few samples over its first 16 s. Huge pages where the
-	 * kernel has them: a sample's record lands on a fresh 4-KiB page every
-	 * few samples, and with hundreds of sessions each such write missed
-	 * the TLB (a fifth of the daemon's CPU in a profile:
-	 * docs/performance.md) */
-	size_t bytes = s->ring.cap * (sizeof *s->ring.samples + per * sizeof(double));
-	void *map = mmap(NULL, bytes, PROT_READ | PROT_WRITE,
-			 MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-	if (map != MAP_FAILED) {
-#ifdef MADV_HUGEPAGE
-		(void)madvise(map, bytes, MADV_HUGEPAGE);
-#endif
-#ifdef MADV_POPULATE_WRITE
-		if (madvise(map, bytes, MADV_POPULATE_WRITE) != 0)
-#endif
-			memset(map, 0, bytes);
-		s->ring.bytes = bytes;
-		s->ring.samples = map;
-		s->ring.store = (double *)(void *)(s->ring.samples + s->ring.cap);
-	}
-	s->ring.wake_t = INFINITY;
-	s->ring.plan_t = INFINITY;
-	s->ring.hist_cap = cfg->history > 16 ? (size_t)cfg->history : 16;
-	s->ring.hist = calloc(s->ring.hist_cap * API_HISTORY_WIDTH(s->columns), sizeof(double));
-	if (!s->ring.bytes || !s->ring.hist ||
-	    srv_sample_alloc(&s->scratch, s->columns, s->layers))
-		return -1;
-	/* trajectory rows every whole number of sample intervals, at least
-	 * 0.01 s apart */
-	double every = ceil(0.01 * s->spec.sample_rate - 1e-9);
-	s->ring.hist_stride = (every < 1 ? 1 : every) / s->spec.sample_rate;
-	return 0;
 }
 
 /* Build s for spec: its sim instance, the initial status and the buffers
@@ -198,7 +153,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	/* a bed process: its cores a simulated second until measured */
 	if (s->dem.link && s->budget.cpu_per_s < s->dem.cores)
 		s->budget.cpu_per_s = s->dem.cores;
-	if (alloc_buffers(s)) {
+	if (srv_ring_alloc(s, cfg->ring, cfg->history)) {
 		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
 		return -1;
 	}
@@ -332,7 +287,7 @@ int srv_session_adopt(srv_session *s)
 	/* what it had before the restart: reserved even beyond the budget */
 	s->budget.mem_reserved = srv_budget_session_need(s->columns, s->layers);
 	srv_budget_take(s->budget.mem_reserved, "a restored session", 1, NULL);
-	if (alloc_buffers(s)) {
+	if (srv_ring_alloc(s, cfg->ring, cfg->history)) {
 		srv_registry_cancel(&sessions, &s->entry);
 		goto fail;
 	}

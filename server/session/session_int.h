@@ -28,10 +28,27 @@ typedef struct srv_replay {
 /* A session's record ring and trajectory history (ring.c: the worker's
  * writers and the readers; session.c allocates them), guarded by the
  * session lock. */
+/* A slot of the record ring: a sample's or event's status; its feed
+ * arrays are in the ring's store, an event's text in its events, at the
+ * same place. */
+typedef struct srv_slot {
+	uint64_t index;
+	int kind;                 /* API_REC_SAMPLE or API_REC_EVENT */
+	sim_status st;
+} srv_slot;
+typedef struct srv_slot_event {
+	char type[16];            /* api_sample's event_type */
+	char json[API_EVENT_MAX]; /* api_sample's event */
+} srv_slot_event;
+
 typedef struct srv_session_records {
-	api_sample *samples;
-	double *store;
-	size_t cap, bytes;        /* store's mapping: bytes */
+	srv_slot *slots;
+	double *store;            /* the slots' feed arrays, cap of them */
+	size_t cap, bytes;        /* slots' and store's mapping: bytes */
+	srv_slot_event *events;   /* cap of them, a mapping of ev_bytes whose
+				     pages are made only where an event is
+				     written */
+	size_t ev_bytes;
 	uint64_t head;
 	uint64_t event_head;      /* head after the newest event record */
 	uint64_t published;       /* head when readers were last woken */
@@ -261,20 +278,22 @@ static inline int srv_state_after(int state, int cpu_paused, double t, const api
 	return state;
 }
 
-/* Slot i of the ring with its arrays pointed into ring.store (set on
- * every use). */
-static inline api_sample *srv_ring_slot(srv_session *s, size_t i)
+/* The feed arrays of slot i (column displacements, then xi, then eta). */
+static inline double *srv_ring_feed(const srv_session *s, size_t i)
 {
 	size_t per = (size_t)s->columns +
 		     2 * (size_t)s->columns * (size_t)s->layers;
-	api_sample *r = &s->ring.samples[i];
-	r->columns = s->columns;
-	r->layers = s->layers;
-	r->column_disp = s->ring.store + i * per;
-	r->xi = r->column_disp + s->columns;
-	r->eta = r->xi + (size_t)s->columns * (size_t)s->layers;
-	return r;
+	return s->ring.store + i * per;
 }
+
+/* ---- ring.c: the ring's memory ------------------------------------------ */
+
+/* Allocate s's record ring (ring records, at least 16, its slots' pages
+ * made now) and trajectory history (history rows) for its feed's size,
+ * and the history's stride from its sample rate; 0, or -1 out of memory
+ * (srv_ring_free frees what was made). */
+int srv_ring_alloc(srv_session *s, int ring, int history);
+void srv_ring_free(srv_session *s);
 
 /* ---- ring.c: the worker's writers (session lock held) ----------------- */
 
