@@ -331,6 +331,7 @@ void *srv_worker_main(void *arg)
 	srv_ring_sample(s);
 	srv_worker_restart_clocks(&clk, s);
 	clk.cpu_wall = -INFINITY;
+	clk.stepped_wall = NAN;
 	/* the thread's CPU clock starts at 0; a LIGGGHTS bed's settling, done
 	 * before the first step, is no cost of simulated time (counted, it
 	 * made a 92-grain bed's first window 25 CPU s a simulated second and
@@ -364,9 +365,11 @@ void *srv_worker_main(void *arg)
 		run_job(s);
 		if (rc != SIM_OK)
 			fail(s, rc, why);
+		/* one read of the clock a step: the cpu phase, next, takes it */
+		clk.stepped_wall = srv_now();
 		if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
-			meter(s, &clk, srv_now()); /* paced: pace() */
-		if (rc != SIM_OK || srv_now() - clk.publish_wall >= PUBLISH_EVERY)
+			meter(s, &clk, clk.stepped_wall); /* paced: pace() */
+		if (rc != SIM_OK || clk.stepped_wall - clk.publish_wall >= PUBLISH_EVERY)
 			srv_worker_publish(s, &clk);
 	}
 	if (srv_stopping()) { /* the next start continues from here */

@@ -95,7 +95,10 @@ void srv_worker_commit_need(srv_session *s, clocks *c)
  * grant pauses. */
 void srv_worker_check_cpu(srv_session *s, clocks *c)
 {
-	double now = srv_now();
+	/* the time the loop read after its step (nothing between slept),
+	 * else now */
+	double now = isnan(c->stepped_wall) ? srv_now() : c->stepped_wall;
+	c->stepped_wall = NAN;
 	struct timespec ts;
 	if (now - c->cpu_wall < CPU_READ_EVERY)
 		return;

@@ -17,6 +17,8 @@ typedef struct clocks {
 	double rate_wall, rate_t;     /* metering window start */
 	uint64_t rate_steps;
 	double cpu_wall;              /* when the CPU clock was last read */
+	double stepped_wall;          /* srv_now() after the last step, until
+					 the cpu phase takes it (NAN) */
 	double publish_wall;          /* when readers were last woken */
 	double batch_start;           /* pacing: when the last batch began */
 	double batch_end;             /* pacing: samples due by then step now */
