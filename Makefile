@@ -103,6 +103,8 @@ DEB_TEST  := $(DEB_UNIT) \
 # and in addition to benchmark (`make bench`: the ODE peers).
 DEB_BENCH := /usr/include/cvode/cvode.h:libsundials-dev \
              /usr/include/gsl/gsl_odeiv2.h:libgsl-dev
+# and in addition to profile the daemon (`make profile-daemon`).
+DEB_PROFILE := /usr/bin/perf:linux-perf
 # and in addition for the DEM coupling (dem/, `make test`, `make bench-dem`):
 # LIGGGHTS's C library, whose header includes <mpi.h>, and mpirun.
 DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
@@ -111,7 +113,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: profile-daemon fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -407,6 +409,20 @@ bench-dem: all $(BUILD)/.deps-dem
 # tests/bench/results/dem_map.csv and dem_map.md.
 bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
+
+# Where a daemon of paced default sessions spends its CPU (tests/bench/profile.mjs,
+# docs/load.md "Where the daemon's CPU goes"; about 20 s): the daemon built
+# with frame pointers into build-prof/, PROFILE_N sessions (200) with a
+# stream each, `perf record -g` for PROFILE_SECONDS (8), the report by
+# function. perf is linux-perf.
+PROFILE_N       ?= 200
+PROFILE_SECONDS ?= 8
+profile-daemon: $(BUILD)/.deps-build $(BUILD)/.deps-profile
+	$(Q)$(MAKE) --no-print-directory BUILD=build-prof CFLAGS="-O2 -g -fno-omit-frame-pointer" build-prof/convsimd
+	$(Q)CONVSIMD=build-prof/convsimd PERF_DATA=build-prof/perf.data node tests/bench/profile.mjs $(PROFILE_N) $(PROFILE_SECONDS)
+$(BUILD)/.deps-profile: Makefile
+	$(Q)NEEDS="$(DEB_PROFILE)" WHY="to profile the daemon (perf)" sh tests/apt-deps.sh
+	$(Q)mkdir -p $(BUILD) && touch $@
 
 # The GSL and SUNDIALS peers at the 1 % gate alone (part of `make bench`;
 # tests/bench/peers.sh), into tests/bench/results.

@@ -59,20 +59,22 @@ static inline double sim_time_ns(double t)
  * pass unchanged. */
 static inline double sim_table_user(const char *setting, double si)
 {
+	/* the last conversion of this thread, kept: a trajectory row converts
+	 * beta and its target 100 times a simulated second, and they rarely
+	 * change (the lookup and the text round trip showed in the daemon's
+	 * profile, docs/load.md). The same setting and the same bits give the
+	 * same answer */
+	static _Thread_local const sim_setting *memo_t;
+	static _Thread_local double memo_si, memo_user;
+	if (memo_t && setting && memcmp(&memo_si, &si, sizeof si) == 0 &&
+	    strcmp(memo_t->name, setting) == 0)
+		return memo_user;
 	const sim_setting *t = sim_setting_find(setting);
 	if (!t)
 		return si;
 	double user = sim_setting_from_si(t, si);
 	if (t->scale == 1 || !isfinite(user))
 		return user;
-	/* the last conversion of this thread, kept: a trajectory row converts
-	 * beta and its target 100 times a simulated second, and they rarely
-	 * change (the text round trip was a tenth of a paced session's
-	 * overhead). The same setting and the same bits give the same answer */
-	static _Thread_local const sim_setting *memo_t;
-	static _Thread_local double memo_si, memo_user;
-	if (memo_t == t && memcmp(&memo_si, &si, sizeof si) == 0)
-		return memo_user;
 	char text[32];
 	snprintf(text, sizeof text, "%.15g", user);
 	memo_t = t;

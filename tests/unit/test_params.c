@@ -90,6 +90,17 @@ static void user_units_come_back_as_written(void **state)
 	const double e = 0.021500000000000002; /* metres: scale 1, not rounded */
 	assert_true(sim_table_user("e", e) == e);
 	assert_true(sim_table_user("no_such_setting", 0.1 + 0.2) == 0.1 + 0.2);
+	/* the thread keeps its last conversion: the same bits again give the
+	 * same degrees, the same bits under another name (or none) are that
+	 * name's, and -0 is not 0 */
+	double si = sim_setting_to_si(beta, 31.4878125);
+	assert_true(sim_table_user("beta", si) == 31.4878125);
+	assert_true(sim_table_user("beta", si) == 31.4878125);
+	assert_true(sim_table_user("e", si) == si);
+	assert_true(sim_table_user("no_such_setting", si) == si);
+	assert_true(sim_table_user("beta_rate", si) == 31.4878125);
+	assert_true(sim_table_user("beta", 0.0) == 0.0 && !signbit(sim_table_user("beta", 0.0)));
+	assert_true(signbit(sim_table_user("beta", -0.0)));
 }
 
 static void sim_new_refuses_invalid_sets(void **state)
