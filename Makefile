@@ -410,16 +410,15 @@ bench-dem: all $(BUILD)/.deps-dem
 bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
 
-# Where a daemon of paced default sessions spends its CPU (tests/bench/profile.mjs,
-# docs/load.md "Where the daemon's CPU goes"; about 20 s): the daemon built
-# with frame pointers into build-prof/, PROFILE_N sessions (200) with a
-# stream each, `perf record -g` for PROFILE_SECONDS (8), the report by
-# function. perf is linux-perf.
+# Where a daemon of paced default sessions spends its CPU, beside the
+# previous build (tests/bench/profile.sh, docs/performance.md; about a
+# minute): both built with frame pointers into build-prof/, PROFILE_N
+# sessions (200) with a stream each, `perf record -g` for PROFILE_SECONDS
+# (8), into tests/bench/results/profile.md. perf is linux-perf.
 PROFILE_N       ?= 200
 PROFILE_SECONDS ?= 8
 profile-daemon: $(BUILD)/.deps-build $(BUILD)/.deps-profile
-	$(Q)$(MAKE) --no-print-directory BUILD=build-prof CFLAGS="-O2 -g -fno-omit-frame-pointer" build-prof/convsimd
-	$(Q)CONVSIMD=build-prof/convsimd PERF_DATA=build-prof/perf.data node tests/bench/profile.mjs $(PROFILE_N) $(PROFILE_SECONDS)
+	$(Q)PROFILE_N=$(PROFILE_N) PROFILE_SECONDS=$(PROFILE_SECONDS) bash tests/bench/profile.sh
 $(BUILD)/.deps-profile: Makefile
 	$(Q)NEEDS="$(DEB_PROFILE)" WHY="to profile the daemon (perf)" sh tests/apt-deps.sh
 	$(Q)mkdir -p $(BUILD) && touch $@

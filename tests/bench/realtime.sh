@@ -5,15 +5,16 @@
 # minutes): tests/bench/realtime.mjs for each N of REALTIME_N (default
 # "200 600": within the default --max-paced-cores, and beyond it, where the
 # admitted must keep real time and the rest get 503). The previous build
-# is commit PREV (default: main at the branch point of the admission's and
-# the pacing's changes, 1b75a01), exported with git archive and built once
+# is commit PREV (default: main before the daemon's overhead was cut, the
+# ring's slots and the workers' per-sample work, 7e56a85; the round before
+# compared with 1b75a01), exported with git archive and built once
 # into $BUILD/prev-PREV (`make build/convsimd`); PREV_CONVSIMD names a
 # built one instead. Writes $1/realtime.md.
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
-PREV=${PREV:-1b75a01}
+PREV=${PREV:-7e56a85}
 prev=${PREV_CONVSIMD:-}
 if [ -z "$prev" ]; then
 	prev_dir="$BUILD/prev-$PREV"
