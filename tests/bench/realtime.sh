@@ -3,8 +3,8 @@
 # Paced default sessions held in real time by one daemon, the previous
 # build beside this one in the same minutes (part of `make bench`; a few
 # minutes): tests/bench/realtime.mjs for each N of REALTIME_N (default
-# "200 600": within the default --max-paced-cores, and beyond it, where the
-# admitted must keep real time and the rest get 503). The previous build
+# "200 600 1000": within the default --max-paced-cores, beyond it, where the
+# admitted must keep real time and the rest get 503, and issue 37's target). The previous build
 # is commit PREV (default: main before the daemon's overhead was cut, the
 # ring's slots and the workers' per-sample work, 7e56a85; the round before
 # compared with 1b75a01), exported with git archive and built once
@@ -28,7 +28,7 @@ if [ -z "$prev" ]; then
 	fi
 fi
 rev=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-N=${REALTIME_N:-200 600}
+N=${REALTIME_N:-200 600 1000}
 {
 	echo "# Paced default sessions in real time: the previous build beside this one"
 	echo
