@@ -25,9 +25,6 @@ typedef struct srv_replay {
 	char exp[SRV_ID_LEN]; /* the experiment that sent it, or "" */
 } srv_replay;
 
-/* A session's record ring and trajectory history (ring.c: the worker's
- * writers and the readers; session.c allocates them), guarded by the
- * session lock. */
 /* A slot of the record ring: a sample's or event's status; its feed
  * arrays are in the ring's store, an event's text in its events, at the
  * same place. */
@@ -41,6 +38,8 @@ typedef struct srv_slot_event {
 	char json[API_EVENT_MAX]; /* api_sample's event */
 } srv_slot_event;
 
+/* A session's record ring and trajectory history (ring.c: their memory,
+ * the worker's writers and the readers), guarded by the session lock. */
 typedef struct srv_session_records {
 	srv_slot *slots;
 	double *store;            /* the slots' feed arrays, cap of them */
