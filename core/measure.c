@@ -142,16 +142,20 @@ static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const s
 }
 
 /* One run of sim_measure: a fresh instance to t_end at most, its shadow
- * over the first SHADOW_MEASURE_SHARE of the window; *st its final
- * status. If early (sim_measure_point) and with a shadow, the run stops early at the first check after the
- * shadow has finished where the bar is within tol and the estimate steady
- * (the rest of the window would only shrink a bar already met), or, if
- * may_refine, where a refinement is asked (refine_asks with last) with
- * the step error alone beyond tol: the step error does not change after
- * the shadow and no longer window makes room for it, so the refinement
- * the whole window would ask for is asked now. A step error within tol
- * whose room a longer window's smaller scatter may yet make is left to
- * the window's end, as before. */
+ * over the first SHADOW_MEASURE_SHARE of the window (a refinement from
+ * the settled start: the run before as its shadow, coarser_run); *st its
+ * final status, *coarser this run for the next. If early
+ * (sim_measure_point) and with a shadow, the run stops early at the first
+ * check after the shadow has finished where the bar is within tol and the
+ * estimate steady (the rest of the window would only shrink a bar already
+ * met), or, if may_refine, where the step error alone is beyond tol and
+ * either a refinement is asked (refine_asks with last) or none can follow
+ * (the step error not shrunk to 0.8 of last): the step error does not
+ * change after the shadow and no longer window makes room for it, so the
+ * refinement the whole window would ask for is asked now, and a bar that
+ * no window or refinement brings within tol is not measured on. A step
+ * error within tol whose room a longer window's smaller scatter may yet
+ * make is left to the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			double t_end, int early, int may_refine, double last, settled_start *start,
 			coarser_run *coarser, sim_status *st, char *msg, size_t msglen)
@@ -185,7 +189,7 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 			break;
 		if (!s->shadow && (early_met(&s->st) ||
 				   (may_refine && s->st.step_error > s->st.tol_allowed &&
-				    refine_asks(&s->st, last))))
+				    (refine_asks(&s->st, last) || s->st.step_error >= 0.8 * last))))
 			break;
 		t = fmin(t_end, t + MEASURE_CHECK);
 	}
