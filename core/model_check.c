@@ -119,8 +119,9 @@ static const char *first_difference(const sim_params *p, const sim_scene *s,
 		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name))
 			continue;
 		double a, b;
-		if (sim_get(p, s, NULL, tab[i].name, &a) == SIM_OK &&
-		    sim_get(q, t, NULL, tab[i].name, &b) == SIM_OK && !same(a, b))
+		sim_get_setting(p, s, NULL, &tab[i], &a);
+		sim_get_setting(q, t, NULL, &tab[i], &b);
+		if (!same(a, b))
 			return tab[i].name;
 	}
 	if (s->friction != t->friction)

@@ -322,6 +322,12 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const 
 	return SIM_OK;
 }
 
+void sim_get_setting(const sim_params *p, const sim_scene *s, const sim_method *m,
+		     const sim_setting *t, double *value)
+{
+	get_at(p, s, m, (size_t)(t - table), value);
+}
+
 int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
 		 double *value)
 {

@@ -123,6 +123,10 @@ int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 /* Read one named setting in SI units; SIM_EUNKNOWN if no such name. */
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
+/* The same for an entry t of sim_settings()' table, found without a
+ * search by name. */
+void sim_get_setting(const sim_params *p, const sim_scene *s, const sim_method *m,
+		     const sim_setting *t, double *value);
 
 /* The integrator step (s) that dt = 0 stands for: the default of method m
  * for the kind of scene: with or without feed, and, for dem, whether the
