@@ -60,6 +60,18 @@ static int early_met(const sim_status *st)
 	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
+/* A refinement's bar that neither a longer window nor a further
+ * refinement brings within tol (its step error alone beyond it and not
+ * shrunk to 0.8 of the run before's, last), measured on no longer where
+ * its scatter and drift are already as small as early_met asks: where
+ * they are larger (a chaotic feed) the rest of the window still makes v
+ * better, if not its bar. */
+static int beyond_tol(const sim_status *st, double last)
+{
+	double scatter = st->transport_velocity_uncertainty - st->step_error;
+	return st->step_error >= 0.8 * last && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed;
+}
+
 /* The first run's instance as it starts (settled, at t = 0, its shadow
  * begun), kept for the refinements: a checkpoint of it restored with
  * finer steps starts them where the first run started, without settling
@@ -153,7 +165,8 @@ static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const s
  * (the step error not shrunk to 0.8 of last): the step error does not
  * change after the shadow and no longer window makes room for it, so the
  * refinement the whole window would ask for is asked now, and a bar that
- * no window or refinement brings within tol is not measured on. A step
+ * no window or refinement brings within tol is not measured on where its
+ * scatter is small already (beyond_tol). A step
  * error within tol whose room a longer window's smaller scatter may yet
  * make is left to the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
@@ -189,7 +202,7 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 			break;
 		if (!s->shadow && (early_met(&s->st) ||
 				   (may_refine && s->st.step_error > s->st.tol_allowed &&
-				    (refine_asks(&s->st, last) || s->st.step_error >= 0.8 * last))))
+				    (refine_asks(&s->st, last) || beyond_tol(&s->st, last)))))
 			break;
 		t = fmin(t_end, t + MEASURE_CHECK);
 	}
