@@ -400,7 +400,10 @@ int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, do
  * check after the shadow's window whose bar is within tol, steady, at most
  * a quarter scatter and 28 whole periods long (out->periods says how long
  * it measured), or whose step error alone is beyond tol; a refinement
- * starts from the first run's settled start. About half the cost of
+ * starts from the first run's settled start and takes the run before it
+ * as its shadow (its own shadow run afterwards only where that bar misses
+ * tol), and one that can neither meet tol nor refine further stops at its
+ * shadow's end where its scatter is small. About half the cost of
  * sim_measure at czubak2016's defaults; v then depends on where the run
  * stopped, a step in the parameters, so fits keep sim_measure. */
 int sim_measure_point(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
