@@ -12,6 +12,8 @@
 # sweep's `uncertainty`) must contain v_ref. Writes $1/accuracy.md.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
 ref=tests/bench/results/vref.tsv
@@ -75,6 +77,7 @@ gate() { # name, what: the summary row of one sweep against the reference
 {
 	echo "# The v(beta) curve against the converged reference"
 	echo
+	echo "$prov"
 	echo "Command: \`bash tests/bench/accuracy.sh\` (part of \`make bench\`). 74 points (beta = 0..180 deg"
 	echo "every 5 deg, cw and ccw), \`build/convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1\`"
 	echo "with its defaults, against \`tests/bench/results/vref.tsv\` (\`tests/bench/vref.sh\`). Error by"
