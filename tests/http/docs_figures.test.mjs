@@ -272,6 +272,13 @@ export const SPEC = [
   ['docs/benchmarks.md', "at 1e-3 within 60 s"],
   ['docs/benchmarks.md', "third point in 60 s"],
   ['docs/benchmarks.md', "peer reaches 1 %"],
+  /* test_energy_balance.c's bound and run length, the commands' run lengths */
+  ['docs/energy.md', "within 0.1 %"],
+  ['docs/energy.md', "cw over 0.5 s"],
+  ['docs/energy.md', "of the input over 4 s"],
+  ['docs/energy.md', "at β = 38° over 4 s"],
+  ['docs/energy.md', "the defaults for 0.5 s"],
+  ['docs/energy.md', "close within 0.1 %"],
 ];
 
 // Specification values on any page: [the exact words around the figure,
