@@ -279,6 +279,15 @@ export const SPEC = [
   ['docs/energy.md', "at β = 38° over 4 s"],
   ['docs/energy.md', "the defaults for 0.5 s"],
   ['docs/energy.md', "close within 0.1 %"],
+  /* the step rule (core/defaults.c: tol / 1 %, the 20 % mass ratio MODEL_CORRECTOR_MAX_RATIO and the added-mass limit it keeps clear of), the stability analysis's own values, and the tests' settings (test_feed.c, test_hard_machine.c) */
+  ['docs/integrators.md', "scaled by tol / 1 % below 1 %"],
+  ['docs/integrators.md', "for feeds over 20 %"],
+  ['docs/integrators.md', "than about 30 %"],
+  ['docs/integrators.md', "weighs at most 20 %"],
+  ['docs/integrators.md', "displacement over 3 s"],
+  ['docs/integrators.md', "edge (RK4 kept 99.7 %"],
+  ['docs/integrators.md', "exact flow 6 %"],
+  ['docs/integrators.md', "5 % either side of it"],
 ];
 
 // Specification values on any page: [the exact words around the figure,
