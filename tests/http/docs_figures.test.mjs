@@ -288,6 +288,10 @@ export const SPEC = [
   ['docs/integrators.md', "edge (RK4 kept 99.7 %"],
   ['docs/integrators.md', "exact flow 6 %"],
   ['docs/integrators.md', "5 % either side of it"],
+  /* the profile's sampling (the command above) and PACE_TICK (server/session/worker.c) */
+  ['docs/performance.md', "each, sampled for 8 s"],
+  ['docs/performance.md', "the next 0.1 s of simulated time, or 0.1 s of wall time"],
+  ['docs/performance.md', "up to 0.1 s"],
 ];
 
 // Specification values on any page: [the exact words around the figure,
