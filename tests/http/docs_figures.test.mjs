@@ -292,6 +292,12 @@ export const SPEC = [
   ['docs/performance.md', "each, sampled for 8 s"],
   ['docs/performance.md', "the next 0.1 s of simulated time, or 0.1 s of wall time"],
   ['docs/performance.md', "up to 0.1 s"],
+  /* the budgets' settings (--max-cpu-seconds 1800, the fair share's slice) and tests/http/budgets.test.mjs's slow client */
+  ['docs/budgets.md', "one byte every 2 s"],
+  ['docs/budgets.md', "after 10 s"],
+  ['docs/budgets.md', "1800 s lasts it days"],
+  ['docs/budgets.md', "now stops after 30 minutes"],
+  ['docs/budgets.md', "0.1 s while others"],
 ];
 
 // Specification values on any page: [the exact words around the figure,
