@@ -298,6 +298,17 @@ export const SPEC = [
   ['docs/budgets.md', "1800 s lasts it days"],
   ['docs/budgets.md', "now stops after 30 minutes"],
   ['docs/budgets.md', "0.1 s while others"],
+  /* the estimator's and the step error's constants (core/estimator.c, core/shadow.c) and the tests' settings and bounds (test_accuracy.c) */
+  ['docs/model-numerics.md', "within 0.05 % 3 s"],
+  ['docs/model-numerics.md', "first 40 periods (30 %"],
+  ['docs/model-numerics.md', "term, 0.5 %"],
+  ['docs/model-numerics.md', "plus 0.025 %"],
+  ['docs/model-numerics.md', "term stands in: 0.75 %"],
+  ['docs/model-numerics.md', "plus 0.04 %"],
+  ['docs/model-numerics.md', "explain) or below 0.5 %"],
+  ['docs/model-numerics.md', "plus 0.5 %"],
+  ['docs/model-numerics.md', "the first 1.5 s"],
+  ['docs/model-numerics.md', "the state after 1 s"],
 ];
 
 // Specification values on any page: [the exact words around the figure,
