@@ -320,6 +320,35 @@ export const SPEC = [
   ['docs/dem.md', "allow: v within 2 %"],
   ['docs/dem.md', "three seeds, 3 s"],
   ['docs/dem.md', "v over the last 2 s"],
+  /* the control bench's settings and criteria (tests/bench/control_loop.mjs, control_shaping.c:
+     steps, holds, the 2 % settling and 90 % reversal definitions, the 1 % steady-error target, the
+     disturbances' sizes), the ramp's time at 90 °/s, and the experiment's sample cap (50 000 at 25 Hz) */
+  ['docs/control.md', 'two `sim_measure` runs of 2 s'],
+  ['docs/control.md', 'each a `sim_measure` of 2 s'],
+  ['docs/control.md', 'steps of ±4° held 1.5 s'],
+  ['docs/control.md', 'steady error\nwell below 1 %'],
+  ['docs/control.md', 'The 2 % settling time'],
+  ['docs/control.md', 'open-loop reversal time (90 % of'],
+  ['docs/control.md', 'to come within 2 %'],
+  ['docs/control.md', 'to settle within 2 %'],
+  ['docs/control.md', '(90 °/s: 0.58 s for 55.2° → 107°, 0.41 s'],
+  ['docs/control.md', 'where 2 % of +0.05 m/s'],
+  ['docs/control.md', '(−4.5 %, −10 %, +5 %), a +50 % load step'],
+  ['docs/control.md', '−20 % friction'],
+  ['docs/control.md', 'rejected to within 2 %'],
+  ['docs/control.md', 'A −10 % `omega_ss` step'],
+  ['docs/control.md', 'about 33 minutes at the preset\'s 25 Hz'],
+  /* the fast feed model's target and criterion, the DEM's window (tests/bench/fast_feed_check.py) */
+  ['docs/feed-models.md', 'at 90 % or more'],
+  ['docs/feed-models.md', 'window: 3 s'],
+  ['docs/feed-models.md', 'most points within 5 % there'],
+  ['docs/feed-models.md', 'points are within 5 %'],
+  ['docs/feed-models.md', '% within 5 % leave one'],
+  ['docs/feed-models.md', 'measured over 5 s instead'],
+  ['docs/feed-models.md', 'v over 5 s'],
+  ['docs/feed-models.md', 'points within 5 % (the'],
+  ['docs/feed-models.md', 'is within 5 % at'],
+  ['docs/feed-models.md', '% within 5 %, with a chaotic'],
 ];
 
 // Specification values on any page: [the exact words around the figure,
