@@ -349,6 +349,11 @@ export const SPEC = [
   ['docs/feed-models.md', 'points within 5 % (the'],
   ['docs/feed-models.md', 'is within 5 % at'],
   ['docs/feed-models.md', '% within 5 %, with a chaotic'],
+  /* tests/http/persistence.test.mjs's checkpoint interval and slack; the persistence targets (docs/formats.md's table) */
+  ['docs/formats.md', 'interval (0.5 s, plus 0.8 s of'],
+  ['docs/formats.md', '| < 2 % of one core |'],
+  ['docs/formats.md', '| < 1 s |'],
+  ['docs/formats.md', 'at the default 10 s'],
 ];
 
 // Specification values on any page: [the exact words around the figure,
