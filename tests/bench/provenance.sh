@@ -13,3 +13,13 @@ provenance() {
 	cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -1)
 	echo "Run $when, build $build, $(nproc) cores (${cpu:-$(uname -m)}), load average $(cut -d' ' -f1-3 /proc/loadavg) before."
 }
+
+# stamp FILE LINE: LINE (a provenance) into a result page written by a
+# program that does not print one, after its title and the blank line
+# that follows it (at the top if it has no title).
+stamp() {
+	local f=$1 line=$2
+	awk -v p="$line" 'NR == 1 && !/^#/ { print p; print ""; done = 1 }
+		{ print }
+		!done && NR > 1 && /^$/ { print p; print ""; done = 1 }' "$f" > "$f.stamp" && mv "$f.stamp" "$f"
+}

@@ -26,6 +26,7 @@ pin() { # core, command...: one core per process where taskset exists
 	if command -v taskset >/dev/null; then taskset -c "$c" "$@"; else "$@"; fi
 }
 . tests/bench/provenance.sh
+prov=$(provenance)
 start=$(date +%s)
 echo "bench: full scene on core 0; machine alone, reduced scene, reductions on core 1"
 pin 0 "$bin" scene full $q > "$out/full.tsv" &
@@ -41,6 +42,7 @@ wait "$rest_pid"
 echo "bench: the GSL and SUNDIALS peers at the 1 % gate (two cores)"
 bash tests/bench/peers.sh "$out" "$cmd"
 "$bin" report "$out" "$cmd"
+stamp "$out/workprec.md" "$prov"
 echo "bench: the 74-point v(beta) curve against the converged reference (one core per sweep)"
 bash tests/bench/accuracy.sh "$out"
 echo "bench: the machine zoo against its converged references (one core per curve)"
