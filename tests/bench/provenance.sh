@@ -1,13 +1,14 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # provenance: one line for a result page, after its command (sourced:
 # `. tests/bench/provenance.sh`): when it ran, the build (the checkout's
-# commit, and whether it had uncommitted changes outside the results),
+# commit, and whether it had uncommitted changes outside the results and
+# the documents),
 # and the machine (cores, CPU model, load average before the run).
 provenance() {
 	local when build cpu
 	when=$(date -u '+%Y-%m-%d %H:%M UTC')
 	build=$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
-	if ! git diff --quiet HEAD -- . ':!tests/bench/results' 2>/dev/null; then
+	if ! git diff --quiet HEAD -- . ':!tests/bench/results' ':!docs' ':!README.md' 2>/dev/null; then
 		build="$build with uncommitted changes"
 	fi
 	cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -1)

@@ -24,7 +24,7 @@ def build():
     """The checkout's commit, and whether it had uncommitted changes."""
     rev = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], stdout=subprocess.PIPE,
                          text=True, cwd=ROOT).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", ".", ":!tests/bench/results"],
+    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", ".", ":!tests/bench/results", ":!docs", ":!README.md"],
                            cwd=ROOT).returncode
     return rev + (" with uncommitted changes" if dirty else "")
 
