@@ -2,8 +2,7 @@
 # provenance: one line for a result page, after its command (sourced:
 # `. tests/bench/provenance.sh`): when it ran, the build (the checkout's
 # commit, and whether it had uncommitted changes outside the results and
-# the documents),
-# and the machine (cores, CPU model, load average before the run).
+# the documents) and the machine (cores, CPU model, load average before).
 provenance() {
 	local when build cpu
 	when=$(date -u '+%Y-%m-%d %H:%M UTC')

@@ -24,8 +24,8 @@ def build():
     """The checkout's commit, and whether it had uncommitted changes."""
     rev = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], stdout=subprocess.PIPE,
                          text=True, cwd=ROOT).stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", ".", ":!tests/bench/results", ":!docs", ":!README.md"],
-                           cwd=ROOT).returncode
+    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", ".", ":!tests/bench/results",
+                            ":!docs", ":!README.md"], cwd=ROOT).returncode
     return rev + (" with uncommitted changes" if dirty else "")
 
 
