@@ -138,7 +138,7 @@ PROVENANCE = {
 # shrinks.
 NOT_YET = {'control_loop.md', 'control_shaping.md', 'dem.md', 'dem_calibration.md',
            'dem_cost.md', 'dem_map.md', 'fast_feed.md', 'fit.md', 'peers.md', 'remote_loop.md',
-           'scaling.md', 'study.md', 'targets.md', 'workprec.md', 'zoo.md'}
+           'scaling.md', 'study.md', 'targets.md', 'workprec.md'}
 
 
 def provenance_missing(text):
