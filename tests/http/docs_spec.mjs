@@ -342,5 +342,4 @@ export const EVERYWHERE = [
 export const PENDING = new Map([
   ['docs/control-remote.md', 5],
   ['docs/control.md', 2],
-  ['docs/log/fast-feed-grains.md', 1],
 ]);
