@@ -236,6 +236,9 @@ srv_cmd *srv_exp_control(srv_experiment *e, const sim_status *st, int sampled, d
 	}
 	if (!cmd->c.set)
 		return NULL;
+	/* beta alone: a step within the segment's estimate (a disturbance
+	 * restarts it anyway) */
+	cmd->loop_step = !dist;
 	cmd->from_experiment = 1;
 	return cmd;
 }
