@@ -10,7 +10,7 @@
 // its lines. OLD=path runs another build on the same requests in the same
 // run, alternating with this one; medians of REPEAT runs.
 //
-//   CONVSIMD=build/convsimd [OLD=old/convsimd] [REPEAT=3] [SECONDS=30] node tests/bench/control_cost.mjs
+//   CONVSIMD=build/convsimd [OLD=old/convsimd] [REPEAT=5] [SECONDS=60] node tests/bench/control_cost.mjs
 import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -18,8 +18,8 @@ import { startDaemon, req, until } from '../http/lib.mjs';
 
 const NEW = process.env.CONVSIMD || 'build/convsimd';
 const OLD = process.env.OLD || '';
-const REPEAT = Number(process.env.REPEAT || 3);
-const SECONDS = Number(process.env.SECONDS || 30);
+const REPEAT = Number(process.env.REPEAT || 5);
+const SECONDS = Number(process.env.SECONDS || 60);
 
 const syncs = async (base) => {
   const m = (await req(base, 'GET', '/metrics')).text.match(/^convsim_control_log_syncs_total (\d+)/m);
