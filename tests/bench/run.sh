@@ -63,9 +63,7 @@ CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs >"$out/body_pars
 echo "bench: the PI loop closed from a client at pace 1, with 0, 100 and 200 ms added, and open loop (one daemon, ~2 min)"
 python3 tests/bench/remote_loop.py "$BUILD/convsimd" >"$out/remote_loop.md"
 echo "bench: the conveyor as a control system: identification, setpoint steps, disturbances (loopback, pace max)"
-CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/control_loop.mjs | tee "$out/control_loop.md"
-echo "bench: what a closed loop's per-period command costs against a schedule (loopback, a temporary data directory)"
-CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/control_cost.mjs | tee "$out/control_cost.md"
+CONVSIMD="$BUILD/convsimd" node tests/bench/control_loop.mjs | tee "$out/control_loop.md"
 echo "bench: shaping the beta command (overdrive, ZV-shaped ramp) against a plain step, on the core"
 ${CC:-cc} -O2 -g -Wall -Wextra -Werror -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icore \
 	-o "$BUILD/control_shaping" tests/bench/control_shaping.c "$BUILD/libcore.a" -lm -lpthread
