@@ -19,8 +19,12 @@
  * its last command (the core ramps it at beta_rate, like any PATCH) and is
  * pulled back by (clamped - unclamped) T_s / T_t (T_t = kp / ki) when the
  * command is at a branch end: both keep it from winding up. Each command
- * goes to the worker as a PATCH does (logged, replayed, in the stream); a
- * disturbance due rides on the next sample's command, one each.
+ * goes to the worker as a PATCH does (logged, in the stream), but steered
+ * (the segment's transport estimate goes on) and its log line left to the
+ * next sync (the experiment sends it again after a restore); a disturbance
+ * due rides on the next sample's command, one each, as a PATCH. When a new
+ * v(beta) curve is taken up, "auto" gains are tuned again by SIMC from its
+ * slope at the operating point (srv_exp_retune).
  */
 #include <math.h>
 #include <stdlib.h>
