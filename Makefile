@@ -209,10 +209,14 @@ $(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
 # `make fast-feed-check`: reduced feed models against the DEM map, leave one
 # depth out (tests/bench/fast_feed_check.py, docs/feed-models.md), into
 # tests/bench/results/fast_feed.md and .csv; the docs' tables follow.
-fast-feed-check: $(BUILD)/convsim
+fast-feed-check: $(BUILD)/convsim $(BUILD)/fast_feed_bed
 	$(Q)python3 tests/bench/fast_feed_check.py $(BUILD)/convsim
 	$(Q)python3 tests/docs_bench.py
 $(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
+# the `grains` candidate's bed (tests/bench/fast_feed_bed.c), standalone
+$(BUILD)/fast_feed_bed: tests/bench/fast_feed_bed.c
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CFLAGS) $(WARN) -o $@ $< -lm
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
