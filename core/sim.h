@@ -233,6 +233,11 @@ double sim_effective_time(const sim *s);
  * both within the settings table's ranges of "beta" and "beta_rate".
  * Returns SIM_OK or SIM_EPARAM (nothing changed). */
 int sim_set_beta(sim *s, double beta, double rate);
+/* As sim_set_beta, but the transport estimate goes on: a controller's
+ * small steps of beta within one estimate (its whole periods keep
+ * counting across them, and so does the measured step error's shadow,
+ * which takes the same command). */
+int sim_steer_beta(sim *s, double beta, double rate);
 /* Sense of the unbalanced mass, SIM_CW or SIM_CCW; else SIM_EPARAM. */
 int sim_set_rotation(sim *s, int rotation);
 /* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
