@@ -86,6 +86,8 @@ static heap heaps[HEAPS];  /* lock */
 static int open_count;     /* lock: registered and not closing */
 static const srv_config *cfg;
 static atomic_ullong evicted, timed_out;
+/* When the connection this thread registers next was accepted (0: now). */
+static _Thread_local double opened_at;
 
 void srv_conns_init(const srv_config *config)
 {
@@ -280,6 +282,11 @@ static int make_room(srv_conn *c, double now, int *over)
 	return closed;
 }
 
+void srv_conn_opened_at(double t)
+{
+	opened_at = t;
+}
+
 srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *over)
 {
 	const union MHD_ConnectionInfo *ci =
@@ -292,6 +299,9 @@ srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *ove
 	c->group = g;
 	c->at[BY_PROGRESS] = c->at[BY_DEADLINE] = c->at[BY_GROUP] = NOWHERE;
 	double now = srv_now();
+	if (opened_at > 0 && opened_at < now)
+		now = opened_at; /* idle since it was accepted */
+	opened_at = 0;
 	int closed = 0;
 	pthread_mutex_lock(&lock);
 	if (cfg)

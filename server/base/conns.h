@@ -58,6 +58,10 @@ void srv_conn_group_free(srv_conn_group *g);
  * g's own while g has --max-client-connections. *over: SRV_CONN_*.
  * Returns the handle (NULL when out of memory: not counted, never closed
  * here). */
+/* The connection this thread registers next with srv_conn_open was
+ * accepted at t (srv_now()): it is idle since then, not since it was
+ * registered (acceptor.c may hold it back a while). */
+void srv_conn_opened_at(double t);
 srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *over);
 /* Forget a connection (at libmicrohttpd's close notice, before its group
  * is let go); NULL is fine. */
