@@ -261,7 +261,7 @@ async function main() {
   console.log('Each row a fresh daemon with default flags unless told; times in ms; "from connect": from the active client\'s connect to its answer\'s end (the part the daemon answers for).\n');
   console.log('| build | flood | sockets connected / closed by the daemon / answered | active client while the flood opens: answered, p50 / p99 / max (p99 from connect) | while it is held: answered, p50 / p99 / max (p99 from connect) | after it: answered, p99 | /health after | closed at the cap / at a deadline / at accept | load average |');
   console.log('|---|---|---|---|---|---|---|---|---|');
-  let failed = false;
+  let failed = '';
   const q = (v, x) => fmt(quantile(v, x), 1);
   const cell = (t) => {
     const bad = Object.entries(t.bad).map(([k, v]) => `${v}x ${k}`).join(', ');
@@ -272,21 +272,29 @@ async function main() {
       `| ${cell(r.opening)}, ${fmt(r.openS, 1)} s | ${cell(r.held)} | ${r.after.ok} of ${r.after.n}, ${q(r.after.ms, 0.99)} ` +
       `| ${r.final.ok ? '200 ok' : `no (${r.final.status || r.final.error})`} ` +
       `| ${r.counters.evicted} / ${r.counters.timedOut} / ${r.counters.dropped} | ${fmt(r.load, 1)} |`);
-    for (const t of [r.opening, r.held, r.after]) if (t.ok !== t.n) failed = true;
-    if (!r.final.ok || r.exit !== 0) failed = true;
+    let bad = false;
+    for (const t of [r.opening, r.held, r.after]) if (t.ok !== t.n) bad = true;
+    if (!r.final.ok || r.exit !== 0) bad = true;
+    if (bad) failed = failed ? `${failed}, ${r.build} ${r.name}` : `${r.build} ${r.name}`;
   }
   if (BASELINE) {
-    // the p99s of each build over its rows (the opening phase: the flood's connect)
-    const summary = (b, key) => {
-      const v = rows.filter((r) => r.build === b).flatMap((r) => r.opening[key]);
-      return `${q(v, 0.5)} / ${q(v, 0.99)}`;
-    };
-    console.log('\n| build | every request while the floods open: p50 / p99 ms | from connect: p50 / p99 ms |');
-    console.log('|---|---|---|');
-    for (const b of builds.map(buildName)) console.log(`| ${b} | ${summary(b, 'ms')} | ${summary(b, 'fromConnect')} |`);
+    // each build over its rows: the opening phase's p50 / p99 (the
+    // flood's connect), the active client's answers in every phase, the
+    // connections closed at accept; the build last (its name may hold digits)
+    console.log('\n| while the floods open, every request: p50 / p99 ms | from connect: p50 / p99 ms | the active client, every phase: answered of asked | closed at accept | build |');
+    console.log('|---|---|---|---|---|');
+    for (const [i, b] of builds.map(buildName).entries()) {
+      const mine = rows.filter((r) => r.build === b);
+      const all = (key) => mine.flatMap((r) => r.opening[key]);
+      const sum = (f) => mine.reduce((a, r) => a + f(r), 0);
+      const asked = sum((r) => r.opening.n + r.held.n + r.after.n);
+      const ok = sum((r) => r.opening.ok + r.held.ok + r.after.ok);
+      console.log(`| ${q(all('ms'), 0.5)} / ${q(all('ms'), 0.99)} | ${q(all('fromConnect'), 0.5)} / ${q(all('fromConnect'), 0.99)} ` +
+        `| ${ok} of ${asked} | ${sum((r) => r.counters.dropped)} | ${i === 0 ? 'baseline' : 'this build'}: ${b} |`);
+    }
   }
   if (failed) {
-    console.log('\nflood: FAILED: the active client or /api/v1/health was not answered every time');
+    console.log(`\nflood: FAILED (${failed}): the active client or /api/v1/health was not answered every time`);
     process.exit(1);
   }
 }
