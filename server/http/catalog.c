@@ -100,6 +100,7 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.connections_dropped = (double)srv_budget_connections_dropped(),
 		.connections_evicted = (double)srv_conns_evicted(),
 		.connections_timed_out = (double)srv_conns_timed_out(),
+		.connections_answered_408 = (double)srv_conns_answered_late(),
 		.connections_accepted = (double)srv_acceptor_accepted(),
 		.connections_waiting_max = (double)srv_acceptor_queued_max(),
 	};
