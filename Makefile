@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -209,10 +209,14 @@ $(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
 # `make fast-feed-check`: reduced feed models against the DEM map, leave one
 # depth out (tests/bench/fast_feed_check.py, docs/feed-models.md), into
 # tests/bench/results/fast_feed.md and .csv; the docs' tables follow.
-fast-feed-check: $(BUILD)/convsim
+fast-feed-check: $(BUILD)/convsim $(BUILD)/fast_feed_bed
 	$(Q)python3 tests/bench/fast_feed_check.py $(BUILD)/convsim
 	$(Q)python3 tests/docs_bench.py
 $(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
+# the `grains` candidate's bed (tests/bench/fast_feed_bed.c), standalone
+$(BUILD)/fast_feed_bed: tests/bench/fast_feed_bed.c
+	@mkdir -p $(@D)
+	$(Q)$(CC) $(CFLAGS) $(WARN) -o $@ $< -lm
 
 $(BUILD)/libcore.a: $(CORE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
@@ -305,11 +309,21 @@ cluster: deps-build $(BUILD)/convsimd
 test: deps all
 	$(Q)$(MAKE) --no-print-directory dem-build
 	$(Q)$(MAKE) --no-print-directory NO_MPI=1 BUILD=$(BUILD)/nompi $(BUILD)/nompi/convsim
-	$(Q)BUILD=$(BUILD) bash tests/run.sh
+	$(Q)BUILD=$(BUILD) TESTS_SKIP='$(TESTS_SKIP)' bash tests/run.sh
 
 check:
 	$(Q)$(MAKE) --no-print-directory BUILD=build-san \
 	  CFLAGS="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all" test
+
+# CI's sanitizer pass (.ci/run, after make test and make fuzz): every group
+# but those whose C paths the rest already drive and that cost two thirds of
+# the sanitizer time: the examples and the OpenAPI tour behind the
+# validating proxy (the same routes as tests/http/), the browser tests (the
+# daemon's routes again), LIGGGHTS and MPI (uninstrumented libraries), the
+# CLI's long fits (fit/ under tests/unit/), the licences (skipped there)
+CHECK_CI_SKIP = ^tests/(web|dem)/|^tests/http/(openapi|docs|cluster)\.test|^tests/cli/(mpi|fit|licences)\.test
+check-ci:
+	$(Q)$(MAKE) --no-print-directory TESTS_SKIP='$(CHECK_CI_SKIP)' check
 
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh

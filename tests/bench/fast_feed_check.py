@@ -13,7 +13,12 @@ bed's depth by a closure fitted to the map:
             k_c from a grid, its layers either the depth in grains or one;
   ensemble  two such columns with different R (the rest shared), v their
             mean: a bed whose grains' impacts do not all dissipate alike
-            (costs the two runs).
+            (costs the two runs);
+  grains    a bed of N point-mass grains on the deck (tests/bench/
+            fast_feed_bed.c, on the deck orbit of a one-way convsim run):
+            free flight, impacts whose restitution is drawn anew at each
+            impact, uniform in [e_lo, e_hi], Coulomb friction mu at impacts
+            and while riding; no depth in it (depth-independent closure).
 For every depth of a material and drive, a family's closure is fitted on
 the map's other depths only (the most points within 5 % of that depth's DEM
 peak, then the smallest worst error) and predicts the held-out depth: the
@@ -52,9 +57,15 @@ TOL = 0.05  # of the depth's DEM peak |v|
 GRID_R = (0.05, 0.15, 0.3, 0.4, 0.5, 0.6, 0.75)
 GRID_MU = (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.65)
 GRID_K = (3e2, 5e2, 1e3, 2e3, 5e3, 1e4, 1e5, 1e6, 1e7)
+GRAIN_E_LO = (0.2, 0.4, 0.5, 0.6)
+GRAIN_E_HI = (0.75, 0.9, 1.0)
+GRAIN_MU = (0.2, 0.25, 0.3, 0.35, 0.4, 0.5)
+GRAINS_N = 8  # grains of a `grains` bed
+ORBIT_RATE = 4000  # Hz: the deck orbit's samples (the bed steps at twice that)
+ORBITS = os.path.join(ROOT, "build", "fast_feed_orbits")
 LAYER_RULES = ("depth", "one")
 PAPER = {"Rs": (0.05,), "mu": 0.4, "k_c": 1e6, "layers": "depth"}
-FAMILIES = ("closure", "ensemble")
+FAMILIES = ("closure", "ensemble", "grains")
 COST_DURATION, COST_REPEATS = 21, 3  # s simulated (20 after the transient); runs
 LONG_DURATION = 6  # s simulated: the window check's 5 s after the transient
 
@@ -88,10 +99,20 @@ def args_of(convsim, cand, r, p, duration=3):
     return a
 
 
+def grains_args(run, cand, p, duration=3):
+    """One `grains` run: fast_feed_bed on the point's deck orbit; over the
+    orbit's last LONG_DURATION - 1 s for the window check."""
+    a = [run.bed, run.orbit(p, duration), "%g" % cand["e"][0], "%g" % cand["e"][1],
+         "%g" % cand["mu"], "%d" % GRAINS_N]
+    return a + (["1", "%g" % duration] if duration != 3 else [])
+
+
 class Runner:
     def __init__(self, convsim):
         self.convsim = convsim
+        self.bed = os.path.join(os.path.dirname(os.path.abspath(convsim)), "fast_feed_bed")
         self.stamp = "%d" % os.stat(convsim).st_mtime
+        self.bed_stamp = "%d" % os.stat(self.bed).st_mtime if os.path.exists(self.bed) else "-"
         self.cache = {}
         if os.path.exists(CACHE):
             with open(CACHE) as f:
@@ -99,7 +120,30 @@ class Runner:
         self.runs = self.total = 0
 
     def key(self, args):
+        if args[0] == self.bed:
+            return "bed " + self.bed_stamp + " " + " ".join(args[1:])
         return self.stamp + " " + " ".join(args[1:])
+
+    def orbit(self, p, duration):
+        """The deck orbit (t, deck_x, deck_y) of the one-way machine at p
+        over `duration` s, from a convsim run's trajectory, made once."""
+        name = "%s_%s_%g_%g.csv" % (self.stamp, p["drive"], p["beta"], duration)
+        path = os.path.join(ORBITS, name)
+        if not os.path.exists(path):
+            os.makedirs(ORBITS, exist_ok=True)
+            full = path + ".full.csv"
+            cand = {"Rs": (0.05,), "mu": 0.4, "k_c": 1e6, "layers": "one"}
+            subprocess.run(args_of(self.convsim, cand, 0.05, p, duration)
+                           + ["-o", full, "-r", "%d" % ORBIT_RATE], check=True,
+                           capture_output=True)
+            with open(full) as fi, open(path + ".new", "w", newline="") as fo:
+                w = csv.writer(fo, lineterminator="\n")
+                w.writerow(["t", "deck_x", "deck_y"])
+                for row in csv.DictReader(fi):
+                    w.writerow([row["t"], row["deck_x"], row["deck_y"]])
+            os.remove(full)
+            os.replace(path + ".new", path)
+        return path
 
     def one(self, args):
         """[v, CPU s] of one run; NaN for a run convsim refuses or that
@@ -108,6 +152,8 @@ class Runner:
         res = subprocess.run(args, capture_output=True, text=True)
         if res.returncode != 0:
             return [math.nan, math.nan]
+        if args[0] == self.bed:
+            return [float(x) for x in res.stdout.split()]
         s = json.loads(res.stdout)
         return [s["transport_velocity"], s["cpu_seconds"]]
 
@@ -118,7 +164,7 @@ class Runner:
             for a, res in zip(todo, ex.map(self.one, todo)):
                 self.cache[self.key(a)] = res
         self.runs += len(todo)
-        self.total = len({self.key(a) for a in jobs})
+        self.total += len({self.key(a) for a in jobs})
         self.save()
 
     def save(self):
@@ -131,6 +177,8 @@ class Runner:
         """CPU s of cand at p: each member's least of COST_REPEATS runs of
         COST_DURATION simulated seconds (a 3-s run takes milliseconds, too
         short to time on a shared machine), summed over the members."""
+        if "e" in cand:
+            return self.grains_cost(cand, p)
         total = 0.0
         for r in cand["Rs"]:
             args = args_of(self.convsim, cand, r, p, COST_DURATION)
@@ -143,6 +191,11 @@ class Runner:
     def long_v(self, cand, p):
         """v of cand at p over LONG_DURATION - 1 s instead of 2 s: a member
         that bounces chaotically moves with the window."""
+        if "e" in cand:
+            args = grains_args(self, cand, p, LONG_DURATION)
+            if self.key(args) not in self.cache:
+                self.cache[self.key(args)] = self.one(args)
+            return self.cache[self.key(args)][0]
         vs = []
         for r in cand["Rs"]:
             args = args_of(self.convsim, cand, r, p, LONG_DURATION)
@@ -154,11 +207,34 @@ class Runner:
 
     def get(self, cand, p):
         """(v, CPU s) of cand at p: its members' mean v and summed cost."""
+        if "e" in cand:
+            return tuple(self.cache[self.key(grains_args(self, cand, p))])
         res = [self.cache[self.key(args_of(self.convsim, cand, r, p))] for r in cand["Rs"]]
         return statistics.fmean(x[0] for x in res), sum(x[1] for x in res)
 
 
+def grains_cost(self, cand, p):
+    """CPU s of a `grains` bed at p over COST_DURATION simulated s: the
+    machine alone (convsim with feed=false: what the bed's deck orbit
+    costs) plus the bed, each the least of COST_REPEATS runs; the bed is
+    timed over the LONG_DURATION-s orbit and scaled to COST_DURATION."""
+    k = "cost grains " + self.key(grains_args(self, cand, p, LONG_DURATION))
+    if k not in self.cache:
+        m = args_of(self.convsim, PAPER, 0.05, p, COST_DURATION) + ["--set", "feed=false"]
+        machine = min(self.one(m)[1] for _ in range(COST_REPEATS))
+        bed = min(self.one(grains_args(self, cand, p, LONG_DURATION))[1]
+                  for _ in range(COST_REPEATS))
+        self.cache[k] = machine + bed * COST_DURATION / LONG_DURATION
+    return self.cache[k]
+
+
+Runner.grains_cost = grains_cost
+
+
 def candidates(family):
+    if family == "grains":
+        return [{"e": (lo, hi), "mu": mu} for lo in GRAIN_E_LO for hi in GRAIN_E_HI
+                for mu in GRAIN_MU if lo < hi]
     n = 1 if family == "closure" else 2
     sets = [(r,) for r in GRID_R] if n == 1 else \
         [(a, b) for i, a in enumerate(GRID_R) for b in GRID_R[i + 1:]]
@@ -167,6 +243,8 @@ def candidates(family):
 
 
 def name_of(c):
+    if "e" in c:
+        return "e %g to %g, mu %g, %d grains" % (c["e"][0], c["e"][1], c["mu"], GRAINS_N)
     return "R %s, mu %g, k_c %g, layers %s" % (
         " and ".join("%g" % r for r in c["Rs"]), c["mu"], c["k_c"],
         "= depth" if c["layers"] == "depth" else "1")
@@ -288,14 +366,16 @@ def write_md(recs, runner, path):
     w("# A fast feed model against the DEM map (leave one depth out)")
     w("")
     w("`make fast-feed-check` (tests/bench/fast_feed_check.py) on %s, build `%s`; data "
-      "tests/bench/results/fast_feed.csv; %d convsim runs, %d of them this time (the others from "
+      "tests/bench/results/fast_feed.csv; %d runs of convsim and fast_feed_bed, %d of them this time (the others from "
       "build/fast_feed_cache.json, same binary). Candidates "
       "(docs/feed-models.md): `closure`, the column model with R, mu, k_c and its layers from a "
-      "closure in the depth; `ensemble`, the mean of two such columns with different R. Each is "
-      "fitted on the map's other depths and predicts the held-out one. Error = (v - v_DEM) / the "
+      "closure in the depth; `ensemble`, the mean of two such columns with different R; "
+      "`grains`, %d point-mass grains whose impacts keep a random share of their rebound "
+      "(tests/bench/fast_feed_bed.c). Each is fitted on the map's other depths and predicts the "
+      "held-out one. Error = (v - v_DEM) / the "
       "depth's DEM peak |v|; the target is |error| <= 5 %% at >= 90 %% of the points at <= 3x "
       "the column model's CPU." % (time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-                                   build_name(), runner.total, runner.runs))
+                                   build_name(), runner.total, runner.runs, GRAINS_N))
     w("")
     w("## Summary")
     w("")
@@ -303,8 +383,10 @@ def write_md(recs, runner, path):
     w("")
     w("CPU: the candidate's convsim runs (both columns for `ensemble`) over the paper's column "
       "model's run at the same point, one-way, each the least of %d runs of %g simulated seconds; "
-      "all points: the sums' ratio. Single points' ratios vary by up to about 1.5x between two "
-      "runs of this tool on a shared machine." % (COST_REPEATS, COST_DURATION))
+      "all points: the sums' ratio. For `grains`: the machine alone (convsim, feed=false) plus "
+      "fast_feed_bed's integration (timed on the %g-s orbit, scaled to %g s). Single points' "
+      "ratios vary by up to about 1.5x between two runs of this tool on a shared machine." %
+      (COST_REPEATS, COST_DURATION, LONG_DURATION, COST_DURATION))
     w("")
     for depth in sorted({(r["material"], r["drive"], r["depth"]) for r in recs}):
         sel = [r for r in recs if (r["material"], r["drive"], r["depth"]) == depth]
@@ -329,13 +411,15 @@ class FakeRunner:
         self.seen = []
 
     def cost(self, cand, p):
-        return float(len(cand["Rs"]))
+        return float(len(cand.get("Rs", (1,))))
 
     def long_v(self, cand, p):
         return self.get(cand, p)[0]
 
     def get(self, cand, p):
         self.seen.append(p["depth"])
+        if "e" in cand:
+            return cand["mu"] * p["beta"] / 100.0, 1.0
         # the depth-d data are made by R = 0.15 d (d = 1, 2: 0.15, 0.3)
         return statistics.fmean(r * p["beta"] / 100.0 for r in cand["Rs"]), 1.0
 
@@ -376,6 +460,9 @@ def main():
     singles = [{"Rs": (r,), "mu": mu, "k_c": k, "layers": lr} for lr in LAYER_RULES
                for r in GRID_R for mu in GRID_MU for k in GRID_K] + [PAPER]
     runner.run_all([args_of(convsim, c, c["Rs"][0], p) for c in singles for p in pts])
+    if not os.path.exists(runner.bed):
+        sys.exit("fast_feed_check: %s is missing (make fast-feed-check builds it)" % runner.bed)
+    runner.run_all([grains_args(runner, c, p) for c in candidates("grains") for p in pts])
     recs = evaluate(runner, pts, peak)
     runner.save()
     write_csv(recs, os.path.join(RESULTS, "fast_feed.csv"))
