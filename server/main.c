@@ -122,6 +122,7 @@ static void shut_down(struct MHD_Daemon *d)
 	     i++)
 		usleep(10000);
 	MHD_stop_daemon(d);
+	srv_acceptor_free();
 	srv_fits_shutdown(); /* their evaluations need the pool */
 	srv_pool_stop();
 	srv_job_close(&srv_sweep_job);
@@ -250,6 +251,7 @@ int main(int argc, char **argv)
 		srv_acceptor_stop();
 		if (d)
 			MHD_stop_daemon(d);
+		srv_acceptor_free();
 		srv_pool_stop();
 		return 1;
 	}

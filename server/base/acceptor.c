@@ -239,6 +239,7 @@ static void hand_over(double now)
 		if (MHD_add_connection(A.d, w.fd, (struct sockaddr *)&w.addr, w.len) != MHD_YES)
 			atomic_fetch_sub(&A.inflight, 1);
 	}
+	A.full_since = 0; /* none waits: the next wait starts afresh */
 }
 
 static void *loop(void *arg)
@@ -333,12 +334,18 @@ void srv_acceptor_stop(void)
 	}
 	while (A.n)
 		close(pop().fd);
+	if (A.lfd >= 0)
+		close(A.lfd);
+	A.lfd = -1;
+}
+
+void srv_acceptor_free(void)
+{
+	srv_acceptor_stop();
 	for (int i = 0; i < 2; i++)
 		if (A.wake[i] >= 0)
 			close(A.wake[i]);
-	if (A.lfd >= 0)
-		close(A.lfd);
-	A.lfd = A.wake[0] = A.wake[1] = -1;
+	A.wake[0] = A.wake[1] = -1;
 	free(A.heap);
 	free(A.slots);
 	free(A.at);

@@ -40,6 +40,9 @@ int srv_acceptor_start(struct MHD_Daemon *d, const srv_config *cfg);
 /* Stop accepting: the loop ends, the waiting connections and the
  * listening socket are closed. Safe to call when not started. */
 void srv_acceptor_stop(void);
+/* After libmicrohttpd has stopped (no notification can come any more):
+ * free the rest (the wake-up pipe, the tables). */
+void srv_acceptor_free(void);
 /* libmicrohttpd's connection notification (MHD_OPTION_NOTIFY_CONNECTION):
  * counts the connections taken up and closed, then
  * srv_budget_connection. */

@@ -11,9 +11,21 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import net from 'node:net';
+import { readFileSync, readdirSync } from 'node:fs';
 import { startDaemon, req, metric, until, SLOW } from './lib.mjs';
 
 const BACKLOG = 300;
+
+// Every thread of process pid stopped (state T in /proc): SIGSTOP is
+// delivered asynchronously, and a thread still running could accept.
+function isStopped(pid) {
+  return readdirSync(`/proc/${pid}/task`).every((t) => {
+    try {
+      const stat = readFileSync(`/proc/${pid}/task/${t}/stat`, 'utf8');
+      return stat.slice(stat.lastIndexOf(')') + 2)[0] === 'T';
+    } catch { return true; } /* a thread that ended */
+  });
+}
 const ADDRESSES = 10;
 
 // GET /api/v1/health on a raw socket from localAddress, once connected;
@@ -47,6 +59,7 @@ test('a backlog of 300 connections from 10 addresses: a newcomer is answered bef
     const bodies = [];
     d.proc.kill('SIGSTOP');
     stopped = true;
+    await until(() => isStopped(d.proc.pid), 5000 * SLOW, 'the daemon stopped');
     for (let i = 0; i < BACKLOG; i++) {
       socks.push(await ask(d.port, `127.3.0.${1 + (i % ADDRESSES)}`, (status) => {
         assert.equal(status, 200, 'a flood connection answered 200');
