@@ -111,7 +111,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -382,6 +382,18 @@ bench-controls: all
 # and disturbances on the preset, into tests/bench/results/control_loop.md.
 bench-control-loop: all
 	$(Q)CONVSIMD=$(BUILD)/convsimd node tests/bench/control_loop.mjs | tee tests/bench/results/control_loop.md
+
+# What the closed loop itself costs against an earlier build
+# (tests/bench/control_cost.mjs, about 30 s; not part of `make bench`: the
+# comparison needs OLD_CONVSIMD=path, a convsimd built from an earlier
+# commit): a control experiment against a schedule of the same betas, on
+# a data directory, into tests/bench/results/control_cost.md.
+bench-control-cost: all
+	$(Q)test -n "$(OLD_CONVSIMD)" || { echo "bench-control-cost: give OLD_CONVSIMD=path, an earlier build's convsimd"; exit 2; }
+	$(Q). tests/bench/provenance.sh && line=$$(provenance) && \
+	  CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/control_cost.mjs > tests/bench/results/control_cost.md && \
+	  stamp tests/bench/results/control_cost.md "$$line Command: \`make bench-control-cost OLD_CONVSIMD=$(OLD_CONVSIMD)\`." && \
+	  cat tests/bench/results/control_cost.md
 
 # Does shaping the beta command settle the feed faster (part of `make bench`;
 # tests/bench/control_shaping.c on the core alone, about 10 s)? Into

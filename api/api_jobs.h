@@ -92,11 +92,35 @@ typedef struct api_disturbance {
 	int applied;
 	int pad;
 } api_disturbance;
+#define API_EXP_MAX_CURVES 6   /* curve changes listed (all are counted) */
+typedef struct api_curve_change {
+	double t;               /* s after the start: taken up at this sample */
+	double omega_ss;        /* rad/s: the new scene's */
+	int rotation;           /* SIM_CW or SIM_CCW */
+	int retuned;            /* 1: "auto" gains re-tuned from the slope */
+	double beta0;           /* deg: the operating point, the running
+				   setpoint's feedforward on the new curve */
+	double slope;           /* m/s per deg: the new curve's secant over
+				   beta0 -+ the identification's step */
+	double kp, ki;          /* the gains in use from then on */
+} api_curve_change;
+/* A closed loop's gains after curve changes, in the bytes of an
+ * identification's models (a union: a closed loop's are zero in records
+ * from before, which read back as no change). */
+typedef struct api_loop_gains {
+	double kp, ki;          /* in use; 0, 0: the controller's kp, ki */
+	int n, pad;             /* entries in curves: the first changes, then
+				   the last one in the last entry */
+	api_curve_change curves[API_EXP_MAX_CURVES];
+} api_loop_gains;
 typedef struct api_exp_ext {
 	int kind;               /* API_EXP_* */
 	int npoints;            /* identify: operating points */
 	double id_step, id_hold; /* deg, s */
-	api_fopdt model[API_EXP_MAX_POINTS];
+	union {
+		api_fopdt model[API_EXP_MAX_POINTS]; /* identify */
+		api_loop_gains gains;                /* control */
+	};
 	/* control */
 	int auto_gains;         /* "controller": "auto" (SIMC) */
 	int branch_sign;        /* sign of dv/dbeta on the branch */
@@ -123,6 +147,9 @@ typedef struct api_exp_ext {
 				   (rotation or omega_ss changed; was padding:
 				   0 in records from before) */
 } api_exp_ext;
+/* The gains a closed loop x had in use at t (s after its start): its
+ * controller's, or the last curve change's at or before t. */
+void api_loop_gains_at(const api_exp_ext *x, double t, double *kp, double *ki);
 
 /* Parse POST /experiments: {"session": ID} or {"session": {create body}}
  * (or none: a fresh czubak2016 session at pace "max"), "schedule":
@@ -161,7 +188,7 @@ char *api_experiment_list_json(const api_experiment_view *v, size_t n);
  * results (a mixed list has the plain columns). */
 #define API_EXPERIMENT_CSV_IDENTIFY \
 	",operating_point,gain,gain_se,time_constant,time_constant_se,dead_time,dead_time_se"
-#define API_EXPERIMENT_CSV_CONTROL ",setpoint,settling_time,overshoot,iae,steady_error"
+#define API_EXPERIMENT_CSV_CONTROL ",setpoint,settling_time,overshoot,iae,steady_error,kp,ki"
 char *api_experiment_csv(const api_experiment_view *v, size_t n);
 
 /* ---- sweeps --------------------------------------------------------------- */

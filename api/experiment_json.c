@@ -241,8 +241,9 @@ static int csv_kind(const api_experiment_view *v, size_t n)
 }
 
 /* The kind's columns of segment k (API_EXPERIMENT_CSV_IDENTIFY or
- * _CONTROL). */
-static void csv_kind_cells(api_buf *b, const api_exp_ext *ext, int k)
+ * _CONTROL; a closed loop's gains in use at the end of a segment done,
+ * t_end s after the start). */
+static void csv_kind_cells(api_buf *b, const api_exp_ext *ext, int k, int done, double t_end)
 {
 	if (ext->kind == API_EXP_IDENTIFY) {
 		const api_fopdt *m = &ext->model[k / API_EXP_ID_SEGS];
@@ -251,7 +252,10 @@ static void csv_kind_cells(api_buf *b, const api_exp_ext *ext, int k)
 			csv_num(b, cells[c]);
 	} else if (ext->kind == API_EXP_CONTROL) {
 		const api_setpoint *s = &ext->sp[k];
-		double cells[] = {s->v, s->settling_time, s->overshoot, s->iae, s->steady_error};
+		double kp = NAN, ki = NAN;
+		if (done)
+			api_loop_gains_at(ext, t_end, &kp, &ki);
+		double cells[] = {s->v, s->settling_time, s->overshoot, s->iae, s->steady_error, kp, ki};
 		for (size_t c = 0; c < sizeof cells / sizeof *cells; c++)
 			csv_num(b, cells[c]);
 	}
@@ -284,7 +288,7 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n)
 			sim_model_error me;
 			api_buf_model_error(&b, segment_model(&v[i], g, &me) ? &me : NULL);
 			if (kind != API_EXP_SCHEDULE)
-				csv_kind_cells(&b, v[i].ext, k);
+				csv_kind_cells(&b, v[i].ext, k, done, g->t_end - v[i].t_start);
 			api_buf_put(&b, "\n", 1);
 		}
 	return api_buf_take(&b);

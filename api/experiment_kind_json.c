@@ -315,6 +315,14 @@ api_err api_parse_experiment_kind(const cJSON *root, api_experiment_req *req,
 	return e;
 }
 
+void api_loop_gains_at(const api_exp_ext *x, double t, double *kp, double *ki)
+{
+	*kp = x->kp, *ki = x->ki;
+	for (int i = 0; i < x->gains.n && i < API_EXP_MAX_CURVES; i++)
+		if (x->gains.curves[i].t <= t)
+			*kp = x->gains.curves[i].kp, *ki = x->gains.curves[i].ki;
+}
+
 /* ---- the results ----------------------------------------------------------- */
 
 static cJSON *model_object(const api_fopdt *m)
@@ -354,6 +362,20 @@ static void add_control(cJSON *o, const api_exp_ext *ext, int nseg)
 	api_add_number(r, "beta_min", ext->nff ? api_user_of("beta", ext->beta_lo) : NAN);
 	api_add_number(r, "beta_max", ext->nff ? api_user_of("beta", ext->beta_hi) : NAN);
 	cJSON_AddNumberToObject(c, "curve_changes", ext->curve_changes);
+	cJSON *cv = cJSON_AddArrayToObject(c, "curves");
+	for (int i = 0; i < ext->gains.n && i < API_EXP_MAX_CURVES; i++) {
+		const api_curve_change *k = &ext->gains.curves[i];
+		cJSON *ko = cJSON_CreateObject();
+		api_add_number(ko, "t", k->t);
+		cJSON_AddStringToObject(ko, "rotation", k->rotation == SIM_CCW ? "ccw" : "cw");
+		api_add_number(ko, "omega_ss", k->omega_ss);
+		api_add_number(ko, "beta0", k->beta0);
+		api_add_number(ko, "slope", k->slope);
+		cJSON_AddBoolToObject(ko, "retuned", k->retuned);
+		api_add_number(ko, "kp", k->kp);
+		api_add_number(ko, "ki", k->ki);
+		cJSON_AddItemToArray(cv, ko);
+	}
 	cJSON *arr = cJSON_AddArrayToObject(c, "setpoints");
 	for (int i = 0; i < nseg; i++) {
 		const api_setpoint *s = &ext->sp[i];

@@ -60,6 +60,18 @@ static int early_met(const sim_status *st)
 	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
+/* A refinement's bar that neither a longer window nor a further
+ * refinement brings within tol (its step error alone beyond it and not
+ * shrunk to 0.8 of the run before's, last), measured on no longer where
+ * its scatter and drift are already as small as early_met asks: where
+ * they are larger (a chaotic feed) the rest of the window still makes v
+ * better, if not its bar. */
+static int beyond_tol(const sim_status *st, double last)
+{
+	double scatter = st->transport_velocity_uncertainty - st->step_error;
+	return st->step_error >= 0.8 * last && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed;
+}
+
 /* The first run's instance as it starts (settled, at t = 0, its shadow
  * begun), kept for the refinements: a checkpoint of it restored with
  * finer steps starts them where the first run started, without settling
@@ -73,14 +85,19 @@ typedef struct settled_start {
 
 /* A run's instance: the first one fresh (its start kept in *start where
  * start is not NULL), a refinement's restored from *start with its own
- * steps (its shadow too), or fresh where no start could be kept. */
+ * steps (its shadow too; *restored then 1), or fresh where no start could
+ * be kept. */
 static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			   double t_end, settled_start *start, int *err, char *msg, size_t msglen)
+			   double t_end, settled_start *start, int *restored, int *err, char *msg,
+			   size_t msglen)
 {
+	*restored = 0;
 	if (start && start->buf) {
 		sim *s = sim_restore(p, sc, m, start->buf, start->len, err, NULL, 0);
-		if (s)
+		if (s) {
+			*restored = 1;
 			return s;
+		}
 	}
 	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
 	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, err, msg, msglen);
@@ -96,43 +113,106 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 	return s;
 }
 
+/* The run before a refinement: its own estimate of v at its shadow's end
+ * and its feed step. A refinement restored from the same settled start
+ * takes it as its shadow (shadow_against): the two estimates span the
+ * same periods from the same state, as a shadow's do, and the coarser run
+ * is already paid for, where the refinement's own shadow would cost it
+ * about 0.8 of itself again. v NaN: none (the refinement runs its own). */
+typedef struct coarser_run {
+	double v, h, dt;
+	int substeps;
+} coarser_run;
+
+/* Whether s's own shadow would be the coarser run itself (the same
+ * machine step, ceil(n / 2) of s's n sub-steps the coarser run's). */
+static int shadow_is(const sim *s, const coarser_run *c)
+{
+	return s->cfg.dt == c->dt && (s->cfg.substeps + 1) / 2 == c->substeps;
+}
+
+/* Where the coarser run as a refinement's shadow leaves its bar beyond
+ * tol (the coarser run, pre-asymptotic, is why the point was refined), the
+ * refinement's own shadow, run now from the settled start to s's
+ * shadow_until (s stands there): the step error as the shadow beside it
+ * would have measured it, bit for bit. */
+static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const sim_method *m,
+		       const settled_start *start)
+{
+	sim *r = sim_restore(p, sc, m, start->buf, start->len, NULL, NULL, 0);
+	if (!r)
+		return;
+	sim *sh = r->shadow;
+	r->shadow = NULL;
+	sim_free(r);
+	if (!sh)
+		return;
+	sim_advance(sh, s->shadow_until);
+	s->shadow = sh;
+	shadow_finish(s);
+	sim_update_status(s);
+}
+
 /* One run of sim_measure: a fresh instance to t_end at most, its shadow
- * over the first SHADOW_MEASURE_SHARE of the window; *st its final
- * status. If early (sim_measure_point) and with a shadow, the run stops early at the first check after the
- * shadow has finished where the bar is within tol and the estimate steady
- * (the rest of the window would only shrink a bar already met), or, if
- * may_refine, where a refinement is asked (refine_asks with last) with
- * the step error alone beyond tol: the step error does not change after
- * the shadow and no longer window makes room for it, so the refinement
- * the whole window would ask for is asked now. A step error within tol
- * whose room a longer window's smaller scatter may yet make is left to
- * the window's end, as before. */
+ * over the first SHADOW_MEASURE_SHARE of the window (a refinement from
+ * the settled start: the run before as its shadow, coarser_run); *st its
+ * final status, *coarser this run for the next. If early
+ * (sim_measure_point) and with a shadow, the run stops early at the first
+ * check after the shadow has finished where the bar is within tol and the
+ * estimate steady (the rest of the window would only shrink a bar already
+ * met), or, if may_refine, where the step error alone is beyond tol and
+ * either a refinement is asked (refine_asks with last) or none can follow
+ * (the step error not shrunk to 0.8 of last): the step error does not
+ * change after the shadow and no longer window makes room for it, so the
+ * refinement the whole window would ask for is asked now, and a bar that
+ * no window or refinement brings within tol is not measured on where its
+ * scatter is small already (beyond_tol). A step
+ * error within tol whose room a longer window's smaller scatter may yet
+ * make is left to the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			double t_end, int early, int may_refine, double last, settled_start *start,
-			sim_status *st, char *msg, size_t msglen)
+			coarser_run *coarser, sim_status *st, char *msg, size_t msglen)
 {
 	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
 			   .rotor_speed_mean = NAN, .step_error = NAN, .tol_allowed = NAN};
-	int err;
-	sim *s = start_instance(p, sc, m, t_end, start, &err, msg, msglen);
+	int err, restored;
+	sim *s = start_instance(p, sc, m, t_end, start, &restored, &err, msg, msglen);
 	if (!s)
 		return err;
+	/* a refinement from the settled start: the run before is its shadow */
+	int against = restored && s->shadow && isfinite(coarser->v);
+	if (against)
+		shadow_stop(s);
+	double until = s->shadow_until;
 	/* the first check at the shadow's end (just past it: the shadow
 	 * finishes once the instance is asked beyond it) */
-	double t = early && s->shadow ? fmin(t_end, nextafter(s->shadow_until, INFINITY)) : t_end;
+	double t = early && (s->shadow || against) ? fmin(t_end, nextafter(until, INFINITY)) : t_end;
 	for (;;) {
+		if (against && t > until) {
+			err = sim_advance(s, until);
+			if (err != SIM_OK)
+				break;
+			shadow_against(s, coarser->v, coarser->h);
+			if (!s->st.tol_met && !shadow_is(s, coarser))
+				own_shadow(s, p, sc, m, start);
+			against = 0;
+		}
 		err = sim_advance(s, t);
 		if (err != SIM_OK || t >= t_end)
 			break;
 		if (!s->shadow && (early_met(&s->st) ||
 				   (may_refine && s->st.step_error > s->st.tol_allowed &&
-				    refine_asks(&s->st, last))))
+				    (refine_asks(&s->st, last) || beyond_tol(&s->st, last)))))
 			break;
 		t = fmin(t_end, t + MEASURE_CHECK);
 	}
 	if (err != SIM_OK && msg)
 		snprintf(msg, msglen, "%s", s->error);
 	*st = s->st;
+	coarser->v = s->shadow_v;
+	coarser->h = s->cfg.dt / s->cfg.substeps;
+	coarser->dt = s->cfg.dt;
+	coarser->substeps = s->cfg.substeps;
 	sim_free(s);
 	return err;
 }
@@ -155,10 +235,11 @@ static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
 	settled_start start = {NULL, 0};
+	coarser_run coarser = {NAN, NAN, NAN, 0};
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
 		err = measure_once(p, sc, &run, t_end, early, may_refine, last,
-				   early && own_steps ? &start : NULL, &st, msg, msglen);
+				   early && own_steps ? &start : NULL, &coarser, &st, msg, msglen);
 		out->refinements = attempt;
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a

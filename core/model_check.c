@@ -119,8 +119,9 @@ static const char *first_difference(const sim_params *p, const sim_scene *s,
 		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name))
 			continue;
 		double a, b;
-		if (sim_get(p, s, NULL, tab[i].name, &a) == SIM_OK &&
-		    sim_get(q, t, NULL, tab[i].name, &b) == SIM_OK && !same(a, b))
+		sim_get_setting(p, s, NULL, &tab[i], &a);
+		sim_get_setting(q, t, NULL, &tab[i], &b);
+		if (!same(a, b))
 			return tab[i].name;
 	}
 	if (s->friction != t->friction)
@@ -207,6 +208,45 @@ static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
 	return sc->layers == map[first].layers ? 0 : 1;
 }
 
+/* An entry's match depends on the scene's settings, not on its controls:
+ * each thread keeps the last scene's matches (a closed loop checks the
+ * same scene at a new beta every period, each command's event), by the
+ * entry's first row; a scene of other settings starts over. */
+#define MAP_ROWS (sizeof map / sizeof *map)
+static _Thread_local struct {
+	int valid;
+	sim_params p; /* the controls zeroed */
+	sim_scene sc;
+	unsigned char known[MAP_ROWS];
+	int rank[MAP_ROWS];
+	const char *diff[MAP_ROWS];
+} memo;
+
+/* The memo for the scene p, sc (its matches kept if they are its). */
+static void memo_for(const sim_params *p, const sim_scene *sc)
+{
+	sim_params k = *p;
+	k.beta = k.beta_rate = k.beta_accel = k.drive_accel = 0;
+	k.rotation = 0;
+	if (memo.valid && !memcmp(&k, &memo.p, sizeof k) && !memcmp(sc, &memo.sc, sizeof *sc))
+		return;
+	memo.valid = 1;
+	memo.p = k;
+	memo.sc = *sc;
+	memset(memo.known, 0, sizeof memo.known);
+}
+
+/* entry_match of the entry at row first, through the memo. */
+static int memo_match(size_t first, const sim_params *p, const sim_scene *sc, const char **diff)
+{
+	if (!memo.known[first]) {
+		memo.rank[first] = entry_match(first, p, sc, &memo.diff[first]);
+		memo.known[first] = 1;
+	}
+	*diff = memo.diff[first];
+	return memo.rank[first];
+}
+
 /* The map's entry nearest the scene, when none checks it. */
 typedef struct {
 	size_t first, end; /* first == SIZE_MAX: no entry */
@@ -220,6 +260,7 @@ typedef struct {
 static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, int can_mirror,
 			sim_model_error *out, nearest_entry *best)
 {
+	memo_for(p, sc);
 	size_t best_first = SIZE_MAX, best_end = 0;
 	int best_rank = 5;
 	const char *best_diff = NULL;
@@ -230,7 +271,7 @@ static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, i
 		     end++)
 			;
 		const char *diff;
-		int rank = entry_match(first, p, sc, &diff);
+		int rank = memo_match(first, p, sc, &diff);
 		if (rank == 0) {
 			double err, unc;
 			int inside = interpolate(first, end, beta, p->rotation, &err, &unc) ||

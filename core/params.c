@@ -287,12 +287,11 @@ int sim_set_user_str(sim_params *p, sim_scene *s, sim_method *m, const char *nam
 	return set_str(p, s, m, name, value, 1, msg, msglen);
 }
 
-int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
-	    double *value)
+/* sim_get of table[i] (i a valid index): no lookup by name, which cost
+ * sim_validate a search of the table for every one of its settings. */
+static void get_at(const sim_params *p, const sim_scene *s, const sim_method *m, size_t i,
+		   double *value)
 {
-	int i = find(name);
-	if (i < 0)
-		return SIM_EUNKNOWN;
 	const sim_setting *t = &table[i];
 	if (strcmp(t->name, "method") == 0) {
 		size_t n;
@@ -300,9 +299,9 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const 
 		for (size_t k = 0; k < n; k++)
 			if (strcmp(mi[k]->name, m->name) == 0)
 				*value = (double)k;
-		return SIM_OK;
+		return;
 	}
-	const void *f = field((sim_params *)p, (sim_scene *)s, (sim_method *)m, (size_t)i);
+	const void *f = field((sim_params *)p, (sim_scene *)s, (sim_method *)m, i);
 	if (strcmp(t->name, "rotation") == 0)
 		*value = *(const int *)f == SIM_CW ? 0 : 1;
 	else if (t->kind == SIM_KIND_REAL && locs[i].size == sizeof(float))
@@ -311,17 +310,34 @@ int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const 
 		*value = *(const double *)f;
 	else
 		*value = *(const int *)f;
+}
+
+int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
+	    double *value)
+{
+	int i = find(name);
+	if (i < 0)
+		return SIM_EUNKNOWN;
+	get_at(p, s, m, (size_t)i, value);
 	return SIM_OK;
+}
+
+void sim_get_setting(const sim_params *p, const sim_scene *s, const sim_method *m,
+		     const sim_setting *t, double *value)
+{
+	get_at(p, s, m, (size_t)(t - table), value);
 }
 
 int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, const char *name,
 		 double *value)
 {
+	int i = find(name);
+	if (i < 0)
+		return SIM_EUNKNOWN;
 	double si;
-	int e = sim_get(p, s, m, name, &si);
-	if (e == SIM_OK)
-		*value = sim_setting_from_si(&table[find(name)], si);
-	return e;
+	get_at(p, s, m, (size_t)i, &si);
+	*value = sim_setting_from_si(&table[i], si);
+	return SIM_OK;
 }
 
 int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, char *msg,
@@ -333,8 +349,9 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 		return SIM_EPARAM;
 	}
 	for (size_t i = 0; i + 1 < N_SETTINGS; i++) {
-		double v;
-		sim_get_user(p, s, m, table[i].name, &v);
+		double si;
+		get_at(p, s, m, i, &si);
+		double v = sim_setting_from_si(&table[i], si);
 		/* a stored value converted back may differ in the last bit */
 		double tol = 1e-12 * fmax(fabs(table[i].min), fabs(table[i].max));
 		if (!isfinite(v) || v < table[i].min - tol || v > table[i].max + tol)

@@ -76,9 +76,29 @@ void shadow_finish(sim *s)
 	estimator_read(&s->est, &a);
 	estimator_read(&s->shadow->est, &b);
 	double r = (double)s->cfg.substeps / (double)s->shadow->cfg.substeps;
-	if (s->shadow->failed)
+	s->shadow_v = NAN;
+	if (s->shadow->failed) {
 		s->step_error = INFINITY;
-	else if (a.transport_periods >= SHADOW_MIN_PERIODS && b.transport_periods >= SHADOW_MIN_PERIODS)
+	} else if (a.transport_periods >= SHADOW_MIN_PERIODS &&
+		   b.transport_periods >= SHADOW_MIN_PERIODS) {
 		s->step_error = fabs(b.transport_velocity - a.transport_velocity) / (r - 1.0);
+		s->shadow_v = a.transport_velocity;
+	}
 	shadow_stop(s);
+}
+
+/* A refinement's shadow without a shadow: s, restored from the checkpoint
+ * the coarser run v_coarse came from (feed step h_coarse, both estimates
+ * from the same start), at that run's shadow_until, the coarser run as
+ * its shadow (sim_measure_point's refinements, measure.c). */
+void shadow_against(sim *s, double v_coarse, double h_coarse)
+{
+	estimate a;
+	estimator_read(&s->est, &a);
+	double r = h_coarse / (s->cfg.dt / s->cfg.substeps);
+	if (a.transport_periods >= SHADOW_MIN_PERIODS && r > 1.0 && !s->failed) {
+		s->step_error = fabs(v_coarse - a.transport_velocity) / (r - 1.0);
+		s->shadow_v = a.transport_velocity;
+	}
+	sim_update_status(s);
 }

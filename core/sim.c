@@ -323,7 +323,9 @@ static void control_changed(sim *s, double settled)
 	sim_update_status(s);
 }
 
-int sim_set_beta(sim *s, double beta, double rate)
+/* beta's new ramp (sim_set_beta, sim_steer_beta): SIM_OK or SIM_EPARAM
+ * (nothing changed). */
+static int beta_ramp(sim *s, double beta, double rate)
 {
 	if (!sim_setting_check(sim_setting_find("beta"), beta))
 		return SIM_EPARAM;
@@ -336,7 +338,29 @@ int sim_set_beta(sim *s, double beta, double rate)
 	}
 	ramp_to_position(&s->ctl.beta_ramp, s->t_int, beta, s->ctl.beta_rate,
 			 s->md.p.beta_accel);
-	control_changed(s, s->ctl.beta_ramp.t_end);
+	return SIM_OK;
+}
+
+int sim_set_beta(sim *s, double beta, double rate)
+{
+	int e = beta_ramp(s, beta, rate);
+	if (e == SIM_OK)
+		control_changed(s, s->ctl.beta_ramp.t_end);
+	return e;
+}
+
+int sim_steer_beta(sim *s, double beta, double rate)
+{
+	int e = beta_ramp(s, beta, rate);
+	if (e != SIM_OK)
+		return e;
+	/* the integrator forgets its cached derivatives as after any
+	 * control; a running shadow takes the same command, so that both
+	 * estimates still see the same controls over the same periods */
+	s->ode->reset(s->ws);
+	if (s->shadow && sim_steer_beta(s->shadow, beta, rate) != SIM_OK)
+		shadow_stop(s);
+	sim_update_status(s);
 	return SIM_OK;
 }
 

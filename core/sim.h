@@ -123,6 +123,10 @@ int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 /* Read one named setting in SI units; SIM_EUNKNOWN if no such name. */
 int sim_get(const sim_params *p, const sim_scene *s, const sim_method *m,
 	    const char *name, double *value);
+/* The same for an entry t of sim_settings()' table, found without a
+ * search by name. */
+void sim_get_setting(const sim_params *p, const sim_scene *s, const sim_method *m,
+		     const sim_setting *t, double *value);
 
 /* The integrator step (s) that dt = 0 stands for: the default of method m
  * for the kind of scene: with or without feed, and, for dem, whether the
@@ -229,6 +233,11 @@ double sim_effective_time(const sim *s);
  * both within the settings table's ranges of "beta" and "beta_rate".
  * Returns SIM_OK or SIM_EPARAM (nothing changed). */
 int sim_set_beta(sim *s, double beta, double rate);
+/* As sim_set_beta, but the transport estimate goes on: a controller's
+ * small steps of beta within one estimate (its whole periods keep
+ * counting across them, and so does the measured step error's shadow,
+ * which takes the same command). */
+int sim_steer_beta(sim *s, double beta, double rate);
 /* Sense of the unbalanced mass, SIM_CW or SIM_CCW; else SIM_EPARAM. */
 int sim_set_rotation(sim *s, int rotation);
 /* rad/s, within the table's range of "omega_ss"; SIM_OK or SIM_EPARAM. */
@@ -396,7 +405,10 @@ int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, do
  * check after the shadow's window whose bar is within tol, steady, at most
  * a quarter scatter and 28 whole periods long (out->periods says how long
  * it measured), or whose step error alone is beyond tol; a refinement
- * starts from the first run's settled start. About half the cost of
+ * starts from the first run's settled start and takes the run before it
+ * as its shadow (its own shadow run afterwards only where that bar misses
+ * tol), and one that can neither meet tol nor refine further stops at its
+ * shadow's end where its scatter is small. About half the cost of
  * sim_measure at czubak2016's defaults; v then depends on where the run
  * stopped, a step in the parameters, so fits keep sim_measure. */
 int sim_measure_point(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,

@@ -44,6 +44,9 @@ struct sim {
 	double shadow_window; /* s: how long a shadow runs after the estimate's start */
 	double step_error;    /* m/s: the last shadow's Richardson estimate of
 				 the feed step's error in v; NaN before one */
+	double shadow_v;      /* m/s: this instance's own estimate of v at
+				 the last shadow's end, NaN where that shadow
+				 measured nothing (too few periods, failed) */
 	sim_status st;
 };
 
@@ -76,6 +79,10 @@ sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method
 void shadow_begin(sim *s);
 void shadow_finish(sim *s);
 void shadow_stop(sim *s);
+/* shadow_against: the step error from a coarser run instead of a shadow
+ * (v_coarse, its feed step h_coarse: its shadow_v, from the same start),
+ * at shadow_until; s has no shadow then. */
+void shadow_against(sim *s, double v_coarse, double h_coarse);
 
 /* Recompute s->st at the observed time after any change; reads the state
  * and evaluates the right-hand side for observation only (no counter

@@ -14,6 +14,11 @@ typedef struct srv_cmd {
 	api_control c;           /* the changes, as PATCH parses them */
 	int restart_transport;   /* then restart the transport estimator */
 	int from_experiment;     /* sent by the attached experiment */
+	int loop_step;           /* a closed loop's per-period beta alone:
+				    steered (sim_steer_beta: the transport
+				    estimate goes on) and logged without a
+				    flush of its own (the experiment sends it
+				    again after a restore) */
 	int replay;              /* taken again from the control log at a
 				    restore: applied, not logged again */
 	double cpu_grant;        /* CPU s a "running": true grants a session

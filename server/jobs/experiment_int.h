@@ -81,6 +81,11 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
  * from the cache or measured, its branch taken up (the integral reset,
  * the pending setpoints' feedforward redone). */
 void srv_exp_follow_curve(srv_experiment *e, const sim_status *st);
+/* A curve just taken up at status st (lock held): the operating point
+ * (the running setpoint's feedforward on it) and the curve's slope there,
+ * "auto" gains re-tuned by SIMC from that slope with the identification's
+ * T and L (given gains kept), listed in curves. */
+void srv_exp_retune(srv_experiment *e, const sim_status *st);
 /* The feedforward beta (rad) of velocity v on the branch (clamped to its
  * ends). */
 double srv_exp_feedforward(const api_exp_ext *ext, double v);

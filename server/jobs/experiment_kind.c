@@ -253,6 +253,7 @@ void srv_exp_follow_curve(srv_experiment *e, const sim_status *st)
 	}
 	x->integ = 0; /* it made up for the old curve */
 	x->curve_changes++;
+	srv_exp_retune(e, st);
 	/* the setpoints still to come start from the new feedforward */
 	for (int i = e->cur + 1; i < e->req.nseg; i++) {
 		double b = srv_exp_feedforward(x, x->sp[i].v);

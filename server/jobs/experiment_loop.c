@@ -19,8 +19,12 @@
  * its last command (the core ramps it at beta_rate, like any PATCH) and is
  * pulled back by (clamped - unclamped) T_s / T_t (T_t = kp / ki) when the
  * command is at a branch end: both keep it from winding up. Each command
- * goes to the worker as a PATCH does (logged, replayed, in the stream); a
- * disturbance due rides on the next sample's command, one each.
+ * goes to the worker as a PATCH does (logged, in the stream), but steered
+ * (the segment's transport estimate goes on) and its log line left to the
+ * next sync (the experiment sends it again after a restore); a disturbance
+ * due rides on the next sample's command, one each, as a PATCH. When a new
+ * v(beta) curve is taken up, "auto" gains are tuned again by SIMC from its
+ * slope at the operating point (srv_exp_retune).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -157,6 +161,47 @@ double srv_exp_feedforward(const api_exp_ext *ext, double v)
 
 /* ---- the controller ------------------------------------------------------- */
 
+/* v on the branch at beta (rad), by linear interpolation (clamped). */
+static double branch_v(const api_exp_ext *x, double beta)
+{
+	int i = 1;
+	while (i < x->nff - 1 && x->ff_beta[i] < beta)
+		i++;
+	double f = (beta - x->ff_beta[i - 1]) / (x->ff_beta[i] - x->ff_beta[i - 1]);
+	f = f < 0 ? 0 : f > 1 ? 1 : f;
+	return x->ff_v[i - 1] + f * (x->ff_v[i] - x->ff_v[i - 1]);
+}
+
+void srv_exp_retune(srv_experiment *e, const sim_status *st)
+{
+	api_exp_ext *x = &e->ext;
+	double b0 = srv_exp_feedforward(x, x->sp[e->cur].v);
+	/* the secant over the identification's step (4 deg), inside the
+	 * branch: the slope the identification's gain stands for */
+	double h = (x->tuned.step > 0 ? x->tuned.step : 4) * DEG;
+	double a = fmax(b0 - h, x->beta_lo), b = fmin(b0 + h, x->beta_hi);
+	double slope = b > a && x->nff >= 2 ? (branch_v(x, b) - branch_v(x, a)) / ((b - a) / DEG) : NAN;
+	api_loop_gains *g = &x->gains;
+	if (g->kp == 0 && g->ki == 0)
+		g->kp = x->kp, g->ki = x->ki;
+	int retuned = 0;
+	if (x->auto_gains) {
+		fopdt_result r = {.k = slope, .t = x->tuned.t, .l = x->tuned.l};
+		double kp, ki;
+		fopdt_simc(&r, x->tau_c, &kp, &ki);
+		retuned = isfinite(kp) && isfinite(ki) && (kp > 0 || ki > 0);
+		if (retuned)
+			g->kp = kp, g->ki = ki;
+	}
+	/* the first ones, then the last one in the last entry */
+	api_curve_change *k = &g->curves[g->n < API_EXP_MAX_CURVES ? g->n++ : API_EXP_MAX_CURVES - 1];
+	k->t = st->t - e->t0;
+	k->rotation = st->rotation, k->omega_ss = st->omega_ss;
+	k->beta0 = b0 / DEG, k->slope = slope;
+	k->retuned = retuned;
+	k->kp = g->kp, k->ki = g->ki;
+}
+
 double srv_exp_control_boundary(const srv_experiment *e)
 {
 	const api_exp_ext *x = &e->ext;
@@ -191,13 +236,15 @@ static double pi_beta(srv_experiment *e, const sim_status *st, double y)
 	double err = isfinite(y) ? r - y : 0;
 	int s = x->branch_sign;
 	double ff = srv_exp_feedforward(x, r) / DEG;
-	double u = ff + s * (x->kp * err + x->integ);
+	int given = x->gains.kp == 0 && x->gains.ki == 0; /* no curve change yet */
+	double kp = given ? x->kp : x->gains.kp, ki = given ? x->ki : x->gains.ki;
+	double u = ff + s * (kp * err + x->integ);
 	double lo = x->beta_lo / DEG, hi = x->beta_hi / DEG, cl = clamp(u, lo, hi);
 	double rate = e->req.beta_rate.si > 0 ? e->req.beta_rate.si : e->req.spec.params.beta_rate;
 	int slewing = fabs(st->beta_target - st->beta) > rate * ts;
-	if (x->ki > 0 && isfinite(y) && !slewing) {
-		double tt = x->kp > 0 ? fmax(x->kp / x->ki, ts) : ts;
-		x->integ += ts * x->ki * err + s * (cl - u) * ts / tt;
+	if (ki > 0 && isfinite(y) && !slewing) {
+		double tt = kp > 0 ? fmax(kp / ki, ts) : ts;
+		x->integ += ts * ki * err + s * (cl - u) * ts / tt;
 	}
 	return cl * DEG;
 }
@@ -236,6 +283,9 @@ srv_cmd *srv_exp_control(srv_experiment *e, const sim_status *st, int sampled, d
 	}
 	if (!cmd->c.set)
 		return NULL;
+	/* beta alone: a step within the segment's estimate (a disturbance
+	 * restarts it anyway) */
+	cmd->loop_step = !dist;
 	cmd->from_experiment = 1;
 	return cmd;
 }

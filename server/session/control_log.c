@@ -15,7 +15,9 @@
  * one session share one fdatasync, and controls of different sessions
  * sync in parallel (each handler its own file: the file system commits
  * them together). Lines nobody waits for (an experiment's segments, a
- * pace-down) are flushed the same way from the store's writer thread,
+ * pace-down) are flushed the same way from the store's writer thread
+ * (a closed loop's per-period beta is not: the experiment sends it again
+ * after a restore, so its line goes with the next sync that comes),
  * and a checkpoint is written only once the log lines it accounts for
  * are on disk (session_store.c), so that a checkpoint never holds more
  * of the log than the file does.
@@ -126,7 +128,7 @@ static void flush(void *arg)
 	srv_registry_put(&srv_sessions_registry, en);
 }
 
-size_t srv_control_log_append(srv_session *s, const char *json, int waited)
+size_t srv_control_log_append(srv_session *s, const char *json, int durable)
 {
 	if (!srv_store_enabled())
 		return 0;
@@ -144,7 +146,7 @@ size_t srv_control_log_append(srv_session *s, const char *json, int waited)
 	memcpy(s->controls + s->controls_len, json, add - 1);
 	s->controls_len += add;
 	s->controls[s->controls_len - 1] = '\n';
-	if (!waited && !s->log.flush_queued) {
+	if (durable == SRV_LINE_FLUSH && !s->log.flush_queued) {
 		char *id = strdup(s->entry.id);
 		if (id) {
 			s->log.flush_queued = 1;

@@ -300,11 +300,17 @@ void srv_persist_spec(srv_session *s, int now);
 
 /* ---- control_log.c: the control log on disk ----------------------------- */
 
+/* How a line appended to the control log reaches the disk: a flush
+ * queued on the store's writer; a handler that waits for it makes it
+ * durable before it answers; or with the next sync that comes (a PATCH's,
+ * a checkpoint's, a flush's: the file stays a prefix of the log), for a
+ * line whose control is sent again after a restore (a closed loop's
+ * per-period beta). */
+enum { SRV_LINE_FLUSH, SRV_LINE_WAITED, SRV_LINE_LATER };
 /* Append a control's event line to s's log in memory (worker, lock held):
  * the log's length with it, for srv_control_log_sync (0 without a data
- * directory). waited: a handler makes it durable before it answers; else
- * a flush is queued on the store's writer. */
-size_t srv_control_log_append(srv_session *s, const char *json, int waited);
+ * directory); durable: SRV_LINE_*. */
+size_t srv_control_log_append(srv_session *s, const char *json, int durable);
 /* Make s's log durable up to end bytes (lock not held): by group commit,
  * one pwrite and one fdatasync for every line appended before the round
  * began. 0, or an errno (ETIMEDOUT after timeout_s, the write's failure,

@@ -55,7 +55,7 @@ static void pace_down(srv_session *s, clocks *c)
 	api_control_event(json, sizeof json, &ctl, sim_effective_time(s->sim));
 	s->pace = pace;
 	srv_ring_event(s, "control", json);
-	srv_control_log_append(s, json, 0);
+	srv_control_log_append(s, json, SRV_LINE_FLUSH);
 	s->persist.ckpt_dirty = 1;
 	srv_worker_restart_clocks(c, s);
 	srv_log(SRV_LOG_WARN, "session %s: %.3g CPU s per simulated s, more than "

@@ -45,7 +45,8 @@ static size_t log_control(srv_session *s, const srv_cmd *cmd, double t_eff)
 	char line[API_EVENT_MAX];
 	api_control_log_line(line, sizeof line, &cmd->c, t_eff,
 			     cmd->from_experiment && s->exp ? srv_exp_id(s->exp) : NULL);
-	return srv_control_log_append(s, line, cmd->waited);
+	return srv_control_log_append(s, line, cmd->waited ? SRV_LINE_WAITED
+					       : cmd->loop_step ? SRV_LINE_LATER : SRV_LINE_FLUSH);
 }
 
 /* ---- the PATCH controls' apply column (api.h API_CONTROLS, by id) ---------- */
@@ -61,7 +62,7 @@ static int apply_beta(srv_session *s, const srv_cmd *cmd, int *reanchor)
 	(void)reanchor;
 	double target = (c->set & API_C_BETA) ? c->beta.si : s->st.beta_target;
 	double rate = (c->set & API_C_BETA_RATE) ? c->beta_rate.si : 0;
-	return sim_set_beta(s->sim, target, rate);
+	return (cmd->loop_step ? sim_steer_beta : sim_set_beta)(s->sim, target, rate);
 }
 
 static int apply_rotation(srv_session *s, const srv_cmd *cmd, int *reanchor)

@@ -85,6 +85,26 @@ try {
     const [dist] = e.control.disturbances;
     console.log(`| ${name} | ${f(dist.max_deviation)} | ${f(dist.recovery_time)} | ${f(100 * e.control.setpoints[0].steady_error, 2)} % |`);
   }
+
+  // "auto" under steps of omega_ss: the gains re-tuned from the new curve's
+  // slope, against the request's gains kept (given: what a build before
+  // the re-tuning did)
+  console.log('\n"auto" under steps of omega_ss at 3 s of 8, setpoint +0.10 m/s: the gains re-tuned by SIMC from the new curve\'s slope at ' +
+    'the operating point, against the request\'s gains kept (recovery: until v stays within 2 %):\n');
+  console.log('| disturbance | gains | kp, ki at the request | curve slope (m/s per °) | kp, ki after | largest deviation (m/s) | recovery (s) | IAE (mm) |');
+  console.log('|---|---|---|---|---|---|---|---|');
+  for (const [set, name] of [[{ omega_ss: 150 }, 'omega_ss −4.5 %'], [{ omega_ss: 141.4 }, 'omega_ss −10 %'], [{ omega_ss: 165 }, 'omega_ss +5 %']]) {
+    let first = null;
+    for (const how of ['re-tuned', 'kept']) {
+      const controller = how === 'kept' ? { kp: first.kp, ki: first.ki } : 'auto';
+      const e = await done((await post({ control: { setpoint: [{ v: 0.10, until: 8 }], controller }, disturbances: [{ at: 3, set }] })).id);
+      const g = e.control.controller, [c] = e.control.curves;
+      first = first || g;
+      const [dist] = e.control.disturbances;
+      console.log(`| ${name} | ${how} | ${f(first.kp)}, ${f(first.ki)} | ${f(c.slope)} | ${f(c.kp)}, ${f(c.ki)} | ` +
+        `${f(dist.max_deviation)} | ${f(dist.recovery_time)} | ${f(1000 * e.control.setpoints[0].iae)} |`);
+    }
+  }
 } finally {
   await d.stop();
 }

@@ -33,6 +33,8 @@ PY
 else
 	: > "$jl"
 fi
+. tests/bench/provenance.sh
+prov=$(provenance)
 start=$(date +%s)
 part=""
 run() { # group, convsim-dem options...
@@ -112,6 +114,7 @@ python3 tests/bench/dem_plot.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" > 
 python3 tests/bench/dem_report.py "$jl" "make bench-dem" "$(date -u +%Y-%m-%d)" \
 	"$(( $(date +%s) - start ))" ${DEM_GROUPS:+" for the parts $DEM_GROUPS (DEM_GROUPS), the other rows kept"} \
 	> "$out/dem.md"
+stamp "$out/dem.md" "$prov"
 # the curve's points for the calibrated preset's fit (docs/dem.md "Calibrated to a bed")
 want curve && python3 tests/bench/dem_report.py --bed4-csv "$jl" > "$out/dem_bed4.csv"
 cat "$out/dem.md"

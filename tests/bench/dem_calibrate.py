@@ -46,6 +46,18 @@ FITSTARTS = 8
 GOOD = 0.05                   # "within 5 % of the peak"
 
 
+
+def machine():
+    """The machine: cores, CPU model and the load average as the page is written."""
+    try:
+        model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
+                      if l.startswith("model name")), os.uname().machine)
+        load = " ".join(open("/proc/loadavg").read().split()[:3])
+    except OSError:
+        model, load = os.uname().machine, "unknown"
+    return "%d cores (%s), load average %s at the end" % (os.cpu_count(), model, load)
+
+
 def git_build():
     """The commit of this tree, and whether it differs from it."""
     head = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
@@ -191,8 +203,9 @@ def page(beds, convsim, started):
       "build %s; the DEM rows from build %s (tests/bench/results/dem_map.csv, each point's "
       "value by the map report's rule: the map's cell, the softest modulus whose overlap "
       "stays within 1 %% of a diameter; counter-clockwise points are the mirror checks' "
-      "rows). %.0f s." % (shown([convsim]), time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-                          git_build(), ", ".join(rows_build) or "-", time.time() - started))
+      "rows). %.0f s, %s." % (shown([convsim]), time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                              git_build(), ", ".join(rows_build) or "-", time.time() - started,
+                              machine()))
     w("")
     w("Each bed (material, depth, drive) is calibrated on three of its points, named below: "
       "the forward peak (largest v clockwise), the reverse peak (smallest v) and the map "

@@ -10,6 +10,8 @@
 # tests/bench/results/dem_cost.md.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 out=${DEM_COST_OUT:-tests/bench/results/dem_cost.md}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
@@ -25,6 +27,7 @@ print('| $depth | %d | %d | $dur | %.1f | %.1f | %+.4f |' % (r['grains'], r['mpi
 	done
 }
 {
+	echo "$prov"
 	echo "\`make bench-dem\` (tests/bench/dem_cost.sh), $(date -u +%Y-%m-%d), $(nproc) cores shared, nice 15:"
 	echo "\`[CONVSIM_DEM_GRAINS=N] mpirun -n RANKS $BUILD/convsim run --set feed_model=liggghts --set layers=DEPTH -d S -q\`."
 	echo

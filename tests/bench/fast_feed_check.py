@@ -360,12 +360,24 @@ def depth_table(sel, w):
                                                    pct(r["err_paper"]), " | ".join(cells)))
 
 
+
+def machine():
+    """The machine: cores, CPU model and the load average as the page is written."""
+    try:
+        model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
+                      if l.startswith("model name")), os.uname().machine)
+        load = " ".join(open("/proc/loadavg").read().split()[:3])
+    except OSError:
+        model, load = os.uname().machine, "unknown"
+    return "%d cores (%s), load average %s at the end" % (os.cpu_count(), model, load)
+
+
 def write_md(recs, runner, path):
     out = []
     w = out.append
     w("# A fast feed model against the DEM map (leave one depth out)")
     w("")
-    w("`make fast-feed-check` (tests/bench/fast_feed_check.py) on %s, build `%s`; data "
+    w("`make fast-feed-check` (tests/bench/fast_feed_check.py) on %s, build `%s`, %s; data "
       "tests/bench/results/fast_feed.csv; %d runs of convsim and fast_feed_bed, %d of them this time (the others from "
       "build/fast_feed_cache.json, same binary). Candidates "
       "(docs/feed-models.md): `closure`, the column model with R, mu, k_c and its layers from a "
@@ -375,7 +387,7 @@ def write_md(recs, runner, path):
       "held-out one. Error = (v - v_DEM) / the "
       "depth's DEM peak |v|; the target is |error| <= 5 %% at >= 90 %% of the points at <= 3x "
       "the column model's CPU." % (time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-                                   build_name(), runner.total, runner.runs, GRAINS_N))
+                                   build_name(), machine(), runner.total, runner.runs, GRAINS_N))
     w("")
     w("## Summary")
     w("")

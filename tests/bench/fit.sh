@@ -9,6 +9,8 @@
 # Repeated REPEAT times (default 3: the machine is shared); the table gives
 # wall and CPU time (user + sys) of each run and what the fit found.
 . "$(dirname "$0")/preamble.sh"
+. tests/bench/provenance.sh
+prov=$(provenance)
 "$cli" sweep --beta 15:150:15 --rotation cw,ccw --set e=0.018 --set mu=0.5 -q --threads 2 > "$work/clean.csv"
 awk -F, 'BEGIN { srand(2016); print "beta,rotation,v,sigma" }
 	NR > 1 { u1 = rand(); u2 = rand(); if (u1 < 1e-12) u1 = 1e-12
@@ -18,6 +20,7 @@ cmd="convsim fit --data DATA --free e,mu --threads 2 --curve-step 0"
 {
 	echo "# Calibration: a 2-parameter fit on 20 points"
 	echo
+	echo "$prov"
 	echo "Made by \`bash tests/bench/fit.sh\` (part of \`make bench\`) on $(nproc) cores, $(date -u +%Y-%m-%d):"
 	echo "\`$cmd\`, the 20 points of the czubak2016 defaults at e = 0.018 m, mu = 0.5 plus noise"
 	echo "(sigma 0.002 m/s, seed 2016), from the preset's e = 0.0215 m, mu = 0.4. Target: < 30 s wall."

@@ -11,6 +11,8 @@
 # by `workprec report`). BENCH_QUICK=1: one point, a shorter ladder.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 CC=${CC:-cc}
 out=${1:-tests/bench/results}
@@ -64,4 +66,5 @@ wait "$a"
 wait "$b"
 cat "$tmp/b.tsv" "$tmp/a.tsv" > "$out/peers.tsv"
 "$bin" report "$out" "$cmd" --points "$points"
+stamp "$out/peers.md" "$prov"
 cat "$out/peers.md"

@@ -6,11 +6,20 @@
 #  2. restart with 64 sessions on disk: wall time from exec to all 64
 #     listed and running;
 #  3. resident memory before, with 100 sessions and after deleting them.
-# Loopback and a temporary directory only.
+# Loopback and a temporary directory only. Writes $1 (default
+# tests/bench/results/persist.md) as well as the terminal.
 set -eu
 cd "$(dirname "$0")/../.."
 BIN=${BUILD:-build}/convsimd
 WINDOW=${WINDOW:-10}
+. tests/bench/provenance.sh
+res=${1:-tests/bench/results/persist.md}
+prov=$(provenance)
+exec > >(tee "$res")
+echo "# Persistence figures"
+echo
+echo "Command: \`WINDOW=$WINDOW bash tests/bench/persist.sh\` (not part of \`make bench\`; about a minute). $prov"
+echo
 dir=$(mktemp -d)
 trap 'kill -9 $pid 2>/dev/null || true; rm -rf "$dir"' EXIT
 
@@ -41,16 +50,17 @@ writer() { cat /proc/$pid/task/*/stat | awk '/\(store\)/ {print $14 + $15}'; }
 w0=$(writer); c0=$(cpu); sleep "$WINDOW"; w1=$(writer); c1=$(cpu)
 files=$(find "$dir/data/sessions" -name checkpoint.bin | wc -l)
 kill -9 "$pid"; wait "$pid" 2>/dev/null || true
-echo "64 sessions ($files checkpointed), daemon $(echo "scale=3; ($c1 - $c0) / $hz / $WINDOW" | bc) cores; writer thread at 0.5 s: $(echo "scale=3; ($w1 - $w0) * 100 / $hz / $WINDOW" | bc) % of one core"
-echo "checkpointing at the default 10 s: $(echo "scale=4; ($w1 - $w0) * 100 / $hz / $WINDOW * 0.5 / 10" | bc) % of one core"
+num() { printf '%.*f' "$1" "$(echo "scale=6; $2" | bc)"; } # digits, bc expression
+echo "- 64 sessions ($files checkpointed), daemon $(num 3 "($c1 - $c0) / $hz / $WINDOW") cores; writer thread at 0.5 s: $(num 3 "($w1 - $w0) * 100 / $hz / $WINDOW") % of one core"
+echo "- checkpointing at the default 10 s: $(num 4 "($w1 - $w0) * 100 / $hz / $WINDOW * 0.5 / 10") % of one core"
 
 # 2. restart: the last load left 64 sessions on disk (killed with -9)
 t0=$(date +%s.%N)
 LOGLEVEL=info start --data-dir "$dir/data"
 until [ "$(curl -sf "$base/sessions" | grep -o '"state":"running"' | wc -l)" -ge 64 ]; do sleep 0.005; done
 t1=$(date +%s.%N)
-echo "restart with 64 sessions on disk: all running again after $(echo "$t1 - $t0" | bc) s (exec to listing)"
-grep restored "$dir/err" || true
+echo "- restart with 64 sessions on disk: all running again after $(num 2 "$t1 - $t0") s (exec to listing)"
+grep restored "$dir/err" | sed "s/^/- the log: /" || true
 kill -9 "$pid"; wait "$pid" 2>/dev/null || true
 
 # 3. memory after deleting 100 sessions
@@ -63,4 +73,4 @@ for id in $(curl -sf "$base/sessions" | grep -o '"id":"[0-9a-f]*"' | cut -d'"' -
 done
 sleep 1
 r2=$(rss)
-echo "RSS: idle $((r0 / 1024)) MB, 100 sessions $((r1 / 1024)) MB, after deleting them $((r2 / 1024)) MB"
+echo "- RSS: idle $((r0 / 1024)) MB, 100 sessions $((r1 / 1024)) MB, after deleting them $((r2 / 1024)) MB"

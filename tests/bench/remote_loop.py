@@ -20,6 +20,15 @@ RUNS = [("PI, as measured", ["--delay", "0"]), ("PI, +100 ms", ["--delay", "0.1"
 ROW = re.compile(r"^ +(\d) +([+-]\S+) +(\S+)(?: s)? +(\S+) % +(\S+) m +(\S+) %$")
 
 
+def build():
+    """The checkout's commit, and whether it had uncommitted changes."""
+    rev = subprocess.run(["git", "rev-parse", "--short=12", "HEAD"], stdout=subprocess.PIPE,
+                         text=True, cwd=ROOT).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "diff", "--quiet", "HEAD", "--", ".", ":!tests/bench/results",
+                            ":!docs", ":!README.md"], cwd=ROOT).returncode
+    return rev + (" with uncommitted changes" if dirty else "")
+
+
 def main():
     daemon = subprocess.Popen([DAEMON, "--port", "0", "--log-level", "warn", "--web-root", os.path.join(ROOT, "web")],
                               stdout=subprocess.PIPE, text=True)
@@ -30,7 +39,7 @@ def main():
         print("# The loop closed from your own code: latency and settling\n")
         print(f"Command: `python3 tests/bench/remote_loop.py` (part of `make bench`), "
               f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} cores, "
-              f"load average {' '.join(load)} before.")
+              f"load average {' '.join(load)} before; build {build()}.")
         print(f"Each run: `python3 docs/examples/remote_pi.py --pace 1 --setpoints {SETPOINTS}` "
               "with the options named; the preset, clockwise, from beta = 38 deg.\n")
         print("| loop | latency p50 / p99 (wall) | dead time p50 (simulated) | setpoint | settling (2 %) "

@@ -25,6 +25,8 @@ pin() { # core, command...: one core per process where taskset exists
 	local c=$1; shift
 	if command -v taskset >/dev/null; then taskset -c "$c" "$@"; else "$@"; fi
 }
+. tests/bench/provenance.sh
+prov=$(provenance)
 start=$(date +%s)
 echo "bench: full scene on core 0; machine alone, reduced scene, reductions on core 1"
 pin 0 "$bin" scene full $q > "$out/full.tsv" &
@@ -40,6 +42,7 @@ wait "$rest_pid"
 echo "bench: the GSL and SUNDIALS peers at the 1 % gate (two cores)"
 bash tests/bench/peers.sh "$out" "$cmd"
 "$bin" report "$out" "$cmd"
+stamp "$out/workprec.md" "$prov"
 echo "bench: the 74-point v(beta) curve against the converged reference (one core per sweep)"
 bash tests/bench/accuracy.sh "$out"
 echo "bench: the machine zoo against its converged references (one core per curve)"
@@ -57,15 +60,19 @@ bash tests/bench/study.sh "$out"
 echo "bench: paced default sessions held in real time, against the previous build (loopback, both cores)"
 bash tests/bench/realtime.sh "$out"
 echo "bench: PATCH throughput with the durable control log (loopback, a temporary data directory)"
-CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs | tee "$out/controls.md"
+{ echo "Command: \`node tests/bench/controls.mjs\` (part of \`make bench\`). $(provenance)"; echo
+	CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs; } | tee "$out/controls.md"
 echo "bench: the request body check: CPU per 1 MiB body of many names (one daemon)"
-CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs >"$out/body_parse.md"
+{ echo "Command: \`node tests/bench/body_parse.mjs\` (part of \`make bench\`). $(provenance)"; echo
+	CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/body_parse.mjs; } >"$out/body_parse.md"
 echo "bench: the PI loop closed from a client at pace 1, with 0, 100 and 200 ms added, and open loop (one daemon, ~2 min)"
 python3 tests/bench/remote_loop.py "$BUILD/convsimd" >"$out/remote_loop.md"
 echo "bench: the conveyor as a control system: identification, setpoint steps, disturbances (loopback, pace max)"
-CONVSIMD="$BUILD/convsimd" node tests/bench/control_loop.mjs | tee "$out/control_loop.md"
+{ echo "Command: \`node tests/bench/control_loop.mjs\` (part of \`make bench\`). $(provenance)"; echo
+	CONVSIMD="$BUILD/convsimd" node tests/bench/control_loop.mjs; } | tee "$out/control_loop.md"
 echo "bench: shaping the beta command (overdrive, ZV-shaped ramp) against a plain step, on the core"
 ${CC:-cc} -O2 -g -Wall -Wextra -Werror -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -Icore \
 	-o "$BUILD/control_shaping" tests/bench/control_shaping.c "$BUILD/libcore.a" -lm -lpthread
-"$BUILD/control_shaping" | tee "$out/control_shaping.md"
+{ echo "Command: \`$BUILD/control_shaping\` (tests/bench/control_shaping.c, part of \`make bench\`). $(provenance)"; echo
+	"$BUILD/control_shaping"; } | tee "$out/control_shaping.md"
 echo "bench: $(( $(date +%s) - start )) s; wrote $out/workprec.md and $out/workprec.svg"

@@ -14,6 +14,8 @@
 # $1/scaling.md and $1/scaling.tsv.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
 mkdir -p "$out"
@@ -70,6 +72,7 @@ table() { # the grid: CPU s per simulated s, real time factor in brackets
 {
 	echo "# Cost against the feed's size"
 	echo
+	echo "$prov"
 	echo "Command: \`bash tests/bench/scaling.sh\` (part of \`make bench\`). Full model"
 	echo "(trough_rotation=true), K columns x L layers at a constant feed mass of 20 kg, dem defaults"
 	echo "(1.25e-3 s, 5 sub-steps, feed_events), one core. CPU seconds per simulated second of the 4-s window after the"

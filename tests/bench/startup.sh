@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Whole-process cost of the command line against the previous build (part
-# of `make bench`; docs/mpi.md "Two binaries", docs/log/targets.md "Targets"):
+# of `make bench`; docs/mpi.md "Two binaries", docs/speed.md):
 # `convsim --version`, `convsim run --duration 0.01` and the 74-point curve
 # (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`), each a
 # whole process, CPU = user + sys from wait4 (tests/bench/cpu_runs.py), the

@@ -10,12 +10,15 @@
 # machine is shared); the table gives every run's wall time and the CPU
 # time (user + sys) of the fastest, and the command.
 . "$(dirname "$0")/preamble.sh"
+. tests/bench/provenance.sh
+prov=$(provenance)
 study="sweep --vary mu=0.1:2:0.1 --beta 0:180:5"
 # mpirun as root wants to be told (Open MPI); more ranks than cores need --oversubscribe
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 {
 	echo "# Design studies: a 20 x 37 study on 2 cores"
 	echo
+	echo "$prov"
 	echo "Made by \`bash tests/bench/study.sh\` (part of \`make bench\`) on $(nproc) cores, $(date -u +%Y-%m-%d):"
 	echo "each command $repeat times (the machine may be shared: the fastest run counts). Target: < 30 s wall."
 	echo

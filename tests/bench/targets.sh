@@ -20,6 +20,8 @@
 # least disturbed. Writes $1/targets.md.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
 RUNS=${RUNS:-15}
@@ -69,6 +71,7 @@ read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 {
 	echo "# Speed targets"
 	echo
+	echo "$prov"
 	echo "Command: \`bash tests/bench/targets.sh\` (part of \`make bench\`), $RUNS runs of each, one"
 	echo "core, czubak2016 at beta = 30 deg with the defaults (dem 1.25e-3 s / 5 sub-steps, feed_events,"
 	echo "steady start; every figure at the 1 % gate of tests/bench/accuracy.sh). A 20-s run's figure"

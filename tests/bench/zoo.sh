@@ -12,6 +12,8 @@
 # TOL=0.005 bash tests/bench/zoo.sh runs the gate at another target.
 set -eu
 cd "$(dirname "$0")/../.."
+. tests/bench/provenance.sh
+prov=$(provenance)
 BUILD=${BUILD:-build}
 TOL=${TOL:-0.01}
 out=${1:-tests/bench/results}
@@ -53,6 +55,7 @@ done < tests/bench/zoo/machines.tsv
 {
 	echo "# The machine zoo against its converged references"
 	echo
+	echo "$prov"
 	echo "Command: \`bash tests/bench/zoo.sh\` (part of \`make bench\`; TOL=$TOL). Each machine's curve,"
 	echo "beta = 0..180 deg every 10 deg, cw and ccw (38 points), by \`build/convsim sweep --beta 0:180:10"
 	echo "--rotation cw,ccw --threads 1 --set tol=$TOL\` with the machine's settings, against"

@@ -76,6 +76,15 @@ test('closed loop: setpoints held with a small steady error, a disturbance appli
   assert.ok(c0.reachable.beta_min < b2 && b2 < b1 && b1 < c0.reachable.beta_max, `${b1} ${b2}`);
   const e = await done(r.body.id);
   assert.equal(e.state, 'done', e.error);
+  // the loop's per-period beta leaves the segment's transport estimate
+  // running: the next segment starts from a measured velocity, and the
+  // overshoot is a fraction of the step from there
+  const [s1, s2] = e.segments;
+  assert.ok(Math.abs(s2.start_velocity + 0.08) < 0.004, `start velocity ${s2.start_velocity}`);
+  assert.ok(Number.isFinite(s1.mean_velocity) && Number.isFinite(s2.uncertainty), JSON.stringify(s2));
+  assert.ok(e.control.setpoints[1].overshoot > 0.01, JSON.stringify(e.control.setpoints[1]));
+  // given gains stay given across the curve change (omega_ss at 4.5 s)
+  assert.deepEqual(e.control.curves.map((c) => [c.omega_ss, c.retuned, c.kp, c.ki]), [[150, false, 2, 800]]);
   for (const [i, sp] of e.control.setpoints.entries()) {
     assert.ok(sp.steady_error < 0.01, `setpoint ${i}: steady error ${sp.steady_error}`);
     assert.ok(sp.settling_time > 0 && sp.settling_time < 2.5, `setpoint ${i}: settling ${sp.settling_time}`);
@@ -97,7 +106,7 @@ test('closed loop: setpoints held with a small steady error, a disturbance appli
   assert.equal(s.body.status.omega_ss, 150);
   const csv = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}?format=csv`);
   const lines = csv.text.trim().split('\n');
-  assert.match(lines[0], /,setpoint,settling_time,overshoot,iae,steady_error$/);
+  assert.match(lines[0], /,setpoint,settling_time,overshoot,iae,steady_error,kp,ki$/);
   const col = lines[0].split(',');
   assert.equal(Number(lines[1].split(',')[col.indexOf('setpoint')]), -0.08);
   assert.equal(Number(lines[2].split(',')[col.indexOf('steady_error')]), e.control.setpoints[1].steady_error);
@@ -133,6 +142,51 @@ test('a change of omega_ss mid-run: the controller takes up the new scene\'s v(b
   assert.ok(Math.abs(s.body.status.beta_target - n1) < 0.01, `${s.body.status.beta_target} vs ${n1}`);
   // which holds the setpoint on the new scene with the feedforward alone
   assert.ok(e.control.setpoints[1].steady_error < 0.02, JSON.stringify(e.control.setpoints[1]));
+  await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
+});
+
+// "auto" gains follow the plant: after -10 % omega_ss the v(beta) curve is
+// flatter at the operating point, and SIMC's gains are tuned again from
+// its slope there with the identification's T and L (docs/control.md).
+test('"auto" gains re-tuned from the new curve\'s slope after a change of omega_ss', { timeout: 120000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/experiments', {
+    control: { setpoint: [{ v: 0.10, until: 2 }, { v: 0.08, until: 4 }] },
+    disturbances: [{ at: 1, set: { omega_ss: 141.4 } }], keep_session: true,
+  });
+  assert.equal(r.status, 201, r.text);
+  assert.deepEqual(r.body.control.curves, []);
+  const e = await done(r.body.id);
+  assert.equal(e.state, 'done', e.error);
+  const { controller: g, curves } = e.control;
+  assert.equal(e.control.curve_changes, 1);
+  assert.equal(curves.length, 1);
+  const [c] = curves;
+  assert.equal(c.rotation, 'cw');
+  assert.equal(c.omega_ss, 141.4);
+  assert.ok(c.t >= 1 && c.t < 1.1, `taken up at the first sample after the change: ${c.t}`);
+  assert.equal(c.retuned, true);
+  // SIMC on the new slope with the identification's T and L and the same tau_c
+  const { time_constant: T, dead_time: L } = g.identification;
+  const kp = T / (Math.abs(c.slope) * (g.tau_c + L));
+  assert.ok(Math.abs(c.kp - kp) < 1e-9 * kp, `kp ${c.kp} vs ${kp}`);
+  assert.ok(Math.abs(c.ki - kp / Math.min(T, 4 * (g.tau_c + L))) < 1e-9 * c.ki, `ki ${c.ki}`);
+  // the flatter curve asks for larger gains than the request's
+  assert.ok(c.kp > 1.3 * g.kp && c.ki > 1.3 * g.ki, `${c.kp} ${c.ki} vs ${g.kp} ${g.ki}`);
+  // the operating point: the running setpoint's feedforward on the new curve
+  assert.ok(Math.abs(e.segments[1].beta - c.beta0) > 1, 'the next setpoint has its own feedforward');
+  // the slope is the new scene's: an identification's secant over beta0 -+ 4 deg there
+  const id = await req(d.base, 'POST', '/api/v1/experiments',
+    { session: e.session, identify: { beta: c.beta0, step: 4, hold: 0.2 } });
+  assert.equal(id.status, 201, id.text);
+  const slope = id.body.identify.models[0].slope;
+  assert.ok(Math.abs(c.slope - slope) < 0.05 * Math.abs(slope), `${c.slope} vs ${slope} at ${c.beta0} deg`);
+  assert.equal((await done(id.body.id)).state, 'done');
+  // the CSV: the gains in use at each segment's end
+  const csv = await req(d.base, 'GET', `/api/v1/experiments/${r.body.id}?format=csv`);
+  const lines = csv.text.trim().split('\n');
+  const col = lines[0].split(',');
+  assert.equal(Number(lines[2].split(',')[col.indexOf('kp')]), c.kp);
+  assert.equal(Number(lines[2].split(',')[col.indexOf('ki')]), c.ki);
   await req(d.base, 'DELETE', `/api/v1/sessions/${e.session}`);
 });
 

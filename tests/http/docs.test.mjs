@@ -267,8 +267,10 @@ test('the API pages and the served OpenAPI document name the same operations', a
 // Benchmark tables between <!-- bench: FILE table N --> and <!-- /bench -->
 // are the N-th table of `make bench`'s output file, line for line, and a
 // figure marked <!-- from FILE "KEY" N --> is the N-th number of FILE's line
-// with KEY (tests/docs_bench.py writes them, --check compares; --self-test
-// shows that a wrong figure, key or number fails).
+// with KEY (tests/docs_bench.py writes them, --check compares, and checks
+// that each result page says its command, date, build and machine;
+// --self-test shows that a wrong figure, key or number fails, and a page
+// without its build).
 test('benchmark tables and marked figures in the documents are those of the bench results', async () => {
   const r = await run('python3', [join(ROOT, 'tests/docs_bench.py'), '--check']).catch((e) => e);
   assert.equal(r.code ?? 0, 0, `${r.stdout}${r.stderr ?? ''}`);
@@ -276,6 +278,7 @@ test('benchmark tables and marked figures in the documents are those of the benc
   const t = await run('python3', [join(ROOT, 'tests/docs_bench.py'), '--self-test']).catch((e) => e);
   assert.equal(t.code ?? 0, 0, `${t.stdout}${t.stderr ?? ''}`);
   assert.match(t.stdout, /docs_bench self-test: 6 of 6/);
+  assert.match(t.stdout, /docs_bench provenance self-test: 3 of 3/);
 });
 
 test('the link checker sees a missing file and a missing anchor', () => {

@@ -124,6 +124,34 @@ test(`an experiment killed ${KILLS} times gives the uninterrupted run's CSV byte
   assert.equal(got, ref, `restored ${kills} times`);
 });
 
+// A closed loop commands beta every period; those commands are not
+// flushed to the control log one by one (the experiment, resumed from the
+// checkpoint, sends them again), and they do not restart the transport
+// estimator. Killed three times, it still ends with the uninterrupted
+// run's CSV byte for byte: its per-setpoint results, and each segment's
+// mean velocity and error bar over the estimate since its command.
+test(`a closed loop killed ${KILLS} times gives the uninterrupted run's CSV byte for byte`, { timeout: 180000 * SLOW }, async () => {
+  const { ref, got, kills } = await bothWays(async (d0, interrupt, cur = () => d0) => {
+    const d = () => cur();
+    const ex = await req(d().base, 'POST', '/api/v1/experiments', {
+      session: { pace: 'max' },
+      control: { setpoint: [{ v: 0.1, until: 300 }, { v: -0.08, until: 600 }, { v: 0.05, until: 900 }],
+        controller: { kp: 2, ki: 800 } },
+      disturbances: [{ at: 450, set: { m_n: 0.75 } }],
+    });
+    assert.equal(ex.status, 201, ex.text);
+    const path = `/api/v1/experiments/${ex.body.id}`;
+    await interrupt(async (dd) => ['waiting', 'running'].includes((await req(dd.base, 'GET', path)).body?.state));
+    const e = await settled(d(), path, (b) => !['waiting', 'running'].includes(b.state), 120000);
+    assert.equal(e.body.state, 'done', JSON.stringify(e.body));
+    assert.ok(e.body.segments.every((s, i) => i === 0 || Number.isFinite(s.mean_velocity)), 'an estimate per segment');
+    const csv = (await req(d().base, 'GET', `${path}?format=csv`)).text;
+    return csv.split(ex.body.id).join('ID').split(e.body.session).join('SESSION');
+  }, 0.3);
+  assert.ok(kills >= 1, `killed while running ${kills} times`);
+  assert.equal(got, ref, `restored ${kills} times`);
+});
+
 // An experiment killed before its session's first checkpoint (none
 // carries it) runs again from its first segment on the session that comes
 // back from its spec at t = 0: done, the uninterrupted run's CSV byte for

@@ -73,10 +73,50 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 	sim_free(s);
 }
 
+/* A closed loop's steps of beta (sim_steer_beta) leave the trajectory
+ * bit for bit as sim_set_beta's, but the estimate goes on across them:
+ * after a restart and 25 steps of one period each, it counts the whole
+ * periods since the restart (sim_set_beta's starts over at each), and its
+ * step error's shadow took every step. */
+static void steered_beta_keeps_the_estimate(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	sim *a = make(&u), *b = make(&u);
+	advance(a, 1.0);
+	advance(b, 1.0);
+	sim_restart_transport(b);
+	sim_status s0 = status(b);
+	double t = 1.0, beta = s0.beta;
+	int shadowed = 0;
+	for (int k = 0; k < 25; k++) {
+		beta += (k % 2 ? -0.2 : 0.3) * M_PI / 180;
+		assert_int_equal(sim_set_beta(a, beta, 0), SIM_OK);
+		assert_int_equal(sim_steer_beta(b, beta, 0), SIM_OK);
+		if (b->shadow)
+			shadowed++, assert_true(status(b->shadow).beta_target == beta);
+		t += 0.04;
+		advance(a, t);
+		advance(b, t);
+	}
+	assert_int_equal(shadowed, 25); /* the preset's dem measures its step error */
+	assert_int_equal(sim_steer_beta(b, 200 * M_PI / 180, 0), SIM_EPARAM);
+	sim_status sa = status(a), sb = status(b);
+	assert_true(sa.feed_displacement == sb.feed_displacement && sa.q[3] == sb.q[3]);
+	assert_true(sa.transport_periods <= 1);
+	assert_true(sb.transport_periods >= 23);
+	double mean = (sb.feed_displacement - s0.feed_displacement) / (sb.t - s0.t);
+	assert_close(sb.transport_velocity, mean, 0.05 * fabs(mean));
+	assert_true(isfinite(sb.feed_velocity));
+	sim_free(a);
+	sim_free(b);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(v_is_dX_over_dt_between_its_crossings),
+		cmocka_unit_test(steered_beta_keeps_the_estimate),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,6 +11,8 @@
  * uncertainty is within model_tol, bounds included; else LIGGGHTS within
  * its limit; else none, naming model_tol and the smallest that fits.
  */
+#include <pthread.h>
+
 #include "testutil.h"
 
 /* the table's rows at 30, 137 and 150 deg cw (v_dem, v_dem_sd, v_column) */
@@ -109,6 +111,67 @@ static void other_scenes_name_the_nearest(void **state)
 	assert_int_equal(check(&u, &me), 1);
 }
 
+static void assert_same_error(const sim_model_error *a, const sim_model_error *b)
+{
+	assert_int_equal(a->checked, b->checked);
+	assert_true(a->error == b->error || (isnan(a->error) && isnan(b->error)));
+	assert_true(a->error_uncertainty == b->error_uncertainty ||
+		    (isnan(a->error_uncertainty) && isnan(b->error_uncertainty)));
+	assert_string_equal(a->note, b->note);
+}
+
+/* The check of u in a thread of its own: no earlier check in it. */
+typedef struct {
+	setup *u;
+	sim_model_error me;
+	int rc;
+} fresh_check;
+
+static void *fresh_thread(void *arg)
+{
+	fresh_check *f = arg;
+	f->rc = sim_model_check(&f->u->p, &f->u->sc, &f->me);
+	return NULL;
+}
+
+static int fresh(setup *u, sim_model_error *me)
+{
+	fresh_check f = {.u = u};
+	pthread_t th;
+	assert_int_equal(pthread_create(&th, NULL, fresh_thread, &f), 0);
+	assert_int_equal(pthread_join(th, NULL), 0);
+	*me = f.me;
+	return f.rc;
+}
+
+/* The entries' matches are kept per thread for the last scene (a closed
+ * loop checks it at a new beta every period): a check gives a fresh
+ * thread's answer whether it follows one of the same scene at another
+ * angle, or one of a scene that differs in a setting, both ways. */
+static void the_same_answer_after_any_check(void **state)
+{
+	(void)state;
+	const char *betas[] = {"30", "45", "137", "150", "170"};
+	const char *other[][2] = {{"beta", "90"}, {"layers", "16"}, {"omega_ss", "140"},
+				  {"beta_rate", "5"}, {"k_c", "1e7"}};
+	for (size_t i = 0; i < sizeof betas / sizeof *betas; i++)
+		for (size_t j = 0; j < sizeof other / sizeof *other; j++) {
+			setup u = bed4(), o = bed4();
+			set(&u, "beta", betas[i]);
+			set(&o, other[j][0], other[j][1]);
+			sim_model_error ref_u, ref_o, me;
+			int rc_u = fresh(&u, &ref_u), rc_o = fresh(&o, &ref_o);
+			assert_int_equal(check(&o, &me), rc_o);
+			assert_same_error(&me, &ref_o);
+			assert_int_equal(check(&u, &me), rc_u);
+			assert_same_error(&me, &ref_u);
+			assert_int_equal(check(&u, &me), rc_u);
+			assert_same_error(&me, &ref_u);
+			assert_int_equal(check(&o, &me), rc_o);
+			assert_same_error(&me, &ref_o);
+		}
+}
+
 static void no_column_feed(void **state)
 {
 	(void)state;
@@ -178,6 +241,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(at_map_points_and_between),
+		cmocka_unit_test(the_same_answer_after_any_check),
 		cmocka_unit_test(bounds_included_and_beyond),
 		cmocka_unit_test(other_scenes_name_the_nearest),
 		cmocka_unit_test(no_column_feed),
