@@ -2,8 +2,9 @@
 /*
  * main.c - convsimd: start-up and graceful shutdown.
  *
- * The daemon binds with libmicrohttpd (one thread per connection, so a
- * stream may wait for its session's records), prints the bound address
+ * The daemon serves with libmicrohttpd (one thread per connection, so a
+ * stream may wait for its session's records) on a socket acceptor.c
+ * listens on and accepts from, prints the bound address
  * as "listening on http://HOST:PORT" (tests start it with --port 0 and
  * read the line), then waits for SIGTERM or SIGINT in sigwait(). Shutdown
  * stops accepting, ends every stream with an "end" record, joins the
