@@ -35,6 +35,17 @@ def pct(x):
     return "n/a" if x is None else "%+.1f %%" % (100 * x)
 
 
+def machine():
+    """This machine as tests/bench/provenance.sh names it: "N cores (CPU model)"."""
+    cpu = ""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            cpu = next((ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")), "")
+    except OSError:
+        pass
+    return "%d cores (%s)" % (len(os.sched_getaffinity(0)), cpu or os.uname().machine)
+
+
 def status(rows, mats):
     """One paragraph for docs/dem.md: what exists, from one build."""
     plan = dem_map.plan()
@@ -75,11 +86,12 @@ def main():
     w("")
     w("`make bench-dem-map` (tests/bench/dem_map.sh; parts: `DEM_MAP_PARTS=\"...\"`), "
       "report by tests/bench/dem_map_report.py on %s. Build: %s. Rows measured %s to %s, "
-      "one LIGGGHTS process at a time at nice 19 on a 2-core machine shared with other work. "
-      "Data: tests/bench/results/dem_map.csv (one row a point; the command of each row in its "
-      "`command` column)." % (time.strftime("%Y-%m-%d", time.gmtime()),
-                              ", ".join("`%s`" % b[:12] for b in builds) or "none yet",
-                              dates[0] if dates else "-", dates[-1] if dates else "-"))
+      "one LIGGGHTS process at a time at nice 19 on this report's machine, %s, shared with "
+      "other work. Data: tests/bench/results/dem_map.csv (one row a point; the command of each "
+      "row in its `command` column)." % (time.strftime("%Y-%m-%d", time.gmtime()),
+                                         ", ".join("`%s`" % b[:12] for b in builds) or "none yet",
+                                         dates[0] if dates else "-", dates[-1] if dates else "-",
+                                         machine()))
     w("")
     # what exists
     total = sum(len(p) for _, p in plan)

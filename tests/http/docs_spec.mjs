@@ -344,5 +344,4 @@ export const EVERYWHERE = [
 // on pages whose owners rewrite them (put them in words or mark them,
 // then lower the cap). Every other page has none. A cap only goes down.
 export const PENDING = new Map([
-  ['docs/control-remote.md', 5],
 ]);

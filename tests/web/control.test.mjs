@@ -2,10 +2,12 @@
 // Browser test of the dashboard's closed-loop and identification panel
 // (docs/control.md, docs/dashboard.md) against the real daemon: a short
 // closed loop and a short identification run from the form at pace "max"
-// on a small scene (ideal drive, 5 columns x 2 layers), and what the page
-// shows is checked against the API's answer: the request the form sends,
-// the table's text from the API's values, the plot's series and its data
-// table, the phone layout, no console errors.
+// on a small scene (ideal drive, 5 columns x 2 layers), and an "auto"
+// loop with the same change of omega_ss, and what the page shows is
+// checked against the API's answer: the request the form sends, the
+// tables' text from the API's values (the gains after a curve change),
+// the plot's series and its data table, the phone layout, no console
+// errors.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdirSync } from 'node:fs';
@@ -41,7 +43,10 @@ function pm(v, se) {
 	return `${fixed(v, n)} ± ${se.toFixed(n)}`;
 }
 
-const tableText = () => page.$$eval('#loop-table tbody tr', rs => rs.map(r => Array.from(r.cells, c => c.textContent)));
+const tableText = (id = 'loop-table') => page.$$eval(`#${id} tbody tr`, rs => rs.map(r => Array.from(r.cells, c => c.textContent)));
+/* a curve change's row as the panel promises it, from the API's values */
+const curveRow = k => [fixed(k.t, 3), k.rotation === 'ccw' ? 'counter-clockwise' : 'clockwise', String(k.omega_ss),
+	fixed(k.beta0, 1), sig(k.slope, 3), sig(k.kp, 3), sig(k.ki, 3), k.retuned ? 're-tuned' : 'kept'];
 const plotData = name => page.evaluate(n => window.convsim.plots[n].plot.data.map(c => Array.from(c)), name);
 const finite = a => a.filter(x => x !== null && Number.isFinite(x));
 
@@ -123,8 +128,36 @@ test('a closed loop from the form: v, setpoint and beta on one axis, the per-set
 	assert.equal(marks.length, 1);
 	assert.equal(marks[0][0], e.control.disturbances[0].t_applied);
 	assert.match(marks[0][1], /^omega_ss → 150/);
+	/* the curve change it made: the given gains kept, in words under the table */
+	assert.equal(e.control.curves.length, 1);
+	assert.deepEqual(await tableText('loop-gains'), [curveRow(e.control.curves[0])]);
+	assert.deepEqual((await tableText('loop-gains'))[0].slice(2), ['150', fixed(e.control.curves[0].beta0, 1), sig(e.control.curves[0].slope, 3), '2', '800', 'kept']);
+	assert.match(await page.textContent('#loop-gains caption'), /^Gains after each curve change: from the change on, the given gains, kept\.$/);
 	await dataTable('loop');
 	await page.locator('#loop-card').screenshot({ path: `${OUT}/control-loop.png` });
+});
+
+test('"auto" with a curve change: the gains in use after it, re-tuned from the new curve', { timeout: 90000 }, async () => {
+	await page.selectOption('#loop-form select[name="controller"]', 'auto');
+	const e = await runFromForm(body => {
+		assert.equal(body.control.controller, 'auto');
+		assert.deepEqual(body.disturbances, [{ at: 2.2, set: { omega_ss: 150 } }]);
+	});
+	const c = e.control, k = c.curves[0];
+	assert.equal(c.curve_changes, 1);
+	assert.equal(k.retuned, true);
+	assert.notEqual(sig(k.kp, 3), sig(c.controller.kp, 3), 'the new curve\'s gains differ from the request\'s');
+	/* the line above keeps the request's gains; the table under it the ones in use after the change */
+	assert.match(await page.textContent('#loop-summary'), new RegExp(`kp = ${sig(c.controller.kp, 3)} ° per m/s, ki = ${sig(c.controller.ki, 3)} ° per m, tuned by SIMC`));
+	const rows = await tableText('loop-gains');
+	assert.deepEqual(rows, [curveRow(k)]);
+	assert.equal(rows[0][7], 're-tuned');
+	assert.equal(await page.isVisible('#loop-gains'), true);
+	assert.deepEqual(await page.$$eval('#loop-gains th', h => h.map(x => [x.textContent, x.scope])), [
+		['at t / s', 'col'], ['rotation', 'col'], ['ω_ss / (rad/s)', 'col'], ['β₀ / °', 'col'], ['slope / (m/s per °)', 'col'],
+		['kp / (° per m/s)', 'col'], ['ki / (° per m)', 'col'], ['gains', 'col']]);
+	assert.equal(await page.getAttribute('#loop-gains', 'aria-label'), 'gains in use after each curve change');
+	assert.match(await page.textContent('#loop-gains caption'), /re-tuned by SIMC from the new curve's slope at the operating point\.$/);
 });
 
 test('an identification from the form: K, T, L with their standard errors, the fit over the response', { timeout: 90000 }, async () => {
@@ -138,6 +171,7 @@ test('an identification from the form: K, T, L with their standard errors, the f
 		assert.equal(body.control, undefined);
 	});
 	assert.equal(e.kind, 'identify');
+	assert.equal(await page.isVisible('#loop-gains'), false, 'no curve changes in an identification');
 	const m = e.identify.models[0];
 	assert.ok(m.gain_se > 0 && m.time_constant_se > 0 && m.dead_time_se > 0, JSON.stringify(m));
 	const rows = await tableText();

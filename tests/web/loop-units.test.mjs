@@ -39,13 +39,20 @@ test('the answer\'s control and identify members', () => {
 	const c = api.normalizeLoop({ kind: 'control', control: {
 		controller: { tuning: 'simc', kp: 25, ki: 838, tau_c: 0.4, identification: { gain: -0.003, gain_se: 1e-4 } }, period: 0.04,
 		setpoints: [{ v: 0.1, settling_time: null, overshoot: 0, iae: 0.01, steady_error: 0.002 }],
-		disturbances: [{ at: 3, set: { omega_ss: 150 }, t_applied: 3.0005, recovery_time: 1.2, max_deviation: 0.04 }] } });
+		disturbances: [{ at: 3, set: { omega_ss: 150 }, t_applied: 3.0005, recovery_time: 1.2, max_deviation: 0.04 }],
+		curve_changes: 2, curves: [{ t: 3.004, rotation: 'cw', omega_ss: 150, beta0: 97.4, slope: -0.00274, retuned: true, kp: 9.92, ki: 696 },
+			{ t: 5, rotation: 'ccw', omega_ss: 150, beta0: 80, slope: null, retuned: false, kp: 2, ki: 800 }] } });
 	assert.equal(c.kind, 'control');
 	assert.deepEqual(c.control.setpoints, [{ v: 0.1, settlingTime: NaN, overshoot: 0, iae: 0.01, steadyError: 0.002 }]);
 	assert.equal(c.control.tuning, 'simc');
 	assert.equal(c.control.tauC, 0.4);
 	assert.equal(c.control.identification.gainSe, 1e-4);
 	assert.deepEqual(c.control.disturbances[0], { at: 3, set: { omega_ss: 150 }, tApplied: 3.0005, recoveryTime: 1.2, maxDeviation: 0.04 });
+	assert.equal(c.control.curveChanges, 2);
+	assert.deepEqual(c.control.curves, [
+		{ t: 3.004, rotation: 'cw', omegaSs: 150, beta0: 97.4, slope: -0.00274, retuned: true, kp: 9.92, ki: 696 },
+		{ t: 5, rotation: 'ccw', omegaSs: 150, beta0: 80, slope: NaN, retuned: false, kp: 2, ki: 800 }]);
+	assert.deepEqual(api.normalizeLoop({ kind: 'control', control: {} }).control.curves, []);
 	const i = api.normalizeLoop({ kind: 'identify', identify: { step: 4, hold: 1.5, models: [{ beta0: 60, gain: -0.0033, gain_se: 7e-5,
 		time_constant: 0.013, time_constant_se: 0.01, dead_time: 0.13, dead_time_se: 0.0096, t_from: 0.75 }] } });
 	assert.equal(i.identify.models[0].deadTimeSe, 0.0096);

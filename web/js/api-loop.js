@@ -80,6 +80,17 @@ function model(m) {
 	};
 }
 
+/* A curve the loop took up (control.curves[]): when, the scene's rotation
+ * and omega_ss, the operating point and the curve's slope there, and the
+ * gains in use from then on, re-tuned ("auto") or kept (given gains). */
+function curve(k) {
+	const r = k || {};
+	return {
+		t: num(r.t), rotation: r.rotation === 'ccw' ? 'ccw' : 'cw', omegaSs: num(r.omega_ss),
+		beta0: num(r.beta0), slope: num(r.slope), retuned: r.retuned === true, kp: num(r.kp), ki: num(r.ki),
+	};
+}
+
 /* The kind of an experiment answer and its control or identify member:
  * {kind: 'schedule'|'control'|'identify', control, identify}. */
 export function normalizeLoop(raw) {
@@ -96,6 +107,8 @@ export function normalizeLoop(raw) {
 			kp: num(g.kp), ki: num(g.ki), tauC: num(g.tau_c),
 			identification: g.identification ? model(g.identification) : null,
 			period: num(c.period),
+			curveChanges: num(c.curve_changes),
+			curves: (Array.isArray(c.curves) ? c.curves : []).map(curve),
 			setpoints: (Array.isArray(c.setpoints) ? c.setpoints : []).map(s => ({
 				v: num(s.v), settlingTime: num(s.settling_time), overshoot: num(s.overshoot),
 				iae: num(s.iae), steadyError: num(s.steady_error),

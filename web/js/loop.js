@@ -100,6 +100,7 @@ function markField(err) {
 function showLoop(j, traj) {
 	$('#loop-plot-control').hidden = j.kind !== 'control';
 	$('#loop-plot-identify').hidden = j.kind !== 'identify';
+	$('#loop-gains-box').hidden = true;
 	if (j.kind === 'identify') {
 		identTable(j);
 		if (traj) plotIdent(j, traj);
@@ -137,6 +138,34 @@ function controlTable(j) {
 	$('#loop-summary').textContent = `PI on β with feedforward: ${gains}, ${how}.`;
 	fillTable(['setpoint', 'v / (m/s)', 'β feedforward / °', 'settling (2 %) / s', 'overshoot / %', 'IAE / m', 'steady error / %'],
 		c.setpoints.map((sp, i) => loopCells(sp, j.segments[i]?.beta, i)));
+	gainsTable(c);
+}
+
+/* The text of a curve change's cells (the browser test formats the API's
+ * values the same way). */
+export const curveCells = k => [fmt(k.t, 3), k.rotation === 'ccw' ? 'counter-clockwise' : 'clockwise',
+	fmtGiven(k.omegaSs), fmt(k.beta0, 1), fmtSig(k.slope, 3), fmtSig(k.kp, 3), fmtSig(k.ki, 3),
+	k.retuned ? 're-tuned' : 'kept'];
+
+/* The gains in use after each curve change (docs/control.md, "auto" after
+ * a curve change), under the per-setpoint table; hidden while there is none. */
+function gainsTable(c) {
+	const box = $('#loop-gains-box'), table = $('#loop-gains');
+	box.hidden = !c.curves.length;
+	table.replaceChildren();
+	if (!c.curves.length) return;
+	const n = c.curveChanges, shown = c.curves.length;
+	const more = n > shown ? ` (${n} changes: the first ${shown - 1} and the last)` : '';
+	table.createCaption().textContent = `Gains after each curve change${more}: from the change on, ` +
+		(c.tuning === 'simc' ? 're-tuned by SIMC from the new curve\'s slope at the operating point.' : 'the given gains, kept.');
+	const tr = table.createTHead().insertRow();
+	for (const h of ['at t / s', 'rotation', 'ω_ss / (rad/s)', 'β₀ / °', 'slope / (m/s per °)', 'kp / (° per m/s)', 'ki / (° per m)', 'gains'])
+		tr.append(Object.assign(document.createElement('th'), { textContent: h, scope: 'col' }));
+	const body = table.createTBody();
+	for (const k of c.curves) {
+		const row = body.insertRow();
+		for (const x of curveCells(k)) row.insertCell().textContent = x;
+	}
 }
 
 /* The text of an identification's cells: each value ± its standard error. */
