@@ -107,7 +107,7 @@ static void own_shadow_where_the_run_before_misses(void **state)
  * is within two of its paired standard errors: the point is measured
  * again over 24 s (599 periods) at 6 sub-steps with its shadow (3)
  * throughout, its step error bounded by that standard error. Against the
- * long-window reference (tests/bench/results/chaos_ref.tsv: the mean of
+ * long-window reference (tests/bench/zoo/chaos_ref.tsv: the mean of
  * 15 4-s windows at 1.25e-4 s / 40 sub-steps, its standard error se) the
  * bar holds and is at most 3 times the error, the error taken as at least
  * 2 se (on main: 4.6 and 7.5 times). */
