@@ -110,7 +110,7 @@ static void own_shadow_where_the_run_before_misses(void **state)
  * long-window reference (tests/bench/zoo/chaos_ref.tsv: the mean of
  * 15 4-s windows at 1.25e-4 s / 40 sub-steps, its standard error se) the
  * bar holds and is at most 3 times the error, the error taken as at least
- * 2 se (on main: 4.6 and 7.5 times). */
+ * 2 se (on main: 5.8 and 4.5 times). */
 static void chaotic_feed_bar_within_three_errors(void **state)
 {
 	(void)state;
