@@ -415,9 +415,14 @@ load: all
 # Connection floods on loopback (about a minute; tests/bench/flood.mjs):
 # 2,000 idle, slow-GET and slow-POST sockets from 500 addresses, an active
 # client's p50 / p99 meanwhile; fails if it or /api/v1/health went
-# unanswered.
+# unanswered. With BASELINE=another convsimd (each flood on both in turn;
+# ROUNDS, LOAD: see the script) the table also goes to
+# tests/bench/results/flood.md, whose figures docs/hardening.md quotes.
 flood: all
-	$(Q)CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/flood.mjs
+	$(Q)if [ -n "$$BASELINE" ]; then \
+	  CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/flood.mjs > tests/bench/results/flood.md.new; \
+	  st=$$?; cat tests/bench/results/flood.md.new; mv tests/bench/results/flood.md.new tests/bench/results/flood.md; exit $$st; \
+	else CONVSIMD=$(CURDIR)/$(BUILD)/convsimd node tests/bench/flood.mjs; fi
 
 # The feed against LIGGGHTS (tests/bench/dem.sh, docs/dem.md): one DEM
 # process at a time, niced, into tests/bench/results/dem.md; then the

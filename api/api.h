@@ -62,6 +62,10 @@
 	  "The Accept header names no representation the route has. Result routes answer " \
 	  "application/json or text/csv (also chosen with ?format=json|csv); the others " \
 	  "application/json.")                                                \
+	X(TIMEOUT, 408, "request-timeout", "Request timeout",                \
+	  "The body came slower than the daemon allows (--min-body-rate after the first " \
+	  "--request-timeout seconds); nothing was done with the request and the "       \
+	  "connection is closed. Send it again, at a steady pace.")          \
 	X(CONFLICT, 409, "conflict", "Conflict",                              \
 	  "The session cannot do this now: it failed (diverged), finished (raise until to " \
 	  "resume), until lies in the past, or it already runs an experiment.") \

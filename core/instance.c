@@ -43,6 +43,7 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
 	s->ode = ode_find(m->name);
 	s->step_error = NAN;
 	s->shadow_v = NAN;
+	s->step_se = NAN;
 	s->shadow_window = SHADOW_PERIODS * 2.0 * M_PI / p->omega_ss;
 	size_t n = (size_t)s->md.n;
 	s->y = calloc(4 * n, sizeof(double));

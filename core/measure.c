@@ -5,7 +5,9 @@
  * part of the window, repeated at finer steps where the measured step
  * error is beyond what the accuracy target tol allows; sim_measure_point,
  * a sweep's point: the same, stopped early once its bar is met with little
- * scatter.
+ * scatter; a point whose bar misses tol where the difference between
+ * the run and its shadow is scatter (a chaotic feed) measured again over a
+ * longer window instead of refined, its step error bounded statistically.
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +31,19 @@
  * has finished (the first check at its end): a fortieth of the preset's
  * 4-s window, two and a half of its periods. */
 #define MEASURE_CHECK 0.1
+
+/* A scatter-dominated point's long run (measure_long): its window the one
+ * that brings the bar to MEASURE_LONG_AIM of tol, at most MEASURE_LONG_MAX
+ * times the measurement's (the shadow beside it throughout: on the R =
+ * 0.5 machine such a point costs about 3 times the default's point,
+ * tests/bench/results/chaos.md) */
+#define MEASURE_LONG_AIM 0.8
+#define MEASURE_LONG_MAX 6.0
+
+/* scatter_only: the first run's shadow's standard error at least this
+ * share of what tol allows (the preset's steps at most 0.95 of it, the
+ * chaotic feed's at least 2.0) */
+#define MEASURE_SCATTER_SE 1.5
 
 /* Whether sim_measure would refine after a run whose status is st: its
  * step error beyond what tol leaves the steps (the bar less its scatter
@@ -122,6 +137,10 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 typedef struct coarser_run {
 	double v, h, dt;
 	int substeps;
+	/* its own shadow's raw difference over (r - 1), that estimate's
+	 * standard error (shadow.c: step_se; NaN: none) and how far past the
+	 * window's start the run went (s) */
+	double raw, se, ran;
 } coarser_run;
 
 /* Whether s's own shadow would be the coarser run itself (the same
@@ -213,6 +232,54 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 	coarser->h = s->cfg.dt / s->cfg.substeps;
 	coarser->dt = s->cfg.dt;
 	coarser->substeps = s->cfg.substeps;
+	coarser->raw = restored ? NAN : s->step_error;
+	coarser->se = restored ? NAN : s->step_se;
+	coarser->ran = s->st.t - fmax(0.0, sc->transient);
+	sim_free(s);
+	return err;
+}
+
+/* A first run whose bar misses tol where its shadow's difference is
+ * within SHADOW_SIGNIFICANT of its standard error (a chaotic feed: the
+ * run and its shadow drift apart, and their difference is scatter, which
+ * finer steps do not shrink): measured again over a longer window with
+ * its shadow beside it throughout (measure_long), not refined. */
+static int scatter_only(const sim_status *st, const coarser_run *c)
+{
+	return !st->tol_met && isfinite(c->se) && c->raw <= SHADOW_SIGNIFICANT * c->se &&
+	       c->se >= MEASURE_SCATTER_SE * st->tol_allowed && c->ran > 0.0;
+}
+
+/* The long run of a scatter-dominated point: from the settled start, with
+ * the first run's steps, its shadow over the whole window, which the
+ * first run's statistical bar and its shadow's standard error (both
+ * shrinking as one over the root of the window) say brings the bar to
+ * MEASURE_LONG_AIM of tol, within [1, MEASURE_LONG_MAX] times t_end's
+ * window. The step error is the shadow's difference where significant,
+ * else its standard error (s->step_bounded). */
+static int measure_long(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			double t_end, const settled_start *start, coarser_run *c, sim_status *st,
+			char *msg, size_t msglen)
+{
+	double t0 = fmax(0.0, sc->transient), w = t_end - t0;
+	double stat = st->transport_velocity_uncertainty - st->step_error;
+	double root = (stat * sqrt(c->ran) + c->se * sqrt(SHADOW_MEASURE_SHARE * w)) /
+		      (MEASURE_LONG_AIM * st->tol_allowed);
+	double len = fmin(MEASURE_LONG_MAX * w, fmax(w, root * root));
+	int err;
+	/* an even number of sub-steps: the shadow's half of them, r = 2 */
+	sim_method even = *m;
+	even.dt = st->dt;
+	even.substeps = st->substeps + st->substeps % 2;
+	sim *s = sim_restore(p, sc, &even, start->buf, start->len, &err, msg, msglen);
+	if (!s)
+		return err;
+	s->step_bounded = 1;
+	s->shadow_until = t0 + len;
+	err = sim_advance(s, nextafter(t0 + len, INFINITY));
+	if (err != SIM_OK && msg)
+		snprintf(msg, msglen, "%s", s->error);
+	*st = s->st;
 	sim_free(s);
 	return err;
 }
@@ -235,12 +302,17 @@ static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
 	settled_start start = {NULL, 0};
-	coarser_run coarser = {NAN, NAN, NAN, 0};
+	coarser_run coarser = {NAN, NAN, NAN, 0, NAN, NAN, NAN};
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
 		err = measure_once(p, sc, &run, t_end, early, may_refine, last,
 				   early && own_steps ? &start : NULL, &coarser, &st, msg, msglen);
 		out->refinements = attempt;
+		if (err == SIM_OK && attempt == 0 && early && own_steps && start.buf &&
+		    scatter_only(&st, &coarser)) {
+			err = measure_long(p, sc, &run, t_end, &start, &coarser, &st, msg, msglen);
+			break;
+		}
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a
 		 * first-order one shrinks: what remains is not the steps' */

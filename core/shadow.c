@@ -31,7 +31,12 @@
  * costs about 0.8 of this instance while it runs: 40 periods after each
  * estimate's start (a control, a restart), and SHADOW_MEASURE_SHARE of a
  * measurement's window (sim_measure). It is not checkpointed: a restored
- * instance keeps the calibrated term until its next estimate starts. */
+ * instance keeps the calibrated term until its next estimate starts.
+ * The difference's standard error (step_se) comes from the two
+ * estimates' paired batch velocities; where a measurement asks it
+ * (step_bounded: a chaotic feed's long run, measure.c) a difference
+ * within SHADOW_SIGNIFICANT of it is scatter, and the step error is
+ * bounded by that standard error instead. */
 
 #include <math.h>
 #include <stdlib.h>
@@ -42,6 +47,11 @@
  * a fraction of a second) leave the step error as it was: a difference
  * over a few periods is the feed's scatter more than the step's error. */
 #define SHADOW_MIN_PERIODS 8
+
+/* paired_se: at least this many paired batches, lag-1 correlation read
+ * at most this (beyond it the batches say little about their mean) */
+#define SHADOW_PAIRED_BATCHES 8
+#define SHADOW_RHO_MAX 0.8
 
 void shadow_stop(sim *s)
 {
@@ -69,6 +79,40 @@ void shadow_begin(sim *s)
 	s->shadow_until = fmax(s->t_int, s->est.start) + s->shadow_window;
 }
 
+/* The standard error of the difference of two estimates over the same
+ * periods (a and b from the same start, the same machine steps: their
+ * batch edges fall at the same period boundaries), from their paired
+ * batch velocity differences; NaN where the batches do not pair or are
+ * too few. The batches' lag-1 correlation, where positive, widens it as
+ * for an AR(1) series, (1 + rho) / (1 - rho) on the variance. */
+static double paired_se(const estimator *a, const estimator *b)
+{
+	int n = a->n_rec < b->n_rec ? a->n_rec : b->n_rec;
+	if (a->stride != b->stride || n - 1 < SHADOW_PAIRED_BATCHES)
+		return NAN;
+	double d[EST_RECORDS], mean = 0.0, span = 0.0;
+	int nb = n - 1;
+	for (int i = 0; i < nb; i++) {
+		double ta = a->rec_t[i + 1] - a->rec_t[i], tb = b->rec_t[i + 1] - b->rec_t[i];
+		if (!(ta > 0.0 && tb > 0.0))
+			return NAN;
+		d[i] = (a->rec_X[i + 1] - a->rec_X[i]) / ta - (b->rec_X[i + 1] - b->rec_X[i]) / tb;
+		mean += d[i] * ta;
+		span += ta;
+	}
+	mean /= span;
+	double ss = 0.0, lag = 0.0;
+	for (int i = 0; i < nb; i++) {
+		ss += (d[i] - mean) * (d[i] - mean);
+		if (i > 0)
+			lag += (d[i] - mean) * (d[i - 1] - mean);
+	}
+	if (!(ss > 0.0))
+		return 0.0;
+	double rho = fmin(SHADOW_RHO_MAX, fmax(0.0, lag / ss));
+	return sqrt(ss / (nb - 1) / nb * (1.0 + rho) / (1.0 - rho));
+}
+
 /* The shadow's estimate against this instance's, both at shadow_until. */
 void shadow_finish(sim *s)
 {
@@ -77,12 +121,18 @@ void shadow_finish(sim *s)
 	estimator_read(&s->shadow->est, &b);
 	double r = (double)s->cfg.substeps / (double)s->shadow->cfg.substeps;
 	s->shadow_v = NAN;
+	s->step_se = NAN;
 	if (s->shadow->failed) {
 		s->step_error = INFINITY;
 	} else if (a.transport_periods >= SHADOW_MIN_PERIODS &&
 		   b.transport_periods >= SHADOW_MIN_PERIODS) {
-		s->step_error = fabs(b.transport_velocity - a.transport_velocity) / (r - 1.0);
+		double d = fabs(b.transport_velocity - a.transport_velocity);
+		s->step_error = d / (r - 1.0);
 		s->shadow_v = a.transport_velocity;
+		s->step_se = paired_se(&s->est, &s->shadow->est) / (r - 1.0);
+		if (s->step_bounded && isfinite(s->step_se) &&
+		    s->step_error <= SHADOW_SIGNIFICANT * s->step_se)
+			s->step_error = s->step_se;
 	}
 	shadow_stop(s);
 }

@@ -47,6 +47,12 @@ struct sim {
 	double shadow_v;      /* m/s: this instance's own estimate of v at
 				 the last shadow's end, NaN where that shadow
 				 measured nothing (too few periods, failed) */
+	double step_se;       /* m/s: the standard error of the last shadow's
+				 step_error from its paired batches (shadow.c),
+				 NaN where they do not pair */
+	int step_bounded;     /* a shadow's difference within SHADOW_SIGNIFICANT
+				 of its standard errors is scatter: step_error
+				 is bounded by step_se (measure.c's long run) */
 	sim_status st;
 };
 
@@ -69,6 +75,10 @@ int sim_start(sim *s, char *msg, size_t msglen);
  * excitation periods). sim.c */
 sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method *m,
 		      double shadow_window, int *err, char *msg, size_t msglen);
+
+/* A shadow's difference within this many of its standard errors (step_se)
+ * is not told from the feed's scatter (step_bounded; measure.c) */
+#define SHADOW_SIGNIFICANT 2.0
 
 /* The measured step error (shadow.c): shadow_begin starts a shadow from
  * the instance's present state (none where it cannot run), to run until

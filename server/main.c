@@ -2,8 +2,9 @@
 /*
  * main.c - convsimd: start-up and graceful shutdown.
  *
- * The daemon binds with libmicrohttpd (one thread per connection, so a
- * stream may wait for its session's records), prints the bound address
+ * The daemon serves with libmicrohttpd (one thread per connection, so a
+ * stream may wait for its session's records) on a socket acceptor.c
+ * listens on and accepts from, prints the bound address
  * as "listening on http://HOST:PORT" (tests start it with --port 0 and
  * read the line), then waits for SIGTERM or SIGINT in sigwait(). Shutdown
  * stops accepting, ends every stream with an "end" record, joins the
@@ -20,6 +21,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "acceptor.h"
 #include "budget.h"
 #include "tether.h"
 #include "catalog.h"
@@ -39,37 +41,29 @@
 #include "job.h"
 #include "util.h"
 
-/* The address to bind and the MHD flags it needs. */
+/* The MHD flags --listen needs. */
 typedef struct listen_addr {
-	struct sockaddr_in a4;
-	struct sockaddr_in6 a6;
-	struct sockaddr *addr;
 	unsigned flags;
 } listen_addr;
 
 /* --listen as an IPv4 or IPv6 address; -1 with a message if neither. */
 static int resolve_listen(const srv_config *cfg, listen_addr *la)
 {
-	memset(la, 0, sizeof *la);
-	/* poll(), not select(): descriptors beyond FD_SETSIZE (1024) work */
+	struct in6_addr a;
+	/* poll(), not select(): descriptors beyond FD_SETSIZE (1024) work;
+	 * the listening socket is acceptor.c's */
 	la->flags = MHD_USE_THREAD_PER_CONNECTION |
 		    MHD_USE_POLL_INTERNAL_THREAD | MHD_USE_ITC |
-		    MHD_USE_ERROR_LOG;
-	if (inet_pton(AF_INET, cfg->listen, &la->a4.sin_addr) == 1) {
-		la->a4.sin_family = AF_INET;
-		la->a4.sin_port = htons((uint16_t)cfg->port);
-		la->addr = (struct sockaddr *)&la->a4;
-	} else if (inet_pton(AF_INET6, cfg->listen, &la->a6.sin6_addr) == 1) {
-		la->a6.sin6_family = AF_INET6;
-		la->a6.sin6_port = htons((uint16_t)cfg->port);
-		la->addr = (struct sockaddr *)&la->a6;
+		    MHD_USE_ERROR_LOG | MHD_USE_NO_LISTEN_SOCKET;
+	if (inet_pton(AF_INET, cfg->listen, &a) == 1)
+		return 0;
+	if (inet_pton(AF_INET6, cfg->listen, &a) == 1) {
 		la->flags |= MHD_USE_IPv6;
-	} else {
-		fprintf(stderr, "convsimd: --listen %s is not an IPv4 or IPv6 "
-				"address\n", cfg->listen);
-		return -1;
+		return 0;
 	}
-	return 0;
+	fprintf(stderr, "convsimd: --listen %s is not an IPv4 or IPv6 "
+			"address\n", cfg->listen);
+	return -1;
 }
 
 /* Raise the soft limit of open files to what the connection budget needs
@@ -96,17 +90,17 @@ static void raise_nofile(const srv_config *cfg)
 			(unsigned long long)need);
 }
 
-/* Start libmicrohttpd with the connection budgets. */
+/* Start libmicrohttpd with the connection budgets; it listens on no
+ * socket of its own: acceptor.c hands it the connections. */
 static struct MHD_Daemon *start_http(const srv_config *cfg,
 				     const listen_addr *la)
 {
 	return MHD_start_daemon(
-		la->flags, (uint16_t)cfg->port, NULL, NULL, srv_dispatch, NULL,
+		la->flags, 0, NULL, NULL, srv_dispatch, NULL,
 		MHD_OPTION_EXTERNAL_LOGGER, srv_budget_mhd_log, NULL,
 		MHD_OPTION_NOTIFY_COMPLETED, srv_request_done, NULL,
 		MHD_OPTION_URI_LOG_CALLBACK, srv_uri_seen, NULL,
-		MHD_OPTION_NOTIFY_CONNECTION, srv_budget_connection, NULL,
-		MHD_OPTION_SOCK_ADDR, la->addr,
+		MHD_OPTION_NOTIFY_CONNECTION, srv_acceptor_notify, NULL,
 		MHD_OPTION_CONNECTION_LIMIT,
 		(unsigned)(cfg->max_connections + SRV_CONN_HEADROOM),
 		/* a backstop only: conns.c holds the per-address cap by
@@ -123,14 +117,13 @@ static void shut_down(struct MHD_Daemon *d)
 {
 	srv_store_watch(); /* the final checkpoints and records from here */
 	srv_stop();
-	MHD_socket ls = MHD_quiesce_daemon(d);
-	if (ls != MHD_INVALID_SOCKET)
-		close(ls);
+	srv_acceptor_stop(); /* no new connection from here */
 	/* streams notice within half a second, send "end" and close */
 	for (int i = 0; i < 500 && atomic_load(&srv_stats.stream_clients) > 0;
 	     i++)
 		usleep(10000);
 	MHD_stop_daemon(d);
+	srv_acceptor_free();
 	srv_fits_shutdown(); /* their evaluations need the pool */
 	srv_pool_stop();
 	srv_job_close(&srv_sweep_job);
@@ -250,16 +243,19 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	restore_state();
-	struct MHD_Daemon *d = start_http(&cfg, &la);
-	if (!d) {
+	int port = cfg.port;
+	struct MHD_Daemon *d = NULL;
+	if (srv_acceptor_open(&cfg, &port) || !(d = start_http(&cfg, &la)) ||
+	    srv_acceptor_start(d, &cfg)) {
 		fprintf(stderr, "convsimd: cannot listen on %s port %d\n",
 			cfg.listen, cfg.port);
+		srv_acceptor_stop();
+		if (d)
+			MHD_stop_daemon(d);
+		srv_acceptor_free();
 		srv_pool_stop();
 		return 1;
 	}
-	const union MHD_DaemonInfo *info =
-		MHD_get_daemon_info(d, MHD_DAEMON_INFO_BIND_PORT);
-	int port = info ? info->port : cfg.port;
 	srv_gate_set_port(port);
 	announce(&cfg, port);
 

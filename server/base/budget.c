@@ -369,6 +369,31 @@ static client *find_client(const unsigned char addr[16], int family)
 	return free_one;
 }
 
+int srv_budget_open_from(const struct sockaddr *sa)
+{
+	unsigned char addr[16] = {0};
+	if (sa->sa_family == AF_INET)
+		memcpy(addr, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, 4);
+	else if (sa->sa_family == AF_INET6)
+		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, 16);
+	else
+		return 0;
+	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
+	int count = 0;
+	pthread_mutex_lock(&lock);
+	for (size_t i = 0; clients && i < n && !count; i++)
+		if (clients[i].count && clients[i].family == sa->sa_family &&
+		    memcmp(clients[i].addr, addr, 16) == 0)
+			count = clients[i].count;
+	pthread_mutex_unlock(&lock);
+	return count;
+}
+
+void srv_budget_count_dropped(void)
+{
+	atomic_fetch_add(&connections_dropped, 1);
+}
+
 void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			   void **socket_context,
 			   enum MHD_ConnectionNotificationCode code)

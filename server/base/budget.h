@@ -113,6 +113,10 @@ size_t srv_budget_points(void);
 void srv_budget_connection(void *cls, struct MHD_Connection *conn,
 			   void **socket_context,
 			   enum MHD_ConnectionNotificationCode code);
+/* Connections open from sa's address now (0 when none, or no IP). */
+int srv_budget_open_from(const struct sockaddr *sa);
+/* Count a connection closed at accept (acceptor.h: no room). */
+void srv_budget_count_dropped(void);
 /* conn's entry in the table of open connections and their deadlines
  * (conns.h), borrowed until libmicrohttpd closes it; NULL if it has none. */
 struct srv_conn *srv_budget_live(struct MHD_Connection *conn);

@@ -39,9 +39,12 @@
  */
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/socket.h>
 
+#include "api.h"
 #include "conns.h"
 #include "util.h"
 
@@ -85,11 +88,35 @@ static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static heap heaps[HEAPS];  /* lock */
 static int open_count;     /* lock: registered and not closing */
 static const srv_config *cfg;
-static atomic_ullong evicted, timed_out;
+static atomic_ullong evicted, timed_out, answered_late;
+/* When the connection this thread registers next was accepted (0: now). */
+static _Thread_local double opened_at;
+
+/* The 408 written on a connection whose body fell behind its deadline. */
+static char *late_answer;
+static size_t late_len;
 
 void srv_conns_init(const srv_config *config)
 {
 	cfg = config;
+	api_problem pb;
+	api_fail(&pb, API_TIMEOUT, "body",
+		 "the body came slower than %zu bytes/s (--min-body-rate) after "
+		 "its first %g s (--request-timeout); nothing was done with the "
+		 "request and the connection is closed: send it again at a "
+		 "steady pace", cfg->min_body_rate, cfg->request_timeout);
+	char *json = api_problem_json(&pb, NULL);
+	size_t n = json ? strlen(json) : 0;
+	free(late_answer);
+	late_answer = json ? malloc(n + 256) : NULL;
+	if (late_answer)
+		late_len = (size_t)snprintf(
+			late_answer, n + 256,
+			"HTTP/1.1 408 Request Timeout\r\nConnection: close\r\n"
+			"Content-Type: application/problem+json\r\n"
+			"Cache-Control: no-store\r\nContent-Length: %zu\r\n\r\n%s",
+			n, json);
+	free(json);
 }
 
 /* ---- the heaps (lock held) ------------------------------------------------- */
@@ -219,6 +246,21 @@ static void cut(srv_conn *c)
 	shutdown(c->fd, SHUT_RDWR);
 }
 
+/* Close c at its deadline. A body of which bytes were read is answered
+ * 408 first: nothing has been sent on c (libmicrohttpd answers once the
+ * body is in, and any "100 Continue" went before the first byte was
+ * read), and the answer and the shutdown happen under the lock, so that
+ * nothing of the request's own answer can follow (the state is closing;
+ * a later write fails on the shut socket). */
+static void cut_late(srv_conn *c)
+{
+	if (c->state == CONN_BODY && c->body_bytes > 0 && late_answer &&
+	    send(c->fd, late_answer, late_len, MSG_DONTWAIT | MSG_NOSIGNAL) ==
+		    (ssize_t)late_len)
+		atomic_fetch_add(&answered_late, 1);
+	cut(c);
+}
+
 /* Bytes wait unread on c's socket: a request on its way. */
 static int request_waiting(const srv_conn *c)
 {
@@ -280,6 +322,11 @@ static int make_room(srv_conn *c, double now, int *over)
 	return closed;
 }
 
+void srv_conn_opened_at(double t)
+{
+	opened_at = t;
+}
+
 srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *over)
 {
 	const union MHD_ConnectionInfo *ci =
@@ -292,6 +339,9 @@ srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *ove
 	c->group = g;
 	c->at[BY_PROGRESS] = c->at[BY_DEADLINE] = c->at[BY_GROUP] = NOWHERE;
 	double now = srv_now();
+	if (opened_at > 0 && opened_at < now)
+		now = opened_at; /* idle since it was accepted */
+	opened_at = 0;
 	int closed = 0;
 	pthread_mutex_lock(&lock);
 	if (cfg)
@@ -358,6 +408,7 @@ int srv_conn_body_read(srv_conn *c, size_t n)
 	pthread_mutex_lock(&lock);
 	if (c->state == CONN_BODY && now > c->key[BY_DEADLINE]) {
 		late = 1;
+		cut_late(c);
 	} else if (c->state == CONN_BODY) {
 		c->body_bytes += n;
 		set_state(c, CONN_BODY,
@@ -387,7 +438,7 @@ void srv_conns_reap(void)
 	unsigned long long n = 0;
 	pthread_mutex_lock(&lock);
 	while (heaps[BY_DEADLINE].n && heaps[BY_DEADLINE].v[0]->key[BY_DEADLINE] < now) {
-		cut(heaps[BY_DEADLINE].v[0]);
+		cut_late(heaps[BY_DEADLINE].v[0]);
 		n++;
 	}
 	pthread_mutex_unlock(&lock);
@@ -406,6 +457,11 @@ unsigned long long srv_conns_evicted(void)
 unsigned long long srv_conns_timed_out(void)
 {
 	return atomic_load(&timed_out);
+}
+
+unsigned long long srv_conns_answered_late(void)
+{
+	return atomic_load(&answered_late);
 }
 
 void srv_conns_shutdown(void)

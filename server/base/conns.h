@@ -58,6 +58,10 @@ void srv_conn_group_free(srv_conn_group *g);
  * g's own while g has --max-client-connections. *over: SRV_CONN_*.
  * Returns the handle (NULL when out of memory: not counted, never closed
  * here). */
+/* The connection this thread registers next with srv_conn_open was
+ * accepted at t (srv_now()): it is idle since then, not since it was
+ * registered (acceptor.c may hold it back a while). */
+void srv_conn_opened_at(double t);
 srv_conn *srv_conn_open(struct MHD_Connection *conn, srv_conn_group *g, int *over);
 /* Forget a connection (at libmicrohttpd's close notice, before its group
  * is let go); NULL is fine. */
@@ -68,7 +72,8 @@ void srv_conn_request_line(srv_conn *c);
  * --min-body-rate after --request-timeout. */
 void srv_conn_body_start(srv_conn *c);
 /* n more body bytes read on c: 1 to go on, 0 if c is past its deadline
- * (the caller closes it; counted as timed out). NULL: 1. */
+ * (answered 408 and shut down here, the caller closes it; counted as
+ * timed out). NULL: 1. */
 int srv_conn_body_read(srv_conn *c, size_t n);
 /* A request is being answered on c (busy 1: no deadline) or has ended
  * (busy 0: idle from now). */
@@ -79,6 +84,8 @@ void srv_conns_reap(void);
  * (by srv_conns_reap or srv_conn_body_read), so far. */
 unsigned long long srv_conns_evicted(void);
 unsigned long long srv_conns_timed_out(void);
+/* Of those timed out, the bodies answered 408 before they were closed. */
+unsigned long long srv_conns_answered_late(void);
 /* Free the table at exit. */
 void srv_conns_shutdown(void);
 

@@ -110,6 +110,15 @@ static void budget_metrics(FILE *f, const srv_gauges *g)
 		 "closed at their deadline: idle beyond --connection-timeout, "
 		 "headers not all in within --request-timeout, a body slower "
 		 "than --min-body-rate.", g->connections_timed_out},
+		{"convsim_connections_answered_408_total", "counter", "Of the "
+		 "connections closed at their deadline, the bodies answered 408 "
+		 "first.", g->connections_answered_408},
+		{"convsim_connections_accepted_total", "counter", "Connections "
+		 "accepted from the listening socket.", g->connections_accepted},
+		{"convsim_connections_waiting_max", "gauge", "The most accepted "
+		 "connections that waited at once to be handed to the HTTP "
+		 "library, those of addresses with fewer open ones first.",
+		 g->connections_waiting_max},
 	};
 	for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
 		metric(f, budgets[i].name, budgets[i].type, budgets[i].help,

@@ -40,6 +40,9 @@ typedef struct srv_gauges {
 	double connections_dropped;    /* closed by libmicrohttpd at accept */
 	double connections_evicted;    /* closed at the cap (conns.c) */
 	double connections_timed_out;  /* closed at their deadline (conns.c) */
+	double connections_answered_408; /* of those timed out (conns.c) */
+	double connections_accepted;   /* accepted (acceptor.c) */
+	double connections_waiting_max; /* most waiting at once (acceptor.c) */
 } srv_gauges;
 
 /* Count one response with this HTTP status. */

@@ -10,6 +10,7 @@
 
 #include <pthread.h>
 
+#include "acceptor.h"
 #include "budget.h"
 #include "budget_turns.h"
 #include "catalog.h"
@@ -99,6 +100,9 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.connections_dropped = (double)srv_budget_connections_dropped(),
 		.connections_evicted = (double)srv_conns_evicted(),
 		.connections_timed_out = (double)srv_conns_timed_out(),
+		.connections_answered_408 = (double)srv_conns_answered_late(),
+		.connections_accepted = (double)srv_acceptor_accepted(),
+		.connections_waiting_max = (double)srv_acceptor_queued_max(),
 	};
 	return srv_reply(r, 200, "text/plain; version=0.0.4; charset=utf-8",
 			 srv_metrics_text(&g), NULL, NULL);

@@ -15,22 +15,28 @@
 // and measures 3 s more. Throughout, an active client from 127.0.0.4 asks
 // GET /api/v1/health back to back (20 ms apart), each on a fresh
 // connection, and counts an answer only if it is 200 with status "ok"
-// within 5 s, in the phase in which it ends. The active client runs in a
-// worker thread of its own, so that its times are the daemon's, not the
-// wait for this process's event loop busy with the flood. It prints one table (markdown): the active
-// client's answers and p50 / p99 / max latency while the flood's sockets
-// connect, while they are held and after they closed, whether
+// within 5 s, in the phase in which it ends. The active client is a
+// process of its own (not a thread of the one that opens the flood), and
+// each request's time is also taken from its socket's connect: the part
+// the daemon answers for (the kernel completes the handshake before the
+// daemon accepts; the wait for the client's own turn on a busy machine
+// comes before it). It prints one table (markdown): the active client's
+// answers, p50 / p99 / max latency and p99 from connect while the flood's
+// sockets connect, while they are held and after they closed, whether
 // /api/v1/health answers after it, and the daemon's counters of
 // connections closed at the cap, at a deadline and at accept; exit 1 if
 // the active client or /api/v1/health was not answered every time.
 // Environment: CONVSIMD (the binary), FLOOD, ADDRESSES, HOLD (s),
 // SCENARIOS (comma-separated, default idle,slow-get,slow-post),
-// DAEMON_FLAGS.
+// DAEMON_FLAGS; BASELINE (another convsimd: each scenario runs on it and
+// on CONVSIMD in turn, ROUNDS times, default 1); LOAD (that many busy
+// processes at the bench's own niceness during each scenario, so that two
+// builds meet the same contention).
 import net from 'node:net';
 import http from 'node:http';
 import os from 'node:os';
 import { fileURLToPath } from 'node:url';
-import { Worker, isMainThread, parentPort, workerData } from 'node:worker_threads';
+import { fork, execFileSync } from 'node:child_process';
 import { startDaemon } from '../http/lib.mjs';
 import { quantile, fmt } from './streamlag.mjs';
 
@@ -39,12 +45,16 @@ const ADDRESSES = Number(process.env.ADDRESSES || 500);
 const HOLD = Number(process.env.HOLD || 12);
 const SCENARIOS = (process.env.SCENARIOS || 'idle,slow-get,slow-post').split(',');
 const FLAGS = (process.env.DAEMON_FLAGS || '').split(/\s+/).filter(Boolean);
+const BASELINE = process.env.BASELINE || '';
+const ROUNDS = Number(process.env.ROUNDS || 1);
+const LOAD = Number(process.env.LOAD || 0);
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // GET path on a fresh connection from localAddress: {ok, status, ms, error}.
 export function health(port, localAddress, timeoutMs = 5000) {
   return new Promise((resolve) => {
     const t0 = performance.now();
+    let tc = NaN;
     const r = http.request({ host: '127.0.0.1', port, path: '/api/v1/health', agent: false, localAddress }, (res) => {
       let text = '';
       res.setEncoding('utf8');
@@ -53,9 +63,11 @@ export function health(port, localAddress, timeoutMs = 5000) {
         let body = null;
         try { body = JSON.parse(text); } catch { /* not JSON */ }
         const ok = res.statusCode === 200 && body !== null && body.status === 'ok';
-        resolve({ ok, status: res.statusCode, ms: performance.now() - t0 });
+        const t1 = performance.now();
+        resolve({ ok, status: res.statusCode, ms: t1 - t0, fromConnect: t1 - tc });
       });
     });
+    r.on('socket', (sock) => sock.once('connect', () => { tc = performance.now(); }));
     r.on('error', (e) => resolve({ ok: false, status: 0, error: e.code || e.message, ms: performance.now() - t0 }));
     r.setTimeout(timeoutMs, () => r.destroy(new Error('timeout')));
     r.end();
@@ -142,54 +154,66 @@ export function closeFlood(st) {
   for (const s of st.socks) s.destroy();
 }
 
-// The active client (in a worker thread): GET /api/v1/health back to
-// back until told "stop"; "after" starts the second tally.
-function activeClient() {
-  const tally = () => ({ n: 0, ok: 0, ms: [], bad: {} });
+// The active client (a process of its own, FLOOD_ACTIVE_PORT set): GET
+// /api/v1/health back to back until told "stop"; "held" and "after"
+// start the next tallies. It ends with its parent.
+function activeClient(port) {
+  const tally = () => ({ n: 0, ok: 0, ms: [], fromConnect: [], bad: {} });
   const phases = { opening: tally(), held: tally(), after: tally() };
   let phase = phases.opening;
   let running = true;
-  parentPort.on('message', (m) => {
+  process.on('message', (m) => {
     if (m in phases) phase = phases[m];
     if (m === 'stop') running = false;
   });
+  process.on('disconnect', () => process.exit(0));
   (async () => {
+    process.send('ready');
     while (running) {
-      const r = await health(workerData.port, '127.0.0.4');
+      const r = await health(port, '127.0.0.4');
       const p = phase;
       p.n++;
-      if (r.ok) { p.ok++; p.ms.push(r.ms); } else {
+      if (r.ok) { p.ok++; p.ms.push(r.ms); p.fromConnect.push(r.fromConnect); } else {
         const k = r.status || r.error;
         p.bad[k] = (p.bad[k] || 0) + 1;
       }
       await sleep(20);
     }
-    parentPort.postMessage(phases);
+    process.send(phases, () => process.exit(0));
   })();
 }
 
-async function scenario(name) {
-  const d = await startDaemon(FLAGS);
-  // the daemon ends with this script, however it ends
-  const kill = () => { if (d.proc.exitCode === null && d.proc.signalCode === null) d.proc.kill('SIGKILL'); };
+// LOAD busy processes (each a spinning node), ended by the returned call.
+function busy(n) {
+  const procs = Array.from({ length: n }, () => fork('-e', ['for (;;) {}'], { execArgv: [], stdio: 'ignore' }));
+  return () => { for (const p of procs) p.kill('SIGKILL'); };
+}
+
+async function scenario(name, bin) {
+  const d = await startDaemon(FLAGS, bin ? { wrap: [bin] } : {});
+  // the daemon and the helpers end with this script, however it ends
+  const unload = busy(LOAD);
+  const kill = () => { unload(); if (d.proc.exitCode === null && d.proc.signalCode === null) d.proc.kill('SIGKILL'); };
   process.on('exit', kill);
   for (const sig of ['SIGINT', 'SIGTERM', 'SIGHUP']) process.once(sig, () => { kill(); process.exit(1); });
-  const worker = new Worker(fileURLToPath(import.meta.url), { workerData: { port: d.port } });
-  const tallies = new Promise((resolve) => worker.once('message', resolve));
+  const client = fork(fileURLToPath(import.meta.url), [], { env: { ...process.env, FLOOD_ACTIVE_PORT: String(d.port) } });
+  process.on('exit', () => client.kill('SIGKILL'));
+  await new Promise((resolve) => client.once('message', resolve)); // ready
+  const tallies = new Promise((resolve) => client.once('message', resolve));
   const load = os.loadavg()[0];
   const t0 = performance.now();
   const st = await openFlood(d.port, name, FLOOD, ADDRESSES);
   const openS = (performance.now() - t0) / 1000;
-  worker.postMessage('held');
+  client.send('held');
   await sleep(HOLD * 1000);
   const closedByDaemon = st.closedByDaemon;
   const answeredFlood = st.answered;
   closeFlood(st);
-  worker.postMessage('after');
+  client.send('after');
   await sleep(3000);
-  worker.postMessage('stop');
+  client.send('stop');
   const { opening, held, after } = await tallies;
-  await worker.terminate();
+  unload();
   const final = await health(d.port, '127.0.0.5');
   const counters = await metrics(d.port);
   const stop = await d.stop();
@@ -199,42 +223,81 @@ async function scenario(name) {
   };
 }
 
+// The build of a binary: the commit this checkout is at for CONVSIMD,
+// the file's name for BASELINE.
+function buildName(bin) {
+  if (bin) return bin.split('/').pop();
+  try {
+    return execFileSync('git', ['rev-parse', '--short', 'HEAD'], { encoding: 'utf8' }).trim() +
+      (execFileSync('git', ['status', '--porcelain', '--untracked-files=no'], { encoding: 'utf8' }).trim() ? '+' : '');
+  } catch { return 'this build'; }
+}
+
 async function main() {
   const rows = [];
-  for (const name of SCENARIOS) {
-    console.error(`flood: ${name}: ${FLOOD} sockets from ${ADDRESSES} addresses, held ${HOLD} s`);
-    const r = await scenario(name);
-    rows.push(r);
-    console.error(`flood: ${name}: active ${r.opening.ok}/${r.opening.n} while opening, ${r.held.ok}/${r.held.n} held, ` +
-      `${r.after.ok}/${r.after.n} after, health after: ${r.final.ok ? 'ok' : r.final.status || r.final.error}`);
+  const builds = BASELINE ? [BASELINE, ''] : [''];
+  const loadBefore = os.loadavg().map((x) => fmt(x, 2)).join(' ');
+  for (let round = 0; round < ROUNDS; round++) {
+    for (const name of SCENARIOS) {
+      for (const bin of builds) {
+        console.error(`flood: ${name} on ${buildName(bin)}: ${FLOOD} sockets from ${ADDRESSES} addresses, held ${HOLD} s`);
+        const r = { build: buildName(bin), ...(await scenario(name, bin)) };
+        rows.push(r);
+        console.error(`flood: ${name}: active ${r.opening.ok}/${r.opening.n} while opening, ${r.held.ok}/${r.held.n} held, ` +
+          `${r.after.ok}/${r.after.n} after, health after: ${r.final.ok ? 'ok' : r.final.status || r.final.error}`);
+      }
+    }
   }
 
-  const cmdEnv = [`FLOOD=${FLOOD}`, `ADDRESSES=${ADDRESSES}`, `HOLD=${HOLD}`]
-    .concat(FLAGS.length ? [`DAEMON_FLAGS="${FLAGS.join(' ')}"`] : []).join(' ');
-  console.log(`\`CONVSIMD=$PWD/build/convsimd ${cmdEnv} node tests/bench/flood.mjs\`\n`);
-  console.log('| flood | sockets connected / closed by the daemon / answered | active client while the flood opens: answered, p50 / p99 / max ms | while it is held: answered, p50 / p99 / max ms | after it: answered, p99 ms | /health after | closed at the cap / at a deadline / at accept |');
-  console.log('|---|---|---|---|---|---|---|');
-  let failed = false;
+  const env = [`FLOOD=${FLOOD}`, `ADDRESSES=${ADDRESSES}`, `HOLD=${HOLD}`]
+    .concat(FLAGS.length ? [`DAEMON_FLAGS="${FLAGS.join(' ')}"`] : [])
+    .concat(BASELINE ? [`BASELINE=.../${buildName(BASELINE)}`, `ROUNDS=${ROUNDS}`] : [])
+    .concat(LOAD ? [`LOAD=${LOAD}`] : []).join(' ');
+  const cpu = os.cpus();
+  console.log('# Connection floods: the active client\n');
+  console.log(`Command: \`CONVSIMD=$PWD/build/convsimd ${env} node tests/bench/flood.mjs\`, ` +
+    `${new Date().toISOString().slice(0, 16).replace('T', ' ')} UTC, build ${buildName('')}, ` +
+    `${cpu.length} cores (${cpu[0] ? cpu[0].model.trim() : 'unknown'}), load average ${loadBefore} before.\n`);
+  console.log('Each row a fresh daemon with default flags unless told; times in ms; "from connect": from the active client\'s connect to its answer\'s end (the part the daemon answers for).\n');
+  console.log('| build | flood | sockets connected / closed by the daemon / answered | active client while the flood opens: answered, p50 / p99 / max (p99 from connect) | while it is held: answered, p50 / p99 / max (p99 from connect) | after it: answered, p99 | /health after | closed at the cap / at a deadline / at accept | load average |');
+  console.log('|---|---|---|---|---|---|---|---|---|');
+  let failed = '';
   const q = (v, x) => fmt(quantile(v, x), 1);
   const cell = (t) => {
     const bad = Object.entries(t.bad).map(([k, v]) => `${v}x ${k}`).join(', ');
-    return `${t.ok} of ${t.n}, ${q(t.ms, 0.5)} / ${q(t.ms, 0.99)} / ${fmt(Math.max(...t.ms), 1)}${bad ? ` (${bad})` : ''}`;
+    return `${t.ok} of ${t.n}, ${q(t.ms, 0.5)} / ${q(t.ms, 0.99)} / ${fmt(Math.max(...t.ms), 1)} (${q(t.fromConnect, 0.99)})${bad ? ` (${bad})` : ''}`;
   };
   for (const r of rows) {
-    console.log(`| ${r.name} | ${r.connected} / ${r.closedByDaemon} / ${r.answeredFlood}${r.pending ? ` (${r.pending} not taken in 5 s)` : ''} ` +
-      `| ${cell(r.opening)} (${fmt(r.openS, 1)} s) | ${cell(r.held)} | ${r.after.ok} of ${r.after.n}, ${q(r.after.ms, 0.99)} ` +
+    console.log(`| ${r.build} | ${r.name} | ${r.connected} / ${r.closedByDaemon} / ${r.answeredFlood}${r.pending ? ` (${r.pending} not taken in 5 s)` : ''} ` +
+      `| ${cell(r.opening)}, ${fmt(r.openS, 1)} s | ${cell(r.held)} | ${r.after.ok} of ${r.after.n}, ${q(r.after.ms, 0.99)} ` +
       `| ${r.final.ok ? '200 ok' : `no (${r.final.status || r.final.error})`} ` +
-      `| ${r.counters.evicted} / ${r.counters.timedOut} / ${r.counters.dropped} |`);
-    for (const t of [r.opening, r.held, r.after]) if (t.ok !== t.n) failed = true;
-    if (!r.final.ok || r.exit !== 0) failed = true;
+      `| ${r.counters.evicted} / ${r.counters.timedOut} / ${r.counters.dropped} | ${fmt(r.load, 1)} |`);
+    let bad = false;
+    for (const t of [r.opening, r.held, r.after]) if (t.ok !== t.n) bad = true;
+    if (!r.final.ok || r.exit !== 0) bad = true;
+    if (bad) failed = failed ? `${failed}, ${r.build} ${r.name}` : `${r.build} ${r.name}`;
   }
-  console.log(`\n(${os.cpus().length} cores; load average over the last minute at each flood's start: ` +
-    `${rows.map((r) => fmt(r.load, 1)).join(', ')})`);
+  if (BASELINE) {
+    // each build over its rows: the opening phase's p50 / p99 (the
+    // flood's connect), the active client's answers in every phase, the
+    // connections closed at accept; the build last (its name may hold digits)
+    console.log('\n| while the floods open, every request: p50 / p99 ms | from connect: p50 / p99 ms | the active client, every phase: answered of asked | closed at accept | build |');
+    console.log('|---|---|---|---|---|');
+    for (const [i, b] of builds.map(buildName).entries()) {
+      const mine = rows.filter((r) => r.build === b);
+      const all = (key) => mine.flatMap((r) => r.opening[key]);
+      const sum = (f) => mine.reduce((a, r) => a + f(r), 0);
+      const asked = sum((r) => r.opening.n + r.held.n + r.after.n);
+      const ok = sum((r) => r.opening.ok + r.held.ok + r.after.ok);
+      console.log(`| ${q(all('ms'), 0.5)} / ${q(all('ms'), 0.99)} | ${q(all('fromConnect'), 0.5)} / ${q(all('fromConnect'), 0.99)} ` +
+        `| ${ok} of ${asked} | ${sum((r) => r.counters.dropped)} | ${i === 0 ? 'baseline' : 'this build'}: ${b} |`);
+    }
+  }
   if (failed) {
-    console.log('\nflood: FAILED: the active client or /api/v1/health was not answered every time');
+    console.log(`\nflood: FAILED (${failed}): the active client or /api/v1/health was not answered every time`);
     process.exit(1);
   }
 }
 
-if (!isMainThread) activeClient();
+if (process.env.FLOOD_ACTIVE_PORT && process.send) activeClient(Number(process.env.FLOOD_ACTIVE_PORT));
 else if (process.argv[1] === fileURLToPath(import.meta.url)) await main();

@@ -47,6 +47,8 @@ echo "bench: the 74-point v(beta) curve against the converged reference (one cor
 bash tests/bench/accuracy.sh "$out"
 echo "bench: the machine zoo against its converged references (one core per curve)"
 bash tests/bench/zoo.sh "$out"
+echo "bench: the chaotic feed's bars against its long-window reference (one core)"
+bash tests/bench/chaos.sh "$out"
 echo "bench: the speed targets (one core)"
 bash tests/bench/targets.sh "$out"
 echo "bench: start-up and the curve, whole processes, against the previous build (one core)"

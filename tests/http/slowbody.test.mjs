@@ -132,11 +132,14 @@ test('a flood of slow POST bodies from many addresses: closed at the cap or at t
     // its second passed (the reaper runs once a second)
     await until(() => st.closedByDaemon === st.connected, 10000, 'every slow body closed by the daemon');
     assert.equal(st.connected, 150, 'the flood connected');
-    assert.equal(st.answered, 0, 'no slow body got an answer (none was complete)');
     await healthy(d.port, '127.0.0.1', 'after the flood');
     const m = (await req(d.base, 'GET', '/metrics')).text;
     const evicted = metric(m, 'convsim_connections_evicted_total');
     const timedOut = metric(m, 'convsim_connections_timed_out_total');
+    // none was complete: only those cut at their deadline with a byte of
+    // the body read were answered, each 408
+    assert.equal(st.answered, metric(m, 'convsim_connections_answered_408_total'), 'answered: the 408s');
+    assert.ok(st.answered <= timedOut, `${st.answered} answered 408, ${timedOut} timed out`);
     assert.equal(evicted + timedOut, 150, `every flood socket closed at the cap (${evicted}) or its deadline (${timedOut})`);
     assert.ok(evicted >= 150 - 32, `beyond the cap the least progressed were closed (${evicted})`);
     assert.ok(timedOut >= 32 - 6, `those under the cap were cut at their deadline (${timedOut})`);
@@ -207,6 +210,56 @@ test('headers that trickle are closed at --request-timeout, a request line that 
     await healthy(d.port, '127.0.0.1', 'after');
   } finally {
     for (const s of socks) s.destroy();
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+// A POST body that trickles (a byte every 300 ms, below --min-body-rate)
+// until the connection closes; resolves with what the daemon sent.
+function trickleBody(port, head) {
+  return new Promise((resolve) => {
+    const s = net.connect(port, '127.0.0.1');
+    const parts = [];
+    let timer = null;
+    s.on('connect', () => {
+      s.write(head);
+      timer = setInterval(() => { if (s.writable) s.write('{'); }, 300);
+    });
+    s.on('data', (b) => parts.push(b));
+    s.on('error', () => {});
+    s.on('close', () => { clearInterval(timer); resolve(Buffer.concat(parts).toString('utf8')); });
+  });
+}
+
+test('a body that falls behind --min-body-rate is answered 408 with a problem, then closed', { timeout: 30000 * SLOW }, async () => {
+  const d = await startDaemon(['--request-timeout', '1']);
+  try {
+    const head = `POST /api/v1/sessions HTTP/1.1\r\nHost: 127.0.0.1:${d.port}\r\n` +
+      'Content-Type: application/json\r\nContent-Length: 1000\r\n\r\n';
+    const raw = await trickleBody(d.port, head);
+    const at = raw.indexOf('\r\n\r\n');
+    assert.ok(at > 0, `an answer came: ${JSON.stringify(raw)}`);
+    const lines = raw.slice(0, at).split('\r\n');
+    assert.equal(lines[0], 'HTTP/1.1 408 Request Timeout');
+    assert.ok(lines.includes('Content-Type: application/problem+json'), lines.join(' | '));
+    assert.ok(lines.includes('Connection: close'), lines.join(' | '));
+    const body = raw.slice(at + 4);
+    assert.ok(lines.includes(`Content-Length: ${Buffer.byteLength(body)}`), lines.join(' | '));
+    assert.deepEqual(JSON.parse(body), {
+      type: '/api/v1/problems/request-timeout', title: 'Request timeout', status: 408,
+      detail: 'the body came slower than 1024 bytes/s (--min-body-rate) after its first 1 s ' +
+        '(--request-timeout); nothing was done with the request and the connection is closed: ' +
+        'send it again at a steady pace',
+      field: 'body',
+    });
+    const m = (await req(d.base, 'GET', '/metrics')).text;
+    assert.equal(metric(m, 'convsim_connections_timed_out_total'), 1);
+    assert.equal(metric(m, 'convsim_connections_answered_408_total'), 1);
+    assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+    const page = await req(d.base, 'GET', '/api/v1/problems/request-timeout');
+    assert.equal(page.status, 200);
+    assert.match(page.text, /slower than the daemon allows/);
+  } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
