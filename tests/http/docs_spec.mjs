@@ -217,7 +217,6 @@ export const SPEC = [
   /* the studies' settings (tests/bench/workprec_scenes.c, peers.sh: the 60-s CPU budget, the check's 0.5-s orbit), the gate and test_feed.c's bound */
   ['docs/benchmarks.md', "periods (0.8 s"],
   ['docs/benchmarks.md', "feed scenes runs 0.8 s"],
-  ['docs/benchmarks.md', "rtol = 1e-5 (0.8 s"],
   ['docs/benchmarks.md', "(< 0.5 %, shrinking)"],
   ['docs/benchmarks.md', "rest has passed 1.5 s"],
   ['docs/benchmarks.md', "a CPU budget of 60 s"],
