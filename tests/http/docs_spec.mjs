@@ -202,7 +202,6 @@ export const SPEC = [
   ['docs/machine-zoo.md', "a-priori**: 0.5 %"],
   ['docs/machine-zoo.md', "plus 0.025 %"],
   ['docs/machine-zoo.md', "term stands in (0.75 %"],
-  ['docs/machine-zoo.md', "(the shadow over 30 %"],
   ['docs/machine-zoo.md', "1 % where their error"],
   ['docs/machine-zoo.md', "when tol is below 1 %"],
   ['docs/machine-zoo.md', "or \"beyond 1.0 %"],
