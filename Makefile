@@ -113,7 +113,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: profile-daemon fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: profile-daemon fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-calibration bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -329,6 +329,12 @@ check-ci:
 
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh
+
+# The paper's case of docs/calibration.md alone (tests/bench/calibration.sh,
+# also part of `make bench`): seven peak fits of the czubak2016 model, a few
+# minutes of two cores; writes tests/bench/results/calibration.md.
+bench-calibration: all
+	$(Q)BUILD=$(BUILD) bash tests/bench/calibration.sh > /dev/null
 
 # The machine zoo's converged references (tests/bench/zoo/ref.tsv, which
 # `make bench`'s zoo.sh reads): one to two hours of CPU. ZOO="stiff deep"

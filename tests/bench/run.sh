@@ -57,6 +57,8 @@ echo "bench: cost against the feed's size (one core)"
 bash tests/bench/scaling.sh "$out"
 echo "bench: a 2-parameter fit on 20 points (two threads)"
 bash tests/bench/fit.sh "$out"
+echo "bench: the paper's peaks fitted: e alone, e with each second parameter, the preset's curve (two threads, a few minutes)"
+bash tests/bench/calibration.sh "$out" > /dev/null
 echo "bench: a 20 x 37 study (two threads; two ranks under mpirun)"
 bash tests/bench/study.sh "$out"
 echo "bench: paced default sessions held in real time, against the previous build (loopback, both cores)"
