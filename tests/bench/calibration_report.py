@@ -54,8 +54,9 @@ def table_one(work):
     print(f'| e alone fitted | {num(p["value"], 3)} ± {num(p["standard_error"], 2)} '
           f'| {peaks(e, d=1)} | {resid(e, d=1)} | {unc} | {e["iterations"]} '
           f'| {e["evaluations"]} | {e["cpu_seconds"]:.1f} |')
-    pe = pre['parameters'][0]
-    print(f'| preset czubak2016-fit | {num(pe["start"])} | {peaks(pre, "model_start")} '
+    pe, pm = pre['parameters']
+    print(f'| preset czubak2016-fit | {num(pe["start"])} (m_n = {num(pm["start"])} kg) '
+          f'| {peaks(pre, "model_start")} '
           f'| {resid(pre, "model_start")} | – | – | – | – |')
 
 
