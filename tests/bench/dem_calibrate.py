@@ -37,6 +37,7 @@ sys.path.insert(0, HERE)
 import dem_map  # noqa: E402
 import dem_points  # noqa: E402
 import model_check  # noqa: E402
+import provenance  # noqa: E402
 
 PAGE = os.path.join(HERE, "results", "dem_calibration.md")
 START = "liggghts-bed4"       # the fit's starting values
@@ -47,15 +48,7 @@ GOOD = 0.05                   # "within 5 % of the peak"
 
 
 
-def machine():
-    """The machine: cores, CPU model and the load average as the page is written."""
-    try:
-        model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
-                      if l.startswith("model name")), os.uname().machine)
-        load = " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        model, load = os.uname().machine, "unknown"
-    return "%d cores (%s), load average %s at the end" % (os.cpu_count(), model, load)
+machine = provenance.machine
 
 
 def git_build():

@@ -18,6 +18,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dem_map  # noqa: E402  (the plan and the CSV's key)
 from dem_points import OVERLAP, chosen  # noqa: E402  (which row is a point's value)
+import provenance  # noqa: E402  (the machine, as provenance.sh names it)
 
 TOL = 0.02    # the relative change a check allows
 
@@ -35,15 +36,7 @@ def pct(x):
     return "n/a" if x is None else "%+.1f %%" % (100 * x)
 
 
-def machine():
-    """This machine as tests/bench/provenance.sh names it: "N cores (CPU model)"."""
-    cpu = ""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            cpu = next((ln.split(":", 1)[1].strip() for ln in fh if ln.startswith("model name")), "")
-    except OSError:
-        pass
-    return "%d cores (%s)" % (len(os.sched_getaffinity(0)), cpu or os.uname().machine)
+machine = provenance.cores
 
 
 def status(rows, mats):

@@ -49,6 +49,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dem_map  # noqa: E402
 import dem_map_report  # noqa: E402
+import provenance  # noqa: E402
 
 ROOT = dem_map.ROOT
 RESULTS = os.path.join(HERE, "results")
@@ -361,15 +362,7 @@ def depth_table(sel, w):
 
 
 
-def machine():
-    """The machine: cores, CPU model and the load average as the page is written."""
-    try:
-        model = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
-                      if l.startswith("model name")), os.uname().machine)
-        load = " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        model, load = os.uname().machine, "unknown"
-    return "%d cores (%s), load average %s at the end" % (os.cpu_count(), model, load)
+machine = provenance.machine
 
 
 def write_md(recs, runner, path):

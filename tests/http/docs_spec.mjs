@@ -202,7 +202,6 @@ export const SPEC = [
   ['docs/machine-zoo.md', "a-priori**: 0.5 %"],
   ['docs/machine-zoo.md', "plus 0.025 %"],
   ['docs/machine-zoo.md', "term stands in (0.75 %"],
-  ['docs/machine-zoo.md', "(the shadow over 30 %"],
   ['docs/machine-zoo.md', "1 % where their error"],
   ['docs/machine-zoo.md', "when tol is below 1 %"],
   ['docs/machine-zoo.md', "or \"beyond 1.0 %"],
@@ -217,7 +216,6 @@ export const SPEC = [
   /* the studies' settings (tests/bench/workprec_scenes.c, peers.sh: the 60-s CPU budget, the check's 0.5-s orbit), the gate and test_feed.c's bound */
   ['docs/benchmarks.md', "periods (0.8 s"],
   ['docs/benchmarks.md', "feed scenes runs 0.8 s"],
-  ['docs/benchmarks.md', "rtol = 1e-5 (0.8 s"],
   ['docs/benchmarks.md', "(< 0.5 %, shrinking)"],
   ['docs/benchmarks.md', "rest has passed 1.5 s"],
   ['docs/benchmarks.md', "a CPU budget of 60 s"],
