@@ -59,6 +59,11 @@ void shadow_stop(sim *s)
 	s->shadow = NULL;
 }
 
+void sim_drop_shadow(sim *s)
+{
+	shadow_stop(s);
+}
+
 /* Start a shadow from the present state, to run until the estimate's
  * start plus the shadow's window. */
 void shadow_begin(sim *s)

@@ -374,6 +374,11 @@ void sim_get_status(const sim *s, sim_status *st);
 /* Restart the transport-velocity estimator at the next period boundary
  * (for example after a beta change, to measure the new steady state). */
 void sim_restart_transport(sim *s);
+/* Free the running shadow of the step error (shadow.c), if any, as its
+ * window's end would without its estimate: the step error keeps the term
+ * it had. For a copy that measures what the instance costs once its start
+ * (40 periods after each estimate's start) is over. */
+void sim_drop_shadow(sim *s);
 
 /* A measurement of the transport velocity: the status fields of the same
  * names at the end of a run. */

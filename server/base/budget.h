@@ -55,9 +55,10 @@ size_t srv_budget_memory(void);
 /* ---- cores of paced sessions ------------------------------------------------ */
 
 /* The cost model (budget_cost.c): doubles per record of a feed (column
- * displacements, xi and eta); CPU s the server spends on one published
- * sample of a feed of columns x layers (status, ring record, trajectory
- * row), besides the core's. */
+ * displacements, xi and eta); CPU s a worker spends on one published
+ * sample of a feed of columns x layers besides the core's step, the
+ * status and the feed's arrays read out (ring record, trajectory row,
+ * sleeping and waking): what cpu_probe.c adds to its measure. */
 size_t srv_budget_record_doubles(int columns, int layers);
 double srv_budget_sample_cpu(int columns, int layers);
 /* Estimated CPU s per simulated s of a session before it has run: from

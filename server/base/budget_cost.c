@@ -21,6 +21,13 @@
 #define COLUMN_SUBSTEP_CPU_S 8.0e-8
 #define ELEMENT_SUBSTEP_CPU_S 0.8e-8
 #define SAMPLE_CPU_S 7e-6
+/* What a published sample costs a worker besides the simulation, the
+ * status and the feed's arrays read out (which the probe, cpu_probe.c,
+ * runs itself): the ring record and trajectory row, sleeping and waking,
+ * the loop's clocks and lock. tests/bench/results/profile.md (200 default
+ * sessions, 22:24 UTC 28 November): 2.7 + 8.4 + 5.5 % of 2.63 ms of
+ * daemon CPU per session-second at 250 samples a simulated second, 1.7 us */
+#define SAMPLE_SERVER_CPU_S 2e-6
 /* and of each double of a published sample's feed record (ring, history) */
 #define RECORD_DOUBLE_CPU_S 2e-9
 /* Doubles per record of a feed: column displacements, xi and eta. */
@@ -64,5 +71,5 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 
 double srv_budget_sample_cpu(int columns, int layers)
 {
-	return SAMPLE_CPU_S + RECORD_DOUBLE_CPU_S * (double)srv_budget_record_doubles(columns, layers);
+	return SAMPLE_SERVER_CPU_S + RECORD_DOUBLE_CPU_S * (double)srv_budget_record_doubles(columns, layers);
 }

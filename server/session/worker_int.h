@@ -26,6 +26,8 @@ typedef struct clocks {
 					 sample at the last wake-up */
 	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of
 					 the cost window */
+	int cost_windows;             /* cost windows measured since the
+					 worker started */
 } clocks;
 
 /* Restart pacing and metering from now (after a pause or a pace change). */

@@ -77,6 +77,7 @@ const NO_SPDX = [
   [/^tests\/fixtures\//, 'data directories written by older builds, as they wrote them'],
   [/^tests\/bench\/results\//, 'benchmark output, as the benchmarks wrote it'],
   [/^tests\/bench\/zoo\/ref\.tsv$/, 'a reference table its readers parse whole'],
+  [/^tests\/bench\/zoo\/chaos_ref\.tsv$/, 'the chaotic feed\'s reference table (tests/bench/chaos.sh), parsed whole like ref.tsv'],
 ];
 
 test('every file the project wrote carries an SPDX line near its top', () => {
