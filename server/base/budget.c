@@ -9,7 +9,8 @@
  * trajectory history, stream buffers); the core instance and the threads
  * are a constant plus a cost per feed element, calibrated against the
  * resident memory the daemon gained per session (docs/budgets.md "Budgets and
- * load" has the measurement). The cores of paced sessions are committed
+ * load" gives the formula; tests/http/memory_formula.test.mjs checks it
+ * against what the daemon reserves). The cores of paced sessions are committed
  * the same way: each session holds its need (CPU s per simulated s, first
  * estimated from its integrator and feed, then measured by its worker,
  * times its pace) while it runs. CPU turns are a first-come-first-served
@@ -32,7 +33,7 @@
 #include "conns.h"
 #include "util.h"
 
-/* Calibration (docs/budgets.md "Budgets and load"): resident bytes a session holds
+/* Calibrated once against resident memory (the formula in docs/budgets.md): bytes a session holds
  * besides its ring and history, as base + per feed element. */
 #define SESSION_BASE_BYTES ((size_t)128 << 10)
 #define ELEMENT_BYTES ((size_t)384)
