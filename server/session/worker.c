@@ -249,6 +249,7 @@ static int pace(srv_session *s, clocks *c, double t_next)
 		c->anchor_t = s->st.t;
 	}
 	c->batch_start = c->batch_end = now;
+	c->batch_steps = 0;
 	return 0;
 }
 
@@ -290,25 +291,32 @@ static int step(srv_session *s, double t_next, char *why, size_t whylen)
 	return rc;
 }
 
+/* A paced batch reads the clock after every this many steps (and at its
+ * start, pace()), so that a batch that runs long (its thread put off the
+ * CPU) still wakes its readers every PUBLISH_EVERY. */
+#define BATCH_CLOCK_EVERY 16
+
 /* After a step: a flat-out session reads the clock (the cpu phase, next,
  * takes it), meters and wakes its readers every PUBLISH_EVERY; a paced
  * one's batch began at a time read once (pace()), which stands for now
- * until the batch is over and its readers are woken (a read of the clock
- * a sample was 1.8 % of a daemon of paced sessions: profile.md). A step
- * that failed wakes them at once. */
+ * but every BATCH_CLOCK_EVERY steps, and its readers are woken at the
+ * batch's end, or every PUBLISH_EVERY of a long batch (a read of the
+ * clock a sample was 1.8 % of a daemon of paced sessions:
+ * docs/performance.md). A step that failed wakes them at once. */
 static void after_step(srv_session *s, clocks *c, int rc)
 {
+	double since = c->publish_wall;
 	if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0) {
 		c->stepped_wall = srv_now();
 		meter(s, c, c->stepped_wall); /* paced: pace() */
-		if (c->stepped_wall - c->publish_wall >= PUBLISH_EVERY) {
-			srv_worker_publish(s, c);
-			return;
-		}
+	} else if (++c->batch_steps % BATCH_CLOCK_EVERY == 0) {
+		c->stepped_wall = srv_now();
+		since = fmax(since, c->batch_start);
 	} else {
 		c->stepped_wall = c->batch_start;
+		since = INFINITY;
 	}
-	if (rc != SIM_OK)
+	if (rc != SIM_OK || c->stepped_wall - since >= PUBLISH_EVERY)
 		srv_worker_publish(s, c);
 }
 
