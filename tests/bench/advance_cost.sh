@@ -49,6 +49,11 @@ ir_long=$(ir long); ir_chunks=$(ir chunks); ir_sampled=$(ir sampled)
 	echo "| sampled: the same, each sample's status and feed arrays read out | $(med sampled) | $(span sampled) | $ir_sampled |"
 	echo "| sessions: $N sampled instances in turn, 0.1 s batches | $(med sessions) | $(span sessions) | as sampled |"
 	echo
+	if [ "$ir_long" != "-" ]; then
+		echo "Instructions over the long run's: chunks $(awk -v a="$ir_chunks" -v b="$ir_long" 'BEGIN {printf "%+.1f", 100 * (a / b - 1)}') %,"
+		echo "sampled $(awk -v a="$ir_sampled" -v b="$ir_long" 'BEGIN {printf "%+.1f", 100 * (a / b - 1)}') %."
+		echo
+	fi
 	echo "The figures of one turn are in the same minutes; the machine's other load raises all of them"
 	echo "alike (the quiet machine's figure is targets.md's)."
 } | tee "$out/advance_cost.md"
