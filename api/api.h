@@ -460,6 +460,10 @@ typedef struct api_sample {
 
 /* Largest text api_format_record can write for this feed size. */
 size_t api_record_max(int columns, int layers);
+/* Numbers api_format_record writes in a sample of these field groups
+ * (API_F_*) for this feed size (0 x 0 without feed): what a stream's
+ * record costs to format (the daemon's stream budget). */
+int api_record_numbers(unsigned fields, int columns, int layers);
 /* Write one record as SSE ("id:", "event:", "data:") or as one NDJSON
  * line with "type" and "id". buf holds api_record_max() bytes. Returns the
  * length. Doubles round-trip. */

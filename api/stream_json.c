@@ -104,6 +104,21 @@ size_t api_record_max(int columns, int layers)
 	return 2048 + API_EVENT_MAX + values * 26;
 }
 
+int api_record_numbers(unsigned fields, int columns, int layers)
+{
+	int n = 3; /* t, beta, beta_target */
+	n += (fields & API_F_TROUGH) ? 6 : 0;
+	n += (fields & API_F_ORBIT) ? 4 : 0;
+	n += (fields & API_F_ROTOR) ? 5 : 0;
+	n += (fields & API_F_ELIMINATORS) ? 4 : 0;
+	n += (fields & API_F_FEED) ? 8 + columns : 0;
+	n += (fields & API_F_ENERGY) ? 5 : 0;
+	if ((fields & API_F_ELEMENTS) && columns > 0)
+		n += 1 + 2 * columns * layers;
+	return n;
+}
+
+/* The members of a sample, as api_record_numbers counts them. */
 static void sample_body(writer *w, const api_sample *s, unsigned f)
 {
 	const sim_status *st = &s->st;

@@ -161,23 +161,28 @@ void srv_budget_give(size_t bytes)
 
 /* ---- cores of paced sessions ------------------------------------------------ */
 
+int srv_budget_raise_paced(double *held, double need, double *taken)
+{
+	pthread_mutex_lock(&lock);
+	double others = paced - *held;
+	int fits = need <= *held || others + need <= cfg->max_paced_cores * (1 + 1e-12);
+	if (fits && need > *held) {
+		paced = others + need;
+		*held = need;
+	}
+	*taken = paced;
+	pthread_mutex_unlock(&lock);
+	return fits;
+}
+
 api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			      const char *field, const char *verb,
 			      api_problem *pb)
 {
-	double need = cpu_per_s * pace, limit = cfg->max_paced_cores;
-	pthread_mutex_lock(&lock);
-	double others = paced - *held;
-	int fits = need <= *held || others + need <= limit * (1 + 1e-12);
-	if (fits) {
-		if (need > *held) {
-			paced = others + need;
-			*held = need;
-		}
-		pthread_mutex_unlock(&lock);
+	double need = cpu_per_s * pace, limit = cfg->max_paced_cores, taken;
+	if (srv_budget_raise_paced(held, need, &taken))
 		return API_OK;
-	}
-	pthread_mutex_unlock(&lock);
+	double others = taken - *held;
 	if (need > limit) {
 		api_fail(pb, API_RANGE, field,
 			 "this session needs %.3g cores (%.3g ms of CPU per "

@@ -79,6 +79,24 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			      const char *field, const char *verb,
 			      api_problem *pb);
+/* Raise *held (cores) to need if need <= *held or the running paced
+ * sessions' sum stays within --max-paced-cores with it: 1; else 0 and
+ * nothing changes. *taken: the cores all hold after. */
+int srv_budget_raise_paced(double *held, double need, double *taken);
+/* CPU s per simulated s a stream client of a session costs the daemon
+ * (budget_cost.c): the records it formats and sends each simulated s
+ * (sample_rate of its session, thinned to rate when 0 < rate), and the
+ * numbers in each (api_record_numbers of its fields). Measured at pace 1
+ * with tests/bench/stream_cost.mjs (docs/budgets.md). */
+double srv_budget_stream_cpu(double sample_rate, double rate, unsigned fields,
+			     int columns, int layers);
+/* Raise what a running paced session holds (*held) to
+ * (session_cpu + stream_cpu) x pace for a stream it opens, stream_cpu
+ * the stream's srv_budget_stream_cpu: API_OK, else nothing changes and
+ * *pb is 503 (budget "cpu", Retry-After) naming what the stream needs and
+ * what is taken. */
+api_err srv_budget_take_stream(double *held, double session_cpu, double stream_cpu,
+			       double pace, api_problem *pb);
 /* Set what a session holds to need (cores, >= 0), even beyond the budget:
  * its worker's own measure, a pause, the end. */
 void srv_budget_set_paced(double *held, double need);

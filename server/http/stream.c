@@ -52,6 +52,8 @@ typedef struct stream {
 	double heartbeat;  /* s */
 	int ended;
 	size_t mem_reserved; /* bytes of the memory budget */
+	double cpu_per_s;  /* its charge in the cores for paced sessions:
+			      CPU s per simulated s (budget.h) */
 } stream;
 
 static void end_stream(stream *k, const char *reason)
@@ -161,7 +163,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
 static void stream_free(void *cls)
 {
 	stream *k = cls;
-	srv_session_stream_count(k->s, -1);
+	srv_session_stream_close(k->s, k->cpu_per_s);
 	atomic_fetch_sub(&srv_stats.stream_clients, 1);
 	srv_session_put(k->s);
 	srv_budget_give(k->mem_reserved);
@@ -191,8 +193,10 @@ static int parse_options(srv_req *r, stream *k, int64_t *resume,
 }
 
 /* Admit a stream of session r->arg[0]: 1 with the session held in k->s, a
- * stream client counted, its memory taken and the feed's size in *columns,
- * *layers; else 0, k freed and the answer in *res. */
+ * stream client counted, its memory taken, its CPU charged with its
+ * session's in the cores for paced sessions and the feed's size in
+ * *columns, *layers; else 0, k freed and the answer in *res (404, 429
+ * --max-streams, 503 memory, 503 cpu). */
 static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Result *res)
 {
 	api_problem pb;
@@ -228,8 +232,17 @@ static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Resu
 		*res = srv_reply_problem(r, &pb, NULL);
 		return 0;
 	}
+	k->cpu_per_s = srv_budget_stream_cpu(srv_session_spec(k->s)->sample_rate, k->rate,
+					     k->fields, *columns, *layers);
+	if (srv_session_stream_open(k->s, k->cpu_per_s, &pb) != API_OK) {
+		srv_budget_give(need);
+		atomic_fetch_sub(&srv_stats.stream_clients, 1);
+		srv_session_put(k->s);
+		free(k);
+		*res = srv_reply_problem(r, &pb, NULL);
+		return 0;
+	}
 	k->mem_reserved = need;
-	srv_session_stream_count(k->s, 1);
 	atomic_fetch_add(&srv_stats.streams_opened, 1);
 	return 1;
 }

@@ -272,10 +272,33 @@ void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 	pthread_mutex_unlock(&s->lock);
 }
 
-void srv_session_stream_count(srv_session *s, int delta)
+api_err srv_session_stream_open(srv_session *s, double cpu_per_s, api_problem *pb)
+{
+	api_err e = API_OK;
+	pthread_mutex_lock(&s->lock);
+	if (srv_paced_need(s) > 0) /* running paced: held from now */
+		e = srv_budget_take_stream(&s->budget.paced_held, srv_paced_cost(s),
+					   cpu_per_s, s->pace, pb);
+	if (e == API_OK) {
+		s->streams++;
+		s->budget.stream_cpu_per_s += cpu_per_s;
+	}
+	pthread_mutex_unlock(&s->lock);
+	return e;
+}
+
+void srv_session_stream_close(srv_session *s, double cpu_per_s)
 {
 	pthread_mutex_lock(&s->lock);
-	s->streams += delta;
+	s->streams--;
+	s->budget.stream_cpu_per_s -= cpu_per_s;
+	if (s->streams == 0 || s->budget.stream_cpu_per_s < 0)
+		s->budget.stream_cpu_per_s = 0; /* no drift */
+	/* given back at once (a hold raised for a queued control keeps the
+	 * rest until the worker applies it: worker_budget.c) */
+	if (srv_paced_need(s) > 0)
+		srv_budget_set_paced(&s->budget.paced_held,
+				     s->budget.paced_held - cpu_per_s * s->pace);
 	pthread_mutex_unlock(&s->lock);
 }
 

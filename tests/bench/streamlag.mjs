@@ -39,13 +39,22 @@ export function call(base, method, path, body, { agent, localAddress } = {}) {
 
 // A stream client of session id: NDJSON or SSE, `rate` samples per
 // simulated second of the trough group. Collects lags (ms) after `warmup`
-// ms; stop() closes it. status: the HTTP status once answered.
+// ms (or from st.collectFrom, a performance.now() time, once set); stop()
+// closes it. status: the HTTP status once answered; ready: a promise of it
+// (0: the connection failed), with the body of a refusal in text.
 export function lagStream(base, id, { ndjson, rate = 10, localAddress, warmup = 0 } = {}) {
   const st = { lags: [], samples: 0, status: 0, error: null, minOffset: Infinity, offsets: [] };
   const path = `/api/v1/sessions/${id}/stream?fields=trough&rate=${rate}${ndjson ? '&format=ndjson' : ''}`;
   const started = performance.now();
+  let answered;
+  st.ready = new Promise((r) => { answered = r; });
   const req = http.get(base + path, { agent: false, localAddress }, (res) => {
     st.status = res.statusCode;
+    if (st.status !== 200) {
+      st.text = '';
+      res.on('data', (c) => { st.text += c; });
+      res.on('end', () => answered(st.status));
+    } else answered(st.status);
     res.setEncoding('utf8');
     let buf = '';
     const sep = ndjson ? '\n' : '\n\n';
@@ -63,12 +72,12 @@ export function lagStream(base, id, { ndjson, rate = 10, localAddress, warmup = 
         const offset = now - 1000 * Number(m[1]);
         st.samples++;
         if (offset < st.minOffset) st.minOffset = offset;
-        if (now - started >= warmup) st.offsets.push(offset);
+        if (now >= (st.collectFrom ?? started + warmup)) st.offsets.push(offset);
       }
     });
     res.on('error', (e) => { st.error = e.code || e.message; });
   });
-  req.on('error', (e) => { if (!st.stopped) st.error = e.code || e.message; });
+  req.on('error', (e) => { if (!st.stopped) st.error = e.code || e.message; answered(0); });
   st.stop = () => {
     st.stopped = true;
     req.destroy();

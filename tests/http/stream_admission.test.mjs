@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Streams in the cores for paced sessions (docs/budgets.md "Streams"): a
+// stream of a running paced session is charged its expected CPU (records a
+// simulated second times the cost of each, formatted and sent) with its
+// session's hold, so that a stream beyond --max-paced-cores is refused 503
+// with the budget named and what is taken, as the next creation is, and
+// the running sessions and their streams go on untouched. Holds are the
+// estimate from the scene (--cpu-probe 0) until the workers have measured
+// (2 simulated s), so the refusal's numbers are known in advance.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import http from 'node:http';
+import { startDaemon, req, metric, until, SLOW } from './lib.mjs';
+
+// printf's %.3g for the magnitudes here (1e-4 .. 1e3)
+const g3 = (x) => String(Number(x.toPrecision(3)));
+
+// The charge of a ?fields=trough&rate=10 stream of a default session (250
+// samples a simulated s), CPU s per simulated s: 10 wake-ups of 75 us and
+// 10 records of 9 numbers at 1.5 us (server/base/budget_stream.c)
+const STREAM = 10 * 75e-6 + 10 * 9 * 1.5e-6;
+const QUERY = '?format=ndjson&fields=trough&rate=10';
+
+// Open a stream of session id: {status, body (parsed when refused),
+// records (parsed NDJSON lines so far), close()}, once its head is in.
+function open(base, id, query = QUERY) {
+  return new Promise((resolve, reject) => {
+    const st = { records: [], text: '' };
+    const r = http.get(`${base}/api/v1/sessions/${id}/stream${query}`, { agent: false }, (res) => {
+      st.status = res.statusCode;
+      st.headers = res.headers;
+      res.setEncoding('utf8');
+      let buf = '';
+      res.on('data', (c) => {
+        if (st.status !== 200) { st.text += c; return; }
+        buf += c;
+        for (let at = buf.indexOf('\n'); at >= 0; at = buf.indexOf('\n')) {
+          st.records.push(JSON.parse(buf.slice(0, at)));
+          buf = buf.slice(at + 1);
+        }
+      });
+      res.on('error', () => {});
+      if (st.status === 200) resolve(st);
+      else res.on('end', () => { st.body = JSON.parse(st.text); resolve(st); });
+    });
+    r.on('error', (e) => { if (!st.closed) reject(e); });
+    st.close = () => { st.closed = true; r.destroy(); };
+  });
+}
+
+test('paced budget: a stream beyond it gets 503 naming the budget, the running sessions and streams go on', { timeout: 90000 * SLOW }, async () => {
+  const limit = 0.01;
+  const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
+  const metrics = async () => (await req(d.base, 'GET', '/metrics')).text;
+  const held = async () => metric(await metrics(), 'convsim_paced_cpu_cores');
+  const streams = [];
+  try {
+    const first = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(first.status, 201, first.text);
+    const cost = await held();
+    assert.ok(cost > STREAM && cost < limit / 2, `a default session's estimate: ${cost}`);
+    const fit = Math.floor(limit / cost);
+    const ids = [first.body.id];
+    while (ids.length < fit) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+      assert.equal(r.status, 201, `session ${ids.length + 1} of ${fit} fits: ${r.text}`);
+      ids.push(r.body.id);
+    }
+    // the streams that fit in what is left, each charged STREAM
+    const room = Math.floor((limit - fit * cost) / STREAM + 1e-9);
+    for (let i = 0; i < room; i++) {
+      const s = await open(d.base, ids[i % fit]);
+      assert.equal(s.status, 200, `stream ${i + 1} of ${room} fits: ${s.text}`);
+      streams.push(s);
+    }
+    const taken = fit * cost + room * STREAM;
+    assert.ok(Math.abs(await held() - taken) < 1e-9, `held ${await held()}, expected ${taken}`);
+    const before = await metrics();
+    const refused = await open(d.base, ids[0]);
+    assert.equal(refused.status, 503, refused.text);
+    assert.equal(refused.headers['content-type'], 'application/problem+json');
+    assert.equal(refused.headers['retry-after'], '5');
+    assert.deepEqual(refused.body, {
+      type: '/api/v1/problems/unavailable',
+      title: 'Service unavailable',
+      status: 503,
+      detail: `this stream needs ${g3(STREAM)} cores (${g3(1e3 * STREAM)} ms of CPU per simulated s at pace 1) ` +
+        `and running paced sessions and their streams hold ${g3(taken)} of the ${limit} cores for paced sessions ` +
+        '(--max-paced-cores); nothing was opened, retry when some have ended or paused, or ask fewer records ' +
+        '(rate, fields)',
+      instance: `/api/v1/sessions/${ids[0]}/stream`,
+      budget: 'cpu',
+      limit,
+    });
+    const after = await metrics();
+    for (const k of ['convsim_stream_clients', 'convsim_streams_opened_total', 'convsim_paced_cpu_cores',
+      'convsim_memory_reserved_bytes']) {
+      assert.equal(metric(after, k), metric(before, k), `${k}: nothing opened or held`);
+    }
+    assert.equal(metric(after, 'convsim_stream_clients'), room);
+    // a creation counts the streams too: refused with them in what is taken
+    const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(r.status, 503, r.text);
+    assert.equal(r.body.budget, 'cpu');
+    assert.match(r.body.detail, new RegExp(`running paced sessions hold ${g3(taken).replace('.', '\\.')} of`));
+    // the running ones are untouched: pace 1, running, their streams
+    // delivering samples after the refusals
+    const list = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions;
+    assert.equal(list.length, fit);
+    for (const s of list) {
+      assert.equal(s.state, 'running', s.id);
+      assert.equal(s.pace, 1, `${s.id} keeps pace 1`);
+    }
+    const t0 = list.find((s) => s.id === ids[0]).status.t;
+    if (room > 0) {
+      await until(() => streams[0].records.some((x) => x.type === 'sample' && x.t > t0), 10000 * SLOW,
+        'a sample after the refusal');
+    }
+    // a paused session holds nothing, its streams neither: a stream of it
+    // is admitted beyond the budget, and held again when it resumes
+    const pause = await req(d.base, 'PATCH', `/api/v1/sessions/${ids[0]}`, { running: false });
+    assert.equal(pause.status, 200, pause.text);
+    const mine = streams.filter((_, i) => i % fit === 0).length;
+    await until(async () => Math.abs(await held() - (taken - cost - mine * STREAM)) < 1e-9, 10000 * SLOW,
+      'the paused session and its streams give their hold back');
+    // closing a stream of a running session gives its charge back at once
+    assert.ok(fit >= 2 && room >= 2, `${fit} sessions and ${room} streams fill the budget`);
+    {
+      const s = streams[1];
+      s.close();
+      await until(async () => metric(await metrics(), 'convsim_stream_clients') === room - 1, 10000 * SLOW,
+        'the closed stream counted out');
+      assert.ok(Math.abs(await held() - (taken - cost - mine * STREAM - STREAM)) < 1e-9);
+    }
+  } finally {
+    for (const s of streams) s.close();
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
