@@ -29,7 +29,8 @@ static const api_query queries[] = {
 	{API_Q_FIELDS, "fields", "{\"type\":\"string\"}",
 	 "comma list of trough, orbit, rotor, eliminators, feed, energy, elements, all, default"},
 	{API_Q_RATE, "rate", "{\"type\":\"number\",\"exclusiveMinimum\":0}",
-	 "samples per simulated second (thins the session's sample_rate)"},
+	 "samples per simulated second (thins the session's sample_rate; a stream of a running "
+	 "paced session holds its records' CPU in --max-paced-cores, fewer cost less)"},
 	{API_Q_LIMIT, "limit", "{\"type\":\"integer\",\"minimum\":1}", "end after this many records"},
 	{API_Q_SINCE, "since", "{\"type\":\"integer\",\"minimum\":0}",
 	 "resume after this record id (as Last-Event-ID)"},
@@ -56,7 +57,8 @@ static const api_route routes[API_R_COUNT] = {
 	[API_R_SESSION_DELETE] = {"DELETE", "/api/v1/sessions/*", 0, 0, "Stop and remove the session", NULL, 204, "",
 	 "400,404,415"},
 	[API_R_SESSION_STREAM] = {"GET", "/api/v1/sessions/*/stream", STREAM, 0,
-	 "Server-Sent Events or NDJSON of samples and events", NULL, 200, "StreamRecord",
+	 "Server-Sent Events or NDJSON of samples and events (503 budget cpu: the stream's CPU "
+	 "would take a running paced session past --max-paced-cores)", NULL, 200, "StreamRecord",
 	 "400,404,429,503"},
 	[API_R_SESSION_TRAJECTORY] = {"GET", "/api/v1/sessions/*/trajectory", TRAJ, 1,
 	 "The recorded, downsampled history (the CLI's trajectory columns)", NULL, 200,
