@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What a stream client costs the daemon per record it formats and sends
-// (`node tests/bench/stream_cost.mjs [N] [SECONDS]`; about a minute): N
+// (`node tests/bench/stream_cost.mjs [N] [SECONDS]`, or tests/bench/stream_cost.sh
+// for the result page; about a minute): N
 // default sessions at pace 1 on a fresh daemon (--max-paced-cores 2, so
 // none is refused), the daemon's CPU time (user + sys) over SECONDS without
 // streams, then with one NDJSON stream on each session of three kinds in
@@ -51,7 +52,9 @@ for (let i = 0; i < N; i++) {
 }
 await sleep(2000);
 const none = await measure(d.proc.pid, T);
-console.log(`Command: \`node tests/bench/stream_cost.mjs ${N} ${T}\`, ${new Date().toISOString().slice(0, 16)} UTC`);
+console.log('# What a stream client costs the daemon per record\n');
+console.log(`Command: \`node tests/bench/stream_cost.mjs ${N} ${T}\` (\`bash tests/bench/stream_cost.sh\`): ${N} default ` +
+  `sessions at pace 1, the daemon's CPU over ${T} s without streams, then with one NDJSON stream on each.`);
 console.log('\n| streams | records received | daemon CPU, s | CPU per record, us |\n|---|---|---|---|');
 console.log(`| none | 0 | ${fmt(none.cpu, 2)} | |`);
 for (const [name, q] of [['trough, rate 10', '&fields=trough&rate=10'], ['trough, rate 50', '&fields=trough&rate=50'],
