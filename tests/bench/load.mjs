@@ -6,7 +6,9 @@
 //     far as the cores for paced sessions (--max-paced-cores) take them:
 //     a pace change beyond is 503 with budget "cpu", counted as correct,
 //   - opens 500 stream clients, half SSE and half NDJSON, spread over the
-//     source addresses 127.0.1.1-127.0.1.10 (50 each: ten users),
+//     source addresses 127.0.1.1-127.0.1.10 (50 each: ten users); a stream
+//     its running paced session's budget cannot take is 503 with budget
+//     "cpu", counted as correct,
 //   - sends a steady stream of PATCH beta from 127.0.0.1 (20 a second),
 //   - opens 64 idle sockets from 127.0.0.2 (its per-client budget), sends
 //     20 requests from there (429), then 1,936 more idle sockets (8 more
@@ -209,12 +211,15 @@ const answers = (s) => metric(`convsim_http_requests_total{status="${s}"}`);
 running = false;
 await otherLoop;
 const lags = [];
-let streamErrors = 0, streamRecords = 0;
+let streamErrors = 0, streamRecords = 0, streamsRefused = 0;
 for (const s of streams) {
   s.stop();
   lags.push(...s.lags);
   streamRecords += s.samples;
-  if (s.status !== 200 || s.error) streamErrors++;
+  // a stream its running paced session's budget cannot take: 503, budget
+  // "cpu" (docs/budgets.md "Streams"), counted as correct
+  if (s.status === 503 && /"budget":"cpu"/.test(s.text || '')) streamsRefused++;
+  else if (s.status !== 200 || s.error) streamErrors++;
 }
 for (const s of idle.socks) s.destroy();
 for (const s of flood.socks) s.destroy();
@@ -247,6 +252,7 @@ const lines = [
   `| PATCH beta (${patchMs.length}, ${fmt(patchMs.length / windowS, 0)}/s) latency p50 / p99 | ${fmt(quantile(patchMs, 0.5))} / ${fmt(quantile(patchMs, 0.99))} ms (answers ${JSON.stringify(patchStatus)}) |`,
   `| stream lag p50 / p99 (${lags.length} samples after 5 s, ${STREAMS} streams) | ${fmt(quantile(lags, 0.5))} / ${fmt(quantile(lags, 0.99))} ms |`,
   `| sessions admitted at pace 1 (the others: 503, budget "cpu") | ${admitted.size} of ${ids.length} (${admission.refused} refused) |`,
+  `| streams refused (503, budget "cpu": their sessions' budget full) | ${streamsRefused} of ${STREAMS} |`,
   `| admitted sessions keeping real time (rtf >= 0.95) | ${realTime} of ${paced1.length} |`,
   `| cores held by paced sessions (metric) / --max-paced-cores | ${fmt(metric('convsim_paced_cpu_cores'), 3)} / ${fmt(metric('convsim_paced_cpu_budget_cores'), 2)} |`,
   `| answers 401 / 429 / 503 (whole run) | ${answers(401)} / ${answers(429)} / ${answers(503)} |`,
