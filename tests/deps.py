@@ -22,20 +22,35 @@ import subprocess
 import sys
 
 
-def symbols(obj):
-    out = subprocess.run(["nm", "-P", obj], capture_output=True, text=True,
-                         check=True).stdout
-    defined, needed = set(), set()
+_SYMBOLS = {}
+
+
+def read_symbols(objs):
+    """nm once for all the objects not read yet (one process, not one an
+    object): fills _SYMBOLS[obj] = (defined, needed)."""
+    todo = sorted({o for o in objs if o not in _SYMBOLS})
+    if not todo:
+        return
+    out = subprocess.run(["nm", "-A", "-P", *todo], capture_output=True,
+                         text=True, check=True).stdout
+    for o in todo:
+        _SYMBOLS[o] = (set(), set())
     for line in out.splitlines():
-        parts = line.split()
-        if len(parts) < 2:
+        obj, _, rest = line.partition(": ")
+        parts = rest.split()
+        if obj not in _SYMBOLS or len(parts) < 2:
             continue
         name, kind = parts[0], parts[1]
+        defined, needed = _SYMBOLS[obj]
         if kind == "U":
             needed.add(name)
         elif kind.isupper():
             defined.add(name)
-    return defined, needed
+
+
+def symbols(obj):
+    read_symbols([obj])
+    return _SYMBOLS[obj]
 
 
 def source_dir(folder):
@@ -71,6 +86,7 @@ def objects(folder):
 
 def graph(folder):
     pairs = objects(folder)
+    read_symbols([o for _, o in pairs])
     names = [n for n, _ in pairs]
     defs, needs = {}, {}
     for n, o in pairs:

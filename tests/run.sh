@@ -10,8 +10,8 @@ BUILD=${BUILD:-build}
 export BUILD CONVSIMD="$PWD/$BUILD/convsimd" CONVSIM="$PWD/$BUILD/convsim" CONVSIM_DEM="$PWD/$BUILD/convsim-dem"
 export CONVSIM_NOMPI="$PWD/$BUILD/nompi/convsim" # the convsim of `make NO_MPI=1` (make test builds it)
 mkdir -p tests/out
-log=$(mktemp)
-trap 'rm -f "$log"' EXIT
+log=$(mktemp) times=$(mktemp)
+trap 'rm -f "$log" "$times"' EXIT
 pass=0; fail=0; failed=(); skipped=()
 # TESTS_SKIP: an extended regular expression; the groups whose names match
 # it do not run and are listed at the end (make check-ci)
@@ -22,8 +22,11 @@ run() { # name, command...
 		return
 	fi
 	echo "=== $name"
+	local t0=$EPOCHREALTIME
 	timeout 900 "$@" 2>&1 | tee "$log"
 	local rc=${PIPESTATUS[0]} p f
+	# the group's wall time, for the slowest-groups line at the end
+	awk -v a="$EPOCHREALTIME" -v b="$t0" -v n="$name" 'BEGIN {printf "%.1f\t%s\n", a - b, n}' >>"$times"
 	# cmocka: "[  PASSED  ] N test(s)." / "[  FAILED  ] N test(s), listed below:"
 	# node:test: "# pass N" / "# fail N"
 	p=$(sed -n -e 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' -e 's/^# pass \([0-9]*\)$/\1/p' "$log" | tail -1)
@@ -61,6 +64,8 @@ for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/w
 	run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
 done
 echo
+total=$(awk -F'\t' '{s += $1} END {printf "%.0f", s}' "$times")
+echo "slowest groups (of ${total} s in all): $(sort -rn "$times" | head -5 | awk -F'\t' '{printf "%s%s %.0f s", (NR > 1 ? ", " : ""), $2, $1}')"
 [ ${#skipped[@]} -eq 0 ] || echo "skipped (TESTS_SKIP): ${skipped[*]}"
 [ ${#failed[@]} -eq 0 ] || printf 'failed group: %s\n' "${failed[@]}"
 echo "tests: $pass passed, $fail failed"

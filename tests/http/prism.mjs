@@ -31,6 +31,14 @@ export async function startPrism(docText, target) {
     child.stderr.on('data', seen);
     child.on('exit', (code) => reject(new Error(`prism exited (${code}): ${text.slice(-2000)}`)));
   });
-  await Promise.race([listening, new Promise((_, no) => setTimeout(() => no(new Error(`prism did not start: ${text}`)), 60000 * SLOW))]);
+  // the deadline's timer is cleared once Prism listens: left to run, it
+  // kept the test process alive 60 s after its last test
+  let timer;
+  const late = new Promise((_, no) => { timer = setTimeout(() => no(new Error(`prism did not start: ${text}`)), 60000 * SLOW); });
+  try {
+    await Promise.race([listening, late]);
+  } finally {
+    clearTimeout(timer);
+  }
   return { url: `http://127.0.0.1:${port}`, log: () => text, stop: () => child.stdin.end() };
 }
