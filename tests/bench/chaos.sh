@@ -101,7 +101,7 @@ n_settle=$(echo $SETTLES | wc -w)
 	echo "most $se_max; its step error not measured). \"bar / error\": the"
 	echo "median over the points of the bar over |v - v_ref|, that taken as at least 2 se; \"within 1 %\":"
 	echo "bars within docs/MODEL.md's 1 % (of |v_ref| where at least 0.3 of the peak, else of the peak),"
-	echo "where \`tol_met\` asks the bar within 1 % of max(|v|, 0.3 of half the trough's largest speed);"
+	echo "where \`tol_met\` asks the same of the run's own v, its peak taken as half the trough's largest speed;"
 	echo "\"holds\": points whose bar contains v_ref; \"within 2 se\": whose bar does to within the"
 	echo "reference's 2 se; CPU: the sweeps' total, one core, over their points. $(date -u +%Y-%m-%d)."
 	echo
