@@ -5,7 +5,7 @@
 # tests/bench/zoo/chaos_ref.tsv (made where missing: vref, as
 # tests/bench/vref.sh builds it, at 1.25e-4 s / 40 sub-steps, beta =
 # 0..180 deg every 5 deg clockwise, 15 consecutive 16-s windows after the
-# steady start; about 600 CPU s): v_ref is the windows' mean, se their
+# steady start; about 700 CPU s): v_ref is the windows' mean, se their
 # standard error; its step error is not measured (one level). For each
 # build of BUILDS (NAME=DIR pairs, space separated; default: this build)
 # the sweep `convsim sweep --beta 0:180:5 --rotation cw --threads 1 --set
