@@ -113,7 +113,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: profile-daemon fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-calibration bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: profile-daemon bench-advance-cost fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-calibration bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -405,6 +405,15 @@ bench-control-cost: all
 	  CONVSIMD=$(BUILD)/convsimd OLD="$(OLD_CONVSIMD)" node tests/bench/control_cost.mjs > tests/bench/results/control_cost.md && \
 	  stamp tests/bench/results/control_cost.md "$$line Command: \`make bench-control-cost OLD_CONVSIMD=$(OLD_CONVSIMD)\`." && \
 	  cat tests/bench/results/control_cost.md
+
+# The simulation of a default session in the daemon's pattern (sample by
+# sample, hundreds of instances in turn) against one long run, in one
+# process (tests/bench/advance_cost.sh, about a minute; callgrind where
+# valgrind is installed). Into tests/bench/results/advance_cost.md.
+$(BUILD)/advance_cost: tests/bench/advance_cost.c $(BUILD)/libcore.a
+	$(Q)$(CC) $(CFLAGS) $(WARN) $(INC_core) -o $@ $< $(BUILD)/libcore.a $(LDLIBS)
+bench-advance-cost: $(BUILD)/advance_cost
+	$(Q)bash tests/bench/advance_cost.sh
 
 # Does shaping the beta command settle the feed faster (part of `make bench`;
 # tests/bench/control_shaping.c on the core alone, about 10 s)? Into

@@ -7,7 +7,8 @@
  * a sweep's point: the same, stopped early once its bar is met with little
  * scatter; a point whose bar misses tol where the difference between
  * the run and its shadow is scatter (a chaotic feed) measured again over a
- * longer window instead of refined, its step error bounded statistically.
+ * longer window instead of refined (at twice the sub-steps), its step
+ * error bounded statistically.
  */
 #include <math.h>
 #include <stdio.h>
@@ -32,32 +33,58 @@
  * 4-s window, two and a half of its periods. */
 #define MEASURE_CHECK 0.1
 
-/* A scatter-dominated point's long run (measure_long): its window the one
- * that brings the bar to MEASURE_LONG_AIM of tol, at most MEASURE_LONG_MAX
- * times the measurement's (the shadow beside it throughout: on the R =
- * 0.5 machine such a point costs about 3 times the default's point,
- * tests/bench/results/chaos.md) */
+/* A scatter-dominated point's long run (measure_long): its first check at
+ * the window that the first run's statistical bar and its shadow's
+ * standard error (both shrinking as one over the root of the window) say
+ * brings the bar to MEASURE_LONG_AIM of scatter_scale, within [1,
+ * MEASURE_LONG_FIRST] times the measurement's; where the bar then misses
+ * what tol allows, on to the window its shrinking part asks for
+ * (MEASURE_LONG_MARGIN over it), at most MEASURE_LONG_MAX windows: a point
+ * that would need more stops at its check (on the R = 0.5 machine:
+ * tests/bench/results/chaos.md). */
 #define MEASURE_LONG_AIM 0.8
-#define MEASURE_LONG_MAX 6.0
+#define MEASURE_LONG_FIRST 6.0
+#define MEASURE_LONG_MAX 25.0
+#define MEASURE_LONG_MARGIN 1.1
 
 /* scatter_only: the first run's shadow's standard error at least this
- * share of what tol allows (the preset's steps at most 0.95 of it, the
+ * share of scatter_scale (the preset's steps at most 0.95 of it, the
  * chaotic feed's at least 2.0) */
 #define MEASURE_SCATTER_SE 1.5
 
+/* The scale the scatter and room rules below were read on: tol max(|v|, 0.3
+ * peak), which is what tol allows where |v| >= 0.3 peak and 0.3 of it
+ * nearer v = 0 (sim_status.c: the convention allows tol peak there). A
+ * short window's scatter near v = 0 is no better read than elsewhere: on
+ * the chaotic feed (R = 0.5, mu = 0.6) at 75 and 80 deg cw a stop at the
+ * first check by what tol allows there left v_ref outside the bar. */
+static double scatter_scale(const sim_status *st)
+{
+	return fmax(st->tol * fabs(st->transport_velocity), 0.3 * st->tol_allowed);
+}
+
+/* What scatter_scale leaves the steps: it less the bar's scatter and
+ * drift, which finer steps cannot shrink. Near v = 0 a refinement is
+ * asked as before the convention's allowance (a chaotic feed's point at
+ * 100 deg cw went from 5 to 80 sub-steps for a room its scatter fills);
+ * a bar within what tol allows there needs none (tol_met ends it). */
+static double room_of(const sim_status *st)
+{
+	return scatter_scale(st) - (st->transport_velocity_uncertainty - st->step_error);
+}
+
 /* Whether sim_measure would refine after a run whose status is st: its
- * step error beyond what tol leaves the steps (the bar less its scatter
- * and drift, which finer steps cannot shrink), and shrunk as a
- * first-order one shrinks (by 0.8 at least) since the last run's, last. */
+ * step error beyond room_of, and shrunk as a first-order one shrinks (by
+ * 0.8 at least) since the last run's, last. */
 static int refine_asks(const sim_status *st, double last)
 {
-	double room = st->tol_allowed - (st->transport_velocity_uncertainty - st->step_error);
+	double room = room_of(st);
 	return room > 0.0 && st->step_error > room && st->step_error < 0.8 * last &&
 	       st->substeps >= 1;
 }
 
 /* A bar met early enough to stop on: within tol, steady, and its scatter
- * and drift at most MEASURE_EARLY_SCATTER of what tol allows. A short
+ * and drift at most MEASURE_EARLY_SCATTER of scatter_scale. A short
  * window's scatter is read from few batches, and where the feed's motion
  * is correlated over many periods it is read low (a 1.2-s window of the
  * zoo's `stiffer` machine said 0.31 % at 140 deg cw where its v was 0.97 %
@@ -71,7 +98,7 @@ static int refine_asks(const sim_status *st, double last)
 static int early_met(const sim_status *st)
 {
 	double scatter = st->transport_velocity_uncertainty - st->step_error;
-	return st->tol_met && st->steady && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed &&
+	return st->tol_met && st->steady && scatter <= MEASURE_EARLY_SCATTER * scatter_scale(st) &&
 	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
@@ -84,7 +111,7 @@ static int early_met(const sim_status *st)
 static int beyond_tol(const sim_status *st, double last)
 {
 	double scatter = st->transport_velocity_uncertainty - st->step_error;
-	return st->step_error >= 0.8 * last && scatter <= MEASURE_EARLY_SCATTER * st->tol_allowed;
+	return st->step_error >= 0.8 * last && scatter <= MEASURE_EARLY_SCATTER * scatter_scale(st);
 }
 
 /* The first run's instance as it starts (settled, at t = 0, its shadow
@@ -239,24 +266,69 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 	return err;
 }
 
-/* A first run whose bar misses tol where its shadow's difference is
+/* A first run whose bar is beyond scatter_scale (what tol allows, but
+ * near v = 0 0.3 of it: the scale the shares were read on) where its
+ * shadow's difference is
  * within SHADOW_SIGNIFICANT of its standard error (a chaotic feed: the
  * run and its shadow drift apart, and their difference is scatter, which
  * finer steps do not shrink): measured again over a longer window with
  * its shadow beside it throughout (measure_long), not refined. */
 static int scatter_only(const sim_status *st, const coarser_run *c)
 {
-	return !st->tol_met && isfinite(c->se) && c->raw <= SHADOW_SIGNIFICANT * c->se &&
-	       c->se >= MEASURE_SCATTER_SE * st->tol_allowed && c->ran > 0.0;
+	return st->transport_velocity_uncertainty > scatter_scale(st) && isfinite(c->se) &&
+	       c->raw <= SHADOW_SIGNIFICANT * c->se &&
+	       c->se >= MEASURE_SCATTER_SE * scatter_scale(st) && c->ran > 0.0;
 }
 
-/* The long run of a scatter-dominated point: from the settled start, with
- * the first run's steps, its shadow over the whole window, which the
- * first run's statistical bar and its shadow's standard error (both
- * shrinking as one over the root of the window) say brings the bar to
- * MEASURE_LONG_AIM of tol, within [1, MEASURE_LONG_MAX] times t_end's
- * window. The step error is the shadow's difference where significant,
- * else its standard error (s->step_bounded). */
+/* The long run's scatter: the estimate's bar (the standard error of its
+ * batches' mean and half its drift), its standard error taken as the
+ * largest of the batches' own and that of the batches merged 2 and 4 at
+ * a time (at least LONG_BLOCKS of them). On the chaotic feed the motion
+ * is correlated beyond a batch at some angles (the reference's 16-s
+ * windows scatter up to 2.5 times as much as its 4-s windows say,
+ * tests/bench/zoo/chaos_ref.tsv at 105 deg), which the batches alone read
+ * low. */
+#define LONG_BLOCKS 8
+static double long_stat(const sim *s)
+{
+	const estimator *e = &s->est;
+	double u = e->bar.uncertainty, half = 0.5 * e->bar.drift, se2 = u * u - half * half;
+	for (int k = 2; k <= 4 && (e->n_rec - 1) / k >= LONG_BLOCKS; k *= 2) {
+		int nb = (e->n_rec - 1) / k;
+		double v[EST_RECORDS], mean = 0.0, span = 0.0, ss = 0.0;
+		for (int i = 0; i < nb; i++) {
+			double dt = e->rec_t[(i + 1) * k] - e->rec_t[i * k];
+			v[i] = (e->rec_X[(i + 1) * k] - e->rec_X[i * k]) / dt;
+			mean += v[i] * dt;
+			span += dt;
+		}
+		mean /= span;
+		for (int i = 0; i < nb; i++)
+			ss += (v[i] - mean) * (v[i] - mean);
+		se2 = fmax(se2, ss / (nb - 1) / nb);
+	}
+	return sqrt(se2 + half * half);
+}
+
+/* The long run's bar at its present time with the running shadow's raw
+ * step error and standard error (shadow_peek): the scatter (long_stat),
+ * the step error as shadow_finish bounds it, the machine step's term;
+ * *shrink the part that shrinks as one over the root of the window. */
+static double long_bar(const sim *s, double raw, double se, double *shrink)
+{
+	double stat = long_stat(s);
+	int scatter = raw <= SHADOW_SIGNIFICANT * se;
+	*shrink = stat + (scatter ? se : 0.0);
+	return stat + (scatter ? se : raw) + s->st.machine_error;
+}
+
+/* The long run of a scatter-dominated point: from the settled start, at
+ * the first run's machine step and twice its sub-steps, its shadow beside
+ * it throughout, to the first
+ * check (MEASURE_LONG_FIRST) and on where the bar misses tol and more
+ * window can bring it within (MEASURE_LONG_MAX). The step error is the
+ * shadow's difference where significant, else its standard error
+ * (s->step_bounded). */
 static int measure_long(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			double t_end, const settled_start *start, coarser_run *c, sim_status *st,
 			char *msg, size_t msglen)
@@ -264,22 +336,44 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 	double t0 = fmax(0.0, sc->transient), w = t_end - t0;
 	double stat = st->transport_velocity_uncertainty - st->step_error;
 	double root = (stat * sqrt(c->ran) + c->se * sqrt(SHADOW_MEASURE_SHARE * w)) /
-		      (MEASURE_LONG_AIM * st->tol_allowed);
-	double len = fmin(MEASURE_LONG_MAX * w, fmax(w, root * root));
+		      (MEASURE_LONG_AIM * scatter_scale(st));
+	double len = fmin(MEASURE_LONG_FIRST * w, fmax(w, root * root));
 	int err;
-	/* an even number of sub-steps: the shadow's half of them, r = 2 */
+	/* twice the first run's sub-steps made even, the shadow half of them
+	 * (r = 2): 3 sub-steps are not yet first order at some angles (at 80
+	 * deg cw over 48 s, 3 and 6 sub-steps gave v 0.33 mm/s apart and 6
+	 * sub-steps 0.65 mm/s from v_ref), and the finer run's own error is
+	 * the smaller */
 	sim_method even = *m;
 	even.dt = st->dt;
-	even.substeps = st->substeps + st->substeps % 2;
+	even.substeps = 2 * (st->substeps + st->substeps % 2);
 	sim *s = sim_restore(p, sc, &even, start->buf, start->len, &err, msg, msglen);
 	if (!s)
 		return err;
 	s->step_bounded = 1;
-	s->shadow_until = t0 + len;
-	err = sim_advance(s, nextafter(t0 + len, INFINITY));
+	s->shadow_until = t0 + MEASURE_LONG_MAX * w;
+	for (;;) {
+		err = sim_advance(s, t0 + len);
+		double raw, se, shrink;
+		if (err != SIM_OK || len >= MEASURE_LONG_MAX * w || !shadow_peek(s, &raw, &se))
+			break;
+		double bar = long_bar(s, raw, se, &shrink), room = s->st.tol_allowed - (bar - shrink);
+		if (bar <= s->st.tol_allowed || !(room > 0.0))
+			break;
+		double need = MEASURE_LONG_MARGIN * len * (shrink / room) * (shrink / room);
+		if (need > MEASURE_LONG_MAX * w)
+			break;
+		len = fmin(MEASURE_LONG_MAX * w, fmax(need, 1.25 * len));
+	}
+	if (err == SIM_OK && s->shadow) {
+		s->shadow_until = t0 + len;
+		err = sim_advance(s, nextafter(t0 + len, INFINITY));
+	}
 	if (err != SIM_OK && msg)
 		snprintf(msg, msglen, "%s", s->error);
 	*st = s->st;
+	st->transport_velocity_uncertainty = long_stat(s) + st->step_error;
+	st->tol_met = st->transport_velocity_uncertainty <= st->tol_allowed;
 	sim_free(s);
 	return err;
 }
@@ -318,7 +412,7 @@ static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m
 		 * first-order one shrinks: what remains is not the steps' */
 		if (err != SIM_OK || !may_refine || st.tol_met || !refine_asks(&st, last))
 			break;
-		double room = st.tol_allowed - (st.transport_velocity_uncertainty - st.step_error);
+		double room = room_of(&st);
 		last = st.step_error;
 		/* first order in both steps: the step whose term is the larger
 		 * shrinks by the factor asked (the machine step with the feed

@@ -345,8 +345,9 @@ typedef struct sim_status {
 	double machine_error;     /* m/s: the machine step's term within it */
 	double tol;               /* the accuracy target in use (sim_method.tol) */
 	double tol_allowed;       /* m/s: the error tol allows at this v:
-				     tol max(|v|, 0.3 v_peak), v_peak estimated
-				     from the trough's vibration speed */
+				     tol |v| where |v| >= 0.3 v_peak, else tol
+				     v_peak, v_peak estimated from the trough's
+				     vibration speed */
 	int tol_met;              /* 1 when the whole uncertainty is within
 				     tol_allowed */
 	double rotor_speed_mean;  /* rad/s, motor_torque_mean N m, power_mean W:

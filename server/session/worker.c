@@ -249,6 +249,7 @@ static int pace(srv_session *s, clocks *c, double t_next)
 		c->anchor_t = s->st.t;
 	}
 	c->batch_start = c->batch_end = now;
+	c->batch_steps = 0;
 	return 0;
 }
 
@@ -263,24 +264,60 @@ static int step(srv_session *s, double t_next, char *why, size_t whylen)
 	sim_status st;
 	api_bed bed = s->dem.bed;
 	int rc = SIM_OK;
+	uint64_t steps = s->st.steps;
 	pthread_mutex_unlock(&s->lock);
 	if (!s->dem.link)
 		rc = sim_advance(s->sim, t_next);
 	else if (srv_dem_step(s, t_next, why, whylen))
 		rc = SIM_EDIVERGED;
-	sim_get_status(s->sim, &st);
 	if (s->dem.link) {
+		sim_get_status(s->sim, &st);
 		srv_dem_controlled(s, &st);
 		srv_dem_read(s, &st, &bed);
 	}
 	srv_ring_gather(s);
 	pthread_mutex_lock(&s->lock);
-	if (st.steps > s->st.steps)
-		atomic_fetch_add(&srv_stats.steps, st.steps - s->st.steps);
-	s->st = st;
-	s->dem.bed = bed;
+	if (s->dem.link) {
+		s->st = st;
+		s->dem.bed = bed;
+	} else {
+		/* straight into the session's status: one copy of it a sample
+		 * fewer (the worker alone touches the sim) */
+		sim_get_status(s->sim, &s->st);
+	}
+	if (s->st.steps > steps)
+		atomic_fetch_add(&srv_stats.steps, s->st.steps - steps);
 	srv_ring_sample(s);
 	return rc;
+}
+
+/* A paced batch reads the clock after every this many steps (and at its
+ * start, pace()), so that a batch that runs long (its thread put off the
+ * CPU) still wakes its readers every PUBLISH_EVERY. */
+#define BATCH_CLOCK_EVERY 16
+
+/* After a step: a flat-out session reads the clock (the cpu phase, next,
+ * takes it), meters and wakes its readers every PUBLISH_EVERY; a paced
+ * one's batch began at a time read once (pace()), which stands for now
+ * but every BATCH_CLOCK_EVERY steps, and its readers are woken at the
+ * batch's end, or every PUBLISH_EVERY of a long batch (a read of the
+ * clock a sample was 1.8 % of a daemon of paced sessions:
+ * docs/performance.md). A step that failed wakes them at once. */
+static void after_step(srv_session *s, clocks *c, int rc)
+{
+	double since = c->publish_wall;
+	if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0) {
+		c->stepped_wall = srv_now();
+		meter(s, c, c->stepped_wall); /* paced: pace() */
+	} else if (++c->batch_steps % BATCH_CLOCK_EVERY == 0) {
+		c->stepped_wall = srv_now();
+		since = fmax(since, c->batch_start);
+	} else {
+		c->stepped_wall = c->batch_start;
+		since = INFINITY;
+	}
+	if (rc != SIM_OK || c->stepped_wall - since >= PUBLISH_EVERY)
+		srv_worker_publish(s, c);
 }
 
 /* job step: the experiment sees the step; it may end or hand over the
@@ -365,12 +402,7 @@ void *srv_worker_main(void *arg)
 		run_job(s);
 		if (rc != SIM_OK)
 			fail(s, rc, why);
-		/* one read of the clock a step: the cpu phase, next, takes it */
-		clk.stepped_wall = srv_now();
-		if (s->pace == API_PACE_MAX || s->restore.catch_up_t > 0)
-			meter(s, &clk, clk.stepped_wall); /* paced: pace() */
-		if (rc != SIM_OK || clk.stepped_wall - clk.publish_wall >= PUBLISH_EVERY)
-			srv_worker_publish(s, &clk);
+		after_step(s, &clk, rc);
 	}
 	if (srv_stopping()) { /* the next start continues from here */
 		/* the log first, here: the session has left the registry, so

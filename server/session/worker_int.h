@@ -22,6 +22,7 @@ typedef struct clocks {
 	double publish_wall;          /* when readers were last woken */
 	double batch_start;           /* pacing: when the last batch began */
 	double batch_end;             /* pacing: samples due by then step now */
+	int batch_steps;              /* pacing: steps since the batch began */
 	int want_all;                 /* pacing: a stream waited for every
 					 sample at the last wake-up */
 	double cost_cpu, cost_t;      /* CPU s and simulated t at the start of

@@ -5,13 +5,14 @@
 # a minute, two builds the first time): both built with frame pointers
 # (-fno-omit-frame-pointer, so that perf's call chains reach the worker's
 # loop) into build-prof/ (this one) and build-prof/prev-PREV (commit PREV,
-# default 7e56a85, exported with git archive), then tests/bench/profile.mjs
+# default dbe9ffc, main before the second pass of issue 37 item 1; the
+# round before compared with 7e56a85; exported with git archive), then tests/bench/profile.mjs
 # with PROFILE_N sessions (200) for PROFILE_SECONDS (8). Writes
 # $1/profile.md (default tests/bench/results).
 set -eu
 cd "$(dirname "$0")/../.."
 out=${1:-tests/bench/results}
-PREV=${PREV:-7e56a85}
+PREV=${PREV:-dbe9ffc}
 N=${PROFILE_N:-200}
 S=${PROFILE_SECONDS:-8}
 FP="-O2 -g -fno-omit-frame-pointer"

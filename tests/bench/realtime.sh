@@ -5,16 +5,16 @@
 # minutes): tests/bench/realtime.mjs for each N of REALTIME_N (default
 # "200 600 1000": within the default --max-paced-cores, beyond it, where the
 # admitted must keep real time and the rest get 503, and issue 37's target). The previous build
-# is commit PREV (default: main before the daemon's overhead was cut, the
-# ring's slots and the workers' per-sample work, 7e56a85; the round before
-# compared with 1b75a01), exported with git archive and built once
+# is commit PREV (default: main before the second pass on the workers'
+# per-sample work, dbe9ffc; the rounds before compared with 7e56a85 and
+# 1b75a01), exported with git archive and built once
 # into $BUILD/prev-PREV (`make build/convsimd`); PREV_CONVSIMD names a
 # built one instead. Writes $1/realtime.md.
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
-PREV=${PREV:-7e56a85}
+PREV=${PREV:-dbe9ffc}
 prev=${PREV_CONVSIMD:-}
 if [ -z "$prev" ]; then
 	prev_dir="$BUILD/prev-$PREV"
