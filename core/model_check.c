@@ -42,7 +42,7 @@ static const map_point map[] = {
 
 /* Settings that are controls, not part of a scene's check: the angle and
  * the sense are interpolated over, the ramps only decide how a control is
- * reached. */
+ * reached (copy_controls sets the same fields). */
 static int is_control(const char *name)
 {
 	static const char *const controls[] = {"beta", "rotation", "beta_rate", "beta_accel",
@@ -51,6 +51,20 @@ static int is_control(const char *name)
 		if (strcmp(name, controls[i]) == 0)
 			return 1;
 	return 0;
+}
+
+/* dst's controls (is_control's settings, the same list) set to src's, or to
+ * 0 where src is NULL: what first_difference and the memo compare without. */
+static void copy_controls(sim_params *dst, const sim_params *src)
+{
+	static const sim_params zero;
+	if (!src)
+		src = &zero;
+	dst->beta = src->beta;
+	dst->rotation = src->rotation;
+	dst->beta_rate = src->beta_rate;
+	dst->beta_accel = src->beta_accel;
+	dst->drive_accel = src->drive_accel;
 }
 
 /* The settings of entry point e: its preset with its changes applied.
@@ -106,11 +120,7 @@ static const char *first_difference(const sim_params *p, const sim_scene *s,
 	/* the common answer first: the same bytes once the controls are
 	 * copied (padding that differs only sends it the long way) */
 	sim_params same_controls = *q;
-	same_controls.beta = p->beta;
-	same_controls.rotation = p->rotation;
-	same_controls.beta_rate = p->beta_rate;
-	same_controls.beta_accel = p->beta_accel;
-	same_controls.drive_accel = p->drive_accel;
+	copy_controls(&same_controls, p);
 	if (!memcmp(&same_controls, p, sizeof *p) && s->friction == t->friction)
 		return NULL;
 	size_t n;
@@ -226,8 +236,7 @@ static _Thread_local struct {
 static void memo_for(const sim_params *p, const sim_scene *sc)
 {
 	sim_params k = *p;
-	k.beta = k.beta_rate = k.beta_accel = k.drive_accel = 0;
-	k.rotation = 0;
+	copy_controls(&k, NULL);
 	if (memo.valid && !memcmp(&k, &memo.p, sizeof k) && !memcmp(sc, &memo.sc, sizeof *sc))
 		return;
 	memo.valid = 1;

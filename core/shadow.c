@@ -118,6 +118,25 @@ static double paired_se(const estimator *a, const estimator *b)
 	return sqrt(ss / (nb - 1) / nb * (1.0 + rho) / (1.0 - rho));
 }
 
+/* A running shadow's step error as shadow_finish would set it now, the
+ * shadow left running: *raw the difference over (r - 1), *se its standard
+ * error (paired_se; NaN where the batches do not pair). 0 where it has
+ * measured nothing yet (no shadow, too few periods, failed). */
+int shadow_peek(const sim *s, double *raw, double *se)
+{
+	if (!s->shadow || s->shadow->failed)
+		return 0;
+	estimate a, b;
+	estimator_read(&s->est, &a);
+	estimator_read(&s->shadow->est, &b);
+	if (a.transport_periods < SHADOW_MIN_PERIODS || b.transport_periods < SHADOW_MIN_PERIODS)
+		return 0;
+	double r = (double)s->cfg.substeps / (double)s->shadow->cfg.substeps;
+	*raw = fabs(b.transport_velocity - a.transport_velocity) / (r - 1.0);
+	*se = paired_se(&s->est, &s->shadow->est) / (r - 1.0);
+	return 1;
+}
+
 /* The shadow's estimate against this instance's, both at shadow_until. */
 void shadow_finish(sim *s)
 {

@@ -89,6 +89,10 @@ sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method
 void shadow_begin(sim *s);
 void shadow_finish(sim *s);
 void shadow_stop(sim *s);
+/* shadow_peek: a running shadow's step error and its standard error as
+ * shadow_finish would set them now (measure.c's long run checks its bar
+ * with it); 0 where it has none yet. */
+int shadow_peek(const sim *s, double *raw, double *se);
 /* shadow_against: the step error from a coarser run instead of a shadow
  * (v_coarse, its feed step h_coarse: its shadow_v, from the same start),
  * at shadow_until; s has no shadow then. */

@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The self-test of tests/bench/fast_feed_check.py (`fast_feed_check.py
+--self-test`, in `make test`): its leave-one-depth-out bookkeeping on a
+fake runner whose v is a known function of the candidate and the point,
+no convsim needed."""
+import os
+import statistics
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fast_feed_check import R_FLOOR, evaluate, fit, rests  # noqa: E402
+
+
+class FakeRunner:
+    """The self-test's runner: v = a known function of the candidate and
+    the point; records the depths each get() saw."""
+
+    def __init__(self):
+        self.seen = []
+
+    def cost(self, cand, p):
+        return float(len(cand.get("Rs", (1,))))
+
+    def long_v(self, cand, p):
+        return self.get(cand, p)[0]
+
+    def get(self, cand, p):
+        self.seen.append(p["depth"])
+        if "e" in cand:
+            return cand["mu"] * p["beta"] / 100.0, 1.0
+        # the depth-d data are made by R = 0.15 d (d = 1, 2: 0.15, 0.3)
+        return statistics.fmean(r * p["beta"] / 100.0 for r in rests(cand, p)), 1.0
+
+
+def self_test():
+    """Checks of the harness itself (no convsim): a fit never sees the
+    depth it predicts, and the errors are (v - v_DEM) / the peak."""
+    pts = [{"material": "m", "drive": "preset", "depth": d, "beta": b, "v_dem": 0.15 * d * b / 100.0,
+            "sd": 0.0} for d in (1, 2) for b in (30, 60, 90)]
+    peak = {("m", "preset", d): 0.15 * d * 0.9 for d in (1, 2)}
+    run = FakeRunner()
+    train = [p for p in pts if p["depth"] == 2]
+    best = fit(run, "closure", train, peak)
+    checks = [("a fit sees only its training depth", set(run.seen) == {2}),
+              ("the fit finds the training depth's R", best["Rs"] == (0.3,))]
+    recs = evaluate(FakeRunner(), pts, peak)
+    r = [x for x in recs if x["depth"] == 1 and x["beta"] == 90][0]
+    # depth 1 predicted by depth 2's R 0.3: v 0.27 against 0.135, peak 0.135
+    checks.append(("held-out error", abs(r["closure_err"] - 1.0) < 1e-12))
+    checks.append(("paper's error", abs(r["err_paper"] - (0.045 - 0.135) / 0.135) < 1e-12))
+    lay = {"Rs": (0.5, 0.75), "P": 1}
+    checks.append(("layered: R^d at P 1", rests(lay, {"depth": 2}) == (0.25, 0.5625)))
+    checks.append(("layered: R^(d^0.5) at P 0.5",
+                   rests(dict(lay, P=0.5), {"depth": 4}) == (0.25, 0.5625)))
+    checks.append(("layered: R at P 0", rests(dict(lay, P=0), {"depth": 8}) == (0.5, 0.75)))
+    checks.append(("layered: R no less than convsim's 0.001",
+                   rests({"Rs": (0.05,), "P": 1}, {"depth": 8}) == (R_FLOOR,)))
+    run = FakeRunner()
+    fit(run, "layered", train, peak)
+    checks.append(("a layered fit sees only its training depth", set(run.seen) == {2}))
+    # held out, depth 1 runs the depth-2 fit's R at d = 1: R_bed = R, whatever P
+    lr = [x for x in recs if x["depth"] == 1]
+    best = fit(FakeRunner(), "layered", train, peak)
+    checks.append(("layered held out at depth 1", all(
+        abs(x["layered_v"] - statistics.fmean(best["Rs"]) * x["beta"] / 100.0) < 1e-12 for x in lr)))
+    for name, ok in checks:
+        print("%s - %s" % ("ok" if ok else "not ok", name))
+    failed = sum(1 for _, ok in checks if not ok)
+    print("# pass %d\n# fail %d" % (len(checks) - failed, failed))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(self_test())
