@@ -132,6 +132,24 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
         'the closed stream counted out');
       assert.ok(Math.abs(await held() - (taken - cost - mine * STREAM - STREAM)) < 1e-9);
     }
+    // the charge counts the numbers of the fields asked: trough and rotor
+    // are 14 a sample (t, beta, beta_target, 6 and 5), as the records say
+    const before2 = await held();
+    const rotor = await open(d.base, ids[1], '?format=ndjson&fields=trough,rotor&rate=10');
+    streams.push(rotor);
+    assert.equal(rotor.status, 200, rotor.text);
+    assert.ok(Math.abs(await held() - before2 - (10 * 75e-6 + 10 * 14 * 1.5e-6)) < 1e-9,
+      `held ${await held()} after ${before2}`);
+    await until(() => rotor.records.some((x) => x.type === 'sample'), 10000 * SLOW, 'a sample');
+    const sample = rotor.records.find((x) => x.type === 'sample');
+    assert.equal(Object.entries(sample).filter(([k, v]) => k !== 'id' && typeof v === 'number').length, 14,
+      JSON.stringify(sample));
+    // a default stream of every sample: 50 wake-ups and 250 records of 35
+    // numbers (5 columns), 16.9 ms of CPU per simulated s, more than the
+    // whole budget's room
+    const all = await open(d.base, ids[1], '?format=ndjson');
+    assert.equal(all.status, 503, all.text);
+    assert.match(all.body.detail, /^this stream needs 0\.0169 cores \(16\.9 ms of CPU per simulated s at pace 1\)/);
   } finally {
     for (const s of streams) s.close();
     assert.equal((await d.stop()).code, 0, d.stderr());
