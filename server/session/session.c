@@ -145,6 +145,15 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	 * estimate alone */
 	s->budget.cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
+	/* refused here where the estimate alone does not fit the paced cores
+	 * (the answer create would give): a flood of creations beyond the
+	 * budget would otherwise spend a probe and a ring on each, CPU taken
+	 * from the sessions that run */
+	if (s->pace != API_PACE_MAX &&
+	    s->budget.cpu_per_s * s->pace > srv_budget_paced_limit() - srv_budget_paced() &&
+	    srv_budget_take_paced(&s->budget.paced_held, s->budget.cpu_per_s, s->pace, "pace",
+				  "created", pb) != API_OK)
+		return -1;
 	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
 							   cfg->cpu_probe)
 					   : -1.0;
