@@ -53,13 +53,10 @@ export async function heldInRealTime(base, N, seconds = 10) {
     if (status !== 200) throw new Error(`stream ${i}: ${status} ${st.text || st.error || ''}`);
     streams.push(st);
   }
-  // the lag from 3 s after the last creation, against each stream's
-  // fastest delivery since the last creation (as when the streams were
-  // opened after all creations): the running sessions as they run on; a
-  // session that fell behind during the creations (and does not catch up)
-  // shows in its rtf only while it is behind
-  const now = performance.now();
-  for (const st of streams) { st.baseFrom = now; st.collectFrom = now + 3000; }
+  // the lag from 3 s after the last creation: the running sessions as
+  // they run on
+  const from = performance.now() + 3000;
+  for (const st of streams) st.collectFrom = from;
   await sleep(seconds * 1000);
   // a fresh connection: a proxy may have closed the kept-alive one while
   // the sessions ran

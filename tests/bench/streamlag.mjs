@@ -39,8 +39,7 @@ export function call(base, method, path, body, { agent, localAddress } = {}) {
 
 // A stream client of session id: NDJSON or SSE, `rate` samples per
 // simulated second of the trough group. Collects lags (ms) after `warmup`
-// ms (or from st.collectFrom, a performance.now() time, once set; the
-// fastest delivery from st.baseFrom on, where set); stop()
+// ms (or from st.collectFrom, a performance.now() time, once set); stop()
 // closes it. status: the HTTP status once answered; ready: a promise of it
 // (0: the connection failed), with the body of a refusal in text.
 export function lagStream(base, id, { ndjson, rate = 10, localAddress, warmup = 0 } = {}) {
@@ -72,7 +71,7 @@ export function lagStream(base, id, { ndjson, rate = 10, localAddress, warmup = 
         const now = performance.now();
         const offset = now - 1000 * Number(m[1]);
         st.samples++;
-        if (now >= (st.baseFrom ?? 0) && offset < st.minOffset) st.minOffset = offset;
+        if (offset < st.minOffset) st.minOffset = offset;
         if (now >= (st.collectFrom ?? started + warmup)) st.offsets.push(offset);
       }
     });
