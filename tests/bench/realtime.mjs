@@ -53,8 +53,10 @@ export async function heldInRealTime(base, N, seconds = 10) {
     if (status !== 200) throw new Error(`stream ${i}: ${status} ${st.text || st.error || ''}`);
     streams.push(st);
   }
-  // the lag from 3 s after the last creation: the running sessions as
-  // they run on
+  // the lag from 3 s after the last creation, against each stream's
+  // fastest delivery over its whole life (from its session's creation): a
+  // session that fell behind while later ones were created, and did not
+  // catch up, shows in it
   const from = performance.now() + 3000;
   for (const st of streams) st.collectFrom = from;
   await sleep(seconds * 1000);
