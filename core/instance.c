@@ -6,11 +6,13 @@
  * instance), checkpoint.c (a restored one) and shadow.c (the measured
  * step error's second instance). Also the feed masses a running instance
  * takes (sim_feed_mass_range), which depend on the method as sim_alloc
- * resolves it.
+ * resolves it, and what an instance would integrate, looked at without
+ * its start (sim_preview).
  */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "sim_int.h"
 #include "units.h"
@@ -66,6 +68,25 @@ fail:
 		*err = e;
 	sim_free(s);
 	return NULL;
+}
+
+int sim_preview(const sim_params *p, const sim_scene *sc, const sim_method *m,
+		sim_status *st, int *columns, int *layers, char *msg, size_t msglen)
+{
+	int err = SIM_OK;
+	memset(st, 0, sizeof *st);
+	*columns = *layers = 0;
+	sim *s = sim_alloc(p, sc, m, &err, msg, msglen);
+	if (!s)
+		return err ? err : SIM_ENOMEM;
+	st->dt = s->cfg.dt;
+	st->substeps = s->cfg.substeps;
+	st->reductions = s->md.reductions;
+	st->n_dof = s->md.nq + 2 * s->md.nf;
+	*columns = sim_columns(s);
+	*layers = sim_layers(s);
+	sim_free(s);
+	return SIM_OK;
 }
 
 void sim_free(sim *s)

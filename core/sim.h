@@ -371,6 +371,16 @@ typedef struct sim_status {
 /* Copy the status at the observed time into *st (SI units). Reading never
  * changes the instance, its counters included. */
 void sim_get_status(const sim *s, sim_status *st);
+/* What sim_new would build for this set, without building it: the
+ * integrator's step and feed sub-steps in use, the reductions and the
+ * integrated coordinates (st's dt, substeps, reductions and n_dof as
+ * sim_new's status reports them; the rest of *st zero) and sim_columns /
+ * sim_layers (*columns, *layers), from the set validated and the
+ * workspace sized but nothing settled: what a caller decides from (the
+ * daemon's CPU estimate) before paying for the start. Returns SIM_OK, or
+ * sim_new's error before its start with the same *msg. */
+int sim_preview(const sim_params *p, const sim_scene *s, const sim_method *m,
+		sim_status *st, int *columns, int *layers, char *msg, size_t msglen);
 
 /* Restart the transport-velocity estimator at the next period boundary
  * (for example after a beta change, to measure the new steady state). */

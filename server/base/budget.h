@@ -69,6 +69,12 @@ double srv_budget_sample_cpu(int columns, int layers);
  * and load"); a running session's worker measures its own. */
 double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			       int columns, int layers);
+/* The same estimate before the instance is built: from what sim_new
+ * would integrate (sim_preview: the set validated, nothing settled), so
+ * that a creation the cores cannot take is refused for the price of its
+ * parse. API_OK and *cpu_per_s, or sim_new's validation error in *pb as a
+ * session's creation answers it. */
+api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
 /* Raise what a paced session holds (*held, cores; the caller's, guarded
  * by its lock) to need = cpu_per_s x pace. API_OK when need <= *held or
  * the running paced sessions' sum stays within --max-paced-cores; else

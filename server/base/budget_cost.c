@@ -2,7 +2,8 @@
 /*
  * budget_cost.c - the CPU cost model of a session: CPU s per simulated s
  * estimated from its integrator's descriptor (cost, default steps) and
- * its feed before it runs, and the cost of a published sample. The cores
+ * its feed before it runs (also before its instance is built and settled:
+ * srv_budget_cpu_preview), and the cost of a published sample. The cores
  * of paced sessions (budget.c) are committed from it until the worker
  * has measured the session's own.
  */
@@ -67,6 +68,19 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
 			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
 	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
+}
+
+api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
+{
+	char msg[256] = "";
+	sim_status st;
+	int columns, layers;
+	int err = sim_preview(&spec->params, &spec->scene, &spec->method, &st, &columns, &layers,
+			      msg, sizeof msg);
+	if (err != SIM_OK)
+		return api_fail(pb, api_from_sim(err), NULL, "%s", msg[0] ? msg : sim_strerror(err));
+	*cpu_per_s = srv_budget_cpu_estimate(spec, &st, columns, layers);
+	return API_OK;
 }
 
 double srv_budget_sample_cpu(int columns, int layers)

@@ -56,6 +56,7 @@ static void session_free(srv_session *s)
 {
 	if (!s)
 		return;
+	int buffers = s->sim || s->ring.hist;
 	srv_dem_free(s); /* the bed process ends before its machine */
 	if (s->dem.slot)
 		srv_dem_release();
@@ -73,8 +74,11 @@ static void session_free(srv_session *s)
 	pthread_cond_destroy(&s->data);
 	free(s);
 	/* a session's buffers are megabytes: give the pages back to the
-	 * system rather than keep them in the allocator (glibc) */
-	malloc_trim(0);
+	 * system rather than keep them in the allocator (glibc); a creation
+	 * refused before its instance was built has none (and a trim costs a
+	 * refusal a tenth of its CPU) */
+	if (buffers)
+		malloc_trim(0);
 }
 
 /* Tell the worker to stop and every waiter to look again. */
@@ -169,6 +173,25 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
+/* A paced creation whose estimate does not fit the room the running paced
+ * sessions leave is refused here, before sim_new builds and settles its
+ * instance (most of what a refusal cost: a flood of refused creations took
+ * the cores of the sessions that run): the estimate from what the instance
+ * would integrate (srv_budget_cpu_preview) is the one session_init makes,
+ * so the answer is the one the whole path would give. A LIGGGHTS bed's
+ * session is charged its bed's cores (session_init). 1 with *pb. */
+static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
+{
+	double cpu;
+	if (spec->pace == API_PACE_MAX || srv_dem_wanted(spec))
+		return 0;
+	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
+		return 1;
+	return cpu * spec->pace > srv_budget_paced_limit() - srv_budget_paced() &&
+	       srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
+				     pb) != API_OK;
+}
+
 srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
@@ -205,6 +228,8 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		s->budget.mem_reserved = 0;
 		goto fail;
 	}
+	if (refused_early(s, spec, pb))
+		goto fail;
 	s->create_fd = client_fd;
 	int bad = session_init(s, spec, pb);
 	s->create_fd = -1;
