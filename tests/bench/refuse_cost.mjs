@@ -12,8 +12,6 @@
 //
 //   [CONVSIMD=build/convsimd] [OLD=path] [COUNT=2000] [LIMIT=0.01] [IN_FLIGHT=4] node tests/bench/refuse_cost.mjs
 import http from 'node:http';
-import { execSync } from 'node:child_process';
-import { loadavg } from 'node:os';
 import { resolve } from 'node:path';
 import { startDaemon } from '../http/lib.mjs';
 import { call, procUsage, quantile, fmt } from './streamlag.mjs';
@@ -70,22 +68,16 @@ async function run(bin) {
   }
 }
 
-function build(bin) {
-  try {
-    return execSync(`git -C ${resolve(bin, '../..')} rev-parse --short=12 HEAD`).toString().trim();
-  } catch {
-    return '?';
-  }
-}
-
-const load = loadavg().map((x) => x.toFixed(2)).join(' ');
-console.log(`\`node tests/bench/refuse_cost.mjs\` (COUNT=${COUNT}, LIMIT=${LIMIT}, IN_FLIGHT=${IN_FLIGHT}), ` +
-  `${new Date().toISOString().slice(0, 16)} UTC, build ${build(NEW)}, load average ${load} at the start\n`);
-console.log('| build | admitted | refused (503 cpu) | other | wall s | daemon CPU s | of it the sessions | CPU per refusal (ms) | latency p50 / p99 (ms) |');
+const runs = [...(OLD ? [[process.env.OLD_NAME || 'before', OLD]] : []), ['this', NEW]];
+console.log('# What a creation refused for CPU costs the daemon\n');
+console.log(`Command: \`${OLD ? `OLD=${OLD} ` : ''}COUNT=${COUNT} LIMIT=${LIMIT} IN_FLIGHT=${IN_FLIGHT} ` +
+  'node tests/bench/refuse_cost.mjs` (`bash tests/bench/refuse_cost.sh`): the cores for paced sessions ' +
+  `(--max-paced-cores ${LIMIT}) filled with default sessions at pace 1, then ${COUNT} more default creations, ` +
+  `${IN_FLIGHT} at a time, each refused 503 budget "cpu".\n`);
+console.log('| build | admitted | refused (503 cpu) | other answers | wall s | daemon CPU s | of it the sessions | CPU per refusal, ms | latency p50 / p99, ms |');
 console.log('|---|---|---|---|---|---|---|---|---|');
-for (const [name, bin] of [...(OLD ? [['before', OLD]] : []), ['this', NEW]]) {
+for (const [name, bin] of runs) {
   const r = await run(bin);
   console.log(`| ${name} | ${r.admitted} | ${r.refused} | ${r.other} | ${fmt(r.wall, 2)} | ${fmt(r.cpu, 2)} | ` +
     `${fmt(r.idle, 2)} | ${fmt(1e3 * r.perRefusal, 3)} | ${fmt(r.p50, 2)} / ${fmt(r.p99, 2)} |`);
 }
-console.log(`\nload average at the end: ${loadavg().map((x) => x.toFixed(2)).join(' ')}`);
