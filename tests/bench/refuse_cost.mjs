@@ -70,7 +70,7 @@ async function run(bin) {
 
 const runs = [...(OLD ? [[process.env.OLD_NAME || 'before', OLD]] : []), ['this', NEW]];
 console.log('# What a creation refused for CPU costs the daemon\n');
-console.log(`Command: \`${OLD ? `OLD=${OLD} ` : ''}COUNT=${COUNT} LIMIT=${LIMIT} IN_FLIGHT=${IN_FLIGHT} ` +
+console.log(`Command: \`${OLD ? 'OLD=path/to/previous/convsimd ' : ''}COUNT=${COUNT} LIMIT=${LIMIT} IN_FLIGHT=${IN_FLIGHT} ` +
   'node tests/bench/refuse_cost.mjs` (`bash tests/bench/refuse_cost.sh`): the cores for paced sessions ' +
   `(--max-paced-cores ${LIMIT}) filled with default sessions at pace 1, then ${COUNT} more default creations, ` +
   `${IN_FLIGHT} at a time, each refused 503 budget "cpu".\n`);

@@ -1,20 +1,38 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# What a creation refused for CPU costs the daemon (tests/bench/
-# refuse_cost.mjs, a few seconds): the figures behind docs/budgets.md
-# "What a refusal costs". OLD=path/to/convsimd (OLD_NAME its label) runs an
-# earlier build the same way first. Writes $1/refuse_cost.md.
+# What a creation refused for CPU costs the daemon, the previous build
+# beside this one in the same minutes (tests/bench/refuse_cost.mjs, a few
+# seconds): the figures behind docs/budgets.md "What a refusal costs". The
+# previous build is commit PREV (default 20f6f5e: main before a refusal
+# was decided ahead of the instance's settling), exported with git
+# archive and built once into $BUILD/prev-PREV (`make build/convsimd`);
+# PREV_CONVSIMD names a built one instead. Writes $1/refuse_cost.md.
 set -eu
 cd "$(dirname "$0")/../.."
+BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
+PREV=${PREV:-20f6f5e}
+prev=${PREV_CONVSIMD:-}
+if [ -z "$prev" ]; then
+	prev_dir="$BUILD/prev-$PREV"
+	prev="$prev_dir/src/build/convsimd"
+	if [ ! -x "$prev" ]; then
+		echo "refuse_cost: building the previous build ($PREV) in $prev_dir" >&2
+		mkdir -p "$prev_dir/src"
+		[ -f "$prev_dir/src/Makefile" ] || git archive "$PREV" | tar -x -C "$prev_dir/src"
+		make -C "$prev_dir/src" --no-print-directory -j2 build/convsimd > "$prev_dir/make.log" 2>&1 ||
+			{ tail -20 "$prev_dir/make.log"; exit 1; }
+	fi
+fi
 . tests/bench/provenance.sh
 line=$(provenance)
-CONVSIMD="${BUILD:-build}/convsimd" node tests/bench/refuse_cost.mjs > "$out/refuse_cost.md"
+CONVSIMD="$BUILD/convsimd" OLD="$prev" OLD_NAME=previous node tests/bench/refuse_cost.mjs > "$out/refuse_cost.md"
 stamp "$out/refuse_cost.md" "$line"
 {
 	echo
-	echo "Load average $(cut -d' ' -f1-3 /proc/loadavg) after. A refusal's CPU: the daemon's CPU (user + sys, /proc, 10-ms"
-	echo "ticks) over the refused creations less what its running sessions spent in as long a quiet window just"
-	echo "before, over the creations; the latency is the client's, a keep-alive connection each."
+	echo "Previous build: $PREV. Load average $(cut -d' ' -f1-3 /proc/loadavg) after. A refusal's CPU: the daemon's CPU"
+	echo "(user + sys, /proc, 10-ms ticks) over the refused creations less what its running sessions spent in"
+	echo "as long a quiet window just before, over the creations; the latency is the client's, over"
+	echo "keep-alive connections."
 } >> "$out/refuse_cost.md"
 cat "$out/refuse_cost.md"

@@ -66,7 +66,7 @@ bash tests/bench/realtime.sh "$out"
 echo "bench: what a stream costs the daemon per record (the charge of its streams in the paced budget)"
 bash tests/bench/stream_cost.sh "$out" > /dev/null
 echo "bench: what a creation refused for CPU costs the daemon (the paced budget full)"
-OLD="${OLD_CONVSIMD:-}" OLD_NAME=previous bash tests/bench/refuse_cost.sh "$out" > /dev/null
+bash tests/bench/refuse_cost.sh "$out" > /dev/null
 echo "bench: PATCH throughput with the durable control log (loopback, a temporary data directory)"
 { echo "Command: \`node tests/bench/controls.mjs\` (part of \`make bench\`). $(provenance)"; echo
 	CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs; } | tee "$out/controls.md"
