@@ -109,6 +109,25 @@ static void destroy(srv_entry *en)
 	session_free(s);
 }
 
+/* A paced creation whose estimate does not fit the room the running paced
+ * sessions leave is refused here, before sim_new builds and settles its
+ * instance (most of what a refusal cost: a flood of refused creations took
+ * the cores of the sessions that run): the estimate from what the instance
+ * would integrate (srv_budget_cpu_preview) is the one session_init makes,
+ * so the answer is the one the whole path would give. A LIGGGHTS bed's
+ * session is charged its bed's cores (session_init). 1 with *pb. */
+static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
+{
+	double cpu;
+	if (spec->pace == API_PACE_MAX || srv_dem_wanted(spec))
+		return 0;
+	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
+		return 1;
+	return cpu * spec->pace > srv_budget_paced_limit() - srv_budget_paced() &&
+	       srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
+				     pb) != API_OK;
+}
+
 /* Build s for spec: its sim instance, the initial status and the buffers
  * (lock and conditions are initialised). 0, or -1 with *pb. */
 static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
@@ -122,6 +141,8 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->state = SRV_RUNNING;
 	s->budget.cpu_limit = cfg->max_cpu_seconds;
 	s->budget.turn.wake = &s->wake;
+	if (refused_early(s, spec, pb))
+		return -1;
 	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
 			 sizeof msg);
 	if (!s->sim) {
@@ -173,25 +194,6 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
-/* A paced creation whose estimate does not fit the room the running paced
- * sessions leave is refused here, before sim_new builds and settles its
- * instance (most of what a refusal cost: a flood of refused creations took
- * the cores of the sessions that run): the estimate from what the instance
- * would integrate (srv_budget_cpu_preview) is the one session_init makes,
- * so the answer is the one the whole path would give. A LIGGGHTS bed's
- * session is charged its bed's cores (session_init). 1 with *pb. */
-static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
-{
-	double cpu;
-	if (spec->pace == API_PACE_MAX || srv_dem_wanted(spec))
-		return 0;
-	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
-		return 1;
-	return cpu * spec->pace > srv_budget_paced_limit() - srv_budget_paced() &&
-	       srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
-				     pb) != API_OK;
-}
-
 srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
@@ -228,8 +230,6 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		s->budget.mem_reserved = 0;
 		goto fail;
 	}
-	if (refused_early(s, spec, pb))
-		goto fail;
 	s->create_fd = client_fd;
 	int bad = session_init(s, spec, pb);
 	s->create_fd = -1;
