@@ -114,8 +114,12 @@ static void destroy(srv_entry *en)
  * instance (most of what a refusal cost: a flood of refused creations took
  * the cores of the sessions that run): the estimate from what the instance
  * would integrate (srv_budget_cpu_preview) is the one session_init makes,
- * so the answer is the one the whole path would give. A LIGGGHTS bed's
- * session is charged its bed's cores (session_init). 1 with *pb. */
+ * so the answer is the one the whole path would give. One that fits holds
+ * its estimate from here on (raised to its probe's measure below, given
+ * back if it fails): creations that come meanwhile see the room taken
+ * rather than each spend a settling and a probe and all but one be
+ * refused at the end. A LIGGGHTS bed's session is charged its bed's cores
+ * (session_init). 1 with *pb. */
 static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 {
 	double cpu;
@@ -123,8 +127,7 @@ static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 		return 0;
 	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
 		return 1;
-	return cpu * spec->pace > srv_budget_paced_limit() - srv_budget_paced() &&
-	       srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
+	return srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
 				     pb) != API_OK;
 }
 
