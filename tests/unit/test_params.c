@@ -123,6 +123,56 @@ static void sim_new_refuses_invalid_sets(void **state)
 	assert_string_equal(msg, "layers must be an integer in [1, 64]");
 }
 
+/* sim_preview tells what sim_new builds (the daemon's CPU estimate is made
+ * from it before any instance exists): step, sub-steps, reductions,
+ * integrated coordinates and feed size as the new instance's status, for
+ * the preset (symmetric reduction, one column integrated), a rocking
+ * trough of 7 x 6 (every column integrated), a scene without feed, and an
+ * explicit step; and sim_new's refusal with its message. */
+static void preview_is_what_sim_new_builds(void **state)
+{
+	(void)state;
+	for (int k = 0; k < 4; k++) {
+		setup u = preset_defaults(); /* the daemon's: a settled start */
+		if (k == 1) {
+			u.sc.trough_rotation = 1;
+			u.sc.columns = 7;
+			u.sc.layers = 6;
+		} else if (k == 2) {
+			u.sc.feed = 0;
+		} else if (k == 3) {
+			u.m.dt = 5e-4;
+		}
+		char msg[200] = "";
+		int err = -1, columns = -1, layers = -1;
+		sim_status pv, st;
+		assert_int_equal(sim_preview(&u.p, &u.sc, &u.m, &pv, &columns, &layers, msg,
+					     sizeof msg), SIM_OK);
+		sim *s = sim_new(&u.p, &u.sc, &u.m, &err, msg, sizeof msg);
+		assert_non_null(s);
+		sim_get_status(s, &st);
+		assert_true(pv.dt == st.dt);
+		assert_int_equal(pv.substeps, st.substeps);
+		assert_int_equal(pv.reductions, st.reductions);
+		assert_int_equal(pv.n_dof, st.n_dof);
+		assert_int_equal(columns, sim_columns(s));
+		assert_int_equal(layers, sim_layers(s));
+		assert_int_equal(pv.steps, 0); /* nothing was run */
+		assert_int_equal(!!(pv.reductions & SIM_RED_SYMMETRIC), k != 1);
+		sim_free(s);
+	}
+	setup u = preset_defaults();
+	u.p.m2 = -3.0;
+	char msg[200];
+	int columns = -1, layers = -1;
+	sim_status pv;
+	assert_int_equal(sim_preview(&u.p, &u.sc, &u.m, &pv, &columns, &layers, msg, sizeof msg),
+			 SIM_EPARAM);
+	assert_string_equal(msg, "m2 must be a finite number in [0.001, 10000] kg");
+	assert_int_equal(columns, 0);
+	assert_int_equal(layers, 0);
+}
+
 static void every_setting_is_described(void **state)
 {
 	(void)state;
@@ -194,6 +244,7 @@ int main(void)
 		cmocka_unit_test(converts_units_and_enums),
 		cmocka_unit_test(user_units_come_back_as_written),
 		cmocka_unit_test(sim_new_refuses_invalid_sets),
+		cmocka_unit_test(preview_is_what_sim_new_builds),
 		cmocka_unit_test(every_setting_is_described),
 		cmocka_unit_test(errors_have_text),
 		cmocka_unit_test(method_choices_are_the_registry),
