@@ -7,10 +7,7 @@
 // measured, so the refusal's numbers are known in advance.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, metric, until, sleep, SLOW } from './lib.mjs';
-
-// printf's %.3g for the magnitudes here (1e-4 .. 1e3)
-const g3 = (x) => String(Number(x.toPrecision(3)));
+import { startDaemon, req, metric, until, sleep, SLOW, pacedBusy, fillPaced } from './lib.mjs';
 
 test('paced budget full: the next session gets 503 with the budget named, the running ones keep pace 1', { timeout: 90000 * SLOW }, async () => {
   const limit = 0.01;
@@ -18,17 +15,7 @@ test('paced budget full: the next session gets 503 with the budget named, the ru
   const held = async () => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
   try {
     // the first one tells the estimate (CPU s per simulated s at pace 1)
-    const first = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-    assert.equal(first.status, 201, first.text);
-    const cost = await held();
-    assert.ok(cost > 1e-4 && cost < limit / 2, `a default session's estimate: ${cost}`);
-    const fit = Math.floor(limit / cost);
-    const ids = [first.body.id];
-    while (ids.length < fit) {
-      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-      assert.equal(r.status, 201, `session ${ids.length + 1} of ${fit} fits: ${r.text}`);
-      ids.push(r.body.id);
-    }
+    const { ids, cost, fit } = await fillPaced(d, limit, held);
     const before = (await req(d.base, 'GET', '/metrics')).text;
     const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
     assert.equal(r.status, 503, r.text);
@@ -37,18 +24,7 @@ test('paced budget full: the next session gets 503 with the budget named, the ru
     // the holds summed as the daemon sums them, in the order they came
     let sum = 0;
     for (let i = 0; i < fit; i++) sum += cost;
-    assert.deepEqual(r.body, {
-      type: '/api/v1/problems/unavailable',
-      title: 'Service unavailable',
-      status: 503,
-      detail: `this session needs ${g3(cost)} cores (${g3(1e3 * cost)} ms of CPU per simulated s at pace 1) ` +
-        `and running paced sessions hold ${g3(sum)} of the ${limit} cores for paced sessions ` +
-        '(--max-paced-cores); nothing was created, retry when paced sessions have ended, paused or slowed down',
-      instance: '/api/v1/sessions',
-      field: 'pace',
-      budget: 'cpu',
-      limit,
-    });
+    assert.deepEqual(r.body, pacedBusy(cost, cost, 1, sum, limit));
     const after = (await req(d.base, 'GET', '/metrics')).text;
     for (const k of ['convsim_sessions', 'convsim_sessions_created_total', 'convsim_paced_cpu_cores']) {
       assert.equal(metric(after, k), metric(before, k), `${k}: nothing created or held`);

@@ -281,3 +281,41 @@ export async function startCluster(n, dir, env = {}) {
     },
   };
 }
+
+// printf's %.3g for the magnitudes the budgets' answers carry (1e-4 .. 1e3)
+export const g3 = (x) => String(Number(x.toPrecision(3)));
+
+// The 503 a creation gets when the cores for paced sessions cannot take it
+// (server/base/budget.c's words): it needs `need` cores, `cpu` CPU s a
+// simulated s at `pace`, while running paced sessions hold `sum` of `limit`.
+export const pacedBusy = (need, cpu, pace, sum, limit) => ({
+  type: '/api/v1/problems/unavailable',
+  title: 'Service unavailable',
+  status: 503,
+  detail: `this session needs ${g3(need)} cores (${g3(1e3 * cpu)} ms of CPU per simulated s at pace ${pace}) ` +
+    `and running paced sessions hold ${g3(sum)} of the ${limit} cores for paced sessions ` +
+    '(--max-paced-cores); nothing was created, retry when paced sessions have ended, paused or slowed down',
+  instance: '/api/v1/sessions',
+  field: 'pace',
+  budget: 'cpu',
+  limit,
+});
+
+// Default sessions at pace 1 (until 600) created on d until as many as
+// --max-paced-cores `limit` takes run; held() reads what they hold. The
+// first one's hold is a session's cost. {ids, cost, fit}.
+export async function fillPaced(d, limit, held, least = 1e-4) {
+  const create = () => req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+  const first = await create();
+  assert.equal(first.status, 201, first.text);
+  const cost = await held();
+  assert.ok(cost > least && cost < limit / 2, `a default session's estimate: ${cost}`);
+  const fit = Math.floor(limit / cost);
+  const ids = [first.body.id];
+  while (ids.length < fit) {
+    const r = await create();
+    assert.equal(r.status, 201, `session ${ids.length + 1} of ${fit} fits: ${r.text}`);
+    ids.push(r.body.id);
+  }
+  return { ids, cost, fit };
+}

@@ -12,10 +12,8 @@
 // no worker's measure replaces its hold before the test ends.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, metric, SLOW } from './lib.mjs';
+import { startDaemon, req, metric, SLOW, g3, pacedBusy } from './lib.mjs';
 
-// printf's %.3g for the magnitudes here (1e-4 .. 1e3)
-const g3 = (x) => String(Number(x.toPrecision(3)));
 const DEFAULT = {};
 const LIGHT = { scene: { drive: 'ideal', feed: false }, sample_rate: 10 };
 const HEAVY = { scene: { trough_rotation: true, columns: 7, layers: 6 } }; // no symmetric reduction
@@ -42,18 +40,7 @@ async function estimates() {
   return out;
 }
 
-const busy = (need, cpu, pace, sum, limit) => ({
-  type: '/api/v1/problems/unavailable',
-  title: 'Service unavailable',
-  status: 503,
-  detail: `this session needs ${g3(need)} cores (${g3(1e3 * cpu)} ms of CPU per simulated s at pace ${pace}) ` +
-    `and running paced sessions hold ${g3(sum)} of the ${limit} cores for paced sessions ` +
-    '(--max-paced-cores); nothing was created, retry when paced sessions have ended, paused or slowed down',
-  instance: '/api/v1/sessions',
-  field: 'pace',
-  budget: 'cpu',
-  limit,
-});
+const busy = pacedBusy;
 
 test('with the paced cores full, the early refusal answers as the whole path and refuses nothing that fits', { timeout: 90000 * SLOW }, async () => {
   const c = await estimates();

@@ -10,10 +10,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
-import { startDaemon, req, metric, until, SLOW } from './lib.mjs';
-
-// printf's %.3g for the magnitudes here (1e-4 .. 1e3)
-const g3 = (x) => String(Number(x.toPrecision(3)));
+import { startDaemon, req, metric, until, SLOW, g3, fillPaced } from './lib.mjs';
 
 // The charge of a ?fields=trough&rate=10 stream of a default session (250
 // samples a simulated s), CPU s per simulated s: 10 wake-ups of 75 us and
@@ -55,17 +52,7 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
   const held = async () => metric(await metrics(), 'convsim_paced_cpu_cores');
   const streams = [];
   try {
-    const first = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-    assert.equal(first.status, 201, first.text);
-    const cost = await held();
-    assert.ok(cost > STREAM && cost < limit / 2, `a default session's estimate: ${cost}`);
-    const fit = Math.floor(limit / cost);
-    const ids = [first.body.id];
-    while (ids.length < fit) {
-      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-      assert.equal(r.status, 201, `session ${ids.length + 1} of ${fit} fits: ${r.text}`);
-      ids.push(r.body.id);
-    }
+    const { ids, cost, fit } = await fillPaced(d, limit, held, STREAM);
     // the streams that fit in what is left, each charged STREAM
     const room = Math.floor((limit - fit * cost) / STREAM + 1e-9);
     for (let i = 0; i < room; i++) {
