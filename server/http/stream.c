@@ -225,26 +225,24 @@ static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Resu
 	}
 	srv_session_feed_size(k->s, columns, layers);
 	size_t need = srv_budget_stream_need(*columns, *layers);
-	if (srv_budget_take(need, "this stream", 0, &pb) != API_OK) {
-		atomic_fetch_sub(&srv_stats.stream_clients, 1);
-		srv_session_put(k->s);
-		free(k);
-		*res = srv_reply_problem(r, &pb, NULL);
-		return 0;
-	}
+	if (srv_budget_take(need, "this stream", 0, &pb) != API_OK)
+		goto counted;
 	k->cpu_per_s = srv_budget_stream_cpu(srv_session_spec(k->s)->sample_rate, k->rate,
 					     k->fields, *columns, *layers);
-	if (srv_session_stream_open(k->s, k->cpu_per_s, &pb) != API_OK) {
-		srv_budget_give(need);
-		atomic_fetch_sub(&srv_stats.stream_clients, 1);
-		srv_session_put(k->s);
-		free(k);
-		*res = srv_reply_problem(r, &pb, NULL);
-		return 0;
-	}
+	if (srv_session_stream_open(k->s, k->cpu_per_s, &pb) != API_OK)
+		goto reserved;
 	k->mem_reserved = need;
 	atomic_fetch_add(&srv_stats.streams_opened, 1);
 	return 1;
+	/* refused by a budget (503 memory, 503 cpu): what was taken given back */
+reserved:
+	srv_budget_give(need);
+counted:
+	atomic_fetch_sub(&srv_stats.stream_clients, 1);
+	srv_session_put(k->s);
+	free(k);
+	*res = srv_reply_problem(r, &pb, NULL);
+	return 0;
 }
 
 /* The cursor where the stream starts: after record resume, or the newest. */
