@@ -14,15 +14,8 @@ out=${1:-tests/bench/results}
 PREV=${PREV:-20f6f5e}
 prev=${PREV_CONVSIMD:-}
 if [ -z "$prev" ]; then
-	prev_dir="$BUILD/prev-$PREV"
-	prev="$prev_dir/src/build/convsimd"
-	if [ ! -x "$prev" ]; then
-		echo "refuse_cost: building the previous build ($PREV) in $prev_dir" >&2
-		mkdir -p "$prev_dir/src"
-		[ -f "$prev_dir/src/Makefile" ] || git archive "$PREV" | tar -x -C "$prev_dir/src"
-		make -C "$prev_dir/src" --no-print-directory -j2 build/convsimd > "$prev_dir/make.log" 2>&1 ||
-			{ tail -20 "$prev_dir/make.log"; exit 1; }
-	fi
+	. tests/bench/prev_build.sh
+	prev_build refuse_cost convsimd
 fi
 . tests/bench/provenance.sh
 line=$(provenance)

@@ -16,15 +16,8 @@
 PREV=${PREV:-c3bc9a1}
 RUNS=${RUNS:-30}
 CURVES=${CURVES:-7}
-prev_dir="$BUILD/prev-$PREV"
-prev="$prev_dir/src/build/convsim"
-if [ ! -x "$prev" ]; then
-	echo "startup: building the previous build ($PREV) in $prev_dir"
-	rm -rf "$prev_dir" && mkdir -p "$prev_dir/src"
-	git archive "$PREV" | tar -x -C "$prev_dir/src"
-	make -C "$prev_dir/src" --no-print-directory -j2 build/convsim > "$prev_dir/make.log" 2>&1 ||
-		{ tail -20 "$prev_dir/make.log"; exit 1; }
-fi
+. tests/bench/prev_build.sh
+prev_build startup convsim
 libs() { ldd "$1" | grep -c '=>' || true; }
 mpi_libs() { ldd "$1" | grep -cE 'libmpi|liggghts' || true; }
 short=(run --duration 0.01 -q)

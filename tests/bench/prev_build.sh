@@ -1,0 +1,18 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+# The previous build a bench compares with (sourced, after BUILD and PREV
+# are set): `prev_build NAME PROGRAM` sets prev to PROGRAM (convsim,
+# convsimd) of commit PREV, exported with git archive into
+# $BUILD/prev-PREV/src once and built there (`make build/PROGRAM`) when it
+# is not yet; the benches that compare with the same commit share the tree
+# (one builds convsim, another convsimd in it). NAME names the bench in
+# the message.
+prev_build() { # bench name, program
+	local dir="$BUILD/prev-$PREV"
+	prev="$dir/src/build/$2"
+	[ -x "$prev" ] && return 0
+	echo "$1: building the previous build ($PREV) in $dir" >&2
+	mkdir -p "$dir/src"
+	[ -f "$dir/src/Makefile" ] || git archive "$PREV" | tar -x -C "$dir/src"
+	make -C "$dir/src" --no-print-directory -j2 "build/$2" > "$dir/make.log" 2>&1 ||
+		{ tail -20 "$dir/make.log" >&2; exit 1; }
+}
