@@ -290,6 +290,18 @@ done:
 	return rc;
 }
 
+/* What a request may ask and a stored spec cannot hold: feed_model auto
+ * is resolved at creation (srv_dem_pick) and the model picked is the one
+ * stored. 0, or -1 with why. */
+static int stored_spec_check(const api_spec *spec, char *why, size_t whylen)
+{
+	if (spec->scene.feed_model != SIM_FEED_AUTO)
+		return 0;
+	snprintf(why, whylen, "feed_model auto, which a session resolves at its creation "
+			      "(a stored spec holds column or liggghts)");
+	return -1;
+}
+
 int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 		    int *owned, char *why, size_t whylen)
 {
@@ -305,6 +317,8 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 		snprintf(why, whylen, "%.*s", whylen > 0 ? (int)(whylen - 1) : 0, pb.detail);
 		return -1;
 	}
+	if (stored_spec_check(&r.spec, why, whylen) != 0)
+		return -1;
 	*spec = r.spec;
 	*created = r.created;
 	*owned = r.owned != 0;
@@ -379,6 +393,10 @@ static int load_spec(srv_session *s, char *why, size_t whylen)
 		free(text);
 		if (e != API_OK)
 			snprintf(why, whylen, "%s: %s", path, pb.detail);
+		else if (stored_spec_check(&s->spec, msg, sizeof msg) != 0) {
+			snprintf(why, whylen, "%s: %s", path, msg);
+			e = API_INVALID;
+		}
 		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
 			s->restore.upgrade = 1;
 		return e == API_OK ? 0 : -1;

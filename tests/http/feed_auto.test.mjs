@@ -9,7 +9,7 @@
 // The LIGGGHTS pick with a real bed process is tests/dem/feed_auto.test.mjs.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { startDaemon, req, until, SLOW } from './lib.mjs';
@@ -116,6 +116,17 @@ test('feed_model auto: a restart keeps the model and the pick (spec.json), it do
     const b = (await req(e.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
     assert.equal(b.spec.scene.feed_model, 'column');
     assert.deepEqual(b.feed_model_pick, pick);
+    // a stored spec holding auto (no build writes one: a damaged file)
+    // is listed damaged with why, not restored into an instance that
+    // cannot be built
+    await e.stop();
+    file.session.scene.feed_model = 'auto';
+    writeFileSync(specFile, JSON.stringify(file));
+    e = await startDaemon(args);
+    const c = (await req(e.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
+    assert.equal(c.state, 'damaged', JSON.stringify(c));
+    assert.equal(c.error, `damaged: sessions/${r.body.id}/spec.json: feed_model auto, which a session resolves at its creation (a stored spec holds column or liggghts)`);
+    assert.equal((await req(e.base, 'GET', '/api/v1/health')).status, 200);
   } finally {
     await e.stop();
     rmSync(dir, { recursive: true, force: true });
