@@ -15,7 +15,8 @@ B=${FUZZ_BUILD:-build-fuzz}
 S=${FUZZ_SECONDS:-60}
 T=${FUZZ_TIMEOUT:-60}
 # FUZZ_RUNS=N: N inputs per harness from the fixed seed 1 instead of a time
-# (CI: the same inputs every run, so a pass is repeatable)
+# (CI: the same amount of fuzzing every run; the inputs kept follow coverage,
+# which can differ between machines)
 R=${FUZZ_RUNS:-}
 NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit query route checkpoint store}
 mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
