@@ -237,6 +237,16 @@ def row_of(p, mats, build, seeds):
 OVERLAP_MAX = 0.01  # of a mean diameter
 
 
+def rungs_above(mats):
+    """The rungs a map point whose overlap passed the bound runs, in
+    order: the ladder's top and, between it and the map's modulus, their
+    geometric mean (4e8 Pa: LIGGGHTS refuses a modulus above 1e9 Pa without
+    hard_particles, so the top has no stiffer rung, and the point's value is
+    shown converged by the change between these two, docs/dem.md "The map")."""
+    top = mats["map"]["youngs_ladder"][2]
+    return [top, math.sqrt(mats["map"]["youngs_map"] * top)]
+
+
 def by_key(k):
     for r in read_rows():
         if key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"], r["e_scale"],
@@ -293,12 +303,12 @@ def run(binary, build, wanted):
                 if k not in done:
                     run_point(binary, build, name, q, mats, seeds.setdefault(k, {}))
                     done.add(k)
-                # a map point whose overlap passed the bound gets the ladder's
-                # next rung at once: the map's value there is the softest
-                # rung within the bound (docs/dem.md "The map")
+                # a map point whose overlap passed the bound gets the stiffer
+                # rungs at once: the map's value there is the softest rung
+                # within the bound (docs/dem.md "The map")
                 r = by_key(k)
                 if q["role"] == "map" and r and float(r["overlap_max_rel"]) > OVERLAP_MAX:
-                    todo.append(dict(q, role="stiffness", youngs=mats["map"]["youngs_ladder"][2]))
+                    todo += [dict(q, role="stiffness", youngs=e) for e in rungs_above(mats)]
 
 
 def main():

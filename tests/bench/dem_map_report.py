@@ -51,11 +51,72 @@ def status(rows, mats):
     extra = len(rows) - len(done)
     builds = sorted({r["build"][:12] for r in rows})
     print("Status (%s, build %s): %d of the plan's %d map points and %d of its %d check rows "
-          "exist, with %d more rows at 8e+08 Pa where 2e+08 overlapped more than 1 %%; %.2f CPU "
+          "exist, with %d more rows at stiffer rungs where 2e+08 Pa overlapped more than 1 %%; %.2f CPU "
           "hours so far (tests/bench/results/dem_map.md)." %
           (max(r["date"] for r in rows)[:10] if rows else "-", ", ".join(builds) or "-", len(mdone),
            len(maps), len(done) - len(mdone), len(planned) - len(maps), extra,
            sum(f(r["cpu_s"]) for r in rows) / 3600))
+
+
+def ladder(rows, mats, w):
+    """The points whose map rung overlapped more than the bound: every rung
+    run there, the one that gives the point its value (dem_points.chosen)
+    and its change to the next stiffer rung, the convergence the map asks."""
+    e_map = mats["map"]["youngs_map"]
+    over = [r for r in rows if r["role"] == "map" and f(r["overlap_max_rel"]) > OVERLAP and
+            f(r["cell_width_d"]) == dem_map.WIDTH]
+    w("### Stiffer rungs where the map's overlapped")
+    w("")
+    if not over:
+        w("No map point overlapped more than %.0f %% of a diameter." % (100 * OVERLAP))
+        w("")
+        return
+    es = sorted({e_map} | {f(x) for x in dem_map.rungs_above(mats)})
+    w("At these points the overlap passed %.0f %% of a diameter at the map's E = %g Pa, so they "
+      "run the stiffer rungs %s Pa; the point's value is the softest rung within the bound "
+      "(bold), converged where its v is within %.0f %% of the next stiffer rung's (\"seeds\": "
+      "the change in units of the two rows' combined standard error). LIGGGHTS refuses E above "
+      "1e9 Pa without `hard_particles`, so %g Pa has no stiffer rung." %
+      (100 * OVERLAP, e_map, " and ".join("%g" % e for e in es[1:]), 100 * TOL, es[-1]))
+    w("")
+    w("| material | depth | beta | " + " | ".join("v at %g Pa (overlap)" % e for e in es) +
+      " | change to the next rung | seeds | within %.0f %% |" % (100 * TOL))
+    w("|---|---|---|" + "---|" * len(es) + "---|---|---|")
+    n_ok = n = 0
+    for m in over:
+        at = {}
+        for r in rows:
+            if (r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
+                    r["cell_width_d"]) == (m["material"], m["layers"], m["drive"], m["beta_deg"],
+                                           m["rotation"], m["cell_width_d"]) and \
+                    r["role"] in ("map", "stiffness"):
+                at[f(r["youngs_pa"])] = r
+        c = chosen(rows, m["material"], int(m["layers"]), m["drive"], f(m["beta_deg"]), mats=mats)
+        cells = []
+        for e in es:
+            r = at.get(e)
+            if not r:
+                cells.append("")
+                continue
+            t = "%+.4f (%.2f %%)" % (f(r["v_dem"]), 100 * f(r["overlap_max_rel"]))
+            cells.append("**%s**" % t if r is c else t)
+        nxt = [e for e in es if c and e > f(c["youngs_pa"]) and e in at]
+        change = z = None
+        if c and nxt:
+            b = at[nxt[0]]
+            change = rel(f(c["v_dem"]), f(b["v_dem"]))
+            se = ((f(c["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
+            z = abs(f(c["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
+        ok = change is not None and abs(change) < TOL
+        n += 1
+        n_ok += ok
+        w("| %s | %s | %s | %s | %s | %s | %s |" %
+          (m["material"], m["layers"], m["beta_deg"], " | ".join(cells), pct(change),
+           "" if z is None else "%.1f" % z,
+           "yes" if ok else ("no stiffer rung" if change is None else "no")))
+    w("")
+    w("Within %.0f %% of the next rung: %d of these %d points." % (100 * TOL, n_ok, n))
+    w("")
 
 
 def main():
@@ -162,6 +223,7 @@ def main():
         return by_key.get(dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], "cw",
                                       e_map / m["youngs_real"], dem_map.WIDTH))
 
+    ladder(rows, mats, w)
     for role, title, what in (("stiffness", "Stiffness", "youngs_pa"),
                               ("cell", "Cell width across the deck", "cell_width_d")):
         sel = [r for r in rows if r["role"] == role]
