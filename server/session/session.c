@@ -173,12 +173,11 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	 * estimate alone */
 	s->budget.cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
 					       s->layers);
-	/* refused here where the estimate alone does not fit the paced cores
-	 * (the answer create would give): a flood of creations beyond the
-	 * budget would otherwise spend a probe and a ring on each, CPU taken
-	 * from the sessions that run */
+	/* the hold raised to this estimate before the probe (the early one
+	 * holds the same figure but where the instance differs from its
+	 * preview, and a LIGGGHTS session has none): refused here where it
+	 * does not fit, before a probe and a ring are spent on it */
 	if (s->pace != API_PACE_MAX &&
-	    s->budget.cpu_per_s * s->pace > srv_budget_paced_limit() - srv_budget_paced() &&
 	    srv_budget_take_paced(&s->budget.paced_held, s->budget.cpu_per_s, s->pace, "pace",
 				  "created", pb) != API_OK)
 		return -1;
