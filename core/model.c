@@ -349,7 +349,7 @@ static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_F
 	memcpy(qdd, qpdd, sizeof(double) * NQ_FULL);
 	model_add_reduced(md, br, qdd);
 	if (md->phi_prescribed) {
-		double s = -rhs[Q_PHI] - dt->drag + dt->load;
+		double s = -rhs[Q_PHI];
 		for (int j = 0; j < NQ_FULL; j++)
 			s += M[Q_PHI][j] * qdd[j];
 		dt->torque = s;
