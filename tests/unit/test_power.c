@@ -158,8 +158,37 @@ static void kloss_against_drag_and_load(void **state)
 		double sign = r ? -1.0 : 1.0;
 		assert_close(st.rotor_speed, sign * w, 1e-6);
 		assert_close(st.motor_torque, sign * (b * w * w + ML), 1e-5);
+		/* what is shown of it: the power, and the means over whole
+		 * periods (the torque is constant: e = 0) */
+		assert_close(st.power, (b * w * w + ML) * w, 2e-3);
+		assert_close(st.rotor_speed_mean, sign * w, 1e-5);
+		assert_close(st.motor_torque_mean, sign * (b * w * w + ML), 1e-5);
+		assert_close(st.power_mean, (b * w * w + ML) * w, 2e-3);
 		sim_free(s);
 	}
+}
+
+/* The centre deck point's displacement shown (status deck) is the
+ * kinematics of the point R(alpha) (0, h_d) from G: (x - h_d sin alpha,
+ * y + h_d (cos alpha - 1)), from its rest position, whatever h_d; here on
+ * the asymmetric machine running, alpha integrated, at a few times. */
+static void deck_point_shown(void **state)
+{
+	(void)state;
+	setup u = asymmetric("motor");
+	set(&u, "h_d", "0.3");
+	sim *s = make(&u);
+	for (int i = 1; i <= 4; i++) {
+		advance(s, 0.05 * i);
+		sim_status st = status(s);
+		double a = st.q[Q_ALPHA], hd = 0.3;
+		assert_true(fabs(a) > 1e-6); /* the trough turns */
+		assert_close(st.deck[0], st.q[Q_X] - hd * sin(a), 1e-12);
+		assert_close(st.deck[1], st.q[Q_Y] + hd * (cos(a) - 1.0), 1e-12);
+		assert_close(st.deck_vel[0], st.qd[Q_X] - hd * cos(a) * st.qd[Q_ALPHA], 1e-10);
+		assert_close(st.deck_vel[1], st.qd[Q_Y] - hd * sin(a) * st.qd[Q_ALPHA], 1e-10);
+	}
+	sim_free(s);
 }
 
 int main(void)
@@ -167,6 +196,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
+		cmocka_unit_test(deck_point_shown),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
