@@ -20,8 +20,11 @@
  *
  * The Kloss motor against bearing drag and a load torque: with no
  * unbalance the rotor is decoupled, and its steady speed solves
- * M_el(w) = b_phi w |w| + M_L (docs/MODEL.md "Drive").
+ * M_el(w) = b_phi w |w| + M_L (docs/MODEL.md "Drive"). And what is shown
+ * of the machine: the deck point against its kinematics, the observation
+ * against the evaluation the integration makes.
  */
+#include "dynamics.h"
 #include "model.h"
 #include "testutil.h"
 
@@ -191,12 +194,59 @@ static void deck_point_shown(void **state)
 	sim_free(s);
 }
 
+/* What is shown of a state (dynamics_observe: the feed's force on the
+ * deck from feed_deck_forces) is what the integration evaluates there
+ * (dynamics_eval: from the feed's right-hand side): the same contact and
+ * friction forces, so the same accelerations and, under the ideal drive,
+ * the same torque, to the last bit. On random states of the full model
+ * (every column, alpha integrated) with the layers pressed into each other
+ * and sliding both ways, both drives. */
+static void observation_is_the_evaluation(void **state)
+{
+	(void)state;
+	const char *drives[] = {"motor", "ideal"};
+	for (int d = 0; d < 2; d++) {
+		setup u = preset();
+		set(&u, "h", "0.1");
+		set(&u, "drive", drives[d]);
+		model md;
+		model_ctl ctl;
+		model_init(&md, &ctl, &u.p, &u.sc);
+		assert_true(md.nf == 40 && !md.alpha_fixed);
+		double *y = calloc((size_t)md.n, sizeof *y), *a = calloc((size_t)md.n, sizeof *a),
+		       *b = calloc((size_t)md.n, sizeof *b);
+		assert_non_null(y);
+		assert_non_null(a);
+		assert_non_null(b);
+		srand(5);
+		for (int trial = 0; trial < 50; trial++) {
+			dynamics_equilibrium(&md, &ctl, y);
+			for (int r = 0; r < md.nq; r++)
+				y[md.npos + r] = 0.2 * (2.0 * rand() / RAND_MAX - 1.0);
+			for (int e = 0; e < md.nf; e++) {
+				y[md.nq + md.nf + e] += 2e-5 * (2.0 * rand() / RAND_MAX - 1.0);
+				y[md.npos + md.nq + e] = 0.3 * (2.0 * rand() / RAND_MAX - 1.0);
+				y[md.npos + md.nq + md.nf + e] = 0.1 * (2.0 * rand() / RAND_MAX - 1.0);
+			}
+			model_eval ea, eb;
+			dynamics_eval(&md, &ctl, 0.01 * trial, y, a, &ea);
+			dynamics_observe(&md, &ctl, 0.01 * trial, y, b, &eb);
+			assert_memory_equal(ea.qdd, eb.qdd, sizeof ea.qdd);
+			assert_true(ea.torque == eb.torque);
+		}
+		free(y);
+		free(a);
+		free(b);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
 		cmocka_unit_test(deck_point_shown),
+		cmocka_unit_test(observation_is_the_evaluation),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
