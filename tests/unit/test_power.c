@@ -21,7 +21,9 @@
  * The Kloss motor against bearing drag and a load torque: with no
  * unbalance the rotor is decoupled, and its steady speed solves
  * M_el(w) = b_phi w |w| + M_L (docs/MODEL.md "Drive"). And what is shown
- * of the machine: the deck point against its kinematics, the observation
+ * of the machine: the deck point against its kinematics (and the deck
+ * points' velocities and accelerations against the rates of their
+ * positions and velocities), the observation
  * against the evaluation the integration makes.
  */
 #include "dynamics.h"
@@ -240,6 +242,48 @@ static void observation_is_the_evaluation(void **state)
 	}
 }
 
+/* A deck point's velocity is the rate of its position and its
+ * acceleration the rate of its velocity (central differences along q(t)
+ * = q + t q' + t^2 q''/2), and deck_point_affine, which the split method
+ * tracks the deck with, gives every column's position and velocity as
+ * deck_point does: on random states with alpha, alpha' and alpha'' large,
+ * at h_d = 0.25 m and body x from -1 to 1 m. */
+static void deck_kinematics(void **state)
+{
+	(void)state;
+	deck dk = {.K = 1, .h_d = 0.25};
+	srand(9);
+	for (int trial = 0; trial < 100; trial++) {
+		double q[NQ_FULL] = {0}, qd[NQ_FULL] = {0}, qdd[NQ_FULL] = {0};
+		for (int i = 0; i < 3; i++) {
+			q[i] = 0.3 * (2.0 * rand() / RAND_MAX - 1.0);
+			qd[i] = 2.0 * (2.0 * rand() / RAND_MAX - 1.0);
+			qdd[i] = 50.0 * (2.0 * rand() / RAND_MAX - 1.0);
+		}
+		double x = 2.0 * rand() / RAND_MAX - 1.0, eps = 1e-5, pv[2][2][2];
+		for (int side = 0; side < 2; side++) { /* t = -eps, +eps */
+			double t = side ? eps : -eps, qs[NQ_FULL] = {0}, qds[NQ_FULL] = {0};
+			for (int i = 0; i < 3; i++) {
+				qs[i] = q[i] + t * qd[i] + 0.5 * t * t * qdd[i];
+				qds[i] = qd[i] + t * qdd[i];
+			}
+			deck_rot R = deck_rotation(qs);
+			deck_point(&dk, x, &R, qs, qds, pv[side][0], pv[side][1]);
+		}
+		deck_rot R = deck_rotation(q);
+		double pos[2], vel[2], aff[3][2][2];
+		deck_point(&dk, x, &R, q, qd, pos, vel);
+		deck_point_affine(&dk, &R, q, qd, qdd, aff);
+		for (int c = 0; c < 2; c++) {
+			assert_close(vel[c], (pv[1][0][c] - pv[0][0][c]) / (2.0 * eps), 1e-8);
+			assert_close(aff[0][0][c] + x * aff[0][1][c], pos[c], 1e-14);
+			assert_close(aff[1][0][c] + x * aff[1][1][c], vel[c], 1e-13);
+			assert_close(aff[2][0][c] + x * aff[2][1][c],
+				     (pv[1][1][c] - pv[0][1][c]) / (2.0 * eps), 1e-6);
+		}
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -247,6 +291,7 @@ int main(void)
 		cmocka_unit_test(kloss_against_drag_and_load),
 		cmocka_unit_test(deck_point_shown),
 		cmocka_unit_test(observation_is_the_evaluation),
+		cmocka_unit_test(deck_kinematics),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
