@@ -41,6 +41,23 @@ mutations=(
 	"the contact period without the Hertzian tangent stiffness|core/defaults.c|s|if (p->p != 1.0) {|if (0) {|"
 	"the default feed step blind to the contact period|core/defaults.c|s|return fmin(hmax, sim_contact_period(p, s) / CONTACT_STEPS)|return fmin(hmax, hmax + 0.0 * sim_contact_period(p, s))|"
 	"no refinement of a measurement's steps|core/measure.c|s|^#define MEASURE_REFINEMENTS 3$|#define MEASURE_REFINEMENTS 0|"
+	# faults the preset's symmetric machine and the dem method hide:
+	# tests/unit/test_power.c (power balance at every state, Kloss
+	# against drag and load, what is shown) and test_energy_balance.c
+	"the ideal drive's torque net of bearing drag and load torque|core/model.c|s|double s = -rhs\[Q_PHI\];|double s = -rhs[Q_PHI] - dt->drag + dt->load;|"
+	"the bearing drag linear in the speed|core/model.c|s|dt->drag = p->b_phi \* dt->omega \* fabs(dt->omega);|dt->drag = p->b_phi * dt->omega;|"
+	"the load torque's power booked as an input|core/model.c|s|- dt->load \* dt->omega;|+ dt->load * dt->omega;|"
+	"eliminator 1 on eliminator 2's spring|core/model.c|s|rhs\[Q_S1\] += -p->k_s1|rhs[Q_S1] += -p->k_s2|"
+	"the trough's inertia without the point masses' x arms|core/model.c|s|M\[Q_ALPHA\]\[Q_ALPHA\] += m \* (ja\[0\] \* ja\[0\] + ja\[1\] \* ja\[1\]);|M[Q_ALPHA][Q_ALPHA] += m * ja[1] * ja[1];|"
+	"the guides' turn left out of the kinetic energy|core/model.c|s|v\[0\] += cs \* cf.beta_d \* Rup\[0\];|v[0] += 0.0;|"
+	"the feed's contact power halved (rk4, dopri5, euler)|core/feed.c|s|\*contact += Fn \* ddot;|*contact += 0.5 * Fn * ddot;|"
+	"the observed feed force on the deck with the wrong sign of friction|core/feed.c|s|			F\[k\]\[0\] = -T;|			F[k][0] = T;|"
+	"a deck point's velocity with the wrong sign of its arm|core/deck.c|s|vel\[0\] = qd\[Q_X\] - qd\[Q_ALPHA\] \* Rd\[1\];|vel[0] = qd[Q_X] + qd[Q_ALPHA] * Rd[1];|"
+	"a deck point's tangential acceleration with the wrong sign|core/deck.c|s|out\[2\]\[b\]\[1\] = a\[1\] + add \* r\[0\]|out[2][b][1] = a[1] - add * r[0]|"
+	"the axle's centripetal acceleration left out (axle off G)|core/model_points.h|s|k->a\[1\] = -ad2 \* Rw\[1\] - e|k->a[1] = - e|"
+	"the spring sets' damping on the wrong arm velocity|core/model.c|s|double vx = qd\[Q_X\] - qd\[Q_ALPHA\] \* RP\[1\]|double vx = qd[Q_X] + qd[Q_ALPHA] * RP[1]|"
+	"a ramp retargeted while moving brakes twice as early|core/ramp.c|s|double stop = v \* fabs(v) / (2.0 \* amax);|double stop = v * fabs(v) / amax;|"
+	"the deck point shown from G's height, not its rest (h_d)|core/sim_status.c|s|st->deck\[1\] -= md->dk.h_d;|st->deck[1] -= 0.0;|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -268,6 +268,34 @@ static void beta_ramps_are_continuous(void **state)
 	sim_free(s);
 }
 
+/* A ramp retargeted while moving towards a target it can still reach
+ * braking at the bound (distance d between v^2 / 2a and v^2 / a) is time
+ * optimal (ramp.c): up to the peak speed V = sqrt(a d + v^2 / 2), then
+ * down, arriving after (2 V - v) / a at rest on the target, continuous in
+ * position and rate, never beyond it. */
+static void ramp_retargeted_while_moving(void **state)
+{
+	(void)state;
+	const double a = 1.0, vmax = 10.0;
+	ramp r;
+	ramp_hold(&r, 0.0, 0.0, 0.0);
+	ramp_to_position(&r, 0.0, 1.0, vmax, a); /* at t = 0.5: b = 0.125, v = 0.5 */
+	const double d = 0.18, b0 = 0.125, v0 = 0.5, target = b0 + d;
+	ramp_to_position(&r, 0.5, target, vmax, a);
+	const double V = sqrt(a * d + 0.5 * v0 * v0), t_end = 0.5 + (2.0 * V - v0) / a;
+	assert_close(r.t_end, t_end, 1e-12);
+	double b, bd, bdd, prev = b0, dt = 1e-4;
+	for (double t = 0.5 + dt; t < t_end + 0.1; t += dt) {
+		ramp_eval(&r, t, &b, &bd, &bdd);
+		assert_true(fabs(b - prev) <= V * dt * (1.0 + 1e-9));
+		assert_true(b <= target + 1e-12);
+		prev = b;
+	}
+	ramp_eval(&r, t_end - 1e-9, &b, &bd, &bdd);
+	assert_close(b, target, 1e-9);
+	assert_close(bd, 0.0, 2e-9);
+}
+
 /* Mirror symmetry of the symmetric machine: (cw, beta) and (ccw, 180 -
  * beta) give mirrored motions: x, alpha and the rotor speed change sign,
  * y stays, and the eliminators swap with their strokes negated (the
@@ -410,6 +438,7 @@ int main(void)
 		cmocka_unit_test(energy_balance_converges),
 		cmocka_unit_test(fixed_step_convergence_order),
 		cmocka_unit_test(beta_ramps_are_continuous),
+		cmocka_unit_test(ramp_retargeted_while_moving),
 		cmocka_unit_test(mirror_symmetry_machine),
 		cmocka_unit_test(reduced_evaluation_is_the_general_one),
 		cmocka_unit_test(angle_sine_and_cosine),
