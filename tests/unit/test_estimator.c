@@ -7,7 +7,9 @@
  * the position at that moment. The test steps an instance one machine
  * step at a time, keeps the ends of every step (phase, position and
  * their rates, from the estimator's own probe), places the boundaries by
- * bisection (not the estimator's Newton) and compares.
+ * bisection (not the estimator's Newton) and compares; and the last
+ * period's feed velocity and length, and the statistical part of the
+ * error bar from the same boundaries.
  */
 #include <math.h>
 
@@ -38,7 +40,7 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 	sim *s = make(&u);
 	const estimator *e = &s->est;
 	double dt = s->cfg.dt, start = e->start;
-	double t_first = NAN, X_first = NAN, t_last = NAN, X_last = NAN;
+	double t_first = NAN, X_first = NAN, t_last = NAN, X_last = NAN, tb[64], Xb[64];
 	int n = 0;
 	for (long k = 1; k <= (long)(1.2 / dt); k++) {
 		double t0 = s->t_int, psi0 = e->psi_prev, psid0 = e->psid_prev;
@@ -61,6 +63,10 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 		}
 		t_last = t;
 		X_last = X;
+		if (n <= 64) {
+			tb[n - 1] = t;
+			Xb[n - 1] = X;
+		}
 	}
 	assert_true(n >= 25); /* 25 Hz over 1.2 s */
 	double v = (X_last - X_first) / (t_last - t_first);
@@ -70,6 +76,35 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 		fail_msg("v %.17g, dX/dt between the crossings %.17g (relative %.3g)",
 			 st.transport_velocity, v, (st.transport_velocity - v) / v);
 	assert_true(fabs(v) > 1e-3); /* the preset moves its feed */
+	/* the last period's feed velocity and length */
+	assert_true(n <= 64);
+	double fv = (Xb[n - 1] - Xb[n - 2]) / (tb[n - 1] - tb[n - 2]);
+	assert_close(st.feed_velocity, fv, 1e-9 * fabs(fv));
+	assert_close(st.period, tb[n - 1] - tb[n - 2], 1e-12);
+	/* the statistical bar: the n - 1 one-period velocities v_i at their
+	 * mid-times c_i, a least-squares line through them; the residuals'
+	 * scatter s (n - 3 degrees of freedom: the line takes two) gives the
+	 * mean's standard error s / sqrt(n - 1), the slope times the window
+	 * the drift D; the bar is sqrt(se^2 + (D / 2)^2) */
+	int nb = n - 1;
+	double vi[63], ci[63], cm = 0.0, vm = 0.0, scc = 0.0, scv = 0.0, ss = 0.0;
+	for (int i = 0; i < nb; i++) {
+		vi[i] = (Xb[i + 1] - Xb[i]) / (tb[i + 1] - tb[i]);
+		ci[i] = 0.5 * (tb[i] + tb[i + 1]);
+		cm += ci[i] / nb;
+		vm += vi[i] / nb;
+	}
+	for (int i = 0; i < nb; i++) {
+		scc += (ci[i] - cm) * (ci[i] - cm);
+		scv += (ci[i] - cm) * (vi[i] - vm);
+	}
+	for (int i = 0; i < nb; i++) {
+		double r = vi[i] - vm - scv / scc * (ci[i] - cm);
+		ss += r * r;
+	}
+	double se = sqrt(ss / (nb - 2)) / sqrt((double)nb), D = scv / scc * (t_last - t_first);
+	double bar = sqrt(se * se + 0.25 * D * D);
+	assert_close(st.transport_velocity_uncertainty - st.step_error, bar, 1e-6 * bar); /* 1e-13 seen */
 	sim_free(s);
 }
 
