@@ -14,7 +14,7 @@
  *     uncertainty and steady where sim_measurement now is; no fits; a
  *     checkpoint without the trailer (its time is read from the core's
  *     part, whose own layout the core refuses: the session is re-created
- *     from its spec and control log, session_store.c).
+ *     from its spec and control log, session_load.c).
  * The c793934 structs are written out in records_v1.h as that build laid them out
  * (x86-64 and aarch64 Linux), not through today's types, so that a later
  * change to those types cannot move them; the static_asserts hold the

@@ -3,7 +3,8 @@
  * session.c - sessions: lifetime (create, restore, delete, reap), the
  * control entry point and attaching an experiment. The registry of
  * sessions and what reads it are session_list.c; their files are
- * session_store.c, which this file calls and which never calls back.
+ * session_store.c and session_load.c, which this file calls and which
+ * never call back.
  *
  * Sessions live in a registry (registry.c) and are reference counted: the
  * registry, each handler while it works and each stream hold one. Handlers

@@ -63,7 +63,7 @@ typedef struct srv_exp_finder {
 	void (*put)(srv_experiment *e);
 	srv_experiment *(*readopt)(const char *session_id);
 } srv_exp_finder;
-/* Rebuild the sessions of the data directory (session_store.c); the
+/* Rebuild the sessions of the data directory (session_load.c); the
  * experiments must be restored first: ef gives the running ones back to
  * their sessions. Returns how many. */
 size_t srv_sessions_restore(const srv_exp_finder *ef);

@@ -86,13 +86,13 @@ typedef struct srv_session_dem {
 } srv_session_dem;
 
 /* A restored session's replay of the controls logged after its checkpoint:
- * session_store.c fills it at the restore; the worker (worker.c) applies
+ * session_load.c fills it at the restore; the worker (worker.c) applies
  * the controls and ends the catch-up; guarded by the session's lock. */
 typedef struct srv_session_restore {
 	srv_replay *replay;       /* controls logged after the checkpoint it
 				     was restored from, in order: applied
 				     again as the integrator reaches each
-				     (session_store.c loads, worker.c runs) */
+				     (session_load.c loads, worker.c runs) */
 	size_t nreplay, replayed;
 	size_t exp_relogged;      /* lines of the resumed experiment in the
 				     log after its checkpoint: its commands
@@ -191,7 +191,7 @@ struct srv_session {
 	size_t controls_len, controls_cap;
 	srv_control_log log;      /* the log on disk (control_log.c), lock */
 	srv_session_persist persist; /* its files' state (session_store.c) */
-	srv_session_restore restore; /* a restored session's replay (session_store.c) */
+	srv_session_restore restore; /* a restored session's replay (session_load.c) */
 	srv_session_budget budget; /* what it holds of the budgets (worker.c) */
 	srv_session_dem dem;      /* a LIGGGHTS session (session_dem.c) */
 	sim_feed_choice pick;     /* feed_model auto's pick (srv_dem_pick) */
@@ -319,7 +319,7 @@ void srv_ring_sample(srv_session *s);
  * (worker; no lock needed). */
 void srv_ring_gather(srv_session *s);
 
-/* ---- session_store.c: the session's files (store.h) ------------------ */
+/* ---- session_store.c, session_load.c: the session's files (store.h) --- */
 
 /* Write the spec files: spec.json now, on this thread (now: a creation,
  * before its worker runs; its answer follows it, and a failure puts it in
@@ -353,13 +353,18 @@ void srv_control_log_close(srv_session *s);
 void srv_persist_checkpoint(srv_session *s, int force);
 /* Queue the removal of the session's files. */
 void srv_persist_remove(const srv_session *s);
+/* The path of a session's file in the data directory, "sessions/ID/FILE"
+ * (file NULL: its directory), shared by session_store.c and
+ * session_load.c. */
+void srv_session_file(char *out, size_t len, const char *id, const char *file);
 
 /* An experiment no checkpoint of s carried but whose record names s
  * (ef->readopt), attached again from its first segment at the restore,
  * before the worker starts (session_control.c): see docs/operations.md
  * "What a crash can lose". */
 void srv_session_readopt(srv_session *s, const srv_exp_finder *ef);
-/* Build session id from its files into s (calloc'd, lock initialised):
+/* Build session id from its files into s (calloc'd, lock initialised;
+ * session_load.c):
  * spec, checkpoint (or the previous one, or a fresh start from the spec),
  * the experiment it ran resumed; s->damaged with the reason in s->error
  * when they do not pass their checks. */
@@ -383,7 +388,7 @@ int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
 /* The registry of sessions (session_list.c; session.c sets its destroy). */
 extern srv_registry srv_sessions_registry;
 
-/* session.c: publish a session built by session_store.c: s has its
+/* session.c: publish a session built by session_load.c: s has its
  * registry id set in s->entry.id, spec, sim (NULL when damaged), state;
  * buffers are allocated here. 0 or -1 (s freed). Its worker starts with
  * srv_sessions_start_restored, once every session is in. */

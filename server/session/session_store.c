@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * session_store.c - a session's files in the data directory, written and
- * read back (docs/operations.md "Persistence"); session.c's restore calls it.
+ * (docs/operations.md "Persistence"), written.
  *
  *   sessions/ID/spec.json        the spec as created, the API's JSON
  *                                (api_spec_file), read first
@@ -17,19 +17,14 @@
  *                                one before it as checkpoint.bin.prev
  *
  * Everything else is written by the store's writer (store.c); the worker only
- * serialises, between steps, with the session lock held. A restore never
- * fails the daemon: a checkpoint that does not pass its checks falls back
- * to the previous one; a session whose spec or both checkpoints are
- * unusable is listed as "damaged" with the reason; a session with a spec
- * and no checkpoint yet starts again from its spec.
+ * serialises, between steps, with the session lock held. They are read
+ * back by session_load.c.
  */
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "experiment.h"
-#include "metrics.h"
 #include "records.h"
 #include "session_int.h"
 #include "store.h"
@@ -38,8 +33,7 @@
 /* sessions/ID/spec.bin (records.h) */
 typedef srv_spec_record spec_record;
 
-static void session_dir(char *out, size_t len, const char *id,
-			const char *file)
+void srv_session_file(char *out, size_t len, const char *id, const char *file)
 {
 	snprintf(out, len, "sessions/%s%s%s", id, file ? "/" : "",
 		 file ? file : "");
@@ -100,7 +94,7 @@ static void queue(const srv_session *s, const char *file, void *buf,
 		  size_t len, int keep_prev, size_t logged)
 {
 	char path[128];
-	session_dir(path, sizeof path, s->entry.id, file);
+	srv_session_file(path, sizeof path, s->entry.id, file);
 	write_of *w = calloc(1, sizeof *w);
 	if (w) {
 		snprintf(w->id, sizeof w->id, "%s", s->entry.id);
@@ -117,7 +111,7 @@ void srv_persist_spec(srv_session *s, int now)
 		return;
 	char *text = api_spec_file(&s->spec, s->created, s->owned, s->picked ? &s->pick : NULL),
 	     path[128];
-	session_dir(path, sizeof path, s->entry.id, "spec.json");
+	srv_session_file(path, sizeof path, s->entry.id, "spec.json");
 	if (text && now) /* a creation: answered once it is on disk */
 		s->persist.spec_unwritten = srv_store_write_now(path, text, strlen(text),
 			s->persist.store_error, sizeof s->persist.store_error) != 0;
@@ -189,330 +183,13 @@ void srv_persist_checkpoint(srv_session *s, int force)
 api_err srv_session_check_removable(const srv_session *s, api_problem *pb)
 {
 	char path[128];
-	session_dir(path, sizeof path, s->entry.id, NULL);
+	srv_session_file(path, sizeof path, s->entry.id, NULL);
 	return srv_store_check_removable(path, pb);
 }
 
 void srv_persist_remove(const srv_session *s)
 {
 	char path[128];
-	session_dir(path, sizeof path, s->entry.id, NULL);
+	srv_session_file(path, sizeof path, s->entry.id, NULL);
 	srv_store_remove(path);
-}
-
-/* ---- restore ------------------------------------------------------------ */
-
-int srv_ckpt_decode(const char *p, size_t len, srv_ckpt_record *r, char *why,
-		    size_t whylen)
-{
-	if (len < sizeof *r) {
-		snprintf(why, whylen, "cut off");
-		return -1;
-	}
-	memcpy(r, p, sizeof *r);
-	/* exp_len first: a length between len - sizeof *r and len wrapped
-	 * the difference below and let sim_len point past the buffer; the
-	 * core's checkpoint ends the payload or is followed by the trailer */
-	size_t left = r->exp_len <= len - sizeof *r ? len - sizeof *r - (size_t)r->exp_len : 0;
-	if (r->exp_len > len - sizeof *r ||
-	    (r->sim_len != left && !(left >= SRV_CKPT_TRAILER && r->sim_len == left - SRV_CKPT_TRAILER)) ||
-	    r->state < SRV_RUNNING || r->state > SRV_FAILED) {
-		snprintf(why, whylen, "inconsistent lengths or state");
-		return -1;
-	}
-	r->error[sizeof r->error - 1] = '\0';
-	r->exp_id[SRV_ID_LEN - 1] = '\0';
-	return 0;
-}
-
-/* The checkpoint of s from file (relative): restores s->sim, run state and
- * the experiment (found with find, given back with put), and *logged, the
- * bytes of the control log it holds; 0, or -1 with why and *unread set
- * when the file could not be read at all (missing). */
-static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finder *ef,
-			   size_t *logged, int *unread, char *why, size_t whylen)
-{
-	size_t n = 0, len;
-	char *raw = srv_store_read_text(file, &n);
-	const char *bad = "missing or unreadable";
-	int older = 0;
-	char *p = raw ? srv_store_unframe(raw, n, SRV_STORE_CHECKPOINT, &len, &older, &bad) : NULL;
-	*unread = !raw;
-	if (older)
-		s->restore.upgrade = 1; /* written again in this build's format */
-	if (!p) {
-		snprintf(why, whylen, "%s: %s", file, bad);
-		return -1;
-	}
-	srv_ckpt_record r;
-	int rc = -1;
-	char msg[256] = "";
-	if (srv_ckpt_decode(p, len, &r, msg, sizeof msg) != 0) {
-		snprintf(why, whylen, "%s: %s", file, msg);
-		goto done;
-	}
-	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
-	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
-		srv_ckpt_trailer tr;
-		memcpy(&tr, p + len - sizeof tr, sizeof tr);
-		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
-		if (isfinite(tr.t) && tr.t > s->restore.catch_up_t)
-			s->restore.catch_up_t = tr.t; /* where it was, if the core's
-						 part is refused */
-	}
-	int err;
-	sim *sm = sim_restore(&s->spec.params, &s->spec.scene, &s->spec.method,
-			      p + sizeof r + r.exp_len, r.sim_len, &err, msg,
-			      sizeof msg);
-	if (!sm) {
-		snprintf(why, whylen, "%s: %s", file, msg);
-		goto done;
-	}
-	s->restore.catch_up_t = 0;
-	sim_free(s->sim);
-	s->sim = sm;
-	s->state = r.state;
-	s->pace = r.pace;
-	s->until = r.until;
-	snprintf(s->error, sizeof s->error, "%s", r.error);
-	if (r.exp_started && r.exp_len) {
-		srv_experiment *e = ef->find(r.exp_id);
-		if (e && srv_exp_resume(e, p + sizeof r, r.exp_len) == 0) {
-			s->exp = e;
-			s->exp_started = 1;
-		}
-		if (e)
-			ef->put(e); /* the registry keeps it */
-	}
-	rc = 0;
-done:
-	free(p);
-	return rc;
-}
-
-/* What a request may ask and a stored spec cannot hold: feed_model auto
- * is resolved at creation (srv_dem_pick) and the model picked is the one
- * stored. 0, or -1 with why. */
-static int stored_spec_check(const api_spec *spec, char *why, size_t whylen)
-{
-	if (spec->scene.feed_model != SIM_FEED_AUTO)
-		return 0;
-	snprintf(why, whylen, "feed_model auto, which a session resolves at its creation "
-			      "(a stored spec holds column or liggghts)");
-	return -1;
-}
-
-int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
-		    int *owned, char *why, size_t whylen)
-{
-	spec_record r;
-	if (len != sizeof r) {
-		snprintf(why, whylen, "of another size");
-		return -1;
-	}
-	memcpy(&r, p, sizeof r);
-	api_problem pb;
-	if (api_check_spec(&r.spec, &pb) != API_OK) {
-		/* the reason cut to the caller's room, as snprintf would */
-		snprintf(why, whylen, "%.*s", whylen > 0 ? (int)(whylen - 1) : 0, pb.detail);
-		return -1;
-	}
-	if (stored_spec_check(&r.spec, why, whylen) != 0)
-		return -1;
-	*spec = r.spec;
-	*created = r.created;
-	*owned = r.owned != 0;
-	return 0;
-}
-
-/* The control log back into s->controls (later controls are appended to
- * it), and the controls logged after its first `logged` bytes (what the
- * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
- * does not say) into s->restore.replay, for the worker to apply again. */
-static void load_controls(srv_session *s, size_t logged)
-{
-	char path[128];
-	session_dir(path, sizeof path, s->entry.id, "controls.ndjson");
-	size_t len = 0;
-	char *text = srv_store_read_text(path, &len);
-	if (!text)
-		return;
-	/* a line a crash cut short was never acknowledged: the log ends at
-	 * its last newline (the file is cut there when it is next written) */
-	while (len > 0 && text[len - 1] != '\n')
-		len--;
-	s->controls = text;
-	s->controls_len = s->log.synced = len;
-	s->controls_cap = len + 1;
-	if (logged >= len)
-		return;
-	size_t lines = 0;
-	for (size_t i = logged; i < len; i++)
-		lines += text[i] == '\n';
-	s->restore.replay = calloc(lines ? lines : 1, sizeof *s->restore.replay);
-	for (size_t at = logged; s->restore.replay && at < len;) {
-		const char *nl = memchr(text + at, '\n', len - at);
-		size_t n = nl ? (size_t)(nl - (text + at)) : len - at;
-		srv_replay *rp = &s->restore.replay[s->restore.nreplay];
-		api_problem pb;
-		char exp[SRV_ID_LEN];
-		if (n && api_parse_control_event(text + at, n, &s->spec, &rp->cmd.c,
-						 &rp->at, exp, sizeof exp, &pb) == API_OK) {
-			/* the experiment resumed from the checkpoint sends its
-			 * segments' commands again: applied twice, the second
-			 * would move the estimator's restart */
-			snprintf(rp->exp, sizeof rp->exp, "%s", exp);
-			rp->exp_own = s->exp && exp[0] && strcmp(exp, srv_exp_id(s->exp)) == 0;
-			s->restore.exp_relogged += rp->exp_own;
-			s->restore.nreplay++;
-		}
-		else if (n)
-			srv_log(SRV_LOG_WARN, "session %s: a line of %s not "
-					      "replayed: %s", s->entry.id, path, pb.detail);
-		at += n + 1;
-	}
-	if (s->restore.nreplay)
-		srv_log(SRV_LOG_INFO, "session %s: %zu controls logged after "
-				      "its checkpoint are replayed", s->entry.id,
-			s->restore.nreplay);
-}
-
-/* The spec of s from spec.json (the API's JSON: this build on) or, when
- * there is none, spec.bin (earlier builds); 0, or -1 with why. */
-static int load_spec(srv_session *s, char *why, size_t whylen)
-{
-	char path[128], msg[256];
-	size_t len = 0;
-	session_dir(path, sizeof path, s->entry.id, "spec.json");
-	char *text = srv_store_read_text(path, &len);
-	if (text) {
-		api_problem pb;
-		int format = 0;
-		api_err e = api_parse_spec_file(text, len, &s->spec, &s->created,
-						&s->owned, &format, &s->pick, &s->picked, &pb);
-		free(text);
-		if (e != API_OK)
-			snprintf(why, whylen, "%s: %s", path, pb.detail);
-		else if (stored_spec_check(&s->spec, msg, sizeof msg) != 0) {
-			snprintf(why, whylen, "%s: %s", path, msg);
-			e = API_INVALID;
-		}
-		if (e == API_OK && format < API_SPEC_FILE_FORMAT)
-			s->restore.upgrade = 1;
-		return e == API_OK ? 0 : -1;
-	}
-	/* no spec.json: a build before it (c793934) wrote only spec.bin */
-	session_dir(path, sizeof path, s->entry.id, "spec.bin");
-	int older = 0;
-	void *r = srv_store_read(path, SRV_STORE_SESSION, &len, &older, why, whylen);
-	int rc = r ? srv_spec_decode(r, len, &s->spec, &s->created, &s->owned,
-				     msg, sizeof msg)
-		   : -1;
-	if (r && rc)
-		snprintf(why, whylen, "%s: %s", path, msg);
-	s->restore.upgrade = 1; /* spec.json (and spec.bin) in this build's format */
-	free(r);
-	return rc;
-}
-
-/* s restored at t0 with its log loaded: it runs flat out (and answers
- * 503 meanwhile: srv_session_replaying) to the later of where a refused
- * checkpoint said it was (rebuilt) and its last control's time, so that
- * no client sees it before the controls it acknowledged. */
-static void catch_up(srv_session *s)
-{
-	for (size_t i = 0; i < s->restore.nreplay; i++)
-		if (s->restore.replay[i].at > s->restore.catch_up_t)
-			s->restore.catch_up_t = s->restore.replay[i].at;
-	s->restore.replay_t0 = s->sim ? sim_effective_time(s->sim) : 0;
-	if (!(s->restore.catch_up_t > s->restore.replay_t0))
-		s->restore.catch_up_t = 0;
-	s->restore.replay_wall = srv_now();
-}
-
-/* s was re-created from its spec because neither checkpoint could be used
- * (why, why2): its worker replays the whole control log and runs flat out
- * to where it was, the later of the time a checkpoint's trailer gave and
- * the last control's, then at its pace again (worker.c). */
-static void rebuild(srv_session *s, const char *why, const char *why2)
-{
-	s->restore.rebuilt = 1;
-	s->restore.replay_seconds = s->restore.catch_up_t > 0 ? NAN : 0; /* 0: nowhere to go */
-	srv_log(SRV_LOG_WARN, "session %s: %.200s; %.200s; re-created from its "
-			      "spec, %zu controls replayed to t = %g s",
-		s->entry.id, why, why2, s->restore.nreplay, s->restore.catch_up_t);
-}
-
-/* The files of session id into s (srv_persist_load). */
-static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
-{
-	char path[128], why[512] = "", why2[512] = "";
-	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
-	s->created = srv_unix_time();
-	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
-	if (load_spec(s, why, sizeof why) != 0) {
-		s->damaged = 1;
-		snprintf(s->error, sizeof s->error, "damaged: %.240s", why);
-		return;
-	}
-	s->pace = s->spec.pace;
-	s->until = s->spec.until;
-	s->state = SRV_RUNNING;
-	session_dir(path, sizeof path, id, "checkpoint.bin");
-	size_t logged = 0;
-	int unread = 0, unread_prev = 0;
-	if (load_checkpoint(s, path, ef, &logged, &unread, why, sizeof why) == 0) {
-		load_controls(s, logged);
-		catch_up(s);
-		return;
-	}
-	char prev[160];
-	snprintf(prev, sizeof prev, "%s.prev", path);
-	if (load_checkpoint(s, prev, ef, &logged, &unread_prev, why2, sizeof why2) == 0) {
-		srv_log(SRV_LOG_WARN, "session %s: %s; restored from the "
-				      "previous checkpoint", id, why);
-		load_controls(s, logged);
-		catch_up(s);
-		return;
-	}
-	/* none: created less than one interval before the crash; else both
-	 * copies are unusable (another build's, damaged): either way it
-	 * starts again from its spec and takes every control it took */
-	int none = unread && unread_prev;
-	char msg[256] = "";
-	int err;
-	s->sim = sim_new(&s->spec.params, &s->spec.scene, &s->spec.method,
-			 &err, msg, sizeof msg);
-	if (s->sim) {
-		load_controls(s, 0);
-		if (none)
-			s->restore.catch_up_t = 0;
-		catch_up(s);
-		if (!none)
-			rebuild(s, why, why2);
-		return;
-	}
-	snprintf(why, sizeof why, "its spec is refused: %s", msg);
-	s->damaged = 1;
-	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
-}
-
-void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
-{
-	load_files(s, id, ef);
-	if (s->damaged) {
-		srv_store_count_damaged(SRV_STORE_SESSION);
-		return;
-	}
-	srv_session_readopt(s, ef);
-	if (!s->restore.upgrade)
-		return;
-	/* an earlier format: its spec written again at once (spec.json and
-	 * spec.bin, each atomically: store.c), its checkpoint at the next
-	 * interval, in this build's format */
-	srv_persist_spec(s, 0);
-	s->persist.ckpt_dirty = 1;
-	srv_store_count_upgraded(SRV_STORE_SESSION);
-	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
-			      "in format %d", s->entry.id, SRV_STORE_VERSION);
 }

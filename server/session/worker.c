@@ -122,7 +122,7 @@ static void run_replay(srv_session *s)
 	}
 }
 
-/* caught up: a restored session (session_store.c catch_up) ran flat out
+/* caught up: a restored session (session_load.c catch_up) ran flat out
  * to where it was, or a replayed control stopped it short of that, or it
  * failed: from here on it keeps its pace and answers. */
 static void check_caught_up(srv_session *s, clocks *c)

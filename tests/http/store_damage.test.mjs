@@ -9,7 +9,7 @@
 // reason (the one whose both checkpoints are refused is re-created from
 // its spec, the reasons logged), reads nothing past a buffer (make check runs
 // this under ASan) and stops cleanly. The offsets are this build's record
-// layouts (server/session/session_store.c, host order, x86-64).
+// layouts (server/session/session_load.c, host order, x86-64).
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
