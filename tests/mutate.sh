@@ -60,7 +60,7 @@ mutations=(
 	"the power shown as half the torque times the speed|core/sim_status.c|s|st->power = ev.torque \* ev.rotor_speed + 0.0;|st->power = 0.5 * ev.torque * ev.rotor_speed + 0.0;|"
 	"the mean torque unsigned (ccw)|core/estimator.c|s|out->torque_mean = out->power_mean / out->rotor_speed_mean + 0.0;|out->torque_mean = out->power_mean / fabs(out->rotor_speed_mean) + 0.0;|"
 	"the error bar's scatter over n, not n - 2 degrees of freedom|core/estimator.c|s|sqrt(ss / (nb - 2))|sqrt(ss / nb)|"
-	"the feed velocity over the whole window, not the last period|core/estimator.c|s|(e->Xb_last - e->Xb_prev) / (e->tb_last - e->tb_prev);|(e->Xb_last - e->Xb_prev) / (e->tb_last - e->tb_first);|"
+	"the slip mode's step bound without the bearing drag's slope|core/setup.c|s|+ 2.0 \* p->b_phi \* p->omega_ss;|+ 0.0 * p->b_phi * p->omega_ss;|"
 	"the deck point shown from G's height, not its rest (h_d)|core/sim_status.c|s|st->deck\[1\] -= md->dk.h_d;|st->deck[1] -= 0.0;|"
 )
 # --check: only that every fault applies (each to a copy of its file), no

@@ -173,6 +173,23 @@ static void kloss_against_drag_and_load(void **state)
 	}
 }
 
+/* The slip mode's rate that bounds a fixed step (model_slip_rate: the
+ * torque's slope at the synchronous speed over the rotor's inertia) takes
+ * the bearing drag's slope 2 b_phi w_ss with the motor's 2 M_ut / s_ut:
+ * the largest step shrinks by their ratio when the drag is added. */
+static void slip_bound_counts_the_drag(void **state)
+{
+	(void)state;
+	setup a = preset(), b = preset();
+	set(&a, "method", "rk4");
+	set(&b, "method", "rk4");
+	set(&b, "b_phi", "1e-3");
+	double da = sim_max_dt(&a.p, &a.sc, &a.m), db = sim_max_dt(&b.p, &b.sc, &b.m);
+	double motor = 2.0 * 50.0 / 15.5, drag = 2.0 * 1e-3 * 157.08;
+	assert_true(isfinite(da) && da > 0.0);
+	assert_close(da / db, (motor + drag) / motor, 1e-12);
+}
+
 /* The centre deck point's displacement shown (status deck) is the
  * kinematics of the point R(alpha) (0, h_d) from G: (x - h_d sin alpha,
  * y + h_d (cos alpha - 1)), from its rest position, whatever h_d; here on
@@ -289,6 +306,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
+		cmocka_unit_test(slip_bound_counts_the_drag),
 		cmocka_unit_test(deck_point_shown),
 		cmocka_unit_test(observation_is_the_evaluation),
 		cmocka_unit_test(deck_kinematics),
