@@ -61,6 +61,7 @@ mutations=(
 	"the mean torque unsigned (ccw)|core/estimator.c|s|out->torque_mean = out->power_mean / out->rotor_speed_mean + 0.0;|out->torque_mean = out->power_mean / fabs(out->rotor_speed_mean) + 0.0;|"
 	"the error bar's scatter over n, not n - 2 degrees of freedom|core/estimator.c|s|sqrt(ss / (nb - 2))|sqrt(ss / nb)|"
 	"the slip mode's step bound without the bearing drag's slope|core/setup.c|s|+ 2.0 \* p->b_phi \* p->omega_ss;|+ 0.0 * p->b_phi * p->omega_ss;|"
+	"the mean feed rate over one column's elements (full model)|core/feed.c|s|return md->nf > 0 ? s / md->nf : 0.0;|return md->nf > 0 ? s / md->L : 0.0;|"
 	"the deck point shown from G's height, not its rest (h_d)|core/sim_status.c|s|st->deck\[1\] -= md->dk.h_d;|st->deck[1] -= 0.0;|"
 )
 # --check: only that every fault applies (each to a copy of its file), no

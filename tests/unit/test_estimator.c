@@ -108,6 +108,32 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 	sim_free(s);
 }
 
+/* The estimator's probe of a state (the mean feed position and its rate
+ * it interpolates at the boundaries) is the mean over every element of
+ * every column: on the full model (five columns integrated, each with its
+ * own motion) against the means taken here from the state itself. */
+static void probe_is_the_mean_over_every_element(void **state)
+{
+	(void)state;
+	setup u = preset();
+	set(&u, "h", "0.1"); /* asymmetric: the columns move apart */
+	sim *s = make(&u);
+	const model *md = &s->md;
+	assert_int_equal(md->dk.K, 5);
+	for (int k = 1; k <= 3; k++) {
+		advance(s, 0.1 * k);
+		double X = 0.0, Xd = 0.0;
+		for (int e = 0; e < md->nf; e++) {
+			X += s->y[md->nq + e] / md->nf;
+			Xd += s->y[md->npos + md->nq + e] / md->nf;
+		}
+		assert_close(s->est.X_prev, X, 1e-12);
+		assert_close(s->est.Xd_prev, Xd, 1e-12);
+		assert_true(fabs(Xd) > 1e-4); /* the feed moves */
+	}
+	sim_free(s);
+}
+
 /* A closed loop's steps of beta (sim_steer_beta) leave the trajectory
  * bit for bit as sim_set_beta's, but the estimate goes on across them:
  * after a restart and 25 steps of one period each, it counts the whole
@@ -152,6 +178,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(v_is_dX_over_dt_between_its_crossings),
 		cmocka_unit_test(steered_beta_keeps_the_estimate),
+		cmocka_unit_test(probe_is_the_mean_over_every_element),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
