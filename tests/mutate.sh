@@ -62,6 +62,8 @@ mutations=(
 	"the error bar's scatter over n, not n - 2 degrees of freedom|core/estimator.c|s|sqrt(ss / (nb - 2))|sqrt(ss / nb)|"
 	"the slip mode's step bound without the bearing drag's slope|core/setup.c|s|+ 2.0 \* p->b_phi \* p->omega_ss;|+ 0.0 * p->b_phi * p->omega_ss;|"
 	"the mean feed rate over one column's elements (full model)|core/feed.c|s|return md->nf > 0 ? s / md->nf : 0.0;|return md->nf > 0 ? s / md->L : 0.0;|"
+	"the contacts' elastic energy as if p = 1|core/feed.c|s|(md->p.p + 1.0);|2.0;|"
+	"the period shown from the first boundary, not the last period|core/estimator.c|s|out->period = e->tb_last - e->tb_prev;|out->period = e->tb_last - e->tb_first;|"
 	"the deck point shown from G's height, not its rest (h_d)|core/sim_status.c|s|st->deck\[1\] -= md->dk.h_d;|st->deck[1] -= 0.0;|"
 )
 # --check: only that every fault applies (each to a copy of its file), no

@@ -147,6 +147,32 @@ static void closes_with_the_feed_in_one_system(void **state)
 	}
 }
 
+/* The contacts' elastic energy (part of the potential shown) is the
+ * work of the law k delta^p up to each compression, k delta^(p+1) /
+ * (p + 1): on a settled stack of six layers under p = 1.5 and 2 (each
+ * contact compressed by (W_above / k)^(1/p)), against that sum. */
+static void elastic_energy_of_a_settled_stack(void **state)
+{
+	(void)state;
+	const double ps[] = {1.5, 2.0}, k = 3e5, w = 0.3 * 9.81;
+	for (int i = 0; i < 2; i++) {
+		setup u = one_element();
+		char pv[16];
+		snprintf(pv, sizeof pv, "%g", ps[i]);
+		set(&u, "layers", "6");
+		set(&u, "p", pv);
+		set(&u, "k_c", "3e5");
+		set(&u, "m_n", "0.3");
+		sim *s = make(&u);
+		double q[NQ_FULL], qd[NQ_FULL], expect = 0.0;
+		model_full_coords(&s->md, &s->ctl, s->t_int, s->y, q, qd);
+		for (int j = 0; j < 6; j++)
+			expect += k * pow(pow((6 - j) * w / k, 1.0 / ps[i]), ps[i] + 1.0) / (ps[i] + 1.0);
+		assert_close(dynamics_contact_energy(&s->md, s->y, q, qd), expect, 1e-10 * expect);
+		sim_free(s);
+	}
+}
+
 /* The coupling's own work in dem's dissipated term (status_energy): what
  * the machine gave the feed less the deck's work on it, J. */
 static double coupling_work(const sim *s)
@@ -201,6 +227,7 @@ int main(void)
 		cmocka_unit_test(closes_on_other_machines),
 		cmocka_unit_test(closes_on_other_scenes),
 		cmocka_unit_test(closes_with_the_feed_in_one_system),
+		cmocka_unit_test(elastic_energy_of_a_settled_stack),
 		cmocka_unit_test(coupling_work_shrinks_with_the_step),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
