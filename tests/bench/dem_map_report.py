@@ -82,7 +82,7 @@ def ladder(rows, mats, w):
     w("| material | depth | beta | " + " | ".join("v at %g Pa (overlap)" % e for e in es) +
       " | change to the next rung | seeds | within %.0f %% |" % (100 * TOL))
     w("|---|---|---|" + "---|" * len(es) + "---|---|---|")
-    n_ok = n = 0
+    n_ok = n = n_close = 0
     for m in over:
         at = {}
         for r in rows:
@@ -110,12 +110,14 @@ def ladder(rows, mats, w):
         ok = change is not None and abs(change) < TOL
         n += 1
         n_ok += ok
+        n_close += z is not None and z < 2
         w("| %s | %s | %s | %s | %s | %s | %s |" %
           (m["material"], m["layers"], m["beta_deg"], " | ".join(cells), pct(change),
            "" if z is None else "%.1f" % z,
            "yes" if ok else ("no stiffer rung" if change is None else "no")))
     w("")
-    w("Within %.0f %% of the next rung: %d of these %d points." % (100 * TOL, n_ok, n))
+    w("Within %.0f %% of the next rung: %d of these %d points; the two rungs not told apart by "
+      "three seeds (within 2 standard errors): %d." % (100 * TOL, n_ok, n, n_close))
     w("")
 
 
