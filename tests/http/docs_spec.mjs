@@ -172,6 +172,9 @@ export const SPEC = [
   ['docs/accuracy.md', "window stays 4 s"],
   ['docs/accuracy.md', "1e-10 J over 1 s"],
   ['docs/accuracy.md', "< 0.5 %, shrinking with the step"],
+  /* test_estimator's steady rule and its scenario (the test's own figures) */
+  ['docs/accuracy.md', "(or 0.5 % of \\|v\\|)"],
+  ['docs/accuracy.md', "0.5°/s for 3 s drifts the window's speed by 1–3 % of v"],
   ['docs/accuracy.md', "5 % below the bound"],
   ['docs/accuracy.md', "slip is within 20 %"],
   ['docs/accuracy.md', "0.1 %;"],

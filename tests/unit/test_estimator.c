@@ -173,12 +173,51 @@ static void steered_beta_keeps_the_estimate(void **state)
 	sim_free(b);
 }
 
+/* steady asks a drift within its own standard error (or within 0.5 % of
+ * |v|) as well as a bar within its gate: with beta steered at 0.5 deg/s
+ * the window's speed falls steadily, by 1 to 3 % of v over it, its drift
+ * many times its standard error while half of it, the bar, stays within
+ * the gate, and the estimate is not steady; the same instance with beta
+ * held is. */
+static void a_steady_drift_is_not_steady(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	sim *held = make(&u), *steered = make(&u);
+	advance(held, 1.0);
+	advance(steered, 1.0);
+	sim_restart_transport(held);
+	sim_restart_transport(steered);
+	double beta = status(steered).beta, t = 1.0;
+	for (int k = 0; k < 75; k++) {
+		beta += 0.5 * 0.04 * M_PI / 180;
+		assert_int_equal(sim_steer_beta(steered, beta, 0), SIM_OK);
+		t += 0.04;
+		advance(held, t);
+		advance(steered, t);
+	}
+	const estimator *e = &steered->est;
+	sim_status st = status(steered);
+	double v = fabs(st.transport_velocity), gate = 0.005 * e->speed_max + 0.01 * v;
+	assert_true(e->n_bound >= 8);
+	/* the case the rule is for: a drift beyond its error and 0.5 % of v,
+	 * a bar within the gate */
+	assert_true(fabs(e->bar.drift) > 10.0 * e->bar.se_drift);
+	assert_true(fabs(e->bar.drift) > 0.01 * v && fabs(e->bar.drift) < 0.03 * v);
+	assert_true(e->bar.uncertainty <= gate);
+	assert_false(st.steady);
+	assert_true(status(held).steady);
+	sim_free(held);
+	sim_free(steered);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(v_is_dX_over_dt_between_its_crossings),
 		cmocka_unit_test(steered_beta_keeps_the_estimate),
 		cmocka_unit_test(probe_is_the_mean_over_every_element),
+		cmocka_unit_test(a_steady_drift_is_not_steady),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
