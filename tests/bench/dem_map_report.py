@@ -17,7 +17,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dem_map  # noqa: E402  (the plan and the CSV's key)
-from dem_points import OVERLAP, chosen  # noqa: E402  (which row is a point's value)
+from dem_points import OVERLAP, chosen, rungs  # noqa: E402  (which row is a point's value)
 import provenance  # noqa: E402  (the machine, as provenance.sh names it)
 
 TOL = 0.02    # the relative change a check allows
@@ -34,6 +34,13 @@ def rel(a, b):
 
 def pct(x):
     return "n/a" if x is None else "%+.1f %%" % (100 * x)
+
+
+def seeds_apart(a, b):
+    """|v_a - v_b| in units of the two rows' combined standard error (each
+    row's seeds' standard deviation over the root of 3)."""
+    se = ((f(a["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
+    return abs(f(a["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
 
 
 machine = provenance.cores
@@ -84,14 +91,9 @@ def ladder(rows, mats, w):
     w("|---|---|---|" + "---|" * len(es) + "---|---|---|")
     n_ok = n = n_close = 0
     for m in over:
-        at = {}
-        for r in rows:
-            if (r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
-                    r["cell_width_d"]) == (m["material"], m["layers"], m["drive"], m["beta_deg"],
-                                           m["rotation"], m["cell_width_d"]) and \
-                    r["role"] in ("map", "stiffness"):
-                at[f(r["youngs_pa"])] = r
-        c = chosen(rows, m["material"], int(m["layers"]), m["drive"], f(m["beta_deg"]), mats=mats)
+        point = (m["material"], int(m["layers"]), m["drive"], f(m["beta_deg"]))
+        at = {f(r["youngs_pa"]): r for r in rungs(rows, *point)}
+        c = chosen(rows, *point, mats=mats)
         cells = []
         for e in es:
             r = at.get(e)
@@ -105,8 +107,7 @@ def ladder(rows, mats, w):
         if c and nxt:
             b = at[nxt[0]]
             change = rel(f(c["v_dem"]), f(b["v_dem"]))
-            se = ((f(c["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
-            z = abs(f(c["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
+            z = seeds_apart(c, b)
         ok = change is not None and abs(change) < TOL
         n += 1
         n_ok += ok
@@ -245,8 +246,7 @@ def main():
                   (r["material"], r["layers"], r["beta_deg"], r[what], f(r["v_dem"]), r["overlap_max_rel"]))
                 continue
             c = rel(f(r["v_dem"]), f(b["v_dem"]))
-            se = ((f(r["v_dem_sd"]) ** 2 + f(b["v_dem_sd"]) ** 2) / 3) ** 0.5
-            z = abs(f(r["v_dem"]) - f(b["v_dem"])) / se if se > 0 else float("inf")
+            z = seeds_apart(r, b)
             w("| %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %.1f | %s / %s | %s | %s |" %
               (r["material"], r["layers"], r["beta_deg"], b[what], r[what], f(b["v_dem"]),
                f(r["v_dem"]), pct(c), z, b["overlap_max_rel"], r["overlap_max_rel"],

@@ -26,12 +26,19 @@ def e_map_of(mats=None):
     return (mats or dem_map.materials())["map"]["youngs_map"]
 
 
+def rungs(rows, material, layers, drive, beta, rotation="cw"):
+    """The point's rows in the map's cell that may give it its value: every
+    Young's modulus run there (roles map and stiffness; mirror for ccw)."""
+    roles = ROLES[rotation]
+    return [r for r in rows if r["material"] == material and int(r["layers"]) == layers and
+            r["drive"] == drive and f(r["beta_deg"]) == beta and r["rotation"] == rotation and
+            f(r["cell_width_d"]) == dem_map.WIDTH and r["role"] in roles]
+
+
 def chosen(rows, material, layers, drive, beta, rotation="cw", mats=None):
     """The row that gives the point its value, or None where it has none."""
     roles = ROLES[rotation]
-    rs = [r for r in rows if r["material"] == material and int(r["layers"]) == layers and
-          r["drive"] == drive and f(r["beta_deg"]) == beta and r["rotation"] == rotation and
-          f(r["cell_width_d"]) == dem_map.WIDTH and r["role"] in roles]
+    rs = rungs(rows, material, layers, drive, beta, rotation)
     if not any(r["role"] == roles[0] for r in rs):
         return None
     rs.sort(key=lambda r: f(r["e_scale"]))
