@@ -200,10 +200,12 @@ $(BUILD)/core/model_map.inc: $(MODEL_MAP) Makefile
 model-check: $(BUILD)/convsim
 	$(Q)python3 tests/bench/model_check.py $(BUILD)/convsim > $(MODEL_MAP).new && mv $(MODEL_MAP).new $(MODEL_MAP)
 # `make bench-dem-calibrate` calibrates the column model on three points of
-# each bed of the DEM map and predicts the rest (tests/bench/dem_calibrate.py:
-# tests/bench/results/dem_calibration.md, tests/bench/model_presets.csv),
-# then computes the table above again. Minutes; not part of `make bench`
-# (it changes the table the build compiles in).
+# each complete bed of the DEM map (mu the material's, k_c and R fitted),
+# predicts the rest and checks how far a point's seed spread moves the result
+# (tests/bench/dem_calibrate.py: tests/bench/results/dem_calibration.md,
+# tests/bench/model_presets.csv), then computes the table above again. About
+# 15 minutes of 2 cores; not part of `make bench` (it changes the table the
+# build compiles in).
 bench-dem-calibrate: $(BUILD)/convsim
 	$(Q)python3 tests/bench/dem_calibrate.py $(BUILD)/convsim > /dev/null
 	$(Q)$(MAKE) --no-print-directory model-check

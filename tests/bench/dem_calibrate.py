@@ -3,7 +3,8 @@
 """The column model against the DEM map, as a user would use it: for each
 material, depth and drive of tests/bench/results/dem_map.csv, calibrate the
 column model on three of the map's points with `convsim fit --data`, predict
-the bed's other points with the calibrated model, and tabulate the error.
+the bed's other points with the calibrated model, and tabulate the error and
+how far it moves when a calibration point moves by its seeds' spread.
 
     dem_calibrate.py [CONVSIM]     (`make bench-dem-calibrate`)
 
@@ -12,19 +13,31 @@ tests/bench/model_presets.csv (one line per calibrated bed, which `make
 model-check` turns into the model_error table). Each point's value is taken
 by the map report's rule (dem_points.py).
 
-The three calibration points of a bed, from its clockwise points: the
-forward peak (largest v), the reverse peak (smallest v), and mid-branch the
-map angle between them nearest their middle (the lower of two). A bed is
-calibrated once its clockwise sweep is complete (every angle of
-dem_map.BETAS). The free parameters are the column model's contact, k_c, R
-and mu (as for the preset liggghts-bed4), started at liggghts-bed4's values,
-FITSTARTS starts; every datum's sigma is the root mean square of the bed's
-seed spreads. The model is run one-way, as the DEM bed is driven, with
-model_check.py's measure (model_check.MEASURE), so the table's errors are
-the model_error the engine reports at the points.
+The calibration (DESIGN): mu, the friction of the bed on the deck, is the
+material's grain-on-deck friction (mu_pw in dem/materials.json), not fitted;
+k_c and R are fitted (from liggghts-bed4's values, FITSTARTS starts) to
+three points of the bed's clockwise sweep: the forward peak (largest v), the
+reverse peak (smallest v) and the map angle next past the reverse peak, away
+from the forward peak, where the reverse flow falls off. Two parameters on
+three points: one degree of freedom. k_c's lower bound (SINK) grows with
+the depth; DESIGN says why. Every datum's sigma is the root mean
+square of the bed's seed spreads. A bed is calibrated once its clockwise
+sweep is complete (every angle of dem_map.BETAS); beds with fewer are named
+and skipped.
+
+Stability: each calibration point in turn is moved by its seeds' standard
+deviation, up and down, and the bed calibrated again; the page gives how far
+the worst error and any predicted v move. FORMER is the calibration this
+replaced (k_c, R and mu all free on the two peaks and the mid-branch angle),
+run through the same perturbations for comparison.
+
+The model is run one-way, as the DEM bed is driven, with model_check.py's
+measure (model_check.MEASURE), so the table's errors are the model_error the
+engine reports at the points.
 """
 import csv
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -42,10 +55,19 @@ import provenance  # noqa: E402
 PAGE = os.path.join(HERE, "results", "dem_calibration.md")
 START = "liggghts-bed4"       # the fit's starting values
 PRESET = "czubak2016"         # the calibrated model: this preset and its settings
-FREE = "k_c:100:1e8,R:0.01:0.6,mu:0.1:1.5"  # k_c from its least; above 1e8 the steps cost
 FITSTARTS = 8
 GOOD = 0.05                   # "within 5 % of the peak"
-
+# k_c from SINK: the bed's weight (layers x m_n g, the preset's m_n 0.5 kg)
+# may press the bottom contact at most a grain diameter (4 mm) into the deck,
+# k_c >= layers x 1226 N/m; softer, a calibration four grains deep (k_c 1.8e3)
+# sank centimetres at an angle it was not fitted at and the run diverged.
+# Above 1e8 the steps cost. R up to 0.6 as before.
+M_N_G = 0.5 * 9.81
+SINK = 0.004
+DESIGN = {"name": "mu fixed", "free": "k_c:{kc_min:.6g}:1e8,R:0.01:0.6", "fix_mu": True,
+          "third": "past reverse peak"}
+FORMER = {"name": "former", "free": "k_c:100:1e8,R:0.01:0.6,mu:0.1:1.5", "fix_mu": False,
+          "third": "mid-branch"}
 
 
 machine = provenance.machine
@@ -60,24 +82,44 @@ def git_build():
     return head[:12] + (" (with uncommitted changes to core/, cli/ or fit/)" if dirty else "")
 
 
-def calibration_points(cw):
-    """The forward peak, the reverse peak and the mid-branch point of a
-    bed's clockwise points (rows), as (name, row)."""
+def beta(r):
+    return float(r["beta_deg"])
+
+
+def calibration_points(cw, third):
+    """The forward peak, the reverse peak and the third point of a bed's
+    clockwise points (rows), as (name, row). third "past reverse peak": the
+    next map angle beyond the reverse peak, away from the forward peak;
+    "mid-branch" (or where there is none past): the angle between the peaks
+    nearest their middle (the lower of two)."""
     fwd = max(cw, key=lambda r: float(r["v_dem"]))
     rev = min(cw, key=lambda r: float(r["v_dem"]))
-    bf, br = float(fwd["beta_deg"]), float(rev["beta_deg"])
-    mid = 0.5 * (bf + br)
-    between = [r for r in cw if min(bf, br) < float(r["beta_deg"]) < max(bf, br)]
+    bf, br = beta(fwd), beta(rev)
     pick = [("forward peak", fwd), ("reverse peak", rev)]
+    side = 1 if br > bf else -1
+    past = [r for r in cw if (beta(r) - br) * side > 0]
+    if third == "past reverse peak" and past:
+        return pick + [("past reverse peak", min(past, key=lambda r: abs(beta(r) - br)))]
+    mid = 0.5 * (bf + br)
+    between = [r for r in cw if min(bf, br) < beta(r) < max(bf, br)]
     if between:
-        pick.append(("mid-branch", min(between, key=lambda r: (abs(float(r["beta_deg"]) - mid),
-                                                                float(r["beta_deg"])))))
+        pick.append(("mid-branch", min(between, key=lambda r: (abs(beta(r) - mid), beta(r)))))
     return pick
 
 
-def fit_command(convsim, data, layers, drive, out):
-    args = [convsim, "fit", "-p", START, "--data", data, "--free", FREE,
+def fixed_settings(design, material, mats):
+    """The settings a design fixes from the material: mu = mu_pw."""
+    if not design["fix_mu"]:
+        return []
+    return ["mu=%g" % mats["materials"][material]["mu_pw"]]
+
+
+def fit_command(convsim, data, layers, drive, out, design, fixed):
+    free = design["free"].format(kc_min=layers * M_N_G / SINK)
+    args = [convsim, "fit", "-p", START, "--data", data, "--free", free,
             "--set", "layers=%d" % layers, "--set", "feed_coupling=false"]
+    for s in fixed:
+        args += ["--set", s]
     args += dem_map.DRIVES[drive]
     args += model_check.MEASURE + ["--starts", str(FITSTARTS), "--threads", "2",
                                    "--curve-step", "0", "-q", "-o", out]
@@ -88,57 +130,46 @@ def shown(args):
     return " ".join(os.path.relpath(a) if os.path.isabs(a) else a for a in args)
 
 
-def fit(convsim, data_rows, sigma, layers, drive):
-    """`convsim fit` on data_rows: (its result, the command as shown, the
-    calibrated model's settings)."""
+def fit(convsim, data, sigma, layers, drive, design, fixed):
+    """`convsim fit` on data, [(beta, rotation, v)]: (its result, the
+    command as shown, the calibrated model's settings)."""
     with tempfile.TemporaryDirectory() as tmp:
-        data, out = os.path.join(tmp, "points.csv"), os.path.join(tmp, "fit.json")
-        with open(data, "w") as fh:
+        path, out = os.path.join(tmp, "points.csv"), os.path.join(tmp, "fit.json")
+        with open(path, "w") as fh:
             fh.write("beta,rotation,v,sigma\n")
-            for r in data_rows:
-                fh.write("%s,%s,%s,%.6g\n" % (r["beta_deg"], r["rotation"], r["v_dem"], sigma))
-        args = fit_command(convsim, data, layers, drive, out)
+            for b, rot, v in data:
+                fh.write("%g,%s,%.6g,%.6g\n" % (b, rot, v, sigma))
+        args = fit_command(convsim, path, layers, drive, out, design, fixed)
         subprocess.run(args, check=True)
-        result = json.load(open(out))
-    args = [{data: "POINTS.csv", out: "fit.json"}.get(a, a) for a in args]
+        with open(out) as fh:
+            result = json.load(fh)
+    args = [{path: "POINTS.csv", out: "fit.json"}.get(a, a) for a in args]
     drive_sets = [a for a in dem_map.DRIVES[drive] if a != "--set"]
-    settings = ";".join(drive_sets + ["%s=%.6g" % (p["name"], p["value"])
-                                      for p in result["parameters"]])
+    settings = ";".join(drive_sets + fixed + ["%s=%.6g" % (p["name"], p["value"])
+                                              for p in result["parameters"]])
     return result, shown(args), settings
 
 
+def data_of(rows, moved=None, dv=0.0):
+    """[(beta, rotation, v)] of rows, row number moved shifted by dv."""
+    return [(beta(r), r["rotation"], float(r["v_dem"]) + (dv if i == moved else 0.0))
+            for i, r in enumerate(rows)]
+
+
 def predict(convsim, pts, settings, layers, peak, calib_rows=()):
-    """[(row, v_column, |v_column - v_DEM| / peak, calibration point?)]."""
+    """[(row, v_column, |v_column - v_DEM| / peak, calibration point?)]; a
+    run that diverges is v nan, error inf."""
     out = []
     for r in pts:
         p = {"preset": PRESET, "settings": settings, "layers": layers,
-             "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"]}
-        v = model_check.v_column(convsim, p)
-        out.append((r, v, abs(v - float(r["v_dem"])) / peak, any(r is c for c in calib_rows)))
+             "beta_deg": beta(r), "rotation": r["rotation"]}
+        try:
+            v = model_check.v_column(convsim, p)
+            err = abs(v - float(r["v_dem"])) / peak
+        except subprocess.CalledProcessError:
+            v, err = float("nan"), float("inf")
+        out.append((r, v, err, any(r is c for c in calib_rows)))
     return out
-
-
-def calibrate(convsim, rows, material, layers, drive, mats):
-    """One bed: the fit on three points and its predictions, and the fit on
-    all the bed's points (the column model's best over the bed); 'why'
-    where it cannot be calibrated yet."""
-    pts = dem_points.points(rows, material, layers, drive, mats)
-    cw = [r for r in pts if r["rotation"] == "cw"]
-    bed = {"material": material, "layers": layers, "drive": drive, "points": pts}
-    have = {float(r["beta_deg"]) for r in cw}
-    if not all(float(b) in have for b in dem_map.BETAS):
-        bed["why"] = "%d of the %d clockwise angles measured so far" % (len(have), len(dem_map.BETAS))
-        return bed
-    calib = calibration_points(cw)
-    sigma = statistics.fmean(float(r["v_dem_sd"]) ** 2 for r in cw) ** 0.5
-    peak = max(abs(float(r["v_dem"])) for r in pts)
-    bed.update(calib=calib, sigma=sigma, peak=peak)
-    bed["fit"], bed["command"], bed["settings"] = fit(convsim, [r for _, r in calib], sigma,
-                                                      layers, drive)
-    bed["pred"] = predict(convsim, pts, bed["settings"], layers, peak, [r for _, r in calib])
-    bed["all_fit"], _, bed["all_settings"] = fit(convsim, pts, sigma, layers, drive)
-    bed["all_pred"] = predict(convsim, pts, bed["all_settings"], layers, peak)
-    return bed
 
 
 def stats(pred):
@@ -147,41 +178,122 @@ def stats(pred):
     return worst, statistics.median(x[2] for x in pred), sum(1 for x in pred if x[2] <= GOOD)
 
 
+def worst_predicted(pred):
+    return stats([x for x in pred if not x[3]])[0][2]
+
+
+def calibrate_design(convsim, bed, design, mats):
+    """A bed's calibration by design: the fit on its three points, its
+    predictions, and each perturbed fit's settings, worst error and largest
+    move of a predicted v (of the peak)."""
+    pts, cw, layers, drive = bed["points"], bed["cw"], bed["layers"], bed["drive"]
+    calib = calibration_points(cw, design["third"])
+    crow = [r for _, r in calib]
+    fixed = fixed_settings(design, bed["material"], mats)
+    c = {"calib": calib, "fixed": fixed}
+    c["fit"], c["command"], c["settings"] = fit(convsim, data_of(crow), bed["sigma"], layers,
+                                                drive, design, fixed)
+    c["pred"] = predict(convsim, pts, c["settings"], layers, bed["peak"], crow)
+    base = worst_predicted(c["pred"])
+    c["moves"] = []
+    for i, (name, r) in enumerate(calib):
+        for sign in (1, -1):
+            dv = sign * float(r["v_dem_sd"])
+            _, _, settings = fit(convsim, data_of(crow, i, dv), bed["sigma"], layers, drive,
+                                 design, fixed)
+            pred = predict(convsim, pts, settings, layers, bed["peak"], crow)
+            dvmax = max(abs(a[1] - b[1]) for a, b in zip(pred, c["pred"])) / bed["peak"]
+            c["moves"].append((name, dv, settings, worst_predicted(pred), dvmax))
+    c["d_worst"] = max(abs(m[3] - base) for m in c["moves"])
+    c["d_v"] = max(m[4] for m in c["moves"])
+    return c
+
+
+def calibrate(convsim, rows, material, layers, drive, mats):
+    """One bed: the calibration (DESIGN) and the former one (FORMER), and the
+    fit on all the bed's points (the column model's best over the bed, mu
+    fixed as in DESIGN); 'why' where it cannot be calibrated."""
+    pts = dem_points.points(rows, material, layers, drive, mats)
+    cw = [r for r in pts if r["rotation"] == "cw"]
+    bed = {"material": material, "layers": layers, "drive": drive, "points": pts, "cw": cw}
+    have = {beta(r) for r in cw}
+    if not all(float(b) in have for b in dem_map.BETAS):
+        bed["why"] = "%d of the %d clockwise angles measured so far" % (len(have), len(dem_map.BETAS))
+        return bed
+    bed["sigma"] = statistics.fmean(float(r["v_dem_sd"]) ** 2 for r in cw) ** 0.5
+    bed["peak"] = max(abs(float(r["v_dem"])) for r in pts)
+    bed["now"] = calibrate_design(convsim, bed, DESIGN, mats)
+    bed["former"] = calibrate_design(convsim, bed, FORMER, mats)
+    fixed = bed["now"]["fixed"]
+    bed["all_fit"], _, bed["all_settings"] = fit(convsim, data_of(pts), bed["sigma"], layers,
+                                                 drive, DESIGN, fixed)
+    bed["all_pred"] = predict(convsim, pts, bed["all_settings"], layers, bed["peak"])
+    return bed
+
+
+def pct(x):
+    return "%.1f %%" % (100 * x) if math.isfinite(x) else "diverges"
+
+
+def moved(x):
+    """A stability figure in points of %; a diverging run makes it none."""
+    return "%.1f" % (100 * x) if math.isfinite(x) else "diverges"
+
+
 def summary_line(b):
     if "why" in b:
-        return "| %s | %s | %d | not calibrated: %s | | | | | | |" % (
+        return "| %s | %s | %d | not calibrated: %s | | | | | | | |" % (
             b["material"], b["drive"], b["layers"], b["why"])
-    calib = ", ".join("%s %g° cw" % (n, float(r["beta_deg"])) for n, r in b["calib"])
-    pars = ", ".join("%s %.3g" % (p["name"], p["value"]) for p in b["fit"]["parameters"])
-    rest = [x for x in b["pred"] if not x[3]]
+    c = b["now"]
+    calib = ", ".join("%s %g° cw" % (n, beta(r)) for n, r in c["calib"])
+    pars = ", ".join(c["fixed"] + ["%s %.3g" % (p["name"], p["value"])
+                                   for p in c["fit"]["parameters"]])
+    rest = [x for x in c["pred"] if not x[3]]
     worst, med, good = stats(rest)
     aw, am, _ = stats(b["all_pred"])
-    return "| %s | %s | %d | %s | %s | %d | %.1f %% (%g° %s) | %.1f %% | %d of %d | %.1f %% / %.1f %% |" % (
-        b["material"], b["drive"], b["layers"], calib, pars, len(rest), 100 * worst[2],
-        float(worst[0]["beta_deg"]), worst[0]["rotation"], 100 * med, good, len(rest),
-        100 * aw[2], 100 * am)
+    return ("| %s | %s | %d | %s | %s | %d | %s (%g° %s) | %s | %d of %d | "
+            "%s / %s | %s / %s |" % (
+                b["material"], b["drive"], b["layers"], calib, pars, len(rest), pct(worst[2]),
+                beta(worst[0]), worst[0]["rotation"], pct(med), good, len(rest),
+                moved(c["d_worst"]), moved(c["d_v"]), pct(aw[2]), pct(am)))
+
+
+def former_line(b):
+    n, f = b["now"], b["former"]
+    calib = ", ".join("%g°" % beta(r) for _, r in f["calib"])
+    pars = ", ".join("%s %.3g" % (p["name"], p["value"]) for p in f["fit"]["parameters"])
+    ranges = [(min(m[3] for m in c["moves"]), max(m[3] for m in c["moves"])) for c in (f, n)]
+    return "| %s | %s | %d | %s | %s | %s | %s–%s | %s / %s | %s | %s–%s | %s / %s |" % (
+        b["material"], b["drive"], b["layers"], calib, pars, pct(worst_predicted(f["pred"])),
+        pct(ranges[0][0]), pct(ranges[0][1]), moved(f["d_worst"]), moved(f["d_v"]),
+        pct(worst_predicted(n["pred"])), pct(ranges[1][0]), pct(ranges[1][1]),
+        moved(n["d_worst"]), moved(n["d_v"]))
 
 
 def detail(b, w):
+    c = b["now"]
     w("### %s, %d grains deep, drive `%s`" % (b["material"], b["layers"], b["drive"]))
     w("")
-    fit = b["fit"]
-    w("Fit on the three points: %s after %d iterations, χ² %.3g on %d degrees of freedom, "
+    fit = c["fit"]
+    w("Fit on the three points: %s after %d iterations, χ² %.3g on %d degree(s) of freedom, "
       "σ %.4f m/s; settings `%s` on the preset %s (the line of tests/bench/model_presets.csv). "
       "On all %d points: `%s`, χ² %.3g on %d degrees of freedom." %
-      (fit["status"], fit["iterations"], fit["chi2"], fit["dof"], b["sigma"], b["settings"],
+      (fit["status"], fit["iterations"], fit["chi2"], fit["dof"], b["sigma"], c["settings"],
        PRESET, len(b["points"]), b["all_settings"], b["all_fit"]["chi2"], b["all_fit"]["dof"]))
     for warning in fit.get("warnings") or []:
         w("Fit warning (three points): %s." % warning.rstrip("."))
     w("")
-    w("    " + b["command"])
+    w("    " + c["command"])
+    w("")
+    w("A calibration point moved by its seeds' sd, the bed calibrated again: " + "; ".join(
+        "%s %+.4f m/s: `%s`, worst %s" % (n, dv, st, pct(wst)) for n, dv, st, wst, _ in c["moves"]) + ".")
     w("")
     w("| β (°) | sense | v_DEM (m/s) | v_column (m/s) | error, % of peak | | v_column, all points fitted | error |")
     w("|---|---|---|---|---|---|---|---|")
-    for (r, v, err, is_calib), (_, va, erra, _) in zip(b["pred"], b["all_pred"]):
-        name = next((n for n, c in b["calib"] if c is r), "")
+    for (r, v, err, is_calib), (_, va, erra, _) in zip(c["pred"], b["all_pred"]):
+        name = next((n for n, x in c["calib"] if x is r), "")
         w("| %g | %s | %+.4f ± %.4f | %+.4f | %.1f | %s | %+.4f | %.1f |" %
-          (float(r["beta_deg"]), r["rotation"], float(r["v_dem"]), float(r["v_dem_sd"]), v,
+          (beta(r), r["rotation"], float(r["v_dem"]), float(r["v_dem_sd"]), v,
            100 * err, "calibration: " + name if is_calib else "", va, 100 * erra))
     w("")
 
@@ -190,6 +302,7 @@ def page(beds, convsim, started):
     out = []
     w = out.append
     rows_build = sorted({r["build"][:12] for b in beds for r in b["points"]})
+    done = [b for b in beds if "now" in b]
     w("# The column model against the DEM map")
     w("")
     w("`make bench-dem-calibrate` (tests/bench/dem_calibrate.py %s) on %s, column model "
@@ -200,33 +313,44 @@ def page(beds, convsim, started):
                               git_build(), ", ".join(rows_build) or "-", time.time() - started,
                               machine()))
     w("")
-    w("Each bed (material, depth, drive) is calibrated on three of its points, named below: "
-      "the forward peak (largest v clockwise), the reverse peak (smallest v) and the map "
-      "angle between them nearest their middle. `convsim fit --data` fits the column "
-      "model's contact (k_c, R, μ; from liggghts-bed4's values, %d starts) to them; the "
-      "calibrated model then predicts every other point of the bed. The error is "
-      "|v_column − v_DEM| in %% of the bed's peak |v_DEM|; worst and median are over the "
-      "predicted points only (not the three it was fitted to). The column model runs "
+    w("Each bed (material, depth, drive) whose clockwise sweep is complete is calibrated on "
+      "three of its points, named below: the forward peak (largest v clockwise), the reverse "
+      "peak (smallest v) and the next map angle past the reverse peak, where the reverse flow "
+      "falls off. μ, the bed's friction on the deck, is the material's grain-on-deck friction "
+      "(μ_pw in dem/materials.json); `convsim fit --data` fits k_c and R (from liggghts-bed4's "
+      "values, %d starts): two parameters on three points. The calibrated model then predicts "
+      "every other point of the bed. The error is |v_column − v_DEM| in %% of the bed's peak "
+      "|v_DEM|; worst and median are over the predicted points only. The column model runs "
       "one-way like the DEM bed (`%s`), so these errors are the `model_error` the engine "
       "reports at the points (tests/bench/model_presets.csv, `make model-check`)." %
       (FITSTARTS, " ".join(model_check.MEASURE)))
     w("")
-    w("The last column fits the same three parameters to all the bed's points (the same "
-      "command with every point as data) and gives the error over all of them, the fitted "
-      "points included: what the column model reaches on that bed when it may see every "
-      "point (the lowest of its starts, not a proven optimum), so what of the three-point "
-      "error is the choice of points and what the model's.")
+    w("Stability: each calibration point in turn moved up and down by its seeds' standard "
+      "deviation and the bed calibrated again (six fits); the column gives the largest change "
+      "of the worst error (points of %) and the largest change of any predicted v (% of the "
+      "peak). The last column fits k_c and R to all the bed's points: what the column model "
+      "reaches when it may see every point (the lowest of its starts, not a proven optimum).")
     w("")
-    w("| material | drive | depth (grains) | calibrated on | k_c (N/m^p), R, μ | points "
-      "predicted | worst | median | within %.0f %% | all points fitted: worst / median |" %
-      (100 * GOOD))
-    w("|---|---|---|---|---|---|---|---|---|---|")
+    w("| material | drive | depth (grains) | calibrated on | μ (fixed), k_c (N/m^p), R | points "
+      "predicted | worst | median | within %.0f %% | stability: worst / v moves by | "
+      "all points fitted: worst / median |" % (100 * GOOD))
+    w("|---|---|---|---|---|---|---|---|---|---|---|")
     for b in beds:
         w(summary_line(b))
     w("")
-    for b in beds:
-        if "fit" in b:
-            detail(b, w)
+    w("The calibration this replaces fitted k_c, R and μ to the two peaks and the angle between "
+      "them (three parameters on three points). The same perturbations, both calibrations "
+      "(worst error with the points as measured, its range over the six perturbed fits, "
+      "and the stability column as above):")
+    w("")
+    w("| material | drive | depth (grains) | former: calibrated on | former: k_c, R, μ | worst "
+      "| worst, perturbed | worst / v moves by | now: worst | worst, perturbed | worst / v moves by |")
+    w("|---|---|---|---|---|---|---|---|---|---|---|")
+    for b in done:
+        w(former_line(b))
+    w("")
+    for b in done:
+        detail(b, w)
     return "\n".join(out) + "\n"
 
 
@@ -238,8 +362,8 @@ def write_presets(beds):
         wr = csv.writer(fh, lineterminator="\n")
         wr.writerow(["material", "layers", "drive", "preset", "settings"])
         for b in beds:
-            if "settings" in b:
-                wr.writerow([b["material"], b["layers"], b["drive"], PRESET, b["settings"]])
+            if "now" in b:
+                wr.writerow([b["material"], b["layers"], b["drive"], PRESET, b["now"]["settings"]])
     os.replace(path + ".new", path)
 
 

@@ -143,3 +143,29 @@ test('model_error: a map point\'s value is the report\'s row: the map\'s cell, t
     Number(r.beta_deg) === 30 && r.rotation === 'cw');
   assert.equal(p30.v_dem, '0.0978932');
 });
+
+test('model_error: every complete bed of the DEM map (all 13 clockwise angles) is calibrated and checked, glass 8 grains and wheat among them', () => {
+  const key = (r) => `${r.material},${r.layers},${r.drive}`;
+  const angles = new Map();
+  for (const r of csvObjects('../bench/results/dem_map.csv')) {
+    if (r.role !== 'map' || r.rotation !== 'cw' || Number(r.cell_width_d) !== 4) continue;
+    if (!angles.has(key(r))) angles.set(key(r), new Set());
+    angles.get(key(r)).add(Number(r.beta_deg));
+  }
+  const complete = [...angles].filter(([, s]) => s.size === 13).map(([k]) => k);
+  for (const k of ['glass,1,preset', 'glass,2,preset', 'glass,4,preset', 'glass,8,preset', 'wheat,1,preset'])
+    assert.ok(complete.includes(k), `${k}: complete in the map`);
+  const presets = csvObjects('../bench/model_presets.csv');
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv'));
+  assert.deepEqual(presets.map(key).sort(), [...complete].sort(), 'the calibrated beds are the complete ones (make bench-dem-calibrate)');
+  assert.deepEqual([...new Set(table.map(key))].sort(), [...complete].sort(), 'each has its rows (make model-check)');
+  // an 8-grain glass scene and a wheat scene at 150 deg cw: checked, with the map's value there
+  for (const k of ['glass,8,preset', 'wheat,1,preset']) {
+    const r = table.find((x) => key(x) === k && Number(x.beta_deg) === 150 && x.rotation === 'cw');
+    const s = summary(r.preset, ...r.settings.split(';'), `layers=${r.layers}`, 'beta=150');
+    assert.equal(s.model_checked, true, `${k}: ${s.model_check_note}`);
+    const want = Math.abs(Number(r.v_column) - Number(r.v_dem)) + Number(r.v_dem_sd);
+    assert.ok(Math.abs(s.model_error - want) < 1e-12, `${k}: ${s.model_error} against ${want}`);
+    assert.match(s.model_check_note, new RegExp(`calibrated to ${r.material}, ${r.layers} layers\\)$`));
+  }
+});
