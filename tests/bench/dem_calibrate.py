@@ -285,8 +285,9 @@ def detail(b, w):
     w("")
     w("    " + c["command"])
     w("")
-    w("A calibration point moved by its seeds' sd, the bed calibrated again: " + "; ".join(
-        "%s %+.4f m/s: `%s`, worst %s" % (n, dv, st, pct(wst)) for n, dv, st, wst, _ in c["moves"]) + ".")
+    moves = ["%s %+.4f m/s: `%s`, worst %s" % (n, dv, st, pct(wst))
+             for n, dv, st, wst, _ in c["moves"]]
+    w("A calibration point moved by its seeds' sd, the bed calibrated again: %s." % "; ".join(moves))
     w("")
     w("| β (°) | sense | v_DEM (m/s) | v_column (m/s) | error, % of peak | | v_column, all points fitted | error |")
     w("|---|---|---|---|---|---|---|---|")
@@ -318,7 +319,10 @@ def page(beds, convsim, started):
       "peak (smallest v) and the next map angle past the reverse peak, where the reverse flow "
       "falls off. μ, the bed's friction on the deck, is the material's grain-on-deck friction "
       "(μ_pw in dem/materials.json); `convsim fit --data` fits k_c and R (from liggghts-bed4's "
-      "values, %d starts): two parameters on three points. The calibrated model then predicts "
+      "values, %d starts): two parameters on three points. k_c is at least the depth × 1226 "
+      "N/m: the bed's weight may press the column's contact at most a grain diameter (4 mm) "
+      "into the deck; softer calibrations sank at angles they were not fitted at and diverged. "
+      "The calibrated model then predicts "
       "every other point of the bed. The error is |v_column − v_DEM| in %% of the bed's peak "
       "|v_DEM|; worst and median are over the predicted points only. The column model runs "
       "one-way like the DEM bed (`%s`), so these errors are the `model_error` the engine "
