@@ -318,8 +318,8 @@ void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
 {
 	double B[3][3] = {{0}};
 	for (int c = 0; c < nb; c++) {
-		double qdd[NQ_FULL] = {0};
-		model_add_reduced(md, qr[c], qdd);
+		double qdd[NQ_FULL];
+		model_reduced_to_full(md, qr[c], qdd);
 		for (int i = 0; i < 3; i++)
 			B[i][c] = qdd[i];
 	}

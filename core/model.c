@@ -96,6 +96,16 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 	}
 }
 
+void model_reduced_to_full(const model *md, const double *qr, double full[NQ_FULL])
+{
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		trough2_full(qr, full);
+		return;
+	}
+	memset(full, 0, sizeof(double) * NQ_FULL);
+	model_add_reduced(md, qr, full);
+}
+
 /* The machine's configuration at time t: full coordinates, beta and its
  * rates, and the three point masses. */
 typedef struct config {
@@ -405,9 +415,16 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	eliminators(&md->p, &cf, rhs, &damp_power);
 	drive(md, ctl, &cf, rhs, &damp_power, &dt);
 	solve(md, ctl, t, M, rhs, &dt, br, qdd);
-	for (int r = 0; r < md->nq; r++) {
-		dy[r] = y[md->npos + r];
-		dy[md->npos + r] = br[r];
+	/* positions' rates and accelerations; in the reduced scene's
+	 * layout (x, y | phi, s1, s2) two copies of constant size */
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		memcpy(dy, y + md->npos, 5 * sizeof *dy);
+		memcpy(dy + md->npos, br, 5 * sizeof *dy);
+	} else {
+		for (int r = 0; r < md->nq; r++) {
+			dy[r] = y[md->npos + r];
+			dy[md->npos + r] = br[r];
+		}
 	}
 	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd) + load_power;
 	dy[2 * md->npos + ACC_DAMP] = damp_power;
