@@ -103,36 +103,48 @@ switch_mode(int L, signed char *restrict mode, signed char *restrict entry, int 
 	mode[j] = nm;
 }
 
-/* The bonded contacts j0..j1 of a solved cluster checked, bottom first;
- * within its bounds a bonded contact stays (bond_mode's tolerance is
- * needed only outside them). Returns 1 where one switched. */
+/* A bonded contact j with impulse p to its consistent mode; within its
+ * bounds it stays (bond_mode's tolerance is needed only outside them).
+ * Returns 1 where it switched. */
+static inline __attribute__((always_inline)) int
+bond_switch(int L, int j, double p, const double *restrict lo, const double *restrict hi,
+	    signed char *restrict mode, signed char *restrict entry, int *switched)
+{
+	double h = hi[j], l = lo[j];
+	if (!(h == l || p > h || p < l))
+		return 0;
+	signed char nm = bond_mode(p, l, h);
+	if (nm == BOND)
+		return 0;
+	switch_mode(L, mode, entry, switched, j, nm);
+	return 1;
+}
+
+/* The bonded contacts j0..j1 of a solved cluster checked, bottom first
+ * (bond_switch); after L rounds (single) up to the first switch. Returns 1
+ * where one switched. */
 static inline __attribute__((always_inline)) int
 check_bonded(int L, int j0, int j1, const double *restrict lo, const double *restrict hi,
 	     const double *restrict P, signed char *restrict mode, signed char *restrict entry,
 	     int *switched, int single)
 {
 	int changed = 0;
-	for (int j = j0; j <= j1; j++) {
-		double h = hi[j], l = lo[j], p = P[j];
-		if (!(h == l || p > h || p < l))
-			continue;
-		signed char nm = bond_mode(p, l, h);
-		if (nm != BOND) {
-			switch_mode(L, mode, entry, switched, j, nm);
+	for (int j = j0; j <= j1; j++)
+		if (bond_switch(L, j, P[j], lo, hi, mode, entry, switched)) {
 			changed = 1;
 			if (single)
 				break;
 		}
-	}
 	return changed;
 }
 
 /* One round of chain_solve: chain_clusters' velocities and impulses for
- * the modes as they stand, each cluster's contacts checked as soon as it
- * is solved (bottom first, the order of chain_clusters' contacts) and
- * switched where inconsistent; after L rounds (single) the checks stop at
- * the first switch. A switch touches only contacts of the clusters
- * already solved, so every cluster is solved with the modes the round
+ * the modes as they stand, each contact checked as its cluster is solved
+ * (a cluster's bottom contact first, then its bonded ones as their
+ * impulses come) and switched where inconsistent; after L rounds (single)
+ * the checks go bottom first, chain_clusters' order, and stop at the first
+ * switch. A switch touches only contacts of the cluster being solved or
+ * those below it, so every cluster is solved with the modes the round
  * began with, as in a full pass followed by the checks; the fixed impulse
  * on a cluster's top is the one under the next (Pbot), the arithmetic
  * chain_clusters'. Returns whether a contact switched. */
@@ -148,13 +160,19 @@ chain_round(int L, double m, const double *restrict vs, double v0, const double 
 		while (b + 1 < L && mode[b + 1] == BOND)
 			b++;
 		Pbot = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
+		/* its contacts checked as their impulses come, top first:
+		 * before the single rounds every contact is checked, so the
+		 * order changes nothing */
 		double Pj = Pbot;
 		for (int j = b; j >= 0; j--) {
 			Pj += m * (v0 - vs[j]);
 			P[j] = Pj;
 			v[j] = v0;
+			if (!single && bond_switch(L, j, Pj, lo, hi, mode, entry, switched))
+				changed = 1;
 		}
-		changed = check_bonded(L, 0, b, lo, hi, P, mode, entry, switched, single);
+		if (single)
+			changed = check_bonded(L, 0, b, lo, hi, P, mode, entry, switched, single);
 		a = b + 1;
 	} else {
 		Pbot = mode[0] == HI ? hi[0] : lo[0];
@@ -167,24 +185,28 @@ chain_round(int L, double m, const double *restrict vs, double v0, const double 
 		double Ptop = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
 		double n = (double)(b - a + 1);
 		double vc = (m * sum + Pbot - Ptop) / (n * m);
+		int check = !(changed && single);
+		if (check) {
+			signed char nm = slip_mode(mode[a], below - vc, lo[a], hi[a]);
+			if (nm != mode[a]) {
+				switch_mode(L, mode, entry, switched, a, nm);
+				changed = 1;
+				check = !single;
+			}
+		}
+		/* the bonded contacts a + 1..b checked as their impulses come */
 		double Pj = Pbot;
 		for (int j = a; j < b; j++) {
 			P[j] = Pj;
 			v[j] = vc;
 			Pj -= m * (vc - vs[j]);
+			if (check && bond_switch(L, j + 1, Pj, lo, hi, mode, entry, switched)) {
+				changed = 1;
+				check = !single;
+			}
 		}
 		P[b] = Pj;
 		v[b] = vc;
-		if (!(changed && single)) {
-			signed char nm = slip_mode(mode[a], below - vc, lo[a], hi[a]);
-			if (nm != mode[a]) {
-				switch_mode(L, mode, entry, switched, a, nm);
-				changed = 1;
-			}
-			if (!(changed && single) &&
-			    check_bonded(L, a + 1, b, lo, hi, P, mode, entry, switched, single))
-				changed = 1;
-		}
 		below = vc;
 		Pbot = Ptop;
 		a = b + 1;
