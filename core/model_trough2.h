@@ -33,7 +33,8 @@ static int trough2_held(const model *md, const model_ctl *ctl, double t, const d
 	if (c->beta_d != 0.0 || c->beta_dd != 0.0)
 		return 0;
 	const sim_params *p = &md->p;
-	model_full_coords(md, ctl, t, y, c->q, c->qd);
+	trough2_full(y, c->q); /* model_full_coords in this layout */
+	trough2_full(y + md->npos, c->qd);
 	c->R = (deck_rot){1.0, 0.0};
 	beta_sincos(c->beta, &c->sbeta, &c->cbeta);
 	zero_matrix(M);
