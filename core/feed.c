@@ -318,8 +318,8 @@ void feed_yield_compliance(const model *md, int nb, const double (*qr)[NQ_FULL],
 {
 	double B[3][3] = {{0}};
 	for (int c = 0; c < nb; c++) {
-		double qdd[NQ_FULL] = {0};
-		model_add_reduced(md, qr[c], qdd);
+		double qdd[NQ_FULL];
+		model_reduced_to_full(md, qr[c], qdd);
 		for (int i = 0; i < 3; i++)
 			B[i][c] = qdd[i];
 	}
@@ -378,6 +378,43 @@ void feed_yield_velocity(const feed_yield *yl, int K, const double (*E)[2], doub
 	yield_velocity(yl, K, E, dv);
 }
 
+/* feed_dem_step's yielding deck for one integrated column (the symmetric
+ * reduction's): yield_velocity's and the sub-step loop's arithmetic
+ * operation for operation, the loops over the columns gone. */
+static void one_column_yielding(const model *md, double *y, int ns, double h,
+				const double (*pos)[2], const double (*vel)[2], int events,
+				const feed_yield *yl, signed char *modes, double imp[2],
+				feed_work *work)
+{
+	const int turns = yl->nb > 2;
+	const double(*T)[3] = yl->T[0];
+	const double *Rd = yl->Rd[0], *F = yl->F[0];
+	double last0 = F[0] * h, last1 = F[1] * h, dv0 = 0.0, dv1 = 0.0, dp0 = 0.0, dp1 = 0.0;
+	for (int i = 0; i < ns; i++) {
+		double E0 = imp[0] + 0.5 * last0 - F[0] * (i + 0.5) * h;
+		double E1 = imp[1] + 0.5 * last1 - F[1] * (i + 0.5) * h;
+		double Gx = 0.0 + E0, Gy = 0.0 + E1, Ga = 0.0;
+		if (turns)
+			Ga += -Rd[1] * E0 + Rd[0] * E1;
+		double n0 = T[0][0] * Gx + T[0][1] * Gy, n1 = T[1][0] * Gx + T[1][1] * Gy;
+		if (turns) {
+			n0 += T[0][2] * Ga;
+			n1 += T[1][2] * Ga;
+		}
+		double p[2] = {pos[i][0] + dp0, pos[i][1] + dp1};
+		double v0[2] = {vel[i][0] + dv0, vel[i][1] + dv1};
+		double v1[2] = {vel[i + 1][0] + n0, vel[i + 1][1] + n1};
+		dp0 += h * n0;
+		dp1 += h * n1;
+		dv0 = n0;
+		dv1 = n1;
+		double before0 = imp[0], before1 = imp[1];
+		column_substep(md, y, 0, h, p, v0, v1, events, modes, imp, work);
+		last0 = imp[0] - before0;
+		last1 = imp[1] - before1;
+	}
+}
+
 void feed_dem_step(const model *md, double *y, int ns, double h, const double (*deck_pos)[2],
 		   const double (*deck_vel)[2], int events, const feed_yield *yield,
 		   signed char *modes, double (*impulse)[2], feed_work *work)
@@ -395,6 +432,11 @@ void feed_dem_step(const model *md, double *y, int ns, double h, const double (*
 				column_substep(md, y, k, h, pos[i], vel[i], vel[i + 1], events, modes,
 					       impulse[k], work);
 		}
+		return;
+	}
+	if (K == 1) {
+		one_column_yielding(md, y, ns, h, deck_pos, deck_vel, events, yield, modes,
+				    impulse[0], work);
 		return;
 	}
 	/* the deck yields: at the middle of sub-step i its velocity at

@@ -67,44 +67,167 @@ chain_clusters(int L, double m, const double *restrict vs, double v0, const doub
 	}
 }
 
+/* The mode a bonded contact with impulse P takes: HI or LO where P is
+ * beyond its bound by more than the tolerance, HI where the bounds are
+ * equal (a fixed impulse, or no contact), else BOND. */
+static inline __attribute__((always_inline)) signed char bond_mode(double P, double lo, double hi)
+{
+	if (hi == lo)
+		return HI;
+	double tolP = 1e-12 * (fabs(hi) + fabs(lo)) + 1e-300;
+	return P > hi + tolP ? HI : P < lo - tolP ? LO : BOND;
+}
+
+/* The mode a slipping contact (mode m, HI or LO) takes at the relative
+ * velocity s: BOND where it has stopped or reversed, HI where its bounds
+ * are equal. */
+static inline __attribute__((always_inline)) signed char slip_mode(signed char m, double s,
+								  double lo, double hi)
+{
+	if (hi == lo)
+		return HI;
+	if (m == HI)
+		return s < -1e-13 ? BOND : HI;
+	return s > 1e-13 ? BOND : LO;
+}
+
+/* Contact j to mode nm, the modes on entry copied at a solve's first
+ * switch (where entry is asked for). */
+static inline __attribute__((always_inline)) void
+switch_mode(int L, signed char *restrict mode, signed char *restrict entry, int *switched, int j,
+	    signed char nm)
+{
+	if (!*switched && entry)
+		memcpy(entry, mode, (size_t)L);
+	*switched = 1;
+	mode[j] = nm;
+}
+
+/* A bonded contact j with impulse p to its consistent mode; within its
+ * bounds it stays (bond_mode's tolerance is needed only outside them).
+ * Returns 1 where it switched. */
+static inline __attribute__((always_inline)) int
+bond_switch(int L, int j, double p, const double *restrict lo, const double *restrict hi,
+	    signed char *restrict mode, signed char *restrict entry, int *switched)
+{
+	double h = hi[j], l = lo[j];
+	if (!(h == l || p > h || p < l))
+		return 0;
+	signed char nm = bond_mode(p, l, h);
+	if (nm == BOND)
+		return 0;
+	switch_mode(L, mode, entry, switched, j, nm);
+	return 1;
+}
+
+/* The bonded contacts j0..j1 of a solved cluster checked, bottom first
+ * (bond_switch); after L rounds (single) up to the first switch. Returns 1
+ * where one switched. */
+static inline __attribute__((always_inline)) int
+check_bonded(int L, int j0, int j1, const double *restrict lo, const double *restrict hi,
+	     const double *restrict P, signed char *restrict mode, signed char *restrict entry,
+	     int *switched, int single)
+{
+	int changed = 0;
+	for (int j = j0; j <= j1; j++)
+		if (bond_switch(L, j, P[j], lo, hi, mode, entry, switched)) {
+			changed = 1;
+			if (single)
+				break;
+		}
+	return changed;
+}
+
+/* One round of chain_solve: chain_clusters' velocities and impulses for
+ * the modes as they stand, each contact checked as its cluster is solved
+ * (a cluster's bottom contact first, then its bonded ones as their
+ * impulses come) and switched where inconsistent; after L rounds (single)
+ * the checks go bottom first, chain_clusters' order, and stop at the first
+ * switch. A switch touches only contacts of the cluster being solved or
+ * those below it, so every cluster is solved with the modes the round
+ * began with, as in a full pass followed by the checks; the fixed impulse
+ * on a cluster's top is the one under the next (Pbot), the arithmetic
+ * chain_clusters'. Returns whether a contact switched. */
+static inline __attribute__((always_inline)) int
+chain_round(int L, double m, const double *restrict vs, double v0, const double *restrict lo,
+	    const double *restrict hi, double *restrict P, double *restrict v,
+	    signed char *restrict mode, signed char *restrict entry, int *switched, int single)
+{
+	int changed = 0, a = 0, b = 0;
+	double below = v0, Pbot = 0.0;
+	if (mode[0] == BOND) {
+		/* rides with the deck */
+		while (b + 1 < L && mode[b + 1] == BOND)
+			b++;
+		Pbot = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
+		/* its contacts checked as their impulses come, top first:
+		 * before the single rounds every contact is checked, so the
+		 * order changes nothing */
+		double Pj = Pbot;
+		for (int j = b; j >= 0; j--) {
+			Pj += m * (v0 - vs[j]);
+			P[j] = Pj;
+			v[j] = v0;
+			if (!single && bond_switch(L, j, Pj, lo, hi, mode, entry, switched))
+				changed = 1;
+		}
+		if (single)
+			changed = check_bonded(L, 0, b, lo, hi, P, mode, entry, switched, single);
+		a = b + 1;
+	} else {
+		Pbot = mode[0] == HI ? hi[0] : lo[0];
+	}
+	while (a < L) {
+		double sum = vs[a];
+		b = a;
+		while (b + 1 < L && mode[b + 1] == BOND)
+			sum += vs[++b];
+		double Ptop = b + 1 < L ? (mode[b + 1] == HI ? hi[b + 1] : lo[b + 1]) : 0.0;
+		double n = (double)(b - a + 1);
+		double vc = (m * sum + Pbot - Ptop) / (n * m);
+		int check = !(changed && single);
+		if (check) {
+			signed char nm = slip_mode(mode[a], below - vc, lo[a], hi[a]);
+			if (nm != mode[a]) {
+				switch_mode(L, mode, entry, switched, a, nm);
+				changed = 1;
+				check = !single;
+			}
+		}
+		/* the bonded contacts a + 1..b checked as their impulses come */
+		double Pj = Pbot;
+		for (int j = a; j < b; j++) {
+			P[j] = Pj;
+			v[j] = vc;
+			Pj -= m * (vc - vs[j]);
+			if (check && bond_switch(L, j + 1, Pj, lo, hi, mode, entry, switched)) {
+				changed = 1;
+				check = !single;
+			}
+		}
+		P[b] = Pj;
+		v[b] = vc;
+		below = vc;
+		Pbot = Ptop;
+		a = b + 1;
+	}
+	return changed;
+}
+
 /* chain_clusters with the modes switched until consistent. With entry
  * (else NULL): returns 1 if a contact that was not bonded on entry ended
  * in another mode (a slipping contact stopped or reversed), entry[] then
  * holding the modes on entry; 0 otherwise (entry[] then unset: the modes
- * are copied only at the first switch, which most solves never make). */
-static int chain_solve(int L, double m, const double *restrict vs, double v0,
-		       const double *restrict lo, const double *restrict hi, double *restrict P,
-		       double *restrict v, signed char *restrict mode, signed char *restrict entry)
+ * are copied only at the first switch, which most solves never make).
+ * Inlined into its four calls: called, it cost the curve 3 % more. */
+static inline __attribute__((always_inline)) int
+chain_solve(int L, double m, const double *restrict vs, double v0, const double *restrict lo,
+	    const double *restrict hi, double *restrict P, double *restrict v,
+	    signed char *restrict mode, signed char *restrict entry)
 {
 	int changed = 0, switched = 0;
 	for (int iter = 0; iter < 4 * L + 8; iter++) {
-		chain_clusters(L, m, vs, v0, lo, hi, P, v, mode);
-		/* consistency; after L rounds switch one contact at a time */
-		changed = 0;
-		double below = v0;
-		for (int j = 0; j < L && !(changed && iter >= L); j++) {
-			double sj = below - v[j];
-			below = v[j];
-			signed char nm = mode[j];
-			if (hi[j] == lo[j]) {
-				nm = HI; /* fixed impulse (or no contact) */
-			} else if (nm == BOND) {
-				double tolP = 1e-12 * (fabs(hi[j]) + fabs(lo[j])) + 1e-300;
-				nm = P[j] > hi[j] + tolP ? HI : P[j] < lo[j] - tolP ? LO : BOND;
-			} else if (nm == HI) {
-				if (sj < -1e-13)
-					nm = BOND;
-			} else if (sj > 1e-13) {
-				nm = BOND;
-			}
-			if (nm != mode[j]) {
-				if (!switched && entry)
-					memcpy(entry, mode, (size_t)L);
-				switched = 1;
-				mode[j] = nm;
-				changed = 1;
-			}
-		}
+		changed = chain_round(L, m, vs, v0, lo, hi, P, v, mode, entry, &switched, iter >= L);
 		if (!changed)
 			break;
 	}

@@ -49,10 +49,29 @@ static double motor_torque(const model *md, const model_ctl *ctl, double omega)
 
 #include "model_points.h" /* the three point masses' kinematics */
 
+/* The full coordinates of reduced ones in the reduced scene's layout
+ * (MODEL_LAYOUT_TROUGH2: x, y | phi, s1, s2; alpha none), each its reduced
+ * one added to zero: the selection of model_full_coords, and zero plus
+ * model_add_reduced, with the indices as constants (several times a step). */
+static inline void trough2_full(const double *qr, double full[NQ_FULL])
+{
+	full[Q_X] = 0.0 + qr[0];
+	full[Q_Y] = 0.0 + qr[1];
+	full[Q_ALPHA] = 0.0;
+	full[Q_PHI] = 0.0 + qr[2];
+	full[Q_S1] = 0.0 + qr[3];
+	full[Q_S2] = 0.0 + qr[4];
+}
+
 void model_full_coords(const model *md, const model_ctl *ctl, double t, const double *y,
 		       double q[NQ_FULL], double qd[NQ_FULL])
 {
 	const double *qr = y, *qrd = y + md->npos;
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		trough2_full(qr, q);
+		trough2_full(qrd, qd);
+		return;
+	}
 	if (md->selection) {
 		/* each reduced coordinate one full one, none prescribed: each
 		 * full coordinate its reduced one added to zero, as
@@ -75,6 +94,16 @@ void model_full_coords(const model *md, const model_ctl *ctl, double t, const do
 		q[Q_PHI] += psi;
 		qd[Q_PHI] += psid;
 	}
+}
+
+void model_reduced_to_full(const model *md, const double *qr, double full[NQ_FULL])
+{
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		trough2_full(qr, full);
+		return;
+	}
+	memset(full, 0, sizeof(double) * NQ_FULL);
+	model_add_reduced(md, qr, full);
 }
 
 /* The machine's configuration at time t: full coordinates, beta and its
@@ -115,6 +144,15 @@ static void configure(const model *md, const model_ctl *ctl, double t, const dou
 				      c->beta_dd, &c->pms[1 + i]);
 }
 
+/* rhs = Qfeed, or 0 without one: a copy of fixed size, a few vector moves */
+static inline void feed_force(const double Qfeed[NQ_FULL], double rhs[NQ_FULL])
+{
+	if (Qfeed)
+		memcpy(rhs, Qfeed, sizeof(double) * NQ_FULL);
+	else
+		memset(rhs, 0, sizeof(double) * NQ_FULL);
+}
+
 /* M = 0, a row at a time: each row's clear is a few vector stores, where
  * the whole matrix's was a string instruction with its start-up cost (5 %
  * of the evaluation on the reduced scene's path). */
@@ -135,8 +173,7 @@ static void mass_matrix_and_bias(const model *md, const config *cf, const double
 	zero_matrix(M);
 	M[Q_X][Q_X] = M[Q_Y][Q_Y] = p->M_r;
 	M[Q_ALPHA][Q_ALPHA] = p->J_r;
-	for (int i = 0; i < NQ_FULL; i++)
-		rhs[i] = Qfeed ? Qfeed[i] : 0.0;
+	feed_force(Qfeed, rhs);
 	rhs[Q_Y] -= p->M_r * p->g;
 	for (int k = 0; k < 3; k++) {
 		const pm *P = &cf->pms[k];
@@ -160,68 +197,7 @@ static void mass_matrix_and_bias(const model *md, const config *cf, const double
 	}
 }
 
-/* Stages configure and mass_matrix_and_bias together for the reduced
- * scene's layout (MODEL_LAYOUT_TROUGH2: x, y | phi, s1, s2, alpha fixed at
- * 0) while beta is held (beta' = beta'' = 0), which is how a measurement
- * runs. There R is the identity and alpha' = beta' = beta'' = 0, so the
- * eliminators' bias accelerations are zero, their Jacobians on s_i are the
- * guide's direction u, and the alpha row and column, which this layout's
- * solve does not read, are left out (M there is zero; cf's point masses
- * are not filled: with beta held nothing reads them). What remains is the
- * two stages' arithmetic operation for operation (terms that are a zero
- * left out: they change at most the sign of a zero), so the results are
- * theirs to the last bit (test_machine.c compares the two on random
- * states) in about two fifths of their instructions (callgrind). Returns
- * 0, having set only c's beta and its rates, where it does not apply. */
-static int trough2_held(const model *md, const model_ctl *ctl, double t, const double *y,
-			const double Qfeed[NQ_FULL], config *c, double M[NQ_FULL][NQ_FULL],
-			double rhs[NQ_FULL])
-{
-	if (md->layout != MODEL_LAYOUT_TROUGH2)
-		return 0;
-	ramp_eval(&ctl->beta_ramp, t, &c->beta, &c->beta_d, &c->beta_dd);
-	if (c->beta_d != 0.0 || c->beta_dd != 0.0)
-		return 0;
-	const sim_params *p = &md->p;
-	model_full_coords(md, ctl, t, y, c->q, c->qd);
-	c->R = (deck_rot){1.0, 0.0};
-	beta_sincos(c->beta, &c->sbeta, &c->cbeta);
-	zero_matrix(M);
-	for (int i = 0; i < NQ_FULL; i++)
-		rhs[i] = Qfeed ? Qfeed[i] : 0.0;
-	rhs[Q_Y] -= p->M_r * p->g;
-	/* the vibrator (point_mass_vibrator with R = I, alpha' = 0) */
-	double cf, sf;
-	angle_sincos(c->q[Q_PHI], &sf, &cf);
-	const double e = p->e, m = p->m;
-	const double pd2 = c->qd[Q_PHI] * c->qd[Q_PHI];
-	const double jo0 = -e * sf, jo1 = e * cf;
-	const double a0 = -(e * pd2 * cf), a1 = -(e * pd2 * sf);
-	M[Q_X][Q_X] = M[Q_Y][Q_Y] = p->M_r + m;
-	M[Q_PHI][Q_X] = m * jo0;
-	M[Q_PHI][Q_Y] = m * jo1;
-	M[Q_PHI][Q_PHI] = md->own_m[Q_PHI];
-	double f0 = -m * a0, f1 = -m * (a1 + p->g);
-	rhs[Q_X] += f0;
-	rhs[Q_Y] += f1;
-	rhs[Q_PHI] += jo0 * f0 + jo1 * f1;
-	/* the eliminators: Jacobian u = (-sin beta, cos beta) on s_i and no
-	 * bias acceleration, so of -m_i J^T (a + g e_y) their weight alone */
-	const double u0 = -c->sbeta, u1 = c->cbeta;
-	for (int i = 0; i < 2; i++) {
-		const int o = i == 0 ? Q_S1 : Q_S2;
-		const double mi = i == 0 ? p->m1 : p->m2;
-		M[Q_X][Q_X] += mi;
-		M[Q_Y][Q_Y] += mi;
-		M[o][Q_X] = mi * u0;
-		M[o][Q_Y] = mi * u1;
-		M[o][o] = md->own_m[o];
-		double fy = -mi * p->g;
-		rhs[Q_Y] += fy;
-		rhs[o] += u1 * fy;
-	}
-	return 1;
-}
+#include "model_trough2.h" /* the reduced scene's two stages, beta held */
 
 /* Spring set i's attachment turned by R(alpha) (RP) and its displacement
  * from rest (u). */
@@ -346,6 +322,10 @@ static void solve(const model *md, const model_ctl *ctl, double t, double M[NQ_F
 		ramp_eval(&ctl->psi_ramp, t, &psi, &psid, &qpdd[Q_PHI]);
 	}
 	model_reduced_solve(md, (const double(*)[NQ_FULL])M, rhs, qpdd, br);
+	if (md->layout == MODEL_LAYOUT_TROUGH2) { /* no prescribed ones there */
+		trough2_full(br, qdd);
+		return;
+	}
 	memcpy(qdd, qpdd, sizeof(double) * NQ_FULL);
 	model_add_reduced(md, br, qdd);
 	if (md->phi_prescribed) {
@@ -435,9 +415,16 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	eliminators(&md->p, &cf, rhs, &damp_power);
 	drive(md, ctl, &cf, rhs, &damp_power, &dt);
 	solve(md, ctl, t, M, rhs, &dt, br, qdd);
-	for (int r = 0; r < md->nq; r++) {
-		dy[r] = y[md->npos + r];
-		dy[md->npos + r] = br[r];
+	/* positions' rates and accelerations; in the reduced scene's
+	 * layout (x, y | phi, s1, s2) two copies of constant size */
+	if (md->layout == MODEL_LAYOUT_TROUGH2) {
+		memcpy(dy, y + md->npos, 5 * sizeof *dy);
+		memcpy(dy + md->npos, br, 5 * sizeof *dy);
+	} else {
+		for (int r = 0; r < md->nq; r++) {
+			dy[r] = y[md->npos + r];
+			dy[md->npos + r] = br[r];
+		}
 	}
 	dy[2 * md->npos + ACC_IN] = dt.torque * dt.omega + guide_power(&md->p, &cf, qdd) + load_power;
 	dy[2 * md->npos + ACC_DAMP] = damp_power;

@@ -129,6 +129,11 @@ static inline void model_add_reduced(const model *md, const double *qr, double f
 			full[md->col[r][a]] += qr[r];
 }
 
+/* The full coordinates of the reduced values qr: zero plus
+ * model_add_reduced, to the same bits (the reduced scene's layout with its
+ * indices as constants). model.c */
+void model_reduced_to_full(const model *md, const double *qr, double full[NQ_FULL]);
+
 /* Largest ratio for which dem corrects its coupling (docs/integrators.md "Integrators"). */
 #define MODEL_CORRECTOR_MAX_RATIO 0.2
 

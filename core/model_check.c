@@ -7,12 +7,15 @@
  * tests/bench/model_check.py and committed as
  * tests/bench/results/model_check.csv) are compiled in: the build turns the
  * CSV into model_map.inc, rows of map_point. Consecutive rows with the same
- * preset, settings and layers are one entry: a calibrated column model and
- * the bed it was checked against. A scene is checked when its settings are
- * an entry's (every machine and feed setting but the controls beta and
- * rotation) and its (beta, sense), or their mirror image on a symmetric
- * machine, lies within the angles the entry measured in that sense. No file
- * is read at run time.
+ * preset, settings, material and layers are one entry: a column model (a
+ * calibrated one, or the preset as it is) and the bed it was checked
+ * against. A scene is checked when its settings are an entry's (every
+ * machine and feed setting but the controls beta and rotation) and its
+ * (beta, sense), or their mirror image on a symmetric machine, lies within
+ * the angles the entry measured in that sense. Where entries of several
+ * materials check it (the preset as it is, against each material's bed),
+ * its error is the largest of theirs, and the note names each. No file is
+ * read at run time.
  */
 #include <math.h>
 #include <stdint.h>
@@ -98,13 +101,20 @@ static int entry_settings(const map_point *e, sim_params *p, sim_scene *sc)
 	return 0;
 }
 
-/* The column model of entry e as a user knows it: its preset, or where
- * the entry changes the preset, "PRESET calibrated to MATERIAL". */
+/* The bed of the preset's own contacts (the first cross-check's), not a
+ * named material. */
+#define OWN_CONTACTS "preset-contacts"
+
+/* The column model of entry e as a user knows it: its preset (against its
+ * own contacts' bed), "PRESET against MATERIAL" (the preset as it is
+ * against a material's bed), or where the entry changes the preset,
+ * "PRESET calibrated to MATERIAL". */
 static const char *entry_name(const map_point *e, char *buf, size_t n)
 {
-	if (!e->settings[0])
+	if (!e->settings[0] && strcmp(e->material, OWN_CONTACTS) == 0)
 		return e->preset;
-	snprintf(buf, n, "%s calibrated to %s", e->preset, e->material);
+	snprintf(buf, n, "%s %s %s", e->preset, e->settings[0] ? "calibrated to" : "against",
+		 e->material);
 	return buf;
 }
 
@@ -256,6 +266,18 @@ static int memo_match(size_t first, const sim_params *p, const sim_scene *sc, co
 	return memo.rank[first];
 }
 
+/* The end of the entry that begins at row first. */
+static size_t entry_end(size_t first)
+{
+	size_t end = first + 1;
+	while (map[end].preset && map[end].layers == map[first].layers &&
+	       strcmp(map[end].preset, map[first].preset) == 0 &&
+	       strcmp(map[end].settings, map[first].settings) == 0 &&
+	       strcmp(map[end].material, map[first].material) == 0)
+		end++;
+	return end;
+}
+
 /* The map's entry nearest the scene, when none checks it. */
 typedef struct {
 	size_t first, end; /* first == SIZE_MAX: no entry */
@@ -263,22 +285,52 @@ typedef struct {
 	const char *diff;  /* the first differing setting */
 } nearest_entry;
 
-/* Walk the map's entries: 1 with *out filled where an entry matching the
- * scene covers its angle (beta in degrees, or its mirror); else 0 and *best
+/* The entries that check a scene: one, or one a material for the preset
+ * as it is (the map has a few materials). */
+#define HITS_MAX 8
+typedef struct {
+	size_t first;
+	double err, unc;
+} hit;
+
+/* *out for the entries hits[0..n) that check the scene: the largest error
+ * of theirs, and a note that names it first, then each other's: "DEM
+ * check: within ±E m/s here (NAME, L layers; against MATERIAL ±E)". */
+static void checked_by(const hit *hits, int n, sim_model_error *out)
+{
+	int top = 0;
+	for (int i = 1; i < n; i++)
+		if (hits[i].err > hits[top].err)
+			top = i;
+	const map_point *e = &map[hits[top].first];
+	char name[64];
+	out->checked = 1;
+	out->error = hits[top].err;
+	out->error_uncertainty = hits[top].unc;
+	int at = snprintf(out->note, sizeof out->note, "DEM check: within ±%.3f m/s here (%s, %d layers",
+			  out->error, entry_name(e, name, sizeof name), e->layers);
+	for (int i = 0; i < n; i++)
+		if (i != top && at >= 0 && (size_t)at < sizeof out->note)
+			at += snprintf(out->note + at, sizeof out->note - at, "; against %s ±%.3f",
+				       map[hits[i].first].material, hits[i].err);
+	if (at >= 0 && (size_t)at < sizeof out->note)
+		snprintf(out->note + at, sizeof out->note - at, ")");
+}
+
+/* Walk the map's entries: 1 with *out filled where entries matching the
+ * scene cover its angle (beta in degrees, or its mirror); else 0 and *best
  * the nearest entry: fewest differences, then the nearest depth. */
 static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, int can_mirror,
 			sim_model_error *out, nearest_entry *best)
 {
 	memo_for(p, sc);
+	hit hits[HITS_MAX];
+	int nhits = 0;
 	size_t best_first = SIZE_MAX, best_end = 0;
 	int best_rank = 5;
 	const char *best_diff = NULL;
 	for (size_t first = 0, end; map[first].preset; first = end) {
-		for (end = first + 1; map[end].preset && map[end].layers == map[first].layers &&
-				      strcmp(map[end].preset, map[first].preset) == 0 &&
-				      strcmp(map[end].settings, map[first].settings) == 0;
-		     end++)
-			;
+		end = entry_end(first);
 		const char *diff;
 		int rank = memo_match(first, p, sc, &diff);
 		if (rank == 0) {
@@ -286,25 +338,21 @@ static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, i
 			int inside = interpolate(first, end, beta, p->rotation, &err, &unc) ||
 				     (can_mirror &&
 				      interpolate(first, end, 180.0 - beta, -p->rotation, &err, &unc));
-			if (inside) {
-				out->checked = 1;
-				out->error = err;
-				out->error_uncertainty = unc;
-				char name[64];
-				snprintf(out->note, sizeof out->note,
-					 "DEM check: within ±%.3f m/s here (%s, %d layers)", err,
-					 entry_name(&map[first], name, sizeof name), map[first].layers);
-				return 1;
-			}
+			if (inside && nhits < HITS_MAX)
+				hits[nhits++] = (hit){first, err, unc};
 		}
 		if (rank < best_rank ||
-		    (rank == best_rank && rank == 1 &&
+		    (rank == best_rank && rank >= 1 && rank < 4 &&
 		     abs(map[first].layers - sc->layers) < abs(map[best_first].layers - sc->layers))) {
 			best_first = first;
 			best_end = end;
 			best_rank = rank;
 			best_diff = diff;
 		}
+	}
+	if (nhits) {
+		checked_by(hits, nhits, out);
+		return 1;
 	}
 	best->first = best_first;
 	best->end = best_end;

@@ -89,19 +89,28 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
  * sessions' sum stays within --max-paced-cores with it: 1; else 0 and
  * nothing changes. *taken: the cores all hold after. */
 int srv_budget_raise_paced(double *held, double need, double *taken);
-/* CPU s per simulated s a stream client of a session costs the daemon
- * (budget_cost.c): the records it formats and sends each simulated s
- * (sample_rate of its session, thinned to rate when 0 < rate), and the
- * numbers in each (api_record_numbers of its fields). Measured at pace 1
- * with tests/bench/stream_cost.mjs (docs/budgets.md). */
-double srv_budget_stream_cpu(double sample_rate, double rate, unsigned fields,
-			     int columns, int layers);
-/* Raise what a running paced session holds (*held) to
- * (session_cpu + stream_cpu) x pace for a stream it opens, stream_cpu
- * the stream's srv_budget_stream_cpu: API_OK, else nothing changes and
- * *pb is 503 (budget "cpu", Retry-After) naming what the stream needs and
- * what is taken. */
-api_err srv_budget_take_stream(double *held, double session_cpu, double stream_cpu,
+/* What a stream client of a session costs the daemon (budget_stream.c,
+ * measured with tests/bench/stream_cost.mjs, docs/budgets.md): the records
+ * it takes a simulated s (sample_rate of its session, thinned to rate when
+ * 0 < rate) and the CPU s a simulated s of formatting their numbers
+ * (api_record_numbers of its fields); next links a session's streams. */
+typedef struct srv_stream_charge {
+	double records;
+	double numbers_cpu;
+	struct srv_stream_charge *next;
+} srv_stream_charge;
+srv_stream_charge srv_budget_stream_charge(double sample_rate, double rate,
+					   unsigned fields, int columns, int layers);
+/* CPU s per simulated s that the streams linked from list cost at pace
+ * (> 0): their numbers, and a wake-up a record but at most one per paced
+ * batch (50 a wall s) each, so at most 50 / pace a simulated s each. */
+double srv_budget_streams_cpu(const srv_stream_charge *list, double pace);
+/* Raise what a running paced session holds (*held) to after x pace for a
+ * stream it opens, before and after its cost (CPU s per simulated s, its
+ * own and its streams') without and with the stream: API_OK, else nothing
+ * changes and *pb is 503 (budget "cpu", Retry-After) naming what the
+ * stream needs and what is taken. */
+api_err srv_budget_take_stream(double *held, double before, double after,
 			       double pace, api_problem *pb);
 /* Set what a session holds to need (cores, >= 0), even beyond the budget:
  * its worker's own measure, a pause, the end. */

@@ -14,29 +14,39 @@
  * stream thread's wake-up (its worker's wake-up for it, the futex, the
  * loopback send) 53-77 us, whichever its records are; a number formatted
  * (shortest round-trip double) 1.5 us; the rest of a record below the
- * measure's noise. A stream of every sample is woken once per paced batch
- * (worker.c PACE_MIN, 20 ms: 50 a second at pace 1), a thinned one once a
- * record. The larger wake-up figure is taken: it is the ?rate=10 stream's. */
+ * measure's noise. A stream is woken once a record, but at most once per
+ * paced batch (worker.c PACE_MIN, 20 ms: 50 a wall second at any pace), so
+ * a stream of every sample of a default session is woken 50 times a
+ * second at pace 1 and 25 times at pace 0.1. The larger wake-up figure is
+ * taken: it is the ?rate=10 stream's. */
 #define STREAM_WAKE_CPU_S 75e-6
 #define STREAM_NUMBER_CPU_S 1.5e-6
-#define STREAM_WAKES_MAX 50.0
+#define STREAM_WAKES_MAX 50.0 /* a wall s: worker.c's PACE_MIN, 20 ms */
 /* Seconds a 503 of the paced budget asks to wait (as budget.c's). */
 #define STREAM_RETRY_S 5
 
-double srv_budget_stream_cpu(double sample_rate, double rate, unsigned fields,
-			     int columns, int layers)
+srv_stream_charge srv_budget_stream_charge(double sample_rate, double rate,
+					   unsigned fields, int columns, int layers)
 {
 	double records = rate > 0 && rate < sample_rate ? rate : sample_rate;
-	double wakes = records < STREAM_WAKES_MAX ? records : STREAM_WAKES_MAX;
 	int numbers = api_record_numbers(fields, columns, layers);
-	return wakes * STREAM_WAKE_CPU_S + records * numbers * STREAM_NUMBER_CPU_S;
+	return (srv_stream_charge){records, records * numbers * STREAM_NUMBER_CPU_S, NULL};
 }
 
-api_err srv_budget_take_stream(double *held, double session_cpu, double stream_cpu,
+double srv_budget_streams_cpu(const srv_stream_charge *list, double pace)
+{
+	double cpu = 0, most = pace > 0 ? STREAM_WAKES_MAX / pace : 0;
+	for (; list; list = list->next)
+		cpu += (list->records < most ? list->records : most) * STREAM_WAKE_CPU_S +
+		       list->numbers_cpu;
+	return cpu;
+}
+
+api_err srv_budget_take_stream(double *held, double before, double after,
 			       double pace, api_problem *pb)
 {
-	double taken, limit = srv_budget_paced_limit();
-	if (srv_budget_raise_paced(held, (session_cpu + stream_cpu) * pace, &taken))
+	double taken, limit = srv_budget_paced_limit(), stream = after - before;
+	if (srv_budget_raise_paced(held, after * pace, &taken))
 		return API_OK;
 	api_fail(pb, API_UNAVAILABLE, NULL,
 		 "this stream needs %.3g cores (%.3g ms of CPU per simulated s at "
@@ -44,6 +54,6 @@ api_err srv_budget_take_stream(double *held, double session_cpu, double stream_c
 		 "of the %g cores for paced sessions (--max-paced-cores); nothing "
 		 "was opened, retry when some have ended or paused, or ask fewer "
 		 "records (rate, fields)",
-		 stream_cpu * pace, 1e3 * stream_cpu, pace, taken, limit);
+		 stream * pace, 1e3 * stream, pace, taken, limit);
 	return api_budget(pb, "cpu", limit, STREAM_RETRY_S);
 }

@@ -52,8 +52,8 @@ typedef struct stream {
 	double heartbeat;  /* s */
 	int ended;
 	size_t mem_reserved; /* bytes of the memory budget */
-	double cpu_per_s;  /* its charge in the cores for paced sessions:
-			      CPU s per simulated s (budget.h) */
+	srv_stream_charge charge; /* in the cores for paced sessions
+				     (budget.h) */
 } stream;
 
 static void end_stream(stream *k, const char *reason)
@@ -163,7 +163,7 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
 static void stream_free(void *cls)
 {
 	stream *k = cls;
-	srv_session_stream_close(k->s, k->cpu_per_s);
+	srv_session_stream_close(k->s, &k->charge);
 	atomic_fetch_sub(&srv_stats.stream_clients, 1);
 	srv_session_put(k->s);
 	srv_budget_give(k->mem_reserved);
@@ -227,9 +227,9 @@ static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Resu
 	size_t need = srv_budget_stream_need(*columns, *layers);
 	if (srv_budget_take(need, "this stream", 0, &pb) != API_OK)
 		goto counted;
-	k->cpu_per_s = srv_budget_stream_cpu(srv_session_spec(k->s)->sample_rate, k->rate,
+	k->charge = srv_budget_stream_charge(srv_session_spec(k->s)->sample_rate, k->rate,
 					     k->fields, *columns, *layers);
-	if (srv_session_stream_open(k->s, k->cpu_per_s, &pb) != API_OK)
+	if (srv_session_stream_open(k->s, &k->charge, &pb) != API_OK)
 		goto reserved;
 	k->mem_reserved = need;
 	atomic_fetch_add(&srv_stats.streams_opened, 1);

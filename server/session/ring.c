@@ -272,33 +272,41 @@ void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 	pthread_mutex_unlock(&s->lock);
 }
 
-api_err srv_session_stream_open(srv_session *s, double cpu_per_s, api_problem *pb)
+api_err srv_session_stream_open(srv_session *s, srv_stream_charge *c, api_problem *pb)
 {
 	api_err e = API_OK;
 	pthread_mutex_lock(&s->lock);
+	srv_session_budget *b = &s->budget;
+	double before = srv_paced_cost(s, s->pace);
+	c->next = b->streams;
+	b->streams = c;
 	if (srv_paced_need(s) > 0) /* running paced: held from now */
-		e = srv_budget_take_stream(&s->budget.paced_held, srv_paced_cost(s),
-					   cpu_per_s, s->pace, pb);
-	if (e == API_OK) {
+		e = srv_budget_take_stream(&b->paced_held, before,
+					   srv_paced_cost(s, s->pace), s->pace, pb);
+	if (e == API_OK)
 		s->streams++;
-		s->budget.stream_cpu_per_s += cpu_per_s;
-	}
+	else
+		b->streams = c->next;
 	pthread_mutex_unlock(&s->lock);
 	return e;
 }
 
-void srv_session_stream_close(srv_session *s, double cpu_per_s)
+void srv_session_stream_close(srv_session *s, srv_stream_charge *c)
 {
 	pthread_mutex_lock(&s->lock);
+	srv_session_budget *b = &s->budget;
+	double was = srv_paced_need(s);
+	srv_stream_charge **at = &b->streams;
+	while (*at && *at != c)
+		at = &(*at)->next;
+	if (*at)
+		*at = c->next;
 	s->streams--;
-	s->budget.stream_cpu_per_s -= cpu_per_s;
-	if (s->streams == 0 || s->budget.stream_cpu_per_s < 0)
-		s->budget.stream_cpu_per_s = 0; /* no drift */
 	/* given back at once (a hold raised for a queued control keeps the
 	 * rest until the worker applies it: worker_budget.c) */
-	if (srv_paced_need(s) > 0)
-		srv_budget_set_paced(&s->budget.paced_held,
-				     s->budget.paced_held - cpu_per_s * s->pace);
+	if (was > 0)
+		srv_budget_set_paced(&b->paced_held,
+				     b->paced_held - (was - srv_paced_need(s)));
 	pthread_mutex_unlock(&s->lock);
 }
 

@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "api.h"
+#include "budget.h"
 #include "config.h"
 
 typedef struct srv_session srv_session;
@@ -130,13 +131,14 @@ void srv_session_read(srv_session *s, uint64_t cursor, double from_t,
  * of steps, and only when such a record exists. */
 void srv_session_wait(srv_session *s, const srv_ring_read *rd, double from_t,
 		      double seconds);
-/* Count a stream client in, its cost (CPU s per simulated s:
- * srv_budget_stream_cpu) charged with the session's own in the cores for
- * paced sessions while it runs paced (and from when it runs paced again):
- * API_OK, or 503 (budget "cpu") with nothing counted nor held. */
-api_err srv_session_stream_open(srv_session *s, double cpu_per_s, api_problem *pb);
-/* Count it out and give its cost back. */
-void srv_session_stream_close(srv_session *s, double cpu_per_s);
+/* Count a stream client in, its charge (srv_budget_stream_charge; linked
+ * into the session's, so it lives until the close) held with the
+ * session's own in the cores for paced sessions while it runs paced (and
+ * from when it runs paced again): API_OK, or 503 (budget "cpu") with
+ * nothing counted nor held. */
+api_err srv_session_stream_open(srv_session *s, srv_stream_charge *c, api_problem *pb);
+/* Count it out and give its charge back. */
+void srv_session_stream_close(srv_session *s, srv_stream_charge *c);
 /* The feed size of this session's records (0 without feed). */
 void srv_session_feed_size(const srv_session *s, int *columns, int *layers);
 /* Allocate / free the arrays of a record for a feed size. 0 or -1. */

@@ -100,13 +100,13 @@ static api_err admit_paced(srv_session *s, const api_control *c,
 	double pace = (c->set & API_C_PACE) ? c->pace : s->pace;
 	if (pace == API_PACE_MAX ||
 	    srv_state_after(s->state, s->budget.cpu_paused, s->st.t, c) != SRV_RUNNING ||
-	    srv_paced_cost(s) * pace <= s->budget.paced_held)
+	    srv_paced_cost(s, pace) * pace <= s->budget.paced_held)
 		return API_OK;
 	const char *field = (c->set & API_C_PACE)      ? "pace"
 			    : (c->set & API_C_RUNNING) ? "running"
 			    : (c->set & API_C_CPU)     ? "cpu_budget"
 						       : "until";
-	return srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s), pace, field,
+	return srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s, pace), pace, field,
 				     "changed", pb);
 }
 
@@ -189,8 +189,8 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 			      "the session already runs experiment %s",
 			      srv_exp_id(s->exp));
 	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
-		 (rc = srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s),
-					     s->pace, "session", "attached",
+		 (rc = srv_budget_take_paced(&s->budget.paced_held,
+					     srv_paced_cost(s, s->pace), s->pace, "session", "attached",
 					     pb)) != API_OK)
 		; /* the experiment would run it on (worker.c extend_until)
 		     past the cores for paced sessions: nothing attached */

@@ -129,9 +129,9 @@ typedef struct srv_session_budget {
 				     creation, then measured by the worker */
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
-	double stream_cpu_per_s;  /* CPU s per simulated s its open streams
-				     are charged (budget_cost.c): held with
-				     its own while it runs paced */
+	srv_stream_charge *streams; /* its open streams' charges, linked
+				       (budget_stream.c): held with its
+				       own while it runs paced */
 } srv_session_budget;
 
 /* The state of a session's files: session_store.c owns it (writes the
@@ -247,11 +247,11 @@ void srv_dem_kill(srv_session *s);
 /* Free the coupling, ending and reaping the bed process. */
 void srv_dem_free(srv_session *s);
 
-/* CPU s per simulated s a session is charged in the paced budget: its
- * worker's and its open streams' (lock held). */
-static inline double srv_paced_cost(const srv_session *s)
+/* CPU s per simulated s a session is charged in the paced budget at
+ * pace: its worker's and its open streams' (lock held). */
+static inline double srv_paced_cost(const srv_session *s, double pace)
 {
-	return s->budget.cpu_per_s + s->budget.stream_cpu_per_s;
+	return s->budget.cpu_per_s + srv_budget_streams_cpu(s->budget.streams, pace);
 }
 
 /* Cores a session needs from the paced budget as it is now: its CPU s per
@@ -262,7 +262,7 @@ static inline double srv_paced_need(const srv_session *s)
 {
 	if (s->state != SRV_RUNNING || s->pace == API_PACE_MAX || s->stop)
 		return 0;
-	double need = srv_paced_cost(s) * s->pace;
+	double need = srv_paced_cost(s, s->pace) * s->pace;
 	/* a LIGGGHTS session's bed process holds its cores */
 	return s->dem.link && need < s->dem.cores ? s->dem.cores : need;
 }

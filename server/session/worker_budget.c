@@ -67,7 +67,7 @@ static void measure_cost(srv_session *s, clocks *c)
  * so that it does not starve the others (lock held). */
 static void pace_down(srv_session *s, clocks *c)
 {
-	double was = s->pace, cost = srv_paced_cost(s);
+	double was = s->pace, cost = srv_paced_cost(s, was);
 	double pace = srv_budget_fit_pace(&s->budget.paced_held, cost, was);
 	if (pace >= was)
 		return;

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""A fast feed model against the DEM map, leave one depth out
+"""A fast feed model against the DEM map, leave one bed out
 (`make fast-feed-check`, docs/feed-models.md).
 
     fast_feed_check.py [CONVSIM]     writes tests/bench/results/fast_feed.md
-                                     and fast_feed.csv
+                                     and fast_feed.csv (fast_feed_report.py)
 
-Two candidate families, both built from the paper's column model
-(one-way, on the deck orbit the map used), whose parameters follow from the
-bed's depth by a closure fitted to the map:
+Candidate families, built from the paper's column model (one-way, on the
+deck orbit the map used) or a bed of point masses, whose parameters follow
+from the bed by a closure fitted to the map:
   closure   one column: restitution R, friction mu and contact stiffness
             k_c from a grid, its layers either the depth in grains or one;
   ensemble  two such columns with different R (the rest shared), v their
@@ -22,13 +22,18 @@ bed's depth by a closure fitted to the map:
             fast_feed_bed.c, on the deck orbit of a one-way convsim run):
             free flight, impacts whose restitution is drawn anew at each
             impact, uniform in [e_lo, e_hi], Coulomb friction mu at impacts
-            and while riding; no depth in it (depth-independent closure).
-For every depth of a material and drive, a family's closure is fitted on
-the map's other depths only (the most points within 5 % of that depth's DEM
-peak, then the smallest worst error) and predicts the held-out depth: the
-tables' figures are those predictions. Beside them: the paper's preset as
-it is (R 0.05, mu 0.4, k_c 1e6, layers = depth), and the best each family
-reaches when fitted on the depth itself (an upper bound of what it can do).
+            and while riding; no depth in it (depth-independent closure);
+  collapse  two regimes of the ensemble split by the bed's dissipation D
+            (dissipation(): from the material's restitutions and the
+            depth) at a scale D_c: below it the grains bounce, above it the
+            bed lands as one body; each regime's mu is C times the
+            material's grain-on-deck mu_pw (dem/materials.json).
+A bed is a material at a depth. Each bed is predicted by a closure fitted
+on the map's other beds only, both materials (leave one bed out: the most
+points within 5 % of a bed's DEM peak, then the smallest worst error); no
+closure has a constant of its own per material. Beside them: the paper's
+preset as it is (R 0.05, mu 0.4, k_c 1e6, layers = depth), and the best
+each family reaches when fitted on the bed itself (an upper bound).
 
 A map point's DEM value is the report's (tests/bench/dem_map_report.py,
 `chosen`: the map's cell, the softest modulus within the overlap bound).
@@ -46,14 +51,12 @@ import os
 import statistics
 import subprocess
 import sys
-import time
 from concurrent.futures import ThreadPoolExecutor
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dem_map  # noqa: E402
 import dem_map_report  # noqa: E402
-import provenance  # noqa: E402
 
 ROOT = dem_map.ROOT
 RESULTS = os.path.join(HERE, "results")
@@ -70,9 +73,12 @@ ORBIT_RATE = 4000  # Hz: the deck orbit's samples (the bed steps at twice that)
 ORBITS = os.path.join(ROOT, "build", "fast_feed_orbits")
 LAYER_RULES = ("depth", "one")
 PAPER = {"Rs": (0.05,), "mu": 0.4, "k_c": 1e6, "layers": "depth"}
-FAMILIES = ("closure", "ensemble", "grains", "layered")
+FAMILIES = ("closure", "ensemble", "grains", "layered", "collapse")
 LAYERED_P = (0, 0.5, 1)  # `layered`: the exponent P of the depth in R_bed = R^(d^P)
 R_FLOOR = 0.001  # convsim's least R: a landing without rebound
+# `collapse`: each regime's mu is C times the material's grain-on-deck mu_pw
+COLLAPSE_C = (2 / 3, 1, 4 / 3, 2, 8 / 3)
+COLLAPSE_K = (1e5, 1e6, 1e7)
 COST_DURATION, COST_REPEATS = 21, 3  # s simulated (20 after the transient); runs
 LONG_DURATION = 6  # s simulated: the window check's 5 s after the transient
 
@@ -88,8 +94,38 @@ def map_points():
             if r:
                 pts.append({"material": mat, "drive": drive, "depth": depth, "beta": b,
                             "v_dem": float(r["v_dem"]), "sd": float(r["v_dem_sd"]),
-                            "youngs": r["youngs_pa"]})
+                            "youngs": r["youngs_pa"], "mat": material_params(mat)})
     return pts
+
+
+def material_params(name):
+    """The material's own parameters (dem/materials.json) a closure may
+    take as inputs: restitutions and friction grain on deck (_pw) and grain
+    on grain (_pp), density, the mean diameter."""
+    m = dem_map.materials()["materials"][name]
+    return {"e_pw": m["e_pw"], "e_pp": m["e_pp"], "mu_pw": m["mu_pw"], "mu_pp": m["mu_pp"],
+            "density": m["density"], "diameter": (m["d_min"] + m["d_max"]) / 2}
+
+
+def dissipation(p):
+    """D of p's bed, d grains deep: the energy shares a rebound loses at
+    the contacts it crosses on its way through the bed, one a layer:
+    1 - e_pw^2 at the deck, 1 - e_pp^2 at each of the d - 1 grain contacts
+    above (summed). Small for a shallow bed of elastic grains; past a scale
+    D_c the bed's grains stop sharing out a rebound and land as one body."""
+    m = p["mat"]
+    return (1 - m["e_pw"] ** 2) + (p["depth"] - 1) * (1 - m["e_pp"] ** 2)
+
+
+def resolve(cand, p):
+    """The columns cand runs at p. A `collapse` candidate is two regimes,
+    each an ensemble of two columns: `bouncy` for D < D_c, `collapsed`
+    above; its mu is C times the material's mu_pw. The others are the
+    same at every point."""
+    if "Dc" not in cand:
+        return cand
+    side = cand["bouncy"] if dissipation(p) < cand["Dc"] else cand["collapsed"]
+    return dict(side, mu=float("%.4g" % (side["c"] * p["mat"]["mu_pw"])))
 
 
 def rests(cand, p):
@@ -195,6 +231,7 @@ class Runner:
         """CPU s of cand at p: each member's least of COST_REPEATS runs of
         COST_DURATION simulated seconds (a 3-s run takes milliseconds, too
         short to time on a shared machine), summed over the members."""
+        cand = resolve(cand, p)
         if "e" in cand:
             return self.grains_cost(cand, p)
         total = 0.0
@@ -209,6 +246,7 @@ class Runner:
     def long_v(self, cand, p):
         """v of cand at p over LONG_DURATION - 1 s instead of 2 s: a member
         that bounces chaotically moves with the window."""
+        cand = resolve(cand, p)
         if "e" in cand:
             args = grains_args(self, cand, p, LONG_DURATION)
             if self.key(args) not in self.cache:
@@ -225,6 +263,7 @@ class Runner:
 
     def get(self, cand, p):
         """(v, CPU s) of cand at p: its members' mean v and summed cost."""
+        cand = resolve(cand, p)
         if "e" in cand:
             return tuple(self.cache[self.key(grains_args(self, cand, p))])
         res = [self.cache[self.key(args_of(self.convsim, cand, r, p))] for r in rests(cand, p)]
@@ -264,7 +303,48 @@ def candidates(family):
             for lr in LAYER_RULES for rs in sets for mu in GRID_MU for k in GRID_K]
 
 
+def collapse_sides():
+    """A `collapse` regime's choices: two columns' R (equal R: one
+    column), C (mu = C * mu_pw), k_c, layers."""
+    pairs = [(a, b) for i, a in enumerate(GRID_R) for b in GRID_R[i:]]
+    return [{"Rs": rs, "c": c, "k_c": k, "layers": lr} for rs in pairs for c in COLLAPSE_C
+            for k in COLLAPSE_K for lr in LAYER_RULES]
+
+
+def fit_collapse(run, pts, peak):
+    """`collapse` fitted on pts: D_c at each geometric midpoint between
+    two neighbouring beds' D there, or above them all; each regime's
+    columns fitted on that regime's points alone (the most within TOL, then
+    the smallest worst error; a regime without points takes the other's);
+    the split with the most points within TOL, then the smallest worst."""
+    ds = sorted({dissipation(p) for p in pts})
+    best = None
+    for dc in [math.sqrt(a * b) for a, b in zip(ds, ds[1:])] + [math.inf]:
+        picks, n, worst = {}, 0, 0.0
+        for side, sel in (("bouncy", [p for p in pts if dissipation(p) < dc]),
+                          ("collapsed", [p for p in pts if dissipation(p) >= dc])):
+            if not sel:
+                continue
+            sc, pick = max(((score(run, {"Dc": math.inf, "bouncy": c}, sel, peak), c)
+                            for c in collapse_sides()), key=lambda x: x[0])
+            picks[side], n, worst = pick, n + sc[0], max(worst, -sc[1])
+        cand = {"Dc": dc, "bouncy": picks.get("bouncy", picks.get("collapsed")),
+                "collapsed": picks.get("collapsed", picks.get("bouncy"))}
+        if best is None or (n, -worst) > best[0]:
+            best = ((n, -worst), cand)
+    return best[1]
+
+
+def side_name(c):
+    return "R %s, mu %.3g mu_pw, k_c %g, layers %s" % (
+        " and ".join("%g" % r for r in c["Rs"]), c["c"], c["k_c"],
+        "= depth" if c["layers"] == "depth" else "1")
+
+
 def name_of(c):
+    if "Dc" in c:
+        return "D_c %.3g; below it %s; above it %s" % (c["Dc"], side_name(c["bouncy"]),
+                                                      side_name(c["collapsed"]))
     if "e" in c:
         return "e %g to %g, mu %g, %d grains" % (c["e"][0], c["e"][1], c["mu"], GRAINS_N)
     if "P" in c:
@@ -289,19 +369,24 @@ def score(run, cand, pts, peak):
 
 def fit(run, family, pts, peak):
     """The family's closure fitted on pts (never on the points it predicts:
-    evaluate passes the other depths)."""
+    evaluate passes the other beds)."""
+    if family == "collapse":
+        return fit_collapse(run, pts, peak)
     return max(candidates(family), key=lambda c: score(run, c, pts, peak))
 
 
 def evaluate(run, pts, peak):
-    """The held-out predictions: one record per point."""
+    """The held-out predictions, one record per point: leave one bed out.
+    A bed is a material at a depth; each is predicted by a closure fitted
+    on every other bed of the same drive, of either material (a closure
+    takes a material's own parameters as inputs and has no constant of
+    its own per material)."""
     out = []
-    groups = sorted({(p["material"], p["drive"]) for p in pts})
-    for mat, drive in groups:
-        gp = [p for p in pts if (p["material"], p["drive"]) == (mat, drive)]
-        for d in sorted({p["depth"] for p in gp}):
-            train = [p for p in gp if p["depth"] != d]
-            test = [p for p in gp if p["depth"] == d]
+    for drive in sorted({p["drive"] for p in pts}):
+        gp = [p for p in pts if p["drive"] == drive]
+        for mat, d in sorted({(p["material"], p["depth"]) for p in gp}):
+            train = [p for p in gp if (p["material"], p["depth"]) != (mat, d)]
+            test = [p for p in gp if (p["material"], p["depth"]) == (mat, d)]
             fits = {f: (fit(run, f, train, peak) if train else PAPER, fit(run, f, test, peak))
                     for f in FAMILIES}
             for p in test:
@@ -319,123 +404,6 @@ def evaluate(run, pts, peak):
                               f + "_err_own": (vo - p["v_dem"]) / pk})
                 out.append(r)
     return out
-
-
-def pct(x):
-    return "%+.1f %%" % (100 * x)
-
-
-def summary(recs, key):
-    e = [abs(r[key]) for r in recs]
-    return (sum(x <= TOL for x in e), len(e), max(e), statistics.median(e))
-
-
-def build_name():
-    try:
-        return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short=12", "HEAD"], check=True,
-                              capture_output=True, text=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
-def write_csv(recs, path):
-    cols = ["material", "drive", "depth", "beta", "v_dem", "sd", "peak", "v_paper", "err_paper",
-            "cpu_paper"]
-    for f in FAMILIES:
-        cols += [f + "_fit", f + "_v", f + "_err", f + "_err_long", f + "_cpu", f + "_own",
-                 f + "_err_own"]
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(cols)
-        for r in recs:
-            w.writerow([("%.6g" % r[c]) if isinstance(r[c], float) else r[c] for c in cols])
-
-
-def summary_table(recs, w):
-    w("| model | points within 5 % | worst | median | CPU / column's (all points, median point) |")
-    w("|---|---|---|---|---|")
-    rows = [("the paper's column model as it is (R 0.05, mu 0.4, k_c 1e6, layers = depth)",
-             "err_paper", None)]
-    for f in FAMILIES:
-        rows.append(("%s, leave one depth out" % f, f + "_err", f + "_cpu"))
-        rows.append(("%s, the same with v over 5 s instead of 2 (window check)" % f,
-                     f + "_err_long", None))
-        rows.append(("%s fitted on the depth itself (upper bound)" % f, f + "_err_own", None))
-    for label, key, cpu in rows:
-        n, tot, worst, med = summary(recs, key)
-        cost = "1" if key == "err_paper" else "-"
-        if cpu:
-            ratios = [r[cpu] / r["cpu_paper"] for r in recs if r["cpu_paper"] > 0]
-            cost = "%.2f, %.2f" % (sum(r[cpu] for r in recs) / sum(r["cpu_paper"] for r in recs),
-                                   statistics.median(ratios))
-        w("| %s | %d of %d (%.0f %%) | %.1f %% | %.1f %% | %s |" %
-          (label, n, tot, 100.0 * n / tot, 100 * worst, 100 * med, cost))
-
-
-def depth_table(sel, w):
-    w("| beta cw | v_DEM ± sd | paper's v | error | " +
-      " | ".join("%s v | error" % f for f in FAMILIES) + " |")
-    w("|---|---|---|---|" + "---|---|" * len(FAMILIES))
-    for r in sel:
-        cells = []
-        for f in FAMILIES:
-            e = r[f + "_err"]
-            cells.append("%.4f | %s%s" % (r[f + "_v"], pct(e), "" if abs(e) <= TOL else " ✗"))
-        w("| %g | %.4f ± %.4f | %.4f | %s | %s |" % (r["beta"], r["v_dem"], r["sd"], r["v_paper"],
-                                                   pct(r["err_paper"]), " | ".join(cells)))
-
-
-
-machine = provenance.machine
-
-
-def write_md(recs, runner, path):
-    out = []
-    w = out.append
-    w("# A fast feed model against the DEM map (leave one depth out)")
-    w("")
-    w("`make fast-feed-check` (tests/bench/fast_feed_check.py) on %s, build `%s`, %s; data "
-      "tests/bench/results/fast_feed.csv; %d runs of convsim and fast_feed_bed, %d of them this time (the others from "
-      "build/fast_feed_cache.json, same binary). Candidates "
-      "(docs/feed-models.md): `closure`, the column model with R, mu, k_c and its layers from a "
-      "closure in the depth; `ensemble`, the mean of two such columns with different R; "
-      "`grains`, %d point-mass grains whose impacts keep a random share of their rebound "
-      "(tests/bench/fast_feed_bed.c); `layered`, the ensemble whose restitutions are the bed's: "
-      "R_bed = R^(d^P) for a bed d grains deep, P in %s fitted with the rest. Each is fitted on "
-      "the map's other depths and predicts the held-out one. Map: %d points (depths %s) from %s. "
-      "Error = (v - v_DEM) / the "
-      "depth's DEM peak |v|; the target is |error| <= 5 %% at >= 90 %% of the points at <= 3x "
-      "the column model's CPU." % (time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-                                   build_name(), machine(), runner.total, runner.runs, GRAINS_N,
-                                   "/".join("%g" % x for x in LAYERED_P), len(recs),
-                                   ", ".join(str(d) for d in sorted({r["depth"] for r in recs})),
-                                   os.environ.get("DEM_MAP_CSV") or
-                                   "tests/bench/results/dem_map.csv"))
-    w("")
-    w("## Summary")
-    w("")
-    summary_table(recs, w)
-    w("")
-    w("CPU: the candidate's convsim runs (both columns for `ensemble`) over the paper's column "
-      "model's run at the same point, one-way, each the least of %d runs of %g simulated seconds; "
-      "all points: the sums' ratio. For `grains`: the machine alone (convsim, feed=false) plus "
-      "fast_feed_bed's integration (timed on the %g-s orbit, scaled to %g s). Single points' "
-      "ratios vary by up to about 1.5x between two runs of this tool on a shared machine." %
-      (COST_REPEATS, COST_DURATION, LONG_DURATION, COST_DURATION))
-    w("")
-    for depth in sorted({(r["material"], r["drive"], r["depth"]) for r in recs}):
-        sel = [r for r in recs if (r["material"], r["drive"], r["depth"]) == depth]
-        w("## %s, drive `%s`, %d grains deep (DEM peak %.4f m/s)" % (depth + (sel[0]["peak"],)))
-        w("")
-        for f in FAMILIES:
-            n, tot, worst, med = summary(sel, f + "_err")
-            w("- %s fitted on the other depths: %s; %d of %d within 5 %%, worst %.1f %%; fitted "
-              "on this depth: %s." % (f, sel[0][f + "_fit"], n, tot, 100 * worst, sel[0][f + "_own"]))
-        w("")
-        depth_table(sel, w)
-        w("")
-    with open(path, "w") as fh:
-        fh.write("\n".join(out))
 
 
 def main():
@@ -457,8 +425,11 @@ def main():
     if not os.path.exists(runner.bed):
         sys.exit("fast_feed_check: %s is missing (make fast-feed-check builds it)" % runner.bed)
     runner.run_all([grains_args(runner, c, p) for c in candidates("grains") for p in pts])
+    cols = [(resolve({"Dc": math.inf, "bouncy": c}, p), p) for c in collapse_sides() for p in pts]
+    runner.run_all([args_of(convsim, c, r, p) for c, p in cols for r in c["Rs"]])
     recs = evaluate(runner, pts, peak)
     runner.save()
+    from fast_feed_report import summary, write_csv, write_md  # noqa: E402 (it imports this)
     write_csv(recs, os.path.join(RESULTS, "fast_feed.csv"))
     write_md(recs, runner, os.path.join(RESULTS, "fast_feed.md"))
     for f in FAMILIES:

@@ -9,7 +9,10 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fast_feed_check import R_FLOOR, evaluate, fit, rests  # noqa: E402
+from fast_feed_check import R_FLOOR, dissipation, evaluate, fit, resolve, rests  # noqa: E402
+
+GLASS = {"e_pw": 0.9, "e_pp": 0.97, "mu_pw": 0.15}  # dem/materials.json's, in part
+WHEAT = {"e_pw": 0.5, "e_pp": 0.5, "mu_pw": 0.3}
 
 
 class FakeRunner:
@@ -18,6 +21,7 @@ class FakeRunner:
 
     def __init__(self):
         self.seen = []
+        self.beds = set()
 
     def cost(self, cand, p):
         return float(len(cand.get("Rs", (1,))))
@@ -27,6 +31,8 @@ class FakeRunner:
 
     def get(self, cand, p):
         self.seen.append(p["depth"])
+        self.beds.add((p["material"], p["depth"]))
+        cand = resolve(cand, p)
         if "e" in cand:
             return cand["mu"] * p["beta"] / 100.0, 1.0
         # the depth-d data are made by R = 0.15 d (d = 1, 2: 0.15, 0.3)
@@ -37,7 +43,7 @@ def self_test():
     """Checks of the harness itself (no convsim): a fit never sees the
     depth it predicts, and the errors are (v - v_DEM) / the peak."""
     pts = [{"material": "m", "drive": "preset", "depth": d, "beta": b, "v_dem": 0.15 * d * b / 100.0,
-            "sd": 0.0} for d in (1, 2) for b in (30, 60, 90)]
+            "sd": 0.0, "mat": GLASS} for d in (1, 2) for b in (30, 60, 90)]
     peak = {("m", "preset", d): 0.15 * d * 0.9 for d in (1, 2)}
     run = FakeRunner()
     train = [p for p in pts if p["depth"] == 2]
@@ -64,6 +70,7 @@ def self_test():
     best = fit(FakeRunner(), "layered", train, peak)
     checks.append(("layered held out at depth 1", all(
         abs(x["layered_v"] - statistics.fmean(best["Rs"]) * x["beta"] / 100.0) < 1e-12 for x in lr)))
+    checks += collapse_checks()
     for name, ok in checks:
         print("%s - %s" % ("ok" if ok else "not ok", name))
     failed = sum(1 for _, ok in checks if not ok)
@@ -73,3 +80,43 @@ def self_test():
 
 if __name__ == "__main__":
     sys.exit(self_test())
+
+
+def collapse_checks():
+    """`collapse`: D from the material's restitutions, the regime and mu
+    it picks, D_c between the training beds, and leave one bed out across
+    materials (a wheat bed held out is fitted on the glass beds and the
+    other wheat bed, never on itself)."""
+    g8 = {"depth": 8, "mat": GLASS}
+    checks = [("collapse: D of glass 8 deep", abs(dissipation(g8) - (0.19 + 7 * 0.0591)) < 1e-12),
+              ("collapse: D of wheat 1 deep", abs(dissipation({"depth": 1, "mat": WHEAT}) - 0.75)
+               < 1e-12)]
+    cand = {"Dc": 0.5, "bouncy": {"Rs": (0.3, 0.75), "c": 2, "k_c": 1e6, "layers": "one"},
+            "collapsed": {"Rs": (0.05, 0.4), "c": 4 / 3, "k_c": 1e7, "layers": "one"}}
+    checks.append(("collapse: glass 1 deep is bouncy, mu 2 * 0.15",
+                   resolve(cand, {"depth": 1, "mat": GLASS}) ==
+                   {"Rs": (0.3, 0.75), "c": 2, "k_c": 1e6, "layers": "one", "mu": 0.3}))
+    checks.append(("collapse: glass 8 deep has collapsed, mu 4/3 * 0.15",
+                   resolve(cand, g8)["Rs"] == (0.05, 0.4) and resolve(cand, g8)["mu"] == 0.2))
+    # the fake data: v = mean(R) * beta / 100 with R 0.3 for a bouncy bed, 0.05 a collapsed one
+    beds = [("glass", GLASS, 1, 0.3), ("glass", GLASS, 2, 0.3), ("wheat", WHEAT, 1, 0.05),
+            ("wheat", WHEAT, 2, 0.05)]
+    pts = [{"material": m, "drive": "preset", "depth": d, "beta": b, "v_dem": r * b / 100.0,
+            "sd": 0.0, "mat": mat} for m, mat, d, r in beds for b in (30, 60, 90)]
+    peak = {(m, "preset", d): r * 0.9 for m, _, d, r in beds}
+    best = fit(FakeRunner(), "collapse", pts, peak)
+    d_glass2, d_wheat1 = 0.19 + 0.0591, 0.75
+    checks.append(("collapse: D_c between glass 2 and wheat 1 deep",
+                   abs(best["Dc"] - (d_glass2 * d_wheat1) ** 0.5) < 1e-9))
+    checks.append(("collapse: each regime's R", best["bouncy"]["Rs"] == (0.3, 0.3)
+                   and best["collapsed"]["Rs"] == (0.05, 0.05)))
+    run = FakeRunner()
+    train = [p for p in pts if (p["material"], p["depth"]) != ("wheat", 2)]
+    fit(run, "collapse", train, peak)
+    checks.append(("collapse: a fit sees only its training beds",
+                   run.beds == {("glass", 1), ("glass", 2), ("wheat", 1)}))
+    recs = evaluate(FakeRunner(), pts, peak)
+    w2 = [x for x in recs if (x["material"], x["depth"]) == ("wheat", 2)]
+    checks.append(("collapse: wheat 2 deep held out, predicted by the collapsed regime",
+                   all(abs(x["collapse_err"]) < 1e-12 for x in w2)))
+    return checks

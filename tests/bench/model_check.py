@@ -14,14 +14,19 @@ Sources, in this order:
   1. the 4-diameter bed's curve at the preset's contacts (dem.jsonl, group
      "curve": 11 angles, both senses, three packing seeds each), the data
      the preset liggghts-bed4 was fitted to;
-  2. every point of the DEM map (tests/bench/results/dem_map.csv), its
+  2. every point of the map's beds under the preset's drive against the
+     preset czubak2016 as it is (settings empty, layers = the depth): the
+     default model's distance from each material's bed, so that a default
+     session is checked at every depth the map has (before 3, so that
+     a scene near no entry is named after the preset, not a calibration);
+  3. every point of the DEM map (tests/bench/results/dem_map.csv), its
      value taken from its rows by the map report's rule (dem_points.py:
      the map's cell, the softest modulus within the overlap bound; the
      mirror rows counter-clockwise), whose material, depth and drive have
      a calibrated column model in tests/bench/model_presets.csv
      (material,layers,drive,preset,settings; an empty layers is every
      depth; tests/bench/dem_calibrate.py writes the lines).
-A map bed without such a line is left out and named on stderr.
+A map bed without a calibrated line is left out of 3 and named on stderr.
 
 v_column is the column model's v at the point: `convsim run -p PRESET
 [--set SETTING]... --set layers=L --set beta=B --set rotation=R --set
@@ -105,6 +110,30 @@ def map_points():
                    "source": "dem_map.csv " + r.get("build", "")}
 
 
+# the default preset, whose machine is the map's drive "preset"
+DEFAULT = "czubak2016"
+
+
+def default_points():
+    """Every map point of the preset's drive, against the default preset as
+    it is: one entry per material and depth."""
+    path = os.path.join(RESULTS, "dem_map.csv")
+    if not os.path.exists(path):
+        return
+    rows = dem_map.read_rows(path)
+    mats = dem_map.materials()
+    for material, layers, drive in dem_points.beds(rows):
+        if drive != "preset":
+            continue
+        for r in dem_points.points(rows, material, layers, drive, mats):
+            sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
+            yield {"preset": DEFAULT, "settings": "", "material": material,
+                   "layers": layers, "drive": drive,
+                   "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
+                   "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
+                   "source": "dem_map.csv " + r.get("build", "")}
+
+
 def v_column(convsim, p):
     args = [convsim, "run", "-p", p["preset"]]
     for s in filter(None, p["settings"].split(";")):
@@ -124,7 +153,7 @@ def main():
     convsim = sys.argv[1] if len(sys.argv) > 1 else "build/convsim"
     w = csv.writer(sys.stdout, lineterminator="\n")
     w.writerow(COLUMNS)
-    for p in list(bed4_points()) + list(map_points()):
+    for p in list(bed4_points()) + list(default_points()) + list(map_points()):
         p["v_column"] = v_column(convsim, p)
         w.writerow([p["preset"], p["settings"], p["material"], p["layers"], p["drive"],
                     num(float(p["beta_deg"]), 6), p["rotation"], num(p["v_dem"], 6),

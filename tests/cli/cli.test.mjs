@@ -92,7 +92,8 @@ test('sweep: plain progress lines off a terminal, the table to --out', () => {
   assert.match(r.err, /^sweep: 2\/2 points in [\d.]+ s$/m);
   const lines = readFileSync(out, 'utf8').trim().split('\n');
   assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
-  assert.match(lines[1], /^30,cw,0\.\d+,\d\.\d+(e-\d+)?,(true|false),done,\d\.\d+(e-\d+)?,\d+,\d\.\d+(e-\d+)?,(true|false),,,false$/);
+  // the preset's 2-layer bed is in the DEM map: its model error, checked
+  assert.match(lines[1], /^30,cw,0\.\d+,\d\.\d+(e-\d+)?,(true|false),done,\d\.\d+(e-\d+)?,\d+,\d\.\d+(e-\d+)?,(true|false),0\.\d+,0\.\d+,true$/);
   const q = run('sweep', '--beta', '30', '--rotation', 'cw', '--duration', '0.3', '-q',
     '--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2', '-f', 'json');
   assert.equal(q.err, '');

@@ -53,7 +53,7 @@ function bedCost(grains, kOverM) {
 }
 
 const UNCHECKED = ['-d', '0.1', ...set('layers=1', 'k_c=10000', 'm_n=0.005', 'feed_model=auto', 'model_tol=0.01')];
-const NOTE = 'not checked against DEM with this contact (m_n differs): nearest checked is 4 layers, liggghts-bed4';
+const NOTE = 'not checked against DEM with this contact (m_n differs): nearest checked is 1 layers, czubak2016 against glass';
 
 test('auto: not checked, a LIGGGHTS bed, its expected cost on stderr before it runs', { skip: !existsSync(`${ROOT}${BUILD}/convsim-dem`) && 'built without LIGGGHTS' }, () => {
   const r = run(UNCHECKED);

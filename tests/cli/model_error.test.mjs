@@ -46,16 +46,22 @@ test('model_error: the table\'s column-model v is this build\'s (make model-chec
   assert.ok(Math.abs(v - Number(row[c.v_column])) < 1e-5 * Math.abs(v), `v ${v}, the table's ${row[c.v_column]}`);
 });
 
-test('model_error: not checked at another depth or for the preset, the note names the nearest checked bed', () => {
+test('model_error: not checked at another depth, the note names the nearest checked bed', () => {
   const s = summary('liggghts-bed4', 'beta=150', 'layers=2');
   assert.equal(s.model_checked, false);
   assert.equal(s.model_error, null);
   assert.equal(s.model_error_uncertainty, null);
   assert.equal(s.model_check_note, 'not checked against DEM for 2-layer beds: nearest checked bed is 4 layers, liggghts-bed4');
   assert.equal(s.feed_warning, s.model_check_note);
-  const p = summary(null, 'beta=150', 'layers=2');
+  // the preset as it is, at a depth the map has not: the nearest depth's bed
+  const p = summary(null, 'beta=150', 'layers=3');
   assert.equal(p.model_checked, false);
-  assert.equal(p.model_check_note, "czubak2016's column model is not checked against DEM (checked: 4 layers, liggghts-bed4)");
+  assert.match(p.model_check_note,
+    /^not checked against DEM for 3-layer beds: nearest checked bed is [24] layers, czubak2016 against (glass|wheat)$/);
+  // and another machine: the preset named plainly
+  const q = summary(null, 'beta=150', 'layers=2', 'omega_ss=200');
+  assert.equal(q.model_checked, false);
+  assert.match(q.model_check_note, /^not checked against DEM at omega_ss = 200 rad\/s: the DEM map's machine is czubak2016's/);
   const n = summary(null, 'feed=false');
   assert.equal(n.model_checked, false);
   assert.equal(n.feed_warning, null);
@@ -97,7 +103,7 @@ function csvObjects(rel) {
 }
 
 test('model_error: each DEM map bed with a calibrated column model is checked at its settings, with the map\'s value', () => {
-  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv'));
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') && r.settings);
   const presets = csvObjects('../bench/model_presets.csv');
   assert.ok(table.length > 0, 'the map has calibrated beds (make bench-dem-calibrate)');
   const beds = new Map();
@@ -135,12 +141,12 @@ test('model_error: a map point\'s value is the report\'s row: the map\'s cell, t
   assert.ok(Number(soft.overlap_max_rel) > 0.01 && within.length > 0);
   const stiff = within[0];
   const point = csvObjects('../bench/results/model_check.csv').filter((r) => r.material === 'glass' && r.layers === '1' &&
-    Number(r.beta_deg) === 45 && r.rotation === 'cw');
+    Number(r.beta_deg) === 45 && r.rotation === 'cw' && r.settings);
   assert.equal(point.length, 1);
   assert.equal(Number(point[0].v_dem), Number(stiff.v_dem));
   // and at 30 deg, where 2e8 Pa is within the bound, the 2e8 row (not the 8e8 check nor the wider cell)
   const p30 = csvObjects('../bench/results/model_check.csv').find((r) => r.material === 'glass' && r.layers === '1' &&
-    Number(r.beta_deg) === 30 && r.rotation === 'cw');
+    Number(r.beta_deg) === 30 && r.rotation === 'cw' && r.settings);
   assert.equal(p30.v_dem, '0.0978932');
 });
 
@@ -153,10 +159,11 @@ test('model_error: every complete bed of the DEM map (all 13 clockwise angles) i
     angles.get(key(r)).add(Number(r.beta_deg));
   }
   const complete = [...angles].filter(([, s]) => s.size === 13).map(([k]) => k);
-  for (const k of ['glass,1,preset', 'glass,2,preset', 'glass,4,preset', 'glass,8,preset', 'wheat,1,preset'])
+  for (const k of ['glass,1,preset', 'glass,2,preset', 'glass,4,preset', 'glass,8,preset', 'wheat,1,preset', 'wheat,2,preset'])
     assert.ok(complete.includes(k), `${k}: complete in the map`);
   const presets = csvObjects('../bench/model_presets.csv');
-  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv'));
+  // the calibrated beds' rows (the default preset's rows have no settings)
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') && r.settings);
   assert.deepEqual(presets.map(key).sort(), [...complete].sort(), 'the calibrated beds are the complete ones (make bench-dem-calibrate)');
   assert.deepEqual([...new Set(table.map(key))].sort(), [...complete].sort(), 'each has its rows (make model-check)');
   // an 8-grain glass scene and a wheat scene at 150 deg cw: checked, with the map's value there
@@ -167,5 +174,46 @@ test('model_error: every complete bed of the DEM map (all 13 clockwise angles) i
     const want = Math.abs(Number(r.v_column) - Number(r.v_dem)) + Number(r.v_dem_sd);
     assert.ok(Math.abs(s.model_error - want) < 1e-12, `${k}: ${s.model_error} against ${want}`);
     assert.match(s.model_check_note, new RegExp(`calibrated to ${r.material}, ${r.layers} layers\\)$`));
+  }
+});
+
+test('model_error: the preset as it is is checked against every material\'s bed at every depth and angle of the map', () => {
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.preset === 'czubak2016' && !r.settings);
+  const materials = new Set(table.map((r) => r.material));
+  assert.ok(materials.has('glass') && materials.has('wheat'), [...materials].join(' '));
+  // the map's points under the preset's drive, every one: (layers, beta, rotation) -> rows a material
+  const at = new Map();
+  for (const r of table) {
+    assert.equal(r.drive, 'preset');
+    const k = `${r.layers},${Number(r.beta_deg)},${r.rotation}`;
+    at.set(k, [...(at.get(k) || []), r]);
+  }
+  const fmt = (x) => x.toFixed(3);
+  // a material without a row at (beta, sense) is checked at the mirror
+  // image (the preset's machine is symmetric): its row at 180 - beta the
+  // other way, the same distance
+  const mirror = (r) => r === 'cw' ? 'ccw' : 'cw';
+  for (const [k, own] of at) {
+    const [layers, beta, rotation] = k.split(',');
+    const rows = [...materials].map((m) => own.find((r) => r.material === m) ||
+      (at.get(`${layers},${180 - Number(beta)},${mirror(rotation)}`) || []).find((r) => r.material === m))
+      .filter(Boolean);
+    const err = rows.map((r) => Math.abs(Number(r.v_column) - Number(r.v_dem)) + Number(r.v_dem_sd));
+    const top = err.indexOf(Math.max(...err));
+    const s = summary(null, `layers=${layers}`, `beta=${beta}`, `rotation=${rotation}`);
+    assert.equal(s.model_checked, true, `${k}: ${s.model_check_note}`);
+    assert.ok(Math.abs(s.model_error - err[top]) < 1e-12, `${k}: ${s.model_error}, the largest of ${err}`);
+    const others = rows.map((r, i) => (i === top ? '' : `; against ${r.material} ±${fmt(err[i])}`)).join('');
+    assert.equal(s.model_check_note,
+      `DEM check: within ±${fmt(err[top])} m/s here (czubak2016 against ${rows[top].material}, ${layers} layers${others})`);
+    assert.equal(s.feed_warning, null);
+  }
+  // the table's v_column is this build's preset, one-way as model_check.py runs it (one point a depth)
+  for (const layers of new Set(table.map((r) => r.layers))) {
+    const r = table.find((x) => x.layers === layers);
+    const v = JSON.parse(execFileSync(CONVSIM, ['run', '--set', `layers=${layers}`, '--set', `beta=${r.beta_deg}`,
+      '--set', `rotation=${r.rotation}`, '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5', '-q'],
+    { encoding: 'utf8' })).transport_velocity;
+    assert.ok(Math.abs(v - Number(r.v_column)) < 1e-5 * Math.abs(v), `${layers} layers: v ${v}, the table's ${r.v_column}`);
   }
 });

@@ -11,7 +11,7 @@ import assert from 'node:assert/strict';
 import { startDaemon, req, SLOW } from '../http/lib.mjs';
 
 const AUTO = { pace: 1, scene: { feed_model: 'auto', model_tol: 0.01, layers: 1 }, params: { k_c: 10000, m_n: 0.005 } };
-const NOTE = 'not checked against DEM with this contact (m_n differs): nearest checked is 4 layers, liggghts-bed4';
+const NOTE = 'not checked against DEM with this contact (m_n differs): nearest checked is 1 layers, czubak2016 against glass';
 
 let d, tight;
 before(async () => {

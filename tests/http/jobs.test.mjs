@@ -80,8 +80,10 @@ test('experiment: a segment too short to settle has no reversal time; the next o
   const col = (name) => rows[0].indexOf(name);
   assert.equal(rows[1][col('t_end')], rows[2][col('t_command')]);
   assert.equal(rows[1][col('reversal_time')], '');
-  // the preset's scene is not checked against DEM: empty error, false
-  assert.deepEqual(rows.slice(1).map((r) => r.slice(col('model_error'))), [['', '', 'false'], ['', '', 'false']]);
+  // the preset's 8-layer bed is in the DEM map: each segment's error at its angle, checked
+  for (const [k, s] of [a, b].entries())
+    assert.deepEqual(rows[k + 1].slice(col('model_error')), [String(s.model_error), String(s.model_error_uncertainty), 'true']);
+  assert.ok(a.model_error > 0 && b.model_error > 0 && a.model_checked && b.model_checked);
 });
 
 test('experiment on an existing session; a second one is 409', { timeout: 60000 * SLOW }, async () => {
@@ -139,9 +141,10 @@ test('sweep v(beta) for cw and ccw, JSON and CSV', { timeout: 60000 * SLOW }, as
   const p0 = done.points[0];
   assert.deepEqual(first, [String(p0.beta), p0.rotation, String(p0.velocity), String(p0.uncertainty),
     String(p0.steady), 'done', String(p0.dt), String(p0.substeps), String(p0.step_error), String(p0.tol_met),
-    // the cheap scene is not the DEM map's: no model error, not checked
-    '', '', 'false']);
-  assert.equal(p0.model_checked, false);
+    // the preset's 2-layer bed is in the DEM map: its model error, checked
+    String(p0.model_error), String(p0.model_error_uncertainty), 'true']);
+  assert.equal(p0.model_checked, true);
+  assert.ok(p0.model_error > 0);
   for (const p of done.points) {
     assert.ok(p.dt > 0 && p.dt <= 1.25e-3, `dt ${p.dt}`);
     assert.ok(Number.isInteger(p.substeps) && p.substeps >= 5, `substeps ${p.substeps}`);

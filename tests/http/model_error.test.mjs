@@ -94,22 +94,49 @@ test('model_error: the calibrated bed moved from 30 to 150 deg cw takes the map\
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
 
-test('model_error: the preset is not checked, in one short sentence; a 2-layer calibrated bed names the nearest checked bed', { timeout: 20000 * SLOW }, async () => {
-  const a = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1 });
+// The preset as it is against the map's beds of a depth, at (beta, sense)
+// in the table: each material's |v_column - v_DEM| + sd, largest first.
+function presetErrors(layers, beta, rotation) {
+  const [head, ...rows] = readFileSync(new URL('../bench/results/model_check.csv', import.meta.url), 'utf8')
+    .trim().split('\n');
+  const c = Object.fromEntries(head.split(',').map((n, i) => [n, i]));
+  return rows.map((l) => l.split(',')).filter((r) => r[c.preset] === 'czubak2016' && r[c.settings] === '' &&
+    Number(r[c.layers]) === layers && Number(r[c.beta_deg]) === beta && r[c.rotation] === rotation)
+    .map((r) => ({ material: r[c.material],
+      err: Math.abs(Number(r[c.v_column]) - Number(r[c.v_dem])) + Number(r[c.v_dem_sd]) }))
+    .sort((a, b) => b.err - a.err);
+}
+
+test('model_error: a default 2-layer session moved from 30 to 150 deg takes the map\'s value there against each material; another depth names the nearest', { timeout: 20000 * SLOW }, async () => {
+  const a = await req(d.base, 'POST', '/api/v1/sessions', { params: { beta: 30 }, scene: { layers: 2 }, pace: 1 });
   assert.equal(a.status, 201);
-  const st = (await req(d.base, 'GET', `/api/v1/sessions/${a.body.id}`)).body.status;
-  assert.equal(st.model_checked, false);
-  assert.equal(st.model_error, null);
-  assert.equal(st.model_check_note,
-    "czubak2016's column model is not checked against DEM (checked: 4 layers, liggghts-bed4)");
-  assert.equal(st.feed_warning, st.model_check_note);
-  const b = await req(d.base, 'POST', '/api/v1/sessions', { preset: 'liggghts-bed4', scene: { layers: 2 }, pace: 1 });
+  const note = (e) => `DEM check: within ±${e[0].err.toFixed(3)} m/s here (czubak2016 against ${e[0].material}, 2 layers` +
+    e.slice(1).map((x) => `; against ${x.material} ±${x.err.toFixed(3)}`).join('') + ')';
+  for (const beta of [30, 150]) {
+    const e = presetErrors(2, beta, 'cw');
+    assert.deepEqual(e.map((x) => x.material).sort(), ['glass', 'wheat'], `both materials at ${beta} deg`);
+    const st = beta === 30 ? (await req(d.base, 'GET', `/api/v1/sessions/${a.body.id}`)).body.status
+      : (await req(d.base, 'PATCH', `/api/v1/sessions/${a.body.id}`, { beta })).body.status;
+    assert.equal(st.model_checked, true, `${beta} deg`);
+    assert.ok(Math.abs(st.model_error - e[0].err) < 1e-12, `${st.model_error} at ${beta} deg, the map's ${e[0].err}`);
+    assert.equal(st.model_check_note, note(e));
+    assert.equal(st.feed_warning, null);
+  }
+  // a depth the map has not: the nearest depth's bed, in one sentence
+  const b = await req(d.base, 'POST', '/api/v1/sessions', { scene: { layers: 3 }, pace: 1 });
   assert.equal(b.status, 201);
   const sb = (await req(d.base, 'GET', `/api/v1/sessions/${b.body.id}`)).body.status;
   assert.equal(sb.model_checked, false);
-  assert.equal(sb.model_check_note,
+  assert.equal(sb.model_error, null);
+  assert.equal(sb.model_check_note, 'not checked against DEM for 3-layer beds: nearest checked bed is 2 layers, czubak2016 against glass');
+  assert.equal(sb.feed_warning, sb.model_check_note);
+  const c = await req(d.base, 'POST', '/api/v1/sessions', { preset: 'liggghts-bed4', scene: { layers: 2 }, pace: 1 });
+  assert.equal(c.status, 201);
+  const sc = (await req(d.base, 'GET', `/api/v1/sessions/${c.body.id}`)).body.status;
+  assert.equal(sc.model_checked, false);
+  assert.equal(sc.model_check_note,
     'not checked against DEM for 2-layer beds: nearest checked bed is 4 layers, liggghts-bed4');
-  for (const id of [a.body.id, b.body.id])
+  for (const id of [a.body.id, b.body.id, c.body.id])
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
 });
 

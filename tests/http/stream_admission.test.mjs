@@ -142,3 +142,49 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
+
+// A stream is woken once a record but at most once per paced batch, 50 a
+// wall second at any pace: at pace 0.1 a stream of every sample (250 a
+// simulated s) is woken 25 times a wall second, at pace 10 a ?rate=10
+// stream 50 times, not 100 (budget_stream.c srv_budget_streams_cpu).
+test('paced budget: a stream is charged its wake-ups a wall second, at most 50, at any pace', { timeout: 60000 * SLOW }, async () => {
+  const limit = 0.02;
+  const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
+  const held = async () => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+  const streams = [];
+  try {
+    // pace 0.1, a default stream of every sample: 250 wake-ups and 250
+    // records of 35 numbers a simulated s, a tenth of that a wall s
+    const slow = await req(d.base, 'POST', '/api/v1/sessions', { pace: 0.1, until: 600 });
+    assert.equal(slow.status, 201, slow.text);
+    const h0 = await held();
+    const all = await open(d.base, slow.body.id, '?format=ndjson');
+    streams.push(all);
+    assert.equal(all.status, 200, all.text);
+    const charge = 0.1 * (250 * 75e-6 + 250 * 35 * 1.5e-6);
+    const h1 = await held();
+    assert.ok(Math.abs(h1 - h0 - charge) < 1e-9, `held ${h1} after ${h0}: the stream ${h1 - h0}, expected ${charge}`);
+    all.close();
+    await until(async () => Math.abs(await held() - h0) < 1e-9, 10000 * SLOW, 'the closed stream gives its charge back');
+    // pace 1 to 10 with a ?rate=10 trough stream open: its 10 records a
+    // simulated s are 100 a wall s, woken 50 times: 5 wake-ups a simulated s
+    const fast = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(fast.status, 201, fast.text);
+    const cost = (await held()) - h0;
+    const thin = await open(d.base, fast.body.id);
+    streams.push(thin);
+    assert.equal(thin.status, 200, thin.text);
+    const perS = cost + 5 * 75e-6 + 10 * 9 * 1.5e-6;
+    assert.ok(10 * perS > limit, `pace 10 needs ${10 * perS} cores, beyond ${limit}`);
+    const r = await req(d.base, 'PATCH', `/api/v1/sessions/${fast.body.id}`, { pace: 10 });
+    assert.equal(r.status, 422, r.text);
+    assert.equal(r.body.field, 'pace');
+    assert.equal(r.body.detail, `this session needs ${g3(10 * perS)} cores (${g3(1e3 * perS)} ms of CPU per ` +
+      `simulated s at pace 10), more than the ${limit} cores for paced sessions (--max-paced-cores); ` +
+      'nothing was changed, lower the pace');
+    assert.equal((await req(d.base, 'GET', `/api/v1/sessions/${fast.body.id}`)).body.pace, 1);
+  } finally {
+    for (const s of streams) s.close();
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});

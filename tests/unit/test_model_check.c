@@ -96,19 +96,54 @@ static void other_scenes_name_the_nearest(void **state)
 	set(&u, "k_c", "1e7");
 	assert_int_equal(check(&u, &me), 0);
 	assert_non_null(strstr(me.note, "k_c differs"));
-	/* the preset itself: one plain sentence */
+	/* the preset as it is at a depth the map has not: the nearest depth
+	 * of its entries (2 and 4 are as near; the first in the table) */
 	setup c = preset_defaults();
+	set(&c, "layers", "3");
 	assert_int_equal(check(&c, &me), 0);
-	assert_string_equal(me.note, "czubak2016's column model is not checked against DEM "
-				     "(checked: 4 layers, liggghts-bed4)");
+	assert_string_equal(me.note, "not checked against DEM for 3-layer beds: nearest checked "
+				     "bed is 2 layers, czubak2016 against glass");
+	/* another machine: the nearest depth's entry names it */
 	set(&c, "layers", "2");
-	set(&c, "beta", "150");
+	set(&c, "omega_ss", "140");
 	assert_int_equal(check(&c, &me), 0);
+	assert_string_equal(me.note, "not checked against DEM at omega_ss = 140 rad/s: the DEM "
+				     "map's machine is czubak2016's (2 layers, czubak2016 against "
+				     "glass)");
 	/* the controls' ramps and the coupling are not part of the check */
 	u = bed4();
 	set(&u, "beta_rate", "5");
 	set(&u, "feed_coupling", "false");
 	assert_int_equal(check(&u, &me), 1);
+}
+
+/* the table's rows of the preset as it is, 2 layers, 150 deg cw: glass
+ * and wheat (v_column, v_dem, v_dem_sd) */
+#define G150 (-0.0739112 + 0.103018 + 0.0016)
+#define W150 (-0.0739112 + 0.0955908 + 0.00427)
+
+/* The preset as it is, checked against each material's bed at its depth:
+ * the larger error, the note naming both. */
+static void the_preset_against_each_material(void **state)
+{
+	(void)state;
+	sim_model_error me;
+	setup c = preset_defaults();
+	set(&c, "layers", "2");
+	set(&c, "beta", "150");
+	assert_int_equal(check(&c, &me), 1);
+	assert_true(G150 > W150);
+	assert_close(me.error, G150, 1e-12);
+	assert_close(me.error_uncertainty, 0.0016, 1e-12);
+	assert_string_equal(me.note, "DEM check: within ±0.031 m/s here (czubak2016 against glass, "
+				     "2 layers; against wheat ±0.026)");
+	/* its mirror image, 30 deg ccw: the same distances */
+	sim_model_error mm;
+	set(&c, "beta", "30");
+	set(&c, "rotation", "ccw");
+	assert_int_equal(check(&c, &mm), 1);
+	assert_close(mm.error, me.error, 1e-12);
+	assert_string_equal(mm.note, me.note);
 }
 
 static void assert_same_error(const sim_model_error *a, const sim_model_error *b)
@@ -244,6 +279,7 @@ int main(void)
 		cmocka_unit_test(the_same_answer_after_any_check),
 		cmocka_unit_test(bounds_included_and_beyond),
 		cmocka_unit_test(other_scenes_name_the_nearest),
+		cmocka_unit_test(the_preset_against_each_material),
 		cmocka_unit_test(no_column_feed),
 		cmocka_unit_test(feed_pick_rule),
 	};

@@ -113,11 +113,12 @@ test('a session starts from the form', async () => {
 	assert.equal(s.layers, 2);
 	assert.equal(s.spec.scene.start, 'steady');
 	await until(async () => !(await page.$eval('#beta-slider', e => e.disabled)), 5000, 'the β control enabled');
-	/* czubak2016's contacts are not checked against DEM: one short line
-	 * under the velocity, no banner */
-	assert.equal(s.status.model_checked, false);
-	await until(async () => await page.$eval('#v-model', e => e.textContent) ===
-		"czubak2016's column model is not checked against DEM", 5000, 'the model check line');
+	/* the preset as it is, 2 layers: checked against the DEM map's 2-grain
+	 * beds, one short line under the velocity, no banner */
+	assert.equal(s.status.model_checked, true);
+	assert.equal(s.status.feed_warning, null);
+	const line = `DEM check: within ±${s.status.model_error.toFixed(3)} m/s here`;
+	await until(async () => await page.$eval('#v-model', e => e.textContent) === line, 5000, 'the model check line');
 	assert.equal(await page.$('#feed-warning'), null, 'no banner');
 });
 
