@@ -190,8 +190,8 @@ MODEL_MAP := tests/bench/results/model_check.csv
 $(BUILD)/core/model_map.inc: $(MODEL_MAP) Makefile
 	@mkdir -p $(dir $@)
 	$(Q)awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$$i] = i; next } \
-	  /^[^#]/ { printf "{\"%s\", \"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
-	    $$c["preset"], $$c["settings"], $$c["material"], $$c["layers"], $$c["beta_deg"], \
+	  /^[^#]/ { printf "{\"%s\", \"%s\", \"%s\", \"%s\", %d, %s, %s, %s, %s, %d, %s},\n", \
+	    $$c["preset"], $$c["settings"], $$c["material"], $$c["model"], $$c["layers"], $$c["beta_deg"], \
 	    $$c["rotation"] == "cw" ? "SIM_CW" : "SIM_CCW", $$c["v_dem"], \
 	    $$c["v_dem_sd"] == "nan" ? "NAN" : $$c["v_dem_sd"], $$c["seeds"], $$c["v_column"] }' \
 	  $< > $@

@@ -223,8 +223,9 @@ static double settle_share(const model_ctl *ctl, double t)
 
 /* Stage suspension: the two spring sets with preload into rhs; their
  * damping power is added to *damp_power. */
-static void suspension(const model *md, const model_ctl *ctl, double t, const config *cf,
-		       double rhs[NQ_FULL], double *damp_power)
+static inline __attribute__((always_inline)) void
+suspension(const model *md, const model_ctl *ctl, double t, const config *cf, double rhs[NQ_FULL],
+	   double *damp_power)
 {
 	const sim_params *p = &md->p;
 	const double *qd = cf->qd;
@@ -282,8 +283,9 @@ typedef struct drive_terms {
 /* Stage drive: motor torque (Kloss; none for the ideal drive), drag and
  * load on phi and their reaction on alpha; drag and load power added to
  * *damp_power. */
-static void drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FULL],
-		  double *damp_power, drive_terms *dt)
+static inline __attribute__((always_inline)) void
+drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FULL],
+      double *damp_power, drive_terms *dt)
 {
 	const sim_params *p = &md->p;
 	dt->omega = cf->qd[Q_PHI] - cf->qd[Q_ALPHA];
@@ -397,6 +399,19 @@ static double deck_load(const model *md, const model_ctl *ctl, const config *cf,
 	return L[0] * (cf->qd[Q_X] - ad * ry) + L[1] * (cf->qd[Q_Y] + ad * rx) + L[2] * ad;
 }
 
+/* The stages between M and the solve: the deck's load (its power
+ * returned), suspension, eliminators and drive, into rhs. */
+static inline __attribute__((always_inline)) double
+forces(const model *md, const model_ctl *ctl, double t, const config *cf, double rhs[NQ_FULL],
+       double *damp_power, drive_terms *dt)
+{
+	double load_power = deck_load(md, ctl, cf, rhs);
+	suspension(md, ctl, t, cf, rhs, damp_power);
+	eliminators(&md->p, cf, rhs, damp_power);
+	drive(md, ctl, cf, rhs, damp_power, dt);
+	return load_power;
+}
+
 void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const double *y,
 		       const double Qfeed[NQ_FULL], double *dy, model_eval *ev)
 {
@@ -406,15 +421,21 @@ void model_machine_rhs(const model *md, const model_ctl *ctl, double t, const do
 	double(*M)[NQ_FULL] = ev ? ev->M : Mown;
 	double damp_power = 0.0;
 	drive_terms dt;
-	if (!trough2_held(md, ctl, t, y, Qfeed, &cf, M, rhs)) {
+	trough2_mass m2;
+	double load_power;
+	if (trough2_held(md, ctl, t, y, Qfeed, &cf, &m2, rhs)) {
+		/* the layout's solve on M's entries in scalars */
+		load_power = forces(md, ctl, t, &cf, rhs, &damp_power, &dt);
+		trough2_solve(md, &m2, rhs, br);
+		trough2_full(br, qdd);
+		if (ev)
+			trough2_matrix(&m2, ev->M);
+	} else {
 		configure(md, ctl, t, y, &cf);
 		mass_matrix_and_bias(md, &cf, Qfeed, M, rhs);
+		load_power = forces(md, ctl, t, &cf, rhs, &damp_power, &dt);
+		solve(md, ctl, t, M, rhs, &dt, br, qdd);
 	}
-	double load_power = deck_load(md, ctl, &cf, rhs);
-	suspension(md, ctl, t, &cf, rhs, &damp_power);
-	eliminators(&md->p, &cf, rhs, &damp_power);
-	drive(md, ctl, &cf, rhs, &damp_power, &dt);
-	solve(md, ctl, t, M, rhs, &dt, br, qdd);
 	/* positions' rates and accelerations; in the reduced scene's
 	 * layout (x, y | phi, s1, s2) two copies of constant size */
 	if (md->layout == MODEL_LAYOUT_TROUGH2) {

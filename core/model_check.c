@@ -30,6 +30,10 @@ typedef struct map_point {
 	const char *preset;   /* the calibrated column model's preset */
 	const char *settings; /* its changes, "name=value;..." in user units */
 	const char *material; /* the DEM bed's material */
+	const char *model;    /* the column model as a user knows it: "PRESET",
+				 "PRESET against MATERIAL", "PRESET at e = E m
+				 against MATERIAL" (a drive of the map's),
+				 "PRESET calibrated to MATERIAL" */
 	int layers;
 	double beta_deg;
 	int rotation;         /* SIM_CW or SIM_CCW */
@@ -40,7 +44,7 @@ typedef struct map_point {
 
 static const map_point map[] = {
 #include "model_map.inc"
-	{NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0} /* the end (the table may be empty) */
+	{NULL, NULL, NULL, NULL, 0, 0, 0, 0, 0, 0, 0} /* the end (the table may be empty) */
 };
 
 /* Settings that are controls, not part of a scene's check: the angle and
@@ -101,52 +105,9 @@ static int entry_settings(const map_point *e, sim_params *p, sim_scene *sc)
 	return 0;
 }
 
-/* The bed of the preset's own contacts (the first cross-check's), not a
- * named material. */
-#define OWN_CONTACTS "preset-contacts"
-
-/* The column model of entry e as a user knows it: its preset (against its
- * own contacts' bed), "PRESET against MATERIAL" (the preset as it is
- * against a material's bed), or where the entry changes the preset,
- * "PRESET calibrated to MATERIAL". */
-static const char *entry_name(const map_point *e, char *buf, size_t n)
-{
-	if (!e->settings[0] && strcmp(e->material, OWN_CONTACTS) == 0)
-		return e->preset;
-	snprintf(buf, n, "%s %s %s", e->preset, e->settings[0] ? "calibrated to" : "against",
-		 e->material);
-	return buf;
-}
-
 static int same(double a, double b)
 {
 	return a == b || fabs(a - b) <= 1e-9 * fmax(fabs(a), fabs(b));
-}
-
-/* The first parameter (not a control) in which p differs from q, or NULL. */
-static const char *first_difference(const sim_params *p, const sim_scene *s,
-				    const sim_params *q, const sim_scene *t)
-{
-	/* the common answer first: the same bytes once the controls are
-	 * copied (padding that differs only sends it the long way) */
-	sim_params same_controls = *q;
-	copy_controls(&same_controls, p);
-	if (!memcmp(&same_controls, p, sizeof *p) && s->friction == t->friction)
-		return NULL;
-	size_t n;
-	const sim_setting *tab = sim_settings(&n);
-	for (size_t i = 0; i < n; i++) {
-		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name))
-			continue;
-		double a, b;
-		sim_get_setting(p, s, NULL, &tab[i], &a);
-		sim_get_setting(q, t, NULL, &tab[i], &b);
-		if (!same(a, b))
-			return tab[i].name;
-	}
-	if (s->friction != t->friction)
-		return "friction";
-	return NULL;
 }
 
 /* A setting of the feed (its contact) rather than of the machine. */
@@ -158,6 +119,37 @@ static int is_feed_setting(const char *name)
 		if (strcmp(name, feed[i]) == 0)
 			return 1;
 	return 0;
+}
+
+/* Which settings first_difference compares. */
+enum { ANY_SETTING = -1, MACHINE_SETTING = 0, FEED_SETTING = 1 };
+
+/* The first parameter (not a control) of the kind asked (is_feed_setting's
+ * or not, or any) in which p differs from q, or NULL. */
+static const char *first_difference(const sim_params *p, const sim_scene *s,
+				    const sim_params *q, const sim_scene *t, int kind)
+{
+	/* the common answer first: the same bytes once the controls are
+	 * copied (padding that differs only sends it the long way) */
+	sim_params same_controls = *q;
+	copy_controls(&same_controls, p);
+	if (!memcmp(&same_controls, p, sizeof *p) && s->friction == t->friction)
+		return NULL;
+	size_t n;
+	const sim_setting *tab = sim_settings(&n);
+	for (size_t i = 0; i < n; i++) {
+		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name) ||
+		    (kind != ANY_SETTING && is_feed_setting(tab[i].name) != kind))
+			continue;
+		double a, b;
+		sim_get_setting(p, s, NULL, &tab[i], &a);
+		sim_get_setting(q, t, NULL, &tab[i], &b);
+		if (!same(a, b))
+			return tab[i].name;
+	}
+	if (kind != MACHINE_SETTING && s->friction != t->friction)
+		return "friction";
+	return NULL;
 }
 
 /* The angle range [lo, hi] (deg) entry [first, end) measured in a sense. */
@@ -213,7 +205,8 @@ static const char *sense_name(int rotation)
 
 /* How well the scene matches entry [first, end): 0 settings and layers
  * match, 1 layers differ, 2 a machine setting differs, 3 a feed setting
- * differs. *diff receives the first differing setting. */
+ * differs, 4 both. *diff receives the first differing setting (the
+ * machine's first). */
 static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
 		       const char **diff)
 {
@@ -221,10 +214,14 @@ static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
 	sim_scene t;
 	*diff = NULL;
 	if (entry_settings(&map[first], &q, &t) != 0)
-		return 4;
-	*diff = first_difference(p, sc, &q, &t);
-	if (*diff)
-		return is_feed_setting(*diff) ? 3 : 2;
+		return 5;
+	const char *machine = first_difference(p, sc, &q, &t, MACHINE_SETTING);
+	const char *feed = first_difference(p, sc, &q, &t, FEED_SETTING);
+	*diff = machine ? machine : feed;
+	if (machine)
+		return feed ? 4 : 2;
+	if (feed)
+		return 3;
 	return sc->layers == map[first].layers ? 0 : 1;
 }
 
@@ -303,12 +300,11 @@ static void checked_by(const hit *hits, int n, sim_model_error *out)
 		if (hits[i].err > hits[top].err)
 			top = i;
 	const map_point *e = &map[hits[top].first];
-	char name[64];
 	out->checked = 1;
 	out->error = hits[top].err;
 	out->error_uncertainty = hits[top].unc;
 	int at = snprintf(out->note, sizeof out->note, "DEM check: within ±%.3f m/s here (%s, %d layers",
-			  out->error, entry_name(e, name, sizeof name), e->layers);
+			  out->error, e->model, e->layers);
 	for (int i = 0; i < n; i++)
 		if (i != top && at >= 0 && (size_t)at < sizeof out->note)
 			at += snprintf(out->note + at, sizeof out->note - at, "; against %s ±%.3f",
@@ -327,7 +323,7 @@ static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, i
 	hit hits[HITS_MAX];
 	int nhits = 0;
 	size_t best_first = SIZE_MAX, best_end = 0;
-	int best_rank = 5;
+	int best_rank = 6;
 	const char *best_diff = NULL;
 	for (size_t first = 0, end; map[first].preset; first = end) {
 		end = entry_end(first);
@@ -342,7 +338,7 @@ static int scan_entries(const sim_params *p, const sim_scene *sc, double beta, i
 				hits[nhits++] = (hit){first, err, unc};
 		}
 		if (rank < best_rank ||
-		    (rank == best_rank && rank >= 1 && rank < 4 &&
+		    (rank == best_rank && rank >= 1 && rank <= 4 &&
 		     abs(map[first].layers - sc->layers) < abs(map[best_first].layers - sc->layers))) {
 			best_first = first;
 			best_end = end;
@@ -371,7 +367,7 @@ static const char *scene_preset(const sim_params *p, const sim_scene *sc, int ra
 		sim_scene t;
 		sim_method m;
 		if (sim_preset(sim_preset_names[i], &q, &t, &m) == SIM_OK &&
-		    !first_difference(p, sc, &q, &t))
+		    !first_difference(p, sc, &q, &t, ANY_SETTING))
 			named = sim_preset_names[i];
 	}
 	return named;
@@ -385,8 +381,8 @@ static void note_unchecked(const sim_params *p, const sim_scene *sc, double beta
 	int best_rank = b->rank;
 	const char *best_diff = b->diff;
 	const map_point *e = &map[best];
-	char where[96], name[64];
-	snprintf(where, sizeof where, "%d layers, %s", e->layers, entry_name(e, name, sizeof name));
+	char where[120];
+	snprintf(where, sizeof where, "%d layers, %s", e->layers, e->model);
 	/* a scene that is another preset as it stands: say so plainly */
 	const char *named = scene_preset(p, sc, best_rank);
 	if (named) {
@@ -409,7 +405,7 @@ static void note_unchecked(const sim_params *p, const sim_scene *sc, double beta
 		snprintf(out->note, sizeof out->note,
 			 "not checked against DEM for %d-layer beds: nearest checked bed is %s",
 			 sc->layers, where);
-	} else if (best_rank == 2) {
+	} else if (best_rank == 2 || best_rank == 4) {
 		double v = NAN;
 		sim_get_user(p, sc, NULL, best_diff, &v);
 		const sim_setting *t = sim_setting_find(best_diff);

@@ -8,17 +8,22 @@ calibrated column model, which the build compiles into the core
 (core/model_check.c includes the table the Makefile generates from it):
 
   preset,settings,material,layers,drive,beta_deg,rotation,v_dem,v_dem_sd,
-  seeds,v_column,source
+  seeds,v_column,source,model
+
+model is the column model as the notes name it: "liggghts-bed4",
+"czubak2016 against glass", "czubak2016 at e = 0.03225 against glass",
+"czubak2016 calibrated to glass".
 
 Sources, in this order:
   1. the 4-diameter bed's curve at the preset's contacts (dem.jsonl, group
      "curve": 11 angles, both senses, three packing seeds each), the data
      the preset liggghts-bed4 was fitted to;
-  2. every point of the map's beds under the preset's drive against the
-     preset czubak2016 as it is (settings empty, layers = the depth): the
-     default model's distance from each material's bed, so that a default
-     session is checked at every depth the map has (before 3, so that
-     a scene near no entry is named after the preset, not a calibration);
+  2. every point of the map against the preset czubak2016 as it is
+     (settings empty, or the drive's changes for the map's other drives,
+     e.g. e=0.03225; layers = the depth): the default model's distance from
+     each material's bed, so that a default session is checked at every
+     depth the map has (before 3, so that a scene near no entry is named
+     after the preset, not a calibration);
   3. every point of the DEM map (tests/bench/results/dem_map.csv), its
      value taken from its rows by the map report's rule (dem_points.py:
      the map's cell, the softest modulus within the overlap bound; the
@@ -54,7 +59,7 @@ PRESETS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "model_preset
 # the column model's measure at a point: one-way, as the DEM bed is driven
 MEASURE = ["-d", "2", "--set", "transient=0.5"]
 COLUMNS = ["preset", "settings", "material", "layers", "drive", "beta_deg", "rotation",
-           "v_dem", "v_dem_sd", "seeds", "v_column", "source"]
+           "v_dem", "v_dem_sd", "seeds", "v_column", "source", "model"]
 
 
 def bed4_points():
@@ -67,6 +72,7 @@ def bed4_points():
                 curve.setdefault((round(r["beta"]), r["rotation"]), []).append(r["v_dem"])
     for (beta, rot), v in sorted(curve.items(), key=lambda kv: (kv[0][1] != "cw", kv[0][0])):
         yield {"preset": "liggghts-bed4", "settings": "", "material": "preset-contacts",
+               "model": "liggghts-bed4",
                "layers": 4, "drive": "preset", "beta_deg": beta, "rotation": rot,
                "v_dem": statistics.fmean(v),
                "v_dem_sd": statistics.stdev(v) if len(v) > 1 else float("nan"),
@@ -104,7 +110,7 @@ def map_points():
         for r in dem_points.points(rows, material, layers, drive, mats):
             sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
             yield {"preset": preset, "settings": settings, "material": material,
-                   "layers": layers, "drive": drive,
+                   "model": f"{preset} calibrated to {material}", "layers": layers, "drive": drive,
                    "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
                    "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
                    "source": "dem_map.csv " + r.get("build", "")}
@@ -114,20 +120,30 @@ def map_points():
 DEFAULT = "czubak2016"
 
 
+def drive_settings(drive):
+    """A map drive's changes to the preset, "name=value;...", and how a
+    user knows the model there ("" and "" for the preset's own drive)."""
+    args = dem_map.DRIVES[drive]
+    sets = [args[i + 1] for i in range(0, len(args), 2) if args[i] == "--set"]
+    where = ", ".join(s.replace("=", " = ") for s in sets)
+    return ";".join(sets), (f" at {where}" if where else "")
+
+
 def default_points():
-    """Every map point of the preset's drive, against the default preset as
-    it is: one entry per material and depth."""
+    """Every map point against the default preset as it is (with the drive's
+    changes for a drive other than its own): one entry per material, depth
+    and drive."""
     path = os.path.join(RESULTS, "dem_map.csv")
     if not os.path.exists(path):
         return
     rows = dem_map.read_rows(path)
     mats = dem_map.materials()
     for material, layers, drive in dem_points.beds(rows):
-        if drive != "preset":
-            continue
+        settings, at = drive_settings(drive)
         for r in dem_points.points(rows, material, layers, drive, mats):
             sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
-            yield {"preset": DEFAULT, "settings": "", "material": material,
+            yield {"preset": DEFAULT, "settings": settings, "material": material,
+                   "model": f"{DEFAULT}{at} against {material}",
                    "layers": layers, "drive": drive,
                    "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
                    "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
@@ -157,7 +173,8 @@ def main():
         p["v_column"] = v_column(convsim, p)
         w.writerow([p["preset"], p["settings"], p["material"], p["layers"], p["drive"],
                     num(float(p["beta_deg"]), 6), p["rotation"], num(p["v_dem"], 6),
-                    num(p["v_dem_sd"], 3), p["seeds"], num(p["v_column"], 6), p["source"]])
+                    num(p["v_dem_sd"], 3), p["seeds"], num(p["v_column"], 6), p["source"],
+                    p["model"]])
 
 
 if __name__ == "__main__":

@@ -103,7 +103,7 @@ function csvObjects(rel) {
 }
 
 test('model_error: each DEM map bed with a calibrated column model is checked at its settings, with the map\'s value', () => {
-  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') && r.settings);
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') && r.model.includes(' calibrated to '));
   const presets = csvObjects('../bench/model_presets.csv');
   assert.ok(table.length > 0, 'the map has calibrated beds (make bench-dem-calibrate)');
   const beds = new Map();
@@ -141,12 +141,12 @@ test('model_error: a map point\'s value is the report\'s row: the map\'s cell, t
   assert.ok(Number(soft.overlap_max_rel) > 0.01 && within.length > 0);
   const stiff = within[0];
   const point = csvObjects('../bench/results/model_check.csv').filter((r) => r.material === 'glass' && r.layers === '1' &&
-    Number(r.beta_deg) === 45 && r.rotation === 'cw' && r.settings);
+    Number(r.beta_deg) === 45 && r.rotation === 'cw' && r.model.includes(' calibrated to '));
   assert.equal(point.length, 1);
   assert.equal(Number(point[0].v_dem), Number(stiff.v_dem));
   // and at 30 deg, where 2e8 Pa is within the bound, the 2e8 row (not the 8e8 check nor the wider cell)
   const p30 = csvObjects('../bench/results/model_check.csv').find((r) => r.material === 'glass' && r.layers === '1' &&
-    Number(r.beta_deg) === 30 && r.rotation === 'cw' && r.settings);
+    Number(r.beta_deg) === 30 && r.rotation === 'cw' && r.model.includes(' calibrated to '));
   assert.equal(p30.v_dem, '0.0978932');
 });
 
@@ -162,8 +162,9 @@ test('model_error: every complete bed of the DEM map (all 13 clockwise angles) i
   for (const k of ['glass,1,preset', 'glass,2,preset', 'glass,4,preset', 'glass,8,preset', 'wheat,1,preset', 'wheat,2,preset'])
     assert.ok(complete.includes(k), `${k}: complete in the map`);
   const presets = csvObjects('../bench/model_presets.csv');
-  // the calibrated beds' rows (the default preset's rows have no settings)
-  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') && r.settings);
+  // the calibrated beds' rows (not the default preset's, under either drive)
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.source.startsWith('dem_map.csv') &&
+    r.model.includes(' calibrated to '));
   assert.deepEqual(presets.map(key).sort(), [...complete].sort(), 'the calibrated beds are the complete ones (make bench-dem-calibrate)');
   assert.deepEqual([...new Set(table.map(key))].sort(), [...complete].sort(), 'each has its rows (make model-check)');
   // an 8-grain glass scene and a wheat scene at 150 deg cw: checked, with the map's value there
@@ -177,15 +178,18 @@ test('model_error: every complete bed of the DEM map (all 13 clockwise angles) i
   }
 });
 
-test('model_error: the preset as it is is checked against every material\'s bed at every depth and angle of the map', () => {
-  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.preset === 'czubak2016' && !r.settings);
+test('model_error: the preset as it is is checked against every material\'s bed at every depth, angle and drive of the map', () => {
+  // the default's entries: its settings empty, or a drive's changes (e=...)
+  const table = csvObjects('../bench/results/model_check.csv').filter((r) => r.preset === 'czubak2016' &&
+    r.model.startsWith('czubak2016 ') && r.model.includes(' against '));
   const materials = new Set(table.map((r) => r.material));
   assert.ok(materials.has('glass') && materials.has('wheat'), [...materials].join(' '));
-  // the map's points under the preset's drive, every one: (layers, beta, rotation) -> rows a material
+  assert.ok(table.some((r) => r.drive === 'preset' && r.settings === ''), 'the preset\'s own drive');
+  // the map's points: (drive, layers, beta, rotation) -> rows, a material each
   const at = new Map();
   for (const r of table) {
-    assert.equal(r.drive, 'preset');
-    const k = `${r.layers},${Number(r.beta_deg)},${r.rotation}`;
+    assert.equal(r.settings === '', r.drive === 'preset', `${r.drive}: ${r.settings}`);
+    const k = `${r.drive},${r.layers},${Number(r.beta_deg)},${r.rotation}`;
     at.set(k, [...(at.get(k) || []), r]);
   }
   const fmt = (x) => x.toFixed(3);
@@ -194,26 +198,28 @@ test('model_error: the preset as it is is checked against every material\'s bed 
   // other way, the same distance
   const mirror = (r) => r === 'cw' ? 'ccw' : 'cw';
   for (const [k, own] of at) {
-    const [layers, beta, rotation] = k.split(',');
+    const [drive, layers, beta, rotation] = k.split(',');
     const rows = [...materials].map((m) => own.find((r) => r.material === m) ||
-      (at.get(`${layers},${180 - Number(beta)},${mirror(rotation)}`) || []).find((r) => r.material === m))
+      (at.get(`${drive},${layers},${180 - Number(beta)},${mirror(rotation)}`) || []).find((r) => r.material === m))
       .filter(Boolean);
     const err = rows.map((r) => Math.abs(Number(r.v_column) - Number(r.v_dem)) + Number(r.v_dem_sd));
     const top = err.indexOf(Math.max(...err));
-    const s = summary(null, `layers=${layers}`, `beta=${beta}`, `rotation=${rotation}`);
+    const s = summary(null, ...own[0].settings.split(';').filter(Boolean), `layers=${layers}`, `beta=${beta}`,
+      `rotation=${rotation}`);
     assert.equal(s.model_checked, true, `${k}: ${s.model_check_note}`);
     assert.ok(Math.abs(s.model_error - err[top]) < 1e-12, `${k}: ${s.model_error}, the largest of ${err}`);
     const others = rows.map((r, i) => (i === top ? '' : `; against ${r.material} ±${fmt(err[i])}`)).join('');
     assert.equal(s.model_check_note,
-      `DEM check: within ±${fmt(err[top])} m/s here (czubak2016 against ${rows[top].material}, ${layers} layers${others})`);
+      `DEM check: within ±${fmt(err[top])} m/s here (${rows[top].model}, ${layers} layers${others})`);
     assert.equal(s.feed_warning, null);
   }
-  // the table's v_column is this build's preset, one-way as model_check.py runs it (one point a depth)
-  for (const layers of new Set(table.map((r) => r.layers))) {
-    const r = table.find((x) => x.layers === layers);
-    const v = JSON.parse(execFileSync(CONVSIM, ['run', '--set', `layers=${layers}`, '--set', `beta=${r.beta_deg}`,
+  // the table's v_column is this build's preset, one-way as model_check.py runs it (one point a bed)
+  for (const key of new Set(table.map((r) => `${r.settings}|${r.layers}`))) {
+    const r = table.find((x) => `${x.settings}|${x.layers}` === key);
+    const v = JSON.parse(execFileSync(CONVSIM, ['run', ...r.settings.split(';').filter(Boolean).flatMap((x) => ['--set', x]),
+      '--set', `layers=${r.layers}`, '--set', `beta=${r.beta_deg}`,
       '--set', `rotation=${r.rotation}`, '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5', '-q'],
     { encoding: 'utf8' })).transport_velocity;
-    assert.ok(Math.abs(v - Number(r.v_column)) < 1e-5 * Math.abs(v), `${layers} layers: v ${v}, the table's ${r.v_column}`);
+    assert.ok(Math.abs(v - Number(r.v_column)) < 1e-5 * Math.abs(v), `${key}: v ${v}, the table's ${r.v_column}`);
   }
 });
