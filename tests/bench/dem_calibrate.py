@@ -19,7 +19,8 @@ k_c and R are fitted (from liggghts-bed4's values, FITSTARTS starts) to
 three points of the bed's clockwise sweep: the forward peak (largest v), the
 reverse peak (smallest v) and the map angle next past the reverse peak, away
 from the forward peak, where the reverse flow falls off. Two parameters on
-three points: one degree of freedom. k_c's lower bound (SINK) grows with
+three points: one degree of freedom; among the fit's equally good ends the
+one nearest liggghts-bed4's (choose()). k_c's lower bound (SINK) grows with
 the depth; DESIGN says why. Every datum's sigma is the root mean
 square of the bed's seed spreads. A bed is calibrated once its clockwise
 sweep is complete (every angle of dem_map.BETAS); beds with fewer are named
@@ -65,9 +66,19 @@ GOOD = 0.05                   # "within 5 % of the peak"
 M_N_G = 0.5 * 9.81
 SINK = 0.004
 DESIGN = {"name": "mu fixed", "free": "k_c:{kc_min:.6g}:1e8,R:0.01:0.6", "fix_mu": True,
-          "third": "past reverse peak"}
+          "third": "past reverse peak", "choose": True}
 FORMER = {"name": "former", "free": "k_c:100:1e8,R:0.01:0.6,mu:0.1:1.5", "fix_mu": False,
-          "third": "mid-branch"}
+          "third": "mid-branch", "choose": False}
+# The choice among equally good ends (DESIGN's "choose"): of the fit's starts
+# that did not fail, those whose chi2 is within the margin of the lowest count
+# as equally good: chi2 <= lowest + max(1, lowest / dof), one unit of chi2 (the
+# usual one-parameter interval) once the data's sigma is scaled so that the
+# lowest chi2 per degree of freedom is 1 (where the model's own misfit, not the
+# seeds' scatter, makes chi2 large); of those, the calibration is the end nearest REFERENCE,
+# liggghts-bed4's k_c and R, in (log10 k_c, R), each over its search range.
+# Three points leave k_c and R a valley or two near-equal minima; without the
+# rule the lowest chi2 jumps between them when a point moves by its scatter.
+REFERENCE = {"k_c": 25613.34, "R": 0.17732}
 
 
 machine = provenance.machine
@@ -130,9 +141,41 @@ def shown(args):
     return " ".join(os.path.relpath(a) if os.path.isabs(a) else a for a in args)
 
 
+def choose(result):
+    """The end taken among the fit's starts (see DESIGN): {"start", "value"
+    (by parameter), "chi2", "equal" (how many ends were within the margin)}."""
+    pars = result["parameters"]
+    runs = [(i, s) for i, s in enumerate(result.get("starts") or [])
+            if s["status"] != "failed" and s["chi2"] is not None
+            and all(v is not None for v in s["value"])]
+    if not runs:
+        return {"start": result.get("best_start", 0), "chi2": result["chi2"], "equal": 1,
+                "value": {p["name"]: p["value"] for p in pars}}
+    low = min(s["chi2"] for _, s in runs)
+    margin = max(1.0, low / max(result.get("dof") or 1, 1))
+    equal = [(i, s) for i, s in runs if s["chi2"] <= low + margin]
+
+    def distance(run):
+        d = 0.0
+        for p, v in zip(pars, run[1]["value"]):
+            ref = REFERENCE.get(p["name"])
+            if ref is None:
+                continue
+            if p["name"] == "k_c":
+                d += (math.log10(v / ref) / math.log10(p["max"] / p["min"])) ** 2
+            else:
+                d += ((v - ref) / (p["max"] - p["min"])) ** 2
+        return (d, run[0])
+    i, s = min(equal, key=distance)
+    return {"start": i, "chi2": s["chi2"], "equal": len(equal),
+            "value": {p["name"]: v for p, v in zip(pars, s["value"])}}
+
+
 def fit(convsim, data, sigma, layers, drive, design, fixed):
     """`convsim fit` on data, [(beta, rotation, v)]: (its result, the
-    command as shown, the calibrated model's settings)."""
+    command as shown, the calibrated model's settings). With the design's
+    "choose", the settings are choose()'s end, in result["chosen"]; else
+    the lowest chi2's."""
     with tempfile.TemporaryDirectory() as tmp:
         path, out = os.path.join(tmp, "points.csv"), os.path.join(tmp, "fit.json")
         with open(path, "w") as fh:
@@ -145,7 +188,12 @@ def fit(convsim, data, sigma, layers, drive, design, fixed):
             result = json.load(fh)
     args = [{path: "POINTS.csv", out: "fit.json"}.get(a, a) for a in args]
     drive_sets = [a for a in dem_map.DRIVES[drive] if a != "--set"]
-    settings = ";".join(drive_sets + fixed + ["%s=%.6g" % (p["name"], p["value"])
+    if design.get("choose"):
+        result["chosen"] = choose(result)
+        values = result["chosen"]["value"]
+    else:
+        values = {p["name"]: p["value"] for p in result["parameters"]}
+    settings = ";".join(drive_sets + fixed + ["%s=%.6g" % (p["name"], values[p["name"]])
                                               for p in result["parameters"]])
     return result, shown(args), settings
 
@@ -226,7 +274,7 @@ def calibrate(convsim, rows, material, layers, drive, mats):
     bed["former"] = calibrate_design(convsim, bed, FORMER, mats)
     fixed = bed["now"]["fixed"]
     bed["all_fit"], _, bed["all_settings"] = fit(convsim, data_of(pts), bed["sigma"], layers,
-                                                 drive, DESIGN, fixed)
+                                                 drive, dict(DESIGN, choose=False), fixed)
     bed["all_pred"] = predict(convsim, pts, bed["all_settings"], layers, bed["peak"])
     return bed
 
@@ -246,7 +294,8 @@ def summary_line(b):
             b["material"], b["drive"], b["layers"], b["why"])
     c = b["now"]
     calib = ", ".join("%s %g° cw" % (n, beta(r)) for n, r in c["calib"])
-    pars = ", ".join(c["fixed"] + ["%s %.3g" % (p["name"], p["value"])
+    values = c["fit"].get("chosen", {}).get("value", {})
+    pars = ", ".join(c["fixed"] + ["%s %.3g" % (p["name"], values.get(p["name"], p["value"]))
                                    for p in c["fit"]["parameters"]])
     rest = [x for x in c["pred"] if not x[3]]
     worst, med, good = stats(rest)
@@ -275,13 +324,19 @@ def detail(b, w):
     w("### %s, %d grains deep, drive `%s`" % (b["material"], b["layers"], b["drive"]))
     w("")
     fit = c["fit"]
-    w("Fit on the three points: %s after %d iterations, χ² %.3g on %d degree(s) of freedom, "
+    w("Fit on the three points (its lowest χ²): %s after %d iterations, χ² %.3g on %d degree(s) of freedom, "
       "σ %.4f m/s; settings `%s` on the preset %s (the line of tests/bench/model_presets.csv). "
       "On all %d points: `%s`, χ² %.3g on %d degrees of freedom." %
       (fit["status"], fit["iterations"], fit["chi2"], fit["dof"], b["sigma"], c["settings"],
        PRESET, len(b["points"]), b["all_settings"], b["all_fit"]["chi2"], b["all_fit"]["dof"]))
+    ch = fit.get("chosen")
+    if ch:
+        w("Of the %d starts, %d ended within the margin of the lowest χ² (%.3g); the "
+          "calibration is start %d's end (χ² %.3g), the one nearest liggghts-bed4's k_c "
+          "and R." % (len(fit.get("starts") or []), ch["equal"], fit["chi2"], ch["start"],
+                      ch["chi2"]))
     for warning in fit.get("warnings") or []:
-        w("Fit warning (three points): %s." % warning.rstrip("."))
+        w("Fit warning (three points, the lowest χ²'s run): %s." % warning.rstrip("."))
     w("")
     w("    " + c["command"])
     w("")
@@ -319,7 +374,11 @@ def page(beds, convsim, started):
       "peak (smallest v) and the next map angle past the reverse peak, where the reverse flow "
       "falls off. μ, the bed's friction on the deck, is the material's grain-on-deck friction "
       "(μ_pw in dem/materials.json); `convsim fit --data` fits k_c and R (from liggghts-bed4's "
-      "values, %d starts): two parameters on three points. k_c is at least the depth × 1226 "
+      "values, %d starts): two parameters on three points. Three points leave k_c and R a valley or two "
+      "near-equal minima, so the calibration is not simply the lowest χ²: of the starts whose "
+      "χ² is within max(1, χ²/dof) of the lowest χ² (one unit once σ is scaled to make the lowest "
+      "χ²/dof 1: the model's misfit, not the seeds' scatter, makes it large), it is the end nearest liggghts-bed4's "
+      "k_c 2.56e4 N/m and R 0.177 in (log k_c, R), each over its search range. k_c is at least the depth × 1226 "
       "N/m: the bed's weight may press the column's contact at most a grain diameter (4 mm) "
       "into the deck; softer calibrations sank at angles they were not fitted at and diverged. "
       "The calibrated model then predicts "
