@@ -92,8 +92,26 @@ static api_err admit_session(const srv_session *s, api_problem *pb)
 	return API_OK;
 }
 
+/* The greatest pace at which s needs at most `cores` from the paced
+ * budget: its need p x srv_paced_cost(s, p) grows with p, more slowly
+ * where its streams' wake-ups meet their cap, so it is found by bisection
+ * (lock held). */
+static double greatest_pace(const srv_session *s, double cores)
+{
+	double lo = 0, hi = s->budget.cpu_per_s > 0 ? cores / s->budget.cpu_per_s : 1e6;
+	for (int i = 0; i < 64; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (mid * srv_paced_cost(s, mid) <= cores)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return lo;
+}
+
 /* The paced cores s needs after c: raise its hold before c is queued, or
- * refuse (lock held). The field named is the one that raises it. */
+ * refuse (lock held). The field named is the one that raises it; a pace
+ * beyond the whole budget is 422 with the greatest pace that fits it. */
 static api_err admit_paced(srv_session *s, const api_control *c,
 			   api_problem *pb)
 {
@@ -106,8 +124,11 @@ static api_err admit_paced(srv_session *s, const api_control *c,
 			    : (c->set & API_C_RUNNING) ? "running"
 			    : (c->set & API_C_CPU)     ? "cpu_budget"
 						       : "until";
-	return srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s, pace), pace, field,
-				     "changed", pb);
+	api_err e = srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s, pace), pace,
+					  field, "changed", pb);
+	if (e == API_RANGE && pb->has_range)
+		pb->max = greatest_pace(s, srv_budget_paced_limit());
+	return e;
 }
 
 /* Admit c to s, the first refusal winning, in this fixed order: the

@@ -182,6 +182,13 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     assert.equal(r.body.detail, `this session needs ${g3(10 * perS)} cores (${g3(1e3 * perS)} ms of CPU per ` +
       `simulated s at pace 10), more than the ${limit} cores for paced sessions (--max-paced-cores); ` +
       'nothing was changed, lower the pace');
+    // the greatest pace the cores allow, with the stream's wake-ups capped
+    // on the way there (at pace p: 10 p of them a wall s, at most 50)
+    const need = (p) => p * (cost + 10 * 9 * 1.5e-6) + Math.min(10 * p, 50) * 75e-6;
+    let lo = 0, hi = 100;
+    for (let i = 0; i < 100; i++) { const mid = (lo + hi) / 2; if (need(mid) <= limit) lo = mid; else hi = mid; }
+    assert.ok(Math.abs(r.body.max - lo) < 1e-9 * lo, `max ${r.body.max}, the greatest pace that fits ${lo}`);
+    assert.ok(need(r.body.max) <= limit * (1 + 1e-12) && need(r.body.max * 1.001) > limit);
     assert.equal((await req(d.base, 'GET', `/api/v1/sessions/${fast.body.id}`)).body.pace, 1);
   } finally {
     for (const s of streams) s.close();
