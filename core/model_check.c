@@ -61,7 +61,7 @@ static int is_control(const char *name)
 }
 
 /* dst's controls (is_control's settings, the same list) set to src's, or to
- * 0 where src is NULL: what first_difference and the memo compare without. */
+ * 0 where src is NULL: what first_differences and the memo compare without. */
 static void copy_controls(sim_params *dst, const sim_params *src)
 {
 	static const sim_params zero;
@@ -121,35 +121,35 @@ static int is_feed_setting(const char *name)
 	return 0;
 }
 
-/* Which settings first_difference compares. */
-enum { ANY_SETTING = -1, MACHINE_SETTING = 0, FEED_SETTING = 1 };
-
-/* The first parameter (not a control) of the kind asked (is_feed_setting's
- * or not, or any) in which p differs from q, or NULL. */
-static const char *first_difference(const sim_params *p, const sim_scene *s,
-				    const sim_params *q, const sim_scene *t, int kind)
+/* The first parameter (not a control) of the machine and the first of the
+ * feed (is_feed_setting's) in which p differs from q, each NULL where none
+ * does; one pass over the settings. */
+static void first_differences(const sim_params *p, const sim_scene *s, const sim_params *q,
+			      const sim_scene *t, const char **machine, const char **feed)
 {
+	*machine = *feed = NULL;
 	/* the common answer first: the same bytes once the controls are
 	 * copied (padding that differs only sends it the long way) */
 	sim_params same_controls = *q;
 	copy_controls(&same_controls, p);
 	if (!memcmp(&same_controls, p, sizeof *p) && s->friction == t->friction)
-		return NULL;
+		return;
 	size_t n;
 	const sim_setting *tab = sim_settings(&n);
-	for (size_t i = 0; i < n; i++) {
-		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name) ||
-		    (kind != ANY_SETTING && is_feed_setting(tab[i].name) != kind))
+	for (size_t i = 0; i < n && !(*machine && *feed); i++) {
+		if (strcmp(tab[i].group, "params") != 0 || is_control(tab[i].name))
+			continue;
+		const char **first = is_feed_setting(tab[i].name) ? feed : machine;
+		if (*first)
 			continue;
 		double a, b;
 		sim_get_setting(p, s, NULL, &tab[i], &a);
 		sim_get_setting(q, t, NULL, &tab[i], &b);
 		if (!same(a, b))
-			return tab[i].name;
+			*first = tab[i].name;
 	}
-	if (kind != MACHINE_SETTING && s->friction != t->friction)
-		return "friction";
-	return NULL;
+	if (!*feed && s->friction != t->friction)
+		*feed = "friction";
 }
 
 /* The angle range [lo, hi] (deg) entry [first, end) measured in a sense. */
@@ -215,8 +215,8 @@ static int entry_match(size_t first, const sim_params *p, const sim_scene *sc,
 	*diff = NULL;
 	if (entry_settings(&map[first], &q, &t) != 0)
 		return 5;
-	const char *machine = first_difference(p, sc, &q, &t, MACHINE_SETTING);
-	const char *feed = first_difference(p, sc, &q, &t, FEED_SETTING);
+	const char *machine, *feed;
+	first_differences(p, sc, &q, &t, &machine, &feed);
 	*diff = machine ? machine : feed;
 	if (machine)
 		return feed ? 4 : 2;
@@ -366,8 +366,11 @@ static const char *scene_preset(const sim_params *p, const sim_scene *sc, int ra
 		sim_params q;
 		sim_scene t;
 		sim_method m;
-		if (sim_preset(sim_preset_names[i], &q, &t, &m) == SIM_OK &&
-		    !first_difference(p, sc, &q, &t, ANY_SETTING))
+		const char *machine, *feed;
+		if (sim_preset(sim_preset_names[i], &q, &t, &m) != SIM_OK)
+			continue;
+		first_differences(p, sc, &q, &t, &machine, &feed);
+		if (!machine && !feed)
 			named = sim_preset_names[i];
 	}
 	return named;
