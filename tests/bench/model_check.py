@@ -90,30 +90,41 @@ def read_presets(path=PRESETS):
     return presets
 
 
-def map_points():
-    """The DEM map's points that have a calibrated column model, each
-    point's value taken by the map's rule (dem_points.py)."""
+def map_rows():
+    """The DEM map's rows and its materials (none without a map)."""
     path = os.path.join(RESULTS, "dem_map.csv")
     if not os.path.exists(path):
-        return
-    rows = dem_map.read_rows(path)
+        return [], {}
+    return dem_map.read_rows(path), dem_map.materials()
+
+
+def bed_points(rows, mats, bed, preset, settings, model):
+    """The points of one map bed (material, layers, drive), each value
+    taken by the map's rule (dem_points.py), against the column model
+    PRESET with SETTINGS that the notes call MODEL."""
+    material, layers, drive = bed
+    for r in dem_points.points(rows, material, layers, drive, mats):
+        sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
+        yield {"preset": preset, "settings": settings, "material": material,
+               "model": model, "layers": layers, "drive": drive,
+               "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
+               "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
+               "source": "dem_map.csv " + r.get("build", "")}
+
+
+def map_points(rows, mats):
+    """The DEM map's points that have a calibrated column model."""
     presets = read_presets()
-    mats = dem_map.materials()
-    for material, layers, drive in dem_points.beds(rows):
-        found = presets.get((material, layers, drive)) or presets.get((material, None, drive))
+    for bed in dem_points.beds(rows):
+        material, layers, drive = bed
+        found = presets.get(bed) or presets.get((material, None, drive))
         if not found:
             print(f"model_check.py: no calibrated column model for material {material}, "
                   f"{layers} grains deep, drive {drive} (tests/bench/model_presets.csv): "
                   "its points left out", file=sys.stderr)
             continue
         preset, settings = found
-        for r in dem_points.points(rows, material, layers, drive, mats):
-            sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
-            yield {"preset": preset, "settings": settings, "material": material,
-                   "model": f"{preset} calibrated to {material}", "layers": layers, "drive": drive,
-                   "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
-                   "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
-                   "source": "dem_map.csv " + r.get("build", "")}
+        yield from bed_points(rows, mats, bed, preset, settings, f"{preset} calibrated to {material}")
 
 
 # the default preset, whose machine is the map's drive "preset"
@@ -129,25 +140,13 @@ def drive_settings(drive):
     return ";".join(sets), (f" at {where}" if where else "")
 
 
-def default_points():
+def default_points(rows, mats):
     """Every map point against the default preset as it is (with the drive's
     changes for a drive other than its own): one entry per material, depth
     and drive."""
-    path = os.path.join(RESULTS, "dem_map.csv")
-    if not os.path.exists(path):
-        return
-    rows = dem_map.read_rows(path)
-    mats = dem_map.materials()
-    for material, layers, drive in dem_points.beds(rows):
-        settings, at = drive_settings(drive)
-        for r in dem_points.points(rows, material, layers, drive, mats):
-            sd = float(r["v_dem_sd"]) if r["v_dem_sd"] not in ("", "nan") else float("nan")
-            yield {"preset": DEFAULT, "settings": settings, "material": material,
-                   "model": f"{DEFAULT}{at} against {material}",
-                   "layers": layers, "drive": drive,
-                   "beta_deg": float(r["beta_deg"]), "rotation": r["rotation"],
-                   "v_dem": float(r["v_dem"]), "v_dem_sd": sd, "seeds": int(r["seeds"]),
-                   "source": "dem_map.csv " + r.get("build", "")}
+    for bed in dem_points.beds(rows):
+        settings, at = drive_settings(bed[2])
+        yield from bed_points(rows, mats, bed, DEFAULT, settings, f"{DEFAULT}{at} against {bed[0]}")
 
 
 def v_column(convsim, p):
@@ -169,7 +168,8 @@ def main():
     convsim = sys.argv[1] if len(sys.argv) > 1 else "build/convsim"
     w = csv.writer(sys.stdout, lineterminator="\n")
     w.writerow(COLUMNS)
-    for p in list(bed4_points()) + list(default_points()) + list(map_points()):
+    rows, mats = map_rows()
+    for p in list(bed4_points()) + list(default_points(rows, mats)) + list(map_points(rows, mats)):
         p["v_column"] = v_column(convsim, p)
         w.writerow([p["preset"], p["settings"], p["material"], p["layers"], p["drive"],
                     num(float(p["beta_deg"]), 6), p["rotation"], num(p["v_dem"], 6),
