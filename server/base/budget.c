@@ -204,21 +204,23 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
 }
 
-double srv_budget_fit_pace(double *held, double cpu_per_s, double pace)
+double srv_budget_fit_pace(double *held, srv_pace_cost cost, const void *session, double pace)
 {
 	pthread_mutex_lock(&lock);
 	double others = paced - *held, room = cfg->max_paced_cores - others;
 	double fit = pace;
-	if (cpu_per_s > 0 && cpu_per_s * pace > room * (1 + 1e-12)) {
-		fit = room / cpu_per_s; /* NaN when no room: the least pace */
-		double unit = pow(10, floor(log10(fit)) - 2);
-		fit = floor(fit / unit) * unit; /* three significant digits */
+	if (cost(session, pace) * pace > room * (1 + 1e-12)) {
+		fit = srv_budget_greatest_pace(cost, session, room);
+		if (fit > 0) { /* three significant digits */
+			double unit = pow(10, floor(log10(fit)) - 2);
+			fit = floor(fit / unit) * unit;
+		}
 	}
 	if (!(fit >= API_PACE_MIN))
 		fit = API_PACE_MIN;
 	if (fit > pace)
 		fit = pace;
-	*held = cpu_per_s * fit;
+	*held = cost(session, fit) * fit;
 	paced = others + *held;
 	pthread_mutex_unlock(&lock);
 	return fit;

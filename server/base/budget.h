@@ -115,12 +115,18 @@ api_err srv_budget_take_stream(double *held, double before, double after,
 /* Set what a session holds to need (cores, >= 0), even beyond the budget:
  * its worker's own measure, a pause, the end. */
 void srv_budget_set_paced(double *held, double need);
-/* The pace, at most pace, at which a running paced session that measured
- * cpu_per_s (CPU s per simulated s) fits beside the other paced sessions'
- * holds within --max-paced-cores (three significant digits, rounded
- * down; at least API_PACE_MIN even where that does not fit); *held is set
- * to its need at that pace. */
-double srv_budget_fit_pace(double *held, double cpu_per_s, double pace);
+/* CPU s per simulated s a paced session costs at a pace (> 0): its own
+ * and its streams' (their share falls as the pace rises: budget_stream.c),
+ * so that its need, pace x cost, grows with the pace. */
+typedef double (*srv_pace_cost)(const void *session, double pace);
+/* The greatest pace at which session needs at most `cores`: bisection on
+ * its growing need (0 where `cores` is none). */
+double srv_budget_greatest_pace(srv_pace_cost cost, const void *session, double cores);
+/* The pace, at most pace, at which a running paced session of that cost
+ * fits beside the other paced sessions' holds within --max-paced-cores
+ * (three significant digits, rounded down; at least API_PACE_MIN even
+ * where that does not fit); *held is set to its need at that pace. */
+double srv_budget_fit_pace(double *held, srv_pace_cost cost, const void *session, double pace);
 /* Cores held by running paced sessions now, and the budget. */
 double srv_budget_paced(void);
 double srv_budget_paced_limit(void);

@@ -92,23 +92,6 @@ static api_err admit_session(const srv_session *s, api_problem *pb)
 	return API_OK;
 }
 
-/* The greatest pace at which s needs at most `cores` from the paced
- * budget: its need p x srv_paced_cost(s, p) grows with p, more slowly
- * where its streams' wake-ups meet their cap, so it is found by bisection
- * (lock held). */
-static double greatest_pace(const srv_session *s, double cores)
-{
-	double lo = 0, hi = s->budget.cpu_per_s > 0 ? cores / s->budget.cpu_per_s : 1e6;
-	for (int i = 0; i < 64; i++) {
-		double mid = 0.5 * (lo + hi);
-		if (mid * srv_paced_cost(s, mid) <= cores)
-			lo = mid;
-		else
-			hi = mid;
-	}
-	return lo;
-}
-
 /* The paced cores s needs after c: raise its hold before c is queued, or
  * refuse (lock held). The field named is the one that raises it; a pace
  * beyond the whole budget is 422 with the greatest pace that fits it. */
@@ -127,7 +110,7 @@ static api_err admit_paced(srv_session *s, const api_control *c,
 	api_err e = srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s, pace), pace,
 					  field, "changed", pb);
 	if (e == API_RANGE && pb->has_range)
-		pb->max = greatest_pace(s, srv_budget_paced_limit());
+		pb->max = srv_budget_greatest_pace(srv_paced_cost_of, s, srv_budget_paced_limit());
 	return e;
 }
 

@@ -254,6 +254,12 @@ static inline double srv_paced_cost(const srv_session *s, double pace)
 	return s->budget.cpu_per_s + srv_budget_streams_cpu(s->budget.streams, pace);
 }
 
+/* srv_paced_cost as the paced budget takes it (budget.h srv_pace_cost). */
+static inline double srv_paced_cost_of(const void *s, double pace)
+{
+	return srv_paced_cost(s, pace);
+}
+
 /* Cores a session needs from the paced budget as it is now: its CPU s per
  * simulated s and its streams' times its pace while it runs paced (at
  * least its bed process's cores for a LIGGGHTS session), else none (lock

@@ -68,7 +68,7 @@ static void measure_cost(srv_session *s, clocks *c)
 static void pace_down(srv_session *s, clocks *c)
 {
 	double was = s->pace, cost = srv_paced_cost(s, was);
-	double pace = srv_budget_fit_pace(&s->budget.paced_held, cost, was);
+	double pace = srv_budget_fit_pace(&s->budget.paced_held, srv_paced_cost_of, s, was);
 	if (pace >= was)
 		return;
 	api_control ctl = {.set = API_C_PACE, .pace = pace};
