@@ -5,7 +5,8 @@
  * its feed before it runs (also before its instance is built and settled:
  * srv_budget_cpu_preview), and the cost of a published sample. The cores
  * of paced sessions (budget.c) are committed from it until the worker
- * has measured the session's own.
+ * has measured the session's own; and the greatest pace a session whose
+ * cost a simulated s changes with the pace (its streams') fits in.
  */
 #include <stdio.h>
 #include <string.h>
@@ -86,4 +87,21 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 double srv_budget_sample_cpu(int columns, int layers)
 {
 	return SAMPLE_SERVER_CPU_S + RECORD_DOUBLE_CPU_S * (double)srv_budget_record_doubles(columns, layers);
+}
+
+double srv_budget_greatest_pace(srv_pace_cost cost, const void *session, double cores)
+{
+	double lo = 0, hi = 1;
+	if (!(cores > 0))
+		return 0;
+	while (hi * cost(session, hi) <= cores && hi < 1e12)
+		hi *= 2;
+	for (int i = 0; i < 64; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (mid * cost(session, mid) <= cores)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return lo;
 }

@@ -4,8 +4,7 @@
  * its charge with its session's in the cores for paced sessions
  * (budget.c): a stream of a running paced session is refused 503 (budget
  * "cpu") where the session and its streams would go past
- * --max-paced-cores, as a creation is; and the greatest pace a session
- * whose streams' share falls with the pace fits in.
+ * --max-paced-cores, as a creation is.
  */
 #include "budget.h"
 
@@ -41,23 +40,6 @@ double srv_budget_streams_cpu(const srv_stream_charge *list, double pace)
 		cpu += (list->records < most ? list->records : most) * STREAM_WAKE_CPU_S +
 		       list->numbers_cpu;
 	return cpu;
-}
-
-double srv_budget_greatest_pace(srv_pace_cost cost, const void *session, double cores)
-{
-	double lo = 0, hi = 1;
-	if (!(cores > 0))
-		return 0;
-	while (hi * cost(session, hi) <= cores && hi < 1e12)
-		hi *= 2;
-	for (int i = 0; i < 64; i++) {
-		double mid = 0.5 * (lo + hi);
-		if (mid * cost(session, mid) <= cores)
-			lo = mid;
-		else
-			hi = mid;
-	}
-	return lo;
 }
 
 api_err srv_budget_take_stream(double *held, double before, double after,
