@@ -127,6 +127,14 @@ test('a flood of slow POST bodies from many addresses: closed at the cap or at t
   let st = null;
   try {
     st = await openFlood(d.port, 'slow-post', 150, 50, '127.3');
+    // held at the cap: beyond 32 the least progressed were closed. Only
+    // then is /health asked: while the daemon takes the flood's
+    // connections up, this process's event loop turns through their
+    // events before it writes the request of a socket that connected
+    // meanwhile, and a connection with nothing sent is the least
+    // progressed of all (the connect phase is measured by `make flood`,
+    // whose active client is a process of its own)
+    await until(() => st.closedByDaemon >= 150 - 32, 10000, 'the flood held at the cap');
     await healthy(d.port, '127.0.0.1', 'during the flood');
     // one byte every 2 s is below --min-body-rate: each body is cut once
     // its second passed (the reaper runs once a second)
