@@ -108,6 +108,10 @@ test('a flood of GETs with slow bodies from many addresses: each answered at onc
   let st = null;
   try {
     st = await openFlood(d.port, 'slow-get', 300, 100, '127.3');
+    // asked once the daemon has taken the flood up (as in the slow-POST
+    // case below: this process writes a new socket's request only after
+    // the flood's events)
+    await until(() => st.closedByDaemon >= 300 - 32, 10000, 'the flood taken up');
     await healthy(d.port, '127.0.0.1', 'during the flood');
     // each one answered 400 at once and closed, or closed at the cap
     // before its thread read it; none waits for its body
