@@ -17,7 +17,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dem_map  # noqa: E402  (the plan and the CSV's key)
-from dem_points import OVERLAP, chosen, rungs  # noqa: E402  (which row is a point's value)
+from dem_points import OVERLAP, chosen, points, rungs  # noqa: E402  (which row is a point's value)
 import provenance  # noqa: E402  (the machine, as provenance.sh names it)
 
 TOL = 0.02    # the relative change a check allows
@@ -44,6 +44,19 @@ def seeds_apart(a, b):
 
 
 machine = provenance.cores
+
+
+def peak_of(rows, r, mats):
+    """The largest |v| of r's bed (material, depth, drive) over its map
+    points so far: the scale a change near v = 0 is judged against, as the
+    model's errors are."""
+    vs = [abs(f(x["v_dem"])) for x in points(rows, r["material"], int(r["layers"]), r["drive"], mats)]
+    return max(vs) if vs else None
+
+
+def of_peak(a, b, peak):
+    """(a - b) in % of the bed's peak, as text."""
+    return "n/a" if not peak else "%+.1f %%" % (100 * (a - b) / peak)
 
 
 def status(rows, mats):
@@ -82,14 +95,16 @@ def ladder(rows, mats, w):
     w("At these points the overlap passed %.0f %% of a diameter at the map's E = %g Pa, so they "
       "run the stiffer rungs %s Pa; the point's value is the softest rung within the bound "
       "(bold), converged where its v is within %.0f %% of the next stiffer rung's (\"seeds\": "
-      "the change in units of the two rows' combined standard error). LIGGGHTS refuses E above "
+      "the change in units of the two rows' combined standard error; \"of the bed's peak\": the "
+      "change in %% of the largest |v| of the bed's map points so far, the scale of the model's "
+      "errors, since near v = 0 any relative change is large). LIGGGHTS refuses E above "
       "1e9 Pa without `hard_particles`, so %g Pa has no stiffer rung." %
       (100 * OVERLAP, e_map, " and ".join("%g" % e for e in es[1:]), 100 * TOL, es[-1]))
     w("")
-    w("| material | depth | beta | " + " | ".join("v at %g Pa (overlap)" % e for e in es) +
-      " | change to the next rung | seeds | within %.0f %% |" % (100 * TOL))
-    w("|---|---|---|" + "---|" * len(es) + "---|---|---|")
-    n_ok = n = n_close = 0
+    w("| material | depth | drive | beta | " + " | ".join("v at %g Pa (overlap)" % e for e in es) +
+      " | change to the next rung | of the bed's peak | seeds | within %.0f %% |" % (100 * TOL))
+    w("|---|---|---|---|" + "---|" * len(es) + "---|---|---|---|")
+    n_ok = n = n_close = n_pending = 0
     for m in over:
         point = (m["material"], int(m["layers"]), m["drive"], f(m["beta_deg"]))
         at = {f(r["youngs_pa"]): r for r in rungs(rows, *point)}
@@ -104,21 +119,28 @@ def ladder(rows, mats, w):
             cells.append("**%s**" % t if r is c else t)
         nxt = [e for e in es if c and e > f(c["youngs_pa"]) and e in at]
         change = z = None
+        peak_change = ""
         if c and nxt:
             b = at[nxt[0]]
             change = rel(f(c["v_dem"]), f(b["v_dem"]))
             z = seeds_apart(c, b)
+            peak_change = of_peak(f(c["v_dem"]), f(b["v_dem"]), peak_of(rows, m, mats))
         ok = change is not None and abs(change) < TOL
+        # a stiffer rung the plan runs here that has no row yet: pending
+        pending = any(e not in at for e in es[1:])
         n += 1
         n_ok += ok
         n_close += z is not None and z < 2
-        w("| %s | %s | %s | %s | %s | %s | %s |" %
-          (m["material"], m["layers"], m["beta_deg"], " | ".join(cells), pct(change),
-           "" if z is None else "%.1f" % z,
-           "yes" if ok else ("no stiffer rung" if change is None else "no")))
+        n_pending += change is None and pending
+        w("| %s | %s | %s | %s | %s | %s | %s | %s | %s |" %
+          (m["material"], m["layers"], m["drive"], m["beta_deg"], " | ".join(cells), pct(change),
+           peak_change, "" if z is None else "%.1f" % z,
+           "yes" if ok else ("no" if change is not None else
+                             "stiffer rungs pending" if pending else "no stiffer rung")))
     w("")
     w("Within %.0f %% of the next rung: %d of these %d points; the two rungs not told apart by "
-      "three seeds (within 2 standard errors): %d." % (100 * TOL, n_ok, n, n_close))
+      "three seeds (within 2 standard errors): %d; stiffer rungs still to run: %d." %
+      (100 * TOL, n_ok, n, n_close, n_pending))
     w("")
 
 
@@ -218,7 +240,8 @@ def main():
       "is (v_check - v_map) / |v_map|, the bound %.0f %%; \"seeds\" is the change in units of the "
       "two points' combined standard error (each point's seeds' standard deviation over the root of "
       "3): where it is below 2 the two rows are not told apart by three seeds, whatever the "
-      "change in %%." % (100 * TOL))
+      "change in %%; \"of the bed's peak\" is the change in %% of the largest |v| of the bed's "
+      "map points so far." % (100 * TOL))
     w("")
 
     def base_of(r):
@@ -236,36 +259,37 @@ def main():
             w("No rows yet.")
             w("")
             continue
-        w("| material | depth | beta | %s | v_map | v_check | change | seeds | overlap map / check (of d) | within %.0f %% | within 2 standard errors |" %
+        w("| material | depth | drive | beta | %s | v_map | v_check | change | of the bed's peak | seeds | overlap map / check (of d) | within %.0f %% | within 2 standard errors |" %
           ("E (Pa) map -> check" if role == "stiffness" else "width (d) map -> check", 100 * TOL))
-        w("|---|---|---|---|---|---|---|---|---|---|---|")
+        w("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in sel:
             b = base_of(r)
             if not b:
-                w("| %s | %s | %s | -> %s | (map row not yet) | %+.4f | | | %s | |" %
-                  (r["material"], r["layers"], r["beta_deg"], r[what], f(r["v_dem"]), r["overlap_max_rel"]))
+                w("| %s | %s | %s | %s | -> %s | (map row not yet) | %+.4f | | | | %s | | |" %
+                  (r["material"], r["layers"], r["drive"], r["beta_deg"], r[what], f(r["v_dem"]),
+                   r["overlap_max_rel"]))
                 continue
             c = rel(f(r["v_dem"]), f(b["v_dem"]))
             z = seeds_apart(r, b)
-            w("| %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %.1f | %s / %s | %s | %s |" %
-              (r["material"], r["layers"], r["beta_deg"], b[what], r[what], f(b["v_dem"]),
-               f(r["v_dem"]), pct(c), z, b["overlap_max_rel"], r["overlap_max_rel"],
+            w("| %s | %s | %s | %s | %s -> %s | %+.4f | %+.4f | %s | %s | %.1f | %s / %s | %s | %s |" %
+              (r["material"], r["layers"], r["drive"], r["beta_deg"], b[what], r[what], f(b["v_dem"]),
+               f(r["v_dem"]), pct(c), of_peak(f(r["v_dem"]), f(b["v_dem"]), peak_of(rows, b, mats)), z, b["overlap_max_rel"], r["overlap_max_rel"],
                "yes" if c is not None and abs(c) < TOL else "no", "yes" if z < 2 else "no"))
         w("")
     sel = [r for r in rows if r["role"] == "mirror"]
     w("### Mirror: counter-clockwise at beta against clockwise at 180 - beta")
     w("")
     if sel:
-        w("| material | depth | beta ccw | v ccw | v cw at 180 - beta | sum / mean |v| |")
-        w("|---|---|---|---|---|---|")
+        w("| material | depth | drive | beta ccw | v ccw | v cw at 180 - beta | sum / mean |v| |")
+        w("|---|---|---|---|---|---|---|")
         for r in sel:
             m = mats["materials"][r["material"]]
             b = by_key.get(dem_map.key(r["material"], r["layers"], r["drive"], 180 - f(r["beta_deg"]),
                                        "cw", e_map / m["youngs_real"], dem_map.WIDTH))
             if b:
                 s = f(r["v_dem"]) + f(b["v_dem"])
-                w("| %s | %s | %s | %+.4f | %+.4f | %s |" %
-                  (r["material"], r["layers"], r["beta_deg"], f(r["v_dem"]), f(b["v_dem"]),
+                w("| %s | %s | %s | %s | %+.4f | %+.4f | %s |" %
+                  (r["material"], r["layers"], r["drive"], r["beta_deg"], f(r["v_dem"]), f(b["v_dem"]),
                    pct(s / (0.5 * (abs(f(r["v_dem"])) + abs(f(b["v_dem"])))))))
         w("")
     else:
@@ -316,8 +340,9 @@ def main():
             w("")
         if big:
             w("Rows above the overlap bound: " + ", ".join(
-                "%s %s grains %s deg %s (%s E %s: %.2f %%)" %
-                (r["material"], r["layers"], r["beta_deg"], r["rotation"], r["role"], r["youngs_pa"],
+                "%s %s grains %s deg %s, drive %s (%s E %s: %.2f %%)" %
+                (r["material"], r["layers"], r["beta_deg"], r["rotation"], r["drive"], r["role"],
+                 r["youngs_pa"],
                  100 * f(r["overlap_max_rel"])) for r in big) + ".")
             w("")
     # cost
