@@ -19,7 +19,8 @@
 const char *const api_members_fit[] = {"preset", "params", "scene", "integrator", "free",
 				       "points", "csv", "peaks", "t_end", "curve_step",
 				       "max_iter", "fd_step", "starts", NULL};
-const char *const api_members_fit_free[] = {"name", "min", "max", "start", NULL};
+const char *const api_members_fit_free[] = {"name", "min", "max", "start", "prior", NULL};
+const char *const api_members_fit_prior[] = {"mean", "sd", "factor", NULL};
 const char *const api_members_fit_point[] = {"beta", "rotation", "v", "sigma", NULL};
 const char *const api_members_fit_peak[] = {"beta", "rotation", "sigma", NULL};
 
@@ -133,7 +134,33 @@ static api_err parse_peaks(const cJSON *root, fit_request *req, api_problem *pb)
 	return e;
 }
 
-/* "free": ["e", {"name": "b_s1", "min": 0, "max": 500, "start": 60}] */
+/* free[i].prior: {"mean": M, "sd": S} (normal) or {"mean": M, "factor": F}
+ * (log-normal), in the parameter's unit. */
+static api_err parse_prior(const cJSON *pr, fit_request *req, const char *name, int i,
+			   api_problem *pb)
+{
+	char prefix[40], field[48], msg[FIT_MSG];
+	snprintf(prefix, sizeof prefix, "free[%d].prior.", i);
+	snprintf(field, sizeof field, "free[%d].prior", i);
+	if (!cJSON_IsObject(pr))
+		return api_fail(pb, API_TYPE, field, "%s must be {mean, sd} or {mean, factor}", field);
+	double mean, sd, factor;
+	api_err e = api_check_members(pr, api_members_fit_prior, prefix, pb);
+	if (e == API_OK)
+		e = number(pr, "mean", prefix, 1, &mean, pb);
+	if (e == API_OK)
+		e = number(pr, "sd", prefix, 0, &sd, pb);
+	if (e == API_OK)
+		e = number(pr, "factor", prefix, 0, &factor, pb);
+	if (e != API_OK)
+		return e;
+	if (fit_set_prior(req, name, mean, sd, factor, msg, sizeof msg) != SIM_OK)
+		return api_fail(pb, API_RANGE, field, "%s", msg);
+	return API_OK;
+}
+
+/* "free": ["e", {"name": "b_s1", "min": 0, "max": 500, "start": 60,
+ * "prior": {"mean": 80, "sd": 20}}] */
 static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 {
 	const cJSON *arr = cJSON_GetObjectItemCaseSensitive(root, "free");
@@ -171,6 +198,12 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 					"%s", msg);
 		if (!isnan(start))
 			req->free[req->nfree - 1].start = sim_setting_to_si(sim_setting_find(name), start);
+		const cJSON *pr = cJSON_IsObject(f) ? cJSON_GetObjectItemCaseSensitive(f, "prior") : NULL;
+		if (pr) {
+			api_err e = parse_prior(pr, req, name, i, pb);
+			if (e != API_OK)
+				return e;
+		}
 	}
 	return API_OK;
 }

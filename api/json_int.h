@@ -157,6 +157,7 @@ extern const char *const api_members_sweep[];
 extern const char *const api_members_beta_range[];
 extern const char *const api_members_fit[];
 extern const char *const api_members_fit_free[];
+extern const char *const api_members_fit_prior[];
 extern const char *const api_members_fit_point[];
 extern const char *const api_members_fit_peak[];
 

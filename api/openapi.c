@@ -328,6 +328,7 @@ char *api_openapi_json(void)
 		{"BetaRange", api_members_beta_range},
 		{"FitCreate", api_members_fit},
 		{"FitFree", api_members_fit_free},
+		{"FitPrior", api_members_fit_prior},
 		{"FitPoint", api_members_fit_point},
 		{"FitPeak", api_members_fit_peak},
 	};

@@ -22,7 +22,7 @@ enum { CMD_RUN = 1, CMD_SWEEP = 2, CMD_LIST = 4, CMD_FIT = 8 };
 
 enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
-	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE,
+	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE, OPT_PRIOR,
 	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_MAX_DEM_COST, OPT_VARY,
 	OPT_LHS, OPT_SEED, OPT_BAND_FROM
 };
@@ -53,7 +53,7 @@ typedef struct cli_opts {
 	double seed;
 	const char *band_from; /* sweep: a fit's JSON result (bands on every point) */
 	/* fit */
-	const char *data, *peaks, *free_list;
+	const char *data, *peaks, *free_list, *prior_list;
 	double curve_step, fd_step; /* deg; relative */
 	int max_iter, starts;
 	/* run --set feed_model=auto: the pick (feed_auto.c), picked 1 */

@@ -44,6 +44,34 @@ static int parse_free(const char *list, fit_request *req)
 	return req->nfree ? 0 : -1;
 }
 
+/* --prior NAME:MEAN:SD|NAME:MEAN:xFACTOR,... into req (after --free). */
+static int parse_priors(const char *list, fit_request *req)
+{
+	char buf[512], msg[FIT_MSG];
+	snprintf(buf, sizeof buf, "%s", list);
+	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+		char name[24], spread[32], tail;
+		double mean, sd = NAN, factor = NAN;
+		int n = sscanf(tok, "%23[A-Za-z0-9_]:%lf:%31s", name, &mean, spread);
+		char *end = NULL;
+		if (n == 3 && spread[0] == 'x')
+			factor = strtod(spread + 1, &end);
+		else if (n == 3)
+			sd = strtod(spread, &end);
+		if (n != 3 || !end || *end || sscanf(spread, "%*s%c", &tail) == 1) {
+			fprintf(stderr, "convsim fit: --prior takes NAME:MEAN:SD (normal) or "
+					"NAME:MEAN:xFACTOR (log-normal), e.g. R:0.5:0.1,k_c:3000:x3; "
+					"got '%s'\n", tok);
+			return -1;
+		}
+		if (fit_set_prior(req, name, mean, sd, factor, msg, sizeof msg) != SIM_OK) {
+			fprintf(stderr, "convsim fit: --prior: %s\n", msg);
+			return -1;
+		}
+	}
+	return 0;
+}
+
 /* --peaks ROT:DEG[:SIGMA],... into req. */
 static int parse_peaks(const char *list, fit_request *req)
 {
@@ -114,7 +142,8 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 				"(one of them)\n");
 		return 2;
 	}
-	if (parse_free(o->free_list, req) || (o->peaks && parse_peaks(o->peaks, req)))
+	if (parse_free(o->free_list, req) || (o->prior_list && parse_priors(o->prior_list, req)) ||
+	    (o->peaks && parse_peaks(o->peaks, req)))
 		return 2;
 	char msg[FIT_MSG], field[48];
 	if (o->data) {
@@ -134,6 +163,7 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 				  : strncmp(field, "peaks", 5) == 0 ? "--peaks"
 				  : strcmp(field, "t_end") == 0     ? "--duration"
 				  : strcmp(field, "free") == 0      ? "--free"
+				  : strstr(field, ".prior")         ? "--prior"
 								    : "--set";
 		fprintf(stderr, "convsim fit: %s: %s\n", opt, msg);
 		return 2;

@@ -73,6 +73,10 @@ static const cli_opt options[] = {
 	{CMD_FIT, OPT_FREE, "free", 0, "NAME[:MIN:MAX],...", NULL, NULL,
 	 "free parameters by setting name, bounds in the setting's unit (default its range); "
 	 "they start at the model's values (--preset, --set)"},
+	{CMD_FIT, OPT_PRIOR, "prior", 0, "NAME:MEAN:SD|NAME:MEAN:xFACTOR,...", NULL, NULL,
+	 "Gaussian priors on free parameters, in the setting's unit: normal with MEAN and SD, or "
+	 "log-normal with median MEAN and FACTOR (MEAN/FACTOR..MEAN*FACTOR one standard deviation); "
+	 "needs sigma with the data"},
 	{CMD_FIT, OPT_CURVE_STEP, "curve-step", 0, "DEG", "deg", "5",
 	 "grid of the fitted and the original curve over [0, 180]; 0: none"},
 	{CMD_FIT, OPT_FD_STEP, "fd-step", 0, "REL", NULL, "0.05",

@@ -180,6 +180,7 @@ static int apply_option(cli_opts *o, unsigned cmd, int id, const char *arg)
 	case OPT_BAND_FROM: o->band_from = arg; break;
 	case OPT_PEAKS: o->peaks = arg; break;
 	case OPT_FREE: o->free_list = arg; break;
+	case OPT_PRIOR: o->prior_list = arg; break;
 	case OPT_CURVE_STEP:
 		bad = cli_number(o->cmd, "curve-step", "deg", arg, 0, 90, 0, &o->curve_step);
 		break;

@@ -21,6 +21,9 @@
  * region shrinks. Multi-start: the request's start, then a Halton design
  * over the bounds; the lowest cost wins.
  *
+ * A free parameter's prior (fit_prior.c) is one more residual after the
+ * data's, with its analytic row of the Jacobian.
+ *
  * Standard errors, correlations and warnings at the optimum: fit_cov.c;
  * the curves and their band: fit_band.c.
  */
@@ -96,6 +99,12 @@ static int cb_f(const gsl_vector *z, void *arg, gsl_vector *f)
 	for (size_t i = 0; i < c->n; i++) {
 		double r = (c->fmodel[i] - c->data[i]) / c->w[i];
 		gsl_vector_set(f, i, r);
+		cost += r * r;
+	}
+	for (int k = 0; k < c->q; k++) {
+		int j = c->prior_of[k];
+		double r = fit_prior_residual(&c->req->prior[j], x[j]);
+		gsl_vector_set(f, c->n + (size_t)k, r);
 		cost += r * r;
 	}
 	if (cost < c->best_cost) {
@@ -177,6 +186,16 @@ static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 			gsl_matrix_set(J, i, (size_t)j,
 				       c->jac_x[i * (size_t)c->p + (size_t)j] *
 					       fit_dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
+	/* a prior's row: its slope in its own parameter's column */
+	for (int k = 0; k < c->q; k++) {
+		int pj = c->prior_of[k];
+		for (int j = 0; j < c->p; j++)
+			gsl_matrix_set(J, c->n + (size_t)k, (size_t)j,
+				       j == pj ? fit_prior_slope(&c->req->prior[j], x[j]) *
+							 fit_dx_dz(&c->req->free[j],
+								   gsl_vector_get(z, (size_t)j))
+					       : 0.0);
+	}
 	return GSL_SUCCESS;
 }
 
@@ -200,6 +219,11 @@ static int rough_se(const fit_ctx *c, double cost, double *se)
 				*gsl_matrix_ptr(A, (size_t)a, (size_t)b) +=
 					c->jac_x[i * (size_t)p + (size_t)a] *
 					c->jac_x[i * (size_t)p + (size_t)b];
+	for (int k = 0; A && k < c->q; k++) {
+		int j = c->prior_of[k];
+		*gsl_matrix_ptr(A, (size_t)j, (size_t)j) +=
+			pow(fit_prior_slope(&c->req->prior[j], c->jx[j]), 2);
+	}
 	double s2 = c->res->sigma_given ? 1 : cost / ((double)c->n - p);
 	/* without sigma and with as many data as parameters there is no
 	 * residual variance: the misfit itself would pass for the error */
@@ -277,9 +301,10 @@ static void solve(fit_ctx *c, const double *x0, fit_start *run)
 	gsl_multifit_nlinear_parameters par = gsl_multifit_nlinear_default_parameters();
 	par.trs = gsl_multifit_nlinear_trs_lm;
 	par.scale = gsl_multifit_nlinear_scale_more;
-	gsl_multifit_nlinear_fdf fdf = {cb_f, cb_df, NULL, c->n, (size_t)p, c, 0, 0, 0};
+	size_t rows = c->n + (size_t)c->q; /* the data's residuals, then the priors' */
+	gsl_multifit_nlinear_fdf fdf = {cb_f, cb_df, NULL, rows, (size_t)p, c, 0, 0, 0};
 	gsl_multifit_nlinear_workspace *w =
-		gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, c->n, (size_t)p);
+		gsl_multifit_nlinear_alloc(gsl_multifit_nlinear_trust, &par, rows, (size_t)p);
 	gsl_vector *z0 = gsl_vector_alloc((size_t)p);
 	memcpy(run->x0, x0, sizeof(double) * (size_t)p);
 	memcpy(run->x, x0, sizeof(double) * (size_t)p);
@@ -360,7 +385,8 @@ static int multistart(fit_ctx *c)
 		memcpy(res->x, c->best_x, sizeof res->x);
 		memcpy(res->model, c->best_model, sizeof(double) * c->n);
 		memcpy(res->model_u, c->best_model_u, sizeof(double) * c->n);
-		res->chi2 = c->best_cost;
+		res->chi2_prior = fit_prior_cost(c->req, c->best_x);
+		res->chi2 = c->best_cost - res->chi2_prior;
 	}
 	return FIT_FAILED;
 }
@@ -389,6 +415,7 @@ static int at_optimum(fit_ctx *c)
 	res->chi2 = 0;
 	for (size_t i = 0; i < c->n; i++)
 		res->chi2 += pow((res->model[i] - c->data[i]) / c->w[i], 2);
+	res->chi2_prior = fit_prior_cost(c->req, res->x);
 	res->dof = (int)c->n - c->p;
 	res->s2 = res->dof > 0 ? res->chi2 / res->dof : NAN;
 	report(c, "covariance", res->x, res->chi2);

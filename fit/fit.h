@@ -57,6 +57,15 @@ typedef struct fit_free {
 	double start;
 } fit_free;
 
+/* A Gaussian prior on a free parameter (fit_set_prior): one more residual,
+ * (x - mean) / sd, or with log (ln x - ln mean) / sd, sd = ln of the
+ * factor; none unless sd > 0. mean SI. (Beside fit_free, not in it: a
+ * sweep's record holds fit_free as it is.) */
+typedef struct fit_prior {
+	double mean, sd;
+	int log;
+} fit_prior;
+
 /* Progress reports (from the thread that runs fit_run). */
 typedef struct fit_progress {
 	const char *phase;   /* "fitting", "covariance", "curve", "done" */
@@ -78,6 +87,7 @@ typedef struct fit_request {
 	double t_end;          /* s simulated per evaluation (> sc.transient) */
 	int nfree;
 	fit_free free[FIT_MAX_FREE];
+	fit_prior prior[FIT_MAX_FREE]; /* free[j]'s prior, if any */
 	size_t npoints;        /* points or peaks, not both */
 	fit_point *points;     /* borrowed */
 	int npeaks;
@@ -133,7 +143,8 @@ typedef struct fit_result {
 	double cov[FIT_MAX_FREE * FIT_MAX_FREE]; /* SI, row-major; NaN where undefined */
 	int at_bound[FIT_MAX_FREE]; /* -1 lower, +1 upper, 0 inside */
 	int sigma_given;            /* 1: se from (J^T W J)^-1; 0: times s2 */
-	double chi2;                /* sum of squared weighted residuals */
+	double chi2;                /* sum of squared weighted residuals (the data's) */
+	double chi2_prior;          /* the priors' share of the cost (0 without) */
 	double s2;                  /* chi2 / dof (the residual variance) */
 	int dof;                    /* data - free parameters */
 	double cond;                /* condition number of J (columns scaled) */
@@ -243,6 +254,25 @@ int fit_band_point(const fit_band_source *src, const int *skip, const sim_params
 		   const sim_scene *s, const sim_method *m, double t_end,
 		   const sim_measurement *at, double *lower, double *upper, char *msg,
 		   size_t len);
+
+/* ---- priors (fit_prior.c) ----------------------------------------------- */
+
+/* A Gaussian prior on free parameter `name` of req (already free), in its
+ * user unit: normal with mean and sd (factor NaN), or log-normal with
+ * median mean and factor (sd NaN): ln x ~ N(ln mean, ln factor), so that
+ * mean / factor .. mean x factor is one standard deviation. The fit then
+ * minimises chi2 plus the priors' squared residuals (a maximum a
+ * posteriori estimate), and the covariance is the posterior's. The
+ * problem into msg (field "prior"). SIM_OK or SIM_EPARAM. */
+int fit_set_prior(fit_request *req, const char *name, double mean, double sd, double factor,
+		  char *msg, size_t mlen);
+/* Whether pr is a prior; its residual at x (SI) and the residual's slope
+ * d r / d x there (0 without one). */
+int fit_has_prior(const fit_prior *pr);
+double fit_prior_residual(const fit_prior *pr, double x);
+double fit_prior_slope(const fit_prior *pr, double x);
+/* The priors' share of the cost at x (SI, one value a free parameter). */
+double fit_prior_cost(const fit_request *req, const double *x);
 
 /* ---- checks and parsers (user units in messages) ---------------------- */
 

@@ -54,6 +54,8 @@ typedef struct fit_ctx {
 	fit_result *res;
 	int p;
 	size_t n;
+	int q;                /* priors: the residuals' rows n .. n + q - 1 */
+	int prior_of[FIT_MAX_FREE]; /* the free parameter of prior row n + k */
 	double *w;            /* per datum: sigma or 1 */
 	double *data;         /* per datum: v or peak beta */
 	/* the last f evaluation at an x, and the last Jacobian */

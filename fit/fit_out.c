@@ -94,6 +94,27 @@ static double user(const fit_free *f, double si)
 	return sim_table_user(f->name, si);
 }
 
+/* ,"prior": null, {"mean", "sd"} (normal) or {"mean", "factor"}
+ * (log-normal), in the parameter's user unit. */
+static void json_prior(text *t, const fit_free *f, const fit_prior *pr)
+{
+	put(t, ",\"prior\":");
+	if (!fit_has_prior(pr)) {
+		put(t, "null");
+		return;
+	}
+	put(t, "{\"mean\":");
+	num(t, user(f, pr->mean), "null");
+	if (pr->log) {
+		put(t, ",\"factor\":");
+		num(t, exp(pr->sd), "null");
+	} else {
+		put(t, ",\"sd\":");
+		num(t, user(f, pr->sd), "null");
+	}
+	put(t, "}");
+}
+
 static void json_parameters(text *t, const fit_request *q, const fit_result *r)
 {
 	put(t, "\"parameters\":[");
@@ -110,9 +131,11 @@ static void json_parameters(text *t, const fit_request *q, const fit_result *r)
 			put(t, ",\"%s\":", keys[k]);
 			num(t, user(f, vals[k]), "null");
 		}
-		put(t, ",\"at_bound\":%s}", r->at_bound[j] < 0   ? "\"lower\""
-					    : r->at_bound[j] > 0 ? "\"upper\""
-								 : "null");
+		put(t, ",\"at_bound\":%s", r->at_bound[j] < 0   ? "\"lower\""
+					   : r->at_bound[j] > 0 ? "\"upper\""
+								: "null");
+		json_prior(t, f, &q->prior[j]);
+		put(t, "}");
 	}
 	put(t, "],\"correlation\":[");
 	for (int a = 0; a < r->nfree; a++) {
@@ -249,8 +272,9 @@ static void json_starts(text *t, const fit_request *q, const fit_result *r, doub
 			}
 			put(t, "]");
 		}
+		/* the data's share: a run's cost includes the priors' */
 		put(t, ",\"chi2\":");
-		num(t, st->chi2 * k2, "null");
+		num(t, (st->chi2 - fit_prior_cost(q, st->x)) * k2, "null");
 		put(t, ",\"status\":\"%s\",\"iterations\":%d}", fit_status_name(st->status),
 		    st->iterations);
 	}
@@ -282,7 +306,8 @@ char *fit_result_json(const fit_request *q, const fit_result *r)
 		"\"iterations\":%d,\"evaluations\":%ld",
 	    r->sigma_given ? "" : q->npoints ? "(m/s)^2" : "deg^2", r->dof,
 	    r->sigma_given ? "sigma" : "residual variance", r->iterations, r->evaluations);
-	put(&t, ",\"rejected\":%d", r->rejected);
+	put(&t, ",\"rejected\":%d,\"chi2_prior\":", r->rejected);
+	num(&t, r->chi2_prior, "null");
 	json_starts(&t, q, r, k2);
 	json_data(&t, q, r);
 	json_curve(&t, q, r);

@@ -124,7 +124,11 @@ int fit_prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 		res->model_start[i] = NAN;
 	}
 	res->nfree = c->p;
-	for (int j = 0; j < c->p; j++)
+	c->q = 0;
+	for (int j = 0; j < c->p; j++) {
 		res->x0[j] = res->x[j] = r->free[j].start;
+		if (fit_has_prior(&r->prior[j]))
+			c->prior_of[c->q++] = j;
+	}
 	return 0;
 }

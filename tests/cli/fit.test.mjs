@@ -44,6 +44,14 @@ test('bad input: exit 2 with a message naming the problem, nothing on stdout', (
     [['--free', 'e'], /give --data FILE \(points\) or --peaks/],
     [['--peaks', 'cw:38,up:128', '--free', 'e'], /--peaks takes .* got 'up:128'/],
     [['--data', good, '--free', 'e:0.1:0.01'], /bounds of 'e' must satisfy/],
+    [['--data', good, '--free', 'e', '--prior', 'e:0.02:0.002'],
+      /--prior: a prior \(on 'e'\) needs the data's sigma, to weigh the two against each other: give sigma with every point$/m],
+    [['--data', good, '--free', 'e', '--prior', 'mu:0.3:0.1'],
+      /--prior: a prior on 'mu', which is not a free parameter: name it in free first$/m],
+    [['--data', good, '--free', 'e', '--prior', 'e:0.02'], /--prior takes NAME:MEAN:SD \(normal\) or NAME:MEAN:xFACTOR \(log-normal\).* got 'e:0.02'$/m],
+    [['--data', good, '--free', 'e', '--prior', 'e:0.02:x0.5'], /--prior: the prior's factor of 'e' must be in \(1, 1e6\]$/m],
+    [['--data', good, '--free', 'e', '--prior', 'e:-1:x2'], /--prior: the prior's mean of 'e' must lie within its bounds \[0, 0.5\] m and be positive$/m],
+    [['--data', good, '--free', 'e', '--prior', 'e:0.02:0.002,e:0.02:0.002'], /--prior: 'e' has a prior already$/m],
   ];
   for (const [args, re] of cases) {
     const r = run('fit', ...args, '-q');
@@ -106,4 +114,41 @@ test('the peaks fit that used to stop at a peak outside its scan converges', { t
     assert.notEqual(p.value, p.start);
   }
   assert.deepEqual(res.starts.map((s) => s.status), ['converged']);
+});
+
+test('a prior: a tight one pins the value, a broad one changes nothing, between them the linearised posterior', { timeout: 300000 * SLOW }, () => {
+  const made = run('sweep', ...CHEAP, '--set', 'e=0.018', '--beta', '20:140:40', '--rotation', 'cw', '-q');
+  assert.equal(made.code, 0, made.err);
+  const rows = made.out.trim().split('\n').slice(1).map((l) => l.split(','));
+  const data = file('sigma.csv', 'beta,rotation,v,sigma\n' + rows.map((c) => `${c[0]},${c[1]},${c[2]},0.001`).join('\n') + '\n');
+  const fit = (...prior) => {
+    const r = run('fit', ...CHEAP, '--data', data, '--free', 'e', '--curve-step', '0', '-q', ...prior);
+    assert.equal(r.code, 0, r.err);
+    const res = JSON.parse(r.out);
+    assert.equal(res.status, 'converged', res.error);
+    return res;
+  };
+  const none = fit();
+  const x0 = none.parameters[0].value, se0 = none.parameters[0].standard_error;
+  assert.equal(none.standard_errors_from, 'sigma');
+  // a prior a thousand times tighter than the data: the value is its mean, the error its sd
+  const tight = fit('--prior', 'e:0.02:1e-7');
+  assert.ok(Math.abs(tight.parameters[0].value - 0.02) < 2e-7, String(tight.parameters[0].value));
+  assert.ok(Math.abs(tight.parameters[0].standard_error / 1e-7 - 1) < 0.01, String(tight.parameters[0].standard_error));
+  assert.deepEqual(tight.parameters[0].prior, { mean: 0.02, sd: 1e-7 });
+  // a prior far broader than the data: nothing moves
+  const broad = fit('--prior', 'e:0.02:1');
+  assert.ok(Math.abs(broad.parameters[0].value - x0) < 0.01 * se0);
+  assert.ok(Math.abs(broad.parameters[0].standard_error / se0 - 1) < 1e-3);
+  // in between: the precision-weighted mean and 1/se^2 = 1/se0^2 + 1/sd^2,
+  // as the model is linear in e over a few standard errors
+  const sd = 5e-4;
+  const mid = fit('--prior', `e:0.02:${sd}`);
+  const w0 = 1 / se0 ** 2, w1 = 1 / sd ** 2;
+  const se = 1 / Math.sqrt(w0 + w1);
+  assert.ok(Math.abs(mid.parameters[0].value - (w0 * x0 + w1 * 0.02) / (w0 + w1)) < 0.3 * se,
+    `${mid.parameters[0].value} against ${(w0 * x0 + w1 * 0.02) / (w0 + w1)}`);
+  assert.ok(Math.abs(mid.parameters[0].standard_error / se - 1) < 0.02, `${mid.parameters[0].standard_error} against ${se}`);
+  assert.equal(mid.chi2_prior, ((mid.parameters[0].value - 0.02) / sd) ** 2);
+  assert.ok(mid.chi2 > none.chi2, 'the prior pulls away from the data');
 });

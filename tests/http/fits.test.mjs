@@ -42,6 +42,18 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
     [{ starts: 0 }, 'starts', /starts must be in \[1, 32\]/],
     [{ starts: 33 }, 'starts', /starts must be in \[1, 32\]/],
     [{ starts: 1.5 }, 'starts', /starts must be an integer/],
+    // priors: on a free parameter, normal (sd) or log-normal (factor), within
+    // the bounds, and only with the data's sigma
+    [{ free: [{ name: 'e', prior: { mean: 0.02, sd: 0.002 } }] }, 'free[0].prior',
+      /^a prior \(on 'e'\) needs the data's sigma, to weigh the two against each other: give sigma with every point$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02 } }] }, 'free[0].prior',
+      /^the prior on 'e' takes a mean with either sd \(normal\) or factor \(log-normal\), one of them$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02, sd: 0.002, factor: 2 } }] }, 'free[0].prior', /either sd \(normal\) or factor/],
+    [{ free: [{ name: 'e', max: 0.05, prior: { mean: 0.06, sd: 0.002 } }] }, 'free[0].prior',
+      /^the prior's mean of 'e' must lie within its bounds \[0, 0.05\] m$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02, factor: 1 } }] }, 'free[0].prior', /^the prior's factor of 'e' must be in \(1, 1e6\]$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02, sd: 0 } }] }, 'free[0].prior', /^the prior's sd of 'e' must be in \(0, 5\] m \(ten times its range\)$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02, width: 1 } }] }, 'free[0].prior.width', /^unknown member "width"; expected any of: mean, sd, factor$/],
   ];
   for (const [extra, field, re] of cases) {
     const r = await req(d.base, 'POST', '/api/v1/fits', body(extra));
@@ -54,6 +66,16 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
   const t = await req(d.base, 'POST', '/api/v1/fits', body({ points: [{ beta: 'NaN', rotation: 'cw', v: 0.1 }] }));
   assert.equal(t.status, 400, t.text);
   assert.equal(t.body.field, 'points[0].beta');
+  // a prior of the wrong shape is a 400 too
+  for (const [prior, field, re] of [
+    [{ sd: 0.002 }, 'free[0].prior.mean', /^free\[0\]\.prior\.mean must be a number$/],
+    [0.02, 'free[0].prior', /^free\[0\]\.prior must be \{mean, sd\} or \{mean, factor\}$/],
+  ]) {
+    const w = await req(d.base, 'POST', '/api/v1/fits', body({ free: [{ name: 'e', prior }] }));
+    assert.equal(w.status, 400, w.text);
+    assert.equal(w.body.field, field, w.text);
+    assert.match(w.body.detail, re);
+  }
   assert.equal((await req(d.base, 'GET', '/api/v1/fits')).text, before);
 });
 
@@ -105,6 +127,41 @@ test('a fit job: progress, JSON and CSV result, list, delete', { timeout: 240000
   assert.match(lc.text, new RegExp(`^fit,state,phase,iteration,evaluations,cost\\n[\\s\\S]*${r.body.id},done,done,`));
   assert.equal((await req(d.base, 'DELETE', path, undefined, JSON_CT)).status, 204);
   assert.equal((await req(d.base, 'GET', path)).status, 404);
+});
+
+test("a prior: the fit between it and the data, the prior in the result, chi2 the data's share", { timeout: 240000 * SLOW }, async () => {
+  const withSigma = POINTS.map((p) => ({ ...p, sigma: 0.005 }));
+  const fit = async (free) => {
+    const r = await req(d.base, 'POST', '/api/v1/fits', body({ points: withSigma, free, curve_step: 0 }));
+    assert.equal(r.status, 202, r.text);
+    const path = `/api/v1/fits/${r.body.id}`;
+    const done = await until(async () => {
+      const g = await req(d.base, 'GET', path);
+      return g.body.state === 'done' && g.body;
+    }, 200000 * SLOW, 'the fit');
+    assert.equal((await req(d.base, 'DELETE', path, undefined, JSON_CT)).status, 204);
+    return done.result;
+  };
+  const plain = await fit(['e']);
+  const p0 = plain.parameters[0];
+  assert.equal(p0.prior, null);
+  assert.equal(plain.chi2_prior, 0);
+  // a prior at the data's own optimum with their standard error: the value
+  // stays, and the posterior's error is the data's over the root of 2
+  const prior = { mean: p0.value, sd: p0.standard_error };
+  const both = await fit([{ name: 'e', prior }]);
+  const p1 = both.parameters[0];
+  assert.deepEqual(p1.prior, prior);
+  assert.ok(Math.abs(p1.value - p0.value) < 0.1 * p0.standard_error, `${p1.value} against ${p0.value}`);
+  const ratio = p1.standard_error / (p0.standard_error / Math.SQRT2);
+  assert.ok(Math.abs(ratio - 1) < 0.02, `posterior se over se / sqrt 2: ${ratio}`);
+  assert.equal(both.chi2_prior, ((p1.value - prior.mean) / prior.sd) ** 2);
+  assert.equal(both.starts[both.best_start].chi2, both.chi2);
+  // a log-normal prior is echoed with its factor
+  const logn = await fit([{ name: 'e', prior: { mean: 0.02, factor: 1.5 } }]);
+  assert.deepEqual(logn.parameters[0].prior, { mean: 0.02, factor: 1.5 });
+  const r = Math.log(logn.parameters[0].value / 0.02) / Math.log(1.5);
+  assert.ok(Math.abs(logn.chi2_prior - r * r) < 1e-12 * Math.max(1, r * r), `${logn.chi2_prior} against ${r * r}`);
 });
 
 test('DELETE cancels a running fit', { timeout: 120000 * SLOW }, async () => {
