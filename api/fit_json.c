@@ -41,6 +41,17 @@ static api_err number(const cJSON *o, const char *name, const char *prefix, int 
 	return API_OK;
 }
 
+/* The first three members of names, numbers, into v (NaN when absent; the
+ * first required when required is set). */
+static api_err numbers(const cJSON *o, const char *prefix, const char *const *names,
+		       int required, double v[3], api_problem *pb)
+{
+	api_err e = API_OK;
+	for (int k = 0; k < 3 && e == API_OK; k++)
+		e = number(o, names[k], prefix, required && k == 0, &v[k], pb);
+	return e;
+}
+
 static api_err rotation(const cJSON *o, const char *prefix, int *rot, api_problem *pb)
 {
 	const cJSON *it = cJSON_GetObjectItemCaseSensitive(o, "rotation");
@@ -144,17 +155,13 @@ static api_err parse_prior(const cJSON *pr, fit_request *req, const char *name, 
 	snprintf(field, sizeof field, "free[%d].prior", i);
 	if (!cJSON_IsObject(pr))
 		return api_fail(pb, API_TYPE, field, "%s must be {mean, sd} or {mean, factor}", field);
-	double mean, sd, factor;
+	double v[3]; /* mean, sd, factor */
 	api_err e = api_check_members(pr, api_members_fit_prior, prefix, pb);
 	if (e == API_OK)
-		e = number(pr, "mean", prefix, 1, &mean, pb);
-	if (e == API_OK)
-		e = number(pr, "sd", prefix, 0, &sd, pb);
-	if (e == API_OK)
-		e = number(pr, "factor", prefix, 0, &factor, pb);
+		e = numbers(pr, prefix, api_members_fit_prior, 1, v, pb);
 	if (e != API_OK)
 		return e;
-	if (fit_set_prior(req, name, mean, sd, factor, msg, sizeof msg) != SIM_OK)
+	if (fit_set_prior(req, name, v[0], v[1], v[2], msg, sizeof msg) != SIM_OK)
 		return api_fail(pb, API_RANGE, field, "%s", msg);
 	return API_OK;
 }
@@ -172,7 +179,7 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 	char field[48], msg[FIT_MSG], prefix[32];
 	int i = 0;
 	for (const cJSON *f = arr->child; f; f = f->next, i++) {
-		double lo = NAN, hi = NAN, start = NAN;
+		double v[3] = {NAN, NAN, NAN}; /* min, max, start */
 		const char *name = cJSON_IsString(f) ? f->valuestring : NULL;
 		snprintf(prefix, sizeof prefix, "free[%d].", i);
 		if (cJSON_IsObject(f)) {
@@ -180,14 +187,11 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 			const cJSON *nm = cJSON_GetObjectItemCaseSensitive(f, "name");
 			name = cJSON_IsString(nm) ? nm->valuestring : NULL;
 			if (e == API_OK)
-				e = number(f, "min", prefix, 0, &lo, pb);
-			if (e == API_OK)
-				e = number(f, "max", prefix, 0, &hi, pb);
-			if (e == API_OK)
-				e = number(f, "start", prefix, 0, &start, pb);
+				e = numbers(f, prefix, api_members_fit_free + 1, 0, v, pb);
 			if (e != API_OK)
 				return e;
 		}
+		double lo = v[0], hi = v[1], start = v[2];
 		snprintf(field, sizeof field, "free[%d]", i);
 		if (!name)
 			return api_fail(pb, API_TYPE, field, "%s must be a parameter name or "
