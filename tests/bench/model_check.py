@@ -12,7 +12,7 @@ calibrated column model, which the build compiles into the core
 
 model is the column model as the notes name it: "liggghts-bed4",
 "czubak2016 against glass", "czubak2016 at e = 0.03225 against glass",
-"czubak2016 calibrated to glass".
+"czubak2016 calibrated to glass", "czubak2016 at e = 0.03225 calibrated to glass".
 
 Sources, in this order:
   1. the 4-diameter bed's curve at the preset's contacts (dem.jsonl, group
@@ -124,7 +124,9 @@ def map_points(rows, mats):
                   "its points left out", file=sys.stderr)
             continue
         preset, settings = found
-        yield from bed_points(rows, mats, bed, preset, settings, f"{preset} calibrated to {material}")
+        at = drive_settings(drive)[1]
+        yield from bed_points(rows, mats, bed, preset, settings,
+                              f"{preset}{at} calibrated to {material}")
 
 
 # the default preset, whose machine is the map's drive "preset"
