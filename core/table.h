@@ -21,22 +21,142 @@
 #include "sim.h"
 #include "units.h"
 
+/* The text of "%.*g" (precision p) for the significant digits dig[0..p)
+ * of a value d.ddd x 10^x, sign neg, into out (at least 32 bytes): the
+ * trailing zeros dropped, scientific where x < -4 or x >= p, as printf
+ * writes it. */
+static inline int sim_fmt_g_digits(char *out, int neg, const char *dig, int p, int x)
+{
+	int nd = p, n = 0;
+	while (nd > 1 && dig[nd - 1] == '0')
+		nd--;
+	if (neg)
+		out[n++] = '-';
+	if (x < -4 || x >= p) {
+		out[n++] = dig[0];
+		if (nd > 1) {
+			out[n++] = '.';
+			for (int i = 1; i < nd; i++)
+				out[n++] = dig[i];
+		}
+		n += sprintf(out + n, "e%c%02d", x < 0 ? '-' : '+', x < 0 ? -x : x);
+	} else if (x >= 0) {
+		for (int i = 0; i <= x; i++)
+			out[n++] = i < nd ? dig[i] : '0';
+		if (nd > x + 1) {
+			out[n++] = '.';
+			for (int i = x + 1; i < nd; i++)
+				out[n++] = dig[i];
+		}
+		out[n] = '\0';
+	} else {
+		out[n++] = '0';
+		out[n++] = '.';
+		for (int i = 0; i < -x - 1; i++)
+			out[n++] = '0';
+		for (int i = 0; i < nd; i++)
+			out[n++] = dig[i];
+		out[n] = '\0';
+	}
+	return n;
+}
+
+/* Whether a decimal dist units from v's 17 significant digits d.ddd x
+ * 10^x (a unit: their last digit) reads back as v: 1 surely, -1 surely
+ * not, 0 when too close to tell. The 17 digits are within half a unit of
+ * v, so the decimal is within dist +- 0.5 units of v; it reads back as v
+ * when that is inside v's rounding interval, half v's spacing each side
+ * (below a power of two the spacing under it is half that). The spacing
+ * in units is computed in logarithms, with a margin far above their
+ * error. */
+static inline int sim_fmt_inside(double v, int x, double dist)
+{
+	int e;
+	double f = frexp(fabs(v), &e); /* |v| = f 2^e, f in [0.5, 1) */
+	int ulp2 = e - 53 < -1074 ? -1074 : e - 53;
+	/* half the spacing, in units of 10^(x - 16) */
+	double half = exp2((double)(ulp2 - 1) - (double)(x - 16) * 3.321928094887362);
+	double below = f == 0.5 ? 0.5 * half : half;
+	if (dist + 0.5 < below * (1 - 1e-6))
+		return 1;
+	if (dist - 0.5 > half * (1 + 1e-6))
+		return -1;
+	return 0;
+}
+
 /* Write v into buf (len bytes) as the shortest text that reads back as v
  * ("-0" and "0" kept apart); non-finite values as `nonfinite` ("null" in
- * JSON, "" in CSV). Returns the length written, as snprintf. */
+ * JSON, "" in CSV). Returns the length written, as snprintf.
+ *
+ * The text is the first of "%.15g", "%.16g" and "%.17g" that strtod reads
+ * back as v. One printf gives v's 17 significant digits (correctly
+ * rounded); the 15- and 16-digit candidates are those digits rounded
+ * again, which is v rounded to 15 or 16 digits unless the digits cut off
+ * are exactly 5 followed by zeros (then v's own tail decides: printf is
+ * asked). A candidate clearly inside or outside v's rounding interval
+ * needs no strtod (sim_fmt_inside); so each value costs one printf and
+ * at most two strtod, where asking printf for each candidate cost up to
+ * three of each;
+ * tests/unit/test_table.c checks the text byte for byte against the three
+ * printf calls. */
 static inline int sim_fmt_double(char *buf, size_t len, double v, const char *nonfinite)
 {
 	if (!isfinite(v))
 		return snprintf(buf, len, "%s", nonfinite);
 	if (v == 0.0)
 		return snprintf(buf, len, signbit(v) ? "-0" : "0");
-	int n = 0;
-	for (int prec = 15; prec <= 17; prec++) {
-		n = snprintf(buf, len, "%.*g", prec, v);
-		if (strtod(buf, NULL) == v)
-			break;
+	char e17[40], dig[18], cand[40];
+	snprintf(e17, sizeof e17, "%.16e", v); /* [-]d.dddddddddddddddde[+-]xx */
+	int neg = e17[0] == '-';
+	const char *m = e17 + neg;
+	dig[0] = m[0];
+	memcpy(dig + 1, m + 2, 16);
+	int x = atoi(m + 19);
+	for (int p = 15; p <= 16; p++) {
+		const char *tail = dig + p;
+		int tie = tail[0] == '5', up = tail[0] >= '5';
+		for (int i = 1; tie && i < 17 - p; i++)
+			tie = tail[i] == '0';
+		if (tie) {
+			/* v's digits beyond the 17th decide: printf's own rounding */
+			int n = snprintf(buf, len, "%.*g", p, v);
+			if (strtod(buf, NULL) == v)
+				return n;
+			continue;
+		}
+		/* how far the candidate is from the 17 digits, in units of
+		 * their last: where that and the 17 digits' own half unit put it
+		 * clearly inside or outside v's rounding interval, no strtod */
+		double cut = 0, whole = 1;
+		for (int i = 0; i < 17 - p; i++) {
+			cut = cut * 10 + (tail[i] - '0');
+			whole *= 10;
+		}
+		double dist = up ? whole - cut : cut;
+		int inside = sim_fmt_inside(v, x, dist);
+		if (inside < 0)
+			continue;
+		char r[17];
+		int rx = x;
+		memcpy(r, dig, (size_t)p);
+		for (int i = p - 1; up && i >= 0; i--) {
+			if (r[i] == '9') {
+				r[i] = '0';
+			} else {
+				r[i]++;
+				up = 0;
+			}
+		}
+		if (up) { /* 9.99...9 rounded up: 1.00...0 x 10^(x + 1) */
+			r[0] = '1';
+			rx++;
+		}
+		sim_fmt_g_digits(cand, neg, r, p, rx);
+		if (inside > 0 || strtod(cand, NULL) == v)
+			return snprintf(buf, len, "%s", cand);
 	}
-	return n;
+	sim_fmt_g_digits(cand, neg, dig, 17, x);
+	return snprintf(buf, len, "%s", cand);
 }
 
 /* A time in s as the tables and answers print it: rounded to the

@@ -2,15 +2,16 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Whole-process cost of the command line against the previous build (part
 # of `make bench`; docs/mpi.md "Two binaries", docs/speed.md):
-# `convsim --version`, `convsim run --duration 0.01` and the 74-point curve
-# (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`), each a
+# `convsim --version`, `convsim run --duration 0.01`, the 74-point curve
+# (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`) and a
+# trajectory file (5 s at 1 kHz, numbers as text), each a
 # whole process, CPU = user + sys from wait4 (tests/bench/cpu_runs.py), the
 # previous build's and this one's taking turns in the same minutes. The
 # previous build is commit PREV (default: main at the branch point of the
 # command line's split and the curve's bar, c3bc9a1), exported with git
 # archive and built once into $BUILD/prev-PREV (`make build/convsim`
 # there). RUNS (default 30) runs of the short commands, CURVES (default 7)
-# of the curve. The machine may be shared: the least CPU is the least
+# of the curve and of the trajectory. The machine may be shared: the least CPU is the least
 # disturbed figure, the median the typical one. Writes $1/startup.md.
 . "$(dirname "$0")/preamble.sh"
 PREV=${PREV:-c3bc9a1}
@@ -22,9 +23,12 @@ libs() { ldd "$1" | grep -c '=>' || true; }
 mpi_libs() { ldd "$1" | grep -cE 'libmpi|liggghts' || true; }
 short=(run --duration 0.01 -q)
 curve=(sweep --beta 0:180:5 --rotation cw,ccw --threads 1 -q)
+# a trajectory file: 5 simulated s at 1 kHz, 5,001 rows of numbers as text
+traj=(run --duration 5 --sample-rate 1000 -q --out /dev/null)
 python3 tests/bench/cpu_runs.py "$RUNS" "$prev" --version -- "$cli" --version \
 	-- "$prev" "${short[@]}" -- "$cli" "${short[@]}" -- /usr/bin/true > "$work/short"
 python3 tests/bench/cpu_runs.py "$CURVES" "$prev" "${curve[@]}" -- "$cli" "${curve[@]}" > "$work/curve"
+python3 tests/bench/cpu_runs.py "$CURVES" "$prev" "${traj[@]}" -- "$cli" "${traj[@]}" > "$work/traj"
 # the points measured again at finer steps (their step columns differ from the scene's)
 # (of the points run, not the mirror images; the scene's steps: the most common pair)
 remeasured() {
@@ -61,6 +65,7 @@ rev="$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- . ':(exclude)tests/
 	row "version" "convsim --version" "$(sed -n 1p "$work/short")" "$(sed -n 2p "$work/short")" 1e3 ms ""
 	row "a short run" "convsim ${short[*]}" "$(sed -n 3p "$work/short")" "$(sed -n 4p "$work/short")" 1e3 ms 10
 	row "the 74-point curve" "convsim ${curve[*]}" "$(sed -n 1p "$work/curve")" "$(sed -n 2p "$work/curve")" 1 s 0.1
+	row "a trajectory file" "convsim ${traj[*]}" "$(sed -n 1p "$work/traj")" "$(sed -n 2p "$work/traj")" 1 s ""
 	echo
 	read -r tb tm _ < <(sed -n 5p "$work/short")
 	awk -v b="$tb" -v m="$tm" 'BEGIN { printf "- The floor, any process started here (`/usr/bin/true`): %.1f / %.1f ms.\n", 1e3 * b, 1e3 * m }'
