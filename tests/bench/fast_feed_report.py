@@ -101,7 +101,7 @@ def beds_named(recs):
         {r["depth"] for r in recs if r["material"] == m}))) for m in mats)
 
 
-def write_md(recs, runner, path):
+def write_md(recs, runner, path, unpredicted=()):
     out = []
     w = out.append
     w("# A fast feed model against the DEM map (leave one bed out)")
@@ -128,6 +128,12 @@ def write_md(recs, runner, path):
                                    os.environ.get("DEM_MAP_CSV") or
                                    "tests/bench/results/dem_map.csv"))
     w("")
+    if unpredicted:
+        w("Not predicted, the only bed of its drive so far (no other bed to fit a closure on; its "
+          "points are not counted): %s." % ", ".join(
+              "%s %d grains deep, drive `%s` (%d points)" % (m, d, dr, n)
+              for m, dr, d, n in unpredicted))
+        w("")
     w("## Summary")
     w("")
     summary_table(recs, w)
