@@ -447,6 +447,8 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	await page.fill('#fit-form textarea[name="csv"]', 'beta,rotation,v,sigma\n20,cw,0.05,0.005\n60,cw,0.05,0.005\n' +
 		'110,cw,-0.05,0.005\n150,cw,-0.05,0.005\n');
 	await page.fill('#fit-form input[name="free"]', 'e');
+	/* a broad log-normal prior on e, as the command line writes it */
+	await page.fill('#fit-form input[name="priors"]', 'e:0.02:x1.5');
 	await page.fill('#fit-form input[name="t_end"]', '2');
 	await page.fill('#fit-form input[name="curve_step"]', '60');
 	await page.click('#fit-run');
@@ -464,12 +466,16 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	assert.ok(Math.abs(Number(row[1]) - e.value) <= 1e-4 * Math.abs(e.value), `${row[1]} vs ${e.value}`);
 	assert.equal(Number(row[3]), 0.0215);
 	assert.equal(fit.result.standard_errors_from, 'sigma');
+	assert.deepEqual(e.prior, { mean: 0.02, factor: 1.5 });
+	assert.equal(row[6], '0.02 ×÷ 1.5', 'the prior as asked');
 	/* χ² at three significant digits (with σ it has no unit) and the reduced χ² */
 	const chi2 = await page.$eval('#fit-table .fit-chi2', e => e.textContent);
-	const m = /χ² = (\S+) with 3 degrees of freedom; reduced χ²\/dof = (\S+)$/.exec(chi2);
+	const m = /χ² = (\S+) with 3 degrees of freedom; reduced χ²\/dof = (\S+); the priors' share (\S+)$/.exec(chi2);
 	assert.ok(m, chi2);
 	assert.equal(Number(m[1]), Number(fit.result.chi2.toPrecision(3)), chi2);
 	assert.equal(Number(m[2]), Number((fit.result.chi2 / 3).toPrecision(3)), chi2);
+	assert.equal(Number(m[3]), Number(fit.result.chi2_prior.toPrecision(3)), chi2);
+	assert.ok(fit.result.chi2_prior > 0, "the fit ends away from the prior's median");
 	/* measured points as markers, not joined; a legend of the series there are (no ccw data) */
 	assert.deepEqual(await page.evaluate(() => window.convsim.plots.fit.joined), [true, true, false, true, true, false, true, true]);
 	const legend = await page.$$eval('#plot-fit .u-legend .u-series', rows => rows

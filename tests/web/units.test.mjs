@@ -6,7 +6,7 @@ import test from 'node:test';
 import assert from 'node:assert/strict';
 import * as api from '../../web/js/api.js';
 import { Trace, slope, recentVelocity } from '../../web/js/series.js';
-import { fmt, fmtGiven, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText, tickText } from '../../web/js/format.js';
+import { fmt, fmtGiven, fmtVelocity, fmtVelocityPm, steadyLabel, direction, wrapBeta, parsePace, problemText, fitChi2Text, fitProgressText, tickText, priorText } from '../../web/js/format.js';
 import { vibrationDirection, guideDirection, guideEnds, columnPositions, toSvg, VIEW } from '../../web/js/schematic.js';
 
 const close = (a, b, tol = 1e-12) => assert.ok(Math.abs(a - b) <= tol, `${a} != ${b}`);
@@ -139,6 +139,11 @@ test('request bodies follow the API request shapes', () => {
 	assert.equal(ex.session.pace, undefined);
 	assert.equal(ex.keep_session, true, 'the page plots the session after the end');
 	assert.equal(api.streamQuery(), 'fields=trough%2Corbit%2Crotor%2Celiminators%2Cfeed');
+	/* a fit's priors as the command line writes them, on the free entries they belong to */
+	const fit = api.fitRequest({ ...form, free: 'e, k_c:100:1e6, R', priors: 'k_c:25600:x10, R:0.18:0.1, mu:0.3:0.05', csv: 'x' });
+	assert.deepEqual(fit.free, ['e', { name: 'k_c', min: 100, max: 1e6, prior: { mean: 25600, factor: 10 } },
+		{ name: 'R', prior: { mean: 0.18, sd: 0.1 } }, { name: 'mu', prior: { mean: 0.3, sd: 0.05 } }]);
+	assert.deepEqual(api.fitRequest({ ...form, free: 'e', priors: ' ', csv: 'x' }).free, ['e']);
 });
 
 test('problem+json becomes an ApiError naming the field', () => {
@@ -259,6 +264,11 @@ test('fit panel: χ² with its unit and the reduced χ², at three significant d
 	assert.equal(fitChi2Text({ chi2: 2.5, dof: 3, chi2_unit: '' }),
 		'χ² = 2.5 with 3 degrees of freedom; reduced χ²/dof = 0.833');
 	assert.equal(fitChi2Text({ chi2: 0, dof: 0, chi2_unit: '' }), 'χ² = 0 with 0 degrees of freedom');
+	assert.equal(fitChi2Text({ chi2: 2.5, dof: 3, chi2_unit: '', chi2_prior: 0.41234 }),
+		"χ² = 2.5 with 3 degrees of freedom; reduced χ²/dof = 0.833; the priors' share 0.412");
+	assert.equal(priorText({ mean: 0.02, sd: 0.002 }), '0.02 ± 0.002');
+	assert.equal(priorText({ mean: 25600, factor: 10 }), '25600 ×÷ 10');
+	assert.equal(priorText(null), '');
 	assert.equal(fitProgressText({ state: 'done', phase: 'done', iteration: 3, evaluations: 40, values: { e: 0.0181234 } }),
 		'done · iteration 3 · 40 evaluations · e = 0.01812');
 	assert.equal(fitProgressText({ state: 'running', phase: 'covariance', iteration: 2, evaluations: 9, values: {} }),

@@ -111,14 +111,24 @@ export function streamQuery(opts = {}) {
 }
 
 /* POST /fits: the session form's model, the free names (NAME or
- * NAME:MIN:MAX), the points as CSV text, the time per evaluation and the
- * curve's grid. */
+ * NAME:MIN:MAX), their priors as the command line writes them
+ * (NAME:MEAN:SD, or NAME:MEAN:xFACTOR log-normal; a name not free is sent
+ * as its own entry, for the daemon to refuse), the points as CSV text, the
+ * time per evaluation and the curve's grid. */
 export function fitRequest(f) {
 	const body = jobModel(f);
 	body.free = String(f.free).split(',').map(s => s.trim()).filter(Boolean).map(s => {
 		const [name, min, max] = s.split(':');
 		return min === undefined ? name : { name, min: Number(min), max: Number(max) };
 	});
+	for (const s of String(f.priors ?? '').split(',').map(x => x.trim()).filter(Boolean)) {
+		const [name, mean, spread = ''] = s.split(':');
+		const prior = spread.startsWith('x') ? { mean: Number(mean), factor: Number(spread.slice(1)) }
+			: { mean: Number(mean), sd: Number(spread) };
+		const at = body.free.findIndex(x => (x.name ?? x) === name);
+		if (at < 0) body.free.push({ name, prior });
+		else body.free[at] = { ...(typeof body.free[at] === 'string' ? { name } : body.free[at]), prior };
+	}
 	body.csv = f.csv;
 	if (Number.isFinite(f.tEnd)) body.t_end = f.tEnd;
 	if (Number.isFinite(f.curveStep)) body.curve_step = f.curveStep;

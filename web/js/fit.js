@@ -9,7 +9,7 @@
  */
 
 import * as api from './api.js';
-import { fitProgressText, fitChi2Text } from './format.js';
+import { fitProgressText, fitChi2Text, priorText } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm } from './session.js';
 
@@ -33,7 +33,7 @@ export function wireFit() {
 async function runFit(ev) {
 	ev.preventDefault();
 	const f = $('#fit-form').elements;
-	const form = { ...readSessionForm(), csv: f.csv.value, free: f.free.value,
+	const form = { ...readSessionForm(), csv: f.csv.value, free: f.free.value, priors: f.priors.value,
 		tEnd: numberOf(f.t_end), curveStep: numberOf(f.curve_step) };
 	const btn = $('#fit-run'), cancel = $('#fit-cancel'), box = $('#fit-progress');
 	for (const el of f) el.removeAttribute?.('aria-invalid');
@@ -91,18 +91,19 @@ function showFit(r) {
 	const table = $('#fit-table');
 	table.replaceChildren();
 	const head = table.createTHead().insertRow();
-	for (const h of ['parameter', 'fitted', '± standard error', 'start', 'unit', 'bound'])
+	for (const h of ['parameter', 'fitted', '± standard error', 'start', 'unit', 'bound', 'prior'])
 		head.append(Object.assign(document.createElement('th'), { textContent: h }));
 	const body = table.createTBody();
 	const sig = (v, n) => (Number.isFinite(v) ? Number(v.toPrecision(n)).toString() : '–');
 	for (const p of r.parameters) {
 		const row = body.insertRow();
 		row.dataset.name = p.name;
-		for (const v of [p.name, sig(p.value, 5), sig(p.standard_error, 2), sig(p.start, 5), p.unit, p.at_bound ?? ''])
+		for (const v of [p.name, sig(p.value, 5), sig(p.standard_error, 2), sig(p.start, 5), p.unit, p.at_bound ?? '',
+			priorText(p.prior)])
 			row.insertCell().textContent = v;
 	}
 	const note = body.insertRow().insertCell();
-	note.colSpan = 6;
+	note.colSpan = 7;
 	note.className = 'fit-chi2';
 	note.textContent = `standard errors from ${r.standard_errors_from}; ${fitChi2Text(r)}`;
 	const list = $('#fit-warnings');

@@ -135,7 +135,15 @@ export function fitProgressText(u) {
 export function fitChi2Text(r) {
 	const unit = { '(m/s)^2': ' (m/s)²', 'deg^2': ' deg²' }[r.chi2_unit] ?? '';
 	const reduced = r.dof > 0 && Number.isFinite(r.chi2) ? `; reduced χ²/dof = ${fmtSig(r.chi2 / r.dof, 3)}${unit}` : '';
-	return `χ² = ${fmtSig(r.chi2, 3)}${unit} with ${r.dof} degrees of freedom${reduced}`;
+	const prior = r.chi2_prior > 0 ? `; the priors' share ${fmtSig(r.chi2_prior, 3)}` : '';
+	return `χ² = ${fmtSig(r.chi2, 3)}${unit} with ${r.dof} degrees of freedom${reduced}${prior}`;
+}
+
+/* A parameter's prior as the fit's table shows it: "0.02 ± 0.002"
+ * (normal), "25600 ×÷ 10" (log-normal), "" without one. */
+export function priorText(p) {
+	if (!p) return '';
+	return p.factor !== undefined ? `${fmtSig(p.mean, 4)} ×÷ ${fmtSig(p.factor, 3)}` : `${fmtSig(p.mean, 4)} ± ${fmtSig(p.sd, 3)}`;
 }
 
 /* An axis tick's text: every tick of an axis with as many decimals as its
