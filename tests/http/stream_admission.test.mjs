@@ -14,8 +14,8 @@ import { startDaemon, req, metric, until, SLOW, g3, fillPaced } from './lib.mjs'
 
 // The charge of a ?fields=trough&rate=10 stream of a default session (250
 // samples a simulated s), CPU s per simulated s: 10 wake-ups of 75 us and
-// 10 records of 9 numbers at 1.5 us (server/base/budget_stream.c)
-const STREAM = 10 * 75e-6 + 10 * 9 * 1.5e-6;
+// 10 records of 9 numbers at 1 us (server/base/budget_stream.c)
+const STREAM = 10 * 75e-6 + 10 * 9 * 1.0e-6;
 const QUERY = '?format=ndjson&fields=trough&rate=10';
 
 // Open a stream of session id: {status, body (parsed when refused),
@@ -125,18 +125,18 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
     const rotor = await open(d.base, ids[1], '?format=ndjson&fields=trough,rotor&rate=10');
     streams.push(rotor);
     assert.equal(rotor.status, 200, rotor.text);
-    assert.ok(Math.abs(await held() - before2 - (10 * 75e-6 + 10 * 14 * 1.5e-6)) < 1e-9,
+    assert.ok(Math.abs(await held() - before2 - (10 * 75e-6 + 10 * 14 * 1.0e-6)) < 1e-9,
       `held ${await held()} after ${before2}`);
     await until(() => rotor.records.some((x) => x.type === 'sample'), 10000 * SLOW, 'a sample');
     const sample = rotor.records.find((x) => x.type === 'sample');
     assert.equal(Object.entries(sample).filter(([k, v]) => k !== 'id' && typeof v === 'number').length, 14,
       JSON.stringify(sample));
     // a default stream of every sample: 50 wake-ups and 250 records of 35
-    // numbers (5 columns), 16.9 ms of CPU per simulated s, more than the
+    // numbers (5 columns), 12.5 ms of CPU per simulated s, more than the
     // whole budget's room
     const all = await open(d.base, ids[1], '?format=ndjson');
     assert.equal(all.status, 503, all.text);
-    assert.match(all.body.detail, /^this stream needs 0\.0169 cores \(16\.9 ms of CPU per simulated s at pace 1\)/);
+    assert.match(all.body.detail, /^this stream needs 0\.0125 cores \(12\.5 ms of CPU per simulated s at pace 1\)/);
   } finally {
     for (const s of streams) s.close();
     assert.equal((await d.stop()).code, 0, d.stderr());
@@ -161,7 +161,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     const all = await open(d.base, slow.body.id, '?format=ndjson');
     streams.push(all);
     assert.equal(all.status, 200, all.text);
-    const charge = 0.1 * (250 * 75e-6 + 250 * 35 * 1.5e-6);
+    const charge = 0.1 * (250 * 75e-6 + 250 * 35 * 1.0e-6);
     const h1 = await held();
     assert.ok(Math.abs(h1 - h0 - charge) < 1e-9, `held ${h1} after ${h0}: the stream ${h1 - h0}, expected ${charge}`);
     all.close();
@@ -174,7 +174,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     const thin = await open(d.base, fast.body.id);
     streams.push(thin);
     assert.equal(thin.status, 200, thin.text);
-    const perS = cost + 5 * 75e-6 + 10 * 9 * 1.5e-6;
+    const perS = cost + 5 * 75e-6 + 10 * 9 * 1.0e-6;
     assert.ok(10 * perS > limit, `pace 10 needs ${10 * perS} cores, beyond ${limit}`);
     const r = await req(d.base, 'PATCH', `/api/v1/sessions/${fast.body.id}`, { pace: 10 });
     assert.equal(r.status, 422, r.text);
@@ -184,7 +184,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
       'nothing was changed, lower the pace');
     // the greatest pace the cores allow, with the stream's wake-ups capped
     // on the way there (at pace p: 10 p of them a wall s, at most 50)
-    const need = (p) => p * (cost + 10 * 9 * 1.5e-6) + Math.min(10 * p, 50) * 75e-6;
+    const need = (p) => p * (cost + 10 * 9 * 1.0e-6) + Math.min(10 * p, 50) * 75e-6;
     let lo = 0, hi = 100;
     for (let i = 0; i < 100; i++) { const mid = (lo + hi) / 2; if (need(mid) <= limit) lo = mid; else hi = mid; }
     assert.ok(Math.abs(r.body.max - lo) < 1e-9 * lo, `max ${r.body.max}, the greatest pace that fits ${lo}`);
