@@ -88,6 +88,12 @@ int fit_set_prior(fit_request *req, const char *name, double mean, double sd, do
 				 "its range)", name, 10 * (hi - lo), sim_unit_shown(t));
 		return SIM_EPARAM;
 	}
+	if (log_normal && !(f->lo > 0)) {
+		/* ln x at the bound 0 is no residual */
+		snprintf(msg, mlen, "a log-normal prior on '%s' needs a positive lower bound: free it "
+			 "as %s:MIN:MAX with MIN > 0", name, name);
+		return SIM_EPARAM;
+	}
 	pr->mean = sim_setting_to_si(t, mean);
 	pr->log = log_normal;
 	pr->sd = log_normal ? log(factor) : sim_setting_to_si(t, sd);

@@ -52,6 +52,7 @@ test('bad input: exit 2 with a message naming the problem, nothing on stdout', (
     [['--data', good, '--free', 'e', '--prior', 'e:0.02:x0.5'], /--prior: the prior's factor of 'e' must be in \(1, 1e6\]$/m],
     [['--data', good, '--free', 'e', '--prior', 'e:-1:x2'], /--prior: the prior's mean of 'e' must lie within its bounds \[0, 0.5\] m and be positive$/m],
     [['--data', good, '--free', 'e', '--prior', 'e:0.02:0.002,e:0.02:0.002'], /--prior: 'e' has a prior already$/m],
+    [['--data', good, '--free', 'e', '--prior', 'e:0.02:x2'], /--prior: a log-normal prior on 'e' needs a positive lower bound: free it as e:MIN:MAX with MIN > 0$/m],
   ];
   for (const [args, re] of cases) {
     const r = run('fit', ...args, '-q');

@@ -52,6 +52,8 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
     [{ free: [{ name: 'e', max: 0.05, prior: { mean: 0.06, sd: 0.002 } }] }, 'free[0].prior',
       /^the prior's mean of 'e' must lie within its bounds \[0, 0.05\] m$/],
     [{ free: [{ name: 'e', prior: { mean: 0.02, factor: 1 } }] }, 'free[0].prior', /^the prior's factor of 'e' must be in \(1, 1e6\]$/],
+    [{ free: [{ name: 'e', prior: { mean: 0.02, factor: 2 } }] }, 'free[0].prior',
+      /^a log-normal prior on 'e' needs a positive lower bound: free it as e:MIN:MAX with MIN > 0$/],
     [{ free: [{ name: 'e', prior: { mean: 0.02, sd: 0 } }] }, 'free[0].prior', /^the prior's sd of 'e' must be in \(0, 5\] m \(ten times its range\)$/],
     [{ free: [{ name: 'e', prior: { mean: 0.02, width: 1 } }] }, 'free[0].prior.width', /^unknown member "width"; expected any of: mean, sd, factor$/],
   ];
@@ -158,7 +160,7 @@ test("a prior: the fit between it and the data, the prior in the result, chi2 th
   assert.equal(both.chi2_prior, ((p1.value - prior.mean) / prior.sd) ** 2);
   assert.equal(both.starts[both.best_start].chi2, both.chi2);
   // a log-normal prior is echoed with its factor
-  const logn = await fit([{ name: 'e', prior: { mean: 0.02, factor: 1.5 } }]);
+  const logn = await fit([{ name: 'e', min: 0.001, max: 0.1, prior: { mean: 0.02, factor: 1.5 } }]);
   assert.deepEqual(logn.parameters[0].prior, { mean: 0.02, factor: 1.5 });
   const r = Math.log(logn.parameters[0].value / 0.02) / Math.log(1.5);
   assert.ok(Math.abs(logn.chi2_prior - r * r) < 1e-12 * Math.max(1, r * r), `${logn.chi2_prior} against ${r * r}`);

@@ -446,8 +446,8 @@ test('the calibration panel: pasted points, a fit, data with fitted and original
 	assert.deepEqual((await apiGet(daemon, '/api/v1/fits')).fits, []);
 	await page.fill('#fit-form textarea[name="csv"]', 'beta,rotation,v,sigma\n20,cw,0.05,0.005\n60,cw,0.05,0.005\n' +
 		'110,cw,-0.05,0.005\n150,cw,-0.05,0.005\n');
-	await page.fill('#fit-form input[name="free"]', 'e');
-	/* a broad log-normal prior on e, as the command line writes it */
+	await page.fill('#fit-form input[name="free"]', 'e:0.001:0.1');
+	/* a broad log-normal prior on e (its lower bound positive), as the command line writes it */
 	await page.fill('#fit-form input[name="priors"]', 'e:0.02:x1.5');
 	await page.fill('#fit-form input[name="t_end"]', '2');
 	await page.fill('#fit-form input[name="curve_step"]', '60');
