@@ -162,6 +162,11 @@ static int jacobian_x(fit_ctx *c, const double *x)
 		for (int j = 0; j < p; j++)
 			c->jac_x[i * (size_t)p + (size_t)j] =
 				(out[((size_t)j + (size_t)base) * n + i] - f0[i]) / h[j] / c->w[i];
+	/* a prior's row: its slope, exact, in its own parameter's column */
+	for (int k = 0; rc == 0 && k < c->q; k++)
+		for (int j = 0; j < p; j++)
+			c->jac_x[(n + (size_t)k) * (size_t)p + (size_t)j] =
+				j == c->prior_of[k] ? fit_prior_slope(&c->req->prior[j], x[j]) : 0.0;
 	if (rc == 0) {
 		memcpy(c->jx, x, sizeof *x * (size_t)p);
 		memcpy(c->jmodel, f0, sizeof(double) * n);
@@ -181,21 +186,11 @@ static int cb_df(const gsl_vector *z, void *arg, gsl_matrix *J)
 	xs_of(c, z, x);
 	if (jacobian_x(c, x) != 0)
 		return GSL_EBADFUNC;
-	for (size_t i = 0; i < c->n; i++)
+	for (size_t i = 0; i < c->n + (size_t)c->q; i++)
 		for (int j = 0; j < c->p; j++)
 			gsl_matrix_set(J, i, (size_t)j,
 				       c->jac_x[i * (size_t)c->p + (size_t)j] *
 					       fit_dx_dz(&c->req->free[j], gsl_vector_get(z, (size_t)j)));
-	/* a prior's row: its slope in its own parameter's column */
-	for (int k = 0; k < c->q; k++) {
-		int pj = c->prior_of[k];
-		for (int j = 0; j < c->p; j++)
-			gsl_matrix_set(J, c->n + (size_t)k, (size_t)j,
-				       j == pj ? fit_prior_slope(&c->req->prior[j], x[j]) *
-							 fit_dx_dz(&c->req->free[j],
-								   gsl_vector_get(z, (size_t)j))
-					       : 0.0);
-	}
 	return GSL_SUCCESS;
 }
 
@@ -213,17 +208,12 @@ static int rough_se(const fit_ctx *c, double cost, double *se)
 {
 	int p = c->p, rc = -1;
 	gsl_matrix *A = gsl_matrix_calloc((size_t)p, (size_t)p);
-	for (size_t i = 0; A && i < c->n; i++)
+	for (size_t i = 0; A && i < c->n + (size_t)c->q; i++)
 		for (int a = 0; a < p; a++)
 			for (int b = 0; b < p; b++)
 				*gsl_matrix_ptr(A, (size_t)a, (size_t)b) +=
 					c->jac_x[i * (size_t)p + (size_t)a] *
 					c->jac_x[i * (size_t)p + (size_t)b];
-	for (int k = 0; A && k < c->q; k++) {
-		int j = c->prior_of[k];
-		*gsl_matrix_ptr(A, (size_t)j, (size_t)j) +=
-			pow(fit_prior_slope(&c->req->prior[j], c->jx[j]), 2);
-	}
 	double s2 = c->res->sigma_given ? 1 : cost / ((double)c->n - p);
 	/* without sigma and with as many data as parameters there is no
 	 * residual variance: the misfit itself would pass for the error */

@@ -64,16 +64,6 @@ static void weak_combination(const fit_ctx *c, const gsl_matrix *V, const double
 					       d[j] / norm, c->req->free[j].name);
 }
 
-/* Row i, column j of the weighted J in x at the optimum: the data's rows
- * (c->jac_x), then one a prior (its slope in its parameter's column). */
-static double jac_entry(const fit_ctx *c, size_t i, int j)
-{
-	if (i < c->n)
-		return c->jac_x[i * (size_t)c->p + (size_t)j];
-	int pj = c->prior_of[i - c->n];
-	return j == pj ? fit_prior_slope(&c->req->prior[pj], c->res->x[pj]) : 0.0;
-}
-
 /* Standard errors, correlations, the condition number and the
  * identifiability warnings from J_x (weighted) at the optimum, the priors'
  * rows with the data's (the posterior's covariance). */
@@ -94,7 +84,7 @@ void fit_covariance(fit_ctx *c)
 	for (int j = 0; j < p; j++) {
 		double s2 = 0;
 		for (size_t i = 0; i < n; i++)
-			s2 += pow(jac_entry(c, i, j), 2);
+			s2 += pow(c->jac_x[i * (size_t)p + (size_t)j], 2);
 		scale[j] = sqrt(s2);
 		if (!(scale[j] > 0)) {
 			fit_warn(res, "'%s' is not identifiable: the data do not change with it",
@@ -102,7 +92,7 @@ void fit_covariance(fit_ctx *c)
 			scale[j] = 1;
 		}
 		for (size_t i = 0; i < n; i++)
-			gsl_matrix_set(A, i, (size_t)j, jac_entry(c, i, j) / scale[j]);
+			gsl_matrix_set(A, i, (size_t)j, c->jac_x[i * (size_t)p + (size_t)j] / scale[j]);
 	}
 	gsl_linalg_SV_decomp(A, V, S, work);
 	double smax = gsl_vector_get(S, 0), smin = gsl_vector_get(S, (size_t)p - 1);

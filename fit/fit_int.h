@@ -61,7 +61,8 @@ typedef struct fit_ctx {
 	/* the last f evaluation at an x, and the last Jacobian */
 	double fx[FIT_MAX_FREE], *fmodel, *fmodel_u;
 	int fvalid;
-	double jx[FIT_MAX_FREE], *jac_x; /* n x p, weighted, in x */
+	double jx[FIT_MAX_FREE], *jac_x; /* (n + q) x p, weighted, in x: the
+					  * data's rows, then the priors' */
 	double *jmodel, *jmodel_u;       /* the model at jx */
 	int jvalid;
 	int iteration;

@@ -91,11 +91,15 @@ int fit_prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 		return -1;
 	c->n = c->ev.ndata;
 	size_t n = c->n;
+	c->q = 0;
+	for (int j = 0; j < c->p; j++)
+		if (fit_has_prior(&r->prior[j]))
+			c->prior_of[c->q++] = j;
 	c->w = malloc(sizeof(double) * n);
 	c->data = malloc(sizeof(double) * n);
 	c->fmodel = malloc(sizeof(double) * n);
 	c->fmodel_u = malloc(sizeof(double) * n);
-	c->jac_x = malloc(sizeof(double) * n * (size_t)c->p);
+	c->jac_x = malloc(sizeof(double) * (n + (size_t)c->q) * (size_t)c->p);
 	c->jmodel = malloc(sizeof(double) * n);
 	c->jmodel_u = malloc(sizeof(double) * n);
 	c->best_model = malloc(sizeof(double) * n);
@@ -124,11 +128,7 @@ int fit_prepare(fit_ctx *c, const fit_request *r, fit_result *res)
 		res->model_start[i] = NAN;
 	}
 	res->nfree = c->p;
-	c->q = 0;
-	for (int j = 0; j < c->p; j++) {
+	for (int j = 0; j < c->p; j++)
 		res->x0[j] = res->x[j] = r->free[j].start;
-		if (fit_has_prior(&r->prior[j]))
-			c->prior_of[c->q++] = j;
-	}
 	return 0;
 }
