@@ -50,15 +50,16 @@ static int parse_priors(const char *list, fit_request *req)
 	char buf[512], msg[FIT_MSG];
 	snprintf(buf, sizeof buf, "%s", list);
 	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		char name[24], spread[32], tail;
+		char name[24], spread[32];
 		double mean, sd = NAN, factor = NAN;
-		int n = sscanf(tok, "%23[A-Za-z0-9_]:%lf:%31s", name, &mean, spread);
+		int used = 0;
+		int n = sscanf(tok, "%23[A-Za-z0-9_]:%lf:%31s%n", name, &mean, spread, &used);
 		char *end = NULL;
 		if (n == 3 && spread[0] == 'x')
 			factor = strtod(spread + 1, &end);
 		else if (n == 3)
 			sd = strtod(spread, &end);
-		if (n != 3 || !end || *end || sscanf(spread, "%*s%c", &tail) == 1) {
+		if (n != 3 || !end || *end || tok[used]) {
 			fprintf(stderr, "convsim fit: --prior takes NAME:MEAN:SD (normal) or "
 					"NAME:MEAN:xFACTOR (log-normal), e.g. R:0.5:0.1,k_c:3000:x3; "
 					"got '%s'\n", tok);
