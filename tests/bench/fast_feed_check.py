@@ -375,18 +375,14 @@ def fit(run, family, pts, peak):
     return max(candidates(family), key=lambda c: score(run, c, pts, peak))
 
 
-# (material, drive, depth, points) of the beds evaluate could not predict
-UNPREDICTED = []
-
-
-def evaluate(run, pts, peak):
+def evaluate(run, pts, peak, unpredicted=None):
     """The held-out predictions, one record per point: leave one bed out.
     A bed is a material at a depth; each is predicted by a closure fitted
     on every other bed of the same drive, of either material (a closure
     takes a material's own parameters as inputs and has no constant of
-    its own per material)."""
+    its own per material). A bed alone on its drive is not predicted: its
+    (material, drive, depth, points) goes to the list unpredicted."""
     out = []
-    del UNPREDICTED[:]
     for drive in sorted({p["drive"] for p in pts}):
         gp = [p for p in pts if p["drive"] == drive]
         for mat, d in sorted({(p["material"], p["depth"]) for p in gp}):
@@ -395,7 +391,8 @@ def evaluate(run, pts, peak):
             if not train:
                 # the only bed of its drive: nothing to fit a closure on, so
                 # no prediction to count (the paper's model would stand in)
-                UNPREDICTED.append((mat, drive, d, len(test)))
+                if unpredicted is not None:
+                    unpredicted.append((mat, drive, d, len(test)))
                 continue
             fits = {f: (fit(run, f, train, peak), fit(run, f, test, peak)) for f in FAMILIES}
             for p in test:
@@ -436,11 +433,12 @@ def main():
     runner.run_all([grains_args(runner, c, p) for c in candidates("grains") for p in pts])
     cols = [(resolve({"Dc": math.inf, "bouncy": c}, p), p) for c in collapse_sides() for p in pts]
     runner.run_all([args_of(convsim, c, r, p) for c, p in cols for r in c["Rs"]])
-    recs = evaluate(runner, pts, peak)
+    unpredicted = []
+    recs = evaluate(runner, pts, peak, unpredicted)
     runner.save()
     from fast_feed_report import summary, write_csv, write_md  # noqa: E402 (it imports this)
     write_csv(recs, os.path.join(RESULTS, "fast_feed.csv"))
-    write_md(recs, runner, os.path.join(RESULTS, "fast_feed.md"), UNPREDICTED)
+    write_md(recs, runner, os.path.join(RESULTS, "fast_feed.md"), unpredicted)
     for f in FAMILIES:
         n, tot, worst, med = summary(recs, f + "_err")
         print("fast_feed_check: %s, %d of %d points within 5 %% (worst %.1f %%, median %.1f %%)" %
