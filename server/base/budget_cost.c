@@ -15,14 +15,22 @@
 
 /* Calibration of the CPU estimate (docs/budgets.md "Budgets and load"): CPU s of
  * one macro step of the machine (four right-hand sides: RK4, or dem's
- * macro step), of one feed sub-step per integrated column and per
- * integrated element, and of one published sample (status, ring record,
- * trajectory row); `build/convsim run` on this machine, the cost of 5
- * simulated s less that of 0.01 s, and the daemon's workers. */
+ * macro step) and of one feed sub-step per integrated column and per
+ * integrated element (`build/convsim run` on this machine, the cost of 5
+ * simulated s less that of 0.01 s); and of one published sample in a
+ * paced worker, with its share of the worker's wake-ups (status, ring
+ * record, trajectory row, the lock, its session's state read back into
+ * the cache). tests/bench/sample_cost.sh: fleets of 150 default sessions
+ * at pace 1 and 250 samples a simulated second measured 1.7 to 2.3 ms of
+ * CPU per simulated s in their workers in four runs of one hour (29
+ * November), the same session flat out about 1.0: 3 to 5.4 us a sample.
+ * 5 us puts a default session's estimate (2.15 ms) in the middle of those
+ * runs; it was 7 us (2.65 ms, above every run), taken before a sample's
+ * record and a number's text became cheaper. */
 #define STEP_CPU_S 0.41e-6
 #define COLUMN_SUBSTEP_CPU_S 8.0e-8
 #define ELEMENT_SUBSTEP_CPU_S 0.8e-8
-#define SAMPLE_CPU_S 7e-6
+#define SAMPLE_CPU_S 5e-6
 /* What a published sample costs a worker besides the simulation, the
  * status and the feed's arrays read out (which the probe, cpu_probe.c,
  * runs itself): the ring record and trajectory row, sleeping and waking,

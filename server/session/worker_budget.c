@@ -22,9 +22,9 @@
  * times what it holds: a scene whose estimate was far off (a restored one
  * is admitted by the estimate alone, without the probe; a 16 x 64 feed
  * measured 12 times its estimate). A default session's measure differs
- * from its estimate by up to 2.6 times on this machine (a lone paced
- * session's wake-ups from an idle core cost it 4-7 ms of CPU per
- * simulated s, hundreds of them 2.4 ms each, the estimate says 2.65), and
+ * from its estimate by up to 3.3 times on this machine (a lone paced
+ * session's wake-ups from an idle core have cost it 1.6-7 ms of CPU per
+ * simulated s, hundreds of them 1.4-2.4 ms each, the estimate says 2.15), and
  * an admitted session keeps its pace through that: the budget's excess
  * then refuses the next session instead. */
 #define PACE_DOWN_OVER 4.0

@@ -65,6 +65,8 @@ echo "bench: paced default sessions held in real time, against the previous buil
 bash tests/bench/realtime.sh "$out"
 echo "bench: what a stream costs the daemon per record (the charge of its streams in the paced budget)"
 bash tests/bench/stream_cost.sh "$out" > /dev/null
+echo "bench: what a paced session's sample costs its worker (the sample term of the CPU estimate; ~1 min)"
+bash tests/bench/sample_cost.sh "$out" > /dev/null
 echo "bench: what a creation refused for CPU costs the daemon (the paced budget full)"
 bash tests/bench/refuse_cost.sh "$out" > /dev/null
 echo "bench: PATCH throughput with the durable control log (loopback, a temporary data directory)"

@@ -40,7 +40,7 @@ export const SPEC = [
   /* the budgets' clocks: CPU_READ_EVERY, COST_WINDOW_CPU, COST_WINDOW_T (server/session/session_int.h) */
   ['docs/budgets.md', '(at most every 10 ms), so a session pauses at most 10 ms of CPU past its grant'],
   ['docs/budgets.md', 'over windows of 50 ms\nof CPU or 2 simulated seconds'],
-  ['docs/budgets.md', 'first\nwindow (50 ms of CPU) replaces it'],
+  ['docs/budgets.md', 'first window (50\nms of CPU) replaces it'],
   /* a sample's interval at the stream's rate */
   ['docs/cluster.md', 'the next sample (about 100 ms at `rate=10`'],
   /* the latencies the bench adds, and the sample interval of the example's stream */

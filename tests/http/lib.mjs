@@ -301,6 +301,20 @@ export const pacedBusy = (need, cpu, pace, sum, limit) => ({
   limit,
 });
 
+// A default session's hold at pace 1 (CPU s per simulated s) as a daemon of
+// its own takes it from the scene's estimate (--cpu-probe 0), before its
+// worker has measured it.
+export async function pacedEstimate() {
+  const d = await startDaemon(['--cpu-probe', '0']);
+  try {
+    const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+    assert.equal(r.status, 201, r.text);
+    return metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+}
+
 // Default sessions at pace 1 (until 600) created on d until as many as
 // --max-paced-cores `limit` takes run; held() reads what they hold. The
 // first one's hold is a session's cost. {ids, cost, fit}.

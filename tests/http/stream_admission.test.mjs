@@ -10,7 +10,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
-import { startDaemon, req, metric, until, SLOW, g3, fillPaced } from './lib.mjs';
+import { startDaemon, req, metric, until, SLOW, g3, fillPaced, pacedEstimate } from './lib.mjs';
 
 // The charge of a ?fields=trough&rate=10 stream of a default session (250
 // samples a simulated s), CPU s per simulated s: 10 wake-ups of 75 us and
@@ -46,13 +46,19 @@ function open(base, id, query = QUERY) {
 }
 
 test('paced budget: a stream beyond it gets 503 naming the budget, the running sessions and streams go on', { timeout: 90000 * SLOW }, async () => {
-  const limit = 0.01;
+  // a budget of three default sessions and what lies halfway between two
+  // streams and a fourth session: the sessions that fit leave room for two
+  // streams (the estimate from a daemon of its own, read as fillPaced does)
+  const c = await pacedEstimate();
+  assert.ok(c > 2 * STREAM, `a default session's estimate ${c} is more than two streams' ${2 * STREAM}`);
+  const limit = Number((3 * c + (2 * STREAM + c) / 2).toPrecision(3));
   const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
   const metrics = async () => (await req(d.base, 'GET', '/metrics')).text;
   const held = async () => metric(await metrics(), 'convsim_paced_cpu_cores');
   const streams = [];
   try {
     const { ids, cost, fit } = await fillPaced(d, limit, held, STREAM);
+    assert.equal(cost, c);
     // the streams that fit in what is left, each charged STREAM
     const room = Math.floor((limit - fit * cost) / STREAM + 1e-9);
     for (let i = 0; i < room; i++) {
