@@ -5,13 +5,13 @@
 # build first in the same minutes (BASELINE), the load average before and
 # after each run: are the admitted sessions in real time while the refused
 # creations' flood arrives? The previous build is PREV_CONVSIMD, or commit
-# PREV (default 20f6f5e) built as refuse_cost.sh builds it. Not part of
+# PREV (default fefabe0, the last release) built as realtime.sh builds it. Not part of
 # `make bench` (about a minute a run). Writes $1/realtime_1500.md.
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
-PREV=${PREV:-20f6f5e}
+PREV=${PREV:-fefabe0}
 N=${OVER_N:-1500}
 RUNS=${RUNS:-3}
 prev=${PREV_CONVSIMD:-}
