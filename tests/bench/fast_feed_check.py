@@ -436,13 +436,13 @@ def main():
     unpredicted = []
     recs = evaluate(runner, pts, peak, unpredicted)
     runner.save()
-    from fast_feed_report import summary, write_csv, write_md  # noqa: E402 (it imports this)
+    from fast_feed_report import pct_of, summary, write_csv, write_md  # noqa: E402 (it imports this)
     write_csv(recs, os.path.join(RESULTS, "fast_feed.csv"))
     write_md(recs, runner, os.path.join(RESULTS, "fast_feed.md"), unpredicted)
     for f in FAMILIES:
         n, tot, worst, med = summary(recs, f + "_err")
-        print("fast_feed_check: %s, %d of %d points within 5 %% (worst %.1f %%, median %.1f %%)" %
-              (f, n, tot, 100 * worst, 100 * med))
+        print("fast_feed_check: %s, %d of %d points within 5 %% (worst %s, median %s)" %
+              (f, n, tot, pct_of(worst), pct_of(med)))
     print("fast_feed_check: tests/bench/results/fast_feed.md")
 
 

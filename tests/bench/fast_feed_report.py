@@ -4,6 +4,7 @@
 tests/bench/results/fast_feed.md and fast_feed.csv from its held-out
 predictions."""
 import csv
+import math
 import os
 import statistics
 import subprocess
@@ -17,9 +18,20 @@ def pct(x):
     return "%+.1f %%" % (100 * x)
 
 
+def err_of(x):
+    """|error|; a run that failed (NaN: refused, or its bed sank and
+    diverged) is a miss by any measure."""
+    return abs(x) if math.isfinite(x) else math.inf
+
+
 def summary(recs, key):
-    e = [abs(r[key]) for r in recs]
+    e = [err_of(r[key]) for r in recs]
     return (sum(x <= TOL for x in e), len(e), max(e), statistics.median(e))
+
+
+def pct_of(x):
+    """An error for a table: its value, or the count of failed runs."""
+    return "%.1f %%" % (100 * x) if math.isfinite(x) else "a run failed"
 
 
 def build_name():
@@ -57,11 +69,14 @@ def summary_table(recs, w):
         n, tot, worst, med = summary(recs, key)
         cost = "1" if key == "err_paper" else "-"
         if cpu:
-            ratios = [r[cpu] / r["cpu_paper"] for r in recs if r["cpu_paper"] > 0]
-            cost = "%.2f, %.2f" % (sum(r[cpu] for r in recs) / sum(r["cpu_paper"] for r in recs),
+            ran = [r for r in recs if r["cpu_paper"] > 0 and math.isfinite(r[cpu])]
+            ratios = [r[cpu] / r["cpu_paper"] for r in ran]
+            cost = "%.2f, %.2f" % (sum(r[cpu] for r in ran) / sum(r["cpu_paper"] for r in ran),
                                    statistics.median(ratios))
-        w("| %s | %d of %d (%.0f %%) | %.1f %% | %.1f %% | %s |" %
-          (label, n, tot, 100.0 * n / tot, 100 * worst, 100 * med, cost))
+            if len(ran) < len(recs):
+                cost += " (%d failed runs left out)" % (len(recs) - len(ran))
+        w("| %s | %d of %d (%.0f %%) | %s | %s | %s |" %
+          (label, n, tot, 100.0 * n / tot, pct_of(worst), pct_of(med), cost))
 
 
 def depth_table(sel, w):
@@ -72,6 +87,9 @@ def depth_table(sel, w):
         cells = []
         for f in FAMILIES:
             e = r[f + "_err"]
+            if not math.isfinite(e):
+                cells.append("failed | ✗")
+                continue
             cells.append("%.4f | %s%s" % (r[f + "_v"], pct(e), "" if abs(e) <= TOL else " ✗"))
         w("| %g | %.4f ± %.4f | %.4f | %s | %s |" % (r["beta"], r["v_dem"], r["sd"], r["v_paper"],
                                                    pct(r["err_paper"]), " | ".join(cells)))
@@ -155,8 +173,8 @@ def write_md(recs, runner, path, unpredicted=()):
         w("")
         for f in FAMILIES:
             n, tot, worst, med = summary(sel, f + "_err")
-            w("- %s fitted on the other beds: %s; %d of %d within 5 %%, worst %.1f %%; fitted "
-              "on this bed: %s." % (f, sel[0][f + "_fit"], n, tot, 100 * worst, sel[0][f + "_own"]))
+            w("- %s fitted on the other beds: %s; %d of %d within 5 %%, worst %s; fitted "
+              "on this bed: %s." % (f, sel[0][f + "_fit"], n, tot, pct_of(worst), sel[0][f + "_own"]))
         w("")
         depth_table(sel, w)
         w("")
