@@ -4,6 +4,7 @@
 --self-test`, in `make test`): its leave-one-depth-out bookkeeping on a
 fake runner whose v is a known function of the candidate and the point,
 no convsim needed."""
+import math
 import os
 import statistics
 import sys
@@ -71,6 +72,7 @@ def self_test():
     checks.append(("layered held out at depth 1", all(
         abs(x["layered_v"] - statistics.fmean(best["Rs"]) * x["beta"] / 100.0) < 1e-12 for x in lr)))
     checks += collapse_checks()
+    checks += summary_checks()
     for name, ok in checks:
         print("%s - %s" % ("ok" if ok else "not ok", name))
     failed = sum(1 for _, ok in checks if not ok)
@@ -80,6 +82,17 @@ def self_test():
 
 if __name__ == "__main__":
     sys.exit(self_test())
+
+
+def summary_checks():
+    """A run that failed (NaN) is a miss in the summary: within 5 % at no
+    point, the worst "a run failed", the median as if it were the largest."""
+    from fast_feed_report import pct_of, summary
+    recs = [{"e": math.nan}, {"e": 0.01}, {"e": -0.02}]
+    n, tot, worst, med = summary(recs, "e")
+    return [("summary: a failed run is a miss", (n, tot) == (2, 3)),
+            ("summary: the worst names the failed run", pct_of(worst) == "a run failed"),
+            ("summary: the median counts it as the largest", abs(med - 0.02) < 1e-15)]
 
 
 def collapse_checks():
