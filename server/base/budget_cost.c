@@ -21,9 +21,9 @@
  * paced worker, with its share of the worker's wake-ups (status, ring
  * record, trajectory row, the lock, its session's state read back into
  * the cache). tests/bench/sample_cost.sh: fleets of 150 default sessions
- * at pace 1 and 250 samples a simulated second measured 1.7 to 2.3 ms of
- * CPU per simulated s in their workers in four runs of one hour (29
- * November), the same session flat out about 1.0: 3 to 5.4 us a sample.
+ * at pace 1 and 250 samples a simulated second measured 1.7 to 2.4 ms of
+ * CPU per simulated s in their workers in five runs of one hour (29
+ * November), the same session flat out 1.0 to 1.3: 3 to 5.4 us a sample.
  * 5 us puts a default session's estimate (2.15 ms) in the middle of those
  * runs; it was 7 us (2.65 ms, above every run), taken before a sample's
  * record and a number's text became cheaper. */
