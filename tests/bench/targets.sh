@@ -16,8 +16,10 @@
 #  - the daemon: 200 default sessions at pace 1 with a stream each
 #    (tests/bench/realtime.mjs 200, half a minute on both cores; skipped
 #    with DAEMON=0 or without node).
-# The machine is shared: a table is one sample of it, the best figures the
-# least disturbed. Writes $1/targets.md.
+# The runs alternate with those of the previous build, commit PREV (default
+# fefabe0, the last release; tests/bench/prev_build.sh builds it), whose
+# rows stand beside this build's. The machine is shared: a table is one
+# sample of it, the best figures the least disturbed. Writes $1/targets.md.
 set -eu
 cd "$(dirname "$0")/../.."
 . tests/bench/provenance.sh
@@ -31,17 +33,25 @@ trap 'rm -rf "$tmp"' EXIT
 field() { # name: the number after "name": in the summary on stdin
 	sed -n "s/.*\"$1\": \([0-9.e+-]*\).*/\1/p"
 }
-run() { # duration, settings...: "rtf cpu" of one run
+PREV=${PREV:-fefabe0}
+. tests/bench/prev_build.sh
+prev_build targets convsim
+run() { # convsim, duration, settings...: "rtf cpu" of one run
 	local s
-	s=$("$BUILD/convsim" run -q --duration "$1" --set beta=30 "${@:2}")
+	s=$("$1" run -q --duration "$2" --set beta=30 "${@:3}")
 	printf '%s %s\n' "$(field real_time_factor <<<"$s")" "$(field cpu_seconds <<<"$s")"
 }
+# this build's runs and the previous build's take turns, run by run
 for ((i = 0; i < RUNS; i++)); do
-	run 20 >> "$tmp/reduced20"
-	run 20 --set trough_rotation=true >> "$tmp/full20"
-	run 60 >> "$tmp/reduced60"
-	run 60 --set trough_rotation=true >> "$tmp/full60"
-	run 20 --set feed=false >> "$tmp/machine20"
+	for b in "" .prev; do
+		bin=$BUILD/convsim
+		[ -z "$b" ] || bin=$prev
+		run "$bin" 20 >> "$tmp/reduced20$b"
+		run "$bin" 20 --set trough_rotation=true >> "$tmp/full20$b"
+		run "$bin" 60 >> "$tmp/reduced60$b"
+		run "$bin" 60 --set trough_rotation=true >> "$tmp/full60$b"
+		run "$bin" 20 --set feed=false >> "$tmp/machine20$b"
+	done
 done
 TIMEFORMAT=%U
 for i in 1 2 3 4; do
@@ -52,12 +62,12 @@ pick() { # column, file: "best median" (best = largest for column 1, least for 2
 		m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
 		printf "%s %s", (c == 1 ? v[NR] : v[1]), m }'
 }
-row() { # scene, target
+row() { # scene, target[, file suffix, label]: the previous build's row with ".prev"
 	local b20 m20 c20 c60 w start
-	read -r b20 m20 <<<"$(pick 1 "$tmp/${1}20")"
-	read -r c20 _ <<<"$(pick 2 "$tmp/${1}20")"
-	read -r c60 _ <<<"$(pick 2 "$tmp/${1}60")"
-	awk -v s="$1" -v t="$2" -v b="$b20" -v m="$m20" -v c20="$c20" -v c60="$c60" 'BEGIN {
+	read -r b20 m20 <<<"$(pick 1 "$tmp/${1}20${3:-}")"
+	read -r c20 _ <<<"$(pick 2 "$tmp/${1}20${3:-}")"
+	read -r c60 _ <<<"$(pick 2 "$tmp/${1}60${3:-}")"
+	awk -v s="$1${4:-}" -v t="$2" -v b="$b20" -v m="$m20" -v c20="$c20" -v c60="$c60" 'BEGIN {
 		w = (c60 - c20) / 40; st = c20 - 20 * w
 		if (b >= t) v = "met by the 20-s run"
 		else if (1 / w >= t) v = "met once running, not by the 20-s run"
@@ -77,14 +87,18 @@ read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 	echo "steady start; every figure at the 1 % gate of tests/bench/accuracy.sh). A 20-s run's figure"
 	echo "is its summary's \`real_time_factor\` (shooting and settling included); once running: the"
 	echo "least CPU of the 60-s runs less that of the 20-s ones, over 40 s; start: what the least 20-s"
-	echo "run spends beyond that. The machine is shared: the best figures are the least disturbed."
+	echo "run spends beyond that. The machine is shared: the best figures are the least disturbed. The"
+	echo "previous build ($PREV, the last release) ran its runs in turn with this build's, run by run, so"
+	echo "the two rows of a scene saw the same machine."
 	echo
 	echo "| scene | target | 20-s run, best | once running | start | verdict |"
 	echo "|---|---|---|---|---|---|"
 	row reduced 1500
+	row reduced 1500 .prev ", the previous build ($PREV)"
 	row full 400
+	row full 400 .prev ", the previous build ($PREV)"
 	echo
-	printf -- '- Machine alone (feed=false), 20-s run: best %.0f× (median %.0f×).\n' "$mb" "$mm"
+	printf -- '- Machine alone (feed=false), 20-s run: best %.0f× (median %.0f×); the previous build %.0f× (median %.0f×).\n' "$mb" "$mm" $(pick 1 "$tmp/machine20.prev")
 	awk -v l="$cl" -v m="$cm" 'BEGIN { printf "- The 74-point curve (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`): %.3f CPU s at least, median %.3f (target <= 0.3 s: %s).\n", l, m, (l <= 0.3 ? "met" : "missed") }'
 	if [ "${DAEMON:-1}" != 0 ] && command -v node >/dev/null && [ -x "$BUILD/convsimd" ]; then
 		echo
