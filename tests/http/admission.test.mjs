@@ -7,7 +7,7 @@
 // measured, so the refusal's numbers are known in advance.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, metric, until, sleep, SLOW, pacedBusy, fillPaced } from './lib.mjs';
+import { startDaemon, req, metric, until, sleep, SLOW, pacedBusy, fillPaced, pacedEstimates } from './lib.mjs';
 
 test('paced budget full: the next session gets 503 with the budget named, the running ones keep pace 1', { timeout: 90000 * SLOW }, async () => {
   const limit = 0.01;
@@ -63,15 +63,7 @@ test('paced budget full: the next session gets 503 with the budget named, the ru
 test('a burst of paced sessions that fits by their steady cost is admitted whole, and they keep pace 1', { timeout: 90000 * SLOW }, async () => {
   const n = 20;
   // the estimate from the scene (no probe), read from a daemon of its own
-  const e = await startDaemon(['--cpu-probe', '0']);
-  let cost;
-  try {
-    const one = await req(e.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-    assert.equal(one.status, 201, one.text);
-    cost = metric((await req(e.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
-  } finally {
-    assert.equal((await e.stop()).code, 0, e.stderr());
-  }
+  const cost = (await pacedEstimates({ DEFAULT: {} })).DEFAULT;
   assert.ok(cost > 1e-4 && cost < 0.01, `a default session's estimate: ${cost}`);
   const limit = Number((1.5 * n * cost).toPrecision(3));
   const d = await startDaemon(['--max-paced-cores', String(limit)]);

@@ -301,18 +301,26 @@ export const pacedBusy = (need, cpu, pace, sum, limit) => ({
   limit,
 });
 
-// A default session's hold at pace 1 (CPU s per simulated s) as a daemon of
-// its own takes it from the scene's estimate (--cpu-probe 0), before its
-// worker has measured it.
-export async function pacedEstimate() {
+// Each kind's hold at pace 1 (CPU s per simulated s), kinds {name: body}, as
+// a daemon of its own takes it from the scene's estimate (--cpu-probe 0),
+// before a worker has measured it: each created (pace 1, until 600), read,
+// deleted and given back, one at a time. {name: hold}.
+export async function pacedEstimates(kinds) {
   const d = await startDaemon(['--cpu-probe', '0']);
+  const held = async () => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+  const out = {};
   try {
-    const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
-    assert.equal(r.status, 201, r.text);
-    return metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
+    for (const [name, body] of Object.entries(kinds)) {
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { ...body, pace: 1, until: 600 });
+      assert.equal(r.status, 201, r.text);
+      out[name] = await held();
+      assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
+      assert.equal(await held(), 0, 'given back');
+    }
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
+  return out;
 }
 
 // Default sessions at pace 1 (until 600) created on d until as many as

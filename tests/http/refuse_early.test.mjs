@@ -12,7 +12,7 @@
 // no worker's measure replaces its hold before the test ends.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, metric, SLOW, g3, pacedBusy } from './lib.mjs';
+import { startDaemon, req, metric, SLOW, g3, pacedBusy, pacedEstimates } from './lib.mjs';
 
 const DEFAULT = {};
 const LIGHT = { scene: { drive: 'ideal', feed: false }, sample_rate: 10 };
@@ -21,29 +21,10 @@ const create = (d, body, pace) => req(d.base, 'POST', '/api/v1/sessions', { ...b
 const held = async (d) => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_paced_cpu_cores');
 const created = async (d) => metric((await req(d.base, 'GET', '/metrics')).text, 'convsim_sessions_created_total');
 
-// Each kind's estimate (CPU s per simulated s) as the daemon holds it at
-// pace 1, read one at a time from a daemon of its own.
-async function estimates() {
-  const d = await startDaemon(['--cpu-probe', '0']);
-  const out = {};
-  try {
-    for (const [name, body] of Object.entries({ DEFAULT, LIGHT, HEAVY })) {
-      const r = await create(d, body, 1);
-      assert.equal(r.status, 201, r.text);
-      out[name] = await held(d);
-      assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
-      assert.equal(await held(d), 0, 'given back');
-    }
-  } finally {
-    assert.equal((await d.stop()).code, 0, d.stderr());
-  }
-  return out;
-}
-
 const busy = pacedBusy;
 
 test('with the paced cores full, the early refusal answers as the whole path and refuses nothing that fits', { timeout: 90000 * SLOW }, async () => {
-  const c = await estimates();
+  const c = await pacedEstimates({ DEFAULT, LIGHT, HEAVY });
   // the scenes' estimates differ as the test needs them to: the light one
   // at pace 1/2 and a default at 1/4 fit the half left (LIGHT < DEFAULT / 2,
   // with room for the limit's rounding), the heavy one needs more than it

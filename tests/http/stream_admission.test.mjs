@@ -10,12 +10,14 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
-import { startDaemon, req, metric, until, SLOW, g3, fillPaced, pacedEstimate } from './lib.mjs';
+import { startDaemon, req, metric, until, SLOW, g3, fillPaced, pacedEstimates } from './lib.mjs';
 
-// The charge of a ?fields=trough&rate=10 stream of a default session (250
-// samples a simulated s), CPU s per simulated s: 10 wake-ups of 75 us and
-// 10 records of 9 numbers at 1 us (server/base/budget_stream.c)
-const STREAM = 10 * 75e-6 + 10 * 9 * 1.0e-6;
+// A stream's charge (server/base/budget_stream.c): a wake-up and a number
+// formatted, CPU s. That of a ?fields=trough&rate=10 stream of a default
+// session (250 samples a simulated s), CPU s per simulated s: 10 wake-ups
+// and 10 records of 9 numbers.
+const WAKE = 75e-6, NUMBER = 1.0e-6;
+const STREAM = 10 * WAKE + 10 * 9 * NUMBER;
 const QUERY = '?format=ndjson&fields=trough&rate=10';
 
 // Open a stream of session id: {status, body (parsed when refused),
@@ -49,7 +51,7 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
   // a budget of three default sessions and what lies halfway between two
   // streams and a fourth session: the sessions that fit leave room for two
   // streams (the estimate from a daemon of its own, read as fillPaced does)
-  const c = await pacedEstimate();
+  const c = (await pacedEstimates({ DEFAULT: {} })).DEFAULT;
   assert.ok(c > 2 * STREAM, `a default session's estimate ${c} is more than two streams' ${2 * STREAM}`);
   const limit = Number((3 * c + (2 * STREAM + c) / 2).toPrecision(3));
   const d = await startDaemon(['--max-paced-cores', String(limit), '--cpu-probe', '0']);
@@ -131,7 +133,7 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
     const rotor = await open(d.base, ids[1], '?format=ndjson&fields=trough,rotor&rate=10');
     streams.push(rotor);
     assert.equal(rotor.status, 200, rotor.text);
-    assert.ok(Math.abs(await held() - before2 - (10 * 75e-6 + 10 * 14 * 1.0e-6)) < 1e-9,
+    assert.ok(Math.abs(await held() - before2 - (10 * WAKE + 10 * 14 * NUMBER)) < 1e-9,
       `held ${await held()} after ${before2}`);
     await until(() => rotor.records.some((x) => x.type === 'sample'), 10000 * SLOW, 'a sample');
     const sample = rotor.records.find((x) => x.type === 'sample');
@@ -167,7 +169,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     const all = await open(d.base, slow.body.id, '?format=ndjson');
     streams.push(all);
     assert.equal(all.status, 200, all.text);
-    const charge = 0.1 * (250 * 75e-6 + 250 * 35 * 1.0e-6);
+    const charge = 0.1 * (250 * WAKE + 250 * 35 * NUMBER);
     const h1 = await held();
     assert.ok(Math.abs(h1 - h0 - charge) < 1e-9, `held ${h1} after ${h0}: the stream ${h1 - h0}, expected ${charge}`);
     all.close();
@@ -180,7 +182,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     const thin = await open(d.base, fast.body.id);
     streams.push(thin);
     assert.equal(thin.status, 200, thin.text);
-    const perS = cost + 5 * 75e-6 + 10 * 9 * 1.0e-6;
+    const perS = cost + 5 * WAKE + 10 * 9 * NUMBER;
     assert.ok(10 * perS > limit, `pace 10 needs ${10 * perS} cores, beyond ${limit}`);
     const r = await req(d.base, 'PATCH', `/api/v1/sessions/${fast.body.id}`, { pace: 10 });
     assert.equal(r.status, 422, r.text);
@@ -190,7 +192,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
       'nothing was changed, lower the pace');
     // the greatest pace the cores allow, with the stream's wake-ups capped
     // on the way there (at pace p: 10 p of them a wall s, at most 50)
-    const need = (p) => p * (cost + 10 * 9 * 1.0e-6) + Math.min(10 * p, 50) * 75e-6;
+    const need = (p) => p * (cost + 10 * 9 * NUMBER) + Math.min(10 * p, 50) * WAKE;
     let lo = 0, hi = 100;
     for (let i = 0; i < 100; i++) { const mid = (lo + hi) / 2; if (need(mid) <= limit) lo = mid; else hi = mid; }
     assert.ok(Math.abs(r.body.max - lo) < 1e-9 * lo, `max ${r.body.max}, the greatest pace that fits ${lo}`);
