@@ -19,12 +19,11 @@ PORT=${SAMPLE_COST_PORT:-18437}
 line=$(provenance)
 tick=$(getconf CLK_TCK)
 flat() { # CPU s per simulated s of the scene flat out, the least of 5
-	local best=
-	for _ in 1 2 3 4 5; do
-		c=$("$BUILD/convsim" run -q --duration 20 --sample-rate "$1" --set beta=30 |
-			sed -n 's/.*"cpu_seconds": *\([0-9.e-]*\).*/\1/p' | head -1)
-		best=$(python3 -c "a='$best'; print(min(float(a), $c) if a else $c)")
-	done
+	local best
+	best=$(for _ in 1 2 3 4 5; do
+		"$BUILD/convsim" run -q --duration 20 --sample-rate "$1" --set beta=30 |
+			sed -n 's/.*"cpu_seconds": *\([0-9.e-]*\).*/\1/p' | head -1
+	done | sort -g | head -1)
 	python3 -c "print($best / 20)"
 }
 fleet() { # r [n] -> "measured daemon" in CPU s per simulated s a session, n sessions (N)
