@@ -355,10 +355,15 @@ def name_of(c):
         "= depth" if c["layers"] == "depth" else "1")
 
 
+def err_of(x):
+    """|error|; a run that failed (NaN: refused, or its bed sank and
+    diverged) is a miss by any measure: infinite."""
+    return abs(x) if math.isfinite(x) else math.inf
+
+
 def rel_err(v, p, peak):
     """|v - v_DEM| / the peak; infinite where the run failed."""
-    e = abs(v - p["v_dem"]) / peak[(p["material"], p["drive"], p["depth"])]
-    return e if math.isfinite(e) else math.inf
+    return err_of((v - p["v_dem"]) / peak[(p["material"], p["drive"], p["depth"])])
 
 
 def score(run, cand, pts, peak):

@@ -12,16 +12,10 @@ import time
 
 import provenance
 from fast_feed_check import FAMILIES, GRAINS_N, LAYERED_P, ROOT, TOL, COST_REPEATS, \
-    COST_DURATION, LONG_DURATION
+    COST_DURATION, LONG_DURATION, err_of
 
 def pct(x):
     return "%+.1f %%" % (100 * x)
-
-
-def err_of(x):
-    """|error|; a run that failed (NaN: refused, or its bed sank and
-    diverged) is a miss by any measure."""
-    return abs(x) if math.isfinite(x) else math.inf
 
 
 def summary(recs, key):
@@ -30,7 +24,7 @@ def summary(recs, key):
 
 
 def pct_of(x):
-    """An error for a table: its value, or the count of failed runs."""
+    """An error for a table: its value, or that a run failed."""
     return "%.1f %%" % (100 * x) if math.isfinite(x) else "a run failed"
 
 
