@@ -5,7 +5,10 @@
 # $BUILD/prev-PREV/src once and built there (`make build/PROGRAM`) when it
 # is not yet; the benches that compare with the same commit share the tree
 # (one builds convsim, another convsimd in it). NAME names the bench in
-# the message.
+# the message. LAST_RELEASE is the last stop's final commit, the previous
+# build of the benches that compare with the release before this one
+# (realtime.sh, realtime_over.sh, targets.sh): one place to move it on.
+LAST_RELEASE=fefabe0
 prev_build() { # bench name, program
 	local dir="$BUILD/prev-$PREV"
 	prev="$dir/src/build/$2"

@@ -5,19 +5,19 @@
 # build first in the same minutes (BASELINE), the load average before and
 # after each run: are the admitted sessions in real time while the refused
 # creations' flood arrives? The previous build is PREV_CONVSIMD, or commit
-# PREV (default fefabe0, the last release) built as realtime.sh builds it. Not part of
+# PREV (default: LAST_RELEASE, fefabe0 now), built by tests/bench/prev_build.sh. Not part of
 # `make bench` (about a minute a run). Writes $1/realtime_1500.md.
 set -eu
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
-PREV=${PREV:-fefabe0}
+. tests/bench/prev_build.sh
+PREV=${PREV:-$LAST_RELEASE}
 N=${OVER_N:-1500}
 RUNS=${RUNS:-3}
 prev=${PREV_CONVSIMD:-}
 if [ -z "$prev" ]; then
-	prev="$BUILD/prev-$PREV/src/build/convsimd"
-	[ -x "$prev" ] || { echo "realtime_over: build $prev first (bash tests/bench/refuse_cost.sh does)" >&2; exit 1; }
+	prev_build realtime_over convsimd
 fi
 . tests/bench/provenance.sh
 {

@@ -17,7 +17,7 @@
 #    (tests/bench/realtime.mjs 200, half a minute on both cores; skipped
 #    with DAEMON=0 or without node).
 # The runs alternate with those of the previous build, commit PREV (default
-# fefabe0, the last release; tests/bench/prev_build.sh builds it), whose
+# LAST_RELEASE, fefabe0 now; tests/bench/prev_build.sh builds it), whose
 # rows stand beside this build's. The machine is shared: a table is one
 # sample of it, the best figures the least disturbed. Writes $1/targets.md.
 set -eu
@@ -33,8 +33,8 @@ trap 'rm -rf "$tmp"' EXIT
 field() { # name: the number after "name": in the summary on stdin
 	sed -n "s/.*\"$1\": \([0-9.e+-]*\).*/\1/p"
 }
-PREV=${PREV:-fefabe0}
 . tests/bench/prev_build.sh
+PREV=${PREV:-$LAST_RELEASE}
 prev_build targets convsim
 run() { # convsim, duration, settings...: "rtf cpu" of one run
 	local s
