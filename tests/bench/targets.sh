@@ -14,7 +14,8 @@
 #  - the 74-point curve (`convsim sweep --beta 0:180:5 --rotation cw,ccw
 #    --threads 1`), user CPU seconds, the least and the median of 4;
 #  - the daemon: 200 default sessions at pace 1 with a stream each
-#    (tests/bench/realtime.mjs 200, half a minute on both cores; skipped
+#    (tests/bench/realtime.mjs 200, the previous build's daemon first as
+#    its baseline, a minute on both cores; skipped
 #    with DAEMON=0 or without node).
 # The runs alternate with those of the previous build, commit PREV (default
 # LAST_RELEASE, 4a42636 now; tests/bench/prev_build.sh builds it), whose
@@ -103,9 +104,12 @@ read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 	if [ "${DAEMON:-1}" != 0 ] && command -v node >/dev/null && [ -x "$BUILD/convsimd" ]; then
 		echo
 		echo "The daemon (target: at least 200 default sessions in real time on 2 cores, stream lag"
-		echo "p99 < 50 ms):"
+		echo "p99 < 50 ms; \"baseline\" is the previous build, $PREV, run first):"
 		echo
-		CONVSIMD="$PWD/$BUILD/convsimd" node tests/bench/realtime.mjs 200
+		conv=$prev
+		prev_build targets convsimd
+		CONVSIMD="$PWD/$BUILD/convsimd" BASELINE="$PWD/$prev" node tests/bench/realtime.mjs 200
+		prev=$conv
 	fi
 } > "$out/targets.md"
 cat "$out/targets.md"
