@@ -6,7 +6,8 @@
 # DEM_MAP_BUILD, else HEAD with dem/ and core/ committed), runs the parts'
 # missing rows (DEM_MAP_PARTS="p1 p2", default all, in the plan's order;
 # tests/bench/dem_map.py plan lists them) one LIGGGHTS process at a time
-# at nice 19, and writes the report tests/bench/results/dem_map.md.
+# at nice 19, and writes the report tests/bench/results/dem_map.md and
+# its plot, dem_map.svg (tests/bench/dem_map_plot.py).
 # Resumable: rows already in the CSV are skipped, a row's finished seeds
 # are kept in dem_map_runs.jsonl.
 set -eu
@@ -35,4 +36,5 @@ fi
 status=0
 python3 tests/bench/dem_map.py run "$bin" "$commit" ${DEM_MAP_PARTS:-} || status=$?
 python3 tests/bench/dem_map_report.py > tests/bench/results/dem_map.md
+python3 tests/bench/dem_map_plot.py > tests/bench/results/dem_map.svg
 exit $status

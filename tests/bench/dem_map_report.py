@@ -205,6 +205,9 @@ def main():
     # the map's tables
     w("## The map: v (m/s), mean of 3 seeds ± their standard deviation")
     w("")
+    w("As a plot, every bed with the paper's column model beside it: [dem_map.svg](dem_map.svg) "
+      "(tests/bench/dem_map_plot.py).")
+    w("")
     maprows = [r for r in rows if r["role"] == "map"]
     for mat in mats["materials"]:
         for drive in dem_map.DRIVES:
