@@ -113,7 +113,7 @@ DEB_DEM   := /usr/lib/x86_64-linux-gnu/libliggghts.so:libliggghts-dev \
              /usr/bin/mpirun:openmpi-bin \
              /usr/bin/pkg-config:pkg-config
 
-.PHONY: profile-daemon bench-advance-cost fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-calibration bench-dem bench-dem-map dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
+.PHONY: profile-daemon bench-advance-cost fast-feed-check model-check bench-dem-calibrate all deps deps-build deps-unit run cluster test check check-ci bench bench-controls bench-control-loop bench-control-cost bench-control-shaping bench-calibration bench-dem bench-dem-map bench-dem-inputs dem-build bench-peers bench-zoo-ref load flood mutate fuzz fuzz-build clean install uninstall
 # `make` builds the unit tests too, so it installs cmocka (deps-unit) as well
 # as what building and running need.
 all: deps-build deps-unit $(BUILD)/convsim $(CLI_MPI_BIN) $(BUILD)/convsimd $(UNIT_BIN) $(DEM_BIN)
@@ -465,6 +465,12 @@ bench-dem: all $(BUILD)/.deps-dem
 # tests/bench/results/dem_map.csv and dem_map.md.
 bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
+# How far the map moves with the contact values it assumes (glass on the
+# deck and its rolling; wheat's restitution, friction between grains and
+# rolling), one at a time at six points, by the map's build
+# (tests/bench/dem_inputs.py, about an hour of a core): dem_inputs.csv, .md.
+bench-dem-inputs: $(BUILD)/.deps-build $(BUILD)/.deps-dem
+	$(Q)bash tests/bench/dem_map.sh inputs
 
 # Where a daemon of paced default sessions spends its CPU, beside the
 # previous build (tests/bench/profile.sh, docs/performance.md; about a

@@ -60,6 +60,8 @@ run "fast feed check (self-test)" python3 tests/bench/fast_feed_check.py --self-
 # the DEM map's plot is what the committed map and model check give, each
 # mark its point's value (tests/bench/dem_map_plot.py)
 run "DEM map plot" python3 tests/bench/dem_map_plot.py --check
+# the inputs' rows are the plan's runs and their report what they give
+run "DEM map inputs" python3 tests/bench/dem_inputs.py --check
 # the size rule: files of at most 500 lines, functions of at most 80
 run "file and function sizes" sh -c "python3 tests/size.py --self-test && python3 tests/size.py && echo '# pass 1'"
 for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/web/*.test.mjs; do

@@ -9,7 +9,8 @@
 # at nice 19, and writes the report tests/bench/results/dem_map.md and
 # its plot, dem_map.svg (tests/bench/dem_map_plot.py).
 # Resumable: rows already in the CSV are skipped, a row's finished seeds
-# are kept in dem_map_runs.jsonl.
+# are kept in dem_map_runs.jsonl. `dem_map.sh inputs` (make
+# bench-dem-inputs) runs tests/bench/dem_inputs.py by the same build instead.
 set -eu
 cd "$(dirname "$0")/../.."
 csv=tests/bench/results/dem_map.csv
@@ -34,6 +35,11 @@ if [ ! -x "$bin" ]; then
 		{ tail -20 "$dir/build.log" >&2; exit 1; }
 fi
 status=0
+if [ "${1:-}" = inputs ]; then # make bench-dem-inputs: the map's inputs changed, by its build
+	python3 tests/bench/dem_inputs.py run "$bin" "$commit" || status=$?
+	python3 tests/bench/dem_inputs.py report > tests/bench/results/dem_inputs.md
+	exit $status
+fi
 python3 tests/bench/dem_map.py run "$bin" "$commit" ${DEM_MAP_PARTS:-} || status=$?
 python3 tests/bench/dem_map_report.py > tests/bench/results/dem_map.md
 python3 tests/bench/dem_map_plot.py > tests/bench/results/dem_map.svg
