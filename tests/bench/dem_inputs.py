@@ -98,15 +98,7 @@ def run(binary, build, only=None):
         dem_map.append(CSV, dem_map.csv_line(COLUMNS))
     done = {row_key(r["input"], {"material": r["material"], "layers": int(r["layers"]),
                                  "drive": r["drive"], "beta": float(r["beta_deg"])}) for r in read_rows()}
-    seeds = {}
-    if os.path.exists(RUNS):
-        for line in open(RUNS):
-            try:
-                r = json.loads(line)
-            except ValueError:
-                continue
-            if r.get("build") == build:
-                seeds.setdefault(r["row"], {})[r["seed"]] = r
+    seeds = dem_map.finished_seeds(build, RUNS, "row")
     for name, p, m in plan(mats):
         k = row_key(name, p)
         if k in done or (only and p["material"] != only):

@@ -161,19 +161,21 @@ def csv_line(values):
     return buf.getvalue()
 
 
-def finished_seeds(build):
-    """The runs file's seeds of this build: {point key: {seed: record}}."""
+def finished_seeds(build, path=None, field="key"):
+    """The runs file's seeds of this build: {point key (the record's
+    `field`): {seed: record}}; path: the map's runs file unless another."""
     out = {}
-    if not os.path.exists(RUNS):
+    path = path or RUNS
+    if not os.path.exists(path):
         return out
-    with open(RUNS) as f:
+    with open(path) as f:
         for line in f:
             try:
                 r = json.loads(line)
             except ValueError:
                 continue
             if r.get("build") == build:
-                out.setdefault(r["key"], {})[r["seed"]] = r
+                out.setdefault(r[field], {})[r["seed"]] = r
     return out
 
 
