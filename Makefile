@@ -467,7 +467,7 @@ bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
 # How far the map moves with the contact values it assumes (glass on the
 # deck and its rolling; wheat's restitution, friction between grains and
-# rolling), one at a time at six points, by the map's build
+# rolling), one at a time at seven points, by the map's build
 # (tests/bench/dem_inputs.py, about an hour of a core): dem_inputs.csv, .md.
 bench-dem-inputs: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh inputs

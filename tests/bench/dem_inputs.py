@@ -50,10 +50,11 @@ VARIANTS = {
 }
 # at the preset's drive, each at the map's stiffness (so that the change is
 # the input's alone): glass one grain deep at the low throw, the forward and
-# the reverse peak, and four deep at the low throw; wheat two deep (grain on
-# grain) at its two peaks
+# the reverse peak and the lowest throw past it, and four deep at the low
+# throw; wheat two deep (grain on grain) at its two peaks
 POINTS = [("glass", 1, "preset", 15), ("glass", 1, "preset", 30), ("glass", 1, "preset", 150),
-          ("glass", 4, "preset", 15), ("wheat", 2, "preset", 30), ("wheat", 2, "preset", 135)]
+          ("glass", 4, "preset", 15), ("wheat", 2, "preset", 30), ("wheat", 2, "preset", 135),
+          ("glass", 1, "preset", 165)]
 COLUMNS = ["input"] + dem_map.COLUMNS
 
 
