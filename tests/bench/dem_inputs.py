@@ -18,7 +18,6 @@ name one build). The report sets each beside its map point: the change in %
 of the bed's peak and in units of the two rows' standard error.
 """
 import contextlib
-import csv
 import io
 import json
 import os
@@ -80,10 +79,13 @@ def row_key(name, p):
 
 
 def read_rows():
-    if not os.path.exists(CSV):
-        return []
-    with open(CSV, newline="") as f:
-        return [r for r in csv.DictReader(f) if r.get("date")]
+    return dem_map.read_rows(CSV)
+
+
+def key_of(r):
+    """row_key of a row of the CSV."""
+    return row_key(r["input"], {"material": r["material"], "layers": int(r["layers"]),
+                                "drive": r["drive"], "beta": float(r["beta_deg"])})
 
 
 def run(binary, build, only=None):
@@ -97,8 +99,7 @@ def run(binary, build, only=None):
     dem_map.repair(RUNS)
     if not os.path.exists(CSV) or os.path.getsize(CSV) == 0:
         dem_map.append(CSV, dem_map.csv_line(COLUMNS))
-    done = {row_key(r["input"], {"material": r["material"], "layers": int(r["layers"]),
-                                 "drive": r["drive"], "beta": float(r["beta_deg"])}) for r in read_rows()}
+    done = {key_of(r) for r in read_rows()}
     seeds = dem_map.finished_seeds(build, RUNS, "row")
     for name, p, m in plan(mats):
         k = row_key(name, p)
@@ -161,14 +162,11 @@ def check():
     want = {row_key(n, p): (p, m) for n, p, m in plan(mats)}
     fails = []
     for r in read_rows():
-        k = row_key(r["input"], {"material": r["material"], "layers": int(r["layers"]),
-                                 "drive": r["drive"], "beta": float(r["beta_deg"])})
+        k = key_of(r)
         if k not in want:
             fails.append("row %s is not in the plan" % k)
             continue
-        p, m = want[k]
-        cmd = "convsim-dem " + " ".join(dem_map.args_of(p, m, "S")) + " (S = %s)" % " ".join(
-            map(str, dem_map.SEEDS))
+        cmd = dem_map.command_of(*want[k])
         if r["command"] != cmd:
             fails.append("row %s: command %s, the plan's %s" % (k, r["command"], cmd))
     buf = io.StringIO()

@@ -205,6 +205,11 @@ def sd(xs):
     return math.sqrt(sum((x - m) ** 2 for x in xs) / (len(xs) - 1))
 
 
+def command_of(p, mats):
+    """The row's `command`: the point's run with its seeds as S."""
+    return "convsim-dem " + " ".join(args_of(p, mats, "S")) + " (S = %s)" % " ".join(map(str, SEEDS))
+
+
 def row_of(p, mats, build, seeds):
     m = mats["materials"][p["material"]]
     outs = [seeds[s]["out"] for s in SEEDS]
@@ -214,7 +219,6 @@ def row_of(p, mats, build, seeds):
     h2 = [o["v_second_half"] for o in outs]
     ovpp = max(o["overlap_pp_max"] for o in outs) / d
     ovpw = max(o["overlap_pw_max"] for o in outs) / d
-    cmd = "convsim-dem " + " ".join(args_of(p, mats, "S")) + " (S = %s)" % " ".join(map(str, SEEDS))
     values = {
         "material": p["material"], "layers": p["layers"], "drive": p["drive"],
         "beta_deg": p["beta"], "rotation": p["rotation"],
@@ -224,7 +228,7 @@ def row_of(p, mats, build, seeds):
         "overlap_max_rel": "%.4g" % max(ovpp, ovpw),
         "e_scale": "%.6g" % (p["youngs"] / m["youngs_real"]), "cell_width_d": "%g" % p["width"],
         "grains": outs[0]["grains"], "cpu_s": "%.1f" % sum(seeds[s]["cpu_s"] for s in SEEDS),
-        "build": build, "command": cmd,
+        "build": build, "command": command_of(p, mats),
         "role": p["role"], "part": p["part"], "youngs_pa": "%g" % p["youngs"],
         "overlap_pp_rel": "%.4g" % ovpp, "overlap_pw_rel": "%.4g" % ovpw,
         "v_seeds": ";".join("%.6g" % x for x in v),

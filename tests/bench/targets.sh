@@ -106,10 +106,8 @@ read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 		echo "The daemon (target: at least 200 default sessions in real time on 2 cores, stream lag"
 		echo "p99 < 50 ms; \"baseline\" is the previous build, $PREV, run first):"
 		echo
-		conv=$prev
 		prev_build targets convsimd
 		CONVSIMD="$PWD/$BUILD/convsimd" BASELINE="$PWD/$prev" node tests/bench/realtime.mjs 200
-		prev=$conv
 	fi
 } > "$out/targets.md"
 cat "$out/targets.md"
