@@ -56,6 +56,15 @@ static void at_map_points_and_between(void **state)
 	assert_int_equal(check(&u, &me), 1);
 	assert_close(me.error, (D137 + D150) / 2 + (SD137 + SD150) / 2, 1e-12);
 	assert_close(me.error_uncertainty, (SD137 + SD150) / 2 + (D150 - D137) / 2, 1e-12);
+	/* anywhere between: rounded to 0.01 um/s, so JSON prints no float noise */
+	set(&u, "beta", "141.3");
+	assert_int_equal(check(&u, &me), 1);
+	assert_true(me.error > 0 && me.error_uncertainty > 0);
+	assert_true(fabs(me.error * 1e8 - round(me.error * 1e8)) < 1e-6);
+	assert_true(fabs(me.error_uncertainty * 1e8 - round(me.error_uncertainty * 1e8)) < 1e-6);
+	char buf[64];
+	snprintf(buf, sizeof buf, "%.15g", me.error);
+	assert_true(strtod(buf, NULL) == me.error && strlen(buf) <= 10);
 }
 
 static void bounds_included_and_beyond(void **state)
@@ -93,7 +102,7 @@ static void other_scenes_name_the_nearest(void **state)
 	assert_int_equal(check(&u, &me), 0);
 	assert_non_null(strstr(me.note, "omega_ss = 140 rad/s"));
 	u = bed4();
-	set(&u, "k_c", "1e7");
+	set(&u, "k_c", "1e8");
 	assert_int_equal(check(&u, &me), 0);
 	assert_non_null(strstr(me.note, "k_c differs"));
 	/* the preset as it is at a depth the map has not: the nearest depth
@@ -188,7 +197,7 @@ static void the_same_answer_after_any_check(void **state)
 	(void)state;
 	const char *betas[] = {"30", "45", "137", "150", "170"};
 	const char *other[][2] = {{"beta", "90"}, {"layers", "16"}, {"omega_ss", "140"},
-				  {"beta_rate", "5"}, {"k_c", "1e7"}};
+				  {"beta_rate", "5"}, {"k_c", "1e8"}};
 	for (size_t i = 0; i < sizeof betas / sizeof *betas; i++)
 		for (size_t j = 0; j < sizeof other / sizeof *other; j++) {
 			setup u = bed4(), o = bed4();
