@@ -164,6 +164,9 @@ static int idle(srv_session *s, clocks *c)
 	srv_cpu_leave(&s->budget.turn);
 	s->budget.waiting_for_cpu = 0;
 	s->steps_per_s = s->rtf = 0;
+	/* the CPU it stopped at: the loop reads it only every 10 ms, and a
+	 * short pace "max" run finishes in less */
+	srv_worker_read_cpu(s);
 	srv_persist_checkpoint(s, 1); /* what it stopped at, exactly */
 	srv_worker_publish(s, c);
 	pthread_cond_wait(&s->wake, &s->lock);

@@ -101,6 +101,16 @@ void srv_worker_commit_need(srv_session *s, clocks *c)
 		srv_budget_set_paced(&s->budget.paced_held, need);
 }
 
+/* The worker's CPU time into the session's cpu_seconds; a LIGGGHTS
+ * session's bed process's CPU is the session's too. */
+void srv_worker_read_cpu(srv_session *s)
+{
+	struct timespec ts;
+	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
+		s->budget.cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
+				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
+}
+
 /* cpu: read the worker's CPU time; a running session that spent its
  * grant pauses. */
 void srv_worker_check_cpu(srv_session *s, clocks *c)
@@ -109,14 +119,10 @@ void srv_worker_check_cpu(srv_session *s, clocks *c)
 	 * else now */
 	double now = isnan(c->stepped_wall) ? srv_now() : c->stepped_wall;
 	c->stepped_wall = NAN;
-	struct timespec ts;
 	if (now - c->cpu_wall < CPU_READ_EVERY)
 		return;
 	c->cpu_wall = now;
-	/* a LIGGGHTS session's bed process's CPU is the session's too */
-	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
-		s->budget.cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
-				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
+	srv_worker_read_cpu(s);
 	measure_cost(s, c);
 	if (s->state != SRV_RUNNING || s->budget.cpu_seconds < s->budget.cpu_limit)
 		return;

@@ -43,6 +43,8 @@ void srv_worker_publish_batch(srv_session *s, clocks *c);
 
 /* need: the session's hold on the paced cores follows what it needs now. */
 void srv_worker_commit_need(srv_session *s, clocks *c);
+/* the worker's CPU time (and a LIGGGHTS bed's) into cpu_seconds, now */
+void srv_worker_read_cpu(srv_session *s);
 /* cpu: read the worker's CPU time; a running session that spent its
  * grant pauses. */
 void srv_worker_check_cpu(srv_session *s, clocks *c);

@@ -15,6 +15,8 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
 import net from 'node:net';
+import { execFileSync } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
 import { startDaemon, req, openStream, until, metric, near, sleep, NO_FEED, SLOW } from './lib.mjs';
 
 const JSON_HEADERS = { 'Content-Type': 'application/json' };
@@ -204,6 +206,32 @@ test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a
     await until(async () => metric(await metrics(d.base), 'convsim_cpu_slots_waiting') === 0, 5000, 'no one waiting');
     const s = (await req(d.base, 'GET', `/api/v1/sessions/${ids[1]}`)).body;
     assert.equal(s.waiting_for_cpu, false);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('CPU: a short pace-max run that finished reports the CPU it took, not the first read of its clock', { timeout: 60000 * SLOW }, async () => {
+  // the same run by the command line: its cpu_seconds is the run's own
+  const cli = JSON.parse(execFileSync(fileURLToPath(new URL('../../build/convsim', import.meta.url)),
+    ['run', '-q', '--duration', '2', '--set', 'beta=150', '--set', 'layers=2'], { encoding: 'utf8' }));
+  assert.ok(cli.cpu_seconds > 0.001, `the CLI's ${cli.cpu_seconds}`);
+  const d = await startDaemon();
+  try {
+    const r = await req(d.base, 'POST', '/api/v1/sessions',
+      { params: { beta: 150 }, scene: { layers: 2 }, pace: 'max', until: 2 });
+    assert.equal(r.status, 201, r.text);
+    const s = await until(async () => {
+      const v = (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
+      return v.state === 'finished' && v;
+    }, 10000 * SLOW, 'the run to finish');
+    assert.equal(s.status.t, 2);
+    // a 2-s run takes a few ms; the worker reads its clock every 10 ms of
+    // wall time, and before the read at the stop reported ~0.1 ms
+    assert.ok(s.cpu_seconds > 0.3 * cli.cpu_seconds && s.cpu_seconds < 20 * cli.cpu_seconds,
+      `the session's ${s.cpu_seconds} s against the CLI's ${cli.cpu_seconds} s`);
+    const listed = (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.find((x) => x.id === r.body.id);
+    assert.equal(listed.cpu_seconds, s.cpu_seconds);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
