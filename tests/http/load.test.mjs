@@ -3,7 +3,7 @@
 // an error; metrics move with them.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, openStream, metric, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, openStream, metric, until, NO_FEED, SLOW } from './lib.mjs';
 
 let d;
 before(async () => { d = await startDaemon(); });
@@ -38,7 +38,12 @@ test('50 sessions with a stream each', { timeout: 120000 * SLOW }, async () => {
     assert.equal(recs.at(-1).data.t, 2);
     assert.ok(Math.abs(recs.at(-1).data.beta - (20 + i)) < 1e-9, 'each stream carries its own session');
   }
-  const m1 = (await req(d.base, 'GET', '/metrics')).text;
+  // a stream's client leaves once the daemon has sent its end and closed
+  // it, which may be a moment after the client read the end
+  const m1 = await until(async () => {
+    const m = (await req(d.base, 'GET', '/metrics')).text;
+    return metric(m, 'convsim_stream_clients') === 0 && m;
+  }, 5000 * SLOW, 'the stream clients to leave');
   assert.equal(metric(m1, 'convsim_sessions'), N);
   assert.equal(metric(m1, 'convsim_sessions_created_total') - metric(m0, 'convsim_sessions_created_total'), N);
   assert.equal(metric(m1, 'convsim_streams_opened_total') - metric(m0, 'convsim_streams_opened_total'), N);
