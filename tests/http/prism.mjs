@@ -7,7 +7,7 @@
 // standard input closes, so that it ends with the test process however that
 // process ends. Used by openapi.test.mjs and docs.test.mjs.
 import { spawn } from 'node:child_process';
-import { mkdtempSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -18,6 +18,9 @@ const PRISM = fileURLToPath(new URL('../node_modules/.bin/prism', import.meta.ur
 // Start Prism on a free port with the document docText in front of target
 // (http://HOST:PORT). Resolves to {url, log(), stop()} once it listens.
 export async function startPrism(docText, target) {
+  // without it the shell below waits on its input for ever (make test
+  // installs it: `make deps`)
+  if (!existsSync(PRISM)) throw new Error(`${PRISM} is missing: run \`make deps\` (make test does)`);
   const file = join(mkdtempSync(join(tmpdir(), 'convsim-prism-')), 'openapi.json');
   writeFileSync(file, docText);
   const [port] = await freePorts(1);
