@@ -33,7 +33,10 @@ const BED = { scene: { feed_model: 'liggghts', layers: 1 } };
 const ENV = { ...process.env, ASAN_OPTIONS: [process.env.ASAN_OPTIONS, 'detect_leaks=0'].filter(Boolean).join(':') };
 
 let d;
-before(async () => { d = await startDaemon(['--worker-nice', '15']); });
+// room for paced CPU beyond one core: a bed's measured cost rises on a
+// loaded host (1.23 cores once, where the stream below was then refused),
+// and these tests are not about the paced budget
+before(async () => { d = await startDaemon(['--worker-nice', '15', '--max-paced-cores', '4']); });
 after(async () => { await d.stop(); });
 
 const get = async (id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
