@@ -102,7 +102,7 @@ static void other_scenes_name_the_nearest(void **state)
 	assert_int_equal(check(&u, &me), 0);
 	assert_non_null(strstr(me.note, "omega_ss = 140 rad/s"));
 	u = bed4();
-	set(&u, "k_c", "1e8");
+	set(&u, "k_c", "1e7");
 	assert_int_equal(check(&u, &me), 0);
 	assert_non_null(strstr(me.note, "k_c differs"));
 	/* the preset as it is at a depth the map has not: the nearest depth
@@ -197,7 +197,7 @@ static void the_same_answer_after_any_check(void **state)
 	(void)state;
 	const char *betas[] = {"30", "45", "137", "150", "170"};
 	const char *other[][2] = {{"beta", "90"}, {"layers", "16"}, {"omega_ss", "140"},
-				  {"beta_rate", "5"}, {"k_c", "1e8"}};
+				  {"beta_rate", "5"}, {"k_c", "1e7"}};
 	for (size_t i = 0; i < sizeof betas / sizeof *betas; i++)
 		for (size_t j = 0; j < sizeof other / sizeof *other; j++) {
 			setup u = bed4(), o = bed4();
