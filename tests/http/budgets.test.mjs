@@ -16,8 +16,7 @@ import assert from 'node:assert/strict';
 import http from 'node:http';
 import net from 'node:net';
 import { execFileSync } from 'node:child_process';
-import { fileURLToPath } from 'node:url';
-import { startDaemon, req, openStream, until, metric, near, sleep, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, openStream, until, metric, near, sleep, NO_FEED, SLOW, CLI } from './lib.mjs';
 
 const JSON_HEADERS = { 'Content-Type': 'application/json' };
 
@@ -213,8 +212,7 @@ test('CPU: with --max-busy 1 two pace-max sessions take turns, one stepping at a
 
 test('CPU: a short pace-max run that finished reports the CPU it took, not the first read of its clock', { timeout: 60000 * SLOW }, async () => {
   // the same run by the command line: its cpu_seconds is the run's own
-  const cli = JSON.parse(execFileSync(fileURLToPath(new URL('../../build/convsim', import.meta.url)),
-    ['run', '-q', '--duration', '2', '--set', 'beta=150', '--set', 'layers=2'], { encoding: 'utf8' }));
+  const cli = JSON.parse(execFileSync(CLI, ['run', '-q', '--duration', '2', '--set', 'beta=150', '--set', 'layers=2'], { encoding: 'utf8' }));
   assert.ok(cli.cpu_seconds > 0.001, `the CLI's ${cli.cpu_seconds}`);
   const d = await startDaemon();
   try {

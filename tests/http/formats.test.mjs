@@ -11,9 +11,8 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, SLOW, CHEAP } from './lib.mjs';
+import { startDaemon, req, until, SLOW, CHEAP, CLI } from './lib.mjs';
 
-const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 let d, sid, eid, wid;
 
 before(async () => {

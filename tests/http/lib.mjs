@@ -13,6 +13,9 @@ import '../tether.mjs'; // nothing started here outlives the test
 
 export const BIN = process.env.CONVSIMD ||
   fileURLToPath(new URL('../../build/convsimd', import.meta.url));
+// the command line of the same build (CONVSIM: another one)
+export const CLI = process.env.CONVSIM ||
+  fileURLToPath(new URL('../../build/convsim', import.meta.url));
 export const SLOW = Number(process.env.CONVSIM_TEST_SLOW ||
   (BIN.includes('build-san') ? 4 : 1));
 export const WEB_ROOT = fileURLToPath(new URL('../../web', import.meta.url));

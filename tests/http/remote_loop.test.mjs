@@ -11,10 +11,9 @@ import assert from 'node:assert/strict';
 import { execFile, execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { promisify } from 'node:util';
-import { startDaemon, tokenFile, req, SLOW } from './lib.mjs';
+import { startDaemon, tokenFile, req, SLOW, CLI } from './lib.mjs';
 
 const SCRIPT = fileURLToPath(new URL('../../docs/examples/remote_pi.py', import.meta.url));
-const CLI = process.env.CONVSIM || fileURLToPath(new URL('../../build/convsim', import.meta.url));
 const TOKEN = 'remote-loop-token-0123456789abcdef';
 const AUTH = { Authorization: `Bearer ${TOKEN}` };
 const run = promisify(execFile);

@@ -12,9 +12,8 @@ import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import Ajv2020 from 'ajv/dist/2020.js';
-import { startDaemon, req, until, CHEAP } from './lib.mjs';
+import { startDaemon, req, until, CHEAP, CLI } from './lib.mjs';
 
-const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 // the CLI's options for CHEAP and t_end
 const CHEAP_CLI = ['--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2', '-q'];
 const cli = (...args) => execFileSync(CLI, ['sweep', ...CHEAP_CLI, ...args], { encoding: 'utf8' });

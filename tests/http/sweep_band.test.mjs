@@ -14,9 +14,8 @@ import { mkdtempSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import Ajv2020 from 'ajv/dist/2020.js';
-import { startDaemon, req, until, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, CHEAP, SLOW, CLI } from './lib.mjs';
 
-const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
 const CHEAP_CLI = ['--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2', '-q'];
 const cli = (...args) => execFileSync(CLI, ['sweep', ...CHEAP_CLI, ...args], { encoding: 'utf8' });
 
