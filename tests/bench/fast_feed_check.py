@@ -41,8 +41,11 @@ Each model run is `convsim run -p czubak2016 [drive's --set] --set layers=L
 --set beta=B --set rotation=R --set feed_coupling=false --set R=.. --set
 mu=.. --set k_c=.. -d 3 --set transient=1 -q`: the DEM's window (3 s, the
 last 2 s measured) on the same one-way machine the map's deck orbit comes
-from. Runs are cached in build/fast_feed_cache.json (keyed by the
-arguments and the binary's modification time).
+from. Runs are cached in build/fast_feed_cache.json, keyed by the arguments
+and by a hash of the sources compiled into the binary (from the build's
+dependency files, less the DEM map's compiled-in table, which changes
+model_error only: a calibration does not run everything again); the
+binary's modification time where it has no dependency files.
 """
 import csv
 import json
@@ -161,11 +164,45 @@ def grains_args(run, cand, p, duration=3):
     return a + (["1", "%g" % duration] if duration != 3 else [])
 
 
+def source_stamp(convsim):
+    """A hash of what v of a run depends on: the compiler, the build's flags
+    and the sources named in the dependency files of the objects beside the
+    binary (core, cli, fit, api), less build/core/model_map.inc (the DEM
+    map's table: model_error and model_checked only). Falls back to the
+    binary's modification time."""
+    import glob
+    import hashlib
+    build = os.path.dirname(os.path.abspath(convsim))
+    deps = set()
+    for sub in ("core", "cli", "fit", "api"):
+        for d in glob.glob(os.path.join(build, sub, "*.d")):
+            with open(d) as f:
+                text = f.read().replace("\\\n", " ")
+            for line in text.splitlines():
+                if ":" in line and not line.rstrip().endswith(":"):
+                    deps.update(line.split(":", 1)[1].split())
+    deps = sorted(x for x in deps if not x.endswith("model_map.inc"))
+    if not deps:
+        return "%d" % os.stat(convsim).st_mtime
+    h = hashlib.sha256()
+    cc = subprocess.run([os.environ.get("CC", "cc"), "--version"],
+                        capture_output=True, text=True).stdout
+    h.update(cc.encode())
+    with open(os.path.join(ROOT, "Makefile")) as f:
+        h.update("".join(l for l in f if l.startswith(("CFLAGS", "WARN"))).encode())
+    for x in deps:
+        path = x if os.path.isabs(x) else os.path.join(ROOT, x)
+        h.update(x.encode() + b"\0")
+        with open(path, "rb") as f:
+            h.update(f.read())
+    return "src-" + h.hexdigest()[:16]
+
+
 class Runner:
     def __init__(self, convsim):
         self.convsim = convsim
         self.bed = os.path.join(os.path.dirname(os.path.abspath(convsim)), "fast_feed_bed")
-        self.stamp = "%d" % os.stat(convsim).st_mtime
+        self.stamp = source_stamp(convsim)
         self.bed_stamp = "%d" % os.stat(self.bed).st_mtime if os.path.exists(self.bed) else "-"
         self.cache = {}
         if os.path.exists(CACHE):

@@ -120,7 +120,7 @@ def write_md(recs, runner, path, unpredicted=()):
     w("")
     w("`make fast-feed-check` (tests/bench/fast_feed_check.py) on %s, build `%s`, %s; data "
       "tests/bench/results/fast_feed.csv; %d runs of convsim and fast_feed_bed, %d of them this time (the others from "
-      "build/fast_feed_cache.json, same binary). Candidates "
+      "build/fast_feed_cache.json, same sources). Candidates "
       "(docs/feed-models.md): `closure`, the column model with R, mu, k_c and its layers from a "
       "closure in the depth; `ensemble`, the mean of two such columns with different R; "
       "`grains`, %d point-mass grains whose impacts keep a random share of their rebound "
