@@ -3,7 +3,6 @@
 """The DEM map's report (tests/bench/results/dem_map.md) from its CSV.
 
     dem_map_report.py [CSV]
-    dem_map_report.py --status      one paragraph of what exists (docs/dem.md)
 
 Prints Markdown: what of the planned map exists, the map's table (v and
 the seeds' spread), the convergence checks (stiffness, cell width, the
@@ -57,25 +56,6 @@ def peak_of(rows, r, mats):
 def of_peak(a, b, peak):
     """(a - b) in % of the bed's peak, as text."""
     return "n/a" if not peak else "%+.1f %%" % (100 * (a - b) / peak)
-
-
-def status(rows, mats):
-    """One paragraph for docs/dem.md: what exists, from one build."""
-    plan = dem_map.plan()
-    planned = [p for _, ps in plan for p in ps]
-    keys = {dem_map.key(r["material"], r["layers"], r["drive"], r["beta_deg"], r["rotation"],
-                        r["e_scale"], r["cell_width_d"]) for r in rows}
-    done = [p for p in planned if dem_map.point_key(p, mats) in keys]
-    maps = [p for p in planned if p["role"] == "map"]
-    mdone = [p for p in done if p["role"] == "map"]
-    extra = len(rows) - len(done)
-    builds = sorted({r["build"][:12] for r in rows})
-    print("Status (%s, build %s): %d of the plan's %d map points and %d of its %d check rows "
-          "exist, with %d more rows at stiffer rungs where 2e+08 Pa overlapped more than 1 %%; %.2f CPU "
-          "hours so far (tests/bench/results/dem_map.md)." %
-          (max(r["date"] for r in rows)[:10] if rows else "-", ", ".join(builds) or "-", len(mdone),
-           len(maps), len(done) - len(mdone), len(planned) - len(maps), extra,
-           sum(f(r["cpu_s"]) for r in rows) / 3600))
 
 
 def ladder(rows, mats, w):
@@ -145,9 +125,6 @@ def ladder(rows, mats, w):
 
 
 def main():
-    if len(sys.argv) > 1 and sys.argv[1] == "--status":
-        status(dem_map.read_rows(), dem_map.materials())
-        return
     path = sys.argv[1] if len(sys.argv) > 1 else dem_map.CSV
     rows = dem_map.read_rows(path)
     mats = dem_map.materials()
@@ -201,6 +178,11 @@ def main():
       "beta clockwise; the machine is mirror-symmetric (checked below), so counter-clockwise "
       "at 180 - beta is the same speed the other way." %
       (map_done, map_planned, 100.0 * map_done / map_planned if map_planned else 0))
+    w("")
+    w("Check rows done: %d of %d; rows at a stiffer rung than the plan's, where 2e+08 Pa "
+      "overlapped more than 1 %% of a diameter: %d; last row %s." %
+      (done_all - map_done, total - map_planned, len(rows) - done_all,
+       max(r["date"] for r in rows)[:10] if rows else "-"))
     w("")
     # the map's tables
     w("## The map: v (m/s), mean of 3 seeds ± their standard deviation")
