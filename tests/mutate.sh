@@ -69,6 +69,8 @@ mutations=(
 	# the symmetric reduction where the machine is not symmetric:
 	# tests/unit/test_asymmetry.c
 	"the symmetric reduction blind to unequal eliminator dampers|core/setup.c|s|p->b_s1 == p->b_s2 \&\&|1 \&\&|"
+	# the ideal drive's speed ramp: tests/unit/test_machine.c
+	"the ideal drive's speed ramp always speeding up|core/ramp.c|s|push(r, \&t, \&b, \&v, copysign(amax, dv), fabs(dv) / amax);|push(r, \&t, \&b, \&v, amax, fabs(dv) / amax);|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -296,6 +296,35 @@ static void ramp_retargeted_while_moving(void **state)
 	assert_close(bd, 0.0, 2e-9);
 }
 
+/* The ideal drive's speed ramps at drive_accel towards the new target,
+ * down as well as up: phi - alpha is prescribed, so the rotor speed is the
+ * ramp's rate itself. From +omega_ss (157.08 rad/s) a reversal at t = 0.1 s
+ * reaches 157.08 - 2000 * 0.05 = 57.08 rad/s 0.05 s later and -157.08
+ * rad/s after 2 * 157.08 / 2000 = 0.157 s; a lower omega_ss (100 rad/s)
+ * then slows it to -100 rad/s within 0.029 s. */
+static void ideal_drive_speed_ramps_both_ways(void **state)
+{
+	(void)state;
+	setup u = machine_only("rk4", "1e-4");
+	set(&u, "drive", "ideal");
+	set(&u, "start", "steady");
+	sim *s = make(&u);
+	const double w = u.p.omega_ss, a = u.p.drive_accel;
+	advance(s, 0.1);
+	assert_close(status(s).rotor_speed, w, 1e-9 * w);
+	assert_int_equal(sim_set_rotation(s, SIM_CCW), SIM_OK);
+	advance(s, 0.15);
+	assert_close(status(s).rotor_speed, w - a * 0.05, 1e-6 * w);
+	advance(s, 0.3);
+	assert_close(status(s).rotor_speed, -w, 1e-9 * w);
+	assert_int_equal(sim_set_omega_ss(s, 100.0), SIM_OK);
+	advance(s, 0.31);
+	assert_close(status(s).rotor_speed, -w + a * 0.01, 1e-6 * w);
+	advance(s, 0.35);
+	assert_close(status(s).rotor_speed, -100.0, 1e-9 * w);
+	sim_free(s);
+}
+
 /* Mirror symmetry of the symmetric machine: (cw, beta) and (ccw, 180 -
  * beta) give mirrored motions: x, alpha and the rotor speed change sign,
  * y stays, and the eliminators swap with their strokes negated (the
@@ -448,6 +477,7 @@ int main(void)
 		cmocka_unit_test(fixed_step_convergence_order),
 		cmocka_unit_test(beta_ramps_are_continuous),
 		cmocka_unit_test(ramp_retargeted_while_moving),
+		cmocka_unit_test(ideal_drive_speed_ramps_both_ways),
 		cmocka_unit_test(mirror_symmetry_machine),
 		cmocka_unit_test(reduced_evaluation_is_the_general_one),
 		cmocka_unit_test(angle_sine_and_cosine),
