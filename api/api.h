@@ -221,8 +221,8 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 			       const char *rate, const char *limit, const char *last_event_id,
 			       const char *since, api_stream_query *q, api_problem *pb);
 /* ?from=, ?to=, ?stride= of GET /sessions/{id}/trajectory (NULL or empty
- * when absent): finite numbers of seconds, from <= to, stride >= 0 (0:
- * as recorded). Defaults -inf, +inf, 0. API_OK or a 400 bad-query. */
+ * when absent): finite numbers of seconds, from <= to, a stride given
+ * > 0. Defaults -inf, +inf, 0 (0: as recorded). API_OK or a 400 bad-query. */
 typedef struct api_trajectory_query {
 	double from, to, stride;
 } api_trajectory_query;

@@ -285,7 +285,7 @@ api_err api_parse_trajectory_query(const char *from, const char *to, const char 
 	if (q->from > q->to)
 		return api_fail(pb, API_QUERY, "from", "from (%g) must not exceed to (%g)", q->from,
 				q->to);
-	if (q->stride < 0)
+	if (stride && *stride && !(q->stride > 0))
 		return api_fail(pb, API_QUERY, "stride", "stride must be positive (s)");
 	return API_OK;
 }

@@ -152,10 +152,13 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 					"stride must be a whole multiple of the recorded spacing, "
 					"now %s s (got %g)", rec, every);
 		}
+		/* a row is on the grid when its time is within a millionth
+		 * of the recorded spacing of a multiple of the stride (a
+		 * ratio alone keeps every row of a stride far beyond them) */
 		size_t width = API_HISTORY_WIDTH(columns), kept = 0;
 		for (size_t i = 0; i < n; i++) {
-			double m = rows[i * width] / every;
-			if (fabs(m - floor(m + 0.5)) < 1e-6)
+			double t = rows[i * width];
+			if (fabs(t - floor(t / every + 0.5) * every) < 1e-6 * stride)
 				memmove(rows + kept++ * width, rows + i * width,
 					width * sizeof *rows);
 		}
