@@ -246,6 +246,7 @@ typedef struct api_value {
 
 #define API_PACE_MAX 0.0         /* pace value meaning "as fast as possible" */
 #define API_PACE_MIN 0.001       /* the least real-time factor a request may set */
+#define API_CPU_BUDGET_MIN 0.001 /* CPU s: the least grant a PATCH may set */
 #define API_DEFAULT_MAX_UNTIL 60.0 /* s: "until" for pace "max" if none given */
 #define API_DEFAULT_SAMPLE_RATE 250.0
 

@@ -172,7 +172,9 @@ static api_err parse_cpu(const cJSON *it, const api_spec *spec, const char *name
 			 api_control *c, api_problem *pb)
 {
 	(void)spec;
-	return api_parse_real(it, name, 1e-3, 1e9, 0, &c->cpu_budget, pb);
+	/* any number: its range, [API_CPU_BUDGET_MIN, --max-cpu-seconds],
+	 * is the daemon's option, checked where the session is admitted */
+	return api_parse_real(it, name, -INFINITY, INFINITY, 0, &c->cpu_budget, pb);
 }
 
 /* ---- echo (angles as the user sent them) ------------------------------------ */

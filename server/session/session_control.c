@@ -31,14 +31,14 @@ static api_err admit_cpu_limit(const srv_session *s, const api_control *c,
 			       api_problem *pb)
 {
 	(void)s;
-	if (!(c->cpu_budget > cfg->max_cpu_seconds))
+	if (c->cpu_budget >= API_CPU_BUDGET_MIN && c->cpu_budget <= cfg->max_cpu_seconds)
 		return API_OK;
 	api_err e = api_fail(pb, API_RANGE, "cpu_budget",
-			     "cpu_budget must be CPU seconds in (0, %g] "
-			     "(--max-cpu-seconds); got %g", cfg->max_cpu_seconds,
-			     c->cpu_budget);
+			     "cpu_budget must be CPU seconds in [%g, %g] "
+			     "(--max-cpu-seconds); got %g", API_CPU_BUDGET_MIN,
+			     cfg->max_cpu_seconds, c->cpu_budget);
 	pb->has_range = 1;
-	pb->min = 0;
+	pb->min = API_CPU_BUDGET_MIN;
 	pb->max = cfg->max_cpu_seconds;
 	return e;
 }

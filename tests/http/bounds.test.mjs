@@ -18,6 +18,30 @@ before(async () => {
 });
 after(async () => { assert.equal((await d.stop()).code, 0, d.stderr()); });
 
+test('cpu_budget: every refusal names one range, [0.001, --max-cpu-seconds], and changes nothing', async () => {
+  const spec = (await req(d.base, 'GET', '/api/v1/openapi.json')).body;
+  const schema = spec.components.schemas.Control.properties.cpu_budget;
+  const before = (await req(d.base, 'GET', path)).body;
+  for (const v of [0, -1, 0.0005, 1e-300, 300.5, 1e9, 1e10, '1e309']) {
+    const body = typeof v === 'string' ? `{"cpu_budget":${v}}` : { cpu_budget: v };
+    const r = await req(d.base, 'PATCH', path, body);
+    assert.equal(r.status, 422, `${v}: ${r.text}`);
+    assert.equal(r.body.type, '/api/v1/problems/out-of-range', r.text);
+    assert.equal(r.body.field, 'cpu_budget', r.text);
+    assert.equal(r.body.min, 0.001, `${v}: ${r.text}`);
+    assert.equal(r.body.max, 300, `${v}: ${r.text}`);
+    assert.match(r.body.detail, /\[0\.001, 300\]/, r.text);
+  }
+  assert.equal(schema.minimum, 0.001, JSON.stringify(schema));
+  assert.equal(schema.exclusiveMinimum, undefined, JSON.stringify(schema));
+  for (const v of [0.001, 300]) {
+    const r = await req(d.base, 'PATCH', path, { cpu_budget: v });
+    assert.equal(r.status, 200, `${v}: ${r.text}`);
+  }
+  const now = (await req(d.base, 'GET', path)).body;
+  assert.equal(now.state, before.state);
+});
+
 test('trajectory: a stride keeps only rows on its grid, however large; 0 or less is 400', async () => {
   const all = (await req(d.base, 'GET', `${path}/trajectory`)).body;
   assert.ok(all.count > 100, `${all.count} rows`);
