@@ -199,6 +199,10 @@ const api_query *api_queries(size_t *n);
 /* API_OK if route rt takes query parameter name, else a 400 bad-query
  * problem naming the parameters it takes (and the nearest one). */
 api_err api_check_query(const api_route *rt, const char *name, api_problem *pb);
+/* API_OK if a parameter the route takes has a value (value NULL: the name
+ * came without '=') and came once (times: how often the query names it),
+ * else a 400 bad-query problem naming it. */
+api_err api_check_query_value(const char *name, const char *value, int times, api_problem *pb);
 /* The representation of a result route from ?format= (may be NULL) and
  * Accept (may be NULL): *csv 0 (JSON) or 1 (CSV); 400 for another format,
  * 406 when Accept names neither. Other routes: JSON, API_OK. */

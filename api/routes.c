@@ -134,6 +134,17 @@ api_err api_check_query(const api_route *rt, const char *name, api_problem *pb)
 			name, hint, n ? list : "none");
 }
 
+api_err api_check_query_value(const char *name, const char *value, int times, api_problem *pb)
+{
+	if (!value)
+		return api_fail(pb, API_QUERY, name, "query parameter \"%.40s\" needs a value "
+				"(%.40s=...)", name, name);
+	if (times > 1)
+		return api_fail(pb, API_QUERY, name, "query parameter \"%.40s\" is given %d "
+				"times; give it once", name, times);
+	return API_OK;
+}
+
 /* The q value Accept gives to type ("text/csv"), 0..1; -1 if not named. */
 static double accept_q(const char *accept, const char *type)
 {

@@ -163,15 +163,36 @@ typedef struct query_check {
 	const api_route *rt;
 	api_problem *pb;
 	int bad;
+	srv_req *r;
+	const char *key; /* count_key: the name counted, and how often */
+	int times;
 } query_check;
 
-static enum MHD_Result check_one_query(void *cls, enum MHD_ValueKind kind, const char *key,
-				       const char *value)
+static enum MHD_Result count_key(void *cls, enum MHD_ValueKind kind, const char *key,
+				 const char *value)
 {
 	(void)kind;
 	(void)value;
 	query_check *qc = cls;
-	if (qc->bad || api_check_query(qc->rt, key, qc->pb) == API_OK)
+	qc->times += strcmp(key, qc->key) == 0;
+	return MHD_YES;
+}
+
+/* A parameter the route takes, with a value, once (the query holds at most
+ * SRV_MAX_QUERY_PARAMS: counting each is cheap). */
+static enum MHD_Result check_one_query(void *cls, enum MHD_ValueKind kind, const char *key,
+				       const char *value)
+{
+	query_check *qc = cls;
+	if (qc->bad)
+		return MHD_NO;
+	api_err e = api_check_query(qc->rt, key, qc->pb);
+	if (e == API_OK) {
+		query_check count = {.key = key};
+		MHD_get_connection_values(qc->r->conn, kind, count_key, &count);
+		e = api_check_query_value(key, value, count.times, qc->pb);
+	}
+	if (e == API_OK)
 		return MHD_YES;
 	qc->bad = 1;
 	return MHD_NO;
@@ -185,7 +206,7 @@ static enum MHD_Result call_route(srv_req *r, size_t id)
 	size_t n;
 	const api_route *rt = &api_routes(&n)[id];
 	api_problem pb;
-	query_check qc = {rt, &pb, 0};
+	query_check qc = {.rt = rt, .pb = &pb, .r = r};
 	MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, check_one_query, &qc);
 	if (qc.bad || api_negotiate(rt, rt->tables ? srv_query(r, "format") : NULL,
 				    srv_header(r, MHD_HTTP_HEADER_ACCEPT), &r->csv, &pb) != API_OK)

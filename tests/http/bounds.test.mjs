@@ -61,3 +61,23 @@ test('trajectory: a stride keeps only rows on its grid, however large; 0 or less
     assert.equal(r.body.field, 'stride');
   }
 });
+
+test('a query parameter without a value or given twice is 400 naming it, never read as absent or as its first', async () => {
+  for (const [q, field] of [
+    ['/api/v1/sessions?format', 'format'],
+    ['/api/v1/sessions?format=csv&format=json', 'format'],
+    ['/api/v1/sessions?scope=local&format=json&scope=all', 'scope'],
+    [`${path}?format`, 'format'],
+    [`${path}/trajectory?from=1&from=2`, 'from'],
+    [`${path}/trajectory?stride`, 'stride'],
+    [`${path}/stream?limit`, 'limit'],
+    [`${path}/stream?limit=1&since=0&limit=5`, 'limit'],
+  ]) {
+    const r = await req(d.base, 'GET', q);
+    assert.equal(r.status, 400, `${q}: ${r.text}`);
+    assert.equal(r.body.type, '/api/v1/problems/bad-query', r.text);
+    assert.equal(r.body.field, field, r.text);
+  }
+  const ok = await req(d.base, 'GET', '/api/v1/sessions?format=csv&scope=local');
+  assert.equal(ok.status, 200, ok.text);
+});
