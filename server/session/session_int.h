@@ -111,6 +111,11 @@ typedef struct srv_session_restore {
 	int exp_after_catch_up;   /* its experiment, attached again at the
 				     restore, begins once it is back where
 				     it was (srv_session_readopt) */
+	double cpu_grant;         /* CPU s: the last grant of the controls
+				     its checkpoint holds (0: none), from 0
+				     again (srv_session_adopt) */
+	int cpu_paused;           /* restored paused by its CPU budget: its
+				     client's last running was not false */
 } srv_session_restore;
 
 /* What a session holds of the daemon's budgets (budget.c keeps the

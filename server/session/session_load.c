@@ -147,6 +147,36 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	return 0;
 }
 
+/* The CPU budget of the controls the checkpoint holds (the log's first
+ * `held` bytes), which no checkpoint stores and nothing replays: the last
+ * cpu_budget, unless a running: true came after it (a resume of a session
+ * its budget paused grants --max-cpu-seconds), and whether a paused
+ * session was paused by its budget (its client's last running was not
+ * false). Applied by srv_session_adopt. */
+static void held_budget(srv_session *s, const char *text, size_t held)
+{
+	int running = 1;
+	for (size_t at = 0; at < held;) {
+		const char *nl = memchr(text + at, '\n', held - at);
+		size_t n = nl ? (size_t)(nl - (text + at)) : held - at;
+		api_control c;
+		api_problem pb;
+		double t;
+		if (n && api_parse_control_event(text + at, n, &s->spec, &c, &t, NULL, 0,
+						 &pb) == API_OK) {
+			if (c.set & API_C_CPU)
+				s->restore.cpu_grant = c.cpu_budget;
+			if (c.set & API_C_RUNNING) {
+				running = c.running;
+				if (c.running)
+					s->restore.cpu_grant = 0;
+			}
+		}
+		at += n + 1;
+	}
+	s->restore.cpu_paused = s->state == SRV_PAUSED && running;
+}
+
 /* The control log back into s->controls (later controls are appended to
  * it), and the controls logged after its first `logged` bytes (what the
  * checkpoint restored holds; 0 without one; SIZE_MAX: a checkpoint that
@@ -166,6 +196,7 @@ static void load_controls(srv_session *s, size_t logged)
 	s->controls = text;
 	s->controls_len = s->log.synced = len;
 	s->controls_cap = len + 1;
+	held_budget(s, text, logged < len ? logged : len);
 	if (logged >= len)
 		return;
 	size_t lines = 0;
