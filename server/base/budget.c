@@ -184,14 +184,18 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		return API_OK;
 	double others = taken - *held;
 	if (need > limit) {
+		/* no pace from the least one up fits: only "max", which
+		 * this budget does not hold, runs it (no empty range) */
+		int none = !(limit / cpu_per_s >= API_PACE_MIN);
 		api_fail(pb, API_RANGE, field,
 			 "this session needs %.3g cores (%.3g ms of CPU per "
 			 "simulated s at pace %g), more than the %g cores for "
-			 "paced sessions (--max-paced-cores); nothing was %s, "
-			 "lower the pace", need, 1e3 * cpu_per_s, pace, limit,
-			 verb);
-		pb->has_range = 1;
-		pb->min = 0.001; /* the least pace (api/) */
+			 "paced sessions (--max-paced-cores); nothing was %s, %s",
+			 need, 1e3 * cpu_per_s, pace, limit, verb,
+			 none ? "no pace from 0.001 fits: run it at pace \"max\""
+			      : "lower the pace");
+		pb->has_range = !none;
+		pb->min = API_PACE_MIN;
 		pb->max = limit / cpu_per_s;
 		return api_budget(pb, "cpu", limit, 0);
 	}

@@ -81,3 +81,26 @@ test('a query parameter without a value or given twice is 400 naming it, never r
   const ok = await req(d.base, 'GET', '/api/v1/sessions?format=csv&scope=local');
   assert.equal(ok.status, 200, ok.text);
 });
+
+test('a session no real-time pace can hold is told to run at pace "max", never given a range with max below min', async () => {
+  // 2,500 CPU s a simulated s: a sample (1e-4 s) within a second of CPU, no pace from 0.001 within
+  // one core; start "rest": nothing to settle, so only the pace is in question
+  const slow = { scene: { ...CHEAP.scene, start: 'rest' }, integrator: { dt: 2e-10 }, sample_rate: 10000 };
+  const c = await req(d.base, 'POST', '/api/v1/sessions', { ...slow, pace: 0.001 });
+  assert.equal(c.status, 422, c.text);
+  assert.equal(c.body.field, 'pace', c.text);
+  assert.equal(c.body.budget, 'cpu', c.text);
+  assert.ok(!('max' in c.body) || c.body.max >= c.body.min, c.text);
+  assert.match(c.body.detail, /pace "max"/, c.text);
+  // the same session at pace "max" is not held by that budget; a PATCH to a pace is refused alike
+  const m = await req(d.base, 'POST', '/api/v1/sessions', { ...slow, pace: 'max', until: 2e-4 });
+  assert.equal(m.status, 201, m.text);
+  const path = `/api/v1/sessions/${m.body.id}`;
+  await until(async () => (await req(d.base, 'GET', path)).body.state === 'finished', 30000 * SLOW, 'finish');
+  const p = await req(d.base, 'PATCH', path, { pace: 1, until: 1 });
+  assert.equal(p.status, 422, p.text);
+  assert.ok(!('max' in p.body) || p.body.max >= p.body.min, p.text);
+  assert.match(p.body.detail, /pace "max"/, p.text);
+  assert.equal((await req(d.base, 'GET', path)).body.pace, 'max');
+  assert.equal((await req(d.base, 'DELETE', path)).status, 204);
+});
