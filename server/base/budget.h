@@ -73,8 +73,17 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
  * would integrate (sim_preview: the set validated, nothing settled), so
  * that a creation the cores cannot take is refused for the price of its
  * parse. API_OK and *cpu_per_s, or sim_new's validation error in *pb as a
- * session's creation answers it. */
+ * session's creation answers it. Then the work no worker's grant or stop
+ * interrupts (API_RANGE with *pb, budget "cpu", nothing built): a sample
+ * interval, which the worker advances whole, estimated beyond
+ * SRV_SAMPLE_CPU_MAX (422 naming integrator.dt, about the least step that
+ * fits as min), and the settling of a steady start, which runs in the
+ * creating request's thread, beyond limit (--max-cpu-seconds; 422 naming
+ * scene.settle, the longest that fits as max). */
+#define SRV_SAMPLE_CPU_MAX 1.0 /* CPU s: well within a control's 5-s wait */
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
+api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_problem *pb);
+
 /* Raise what a paced session holds (*held, cores; the caller's, guarded
  * by its lock) to need = cpu_per_s x pace. API_OK when need <= *held or
  * the running paced sessions' sum stays within --max-paced-cores; else

@@ -79,17 +79,56 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
 }
 
-api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
+/* What sim_new would integrate (its step in st->dt) and its estimate. */
+static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
+		       api_problem *pb)
 {
 	char msg[256] = "";
-	sim_status st;
 	int columns, layers;
-	int err = sim_preview(&spec->params, &spec->scene, &spec->method, &st, &columns, &layers,
+	int err = sim_preview(&spec->params, &spec->scene, &spec->method, st, &columns, &layers,
 			      msg, sizeof msg);
 	if (err != SIM_OK)
 		return api_fail(pb, api_from_sim(err), NULL, "%s", msg[0] ? msg : sim_strerror(err));
-	*cpu_per_s = srv_budget_cpu_estimate(spec, &st, columns, layers);
+	*cpu_per_s = srv_budget_cpu_estimate(spec, st, columns, layers);
 	return API_OK;
+}
+
+api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
+{
+	sim_status st;
+	return preview(spec, &st, cpu_per_s, pb);
+}
+
+api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_problem *pb)
+{
+	sim_status st;
+	double cpu;
+	if (preview(spec, &st, &cpu, pb) != API_OK)
+		return pb->code;
+	double sample = cpu / spec->sample_rate;
+	double settle = spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+	if (sample > SRV_SAMPLE_CPU_MAX) {
+		api_fail(pb, API_RANGE, "integrator.dt",
+			 "a sample interval (%g s) of this session would take about %.3g CPU s "
+			 "(%.3g CPU s per simulated s at integrator.dt = %g s), more than the %g s a "
+			 "worker may go without taking a control or its stop; nothing was created: "
+			 "a larger integrator.dt or a smaller scene", 1.0 / spec->sample_rate,
+			 sample, cpu, st.dt, SRV_SAMPLE_CPU_MAX);
+		pb->min = st.dt * sample / SRV_SAMPLE_CPU_MAX;
+		pb->max = 0.01; /* the settings table's */
+	} else if (cpu * settle > limit) {
+		api_fail(pb, API_RANGE, "scene.settle",
+			 "the steady start would settle for about %.3g CPU s (%.3g CPU s per "
+			 "simulated s over scene.settle = %g s), more than --max-cpu-seconds (%g); "
+			 "nothing was created: a larger integrator.dt, a smaller scene, a shorter "
+			 "scene.settle or scene.start \"rest\"", cpu * settle, cpu, settle, limit);
+		pb->min = 0;
+		pb->max = limit / cpu;
+	} else {
+		return API_OK;
+	}
+	pb->has_range = 1;
+	return api_budget(pb, "cpu", limit, 0);
 }
 
 double srv_budget_sample_cpu(int columns, int layers)

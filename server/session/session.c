@@ -120,11 +120,16 @@ static void destroy(srv_entry *en)
  * back if it fails): creations that come meanwhile see the room taken
  * rather than each spend a settling and a probe and all but one be
  * refused at the end. A LIGGGHTS bed's session is charged its bed's cores
- * (session_init). 1 with *pb. */
+ * (session_init). At any pace: work no worker's grant or stop would
+ * interrupt (a sample, the settling). 1 with *pb. */
 static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 {
 	double cpu;
-	if (spec->pace == API_PACE_MAX || srv_dem_wanted(spec))
+	if (srv_dem_wanted(spec))
+		return 0;
+	if (srv_budget_uninterrupted_check(spec, cfg->max_cpu_seconds, pb) != API_OK)
+		return 1;
+	if (spec->pace == API_PACE_MAX)
 		return 0;
 	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
 		return 1;

@@ -104,3 +104,25 @@ test('a session no real-time pace can hold is told to run at pace "max", never g
   assert.equal((await req(d.base, 'GET', path)).body.pace, 'max');
   assert.equal((await req(d.base, 'DELETE', path)).status, 204);
 });
+
+test('a session whose sample or steady start would outlast what a worker can interrupt is refused at once, at any pace', { timeout: 30000 * SLOW }, async () => {
+  const count = async () => (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length;
+  const before = await count();
+  const tiny = { ...CHEAP, integrator: { dt: 1e-12 } };
+  for (const [url, body, field] of [
+    ['/api/v1/sessions', { ...tiny, pace: 'max' }, /^integrator\.dt$/],
+    ['/api/v1/sessions', { ...tiny, scene: { ...CHEAP.scene, start: 'rest' }, pace: 'max', until: 1 }, /^integrator\.dt$/],
+    ['/api/v1/experiments', { session: tiny, schedule: [{ beta: 38, until: 1 }] }, /integrator\.dt$/],
+    ['/api/v1/sessions', { scene: { ...CHEAP.scene, settle: 10 }, integrator: { dt: 1e-8 }, pace: 'max' }, /^scene\.settle$/],
+  ]) {
+    const t0 = Date.now();
+    const r = await req(d.base, 'POST', url, body);
+    assert.ok(Date.now() - t0 < 5000 * SLOW, `answered after ${Date.now() - t0} ms`);
+    assert.equal(r.status, 422, r.text);
+    assert.equal(r.body.type, '/api/v1/problems/out-of-range', r.text);
+    assert.match(r.body.field, field, r.text);
+    assert.equal(r.body.budget, 'cpu', r.text);
+    assert.ok(r.body.min < r.body.max, r.text);
+  }
+  assert.equal(await count(), before);
+});
