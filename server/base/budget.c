@@ -53,6 +53,7 @@ void srv_budget_init(const srv_config *config)
 {
 	cfg = config;
 	srv_cpu_turns_init(config);
+	srv_budget_cost_init(config->max_cpu_seconds);
 }
 
 /* ---- memory ---------------------------------------------------------------- */
@@ -184,8 +185,7 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		return API_OK;
 	double others = taken - *held;
 	if (need > limit) {
-		/* no pace from the least one up fits: only "max", which
-		 * this budget does not hold, runs it (no empty range) */
+		/* none from the least pace up fits: "max" only (no range) */
 		int none = !(limit / cpu_per_s >= API_PACE_MIN);
 		api_fail(pb, API_RANGE, field,
 			 "this session needs %.3g cores (%.3g ms of CPU per "

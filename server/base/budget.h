@@ -83,6 +83,16 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 #define SRV_SAMPLE_CPU_MAX 1.0 /* CPU s: well within a control's 5-s wait */
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
 api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_problem *pb);
+/* A job's run (a sweep's point, a fit's evaluation): a steady start's
+ * settling and t_end simulated s, which nothing interrupts once begun (a
+ * DELETE, a SIGTERM wait for it). One estimated beyond --max-cpu-seconds
+ * (srv_budget_cost_init) is refused: 422, budget "cpu", naming t_end with
+ * the longest after scene.transient that fits as max, or integrator.dt
+ * (about the least step that fits as min) where none does. API_OK (also
+ * for a set sim_new refuses: the run fails at once) or API_RANGE with
+ * *pb. */
+void srv_budget_cost_init(double max_cpu_seconds);
+api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb);
 
 /* Raise what a paced session holds (*held, cores; the caller's, guarded
  * by its lock) to need = cpu_per_s x pace. API_OK when need <= *held or

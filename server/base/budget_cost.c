@@ -131,6 +131,37 @@ api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_p
 	return api_budget(pb, "cpu", limit, 0);
 }
 
+static double run_limit = 1800.0; /* CPU s: --max-cpu-seconds */
+
+void srv_budget_cost_init(double max_cpu_seconds)
+{
+	run_limit = max_cpu_seconds;
+}
+
+api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb)
+{
+	sim_status st;
+	double cpu;
+	if (preview(spec, &st, &cpu, pb) != API_OK)
+		return API_OK; /* a set sim_new refuses: the run fails at once */
+	double settle = spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+	double run = cpu * (settle + t_end), longest = run_limit / cpu - settle;
+	if (!(run > run_limit))
+		return API_OK;
+	int none = !(longest > spec->scene.transient);
+	api_fail(pb, API_RANGE, none ? "integrator.dt" : "t_end",
+		 "a run would take about %.3g CPU s (%.3g CPU s per simulated s at integrator.dt "
+		 "= %g s over %g s of settling and t_end = %g s), more than --max-cpu-seconds "
+		 "(%g), and nothing stops a run once begun; nothing was started: %s",
+		 run, cpu, st.dt, settle, t_end, run_limit,
+		 none ? "a larger integrator.dt or a smaller scene" : "a shorter t_end, a larger "
+								      "integrator.dt or a smaller scene");
+	pb->has_range = 1;
+	pb->min = none ? st.dt * run / run_limit : spec->scene.transient;
+	pb->max = none ? 0.01 : longest;
+	return api_budget(pb, "cpu", run_limit, 0);
+}
+
 double srv_budget_sample_cpu(int columns, int layers)
 {
 	return SAMPLE_SERVER_CPU_S + RECORD_DOUBLE_CPU_S * (double)srv_budget_record_doubles(columns, layers);

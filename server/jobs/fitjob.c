@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "fit.h"
 #include "fitjob.h"
 #include "job.h"
@@ -284,10 +285,19 @@ static srv_fit *fit_new(const char *body, size_t len, api_problem *pb)
 	return f;
 }
 
+/* A new fit, refused whole where one evaluation (its model at the start
+ * values) would outlast --max-cpu-seconds (a restored one is not). */
 static srv_entry *fit_create(const char *body, size_t len, api_problem *pb)
 {
 	srv_fit *f = fit_new(body, len, pb);
-	return f ? &f->entry : NULL;
+	if (!f)
+		return NULL;
+	api_spec spec = {.params = f->req.p, .scene = f->req.sc, .method = f->req.m};
+	if (srv_budget_run_check(&spec, f->req.t_end, pb) != API_OK) {
+		fit_free_job(f);
+		return NULL;
+	}
+	return &f->entry;
 }
 
 static void fit_discard(srv_entry *en)

@@ -353,12 +353,9 @@ static srv_entry *sweep_create(const char *body, size_t len, api_problem *pb)
 	/* the points hold the values from here on (and in the record) */
 	free(sw->req.values);
 	sw->req.values = NULL;
-	if (srv_sweep_plan(sw) != 0) {
-		sweep_free(sw);
-		api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
-		return NULL;
-	}
-	if (srv_budget_take_points(sw->jobs, "beta", 0, pb) != API_OK) {
+	api_err e = srv_sweep_plan(sw) != 0 ? api_fail(pb, API_UNAVAILABLE, NULL, "out of memory")
+					     : srv_sweep_check_cost(sw, pb);
+	if (e != API_OK || srv_budget_take_points(sw->jobs, "beta", 0, pb) != API_OK) {
 		sweep_free(sw);
 		return NULL;
 	}

@@ -34,6 +34,9 @@ typedef struct srv_sweep {
  * `mirrored`). The plan depends only on the request, so a restart makes it
  * again. 0, or -1 when out of memory. */
 int srv_sweep_plan(srv_sweep *sw);
+/* Each point's run within --max-cpu-seconds (srv_budget_run_check, its
+ * own settings applied): API_OK, or the first refusal in *pb. */
+api_err srv_sweep_check_cost(const srv_sweep *sw, api_problem *pb);
 /* Point i's settings on *spec (a copy of the request's): its beta
  * (SI, from api/), rotation and every other varied setting. SIM_OK, or
  * the setting's error with msg. */

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "fitjob.h"
 #include "study.h"
 #include "sweep_int.h"
@@ -69,6 +70,23 @@ int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, si
 			return rc;
 	}
 	return SIM_OK;
+}
+
+api_err srv_sweep_check_cost(const srv_sweep *sw, api_problem *pb)
+{
+	/* beta and the sense leave a run's cost as it is: the first point
+	 * stands for all unless other settings vary */
+	int others = 0;
+	for (int a = 0; a < sw->req.nvary; a++)
+		others |= strcmp(sw->req.vary[a], "beta") != 0;
+	for (size_t i = 0; i < (others ? sw->total : sw->total > 0); i++) {
+		api_spec spec = sw->req.spec;
+		char msg[160];
+		if (srv_sweep_apply(sw, i, &spec, msg, sizeof msg) == SIM_OK &&
+		    srv_budget_run_check(&spec, sw->req.t_end, pb) != API_OK)
+			return pb->code;
+	}
+	return API_OK;
 }
 
 /* Point i is over (done or failed): its mirror image, if it has one, is

@@ -126,3 +126,29 @@ test('a session whose sample or steady start would outlast what a worker can int
   }
   assert.equal(await count(), before);
 });
+
+test('a sweep or fit whose one run would outlast --max-cpu-seconds is refused whole at once; nothing is started', { timeout: 30000 * SLOW }, async () => {
+  const count = async (kind) => (await req(d.base, 'GET', `/api/v1/${kind}`)).body[kind].length;
+  const before = [await count('sweeps'), await count('fits')];
+  const one = { beta: [30], rotations: ['cw'] };
+  const peaks = { free: ['e'], peaks: [{ rotation: 'cw', beta: 38 }, { rotation: 'cw', beta: 128 }] };
+  for (const [url, body, field] of [
+    ['/api/v1/sweeps', { ...CHEAP, integrator: { dt: 1e-12 }, ...one, t_end: 1 }, 'integrator.dt'],
+    ['/api/v1/sweeps', { ...CHEAP, integrator: { dt: 1e-8 }, ...one, t_end: 100 }, 't_end'],
+    ['/api/v1/sweeps', { ...CHEAP, vary: { dt: [1e-3, 1e-12] }, rotations: ['cw'], t_end: 1 }, 'integrator.dt'],
+    ['/api/v1/fits', { ...CHEAP, integrator: { dt: 1e-12 }, ...peaks, t_end: 1 }, 'integrator.dt'],
+  ]) {
+    const t0 = Date.now();
+    const r = await req(d.base, 'POST', url, body);
+    assert.ok(Date.now() - t0 < 5000 * SLOW, `answered after ${Date.now() - t0} ms`);
+    assert.equal(r.status, 422, r.text);
+    assert.equal(r.body.type, '/api/v1/problems/out-of-range', r.text);
+    assert.equal(r.body.field, field, r.text);
+    assert.equal(r.body.budget, 'cpu', r.text);
+    assert.ok(r.body.min < r.body.max, r.text);
+  }
+  assert.deepEqual([await count('sweeps'), await count('fits')], before);
+  // within the bound: accepted as before
+  const ok = await req(d.base, 'POST', '/api/v1/sweeps', { ...CHEAP, ...one, t_end: 0.5 });
+  assert.equal(ok.status, 202, ok.text);
+});
