@@ -28,7 +28,7 @@ static const api_query queries[] = {
 	 "Server-Sent Events (default) or NDJSON (also Accept: application/x-ndjson)"},
 	{API_Q_FIELDS, "fields", "{\"type\":\"string\"}",
 	 "comma list of trough, orbit, rotor, eliminators, feed, energy, elements, all, default"},
-	{API_Q_RATE, "rate", "{\"type\":\"number\",\"exclusiveMinimum\":0}",
+	{API_Q_RATE, "rate", "{\"type\":\"number\",\"exclusiveMinimum\":0,\"maximum\":100000}",
 	 "samples per simulated second (thins the session's sample_rate; a stream of a running "
 	 "paced session holds its records' CPU in --max-paced-cores, fewer cost less)"},
 	{API_Q_LIMIT, "limit", "{\"type\":\"integer\",\"minimum\":1}", "end after this many records"},
@@ -221,6 +221,18 @@ static int decimal(const char *text, uint64_t max, uint64_t *out)
 	return 1;
 }
 
+/* A decimal number in a query value: digits, a sign, a point and an
+ * exponent only (strtod alone also reads hexadecimal, "inf" and "nan"),
+ * finite, the whole value. */
+static int query_number(const char *v, double *x)
+{
+	if (!*v || strspn(v, "0123456789+-.eE") != strlen(v))
+		return 0;
+	char *end;
+	*x = strtod(v, &end);
+	return !*end && isfinite(*x);
+}
+
 api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
 			       const char *rate, const char *limit, const char *last_event_id,
 			       const char *since, api_stream_query *q, api_problem *pb)
@@ -238,10 +250,8 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 	q->fields = fields ? api_parse_fields(fields, pb) : API_F_DEFAULT;
 	if (!q->fields)
 		return pb->code;
-	char *end;
 	if (rate) {
-		q->rate = strtod(rate, &end);
-		if (*end || !(q->rate > 0 && q->rate <= 100000))
+		if (!query_number(rate, &q->rate) || !(q->rate > 0 && q->rate <= 100000))
 			return api_fail(pb, API_QUERY, "rate",
 					"rate must be a number of samples per "
 					"simulated second in (0, 100000]");
@@ -271,9 +281,8 @@ static api_err query_seconds(const char *key, const char *v, double *out, api_pr
 {
 	if (!v || !*v)
 		return API_OK;
-	char *end;
-	double x = strtod(v, &end);
-	if (*end || !isfinite(x))
+	double x;
+	if (!query_number(v, &x))
 		return api_fail(pb, API_QUERY, key, "%s must be a number of seconds (got \"%.40s\")",
 				key, v);
 	*out = x;

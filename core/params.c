@@ -175,9 +175,13 @@ static int range_error(size_t i, char *msg, size_t len)
 		else if (t->kind == SIM_KIND_BOOL)
 			snprintf(msg, len, "%s must be true or false", t->name);
 		else
+		{
+			/* "1" marks a number without a unit: nothing follows */
+			const char *unit = strcmp(t->unit, "1") == 0 ? "" : t->unit;
 			snprintf(msg, len, "%s must be %s in [%g, %g]%s%s", t->name,
 				 t->kind == SIM_KIND_INT ? "an integer" : "a finite number", t->min,
-				 t->max, *t->unit ? " " : "", t->unit);
+				 t->max, *unit ? " " : "", unit);
+		}
 	}
 	return SIM_EPARAM;
 }

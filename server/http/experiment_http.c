@@ -3,8 +3,8 @@
  * experiment_http.c - the experiments as a kind of job: their registry and
  * the descriptor the handlers of /api/v1/experiments[/{id}] use (job.c).
  *
- * Experiments are kept in a registry until shutdown; beyond
- * --max-experiments the oldest finished one that no worker refers to is
+ * Experiments are kept in a registry until shutdown; beyond 256 (the
+ * configuration's max_experiments, no flag) the oldest finished one that no worker refers to is
  * evicted. Creating one either creates a fresh session with the
  * experiment attached before its first step, or attaches it to a running
  * session; the session's worker then runs it (experiment.c).
@@ -207,7 +207,7 @@ const srv_job_kind srv_experiment_job = {
 	.plural = "experiments",
 	.reg = &experiments,
 	.created_status = 201,
-	.limit = "experiments are running or kept (--max-experiments)",
+	.limit = "experiments are running or held by their sessions; wait for one to end",
 	.store_kind = SRV_STORE_EXPERIMENT,
 	.restore_evicts = 1,
 	.create = experiment_create,

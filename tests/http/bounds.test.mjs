@@ -82,6 +82,39 @@ test('a query parameter without a value or given twice is 400 naming it, never r
   assert.equal(ok.status, 200, ok.text);
 });
 
+test('a number in a query is decimal: hexadecimal, inf and nan are 400 naming the parameter; the stream\'s rate has its maximum in the OpenAPI document', async () => {
+  for (const [q, field] of [
+    [`${path}/trajectory?from=0x10`, 'from'],
+    [`${path}/trajectory?to=inf`, 'to'],
+    [`${path}/trajectory?stride=nan`, 'stride'],
+    [`${path}/trajectory?from=1%20`, 'from'],
+    [`${path}/stream?rate=0x10`, 'rate'],
+    [`${path}/stream?rate=100001`, 'rate'],
+  ]) {
+    const r = await req(d.base, 'GET', q);
+    assert.equal(r.status, 400, `${q}: ${r.text}`);
+    assert.equal(r.body.type, '/api/v1/problems/bad-query', r.text);
+    assert.equal(r.body.field, field, r.text);
+  }
+  const ok = await req(d.base, 'GET', `${path}/trajectory?from=1.5e0&to=%2B2`);
+  assert.equal(ok.status, 200, ok.text);
+  assert.ok(ok.body.rows.every((row) => row[0] >= 1.5 && row[0] <= 2), ok.text.slice(0, 200));
+  const spec = (await req(d.base, 'GET', '/api/v1/openapi.json')).body;
+  const rate = Object.values(spec.paths).flatMap((m) => Object.values(m)).flatMap((o) => o.parameters ?? [])
+    .find((prm) => prm.name === 'rate');
+  assert.equal(rate.schema.maximum, 100000, JSON.stringify(rate));
+});
+
+test('a dimensionless setting\'s range is named without a unit; one with a unit keeps it', async () => {
+  const mu = await req(d.base, 'PATCH', path, { mu: 5 });
+  assert.equal(mu.status, 422, mu.text);
+  assert.equal(mu.body.field, 'mu', mu.text);
+  assert.match(mu.body.detail, /mu must be a finite number in \[0, 2\]$/, mu.text);
+  const beta = await req(d.base, 'PATCH', path, { beta: 200 });
+  assert.equal(beta.status, 422, beta.text);
+  assert.match(beta.body.detail, /in \[0, 180\] deg$/, beta.text);
+});
+
 test('a session no real-time pace can hold is told to run at pace "max", never given a range with max below min', async () => {
   // 2,500 CPU s a simulated s: a sample (1e-4 s) within a second of CPU, no pace from 0.001 within
   // one core; start "rest": nothing to settle, so only the pace is in question
