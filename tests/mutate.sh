@@ -71,6 +71,9 @@ mutations=(
 	"the symmetric reduction blind to unequal eliminator dampers|core/setup.c|s|p->b_s1 == p->b_s2 \&\&|1 \&\&|"
 	# the ideal drive's speed ramp: tests/unit/test_machine.c
 	"the ideal drive's speed ramp always speeding up|core/ramp.c|s|push(r, \&t, \&b, \&v, copysign(amax, dv), fabs(dv) / amax);|push(r, \&t, \&b, \&v, amax, fabs(dv) / amax);|"
+	# the machine step's a-priori error term, which the preset's own period
+	# hides: tests/unit/test_measure_point.c
+	"the machine step's error term in the preset's period, not the machine's|core/sim_status.c|s|s->cfg.dt \* 32.0 \* s->md.p.omega_ss / (2.0 \* M_PI)|s->cfg.dt * 32.0 * 157.08 / (2.0 * M_PI)|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -10,7 +10,8 @@
  * inside the reported error bar. On a chaotic feed, where the run and its
  * shadow differ by scatter, it is measured over a longer window instead,
  * its bar holding a long-window reference, and the long run's check reads
- * the running shadow as its end would.
+ * the running shadow as its end would. The machine step's a-priori term
+ * in the bar is held to its formula on a machine with its own period.
  */
 #include "testutil.h"
 
@@ -135,6 +136,38 @@ static void tol_allows_the_conventions_error(void **state)
 	holds(&m, 0.0322247, PEAK, 75.0);
 }
 
+/* The machine step's a-priori term (sim_status.c) is first order in the
+ * step counted in the machine's own excitation periods: 0.5 % of |v| plus
+ * 0.025 % of the trough's largest speed at 32 steps a period, that times
+ * dt / (T / 32) with T = 2 pi / omega_ss. A motor of 300 rad/s (J_w and
+ * M_ut raised so the slip mode stays stable and the motor keeps up) at 32
+ * and at 16 steps of its own period gives one and two times the two
+ * fractions; the preset's period (157.08 rad/s) would give 0.52 and 1.05. */
+static void machine_step_term_in_the_machines_own_period(void **state)
+{
+	(void)state;
+	static const double steps[] = {32.0, 16.0};
+	for (int i = 0; i < 2; i++) {
+		setup u = preset_defaults();
+		set(&u, "omega_ss", "300");
+		set(&u, "J_w", "0.002");
+		set(&u, "M_ut", "80");
+		set(&u, "rotation", "cw");
+		u.p.beta = 30.0 * RAD_PER_DEG;
+		u.m.dt = 2.0 * M_PI / 300.0 / steps[i];
+		sim *s = make(&u);
+		advance(s, 0.6);
+		sim_status st = status(s);
+		double speed = s->est.speed_max, v = fabs(st.transport_velocity);
+		sim_free(s);
+		assert_true(st.dt == u.m.dt && v > 0.01 && speed > 0.0);
+		double want = (0.005 * v + 0.00025 * speed) * 32.0 / steps[i];
+		if (!(fabs(st.machine_error - want) <= 1e-12 * want))
+			fail_msg("%g steps a period: machine_error %.9g, want %.9g", steps[i],
+				 st.machine_error, want);
+	}
+}
+
 /* Issue 37's chaotic feed (R = 0.5, mu = 0.6): the run and its shadow
  * drift apart and their difference is scatter, which the shadow's bar
  * divided by r - 1 (up to 7 times the true error on main at f416208, the
@@ -217,6 +250,7 @@ int main(void)
 		cmocka_unit_test(beyond_tol_stops_at_the_shadows_end),
 		cmocka_unit_test(own_shadow_where_the_run_before_misses),
 		cmocka_unit_test(tol_allows_the_conventions_error),
+		cmocka_unit_test(machine_step_term_in_the_machines_own_period),
 		cmocka_unit_test(chaotic_feed_long_run),
 		cmocka_unit_test(peek_is_what_the_shadows_end_sets),
 	};
