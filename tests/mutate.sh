@@ -74,6 +74,9 @@ mutations=(
 	# the machine step's a-priori error term, which the preset's own period
 	# hides: tests/unit/test_measure_point.c
 	"the machine step's error term in the preset's period, not the machine's|core/sim_status.c|s|s->cfg.dt \* 32.0 \* s->md.p.omega_ss / (2.0 \* M_PI)|s->cfg.dt * 32.0 * 157.08 / (2.0 * M_PI)|"
+	# the DEM map's interpolation in beta away from midway:
+	# tests/unit/test_model_check.c
+	"the model check's weights between two map points swapped|core/model_check.c|s|double d = (1 - w) \* d_lo + w \* d_hi,|double d = w * d_lo + (1 - w) * d_hi,|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

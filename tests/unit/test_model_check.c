@@ -56,6 +56,15 @@ static void at_map_points_and_between(void **state)
 	assert_int_equal(check(&u, &me), 1);
 	assert_close(me.error, (D137 + D150) / 2 + (SD137 + SD150) / 2, 1e-12);
 	assert_close(me.error_uncertainty, (SD137 + SD150) / 2 + (D150 - D137) / 2, 1e-12);
+	/* at 140, w = 3/13 of the way from 137 to 150: weighted toward 137's
+	 * row (the midway above cannot tell the weights apart), the
+	 * interpolation's share 2 w times half the change (rounded to 0.01
+	 * um/s) */
+	double w = 3.0 / 13.0;
+	set(&u, "beta", "140");
+	assert_int_equal(check(&u, &me), 1);
+	assert_close(me.error, (1 - w) * (D137 + SD137) + w * (D150 + SD150), 1e-8);
+	assert_close(me.error_uncertainty, (1 - w) * SD137 + w * SD150 + w * (D150 - D137), 1e-8);
 	/* anywhere between: rounded to 0.01 um/s, so JSON prints no float noise */
 	set(&u, "beta", "141.3");
 	assert_int_equal(check(&u, &me), 1);
