@@ -77,6 +77,9 @@ mutations=(
 	# the DEM map's interpolation in beta away from midway:
 	# tests/unit/test_model_check.c
 	"the model check's weights between two map points swapped|core/model_check.c|s|double d = (1 - w) \* d_lo + w \* d_hi,|double d = w * d_lo + (1 - w) * d_hi,|"
+	# the regularised friction law's width (rk4, dopri5, euler):
+	# tests/unit/test_feed.c
+	"the regularised friction's width doubled|core/feed.c|s|return tanh(v / md->sc.friction_eps);|return tanh(v / (2.0 * md->sc.friction_eps));|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -3,8 +3,9 @@
  * test_feed.c - the feed against known answers: rebound at R times the
  * impact speed, transport direction and its reversal by beta, mirror
  * symmetry with opposite transport, agreement of the symmetric reduction
- * with the full model, and the energy balance (the hopping theory of VDI
- * 2333 runs through the engine in test_accuracy.c).
+ * with the full model, the energy balance, and a slide under the
+ * regularised friction law against its closed form (the hopping theory of
+ * VDI 2333 runs through the engine in test_accuracy.c).
  */
 #include "sim_int.h" /* the state at t = 0, column by column */
 #include "testutil.h"
@@ -228,6 +229,52 @@ static void energy_balance_with_feed(void **state)
 		fail_msg("energy residual %.3g, %.3g of the input", rel[0], rel[1]);
 }
 
+/* One element sliding on a deck held still under the regularised law,
+ * m xi'' = -mu m g tanh(xi' / eps) (settled, so its normal force is m g):
+ * d/dt ln sinh(v / eps) = -mu g / eps, so
+ *   v(t) = eps asinh(sinh(v0 / eps) exp(-mu g t / eps)),
+ * its displacement the integral of that (Simpson's rule, 2000 intervals:
+ * 1e-13 m). From v0 = 2 eps over 0.005 s the element loses three quarters
+ * of its speed; a width of 2 eps would take it 10 um further (of 58 um).
+ * Tolerance as in test_beyond_preset's slide: rk4 far below 1e-8 m, the
+ * split method's symplectic Euler |a| h t / 2 = 1e-7 m at h = 1e-5 s. */
+static double slide_speed(double v0, double eps, double a, double t)
+{
+	return eps * asinh(sinh(v0 / eps) * exp(-a * t / eps));
+}
+
+static void regularised_slide_slows_as_tanh(void **state)
+{
+	(void)state;
+	const char *methods[][2] = {{"rk4", "1e-8"}, {"dem", "3e-7"}};
+	const double mu = 0.4, g = 9.81, eps = 0.01, v0 = 0.02, t = 0.005;
+	const int n = 2000;
+	double expect = 0.0;
+	for (int i = 0; i <= n; i++)
+		expect += (i == 0 || i == n ? 1 : i % 2 ? 4 : 2) *
+			  slide_speed(v0, eps, mu * g, t * i / n) * t / (3.0 * n);
+	for (int mi = 0; mi < 2; mi++) {
+		setup u = one_element();
+		set(&u, "mu", "0.4");
+		set(&u, "R", "1"); /* at rest the law's switch would let it creep down */
+		set(&u, "friction", "regularised");
+		set(&u, "friction_eps", "0.01");
+		set(&u, "method", methods[mi][0]);
+		set(&u, "dt", "1e-5");
+		set(&u, "substeps", "1");
+		sim *s = make(&u);
+		double xi0, xi1;
+		sim_feed_state(s, &xi0, NULL);
+		assert_int_equal(sim_place_feed(s, NULL, NULL, &v0, NULL), SIM_OK);
+		advance(s, t);
+		sim_feed_state(s, &xi1, NULL);
+		sim_free(s);
+		if (!(fabs(xi1 - xi0 - expect) <= atof(methods[mi][1])))
+			fail_msg("%s: slid %.9g m, the tanh law's %.9g m", methods[mi][0], xi1 - xi0,
+				 expect);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -237,6 +284,7 @@ int main(void)
 		cmocka_unit_test(reduction_agrees_with_full_model),
 		cmocka_unit_test(full_model_settles_through_the_reduction),
 		cmocka_unit_test(energy_balance_with_feed),
+		cmocka_unit_test(regularised_slide_slows_as_tanh),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
