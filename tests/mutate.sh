@@ -80,6 +80,8 @@ mutations=(
 	# the regularised friction law's width (rk4, dopri5, euler):
 	# tests/unit/test_feed.c
 	"the regularised friction's width doubled|core/feed.c|s|return tanh(v / md->sc.friction_eps);|return tanh(v / (2.0 * md->sc.friction_eps));|"
+	# the deck points the core shows (sim_deck_points): tests/unit/test_feed.c
+	"the deck points shown from the trough's centre, not each one's rest|core/sim_status.c|s|deck_point(dk, dk->d\[k\], \&R0, zero, zero, rest, vel);|deck_point(dk, 0.0, \&R0, zero, zero, rest, vel);|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -3,9 +3,10 @@
  * test_feed.c - the feed against known answers: rebound at R times the
  * impact speed, transport direction and its reversal by beta, mirror
  * symmetry with opposite transport, agreement of the symmetric reduction
- * with the full model, the energy balance, and a slide under the
- * regularised friction law against its closed form (the hopping theory of
- * VDI 2333 runs through the engine in test_accuracy.c).
+ * with the full model, the energy balance, a slide under the regularised
+ * friction law against its closed form, the deck points shown from their
+ * rest (the hopping theory of VDI 2333 runs through the engine in
+ * test_accuracy.c).
  */
 #include "sim_int.h" /* the state at t = 0, column by column */
 #include "testutil.h"
@@ -275,6 +276,36 @@ static void regularised_slide_slows_as_tanh(void **state)
 	}
 }
 
+/* The deck points shown (sim_deck_points) are each column's displacement
+ * from its rest: D_k = G + R(alpha) (d_k, h_d) (docs/MODEL.md) less the
+ * same at x = y = alpha = 0, with d_k = -0.8 ... 0.8 m evenly (the
+ * preset's column_span). A trough rocking (l2 != l1) with its deck above
+ * G (h_d = 0.1 m), settled under the feed's weight at the start and in
+ * its run-up at 0.3 s: each column's own arm in the rotation. */
+static void deck_points_from_their_rest(void **state)
+{
+	(void)state;
+	setup u = preset();
+	set(&u, "l2", "0.9");
+	set(&u, "h_d", "0.1");
+	sim *s = make(&u);
+	int K = sim_columns(s);
+	assert_int_equal(K, 5);
+	for (int i = 0; i < 2; i++) {
+		advance(s, 0.3 * i);
+		sim_status st = status(s);
+		double x = st.q[Q_X], y = st.q[Q_Y], a = st.q[Q_ALPHA], h = 0.1, d[2 * 5];
+		assert_true(fabs(a) > 1e-7);
+		sim_deck_points(s, d);
+		for (int c = 0; c < K; c++) {
+			double dk = -0.8 + 0.4 * c;
+			assert_close(d[2 * c], x + dk * cos(a) - h * sin(a) - dk, 1e-12);
+			assert_close(d[2 * c + 1], y + dk * sin(a) + h * cos(a) - h, 1e-12);
+		}
+	}
+	sim_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -285,6 +316,7 @@ int main(void)
 		cmocka_unit_test(full_model_settles_through_the_reduction),
 		cmocka_unit_test(energy_balance_with_feed),
 		cmocka_unit_test(regularised_slide_slows_as_tanh),
+		cmocka_unit_test(deck_points_from_their_rest),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
