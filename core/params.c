@@ -174,8 +174,7 @@ static int range_error(size_t i, char *msg, size_t len)
 			snprintf(msg, len, "%s must be one of %s", t->name, t->choices);
 		else if (t->kind == SIM_KIND_BOOL)
 			snprintf(msg, len, "%s must be true or false", t->name);
-		else
-		{
+		else {
 			/* "1" marks a number without a unit: nothing follows */
 			const char *unit = strcmp(t->unit, "1") == 0 ? "" : t->unit;
 			snprintf(msg, len, "%s must be %s in [%g, %g]%s%s", t->name,

@@ -78,11 +78,10 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
  * interval, which the worker advances whole, estimated beyond
  * SRV_SAMPLE_CPU_MAX (422 naming integrator.dt, about the least step that
  * fits as min), and the settling of a steady start, which runs in the
- * creating request's thread, beyond limit (--max-cpu-seconds; 422 naming
+ * creating request's thread, beyond --max-cpu-seconds (srv_budget_cost_init; 422 naming
  * scene.settle, the longest that fits as max). */
 #define SRV_SAMPLE_CPU_MAX 1.0 /* CPU s: well within a control's 5-s wait */
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
-api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_problem *pb);
 /* A job's run (a sweep's point, a fit's evaluation): a steady start's
  * settling and t_end simulated s, which nothing interrupts once begun (a
  * DELETE, a SIGTERM wait for it). One estimated beyond --max-cpu-seconds

@@ -79,6 +79,13 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
 }
 
+static double run_limit = 1800.0; /* CPU s: --max-cpu-seconds */
+
+void srv_budget_cost_init(double max_cpu_seconds)
+{
+	run_limit = max_cpu_seconds;
+}
+
 /* What sim_new would integrate (its step in st->dt) and its estimate. */
 static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
 		       api_problem *pb)
@@ -93,20 +100,29 @@ static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
 	return API_OK;
 }
 
+/* Simulated s a steady start settles before the run (in the creating
+ * request's thread or the job's, uninterrupted). */
+static double settling(const api_spec *spec)
+{
+	return spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+}
+
+/* The range a refusal names for integrator.dt: about the least step whose
+ * work cpu_s (at step dt) comes within bound, up to the settings table's
+ * largest step (SI). */
+static void dt_range(api_problem *pb, double dt, double cpu_s, double bound)
+{
+	const sim_setting *t = sim_setting_find("dt");
+	pb->min = dt * cpu_s / bound;
+	pb->max = t->max * t->scale;
+}
+
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
 {
 	sim_status st;
-	return preview(spec, &st, cpu_per_s, pb);
-}
-
-api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_problem *pb)
-{
-	sim_status st;
-	double cpu;
-	if (preview(spec, &st, &cpu, pb) != API_OK)
+	if (preview(spec, &st, cpu_per_s, pb) != API_OK)
 		return pb->code;
-	double sample = cpu / spec->sample_rate;
-	double settle = spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+	double cpu = *cpu_per_s, sample = cpu / spec->sample_rate, settle = settling(spec);
 	if (sample > SRV_SAMPLE_CPU_MAX) {
 		api_fail(pb, API_RANGE, "integrator.dt",
 			 "a sample interval (%g s) of this session would take about %.3g CPU s "
@@ -114,28 +130,20 @@ api_err srv_budget_uninterrupted_check(const api_spec *spec, double limit, api_p
 			 "worker may go without taking a control or its stop; nothing was created: "
 			 "a larger integrator.dt or a smaller scene", 1.0 / spec->sample_rate,
 			 sample, cpu, st.dt, SRV_SAMPLE_CPU_MAX);
-		pb->min = st.dt * sample / SRV_SAMPLE_CPU_MAX;
-		pb->max = 0.01; /* the settings table's */
-	} else if (cpu * settle > limit) {
+		dt_range(pb, st.dt, sample, SRV_SAMPLE_CPU_MAX);
+	} else if (cpu * settle > run_limit) {
 		api_fail(pb, API_RANGE, "scene.settle",
 			 "the steady start would settle for about %.3g CPU s (%.3g CPU s per "
 			 "simulated s over scene.settle = %g s), more than --max-cpu-seconds (%g); "
 			 "nothing was created: a larger integrator.dt, a smaller scene, a shorter "
-			 "scene.settle or scene.start \"rest\"", cpu * settle, cpu, settle, limit);
+			 "scene.settle or scene.start \"rest\"", cpu * settle, cpu, settle, run_limit);
 		pb->min = 0;
-		pb->max = limit / cpu;
+		pb->max = run_limit / cpu;
 	} else {
 		return API_OK;
 	}
 	pb->has_range = 1;
-	return api_budget(pb, "cpu", limit, 0);
-}
-
-static double run_limit = 1800.0; /* CPU s: --max-cpu-seconds */
-
-void srv_budget_cost_init(double max_cpu_seconds)
-{
-	run_limit = max_cpu_seconds;
+	return api_budget(pb, "cpu", run_limit, 0);
 }
 
 api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb)
@@ -144,7 +152,7 @@ api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb
 	double cpu;
 	if (preview(spec, &st, &cpu, pb) != API_OK)
 		return API_OK; /* a set sim_new refuses: the run fails at once */
-	double settle = spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+	double settle = settling(spec);
 	double run = cpu * (settle + t_end), longest = run_limit / cpu - settle;
 	if (!(run > run_limit))
 		return API_OK;
@@ -157,8 +165,12 @@ api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb
 		 none ? "a larger integrator.dt or a smaller scene" : "a shorter t_end, a larger "
 								      "integrator.dt or a smaller scene");
 	pb->has_range = 1;
-	pb->min = none ? st.dt * run / run_limit : spec->scene.transient;
-	pb->max = none ? 0.01 : longest;
+	if (none) {
+		dt_range(pb, st.dt, run, run_limit);
+	} else {
+		pb->min = spec->scene.transient;
+		pb->max = longest;
+	}
 	return api_budget(pb, "cpu", run_limit, 0);
 }
 

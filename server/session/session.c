@@ -127,12 +127,10 @@ static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 	double cpu;
 	if (srv_dem_wanted(spec))
 		return 0;
-	if (srv_budget_uninterrupted_check(spec, cfg->max_cpu_seconds, pb) != API_OK)
+	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
 		return 1;
 	if (spec->pace == API_PACE_MAX)
 		return 0;
-	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
-		return 1;
 	return srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
 				     pb) != API_OK;
 }

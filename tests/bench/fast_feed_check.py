@@ -48,6 +48,8 @@ model_error only: a calibration does not run everything again); the
 binary's modification time where it has no dependency files.
 """
 import csv
+import glob
+import hashlib
 import json
 import math
 import os
@@ -170,8 +172,6 @@ def source_stamp(convsim):
     binary (core, cli, fit, api), less build/core/model_map.inc (the DEM
     map's table: model_error and model_checked only). Falls back to the
     binary's modification time."""
-    import glob
-    import hashlib
     build = os.path.dirname(os.path.abspath(convsim))
     deps = set()
     for sub in ("core", "cli", "fit", "api"):
