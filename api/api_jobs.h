@@ -15,11 +15,22 @@
 /* ---- experiments --------------------------------------------------------- */
 
 #define API_EXP_MAX_SEGMENTS 32
+/* A segment's state. ABORTED: the experiment ended early (aborted with its
+ * session, or interrupted) before this segment was done. */
+typedef enum api_seg_state {
+	API_SEG_PENDING,
+	API_SEG_RUNNING,
+	API_SEG_DONE,
+	API_SEG_ABORTED,
+	API_SEG_NSTATES
+} api_seg_state;
+/* The state's name in JSON and CSV ("pending" for one out of range). */
+const char *api_segment_state(int state);
 typedef struct api_segment {
 	api_value beta;         /* rad (deg as sent) commanded at the start */
 	double until;           /* s after the experiment start */
 	/* results, filled by the server */
-	int state;              /* 0 pending, 1 running, 2 done */
+	int state;              /* api_seg_state */
 	int beta_same;          /* 1: beta was already there at the command,
 				 * so there is no reversal to time (fills the
 				 * padding: saved records keep their size) */

@@ -158,9 +158,15 @@ static int segment_model(const api_experiment_view *v, const api_segment *s, sim
 	return 1;
 }
 
+const char *api_segment_state(int state)
+{
+	static const char *const names[API_SEG_NSTATES] = {"pending", "running", "done",
+							   "aborted"};
+	return names[state >= 0 && state < API_SEG_NSTATES ? state : API_SEG_PENDING];
+}
+
 static cJSON *experiment_object(const api_experiment_view *v)
 {
-	static const char *const seg_state[] = {"pending", "running", "done"};
 	char link[96];
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "id", v->id);
@@ -177,17 +183,14 @@ static cJSON *experiment_object(const api_experiment_view *v)
 		cJSON *so = cJSON_CreateObject();
 		api_add_number(so, "beta", s->beta.user);
 		api_add_number(so, "until", s->until);
-		cJSON_AddStringToObject(so, "state",
-					seg_state[s->state < 0 || s->state > 2
-							  ? 0
-							  : s->state]);
+		cJSON_AddStringToObject(so, "state", api_segment_state(s->state));
 		api_add_number(so, "t_command", sim_time_ns(s->t_command));
 		api_add_number(so, "t_end", sim_time_ns(s->t_end));
 		api_add_number(so, "start_velocity", s->start_velocity);
 		api_add_number(so, "steady_velocity", s->steady_velocity);
 		api_add_number(so, "mean_velocity", s->mean_velocity);
 		api_add_number(so, "uncertainty", s->uncertainty);
-		if (s->state == 2)
+		if (s->state == API_SEG_DONE)
 			cJSON_AddBoolToObject(so, "steady", s->steady);
 		else
 			cJSON_AddNullToObject(so, "steady");
@@ -263,7 +266,6 @@ static void csv_kind_cells(api_buf *b, const api_exp_ext *ext, int k, int done, 
 
 char *api_experiment_csv(const api_experiment_view *v, size_t n)
 {
-	static const char *const seg_state[] = {"pending", "running", "done"};
 	api_buf b = {0};
 	int kind = csv_kind(v, n);
 	api_buf_puts(&b, kind == API_EXP_IDENTIFY  ? API_EXPERIMENT_CSV API_EXPERIMENT_CSV_IDENTIFY "\n"
@@ -272,14 +274,14 @@ char *api_experiment_csv(const api_experiment_view *v, size_t n)
 	for (size_t i = 0; i < n; i++)
 		for (int k = 0; k < v[i].nseg; k++) {
 			const api_segment *g = &v[i].seg[k];
-			int done = g->state == 2;
+			int done = g->state == API_SEG_DONE;
 			api_buf_printf(&b, "%s,%s,%d", v[i].id, v[i].session_id, k + 1);
 			csv_num(&b, g->beta.user);
 			csv_num(&b, g->until);
-			api_buf_printf(&b, ",%s", seg_state[g->state >= 0 && g->state <= 2 ? g->state : 0]);
-			csv_num(&b, g->state ? sim_time_ns(g->t_command) : NAN);
+			api_buf_printf(&b, ",%s", api_segment_state(g->state));
+			csv_num(&b, g->state != API_SEG_PENDING ? sim_time_ns(g->t_command) : NAN);
 			csv_num(&b, done ? sim_time_ns(g->t_end) : NAN);
-			csv_num(&b, g->state ? g->start_velocity : NAN);
+			csv_num(&b, g->state != API_SEG_PENDING ? g->start_velocity : NAN);
 			csv_num(&b, done ? g->steady_velocity : NAN);
 			csv_num(&b, done ? g->mean_velocity : NAN);
 			csv_num(&b, done ? g->uncertainty : NAN);

@@ -139,6 +139,16 @@ static void drop_record(srv_experiment *e)
 	e->rec_n = e->rec_cap = 0;
 }
 
+/* An experiment that ends early ends its segments not done with it, so
+ * that none shows pending or running for ever (lock held, or e not yet
+ * shared). */
+static void end_segments(srv_experiment *e)
+{
+	for (int i = 0; i < e->req.nseg; i++)
+		if (e->req.seg[i].state != API_SEG_DONE)
+			e->req.seg[i].state = API_SEG_ABORTED;
+}
+
 /* The view of e (lock held); v->seg borrows e's segments. */
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
@@ -354,6 +364,9 @@ srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen
 		e->t_now = r->t_now;
 		e->attached = 0;
 		drop_record(e);
+		/* a record of a build before the segments' own end */
+		if (e->state == EXP_ABORTED || e->state == EXP_INTERRUPTED)
+			end_segments(e);
 	} else {
 		snprintf(why, whylen, "%s", pb.detail);
 	}
@@ -371,6 +384,7 @@ int srv_exp_interrupt(srv_experiment *e)
 		snprintf(e->error, sizeof e->error,
 			 "the daemon stopped before it ended and its session "
 			 "could not resume it; the segments done are kept");
+		end_segments(e);
 		persist_locked(e, 0);
 	}
 	pthread_mutex_unlock(&e->lock);
@@ -450,12 +464,14 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over)
 	return cmd;
 }
 
-/* Abort (lock held): the state and the error, the record dropped. */
+/* Abort (lock held): the state and the error, the segments not done
+ * ended with it, the record dropped. */
 static void abort_locked(srv_experiment *e, const char *why)
 {
 	if (e->state == EXP_WAITING || e->state == EXP_RUNNING) {
 		e->state = EXP_ABORTED;
 		snprintf(e->error, sizeof e->error, "%s", why);
+		end_segments(e);
 	}
 	e->attached = 0;
 	drop_record(e);

@@ -43,7 +43,7 @@ srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st)
 	/* a segment that commands the beta already set (and reached) changes
 	 * nothing there is to time */
 	seg->beta_same = seg->beta.si == st->beta_target && st->beta == st->beta_target;
-	seg->state = 1;
+	seg->state = API_SEG_RUNNING;
 	e->cur = i;
 	e->seg_first = e->rec_n;
 	return cmd;
@@ -82,7 +82,7 @@ void srv_exp_finish_segment(srv_experiment *e, const sim_status *st)
 				break;
 			}
 		}
-	seg->state = 2;
+	seg->state = API_SEG_DONE;
 	srv_exp_control_results(e);
 	srv_exp_identify_results(e);
 }
