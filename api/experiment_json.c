@@ -107,7 +107,7 @@ api_err api_parse_experiment(const char *body, size_t len,
 		e = api_fail(pb, API_TYPE, "keep_session",
 			     "keep_session must be true or false");
 	req->keep_session = cJSON_IsTrue(keep);
-	if (e == API_OK && rate && !cJSON_IsNull(rate))
+	if (e == API_OK && rate)
 		e = api_parse_user_value(&req->spec, "beta_rate", rate,
 					 "beta_rate", &req->beta_rate, pb);
 	if (e == API_OK)

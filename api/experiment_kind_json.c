@@ -301,6 +301,12 @@ api_err api_parse_experiment_kind(const cJSON *root, api_experiment_req *req,
 	const cJSON *id = cJSON_GetObjectItemCaseSensitive(root, "identify");
 	const cJSON *ctl = cJSON_GetObjectItemCaseSensitive(root, "control");
 	const cJSON *sched = cJSON_GetObjectItemCaseSensitive(root, "schedule");
+	/* a kind given as something else than an object (null too) is its
+	 * type error, before the choice between the kinds */
+	if (id && !cJSON_IsObject(id))
+		return parse_identify(id, req, ext, pb);
+	if (ctl && !cJSON_IsObject(ctl))
+		return parse_control(ctl, req, ext, pb);
 	if (!!id + !!ctl + !!sched > 1)
 		return api_fail(pb, API_INVALID, id && ctl ? "control" : "schedule",
 				"an experiment is one of schedule, identify or control");

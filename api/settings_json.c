@@ -169,10 +169,13 @@ api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)
 	static const char *const groups[] = {"params", "scene", "integrator"};
 	const char *preset = "czubak2016";
 	const cJSON *pr = cJSON_GetObjectItemCaseSensitive(obj, "preset");
-	if (pr && !cJSON_IsNull(pr)) {
+	/* null is no value of these members (a wrong type, as 5 is), not
+	 * their absence: leaving a member out is how a default is asked for */
+	if (pr) {
 		if (!cJSON_IsString(pr))
 			return api_fail(pb, API_TYPE, "preset",
-					"preset must be a string");
+					"preset must be a string, a preset's name (%s "
+					"when left out)", preset);
 		preset = pr->valuestring;
 	}
 	if (sim_preset(preset, &spec->params, &spec->scene, &spec->method) !=
@@ -193,7 +196,7 @@ api_err api_apply_model(const cJSON *obj, api_spec *spec, api_problem *pb)
 	for (size_t g = 0; g < 3; g++) {
 		const cJSON *grp =
 			cJSON_GetObjectItemCaseSensitive(obj, groups[g]);
-		if (!grp || cJSON_IsNull(grp))
+		if (!grp)
 			continue;
 		if (!cJSON_IsObject(grp))
 			return api_fail(pb, API_TYPE, groups[g],
