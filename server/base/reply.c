@@ -88,6 +88,16 @@ enum MHD_Result srv_reply_empty(srv_req *r)
 	return srv_queue(r, 204, resp);
 }
 
+enum MHD_Result srv_reply_not_found(srv_req *r, const char *what)
+{
+	return srv_fail(r, API_NOTFOUND, NULL, "no %s with id \"%.40s\"", what, r->arg[0]);
+}
+
+enum MHD_Result srv_reply_deleted(srv_req *r, int removed, const char *what)
+{
+	return removed ? srv_reply_empty(r) : srv_reply_not_found(r, what);
+}
+
 enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
 				 const void *data, size_t len)
 {

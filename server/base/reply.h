@@ -39,6 +39,14 @@ enum MHD_Result srv_reply_created(srv_req *r, int status, char *text,
 				  const char *prefix, const char *id);
 /* 204 without a body. */
 enum MHD_Result srv_reply_empty(srv_req *r);
+/* 404 for r->arg[0], an id no `what` ("session", "sweep") has: the one
+ * answer of every route of an object to an unknown id. */
+enum MHD_Result srv_reply_not_found(srv_req *r, const char *what);
+/* DELETE's answer: 204 when this request unlinked the object (removed
+ * nonzero), else srv_reply_not_found's 404: another DELETE unlinked it
+ * between this one's lookup and its own unlink, and one deletion has one
+ * 204. */
+enum MHD_Result srv_reply_deleted(srv_req *r, int removed, const char *what);
 /* Queue a static, borrowed buffer (not freed). */
 enum MHD_Result srv_reply_static(srv_req *r, int status, const char *ctype,
 				 const void *data, size_t len);

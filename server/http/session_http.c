@@ -18,10 +18,9 @@
 
 #define CONTROL_TIMEOUT_S 5.0
 
-static enum MHD_Result not_found(srv_req *r, const char *id)
+static enum MHD_Result not_found(srv_req *r)
 {
-	return srv_fail(r, API_NOTFOUND, NULL, "no session with id \"%.40s\"",
-			id);
+	return srv_reply_not_found(r, "session");
 }
 
 enum MHD_Result srv_h_sessions_create(srv_req *r)
@@ -65,7 +64,7 @@ enum MHD_Result srv_h_session_get(srv_req *r)
 {
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
-		return not_found(r, r->arg[0]);
+		return not_found(r);
 	api_problem pb;
 	if (srv_session_replaying(s, &pb) != API_OK) {
 		srv_session_put(s);
@@ -84,7 +83,7 @@ enum MHD_Result srv_h_session_patch(srv_req *r)
 	enum MHD_Result res;
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
-		return not_found(r, r->arg[0]);
+		return not_found(r);
 	api_control c;
 	api_problem pb;
 	double t_eff = NAN;
@@ -109,15 +108,15 @@ enum MHD_Result srv_h_session_delete(srv_req *r)
 {
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
-		return not_found(r, r->arg[0]);
+		return not_found(r);
 	api_problem pb;
 	if (srv_session_check_removable(s, &pb) != API_OK) {
 		srv_session_put(s);
 		return srv_reply_problem(r, &pb, NULL);
 	}
-	srv_session_delete(s);
+	int removed = srv_session_delete(s);
 	srv_session_put(s);
-	return srv_reply_empty(r);
+	return srv_reply_deleted(r, removed, "session");
 }
 
 enum MHD_Result srv_h_trajectory(srv_req *r)
@@ -131,7 +130,7 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 	double from = q.from, to = q.to, every = q.stride;
 	srv_session *s = srv_session_get(r->arg[0]);
 	if (!s)
-		return not_found(r, r->arg[0]);
+		return not_found(r);
 	if (srv_session_replaying(s, &pb) != API_OK) {
 		srv_session_put(s);
 		return srv_reply_problem(r, &pb, NULL);

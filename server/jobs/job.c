@@ -158,8 +158,7 @@ static void job_unlock(const srv_job_kind *kind, srv_entry *e)
 
 static enum MHD_Result not_found(srv_req *r)
 {
-	return srv_fail(r, API_NOTFOUND, NULL, "no %s with id \"%.40s\"", r->job->name,
-			r->arg[0]);
+	return srv_reply_not_found(r, r->job->name);
 }
 
 enum MHD_Result srv_h_job_create(srv_req *r)
@@ -241,8 +240,9 @@ enum MHD_Result srv_h_job_delete(srv_req *r)
 	job_lock(kind, e);
 	kind->cancel(e);
 	job_unlock(kind, e);
-	if (srv_registry_remove(kind->reg, e))
+	int removed = srv_registry_remove(kind->reg, e);
+	if (removed)
 		forget(kind, e->id);
 	srv_registry_put(kind->reg, e);
-	return srv_reply_empty(r);
+	return srv_reply_deleted(r, removed, kind->name);
 }

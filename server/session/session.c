@@ -346,11 +346,12 @@ fail:
 }
 
 /* Unlink s and stop its worker; its files go too unless the daemon
- * stops (then they are what the next start restores). */
-static void remove_session(srv_session *s, int files)
+ * stops (then they are what the next start restores). 1, or 0 when
+ * another call unlinked it first (and nothing is done). */
+static int remove_session(srv_session *s, int files)
 {
 	if (!srv_registry_remove(&sessions, &s->entry))
-		return;
+		return 0;
 	stop_worker(s);
 	/* its bed process ends and is reaped now, and its slot is free for
 	 * the next LIGGGHTS session at once, not when the last reader lets
@@ -368,11 +369,12 @@ static void remove_session(srv_session *s, int files)
 	} else {
 		srv_log(SRV_LOG_INFO, "session %s closed", s->entry.id);
 	}
+	return 1;
 }
 
-void srv_session_delete(srv_session *s)
+int srv_session_delete(srv_session *s)
 {
-	remove_session(s, 1);
+	return remove_session(s, 1);
 }
 
 void srv_sessions_shutdown(void)

@@ -45,8 +45,9 @@ srv_session *srv_session_get(const char *id);
  * NULL is accepted. */
 void srv_session_put(srv_session *s);
 /* Remove from the registry, stop the worker, end the streams, remove its
- * files. The caller holds a reference (and still puts it). */
-void srv_session_delete(srv_session *s);
+ * files. The caller holds a reference (and still puts it). 1, or 0 when
+ * another call removed it first (a concurrent DELETE: nothing done). */
+int srv_session_delete(srv_session *s);
 /* API_OK if its files could be removed now (store.c
  * srv_store_check_removable); else 503 in *pb. */
 api_err srv_session_check_removable(const srv_session *s, api_problem *pb);
