@@ -139,16 +139,6 @@ static void drop_record(srv_experiment *e)
 	e->rec_n = e->rec_cap = 0;
 }
 
-/* An experiment that ends early ends its segments not done with it, so
- * that none shows pending or running for ever (lock held, or e not yet
- * shared). */
-static void end_segments(srv_experiment *e)
-{
-	for (int i = 0; i < e->req.nseg; i++)
-		if (e->req.seg[i].state != API_SEG_DONE)
-			e->req.seg[i].state = API_SEG_ABORTED;
-}
-
 /* The view of e (lock held); v->seg borrows e's segments. */
 static void fill_view(const srv_experiment *e, api_experiment_view *v)
 {
@@ -366,7 +356,7 @@ srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen
 		drop_record(e);
 		/* a record of a build before the segments' own end */
 		if (e->state == EXP_ABORTED || e->state == EXP_INTERRUPTED)
-			end_segments(e);
+			srv_exp_end_segments(e);
 	} else {
 		snprintf(why, whylen, "%s", pb.detail);
 	}
@@ -384,7 +374,7 @@ int srv_exp_interrupt(srv_experiment *e)
 		snprintf(e->error, sizeof e->error,
 			 "the daemon stopped before it ended and its session "
 			 "could not resume it; the segments done are kept");
-		end_segments(e);
+		srv_exp_end_segments(e);
 		persist_locked(e, 0);
 	}
 	pthread_mutex_unlock(&e->lock);
@@ -471,7 +461,7 @@ static void abort_locked(srv_experiment *e, const char *why)
 	if (e->state == EXP_WAITING || e->state == EXP_RUNNING) {
 		e->state = EXP_ABORTED;
 		snprintf(e->error, sizeof e->error, "%s", why);
-		end_segments(e);
+		srv_exp_end_segments(e);
 	}
 	e->attached = 0;
 	drop_record(e);
@@ -480,27 +470,12 @@ static void abort_locked(srv_experiment *e, const char *why)
 
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd)
 {
+	char why[200];
 	pthread_mutex_lock(&e->lock);
-	api_segment *seg = &e->req.seg[e->cur];
-	int refused = cmd->rc != SIM_OK;
+	int refused = srv_exp_segment_commanded(e, cmd, why, sizeof why);
 	if (refused) {
-		char why[200];
-		if (e->dist_to > e->dist_from)
-			snprintf(why, sizeof why, "disturbances[%d]: the session refused it: %s",
-				 e->dist_from, sim_strerror(cmd->rc));
-		else
-			snprintf(why, sizeof why,
-				 "segment %d: the session refused beta = %g deg: %s", e->cur,
-				 cmd->c.beta.user, sim_strerror(cmd->rc));
 		srv_log(SRV_LOG_WARN, "experiment %s: %s", e->entry.id, why);
 		abort_locked(e, why);
-	} else if (e->cmd_starts) {
-		seg->t_command = cmd->t_eff;
-		/* a control acts at the end of the integrator's step: the
-		 * segment before ran its beta up to this command, not only to
-		 * its boundary's observation inside that step */
-		if (e->cur > 0)
-			e->req.seg[e->cur - 1].t_end = cmd->t_eff;
 	}
 	srv_exp_dist_commanded(e, cmd, refused);
 	pthread_mutex_unlock(&e->lock);

@@ -53,6 +53,14 @@ struct srv_experiment {
 	int freed;               /* srv_exp_free came while writes > 0 */
 };
 
+/* The worker's answer to e's command (lock held): a command that starts a
+ * segment sets its t_command and the end of the one before; a refusal
+ * writes why (the segment or disturbance refused) and returns 1. */
+int srv_exp_segment_commanded(srv_experiment *e, const srv_cmd *cmd, char *why, size_t whylen);
+/* An experiment that ends early (aborted, interrupted) ends every segment
+ * not done with it, so that none shows pending or running for ever (lock
+ * held, or e not yet shared). */
+void srv_exp_end_segments(srv_experiment *e);
 /* Start segment i at status st (lock held): its command for the worker. */
 srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st);
 /* The running segment ends at status st (lock held): its mean and steady

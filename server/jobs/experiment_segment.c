@@ -7,10 +7,14 @@
  * mean feed velocity over the segment's second half, and the reversal time
  * from the command until the feed velocity first reaches 90 % of that
  * steady value, before that second half begins (else none: the segment
- * was too short for the feed to settle).
+ * was too short for the feed to settle). The worker's answer to a
+ * segment's command is read here (its t_command, the end of the one
+ * before, or why it was refused), and a segment not done when its
+ * experiment ends early ends with it (aborted).
  */
 #include <math.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -127,4 +131,34 @@ int srv_exp_readopt(srv_experiment *e, const char *session_id)
 	}
 	pthread_mutex_unlock(&e->lock);
 	return hit;
+}
+
+int srv_exp_segment_commanded(srv_experiment *e, const srv_cmd *cmd, char *why, size_t whylen)
+{
+	api_segment *seg = &e->req.seg[e->cur];
+	if (cmd->rc != SIM_OK) {
+		if (e->dist_to > e->dist_from)
+			snprintf(why, whylen, "disturbances[%d]: the session refused it: %s",
+				 e->dist_from, sim_strerror(cmd->rc));
+		else
+			snprintf(why, whylen, "segment %d: the session refused beta = %g deg: %s",
+				 e->cur, cmd->c.beta.user, sim_strerror(cmd->rc));
+		return 1;
+	}
+	if (e->cmd_starts) {
+		seg->t_command = cmd->t_eff;
+		/* a control acts at the end of the integrator's step: the
+		 * segment before ran its beta up to this command, not only to
+		 * its boundary's observation inside that step */
+		if (e->cur > 0)
+			e->req.seg[e->cur - 1].t_end = cmd->t_eff;
+	}
+	return 0;
+}
+
+void srv_exp_end_segments(srv_experiment *e)
+{
+	for (int i = 0; i < e->req.nseg; i++)
+		if (e->req.seg[i].state != API_SEG_DONE)
+			e->req.seg[i].state = API_SEG_ABORTED;
 }
