@@ -64,6 +64,9 @@ void srv_exp_view(srv_experiment *e, api_experiment_view *v, srv_exp_scratch *sc
  * (owned by e) for the worker to queue. */
 srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 		       double *t_end);
+/* The simulated time (s) a running experiment ends at, its last segment's
+ * end; NAN before it begins and once it is over. */
+double srv_exp_end(const srv_experiment *e);
 /* The next segment boundary (s), where an advance must stop, or INFINITY. */
 double srv_exp_boundary(const srv_experiment *e);
 /* After each advance: record, close a segment that ended and start the

@@ -7,6 +7,7 @@
  * is durable; and an experiment attached to send its segments' controls.
  */
 #include <errno.h>
+#include <math.h>
 #include <string.h>
 
 #include "experiment.h"
@@ -50,6 +51,15 @@ static api_err admit_until(const srv_session *s, const api_control *c,
 		return api_fail(pb, API_CONFLICT, "until",
 				"until (%g s) lies in the past: the session is at "
 				"t = %g s", c->until, s->st.t);
+	/* an experiment runs its session to its schedule's end (worker.c
+	 * extend_until); an until before that would end the session under
+	 * it. One not yet begun raises until when it begins. */
+	double end = s->exp ? srv_exp_end(s->exp) : NAN;
+	if (c->until > 0 && end > c->until)
+		return api_fail(pb, API_CONFLICT, "until",
+				"experiment %s runs the session to t = %g s: until "
+				"(%g s) must be at least that, or null, until it ends",
+				srv_exp_id(s->exp), end, c->until);
 	return API_OK;
 }
 

@@ -92,3 +92,45 @@ test('a session deleted before its experiment\'s first segment ends: every segme
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
+
+test('until during an experiment: one before its end is 409 naming until and changes nothing; null or a later one is taken', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon([]);
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 1 });
+    assert.equal(s.status, 201, s.text);
+    const spath = `/api/v1/sessions/${s.body.id}`;
+    const ex = await req(d.base, 'POST', '/api/v1/experiments', {
+      session: s.body.id,
+      schedule: [{ beta: 40, until: 0.2 }, { beta: 120, until: 300 }],
+    });
+    assert.equal(ex.status, 201, ex.text);
+    const path = `/api/v1/experiments/${ex.body.id}`;
+    const running = await until(async () => {
+      const g = (await req(d.base, 'GET', path)).body;
+      return g.state === 'running' && g;
+    }, 20000, 'the experiment running');
+    // the session, without an until of its own, runs on past the
+    // schedule's end: its start plus 300 s
+    assert.equal((await req(d.base, 'GET', spath)).body.until, null);
+    const end = running.t_start + 300;
+    const r = await req(d.base, 'PATCH', spath, { until: end - 100 });
+    assert.equal(r.status, 409, r.text);
+    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    assert.equal(r.body.status, 409);
+    assert.equal(r.body.type, '/api/v1/problems/conflict');
+    assert.equal(r.body.field, 'until');
+    assert.equal(r.body.detail, `experiment ${ex.body.id} runs the session to t = ${+end.toPrecision(6)} s: ` +
+      `until (${+(end - 100).toPrecision(6)} s) must be at least that, or null, until it ends`);
+    assert.equal((await req(d.base, 'GET', spath)).body.until, null, 'until unchanged');
+    assert.equal((await req(d.base, 'GET', path)).body.state, 'running');
+    const later = await req(d.base, 'PATCH', spath, { until: 400 });
+    assert.equal(later.status, 200, later.text);
+    assert.equal(later.body.until, 400);
+    const none = await req(d.base, 'PATCH', spath, { until: null });
+    assert.equal(none.status, 200, none.text);
+    assert.equal(none.body.until, null);
+    assert.equal(running.segments.length, 2);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
