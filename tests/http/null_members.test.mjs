@@ -168,3 +168,21 @@ test('the model members named in the issue: the same problem as a wrong type', a
     assert.match(none.body.detail, member === 'preset' ? /^preset must be a string/ : new RegExp(`^${member} must be an object of NAME: VALUE`));
   }
 });
+
+test('an experiment\'s fresh session names its members by their path in the body (session.scene, not scene)', async () => {
+  const schedule = [{ beta: 30, until: 1 }];
+  const cases = [
+    [{ scene: 5 }, 400, 'wrong-type', 'session.scene'],
+    [{ scene: null }, 400, 'wrong-type', 'session.scene'],
+    [{ params: { beta: 500 } }, 422, 'out-of-range', 'session.params.beta'],
+    [{ scene: { layers: 0 } }, 422, 'out-of-range', 'session.scene.layers'],
+    [{ pace: -1 }, 422, 'out-of-range', 'session.pace'],
+    [{ foo: 1 }, 422, 'unknown-field', 'session.foo'],
+  ];
+  for (const [session, status, slug, field] of cases) {
+    const r = await req(d.base, 'POST', '/api/v1/experiments', { session, schedule });
+    assert.equal(r.status, status, r.text);
+    assert.equal(r.body.type, `/api/v1/problems/${slug}`, r.text);
+    assert.equal(r.body.field, field, r.text);
+  }
+});
