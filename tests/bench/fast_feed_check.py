@@ -29,7 +29,8 @@ from the bed by a closure fitted to the map:
             bed lands as one body; each regime's mu is C times the
             material's grain-on-deck mu_pw (dem/materials.json).
 A bed is a material at a depth. Each bed is predicted by a closure fitted
-on the map's other beds only, both materials (leave one bed out: the most
+on the map's other beds only, both materials and both drives (leave one
+bed out, the same material and depth on the other drive too: the most
 points within 5 % of a bed's DEM peak, then the smallest worst error); no
 closure has a constant of its own per material. Beside them: the paper's
 preset as it is (R 0.05, mu 0.4, k_c 1e6, layers = depth), and the best
@@ -417,26 +418,36 @@ def fit(run, family, pts, peak):
     return max(candidates(family), key=lambda c: score(run, c, pts, peak))
 
 
+def training(pts, mat, d):
+    """The points a closure for the bed (mat, d) is fitted on: every other
+    bed, of both materials and both drives, never this material at this
+    depth on either drive. A closure takes the material's parameters and
+    the depth as inputs and runs on the drive's own machine, so it has no
+    constant of its own per material or per drive."""
+    return [p for p in pts if (p["material"], p["depth"]) != (mat, d)]
+
+
 def evaluate(run, pts, peak, unpredicted=None):
     """The held-out predictions, one record per point: leave one bed out.
-    A bed is a material at a depth; each is predicted by a closure fitted
-    on every other bed of the same drive, of either material (a closure
-    takes a material's own parameters as inputs and has no constant of
-    its own per material). A bed alone on its drive is not predicted: its
-    (material, drive, depth, points) goes to the list unpredicted."""
+    A bed is a material at a depth; each is predicted, on every drive the
+    map has it at, by a closure fitted on the points training() gives. A
+    bed alone in the map is not predicted: its (material, drive, depth,
+    points) go to the list unpredicted."""
     out = []
-    for drive in sorted({p["drive"] for p in pts}):
-        gp = [p for p in pts if p["drive"] == drive]
-        for mat, d in sorted({(p["material"], p["depth"]) for p in gp}):
-            train = [p for p in gp if (p["material"], p["depth"]) != (mat, d)]
-            test = [p for p in gp if (p["material"], p["depth"]) == (mat, d)]
-            if not train:
-                # the only bed of its drive: nothing to fit a closure on, so
-                # no prediction to count (the paper's model would stand in)
-                if unpredicted is not None:
-                    unpredicted.append((mat, drive, d, len(test)))
-                continue
-            fits = {f: (fit(run, f, train, peak), fit(run, f, test, peak)) for f in FAMILIES}
+    for mat, d in sorted({(p["material"], p["depth"]) for p in pts}):
+        train = training(pts, mat, d)
+        held = [p for p in pts if (p["material"], p["depth"]) == (mat, d)]
+        if not train:
+            # nothing to fit a closure on, so no prediction to count (the
+            # paper's model would stand in)
+            if unpredicted is not None:
+                for drive in sorted({p["drive"] for p in held}):
+                    unpredicted.append((mat, drive, d, sum(p["drive"] == drive for p in held)))
+            continue
+        closures = {f: fit(run, f, train, peak) for f in FAMILIES}
+        for drive in sorted({p["drive"] for p in held}):
+            test = [p for p in held if p["drive"] == drive]
+            fits = {f: (closures[f], fit(run, f, test, peak)) for f in FAMILIES}
             for p in test:
                 pk = peak[(mat, drive, d)]
                 v0 = run.get(PAPER, p)[0]

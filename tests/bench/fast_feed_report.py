@@ -129,8 +129,9 @@ def write_md(recs, runner, path, unpredicted=()):
       "regimes split at D_c by the bed's dissipation D = (1 - e_pw^2) + (d - 1)(1 - e_pp^2) from "
       "the material's restitutions (dem/materials.json), each an ensemble whose mu is C times "
       "the material's mu_pw. A bed is a material at a depth: each is predicted by a closure "
-      "fitted on all the map's other beds, both materials (leave one bed out); no closure has "
-      "a constant of its own per material. Map: %d points (%s) from %s. "
+      "fitted on all the map's other beds, both materials and both drives (leave one bed out: "
+      "never on the same material and depth at either drive); no closure has "
+      "a constant of its own per material or drive. Map: %d points (%s) from %s. "
       "Error = (v - v_DEM) / the "
       "bed's DEM peak |v|; the target is |error| <= 5 %% at >= 90 %% of the points at <= 3x "
       "the column model's CPU." % (time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
@@ -141,7 +142,7 @@ def write_md(recs, runner, path, unpredicted=()):
                                    "tests/bench/results/dem_map.csv"))
     w("")
     if unpredicted:
-        w("Not predicted, the only bed of its drive so far (no other bed to fit a closure on; its "
+        w("Not predicted, the only bed in the map so far (no other bed to fit a closure on; its "
           "points are not counted): %s." % ", ".join(
               "%s %d grains deep, drive `%s` (%d points)" % (m, d, dr, n)
               for m, dr, d, n in unpredicted))

@@ -10,7 +10,7 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fast_feed_check import R_FLOOR, dissipation, evaluate, fit, resolve, rests  # noqa: E402
+from fast_feed_check import R_FLOOR, dissipation, evaluate, fit, resolve, rests, training  # noqa: E402
 
 GLASS = {"e_pw": 0.9, "e_pp": 0.97, "mu_pw": 0.15}  # dem/materials.json's, in part
 WHEAT = {"e_pw": 0.5, "e_pp": 0.5, "mu_pw": 0.3}
@@ -132,4 +132,14 @@ def collapse_checks():
     w2 = [x for x in recs if (x["material"], x["depth"]) == ("wheat", 2)]
     checks.append(("collapse: wheat 2 deep held out, predicted by the collapsed regime",
                    all(abs(x["collapse_err"]) < 1e-12 for x in w2)))
+    # two drives: a bed is held out on both, and the other drive's other beds train
+    two = [dict(p, drive=dr) for p in pts for dr in ("preset", "a150")]
+    seen = {(p["material"], p["drive"], p["depth"]) for p in training(two, "wheat", 2)}
+    checks.append(("training: never the held-out material and depth, on either drive",
+                   seen == {(m, dr, d) for m, d in (("glass", 1), ("glass", 2), ("wheat", 1))
+                            for dr in ("preset", "a150")}))
+    peak2 = {(m, dr, d): v for (m, _, d), v in peak.items() for dr in ("preset", "a150")}
+    recs = evaluate(FakeRunner(), two, peak2)
+    checks.append(("evaluate: every bed predicted on both drives",
+                   len(recs) == len(two) and {r["drive"] for r in recs} == {"preset", "a150"}))
     return checks
