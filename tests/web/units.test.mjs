@@ -102,6 +102,26 @@ test('sweep points from a list, and from per-rotation columns', () => {
 	assert.equal(api.normalizeSweep({ state: 'cancelled' }).failed, true);
 });
 
+test('a job that ended early ends the page\'s wait as a failure; one that runs does not', () => {
+	// the daemon's end states (api/schemas.json): an experiment aborted
+	// (its session deleted or failed), interrupted (a restart), damaged
+	// (its record unreadable), a sweep damaged
+	for (const state of ['aborted', 'interrupted', 'damaged', 'error']) {
+		const e = api.normalizeExperiment({ id: 'e', state, error: 'the session was deleted or the daemon stopped' });
+		assert.equal(e.done, true, state);
+		assert.equal(e.failed, true, state);
+	}
+	for (const state of ['damaged', 'error', 'cancelled']) {
+		assert.deepEqual([api.normalizeSweep({ state }).done, api.normalizeSweep({ state }).failed], [true, true], state);
+	}
+	for (const state of ['waiting', 'running', 'queued']) {
+		assert.equal(api.normalizeExperiment({ state }).done, false, state);
+		assert.equal(api.normalizeSweep({ state }).done, false, state);
+	}
+	const done = api.normalizeExperiment({ state: 'done' });
+	assert.deepEqual([done.done, done.failed], [true, false]);
+});
+
 test('experiment segments carry steady velocity and reversal time', () => {
 	const e = api.normalizeExperiment({ id: 'e1', session: 's9', state: 'done', progress: 1, t: 6, segments: [
 		{ beta: 38, until: 3, state: 'done', t_command: 0, t_end: 3, steady_velocity: 0.15, reversal_time: null },

@@ -416,11 +416,14 @@ export function normalizeExperiment(raw) {
 	};
 }
 
+/* A job's end: done, or ended early (an experiment aborted with its
+ * session or interrupted by a restart, a record damaged on disk), which
+ * the page reports as a failure instead of waiting on. */
 export function isFinished(state) {
-	return /^(done|finished|complete|completed|succeeded|success|ok|failed|error|cancel+ed)$/i.test(state || '');
+	return /^(done|finished|complete|completed|succeeded|success|ok|failed|error|cancel+ed|aborted|interrupted|damaged)$/i.test(state || '');
 }
 export function isFailed(state) {
-	return /^(failed|error|cancel+ed)$/i.test(state || '');
+	return /^(failed|error|cancel+ed|aborted|interrupted|damaged)$/i.test(state || '');
 }
 
 /* A preset list from {presets:[...]}, [...] of names, or [...] of objects. */
