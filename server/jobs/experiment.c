@@ -413,13 +413,18 @@ void srv_exp_view(srv_experiment *e, api_experiment_view *v, srv_exp_scratch *sc
 	v->ext = &sc->ext;
 }
 
+double srv_exp_end(const srv_experiment *e)
+{
+	return e->state == EXP_RUNNING ? e->t0 + exp_end(e) : NAN;
+}
+
 srv_cmd *srv_exp_begin(srv_experiment *e, const sim_status *st,
 		       double *t_end)
 {
 	pthread_mutex_lock(&e->lock);
 	e->t0 = e->t_now = st->t;
 	e->state = EXP_RUNNING;
-	*t_end = e->t0 + exp_end(e);
+	*t_end = srv_exp_end(e);
 	if (e->ext.kind != API_EXP_SCHEDULE)
 		srv_exp_clock_start(e, st);
 	srv_cmd *cmd = srv_exp_start_segment(e, 0, st);

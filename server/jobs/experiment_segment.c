@@ -96,11 +96,6 @@ double srv_exp_segment_end(const srv_experiment *e)
 	return e->state == EXP_RUNNING ? e->t0 + e->req.seg[e->cur].until : INFINITY;
 }
 
-double srv_exp_end(const srv_experiment *e)
-{
-	return e->state == EXP_RUNNING ? e->t0 + e->req.seg[e->req.nseg - 1].until : NAN;
-}
-
 double srv_exp_boundary(const srv_experiment *e)
 {
 	return fmin(srv_exp_segment_end(e), srv_exp_control_boundary(e));
