@@ -23,7 +23,7 @@
 import { loopRequest, normalizeLoop } from './api-loop.js';
 import { BASE, authHeaders, sessionRequest, sweepRequest, experimentRequest, fitRequest } from './api-requests.js';
 import { normalizeSession, normalizeControl, normalizeSweep, normalizeExperiment,
-	normalizePresets, normalizeMethods, trajectoryColumns, methodEnum } from './api-normalize.js';
+	normalizePresets, normalizeMethods, trajectoryColumns, methodEnum, isFinished, isFailed } from './api-normalize.js';
 
 export * from './api-normalize.js';
 export * from './api-requests.js';
@@ -182,8 +182,8 @@ export function normalizeFit(raw) {
 		maxIter: r.max_iter ?? 1, evaluations: r.evaluations ?? 0, values: r.values || {},
 		result: r.result || null,
 		error: r.error || null, /* state "error": its record could not be written */
-		done: ['done', 'failed', 'cancelled', 'error'].includes(r.state),
-		failed: ['failed', 'cancelled', 'error'].includes(r.state),
+		done: isFinished(r.state),
+		failed: isFailed(r.state),
 		progress: r.state === 'done' ? 1 : Math.min(1, (r.iteration ?? 0) / (r.max_iter || 1)),
 	};
 }
