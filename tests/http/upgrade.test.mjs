@@ -133,8 +133,8 @@ function checkFormat(dir, exp) {
 
 const releases = readdirSync(FIXTURES).filter((r) => existsSync(join(FIXTURES, r, 'expected.json'))).sort();
 
-test('the fixtures: c793934\'s, c3bc9a1\'s, 7e56a85\'s, dbe9ffc\'s, 3005e12\'s, fefabe0\'s, 4a42636\'s, 4eff261\'s, 357b026\'s and 685132b\'s data directories are kept', () => {
-  assert.ok(['c793934', 'c3bc9a1', '7e56a85', 'dbe9ffc', '3005e12', 'fefabe0', '4a42636', '4eff261', '357b026', '685132b'].every((r) => releases.includes(r)), releases.join(' '));
+test('the fixtures: c793934\'s, c3bc9a1\'s, 7e56a85\'s, dbe9ffc\'s, 3005e12\'s, fefabe0\'s, 4a42636\'s, 4eff261\'s, 357b026\'s, 685132b\'s and b09537b\'s data directories are kept', () => {
+  assert.ok(['c793934', 'c3bc9a1', '7e56a85', 'dbe9ffc', '3005e12', 'fefabe0', '4a42636', '4eff261', '357b026', '685132b', 'b09537b'].every((r) => releases.includes(r)), releases.join(' '));
 });
 
 for (const release of releases) {
