@@ -9,11 +9,13 @@
  * measures the copy without its shadow (shadow.c): a session's steady
  * cost, what it holds once its start is over.
  */
+#include <math.h>
 #include <stdlib.h>
 #include <time.h>
 
 #include "budget.h"
 #include "cpu_probe.h"
+#include "util.h"
 
 static double thread_cpu(void)
 {
@@ -23,7 +25,7 @@ static double thread_cpu(void)
 }
 
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
-		     double cpu_s)
+		     double cpu_s, const char *id)
 {
 	size_t len = sim_checkpoint_size(live), n = (size_t)columns * (size_t)layers;
 	void *buf = malloc(len);
@@ -46,22 +48,31 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int lay
 	sim_drop_shadow(copy);
 	sim_status st;
 	sim_get_status(copy, &st);
-	double t0 = st.t, t = t0, dt = 1.0 / spec->sample_rate;
+	/* sample by sample, each sample in pieces of at most
+	 * SRV_PROBE_PIECE_S: a sample of a slow rate (1 s at 1 per s) of a
+	 * dear scene would otherwise be one piece of seconds of CPU */
+	double t0 = st.t, t = t0, dt = 1.0 / spec->sample_rate, sample = t0 + dt;
 	double cpu0 = thread_cpu(), cpu = cpu0;
 	while (cpu - cpu0 < cpu_s && t - t0 < SRV_PROBE_T_S) {
-		t += dt;
+		t = fmin(sample, t + SRV_PROBE_PIECE_S);
 		if (sim_advance(copy, t) != SIM_OK)
 			break;
-		sim_get_status(copy, &st);
-		if (columns > 0) {
-			sim_column_displacement(copy, feed);
-			sim_feed_state(copy, feed + columns, feed + columns + n);
+		if (t >= sample) {
+			sim_get_status(copy, &st);
+			if (columns > 0) {
+				sim_column_displacement(copy, feed);
+				sim_feed_state(copy, feed + columns, feed + columns + n);
+			}
+			sample = t + dt;
 		}
 		cpu = thread_cpu();
 	}
-	if (t > t0)
+	if (t > t0) {
 		cost = (cpu - cpu0) / (t - t0) +
 		       srv_budget_sample_cpu(columns, layers) * spec->sample_rate;
+		srv_log(SRV_LOG_DEBUG, "session %s: probe %.3g ms of CPU per simulated s over "
+			"%.3g simulated s", id, 1e3 * cost, t - t0);
+	}
 out:
 	sim_free(copy);
 	free(feed);

@@ -13,16 +13,22 @@
 
 /* Longest a probe runs in simulated s (its CPU s: --cpu-probe). */
 #define SRV_PROBE_T_S 0.2
+/* Longest piece of simulated time it advances between two reads of its
+ * CPU clock (a quarter of the preset's 25-Hz period): the probe ends
+ * within one such piece of --cpu-probe whatever the sample rate. */
+#define SRV_PROBE_PIECE_S 0.01
 
 /* CPU s per simulated s of running live (borrowed, read only) as its
  * worker would: a copy made from a checkpoint of it (no settling) is
  * advanced sample by sample at spec's sample rate, with the status and
  * the feed's state read at each sample as the worker reads them, for
  * cpu_s of this thread's CPU (--cpu-probe) or SRV_PROBE_T_S simulated s,
- * whichever comes first; plus the server's cost per published sample.
- * columns x layers: the feed recorded (0 without). Returns a negative
- * value if the copy cannot be made (out of memory): then estimate. */
+ * whichever comes first, in pieces of at most SRV_PROBE_PIECE_S; plus
+ * the server's cost per published sample. columns x layers: the feed
+ * recorded (0 without). Logs its figure and the simulated s it ran at
+ * debug level, for session id. Returns a negative value if the copy
+ * cannot be made (out of memory): then estimate. */
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
-		     double cpu_s);
+		     double cpu_s, const char *id);
 
 #endif

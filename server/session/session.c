@@ -186,7 +186,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 				  "created", pb) != API_OK)
 		return -1;
 	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
-							   cfg->cpu_probe)
+							   cfg->cpu_probe, s->entry.id)
 					   : -1.0;
 	if (probed > s->budget.cpu_per_s)
 		s->budget.cpu_per_s = probed;
