@@ -236,10 +236,12 @@ typedef struct api_sweep_req {
  * start, a 4-s window keeps all 74 points of the czubak2016 v(beta) within
  * 1 % (docs/MODEL.md's convention). */
 #define API_SWEEP_WINDOW 4.0
+/* The most simulated time per point, s. */
+#define API_SWEEP_T_END_MAX 600.0
 /* Parse POST /sweeps: preset/params/scene/integrator as for sessions,
  * "beta": {"from","to","step"} or [DEG, ...], "rotations": ["cw","ccw"],
  * "t_end" (default scene.transient + API_SWEEP_WINDOW; it must exceed
- * scene.transient); a study: "vary": {"NAME": {"from","to","step"} or
+ * scene.transient, each point's where a study varies it); a study: "vary": {"NAME": {"from","to","step"} or
  * [v, ...], ...} over number settings in their user units (beta, when
  * given as "beta", the first), "lhs": N for a Latin-hypercube sample of
  * the ranges, "seed" (core/study.h); "band_from_fit": a fit's id (the

@@ -56,7 +56,11 @@ static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *
 	char field[96], msg[256] = "", sub[128];
 	const api_spec *sp = &req->spec;
 	snprintf(field, sizeof field, "vary.%.80s", it->string);
-	int rc;
+	/* the setting before its values: ["cw", "ccw"] for rotation is
+	 * refused as rotation, not as a list of non-numbers */
+	int rc = sim_study_check_axis(st, it->string, msg, sizeof msg);
+	if (rc != SIM_OK)
+		return study_problem(rc, field, it->string, msg, pb);
 	if (cJSON_IsObject(it)) {
 		snprintf(sub, sizeof sub, "%s.", field);
 		api_err e = api_check_members(it, range_members, sub, pb);
@@ -203,6 +207,16 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 			     "the study has %zu points (%zu per rotation sense); a sweep has at "
 			     "most %d",
 			     st.npoints * (size_t)req->nrot, st.npoints, API_SWEEP_MAX_POINTS);
+	/* each point measures after its own transient: t_end (sweep_json.c
+	 * checked it against the model's) must exceed the largest varied */
+	double transient = sim_study_largest(&st, "transient", 0);
+	if (e == API_OK && !(req->t_end > transient)) {
+		e = api_fail(pb, API_RANGE, "t_end",
+			     "t_end (%g s) must exceed scene.transient = %g s (the largest of "
+			     "vary.transient: the transport velocity is measured after it) and be "
+			     "at most %g s", req->t_end, transient, API_SWEEP_T_END_MAX);
+		pb->has_range = 1, pb->min = transient, pb->max = API_SWEEP_T_END_MAX;
+	}
 	if (e == API_OK)
 		e = take_study(&st, req, pb);
 	sim_study_free(&st);

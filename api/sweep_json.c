@@ -21,8 +21,6 @@ const char *const api_members_sweep[] = {"preset", "params", "scene", "integrato
 					  "beta", "rotations", "t_end", "vary", "lhs",
 					  "seed", "band_from_fit", NULL};
 
-#define T_END_MAX 600.0 /* s simulated per point, at most */
-
 /* beta as an array of angles (deg) into req->betas. */
 static api_err parse_beta_list(const cJSON *it, api_sweep_req *req, api_problem *pb)
 {
@@ -149,7 +147,7 @@ static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
 static api_err parse_t_end(const cJSON *te, const sim_scene *scene,
 			   double *t_end, api_problem *pb)
 {
-	const double lo = scene->transient, hi = T_END_MAX;
+	const double lo = scene->transient, hi = API_SWEEP_T_END_MAX;
 	*t_end = fmin(scene->transient + API_SWEEP_WINDOW, hi);
 	if (!(lo < hi)) {
 		api_fail(pb, API_RANGE, "scene.transient",

@@ -371,6 +371,14 @@ static int prepare(int argc, char **argv, cli_opts *o, sim_study *st, fit_band_s
 	}
 	if ((rc = cli_plan_study(o, st)) != 0)
 		return rc;
+	double transient = sim_study_largest(st, "transient", o->sc.transient);
+	if (!(o->duration > transient)) { /* each point measures after its own */
+		fprintf(stderr, "convsim sweep: --duration (%g s) must exceed the largest "
+				"transient the study varies (%g s): v is measured over "
+				"[transient, duration]\n",
+			o->duration, transient);
+		return 2;
+	}
 	return o->band_from ? cli_band_from(o, st, band, skip) : 0;
 }
 

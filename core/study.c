@@ -52,6 +52,28 @@ static const sim_setting *axis_setting(const sim_study *st, const char *name, ch
 	return t;
 }
 
+int sim_study_check_axis(const sim_study *st, const char *name, char *msg, size_t msglen)
+{
+	return axis_setting(st, name, msg, msglen) ? SIM_OK : SIM_EUNKNOWN;
+}
+
+double sim_study_largest(const sim_study *st, const char *name, double otherwise)
+{
+	for (size_t a = 0; a < st->naxes; a++) {
+		if (strcmp(st->axis[a].setting->name, name) != 0)
+			continue;
+		double top = -INFINITY;
+		if (st->values) /* planned: its points (a sample's too) */
+			for (size_t k = 0; k < st->npoints; k++)
+				top = fmax(top, sim_study_value(st, k, a));
+		else
+			for (size_t k = 0; k < st->axis[a].n; k++)
+				top = fmax(top, st->axis[a].values[k]);
+		return top;
+	}
+	return otherwise;
+}
+
 /* Value v (user units) set as setting t on a scratch copy of the model:
  * the same check as --set (range, whole numbers). */
 static int check_value(const sim_setting *t, const sim_params *p, const sim_scene *s,

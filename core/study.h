@@ -38,6 +38,13 @@ typedef struct sim_study {
 	double *values;   /* npoints x naxes, user units (sim_study_plan) */
 } sim_study;
 
+/* Whether the setting `name` may be an axis of st: a number setting
+ * (real or whole; not `rotation`) that is not one yet, with room for one
+ * more. SIM_OK, or SIM_EUNKNOWN with a sentence in msg. The add functions
+ * check it first; a caller may check it before it reads the values, so
+ * that a setting no values could make an axis is refused as such. */
+int sim_study_check_axis(const sim_study *st, const char *name, char *msg, size_t msglen);
+
 /* Add an axis: the setting `name` from `from` to `to` (user units) by
  * `step` > 0, the values from + k step (k = 0, 1, ...) up to `to` (1e-9
  * of a step of slack), each rounded to 12 significant digits (0.6, not
@@ -63,6 +70,12 @@ int sim_study_add_list(sim_study *st, const sim_params *p, const sim_scene *s,
  * lists. At most SIM_STUDY_MAX_POINTS points. SIM_OK, or SIM_EPARAM /
  * SIM_ENOMEM with the reason in msg. */
 int sim_study_plan(sim_study *st, char *msg, size_t msglen);
+
+/* The largest value (user units) the axis of setting `name` takes (over
+ * the points once planned, else over its values), or `otherwise` when the
+ * study does not vary it: the bound every point must respect, as t_end
+ * past each point's scene.transient. */
+double sim_study_largest(const sim_study *st, const char *name, double otherwise);
 
 /* Point k's value of axis a (user units). */
 static inline double sim_study_value(const sim_study *st, size_t k, size_t a)

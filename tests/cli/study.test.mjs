@@ -110,6 +110,7 @@ test('a setting that does not exist, or a value out of its range: exit 2 naming 
     [['--beta', '10', '--vary', 'beta=20,30'], /beta is varied twice/],
     [['--vary', 'mu=0.1,0.2', '--lhs', '3'], /mu: a Latin-hypercube sample needs a range/],
     [['--vary', 'mu=0:2:0.01', '--vary', 'beta=0:180:1'], /the study has 36381 points; at most 10000/],
+    [['--vary', 'transient=0,10', '--duration', '4'], /^convsim sweep: --duration \(4 s\) must exceed the largest transient the study varies \(10 s\)/],
   ]) {
     const r = run('sweep', ...args);
     assert.equal(r.code, 2, `${args.join(' ')}: ${r.err}`);

@@ -85,6 +85,15 @@ test('an unknown setting or a value out of range: 422 naming the field and the r
     [{ vary: { columns: [1, 2.5] } }, 422, 'vary.columns', /columns must be an integer/, [1, 64]],
     [{ vary: { drive: [0, 1] } }, 422, 'vary.drive', /drive is a choice, not a number/],
     [{ vary: { rotation: [0, 1] } }, 422, 'vary.rotation', /rotation is not varied as a setting/],
+    // the setting is judged before its values: the senses as strings, a
+    // choice by its names, an unknown name with an empty list
+    [{ vary: { rotation: ['cw', 'ccw'] } }, 422, 'vary.rotation', /rotation is not varied as a setting/],
+    [{ vary: { drive: ['ideal', 'motor'] } }, 422, 'vary.drive', /drive is a choice, not a number/],
+    [{ vary: { drive: { from: 'a', to: 'b', step: 1 } } }, 422, 'vary.drive', /drive is a choice, not a number/],
+    [{ vary: { muu: [] } }, 422, 'vary.muu', /unknown setting "muu" \(did you mean "mu"\?\)/],
+    // every point's transient lies before t_end (given or default)
+    [{ vary: { transient: [0, 10] }, t_end: 4 }, 422, 't_end', /^t_end \(4 s\) must exceed scene\.transient = 10 s \(the largest of vary\.transient/, [10, 600]],
+    [{ vary: { transient: { from: 0, to: 6, step: 3 } } }, 422, 't_end', /^t_end \(4 s\) must exceed scene\.transient = 6 s/, [6, 600]],
     [{ vary: { mu: { from: 1, to: 0, step: 0.1 } } }, 422, 'vary.mu', /a range needs FROM <= TO/],
     [{ vary: { mu: { from: 0, to: 1 } } }, 400, 'vary.mu', /vary\.mu\.step must be a number/],
     [{ vary: { mu: { from: 0, to: 1, step: 0.5, by: 1 } } }, 422, 'vary.mu.by', /by/],
