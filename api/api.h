@@ -232,6 +232,13 @@ typedef struct api_trajectory_query {
 } api_trajectory_query;
 api_err api_parse_trajectory_query(const char *from, const char *to, const char *stride,
 				   api_trajectory_query *q, api_problem *pb);
+/* The spacing of the rows a ?stride= of `asked` s gives on a history
+ * recorded every `recorded` s: a whole multiple k of it (within 1e-6 of
+ * one, so 0.036000000000000004 is 3 x 0.012) gives k x recorded, to the
+ * nanosecond as times are, in *spacing (never the asked value when that
+ * is off the grid: rows would drop out where the two drift apart). Else
+ * a 400 bad-query naming stride and the recorded spacing. */
+api_err api_trajectory_stride(double asked, double recorded, double *spacing, api_problem *pb);
 /* The page a problem type URI serves (/api/v1/problems/SLUG): malloc'd
  * HTML, or NULL for an unknown slug. */
 char *api_problem_page(const char *slug);

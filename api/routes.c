@@ -309,3 +309,18 @@ api_err api_parse_trajectory_query(const char *from, const char *to, const char 
 		return api_fail(pb, API_QUERY, "stride", "stride must be positive (s)");
 	return API_OK;
 }
+
+api_err api_trajectory_stride(double asked, double recorded, double *spacing, api_problem *pb)
+{
+	double k = asked / recorded, whole = floor(k + 0.5);
+	if (fabs(k - whole) > 1e-6 || k < 0.5) {
+		char rec[40], got[40];
+		api_fmt_double(rec, sizeof rec, recorded);
+		api_fmt_double(got, sizeof got, asked);
+		return api_fail(pb, API_QUERY, "stride",
+				"stride must be a whole multiple of the recorded spacing, now %s s "
+				"(got %s)", rec, got);
+	}
+	*spacing = sim_time_ns(whole * recorded);
+	return API_OK;
+}

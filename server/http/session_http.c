@@ -141,15 +141,11 @@ enum MHD_Result srv_h_trajectory(srv_req *r)
 	srv_session_put(s);
 	if (rows && every > 0) {
 		/* rows on the grid of multiples of the asked stride, which must
-		 * be a whole number of the recorded spacing */
-		double k = every / stride;
-		if (fabs(k - floor(k + 0.5)) > 1e-6 || k < 0.5) {
+		 * be a whole number of the recorded spacing (and is taken as
+		 * that multiple) */
+		if (api_trajectory_stride(every, stride, &every, &pb) != API_OK) {
 			free(rows);
-			char rec[40];
-			api_fmt_double(rec, sizeof rec, stride);
-			return srv_fail(r, API_QUERY, "stride",
-					"stride must be a whole multiple of the recorded spacing, "
-					"now %s s (got %g)", rec, every);
+			return srv_reply_problem(r, &pb, NULL);
 		}
 		/* a row is on the grid when its time is within a millionth
 		 * of the recorded spacing of a multiple of the stride (a

@@ -62,6 +62,29 @@ test('trajectory: a stride keeps only rows on its grid, however large; 0 or less
   }
 });
 
+test('trajectory: a stride a hair off a whole multiple gives that multiple\'s rows, and says so', async () => {
+  const all = (await req(d.base, 'GET', `${path}/trajectory`)).body;
+  const exact = (await req(d.base, 'GET', `${path}/trajectory?stride=${2 * all.stride}`)).body;
+  assert.ok(exact.count > 50, `${exact.count} rows`);
+  // as a stride rounded in a spreadsheet or typed from a plot reads:
+  // within a millionth of 2 x recorded, so taken as that multiple
+  for (const off of [1 + 4e-7, 1 - 4e-7]) {
+    const asked = 2 * all.stride * off;
+    const r = await req(d.base, 'GET', `${path}/trajectory?stride=${asked}`);
+    assert.equal(r.status, 200, r.text);
+    assert.equal(r.body.stride, 2 * all.stride, `asked ${asked}`);
+    assert.equal(r.body.count, exact.count, `asked ${asked}: rows ${r.body.rows.map((row) => row[0]).slice(-3)}`);
+    assert.deepEqual(r.body.rows, exact.rows);
+  }
+  const csv = await req(d.base, 'GET', `${path}/trajectory?format=csv&stride=${2 * all.stride * (1 + 4e-7)}`);
+  assert.equal(csv.text.trim().split('\n').length, exact.count + 1);
+  // further off, still a 400 that names the recorded spacing
+  const bad = await req(d.base, 'GET', `${path}/trajectory?stride=${2 * all.stride * (1 + 1e-4)}`);
+  assert.equal(bad.status, 400, bad.text);
+  assert.equal(bad.body.field, 'stride');
+  assert.equal(bad.body.detail, `stride must be a whole multiple of the recorded spacing, now ${all.stride} s (got ${2 * all.stride * (1 + 1e-4)})`);
+});
+
 test('a query parameter without a value or given twice is 400 naming it, never read as absent or as its first', async () => {
   for (const [q, field] of [
     ['/api/v1/sessions?format', 'format'],
