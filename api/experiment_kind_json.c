@@ -253,7 +253,9 @@ static api_err parse_disturbance(const cJSON *it, int i, const api_experiment_re
 	api_problem sub;
 	if (api_parse_control(d->set, strlen(d->set), &req->spec, &c, &sub) != API_OK) {
 		*pb = sub;
-		snprintf(pb->field, sizeof pb->field, "%.22s.%.40s", field, sub.field);
+		/* the member at fault, or the set itself ({}: no change) */
+		snprintf(pb->field, sizeof pb->field, "%.22s%s%.40s", field,
+			 sub.field[0] ? "." : "", sub.field);
 		snprintf(pb->detail, sizeof pb->detail, "%.24s: %.280s", field, sub.detail);
 		return pb->code;
 	}

@@ -276,6 +276,11 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
   assert.deepEqual(r.body, problem('invalid-value', 'Invalid value',
     'disturbances[0].set.beta: a disturbance changes the machine, not beta (the controller\'s) nor the session\'s run',
     'disturbances[0].set.beta'));
+  // an empty set names the set itself, not a member after a dot
+  r = await post({ control: ctl, disturbances: [{ at: 1, set: {} }] });
+  assert.equal(r.status, 422, r.text);
+  assert.equal(r.body.field, 'disturbances[0].set');
+  assert.match(r.body.detail, /^disturbances\[0\]\.set: no change given/);
   r = await post({ control: ctl, disturbances: [{ at: 3, set: { omega_ss: 150 } }] });
   assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
     'disturbances[0].at must lie within [0, 2] s (within the experiment)', 'disturbances[0].at', { min: 0, max: 2 }));
