@@ -163,8 +163,8 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 		const char *opt = strncmp(field, "points", 6) == 0  ? "--data"
 				  : strncmp(field, "peaks", 5) == 0 ? "--peaks"
 				  : strcmp(field, "t_end") == 0     ? "--duration"
-				  : strcmp(field, "free") == 0      ? "--free"
 				  : strstr(field, ".prior")         ? "--prior"
+				  : strncmp(field, "free", 4) == 0  ? "--free"
 								    : "--set";
 		fprintf(stderr, "convsim fit: %s: %s\n", opt, msg);
 		return 2;

@@ -331,14 +331,15 @@ int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t 
 		     "parameters", ndata, r->nfree);
 	for (int i = 0; i < r->nfree; i++) {
 		const fit_free *f = &r->free[i];
+		char at[32];
+		snprintf(at, sizeof at, "free[%d].start", i);
 		if (!(f->start >= f->lo && f->start <= f->hi))
-			FAIL("free", "the start of '%s' (%g) lies outside its bounds [%g, %g]",
+			FAIL(at, "the start of '%s' (%g) lies outside its bounds [%g, %g]",
 			     f->name, f->start, f->lo, f->hi);
 		/* a prior weighs against the data's residuals in units of their
 		 * sigma: without it the two are on no common scale */
 		if (fit_has_prior(&r->prior[i]) &&
 		    isnan(r->npoints ? r->points[0].sigma : r->peaks[0].sigma)) {
-			char at[32];
 			snprintf(at, sizeof at, "free[%d].prior", i);
 			FAIL(at, "a prior (on '%s') needs the data's sigma, to weigh the two "
 				 "against each other: give sigma with every %s", f->name,

@@ -39,6 +39,7 @@ test('bad input: 422 naming the field, nothing started', { timeout: 30000 * SLOW
     [{ peaks: [{ rotation: 'cw', beta: 38 }] }, 'peaks', /points or peaks, not both/],
     [{ t_end: 0 }, 't_end', /t_end must exceed/],
     [{ free: [{ name: 'e', min: 0.1, max: 0.01 }] }, 'free[0]', /bounds of 'e'/],
+    [{ free: ['mu', { name: 'e', start: 5 }] }, 'free[1].start', /^the start of 'e' \(5\) lies outside its bounds \[0, 0\.5\]$/],
     [{ starts: 0 }, 'starts', /starts must be in \[1, 32\]/],
     [{ starts: 33 }, 'starts', /starts must be in \[1, 32\]/],
     [{ starts: 1.5 }, 'starts', /starts must be an integer/],
