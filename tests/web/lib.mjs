@@ -18,13 +18,14 @@ export const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '
 const DAEMON = path.resolve(ROOT, process.env.CONVSIMD || 'build/convsimd');
 const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 
-/* The daemon with a fresh token; {proc, base, auth, token}. */
-export function startDaemon() {
-	const token = randomBytes(20).toString('hex');
+/* The daemon with a fresh token; {proc, base, auth, token}. opts: port
+ * (default 0: a free one), token (the same again, for a restart) and
+ * args (more daemon options, e.g. ['--data-dir', DIR]). */
+export function startDaemon({ port = 0, token = randomBytes(20).toString('hex'), args = [] } = {}) {
 	const file = path.join(mkdtempSync(path.join(tmpdir(), 'convsim-web-')), 'token');
 	writeFileSync(file, token + '\n', { mode: 0o600 });
 	return new Promise((resolve, reject) => {
-		const p = spawn(DAEMON, ['--port', '0', '--token-file', file], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
+		const p = spawn(DAEMON, ['--port', String(port), '--token-file', file, ...args], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
 		let out = '', up = false;
 		const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`no "listening on" line from ${DAEMON} in 15 s:\n${out}`)); }, 15000);
 		/* once up, later output (the daemon's words at a SIGTERM) leaves

@@ -54,8 +54,9 @@ async function readEvents(body, onEvent, retry) {
 
 /* Open the session's SSE stream. handlers: sample(s), control(c, raw),
  * dropped(n), open(), error(readyState: 0 reconnecting, 2 closed), end().
- * Returns {close()}. After a drop it resumes with Last-Event-ID; a refusal
- * (401, 404, 429) closes it. */
+ * Returns {close()}. After a drop, a 503 or the daemon's shutdown it asks
+ * again every `retry` ms (the daemon's, default 1 s) and resumes with
+ * Last-Event-ID; another refusal (401, 404, 429) or end closes it. */
 export function openStream(id, opts, handlers) {
 	const url = `${BASE}/sessions/${encodeURIComponent(id)}/stream?${streamQuery(opts)}`;
 	const h = handlers;
@@ -75,7 +76,11 @@ export function openStream(id, opts, handlers) {
 		} else if (/drop|miss|lag/i.test(kind)) {
 			h.dropped?.(num(d.missed ?? d.dropped ?? d.count ?? d.n));
 		} else if (/end|close|stop|done|error/i.test(kind) && !/sample/i.test(kind)) {
-			/* the daemon closes the stream after "end": do not reconnect */
+			/* the daemon closes the stream after "end". A daemon that stops
+			 * ("shutdown") restores its sessions when it starts again: ask
+			 * again until it answers, as after a drop; any other end is
+			 * final */
+			if (d?.reason === 'shutdown') return;
 			close();
 			h.end?.(d);
 		} else if (Array.isArray(d)) {
@@ -94,6 +99,13 @@ export function openStream(id, opts, handlers) {
 			if (lastId) headers['Last-Event-ID'] = lastId;
 			try {
 				const res = await fetch(url, { headers, signal: ctrl.signal, cache: 'no-store' });
+				/* 503: a daemon stopping, or its budget spent for now
+				 * (Retry-After): ask again; any other refusal is final */
+				if (res.status === 503) {
+					const after = Number(res.headers.get('Retry-After'));
+					if (after > 0) wait = 1000 * after;
+					throw new Error('unavailable');
+				}
 				if (!res.ok) {
 					closed = true;
 					h.error?.(CLOSED);
