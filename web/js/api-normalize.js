@@ -36,6 +36,7 @@ export const FIELDS = {
 		running: ['status.running', 'running'],
 		state: ['state', 'status.state'],
 		experiment: ['experiment'],
+		until: ['until', 'spec.until'],
 		sampleRate: ['sample_rate'],
 		pace: ['status.pace', 'pace', 'spec.pace'],
 		realTimeFactor: ['status.real_time_factor', 'real_time_factor', 'status.rtf', 'rtf'],
@@ -233,6 +234,7 @@ export function normalizeSession(raw) {
 		preset: pick(raw, F.preset),
 		error: pick(raw, F.error),
 		experiment: pick(raw, F.experiment) ?? null,
+		until: scalar(raw, F.until), /* the simulated end time, s (NaN: none) */
 		sampleRate: scalar(raw, F.sampleRate),
 	};
 }

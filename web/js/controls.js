@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 /*
  * controls.js - the live-control card of the attached session: pause,
- * resume and delete; the beta slider, its number field and the quick
+ * resume (for a finished session: run on) and delete; the beta slider, its number field and the quick
  * buttons (with the optional slew rate); the rotation flip; the drive row
  * (motor on/off, omega_ss, pace). Each change is one PATCH (session.js).
  */
@@ -11,7 +11,10 @@ import { patch, setBeta, removeSession } from './session.js';
 
 export function wireControls() {
 	$('#pause').onclick = () => patch({ running: false }, 'Pause');
-	$('#resume').onclick = () => patch({ running: true }, 'Resume');
+	/* a finished session runs on without an end (at pace "max" the
+	 * daemon sets one 60 s on again) */
+	$('#resume').onclick = () => (app.session?.state === 'finished'
+		? patch({ until: null }, 'Run on') : patch({ running: true }, 'Resume'));
 	$('#delete').onclick = removeSession;
 	$('#flip').onclick = () => {
 		const now = app.session?.rotation ?? 'cw';

@@ -71,6 +71,7 @@ export function detach() {
 	$('#session-downloads').hidden = true;
 	$('#beta-now-mark').hidden = true;
 	$('#session-label').textContent = 'no session';
+	$('#resume').textContent = 'Resume';
 	$('#live-state').textContent = 'stream: idle';
 	$('#session-select').value = '';
 	clearStatus();

@@ -8,7 +8,7 @@
  * lies outside its validated domain.
  */
 
-import { fmt, fmtSig, fmtTime, fmtVelocityPm, steadyLabel, fmtPace, RAD_S_TO_RPM, rotationLabel,
+import { fmt, fmtGiven, fmtSig, fmtTime, fmtVelocityPm, steadyLabel, fmtPace, RAD_S_TO_RPM, rotationLabel,
 	wrapBeta, DASH } from './format.js';
 import { app, $ } from './ui.js';
 import { resetTraces } from './live.js';
@@ -25,12 +25,19 @@ export function showStatus(s) {
 	const opt = Array.from($('#session-select').options).find(o => o.value === app.id);
 	if (opt && s.id === app.id) opt.textContent = sessionLabel(s);
 	$('#t-now').textContent = fmtTime(s.t);
-	const state = s.error ? `error: ${s.error}` : s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
+	/* a session ends at its until (pace "max" sets one 60 s on, docs/api.md):
+	 * say where, and offer to run on */
+	const finished = s.state === 'finished' && !s.error;
+	const state = s.error ? `error: ${s.error}` : finished && Number.isFinite(s.until)
+		? `finished at until = ${fmtGiven(s.until)} s`
+		: s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
 	$('#state-now').textContent = state;
 	document.body.dataset.running = s.running === false ? 'false' : 'true';
-	/* finished and failed sessions can be neither paused nor resumed */
+	/* a failed session can be neither paused nor resumed; a finished one
+	 * runs on (controls.js lifts its until) */
 	$('#pause').disabled = !app.id || !/^running$/i.test(s.state || (s.running ? 'running' : ''));
-	$('#resume').disabled = !app.id || !/^paused$/i.test(s.state || (s.running === false ? 'paused' : ''));
+	$('#resume').disabled = !app.id || !(finished || /^paused$/i.test(s.state || (s.running === false ? 'paused' : '')));
+	$('#resume').textContent = finished ? 'Run on' : 'Resume';
 	$('#rotor-now').textContent = fmt(s.rotorSpeed, 2, 'rad/s');
 	$('#rotor-rpm').textContent = Number.isFinite(s.rotorSpeed) ? `${fmt(Math.abs(s.rotorSpeed) * RAD_S_TO_RPM, 0)} rpm` +
 		(Number.isFinite(s.omegaSs) ? ` · ω_ss ${fmt(s.omegaSs, 2)} rad/s` : '') : DASH;
