@@ -12,6 +12,12 @@ import { fmt, fmtGiven, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direct
 import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
 import { readSessionForm, attach } from './session.js';
 
+/* The inputs behind the schedule's members (api-requests.js
+ * experimentRequest): segment 1 is beta1 until t_switch, segment 2 beta2
+ * until t_end. */
+const SCHEDULE_INPUT = [[/^schedule\[0\]\.beta/, 'beta1'], [/^schedule\[0\]\.until/, 't_switch'],
+	[/^schedule\[1\]\.beta/, 'beta2'], [/^schedule\[1\]\.until/, 't_end']];
+
 export async function runExperiment(ev) {
 	ev.preventDefault();
 	const f = $('#experiment-form').elements;
@@ -55,7 +61,7 @@ export async function runExperiment(ev) {
 			showExperiment(end, form, traj);
 		}
 	} catch (err) {
-		report(err, 'Experiment', $('#experiment-form'));
+		report(err, 'Experiment', $('#experiment-form'), SCHEDULE_INPUT);
 	} finally {
 		busy(btn, false);
 	}

@@ -76,26 +76,16 @@ async function runLoop(ev) {
 		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
 		else message('ok', `Experiment ${end.id} finished.`);
 	} catch (err) {
-		report(err, 'Experiment', $('#loop-form'));
-		markField(err);
+		report(err, 'Experiment', $('#loop-form'), FIELD_INPUT);
 	} finally {
 		busy(btn, false);
 	}
 }
 
 /* The input behind a refused member that report() does not find by its
- * last name: control.setpoint[1].v is the setpoints text, disturbances[0]
+ * path: control.setpoint[1].v is the setpoints text, disturbances[0]
  * the disturbances text, identify.beta the operating points. */
 const FIELD_INPUT = [[/^control\.setpoint/, 'setpoints'], [/^disturbances/, 'disturbances'], [/^identify\.beta/, 'points']];
-function markField(err) {
-	const field = String(err?.field ?? '');
-	const hit = FIELD_INPUT.find(([re]) => re.test(field));
-	const input = hit && $('#loop-form').elements[hit[1]];
-	if (!input) return;
-	input.setAttribute('aria-invalid', 'true');
-	input.title = err.detail;
-	input.addEventListener('input', () => input.removeAttribute('aria-invalid'), { once: true });
-}
 
 function showLoop(j, traj) {
 	$('#loop-plot-control').hidden = j.kind !== 'control';

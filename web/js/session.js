@@ -52,7 +52,7 @@ export async function startSession(ev) {
 		attach(s.id, null);
 		refreshSessionList();
 	} catch (err) {
-		report(err, 'Start session', $('#session-form'));
+		report(err, 'Start session', $('#session-form'), [[/^sample_rate$/, 'rate']]);
 	} finally {
 		busy(btn, false);
 	}

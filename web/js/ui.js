@@ -64,9 +64,26 @@ function clearMessage(key) {
 	$(`#messages [data-key="${key}"]`)?.remove();
 }
 
+/* The input of form behind the member field a problem names: the first
+ * of fields ([RegExp, input name] pairs: the form's members whose input
+ * has another name) that matches, else the member's path read from its
+ * end, indices dropped (scene.columns: columns; vary.mu: vary; free[0]:
+ * free). */
+function fieldInput(form, field, fields = []) {
+	const hit = fields.find(([re]) => re.test(field));
+	if (hit) return form.elements[hit[1]] ?? null;
+	for (const part of field.split(/[./]/).reverse()) {
+		const input = form.elements[part.replace(/\[\d*\]$/, '')];
+		if (input) return input;
+	}
+	return null;
+}
+
 /* Report a failed request: a refused input shows the daemon's problem
- * detail and marks the field it names; an unreachable daemon says so. */
-export function report(err, what, form) {
+ * detail and marks the input of form behind the member it names
+ * (fieldInput: fields maps members to inputs of other names); an
+ * unreachable daemon says so. */
+export function report(err, what, form, fields) {
 	if (err instanceof api.NetworkError) {
 		setOnline(false);
 		message('error', `${what}: ${err.message}`, { key: 'network', sticky: true });
@@ -75,8 +92,7 @@ export function report(err, what, form) {
 	if (err instanceof api.ApiError) {
 		message('error', `${what} refused: ${problemText(err)}`, { key: `refused-${what}` });
 		if (form && err.field) {
-			const name = String(err.field).split(/[./]/).pop();
-			const input = form.elements[name];
+			const input = fieldInput(form, String(err.field), fields);
 			if (input) {
 				input.setAttribute('aria-invalid', 'true');
 				input.title = err.detail;
