@@ -53,12 +53,14 @@ test('the daemon stops and starts again: the page says so, and its live plots go
 	assert.equal(await page.$eval('#messages', m => m.textContent.includes('does not answer')), false,
 		'the "does not answer" message goes once the daemon answers');
 	/* the restored session runs on: one simulated second more on the plots,
-	 * and as many samples as the stream gives in it (500 a second) */
+	 * and the stream's count goes on with them (how many come in that
+	 * second depends on the load: a page that reads too slowly misses
+	 * the records the ring overwrote, docs/api-streams.md) */
 	const s = await apiGet(d, `/api/v1/sessions/${id}`);
 	assert.equal(s.state, 'running');
 	await until(async () => await rotorEnd() > down.t + 1, 15000,
 		`the rotor plot past t = ${down.t + 1} s (it stood at ${down.t} s when the daemon stopped)`);
-	assert.ok(await samples() >= down.n + 400, `samples ${await samples()} after ${down.n} at the stop`);
+	assert.ok(await samples() > down.n, `samples ${await samples()} after ${down.n} at the stop`);
 	assert.equal(await page.evaluate(() => document.body.dataset.sessionId), id);
 	assert.match(await page.textContent('#live-state'), /^stream: \d+ samples$/);
 	assert.deepEqual(ui.pageErrors, []);
