@@ -138,6 +138,12 @@ api_err api_from_sim(int sim_err);
  * Returns code, so handlers can `return api_fail(...)`. */
 api_err api_fail(api_problem *pb, api_err code, const char *field,
 		 const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* A value of field outside [min, max] (an open end given as its limit):
+ * api_fail with API_RANGE and that range, the problem's min and max
+ * members; the one way a refusal states a range that is not the
+ * settings table's. Returns API_RANGE. */
+api_err api_fail_range(api_problem *pb, const char *field, double min, double max,
+		       const char *fmt, ...) __attribute__((format(printf, 5, 6)));
 /* Name the budget that refused a request (copied) and its limit, with the
  * Retry-After seconds; returns pb->code. */
 api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);

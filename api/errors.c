@@ -93,16 +93,35 @@ static const sim_setting *field_setting(const char *field)
 	return api_setting(group, dot + 1);
 }
 
-api_err api_fail(api_problem *pb, api_err code, const char *field,
-		 const char *fmt, ...)
+static void vfail(api_problem *pb, api_err code, const char *field, const char *fmt,
+		  va_list ap)
 {
 	memset(pb, 0, sizeof *pb);
 	pb->code = code;
 	if (field)
 		snprintf(pb->field, sizeof pb->field, "%s", field);
+	vsnprintf(pb->detail, sizeof pb->detail, fmt, ap);
+}
+
+api_err api_fail_range(api_problem *pb, const char *field, double min, double max,
+		       const char *fmt, ...)
+{
 	va_list ap;
 	va_start(ap, fmt);
-	vsnprintf(pb->detail, sizeof pb->detail, fmt, ap);
+	vfail(pb, API_RANGE, field, fmt, ap);
+	va_end(ap);
+	pb->has_range = 1;
+	pb->min = min;
+	pb->max = max;
+	return API_RANGE;
+}
+
+api_err api_fail(api_problem *pb, api_err code, const char *field,
+		 const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vfail(pb, code, field, fmt, ap);
 	va_end(ap);
 	const sim_setting *set = field ? field_setting(field) : NULL;
 	if (set && (code == API_RANGE || code == API_TYPE)) {

@@ -161,9 +161,14 @@ static api_err parse_prior(const cJSON *pr, fit_request *req, const char *name, 
 		e = numbers(pr, prefix, api_members_fit_prior, 1, v, pb);
 	if (e != API_OK)
 		return e;
-	if (fit_set_prior(req, name, v[0], v[1], v[2], msg, sizeof msg) != SIM_OK)
-		return api_fail(pb, API_RANGE, field, "%s", msg);
-	return API_OK;
+	const char *member = NULL;
+	fit_range range;
+	if (fit_set_prior(req, name, v[0], v[1], v[2], msg, sizeof msg, &member, &range) == SIM_OK)
+		return API_OK;
+	if (!range.has)
+		return api_fail(pb, API_INVALID, field, "%s", msg);
+	snprintf(field, sizeof field, "free[%d].prior.%s", i, member);
+	return api_fail_range(pb, field, range.min, range.max, "%s", msg);
 }
 
 /* "free": ["e", {"name": "b_s1", "min": 0, "max": 500, "start": 60,
@@ -176,7 +181,8 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 		return api_fail(pb, !arr || n >= 0 ? API_INVALID : API_TYPE, "free",
 				"free must list 1 to %d parameter names (or {name, min, max, "
 				"start})", FIT_MAX_FREE);
-	char field[48], msg[FIT_MSG], prefix[32];
+	char field[48], msg[FIT_MSG], prefix[32], member[8];
+	fit_range range;
 	int i = 0;
 	for (const cJSON *f = arr->child; f; f = f->next, i++) {
 		double v[3] = {NAN, NAN, NAN}; /* min, max, start */
@@ -196,7 +202,12 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 		if (!name)
 			return api_fail(pb, API_TYPE, field, "%s must be a parameter name or "
 					"{name, min, max, start}", field);
-		int rc = fit_add_free(req, name, lo, hi, prefix, sizeof prefix, msg, sizeof msg);
+		int rc = fit_add_free(req, name, lo, hi, member, sizeof member, msg, sizeof msg,
+				      &range);
+		if (rc != SIM_OK && range.has) {
+			snprintf(field, sizeof field, "%s%s", prefix, member);
+			return api_fail_range(pb, field, range.min, range.max, "%s", msg);
+		}
 		if (rc != SIM_OK)
 			return api_fail(pb, rc == SIM_EUNKNOWN ? API_UNKNOWN : API_INVALID, field,
 					"%s", msg);
@@ -225,13 +236,14 @@ static api_err parse_options(const cJSON *root, fit_request *req, api_problem *p
 		req->fd_rel = v;
 	if (e == API_OK && (e = number(root, "max_iter", "", 0, &v, pb)) == API_OK && !isnan(v)) {
 		if (v != floor(v))
-			return api_fail(pb, API_RANGE, "max_iter", "max_iter must be an integer");
+			return api_fail_range(pb, "max_iter", 1, FIT_MAX_ITER,
+					      "max_iter must be an integer in [1, %d]", FIT_MAX_ITER);
 		req->max_iter = (int)fmax(fmin(v, 1e6), -1);
 	}
 	if (e == API_OK && (e = number(root, "starts", "", 0, &v, pb)) == API_OK && !isnan(v)) {
 		if (v != floor(v))
-			return api_fail(pb, API_RANGE, "starts", "starts must be an integer in [1, %d]",
-					FIT_MAX_STARTS);
+			return api_fail_range(pb, "starts", 1, FIT_MAX_STARTS,
+					      "starts must be an integer in [1, %d]", FIT_MAX_STARTS);
 		req->starts = (int)fmax(fmin(v, 1e6), -1);
 	}
 	return e;
@@ -264,13 +276,11 @@ api_err api_parse_fit(const char *body, size_t len, fit_request *req, fit_point 
 	if (e == API_OK)
 		e = parse_options(root, req, pb);
 	char field[48], msg[FIT_MSG];
-	if (e == API_OK && fit_check(req, field, sizeof field, msg, sizeof msg) != SIM_OK) {
-		int range = strstr(field, "beta") || strstr(field, "sigma") || strstr(field, ".v") ||
-			    strcmp(field, "t_end") == 0 || strcmp(field, "fd_step") == 0 ||
-			    strcmp(field, "max_iter") == 0 || strcmp(field, "curve_step") == 0 ||
-			    strcmp(field, "starts") == 0;
-		e = api_fail(pb, range ? API_RANGE : API_INVALID, field, "%s", msg);
-	}
+	fit_range range;
+	if (e == API_OK &&
+	    fit_check_range(req, field, sizeof field, msg, sizeof msg, &range) != SIM_OK)
+		e = range.has ? api_fail_range(pb, field, range.min, range.max, "%s", msg)
+			      : api_fail(pb, API_INVALID, field, "%s", msg);
 	cJSON_Delete(root);
 	if (e != API_OK) {
 		free(*points);

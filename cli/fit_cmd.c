@@ -34,7 +34,7 @@ static int parse_free(const char *list, fit_request *req)
 				return -1;
 			}
 		}
-		if (fit_add_free(req, tok, lo, hi, field, sizeof field, msg, sizeof msg) != SIM_OK) {
+		if (fit_add_free(req, tok, lo, hi, field, sizeof field, msg, sizeof msg, NULL) != SIM_OK) {
 			fprintf(stderr, "convsim fit: --free: %s\n", msg);
 			return -1;
 		}
@@ -65,7 +65,7 @@ static int parse_priors(const char *list, fit_request *req)
 					"got '%s'\n", tok);
 			return -1;
 		}
-		if (fit_set_prior(req, name, mean, sd, factor, msg, sizeof msg) != SIM_OK) {
+		if (fit_set_prior(req, name, mean, sd, factor, msg, sizeof msg, NULL, NULL) != SIM_OK) {
 			fprintf(stderr, "convsim fit: --prior: %s\n", msg);
 			return -1;
 		}

@@ -29,6 +29,16 @@
 #define FIT_MAX_WARNINGS 8
 #define FIT_MSG 240
 #define FIT_MAX_STARTS 32
+#define FIT_MAX_ITER 1000
+
+/* The range a refused value had to lie in, in its user unit, for answers
+ * that give it (the API's min and max): fit_check_range, fit_add_free and fit_set_prior fill it (when
+ * not NULL), has 0 for a refusal of another kind. An open end is given as
+ * its limit: (0, 0.5] is min 0, max 0.5. */
+typedef struct fit_range {
+	int has;
+	double min, max;
+} fit_range;
 
 /* One measured point: beta (rad), rotation SIM_CW / SIM_CCW, v (m/s) and
  * its standard deviation sigma (m/s; NaN when not given). */
@@ -263,9 +273,10 @@ int fit_band_point(const fit_band_source *src, const int *skip, const sim_params
  * mean / factor .. mean x factor is one standard deviation. The fit then
  * minimises chi2 plus the priors' squared residuals (a maximum a
  * posteriori estimate), and the covariance is the posterior's. The
- * problem into msg (field "prior"). SIM_OK or SIM_EPARAM. */
+ * problem into msg; a value outside its range ("mean", "sd" or "factor",
+ * into *member when not NULL) with *range. SIM_OK or SIM_EPARAM. */
 int fit_set_prior(fit_request *req, const char *name, double mean, double sd, double factor,
-		  char *msg, size_t mlen);
+		  char *msg, size_t mlen, const char **member, fit_range *range);
 /* Whether pr is a prior; its residual at x (SI) and the residual's slope
  * d r / d x there (0 without one). */
 int fit_has_prior(const fit_prior *pr);
@@ -284,9 +295,11 @@ const sim_setting *fit_free_param(const char *name, int *err, char *msg, size_t 
 
 /* Set free parameter i of req by name with the bounds of its setting's
  * range (or lo/hi in user units when finite) and the model's current
- * value as its start; the problem into field/msg. SIM_OK or an error. */
+ * value as its start; the problem into field ("name", or "min" or "max"
+ * for a bound outside the setting's range or not below max, with *range)
+ * and msg. SIM_OK or an error. */
 int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_user,
-		 char *field, size_t flen, char *msg, size_t mlen);
+		 char *field, size_t flen, char *msg, size_t mlen, fit_range *range);
 
 /* Parse CSV text (header beta,rotation,v[,sigma], any column order, beta
  * in deg) into a malloc'd array (*out, *n; caller frees). Returns SIM_OK,
@@ -294,13 +307,18 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len);
 
 /* Whole-request checks: data present (points or peaks, not both), beta
- * finite in [0, 180] deg, rotation known, v and sigma finite (sigma > 0,
- * given for every point or none), no duplicate (beta, rotation), at least
- * as many data as free parameters, starts within bounds, 1 to
- * FIT_MAX_STARTS runs, t_end after the
- * transient, the model valid. On error returns SIM_EPARAM with the field
- * ("points[3].beta", "free", "t_end", ...) and the message. */
+ * finite in [0, 180] deg, rotation known, v and sigma finite (sigma in
+ * (0, 100] m/s for points, (0, 180] deg for peaks, given for every datum
+ * or none), no duplicate (beta, rotation), at least as many data as free
+ * parameters, starts within bounds, 1 to FIT_MAX_STARTS runs, 1 to
+ * FIT_MAX_ITER iterations, t_end after the transient, the model valid. On
+ * error returns SIM_EPARAM with the field ("points[3].beta", "free",
+ * "t_end", ...) and the message. */
 int fit_check(const fit_request *req, char *field, size_t flen, char *msg, size_t mlen);
+/* The same, with the range of a value refused for lying outside one in
+ * *range (may be NULL). */
+int fit_check_range(const fit_request *req, char *field, size_t flen, char *msg, size_t mlen,
+		    fit_range *range);
 
 /* ---- results as text (user units: beta in deg, parameters in their
  * setting's unit; numbers round-trip, core/table.h's printer) ---------- */

@@ -73,10 +73,12 @@ const sim_setting *fit_free_param(const char *name, int *err, char *msg, size_t 
 }
 
 int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_user,
-		 char *field, size_t flen, char *msg, size_t mlen)
+		 char *field, size_t flen, char *msg, size_t mlen, fit_range *range)
 {
 	int err;
-	snprintf(field, flen, "free");
+	snprintf(field, flen, "name");
+	if (range)
+		range->has = 0;
 	const sim_setting *t = fit_free_param(name, &err, msg, mlen);
 	if (!t)
 		return err;
@@ -91,6 +93,12 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 	}
 	double lo = isnan(lo_user) ? t->min : lo_user, hi = isnan(hi_user) ? t->max : hi_user;
 	if (!(lo >= t->min && hi <= t->max && lo < hi)) {
+		/* the bound at fault: min below the range or not below max
+		 * (min in [table min, table max)), else max ((min, table max]) */
+		int at_min = !(lo >= t->min && lo < t->max);
+		snprintf(field, flen, "%s", at_min ? "min" : "max");
+		if (range)
+			*range = (fit_range){1, at_min ? t->min : lo, t->max};
 		snprintf(msg, mlen, "the bounds of '%s' must satisfy %g <= min < max <= %g %s", name,
 			 t->min, t->max, sim_unit_shown(t));
 		return SIM_EPARAM;
@@ -240,13 +248,21 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 		return SIM_EPARAM;                           \
 	} while (0)
 
+/* A value outside [lo, hi] (user unit): FAIL with the range. */
+#define FAIL_RANGE(f, lo, hi, ...)                           \
+	do {                                                 \
+		if (range)                                   \
+			*range = (fit_range){1, lo, hi};     \
+		FAIL(f, __VA_ARGS__);                        \
+	} while (0)
+
 static int check_beta(double beta, int rotation, const char *name, char *field, size_t flen,
-		      char *msg, size_t mlen)
+		      char *msg, size_t mlen, fit_range *range)
 {
 	char f[48];
 	snprintf(f, sizeof f, "%s.beta", name);
 	if (!(isfinite(beta) && beta >= 0 && beta <= SIM_PI * (1 + 1e-12)))
-		FAIL(f, "%s: beta must be a finite number in [0, 180] deg", name);
+		FAIL_RANGE(f, 0, 180, "%s: beta must be a finite number in [0, 180] deg", name);
 	if (rotation != SIM_CW && rotation != SIM_CCW) {
 		snprintf(f, sizeof f, "%s.rotation", name);
 		FAIL(f, "%s: rotation must be cw or ccw", name);
@@ -254,21 +270,22 @@ static int check_beta(double beta, int rotation, const char *name, char *field, 
 	return SIM_OK;
 }
 
-static int check_points(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
+static int check_points(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen,
+			fit_range *range)
 {
 	char name[32], f[48];
 	int with_sigma = r->npoints && !isnan(r->points[0].sigma);
 	for (size_t i = 0; i < r->npoints; i++) {
 		const fit_point *p = &r->points[i];
 		snprintf(name, sizeof name, "points[%zu]", i);
-		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen))
+		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen, range))
 			return SIM_EPARAM;
 		snprintf(f, sizeof f, "%s.v", name);
 		if (!isfinite(p->v) || fabs(p->v) > 100)
-			FAIL(f, "%s: v must be a finite number in [-100, 100] m/s", name);
+			FAIL_RANGE(f, -100, 100, "%s: v must be a finite number in [-100, 100] m/s", name);
 		snprintf(f, sizeof f, "%s.sigma", name);
 		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0 && p->sigma <= 100))
-			FAIL(f, "%s: sigma must be a number in (0, 100] m/s", name);
+			FAIL_RANGE(f, 0, 100, "%s: sigma must be a number in (0, 100] m/s", name);
 		if (isnan(p->sigma) == with_sigma)
 			FAIL(f, "%s: sigma must be given for every point or for none", name);
 		for (size_t k = 0; k < i; k++)
@@ -280,7 +297,8 @@ static int check_points(const fit_request *r, char *field, size_t flen, char *ms
 	return SIM_OK;
 }
 
-static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
+static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen,
+		       fit_range *range)
 {
 	char name[32], f[48];
 	if (r->npeaks > FIT_MAX_PEAKS)
@@ -288,11 +306,11 @@ static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg
 	for (int i = 0; i < r->npeaks; i++) {
 		const fit_peak *p = &r->peaks[i];
 		snprintf(name, sizeof name, "peaks[%d]", i);
-		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen))
+		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen, range))
 			return SIM_EPARAM;
 		snprintf(f, sizeof f, "%s.sigma", name);
-		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0))
-			FAIL(f, "%s: sigma must be a positive number of deg", name);
+		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0 && p->sigma <= SIM_PI))
+			FAIL_RANGE(f, 0, 180, "%s: sigma must be a number in (0, 180] deg", name);
 		if (isnan(p->sigma) != isnan(r->peaks[0].sigma))
 			FAIL(f, "%s: sigma must be given for every peak or for none", name);
 		for (int k = 0; k < i; k++)
@@ -307,12 +325,20 @@ static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg
 
 int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen)
 {
+	return fit_check_range(r, field, flen, msg, mlen, NULL);
+}
+
+int fit_check_range(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen,
+		    fit_range *range)
+{
+	if (range)
+		range->has = 0;
 	if (sim_validate(&r->p, &r->sc, &r->m, msg, mlen) != SIM_OK) {
 		snprintf(field, flen, "params");
 		return SIM_EPARAM;
 	}
 	if (!(r->t_end > r->sc.transient && r->t_end <= 600))
-		FAIL("t_end", "t_end must exceed the scene's transient (%g s) and be at most 600 s",
+		FAIL_RANGE("t_end", r->sc.transient, 600, "t_end must exceed the scene's transient (%g s) and be at most 600 s",
 		     r->sc.transient);
 	if (r->nfree < 1)
 		FAIL("free", "name at least one free parameter (e.g. e)");
@@ -322,7 +348,8 @@ int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t 
 		FAIL("points", "no data: give points (beta, rotation, v[, sigma]) or peaks");
 	if (r->npoints > FIT_MAX_POINTS)
 		FAIL("points", "at most %d points", FIT_MAX_POINTS);
-	if (check_points(r, field, flen, msg, mlen) || check_peaks(r, field, flen, msg, mlen))
+	if (check_points(r, field, flen, msg, mlen, range) ||
+	    check_peaks(r, field, flen, msg, mlen, range))
 		return SIM_EPARAM;
 	size_t ndata = r->npoints ? r->npoints : (size_t)r->npeaks;
 	if (ndata < (size_t)r->nfree)
@@ -333,9 +360,11 @@ int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t 
 		const fit_free *f = &r->free[i];
 		char at[32];
 		snprintf(at, sizeof at, "free[%d].start", i);
+		const sim_setting *t = sim_setting_find(f->name);
+		double lo = sim_setting_from_si(t, f->lo), hi = sim_setting_from_si(t, f->hi);
 		if (!(f->start >= f->lo && f->start <= f->hi))
-			FAIL(at, "the start of '%s' (%g) lies outside its bounds [%g, %g]",
-			     f->name, f->start, f->lo, f->hi);
+			FAIL_RANGE(at, lo, hi, "the start of '%s' (%g) lies outside its bounds [%g, %g]",
+				   f->name, sim_setting_from_si(t, f->start), lo, hi);
 		/* a prior weighs against the data's residuals in units of their
 		 * sigma: without it the two are on no common scale */
 		if (fit_has_prior(&r->prior[i]) &&
@@ -347,13 +376,14 @@ int fit_check(const fit_request *r, char *field, size_t flen, char *msg, size_t 
 		}
 	}
 	if (!(r->fd_rel > 0 && r->fd_rel <= 0.5))
-		FAIL("fd_step", "fd_step must be in (0, 0.5]");
-	if (!(r->max_iter >= 1 && r->max_iter <= 1000))
-		FAIL("max_iter", "max_iter must be in [1, 1000]");
+		FAIL_RANGE("fd_step", 0, 0.5, "fd_step must be in (0, 0.5]");
+	if (!(r->max_iter >= 1 && r->max_iter <= FIT_MAX_ITER))
+		FAIL_RANGE("max_iter", 1, FIT_MAX_ITER, "max_iter must be in [1, %d]", FIT_MAX_ITER);
 	if (!(r->starts >= 1 && r->starts <= FIT_MAX_STARTS))
-		FAIL("starts", "starts must be in [1, %d]", FIT_MAX_STARTS);
+		FAIL_RANGE("starts", 1, FIT_MAX_STARTS, "starts must be in [1, %d]", FIT_MAX_STARTS);
 	if (!(r->curve_step == 0 || (r->curve_step >= 0.5 * RAD_PER_DEG &&
 				     r->curve_step <= 90 * RAD_PER_DEG)))
-		FAIL("curve_step", "curve_step must be 0 (no curve) or in [0.5, 90] deg");
+		FAIL_RANGE("curve_step", 0, 90,
+			   "curve_step must be 0 (no curve) or in [0.5, 90] deg");
 	return SIM_OK;
 }

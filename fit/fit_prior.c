@@ -47,9 +47,23 @@ double fit_prior_cost(const fit_request *req, const double *x)
 	return cost;
 }
 
-int fit_set_prior(fit_request *req, const char *name, double mean, double sd, double factor,
-		  char *msg, size_t mlen)
+/* A member of the prior outside [lo, hi]: its name and range. */
+static void out_of(const char *name, double lo, double hi, const char **member,
+		   fit_range *range)
 {
+	if (member)
+		*member = name;
+	if (range)
+		*range = (fit_range){1, lo, hi};
+}
+
+int fit_set_prior(fit_request *req, const char *name, double mean, double sd, double factor,
+		  char *msg, size_t mlen, const char **member, fit_range *range)
+{
+	if (member)
+		*member = NULL;
+	if (range)
+		range->has = 0;
 	fit_free *f = NULL;
 	fit_prior *pr = NULL;
 	for (int j = 0; j < req->nfree && !f; j++)
@@ -75,17 +89,21 @@ int fit_set_prior(fit_request *req, const char *name, double mean, double sd, do
 	}
 	double lo = sim_setting_from_si(t, f->lo), hi = sim_setting_from_si(t, f->hi);
 	if (!(isfinite(mean) && mean >= lo && mean <= hi) || (log_normal && !(mean > 0))) {
+		out_of("mean", lo, hi, member, range);
 		snprintf(msg, mlen, "the prior's mean of '%s' must lie within its bounds [%g, %g] %s%s",
 			 name, lo, hi, sim_unit_shown(t), log_normal ? " and be positive" : "");
 		return SIM_EPARAM;
 	}
 	if (log_normal ? !(isfinite(factor) && factor > 1 && factor <= 1e6)
 		       : !(isfinite(sd) && sd > 0 && sd <= 10 * (hi - lo))) {
-		if (log_normal)
+		if (log_normal) {
+			out_of("factor", 1, 1e6, member, range);
 			snprintf(msg, mlen, "the prior's factor of '%s' must be in (1, 1e6]", name);
-		else
+		} else {
+			out_of("sd", 0, 10 * (hi - lo), member, range);
 			snprintf(msg, mlen, "the prior's sd of '%s' must be in (0, %g] %s (ten times "
 				 "its range)", name, 10 * (hi - lo), sim_unit_shown(t));
+		}
 		return SIM_EPARAM;
 	}
 	if (log_normal && !(f->lo > 0)) {

@@ -26,8 +26,10 @@ static inline void cheap_request(fit_request *r)
 	r->curve_step = 0;
 	r->threads = 2;
 	char field[48], msg[FIT_MSG];
-	assert_int_equal(fit_add_free(r, "e", NAN, NAN, field, sizeof field, msg, sizeof msg), SIM_OK);
-	assert_int_equal(fit_add_free(r, "mu", NAN, NAN, field, sizeof field, msg, sizeof msg), SIM_OK);
+	assert_int_equal(fit_add_free(r, "e", NAN, NAN, field, sizeof field, msg, sizeof msg, NULL),
+			 SIM_OK);
+	assert_int_equal(fit_add_free(r, "mu", NAN, NAN, field, sizeof field, msg, sizeof msg, NULL),
+			 SIM_OK);
 }
 
 /* v at (beta, rotation) of the cheap scene at e, mu. */

@@ -156,18 +156,27 @@ static void refuses_bad_input(void **state)
 	char field[48], msg[FIT_MSG];
 	const char *bad[] = {"ee", "beta", "rotation", "layers", "dt", "beta_rate"};
 	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
-		int rc = fit_add_free(&r, bad[i], NAN, NAN, field, sizeof field, msg, sizeof msg);
+		int rc = fit_add_free(&r, bad[i], NAN, NAN, field, sizeof field, msg, sizeof msg,
+				      NULL);
 		printf("  --free %s: %s\n", bad[i], msg);
 		assert_int_equal(rc, i == 0 ? SIM_EUNKNOWN : SIM_EPARAM);
 		assert_non_null(strstr(msg, bad[i]));
 	}
 	assert_non_null(strstr((fit_add_free(&r, "ee", NAN, NAN, field, sizeof field, msg,
-					     sizeof msg), msg), "did you mean 'e'"));
+					     sizeof msg, NULL), msg), "did you mean 'e'"));
 	assert_int_equal(r.nfree, 2);
-	assert_int_equal(fit_add_free(&r, "b_s1", 10, 5, field, sizeof field, msg, sizeof msg),
-			 SIM_EPARAM); /* min above max */
-	assert_int_equal(fit_add_free(&r, "e", NAN, NAN, field, sizeof field, msg, sizeof msg),
-			 SIM_EPARAM); /* named twice */
+	fit_range range;
+	assert_int_equal(fit_add_free(&r, "b_s1", 10, 5, field, sizeof field, msg, sizeof msg,
+				      &range), SIM_EPARAM); /* min above max: max in (10, 1e6] */
+	assert_string_equal(field, "max");
+	assert_true(range.has && range.min == 10 && range.max == sim_setting_find("b_s1")->max);
+	assert_int_equal(fit_add_free(&r, "b_s1", -1, 5, field, sizeof field, msg, sizeof msg,
+				      &range), SIM_EPARAM); /* min below the setting's range */
+	assert_string_equal(field, "min");
+	assert_true(range.has && range.min == 0 && range.max == sim_setting_find("b_s1")->max);
+	assert_int_equal(fit_add_free(&r, "e", NAN, NAN, field, sizeof field, msg, sizeof msg,
+				      &range), SIM_EPARAM); /* named twice */
+	assert_false(range.has);
 }
 
 static void parses_csv(void **state)
