@@ -48,6 +48,20 @@ static api_err study_problem(int rc, const char *field, const char *name, const 
 	return pb->code;
 }
 
+/* A list of n values of field that repeats one: a 422 naming the repeat,
+ * field[k] (sim_study_repeat, the rule the study itself keeps). */
+static api_err list_repeat(const char *field, const double *values, size_t n, api_problem *pb)
+{
+	size_t first = 0;
+	long again = sim_study_repeat(values, n, &first);
+	if (again < 0)
+		return API_OK;
+	char at[112];
+	snprintf(at, sizeof at, "%s[%ld]", field, again);
+	return api_fail(pb, API_INVALID, at, "%s repeats %s[%zu] (%.15g): each point runs once; "
+			"list each value once", at, field, first, values[again]);
+}
+
 /* One member of "vary" as an axis of st: {"from","to","step"} or a
  * list of numbers, on the request's model. */
 static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *st,
@@ -92,6 +106,11 @@ static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *
 			}
 			values[k] = v->valuedouble;
 		}
+		api_err e = list_repeat(field, values, (size_t)n, pb);
+		if (e != API_OK) {
+			free(values);
+			return e;
+		}
 		rc = sim_study_add_list(st, &sp->params, &sp->scene, &sp->method, it->string,
 					values, (size_t)n, msg, sizeof msg);
 		free(values);
@@ -113,14 +132,17 @@ static api_err parse_sample(const cJSON *lhs, const cJSON *seed, sim_study *st,
 	if (lhs) {
 		e = api_parse_real(lhs, "lhs", 1, API_SWEEP_MAX_POINTS, 0, &v, pb);
 		if (e == API_OK && v != floor(v))
-			e = api_fail(pb, API_RANGE, "lhs", "lhs must be a whole number of points");
+			e = api_fail_range(pb, "lhs", 1, API_SWEEP_MAX_POINTS,
+					   "lhs must be a whole number of points in [1, %d]",
+					   API_SWEEP_MAX_POINTS);
 		st->lhs = (size_t)v;
 	}
 	st->seed = 1;
 	if (e == API_OK && seed) {
 		e = api_parse_real(seed, "seed", 0, 4294967295.0, 0, &v, pb);
 		if (e == API_OK && v != floor(v))
-			e = api_fail(pb, API_RANGE, "seed", "seed must be a whole number");
+			e = api_fail_range(pb, "seed", 0, 4294967295.0,
+					   "seed must be a whole number in [0, 4294967295]");
 		st->seed = (uint64_t)v;
 	}
 	return e;
@@ -172,6 +194,9 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 	if (!vary && (lhs || seed))
 		return api_fail(pb, API_INVALID, lhs ? "lhs" : "seed",
 				"%s samples the ranges of vary: give vary", lhs ? "lhs" : "seed");
+	if (seed && !lhs)
+		return api_fail(pb, API_INVALID, "seed",
+				"seed shuffles a Latin-hypercube sample: it applies only with lhs");
 	if (vary && (!cJSON_IsObject(vary) || !vary->child))
 		return api_fail(pb, API_TYPE, "vary",
 				"vary must be an object of settings, each {\"from\",\"to\",\"step\"} "
@@ -184,6 +209,10 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 		int rc = user ? SIM_OK : SIM_ENOMEM;
 		for (int k = 0; user && k < req->nbeta; k++)
 			user[k] = req->betas[k].user;
+		if (rc == SIM_OK && (e = list_repeat("beta", user, (size_t)req->nbeta, pb)) != API_OK) {
+			free(user);
+			return e;
+		}
 		if (rc == SIM_OK)
 			rc = sim_study_add_list(&st, &req->spec.params, &req->spec.scene,
 						&req->spec.method, "beta", user, (size_t)req->nbeta,

@@ -139,6 +139,17 @@ int sim_study_add_range(sim_study *st, const sim_params *p, const sim_scene *s,
 	return SIM_OK;
 }
 
+long sim_study_repeat(const double *values, size_t n, size_t *first)
+{
+	for (size_t k = 1; k < n; k++)
+		for (size_t j = 0; j < k; j++)
+			if (values[j] == values[k]) {
+				*first = j;
+				return (long)k;
+			}
+	return -1;
+}
+
 int sim_study_add_list(sim_study *st, const sim_params *p, const sim_scene *s,
 		       const sim_method *m, const char *name, const double *values, size_t n,
 		       char *msg, size_t msglen)
@@ -155,6 +166,13 @@ int sim_study_add_list(sim_study *st, const sim_params *p, const sim_scene *s,
 		int rc = check_value(t, p, s, m, values[k], msg, msglen);
 		if (rc != SIM_OK)
 			return rc;
+	}
+	size_t first = 0;
+	long again = sim_study_repeat(values, n, &first);
+	if (again >= 0) {
+		snprintf(msg, msglen, "%s: %.15g is listed twice: each point runs once; list each "
+			 "value once", t->name, values[again]);
+		return SIM_EPARAM;
 	}
 	sim_study_axis *ax = &st->axis[st->naxes];
 	ax->values = malloc(n * sizeof(double));

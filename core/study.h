@@ -57,10 +57,15 @@ int sim_study_check_axis(const sim_study *st, const char *name, char *msg, size_
 int sim_study_add_range(sim_study *st, const sim_params *p, const sim_scene *s,
 			const sim_method *m, const char *name, double from, double to,
 			double step, char *msg, size_t msglen);
-/* The same for a list of n values (each checked; copied). */
+/* The same for a list of n values (each checked; copied), no value twice
+ * (the same point would run twice): SIM_EPARAM naming the repeat. */
 int sim_study_add_list(sim_study *st, const sim_params *p, const sim_scene *s,
 		       const sim_method *m, const char *name, const double *values, size_t n,
 		       char *msg, size_t msglen);
+/* The index of the first of values[0..n) that repeats an earlier one (the
+ * earlier's index into *first), or -1: the repeat sim_study_add_list
+ * refuses. */
+long sim_study_repeat(const double *values, size_t n, size_t *first);
 
 /* Make the study's points: the full grid of its axes (the first axis
  * outermost, the last varying fastest), or, with st->lhs > 0, a Latin
