@@ -90,10 +90,12 @@ void srv_sessions_release(srv_session **all, size_t n);
 double srv_sessions_steps_per_s(void);
 
 /* Apply a control through the worker; waits up to timeout_s for the
- * acknowledgement. Returns API_OK (acked, *t_eff set), API_NOTFOUND (being
+ * acknowledgement. Returns API_OK (acked, *t_eff set, *c as applied: with
+ * the end the worker gave a session of pace "max" that has none, as its
+ * until), API_NOTFOUND (being
  * deleted), API_CONFLICT (the session cannot take it), the core's refusal,
  * or API_UNAVAILABLE (not acknowledged; nothing changed), with *pb set. */
-api_err srv_session_control(srv_session *s, const api_control *c,
+api_err srv_session_control(srv_session *s, api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb);
 /* Attach an experiment (borrowed until it detaches) to a running
  * session's worker. API_CONFLICT if it already runs one or has failed;

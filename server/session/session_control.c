@@ -145,7 +145,7 @@ static api_err admit_control(srv_session *s, const api_control *c,
 	return admit_paced(s, c, pb);
 }
 
-api_err srv_session_control(srv_session *s, const api_control *c,
+api_err srv_session_control(srv_session *s, api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb)
 {
 	srv_cmd cmd = {.c = *c, .cpu_grant = cfg->max_cpu_seconds, .waited = 1};
@@ -184,6 +184,7 @@ api_err srv_session_control(srv_session *s, const api_control *c,
 		return API_UNAVAILABLE;
 	}
 	*t_eff = cmd.t_eff;
+	*c = cmd.c;
 	return API_OK;
 }
 

@@ -180,8 +180,13 @@ int srv_worker_apply_commands(srv_session *s)
 			s->cmd_tail = NULL;
 		double t_eff = sim_effective_time(s->sim);
 		int rc = apply_command(s, cmd, &reanchor);
-		if (s->pace == API_PACE_MAX && s->until == 0)
+		if (s->pace == API_PACE_MAX && s->until == 0) {
+			/* an end for pace "max" (api.h): part of what this
+			 * control did, so its answer, event and log line say it */
 			s->until = s->st.t + API_DEFAULT_MAX_UNTIL;
+			cmd->c.until = s->until;
+			cmd->c.set |= API_C_UNTIL;
+		}
 		if (rc == SIM_OK) {
 			/* the control log keeps the control (log_control); the
 			 * stream's event also carries the scene's model error
