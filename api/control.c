@@ -11,7 +11,8 @@
  * on a scratch copy, so the messages and ranges are the core's; a control
  * is all or nothing. Angles are converted to SI once, where they are
  * parsed (api_parse_user_value), and leave here in degrees, as users type
- * them: the "applied" echo shows what was sent.
+ * them: the "applied" echo shows what was sent, and the end the worker
+ * gives a session left at pace "max" without one (worker_control.c).
  */
 #include <math.h>
 #include <stdio.h>
@@ -80,6 +81,22 @@ static api_err feed_value(const cJSON *it, const api_spec *spec, const char *nam
 	return e == API_OK ? feed_disturbable(spec, name, pb) : e;
 }
 
+/* v rounded to 6 significant digits (as %.6g prints it) towards the
+ * inside of a range: up for its lower end, down for its upper, so that
+ * the end stated is a value the range takes (0.2 x 166 kg / 40 is
+ * 0.8300000000000001 in binary, stated 0.83). */
+static double round_inward(double v, int up)
+{
+	char text[32];
+	snprintf(text, sizeof text, "%.5e", v);
+	double r = strtod(text, NULL);
+	if (!isfinite(v) || (up ? r >= v : r <= v))
+		return r;
+	int exp10 = atoi(strchr(text, 'e') + 1);
+	double q = pow(10, 5 - exp10), k = round(r * q) + (up ? 1 : -1);
+	return q >= 1 ? k / q : k * pow(10, exp10 - 5);
+}
+
 static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name,
 			 api_control *c, api_problem *pb)
 {
@@ -90,18 +107,16 @@ static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name
 	double lo, hi;
 	sim_feed_mass_range(&spec->params, &spec->scene, &spec->method, &lo, &hi);
 	if (v.si < lo || v.si > hi) {
-		/* narrowed from the table's range: the coupling's side */
+		/* narrowed from the table's range: the coupling's side; the
+		 * range stated as the detail prints it, within the exact one */
 		int light = hi < sim_setting_find(name)->max;
-		e = api_fail(pb, API_RANGE, name,
-			     "m_n must lie in [%.6g, %.6g] kg in this session; got %g: its "
-			     "integrator (dem with sub-steps) couples a feed of %s 0.2 of "
-			     "the machine's mass %s, and keeps it so", lo, hi, v.si,
-			     light ? "at most" : "more than",
-			     light ? "with its corrector" : "without it");
-		pb->has_range = 1;
-		pb->min = lo;
-		pb->max = hi;
-		return e;
+		double lo_shown = round_inward(lo, 1), hi_shown = round_inward(hi, 0);
+		return api_fail_range(pb, name, lo_shown, hi_shown,
+				      "m_n must lie in [%.6g, %.6g] kg in this session; got %g: its "
+				      "integrator (dem with sub-steps) couples a feed of %s 0.2 of "
+				      "the machine's mass %s, and keeps it so", lo_shown, hi_shown,
+				      v.si, light ? "at most" : "more than",
+				      light ? "with its corrector" : "without it");
 	}
 	c->m_n = v.si;
 	return API_OK;
