@@ -298,7 +298,7 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
  * status shows it; pick NULL: none), read back into *pick with *picked 1
  * (0 where the file has none or one this build cannot read; a build
  * before it ignores the member). */
-#define API_SPEC_FILE_FORMAT 2
+#define API_SPEC_FILE_FORMAT 3
 char *api_spec_file(const api_spec *spec, double created, int owned,
 		    const sim_feed_choice *pick);
 api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,

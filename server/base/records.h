@@ -2,8 +2,8 @@
 /*
  * records.h - the layouts of the framed records in the data directory at
  * format version SRV_STORE_VERSION (store.h), in one place: what a build
- * writes and, through the upgraders of earlier versions (store_v1.c), what
- * it hands its readers whatever version the file says
+ * writes and, through the upgraders of earlier versions (store_v1.c,
+ * store_v2.c), what it hands its readers whatever version the file says
  * (docs/formats.md "Stored formats").
  *
  *   sessions/ID/spec.bin        srv_spec_record
@@ -82,11 +82,18 @@ typedef struct srv_fit_record {
 /* sessions/ID/checkpoint.bin: this head, the experiment's state (exp_len
  * bytes), the core's checkpoint (sim_len bytes), then this trailer: the
  * length of the control log it holds, so that a restore replays what came
- * after, and its time, so that a session re-created from its spec knows
- * where it was (c793934's checkpoints had no trailer: store_v1.c adds it). */
+ * after; its time, so that a session re-created from its spec knows where
+ * it was (c793934's checkpoints had no trailer: store_v1.c adds it); and
+ * its CPU budget, so that a restart does not grant it again (format 2's
+ * trailer ended after t: store_v2.c gives it cpu_seconds NAN, unknown). */
 typedef struct srv_ckpt_trailer {
 	uint64_t logged;
-	double t; /* s */
+	double t;              /* s */
+	double cpu_seconds;    /* s: the CPU the session had spent (NAN:
+				  unknown, a format-2 checkpoint) */
+	double cpu_limit;      /* s: the count at which it pauses */
+	int32_t cpu_paused;    /* paused by its CPU budget */
+	int32_t pad;
 } srv_ckpt_trailer;
 #define SRV_CKPT_TRAILER sizeof(srv_ckpt_trailer)
 typedef struct srv_ckpt_record {
@@ -97,7 +104,7 @@ typedef struct srv_ckpt_record {
 	uint64_t exp_len, sim_len;
 } srv_ckpt_record;
 
-/* Version 2's sizes (x86-64 and aarch64 Linux, where the daemon is built
+/* Version 3's sizes (x86-64 and aarch64 Linux, where the daemon is built
  * and tested): see the top of this file before changing one. */
 #if defined(__x86_64__) || defined(__aarch64__)
 static_assert(sizeof(srv_spec_record) == 576, "spec.bin's layout changed: a new format version");
@@ -106,7 +113,7 @@ static_assert(sizeof(api_exp_ext) == 5040, "an experiment kind's tail changed: a
 static_assert(sizeof(srv_sweep_record) == 1888, "the sweep record changed: a new format version");
 static_assert(sizeof(api_sweep_point) == 352, "the sweep point changed: a new format version");
 static_assert(sizeof(srv_fit_record) == 152, "the fit record changed: a new format version");
-static_assert(sizeof(srv_ckpt_record) == 320 && sizeof(srv_ckpt_trailer) == 16,
+static_assert(sizeof(srv_ckpt_record) == 320 && sizeof(srv_ckpt_trailer) == 40,
 	      "the checkpoint's head or trailer changed: a new format version");
 #endif
 

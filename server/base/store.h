@@ -41,9 +41,12 @@
  *   1  c793934 and the builds up to c3bc9a1: no word of the layout
  *      beyond the frame's version, two layouts under the same number
  *      (told apart by the records' sizes, store_v1.c)
- *   2  this build: the layouts of records.h, their sizes asserted at
- *      build time; spec.json says "format": 2 */
-#define SRV_STORE_VERSION 2
+ *   2  7e56a85 to b09537b: the layouts of records.h but the checkpoint's
+ *      trailer, which ended after its time (store_v2.c)
+ *   3  this build: the layouts of records.h, their sizes asserted at
+ *      build time, the checkpoint's trailer with the session's CPU count
+ *      and grant; spec.json says "format": 3 */
+#define SRV_STORE_VERSION 3
 #define SRV_STORE_OLDEST 1
 
 /* Kinds of framed files. */
@@ -145,10 +148,12 @@ void *srv_store_read(const char *path, uint32_t kind, size_t *len, int *older,
  * tests/fuzz/fuzz_store.c calls it). */
 void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *older,
 			const char **bad);
-/* A version-1 payload of kind (taken) in version 2's layout (store_v1.c):
- * the payload (malloc'd; p itself when already in it) and *len, or NULL
- * (p freed) with the reason in *bad. */
+/* A version-1 payload of kind (taken) in version 2's layout (store_v1.c),
+ * and a version-2 one in version 3's (store_v2.c): the payload (malloc'd;
+ * p itself when already in it) and *len, or NULL (p freed) with the
+ * reason in *bad. A version-1 file goes through both. */
 void *srv_store_upgrade_v1(uint32_t kind, void *p, size_t *len, const char **bad);
+void *srv_store_upgrade_v2(uint32_t kind, void *p, size_t *len, const char **bad);
 
 /* What a start-up restore found, by kind (SRV_STORE_SESSION for sessions,
  * else a job kind's store_kind): a record listed damaged, and one read

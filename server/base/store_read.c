@@ -110,7 +110,10 @@ void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *ol
 	if (h.version == SRV_STORE_VERSION)
 		return buf;
 	*older = 1;
-	return srv_store_upgrade_v1(kind, buf, len, bad);
+	void *p = buf;
+	if (h.version < 2)
+		p = srv_store_upgrade_v1(kind, p, len, bad);
+	return p ? srv_store_upgrade_v2(kind, p, len, bad) : NULL;
 }
 
 void *srv_store_read(const char *rel, uint32_t kind, size_t *len, int *older,

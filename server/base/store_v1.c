@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * store_v1.c - the reader of format version 1 (store.h): a version-1
- * payload into version 2's layout (records.h), so that every reader sees
- * one layout and a data directory of an earlier release comes back whole.
+ * payload into version 2's layout (records.h's but the checkpoint's
+ * trailer, which store_v2.c then takes to version 3), so that every reader
+ * sees one layout and a data directory of an earlier release comes back
+ * whole.
  *
  * Version 1 is two layouts under one number, told apart by the sizes the
  * payload's own lengths imply:
@@ -332,14 +334,14 @@ static void *checkpoint_v1(char *p, size_t *len, const char **bad)
 	r.exp_id[sizeof r.exp_id - 1] = '\0';
 	r.exp_len = exp_len;
 	r.sim_len = o.sim_len;
-	srv_ckpt_trailer t2 = {.logged = tr.logged, .t = tr.t};
-	size_t out_len = sizeof r + exp_len + o.sim_len + sizeof t2;
+	/* version 2's trailer is version 1's (store_v2.c takes it on) */
+	size_t out_len = sizeof r + exp_len + o.sim_len + sizeof tr;
 	char *out = exp ? malloc(out_len) : NULL;
 	if (out) {
 		memcpy(out, &r, sizeof r);
 		memcpy(out + sizeof r, exp, exp_len);
 		memcpy(out + sizeof r + exp_len, p + sizeof o + o.exp_len, o.sim_len);
-		memcpy(out + sizeof r + exp_len + o.sim_len, &t2, sizeof t2);
+		memcpy(out + sizeof r + exp_len + o.sim_len, &tr, sizeof tr);
 		*len = out_len;
 	} else {
 		*bad = "out of memory";

@@ -12,8 +12,9 @@
  *                                appended and synced before the control
  *                                is answered (control_log.c)
  *   sessions/ID/checkpoint.bin   the latest checkpoint: run state, pace,
- *                                until, the attached experiment's state
- *                                and the core's checkpoint (sim.h); the
+ *                                until, the attached experiment's state,
+ *                                the core's checkpoint (sim.h) and the
+ *                                CPU budget (its count and limit); the
  *                                one before it as checkpoint.bin.prev
  *
  * Everything else is written by the store's writer (store.c); the worker only
@@ -157,8 +158,12 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	}
 	r.sim_len = sim_checkpoint_size(s->sim);
 	/* the trailer: how much of the control log the checkpoint holds,
-	 * and its time */
-	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t};
+	 * its time, and its CPU budget (the count as the worker last read
+	 * it: at most 10 ms of wall time ago, and where it stopped) */
+	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t,
+			       .cpu_seconds = s->budget.cpu_seconds,
+			       .cpu_limit = s->budget.cpu_limit,
+			       .cpu_paused = s->budget.cpu_paused};
 	size_t plen = sizeof r + r.exp_len + r.sim_len + sizeof tr;
 	char *payload = malloc(plen);
 	if (payload) {

@@ -16,7 +16,7 @@ import { join } from 'node:path';
 import { startDaemon, req, until, getReady, SLOW } from './lib.mjs';
 
 const FIXTURES = new URL('../fixtures/datadir/', import.meta.url).pathname;
-const FORMAT = 2; // SRV_STORE_VERSION, API_SPEC_FILE_FORMAT
+const FORMAT = 3; // SRV_STORE_VERSION, API_SPEC_FILE_FORMAT
 const JSON_CT = { 'Content-Type': 'application/json' };
 
 // the frame's version (store.c: magic "CVSF", then a uint32 version)
