@@ -159,7 +159,8 @@ void srv_persist_checkpoint(srv_session *s, int force)
 	r.sim_len = sim_checkpoint_size(s->sim);
 	/* the trailer: how much of the control log the checkpoint holds,
 	 * its time, and its CPU budget (the count as the worker last read
-	 * it: at most 10 ms of wall time ago, and where it stopped) */
+	 * it: after its last batch of steps, at most 10 ms of stepping ago;
+	 * where it stopped, exactly: idle() and a SIGTERM read it first) */
 	srv_ckpt_trailer tr = {.logged = s->controls_len, .t = s->st.t,
 			       .cpu_seconds = s->budget.cpu_seconds,
 			       .cpu_limit = s->budget.cpu_limit,
