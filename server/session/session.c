@@ -302,11 +302,7 @@ static void adopt_bed(srv_session *s)
 int srv_session_adopt(srv_session *s)
 {
 	s->last_access = s->persist.ckpt_wall = srv_now();
-	/* the CPU count starts again at 0 with the grant the session had */
-	s->budget.cpu_limit = s->restore.cpu_grant > 0
-				      ? fmin(s->restore.cpu_grant, cfg->max_cpu_seconds)
-				      : cfg->max_cpu_seconds;
-	s->budget.cpu_paused = s->restore.cpu_paused && s->state == SRV_PAUSED;
+	srv_restore_budget(s, cfg->max_cpu_seconds);
 	s->budget.turn.wake = &s->wake;
 	if (s->damaged) {
 		s->state = SRV_FAILED;

@@ -111,11 +111,17 @@ typedef struct srv_session_restore {
 	int exp_after_catch_up;   /* its experiment, attached again at the
 				     restore, begins once it is back where
 				     it was (srv_session_readopt) */
-	double cpu_grant;         /* CPU s: the last grant of the controls
-				     its checkpoint holds (0: none), from 0
-				     again (srv_session_adopt) */
+	double cpu_seconds;       /* CPU s its checkpoint counted (NAN: it
+				     kept none: format 2, or no checkpoint) */
+	double cpu_limit;         /* CPU s: the count its checkpoint would
+				     pause it at */
+	double cpu_grant;         /* CPU s: without a count kept, the last
+				     grant of the controls its checkpoint
+				     holds (0: none), from 0 again */
 	int cpu_paused;           /* restored paused by its CPU budget: its
-				     client's last running was not false */
+				     checkpoint says so, or without one that
+				     kept it, its client's last running was
+				     not false (srv_restore_budget) */
 } srv_session_restore;
 
 /* What a session holds of the daemon's budgets (budget.c keeps the
@@ -127,7 +133,10 @@ typedef struct srv_session_budget {
 	size_t mem_reserved;      /* bytes of the memory budget it holds */
 	srv_cpu_turn turn;        /* worker only: its CPU turn at pace max */
 	int waiting_for_cpu;      /* its turn has not come */
-	double cpu_seconds;       /* the worker's CPU time, s */
+	double cpu_seconds;       /* the CPU it spent, s: its worker's CPU
+				     time on cpu_base */
+	double cpu_base;          /* CPU s it had spent when its worker
+				     started (its checkpoint's, restored) */
 	double cpu_limit;         /* pauses when cpu_seconds reaches it */
 	int cpu_paused;           /* paused because cpu_limit was reached */
 	double cpu_per_s;         /* CPU s per simulated s: estimated at
@@ -380,6 +389,13 @@ void srv_session_readopt(srv_session *s, const srv_exp_finder *ef);
  * the experiment it ran resumed; s->damaged with the reason in s->error
  * when they do not pass their checks. */
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef);
+/* The CPU budget s goes on with after its restore (srv_session_adopt;
+ * session_load.c), with at most max_cpu (--max-cpu-seconds) left of its
+ * grant: the count and limit its checkpoint kept, else a count from 0
+ * with the grant of the controls its checkpoint holds; a running: true
+ * replayed from its log grants max_cpu from the count, as when it was
+ * acknowledged. */
+void srv_restore_budget(srv_session *s, double max_cpu);
 
 /* checkpoint.bin's head and trailer: srv_ckpt_record, srv_ckpt_trailer
  * (records.h, with every stored layout). */

@@ -74,8 +74,8 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 		goto done;
 	}
 	*logged = SIZE_MAX; /* a checkpoint without the trailer: unknown */
+	srv_ckpt_trailer tr = {.t = NAN, .cpu_seconds = NAN};
 	if (len == sizeof r + r.exp_len + r.sim_len + SRV_CKPT_TRAILER) {
-		srv_ckpt_trailer tr;
 		memcpy(&tr, p + len - sizeof tr, sizeof tr);
 		*logged = tr.logged <= SIZE_MAX ? (size_t)tr.logged : SIZE_MAX;
 		if (isfinite(tr.t) && tr.t > s->restore.catch_up_t)
@@ -94,6 +94,11 @@ static int load_checkpoint(srv_session *s, const char *file, const srv_exp_finde
 	sim_free(s->sim);
 	s->sim = sm;
 	s->state = r.state;
+	/* its CPU budget (format 3 on): srv_restore_budget */
+	int kept = isfinite(tr.cpu_seconds) && tr.cpu_seconds >= 0 && isfinite(tr.cpu_limit);
+	s->restore.cpu_seconds = kept ? tr.cpu_seconds : NAN;
+	s->restore.cpu_limit = kept ? tr.cpu_limit : NAN;
+	s->restore.cpu_paused = kept && tr.cpu_paused;
 	s->pace = r.pace;
 	s->until = r.until;
 	snprintf(s->error, sizeof s->error, "%s", r.error);
@@ -147,14 +152,16 @@ int srv_spec_decode(const void *p, size_t len, api_spec *spec, double *created,
 	return 0;
 }
 
-/* The CPU budget of the controls the checkpoint holds (the log's first
- * `held` bytes), which no checkpoint stores and nothing replays: the last
- * cpu_budget, unless a running: true came after it (a resume of a session
- * its budget paused grants --max-cpu-seconds), and whether a paused
- * session was paused by its budget (its client's last running was not
- * false). Applied by srv_session_adopt. */
+/* A checkpoint that did not keep its CPU budget (format 2, or none): the
+ * budget of the controls it holds (the log's first `held` bytes), which
+ * nothing replays: the last cpu_budget, unless a running: true came after
+ * it (a resume of a session its budget paused grants --max-cpu-seconds),
+ * and whether a paused session was paused by its budget (its client's
+ * last running was not false). Applied by srv_restore_budget. */
 static void held_budget(srv_session *s, const char *text, size_t held)
 {
+	if (isfinite(s->restore.cpu_seconds))
+		return; /* the checkpoint kept it */
 	int running = 1;
 	for (size_t at = 0; at < held;) {
 		const char *nl = memchr(text + at, '\n', held - at);
@@ -301,6 +308,7 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 {
 	char path[128], why[512] = "", why2[512] = "";
 	snprintf(s->entry.id, sizeof s->entry.id, "%s", id);
+	s->restore.cpu_seconds = NAN; /* until a checkpoint says */
 	s->created = srv_unix_time();
 	s->spec.sample_rate = API_DEFAULT_SAMPLE_RATE;
 	if (load_spec(s, why, sizeof why) != 0) {
@@ -348,6 +356,22 @@ static void load_files(srv_session *s, const char *id, const srv_exp_finder *ef)
 	snprintf(why, sizeof why, "its spec is refused: %s", msg);
 	s->damaged = 1;
 	snprintf(s->error, sizeof s->error, "damaged: %.120s; %.120s", why, why2);
+}
+
+void srv_restore_budget(srv_session *s, double max_cpu)
+{
+	srv_session_budget *b = &s->budget;
+	if (isfinite(s->restore.cpu_seconds)) {
+		/* what it spent stays spent: a restart grants nothing */
+		b->cpu_base = b->cpu_seconds = s->restore.cpu_seconds;
+		b->cpu_limit = b->cpu_seconds + fmin(s->restore.cpu_limit - b->cpu_seconds, max_cpu);
+	} else {
+		b->cpu_limit = s->restore.cpu_grant > 0 ? fmin(s->restore.cpu_grant, max_cpu)
+							: max_cpu;
+	}
+	b->cpu_paused = s->restore.cpu_paused && s->state == SRV_PAUSED;
+	for (size_t i = 0; i < s->restore.nreplay; i++)
+		s->restore.replay[i].cmd.cpu_grant = max_cpu;
 }
 
 void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)

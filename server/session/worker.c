@@ -372,12 +372,13 @@ void *srv_worker_main(void *arg)
 	srv_worker_restart_clocks(&clk, s);
 	clk.cpu_wall = -INFINITY;
 	clk.stepped_wall = NAN;
-	/* the thread's CPU clock starts at 0; a LIGGGHTS bed's settling, done
-	 * before the first step, is no cost of simulated time (counted, it
-	 * made a 92-grain bed's first window 25 CPU s a simulated second and
-	 * paced the session down to 0.04) */
+	/* the thread's CPU clock starts at 0 (on what a restored session had
+	 * spent); a LIGGGHTS bed's settling, done before the first step, is
+	 * no cost of simulated time (counted, it made a 92-grain bed's first
+	 * window 25 CPU s a simulated second and paced the session down to
+	 * 0.04) */
 	clk.cost_t = s->st.t;
-	clk.cost_cpu = s->dem.link ? s->dem.bed.cpu_seconds : 0.0;
+	clk.cost_cpu = s->budget.cpu_base + (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
 	srv_worker_publish(s, &clk);
 	for (;;) {
 		start_job(s);
@@ -416,6 +417,7 @@ void *srv_worker_main(void *arg)
 		srv_control_log_sync(s, logged, 30.0);
 		pthread_mutex_lock(&s->lock);
 		s->persist.ckpt_dirty = 1;
+		srv_worker_read_cpu(s); /* the CPU it spent, to the end */
 		srv_persist_checkpoint(s, 1);
 	}
 	srv_worker_detach_exp(s, "the session was deleted or the daemon stopped");

@@ -101,14 +101,16 @@ void srv_worker_commit_need(srv_session *s, clocks *c)
 		srv_budget_set_paced(&s->budget.paced_held, need);
 }
 
-/* The worker's CPU time into the session's cpu_seconds; a LIGGGHTS
- * session's bed process's CPU is the session's too. */
+/* The worker's CPU time into the session's cpu_seconds, on what it had
+ * spent before a restart (cpu_base); a LIGGGHTS session's bed process's
+ * CPU is the session's too. */
 void srv_worker_read_cpu(srv_session *s)
 {
 	struct timespec ts;
 	if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) == 0)
-		s->budget.cpu_seconds = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec +
-				 (s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
+		s->budget.cpu_seconds = s->budget.cpu_base + (double)ts.tv_sec +
+					1e-9 * (double)ts.tv_nsec +
+					(s->dem.link ? s->dem.bed.cpu_seconds : 0.0);
 }
 
 /* cpu: read the worker's CPU time; a running session that spent its

@@ -2,10 +2,10 @@
 // A session's CPU grant is an acknowledged control like any other
 // (docs/durability.md: none is lost to a restart): after a SIGTERM or a
 // kill -9, whether or not a checkpoint came after it, the session keeps
-// the last cpu_budget it was given (the CPU count starts again at 0,
-// docs/budgets.md), and one its budget paused comes back paused by the
-// budget (pause_reason "cpu-budget", not "client"), so that running: true
-// grants it --max-cpu-seconds again.
+// the last cpu_budget it was given (and the CPU it spent of it:
+// cpu_spent.test.mjs, docs/budgets.md), and one its budget paused comes
+// back paused by the budget (pause_reason "cpu-budget", not "client"), so
+// that running: true grants it --max-cpu-seconds again.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdtempSync } from 'node:fs';

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The CPU a session spent against its grant survives a restart
+// (docs/budgets.md "CPU"): after a SIGTERM or a kill -9 its count goes on
+// from its last checkpoint, not from 0, its cpu_limit is the one it had,
+// and its budget pauses it once the rest of the grant is spent, not a
+// whole new grant later. A session paused by its client checkpoints its
+// count exactly; one running when the daemon dies loses at most what it
+// spent since its last checkpoint (here 1 s of wall time before the kill
+// is allowed, the checkpoints coming every 0.2 s). The daemon's own CPU
+// after the restart (/proc) tells apart a build that restores the figures
+// but spends a whole grant again.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startDaemon, req, until, getReady, near, sleep, CHEAP, SLOW } from './lib.mjs';
+
+const MAX = 300;  // --max-cpu-seconds
+const SPEND = 1;  // CPU s each session spends before its grant
+const GRANT = 4;  // CPU s of the grant (cpu_budget)
+const INTO = 2;   // CPU s of the grant spent before the restart
+
+const TICK = Number(execFileSync('getconf', ['CLK_TCK'], { encoding: 'utf8' }));
+// the daemon's CPU time so far, s (utime + stime of /proc/PID/stat)
+const daemonCpu = (pid) => {
+  const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
+  return (Number(f[11]) + Number(f[12])) / TICK;
+};
+
+const at = (id) => `/api/v1/sessions/${id}`;
+const get = async (d, id) => (await getReady(d.base, at(id))).body;
+
+for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
+  test(`${signal}: the CPU spent against the grant is still spent after the restart`, { timeout: 120000 * SLOW }, async () => {
+    const dir = mkdtempSync(join(tmpdir(), 'convsimd-spent-'));
+    const args = ['--data-dir', dir, '--max-cpu-seconds', String(MAX), '--checkpoint-interval', interval];
+    let d = await startDaemon(args);
+    try {
+      // paused: paused by its client after INTO of its grant; running:
+      // running when the daemon stops
+      const ids = {};
+      for (const name of ['paused', 'running']) {
+        const r = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 1e6 });
+        assert.equal(r.status, 201, r.text);
+        ids[name] = r.body.id;
+      }
+      const limit = {};
+      for (const [name, id] of Object.entries(ids)) {
+        await until(async () => (await get(d, id)).cpu_seconds >= SPEND, 30000, `${name} to spend ${SPEND} CPU s`);
+        const r = await req(d.base, 'PATCH', at(id), { cpu_budget: GRANT });
+        assert.equal(r.status, 200, r.text);
+        limit[name] = r.body.cpu_limit;
+        assert.ok(limit[name] >= SPEND + GRANT, `${name}: cpu_limit ${limit[name]}, the grant from what it spent`);
+      }
+      for (const [name, id] of Object.entries(ids))
+        await until(async () => (await get(d, id)).cpu_seconds >= limit[name] - GRANT + INTO, 30000, `${name} to spend ${INTO} CPU s of its grant`);
+      let r = await req(d.base, 'PATCH', at(ids.paused), { running: false });
+      assert.equal(r.status, 200, r.text);
+      await sleep(300); // its worker reads its CPU where it stops
+      const spentPaused = (await get(d, ids.paused)).cpu_seconds;
+      const spentRunning = (await get(d, ids.running)).cpu_seconds;
+      assert.ok(spentPaused < limit.paused && spentRunning < limit.running, 'neither spent its grant before the restart');
+      await sleep(1000); // checkpoints of the running one (SIGKILL's interval is 0.2 s)
+      await d.stop(signal);
+
+      d = await startDaemon(args);
+      const cpuAtStart = daemonCpu(d.proc.pid);
+      const p = await get(d, ids.paused);
+      assert.equal(p.state, 'paused');
+      assert.equal(p.pause_reason, 'client');
+      assert.ok(p.cpu_seconds >= spentPaused, `paused: cpu_seconds ${p.cpu_seconds}, it had spent ${spentPaused}`);
+      near(p.cpu_seconds, spentPaused, 0.1, 'paused: cpu_seconds after the restart');
+      near(p.cpu_limit, limit.paused, 1e-6, 'paused: cpu_limit after the restart');
+      const g = await get(d, ids.running);
+      assert.ok(g.cpu_seconds >= spentRunning, `running: cpu_seconds ${g.cpu_seconds}, it had spent ${spentRunning} a second before the ${signal}`);
+      near(g.cpu_limit, limit.running, 1e-6, 'running: cpu_limit after the restart');
+
+      // the rest of the grant, not a new one: each pauses at its old limit
+      r = await req(d.base, 'PATCH', at(ids.paused), { running: true });
+      assert.equal(r.status, 200, r.text);
+      near(r.body.cpu_limit, limit.paused, 1e-6, 'paused: cpu_limit resumed by its client (no grant)');
+      for (const [name, id] of Object.entries(ids))
+        await until(async () => (await get(d, id)).pause_reason === 'cpu-budget', 60000, `${name}'s budget to pause it`);
+      const left = (limit.paused - spentPaused) + (limit.running - spentRunning);
+      const spentAfter = daemonCpu(d.proc.pid) - cpuAtStart;
+      assert.ok(spentAfter < left + 1, `the daemon spent ${spentAfter} CPU s after the restart; what was left of the grants: ${left} s (a new grant each: ${2 * GRANT} s)`);
+      for (const [name, id] of Object.entries(ids)) {
+        const s = await get(d, id);
+        near(s.cpu_limit, limit[name], 1e-6, `${name}: cpu_limit where its budget paused it`);
+        assert.ok(s.cpu_seconds >= s.cpu_limit && s.cpu_seconds < s.cpu_limit + 0.5,
+          `${name}: paused at cpu_seconds ${s.cpu_seconds}, its limit ${s.cpu_limit}`);
+      }
+    } finally {
+      assert.equal((await d.stop()).code, 0, d.stderr());
+    }
+  });
+}
+
+// A running: true acknowledged after the checkpoint of a session its budget
+// paused is replayed with its grant: --max-cpu-seconds from the count it
+// had, not the spent grant again (with no checkpoint in between: the
+// interval is an hour, the last one written where the budget paused it).
+test('SIGKILL: a running: true logged after the checkpoint grants again when replayed', { timeout: 90000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsimd-spent-'));
+  const args = ['--data-dir', dir, '--max-cpu-seconds', String(MAX), '--checkpoint-interval', '3600'];
+  let d = await startDaemon(args);
+  try {
+    const c = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 1e6 });
+    assert.equal(c.status, 201, c.text);
+    const id = c.body.id;
+    await until(async () => (await get(d, id)).cpu_seconds >= SPEND, 30000, `spending ${SPEND} CPU s`);
+    let r = await req(d.base, 'PATCH', at(id), { cpu_budget: 0.05 });
+    assert.equal(r.status, 200, r.text);
+    await until(async () => (await get(d, id)).pause_reason === 'cpu-budget', 30000, 'the budget to pause it');
+    await sleep(1000); // its checkpoint where it stopped
+    const spent = (await get(d, id)).cpu_seconds;
+    assert.ok(spent >= SPEND, `cpu_seconds ${spent}`);
+    r = await req(d.base, 'PATCH', at(id), { running: true });
+    assert.equal(r.status, 200, r.text);
+    near(r.body.cpu_limit, spent + MAX, 0.1, 'cpu_limit resumed');
+    await d.stop('SIGKILL');
+
+    d = await startDaemon(args);
+    const s = await get(d, id);
+    assert.equal(s.state, 'running', JSON.stringify(s));
+    assert.equal(s.pause_reason, null);
+    assert.ok(s.cpu_seconds >= spent, `cpu_seconds ${s.cpu_seconds}, it had spent ${spent}`);
+    near(s.cpu_limit, spent + MAX, 0.1, 'cpu_limit after the replayed running: true');
+    await sleep(500);
+    assert.equal((await get(d, id)).state, 'running', 'still running on its new grant');
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
