@@ -49,8 +49,8 @@ static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, si
 	}
 	size_t len;
 	memset(copy + FRAME_PAD, 0, 4);
-	/* an earlier format comes back upgraded (store_v1.c): framed again,
-	 * it is this build's */
+	/* an earlier format comes back upgraded (store_v1.c, store_v2.c):
+	 * framed again, it is this build's */
 	char *again = older ? NULL : srv_store_frame(kind, payload, *plen, &len);
 	FUZZ_CHECK(older || (again && len == n && memcmp(again, copy, n) == 0),
 		   "an accepted file framed again differs");

@@ -77,6 +77,11 @@ async function checkWhole(d, dir, exp, first) {
     // at the target its last control set (the log), else as it was
     const target = lastBeta(controls) ?? want.beta_target;
     assert.ok(Math.abs(g.status.beta_target - target) < 1e-9, `${want.role}: beta_target ${g.status.beta_target}, log ${target}`);
+    // its CPU budget: no fixture's log grants one, and no release's
+    // checkpoint kept a count: --max-cpu-seconds' default from 0
+    assert.equal(g.cpu_limit, 1800, `${want.role}: cpu_limit`);
+    assert.ok(g.cpu_seconds >= 0 && g.cpu_seconds < g.cpu_limit, `${want.role}: cpu_seconds ${g.cpu_seconds}`);
+    if (first && want.role !== 'running') assert.ok(g.cpu_seconds < 1, `${want.role}: cpu_seconds ${g.cpu_seconds}, from 0`);
     if (want.role === 'running') {
       // it runs on from at least where it was
       await until(async () => (await req(d.base, 'GET', path)).body.status.t > want.t, 20000 * SLOW, `${id} past t ${want.t}`);
