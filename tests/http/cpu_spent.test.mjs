@@ -4,11 +4,12 @@
 // from its last checkpoint, not from 0, its cpu_limit is the one it had,
 // and its budget pauses it once the rest of the grant is spent, not a
 // whole new grant later. A session paused by its client checkpoints its
-// count exactly; one running when the daemon dies loses at most what it
-// spent since its last checkpoint (here 1 s of wall time before the kill
-// is allowed, the checkpoints coming every 0.2 s). The daemon's own CPU
-// after the restart (/proc) tells apart a build that restores the figures
-// but spends a whole grant again.
+// count exactly; one running when the daemon stops loses nothing to a
+// SIGTERM and to a kill -9 what it spent since the checkpoint on disk
+// (read from the file after the kill, so that a writer behind on a busy
+// disk does not decide the test). The daemon's own CPU after the restart
+// (/proc) tells apart a build that restores the figures but spends a
+// whole grant again.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
@@ -28,6 +29,30 @@ const daemonCpu = (pid) => {
   const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
   return (Number(f[11]) + Number(f[12])) / TICK;
 };
+
+// What the checkpoint on disk of session id kept of its CPU budget: its
+// frame's format (null: no file) and, in format 3, the trailer
+// (server/base/records.h srv_ckpt_trailer, its last 40 bytes: the log's
+// length, t, the count, the limit, paused); NaN in another format.
+const kept = (dir, id) => {
+  let b;
+  try {
+    b = readFileSync(join(dir, 'sessions', id, 'checkpoint.bin'));
+  } catch {
+    return { format: null, cpu: NaN, limit: NaN, paused: NaN };
+  }
+  const format = b.readUInt32LE(4);
+  if (format !== 3 || b.length < 72)
+    return { format, cpu: NaN, limit: NaN, paused: NaN };
+  const at = b.length - 40;
+  return { format, cpu: b.readDoubleLE(at + 16), limit: b.readDoubleLE(at + 24), paused: b.readInt32LE(at + 32) };
+};
+// Wait (up to 10 s, then go on) for the checkpoint on disk to say ok; a
+// build that writes another format: its first checkpoint.
+const onDisk = (dir, id, ok) => until(async () => {
+  const k = kept(dir, id);
+  return k.format !== null && (k.format !== 3 || ok(k));
+}, 10000, 'a checkpoint').catch(() => {});
 
 const at = (id) => `/api/v1/sessions/${id}`;
 const get = async (d, id) => (await getReady(d.base, at(id))).body;
@@ -60,10 +85,12 @@ for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
       assert.equal(r.status, 200, r.text);
       await sleep(300); // its worker reads its CPU where it stops
       const spentPaused = (await get(d, ids.paused)).cpu_seconds;
+      await onDisk(dir, ids.paused, (k) => k.cpu >= spentPaused);
+      await sleep(500); // checkpoints of the running one (SIGKILL's interval is 0.2 s)
       const spentRunning = (await get(d, ids.running)).cpu_seconds;
-      assert.ok(spentPaused < limit.paused && spentRunning < limit.running, 'neither spent its grant before the restart');
-      await sleep(1000); // checkpoints of the running one (SIGKILL's interval is 0.2 s)
+      assert.ok(spentPaused < limit.paused, 'paused: its grant not spent before the restart');
       await d.stop(signal);
+      const kp = kept(dir, ids.paused), kr = kept(dir, ids.running);
 
       d = await startDaemon(args);
       const cpuAtStart = daemonCpu(d.proc.pid);
@@ -73,8 +100,14 @@ for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
       assert.ok(p.cpu_seconds >= spentPaused, `paused: cpu_seconds ${p.cpu_seconds}, it had spent ${spentPaused}`);
       near(p.cpu_seconds, spentPaused, 0.1, 'paused: cpu_seconds after the restart');
       near(p.cpu_limit, limit.paused, 1e-6, 'paused: cpu_limit after the restart');
+      // on disk: the paused one's count where it stopped; the running
+      // one's at its last checkpoint, all of it after a SIGTERM
+      near(kp.cpu, spentPaused, 0.05, 'paused: the count its checkpoint kept');
+      near(kp.limit, limit.paused, 1e-6, 'paused: the limit its checkpoint kept');
+      assert.ok(kr.cpu >= (signal === 'SIGTERM' ? spentRunning : limit.running - GRANT),
+        `running: its checkpoint kept a count of ${kr.cpu} (it had spent ${spentRunning} before the ${signal})`);
       const g = await get(d, ids.running);
-      assert.ok(g.cpu_seconds >= spentRunning, `running: cpu_seconds ${g.cpu_seconds}, it had spent ${spentRunning} a second before the ${signal}`);
+      assert.ok(g.cpu_seconds >= kr.cpu, `running: cpu_seconds ${g.cpu_seconds}, its checkpoint's count ${kr.cpu}`);
       near(g.cpu_limit, limit.running, 1e-6, 'running: cpu_limit after the restart');
 
       // the rest of the grant, not a new one: each pauses at its old limit
@@ -83,7 +116,7 @@ for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
       near(r.body.cpu_limit, limit.paused, 1e-6, 'paused: cpu_limit resumed by its client (no grant)');
       for (const [name, id] of Object.entries(ids))
         await until(async () => (await get(d, id)).pause_reason === 'cpu-budget', 60000, `${name}'s budget to pause it`);
-      const left = (limit.paused - spentPaused) + (limit.running - spentRunning);
+      const left = (limit.paused - kp.cpu) + (limit.running - kr.cpu);
       const spentAfter = daemonCpu(d.proc.pid) - cpuAtStart;
       assert.ok(spentAfter < left + 1, `the daemon spent ${spentAfter} CPU s after the restart; what was left of the grants: ${left} s (a new grant each: ${2 * GRANT} s)`);
       for (const [name, id] of Object.entries(ids)) {
@@ -114,13 +147,15 @@ test('SIGKILL: a running: true logged after the checkpoint grants again when rep
     let r = await req(d.base, 'PATCH', at(id), { cpu_budget: 0.05 });
     assert.equal(r.status, 200, r.text);
     await until(async () => (await get(d, id)).pause_reason === 'cpu-budget', 30000, 'the budget to pause it');
-    await sleep(1000); // its checkpoint where it stopped
+    await sleep(300); // its worker reads its CPU where it stops
     const spent = (await get(d, id)).cpu_seconds;
     assert.ok(spent >= SPEND, `cpu_seconds ${spent}`);
+    await onDisk(dir, id, (k) => k.paused === 1); // its checkpoint where it stopped
     r = await req(d.base, 'PATCH', at(id), { running: true });
     assert.equal(r.status, 200, r.text);
     near(r.body.cpu_limit, spent + MAX, 0.1, 'cpu_limit resumed');
     await d.stop('SIGKILL');
+    const k = kept(dir, id);
 
     d = await startDaemon(args);
     const s = await get(d, id);
@@ -128,6 +163,8 @@ test('SIGKILL: a running: true logged after the checkpoint grants again when rep
     assert.equal(s.pause_reason, null);
     assert.ok(s.cpu_seconds >= spent, `cpu_seconds ${s.cpu_seconds}, it had spent ${spent}`);
     near(s.cpu_limit, spent + MAX, 0.1, 'cpu_limit after the replayed running: true');
+    near(k.cpu, spent, 0.05, 'the count its checkpoint kept');
+    assert.equal(k.paused, 1, 'its checkpoint: paused by its budget');
     await sleep(500);
     assert.equal((await get(d, id)).state, 'running', 'still running on its new grant');
   } finally {
