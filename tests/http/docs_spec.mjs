@@ -40,7 +40,8 @@ export const SPEC = [
   ['docs/benchmarks.md', 'cut at 60 CPU s each'],
   ['docs/cli.md', '[The curve\nat 0.1 CPU s]'],
   /* the budgets' clocks: CPU_READ_EVERY, COST_WINDOW_CPU, COST_WINDOW_T (server/session/session_int.h) */
-  ['docs/budgets.md', '(at most every 10 ms), so a session pauses at most 10 ms of CPU past its grant'],
+  ['docs/budgets.md', 'reads its CPU clock at most every 10 ms: a session pauses at most 10 ms of CPU past its grant'],
+  ['docs/hardening.md', '(in pieces of at most 0.01 s)'],
   ['docs/budgets.md', 'over windows of 50 ms\nof CPU or 2 simulated seconds'],
   ['docs/budgets.md', 'first window (50\nms of CPU) replaces it'],
   /* a sample's interval at the stream's rate */
