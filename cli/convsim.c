@@ -283,10 +283,9 @@ static int unknown_command(const char *name)
 	return 2;
 }
 
-int main(int argc, char **argv)
+/* The command's work: its exit status (main checks stdout after it). */
+static int dispatch(int argc, char **argv)
 {
-	sim_tether_from_env(); /* the test suite's: end with the test */
-	cli_handover_init(argv);
 	if (argc < 2) {
 		cli_help(stderr, 0);
 		return 2;
@@ -314,4 +313,26 @@ int main(int argc, char **argv)
 	case CMD_LIST: return cmd_list(argc - 1, argv + 1);
 	default: return unknown_command(c);
 	}
+}
+
+/* What went to stdout (a summary, a table, a fit's result, the help)
+ * reached it: a full disk or a closed stdout is exit 1 with the reason
+ * on stderr, never a 0 over a table cut short. rc is the command's. */
+static int stdout_written(int argc, char **argv, int rc)
+{
+	errno = 0;
+	int flushed = fflush(stdout) == 0;
+	if (flushed && !ferror(stdout))
+		return rc;
+	const char *c = argc > 1 && cli_command(argv[1]) ? argv[1] : NULL;
+	fprintf(stderr, "convsim%s%s: writing to stdout failed%s%s\n", c ? " " : "", c ? c : "",
+		!flushed && errno ? ": " : "", !flushed && errno ? strerror(errno) : "");
+	return rc ? rc : 1;
+}
+
+int main(int argc, char **argv)
+{
+	sim_tether_from_env(); /* the test suite's: end with the test */
+	cli_handover_init(argv);
+	return stdout_written(argc, argv, dispatch(argc, argv));
 }
