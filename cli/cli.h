@@ -175,4 +175,12 @@ void cli_progress_update(cli_progress *p, double done, double total, const char 
 void cli_progress_end(cli_progress *p, const char *summary, int force);
 double cli_now(void);
 
+/* Interruptions (interrupt.c): from cli_catch_interrupts on, SIGINT and
+ * SIGTERM are noted, not fatal, so that a long job can stop starting
+ * work and write what it has (marked); the handler is reset by the first
+ * signal, so a second one ends the program at once. cli_interrupted():
+ * the signal noted, else 0. */
+void cli_catch_interrupts(void);
+int cli_interrupted(void);
+
 #endif

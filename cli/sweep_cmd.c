@@ -13,6 +13,7 @@
  */
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -33,6 +34,7 @@ typedef struct task {
 	sim_measurement r;
 	double band[2]; /* --band-from: the 95 % band's lower and upper ends, m/s */
 	int err;
+	int cancelled; /* not measured: the sweep was interrupted first */
 	char msg[160];
 } task;
 
@@ -44,7 +46,7 @@ typedef struct pool {
 	const int *skip;             /* the band's parameters the study varies */
 	task *tasks;
 	int *run;    /* the tasks to measure, in order */
-	int n, done; /* done: of this rank's share */
+	int n, measured; /* measured: of this rank's share (not cancelled) */
 	cli_progress progress;
 } pool;
 
@@ -82,6 +84,12 @@ static void measure_task(void *arg, size_t j)
 	sim_scene sc = pl->o->sc;
 	sim_method m = pl->o->m;
 	t->band[0] = t->band[1] = NAN;
+	if (cli_interrupted()) { /* the rest of the share is skipped */
+		t->cancelled = 1;
+		t->r = (sim_measurement){.transport_velocity = NAN, .uncertainty = NAN,
+					 .step_error = NAN, .dt = NAN};
+		return;
+	}
 	t->err = sim_study_apply(pl->st, i, &p, &sc, &m, t->msg, sizeof t->msg);
 	/* a point stops once its bar is met; with a band its v is the
 	 * centre of the band's finite differences, which run the whole window */
@@ -98,10 +106,13 @@ static void task_done(void *arg, size_t j, size_t done)
 {
 	pool *pl = arg;
 	char what[200], detail[220];
-	pl->done = (int)done;
+	(void)done;
+	if (pl->tasks[share_task(pl, j)].cancelled)
+		return;
+	pl->measured++;
 	snprintf(detail, sizeof detail, " (last: %s)",
 		 describe_task(pl->st, share_task(pl, j), what, sizeof what));
-	cli_progress_update(&pl->progress, pl->done,
+	cli_progress_update(&pl->progress, pl->measured,
 			    (double)cli_spread_share(pl->sp, (size_t)pl->n),
 			    pl->sp->ranks > 1 ? "points of rank 0's share" : "points", detail);
 }
@@ -128,6 +139,7 @@ static void mirror_tasks(const pool *pl, int ntasks)
 		t->band[0] = -src->band[1]; /* the band's image: v -> -v */
 		t->band[1] = -src->band[0];
 		t->err = src->err;
+		t->cancelled = src->cancelled;
 		if (src->err != SIM_OK)
 			sim_mirror_failure(t->msg, sizeof t->msg, task_beta(pl, (size_t)t->source),
 					   pl->st->rotation[(size_t)t->source / pl->st->npoints],
@@ -223,9 +235,9 @@ static int print_sweep(FILE *f, const cli_opts *o, const pool *pl, int ntasks)
 	for (int i = 0; i < ntasks; i++) {
 		const task *t = &pl->tasks[i];
 		const char *rot = st->rotation[(size_t)i / st->npoints] == SIM_CW ? "cw" : "ccw";
-		const char *state = t->err == SIM_OK ? "done" : "failed";
+		const char *state = t->cancelled ? "cancelled" : t->err == SIM_OK ? "done" : "failed";
 		const char *steady = t->r.steady ? "true" : "false";
-		if (t->err != SIM_OK) {
+		if (t->err != SIM_OK && !t->cancelled) {
 			char what[200];
 			failed++;
 			fprintf(stderr, "convsim sweep: %s: %s\n",
@@ -293,21 +305,30 @@ static int measure_study(const cli_opts *o, pool *pl, int ntasks)
 	free(source);
 	const cli_spread *sp = pl->sp;
 	cli_progress_start(&pl->progress, "sweep", o->quiet || sp->rank > 0, 0);
+	cli_catch_interrupts();
 	pmap_run(o->threads, cli_spread_share(sp, (size_t)pl->n), measure_task, pl, task_done);
 	if (cli_spread_gather(sp, pl->tasks, sizeof(task), pl->run, (size_t)pl->n))
 		cli_spread_abort(sp, 1);
 	if (sp->rank > 0)
 		return 0;
 	mirror_tasks(pl, ntasks);
-	char done[160];
-	snprintf(done, sizeof done, "%d/%d points in %.1f s", sp->ranks > 1 ? pl->n : pl->done,
-		 pl->n, cli_now() - pl->progress.t0);
+	int measured = 0, cancelled = 0;
+	for (int k = 0; k < ntasks; k++) {
+		cancelled += pl->tasks[k].cancelled;
+		measured += pl->tasks[k].source < 0 && !pl->tasks[k].cancelled;
+	}
+	char done[200];
+	snprintf(done, sizeof done, "%d/%d points in %.1f s", measured, pl->n,
+		 cli_now() - pl->progress.t0);
 	if (sp->ranks > 1)
 		snprintf(done + strlen(done), sizeof done - strlen(done),
-			 " on %d ranks (%d on rank 0)", sp->ranks, pl->done);
+			 " on %d ranks (%d on rank 0)", sp->ranks, pl->measured);
 	if (pl->n < ntasks)
 		snprintf(done + strlen(done), sizeof done - strlen(done),
 			 "; %d more as their mirror images (mirror reduction)", ntasks - pl->n);
+	if (cancelled)
+		snprintf(done + strlen(done), sizeof done - strlen(done),
+			 "; interrupted: %d points not measured, written as cancelled", cancelled);
 	cli_progress_end(&pl->progress, done, 1);
 	return 0;
 }
@@ -443,6 +464,12 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 		goto done;
 	}
 	rc = print_sweep(out, &o, &pl, ntasks) ? 1 : 0;
+	if (cli_interrupted()) {
+		fprintf(stderr, "convsim sweep: interrupted (%s): the table has the points measured "
+				"before it, the others with state cancelled\n",
+			cli_interrupted() == SIGINT ? "SIGINT, Ctrl-C" : "SIGTERM");
+		rc = 128 + cli_interrupted();
+	}
 	if (out != stdout && (ferror(out) | (fclose(out) != 0))) {
 		fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
 		rc = 1;

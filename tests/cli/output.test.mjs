@@ -2,11 +2,15 @@
 // Where convsim's output goes and what becomes of it when it cannot all
 // get there: a stdout that cannot be written (a full disk behind `>`,
 // a closed stdout) is exit 1 with the reason, never 0 over a table cut
-// short. CONVSIM names the binary.
+// short; Ctrl-C (SIGINT) or SIGTERM during a sweep writes the points
+// measured and marks the others cancelled, exit 128 + the signal.
+// CONVSIM names the binary.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
-import { closeSync, existsSync, openSync } from 'node:fs';
+import { spawn, spawnSync } from 'node:child_process';
+import { closeSync, existsSync, mkdtempSync, openSync, readFileSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import '../tether.mjs'; // nothing started here outlives the test
 
 const CLI = process.env.CONVSIM || new URL('../../build/convsim', import.meta.url).pathname;
@@ -36,4 +40,58 @@ test('a stdout that cannot be written is exit 1 with the reason', { skip: !exist
   } finally {
     closeSync(full);
   }
+});
+
+// A sweep of 181 points on one thread (several seconds), sent signal once
+// its first progress line is out: its exit code, signal and stderr.
+function interrupt(signal, args) {
+  return new Promise((resolve, reject) => {
+    const p = spawn(CLI, ['sweep', '--beta', '0:180:1', '--rotation', 'cw', '-d', '20', '-j', '1', ...args],
+      { stdio: ['ignore', 'pipe', 'pipe'] });
+    let err = '', out = '', sent = false;
+    const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error('no progress in 60 s')); }, 60000);
+    p.stdout.on('data', (d) => { out += d; });
+    p.stderr.on('data', (d) => {
+      err += d;
+      if (!sent && /^sweep: \d+\/181 points/m.test(err)) {
+        sent = true;
+        p.kill(signal);
+      }
+    });
+    p.on('close', (code, sig) => { clearTimeout(timer); resolve({ code, signal: sig, out, err }); });
+  });
+}
+
+test('Ctrl-C during a sweep: the points measured are written, the others marked cancelled, exit 130', async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-int-'));
+  const file = join(dir, 'v.csv');
+  writeFileSync(file, 'an earlier table\n');
+  const r = await interrupt('SIGINT', ['--out', file]);
+  assert.equal(r.signal, null);
+  assert.equal(r.code, 130);
+  assert.match(r.err, /^convsim sweep: interrupted \(SIGINT, Ctrl-C\): the table has the points measured before it, the others with state cancelled$/m);
+  assert.match(r.err, /^sweep: \d+\/181 points in [\d.]+ s; interrupted: \d+ points not measured, written as cancelled$/m);
+  const lines = readFileSync(file, 'utf8').trim().split('\n');
+  assert.equal(lines[0], 'beta,rotation,velocity,uncertainty,steady,state,dt,substeps,step_error,tol_met,model_error,model_error_uncertainty,model_checked');
+  assert.equal(lines.length, 1 + 181); // every point, in order
+  const rows = lines.slice(1).map((l) => l.split(','));
+  rows.forEach((c, k) => assert.equal(Number(c[0]), k));
+  const done = rows.filter((c) => c[5] === 'done'), cancelled = rows.filter((c) => c[5] === 'cancelled');
+  assert.ok(done.length >= 1 && cancelled.length >= 1, `${done.length} done, ${cancelled.length} cancelled`);
+  assert.equal(done.length + cancelled.length, 181);
+  for (const c of done) assert.ok(Number.isFinite(Number(c[2])) && c[2] !== '');
+  for (const c of cancelled) assert.deepEqual([c[2], c[3], c[4]], ['', '', 'false']);
+});
+
+test('SIGTERM during a JSON sweep: a whole JSON table with cancelled points, exit 143', async () => {
+  const r = await interrupt('SIGTERM', ['--format', 'json']);
+  assert.equal(r.signal, null);
+  assert.equal(r.code, 143);
+  assert.match(r.err, /^convsim sweep: interrupted \(SIGTERM\)/m);
+  const t = JSON.parse(r.out);
+  assert.equal(t.points.length, 181);
+  const cancelled = t.points.filter((p) => p.state === 'cancelled');
+  assert.ok(cancelled.length >= 1);
+  for (const p of cancelled) assert.deepEqual([p.velocity, p.uncertainty, p.steady], [null, null, false]);
+  assert.ok(t.points.some((p) => p.state === 'done' && Number.isFinite(p.velocity)));
 });
