@@ -166,7 +166,9 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 				  : strstr(field, ".prior")         ? "--prior"
 				  : strncmp(field, "free", 4) == 0  ? "--free"
 								    : "--set";
-		fprintf(stderr, "convsim fit: %s: %s\n", opt, msg);
+		int data = strcmp(opt, "--data") == 0; /* and the file, as the CSV's errors */
+		fprintf(stderr, "convsim fit: %s%s%s: %s\n", opt, data ? " " : "", data ? o->data : "",
+			msg);
 		return 2;
 	}
 	return 0;

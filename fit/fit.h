@@ -41,11 +41,14 @@ typedef struct fit_range {
 } fit_range;
 
 /* One measured point: beta (rad), rotation SIM_CW / SIM_CCW, v (m/s) and
- * its standard deviation sigma (m/s; NaN when not given). */
+ * its standard deviation sigma (m/s; NaN when not given); line: its line
+ * in a CSV file (fit_parse_csv), 0 when it comes from elsewhere, so that
+ * fit_check's messages name the line (the field stays points[i]). */
 typedef struct fit_point {
 	double beta;
 	int rotation;
 	double v, sigma;
+	int line;
 } fit_point;
 
 /* One measured peak of v(beta) (the fastest transport in one direction):

@@ -190,6 +190,7 @@ static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit
 	pt->rotation = r[1] == 'w' ? SIM_CW : SIM_CCW;
 	pt->v = num[COL_V];
 	pt->sigma = num[COL_SIGMA];
+	pt->line = lineno;
 	return 0;
 }
 
@@ -208,8 +209,13 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 	}
 	memcpy(buf, text, len + 1);
 	int col[NCOLS], ncol = -1, lineno = 0, rc = SIM_OK;
-	for (char *save, *line = strtok_r(buf, "\n", &save); line && rc == SIM_OK;
-	     line = strtok_r(NULL, "\n", &save)) {
+	/* line by line, blank ones counted (strtok_r would skip them and the
+	 * messages' line numbers with them) */
+	for (char *line = buf, *next; line && rc == SIM_OK; line = next) {
+		char *nl = strchr(line, '\n');
+		next = nl ? nl + 1 : NULL;
+		if (nl)
+			*nl = '\0';
 		lineno++;
 		if (line[strspn(line, " \r\t")] == '\0' || line[0] == '#')
 			continue;
@@ -256,43 +262,56 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 		FAIL(f, __VA_ARGS__);                        \
 	} while (0)
 
-static int check_beta(double beta, int rotation, const char *name, char *field, size_t flen,
-		      char *msg, size_t mlen, fit_range *range)
+/* name: the field's ("points[2]"); who: the messages' ("CSV line 4") */
+static int check_beta(double beta, int rotation, const char *name, const char *who, char *field,
+		      size_t flen, char *msg, size_t mlen, fit_range *range)
 {
 	char f[48];
 	snprintf(f, sizeof f, "%s.beta", name);
 	if (!(isfinite(beta) && beta >= 0 && beta <= SIM_PI * (1 + 1e-12)))
-		FAIL_RANGE(f, 0, 180, "%s: beta must be a finite number in [0, 180] deg", name);
+		FAIL_RANGE(f, 0, 180, "%s: beta must be a finite number in [0, 180] deg", who);
 	if (rotation != SIM_CW && rotation != SIM_CCW) {
 		snprintf(f, sizeof f, "%s.rotation", name);
-		FAIL(f, "%s: rotation must be cw or ccw", name);
+		FAIL(f, "%s: rotation must be cw or ccw", who);
 	}
 	return SIM_OK;
+}
+
+/* Point i as messages name it: its CSV line, else points[i]. */
+static const char *point_name(const fit_request *r, size_t i, char *buf, size_t len)
+{
+	if (r->points[i].line > 0)
+		snprintf(buf, len, "CSV line %d", r->points[i].line);
+	else
+		snprintf(buf, len, "points[%zu]", i);
+	return buf;
 }
 
 static int check_points(const fit_request *r, char *field, size_t flen, char *msg, size_t mlen,
 			fit_range *range)
 {
-	char name[32], f[48];
+	char name[32], who[32], f[48], other[32];
 	int with_sigma = r->npoints && !isnan(r->points[0].sigma);
 	for (size_t i = 0; i < r->npoints; i++) {
 		const fit_point *p = &r->points[i];
 		snprintf(name, sizeof name, "points[%zu]", i);
-		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen, range))
+		point_name(r, i, who, sizeof who);
+		if (check_beta(p->beta, p->rotation, name, who, field, flen, msg, mlen, range))
 			return SIM_EPARAM;
 		snprintf(f, sizeof f, "%s.v", name);
 		if (!isfinite(p->v) || fabs(p->v) > 100)
-			FAIL_RANGE(f, -100, 100, "%s: v must be a finite number in [-100, 100] m/s", name);
+			FAIL_RANGE(f, -100, 100, "%s: v must be a finite number in [-100, 100] m/s", who);
 		snprintf(f, sizeof f, "%s.sigma", name);
 		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0 && p->sigma <= 100))
-			FAIL_RANGE(f, 0, 100, "%s: sigma must be a number in (0, 100] m/s", name);
+			FAIL_RANGE(f, 0, 100, "%s: sigma must be a number in (0, 100] m/s", who);
 		if (isnan(p->sigma) == with_sigma)
-			FAIL(f, "%s: sigma must be given for every point or for none", name);
+			FAIL(f, "%s: sigma must be given for every point or for none", who);
 		for (size_t k = 0; k < i; k++)
 			if (fabs(r->points[k].beta - p->beta) < 1e-9 &&
 			    r->points[k].rotation == p->rotation)
-				FAIL(name, "%s duplicates points[%zu] (beta %g deg, %s)", name, k,
-				     p->beta * DEG_PER_RAD, p->rotation == SIM_CW ? "cw" : "ccw");
+				FAIL(name, "%s duplicates %s (beta %g deg, %s)", who,
+				     point_name(r, k, other, sizeof other), p->beta * DEG_PER_RAD,
+				     p->rotation == SIM_CW ? "cw" : "ccw");
 	}
 	return SIM_OK;
 }
@@ -306,7 +325,7 @@ static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg
 	for (int i = 0; i < r->npeaks; i++) {
 		const fit_peak *p = &r->peaks[i];
 		snprintf(name, sizeof name, "peaks[%d]", i);
-		if (check_beta(p->beta, p->rotation, name, field, flen, msg, mlen, range))
+		if (check_beta(p->beta, p->rotation, name, name, field, flen, msg, mlen, range))
 			return SIM_EPARAM;
 		snprintf(f, sizeof f, "%s.sigma", name);
 		if (!isnan(p->sigma) && !(isfinite(p->sigma) && p->sigma > 0 && p->sigma <= SIM_PI))

@@ -25,18 +25,23 @@ const CHEAP = ['--set', 'drive=ideal', '--set', 'columns=1', '--set', 'layers=2'
 test('bad input: exit 2 with a message naming the problem, nothing on stdout', () => {
   const good = file('good.csv', 'beta,rotation,v\n30,cw,0.1\n60,cw,0.05\n120,cw,-0.07\n');
   const cases = [
+    // a point out of range is named by the file and its line, as a row that does not parse
     [['--data', file('nan.csv', 'beta,rotation,v\nnan,cw,0.1\n60,cw,0.05\n'), '--free', 'e'],
-     /--data: points\[0\]: beta must be a finite number in \[0, 180\] deg/],
+     /^convsim fit: --data \S*nan\.csv: CSV line 2: beta must be a finite number in \[0, 180\] deg$/m],
     [['--data', file('far.csv', 'beta,rotation,v\n30,cw,0.1\n190,cw,0.05\n'), '--free', 'e'],
-     /points\[1\]: beta must be a finite number in \[0, 180\] deg/],
+     /^convsim fit: --data \S*far\.csv: CSV line 3: beta must be a finite number in \[0, 180\] deg$/m],
+    [['--data', file('fast.csv', 'beta,rotation,v\n# rig 2\n\n30,cw,0.1\n\n60,cw,150\n'), '--free', 'e'],
+     /^convsim fit: --data \S*fast\.csv: CSV line 6: v must be a finite number in \[-100, 100\] m\/s$/m],
+    [['--data', file('gap.csv', 'beta,rotation,v\n30,cw,0.1\n\n\n60,cw,abc\n'), '--free', 'e'],
+     /^convsim fit: --data \S*gap\.csv: CSV line 5: v must be a number, got 'abc'$/m],
     [['--data', good, '--free', 'ee'], /--free: unknown parameter 'ee' \(did you mean 'e'\?\)/],
     [['--data', good, '--free', 'rotation'], /--free: 'rotation' cannot be fitted/],
     [['--data', good, '--free', 'beta'], /--free: 'beta' cannot be fitted/],
     [['--data', good, '--free', 'layers'], /--free: 'layers' cannot be fitted/],
     [['--data', file('one.csv', 'beta,rotation,v\n30,cw,0.1\n'), '--free', 'e,mu'],
      /1 data for 2 free parameters/],
-    [['--data', file('dup.csv', 'beta,rotation,v\n30,cw,0.1\n30,cw,0.11\n'), '--free', 'e'],
-     /points\[1\] duplicates points\[0\] \(beta 30 deg, cw\)/],
+    [['--data', file('dup.csv', 'beta,rotation,v\n30,cw,0.1\n\n30,cw,0.11\n'), '--free', 'e'],
+     /^convsim fit: --data \S*dup\.csv: CSV line 4 duplicates CSV line 2 \(beta 30 deg, cw\)$/m],
     [['--data', file('col.csv', 'beta,v\n30,0.1\n60,0.05\n'), '--free', 'e'],
      /CSV line 1: column 'rotation' is missing/],
     [['--data', join(dir, 'absent.csv'), '--free', 'e'], /cannot read .*absent\.csv/],

@@ -53,7 +53,7 @@ static inline void truth(fit_point *pts)
 {
 	for (int i = 0; i < NPTS; i++) {
 		double beta = (15.0 + 30.0 * i) * RAD_PER_DEG;
-		pts[i] = (fit_point){beta, SIM_CW, cheap_v(TRUE_E, TRUE_MU, beta, SIM_CW), SIGMA};
+		pts[i] = (fit_point){beta, SIM_CW, cheap_v(TRUE_E, TRUE_MU, beta, SIM_CW), SIGMA, 0};
 	}
 }
 

@@ -60,7 +60,7 @@ static void mirror_reduction_in_batches(void **state)
 	unsigned long long seed = 20161124;
 	for (int i = 0; i < NPTS; i++) {
 		pts[2 * i] = clean[i];
-		pts[2 * i + 1] = (fit_point){SIM_PI - clean[i].beta, SIM_CCW, -clean[i].v, SIGMA};
+		pts[2 * i + 1] = (fit_point){SIM_PI - clean[i].beta, SIM_CCW, -clean[i].v, SIGMA, 0};
 	}
 	for (int i = 0; i < 2 * NPTS; i++)
 		pts[i].v += SIGMA * fit_normal(&seed);
@@ -129,9 +129,9 @@ static const char *verdict(const fit_request *r)
 static void refuses_bad_input(void **state)
 {
 	(void)state;
-	fit_point pts[3] = {{30 * RAD_PER_DEG, SIM_CW, 0.1, NAN},
-			    {60 * RAD_PER_DEG, SIM_CW, 0.05, NAN},
-			    {120 * RAD_PER_DEG, SIM_CW, -0.07, NAN}};
+	fit_point pts[3] = {{30 * RAD_PER_DEG, SIM_CW, 0.1, NAN, 0},
+			    {60 * RAD_PER_DEG, SIM_CW, 0.05, NAN, 0},
+			    {120 * RAD_PER_DEG, SIM_CW, -0.07, NAN, 0}};
 	fit_request r;
 	cheap_request(&r);
 	r.points = pts;
