@@ -46,6 +46,16 @@ static int choice_name(const char *choices, int idx, char *out, size_t len)
 	return 0;
 }
 
+/* " (unit)" for a "must be a number" message, or "" for a setting
+ * without a unit (scene.columns): no empty brackets. */
+static const char *unit_note(const sim_setting *set, char *out, size_t len)
+{
+	if (!set || !set->unit || !set->unit[0])
+		return "";
+	snprintf(out, len, " (%s)", set->unit);
+	return out;
+}
+
 static api_err from_sim_set(int rc, const char *field, const char *msg,
 			    api_problem *pb)
 {
@@ -59,7 +69,7 @@ api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
 			  const char *group, const cJSON *item,
 			  api_problem *pb)
 {
-	char field[64], msg[256] = "";
+	char field[64], msg[256] = "", unit[32];
 	const char *name = item->string ? item->string : "";
 	snprintf(field, sizeof field, "%s.%s", group, name);
 	const sim_setting *set = api_setting(group, name);
@@ -84,8 +94,8 @@ api_err api_apply_setting(sim_params *p, sim_scene *s, sim_method *m,
 	case SIM_KIND_INT:
 		if (!cJSON_IsNumber(item))
 			return api_fail(pb, API_TYPE, field,
-					"%s must be a number (%s)", field,
-					set->unit ? set->unit : "");
+					"%s must be a number%s", field,
+					unit_note(set, unit, sizeof unit));
 		if (set->kind == SIM_KIND_INT &&
 		    item->valuedouble != floor(item->valuedouble))
 			return api_fail(pb, API_RANGE, field,
@@ -152,9 +162,9 @@ api_err api_parse_user_value(const api_spec *spec, const char *name,
 			     api_value *out, api_problem *pb)
 {
 	if (!cJSON_IsNumber(it)) {
-		const sim_setting *set = sim_setting_find(name);
-		return api_fail(pb, API_TYPE, field, "%s must be a number (%s)",
-				field, set && set->unit ? set->unit : "");
+		char unit[32];
+		return api_fail(pb, API_TYPE, field, "%s must be a number%s", field,
+				unit_note(sim_setting_find(name), unit, sizeof unit));
 	}
 	return api_user_value(spec, name, it->valuedouble, field, out, pb);
 }
