@@ -35,10 +35,18 @@ export function sessionRequest(f) {
 		pace: f.pace,
 	};
 	if (f.start) body.scene.start = f.start;
-	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.params.beta_rate = f.betaRate;
-	if (Number.isFinite(f.dt) && f.dt > 0) body.integrator.dt = f.dt;
-	if (Number.isFinite(f.rate) && f.rate > 0) body.sample_rate = f.rate;
+	if (typed(f.betaRate)) body.params.beta_rate = f.betaRate;
+	if (typed(f.dt)) body.integrator.dt = f.dt;
+	if (typed(f.rate)) body.sample_rate = f.rate;
 	return body;
+}
+
+/* Whether an optional field holds a value: an empty one (NaN) asks for the
+ * daemon's default; anything typed goes as typed, 0 and -5 too, for the
+ * daemon to refuse naming the member (integrator.dt 0 is the method's
+ * default step, docs/api.md). */
+function typed(v) {
+	return typeof v === 'number' && !Number.isNaN(v);
 }
 
 /* The session form's model for a job that sets beta and rotation per
@@ -96,7 +104,7 @@ export function experimentRequest(f) {
 		schedule: [{ beta: f.beta1, until: f.tSwitch }, { beta: f.beta2, until: f.tEnd }],
 		keep_session: true,
 	};
-	if (Number.isFinite(f.betaRate) && f.betaRate > 0) body.beta_rate = f.betaRate;
+	if (typed(f.betaRate)) body.beta_rate = f.betaRate;
 	return body;
 }
 

@@ -15,6 +15,13 @@ import { showStatus, clearStatus, sessionLabel, showModelCheck } from './status.
 
 const STATUS_MS = 500;
 
+/* The inputs behind members whose names differ (ui.js report): the
+ * session form's Samples, and the live card's slew rate, which a new
+ * session takes as its params.beta_rate. */
+const SESSION_INPUT = [[/^sample_rate$/, 'rate'], [/^params\.beta_rate$/, '#beta-rate']];
+const CONTROL_INPUT = [[/^beta$/, '#beta-number'], [/^beta_rate$/, '#beta-rate'], [/^omega_ss$/, '#omega-ss'],
+	[/^pace$/, '#pace-live']];
+
 /* Values of the new-session form. Numbers are passed on as typed, so the
  * daemon (not the browser) judges their ranges and names the field. */
 export function readSessionForm() {
@@ -52,7 +59,7 @@ export async function startSession(ev) {
 		attach(s.id, null);
 		refreshSessionList();
 	} catch (err) {
-		report(err, 'Start session', $('#session-form'), [[/^sample_rate$/, 'rate']]);
+		report(err, 'Start session', $('#session-form'), SESSION_INPUT);
 	} finally {
 		busy(btn, false);
 	}
@@ -156,7 +163,7 @@ export async function patch(body, what) {
 		pollStatus();
 		return r;
 	} catch (err) {
-		report(err, what);
+		report(err, what, $('#control-card'), CONTROL_INPUT);
 		pollStatus();
 		return null;
 	}
@@ -164,8 +171,9 @@ export async function patch(body, what) {
 
 export async function setBeta(beta) {
 	const body = { beta };
+	/* a slew typed goes as typed (a negative one for the daemon to refuse) */
 	const rate = numberOf($('#beta-rate'));
-	if (Number.isFinite(rate) && rate > 0) body.beta_rate = rate;
+	if (!Number.isNaN(rate)) body.beta_rate = rate;
 	const r = await patch(body, 'β change');
 	if (r) {
 		const t = r.control.t;

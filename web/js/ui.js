@@ -66,14 +66,14 @@ function clearMessage(key) {
 
 /* The input of form behind the member field a problem names: the first
  * of fields ([RegExp, input name] pairs: the form's members whose input
- * has another name) that matches, else the member's path read from its
- * end, indices dropped (scene.columns: columns; vary.mu: vary; free[0]:
- * free). */
+ * has another name, or '#id' for an input outside it, such as the slew
+ * rate) that matches, else the member's path read from its end, indices
+ * dropped (scene.columns: columns; vary.mu: vary; free[0]: free). */
 function fieldInput(form, field, fields = []) {
 	const hit = fields.find(([re]) => re.test(field));
-	if (hit) return form.elements[hit[1]] ?? null;
+	if (hit) return hit[1].startsWith('#') ? $(hit[1]) : form.elements?.[hit[1]] ?? null;
 	for (const part of field.split(/[./]/).reverse()) {
-		const input = form.elements[part.replace(/\[\d*\]$/, '')];
+		const input = form.elements?.[part.replace(/\[\d*\]$/, '')];
 		if (input) return input;
 	}
 	return null;
