@@ -4,8 +4,10 @@
 // daemon, which refuses the bad ones naming the member (the message and
 // the outlined input) and changes nothing; an empty Δt or Samples still
 // asks for the default. The page dropped them (the session started with
-// the default; β jumped instead of ramping). An empty Columns field reads
-// "must be a number" (it read "must be a number ()").
+// the default; β jumped instead of ramping). A refused β (181, -5) puts
+// the slider and the number field back on the session's β target: the
+// slider stood at 180 or 0 until the field lost focus. An empty Columns
+// field reads "must be a number" (it read "must be a number ()").
 // Scene: ideal drive, 5 columns x 2 layers, no feed, pace 1 (cheap).
 import { test, before, after, beforeEach } from 'node:test';
 import assert from 'node:assert/strict';
@@ -100,6 +102,23 @@ test('a negative slew is sent and refused: β stays where it was', async () => {
 	assert.equal(s.status.beta_target, 38);
 	assert.equal(s.status.beta, 38);
 	await page.fill('#beta-rate', '');
+});
+
+test('a refused β puts the slider and the number field back on the target', async () => {
+	await attached();
+	for (const typed of ['181', '-5']) {
+		await page.$$eval('#messages .msg', ms => ms.forEach(m => m.remove()));
+		await page.fill('#beta-number', typed);
+		await page.press('#beta-number', 'Enter');
+		const msg = await page.waitForSelector('#messages .msg.error', { timeout: 10000 });
+		assert.equal(await msg.$eval('.msg-text', e => e.textContent),
+			'β change refused: 422 Value out of range: beta must be a finite number in [0, 180] deg');
+		/* the number field keeps the focus: no poll would have written it */
+		assert.equal(await page.evaluate(() => document.activeElement.id), 'beta-number');
+		assert.equal(await page.inputValue('#beta-slider'), '38', `slider after β ${typed}`);
+		assert.equal(await page.inputValue('#beta-number'), '38', `number field after β ${typed}`);
+		assert.equal(await page.textContent('#beta-target'), '38.0 °');
+	}
 });
 
 test('an empty Columns field: the daemon\'s message has no empty brackets', async () => {

@@ -11,7 +11,7 @@ import * as api from './api.js';
 import { fmt, fmtGiven, fmtTime, rotationLabel, parsePace } from './format.js';
 import { app, $, $$, message, report, setOnline, numberOf, busy } from './ui.js';
 import { resetTraces, onSample, onControl } from './live.js';
-import { showStatus, clearStatus, sessionLabel, showModelCheck } from './status.js';
+import { showStatus, clearStatus, sessionLabel, showModelCheck, showBetaTarget } from './status.js';
 
 const STATUS_MS = 500;
 
@@ -163,8 +163,9 @@ export async function patch(body, what) {
 		pollStatus();
 		return r;
 	} catch (err) {
+		/* a refusal changes nothing: the inputs show the session again */
 		report(err, what, $('#control-card'), CONTROL_INPUT);
-		pollStatus();
+		await pollStatus();
 		return null;
 	}
 }
@@ -178,6 +179,10 @@ export async function setBeta(beta) {
 	if (r) {
 		const t = r.control.t;
 		message('ok', `β → ${fmtGiven(beta)}°` + (Number.isFinite(t) ? ` from t = ${fmtTime(t)}` : '') + '.');
+	} else if (app.session) {
+		/* refused (181, -5): the slider and the number field, focused or
+		 * not, show the session's β target again */
+		showBetaTarget(app.session);
 	}
 	return r;
 }

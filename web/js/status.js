@@ -64,11 +64,7 @@ export function showStatus(s) {
 	$('#v-tol').textContent = tol ? `${tol} ${fmt(100 * s.tol, 1)} %` : '';
 	$('#v-tol').dataset.tol = tol;
 	/* slider follows the target unless the user is moving it */
-	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
-	if (!app.betaEditing && Number.isFinite(target) && document.activeElement !== $('#beta-number')) {
-		$('#beta-slider').value = String(target);
-		$('#beta-number').value = String(Math.round(target * 10) / 10);
-	}
+	if (!app.betaEditing && document.activeElement !== $('#beta-number')) showBetaTarget(s);
 	const now = $('#beta-now-mark');
 	now.hidden = !Number.isFinite(s.beta);
 	if (Number.isFinite(s.beta)) now.style.left = `${(wrapBeta(s.beta) / 180) * 100}%`;
@@ -87,6 +83,15 @@ export function showStatus(s) {
 	$('#plot-feed').dataset.empty = s.feed === false ? 'this scene has no feed' : 'waiting for stream samples';
 	if (!app.columns && Number.isFinite(s.columns) && s.columns > 0 && s.feed !== false) resetTraces(s.columns);
 	app.dirty = true;
+}
+
+/* The β slider and number field at the session s's β target (its β
+ * where it has none). */
+export function showBetaTarget(s) {
+	const target = Number.isFinite(s.betaTarget) ? s.betaTarget : s.beta;
+	if (!Number.isFinite(target)) return;
+	$('#beta-slider').value = String(target);
+	$('#beta-number').value = String(Math.round(target * 10) / 10);
 }
 
 /* No session attached: every tile, readout and model field back to a dash,
