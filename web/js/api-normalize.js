@@ -35,6 +35,8 @@ export const FIELDS = {
 		feedVelocity: ['status.feed_velocity', 'feed_velocity'],
 		running: ['status.running', 'running'],
 		state: ['state', 'status.state'],
+		pauseReason: ['pause_reason'],
+		cpuSeconds: ['cpu_seconds'],
 		experiment: ['experiment'],
 		until: ['until', 'spec.until'],
 		sampleRate: ['sample_rate'],
@@ -235,6 +237,10 @@ export function normalizeSession(raw) {
 		error: pick(raw, F.error),
 		experiment: pick(raw, F.experiment) ?? null,
 		until: scalar(raw, F.until), /* the simulated end time, s (NaN: none) */
+		/* why it is paused ("client", "cpu-budget"; '' when it is not) and
+		 * the CPU seconds it has used (docs/budgets.md) */
+		pauseReason: typeof pick(raw, F.pauseReason) === 'string' ? pick(raw, F.pauseReason) : '',
+		cpuSeconds: scalar(raw, F.cpuSeconds),
 		sampleRate: scalar(raw, F.sampleRate),
 	};
 }

@@ -28,10 +28,15 @@ export function showStatus(s) {
 	/* a session ends at its until (pace "max" sets one 60 s on, docs/api.md):
 	 * say where, and offer to run on */
 	const finished = s.state === 'finished' && !s.error;
+	/* a session its CPU budget paused says so; Resume grants a new one
+	 * (PATCH {"running": true}, docs/budgets.md) */
+	const spent = s.state === 'paused' && s.pauseReason === 'cpu-budget';
 	const state = s.error ? `error: ${s.error}` : finished && Number.isFinite(s.until)
 		? `finished at until = ${fmtGiven(s.until)} s`
+		: spent ? `paused: CPU budget spent (${fmtSig(s.cpuSeconds, 2)} CPU s)`
 		: s.state || (s.running === false ? 'paused' : s.running ? 'running' : DASH);
 	$('#state-now').textContent = state;
+	$('#resume').title = spent ? 'Resume with a new CPU budget (the daemon\'s --max-cpu-seconds)' : '';
 	document.body.dataset.running = s.running === false ? 'false' : 'true';
 	/* a failed session can be neither paused nor resumed; a finished one
 	 * runs on (controls.js lifts its until) */
