@@ -32,7 +32,7 @@ export function makePlots() {
 		series: [{ label: '95 % band cw', color: PALETTE[0], band: true, fill: 'rgba(148, 163, 184, 0.3)' },
 			{ label: '95 % band ccw', color: PALETTE[1], band: true, fill: 'rgba(203, 213, 225, 0.35)' },
 			{ label: 'clockwise', color: PALETTE[0] }, { label: 'counter-clockwise', color: PALETTE[1] }],
-		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', markers: true, zeroLine: true, aspect: 0.5, emptyX: [0, 180],
+		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', yShort: 'v / (m/s)', markers: true, zeroLine: true, aspect: 0.5, emptyX: [0, 180],
 	});
 	/* the bands first, so that the curves and data are drawn over them */
 	app.plots.fit = new XYPlot($('#plot-fit'), {
@@ -41,7 +41,7 @@ export function makePlots() {
 			{ label: 'data cw', color: PALETTE[0], line: false }, { label: 'fitted cw', color: PALETTE[2] },
 			{ label: 'original cw', color: '#94a3b8' }, { label: 'data ccw', color: PALETTE[1], line: false },
 			{ label: 'fitted ccw', color: PALETTE[4] }, { label: 'original ccw', color: '#cbd5e1' }],
-		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', zeroLine: true, aspect: 0.5, emptyX: [0, 180],
+		xLabel: 'β / °', yLabel: 'transport velocity v / (m/s)', yShort: 'v / (m/s)', zeroLine: true, aspect: 0.5, emptyX: [0, 180],
 	});
 	app.plots.experiment = new TimePlot($('#plot-experiment'), {
 		series: [{ label: 'feed velocity / (m/s)', color: PALETTE[0] }, { label: 'β / °', color: PALETTE[3], scale: 'y2' }],

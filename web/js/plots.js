@@ -377,9 +377,9 @@ export class XYPlot {
 	/* series: [{label, color, line, band}] (line: false draws the points
 	 * alone; band: true shades y ± the error bars instead, in fill);
 	 * equal: keep aspect 1:1 in data units; markers: draw a dot per point;
-	 * zeroLine: draw y = 0. The legend lists only the series that have
-	 * points. */
-	constructor(el, { series, xLabel, yLabel, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange, emptyX }) {
+	 * zeroLine: draw y = 0; yShort: the y label where yLabel does not fit.
+	 * The legend lists only the series that have points. */
+	constructor(el, { series, xLabel, yLabel, yShort, aspect = 0.75, equal = false, markers = false, zeroLine = false, xRange, emptyX }) {
 		this.el = el;
 		this.equal = equal;
 		this.xRange = xRange;
@@ -403,6 +403,9 @@ export class XYPlot {
 			if (axisKey === 'x' && self.emptyX && !Number.isFinite(e.x0)) return self.emptyX;
 			return axisKey === 'x' ? padRange(e.x0, e.x1, 0.05) : padRange(Math.min(e.y0, zeroLine ? 0 : e.y0), Math.max(e.y1, zeroLine ? 0 : e.y1));
 		};
+		/* yLabel where it fits the plot's height, else yShort (400 px wide cut it at both ends) */
+		const text = Object.assign(document.createElement('canvas').getContext('2d'), { font: AXIS.labelFont });
+		const yText = yShort ? u => (text.measureText(yLabel).width <= u.bbox.height / uPlot.pxRatio ? yLabel : yShort) : yLabel;
 		const hooks = {};
 		if (zeroLine) {
 			hooks.drawAxes = [u => {
@@ -426,7 +429,7 @@ export class XYPlot {
 			legend: { show: legend, live: false },
 			cursor: { show: false, drag: { x: false, y: false } },
 			scales: { x: { time: false, range: rangeFn('x') }, y: { range: rangeFn('y') } },
-			axes: [axis(xLabel, { size: 34 }), axis(yLabel, { size: 66, space: 24 })],
+			axes: [axis(xLabel, { size: 34 }), axis(yText, { size: 66, space: 24 })],
 			hooks,
 			series: [{}, ...series.map((d, i) => ({
 				label: d.label,
