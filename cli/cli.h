@@ -85,14 +85,27 @@ int cli_plan_study(const cli_opts *o, sim_study *st);
 
 /* Output (options.c): a number as the daemon prints it (shortest round
  * trip), non-finite as `nonfinite`; whether a file is JSON (--format, else
- * the name's extension); --out opened for writing, or NULL with the reason
- * on stderr. */
+ * the name's extension). */
 void cli_put_num(FILE *f, double v, const char *nonfinite);
 /* JSON text head (a member's name and colon, with what comes before it),
  * then v as cli_put_num writes it, null when not finite. */
 void cli_put_json_num(FILE *f, const char *head, double v);
 int cli_wants_json(const char *format, const char *file);
-FILE *cli_open_out(const cli_opts *o);
+
+/* --out (out_file.c): a regular or new file is written as PATH.partial and
+ * renamed over PATH when closed with all of it written, so a command that
+ * fails or is killed leaves an earlier PATH as it was (and, killed, its
+ * PATH.partial); a device, FIFO or link is written in place. Open: the
+ * stream, or NULL with "convsim CMD: --out: cannot write ..." on stderr.
+ * Close: keep 0 drops what was written; nonzero when keeping failed (a
+ * write, the close or the rename), PATH then as it was. */
+typedef struct cli_out {
+	FILE *f;
+	const char *path;
+	char *partial;
+} cli_out;
+FILE *cli_out_open(cli_out *w, const char *cmd, const char *path);
+int cli_out_close(cli_out *w, int keep);
 /* The whole of file path (stdin for "-", at most 16 MB), malloc'd (the
  * caller frees); NULL after "convsim CMD: --OPT: ..." on stderr. */
 char *cli_slurp(const char *cmd, const char *opt, const char *path);

@@ -183,12 +183,12 @@ static int cmd_run(int argc, char **argv)
 		return 2;
 	}
 	traj_file tf = {.json = cli_wants_json(o.format, o.out), .columns = sim_columns(s)};
+	cli_out out = {0};
 	if (o.out) {
-		tf.f = cli_open_out(&o);
+		tf.f = cli_out_open(&out, "run", o.out);
 		tf.colbuf = calloc(SIM_MAX_COLUMNS, sizeof(double));
 		if (!tf.f || !tf.colbuf) {
-			if (tf.f)
-				fclose(tf.f);
+			cli_out_close(&out, 0);
 			free(tf.colbuf);
 			sim_free(s);
 			return 1;
@@ -229,7 +229,7 @@ static int cmd_run(int argc, char **argv)
 	if (tf.f) {
 		if (tf.json)
 			fprintf(tf.f, "],\"count\":%ld}\n", tf.rows);
-		write_failed = ferror(tf.f) | (fclose(tf.f) != 0);
+		write_failed = cli_out_close(&out, 1);
 		free(tf.colbuf);
 		if (write_failed)
 			fprintf(stderr, "convsim run: --out: writing '%s' failed\n", o.out);

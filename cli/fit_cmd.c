@@ -220,9 +220,9 @@ int cli_cmd_fit(int argc, char **argv)
 		free(points);
 		return rc;
 	}
-	FILE *out = o.out ? fopen(o.out, "w") : stdout;
+	cli_out file = {0};
+	FILE *out = o.out ? cli_out_open(&file, "fit", o.out) : stdout;
 	if (!out) {
-		fprintf(stderr, "convsim fit: --out: cannot write '%s': %s\n", o.out, strerror(errno));
 		free(points);
 		return 1;
 	}
@@ -237,7 +237,7 @@ int cli_cmd_fit(int argc, char **argv)
 		fprintf(out, "%s%s", text, csv ? "" : "\n");
 	int write_failed = !text || ferror(out);
 	if (out != stdout)
-		write_failed |= fclose(out) != 0;
+		write_failed |= cli_out_close(&file, !write_failed);
 	if (write_failed)
 		fprintf(stderr, "convsim fit: writing the result failed\n");
 	if (!o.quiet || res.status == FIT_FAILED)

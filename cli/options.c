@@ -376,16 +376,6 @@ int cli_wants_json(const char *format, const char *file)
 	return n > 5 && strcmp(file + n - 5, ".json") == 0;
 }
 
-FILE *cli_open_out(const cli_opts *o)
-{
-	FILE *f = fopen(o->out, "w");
-	if (!f) {
-		fprintf(stderr, "convsim %s: --out: cannot write '%s': %s\n", o->cmd, o->out,
-			strerror(errno));
-	}
-	return f;
-}
-
 char *cli_slurp(const char *cmd, const char *opt, const char *path)
 {
 	FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");

@@ -443,7 +443,8 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 	if (sp->rank > 0)
 		quiet_end(&q, sp->rank, other);
 	FILE *out = stdout;
-	if (rc == 0 && sp->rank == 0 && o.out && !(out = cli_open_out(&o))) {
+	cli_out file = {0};
+	if (rc == 0 && sp->rank == 0 && o.out && !(out = cli_out_open(&file, "sweep", o.out))) {
 		out = stdout;
 		rc = 1;
 	}
@@ -470,14 +471,12 @@ static int sweep_on_rank(int argc, char **argv, const cli_spread *sp)
 			cli_interrupted() == SIGINT ? "SIGINT, Ctrl-C" : "SIGTERM");
 		rc = 128 + cli_interrupted();
 	}
-	if (out != stdout && (ferror(out) | (fclose(out) != 0))) {
+	if (out != stdout && cli_out_close(&file, 1)) {
 		fprintf(stderr, "convsim sweep: --out: writing '%s' failed\n", o.out);
 		rc = 1;
 	}
-	out = stdout;
 done:
-	if (out != stdout)
-		fclose(out);
+	cli_out_close(&file, 0); /* what a study that did not run wrote */
 	free(pl.tasks);
 	free(pl.run);
 	sim_study_free(&st);

@@ -95,3 +95,63 @@ test('SIGTERM during a JSON sweep: a whole JSON table with cancelled points, exi
   for (const p of cancelled) assert.deepEqual([p.velocity, p.uncertainty, p.steady], [null, null, false]);
   assert.ok(t.points.some((p) => p.state === 'done' && Number.isFinite(p.velocity)));
 });
+
+// --out is written whole or not at all: FILE.partial, renamed over FILE at
+// the end; a command killed on its way (SIGKILL: nothing of it runs again)
+// leaves an earlier FILE as it was. spawn args, kill once FILE.partial
+// exists and stderr matches ready: the exit.
+function killWhile(args, partial, ready) {
+  return new Promise((resolve, reject) => {
+    const p = spawn(CLI, args, { stdio: ['ignore', 'ignore', 'pipe'] });
+    let err = '', sent = false;
+    const timer = setTimeout(() => { p.kill('SIGKILL'); reject(new Error(`not ready in 60 s: ${err}`)); }, 60000);
+    p.stderr.on('data', (d) => {
+      err += d;
+      if (!sent && ready.test(err) && existsSync(partial)) {
+        sent = true;
+        p.kill('SIGKILL');
+      }
+    });
+    p.on('close', (code, sig) => { clearTimeout(timer); resolve({ code, signal: sig, err }); });
+  });
+}
+
+test('a command killed on its way leaves an earlier --out file as it was', async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-out-'));
+  const cases = [
+    ['run.csv', ['run', '-d', '600', '--sample-rate', '100'], /^run: /m],
+    ['sweep.csv', ['sweep', '--beta', '0:180:1', '--rotation', 'cw', '-d', '20', '-j', '1'], /^sweep: \d+\/181 points/m],
+    ['fit.json', ['fit', '--data', 'FIT', '--free', 'e', '-j', '1'], /^fit: /m],
+  ];
+  const data = join(dir, 'points.csv');
+  writeFileSync(data, 'beta,rotation,v\n30,cw,0.15\n60,cw,0.08\n120,cw,-0.09\n');
+  for (const [name, args, ready] of cases) {
+    const file = join(dir, name);
+    writeFileSync(file, 'an earlier table\n');
+    const r = await killWhile([...args.map((a) => (a === 'FIT' ? data : a)), '--out', file], `${file}.partial`, ready);
+    assert.equal(r.signal, 'SIGKILL', `${name}: ${r.err}`);
+    assert.equal(readFileSync(file, 'utf8'), 'an earlier table\n', name);
+    assert.ok(existsSync(`${file}.partial`), `${name}: what it wrote is in ${name}.partial`);
+  }
+});
+
+test('--out whole: a finished command replaces the file and leaves no .partial; a failed write keeps the old one', () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-out-'));
+  const file = join(dir, 'traj.csv');
+  writeFileSync(file, 'an earlier table\n');
+  let r = spawnSync(CLI, ['run', '-d', '0.1', '--sample-rate', '100', '-q', '--out', file], { encoding: 'utf8' });
+  assert.equal(r.status, 0, r.stderr);
+  const lines = readFileSync(file, 'utf8').trim().split('\n');
+  assert.equal(lines.length, 1 + 11); // header, t = 0 to 0.1 every 0.01
+  assert.equal(existsSync(`${file}.partial`), false);
+  // a device is written in place: /dev/full fails the write, exit 1
+  if (existsSync('/dev/full')) {
+    r = spawnSync(CLI, ['run', '-d', '0.1', '-q', '--out', '/dev/full'], { encoding: 'utf8' });
+    assert.equal(r.status, 1);
+    assert.match(r.stderr, /^convsim run: --out: writing '\/dev\/full' failed$/m);
+  }
+  // a directory that cannot be written: the reason names the file asked for
+  r = spawnSync(CLI, ['run', '-d', '0.1', '-q', '--out', '/nonexistent/x.csv'], { encoding: 'utf8' });
+  assert.equal(r.status, 1);
+  assert.match(r.stderr, /^convsim run: --out: cannot write '\/nonexistent\/x.csv': No such file or directory$/m);
+});
