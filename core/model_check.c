@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "decimal.h"
 #include "sim.h"
 #include "units.h"
 
@@ -94,10 +95,9 @@ static int entry_settings(const map_point *e, sim_params *p, sim_scene *sc)
 		if (!eq)
 			return -1;
 		*eq = '\0';
-		char *end;
-		double v = strtod(eq + 1, &end);
-		int rc = *end ? sim_set_user_str(p, sc, &m, item, eq + 1, NULL, 0)
-			      : sim_set_user(p, sc, &m, item, v, NULL, 0);
+		double v;
+		int rc = sim_decimal(eq + 1, &v) ? sim_set_user(p, sc, &m, item, v, NULL, 0)
+						  : sim_set_user_str(p, sc, &m, item, eq + 1, NULL, 0);
 		if (rc != SIM_OK)
 			return -1;
 	}

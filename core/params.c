@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "decimal.h"
 #include "model.h"
 #include "ode.h"
 #include "sim.h"
@@ -256,9 +257,7 @@ static int parse_value(size_t i, const char *value, double *out, char *msg, size
 			return range_error(i, msg, msglen);
 		return SIM_OK;
 	}
-	char *end;
-	*out = strtod(value, &end);
-	if (end == value || *end != '\0')
+	if (!sim_decimal(value, out)) /* 0x1e, " 30", "nan": not numbers here */
 		return range_error(i, msg, msglen);
 	return SIM_OK;
 }

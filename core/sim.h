@@ -117,7 +117,8 @@ int sim_preset(const char *name, sim_params *p, sim_scene *s, sim_method *m);
 int sim_set(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 	    double value, char *msg, size_t msglen);
 /* The same for a string value: enum choices ("cw", "ideal", "rk4" for
- * the integrator "method"), true/false, or a number in SI units. */
+ * the integrator "method"), true/false, or a plain decimal number in SI
+ * units (decimal.h: not 0x1e, " 30" or "nan"). */
 int sim_set_str(sim_params *p, sim_scene *s, sim_method *m, const char *name,
 		const char *value, char *msg, size_t msglen);
 /* Read one named setting in SI units; SIM_EUNKNOWN if no such name. */
