@@ -305,8 +305,10 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 		 char *field, size_t flen, char *msg, size_t mlen, fit_range *range);
 
 /* Parse CSV text (header beta,rotation,v[,sigma], any column order, beta
- * in deg) into a malloc'd array (*out, *n; caller frees). Returns SIM_OK,
- * or SIM_EPARAM with a message naming the line and column. */
+ * in deg) into a malloc'd array (*out, *n; caller frees). A number is a
+ * plain decimal one (decimal.h; spaces around a cell allowed, not 0x10,
+ * inf or nan). Returns SIM_OK, or SIM_EPARAM with a message naming the
+ * line and column. */
 int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len);
 
 /* Whole-request checks: data present (points or peaks, not both), beta

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "decimal.h"
 #include "fit.h"
 #include "suggest.h"
 #include "units.h"
@@ -169,13 +170,15 @@ static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit
 	for (int c = 0; c < NCOLS; c++) {
 		if (col[c] < 0 || c == COL_ROTATION)
 			continue;
-		char *s = cell[col[c]], *end;
-		num[c] = strtod(s, &end);
-		while (*end == ' ' || *end == '\r')
-			end++;
-		if (end == s || *end) {
-			snprintf(msg, mlen, "CSV line %d: %s must be a number, got '%.40s'", lineno,
-				 col_names[c], s);
+		/* a plain decimal number (decimal.h), spaces around it allowed:
+		 * "30, cw, 0.1" as people write it, never 0x10 or inf */
+		char *s = cell[col[c]] + strspn(cell[col[c]], " ");
+		size_t n = strlen(s);
+		while (n && (s[n - 1] == ' ' || s[n - 1] == '\r'))
+			n--;
+		if (!sim_decimal_n(s, n, &num[c])) {
+			snprintf(msg, mlen, "CSV line %d: %s must be a number, got '%.*s'", lineno,
+				 col_names[c], (int)(n > 40 ? 40 : n), s);
 			return -1;
 		}
 	}

@@ -11,10 +11,12 @@
  */
 #include <ctype.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "decimal.h"
 #include "fit.h"
 #include "units.h"
 
@@ -76,7 +78,8 @@ static int string(scan *c, char *buf, size_t len)
 	return 1;
 }
 
-/* A number, or null as NaN. */
+/* A number (a plain decimal one, decimal.h: as JSON writes it, never
+ * 0x10 or inf), or null as NaN. */
 static double number(scan *c)
 {
 	ws(c);
@@ -84,11 +87,11 @@ static double number(scan *c)
 		c->s += 4;
 		return NAN;
 	}
-	char *end;
-	double v = strtod(c->s, &end);
-	if (end == c->s)
+	double v = NAN;
+	size_t n = sim_decimal_len(c->s, SIZE_MAX);
+	if (!sim_decimal_n(c->s, n, &v))
 		c->bad = 1;
-	c->s = end;
+	c->s += n;
 	return v;
 }
 

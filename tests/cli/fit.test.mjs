@@ -26,8 +26,9 @@ test('bad input: exit 2 with a message naming the problem, nothing on stdout', (
   const good = file('good.csv', 'beta,rotation,v\n30,cw,0.1\n60,cw,0.05\n120,cw,-0.07\n');
   const cases = [
     // a point out of range is named by the file and its line, as a row that does not parse
+    // (nan is no number there: tests/cli/numbers.test.mjs)
     [['--data', file('nan.csv', 'beta,rotation,v\nnan,cw,0.1\n60,cw,0.05\n'), '--free', 'e'],
-     /^convsim fit: --data \S*nan\.csv: CSV line 2: beta must be a finite number in \[0, 180\] deg$/m],
+     /^convsim fit: --data \S*nan\.csv: CSV line 2: beta must be a number, got 'nan'$/m],
     [['--data', file('far.csv', 'beta,rotation,v\n30,cw,0.1\n190,cw,0.05\n'), '--free', 'e'],
      /^convsim fit: --data \S*far\.csv: CSV line 3: beta must be a finite number in \[0, 180\] deg$/m],
     [['--data', file('fast.csv', 'beta,rotation,v\n# rig 2\n\n30,cw,0.1\n\n60,cw,150\n'), '--free', 'e'],

@@ -194,12 +194,21 @@ static void parses_csv(void **state)
 	assert_int_equal(pts[1].rotation, SIM_CCW);
 	assert_true(pts[0].v == 0.1 && pts[1].sigma == 0.003);
 	free(pts);
-	/* a missing column, a short row, a bad number, a bad rotation */
-	const char *bad[] = {"beta,v\n30,0.1\n", "beta,rotation,v\n30,cw\n",
-			     "beta,rotation,v\n30,cw,fast\n", "beta,rotation,v\n30,left,0.1\n"};
-	const char *says[] = {"'rotation' is missing", "line 2", "v must be a number",
-			      "rotation must be cw or ccw"};
-	for (int i = 0; i < 4; i++) {
+	/* a missing column, a short row, a bad number, a bad rotation; numbers
+	 * strtod would have read (hexadecimal, inf) are no numbers here */
+	const char *bad[] = {"beta,v\n30,0.1\n",
+			     "beta,rotation,v\n30,cw\n",
+			     "beta,rotation,v\n30,cw,fast\n",
+			     "beta,rotation,v\n30,left,0.1\n",
+			     "beta,rotation,v\n30,cw,0x10\n",
+			     "beta,rotation,v,sigma\n30,cw,0.1, inf \r\n"};
+	const char *says[] = {"'rotation' is missing",
+			      "line 2",
+			      "v must be a number",
+			      "rotation must be cw or ccw",
+			      "CSV line 2: v must be a number, got '0x10'",
+			      "CSV line 2: sigma must be a number, got 'inf'"};
+	for (int i = 0; i < 6; i++) {
 		assert_int_equal(fit_parse_csv(bad[i], &pts, &n, msg, sizeof msg), SIM_EPARAM);
 		printf("  %s\n", msg);
 		assert_non_null(strstr(msg, says[i]));
