@@ -166,11 +166,16 @@ void cli_restart_options(void);
 /* " (did you mean 'X'?)" for a near miss, else "": into buf. */
 const char *cli_did_you_mean(char *buf, size_t len, const char *suggestion);
 
-/* Parse text as a finite number in [lo, hi] (lo excluded if lo_open).
- * On error prints "convsim CMD: --NAME must be ..., got 'text'" and
- * returns -1. */
+/* Parse text as a plain decimal number (decimal.h: no 0x10, no spaces)
+ * in [lo, hi] (lo excluded if lo_open). On error prints "convsim CMD:
+ * --NAME must be ..., got 'text'" and returns -1. */
 int cli_number(const char *cmd, const char *opt, const char *unit, const char *text,
 	       double lo, double hi, int lo_open, double *out);
+
+/* text as 1 to max plain decimal numbers separated by sep ("0:90:2" with
+ * ':') into v[0..): their count, or -1 (no message) when a field is
+ * empty or not one, or there are more than max. */
+int cli_numbers(const char *text, char sep, double *v, int max);
 
 /* Progress on stderr: a bar redrawn in place on a terminal, plain lines
  * (every tenth of the work) otherwise. Reports start after min_wall

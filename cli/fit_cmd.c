@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "decimal.h"
 #include "fit.h"
 #include "table.h"
 #include "units.h"
@@ -24,17 +25,18 @@ static int parse_free(const char *list, fit_request *req)
 	char buf[512], field[48], msg[FIT_MSG];
 	snprintf(buf, sizeof buf, "%s", list);
 	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		double lo = NAN, hi = NAN;
-		char *colon = strchr(tok, ':'), tail;
+		double range[2] = {NAN, NAN};
+		char *colon = strchr(tok, ':');
 		if (colon) {
 			*colon = '\0';
-			if (sscanf(colon + 1, "%lf:%lf%c", &lo, &hi, &tail) != 2) {
+			if (cli_numbers(colon + 1, ':', range, 2) != 2) {
 				fprintf(stderr, "convsim fit: --free takes NAME or NAME:MIN:MAX, got "
 						"'%s:%s'\n", tok, colon + 1);
 				return -1;
 			}
 		}
-		if (fit_add_free(req, tok, lo, hi, field, sizeof field, msg, sizeof msg, NULL) != SIM_OK) {
+		if (fit_add_free(req, tok, range[0], range[1], field, sizeof field, msg, sizeof msg,
+				 NULL) != SIM_OK) {
 			fprintf(stderr, "convsim fit: --free: %s\n", msg);
 			return -1;
 		}
@@ -50,16 +52,20 @@ static int parse_priors(const char *list, fit_request *req)
 	char buf[512], msg[FIT_MSG];
 	snprintf(buf, sizeof buf, "%s", list);
 	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		char name[24], spread[32];
-		double mean, sd = NAN, factor = NAN;
-		int used = 0;
-		int n = sscanf(tok, "%23[A-Za-z0-9_]:%lf:%31s%n", name, &mean, spread, &used);
-		char *end = NULL;
-		if (n == 3 && spread[0] == 'x')
-			factor = strtod(spread + 1, &end);
-		else if (n == 3)
-			sd = strtod(spread, &end);
-		if (n != 3 || !end || *end || tok[used]) {
+		/* NAME, then MEAN and SD (or x and FACTOR) as numbers */
+		char name[24];
+		double mean = NAN, sd = NAN, factor = NAN;
+		size_t len = strspn(tok, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+					 "0123456789_");
+		const char *spread = tok[len] == ':' ? strchr(tok + len + 1, ':') : NULL;
+		int ok = len > 0 && len < sizeof name && spread &&
+			 sim_decimal_n(tok + len + 1, (size_t)(spread - tok - len - 1), &mean);
+		if (ok && spread[1] == 'x')
+			ok = sim_decimal(spread + 2, &factor);
+		else if (ok)
+			ok = sim_decimal(spread + 1, &sd);
+		snprintf(name, sizeof name, "%.*s", (int)len, tok);
+		if (!ok) {
 			fprintf(stderr, "convsim fit: --prior takes NAME:MEAN:SD (normal) or "
 					"NAME:MEAN:xFACTOR (log-normal), e.g. R:0.5:0.1,k_c:3000:x3; "
 					"got '%s'\n", tok);
@@ -79,10 +85,14 @@ static int parse_peaks(const char *list, fit_request *req)
 	char buf[512];
 	snprintf(buf, sizeof buf, "%s", list);
 	for (char *save, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-		char rot[8], tail;
-		double beta, sigma = NAN;
-		int n = sscanf(tok, "%7[a-z]:%lf:%lf%c", rot, &beta, &sigma, &tail);
-		int ok = (n == 2 || n == 3) && (strcmp(rot, "cw") == 0 || strcmp(rot, "ccw") == 0);
+		double v[2] = {NAN, NAN}; /* DEG, SIGMA */
+		const char *colon = strchr(tok, ':');
+		size_t len = colon ? (size_t)(colon - tok) : 0;
+		int cw = len == 2 && strncmp(tok, "cw", 2) == 0;
+		int n = cw || (len == 3 && strncmp(tok, "ccw", 3) == 0)
+				? cli_numbers(colon + 1, ':', v, 2)
+				: -1;
+		int ok = n == 1 || n == 2;
 		if (!ok || req->npeaks >= FIT_MAX_PEAKS) {
 			fprintf(stderr, "convsim fit: --peaks takes up to %d of ROT:DEG[:SIGMA] (cw or "
 					"ccw, deg, deg), e.g. cw:38,cw:128; got '%s'\n",
@@ -90,9 +100,9 @@ static int parse_peaks(const char *list, fit_request *req)
 			return -1;
 		}
 		fit_peak *p = &req->peaks[req->npeaks++];
-		p->rotation = rot[1] == 'w' ? SIM_CW : SIM_CCW;
-		p->beta = beta * RAD_PER_DEG;
-		p->sigma = sigma * RAD_PER_DEG;
+		p->rotation = cw ? SIM_CW : SIM_CCW;
+		p->beta = v[0] * RAD_PER_DEG;
+		p->sigma = v[1] * RAD_PER_DEG;
 	}
 	return 0;
 }

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "decimal.h"
 #include "suggest.h"
 #include "table.h"
 
@@ -282,10 +283,8 @@ void cli_restart_options(void)
 int cli_number(const char *cmd, const char *opt, const char *unit, const char *text,
 	       double lo, double hi, int lo_open, double *out)
 {
-	char *end;
-	double v = strtod(text, &end);
-	int ok = end != text && *end == '\0' && isfinite(v) && (lo_open ? v > lo : v >= lo) &&
-		 v <= hi;
+	double v = NAN;
+	int ok = sim_decimal(text, &v) && (lo_open ? v > lo : v >= lo) && v <= hi;
 	if (ok) {
 		*out = v;
 		return 0;
@@ -293,6 +292,20 @@ int cli_number(const char *cmd, const char *opt, const char *unit, const char *t
 	fprintf(stderr, "convsim %s: --%s must be a number%s%s in %c%g, %g], got '%s'\n", cmd, opt,
 		unit ? " of " : "", unit ? unit : "", lo_open ? '(' : '[', lo, hi, text);
 	return -1;
+}
+
+int cli_numbers(const char *text, char sep, double *v, int max)
+{
+	int k = 0;
+	for (const char *p = text;; k++) {
+		const char *end = strchr(p, sep);
+		size_t n = end ? (size_t)(end - p) : strlen(p);
+		if (k == max || !sim_decimal_n(p, n, &v[k]))
+			return -1;
+		if (!end)
+			return k + 1;
+		p = end + 1;
+	}
 }
 
 /* ---- progress ------------------------------------------------------------ */

@@ -6,6 +6,7 @@
  * senses, each checked with a message that names the option and what it
  * accepts. sweep_cmd.c measures what this plans.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,13 +19,16 @@
 /* --beta FROM:TO:STEP or one angle into *from, *to, *step. */
 static int parse_beta(const char *text, double *from, double *to, double *step)
 {
-	char tail;
-	int n = sscanf(text, "%lf:%lf:%lf%c", from, to, step, &tail);
-	if (n == 1 && sscanf(text, "%lf%c", from, &tail) == 1) {
-		*to = *from;
-		*step = 1;
+	double v[3] = {NAN, NAN, NAN};
+	int n = cli_numbers(text, ':', v, 3);
+	if (n == 1) {
+		v[1] = v[0];
+		v[2] = 1;
 		n = 3;
 	}
+	*from = v[0];
+	*to = v[1];
+	*step = v[2];
 	if (n != 3 || !(*step > 0) || !(*from >= 0) || !(*to <= 180) || !(*to >= *from)) {
 		fprintf(stderr, "convsim sweep: --beta must be FROM:TO:STEP in degrees with 0 <= FROM "
 				"<= TO <= 180 and STEP > 0 (or one angle), got '%s'\n",
@@ -50,9 +54,8 @@ static int add_vary(sim_study *st, const cli_opts *o, const char *text)
 	}
 	snprintf(name, sizeof name, "%.*s", (int)(eq - text), text);
 	const char *spec = eq + 1;
-	char tail;
 	if (strchr(spec, ':')) {
-		if (sscanf(spec, "%lf:%lf:%lf%c", &v[0], &v[1], &v[2], &tail) == 3)
+		if (cli_numbers(spec, ':', v, 3) == 3)
 			rc = sim_study_add_range(st, &o->p, &o->sc, &o->m, name, v[0], v[1], v[2],
 						 msg, sizeof msg);
 		else
@@ -62,20 +65,12 @@ static int add_vary(sim_study *st, const cli_opts *o, const char *text)
 		for (const char *c = spec; *c; c++)
 			n += *c == ',';
 		double *list = calloc(n, sizeof(double));
-		char *copy = strdup(spec);
-		size_t k = 0;
-		int ok = list && copy;
-		char *save = NULL;
-		for (char *tok = ok ? strtok_r(copy, ",", &save) : NULL; ok && tok;
-		     tok = strtok_r(NULL, ",", &save))
-			ok = sscanf(tok, "%lf%c", &list[k++], &tail) == 1;
-		if (ok && k == n)
+		if (list && cli_numbers(spec, ',', list, (int)n) == (int)n)
 			rc = sim_study_add_list(st, &o->p, &o->sc, &o->m, name, list, n, msg,
 						sizeof msg);
 		else
 			snprintf(msg, sizeof msg, "a list is numbers separated by commas");
 		free(list);
-		free(copy);
 	}
 	if (rc == SIM_OK)
 		return 0;
