@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "decimal.h"
 #include "json_int.h"
 #include "suggest.h"
 
@@ -221,18 +222,6 @@ static int decimal(const char *text, uint64_t max, uint64_t *out)
 	return 1;
 }
 
-/* A decimal number in a query value: digits, a sign, a point and an
- * exponent only (strtod alone also reads hexadecimal, "inf" and "nan"),
- * finite, the whole value. */
-static int query_number(const char *v, double *x)
-{
-	if (!*v || strspn(v, "0123456789+-.eE") != strlen(v))
-		return 0;
-	char *end;
-	*x = strtod(v, &end);
-	return !*end && isfinite(*x);
-}
-
 api_err api_parse_stream_query(const char *format, const char *accept, const char *fields,
 			       const char *rate, const char *limit, const char *last_event_id,
 			       const char *since, api_stream_query *q, api_problem *pb)
@@ -251,7 +240,7 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 	if (!q->fields)
 		return pb->code;
 	if (rate) {
-		if (!query_number(rate, &q->rate) || !(q->rate > 0 && q->rate <= 100000))
+		if (!sim_decimal(rate, &q->rate) || !(q->rate > 0 && q->rate <= 100000))
 			return api_fail(pb, API_QUERY, "rate",
 					"rate must be a number of samples per "
 					"simulated second in (0, 100000]");
@@ -282,7 +271,7 @@ static api_err query_seconds(const char *key, const char *v, double *out, api_pr
 	if (!v || !*v)
 		return API_OK;
 	double x;
-	if (!query_number(v, &x))
+	if (!sim_decimal(v, &x)) /* decimal.h: not 0x10, inf or nan */
 		return api_fail(pb, API_QUERY, key, "%s must be a number of seconds (got \"%.40s\")",
 				key, v);
 	*out = x;

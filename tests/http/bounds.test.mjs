@@ -113,6 +113,11 @@ test('a number in a query is decimal: hexadecimal, inf and nan are 400 naming th
     [`${path}/trajectory?from=1%20`, 'from'],
     [`${path}/stream?rate=0x10`, 'rate'],
     [`${path}/stream?rate=100001`, 'rate'],
+    [`${path}/stream?rate=1e`, 'rate'],
+    [`${path}/trajectory?stride=0x1`, 'stride'],
+    [`${path}/trajectory?stride=%201`, 'stride'],
+    [`${path}/stream?since=0x10`, 'since'],
+    [`${path}/stream?limit=0x1`, 'limit'],
   ]) {
     const r = await req(d.base, 'GET', q);
     assert.equal(r.status, 400, `${q}: ${r.text}`);
