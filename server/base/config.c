@@ -7,7 +7,9 @@
  * them all, each kind checks its range with one message, and --help is
  * printed from the same rows with the defaults' values.
  */
+#include <ctype.h>
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +17,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "decimal.h"
 #include "util.h"
 
 static const srv_config defaults = {
@@ -237,7 +240,9 @@ static int parse_int(const char *arg, const char *name, long lo, long hi,
 		v <<= 10 * (u - units + 1);
 		end++;
 	}
-	if (*end || end == arg || v < lo || v > hi) {
+	/* strtol (base 10) takes a sign and digits, after skipping white
+	 * space: " 8" is refused as a number is elsewhere (decimal.h) */
+	if (*end || end == arg || isspace((unsigned char)*arg) || v < lo || v > hi) {
 		fprintf(stderr, "convsimd: %s must be an integer in [%ld, %ld]\n",
 			name, lo, hi);
 		return -1;
@@ -249,7 +254,7 @@ static int parse_int(const char *arg, const char *name, long lo, long hi,
 /* Set one option of cfg from its argument; -1 with a message if bad. */
 static int set_option(srv_config *cfg, const opt *o, const char *arg)
 {
-	char *at = (char *)cfg + o->field, flag[40], *end;
+	char *at = (char *)cfg + o->field, flag[40];
 	long v;
 	snprintf(flag, sizeof flag, "--%s", o->name);
 	switch (o->kind) {
@@ -279,9 +284,9 @@ static int set_option(srv_config *cfg, const opt *o, const char *arg)
 	case OPT_CORES: {
 		/* lo, hi: the range in milliseconds, millionths of a core */
 		double unit = o->kind == OPT_CORES ? 1e-6 : 1e-3;
-		double s = strtod(arg, &end);
-		if (*end || end == arg || !(s >= unit * (double)o->lo &&
-					    s <= unit * (double)o->hi)) {
+		double s = NAN; /* a plain decimal number (decimal.h): not 0x10 */
+		if (!sim_decimal(arg, &s) || !(s >= unit * (double)o->lo &&
+					       s <= unit * (double)o->hi)) {
 			fprintf(stderr, "convsimd: %s must be %s in [%g, %g]\n",
 				flag, o->kind == OPT_CORES ? "cores" : "seconds",
 				unit * (double)o->lo, unit * (double)o->hi);
