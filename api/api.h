@@ -138,6 +138,11 @@ api_err api_from_sim(int sim_err);
  * Returns code, so handlers can `return api_fail(...)`. */
 api_err api_fail(api_problem *pb, api_err code, const char *field,
 		 const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+/* v rounded to digits significant digits (as %.{digits}g prints it)
+ * towards the inside of a range: up for its lower end, down for its
+ * upper, so that the end a refusal states is a value the range takes
+ * (0.2 x 166 kg / 40 is 0.8300000000000001 in binary, stated 0.83). */
+double api_round_inward(double v, int up, int digits);
 /* A value of field outside [min, max] (an open end given as its limit):
  * api_fail with API_RANGE and that range, the problem's min and max
  * members; the one way a refusal states a range that is not the

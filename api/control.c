@@ -81,22 +81,6 @@ static api_err feed_value(const cJSON *it, const api_spec *spec, const char *nam
 	return e == API_OK ? feed_disturbable(spec, name, pb) : e;
 }
 
-/* v rounded to 6 significant digits (as %.6g prints it) towards the
- * inside of a range: up for its lower end, down for its upper, so that
- * the end stated is a value the range takes (0.2 x 166 kg / 40 is
- * 0.8300000000000001 in binary, stated 0.83). */
-static double round_inward(double v, int up)
-{
-	char text[32];
-	snprintf(text, sizeof text, "%.5e", v);
-	double r = strtod(text, NULL);
-	if (!isfinite(v) || (up ? r >= v : r <= v))
-		return r;
-	int exp10 = atoi(strchr(text, 'e') + 1);
-	double q = pow(10, 5 - exp10), k = round(r * q) + (up ? 1 : -1);
-	return q >= 1 ? k / q : k * pow(10, exp10 - 5);
-}
-
 static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name,
 			 api_control *c, api_problem *pb)
 {
@@ -110,7 +94,7 @@ static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name
 		/* narrowed from the table's range: the coupling's side; the
 		 * range stated as the detail prints it, within the exact one */
 		int light = hi < sim_setting_find(name)->max;
-		double lo_shown = round_inward(lo, 1), hi_shown = round_inward(hi, 0);
+		double lo_shown = api_round_inward(lo, 1, 6), hi_shown = api_round_inward(hi, 0, 6);
 		return api_fail_range(pb, name, lo_shown, hi_shown,
 				      "m_n must lie in [%.6g, %.6g] kg in this session; got %g: its "
 				      "integrator (dem with sub-steps) couples a feed of %s 0.2 of "

@@ -9,6 +9,7 @@
  * JSON path and, when the field is a setting of the core's table, adds the
  * allowed range or choices so that a client can correct itself.
  */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -101,6 +102,18 @@ static void vfail(api_problem *pb, api_err code, const char *field, const char *
 	if (field)
 		snprintf(pb->field, sizeof pb->field, "%s", field);
 	vsnprintf(pb->detail, sizeof pb->detail, fmt, ap);
+}
+
+double api_round_inward(double v, int up, int digits)
+{
+	char text[40];
+	snprintf(text, sizeof text, "%.*e", digits - 1, v);
+	double r = strtod(text, NULL);
+	if (!isfinite(v) || (up ? r >= v : r <= v))
+		return r;
+	int exp10 = atoi(strchr(text, 'e') + 1);
+	double q = pow(10, digits - 1 - exp10), k = round(r * q) + (up ? 1 : -1);
+	return q >= 1 ? k / q : k * pow(10, exp10 - digits + 1);
 }
 
 api_err api_fail_range(api_problem *pb, const char *field, double min, double max,

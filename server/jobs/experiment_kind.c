@@ -322,17 +322,20 @@ static api_err check_setpoints(srv_experiment *e, api_problem *pb)
 	for (int i = 0; i < e->req.nseg; i++) {
 		double v = x->sp[i].v;
 		if (!(v > x->v_lo && v < x->v_hi)) {
+			/* the range stated as the detail prints it, within the
+			 * open one: a setpoint at a stated end is taken */
 			char field[48];
+			double lo = api_round_inward(x->v_lo, 1, 4), hi = api_round_inward(x->v_hi, 0, 4);
+			lo = lo > x->v_lo ? lo : api_round_inward(nextafter(x->v_lo, INFINITY), 1, 4);
+			hi = hi < x->v_hi ? hi : api_round_inward(nextafter(x->v_hi, -INFINITY), 0, 4);
 			snprintf(field, sizeof field, "control.setpoint[%d].v", i);
-			api_fail(pb, API_RANGE, field,
-				 "%s = %g m/s is outside the machine's reachable range (%.4g, %.4g) "
+			return api_fail_range(pb, field, lo, hi,
+				 "%s = %g m/s is outside the machine's reachable range [%.4g, %.4g] "
 				 "m/s: the v(beta) curve between its minimum at %g deg and its maximum "
 				 "at %g deg",
-				 field, v, x->v_lo, x->v_hi,
+				 field, v, lo, hi,
 				 (x->branch_sign < 0 ? x->beta_hi : x->beta_lo) / DEG,
 				 (x->branch_sign < 0 ? x->beta_lo : x->beta_hi) / DEG);
-			pb->has_range = 1, pb->min = x->v_lo, pb->max = x->v_hi;
-			return API_RANGE;
 		}
 		double b = srv_exp_feedforward(x, v);
 		e->req.seg[i].beta = (api_value){b, ((b) / DEG)};

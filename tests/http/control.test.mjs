@@ -238,11 +238,15 @@ test('422: a setpoint out of the machine\'s reach names it and the range', { tim
   assert.equal(r.headers.get('content-type'), 'application/problem+json');
   const { min, max } = r.body;
   assert.ok(min < -0.14 && max > 0.15, `${min} ${max}`);
-  const g = (x) => String(Number(x.toPrecision(4)));
+  // the range as the detail prints it (4 digits), rounded inward: its ends are taken
+  for (const x of [min, max]) assert.equal(x, Number(x.toPrecision(4)), `${x} has more than 4 digits`);
   assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
-    `control.setpoint[1].v = 0.5 m/s is outside the machine's reachable range (${g(min)}, ${g(max)}) m/s: ` +
+    `control.setpoint[1].v = 0.5 m/s is outside the machine's reachable range [${min}, ${max}] m/s: ` +
     'the v(beta) curve between its minimum at 137.5 deg and its maximum at 30 deg',
     'control.setpoint[1].v', { min, max }));
+  const ok = await post({ control: { setpoint: [{ v: max, until: 0.5 }, { v: min, until: 1 }] } });
+  assert.equal(ok.status, 201, ok.text);
+  await req(d.base, 'DELETE', `/api/v1/sessions/${ok.body.session}`);
 });
 
 test('422: gains that make no sense', async () => {
