@@ -154,6 +154,17 @@ void *srv_store_unframe(char *buf, size_t n, uint32_t kind, size_t *len, int *ol
  * reason in *bad. A version-1 file goes through both. */
 void *srv_store_upgrade_v1(uint32_t kind, void *p, size_t *len, const char **bad);
 void *srv_store_upgrade_v2(uint32_t kind, void *p, size_t *len, const char **bad);
+/* An older checkpoint's head (head bytes stating exp_len and sim_len) and
+ * its two parts within the n bytes read: their length, or 0 when the
+ * lengths the head states do not fit (exp_len checked first, so that the
+ * differences cannot wrap). */
+static inline size_t srv_store_ckpt_body(size_t n, size_t head, uint64_t exp_len,
+					 uint64_t sim_len)
+{
+	return n >= head && exp_len <= n - head && sim_len <= n - head - exp_len
+		       ? head + (size_t)exp_len + (size_t)sim_len
+		       : 0;
+}
 
 /* What a start-up restore found, by kind (SRV_STORE_SESSION for sessions,
  * else a job kind's store_kind): a record listed damaged, and one read

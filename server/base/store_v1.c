@@ -293,12 +293,12 @@ static void *checkpoint_v1(char *p, size_t *len, const char **bad)
 	v1_ckpt_record o;
 	if (n >= sizeof o)
 		memcpy(&o, p, sizeof o);
-	if (n < sizeof o || o.exp_len > n - sizeof o || o.sim_len > n - sizeof o - o.exp_len) {
+	size_t body = n >= sizeof o ? srv_store_ckpt_body(n, sizeof o, o.exp_len, o.sim_len) : 0;
+	if (!body) {
 		*bad = "inconsistent lengths";
 		free(p);
 		return NULL;
 	}
-	size_t body = sizeof o + o.exp_len + o.sim_len;
 	v1_ckpt_trailer tr = {.logged = UINT64_MAX, .t = NAN};
 	char *exp = NULL;
 	size_t exp_len = o.exp_len;

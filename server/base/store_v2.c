@@ -48,12 +48,12 @@ static void *checkpoint_v2(char *p, size_t *len, const char **bad)
 	v2_ckpt_record o;
 	if (n >= sizeof o)
 		memcpy(&o, p, sizeof o);
-	if (n < sizeof o || o.exp_len > n - sizeof o || o.sim_len > n - sizeof o - o.exp_len) {
+	size_t body = n >= sizeof o ? srv_store_ckpt_body(n, sizeof o, o.exp_len, o.sim_len) : 0;
+	if (!body) {
 		*bad = "inconsistent lengths";
 		free(p);
 		return NULL;
 	}
-	size_t body = sizeof o + o.exp_len + o.sim_len;
 	if (n == body)
 		return p; /* no trailer: read as it is (srv_ckpt_decode) */
 	v2_ckpt_trailer old;
