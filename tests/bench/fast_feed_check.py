@@ -90,13 +90,18 @@ LONG_DURATION = 6  # s simulated: the window check's 5 s after the transient
 
 
 def map_points():
-    """(material, drive, depth, beta, v_dem, v_dem_sd) of every map point."""
+    """(material, drive, depth, beta, v_dem, v_dem_sd) of every point of the
+    map's complete beds: a bed (material, drive, depth) still being measured
+    has no peak yet to state its errors against, so it waits until it has
+    every angle."""
     rows = dem_map.read_rows()
     keys = sorted({(r["material"], r["drive"], int(r["layers"])) for r in rows if r["role"] == "map"})
     pts = []
     for mat, drive, depth in keys:
-        for b in dem_map.BETAS:
-            r = dem_map_report.chosen(rows, mat, depth, drive, b)
+        bed = [dem_map_report.chosen(rows, mat, depth, drive, b) for b in dem_map.BETAS]
+        if not all(bed):
+            continue
+        for b, r in zip(dem_map.BETAS, bed):
             if r:
                 pts.append({"material": mat, "drive": drive, "depth": depth, "beta": b,
                             "v_dem": float(r["v_dem"]), "sd": float(r["v_dem_sd"]),

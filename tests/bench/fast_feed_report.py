@@ -131,7 +131,7 @@ def write_md(recs, runner, path, unpredicted=()):
       "the material's mu_pw. A bed is a material at a depth: each is predicted by a closure "
       "fitted on all the map's other beds, both materials and both drives (leave one bed out: "
       "never on the same material and depth at either drive); no closure has "
-      "a constant of its own per material or drive. Map: %d points (%s) from %s. "
+      "a constant of its own per material or drive. Map: %d points of its complete beds (%s) from %s. "
       "Error = (v - v_DEM) / the "
       "bed's DEM peak |v|; the target is |error| <= 5 %% at >= 90 %% of the points at <= 3x "
       "the column model's CPU." % (time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
