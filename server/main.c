@@ -180,6 +180,7 @@ static void open_services(srv_config *config)
 {
 	raise_nofile(config);
 	srv_budget_init(config);
+	srv_budget_settling_init(config);
 	srv_conns_init(config);
 	srv_catalog_init(config);
 	srv_sessions_init(config);
@@ -201,11 +202,12 @@ static void announce(const srv_config *config, int port)
 	srv_log(SRV_LOG_INFO, "serving %s at /; %d sessions, %d streams max; "
 			      "budgets: %.1f GiB memory, %g CPU s per session, "
 			      "%g core%s for paced sessions, %d pace-max at once, "
-			      "%d connections per client (%d in all), %d queued "
-			      "sweep points",
+			      "%d settling at once, %d connections per client (%d in "
+			      "all), %d queued sweep points",
 		config->web_root, config->max_sessions, config->max_streams,
 		(double)config->max_memory / (1 << 30), config->max_cpu_seconds,
-		config->max_paced_cores, config->max_paced_cores == 1 ? "" : "s", config->max_busy, config->max_client_connections,
+		config->max_paced_cores, config->max_paced_cores == 1 ? "" : "s", config->max_busy, config->max_settling,
+		config->max_client_connections,
 		config->max_connections,
 		config->max_queued_points);
 }

@@ -8,7 +8,9 @@
  * sped up), CPU turns for pace "max" sessions (at most --max-busy step at
  * once, taking turns in time slices, first come first served) and the
  * open connections of each client address (counted in libmicrohttpd's
- * connection notification). The CPU turns are in budget_turns.h.
+ * connection notification), and the requests that settle simulations in
+ * their own thread at once (--max-settling). The CPU turns are in
+ * budget_turns.h.
  *
  * A leaf like metrics.c: it calls nothing else of server/ but util.c. Its
  * lock is a leaf of the lock order (registry.h): nothing is taken under it
@@ -148,6 +150,22 @@ double srv_budget_fit_pace(double *held, srv_pace_cost cost, const void *session
 /* Cores held by running paced sessions now, and the budget. */
 double srv_budget_paced(void);
 double srv_budget_paced_limit(void);
+
+/* ---- requests settling ------------------------------------------------------- */
+
+/* A request that builds and settles simulations in its own thread (a
+ * session's creation: its instance, the steady start's settling, the
+ * probe; an identification's or a closed loop's measurements at the
+ * request) holds one of --max-settling slots meanwhile (budget_settling.c;
+ * cfg borrowed). take: API_OK with *held 1; else at once, nothing taken,
+ * *pb is 503 (budget "settling", its limit, Retry-After 1). give: gives
+ * the slot back where *held (then 0); any number of times. Its lock is a
+ * leaf of the lock order (registry.h). */
+void srv_budget_settling_init(const srv_config *cfg);
+api_err srv_budget_take_settling(int *held, api_problem *pb);
+void srv_budget_give_settling(int *held);
+/* Requests settling now, the most at once so far, those refused so far. */
+void srv_budget_settling_counts(int *now, int *most, unsigned long long *refused);
 
 /* ---- queued sweep points ------------------------------------------------------ */
 

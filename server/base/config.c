@@ -43,6 +43,7 @@ static const srv_config defaults = {
 	.max_cpu_seconds = 1800.0,
 	.max_busy = 0,         /* set from the machine */
 	.max_paced_cores = 0,  /* set from the machine */
+	.max_settling = 0,     /* set from the machine */
 	.max_client_connections = 64,
 	.max_connections = 1024,
 	.connection_timeout = 30.0,
@@ -128,6 +129,10 @@ static const opt opts[] = {
 	{"max-paced-cores", OPT_CORES, 10, 4096000000L, F(max_paced_cores), "C",
 	 "cores the running paced sessions may need together: each its CPU s\n"
 	 "per simulated s times its pace (default %D: half the cores)", NULL},
+	{"max-settling", OPT_INT, 1, 1024, F(max_settling), "N",
+	 "requests that settle simulations in their own thread at once (a\n"
+	 "session's creation, an experiment's measurements); beyond, 503\n"
+	 "(default %D: half the cores, rounded up)", NULL},
 	{"max-client-connections", OPT_INT, 1, 100000, F(max_client_connections), "N",
 	 "open connections per client address (default %D); beyond, each\n"
 	 "closes the address's least progressing one", NULL},
@@ -168,7 +173,10 @@ static const opt opts[] = {
  * "max" session per core, half the cores for paced sessions (the other
  * half answers requests, feeds their streams, about 15 % more than the
  * sessions themselves, and takes what a measured cost exceeds its
- * estimate). */
+ * estimate), and requests settling at once on that other half: one per
+ * core of it, rounded up (a settling takes a whole core, at a priority
+ * above the workers'; more at once would only share those cores, each
+ * slower, and take the paced sessions' half). */
 static void machine_defaults(srv_config *cfg)
 {
 	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
@@ -178,6 +186,7 @@ static void machine_defaults(srv_config *cfg)
 				  : (size_t)4 << 30;
 	cfg->max_busy = cores > 0 ? (int)cores : 1;
 	cfg->max_paced_cores = 0.5 * (cores > 0 ? (double)cores : 1.0);
+	cfg->max_settling = cores > 1 ? (int)((cores + 1) / 2) : 1;
 }
 
 static const char *const levels[] = {"error", "warn", "info", "debug"};

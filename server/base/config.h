@@ -49,6 +49,8 @@ typedef struct srv_config {
 	double max_paced_cores; /* cores the running paced sessions may need,
 				   all together (their CPU s per simulated s
 				   times their pace) */
+	int max_settling;      /* requests that settle simulations in their
+				  own thread at once (budget_settling.c) */
 	int max_client_connections; /* open connections per client address */
 	int max_connections;   /* open connections, all clients */
 	double connection_timeout; /* s a connection may stay silent */

@@ -95,6 +95,13 @@ static void budget_metrics(FILE *f, const srv_gauges *g)
 		 "(at most --max-busy).", g->cpu_busy},
 		{"convsim_cpu_slots_waiting", "gauge", "Pace max sessions waiting "
 		 "for their turn.", g->cpu_waiting},
+		{"convsim_settling", "gauge", "Requests settling simulations in "
+		 "their own thread now: creations, experiments' measurements "
+		 "(at most --max-settling).", g->settling},
+		{"convsim_settling_max", "gauge", "The most requests that settled "
+		 "simulations at once.", g->settling_max},
+		{"convsim_settling_refused_total", "counter", "Requests answered "
+		 "503 beyond --max-settling.", g->settling_refused},
 		{"convsim_sweep_points_queued", "gauge", "Sweep points queued or "
 		 "running (at most --max-queued-points).", g->sweep_points},
 		{"convsim_client_connections_refused_total", "counter", "Connections "

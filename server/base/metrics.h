@@ -35,6 +35,9 @@ typedef struct srv_gauges {
 	double paced_cores, paced_cores_budget; /* held by running paced
 						   sessions, --max-paced-cores */
 	double cpu_busy, cpu_waiting;  /* pace "max" slots in use, waiting */
+	double settling, settling_max; /* requests settling now, the most at
+					  once (budget_settling.c) */
+	double settling_refused;       /* requests refused beyond them */
 	double sweep_points;           /* queued or running */
 	double client_refused;         /* connections answered 429 */
 	double connections_dropped;    /* closed by libmicrohttpd at accept */

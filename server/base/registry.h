@@ -22,8 +22,9 @@
  * A registry's lock is only held inside these functions: it is taken
  * before an object's lock only by the evictable test, and nothing takes it
  * while holding an object's lock. The pool's lock, the store's queue lock
- * (store.c) and the metrics are leaves: nothing is taken under them; the
- * store's callbacks run with no store lock held and may take any.
+ * (store.c), the budgets' locks (budget.c, budget_turns.c,
+ * budget_settling.c) and the metrics are leaves: nothing is taken under
+ * them; the store's callbacks run with no store lock held and may take any.
  */
 #ifndef CONVSIM_REGISTRY_H
 #define CONVSIM_REGISTRY_H

@@ -83,8 +83,10 @@ enum MHD_Result srv_h_health(srv_req *r)
 
 enum MHD_Result srv_h_metrics(srv_req *r)
 {
-	int busy, waiting;
+	int busy, waiting, settling, settling_max;
+	unsigned long long settling_refused;
 	srv_cpu_counts(&busy, &waiting);
+	srv_budget_settling_counts(&settling, &settling_max, &settling_refused);
 	srv_gauges g = {
 		.sessions = (double)srv_session_count(),
 		.steps_per_s = srv_sessions_steps_per_s(),
@@ -95,6 +97,9 @@ enum MHD_Result srv_h_metrics(srv_req *r)
 		.paced_cores_budget = srv_budget_paced_limit(),
 		.cpu_busy = busy,
 		.cpu_waiting = waiting,
+		.settling = settling,
+		.settling_max = settling_max,
+		.settling_refused = (double)settling_refused,
 		.sweep_points = (double)srv_budget_points(),
 		.client_refused = (double)srv_budget_client_refused(),
 		.connections_dropped = (double)srv_budget_connections_dropped(),

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "experiment_int.h"
 #include "fopdt.h"
 #include "util.h"
@@ -417,7 +418,17 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 
 api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
 {
-	return e->ext.kind == API_EXP_SCHEDULE ? API_OK : srv_exp_prepare(e, spec, pb);
+	if (e->ext.kind == API_EXP_SCHEDULE)
+		return API_OK;
+	/* its measurements settle and run instances in the request's thread
+	 * (a closed loop's v(beta) curve: 73 of them): one of the
+	 * --max-settling slots meanwhile, as a session's creation */
+	int settling = 0;
+	if (srv_budget_take_settling(&settling, pb) != API_OK)
+		return pb->code;
+	api_err err = srv_exp_prepare(e, spec, pb);
+	srv_budget_give_settling(&settling);
+	return err;
 }
 
 /* ---- the kind in the stored record (experiment.c) ---- */

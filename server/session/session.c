@@ -120,8 +120,10 @@ static void destroy(srv_entry *en)
  * back if it fails): creations that come meanwhile see the room taken
  * rather than each spend a settling and a probe and all but one be
  * refused at the end. A LIGGGHTS bed's session is charged its bed's cores
- * (session_init). At any pace: work no worker's grant or stop would
- * interrupt (a sample, the settling). 1 with *pb. */
+ * (session_init; --max-dem-sessions bounds their settling). At any pace:
+ * work no worker's grant or stop would interrupt (a sample, the settling);
+ * last a --max-settling slot, held while its instance is built, settled
+ * and probed (srv_session_create gives it back). 1 with *pb. */
 static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 {
 	double cpu;
@@ -129,10 +131,11 @@ static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 		return 0;
 	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
 		return 1;
-	if (spec->pace == API_PACE_MAX)
-		return 0;
-	return srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
-				     pb) != API_OK;
+	if (spec->pace != API_PACE_MAX &&
+	    srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
+				  pb) != API_OK)
+		return 1;
+	return srv_budget_take_settling(&s->budget.settling, pb) != API_OK;
 }
 
 /* Build s for spec: its sim instance, the initial status and the buffers
@@ -239,6 +242,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	s->create_fd = client_fd;
 	int bad = session_init(s, spec, pb);
 	s->create_fd = -1;
+	srv_budget_give_settling(&s->budget.settling); /* built, or not at all */
 	if (bad)
 		goto fail;
 	/* the cores it needs at its pace, before it runs */

@@ -35,8 +35,11 @@ void srv_sessions_shutdown(void);
  * (may be NULL; borrowed, must outlive the attachment) attached before
  * the first step. client_fd: -1, or the creating client's socket: a
  * LIGGGHTS bed's settling is cancelled (503, nothing kept) when the client
- * leaves before it ends. Returns a new reference or NULL with *pb set (429
- * at --max-sessions, 422 when the core refuses the spec, 503). */
+ * leaves before it ends. Its instance is built, settled and probed in the
+ * calling thread, holding a --max-settling slot (not a LIGGGHTS session's:
+ * --max-dem-sessions bounds those). Returns a new reference or NULL with
+ * *pb set (429 at --max-sessions, 422 when the core refuses the spec, 503:
+ * budget "memory", "cpu" or "settling"). */
 srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp, int client_fd,
 				api_problem *pb);
 /* Look up by id; returns a new reference or NULL. */

@@ -143,6 +143,7 @@ typedef struct srv_session_budget {
 				     creation, then measured by the worker */
 	int cpu_measured;         /* cpu_per_s is the worker's measure */
 	double paced_held;        /* cores of the paced budget it holds */
+	int settling;             /* holds a --max-settling slot (creation) */
 	srv_stream_charge *streams; /* its open streams' charges, linked
 				       (budget_stream.c): held with its
 				       own while it runs paced */
