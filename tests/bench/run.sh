@@ -69,6 +69,8 @@ echo "bench: what a paced session's sample costs its worker (the sample term of 
 bash tests/bench/sample_cost.sh "$out" > /dev/null
 echo "bench: what a creation refused for CPU costs the daemon (the paced budget full)"
 bash tests/bench/refuse_cost.sh "$out" > /dev/null
+echo "bench: a burst of large creations beside running sessions (how many settle at once; ~1 min)"
+bash tests/bench/settle_flood.sh "$out" > /dev/null
 echo "bench: PATCH throughput with the durable control log (loopback, a temporary data directory)"
 { echo "Command: \`node tests/bench/controls.mjs\` (part of \`make bench\`). $(provenance)"; echo
 	CONVSIMD="$BUILD/convsimd" OLD="${OLD_CONVSIMD:-}" node tests/bench/controls.mjs; } | tee "$out/controls.md"
