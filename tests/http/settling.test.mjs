@@ -7,13 +7,13 @@
 // and changes nothing; the slot comes back on every path (an answer, a
 // failed settling, a client that left). A 64 x 64 scene settles for about
 // a CPU second here, so a burst of them overlaps whatever the machine's
-// load: the build before settled every one of 8 at once (each 201, after
-// 8 times as long), tests/bench/settle_flood.mjs measures what that did
-// to a running paced session.
+// load: with no slot taken (the build before) all 8 of the first test are
+// created; tests/bench/settle_flood.mjs measures what that did to a
+// running paced session.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { mkdtempSync, readdirSync, readFileSync, rmSync } from 'node:fs';
 import { cpus, tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { BIN, startDaemon, req, metric, until, SLOW } from './lib.mjs';
@@ -123,6 +123,14 @@ test('the slot comes back after a settling that fails and after a client that le
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
+});
+
+test('docs/hardening.md shows the 503 the daemon answers (with --max-settling 1)', () => {
+  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
+  const section = doc.slice(doc.indexOf('## Creations that settle'));
+  const block = section.match(/```json\n([\s\S]*?)```/);
+  assert.ok(block, 'a json block in "Creations that settle"');
+  assert.deepEqual(JSON.parse(block[1]), busy(1, '/api/v1/sessions'));
 });
 
 test('--max-settling: half the cores by default, 1 to 1024', () => {
