@@ -49,9 +49,8 @@ const failures = [];
 const check = (ok, what) => { if (!ok) failures.push(what); };
 
 const FLAGS = (process.env.DAEMON_FLAGS || '').split(/\s+/).filter(Boolean);
-// its creations come four at a time: as many may settle at once (--max-settling)
 const d = await startDaemon(['--max-sessions', String(SESSIONS + 16), '--max-streams', String(STREAMS + 16),
-  '--max-memory', `${MEMORY_GIB}G`, '--max-settling', '4', ...FLAGS]);
+  '--max-memory', `${MEMORY_GIB}G`, ...FLAGS]);
 const base = d.base;
 // bounded: whatever happens, the run and its daemon end within 6 minutes
 process.on('exit', () => { if (d.proc.exitCode === null) d.proc.kill('SIGKILL'); });

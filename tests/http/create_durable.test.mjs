@@ -26,8 +26,7 @@ const ROUNDS = 2 * KINDS.length;
 for (const delay of [0, 1]) {
   test(`every acknowledged creation survives kill -9 ${delay} ms after its answer (${ROUNDS} rounds)`, { timeout: 180000 * SLOW }, async () => {
     const dir = mkdtempSync(join(tmpdir(), 'convsimd-create-'));
-    // two creations at once: two may settle at once (--max-settling)
-    const args = ['--data-dir', dir, '--checkpoint-interval', '3600', '--max-settling', '2'];
+    const args = ['--data-dir', dir, '--checkpoint-interval', '3600'];
     const acked = []; // [kind name, id] answered 201/202
     try {
       for (let round = 0; round <= ROUNDS; round++) {

@@ -22,6 +22,10 @@ export const SPEC = [
   /* issue 35's stiffness rule */
   ['docs/dem.md', 'within 2 % of the next rung'],
   ['docs/hardening.md', 'target, p99 under 100 ms'],
+  // the settling slot's wait, SETTLING_WAIT_MS in server/base/budget_settling.c
+  ['docs/hardening.md', 'waits at most 250 ms for a slot'],
+  ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],
+  ['docs/operations.md', 'a request waits up to 250 ms for a slot'],
   ['docs/hardening.md', 'runs for up to 30 ms of CPU'],
   ['docs/hardening.md', 'within the first 50 ms of CPU'],
   /* SRV_SAMPLE_CPU_MAX in server/base/budget.h: the longest sample a creation may ask for */

@@ -10,9 +10,7 @@ import { spawn } from 'node:child_process';
 import { startDaemon, req, openStream, until, near, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 let d;
-// the peaks' three sessions are created at once: as many settling at once
-// (--max-settling is half the cores by default, 1 on 2 cores)
-before(async () => { d = await startDaemon(['--heartbeat', '0.5', '--max-settling', '3']); });
+before(async () => { d = await startDaemon(['--heartbeat', '0.5']); });
 after(async () => {
   const r = await d.stop();
   assert.equal(r.code, 0, d.stderr());

@@ -3,8 +3,9 @@
 // at once (docs/hardening.md "Creations that settle"): a session's
 // creation settles its steady start and runs its probe before it is
 // answered, an identification or a closed loop measures its scene at the
-// request. Beyond, a request is answered 503 at once, naming the limit,
-// and changes nothing; the slot comes back on every path (an answer, a
+// request. Beyond, a request waits at most 250 ms for a slot (a burst of
+// default creations queues through), then is answered 503 naming the
+// limit, and changes nothing; the slot comes back on every path (an answer, a
 // failed settling, a client that left). A 64 x 64 scene settles for about
 // a CPU second here, so a burst of them overlaps whatever the machine's
 // load: with no slot taken (the build before) all 8 of the first test are
@@ -22,9 +23,9 @@ const LARGE = { scene: { columns: 64, layers: 64 }, pace: 0.01, sample_rate: 1 }
 const metrics = async (d) => (await req(d.base, 'GET', '/metrics')).text;
 const busy = (limit, instance) => ({
   type: '/api/v1/problems/unavailable', title: 'Service unavailable', status: 503,
-  detail: `as many requests as may settle simulations at once are settling (${limit}, --max-settling): ` +
-    'a session\'s creation (its steady start and its probe) and an experiment\'s measurements each ' +
-    'take a core while they settle; nothing was created, retry in a second',
+  detail: `as many requests as may settle simulations at once are settling (${limit}, --max-settling), ` +
+    'and none ended within 250 ms: a session\'s creation (its steady start and its probe) and an ' +
+    'experiment\'s measurements each take a core while they settle; nothing was created, retry in a second',
   instance, budget: 'settling', limit,
 });
 function assertBusy(r, limit, instance) {
@@ -35,7 +36,7 @@ function assertBusy(r, limit, instance) {
 }
 const ids = async (d) => (await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.map((s) => s.id).sort();
 
-test('a burst of 8 large creations under --max-settling 2: 2 settle, 6 get 503 at once and leave nothing', { timeout: 120000 * SLOW }, async () => {
+test('a burst of 8 large creations under --max-settling 2: 2 settle, 6 get 503 after waiting 250 ms and leave nothing', { timeout: 120000 * SLOW }, async () => {
   const dir = mkdtempSync(join(tmpdir(), 'convsim-settling-'));
   const d = await startDaemon(['--max-settling', '2', '--ring', '64', '--data-dir', dir]);
   try {
@@ -50,9 +51,10 @@ test('a burst of 8 large creations under --max-settling 2: 2 settle, 6 get 503 a
     const created = answers.filter((a) => a.status === 201), refused = answers.filter((a) => a.status !== 201);
     assert.equal(created.length, 2, answers.map((a) => `${a.status} ${a.text.slice(0, 120)}`).join('\n'));
     for (const r of refused) assertBusy(r, 2, '/api/v1/sessions');
-    // refused at once: every 503 was in before either settling ended
+    // refused after the wait, not after the settling: every 503 was in
+    // before either settling ended, none before 250 ms
     const firstCreated = Math.min(...created.map((a) => a.ms));
-    for (const r of refused) assert.ok(r.ms < firstCreated, `a 503 after ${r.ms} ms, the first 201 after ${firstCreated} ms`);
+    for (const r of refused) assert.ok(r.ms < firstCreated && r.ms >= 250, `a 503 after ${r.ms} ms, the first 201 after ${firstCreated} ms`);
     const after = await metrics(d);
     assert.equal(metric(after, 'convsim_settling_max'), 2);
     assert.equal(metric(after, 'convsim_settling_refused_total'), 6);
@@ -72,6 +74,19 @@ test('a burst of 8 large creations under --max-settling 2: 2 settle, 6 get 503 a
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
     rmSync(dir, { recursive: true, force: true });
+  }
+});
+
+test('a burst of 12 default creations under --max-settling 1: all 201, queued through the wait', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon(['--max-settling', '1']);
+  try {
+    const answers = await Promise.all(Array.from({ length: 12 }, () => req(d.base, 'POST', '/api/v1/sessions', { pace: 1 })));
+    assert.deepEqual(answers.map((a) => a.status), Array(12).fill(201), answers.map((a) => a.text.slice(0, 160)).join('\n'));
+    const m = await metrics(d);
+    assert.equal(metric(m, 'convsim_settling_max'), 1);
+    assert.equal(metric(m, 'convsim_settling_refused_total'), 0);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
 
