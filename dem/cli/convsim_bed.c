@@ -25,6 +25,7 @@
 #include <mpi.h>
 
 #include "bed_proto.h"
+#include "decimal.h"
 #include "dem.h"
 #include "tether.h"
 
@@ -36,7 +37,23 @@ static const char usage[] =
 	"  A LIGGGHTS bed driven over stdin, answering on stdout, one line each way\n"
 	"  (the bed protocol, docs/dem.md). The daemon convsimd starts it for each\n"
 	"  session with feed_model liggghts (under mpirun -n N with --dem-ranks N);\n"
-	"  --nice N lowers its priority by N.\n";
+	"  --nice N (a whole number, 0 to 19) lowers its priority by N.\n";
+
+/* --nice's value, a whole number in [0, 19] as decimal.h reads one (not
+ * 0x5, ' 5' or 5abc, which atoi would take), or -1 after a message. */
+static int bed_nice(const char *text)
+{
+	double v;
+	if (!sim_decimal(text, &v) || v < 0 || v > 19) {
+		fprintf(stderr, "convsim-bed: --nice must be a number in [0, 19], got '%s'\n", text);
+		return -1;
+	}
+	if (v != (int)v) {
+		fprintf(stderr, "convsim-bed: --nice must be a whole number, got '%s'\n", text);
+		return -1;
+	}
+	return (int)v;
+}
 
 /* Write one answer line and flush it; 0 or -1. */
 static int bed_answer(FILE *out, const char *line)
@@ -137,8 +154,10 @@ int main(int argc, char **argv)
 		if (!strcmp(argv[i], "--serve")) {
 			serve = 1;
 		} else if (!strcmp(argv[i], "--nice") && i + 1 < argc) {
-			int n = atoi(argv[++i]);
-			if (n > 0 && n <= 19 && setpriority(PRIO_PROCESS, 0, n) != 0)
+			int n = bed_nice(argv[++i]);
+			if (n < 0)
+				return 2;
+			if (n > 0 && setpriority(PRIO_PROCESS, 0, n) != 0)
 				perror("convsim-bed: setpriority");
 		} else {
 			fputs(usage, !strcmp(argv[i], "--help") ? stdout : stderr);

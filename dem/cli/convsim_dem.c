@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "decimal.h"
 #include "dem.h"
 #include "couple.h"
 #include "motion.h"
@@ -107,12 +108,12 @@ static void dem_help(FILE *f)
 	cli_help_options(f, dem_options, DEM_NOPTIONS, 1);
 }
 
-/* A number in [lo, hi] or exit 2 with the option's name and range. */
+/* A plain decimal number (decimal.h: no 0x8, no spaces, no inf) in
+ * [lo, hi], or exit 2 with the option's name and range. */
 static double dem_number(const char *opt, const char *text, double lo, double hi)
 {
-	char *end;
-	double v = strtod(text, &end);
-	if (end == text || *end || !isfinite(v) || v < lo || v > hi) {
+	double v;
+	if (!sim_decimal(text, &v) || v < lo || v > hi) {
 		fprintf(stderr, "convsim-dem: --%s must be a number in [%g, %g], got '%s'\n", opt, lo, hi,
 			text);
 		exit(2);
@@ -120,11 +121,25 @@ static double dem_number(const char *opt, const char *text, double lo, double hi
 	return v;
 }
 
-/* The options whose argument has parts: NAME=VALUE, A:DEG, E:NU, E:MU:MUR. */
+/* A count: dem_number's, and whole (2.5 is not cut to 2), or exit 2. */
+static int dem_whole(const char *opt, const char *text, double lo, double hi)
+{
+	double v = dem_number(opt, text, lo, hi);
+	if (v != floor(v)) {
+		fprintf(stderr, "convsim-dem: --%s must be a whole number, got '%s'\n", opt, text);
+		exit(2);
+	}
+	return (int)v;
+}
+
+/* The options whose argument has parts: NAME=VALUE, A:DEG, E:NU, E:MU:MUR;
+ * the numbers between the colons plain decimal ones (cli_numbers), exactly
+ * as many as the option has. */
 static void dem_parse_compound(int c, const char *arg, dem_opts *o)
 {
 	char msg[200], name[64];
 	const char *eq;
+	double v[3];
 	switch (c) {
 	case D_SET:
 		eq = strchr(arg, '=');
@@ -139,26 +154,27 @@ static void dem_parse_compound(int c, const char *arg, dem_opts *o)
 		}
 		break;
 	case D_FRAME_CHECK:
-		if (sscanf(arg, "%lf:%lf", &o->frame_amp, &o->frame_angle) != 2 ||
-		    !(o->frame_amp > 0) || !(o->frame_amp <= 0.01) || !(o->frame_angle >= 0) ||
-		    !(o->frame_angle <= 180)) {
+		if (cli_numbers(arg, ':', v, 2) != 2 || !(v[0] > 0) || !(v[0] <= 0.01) ||
+		    !(v[1] >= 0) || !(v[1] <= 180)) {
 			fprintf(stderr, "convsim-dem: --frame-check must be A:DEG with A in (0, 0.01] m "
 					"and DEG in [0, 180], got '%s'\n", arg);
 			exit(2);
 		}
+		o->frame_amp = v[0], o->frame_angle = v[1];
 		break;
 	case D_HERTZ:
-		if (sscanf(arg, "%lf:%lf", &o->youngs, &o->poisson) != 2 || !(o->youngs >= 5e6) ||
-		    !(o->youngs <= 1e9) || !(o->poisson > 0) || !(o->poisson < 0.5)) {
+		if (cli_numbers(arg, ':', v, 2) != 2 || !(v[0] >= 5e6) || !(v[0] <= 1e9) ||
+		    !(v[1] > 0) || !(v[1] < 0.5)) {
 			fprintf(stderr, "convsim-dem: --hertz must be E:NU with E in [5e6, 1e9] Pa "
 					"and NU in (0, 0.5), got '%s'\n", arg);
 			exit(2);
 		}
+		o->youngs = v[0], o->poisson = v[1];
 		break;
 	case D_PAIR:
 	case D_WALL: {
 		double *t = c == D_PAIR ? o->pair : o->wall;
-		if (sscanf(arg, "%lf:%lf:%lf", &t[0], &t[1], &t[2]) != 3 || !(t[0] > 0.05) ||
+		if (cli_numbers(arg, ':', t, 3) != 3 || !(t[0] > 0.05) ||
 		    !(t[0] <= 1) || !(t[1] >= 0) || !(t[1] <= 10) || !(t[2] >= 0) || !(t[2] <= 10)) {
 			fprintf(stderr, "convsim-dem: --%s must be E:MU:MUR with E in (0.05, 1], MU and "
 					"MUR in [0, 10], got '%s'\n", c == D_PAIR ? "pair" : "wall", arg);
@@ -206,9 +222,9 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 		case D_WALL: dem_parse_compound(c, arg, o); break;
 		case D_DURATION: o->duration = dem_number("duration", arg, 0.01, 1000); break;
 		case D_TRANSIENT: o->transient = dem_number("transient", arg, 0, 1000); break;
-		case D_GRAINS: o->grains = (int)dem_number("grains", arg, 1, 1e6); break;
+		case D_GRAINS: o->grains = dem_whole("grains", arg, 1, 1e6); break;
 		case D_DEPTH: o->depth = dem_number("depth", arg, 0.1, 1000); break;
-		case D_SEED: o->seed = (int)dem_number("seed", arg, 0, 1e9); break;
+		case D_SEED: o->seed = dem_whole("seed", arg, 0, 1e9); break;
 		case D_STIFFNESS: o->stiffness = dem_number("stiffness", arg, 1e-3, 1e6); break;
 		case D_D_MIN: o->d_min = dem_number("d-min", arg, 1e-6, 0.5); break;
 		case D_D_MAX: o->d_max = dem_number("d-max", arg, 1e-6, 0.5); break;
@@ -218,13 +234,13 @@ static void dem_parse(int argc, char **argv, dem_opts *o)
 		case D_MU: o->mu = dem_number("mu", arg, 0, 10); break;
 		case D_MU_ROLL: o->mu_roll = dem_number("mu-roll", arg, 0, 10); break;
 		case D_FREEZE: o->freeze_rotation = 1; break;
-		case D_INTERVALS: o->intervals = (int)dem_number("intervals", arg, 0, 100000); break;
-		case D_HARMONICS: o->harmonics = (int)dem_number("harmonics", arg, 1, DEM_MAX_HARMONICS); break;
+		case D_INTERVALS: o->intervals = dem_whole("intervals", arg, 0, 100000); break;
+		case D_HARMONICS: o->harmonics = dem_whole("harmonics", arg, 1, DEM_MAX_HARMONICS); break;
 		case D_SETTLE: o->settle = dem_number("settle", arg, 0, 100); break;
 		case D_NO_COLUMN: o->column = 0; break;
 		case D_MOTION: o->motion_machine = dem_choice("motion", arg, "fit", "machine"); break;
 		case D_TANGENTIAL: o->tangential_viscous = dem_choice("tangential", arg, "spring", "viscous"); break;
-		case D_COUPLING_STEPS: o->coupling_steps = (int)dem_number("coupling-steps", arg, 1, 1000); break;
+		case D_COUPLING_STEPS: o->coupling_steps = dem_whole("coupling-steps", arg, 1, 1000); break;
 		case D_DENSITY: o->density = dem_number("density", arg, 1, 100000); break;
 		case D_HELP: dem_help(stdout); exit(0);
 		default: exit(2); /* cli_next_option_in said why */

@@ -26,6 +26,7 @@
 
 #include "cli.h"
 #include "couple.h"
+#include "decimal.h"
 #include "dem.h"
 
 static void run_summary(const cli_opts *o, const dem_coupled *c, const dem_bed_spec *spec, int ranks,
@@ -80,9 +81,8 @@ int cli_run_coupled(const cli_opts *o)
 	 * `layers` diameters' worth (the cost bench's beds past 64 layers) */
 	const char *grains = getenv("CONVSIM_DEM_GRAINS");
 	if (grains && *grains) {
-		char *end;
-		long n = strtol(grains, &end, 10);
-		if (end == grains || *end || n < 1 || n > 1000000) {
+		double n; /* decimal.h's rule: not ' 5', +5x or 0x5 */
+		if (!sim_decimal(grains, &n) || n < 1 || n > 1000000 || n != floor(n)) {
 			if (rank == 0)
 				fprintf(stderr, "convsim run: CONVSIM_DEM_GRAINS must be an integer in [1, "
 						"1000000], got '%s'\n", grains);
