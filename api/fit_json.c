@@ -65,6 +65,17 @@ static api_err rotation(const cJSON *o, const char *prefix, int *rot, api_proble
 	return API_OK;
 }
 
+/* A count of data (what: "points has 1001 entries") outside what a fit of
+ * req's free parameters takes, nfree to most: out-of-range with those
+ * counts as min and max. */
+static api_err data_count(api_problem *pb, const char *field, const char *what,
+			  const fit_request *req, int most)
+{
+	int k = req->nfree;
+	return api_fail_range(pb, field, k, most, "%s; a fit of %d free parameter%s takes %d to %d",
+			      what, k, k == 1 ? "" : "s", k, most);
+}
+
 /* "points": [{beta, rotation, v, sigma?}] or "csv": "beta,rotation,v..." */
 static api_err parse_points(const cJSON *root, fit_request *req, fit_point **pts,
 			    api_problem *pb)
@@ -77,18 +88,28 @@ static api_err parse_points(const cJSON *root, fit_request *req, fit_point **pts
 	if (csv) {
 		if (!cJSON_IsString(csv))
 			return api_fail(pb, API_TYPE, "csv", "csv must be a string (CSV text)");
-		if (fit_parse_csv(csv->valuestring, pts, &req->npoints, msg, sizeof msg) != SIM_OK)
-			return api_fail(pb, API_INVALID, "csv", "csv: %s", msg);
+		fit_range rows;
+		if (fit_parse_csv(csv->valuestring, pts, &req->npoints, msg, sizeof msg, &rows) !=
+		    SIM_OK) {
+			char what[FIT_MSG + 8];
+			snprintf(what, sizeof what, "csv: %s", msg);
+			return rows.has ? data_count(pb, "csv", what, req, FIT_MAX_POINTS)
+					: api_fail(pb, API_INVALID, "csv", "%s", what);
+		}
 		req->points = *pts;
 		return API_OK;
 	}
 	if (!arr)
 		return API_OK;
 	int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : -1;
-	if (n < 0 || n > FIT_MAX_POINTS)
-		return api_fail(pb, n < 0 ? API_TYPE : API_RANGE, "points",
+	if (n < 0)
+		return api_fail(pb, API_TYPE, "points",
 				"points must be an array of at most %d {beta, rotation, v, sigma}",
 				FIT_MAX_POINTS);
+	if (n > FIT_MAX_POINTS) {
+		snprintf(prefix, sizeof prefix, "points has %d entries", n);
+		return data_count(pb, "points", prefix, req, FIT_MAX_POINTS);
+	}
 	*pts = calloc((size_t)n + 1, sizeof **pts);
 	if (!*pts)
 		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
@@ -121,12 +142,16 @@ static api_err parse_peaks(const cJSON *root, fit_request *req, api_problem *pb)
 	if (!arr)
 		return API_OK;
 	int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : -1;
-	if (n < 0 || n > FIT_MAX_PEAKS)
-		return api_fail(pb, n < 0 ? API_TYPE : API_RANGE, "peaks",
+	char prefix[40];
+	if (n < 0)
+		return api_fail(pb, API_TYPE, "peaks",
 				"peaks must be an array of at most %d {rotation, beta, sigma}",
 				FIT_MAX_PEAKS);
+	if (n > FIT_MAX_PEAKS) {
+		snprintf(prefix, sizeof prefix, "peaks has %d entries", n);
+		return data_count(pb, "peaks", prefix, req, FIT_MAX_PEAKS);
+	}
 	api_err e = API_OK;
-	char prefix[40];
 	for (const cJSON *p = arr->child; p && e == API_OK; p = p->next) {
 		fit_peak *pk = &req->peaks[req->npeaks];
 		snprintf(prefix, sizeof prefix, "peaks[%d].", req->npeaks++);
@@ -177,10 +202,14 @@ static api_err parse_free(const cJSON *root, fit_request *req, api_problem *pb)
 {
 	const cJSON *arr = cJSON_GetObjectItemCaseSensitive(root, "free");
 	int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : -1;
-	if (n < 1 || n > FIT_MAX_FREE)
-		return api_fail(pb, !arr || n >= 0 ? API_INVALID : API_TYPE, "free",
+	if (n < 0)
+		return api_fail(pb, arr ? API_TYPE : API_INVALID, "free",
 				"free must list 1 to %d parameter names (or {name, min, max, "
 				"start})", FIT_MAX_FREE);
+	if (n < 1 || n > FIT_MAX_FREE)
+		return api_fail_range(pb, "free", 1, FIT_MAX_FREE,
+				      "free has %d entries; a fit takes 1 to %d free parameters", n,
+				      FIT_MAX_FREE);
 	char field[48], msg[FIT_MSG], prefix[32], member[8];
 	fit_range range;
 	int i = 0;

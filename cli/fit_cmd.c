@@ -161,7 +161,7 @@ static int build_request(const cli_opts *o, fit_request *req, fit_point **points
 		char *text = cli_slurp("fit", "data", o->data);
 		if (!text)
 			return 2;
-		int rc = fit_parse_csv(text, points, &req->npoints, msg, sizeof msg);
+		int rc = fit_parse_csv(text, points, &req->npoints, msg, sizeof msg, NULL);
 		free(text);
 		if (rc != SIM_OK) {
 			fprintf(stderr, "convsim fit: --data %s: %s\n", o->data, msg);

@@ -308,8 +308,10 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
  * in deg) into a malloc'd array (*out, *n; caller frees). A number is a
  * plain decimal one (decimal.h; spaces around a cell allowed, not 0x10,
  * inf or nan). Returns SIM_OK, or SIM_EPARAM with a message naming the
- * line and column. */
-int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len);
+ * line and column; for more than FIT_MAX_POINTS data rows, with *range
+ * (when not NULL) the counts a CSV may hold, 1 to FIT_MAX_POINTS. */
+int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len,
+		  fit_range *range);
 
 /* Whole-request checks: data present (points or peaks, not both), beta
  * finite in [0, 180] deg, rotation known, v and sigma finite (sigma in

@@ -197,10 +197,13 @@ static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit
 	return 0;
 }
 
-int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t mlen)
+int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t mlen,
+		  fit_range *range)
 {
 	*out = NULL;
 	*n = 0;
+	if (range)
+		range->has = 0;
 	size_t len = strlen(text);
 	char *buf = malloc(len + 1);
 	fit_point *pts = malloc(sizeof *pts * FIT_MAX_POINTS);
@@ -226,7 +229,10 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 			ncol = parse_header(line, strlen(line), col, msg, mlen);
 			rc = ncol < 0 ? SIM_EPARAM : SIM_OK;
 		} else if (*n >= FIT_MAX_POINTS) {
-			snprintf(msg, mlen, "CSV: more than %d points", FIT_MAX_POINTS);
+			snprintf(msg, mlen, "CSV line %d: more than %d points", lineno,
+				 FIT_MAX_POINTS);
+			if (range)
+				*range = (fit_range){1, 1, FIT_MAX_POINTS};
 			rc = SIM_EPARAM;
 		} else if (parse_row(line, lineno, col, ncol, &pts[*n], msg, mlen) == 0) {
 			(*n)++;
@@ -323,8 +329,6 @@ static int check_peaks(const fit_request *r, char *field, size_t flen, char *msg
 		       fit_range *range)
 {
 	char name[32], f[48];
-	if (r->npeaks > FIT_MAX_PEAKS)
-		FAIL("peaks", "at most %d peaks", FIT_MAX_PEAKS);
 	for (int i = 0; i < r->npeaks; i++) {
 		const fit_peak *p = &r->peaks[i];
 		snprintf(name, sizeof name, "peaks[%d]", i);
@@ -363,21 +367,27 @@ int fit_check_range(const fit_request *r, char *field, size_t flen, char *msg, s
 		FAIL_RANGE("t_end", r->sc.transient, 600, "t_end must exceed the scene's transient (%g s) and be at most 600 s",
 		     r->sc.transient);
 	if (r->nfree < 1)
-		FAIL("free", "name at least one free parameter (e.g. e)");
+		FAIL_RANGE("free", 1, FIT_MAX_FREE, "name at least one free parameter (e.g. e; 1 to %d)",
+			   FIT_MAX_FREE);
 	if (r->npoints && r->npeaks)
 		FAIL("peaks", "give points or peaks, not both");
 	if (!r->npoints && !r->npeaks)
 		FAIL("points", "no data: give points (beta, rotation, v[, sigma]) or peaks");
-	if (r->npoints > FIT_MAX_POINTS)
-		FAIL("points", "at most %d points", FIT_MAX_POINTS);
+	/* the data's count: at least one a free parameter, at most the
+	 * table's (the API refuses more before it reads them) */
+	size_t ndata = r->npoints ? r->npoints : (size_t)r->npeaks;
+	int most = r->npoints ? FIT_MAX_POINTS : FIT_MAX_PEAKS;
+	const char *kind = r->npoints ? "points" : "peaks";
+	if (ndata > (size_t)most)
+		FAIL_RANGE(kind, r->nfree, most, "%zu %s for %d free parameter%s: a fit takes %d to %d",
+			   ndata, kind, r->nfree, r->nfree == 1 ? "" : "s", r->nfree, most);
 	if (check_points(r, field, flen, msg, mlen, range) ||
 	    check_peaks(r, field, flen, msg, mlen, range))
 		return SIM_EPARAM;
-	size_t ndata = r->npoints ? r->npoints : (size_t)r->npeaks;
 	if (ndata < (size_t)r->nfree)
-		FAIL(r->npoints ? "points" : "peaks",
-		     "%zu data for %d free parameters: a fit needs at least as many data as free "
-		     "parameters", ndata, r->nfree);
+		FAIL_RANGE(kind, r->nfree, most,
+			   "%zu data for %d free parameters: a fit needs at least as many data as "
+			   "free parameters (%d to %d %s)", ndata, r->nfree, r->nfree, most, kind);
 	for (int i = 0; i < r->nfree; i++) {
 		const fit_free *f = &r->free[i];
 		char at[32];

@@ -187,7 +187,7 @@ static void parses_csv(void **state)
 	char msg[FIT_MSG];
 	assert_int_equal(fit_parse_csv("v,beta,rotation,sigma\n0.1,30,cw,0.002\n-0.05, 120 ,ccw,"
 				       "0.003\n",
-				       &pts, &n, msg, sizeof msg),
+				       &pts, &n, msg, sizeof msg, NULL),
 			 SIM_OK);
 	assert_int_equal(n, 2);
 	assert_true(fabs(pts[1].beta - 120 * RAD_PER_DEG) < 1e-15);
@@ -209,7 +209,7 @@ static void parses_csv(void **state)
 			      "CSV line 2: v must be a number, got '0x10'",
 			      "CSV line 2: sigma must be a number, got 'inf'"};
 	for (int i = 0; i < 6; i++) {
-		assert_int_equal(fit_parse_csv(bad[i], &pts, &n, msg, sizeof msg), SIM_EPARAM);
+		assert_int_equal(fit_parse_csv(bad[i], &pts, &n, msg, sizeof msg, NULL), SIM_EPARAM);
 		printf("  %s\n", msg);
 		assert_non_null(strstr(msg, says[i]));
 		assert_null(pts);
