@@ -88,13 +88,19 @@ static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *
 						field, range_members[k]);
 			g[k] = v->valuedouble;
 		}
+		double count = sim_study_range_count(g[0], g[1], g[2]);
+		if (count > API_SWEEP_MAX_POINTS)
+			return api_fail_range(pb, field, 1, API_SWEEP_MAX_POINTS,
+					      "%s: %g:%g:%g gives %.0f values; a sweep takes 1 to %d",
+					      field, g[0], g[1], g[2], count, API_SWEEP_MAX_POINTS);
 		rc = sim_study_add_range(st, &sp->params, &sp->scene, &sp->method, it->string,
 					 g[0], g[1], g[2], msg, sizeof msg);
 	} else if (cJSON_IsArray(it)) {
 		int n = cJSON_GetArraySize(it), k = 0;
 		if (n < 1 || n > API_SWEEP_MAX_POINTS)
-			return api_fail(pb, API_RANGE, field, "%s must list 1 to %d values",
-					field, API_SWEEP_MAX_POINTS);
+			return api_fail_range(pb, field, 1, API_SWEEP_MAX_POINTS,
+					      "%s has %d values; a sweep takes 1 to %d", field, n,
+					      API_SWEEP_MAX_POINTS);
 		double *values = malloc((size_t)n * sizeof *values);
 		if (!values)
 			return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
@@ -120,6 +126,23 @@ static api_err parse_axis(const cJSON *it, const api_sweep_req *req, sim_study *
 				field);
 	}
 	return rc == SIM_OK ? API_OK : study_problem(rc, field, it->string, msg, pb);
+}
+
+/* The study's points in all (per sense times nrot senses) within a
+ * sweep's 1 to API_SWEEP_MAX_POINTS, before they are made: else
+ * out-of-range naming lhs (with the sample sizes that fit) or vary. */
+static api_err study_points(const sim_study *st, int nrot, api_problem *pb)
+{
+	double per = sim_study_count(st), all = per * nrot;
+	int most = API_SWEEP_MAX_POINTS;
+	if (all <= most)
+		return API_OK;
+	if (!st->lhs)
+		return api_fail_range(pb, "vary", 1, most, "the study has %.0f points (%.0f per "
+				      "rotation sense); a sweep takes 1 to %d", all, per, most);
+	return api_fail_range(pb, "lhs", 1, most / nrot, "the study has %.0f points (%.0f per "
+			      "rotation sense); a sweep takes 1 to %d: lhs 1 to %d with %d rotation "
+			      "sense%s", all, per, most, most / nrot, nrot, nrot == 1 ? "" : "s");
 }
 
 /* "lhs" (1 to API_SWEEP_MAX_POINTS points) and "seed" (0 to 2^32 - 1),
@@ -197,10 +220,15 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 	if (seed && !lhs)
 		return api_fail(pb, API_INVALID, "seed",
 				"seed shuffles a Latin-hypercube sample: it applies only with lhs");
-	if (vary && (!cJSON_IsObject(vary) || !vary->child))
+	if (vary && !cJSON_IsObject(vary))
 		return api_fail(pb, API_TYPE, "vary",
 				"vary must be an object of settings, each {\"from\",\"to\",\"step\"} "
 				"or an array of values");
+	/* the axes: vary's settings and beta's grid when given */
+	int nvary = vary ? cJSON_GetArraySize(vary) : 0, most = SIM_STUDY_MAX_AXES - !!req->betas;
+	if (vary && (nvary < 1 || nvary > most))
+		return api_fail_range(pb, "vary", 1, most, "vary has %d settings; a sweep varies 1 to "
+				      "%d%s", nvary, most, req->betas ? " besides beta" : "");
 	/* beta first: the "beta" member's grid (for a plain sweep, the
 	 * study over beta alone) */
 	if (req->betas) {
@@ -228,14 +256,11 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 			    : parse_axis(it, req, &st, pb);
 	if (e == API_OK)
 		e = parse_sample(lhs, seed, &st, pb);
+	if (e == API_OK)
+		e = study_points(&st, req->nrot, pb);
 	char msg[256] = "";
-	if (e == API_OK && sim_study_plan(&st, msg, sizeof msg) != SIM_OK)
-		e = api_fail(pb, API_RANGE, st.lhs ? "lhs" : "vary", "%s", msg);
-	if (e == API_OK && st.npoints * (size_t)req->nrot > API_SWEEP_MAX_POINTS)
-		e = api_fail(pb, API_RANGE, st.lhs ? "lhs" : "vary",
-			     "the study has %zu points (%zu per rotation sense); a sweep has at "
-			     "most %d",
-			     st.npoints * (size_t)req->nrot, st.npoints, API_SWEEP_MAX_POINTS);
+	if (e == API_OK && sim_study_plan(&st, msg, sizeof msg) != SIM_OK) /* lhs of a list */
+		e = api_fail(pb, API_INVALID, st.lhs ? "lhs" : "vary", "%s", msg);
 	/* each point measures after its own transient: t_end (sweep_json.c
 	 * checked it against the model's) must exceed the largest varied */
 	double transient = sim_study_largest(&st, "transient", 0);

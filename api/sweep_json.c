@@ -27,9 +27,9 @@ static api_err parse_beta_list(const cJSON *it, api_sweep_req *req, api_problem 
 	char field[32];
 	int n = cJSON_GetArraySize(it);
 	if (n < 1 || n > API_SWEEP_MAX_POINTS / 2)
-		return api_fail(pb, API_RANGE, "beta",
-				"beta must list 1 to %d angles",
-				API_SWEEP_MAX_POINTS / 2);
+		return api_fail_range(pb, "beta", 1, API_SWEEP_MAX_POINTS / 2,
+				      "beta has %d angles; a sweep takes 1 to %d", n,
+				      API_SWEEP_MAX_POINTS / 2);
 	req->betas = malloc((size_t)n * sizeof *req->betas);
 	if (!req->betas)
 		return api_fail(pb, API_UNAVAILABLE, NULL,
@@ -90,15 +90,27 @@ static api_err parse_grid(const cJSON *it, api_sweep_req *req,
 	}
 	if (e != API_OK)
 		return e;
-	if (!(g[2] > 0) || g[1] < g[0])
-		return api_fail(pb, API_RANGE, "beta.step",
-				"beta.step must be > 0 and beta.to >= "
-				"beta.from");
-	double count = floor((g[1] - g[0]) / g[2] + 1e-9) + 1;
-	if (count > API_SWEEP_MAX_POINTS / 2)
-		return api_fail(pb, API_RANGE, "beta.step",
-				"the grid has %.0f angles; at most %d are "
-				"allowed", count, API_SWEEP_MAX_POINTS / 2);
+	/* the step in (0, the span of beta]: a longer one gives beta.from
+	 * alone, as the span does */
+	const sim_setting *b = sim_setting_find("beta");
+	double span = b->max - b->min;
+	if (!(g[2] > 0 && g[2] <= span))
+		return api_fail_range(pb, "beta.step", 0, span, "beta.step must lie in (0, %g] deg",
+				      span);
+	if (g[1] < g[0])
+		return api_fail_range(pb, "beta.to", g[0], b->max,
+				      "beta.to must lie in [%g, %g] deg, not below beta.from", g[0],
+				      b->max);
+	int most = API_SWEEP_MAX_POINTS / 2;
+	double count = sim_study_range_count(g[0], g[1], g[2]);
+	if (count > most) {
+		/* the least step of at most `most` angles, as %g states it */
+		double least = api_round_inward((g[1] - g[0]) / (most - 1), 1, 6);
+		return api_fail_range(pb, "beta.step", least, span,
+				      "beta.step %g gives %.0f angles from %g to %g deg; a sweep "
+				      "takes 1 to %d: beta.step must lie in [%g, %g] deg",
+				      g[2], count, g[0], g[1], most, least, span);
+	}
 	req->nbeta = (int)count;
 	req->betas = malloc((size_t)req->nbeta * sizeof *req->betas);
 	if (!req->betas)
@@ -119,10 +131,14 @@ static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
 		return API_OK;
 	}
 	int n = cJSON_IsArray(it) ? cJSON_GetArraySize(it) : -1;
-	if (n < 1 || n > 2)
-		return api_fail(pb, n < 0 ? API_TYPE : API_RANGE, "rotations",
+	if (n < 0)
+		return api_fail(pb, API_TYPE, "rotations",
 				"rotations must be an array of one or two of "
 				"\"cw\", \"ccw\"");
+	if (n < 1 || n > 2)
+		return api_fail_range(pb, "rotations", 1, 2,
+				      "rotations has %d entries; a sweep takes 1 to 2 (\"cw\", "
+				      "\"ccw\")", n);
 	for (const cJSON *r = it->child; r; r = r->next) {
 		int rot;
 		if (cJSON_IsString(r) && strcmp(r->valuestring, "cw") == 0)
@@ -184,9 +200,9 @@ static api_err parse_band_from(const cJSON *it, api_sweep_req *req, api_problem 
 				"band_from_fit must be a fit's id (a string, GET /api/v1/fits)");
 	size_t n = strlen(it->valuestring);
 	if (n < 1 || n >= sizeof req->band_fit)
-		return api_fail(pb, API_INVALID, "band_from_fit",
-				"band_from_fit must be a fit's id of 1 to %d characters",
-				(int)sizeof req->band_fit - 1);
+		return api_fail_range(pb, "band_from_fit", 1, (double)sizeof req->band_fit - 1,
+				      "band_from_fit has %zu bytes; a fit's id has 1 to %d", n,
+				      (int)sizeof req->band_fit - 1);
 	memcpy(req->band_fit, it->valuestring, n + 1);
 	return API_OK;
 }

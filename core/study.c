@@ -95,6 +95,13 @@ static double decimal(double v)
 	return strtod(buf, NULL);
 }
 
+double sim_study_range_count(double from, double to, double step)
+{
+	if (!(to >= from) || !(step > 0) || !isfinite(step))
+		return NAN;
+	return floor((to - from) / step + 1e-9) + 1;
+}
+
 int sim_study_add_range(sim_study *st, const sim_params *p, const sim_scene *s,
 			const sim_method *m, const char *name, double from, double to,
 			double step, char *msg, size_t msglen)
@@ -112,7 +119,7 @@ int sim_study_add_range(sim_study *st, const sim_params *p, const sim_scene *s,
 			 t->name, from, to, step);
 		return SIM_EPARAM;
 	}
-	double count = floor((to - from) / step + 1e-9) + 1;
+	double count = sim_study_range_count(from, to, step);
 	if (count > SIM_STUDY_MAX_POINTS) {
 		snprintf(msg, msglen, "%s: %g:%g:%g gives %.0f values; at most %d", t->name, from,
 			 to, step, count, SIM_STUDY_MAX_POINTS);
@@ -232,22 +239,26 @@ static int plan_lhs(sim_study *st, size_t *perm)
 	return SIM_OK;
 }
 
-int sim_study_plan(sim_study *st, char *msg, size_t msglen)
+double sim_study_count(const sim_study *st)
 {
 	double count = 1;
-	if (st->lhs) {
-		for (size_t a = 0; a < st->naxes; a++)
-			if (st->axis[a].step == 0 && st->axis[a].n > 1) {
-				snprintf(msg, msglen, "%s: a Latin-hypercube sample needs a range "
-						      "FROM:TO:STEP, not a list",
-					 st->axis[a].setting->name);
-				return SIM_EPARAM;
-			}
-		count = (double)st->lhs;
-	} else {
-		for (size_t a = 0; a < st->naxes; a++)
-			count *= (double)st->axis[a].n;
-	}
+	if (st->lhs)
+		return (double)st->lhs;
+	for (size_t a = 0; a < st->naxes; a++)
+		count *= (double)st->axis[a].n;
+	return count;
+}
+
+int sim_study_plan(sim_study *st, char *msg, size_t msglen)
+{
+	double count = sim_study_count(st);
+	for (size_t a = 0; st->lhs && a < st->naxes; a++)
+		if (st->axis[a].step == 0 && st->axis[a].n > 1) {
+			snprintf(msg, msglen, "%s: a Latin-hypercube sample needs a range "
+					      "FROM:TO:STEP, not a list",
+				 st->axis[a].setting->name);
+			return SIM_EPARAM;
+		}
 	if (count > SIM_STUDY_MAX_POINTS) {
 		snprintf(msg, msglen, "the study has %.0f points; at most %d", count,
 			 SIM_STUDY_MAX_POINTS);

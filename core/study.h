@@ -57,6 +57,11 @@ int sim_study_check_axis(const sim_study *st, const char *name, char *msg, size_
 int sim_study_add_range(sim_study *st, const sim_params *p, const sim_scene *s,
 			const sim_method *m, const char *name, double from, double to,
 			double step, char *msg, size_t msglen);
+/* The count of values a range FROM:TO:STEP gives (as sim_study_add_range
+ * makes them: 1e-9 of a step of slack at TO), NaN unless to >= from and
+ * step > 0 is finite. A double: a tiny step's count may pass any integer
+ * type. */
+double sim_study_range_count(double from, double to, double step);
 /* The same for a list of n values (each checked; copied), no value twice
  * (the same point would run twice): SIM_EPARAM naming the repeat. */
 int sim_study_add_list(sim_study *st, const sim_params *p, const sim_scene *s,
@@ -75,6 +80,10 @@ long sim_study_repeat(const double *values, size_t n, size_t *first);
  * lists. At most SIM_STUDY_MAX_POINTS points. SIM_OK, or SIM_EPARAM /
  * SIM_ENOMEM with the reason in msg. */
 int sim_study_plan(sim_study *st, char *msg, size_t msglen);
+/* The points per sense sim_study_plan makes of st as it stands: st->lhs,
+ * else the product of its axes' counts (1 without axes). A double, as
+ * above. */
+double sim_study_count(const sim_study *st);
 
 /* The largest value (user units) the axis of setting `name` takes (over
  * the points once planned, else over its values), or `otherwise` when the

@@ -2,7 +2,10 @@
 // A count outside its limit is refused as a number outside its range is
 // (docs/api-errors.md): 422 out-of-range naming the member, with the
 // counts allowed as `min` and `max` and the detail saying the same: a
-// fit's points, peaks, free parameters and CSV rows. Nothing is started.
+// fit's points, peaks, free parameters and CSV rows; a sweep's beta list
+// and grid (beta.step: the step's own range), rotations, vary's settings
+// and each one's values, the study's points, band_from_fit's bytes.
+// Nothing is started.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, CHEAP } from './lib.mjs';
@@ -53,4 +56,51 @@ test('a fit: points, peaks, free parameters and CSV rows are counts with their r
       'csv: CSV line 1002: more than 1000 points; a fit of 1 free parameter takes 1 to 1000'],
   ]);
   assert.deepEqual(await listed(), was, 'nothing started');
+});
+
+// nine settings, each with a value it takes
+const SETTINGS = [['mu', 0.5], ['e', 0.01], ['R', 0.5], ['k_c', 1e5], ['m_n', 0.01], ['b_s1', 10], ['k_s1', 1e4],
+  ['m1', 1], ['m2', 1]];
+const vary = (n) => Object.fromEntries(SETTINGS.slice(0, n).map(([s, v]) => [s, [v]]));
+
+test('a sweep: the beta list and grid, rotations, vary and its values, the study\'s points, band_from_fit', async () => {
+  const was = await listed();
+  const sweep = (extra) => ({ ...CHEAP, t_end: 0.3, ...extra });
+  await refused('/api/v1/sweeps', [
+    [sweep({ beta: times(1001, (i) => i * 0.1) }), 'beta', 1, 1000, 'beta has 1001 angles; a sweep takes 1 to 1000'],
+    [sweep({ beta: [] }), 'beta', 1, 1000, 'beta has 0 angles; a sweep takes 1 to 1000'],
+    [sweep({ beta: { from: 0, to: 180, step: 0 } }), 'beta.step', 0, 180, 'beta.step must lie in (0, 180] deg'],
+    [sweep({ beta: { from: 0, to: 180, step: 200 } }), 'beta.step', 0, 180, 'beta.step must lie in (0, 180] deg'],
+    [sweep({ beta: { from: 90, to: 30, step: 10 } }), 'beta.to', 90, 180,
+      'beta.to must lie in [90, 180] deg, not below beta.from'],
+    [sweep({ beta: { from: 0, to: 180, step: 0.1 } }), 'beta.step', 0.180181, 180,
+      'beta.step 0.1 gives 1801 angles from 0 to 180 deg; a sweep takes 1 to 1000: beta.step must lie in ' +
+      '[0.180181, 180] deg'],
+    [sweep({ rotations: [] }), 'rotations', 1, 2, 'rotations has 0 entries; a sweep takes 1 to 2 ("cw", "ccw")'],
+    [sweep({ rotations: ['cw', 'ccw', 'cw'] }), 'rotations', 1, 2,
+      'rotations has 3 entries; a sweep takes 1 to 2 ("cw", "ccw")'],
+    [sweep({ vary: { mu: times(2001, (i) => i * 0.001) } }), 'vary.mu', 1, 2000,
+      'vary.mu has 2001 values; a sweep takes 1 to 2000'],
+    [sweep({ vary: { mu: [] } }), 'vary.mu', 1, 2000, 'vary.mu has 0 values; a sweep takes 1 to 2000'],
+    [sweep({ vary: { mu: { from: 0, to: 2, step: 0.001 } } }), 'vary.mu', 1, 2000,
+      'vary.mu: 0:2:0.001 gives 2001 values; a sweep takes 1 to 2000'],
+    [sweep({ vary: vary(9) }), 'vary', 1, 8, 'vary has 9 settings; a sweep varies 1 to 8'],
+    [sweep({ beta: [30, 60], vary: vary(8) }), 'vary', 1, 7, 'vary has 8 settings; a sweep varies 1 to 7 besides beta'],
+    [sweep({ vary: {} }), 'vary', 1, 8, 'vary has 0 settings; a sweep varies 1 to 8'],
+    [sweep({ vary: { mu: { from: 0, to: 2, step: 0.01 }, e: { from: 0.01, to: 0.05, step: 0.01 } } }), 'vary', 1, 2000,
+      'the study has 2010 points (1005 per rotation sense); a sweep takes 1 to 2000'],
+    [sweep({ vary: { mu: { from: 0, to: 2, step: 0.1 } }, lhs: 1500 }), 'lhs', 1, 1000,
+      'the study has 3000 points (1500 per rotation sense); a sweep takes 1 to 2000: lhs 1 to 1000 with 2 rotation senses'],
+    [sweep({ band_from_fit: 'f'.repeat(24) }), 'band_from_fit', 1, 23,
+      'band_from_fit has 24 bytes; a fit\'s id has 1 to 23'],
+    [sweep({ band_from_fit: '' }), 'band_from_fit', 1, 23, 'band_from_fit has 0 bytes; a fit\'s id has 1 to 23'],
+  ]);
+  assert.deepEqual(await listed(), was, 'nothing started');
+  // the ends stated are taken: the grid's least step, a list of 1000 angles
+  for (const [beta, n] of [[{ from: 0, to: 180, step: 0.180181 }, 999], [times(1000, (i) => i * 0.1), 1000]]) {
+    const ok = await req(d.base, 'POST', '/api/v1/sweeps', sweep({ beta, rotations: ['cw'] }));
+    assert.equal(ok.status, 202, ok.text);
+    assert.equal(ok.body.total, n, ok.text);
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${ok.body.id}`)).status, 204);
+  }
 });

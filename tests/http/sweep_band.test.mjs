@@ -102,7 +102,7 @@ test('bad band_from_fit: a 4xx naming it, nothing started', { timeout: 60000 * S
     [{ band_from_fit: 'nosuch' }, 422, /band_from_fit: no fit has the id 'nosuch'/],
     [{ band_from_fit: slow.body.id }, 422, new RegExp(`band_from_fit: fit '${slow.body.id}' is (queued|running); a band needs a finished fit`)],
     [{ band_from_fit: 5 }, 400, /band_from_fit must be a fit's id/],
-    [{ band_from_fit: '' }, 422, /band_from_fit must be a fit's id of 1 to 23 characters/],
+    [{ band_from_fit: '' }, 422, /^band_from_fit has 0 bytes; a fit's id has 1 to 23$/],
   ];
   for (const [extra, status, re] of cases) {
     const r = await req(d.base, 'POST', '/api/v1/sweeps', { ...CHEAP, t_end: 2, beta: [30], ...extra });
