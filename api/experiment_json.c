@@ -61,8 +61,13 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 				    api_problem *pb)
 {
 	if (sess && cJSON_IsString(sess)) {
-		snprintf(req->session_id, sizeof req->session_id, "%s",
-			 sess->valuestring);
+		/* an id longer than the buffer is refused, not cut to another */
+		size_t n = strlen(sess->valuestring);
+		if (n < 1 || n >= sizeof req->session_id)
+			return api_fail_range(pb, "session", 1, (double)sizeof req->session_id - 1,
+					      "session has %zu bytes; a session's id has 1 to %d", n,
+					      (int)sizeof req->session_id - 1);
+		memcpy(req->session_id, sess->valuestring, n + 1);
 		if (sim_preset("czubak2016", &req->spec.params,
 			       &req->spec.scene, &req->spec.method) != SIM_OK)
 			return api_fail(pb, API_UNAVAILABLE, NULL,
@@ -131,9 +136,9 @@ api_err api_parse_experiment(const char *body, size_t len,
 	if (e == API_OK) {
 		int n = cJSON_GetArraySize(sched);
 		if (n < 1 || n > API_EXP_MAX_SEGMENTS) {
-			e = api_fail(pb, API_RANGE, "schedule",
-				     "schedule must have 1 to %d segments",
-				     API_EXP_MAX_SEGMENTS);
+			e = api_fail_range(pb, "schedule", 1, API_EXP_MAX_SEGMENTS,
+					   "schedule has %d segments; an experiment takes 1 to %d",
+					   n, API_EXP_MAX_SEGMENTS);
 		} else {
 			double prev = 0;
 			int i = 0;

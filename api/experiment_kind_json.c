@@ -119,8 +119,9 @@ static api_err parse_identify(const cJSON *id, api_experiment_req *req, api_exp_
 		return api_fail(pb, API_INVALID, "identify.beta",
 				"identify.beta is required: the operating point(s), deg");
 	if (n < 1 || n > API_EXP_MAX_POINTS)
-		return api_fail(pb, API_RANGE, "identify.beta",
-				"identify.beta must have 1 to %d operating points", API_EXP_MAX_POINTS);
+		return api_fail_range(pb, "identify.beta", 1, API_EXP_MAX_POINTS,
+				      "identify.beta has %d operating points; an identification takes 1 "
+				      "to %d", n, API_EXP_MAX_POINTS);
 	ext->kind = API_EXP_IDENTIFY;
 	ext->npoints = n;
 	const cJSON *it = cJSON_IsArray(beta) ? beta->child : beta;
@@ -204,8 +205,9 @@ static api_err parse_control(const cJSON *c, api_experiment_req *req, api_exp_ex
 		return api_fail(pb, sp ? API_TYPE : API_INVALID, "control.setpoint",
 				"control.setpoint must be an array of {\"v\": M_S, \"until\": S}");
 	if (n < 1 || n > API_EXP_MAX_SEGMENTS)
-		return api_fail(pb, API_RANGE, "control.setpoint",
-				"control.setpoint must have 1 to %d setpoints", API_EXP_MAX_SEGMENTS);
+		return api_fail_range(pb, "control.setpoint", 1, API_EXP_MAX_SEGMENTS,
+				      "control.setpoint has %d setpoints; a closed loop takes 1 to %d",
+				      n, API_EXP_MAX_SEGMENTS);
 	ext->kind = API_EXP_CONTROL;
 	int i = 0;
 	for (const cJSON *it = sp->child; it && e == API_OK; it = it->next, i++)
@@ -241,11 +243,18 @@ static api_err parse_disturbance(const cJSON *it, int i, const api_experiment_re
 	const cJSON *set = cJSON_GetObjectItemCaseSensitive(it, "set");
 	snprintf(field, sizeof field, "%sset", prefix);
 	char *text = cJSON_IsObject(set) ? cJSON_PrintUnformatted(set) : NULL;
-	if (!text || strlen(text) >= sizeof d->set) {
+	size_t len = text ? strlen(text) : 0;
+	if (cJSON_IsObject(set) && !text)
+		return api_fail(pb, API_UNAVAILABLE, NULL, "out of memory");
+	if (!text || len >= sizeof d->set) {
 		cJSON_free(text);
-		return api_fail(pb, set && !cJSON_IsObject(set) ? API_TYPE : API_INVALID, field,
+		if (text) /* "{}" is the shortest; it is refused below as no change */
+			return api_fail_range(pb, field, 2, API_EXP_DIST_LEN - 1,
+					      "%s is %zu bytes as JSON; a disturbance's set takes 2 to "
+					      "%d", field, len, API_EXP_DIST_LEN - 1);
+		return api_fail(pb, set ? API_TYPE : API_INVALID, field,
 				"%s must be an object of session controls (as a PATCH body, at most "
-				"%d characters)", field, API_EXP_DIST_LEN - 1);
+				"%d bytes as JSON)", field, API_EXP_DIST_LEN - 1);
 	}
 	snprintf(d->set, sizeof d->set, "%s", text);
 	cJSON_free(text);
@@ -282,8 +291,9 @@ static api_err parse_disturbances(const cJSON *arr, const api_experiment_req *re
 		return api_fail(pb, API_TYPE, "disturbances",
 				"disturbances must be an array of {\"at\": S, \"set\": {...}}");
 	if (n > API_EXP_MAX_DIST)
-		return api_fail(pb, API_RANGE, "disturbances", "disturbances must have at most %d "
-				"entries", API_EXP_MAX_DIST);
+		return api_fail_range(pb, "disturbances", 0, API_EXP_MAX_DIST,
+				      "disturbances has %d entries; a closed loop takes 0 to %d", n,
+				      API_EXP_MAX_DIST);
 	api_err e = API_OK;
 	int i = 0;
 	for (const cJSON *it = arr->child; it && e == API_OK; it = it->next, i++) {

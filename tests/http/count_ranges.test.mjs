@@ -4,8 +4,9 @@
 // counts allowed as `min` and `max` and the detail saying the same: a
 // fit's points, peaks, free parameters and CSV rows; a sweep's beta list
 // and grid (beta.step: the step's own range), rotations, vary's settings
-// and each one's values, the study's points, band_from_fit's bytes.
-// Nothing is started.
+// and each one's values, the study's points, band_from_fit's characters;
+// an experiment's schedule, operating points, setpoints, disturbances, a
+// disturbance's set and a session id's characters. Nothing is started.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, CHEAP } from './lib.mjs';
@@ -103,4 +104,30 @@ test('a sweep: the beta list and grid, rotations, vary and its values, the study
     assert.equal(ok.body.total, n, ok.text);
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sweeps/${ok.body.id}`)).status, 204);
   }
+});
+
+test('an experiment: its schedule, operating points, setpoints, disturbances, a set\'s and an id\'s length', async () => {
+  const was = await listed();
+  const seg = (i) => ({ beta: 30, until: i + 1 });
+  const sp = (i) => ({ v: 0.1, until: i + 1 });
+  const loop = (extra) => ({ control: { setpoint: [sp(0), sp(1)] }, ...extra });
+  const long = { ['a'.repeat(250)]: 1 };
+  await refused('/api/v1/experiments', [
+    [{ schedule: times(33, seg) }, 'schedule', 1, 32, 'schedule has 33 segments; an experiment takes 1 to 32'],
+    [{ schedule: [] }, 'schedule', 1, 32, 'schedule has 0 segments; an experiment takes 1 to 32'],
+    [{ identify: { beta: [30, 50, 70, 90, 110] } }, 'identify.beta', 1, 4,
+      'identify.beta has 5 operating points; an identification takes 1 to 4'],
+    [{ identify: { beta: [] } }, 'identify.beta', 1, 4, 'identify.beta has 0 operating points; an identification takes 1 to 4'],
+    [{ control: { setpoint: times(33, sp) } }, 'control.setpoint', 1, 32,
+      'control.setpoint has 33 setpoints; a closed loop takes 1 to 32'],
+    [{ control: { setpoint: [] } }, 'control.setpoint', 1, 32, 'control.setpoint has 0 setpoints; a closed loop takes 1 to 32'],
+    [loop({ disturbances: times(9, () => ({ at: 1, set: { omega_ss: 150 } })) }), 'disturbances', 0, 8,
+      'disturbances has 9 entries; a closed loop takes 0 to 8'],
+    [loop({ disturbances: [{ at: 1, set: long }] }), 'disturbances[0].set', 2, 199,
+      'disturbances[0].set is 256 bytes as JSON; a disturbance\'s set takes 2 to 199'],
+    [{ session: 's'.repeat(24), schedule: [seg(0)] }, 'session', 1, 23,
+      'session has 24 bytes; a session\'s id has 1 to 23'],
+    [{ session: '', schedule: [seg(0)] }, 'session', 1, 23, 'session has 0 bytes; a session\'s id has 1 to 23'],
+  ]);
+  assert.deepEqual(await listed(), was, 'nothing started');
 });
