@@ -24,7 +24,7 @@ enum {
 	OPT_PRESET = 256, OPT_SET, OPT_DURATION, OPT_OUT, OPT_FORMAT, OPT_RATE, OPT_BETA,
 	OPT_ROTATION, OPT_THREADS, OPT_QUIET, OPT_HELP, OPT_DATA, OPT_PEAKS, OPT_FREE, OPT_PRIOR,
 	OPT_CURVE_STEP, OPT_FD_STEP, OPT_MAX_ITER, OPT_STARTS, OPT_COUPLING_STEPS, OPT_MAX_DEM_COST, OPT_VARY,
-	OPT_LHS, OPT_SEED, OPT_BAND_FROM
+	OPT_LHS, OPT_SEED, OPT_BAND_FROM, OPT_MAX_OUTPUT
 };
 
 /* The default measuring window (s after the transient) of run, sweep and
@@ -60,6 +60,7 @@ typedef struct cli_opts {
 	sim_feed_choice pick;
 	int picked;
 	double max_dem_cost; /* run --max-dem-cost: CPU s a simulated second, INFINITY none */
+	double max_output;   /* run --max-output: bytes --out may take */
 } cli_opts;
 
 /* The first pass over command cmd's options: help (shown, -1), a wrong
@@ -105,6 +106,15 @@ typedef struct cli_out {
 	char *partial;
 } cli_out;
 FILE *cli_out_open(cli_out *w, const char *cmd, const char *path);
+/* The most bytes a trajectory of rows rows of width values takes in
+ * --out, CSV or JSON: each value at most SIM_FMT_DOUBLE_MAX bytes and a
+ * separator, 3 more a row (JSON's ",\n[" and "]"), 4096 for the header
+ * and the end. */
+double cli_out_bound(double rows, int width);
+/* run's check before it starts: 0 if such a trajectory fits in
+ * max_bytes, else 2 after "convsim CMD: --out would write ..." on stderr
+ * with the estimate, the limit and the --max-output that allows it. */
+int cli_out_fits(const char *cmd, double rows, int width, double max_bytes);
 int cli_out_close(cli_out *w, int keep);
 /* The whole of file path (stdin for "-", at most 16 MB), malloc'd (the
  * caller frees); NULL after "convsim CMD: --OPT: ..." on stderr. */

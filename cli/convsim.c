@@ -164,6 +164,15 @@ static void print_summary(const cli_opts *o, const sim *s, const sim_status *st,
 #undef NUM
 }
 
+/* What --out would take, before anything is built (cli_out_fits): the
+ * row at t = 0 and one a sample, the named columns and at most every
+ * feed column. 0, or 2 after the refusal. */
+static int run_out_fits(const cli_opts *o, long nsamples)
+{
+	int width = SIM_TRAJECTORY_NAMED + (o->sc.feed ? o->sc.columns : 0);
+	return o->out ? cli_out_fits("run", (double)nsamples + 1, width, o->max_output) : 0;
+}
+
 static int cmd_run(int argc, char **argv)
 {
 	cli_opts o = {0};
@@ -174,6 +183,9 @@ static int cmd_run(int argc, char **argv)
 		return 2;
 	if (o.sc.feed_model == SIM_FEED_EXTERNAL)
 		return cli_run_coupled(&o);
+	long nsamples = (long)ceil(o.duration * o.rate - 1e-9);
+	if (run_out_fits(&o, nsamples))
+		return 2;
 	char msg[200];
 	int err;
 	double w0 = cli_now(), c0 = cpu_now(); /* the steady start's settling included */
@@ -195,7 +207,6 @@ static int cmd_run(int argc, char **argv)
 		}
 	}
 	sim_status st;
-	long nsamples = (long)ceil(o.duration * o.rate - 1e-9);
 	if (tf.f) {
 		sim_get_status(s, &st);
 		traj_begin(&tf, 1.0 / o.rate);

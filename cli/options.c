@@ -44,6 +44,9 @@ static const cli_opt options[] = {
 	 "guide angle in [0, 180]; the same as --set beta=DEG"},
 	{CMD_RUN, OPT_ROTATION, "rotation", 0, "cw|ccw", NULL, "the preset's (cw)",
 	 "cw (the paper's clockwise, rotor speed > 0) or ccw; the same as --set rotation=..."},
+	{CMD_RUN, OPT_MAX_OUTPUT, "max-output", 0, "BYTES", "bytes", "1e9 (1 GB)",
+	 "a run whose --out could take more (rows x columns, at most 25 bytes a value) is refused "
+	 "before it starts"},
 	{CMD_RUN, OPT_COUPLING_STEPS, "coupling-steps", 0, "N", NULL, "1",
 	 "feed_model=liggghts: machine steps per coupling interval with the bed (docs/dem.md)"},
 	{CMD_RUN, OPT_MAX_DEM_COST, "max-dem-cost", 0, "S", "CPU s per simulated s", "none",

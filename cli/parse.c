@@ -146,6 +146,9 @@ static int apply_option(cli_opts *o, unsigned cmd, int id, const char *arg)
 		bad = cli_number(o->cmd, "max-dem-cost", "CPU seconds", arg, 0, 1e9, 1,
 				 &o->max_dem_cost);
 		break;
+	case OPT_MAX_OUTPUT:
+		bad = cli_number(o->cmd, "max-output", "bytes", arg, 0, 1e18, 1, &o->max_output);
+		break;
 	case OPT_OUT: o->out = arg; break;
 	case OPT_FORMAT: o->format = arg; break;
 	case OPT_BETA:
@@ -203,6 +206,7 @@ int cli_parse(int argc, char **argv, unsigned cmd, cli_opts *o)
 	o->threads = 2;
 	o->coupling_steps = 1;
 	o->max_dem_cost = INFINITY;
+	o->max_output = 1e9;
 	o->rotation = "cw,ccw";
 	o->seed = 1;
 	o->curve_step = 5;

@@ -84,6 +84,11 @@ static inline int sim_fmt_inside(double v, int x, double dist)
 	return 0;
 }
 
+/* The longest text sim_fmt_double writes for a finite v, 24 bytes:
+ * -d.dddddddddddddddde-ddd (17 digits, a three-digit exponent). What
+ * writes many values bounds its output with it (convsim run --out). */
+#define SIM_FMT_DOUBLE_MAX 24
+
 /* Write v into buf (len bytes) as the shortest text that reads back as v
  * ("-0" and "0" kept apart); non-finite values as `nonfinite` ("null" in
  * JSON, "" in CSV). Returns the length written, as snprintf.

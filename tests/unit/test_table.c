@@ -54,6 +54,10 @@ static int same(double v)
 		print_message("%.17g: \"%s\" (%d) against \"%s\" (%d)\n", v, a, na, b, nb);
 		return 0;
 	}
+	if (isfinite(v) && na > SIM_FMT_DOUBLE_MAX) { /* the bound --out's estimate takes */
+		print_message("%.17g: \"%s\" is longer than SIM_FMT_DOUBLE_MAX\n", v, a);
+		return 0;
+	}
 	return 1;
 }
 
@@ -100,7 +104,11 @@ static void edges(void **st)
 			    0.30000000000000004, 1.0 / 3, 2.0 / 3, M_PI, 1e-4, 9.99999e-5, 0.0001,
 			    99999.999999999985, 999999999999999.9, 0.15, 0.25, 1.5, 2.5, 1e300, 1e-300};
 	for (size_t i = 0; i < sizeof v / sizeof *v; i++)
-		assert_true(same(v[i]));
+		assert_true(same(v[i]) && same(-v[i]));
+	/* SIM_FMT_DOUBLE_MAX is met: 17 digits, a sign, a three-digit exponent */
+	char b[64];
+	assert_int_equal(sim_fmt_double(b, sizeof b, -1.0000000000000002e-300, ""),
+			 SIM_FMT_DOUBLE_MAX);
 	for (int k = -330; k <= 310; k++) {
 		double p = pow(10.0, k);
 		assert_true(same(p));
@@ -109,7 +117,6 @@ static void edges(void **st)
 	}
 	for (int k = -1074; k <= 1023; k++)
 		assert_true(same(ldexp(1.0, k)));
-	char b[64];
 	assert_int_equal(sim_fmt_double(b, sizeof b, 0.0, "null"), 1);
 	assert_string_equal(b, "0");
 	sim_fmt_double(b, sizeof b, -0.0, "null");
