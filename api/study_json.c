@@ -259,8 +259,10 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 	if (e == API_OK)
 		e = study_points(&st, req->nrot, pb);
 	char msg[256] = "";
-	if (e == API_OK && sim_study_plan(&st, msg, sizeof msg) != SIM_OK) /* lhs of a list */
-		e = api_fail(pb, API_INVALID, st.lhs ? "lhs" : "vary", "%s", msg);
+	int rc = e == API_OK ? sim_study_plan(&st, msg, sizeof msg) : SIM_OK;
+	if (rc != SIM_OK) /* a sample of a list, or no memory */
+		e = api_fail(pb, rc == SIM_ENOMEM ? API_UNAVAILABLE : API_INVALID,
+			     rc == SIM_ENOMEM ? NULL : st.lhs ? "lhs" : "vary", "%s", msg);
 	/* each point measures after its own transient: t_end (sweep_json.c
 	 * checked it against the model's) must exceed the largest varied */
 	double transient = sim_study_largest(&st, "transient", 0);
