@@ -26,6 +26,7 @@ export const SPEC = [
   ['docs/hardening.md', 'waits at most 250 ms for a slot'],
   ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],
   ['docs/operations.md', 'a request waits up to 250 ms for a slot'],
+  ['docs/api-errors.md', 'after waiting up to 250 ms for a slot'],
   ['docs/hardening.md', 'runs for up to 30 ms of CPU'],
   ['docs/hardening.md', 'within the first 50 ms of CPU'],
   /* SRV_SAMPLE_CPU_MAX in server/base/budget.h: the longest sample a creation may ask for */
