@@ -149,6 +149,12 @@ double api_round_inward(double v, int up, int digits);
  * settings table's. Returns API_RANGE. */
 api_err api_fail_range(api_problem *pb, const char *field, double min, double max,
 		       const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+/* Copy the id text of field (a session's or a fit's: what names it in
+ * the detail) into buf of size bytes, or refuse a length outside 1 to
+ * size - 1 bytes with that range (api_fail_range): an id longer than the
+ * buffer is refused, not cut to another one's. */
+api_err api_copy_id(api_problem *pb, const char *field, const char *what,
+		    const char *text, char *buf, size_t size);
 /* Name the budget that refused a request (copied) and its limit, with the
  * Retry-After seconds; returns pb->code. */
 api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);

@@ -129,6 +129,18 @@ api_err api_fail_range(api_problem *pb, const char *field, double min, double ma
 	return API_RANGE;
 }
 
+api_err api_copy_id(api_problem *pb, const char *field, const char *what,
+		    const char *text, char *buf, size_t size)
+{
+	size_t n = strlen(text);
+	if (n < 1 || n >= size)
+		return api_fail_range(pb, field, 1, (double)size - 1,
+				      "%s has %zu bytes; %s id has 1 to %zu", field, n, what,
+				      size - 1);
+	memcpy(buf, text, n + 1);
+	return API_OK;
+}
+
 api_err api_fail(api_problem *pb, api_err code, const char *field,
 		 const char *fmt, ...)
 {

@@ -61,13 +61,10 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 				    api_problem *pb)
 {
 	if (sess && cJSON_IsString(sess)) {
-		/* an id longer than the buffer is refused, not cut to another */
-		size_t n = strlen(sess->valuestring);
-		if (n < 1 || n >= sizeof req->session_id)
-			return api_fail_range(pb, "session", 1, (double)sizeof req->session_id - 1,
-					      "session has %zu bytes; a session's id has 1 to %d", n,
-					      (int)sizeof req->session_id - 1);
-		memcpy(req->session_id, sess->valuestring, n + 1);
+		api_err e = api_copy_id(pb, "session", "a session's", sess->valuestring,
+					req->session_id, sizeof req->session_id);
+		if (e != API_OK)
+			return e;
 		if (sim_preset("czubak2016", &req->spec.params,
 			       &req->spec.scene, &req->spec.method) != SIM_OK)
 			return api_fail(pb, API_UNAVAILABLE, NULL,

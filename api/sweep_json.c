@@ -198,13 +198,8 @@ static api_err parse_band_from(const cJSON *it, api_sweep_req *req, api_problem 
 	if (!cJSON_IsString(it))
 		return api_fail(pb, API_TYPE, "band_from_fit",
 				"band_from_fit must be a fit's id (a string, GET /api/v1/fits)");
-	size_t n = strlen(it->valuestring);
-	if (n < 1 || n >= sizeof req->band_fit)
-		return api_fail_range(pb, "band_from_fit", 1, (double)sizeof req->band_fit - 1,
-				      "band_from_fit has %zu bytes; a fit's id has 1 to %d", n,
-				      (int)sizeof req->band_fit - 1);
-	memcpy(req->band_fit, it->valuestring, n + 1);
-	return API_OK;
+	return api_copy_id(pb, "band_from_fit", "a fit's", it->valuestring, req->band_fit,
+			   sizeof req->band_fit);
 }
 
 api_err api_parse_sweep(const char *body, size_t len, api_sweep_req *req,
