@@ -19,3 +19,16 @@ prev_build() { # bench name, program
 	make -C "$dir/src" --no-print-directory -j2 "build/$2" > "$dir/make.log" 2>&1 ||
 		{ tail -20 "$dir/make.log" >&2; exit 1; }
 }
+# `daemon_beside_previous NAME`: tests/bench/NAME.mjs with this build's
+# daemon beside the previous one (PREV_CONVSIMD when set, else PREV's,
+# built by prev_build), its table written to $out/NAME.md and stamped
+# with the machine and build (provenance.sh); the caller appends its notes.
+daemon_beside_previous() { # bench name
+	prev=${PREV_CONVSIMD:-}
+	[ -n "$prev" ] || prev_build "$1" convsimd
+	. tests/bench/provenance.sh
+	local line
+	line=$(provenance)
+	CONVSIMD="$BUILD/convsimd" OLD="$prev" OLD_NAME=previous node "tests/bench/$1.mjs" > "$out/$1.md"
+	stamp "$out/$1.md" "$line"
+}

@@ -12,15 +12,8 @@ cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
 PREV=${PREV:-20f6f5e}
-prev=${PREV_CONVSIMD:-}
-if [ -z "$prev" ]; then
-	. tests/bench/prev_build.sh
-	prev_build refuse_cost convsimd
-fi
-. tests/bench/provenance.sh
-line=$(provenance)
-CONVSIMD="$BUILD/convsimd" OLD="$prev" OLD_NAME=previous node tests/bench/refuse_cost.mjs > "$out/refuse_cost.md"
-stamp "$out/refuse_cost.md" "$line"
+. tests/bench/prev_build.sh
+daemon_beside_previous refuse_cost
 {
 	echo
 	echo "Previous build: $PREV. Load average $(cut -d' ' -f1-3 /proc/loadavg) after. A refusal's CPU: the daemon's CPU"

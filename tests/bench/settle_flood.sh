@@ -12,15 +12,8 @@ cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 out=${1:-tests/bench/results}
 PREV=${PREV:-3fec5b4}
-prev=${PREV_CONVSIMD:-}
-if [ -z "$prev" ]; then
-	. tests/bench/prev_build.sh
-	prev_build settle_flood convsimd
-fi
-. tests/bench/provenance.sh
-line=$(provenance)
-CONVSIMD="$BUILD/convsimd" OLD="$prev" OLD_NAME=previous node tests/bench/settle_flood.mjs > "$out/settle_flood.md"
-stamp "$out/settle_flood.md" "$line"
+. tests/bench/prev_build.sh
+daemon_beside_previous settle_flood
 {
 	echo
 	echo "Previous build: $PREV. Load average $(cut -d' ' -f1-3 /proc/loadavg) after. This build runs with its"
