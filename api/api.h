@@ -155,6 +155,19 @@ api_err api_fail_range(api_problem *pb, const char *field, double min, double ma
  * buffer is refused, not cut to another one's. */
 api_err api_copy_id(api_problem *pb, const char *field, const char *what,
 		    const char *text, char *buf, size_t size);
+/* A value of field that is none of choices ("cw|ccw": a setting's
+ * choices, or those of them the request takes): api_fail with code
+ * (API_RANGE; API_TYPE for a value of another JSON type) and those
+ * choices, the problem's choices member; the one way a refusal states
+ * choices its field's path does not give from the settings table.
+ * Returns code. */
+api_err api_fail_choices(api_problem *pb, api_err code, const char *field, const char *choices,
+			 const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+/* The choices of the enum setting name whose values are in mask (bit v for
+ * the value v), joined by "|" into out (n bytes): the ones a request
+ * takes where it takes fewer than the setting has. "" for a name that is
+ * no enum setting. Returns out. */
+const char *api_choices_of(const char *name, unsigned mask, char *out, size_t n);
 /* Name the budget that refused a request (copied) and its limit, with the
  * Retry-After seconds; returns pb->code. */
 api_err api_budget(api_problem *pb, const char *budget, double limit, int retry_after);

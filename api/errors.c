@@ -141,6 +141,36 @@ api_err api_copy_id(api_problem *pb, const char *field, const char *what,
 	return API_OK;
 }
 
+api_err api_fail_choices(api_problem *pb, api_err code, const char *field, const char *choices,
+			 const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	vfail(pb, code, field, fmt, ap);
+	va_end(ap);
+	snprintf(pb->choices, sizeof pb->choices, "%s", choices);
+	return code;
+}
+
+const char *api_choices_of(const char *name, unsigned mask, char *out, size_t n)
+{
+	const sim_setting *set = api_setting(NULL, name);
+	size_t at = 0;
+	if (n)
+		out[0] = '\0';
+	if (!set || set->kind != SIM_KIND_ENUM || !set->choices)
+		return out;
+	const char *c = set->choices;
+	for (unsigned v = 0; *c; v++) {
+		size_t len = strcspn(c, "|");
+		if (v < 32 && (mask >> v & 1u) && at < n)
+			at += (size_t)snprintf(out + at, n - at, "%s%.*s", at ? "|" : "", (int)len,
+					       c);
+		c += len + (c[len] == '|');
+	}
+	return out;
+}
+
 api_err api_fail(api_problem *pb, api_err code, const char *field,
 		 const char *fmt, ...)
 {

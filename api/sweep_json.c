@@ -139,17 +139,19 @@ static api_err parse_rotations(const cJSON *it, api_sweep_req *req,
 		return api_fail_range(pb, "rotations", 1, 2,
 				      "rotations has %d entries; a sweep takes 1 to 2 (\"cw\", "
 				      "\"ccw\")", n);
-	for (const cJSON *r = it->child; r; r = r->next) {
+	int i = 0;
+	for (const cJSON *r = it->child; r; r = r->next, i++) {
 		int rot;
+		char field[24];
+		snprintf(field, sizeof field, "rotations[%d]", i);
 		if (cJSON_IsString(r) && strcmp(r->valuestring, "cw") == 0)
 			rot = SIM_CW;
 		else if (cJSON_IsString(r) && strcmp(r->valuestring, "ccw") == 0)
 			rot = SIM_CCW;
 		else
-			return api_fail(pb, cJSON_IsString(r) ? API_RANGE
-							      : API_TYPE,
-					"rotations",
-					"rotations lists \"cw\" and/or \"ccw\"");
+			return api_fail_choices(pb, cJSON_IsString(r) ? API_RANGE : API_TYPE, field,
+						sim_setting_find("rotation")->choices,
+						"%s must be \"cw\" or \"ccw\"", field);
 		if (req->nrot == 1 && req->rotations[0] == rot)
 			return api_fail(pb, API_INVALID, "rotations",
 					"rotations lists a direction twice");
