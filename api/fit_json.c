@@ -59,8 +59,9 @@ static api_err rotation(const cJSON *o, const char *prefix, int *rot, api_proble
 	snprintf(field, sizeof field, "%srotation", prefix);
 	if (!cJSON_IsString(it) ||
 	    (strcmp(it->valuestring, "cw") != 0 && strcmp(it->valuestring, "ccw") != 0))
-		return api_fail(pb, cJSON_IsString(it) ? API_RANGE : API_TYPE, field,
-				"%s must be \"cw\" or \"ccw\"", field);
+		return api_fail_choices(pb, cJSON_IsString(it) ? API_RANGE : API_TYPE, field,
+					sim_setting_find("rotation")->choices,
+					"%s must be \"cw\" or \"ccw\"", field);
 	*rot = it->valuestring[1] == 'w' ? SIM_CW : SIM_CCW;
 	return API_OK;
 }

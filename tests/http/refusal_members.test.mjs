@@ -54,3 +54,21 @@ test("a sweep's rotations entry that is no sense: its choices, the entry named",
   ]);
   assert.deepEqual(await listed(), was, 'nothing started');
 });
+
+test("a fit point's or peak's rotation that is no sense: its choices, the point named", async () => {
+  const was = await listed();
+  const P = [{ beta: 20, rotation: 'cw', v: 0.07 }, { beta: 40, rotation: 'cw', v: 0.06 }, { beta: 60, rotation: 'cw', v: 0.05 }];
+  const fit = (extra) => ({ ...CHEAP, t_end: 2, free: ['e'], curve_step: 45, points: P, ...extra });
+  await refused(d.base, '/api/v1/fits', [
+    [fit({ points: [P[0], P[1], { ...P[2], rotation: 'x' }] }),
+      problem('out-of-range', '/api/v1/fits', 'points[2].rotation must be "cw" or "ccw"',
+        { field: 'points[2].rotation', choices: ROTATION })],
+    [fit({ points: [P[0], { ...P[1], rotation: 2 }, P[2]] }),
+      problem('wrong-type', '/api/v1/fits', 'points[1].rotation must be "cw" or "ccw"',
+        { field: 'points[1].rotation', choices: ROTATION })],
+    [fit({ points: undefined, peaks: [{ rotation: 'cw', beta: 38 }, { rotation: 'both', beta: 140 }] }),
+      problem('out-of-range', '/api/v1/fits', 'peaks[1].rotation must be "cw" or "ccw"',
+        { field: 'peaks[1].rotation', choices: ROTATION })],
+  ]);
+  assert.deepEqual(await listed(), was, 'nothing started');
+});
