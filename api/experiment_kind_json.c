@@ -26,6 +26,9 @@ const char *const api_members_disturbance[] = {"at", "set", NULL};
  * rest the session's (its run, not the machine). */
 #define DIST_REFUSED (API_C_BETA | API_C_BETA_RATE | API_C_RUNNING | API_C_PACE | API_C_UNTIL | API_C_CPU)
 
+/* The least identify.step, deg. */
+#define ID_STEP_MIN 0.1
+
 /* A number member within [lo, hi] (def when absent); 400 for a type, 422
  * for a range naming field. */
 static api_err number_in(const cJSON *obj, const char *name, const char *field, double lo,
@@ -65,13 +68,38 @@ static void add_segment(api_experiment_req *req, api_value beta, double until)
 	api_segment_reset(&req->seg[req->nseg++], beta, until);
 }
 
+/* An operating point b0 (field) whose step d leaves beta's range: the
+ * points this step allows as the range, rounded inward as printed (both
+ * taken), and the steps this point allows in the detail when there are. */
+static api_err identify_off_range(const char *field, double b0, double d, api_problem *pb)
+{
+	const sim_setting *b = sim_setting_find("beta");
+	double lo = api_round_inward(b->min + d, 1, 6), hi = api_round_inward(b->max - d, 0, 6);
+	double out = b0 + d > b->max ? b0 + d : b0 - d;
+	double most = fmin(b0 - b->min, b->max - b0);
+	char steps[96] = "";
+	if (most >= ID_STEP_MIN)
+		snprintf(steps, sizeof steps, " (or, at %g deg, a step of %g to %g deg)", b0,
+			 ID_STEP_MIN, api_round_inward(most, 0, 6));
+	return api_fail_range(pb, field, lo, hi,
+			      "%s = %g deg steps to %g deg with identify.step = %g deg, outside "
+			      "beta's [%g, %g] deg: with this step an operating point lies in [%g, %g] "
+			      "deg%s",
+			      field, b0, out, d, b->min, b->max, lo, hi, steps);
+}
+
 /* One operating point's segments: settle at beta0, +step, back, -step,
- * back, each hold long. */
+ * back, each hold long. The point's field is identify.beta[i], or
+ * identify.beta for a single number (i < 0). */
 static api_err identify_point(const cJSON *it, int i, api_experiment_req *req, api_exp_ext *ext,
 			      api_problem *pb)
 {
 	char field[48];
-	snprintf(field, sizeof field, "identify.beta[%d]", i);
+	if (i < 0)
+		snprintf(field, sizeof field, "identify.beta");
+	else
+		snprintf(field, sizeof field, "identify.beta[%d]", i);
+	i = i < 0 ? 0 : i;
 	if (!cJSON_IsNumber(it))
 		return api_fail(pb, API_TYPE, field, "%s must be a number (deg)", field);
 	api_value b0, up, down;
@@ -80,13 +108,8 @@ static api_err identify_point(const cJSON *it, int i, api_experiment_req *req, a
 		return e;
 	double d = ext->id_step;
 	if (api_user_value(&req->spec, "beta", b0.user + d, field, &up, pb) != API_OK ||
-	    api_user_value(&req->spec, "beta", b0.user - d, field, &down, pb) != API_OK) {
-		api_fail(pb, API_RANGE, "identify.step",
-			 "%s -+ identify.step (%g -+ %g deg) must lie within the range of beta, [0, "
-			 "180] deg",
-			 field, b0.user, d);
-		return API_RANGE;
-	}
+	    api_user_value(&req->spec, "beta", b0.user - d, field, &down, pb) != API_OK)
+		return identify_off_range(field, b0.user, d, pb);
 	double t = req->nseg ? req->seg[req->nseg - 1].until : 0, h = ext->id_hold;
 	api_fopdt *m = &ext->model[i];
 	m->beta0 = b0.user;
@@ -108,7 +131,8 @@ static api_err parse_identify(const cJSON *id, api_experiment_req *req, api_exp_
 				     "an object {\"beta\": DEG or [DEG, ...], \"step\": DEG, "
 				     "\"hold\": S}", api_members_identify, pb);
 	if (e == API_OK)
-		e = number_in(id, "step", "identify.step", 0.1, 30, 4, "deg", &ext->id_step, pb);
+		e = number_in(id, "step", "identify.step", ID_STEP_MIN, 30, 4, "deg",
+			      &ext->id_step, pb);
 	if (e == API_OK)
 		e = number_in(id, "hold", "identify.hold", 0.2, 600, 2, "s", &ext->id_hold, pb);
 	if (e != API_OK)
@@ -126,7 +150,7 @@ static api_err parse_identify(const cJSON *id, api_experiment_req *req, api_exp_
 	ext->npoints = n;
 	const cJSON *it = cJSON_IsArray(beta) ? beta->child : beta;
 	for (int i = 0; i < n && e == API_OK; i++, it = it->next)
-		e = identify_point(it, i, req, ext, pb);
+		e = identify_point(it, cJSON_IsArray(beta) ? i : -1, req, ext, pb);
 	return e;
 }
 

@@ -296,8 +296,9 @@ test('422: a disturbance outside a setting\'s range, or not a machine control', 
     'identify needs a session whose feed is the engine\'s own (scene.feed true, not a LIGGGHTS bed)', 'session'));
   r = await post({ identify: { beta: 178 } });
   assert.deepEqual(r.body, problem('out-of-range', 'Value out of range',
-    'identify.beta[0] -+ identify.step (178 -+ 4 deg) must lie within the range of beta, [0, 180] deg',
-    'identify.step'));
+    'identify.beta = 178 deg steps to 182 deg with identify.step = 4 deg, outside beta\'s [0, 180] deg: ' +
+    'with this step an operating point lies in [4, 176] deg (or, at 178 deg, a step of 0.1 to 2 deg)',
+    'identify.beta', { min: 4, max: 176 }));
   // nothing was created
   assert.equal((await req(d.base, 'GET', '/api/v1/experiments')).body.experiments.length, before);
 });

@@ -72,3 +72,33 @@ test("a fit point's or peak's rotation that is no sense: its choices, the point 
   ]);
   assert.deepEqual(await listed(), was, 'nothing started');
 });
+
+test("an identification's operating point whose step leaves [0, 180] deg: the points the step allows", { timeout: 60000 * SLOW }, async () => {
+  const was = await listed();
+  const id = (identify) => ({ session: { ...CHEAP, pace: 'max' }, identify: { hold: 0.2, ...identify } });
+  const at = (field, min, max, detail) => problem('out-of-range', '/api/v1/experiments', detail, { field, min, max });
+  await refused(d.base, '/api/v1/experiments', [
+    [id({ beta: 178, step: 4 }), at('identify.beta', 4, 176,
+      'identify.beta = 178 deg steps to 182 deg with identify.step = 4 deg, outside beta\'s [0, 180] deg: ' +
+      'with this step an operating point lies in [4, 176] deg (or, at 178 deg, a step of 0.1 to 2 deg)')],
+    [id({ beta: [60, 1], step: 4 }), at('identify.beta[1]', 4, 176,
+      'identify.beta[1] = 1 deg steps to -3 deg with identify.step = 4 deg, outside beta\'s [0, 180] deg: ' +
+      'with this step an operating point lies in [4, 176] deg (or, at 1 deg, a step of 0.1 to 1 deg)')],
+    [id({ beta: [0], step: 0.3 }), at('identify.beta[0]', 0.3, 179.7,
+      'identify.beta[0] = 0 deg steps to -0.3 deg with identify.step = 0.3 deg, outside beta\'s [0, 180] deg: ' +
+      'with this step an operating point lies in [0.3, 179.7] deg')],
+    [id({ beta: [90, 179.95], step: 0.123456789 }), at('identify.beta[1]', 0.123457, 179.876,
+      'identify.beta[1] = 179.95 deg steps to 180.073 deg with identify.step = 0.123457 deg, outside beta\'s ' +
+      '[0, 180] deg: with this step an operating point lies in [0.123457, 179.876] deg')],
+  ]);
+  assert.deepEqual(await listed(), was, 'nothing started');
+  // the ends stated are taken (an experiment is kept, not deleted)
+  for (const identify of [{ beta: [0.3, 179.7], step: 0.3 }, { beta: [0.123457, 179.876], step: 0.123456789 }]) {
+    const ok = await req(d.base, 'POST', '/api/v1/experiments', id(identify));
+    assert.equal(ok.status, 201, ok.text);
+    const path = `/api/v1/experiments/${ok.body.id}`;
+    await until(async () => !['waiting', 'running'].includes((await req(d.base, 'GET', path)).body.state),
+      60000 * SLOW, 'the identification ends');
+    assert.equal((await req(d.base, 'GET', path)).body.state, 'done');
+  }
+});
