@@ -18,6 +18,10 @@
 #include "json_int.h"
 #include "suggest.h"
 
+/* A macro's value as text, for the schemas below. */
+#define TEXT_OF(x) #x
+#define TEXT(x) TEXT_OF(x)
+
 static const api_query queries[] = {
 	{API_Q_FORMAT, "format", "{\"type\":\"string\",\"enum\":[\"json\",\"csv\"]}",
 	 "representation; overrides Accept (application/json or text/csv)"},
@@ -32,7 +36,9 @@ static const api_query queries[] = {
 	{API_Q_RATE, "rate", "{\"type\":\"number\",\"exclusiveMinimum\":0,\"maximum\":100000}",
 	 "samples per simulated second (thins the session's sample_rate; a stream of a running "
 	 "paced session holds its records' CPU in --max-paced-cores, fewer cost less)"},
-	{API_Q_LIMIT, "limit", "{\"type\":\"integer\",\"minimum\":1}", "end after this many records"},
+	{API_Q_LIMIT, "limit",
+	 "{\"type\":\"integer\",\"minimum\":1,\"maximum\":" TEXT(API_STREAM_LIMIT_MAX) "}",
+	 "end after this many records"},
 	{API_Q_SINCE, "since", "{\"type\":\"integer\",\"minimum\":0}",
 	 "resume after this record id (as Last-Event-ID)"},
 	{API_Q_SCOPE, "scope", "{\"type\":\"string\",\"enum\":[\"all\",\"local\"]}",
@@ -247,10 +253,13 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 	}
 	uint64_t n;
 	if (limit) {
-		if (!decimal(limit, UINT64_MAX, &n) || n == 0)
-			return api_fail(pb, API_QUERY, "limit",
-					"limit must be a positive integer (at most "
-					"%" PRIu64 ")", UINT64_MAX);
+		if (!decimal(limit, API_STREAM_LIMIT_MAX, &n) || n == 0) {
+			api_fail(pb, API_QUERY, "limit",
+				 "limit must be a whole number of records from 1 to %" PRIu64
+				 " (2^53)", (uint64_t)API_STREAM_LIMIT_MAX);
+			pb->has_range = 1, pb->min = 1, pb->max = (double)API_STREAM_LIMIT_MAX;
+			return API_QUERY;
+		}
 		q->limit = n;
 	}
 	const char *v = last_event_id ? last_event_id : since;

@@ -295,14 +295,19 @@ test('%00 in the path or the query is 400, never a shorter path; a Last-Event-ID
     const since = await get(`${stream}?since=18446744073709551616`);
     assert.equal(since.status, 400);
     assert.deepEqual(JSON.parse(since.body.toString('utf8')), idProblem('since'));
-    const limit = await get(`${stream}?limit=18446744073709551616`);
-    assert.equal(limit.status, 400);
-    assert.deepEqual(JSON.parse(limit.body.toString('utf8')), {
-      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
-      detail: 'limit must be a positive integer (at most 18446744073709551615)', instance: stream, field: 'limit',
-    });
+    // a limit states its range, up to 2^53: the largest integer a JSON
+    // number (a double) holds exactly, so that max is the very number
+    for (const limit of ['9007199254740993', '18446744073709551615', '18446744073709551616', '0', '+5', '0x1']) {
+      const r = await get(`${stream}?limit=${limit}`);
+      assert.equal(r.status, 400, limit);
+      assert.deepEqual(JSON.parse(r.body.toString('utf8')), {
+        type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+        detail: 'limit must be a whole number of records from 1 to 9007199254740992 (2^53)', instance: stream,
+        field: 'limit', min: 1, max: 9007199254740992,
+      }, limit);
+    }
     // the largest id and limit still open a stream
-    const ok = await fetch(`${d.base}${stream}?limit=18446744073709551615`,
+    const ok = await fetch(`${d.base}${stream}?limit=9007199254740992`,
       { headers: { 'Last-Event-ID': '9223372036854775807' } });
     assert.equal(ok.status, 200);
     await ok.body.cancel();
