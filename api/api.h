@@ -73,10 +73,11 @@
 	  "The Host header names neither the address the daemon listens on nor a " \
 	  "--server-name (a defence against DNS rebinding); nothing was changed.") \
 	X(TOOLARGE, 413, "body-too-large", "Request body too large",          \
-	  "The body is larger than the daemon's --max-body; it was not read.") \
+	  "The body is larger than the daemon's --max-body (`budget` body-bytes, `limit` " \
+	  "its bytes); it was not read.")                                     \
 	X(HEADERS, 431, "header-fields-too-large", "Request header fields too large", \
-	  "The query has more parameters than any route takes (at most 64); it was not " \
-	  "read.")                                                            \
+	  "The query has more parameters than any route takes (`budget` query-parameters, " \
+	  "`limit` 64); it was not read.")                                    \
 	X(MEDIATYPE, 415, "unsupported-media-type", "Unsupported media type", \
 	  "POST, PATCH, PUT and DELETE must carry Content-Type: application/json, even with " \
 	  "an empty body (a web page of another origin cannot send that type unasked).") \
@@ -117,7 +118,8 @@ typedef struct api_problem {
 	int has_range;
 	double min, max;
 	char choices[96];
-	char budget[24];   /* the budget that refused it ("memory", ...), "" */
+	char budget[24];   /* the budget or limit that refused it ("memory",
+			      "body-bytes", ...), "" */
 	double limit;      /* its limit, in the budget's unit */
 	int retry_after;   /* s for Retry-After (429, 503); 0: 1 s */
 	int has_position;  /* a malformed body: the byte where it goes wrong */

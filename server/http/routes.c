@@ -322,6 +322,14 @@ static int refuse_body(srv_req *r, enum MHD_Result *result)
 	return 1;
 }
 
+/* A 413 (*pb, its detail given) with --max-body as the limit that refused
+ * it: no field is at fault. */
+static enum MHD_Result too_large(srv_req *r, api_problem *pb)
+{
+	api_budget(pb, "body-bytes", (double)cfg->max_body, 0);
+	return srv_reply_problem(r, pb, NULL);
+}
+
 /* The request as first seen, headers only: the client's budget, the
  * gate, the declared body (its size, whether the route reads one), all
  * answered before a byte of the body is read. 1 if answered (*result). */
@@ -341,12 +349,11 @@ static int first_look(srv_req *r, enum MHD_Result *result)
 				   st->nul_at - 1);
 		return 1;
 	}
-	if (((req_state *)r)->query_params) {
-		*result = srv_fail(r, API_HEADERS, NULL,
-				   "the query has %zu parameters; no route "
-				   "takes more than %d",
-				   ((req_state *)r)->query_params,
-				   SRV_MAX_QUERY_PARAMS);
+	if (st->query_params) {
+		api_fail(&pb, API_HEADERS, NULL, "the query has %zu parameters; no route takes more "
+			 "than %d", st->query_params, SRV_MAX_QUERY_PARAMS);
+		api_budget(&pb, "query-parameters", SRV_MAX_QUERY_PARAMS, 0);
+		*result = srv_reply_problem(r, &pb, NULL);
 		return 1;
 	}
 	if (!srv_gate_check(r, result))
@@ -362,9 +369,9 @@ static int first_look(srv_req *r, enum MHD_Result *result)
 	}
 	const char *cl = srv_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
 	if (cl && strtoull(cl, NULL, 10) > cfg->max_body) {
-		*result = srv_fail(r, API_TOOLARGE, NULL,
-				   "the body has %.30s bytes; the limit is %zu "
-				   "(--max-body)", cl, cfg->max_body);
+		api_fail(&pb, API_TOOLARGE, NULL, "the body has %.30s bytes; the limit is %zu "
+			 "(--max-body)", cl, cfg->max_body);
+		*result = too_large(r, &pb);
 		return 1;
 	}
 	return refuse_body(r, result);
@@ -425,10 +432,12 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 	srv_conn_busy(st->live, 1); /* the body is in: answered now */
 	st->r.body = st->body ? st->body : "";
 	st->r.body_len = st->len;
-	if (st->too_large)
-		return srv_fail(&st->r, API_TOOLARGE, NULL,
-				"the body exceeds the limit of %zu bytes "
-				"(--max-body)", cfg->max_body);
+	if (st->too_large) {
+		api_problem pb;
+		api_fail(&pb, API_TOOLARGE, NULL, "the body exceeds the limit of %zu bytes "
+			 "(--max-body)", cfg->max_body);
+		return too_large(&st->r, &pb);
+	}
 	if (srv_stopping() && strncmp(url, "/api/", 5) == 0)
 		return srv_fail(&st->r, API_UNAVAILABLE, NULL,
 				"the daemon is shutting down");

@@ -102,3 +102,32 @@ test("an identification's operating point whose step leaves [0, 180] deg: the po
     assert.equal((await req(d.base, 'GET', path)).body.state, 'done');
   }
 });
+
+test('a body over --max-body is 413 with the limit as budget and limit, no field: declared or chunked', async () => {
+  const was = await listed();
+  const body = JSON.stringify({ ...CHEAP, pad: 'x'.repeat(5000) });
+  const r = await req(d.base, 'POST', '/api/v1/sessions', body);
+  assert.equal(r.status, 413, r.text);
+  assert.deepEqual(r.body, problem('body-too-large', '/api/v1/sessions',
+    `the body has ${body.length} bytes; the limit is 4096 (--max-body)`, { budget: 'body-bytes', limit: 4096 }));
+  // chunked: no Content-Length, refused once the body has gone past the limit
+  const chunk = (s) => `${Buffer.byteLength(s).toString(16)}\r\n${s}\r\n`;
+  const c = await rawRequest(d.port, `POST /api/v1/sessions HTTP/1.1\r\nHost: 127.0.0.1:${d.port}\r\n` +
+    'Content-Type: application/json\r\nTransfer-Encoding: chunked', `${chunk(body.slice(0, 3000))}${chunk(body.slice(3000))}0\r\n\r\n`);
+  assert.equal(c.status, 413, c.raw.toString('latin1').slice(0, 400));
+  assert.deepEqual(JSON.parse(c.body.toString('utf8')), problem('body-too-large', '/api/v1/sessions',
+    'the body exceeds the limit of 4096 bytes (--max-body)', { budget: 'body-bytes', limit: 4096 }));
+  assert.deepEqual(await listed(), was, 'nothing created');
+});
+
+test('a query of more parameters than any route takes is 431 with the limit as budget and limit, no field', async () => {
+  const query = (n) => Array.from({ length: n }, (_, i) => `a${i}=${i}`).join('&');
+  const r = await rawRequest(d.port, `GET /api/v1/sessions?${query(65)} HTTP/1.1\r\nHost: 127.0.0.1:${d.port}`);
+  assert.equal(r.status, 431, r.raw.toString('latin1').slice(0, 400));
+  assert.deepEqual(JSON.parse(r.body.toString('utf8')), problem('header-fields-too-large', '/api/v1/sessions',
+    'the query has 65 parameters; no route takes more than 64', { budget: 'query-parameters', limit: 64 }));
+  // 64 are read, and the first unknown one is named
+  const at = await req(d.base, 'GET', `/api/v1/sessions?${query(64)}`);
+  assert.equal(at.status, 400, at.text);
+  assert.equal(at.body.field, 'a0', at.text);
+});
