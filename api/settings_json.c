@@ -361,14 +361,14 @@ api_err api_validate_spec(api_spec *spec, api_problem *pb)
 	 * bed process, docs/dem.md): sweeps, fits and experiments, which run
 	 * many scenes at once, take the column model only */
 	if (spec->scene.feed_model != SIM_FEED_COLUMN) {
-		api_fail(pb, API_RANGE, "scene.feed_model",
-			 "scene.feed_model must be column in sweeps, fits and experiments; liggghts "
-			 "and auto run as a session (POST /api/v1/sessions) or in `convsim run` "
-			 "(docs/dem.md, docs/feed-models.md)");
-		pb->has_range = 1;
-		pb->min = 0.0;
-		pb->max = 0.0;
-		return pb->code;
+		char column[16];
+		return api_fail_choices(pb, API_RANGE, "scene.feed_model",
+					api_choices_of("feed_model", 1u << SIM_FEED_COLUMN, column,
+						       sizeof column),
+					"scene.feed_model must be column in sweeps, fits and "
+					"experiments; liggghts and auto run as a session (POST "
+					"/api/v1/sessions) or in `convsim run` (docs/dem.md, "
+					"docs/feed-models.md)");
 	}
 	return validate_model(spec, pb);
 }

@@ -185,7 +185,7 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		return API_OK;
 	double others = taken - *held;
 	if (need > limit) {
-		/* none from the least pace up fits: "max" only (no range) */
+		/* none from the least pace up fits: "max" only, pace's one choice (no range) */
 		int none = !(limit / cpu_per_s >= API_PACE_MIN);
 		api_fail(pb, API_RANGE, field,
 			 "this session needs %.3g cores (%.3g ms of CPU per "
@@ -194,9 +194,9 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			 need, 1e3 * cpu_per_s, pace, limit, verb,
 			 none ? "no pace from 0.001 fits: run it at pace \"max\""
 			      : "lower the pace");
-		pb->has_range = !none;
-		pb->min = API_PACE_MIN;
-		pb->max = limit / cpu_per_s;
+		pb->has_range = !none, pb->min = API_PACE_MIN, pb->max = limit / cpu_per_s;
+		if (none && strcmp(field, "pace") == 0)
+			snprintf(pb->choices, sizeof pb->choices, "max");
 		return api_budget(pb, "cpu", limit, 0);
 	}
 	api_fail(pb, API_UNAVAILABLE, field,

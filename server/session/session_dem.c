@@ -62,22 +62,33 @@ int srv_dem_wanted(const api_spec *spec)
 
 api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 {
-	char msg[256];
+	char msg[256], choices[96];
 	if (!bed_path[0] || access(bed_path, X_OK) != 0) {
-		api_fail(pb, API_RANGE, "scene.feed_model",
-			 "scene.feed_model liggghts needs the bed program %s, which this daemon does "
-			 "not find (built only where LIGGGHTS is installed: `make deps` then `make`; "
-			 "or --dem-bed PATH); column is offered",
-			 bed_path[0] ? bed_path : "convsim-bed");
-		pb->has_range = 1;
-		pb->min = pb->max = 0.0;
-		return pb->code;
+		/* auto picks among the models this daemon runs: column here */
+		unsigned offered = 1u << SIM_FEED_COLUMN | 1u << SIM_FEED_AUTO;
+		return api_fail_choices(pb, API_RANGE, "scene.feed_model",
+					api_choices_of("feed_model", offered, choices, sizeof choices),
+					"scene.feed_model liggghts needs the bed program %s, which "
+					"this daemon does not find (built only where LIGGGHTS is "
+					"installed: `make deps` then `make`; or --dem-bed PATH); column "
+					"is offered",
+					bed_path[0] ? bed_path : "convsim-bed");
 	}
 	if (spec->method.dt == 0.0) /* as `convsim run` couples it */
 		spec->method.dt = DEM_COUPLED_DT;
 	if (dem_coupled_check(&spec->scene, &spec->method, 1, spec->scene.transient, msg,
-			      sizeof msg))
-		return api_fail(pb, API_RANGE, "integrator.method", "%s", msg);
+			      sizeof msg)) {
+		/* the methods a bed couples to: those of a fixed step (the
+		 * setting's choices are the registry's names, in its order) */
+		size_t nm;
+		const sim_method_info *const *mi = sim_methods(&nm);
+		unsigned fixed = 0;
+		for (size_t i = 0; i < nm && i < 32; i++)
+			fixed |= mi[i]->adaptive ? 0u : 1u << i;
+		return api_fail_choices(pb, API_RANGE, "integrator.method",
+					api_choices_of("method", fixed, choices, sizeof choices), "%s",
+					msg);
+	}
 	/* the bed's cost: its grains over its DEM step, which shrinks as the
 	 * contact stiffens (k/m = k_c / m_n); the cost grows as sqrt(k_c) */
 	dem_bed_spec bed;

@@ -2,9 +2,9 @@
 // scene.feed_model in the daemon: the settings list it (column|liggghts),
 // the column model is the default and runs; liggghts, whose bed runs in a
 // bed process (build/convsim-bed, tests/dem/session.test.mjs), is refused
-// with a problem naming the field and its range where the daemon finds no
-// bed program, and always in sweeps (which run many scenes at once);
-// nothing is created then.
+// with a problem naming the field and the choices it takes where the
+// daemon finds no bed program (column, auto), and always in sweeps (which
+// run many scenes at once: column); nothing is created then.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, openStream, SLOW } from './lib.mjs';
@@ -36,14 +36,15 @@ test('feed_model: listed, column by default, liggghts refused with 422 and nothi
   assert.equal(r.status, 422);
   assert.equal(r.headers.get('content-type'), 'application/problem+json');
   assert.equal(r.body.field, 'scene.feed_model');
-  assert.equal(r.body.min, 0);
-  assert.equal(r.body.max, 0);
+  assert.deepEqual(r.body.choices, ['column', 'auto']);
+  assert.ok(!('min' in r.body) && !('max' in r.body), r.text);
   assert.match(r.body.detail, /needs the bed program \/nonexistent\/convsim-bed, which this daemon does not find/);
   assert.equal((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions.length, n0);
   const sw = await req(d.base, 'POST', '/api/v1/sweeps', { beta: [30], scene: { feed_model: 'liggghts' } });
   assert.equal(sw.status, 422);
   assert.equal(sw.body.field, 'scene.feed_model');
   assert.match(sw.body.detail, /must be column in sweeps, fits and experiments/);
+  assert.deepEqual(sw.body.choices, ['column']);
   const ok = await req(d.base, 'POST', '/api/v1/sessions', { scene: { feed_model: 'column' }, pace: 1 });
   assert.equal(ok.status, 201);
 });

@@ -131,3 +131,62 @@ test('a query of more parameters than any route takes is 431 with the limit as b
   assert.equal(at.status, 400, at.text);
   assert.equal(at.body.field, 'a0', at.text);
 });
+
+test('scene.feed_model beyond what a sweep takes: the choices it takes, no range', async () => {
+  const was = await listed();
+  const detail = 'scene.feed_model must be column in sweeps, fits and experiments; liggghts and auto run as a ' +
+    'session (POST /api/v1/sessions) or in `convsim run` (docs/dem.md, docs/feed-models.md)';
+  await refused(d.base, '/api/v1/sweeps', [[{ beta: [30], scene: { feed_model: 'liggghts' } },
+    problem('out-of-range', '/api/v1/sweeps', detail, { field: 'scene.feed_model', choices: ['column'] })]]);
+  await refused(d.base, '/api/v1/fits', [[{ free: ['e'], points: [{ beta: 30, rotation: 'cw', v: 0.1 }], scene: { feed_model: 'auto', model_tol: 0.01 } },
+    problem('out-of-range', '/api/v1/fits', detail, { field: 'scene.feed_model', choices: ['column'] })]]);
+  assert.deepEqual(await listed(), was, 'nothing started');
+});
+
+test('a LIGGGHTS session where the daemon has no bed program, or with an adaptive method: the choices it takes', { timeout: 30000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-refusal-'));
+  const none = join(dir, 'no-bed');
+  const nobed = await startDaemon(['--dem-bed', none]);
+  try {
+    await refused(nobed.base, '/api/v1/sessions', [[{ scene: { feed_model: 'liggghts', layers: 1 }, pace: 'max', until: 1 },
+      problem('out-of-range', '/api/v1/sessions', `scene.feed_model liggghts needs the bed program ${none}, which this ` +
+        'daemon does not find (built only where LIGGGHTS is installed: `make deps` then `make`; or --dem-bed PATH); ' +
+        'column is offered', { field: 'scene.feed_model', choices: ['column', 'auto'] })]]);
+    assert.equal((await req(nobed.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+  } finally {
+    assert.equal((await nobed.stop()).code, 0, nobed.stderr());
+  }
+  // a bed program that is never started: the method is refused before it,
+  // with the methods of a fixed step in the setting's order
+  const bed = join(dir, 'bed');
+  writeFileSync(bed, '#!/bin/sh\nexit 1\n');
+  chmodSync(bed, 0o755);
+  const dem = await startDaemon(['--dem-bed', bed]);
+  try {
+    await refused(dem.base, '/api/v1/sessions', [[{ scene: { feed_model: 'liggghts', layers: 1 }, integrator: { method: 'dopri5' }, pace: 'max', until: 1 },
+      problem('out-of-range', '/api/v1/sessions', 'feed_model liggghts: the method must take a fixed step (euler, rk4 or dem), not dopri5',
+        { field: 'integrator.method', choices: ['rk4', 'euler', 'dem'] })]]);
+    assert.equal((await req(dem.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+  } finally {
+    assert.equal((await dem.stop()).code, 0, dem.stderr());
+  }
+});
+
+test('a session no real-time pace can hold: pace\'s one choice, "max", with the budget', { timeout: 30000 * SLOW }, async () => {
+  const cores = await startDaemon(['--max-paced-cores', '1']);
+  try {
+    // 2,500 CPU s a simulated s (bounds.test.mjs): no pace from 0.001 within one core
+    const slow = { scene: { ...CHEAP.scene, start: 'rest' }, integrator: { dt: 2e-10 }, sample_rate: 10000, pace: 0.001 };
+    const r = await req(cores.base, 'POST', '/api/v1/sessions', slow);
+    assert.equal(r.status, 422, r.text);
+    const { detail, ...rest } = r.body;
+    assert.deepEqual(rest, {
+      type: '/api/v1/problems/out-of-range', title: 'Value out of range', status: 422, instance: '/api/v1/sessions',
+      field: 'pace', budget: 'cpu', limit: 1, choices: ['max'],
+    }, r.text);
+    assert.match(detail, /^this session needs [\d.e+]+ cores \([\d.e+]+ ms of CPU per simulated s at pace 0\.001\), more than the 1 cores for paced sessions \(--max-paced-cores\); nothing was created, no pace from 0\.001 fits: run it at pace "max"$/);
+    assert.equal((await req(cores.base, 'GET', '/api/v1/sessions')).body.sessions.length, 0, 'nothing created');
+  } finally {
+    assert.equal((await cores.stop()).code, 0, cores.stderr());
+  }
+});
