@@ -246,10 +246,12 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 	if (!q->fields)
 		return pb->code;
 	if (rate) {
-		if (!sim_decimal(rate, &q->rate) || !(q->rate > 0 && q->rate <= 100000))
-			return api_fail(pb, API_QUERY, "rate",
-					"rate must be a number of samples per "
-					"simulated second in (0, 100000]");
+		if (!sim_decimal(rate, &q->rate) || !(q->rate > 0 && q->rate <= 100000)) {
+			api_fail(pb, API_QUERY, "rate", "rate must be a number of samples per "
+				 "simulated second in (0, 100000]");
+			pb->has_range = 1, pb->min = 0, pb->max = 100000; /* the open end as its limit */
+			return API_QUERY;
+		}
 	}
 	uint64_t n;
 	if (limit) {

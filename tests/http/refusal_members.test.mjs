@@ -5,9 +5,10 @@
 // sweep or this daemon takes fewer than the setting has, integrator.method
 // beside a LIGGGHTS bed, a pace no real-time factor can hold), a number
 // outside its range `min` and `max` (an identification's operating point
-// with its step), and a limit no field is at fault for names it in
-// `budget` and `limit` without a `field` (413 over --max-body, 431 over
-// the query's parameters). Nothing is created.
+// with its step, a stream's rate; its limit is in strict.test.mjs), and a
+// limit no field is at fault for names it in `budget` and `limit` without
+// a `field` (413 over --max-body, 431 over the query's parameters).
+// Nothing is created.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { chmodSync, mkdtempSync, writeFileSync } from 'node:fs';
@@ -189,4 +190,20 @@ test('a session no real-time pace can hold: pace\'s one choice, "max", with the 
   } finally {
     assert.equal((await cores.stop()).code, 0, cores.stderr());
   }
+});
+
+test("a stream's rate outside (0, 100000] is 400 bad-query with that range, its open end as min", async () => {
+  const s = await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, scene: { ...CHEAP.scene, feed: false }, pace: 1 });
+  assert.equal(s.status, 201, s.text);
+  const stream = `/api/v1/sessions/${s.body.id}/stream`;
+  for (const rate of ['0', '-1', '100001', '1e6', '0x10', 'x']) {
+    const r = await req(d.base, 'GET', `${stream}?rate=${rate}`);
+    assert.equal(r.status, 400, `${rate}: ${r.text}`);
+    assert.deepEqual(r.body, {
+      type: '/api/v1/problems/bad-query', title: 'Bad query parameter', status: 400,
+      detail: 'rate must be a number of samples per simulated second in (0, 100000]', instance: stream,
+      field: 'rate', min: 0, max: 100000,
+    }, rate);
+  }
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${s.body.id}`)).status, 204);
 });
