@@ -79,10 +79,7 @@ int sim_preview(const sim_params *p, const sim_scene *sc, const sim_method *m,
 	sim *s = sim_alloc(p, sc, m, &err, msg, msglen);
 	if (!s)
 		return err ? err : SIM_ENOMEM;
-	st->dt = s->cfg.dt;
-	st->substeps = s->cfg.substeps;
-	st->reductions = s->md.reductions;
-	st->n_dof = s->md.nq + 2 * s->md.nf;
+	sim_status_shape(s, st);
 	*columns = sim_columns(s);
 	*layers = sim_layers(s);
 	sim_free(s);

@@ -367,14 +367,24 @@ typedef struct sim_status {
 	int substeps;             /* feed sub-steps per step in use (dem) */
 	unsigned reductions;      /* SIM_RED_* bits */
 	int n_dof;                /* integrated machine + feed coordinates */
+	int settle_columns;       /* feed columns the steady start's settling
+				     integrates (sim.c): one where it settles
+				     the symmetric reduction's column, else
+				     every integrated one; 0 without feed */
+	double feed_mass_ratio;   /* the feed's mass over the machine's where
+				     the feed acts on it (0 one-way or
+				     without feed); above 0.2 dem holds the
+				     feed's reaction a step (docs/
+				     integrators.md) */
 } sim_status;
 
 /* Copy the status at the observed time into *st (SI units). Reading never
  * changes the instance, its counters included. */
 void sim_get_status(const sim *s, sim_status *st);
 /* What sim_new would build for this set, without building it: the
- * integrator's step and feed sub-steps in use, the reductions and the
- * integrated coordinates (st's dt, substeps, reductions and n_dof as
+ * integrator's step and feed sub-steps in use, the reductions, the
+ * integrated coordinates and what its settling integrates (st's dt,
+ * substeps, reductions, n_dof, settle_columns and feed_mass_ratio as
  * sim_new's status reports them; the rest of *st zero) and sim_columns /
  * sim_layers (*columns, *layers), from the set validated and the
  * workspace sized but nothing settled: what a caller decides from (the

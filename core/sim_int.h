@@ -102,5 +102,13 @@ void shadow_against(sim *s, double v_coarse, double h_coarse);
  * and evaluates the right-hand side for observation only (no counter
  * moves). sim_status.c */
 void sim_update_status(sim *s);
+/* The feed columns the steady start's settling integrates (sim.c): one
+ * where it settles through the symmetric reduction (or has it), else every
+ * integrated column; 0 without feed. */
+int sim_settle_columns(const sim *s);
+/* What s integrates into st: its step and sub-steps, reductions,
+ * coordinates, settle_columns and feed_mass_ratio (sim_status.c; what
+ * sim_preview reports and every status carries). */
+void sim_status_shape(const sim *s, sim_status *st);
 
 #endif

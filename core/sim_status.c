@@ -195,10 +195,19 @@ void sim_update_status(sim *s)
 	status_energy(s, &ev, st);
 	st->steps = s->steps;
 	st->rhs_evals = s->sys.rhs_evals;
+	sim_status_shape(s, st);
+}
+
+void sim_status_shape(const sim *s, sim_status *st)
+{
+	const model *md = &s->md;
 	st->dt = s->cfg.dt;
 	st->substeps = s->cfg.substeps;
 	st->reductions = md->reductions;
 	st->n_dof = md->nq + 2 * md->nf;
+	st->settle_columns = sim_settle_columns(s);
+	st->feed_mass_ratio =
+		md->nf > 0 && md->sc.feed_coupling ? model_feed_mass_ratio(&md->p, &md->sc) : 0.0;
 }
 
 void sim_get_status(const sim *s, sim_status *st)

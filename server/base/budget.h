@@ -71,6 +71,11 @@ double srv_budget_sample_cpu(int columns, int layers);
  * and load"); a running session's worker measures its own. */
 double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 			       int columns, int layers);
+/* Estimated CPU s of the steady start's settling (0 for a start at rest):
+ * scene.settle simulated s over the columns it integrates
+ * (st->settle_columns, each of layers elements) with the same model, no
+ * samples published; the creating request's thread runs it whole. */
+double srv_budget_settle_cpu(const api_spec *spec, const sim_status *st, int layers);
 /* The same estimate before the instance is built: from what sim_new
  * would integrate (sim_preview: the set validated, nothing settled), so
  * that a creation the cores cannot take is refused for the price of its

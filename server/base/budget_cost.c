@@ -8,6 +8,7 @@
  * has measured the session's own; and the greatest pace a session whose
  * cost a simulated s changes with the pace (its streams') fits in.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -40,17 +41,37 @@
 #define SAMPLE_SERVER_CPU_S 2e-6
 /* and of each double of a published sample's feed record (ring, history) */
 #define RECORD_DOUBLE_CPU_S 2e-9
+/* The chain solve of a feed heavier than about 1.6 times the machine
+ * (feed.c's column_substep; dem holds its reaction a step there): its
+ * rounds, each a pass over the column's layers, grow with the layers L and
+ * the mass ratio r instead of staying near one, to about L^2 (CHAIN_BASE +
+ * CHAIN_SLOPE r) layer visits a sub-step and integrated column. Counted in
+ * the settling of czubak2016, columns x layers 1 to 64 x 2 to 64
+ * (docs/load.md "What settling costs"): 2.0 to 3.1 L up to r = 1.54 (8 x
+ * 64, 16 x 32, 64 x 8: the element term's), then 0.12 L^2 at 1.73 (9 x 64),
+ * 0.42 at 1.93, 0.54 to 0.68 at 2.3, 0.69 to 0.95 at 3.1 (16 x 64, 32 x 32,
+ * 64 x 16), 0.87 to 1.17 at 4.6, 1.25 to 1.46 at 6.2, 1.76 at 9.3, 2.0 at
+ * 12.3 (64 x 64); at 1.93 a smaller eccentricity (e = 0.012 m) made it
+ * 0.71, a smaller friction (mu = 0.2) 0.11. A visit: 4.7 ns on this machine
+ * under load, where the default scene's step measured 2.1 times the
+ * constants above; 2.2 ns beside them. */
+#define CHAIN_ONSET 1.6
+#define CHAIN_BASE 0.1
+#define CHAIN_SLOPE 0.2
+#define CHAIN_VISIT_CPU_S 2.2e-9
 /* Doubles per record of a feed: column displacements, xi and eta. */
 size_t srv_budget_record_doubles(int columns, int layers)
 {
 	return (size_t)columns + 2 * (size_t)columns * (size_t)layers;
 }
 
-double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
-			       int columns, int layers)
+/* CPU s of one integrator step of spec (the step into *dt_out) over
+ * integrated feed columns of layers elements each. */
+static double step_cpu(const api_spec *spec, const sim_status *st, int integrated, int layers,
+		       double *dt_out)
 {
 	const sim_method *m = &spec->method;
-	double dt = st->dt, evals = 1;
+	double dt = st->dt, evals = 1, chain = 0;
 	int substeps = st->substeps;
 	size_t n;
 	const sim_method_info *const *all = sim_methods(&n);
@@ -58,6 +79,9 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 		if (strcmp(all[i]->name, m->name) != 0)
 			continue;
 		evals = all[i]->cost;
+		if (all[i]->substeps && st->feed_mass_ratio > CHAIN_ONSET)
+			chain = (double)layers * (double)layers *
+				(CHAIN_BASE + CHAIN_SLOPE * st->feed_mass_ratio);
 		if (all[i]->adaptive) {
 			/* its steps follow the solution: guess the default method's */
 			sim_method guess = *m;
@@ -70,13 +94,40 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 		dt = 1e-3;
 	if (substeps < 1)
 		substeps = 1;
+	if (integrated < 0 || layers <= 0)
+		integrated = 0;
+	*dt_out = dt;
+	return evals * (STEP_CPU_S + (double)substeps * (double)integrated *
+					     (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S +
+					      chain * CHAIN_VISIT_CPU_S));
+}
+
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers)
+{
 	/* the symmetric reduction integrates one representative column */
 	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
-	if (columns <= 0 || layers <= 0)
+	if (columns <= 0)
 		integrated = 0;
-	double per_step = STEP_CPU_S + (double)substeps * (double)integrated *
-			  (COLUMN_SUBSTEP_CPU_S + (double)layers * ELEMENT_SUBSTEP_CPU_S);
-	return evals * per_step / dt + SAMPLE_CPU_S * spec->sample_rate;
+	double dt, step = step_cpu(spec, st, integrated, layers, &dt);
+	return step / dt + SAMPLE_CPU_S * spec->sample_rate;
+}
+
+/* Simulated s a steady start settles before the run (in the creating
+ * request's thread or the job's, uninterrupted). */
+static double settling(const api_spec *spec)
+{
+	return spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
+}
+
+double srv_budget_settle_cpu(const api_spec *spec, const sim_status *st, int layers)
+{
+	double span = settling(spec), dt;
+	if (!(span > 0))
+		return 0;
+	double step = step_cpu(spec, st, st->settle_columns, layers, &dt);
+	/* whole steps (sim.c rounds the fixed-step methods' span up) */
+	return ceil(span / dt - 1e-9) * step;
 }
 
 static double run_limit = 1800.0; /* CPU s: --max-cpu-seconds */
@@ -86,9 +137,10 @@ void srv_budget_cost_init(double max_cpu_seconds)
 	run_limit = max_cpu_seconds;
 }
 
-/* What sim_new would integrate (its step in st->dt) and its estimate. */
+/* What sim_new would integrate (its step in st->dt), its estimate and
+ * its settling's. */
 static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
-		       api_problem *pb)
+		       double *settle_cpu, api_problem *pb)
 {
 	char msg[256] = "";
 	int columns, layers;
@@ -97,14 +149,8 @@ static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
 	if (err != SIM_OK)
 		return api_fail(pb, api_from_sim(err), NULL, "%s", msg[0] ? msg : sim_strerror(err));
 	*cpu_per_s = srv_budget_cpu_estimate(spec, st, columns, layers);
+	*settle_cpu = srv_budget_settle_cpu(spec, st, layers);
 	return API_OK;
-}
-
-/* Simulated s a steady start settles before the run (in the creating
- * request's thread or the job's, uninterrupted). */
-static double settling(const api_spec *spec)
-{
-	return spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
 }
 
 /* The range a refusal names for integrator.dt: about the least step whose
@@ -120,7 +166,8 @@ static void dt_range(api_problem *pb, double dt, double cpu_s, double bound)
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
 {
 	sim_status st;
-	if (preview(spec, &st, cpu_per_s, pb) != API_OK)
+	double settle_cpu;
+	if (preview(spec, &st, cpu_per_s, &settle_cpu, pb) != API_OK)
 		return pb->code;
 	double cpu = *cpu_per_s, sample = cpu / spec->sample_rate, settle = settling(spec);
 	if (sample > SRV_SAMPLE_CPU_MAX) {
@@ -131,14 +178,15 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 			 "a larger integrator.dt or a smaller scene", 1.0 / spec->sample_rate,
 			 sample, cpu, st.dt, SRV_SAMPLE_CPU_MAX);
 		dt_range(pb, st.dt, sample, SRV_SAMPLE_CPU_MAX);
-	} else if (cpu * settle > run_limit) {
+	} else if (settle_cpu > run_limit) {
+		double per_s = settle_cpu / settle;
 		api_fail(pb, API_RANGE, "scene.settle",
 			 "the steady start would settle for about %.3g CPU s (%.3g CPU s per "
 			 "simulated s over scene.settle = %g s), more than --max-cpu-seconds (%g); "
 			 "nothing was created: a larger integrator.dt, a smaller scene, a shorter "
-			 "scene.settle or scene.start \"rest\"", cpu * settle, cpu, settle, run_limit);
+			 "scene.settle or scene.start \"rest\"", settle_cpu, per_s, settle, run_limit);
 		pb->min = 0;
-		pb->max = run_limit / cpu;
+		pb->max = run_limit / per_s;
 	} else {
 		return API_OK;
 	}
@@ -149,19 +197,19 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb)
 {
 	sim_status st;
-	double cpu;
-	if (preview(spec, &st, &cpu, pb) != API_OK)
+	double cpu, settle_cpu;
+	if (preview(spec, &st, &cpu, &settle_cpu, pb) != API_OK)
 		return API_OK; /* a set sim_new refuses: the run fails at once */
-	double settle = settling(spec);
-	double run = cpu * (settle + t_end), longest = run_limit / cpu - settle;
+	double run = settle_cpu + cpu * t_end, longest = (run_limit - settle_cpu) / cpu;
 	if (!(run > run_limit))
 		return API_OK;
 	int none = !(longest > spec->scene.transient);
 	api_fail(pb, API_RANGE, none ? "integrator.dt" : "t_end",
-		 "a run would take about %.3g CPU s (%.3g CPU s per simulated s at integrator.dt "
-		 "= %g s over %g s of settling and t_end = %g s), more than --max-cpu-seconds "
-		 "(%g), and nothing stops a run once begun; nothing was started: %s",
-		 run, cpu, st.dt, settle, t_end, run_limit,
+		 "a run would take about %.3g CPU s (%.3g CPU s settling %g s, then %.3g CPU s "
+		 "per simulated s at integrator.dt = %g s over t_end = %g s), more than "
+		 "--max-cpu-seconds (%g), and nothing stops a run once begun; nothing was "
+		 "started: %s",
+		 run, settle_cpu, settling(spec), cpu, st.dt, t_end, run_limit,
 		 none ? "a larger integrator.dt or a smaller scene" : "a shorter t_end, a larger "
 								      "integrator.dt or a smaller scene");
 	pb->has_range = 1;

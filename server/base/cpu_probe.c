@@ -11,18 +11,10 @@
  */
 #include <math.h>
 #include <stdlib.h>
-#include <time.h>
 
 #include "budget.h"
 #include "cpu_probe.h"
 #include "util.h"
-
-static double thread_cpu(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
 		     double cpu_s, const char *id)
@@ -52,7 +44,7 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int lay
 	 * SRV_PROBE_PIECE_S: a sample of a slow rate (1 s at 1 per s) of a
 	 * dear scene would otherwise be one piece of seconds of CPU */
 	double t0 = st.t, t = t0, dt = 1.0 / spec->sample_rate, sample = t0 + dt;
-	double cpu0 = thread_cpu(), cpu = cpu0;
+	double cpu0 = srv_thread_cpu(), cpu = cpu0;
 	while (cpu - cpu0 < cpu_s && t - t0 < SRV_PROBE_T_S) {
 		t = fmin(sample, t + SRV_PROBE_PIECE_S);
 		if (sim_advance(copy, t) != SIM_OK)
@@ -65,7 +57,7 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int lay
 			}
 			sample = t + dt;
 		}
-		cpu = thread_cpu();
+		cpu = srv_thread_cpu();
 	}
 	if (t > t0) {
 		cost = (cpu - cpu0) / (t - t0) +

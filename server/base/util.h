@@ -19,6 +19,8 @@ void srv_log(int level, const char *fmt, ...)
 /* Wall-clock seconds: monotonic (for pacing) and unix time. */
 double srv_now(void);
 double srv_unix_time(void);
+/* The calling thread's CPU time, seconds. */
+double srv_thread_cpu(void);
 /* Ids made from now on start "node_id-" (borrowed, kept; NULL or "": no
  * prefix). Call once at start-up, before any id is made. */
 void srv_ids_init(const char *node_id);

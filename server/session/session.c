@@ -153,33 +153,34 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->budget.turn.wake = &s->wake;
 	if (refused_early(s, spec, pb))
 		return -1;
-	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg,
-			 sizeof msg);
+	double cpu0 = srv_thread_cpu();
+	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg, sizeof msg);
 	if (!s->sim) {
 		api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
 			 msg[0] ? msg : sim_strerror(err));
 		return -1;
 	}
-	/* the worker has not run yet: publish the initial state ourselves so
-	 * that the 201 answer shows beta, rotation and the equilibrium */
+	/* the worker has not run yet: publish the initial state ourselves (the
+	 * 201 shows beta, rotation and the equilibrium); the settling's cost */
 	sim_get_status(s->sim, &s->st);
 	if (spec->scene.feed) {
 		s->columns = sim_columns(s->sim);
 		s->layers = sim_layers(s->sim);
 	}
+	srv_log(SRV_LOG_DEBUG, "session %s: built and settled in %.3g CPU s, settling estimated "
+		"at %.3g", s->entry.id, srv_thread_cpu() - cpu0,
+		srv_budget_settle_cpu(spec, &s->st, s->layers));
 	if (srv_dem_wanted(spec) && srv_dem_start(s, 0, msg, sizeof msg)) {
 		api_fail(pb, API_UNAVAILABLE, "scene.feed_model",
 			 "the LIGGGHTS bed did not start: %s", msg);
 		return -1;
 	}
-	/* what a simulated second costs: the larger of the estimate from the
-	 * integrator and a short run of a copy (cpu_probe.c; what grows with
-	 * a large feed). A threshold (the measurement only beyond twice the
-	 * estimate) made a large scene's hold jump to the estimate when a
-	 * busy machine's probe fell just below it; --cpu-probe 0: the
+	/* what a simulated second costs: the larger of the estimate and a short
+	 * run of a copy (cpu_probe.c). A threshold (the measurement only beyond
+	 * twice the estimate) made a large scene's hold jump to the estimate
+	 * when a busy machine's probe fell just below it; --cpu-probe 0: the
 	 * estimate alone */
-	s->budget.cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns,
-					       s->layers);
+	s->budget.cpu_per_s = srv_budget_cpu_estimate(spec, &s->st, s->columns, s->layers);
 	/* the hold raised to this estimate before the probe (the early one
 	 * holds the same figure but where the instance differs from its
 	 * preview, and a LIGGGHTS session has none): refused here where it
@@ -318,8 +319,7 @@ int srv_session_adopt(srv_session *s)
 		}
 		/* its worker commits the cores it needs, even beyond the
 		 * budget: it existed before */
-		s->budget.cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st,
-						       s->columns, s->layers);
+		s->budget.cpu_per_s = srv_budget_cpu_estimate(&s->spec, &s->st, s->columns, s->layers);
 		if (srv_dem_wanted(&s->spec))
 			adopt_bed(s);
 	}

@@ -125,23 +125,30 @@ static void sim_new_refuses_invalid_sets(void **state)
 
 /* sim_preview tells what sim_new builds (the daemon's CPU estimate is made
  * from it before any instance exists): step, sub-steps, reductions,
- * integrated coordinates and feed size as the new instance's status, for
- * the preset (symmetric reduction, one column integrated), a rocking
- * trough of 7 x 6 (every column integrated), a scene without feed, and an
- * explicit step; and sim_new's refusal with its message. */
+ * integrated coordinates, feed size, the columns its settling integrates
+ * and the feed's mass ratio as the new instance's status, for the preset
+ * (symmetric reduction, one column integrated), a rocking trough of 7 x 6
+ * (every column integrated, one settled: the symmetric machine's), a
+ * scene without feed, an explicit step, the rocking trough on a machine
+ * that is not symmetric (every column settled) and a one-way feed (no
+ * ratio); and sim_new's refusal with its message. */
 static void preview_is_what_sim_new_builds(void **state)
 {
 	(void)state;
-	for (int k = 0; k < 4; k++) {
+	const int settled[6] = {1, 1, 0, 1, 7, 1};
+	for (int k = 0; k < 6; k++) {
 		setup u = preset_defaults(); /* the daemon's: a settled start */
-		if (k == 1) {
+		if (k == 1 || k == 4) {
 			u.sc.trough_rotation = 1;
 			u.sc.columns = 7;
 			u.sc.layers = 6;
+			u.p.h = k == 4 ? 0.05 : 0.0;
 		} else if (k == 2) {
 			u.sc.feed = 0;
 		} else if (k == 3) {
 			u.m.dt = 5e-4;
+		} else if (k == 5) {
+			u.sc.feed_coupling = 0;
 		}
 		char msg[200] = "";
 		int err = -1, columns = -1, layers = -1;
@@ -158,7 +165,13 @@ static void preview_is_what_sim_new_builds(void **state)
 		assert_int_equal(columns, sim_columns(s));
 		assert_int_equal(layers, sim_layers(s));
 		assert_int_equal(pv.steps, 0); /* nothing was run */
-		assert_int_equal(!!(pv.reductions & SIM_RED_SYMMETRIC), k != 1);
+		assert_int_equal(!!(pv.reductions & SIM_RED_SYMMETRIC), k != 1 && k != 4);
+		assert_int_equal(pv.settle_columns, st.settle_columns);
+		assert_int_equal(pv.settle_columns, settled[k]);
+		assert_true(pv.feed_mass_ratio == st.feed_mass_ratio);
+		/* the feed's 0.5 kg elements over the machine's 166 kg */
+		double feed = u.sc.feed && u.sc.feed_coupling ? 0.5 * u.sc.columns * u.sc.layers : 0;
+		assert_true(fabs(pv.feed_mass_ratio - feed / 166.0) < 1e-12);
 		sim_free(s);
 	}
 	setup u = preset_defaults();

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A steady start's settling runs in the creating request's thread and
+// nothing interrupts it, so a creation whose settling is estimated beyond
+// --max-cpu-seconds is refused before it settles (docs/hardening.md "The
+// cores for paced sessions"), and the estimate has to be near what the
+// settling costs for every scene size (docs/budgets.md "What settling
+// costs"). A 64 x 64 scene settles for about a CPU second; the estimate
+// that counted a light column's work said 0.024 CPU s, so --max-cpu-seconds
+// 0.2 admitted it and it settled for five times the bound.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdtempSync, readdirSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { startDaemon, req, metric, SLOW } from './lib.mjs';
+
+const LARGE = { scene: { columns: 64, layers: 64 }, pace: 0.01, sample_rate: 1 };
+const BOUND = 0.2;
+// the estimate for the 64 x 64 scene (server/base/budget_cost.c): CPU s of
+// its settling, per simulated s of it, and the longest scene.settle that
+// fits the bound
+const SETTLE_CPU = 0.579, PER_S = 0.966, MAX = 0.20714239765039225;
+
+const refusal = {
+  type: '/api/v1/problems/out-of-range',
+  title: 'Value out of range',
+  status: 422,
+  detail: `the steady start would settle for about ${SETTLE_CPU} CPU s (${PER_S} CPU s per simulated s ` +
+    `over scene.settle = 0.6 s), more than --max-cpu-seconds (${BOUND}); nothing was created: a larger ` +
+    'integrator.dt, a smaller scene, a shorter scene.settle or scene.start "rest"',
+  instance: '/api/v1/sessions',
+  field: 'scene.settle',
+  budget: 'cpu',
+  limit: BOUND,
+  min: 0,
+  max: MAX,
+};
+
+test('a 64 x 64 scene is refused under --max-cpu-seconds 0.2 before it settles; scenes that fit are created', { timeout: 60000 * SLOW }, async () => {
+  const dir = mkdtempSync(join(tmpdir(), 'convsim-settle-bound-'));
+  const d = await startDaemon(['--max-cpu-seconds', String(BOUND), '--data-dir', dir]);
+  const metrics = async () => (await req(d.base, 'GET', '/metrics')).text;
+  try {
+    const t0 = performance.now();
+    const r = await req(d.base, 'POST', '/api/v1/sessions', LARGE);
+    const ms = performance.now() - t0;
+    assert.equal(r.status, 422, r.text);
+    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    assert.deepEqual(r.body, refusal);
+    assert.ok(Math.abs(MAX * SETTLE_CPU / 0.6 - BOUND) < 1e-3 * BOUND, 'max is the settle that fits');
+    // refused before anything settled (a settling of it takes about a second)
+    assert.ok(ms < 300 * SLOW, `answered after ${ms} ms`);
+    // nothing was created or held: not listed, no directory, no memory, no settling slot taken
+    assert.deepEqual((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions, []);
+    assert.deepEqual(readdirSync(join(dir, 'sessions')), []);
+    const m = await metrics();
+    assert.equal(metric(m, 'convsim_sessions_created_total'), 0);
+    assert.equal(metric(m, 'convsim_memory_reserved_bytes'), 0);
+    assert.equal(metric(m, 'convsim_settling_max'), 0);
+    // the longest settling it names fits (201), a little longer does not
+    const at = async (settle) => req(d.base, 'POST', '/api/v1/sessions',
+      { ...LARGE, scene: { ...LARGE.scene, settle } });
+    const fits = await at(Math.floor(MAX * 1000) / 1000);
+    assert.equal(fits.status, 201, fits.text);
+    assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${fits.body.id}`)).status, 204);
+    const over = await at(Math.ceil(MAX * 1000) / 1000);
+    assert.equal(over.status, 422, over.text);
+    assert.equal(over.body.field, 'scene.settle', over.text);
+    // scenes whose settling fits the bound are created: the default, 8 x 8
+    // and 8 x 64 (about 0.03 CPU s; its feed is heavier than the machine)
+    for (const scene of [{}, { columns: 8, layers: 8 }, { columns: 8, layers: 64 }]) {
+      const ok = await req(d.base, 'POST', '/api/v1/sessions', { scene, pace: 0.01, sample_rate: 1 });
+      assert.equal(ok.status, 201, `${JSON.stringify(scene)}: ${ok.text}`);
+    }
+    assert.equal(metric(await metrics(), 'convsim_sessions_created_total'), 4);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
