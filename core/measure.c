@@ -443,6 +443,12 @@ static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m
 	return err;
 }
 
+double sim_measure_span(const sim_scene *sc, double t_end)
+{
+	double window = t_end - fmax(0.0, sc->transient);
+	return t_end + (window > 0.0 ? SHADOW_MEASURE_SHARE * window : 0.0);
+}
+
 int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen)
 {

@@ -427,6 +427,13 @@ typedef struct sim_measurement {
  * bands' finite differences. For sweeps (thread-safe). */
 int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen);
+/* Simulated s sim_measure's first run integrates to t_end after its
+ * settling, at most: the run and a shadow over the window's first part
+ * (counted whole where one runs at about 0.8 of the run's cost, and where
+ * none does: dem with fewer than 3 sub-steps, the other methods); the
+ * refinements it may repeat at finer steps not counted. What a caller
+ * estimates its cost from. */
+double sim_measure_span(const sim_scene *s, double t_end);
 /* A sweep's point: sim_measure, but where a shadow measures the step
  * error (dem with feed events) each run stops before t_end at the first
  * check after the shadow's window whose bar is within tol, steady, at most

@@ -98,6 +98,13 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
  * for a set sim_new refuses: the run fails at once) or API_RANGE with
  * *pb. */
 void srv_budget_cost_init(double max_cpu_seconds);
+/* --max-cpu-seconds: also what a request's own measurements may cost. */
+double srv_budget_run_limit(void);
+/* Estimated CPU s of one sim_measure of spec to t_end (its first run:
+ * the settling, then sim_measure_span's simulated s; no samples), as the
+ * request's thread of an identification or a closed loop runs it; 0 for
+ * a set sim_new refuses (it fails at once). */
+double srv_budget_measure_cpu(const api_spec *spec, double t_end);
 api_err srv_budget_run_check(const api_spec *spec, double t_end, api_problem *pb);
 
 /* Raise what a paced session holds (*held, cores; the caller's, guarded

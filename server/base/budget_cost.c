@@ -102,15 +102,21 @@ static double step_cpu(const api_spec *spec, const sim_status *st, int integrate
 					      chain * CHAIN_VISIT_CPU_S));
 }
 
-double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
-			       int columns, int layers)
+/* CPU s per simulated s of the integration alone, no samples. */
+static double run_cpu(const api_spec *spec, const sim_status *st, int columns, int layers)
 {
 	/* the symmetric reduction integrates one representative column */
 	int integrated = (st->reductions & SIM_RED_SYMMETRIC) ? 1 : columns;
 	if (columns <= 0)
 		integrated = 0;
 	double dt, step = step_cpu(spec, st, integrated, layers, &dt);
-	return step / dt + SAMPLE_CPU_S * spec->sample_rate;
+	return step / dt;
+}
+
+double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
+			       int columns, int layers)
+{
+	return run_cpu(spec, st, columns, layers) + SAMPLE_CPU_S * spec->sample_rate;
 }
 
 /* Simulated s a steady start settles before the run (in the creating
@@ -151,6 +157,23 @@ static api_err preview(const api_spec *spec, sim_status *st, double *cpu_per_s,
 	*cpu_per_s = srv_budget_cpu_estimate(spec, st, columns, layers);
 	*settle_cpu = srv_budget_settle_cpu(spec, st, layers);
 	return API_OK;
+}
+
+double srv_budget_run_limit(void)
+{
+	return run_limit;
+}
+
+double srv_budget_measure_cpu(const api_spec *spec, double t_end)
+{
+	sim_status st;
+	char msg[256];
+	int columns, layers;
+	if (sim_preview(&spec->params, &spec->scene, &spec->method, &st, &columns, &layers, msg,
+			sizeof msg) != SIM_OK)
+		return 0;
+	return srv_budget_settle_cpu(spec, &st, layers) +
+	       run_cpu(spec, &st, columns, layers) * sim_measure_span(&spec->scene, t_end);
 }
 
 /* The range a refusal names for integrator.dt: about the least step whose

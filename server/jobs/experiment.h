@@ -26,10 +26,12 @@ typedef struct srv_experiment srv_experiment;
 srv_experiment *srv_exp_new(const api_experiment_req *req, const api_exp_ext *ext,
 			    const char *data_dir, api_problem *pb);
 /* An identification or a closed loop measures what it needs on spec (its
- * session's scene) before it starts (experiment_kind.c), holding a
- * --max-settling slot meanwhile: API_OK, or the problem (a setpoint out
- * of the machine's reach: 422; 503 budget "settling" when every slot is
- * taken, nothing measured). A plain schedule: API_OK at once. */
+ * session's scene) before it starts (experiment_cost.c, experiment_kind.c),
+ * holding a --max-settling slot meanwhile: API_OK, or the problem (those
+ * measurements estimated beyond --max-cpu-seconds: 422 budget "cpu",
+ * nothing measured; a setpoint out of the machine's reach: 422; 503
+ * budget "settling" when every slot is taken, nothing measured). A plain
+ * schedule: API_OK at once. */
 api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb);
 void srv_exp_free(srv_experiment *e);
 /* Its registry entry (the id), and back. */

@@ -79,6 +79,29 @@ void srv_exp_dist_commanded(srv_experiment *e, const srv_cmd *cmd, int refused);
 
 /* ---- identify and control (experiment_kind.c, experiment_loop.c) ---- */
 
+/* s measured per point of a v(beta) curve (and per slope) after the
+ * transient; s per segment of the identification behind "auto" gains
+ * (settle, +d, back, -d, back: five). */
+#define SRV_EXP_CURVE_WINDOW 2.0
+#define SRV_EXP_SCRATCH_HOLD 1.5
+/* Whether the v(beta) curve of spec's scene is in the cache now; whether
+ * a and b have the same curve (experiment_kind.c). */
+int srv_exp_curve_cached(const api_spec *spec);
+int srv_exp_same_curve(const api_spec *a, const api_spec *b);
+/* The scenes x's scheduled disturbances of rotation or omega_ss lead to,
+ * in their order (each from the one before), into out (room for
+ * API_EXP_MAX_DIST); their count. */
+int srv_exp_dist_specs(const api_exp_ext *x, const api_spec *spec, api_spec *out);
+/* What e's measurements before it runs would cost the request's thread
+ * (experiment_cost.c: the runs srv_exp_prepare makes that the curve cache
+ * does not spare, estimated as budget_cost.c's), into *estimate (CPU s).
+ * Beyond --max-cpu-seconds: 422 budget "cpu" naming identify.beta (the
+ * most operating points that fit as max), session.scene.columns (a fresh
+ * session: the most columns that fit, where any does) or session (a
+ * running one's scene), nothing measured or changed. */
+api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, double *estimate,
+				api_problem *pb);
+
 /* Before the experiment runs (the request's thread, spec: its session's
  * scene): the v(beta) curve and its branch, the setpoints checked and
  * their feedforward beta, "auto" gains; an identification's comparison

@@ -27,7 +27,7 @@
 #include "util.h"
 
 #define CURVES 4
-#define CURVE_WINDOW 2.0 /* s measured per point after the transient */
+#define CURVE_WINDOW SRV_EXP_CURVE_WINDOW
 #define DEG (M_PI / 180)
 #define SIMC_TAU_L 3.0 /* "auto": tau_c = 3 L unless given */
 
@@ -77,6 +77,22 @@ static int cached(const curve_key *k, double *v)
 		}
 	pthread_mutex_unlock(&cache.lock);
 	return rc;
+}
+
+int srv_exp_curve_cached(const api_spec *spec)
+{
+	curve_key k;
+	double v[API_FF_NODES];
+	key_of(spec, &k);
+	return cached(&k, v) == 0;
+}
+
+int srv_exp_same_curve(const api_spec *a, const api_spec *b)
+{
+	curve_key ka, kb;
+	key_of(a, &ka);
+	key_of(b, &kb);
+	return memcmp(&ka, &kb, sizeof ka) == 0;
 }
 
 /* The curve of spec's scene, from the cache or measured (unlocked while
@@ -193,15 +209,9 @@ static int curve_into(api_exp_ext *x, const double *v)
 	return rc;
 }
 
-/* The curves the scheduled disturbances of rotation or omega_ss lead to,
- * measured now into the cache (the request's thread), so that the worker
- * finds them there when the session gets there. */
-static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
+int srv_exp_dist_specs(const api_exp_ext *x, const api_spec *spec, api_spec *out)
 {
-	api_spec *at = malloc(sizeof *at);
-	if (!at)
-		return;
-	*at = *spec;
+	int n = 0;
 	for (int k = 0; k < x->ndist; k++) {
 		api_control c;
 		api_problem pb;
@@ -209,13 +219,29 @@ static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
 		if (api_parse_control(set, strlen(set), spec, &c, &pb) != API_OK ||
 		    !(c.set & (API_C_ROTATION | API_C_OMEGA_SS)))
 			continue;
+		out[n] = n ? out[n - 1] : *spec;
 		if (c.set & API_C_ROTATION)
-			at->params.rotation = c.rotation;
+			out[n].params.rotation = c.rotation;
 		if (c.set & API_C_OMEGA_SS)
-			at->params.omega_ss = c.omega_ss;
+			out[n].params.omega_ss = c.omega_ss;
+		n++;
+	}
+	return n;
+}
+
+/* The curves the scheduled disturbances of rotation or omega_ss lead to,
+ * measured now into the cache (the request's thread), so that the worker
+ * finds them there when the session gets there. */
+static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
+{
+	api_spec *at = malloc(API_EXP_MAX_DIST * sizeof *at);
+	if (!at)
+		return;
+	int n = srv_exp_dist_specs(x, spec, at);
+	for (int k = 0; k < n; k++) {
 		double v[API_FF_NODES];
 		char msg[200];
-		curve_of(at, v, msg, sizeof msg);
+		curve_of(&at[k], v, msg, sizeof msg);
 	}
 	free(at);
 }
@@ -354,8 +380,8 @@ static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *
 	m->beta0 = b0 / DEG;
 	m->step = 4;
 	m->slope = NAN; /* no secant measured for it */
-	if (identify_scratch(spec, b0, m->step, 1.5, rate > 0 ? rate : spec->params.beta_rate, m,
-			     msg, sizeof msg) != 0)
+	if (identify_scratch(spec, b0, m->step, SRV_EXP_SCRATCH_HOLD,
+			     rate > 0 ? rate : spec->params.beta_rate, m, msg, sizeof msg) != 0)
 		return api_fail(pb, API_INVALID, "control.controller",
 				"control.controller \"auto\": the identification at %g deg gave no "
 				"model (%s); give kp and ki", m->beta0, msg);
@@ -413,21 +439,6 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 	x->integ = 0;
 	x->t_sample = 0;
 	x->period = NAN; /* measured from the start */
-	return err;
-}
-
-api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
-{
-	if (e->ext.kind == API_EXP_SCHEDULE)
-		return API_OK;
-	/* its measurements settle and run instances in the request's thread
-	 * (a closed loop's v(beta) curve: 73 of them): one of the
-	 * --max-settling slots meanwhile, as a session's creation */
-	int settling = 0;
-	if (srv_budget_take_settling(&settling, pb) != API_OK)
-		return pb->code;
-	api_err err = srv_exp_prepare(e, spec, pb);
-	srv_budget_give_settling(&settling);
 	return err;
 }
 
