@@ -3,9 +3,9 @@
  * experiment_http.c - the experiments as a kind of job: their registry and
  * the descriptor the handlers of /api/v1/experiments[/{id}] use (job.c).
  *
- * Experiments are kept in a registry until shutdown; beyond 256 (the
- * configuration's max_experiments, no flag) the oldest finished one that no worker refers to is
- * evicted. Creating one either creates a fresh session with the
+ * Experiments are kept in a registry until shutdown; beyond
+ * --max-experiments (256) the oldest finished one is evicted once the new
+ * one has started (job.c: a refused start keeps it). Creating one either creates a fresh session with the
  * experiment attached before its first step, or attaches it to a running
  * session; the session's worker then runs it (experiment.c).
  */
