@@ -31,7 +31,8 @@ static srv_entry *find(srv_registry *reg, const char *id)
 	return e;
 }
 
-/* Unlink e and give back its place (lock held). */
+/* Unlink e and give back its place (lock held); a claimed victim that
+ * goes (deleted meanwhile) has made the room its claim stood for. */
 static void unlink_entry(srv_registry *reg, srv_entry *e)
 {
 	srv_entry **pp = &reg->head;
@@ -42,6 +43,10 @@ static void unlink_entry(srv_registry *reg, srv_entry *e)
 	e->next = NULL;
 	e->published = 0;
 	reg->count--;
+	if (e->claimed) {
+		e->claimed = 0;
+		reg->claims--;
+	}
 }
 
 /* Drop a reference (lock held); returns e if it was the last. */
@@ -50,20 +55,38 @@ static srv_entry *unref(srv_entry *e)
 	return --e->refs == 0 ? e : NULL;
 }
 
-/* Remove the oldest published entry evictable accepts (lock held);
- * returns it if that dropped its last reference. 0 in *found if none. */
-static srv_entry *evict(srv_registry *reg, int (*evictable)(srv_entry *),
-			int *found)
+/* The oldest published entry evictable accepts that no reservation has
+ * claimed (lock held), or NULL. */
+static srv_entry *oldest_evictable(srv_registry *reg, int (*evictable)(srv_entry *))
 {
 	srv_entry *victim = NULL;
 	for (srv_entry *e = reg->head; evictable && e; e = e->next)
-		if (e->published && evictable(e))
+		if (e->published && !e->claimed && evictable(e))
 			victim = e; /* newest first: the last is the oldest */
-	*found = victim != NULL;
-	if (!victim)
-		return NULL;
-	unlink_entry(reg, victim);
-	return unref(victim);
+	return victim;
+}
+
+/* Whether the registry is full: its entries less those claimed (each
+ * goes when its reservation's start is certain) at the cap. */
+static int full(const srv_registry *reg)
+{
+	return reg->count - reg->claims >= reg->cap;
+}
+
+/* Take e's place (lock held), e's id kept or made; 0 if an id is taken. */
+static int place(srv_registry *reg, srv_entry *e)
+{
+	if (e->id[0] && find(reg, e->id))
+		return 0; /* a restored id that is taken already */
+	while (!e->id[0] || find(reg, e->id))
+		srv_new_id(e->id);
+	e->refs = 0;
+	e->published = 0;
+	e->claimed = 0;
+	e->next = reg->head;
+	reg->head = e;
+	reg->count++;
+	return 1;
 }
 
 int srv_registry_reserve(srv_registry *reg, srv_entry *e,
@@ -72,23 +95,83 @@ int srv_registry_reserve(srv_registry *reg, srv_entry *e,
 	srv_entry *dead = NULL;
 	int room = 1;
 	pthread_mutex_lock(&reg->lock);
-	if (reg->count >= reg->cap)
-		dead = evict(reg, evictable, &room);
-	if (room && e->id[0] && find(reg, e->id))
-		room = 0; /* a restored id that is taken already */
-	if (room) {
-		while (!e->id[0] || find(reg, e->id))
-			srv_new_id(e->id);
-		e->refs = 0;
-		e->published = 0;
-		e->next = reg->head;
-		reg->head = e;
-		reg->count++;
+	if (full(reg)) {
+		srv_entry *victim = oldest_evictable(reg, evictable);
+		room = victim != NULL;
+		if (victim) {
+			unlink_entry(reg, victim);
+			dead = unref(victim);
+		}
 	}
+	room = room && place(reg, e);
 	pthread_mutex_unlock(&reg->lock);
 	if (dead)
 		reg->destroy(dead);
 	return room ? 0 : -1;
+}
+
+int srv_registry_reserve_claim(srv_registry *reg, srv_entry *e,
+			       int (*evictable)(srv_entry *e), srv_entry **victim)
+{
+	*victim = NULL;
+	pthread_mutex_lock(&reg->lock);
+	int room = 1;
+	if (full(reg)) {
+		*victim = oldest_evictable(reg, evictable);
+		room = *victim != NULL;
+	}
+	room = room && place(reg, e);
+	if (room && *victim) {
+		(*victim)->claimed = 1;
+		(*victim)->refs++;
+		reg->claims++;
+	} else {
+		*victim = NULL;
+	}
+	pthread_mutex_unlock(&reg->lock);
+	return room ? 0 : -1;
+}
+
+void srv_registry_evict_claim(srv_registry *reg, srv_entry *victim)
+{
+	if (!victim)
+		return;
+	srv_entry *dead = NULL, *last;
+	pthread_mutex_lock(&reg->lock);
+	if (victim->published) { /* not gone meanwhile */
+		unlink_entry(reg, victim);
+		dead = unref(victim); /* the registry's reference */
+	}
+	last = unref(victim); /* the claim's */
+	pthread_mutex_unlock(&reg->lock);
+	if (last)
+		dead = last;
+	if (dead)
+		reg->destroy(dead);
+}
+
+int srv_registry_withdraw(srv_registry *reg, srv_entry *e, srv_entry *victim)
+{
+	srv_entry *dead = NULL, *last = NULL;
+	pthread_mutex_lock(&reg->lock);
+	int linked = e->published;
+	if (linked) {
+		unlink_entry(reg, e);
+		dead = unref(e);
+	}
+	if (victim) {
+		if (victim->claimed) {
+			victim->claimed = 0;
+			reg->claims--;
+		}
+		last = unref(victim);
+	}
+	pthread_mutex_unlock(&reg->lock);
+	if (dead)
+		reg->destroy(dead);
+	if (last)
+		reg->destroy(last);
+	return linked;
 }
 
 void srv_registry_publish(srv_registry *reg, srv_entry *e)

@@ -38,6 +38,7 @@ typedef struct srv_entry {
 	char id[SRV_ID_LEN];     /* srv_new_id's, set by reserve */
 	int refs;                /* registry lock */
 	int published;           /* registry lock */
+	int claimed;             /* registry lock: a reservation's victim */
 	struct srv_entry *next;  /* registry lock; newest first */
 } srv_entry;
 
@@ -45,12 +46,13 @@ typedef struct srv_registry {
 	pthread_mutex_t lock;
 	srv_entry *head;
 	size_t count;            /* reserved and published entries */
+	size_t claims;           /* entries claimed as victims, still listed */
 	size_t cap;
 	void (*destroy)(srv_entry *e); /* on the last reference */
 } srv_registry;
 
 #define SRV_REGISTRY_INIT(destroy_fn) \
-	{PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, (destroy_fn)}
+	{PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, 0, (destroy_fn)}
 
 /* The object of type `type` whose srv_entry member `member` is at e. */
 #define SRV_CONTAINER(e, type, member) \
@@ -67,6 +69,21 @@ void srv_registry_open(srv_registry *reg, size_t cap);
  * evictable NULL never evicts. Returns 0, or -1 when full. */
 int srv_registry_reserve(srv_registry *reg, srv_entry *e,
 			 int (*evictable)(srv_entry *e));
+/* srv_registry_reserve for a start that may still be refused: when the
+ * registry is full, the oldest published entry evictable accepts is not
+ * removed but claimed (*victim, held: it stays listed and fetchable, no
+ * other reservation claims it, and it leaves room for e), until one of
+ * the two below. *victim NULL where there was room. Returns 0, or -1
+ * when full. */
+int srv_registry_reserve_claim(srv_registry *reg, srv_entry *e,
+			       int (*evictable)(srv_entry *e), srv_entry **victim);
+/* The start is certain: the claimed victim is removed now (unless it went
+ * meanwhile) and the claim's reference dropped. NULL is accepted. */
+void srv_registry_evict_claim(srv_registry *reg, srv_entry *victim);
+/* The start was refused: the published e removed (as srv_registry_remove:
+ * 1, or 0 if it was removed already) and the victim (NULL accepted) kept
+ * as if never claimed, at once. The caller still holds its reference to e. */
+int srv_registry_withdraw(srv_registry *reg, srv_entry *e, srv_entry *victim);
 /* Make a reserved entry visible. It then has two references: the
  * registry's and the caller's (put it when done). */
 void srv_registry_publish(srv_registry *reg, srv_entry *e);

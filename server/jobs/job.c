@@ -161,25 +161,30 @@ static enum MHD_Result not_found(srv_req *r)
 	return srv_reply_not_found(r, r->job->name);
 }
 
+/* A job's place is reserved before its start, which may still refuse it
+ * (an experiment's session: 404, 422, 503); an old finished job that
+ * makes room is only claimed then, and removed once the start is certain,
+ * so that a refusal changes nothing. */
 enum MHD_Result srv_h_job_create(srv_req *r)
 {
 	const srv_job_kind *kind = r->job;
 	api_problem pb;
-	srv_entry *e = kind->create(r->body, r->body_len, &pb);
+	srv_entry *e = kind->create(r->body, r->body_len, &pb), *victim;
 	if (!e)
 		return srv_reply_problem(r, &pb, NULL);
-	if (srv_registry_reserve(kind->reg, e, kind->evictable)) {
+	if (srv_registry_reserve_claim(kind->reg, e, kind->evictable, &victim)) {
 		kind->discard(e);
 		return srv_fail(r, API_LIMIT, NULL, "%zu %s", kind->reg->cap, kind->limit);
 	}
 	srv_registry_publish(kind->reg, e);
 	char *text = NULL;
 	if (kind->start(e, &text, &pb) != API_OK) {
-		if (srv_registry_remove(kind->reg, e))
+		if (srv_registry_withdraw(kind->reg, e, victim))
 			forget(kind, e->id);
 		srv_registry_put(kind->reg, e);
 		return srv_reply_problem(r, &pb, NULL);
 	}
+	srv_registry_evict_claim(kind->reg, victim);
 	char prefix[48];
 	snprintf(prefix, sizeof prefix, "/api/v1/%s", kind->plural);
 	enum MHD_Result res = srv_reply_created(r, kind->created_status, text, prefix, e->id);
