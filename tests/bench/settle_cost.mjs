@@ -37,33 +37,35 @@ const SCENES = [
   ['32 x 64', { columns: 32, layers: 64 }],
   ['64 x 64', { columns: 64, layers: 64 }],
   ['64 x 64, trough_rotation', { columns: 64, layers: 64, trough_rotation: true }],
+  // an adaptive method: estimated at dem's steps (docs/budgets.md)
+  ['5 x 8, dopri5', {}, { method: 'dopri5' }],
 ];
 const LINE = /session ([0-9a-f]+): built and settled in ([0-9.e+-]+) CPU s, settling estimated at ([0-9.e+-]+)/g;
 
-async function measure(scene) {
+async function measure(scene, integrator) {
   const d = await startDaemon(['--log-level', 'debug', '--cpu-probe', '0', '--max-paced-cores', '100',
     '--ring', '16', '--history', '16'], { wrap: [resolve(NEW)] });
   try {
-    let least = Infinity, estimate = NaN, integrator = null;
+    let least = Infinity, estimate = NaN, status = null;
     for (let i = 0; i < REPEAT; i++) {
-      const r = await req(d.base, 'POST', '/api/v1/sessions', { scene, pace: 0.01, sample_rate: RATE });
+      const r = await req(d.base, 'POST', '/api/v1/sessions', { scene, integrator, pace: 0.01, sample_rate: RATE });
       if (r.status !== 201) throw new Error(`${JSON.stringify(scene)}: ${r.status} ${r.text}`);
-      integrator = r.body.status;
+      status = r.body.status;
       const line = await until(() => [...d.stderr().matchAll(LINE)].find((m) => m[1] === r.body.id), 10000, 'its line');
       least = Math.min(least, Number(line[2]));
       estimate = Number(line[3]);
       await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`);
     }
-    return { least, estimate, dt: integrator.dt, substeps: integrator.substeps };
+    return { least, estimate, dt: status.dt, substeps: status.substeps };
   } finally {
     await d.stop();
   }
 }
 
-async function before(scene) {
+async function before(scene, integrator) {
   const d = await startDaemon(['--cpu-probe', '0', '--max-paced-cores', '0.0001'], { wrap: [resolve(OLD)] });
   try {
-    const r = await req(d.base, 'POST', '/api/v1/sessions', { scene, pace: 1, sample_rate: RATE });
+    const r = await req(d.base, 'POST', '/api/v1/sessions', { scene, integrator, pace: 1, sample_rate: RATE });
     const m = r.body && r.body.detail && r.body.detail.match(/\(([0-9.e+-]+) ms of CPU per simulated s at pace 1\)/);
     // less the samples' term (5 us a sample), which the settling publishes none of
     return m ? (Number(m[1]) / 1e3 - 5e-6 * RATE) * SETTLE : NaN;
@@ -82,9 +84,9 @@ console.log(`Command: \`${OLD ? 'OLD=path/to/previous/convsimd ' : ''}REPEAT=${R
   'the settling\'s, as the creation is admitted by.\n');
 console.log('| scene | feed / machine mass | step s, sub-steps | settled CPU s | estimate CPU s | settled / estimate | estimate before | settled / before |');
 console.log('|---|---|---|---|---|---|---|---|');
-for (const [name, scene] of SCENES) {
-  const m = await measure(scene);
-  const old = OLD ? await before(scene) : NaN;
+for (const [name, scene, integrator] of SCENES) {
+  const m = await measure(scene, integrator);
+  const old = OLD ? await before(scene, integrator) : NaN;
   const ratio = M_N * (scene.columns ?? 5) * (scene.layers ?? 8) / MACHINE;
   console.log(`| ${name} | ${ratio.toFixed(2)} | ${m.dt}, ${m.substeps} | ${f3(m.least)} | ${f3(m.estimate)} | ` +
     `${f2(m.least / m.estimate)} | ${f3(old)} | ${f2(m.least / old)} |`);
