@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What a steady start's settling costs beside its estimate
-// (docs/budgets.md "What settling costs"): scenes from 1 x 2 to 64 x 64
+// (docs/load.md "What settling costs"): scenes from 1 x 2 to 64 x 64
 // are created one at a time (pace 0.01, --cpu-probe 0) and deleted; the
 // daemon's debug line gives the CPU its request thread spent building and
 // settling the instance and the settling's estimate. Each scene REPEAT times, the least CPU kept (a

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # The settling of a steady start beside its estimate, scenes 1 x 2 to 64 x
 # 64, and the estimate of the previous build (tests/bench/settle_cost.mjs,
-# a minute or two): the figures behind docs/budgets.md "What settling
+# a minute or two): the figures behind docs/load.md "What settling
 # costs". The previous build is commit PREV (default 09f3a0d: the estimate
 # that counted a light column's work), built once into $BUILD/prev-PREV;
 # PREV_CONVSIMD names a built one instead. Writes $1/settle_cost.md.

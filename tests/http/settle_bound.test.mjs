@@ -3,7 +3,7 @@
 // nothing interrupts it, so a creation whose settling is estimated beyond
 // --max-cpu-seconds is refused before it settles (docs/hardening.md "The
 // cores for paced sessions"), and the estimate has to be near what the
-// settling costs for every scene size (docs/budgets.md "What settling
+// settling costs for every scene size (docs/load.md "What settling
 // costs"). A 64 x 64 scene settles for about a CPU second; the estimate
 // that counted a light column's work said 0.024 CPU s, so --max-cpu-seconds
 // 0.2 admitted it and it settled for five times the bound.
