@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // What a burst of large creations does to a running daemon
-// (docs/hardening.md "Creations that settle"): a default session at pace
+// (docs/load.md "Creations that settle"): a default session at pace
 // 1 and a 16 x 64 scene at pace 0.5 run, then N creations of a COLUMNS x
 // LAYERS scene (pace 0.01, one sample a simulated s) are sent at once.
 // Each settles its steady start and runs its probe in its request's

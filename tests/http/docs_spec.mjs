@@ -23,7 +23,7 @@ export const SPEC = [
   ['docs/dem.md', 'within 2 % of the next rung'],
   ['docs/hardening.md', 'target, p99 under 100 ms'],
   // the settling slot's wait, SETTLING_WAIT_MS in server/base/budget_settling.c
-  ['docs/hardening.md', 'waits at most 250 ms for a slot'],
+  ['docs/load.md', 'waits at most 250 ms for a slot'],
   ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],
   ['docs/operations.md', 'a request waits up to 250 ms for a slot'],
   ['docs/api-errors.md', 'after waiting up to 250 ms for a slot'],

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // An identification or a closed loop measures its scene in the request's
-// thread before it answers (docs/hardening.md "Creations that settle"):
+// thread before it answers (docs/load.md "Creations that settle"):
 // an identification's slopes, two runs a point; a closed loop's v(beta)
 // curve, 73 runs. Nothing interrupts them, so they are estimated first and
 // refused beyond --max-cpu-seconds, with nothing measured, started or

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // At most --max-settling requests settle simulations in their own thread
-// at once (docs/hardening.md "Creations that settle"): a session's
+// at once (docs/load.md "Creations that settle"): a session's
 // creation settles its steady start and runs its probe before it is
 // answered, an identification or a closed loop measures its scene at the
 // request. Beyond, a request waits at most 250 ms for a slot (a burst of
@@ -140,8 +140,8 @@ test('the slot comes back after a settling that fails and after a client that le
   }
 });
 
-test('docs/hardening.md shows the 503 the daemon answers (with --max-settling 1)', () => {
-  const doc = readFileSync(new URL('../../docs/hardening.md', import.meta.url), 'utf8');
+test('docs/load.md shows the 503 the daemon answers (with --max-settling 1)', () => {
+  const doc = readFileSync(new URL('../../docs/load.md', import.meta.url), 'utf8');
   const section = doc.slice(doc.indexOf('## Creations that settle'));
   const block = section.match(/```json\n([\s\S]*?)```/);
   assert.ok(block, 'a json block in "Creations that settle"');
