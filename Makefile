@@ -44,7 +44,7 @@ CLI_SRC    := $(filter-out cli/spread_mpi.c,$(wildcard cli/*.c))
 FIT_SRC    := $(wildcard fit/*.c)
 API_SRC    := $(wildcard api/*.c)
 # server/ in floors (docs/development.md "Architecture"), bottom to top
-SERVER_FLOORS := base jobs session http
+SERVER_FLOORS := base store admit jobs session http
 SERVER_SRC := $(foreach f,$(SERVER_FLOORS),$(wildcard server/$(f)/*.c)) server/main.c
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 
@@ -150,7 +150,8 @@ $(BUILD)/.deps-bench: Makefile
 # below it, so a header included upward fails the build. core/ sees only
 # core/; fit/ (the calibration library) core/ and GSL; api/ core/ and fit/;
 # the application cli/ (convsim) core/ and fit/; server/'s floors, bottom
-# to top, base/ < jobs/ < session/ < http/ < server/main.c, each core/,
+# to top, base/ < store/ < admit/ < jobs/ < session/ < http/ <
+# server/main.c, each core/,
 # fit/, api/ and the floors below it (session/ and up also dem/'s headers:
 # the LIGGGHTS-free client of the bed process, libdemlink.a); dem/ core/
 # and LIGGGHTS, its programs dem/cli/ also cli/ (convsim's coupled run);
@@ -160,7 +161,9 @@ INC_fit    := -Icore -Ifit
 INC_api    := -Icore -Ifit -Iapi
 INC_cli    := -Icore -Ifit -Icli
 INC_server_base    := $(INC_api) -Iserver/base
-INC_server_jobs    := $(INC_server_base) -Iserver/jobs
+INC_server_store   := $(INC_server_base) -Iserver/store
+INC_server_admit   := $(INC_server_store) -Iserver/admit
+INC_server_jobs    := $(INC_server_admit) -Iserver/jobs
 INC_server_session := $(INC_server_jobs) -Iserver/session -Idem
 INC_server_http    := $(INC_server_session) -Iserver/http
 INC_server := $(INC_server_http)

@@ -64,7 +64,7 @@ void api_segment_reset(api_segment *seg, api_value beta, double until);
  * plus-dead-time model fitted per point) or a closed loop (a PI controller
  * on beta holding transport-velocity setpoints), with disturbances
  * scheduled on the session. Kept beside api_experiment_req, whose layout
- * the stored records copy (server/base/records.h): a record of a plain
+ * the stored records copy (server/store/records.h): a record of a plain
  * schedule is what it was. */
 enum { API_EXP_SCHEDULE, API_EXP_IDENTIFY, API_EXP_CONTROL };
 #define API_EXP_MAX_POINTS 4    /* operating points of an identification */

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # What a paced session's sample costs its worker (part of `make bench`,
 # about two minutes of both cores): the figures behind the sample term of the
-# CPU estimate (server/base/budget_cost.c SAMPLE_CPU_S, docs/budgets.md
+# CPU estimate (server/admit/budget_cost.c SAMPLE_CPU_S, docs/budgets.md
 # "CPU"). A daemon runs a fleet of N default sessions at pace 1 and a
 # sample rate r (50, 250, 1000 a simulated s; no streams); once they have
 # run 6 s, the workers' own measure (convsim_paced_cpu_cores over N, CPU s

@@ -23,7 +23,7 @@ stamp "$out/settle_cost.md" "$line"
 {
 	echo
 	echo "Previous build: $PREV. Load average $(cut -d' ' -f1-3 /proc/loadavg) after. The estimate's"
-	echo "constants are calibrated to a quiet machine (server/base/budget_cost.c); under load every scene"
+	echo "constants are calibrated to a quiet machine (server/admit/budget_cost.c); under load every scene"
 	echo "measures more than its estimate, the default one too."
 } >> "$out/settle_cost.md"
 cat "$out/settle_cost.md"

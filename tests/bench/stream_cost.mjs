@@ -8,7 +8,7 @@
 // turn: trough fields at ?rate=10, trough fields at every sample, the
 // default fields at every sample. A kind's CPU per record is its CPU less
 // the one without streams over the records its clients received. The cost
-// model of server/base/budget_cost.c (a record's fixed part and its part
+// model of server/admit/budget_cost.c (a record's fixed part and its part
 // per formatted double) comes from these figures (docs/budgets.md).
 import http from 'node:http';
 import { startDaemon } from '../http/lib.mjs';

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The daemon's own accept loop (server/base/acceptor.c): it empties the
+// The daemon's own accept loop (server/admit/acceptor.c): it empties the
 // kernel's accept queue at once and hands the connections to the HTTP
 // library those of an address with fewer open or waiting first, so a
 // newcomer passes a flood's backlog instead of waiting behind all of it.

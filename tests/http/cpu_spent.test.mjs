@@ -32,7 +32,7 @@ const daemonCpu = (pid) => {
 
 // What the checkpoint on disk of session id kept of its CPU budget: its
 // frame's format (null: no file) and, in format 3, the trailer
-// (server/base/records.h srv_ckpt_trailer, its last 40 bytes: the log's
+// (server/store/records.h srv_ckpt_trailer, its last 40 bytes: the log's
 // length, t, the count, the limit, paused); NaN in another format.
 const kept = (dir, id) => {
   let b;

@@ -22,14 +22,14 @@ export const SPEC = [
   /* issue 35's stiffness rule */
   ['docs/dem.md', 'within 2 % of the next rung'],
   ['docs/hardening.md', 'target, p99 under 100 ms'],
-  // the settling slot's wait, SETTLING_WAIT_MS in server/base/budget_settling.c
+  // the settling slot's wait, SETTLING_WAIT_MS in server/admit/budget_settling.c
   ['docs/load.md', 'waits at most 250 ms for a slot'],
   ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],
   ['docs/operations.md', 'a request waits up to 250 ms for a slot'],
   ['docs/api-errors.md', 'after waiting up to 250 ms for a slot'],
   ['docs/hardening.md', 'runs for up to 30 ms of CPU'],
   ['docs/hardening.md', 'within the first 50 ms of CPU'],
-  /* SRV_SAMPLE_CPU_MAX in server/base/budget.h: the longest sample a creation may ask for */
+  /* SRV_SAMPLE_CPU_MAX in server/admit/budget.h: the longest sample a creation may ask for */
   ['docs/hardening.md', 'advances whole, of more than 1 s of CPU'],
   /* the moments the durability tests and the kill probe kill the daemon at */
   ['docs/durability.md', 'down to 0 ms)'],

@@ -289,7 +289,7 @@ export async function startCluster(n, dir, env = {}) {
 export const g3 = (x) => String(Number(x.toPrecision(3)));
 
 // The 503 a creation gets when the cores for paced sessions cannot take it
-// (server/base/budget.c's words): it needs `need` cores, `cpu` CPU s a
+// (server/admit/budget.c's words): it needs `need` cores, `cpu` CPU s a
 // simulated s at `pace`, while running paced sessions hold `sum` of `limit`.
 export const pacedBusy = (need, cpu, pace, sum, limit) => ({
   type: '/api/v1/problems/unavailable',

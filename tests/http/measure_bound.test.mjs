@@ -6,7 +6,7 @@
 // refused beyond --max-cpu-seconds, with nothing measured, started or
 // changed; a closed loop on a 16 x 16 scene measured for about ten CPU
 // seconds here whatever the bound. Exact bodies: the estimate's figures
-// are server/base/budget_cost.c's for these scenes.
+// are server/admit/budget_cost.c's for these scenes.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, metric, SLOW } from './lib.mjs';

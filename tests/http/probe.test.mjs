@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The CPU probe a creation runs (docs/budgets.md, server/base/cpu_probe.c)
+// The CPU probe a creation runs (docs/budgets.md, server/admit/cpu_probe.c)
 // stops within one piece of simulated time (SRV_PROBE_PIECE_S, 0.01 s) of
 // its bounds, --cpu-probe of CPU or SRV_PROBE_T_S = 0.2 simulated s,
 // whatever the sample rate: at 1 sample per s it once advanced a whole

@@ -16,7 +16,7 @@ import { startDaemon, req, metric, SLOW } from './lib.mjs';
 
 const LARGE = { scene: { columns: 64, layers: 64 }, pace: 0.01, sample_rate: 1 };
 const BOUND = 0.2;
-// the estimate for the 64 x 64 scene (server/base/budget_cost.c): CPU s of
+// the estimate for the 64 x 64 scene (server/admit/budget_cost.c): CPU s of
 // its settling, per simulated s of it, and the longest scene.settle that
 // fits the bound
 const SETTLE_CPU = 0.579, PER_S = 0.966, MAX = 0.20714239765039225;

@@ -12,7 +12,7 @@ import assert from 'node:assert/strict';
 import http from 'node:http';
 import { startDaemon, req, metric, until, SLOW, g3, fillPaced, pacedEstimates } from './lib.mjs';
 
-// A stream's charge (server/base/budget_stream.c): a wake-up and a number
+// A stream's charge (server/admit/budget_stream.c): a wake-up and a number
 // formatted, CPU s. That of a ?fields=trough&rate=10 stream of a default
 // session (250 samples a simulated s), CPU s per simulated s: 10 wake-ups
 // and 10 records of 9 numbers.
