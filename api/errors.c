@@ -42,7 +42,8 @@ int api_status(api_err code)
 	X(EDIVERGED, INVALID)                                                 \
 	X(ESTEP, INVALID)                                                     \
 	X(ETIME, INVALID)                                                     \
-	X(ECHECKPOINT, INVALID)
+	X(ECHECKPOINT, INVALID)                                               \
+	X(ECPU, RANGE)
 
 static const api_err sim_to_api[SIM_NERR] = {
 #define SIM_TO_API_ROW(sim, api) [SIM_##sim] = API_##api,

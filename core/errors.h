@@ -17,7 +17,8 @@
 	X(EDIVERGED, "simulation diverged")                                   \
 	X(ESTEP, "step size underflow")                                       \
 	X(ETIME, "requested time lies in the past")                           \
-	X(ECHECKPOINT, "checkpoint damaged, cut off or of another version")
+	X(ECHECKPOINT, "checkpoint damaged, cut off or of another version")   \
+	X(ECPU, "stopped at the caller's CPU limit")
 
 typedef enum {
 #define SIM_ERR_ENUM(name, msg) SIM_##name,

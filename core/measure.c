@@ -142,7 +142,8 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 		}
 	}
 	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
-	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, err, msg, msglen);
+	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, INFINITY, NULL, err,
+				  msg, msglen);
 	if (s && start && !start->buf) {
 		size_t len = sim_checkpoint_size(s);
 		start->buf = malloc(len);

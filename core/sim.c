@@ -66,7 +66,13 @@ static int settle(sim *s)
 			e = check_state(s, q, qd);
 		else
 			snprintf(s->error, sizeof s->error, "step size underflow while settling");
+		if (e == SIM_OK && s->t_int < 0.0 && cpu_bound_passed(&s->cpu)) {
+			e = SIM_ECPU;
+			snprintf(s->error, sizeof s->error, "the settling stopped at the CPU limit, "
+				 "%.3g of its %.3g simulated s settled", s->t_int + span, span);
+		}
 	}
+	s->cpu.ran = e == SIM_ECPU ? s->t_int + span : span;
 	s->t_int = 0.0;
 	ctl->settle_b = 0.0;
 	ramp_hold(&ctl->beta_ramp, 0.0, s->md.p.beta, 0.0);
@@ -145,7 +151,9 @@ static int settle_reduced(sim *s)
 		return -1;
 	}
 	/* the reduced scene's own start (it settles itself: alpha fixed) */
+	r->cpu = s->cpu;
 	int e = sim_start(r, s->error, sizeof s->error);
+	s->cpu.ran = r->cpu.ran;
 	if (e != SIM_OK) {
 		sim_free(r);
 		return e;
@@ -195,12 +203,17 @@ int sim_start(sim *s, char *msg, size_t msglen)
 }
 
 sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			 double shadow_window, int *err, char *msg, size_t msglen)
+		      double shadow_window, double cpu_deadline, double *settled, int *err,
+		      char *msg, size_t msglen)
 {
 	sim *s = sim_alloc(p, sc, m, err, msg, msglen);
 	if (!s)
 		return NULL;
+	cpu_bound_start(&s->cpu, cpu_deadline);
 	int e = sim_start(s, msg, msglen);
+	if (settled)
+		*settled = s->cpu.ran;
+	cpu_bound_start(&s->cpu, INFINITY);
 	if (e != SIM_OK) {
 		if (err)
 			*err = e;
@@ -216,7 +229,7 @@ sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method
 sim *sim_new(const sim_params *p, const sim_scene *sc, const sim_method *m, int *err, char *msg,
 	     size_t msglen)
 {
-	return sim_new_windowed(p, sc, m, 0.0, err, msg, msglen);
+	return sim_new_windowed(p, sc, m, 0.0, INFINITY, NULL, err, msg, msglen);
 }
 
 const char *sim_last_error(const sim *s)
@@ -286,6 +299,13 @@ static int advance(sim *s, double t_end)
 		s->t_prev = t0;
 		s->steps++;
 		estimator_step(&s->est, &s->md, t0, s->t_int, s->y, q, qd);
+		if (s->t_int < t_end - eps && cpu_bound_passed(&s->cpu)) {
+			/* observed where the integrator stands; it goes on from there */
+			memcpy(s->y_obs, s->y, sizeof(double) * n);
+			s->t_obs = s->t_int;
+			sim_update_status(s);
+			return SIM_ECPU;
+		}
 	}
 	if (s->t_int > t_end + eps) {
 		if (s->ode->dense)
@@ -310,12 +330,16 @@ int sim_advance(sim *s, double t_end)
 		int e = advance(s, s->shadow_until);
 		if (e != SIM_OK)
 			return e;
-		advance(s->shadow, s->shadow_until);
+		if (advance(s->shadow, s->shadow_until) == SIM_ECPU)
+			return SIM_ECPU; /* finished at the next call */
 		shadow_finish(s);
 		sim_update_status(s);
 	}
 	int e = advance(s, t_end);
-	if (s->shadow && e == SIM_OK && advance(s->shadow, t_end) != SIM_OK) {
+	int es = s->shadow && e == SIM_OK ? advance(s->shadow, t_end) : SIM_OK;
+	if (es == SIM_ECPU)
+		return es; /* it catches up at the next call */
+	if (es != SIM_OK) {
 		shadow_finish(s);
 		sim_update_status(s);
 	}

@@ -180,6 +180,14 @@ typedef struct sim sim;
  * workspace here; stepping never allocates. */
 sim *sim_new(const sim_params *p, const sim_scene *s, const sim_method *m,
 	     int *err, char *msg, size_t msglen);
+/* sim_new, its steady start's settling stopped once the thread's CPU clock
+ * (sim_thread_cpu: s, CLOCK_THREAD_CPUTIME_ID) passes cpu_deadline
+ * (INFINITY: never), read every so many steps (about 2 ms or a step late
+ * at most): NULL, *err SIM_ECPU, msg how far it settled. No estimate knows
+ * an adaptive method's steps. *settled (may be NULL): simulated s settled. */
+sim *sim_new_bounded(const sim_params *p, const sim_scene *s, const sim_method *m,
+		     double cpu_deadline, double *settled, int *err, char *msg, size_t msglen);
+double sim_thread_cpu(void);
 /* Free an instance; NULL is accepted. */
 void sim_free(sim *s);
 
@@ -191,6 +199,10 @@ void sim_free(sim *s);
  * SIM_EDIVERGED / SIM_ESTEP (the instance is then frozen; sim_last_error()
  * tells time and cause). */
 int sim_advance(sim *s, double t_end);
+/* sim_advance, stopped as sim_new_bounded's settling: SIM_ECPU a whole
+ * step short of t_end, observed where the integrator stands, not frozen:
+ * a later call goes on (a shadow behind catches up). */
+int sim_advance_bounded(sim *s, double t_end, double cpu_deadline);
 /* Why the instance froze (time and cause), "" while it runs; owned by s. */
 const char *sim_last_error(const sim *s);
 

@@ -12,6 +12,17 @@
 #include "ode.h"
 #include "sim.h"
 
+/* A bound on the calling thread's CPU while a bounded call runs
+ * (cpu_bound.c): off, or a deadline on the thread's CPU clock (s) read
+ * every `stride` steps (`left` to go), the stride adapted so that reads
+ * come about CPU_READ_S of CPU apart (`last`: the last read; NaN none). */
+typedef struct cpu_bound {
+	int on;
+	unsigned stride, left;
+	double deadline, last;
+	double ran; /* s: what the settling ran before a stop (sim.c) */
+} cpu_bound;
+
 struct sim {
 	model md;            /* const after sim_new, but for the feed's m_n
 				and mu, which sim_set_feed changes between
@@ -53,8 +64,21 @@ struct sim {
 	int step_bounded;     /* a shadow's difference within SHADOW_SIGNIFICANT
 				 of its standard errors is scatter: step_error
 				 is bounded by step_se (measure.c's long run) */
+	cpu_bound cpu;        /* off but within sim_new_bounded and
+				 sim_advance_bounded */
 	sim_status st;
 };
+
+/* Start (deadline finite) or switch off (INFINITY) b. cpu_bound.c */
+void cpu_bound_start(cpu_bound *b, double deadline);
+/* Read the clock, adapt the stride: 1 when past the deadline. */
+int cpu_bound_read(cpu_bound *b);
+/* After each step of a bounded call: 1 once the thread's CPU clock has
+ * passed b's deadline (read every b->stride steps); 0 while off. */
+static inline int cpu_bound_passed(cpu_bound *b)
+{
+	return b->on && --b->left == 0 && cpu_bound_read(b);
+}
 
 /* An instance for a validated set with its workspace allocated and the
  * controls initialised, but no state yet (all zero): sim_new fills it with
@@ -72,9 +96,11 @@ sim *sim_alloc(const sim_params *p, const sim_scene *sc, const sim_method *m, in
 int sim_start(sim *s, char *msg, size_t msglen);
 
 /* sim_new with the shadow's window (s; <= 0: the default, SHADOW_PERIODS
- * excitation periods). sim.c */
+ * excitation periods), its settling bounded as sim_new_bounded's
+ * (cpu_deadline INFINITY: unbounded). sim.c */
 sim *sim_new_windowed(const sim_params *p, const sim_scene *sc, const sim_method *m,
-		      double shadow_window, int *err, char *msg, size_t msglen);
+		      double shadow_window, double cpu_deadline, double *settled, int *err,
+		      char *msg, size_t msglen);
 
 /* A shadow's difference within this many of its standard errors (step_se)
  * is not told from the feed's scatter (step_bounded; measure.c) */

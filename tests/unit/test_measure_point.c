@@ -224,7 +224,8 @@ static void peek_is_what_the_shadows_end_sets(void **state)
 	u.m.substeps = 6;
 	int err;
 	char msg[200] = "";
-	sim *s = sim_new_windowed(&u.p, &u.sc, &u.m, 4.0, &err, msg, sizeof msg);
+	sim *s = sim_new_windowed(&u.p, &u.sc, &u.m, 4.0, INFINITY, NULL, &err, msg,
+				  sizeof msg);
 	if (!s)
 		fail_msg("sim_new_windowed: %s", msg);
 	double raw = -1.0, se = -1.0;
