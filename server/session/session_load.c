@@ -6,6 +6,7 @@
  * checks falls back to the previous one; a session whose spec or both
  * checkpoints are unusable is listed as "damaged" with the reason; a
  * session with a spec and no checkpoint yet starts again from its spec.
+ * Last the restored sessions' workers are started, once all are in.
  */
 #include <math.h>
 #include <stdint.h>
@@ -392,4 +393,51 @@ void srv_persist_load(srv_session *s, const char *id, const srv_exp_finder *ef)
 	srv_store_count_upgraded(SRV_STORE_SESSION);
 	srv_log(SRV_LOG_INFO, "session %s: read from an earlier format, written again "
 			      "in format %d", s->entry.id, SRV_STORE_VERSION);
+}
+
+/* ---- the restored sessions' workers ------------------------------------ */
+
+size_t srv_sessions_start_restored(void)
+{
+	srv_session **all = NULL;
+	size_t n = srv_sessions_all(&all), started = 0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (s->damaged || s->worker_started)
+			continue;
+		if (pthread_create(&s->worker, NULL, srv_worker_main, s) == 0) {
+			s->worker_started = 1;
+			started++;
+		} else {
+			pthread_mutex_lock(&s->lock);
+			s->state = SRV_FAILED;
+			snprintf(s->error, sizeof s->error,
+				 "cannot start the session's worker thread");
+			pthread_mutex_unlock(&s->lock);
+		}
+	}
+	/* the restored controls due now applied before anyone can read a
+	 * status: a GET right after the start shows the targets the session
+	 * acknowledged, not its checkpoint's (bounded: a worker that does not
+	 * get there within 5 s is read as it is) */
+	double until = srv_now() + 5.0;
+	for (size_t i = 0; i < n; i++) {
+		srv_session *s = all[i];
+		if (!s->worker_started)
+			continue;
+		pthread_mutex_lock(&s->lock);
+		while (!s->first_applied && srv_now() < until) {
+			struct timespec ts;
+			clock_gettime(CLOCK_REALTIME, &ts);
+			ts.tv_nsec += 10000000; /* 10 ms */
+			if (ts.tv_nsec >= 1000000000) {
+				ts.tv_sec++;
+				ts.tv_nsec -= 1000000000;
+			}
+			pthread_cond_timedwait(&s->data, &s->lock, &ts);
+		}
+		pthread_mutex_unlock(&s->lock);
+	}
+	srv_sessions_release(all, n);
+	return started;
 }
