@@ -89,6 +89,14 @@ double srv_budget_settle_cpu(const api_spec *spec, const sim_status *st, int lay
  * scene.settle, the longest that fits as max). */
 #define SRV_SAMPLE_CPU_MAX 1.0 /* CPU s: well within a control's 5-s wait */
 api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
+/* The refusal of a creation whose settling the core stopped at
+ * --max-cpu-seconds (sim_new_bounded's SIM_ECPU) after spent CPU s, with
+ * settled of scene.settle's simulated s settled: 422, budget "cpu", naming
+ * integrator.method with the methods of a fixed step as choices where the
+ * method is adaptive (no estimate knows its steps), else scene.settle with
+ * what settled as max. Returns API_RANGE. */
+api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
+				  api_problem *pb);
 /* A job's run (a sweep's point, a fit's evaluation): a steady start's
  * settling and t_end simulated s, which nothing interrupts once begun (a
  * DELETE, a SIGTERM wait for it). One estimated beyond --max-cpu-seconds

@@ -120,7 +120,8 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
 }
 
 /* Simulated s a steady start settles before the run (in the creating
- * request's thread or the job's, uninterrupted). */
+ * request's thread, stopped at --max-cpu-seconds: session.c; or the
+ * job's, uninterrupted). */
 static double settling(const api_spec *spec)
 {
 	return spec->scene.start == SIM_START_STEADY ? spec->scene.settle : 0.0;
@@ -214,6 +215,58 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 		return API_OK;
 	}
 	pb->has_range = 1;
+	return api_budget(pb, "cpu", run_limit, 0);
+}
+
+/* The descriptor of spec's method (the registry's entry of its name;
+ * validated before, NULL otherwise). */
+static const sim_method_info *method_of(const api_spec *spec)
+{
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(all[i]->name, spec->method.name) == 0)
+			return all[i];
+	return NULL;
+}
+
+api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
+				  api_problem *pb)
+{
+	const sim_method_info *mi = method_of(spec);
+	double settle = settling(spec);
+	if (mi && mi->adaptive) {
+		/* the methods of a fixed step: the choices, and in the detail */
+		size_t n;
+		const sim_method_info *const *all = sim_methods(&n);
+		unsigned fixed = 0;
+		char names[96] = "", choices[96];
+		for (size_t i = 0; i < n && i < 32; i++) {
+			if (all[i]->adaptive)
+				continue;
+			fixed |= 1u << i;
+			size_t at = strlen(names);
+			snprintf(names + at, sizeof names - at, "%s%s", at ? ", " : "", all[i]->name);
+		}
+		api_fail_choices(pb, API_RANGE, "integrator.method",
+				 api_choices_of("method", fixed, choices, sizeof choices),
+				 "the steady start's settling stopped at %.3g CPU s, past "
+				 "--max-cpu-seconds (%g), %.3g of scene.settle's %g simulated s "
+				 "settled: no estimate knows the steps of integrator.method %s "
+				 "(adaptive); nothing was created: a method of a fixed step (%s), a "
+				 "shorter scene.settle or scene.start \"rest\"",
+				 spent, run_limit, settled, settle, mi->name, names);
+	} else {
+		api_fail(pb, API_RANGE, "scene.settle",
+			 "the steady start's settling stopped at %.3g CPU s, past "
+			 "--max-cpu-seconds (%g), %.3g of scene.settle's %g simulated s settled, "
+			 "estimated within it; nothing was created: a shorter scene.settle, a larger "
+			 "integrator.dt, a smaller scene or scene.start \"rest\"",
+			 spent, run_limit, settled, settle);
+		pb->has_range = 1;
+		pb->min = 0;
+		pb->max = settled; /* what settled within the limit */
+	}
 	return api_budget(pb, "cpu", run_limit, 0);
 }
 

@@ -17,7 +17,7 @@
 #include "util.h"
 
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
-		     double cpu_s, const char *id)
+		     double cpu_s, double deadline, const char *id)
 {
 	size_t len = sim_checkpoint_size(live), n = (size_t)columns * (size_t)layers;
 	void *buf = malloc(len);
@@ -47,7 +47,14 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int lay
 	double cpu0 = srv_thread_cpu(), cpu = cpu0;
 	while (cpu - cpu0 < cpu_s && t - t0 < SRV_PROBE_T_S) {
 		t = fmin(sample, t + SRV_PROBE_PIECE_S);
-		if (sim_advance(copy, t) != SIM_OK)
+		int e = sim_advance_bounded(copy, t, deadline);
+		if (e == SIM_ECPU) { /* the creation's bound: what it ran */
+			sim_get_status(copy, &st);
+			t = st.t;
+			cpu = srv_thread_cpu();
+			break;
+		}
+		if (e != SIM_OK)
 			break;
 		if (t >= sample) {
 			sim_get_status(copy, &st);

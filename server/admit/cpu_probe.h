@@ -24,11 +24,13 @@
  * the feed's state read at each sample as the worker reads them, for
  * cpu_s of this thread's CPU (--cpu-probe) or SRV_PROBE_T_S simulated s,
  * whichever comes first, in pieces of at most SRV_PROBE_PIECE_S; plus
- * the server's cost per published sample. columns x layers: the feed
- * recorded (0 without). Logs its figure and the simulated s it ran at
- * debug level, for session id. Returns a negative value if the copy
- * cannot be made (out of memory): then estimate. */
+ * the server's cost per published sample; stopped within a piece where
+ * this thread's CPU clock passes deadline (srv_thread_cpu; the creation's
+ * --max-cpu-seconds), measured over what it ran. columns x layers: the
+ * feed recorded (0 without). Logs its figure and the simulated s it ran
+ * at debug level, for session id. Returns a negative value if the copy
+ * cannot be made (out of memory) or ran nothing: then estimate. */
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
-		     double cpu_s, const char *id);
+		     double cpu_s, double deadline, const char *id);
 
 #endif

@@ -153,11 +153,18 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->budget.turn.wake = &s->wake;
 	if (refused_early(s, spec, pb))
 		return -1;
-	double cpu0 = srv_thread_cpu();
-	s->sim = sim_new(&spec->params, &spec->scene, &spec->method, &err, msg, sizeof msg);
+	/* the settling and the probe stop at --max-cpu-seconds of this
+	 * thread's CPU whatever the method: the estimate above cannot know an
+	 * adaptive method's steps (core/cpu_bound.c) */
+	double cpu0 = srv_thread_cpu(), deadline = cpu0 + cfg->max_cpu_seconds, settled = 0;
+	s->sim = sim_new_bounded(&spec->params, &spec->scene, &spec->method, deadline, &settled,
+				 &err, msg, sizeof msg);
 	if (!s->sim) {
-		api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
-			 msg[0] ? msg : sim_strerror(err));
+		if (err == SIM_ECPU)
+			srv_budget_settle_stopped(spec, srv_thread_cpu() - cpu0, settled, pb);
+		else
+			api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
+				 msg[0] ? msg : sim_strerror(err));
 		return -1;
 	}
 	/* the worker has not run yet: publish the initial state ourselves (the
@@ -190,7 +197,7 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 				  "created", pb) != API_OK)
 		return -1;
 	double probed = cfg->cpu_probe > 0 ? srv_cpu_probe(s->sim, spec, s->columns, s->layers,
-							   cfg->cpu_probe, s->entry.id)
+							   cfg->cpu_probe, deadline, s->entry.id)
 					   : -1.0;
 	if (probed > s->budget.cpu_per_s)
 		s->budget.cpu_per_s = probed;
