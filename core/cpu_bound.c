@@ -60,14 +60,17 @@ sim *sim_new_bounded(const sim_params *p, const sim_scene *sc, const sim_method 
 	return sim_new_windowed(p, sc, m, 0.0, cpu_deadline, settled, err, msg, msglen);
 }
 
+void sim_bound_cpu(sim *s, double deadline)
+{
+	cpu_bound_start(&s->cpu, deadline);
+	if (s->shadow) /* it steps beside the instance, on the same thread */
+		cpu_bound_start(&s->shadow->cpu, deadline);
+}
+
 int sim_advance_bounded(sim *s, double t_end, double cpu_deadline)
 {
-	cpu_bound_start(&s->cpu, cpu_deadline);
-	if (s->shadow) /* it steps beside the instance, on the same thread */
-		cpu_bound_start(&s->shadow->cpu, cpu_deadline);
+	sim_bound_cpu(s, cpu_deadline);
 	int e = sim_advance(s, t_end);
-	cpu_bound_start(&s->cpu, INFINITY);
-	if (s->shadow)
-		cpu_bound_start(&s->shadow->cpu, INFINITY);
+	sim_bound_cpu(s, INFINITY);
 	return e;
 }

@@ -130,20 +130,23 @@ typedef struct settled_start {
  * steps (its shadow too; *restored then 1), or fresh where no start could
  * be kept. */
 static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			   double t_end, settled_start *start, int *restored, int *err, char *msg,
-			   size_t msglen)
+			   double t_end, double deadline, settled_start *start, int *restored,
+			   int *err, char *msg, size_t msglen)
 {
 	*restored = 0;
 	if (start && start->buf) {
 		sim *s = sim_restore(p, sc, m, start->buf, start->len, err, NULL, 0);
 		if (s) {
 			*restored = 1;
+			sim_bound_cpu(s, deadline);
 			return s;
 		}
 	}
 	double window = SHADOW_MEASURE_SHARE * (t_end - fmax(0.0, sc->transient));
-	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, INFINITY, NULL, err,
+	sim *s = sim_new_windowed(p, sc, m, window > 0.0 ? window : 0.0, deadline, NULL, err,
 				  msg, msglen);
+	if (s)
+		sim_bound_cpu(s, deadline); /* its steps to come, its shadow's too */
 	if (s && start && !start->buf) {
 		size_t len = sim_checkpoint_size(s);
 		start->buf = malloc(len);
@@ -194,7 +197,11 @@ static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const s
 	sim_free(r);
 	if (!sh)
 		return;
-	sim_advance(sh, s->shadow_until);
+	sh->cpu = s->cpu;
+	if (sim_advance(sh, s->shadow_until) == SIM_ECPU) {
+		sim_free(sh); /* measure_once's next advance stops too */
+		return;
+	}
 	s->shadow = sh;
 	shadow_finish(s);
 	sim_update_status(s);
@@ -217,13 +224,14 @@ static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const s
  * error within tol whose room a longer window's smaller scatter may yet
  * make is left to the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, int early, int may_refine, double last, settled_start *start,
-			coarser_run *coarser, sim_status *st, char *msg, size_t msglen)
+			double t_end, double deadline, int early, int may_refine, double last,
+			settled_start *start, coarser_run *coarser, sim_status *st, char *msg,
+			size_t msglen)
 {
 	*st = (sim_status){.transport_velocity = NAN, .transport_velocity_uncertainty = NAN,
 			   .rotor_speed_mean = NAN, .step_error = NAN, .tol_allowed = NAN};
 	int err, restored;
-	sim *s = start_instance(p, sc, m, t_end, start, &restored, &err, msg, msglen);
+	sim *s = start_instance(p, sc, m, t_end, deadline, start, &restored, &err, msg, msglen);
 	if (!s)
 		return err;
 	/* a refinement from the settled start: the run before is its shadow */
@@ -331,8 +339,8 @@ static double long_bar(const sim *s, double raw, double se, double *shrink)
  * shadow's difference where significant, else its standard error
  * (s->step_bounded). */
 static int measure_long(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			double t_end, const settled_start *start, coarser_run *c, sim_status *st,
-			char *msg, size_t msglen)
+			double t_end, double deadline, const settled_start *start, coarser_run *c,
+			sim_status *st, char *msg, size_t msglen)
 {
 	double t0 = fmax(0.0, sc->transient), w = t_end - t0;
 	double stat = st->transport_velocity_uncertainty - st->step_error;
@@ -351,6 +359,7 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 	sim *s = sim_restore(p, sc, &even, start->buf, start->len, &err, msg, msglen);
 	if (!s)
 		return err;
+	sim_bound_cpu(s, deadline);
 	s->step_bounded = 1;
 	s->shadow_until = t0 + MEASURE_LONG_MAX * w;
 	for (;;) {
@@ -383,7 +392,7 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
  * bar is met, and its refinements start from the first run's settled
  * start. */
 static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
-		   int early, sim_measurement *out, char *msg, size_t msglen)
+		   int early, double deadline, sim_measurement *out, char *msg, size_t msglen)
 {
 	struct timespec c0, c1;
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
@@ -400,12 +409,13 @@ static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m
 	coarser_run coarser = {NAN, NAN, NAN, 0, NAN, NAN, NAN};
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
-		err = measure_once(p, sc, &run, t_end, early, may_refine, last,
+		err = measure_once(p, sc, &run, t_end, deadline, early, may_refine, last,
 				   early && own_steps ? &start : NULL, &coarser, &st, msg, msglen);
 		out->refinements = attempt;
 		if (err == SIM_OK && attempt == 0 && early && own_steps && start.buf &&
 		    scatter_only(&st, &coarser)) {
-			err = measure_long(p, sc, &run, t_end, &start, &coarser, &st, msg, msglen);
+			err = measure_long(p, sc, &run, t_end, deadline, &start, &coarser, &st, msg,
+					   msglen);
 			break;
 		}
 		/* done: within tol, the user's own steps, no room the steps could
@@ -453,11 +463,18 @@ double sim_measure_span(const sim_scene *sc, double t_end)
 int sim_measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen)
 {
-	return measure(p, sc, m, t_end, 0, out, msg, msglen);
+	return measure(p, sc, m, t_end, 0, INFINITY, out, msg, msglen);
+}
+
+int sim_measure_bounded(const sim_params *p, const sim_scene *sc, const sim_method *m,
+			double t_end, double cpu_deadline, sim_measurement *out, char *msg,
+			size_t msglen)
+{
+	return measure(p, sc, m, t_end, 0, cpu_deadline, out, msg, msglen);
 }
 
 int sim_measure_point(const sim_params *p, const sim_scene *sc, const sim_method *m,
 		      double t_end, sim_measurement *out, char *msg, size_t msglen)
 {
-	return measure(p, sc, m, t_end, 1, out, msg, msglen);
+	return measure(p, sc, m, t_end, 1, INFINITY, out, msg, msglen);
 }

@@ -80,6 +80,8 @@ void shadow_begin(sim *s)
 		return;
 	if (sim_checkpoint(s, buf, len) == SIM_OK)
 		s->shadow = sim_restore(&s->md.p, &s->md.sc, &m, buf, len, NULL, NULL, 0);
+	if (s->shadow) /* stepped beside s: bounded as s is (cpu_bound.c) */
+		s->shadow->cpu = s->cpu;
 	free(buf);
 	s->shadow_until = fmax(s->t_int, s->est.start) + s->shadow_window;
 }

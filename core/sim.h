@@ -439,6 +439,10 @@ typedef struct sim_measurement {
  * bands' finite differences. For sweeps (thread-safe). */
 int sim_measure(const sim_params *p, const sim_scene *s, const sim_method *m, double t_end,
 		sim_measurement *out, char *msg, size_t msglen);
+/* sim_measure, its settlings and runs stopped as sim_new_bounded's: SIM_ECPU. */
+int sim_measure_bounded(const sim_params *p, const sim_scene *s, const sim_method *m,
+			double t_end, double cpu_deadline, sim_measurement *out, char *msg,
+			size_t msglen);
 /* Simulated s sim_measure's first run integrates to t_end after its
  * settling, at most: the run and a shadow over the window's first part
  * (counted whole where one runs at about 0.8 of the run's cost, and where

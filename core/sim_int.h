@@ -71,6 +71,9 @@ struct sim {
 
 /* Start (deadline finite) or switch off (INFINITY) b. cpu_bound.c */
 void cpu_bound_start(cpu_bound *b, double deadline);
+/* The same for s's bound and its shadow's: every later step of either
+ * (sim_advance) is bounded until switched off. cpu_bound.c */
+void sim_bound_cpu(sim *s, double deadline);
 /* Read the clock, adapt the stride: 1 when past the deadline. */
 int cpu_bound_read(cpu_bound *b);
 /* After each step of a bounded call: 1 once the thread's CPU clock has

@@ -7,7 +7,8 @@
  * model's settling (dopri5) and the symmetric reduction's (dem, a rocking
  * trough); a deadline not reached changes nothing, bit for bit; and
  * sim_advance_bounded stops short of t_end without freezing the instance,
- * which goes on from there.
+ * which goes on from there; sim_measure_bounded stops its runs and their
+ * shadows.
  */
 #include "testutil.h"
 
@@ -116,6 +117,36 @@ static void advance_stops_and_goes_on(void **state)
 	sim_free(s);
 }
 
+/* A measurement under a deadline: stopped (dem, its shadow beside it, and
+ * dopri5 in its settling) with SIM_ECPU near the deadline; one not
+ * reached measures what sim_measure does, bit for bit. */
+static void measure_stops_and_one_within_is_the_same(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	double t_end = u.sc.transient + 8.0, limit = 0.005;
+	char msg[200] = "";
+	sim_measurement a, b;
+	for (int k = 0; k < 2; k++) {
+		if (k)
+			u = dopri5();
+		double cpu0 = sim_thread_cpu();
+		int e = sim_measure_bounded(&u.p, &u.sc, &u.m, t_end, cpu0 + limit, &a, msg,
+					    sizeof msg);
+		double spent = sim_thread_cpu() - cpu0;
+		assert_int_equal(e, SIM_ECPU);
+		if (!(spent >= limit && spent < limit + LATE))
+			fail_msg("%s stopped after %.4g CPU s, the limit %.3g", u.m.name, spent, limit);
+	}
+	u = preset_defaults();
+	assert_int_equal(sim_measure(&u.p, &u.sc, &u.m, t_end, &a, msg, sizeof msg), SIM_OK);
+	assert_int_equal(sim_measure_bounded(&u.p, &u.sc, &u.m, t_end, sim_thread_cpu() + 60.0,
+					     &b, msg, sizeof msg),
+			 SIM_OK);
+	assert_true(a.transport_velocity == b.transport_velocity && a.uncertainty == b.uncertainty &&
+		    a.step_error == b.step_error && a.refinements == b.refinements);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -123,6 +154,7 @@ int main(void)
 		cmocka_unit_test(reduced_settling_stops_too),
 		cmocka_unit_test(a_deadline_not_reached_changes_nothing),
 		cmocka_unit_test(advance_stops_and_goes_on),
+		cmocka_unit_test(measure_stops_and_one_within_is_the_same),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
