@@ -97,6 +97,11 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
  * what settled as max. Returns API_RANGE. */
 api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
 				  api_problem *pb);
+/* 1 when spec's method is adaptive; the methods of a fixed step into
+ * names ("rk4, euler, dem", for a detail) and choices (api_choices_of's
+ * "rk4|euler|dem"), each of its length in bytes. */
+int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len,
+			     char *choices, size_t choices_len);
 /* A job's run (a sweep's point, a fit's evaluation): a steady start's
  * settling and t_end simulated s, which nothing interrupts once begun (a
  * DELETE, a SIGTERM wait for it). One estimated beyond --max-cpu-seconds

@@ -218,44 +218,40 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 	return api_budget(pb, "cpu", run_limit, 0);
 }
 
-/* The descriptor of spec's method (the registry's entry of its name;
- * validated before, NULL otherwise). */
-static const sim_method_info *method_of(const api_spec *spec)
+int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len,
+			     char *choices, size_t choices_len)
 {
 	size_t n;
 	const sim_method_info *const *all = sim_methods(&n);
-	for (size_t i = 0; i < n; i++)
+	unsigned fixed = 0;
+	int adaptive = 0;
+	names[0] = '\0';
+	for (size_t i = 0; i < n && i < 32; i++) {
 		if (strcmp(all[i]->name, spec->method.name) == 0)
-			return all[i];
-	return NULL;
+			adaptive = all[i]->adaptive;
+		if (all[i]->adaptive)
+			continue;
+		fixed |= 1u << i;
+		size_t at = strlen(names);
+		snprintf(names + at, names_len - at, "%s%s", at ? ", " : "", all[i]->name);
+	}
+	api_choices_of("method", fixed, choices, choices_len);
+	return adaptive;
 }
 
 api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
 				  api_problem *pb)
 {
-	const sim_method_info *mi = method_of(spec);
 	double settle = settling(spec);
-	if (mi && mi->adaptive) {
-		/* the methods of a fixed step: the choices, and in the detail */
-		size_t n;
-		const sim_method_info *const *all = sim_methods(&n);
-		unsigned fixed = 0;
-		char names[96] = "", choices[96];
-		for (size_t i = 0; i < n && i < 32; i++) {
-			if (all[i]->adaptive)
-				continue;
-			fixed |= 1u << i;
-			size_t at = strlen(names);
-			snprintf(names + at, sizeof names - at, "%s%s", at ? ", " : "", all[i]->name);
-		}
-		api_fail_choices(pb, API_RANGE, "integrator.method",
-				 api_choices_of("method", fixed, choices, sizeof choices),
+	char names[96], choices[96];
+	if (srv_budget_fixed_methods(spec, names, sizeof names, choices, sizeof choices)) {
+		api_fail_choices(pb, API_RANGE, "integrator.method", choices,
 				 "the steady start's settling stopped at %.3g CPU s, past "
 				 "--max-cpu-seconds (%g), %.3g of scene.settle's %g simulated s "
 				 "settled: no estimate knows the steps of integrator.method %s "
 				 "(adaptive); nothing was created: a method of a fixed step (%s), a "
 				 "shorter scene.settle or scene.start \"rest\"",
-				 spent, run_limit, settled, settle, mi->name, names);
+				 spent, run_limit, settled, settle, spec->method.name, names);
 	} else {
 		api_fail(pb, API_RANGE, "scene.settle",
 			 "the steady start's settling stopped at %.3g CPU s, past "

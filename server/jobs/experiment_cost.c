@@ -135,6 +135,34 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 	return api_budget(pb, "cpu", bound, 0);
 }
 
+api_err srv_exp_stopped(const srv_experiment *e, const api_spec *spec, double deadline,
+			api_problem *pb)
+{
+	double bound = srv_budget_run_limit(), spent = srv_thread_cpu() - (deadline - bound);
+	const char *what = e->ext.kind == API_EXP_IDENTIFY ? "identify's slopes"
+							    : "control's measurements";
+	char names[96], choices[96];
+	if (srv_budget_fixed_methods(spec, names, sizeof names, choices, sizeof choices)) {
+		const char *field = e->req.fresh ? "session.integrator.method" : "session";
+		api_fail_choices(pb, API_RANGE, field, e->req.fresh ? choices : "",
+				 "%s stopped at %.3g CPU s in this request's thread, past "
+				 "--max-cpu-seconds (%g): no estimate knows the steps of "
+				 "integrator.method %s (adaptive); nothing was started: a session whose "
+				 "integrator.method has a fixed step (%s)", what, spent, bound,
+				 spec->method.name, names);
+	} else {
+		const char *field = e->ext.kind == API_EXP_IDENTIFY ? "identify.beta"
+				    : e->req.fresh			 ? "session.scene.columns"
+									 : "session";
+		api_fail(pb, API_RANGE, field,
+			 "%s stopped at %.3g CPU s in this request's thread, past --max-cpu-seconds "
+			 "(%g), estimated within it; nothing was started: %sa larger integrator.dt or "
+			 "a smaller scene", what, spent, bound,
+			 e->ext.kind == API_EXP_IDENTIFY ? "fewer operating points, " : "");
+	}
+	return api_budget(pb, "cpu", bound, 0);
+}
+
 api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
 {
 	if (e->ext.kind == API_EXP_SCHEDULE)
@@ -150,7 +178,9 @@ api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
 	if (srv_budget_take_settling(&settling, pb) != API_OK)
 		return pb->code;
 	double cpu0 = srv_thread_cpu();
-	api_err err = srv_exp_prepare(e, spec, pb);
+	/* stopped at the bound whatever the method (an adaptive one's steps
+	 * are beyond the estimate): srv_exp_stopped */
+	api_err err = srv_exp_prepare(e, spec, cpu0 + srv_budget_run_limit(), pb);
 	srv_budget_give_settling(&settling);
 	srv_log(SRV_LOG_DEBUG, "experiment: measured for %.3g CPU s in the request's thread, "
 		"estimated at %.3g", srv_thread_cpu() - cpu0, estimate);

@@ -105,8 +105,21 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 /* Before the experiment runs (the request's thread, spec: its session's
  * scene): the v(beta) curve and its branch, the setpoints checked and
  * their feedforward beta, "auto" gains; an identification's comparison
- * slopes. API_OK or the problem (422 naming the field). */
-api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb);
+ * slopes; each measurement stopped once this thread's CPU clock passes
+ * deadline (srv_thread_cpu; the scheduled disturbances' curves are then
+ * left to the worker). API_OK or the problem (422 naming the field;
+ * srv_exp_stopped's where a measurement was stopped). */
+api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, double deadline,
+			api_problem *pb);
+/* The refusal of e's measurements stopped at --max-cpu-seconds
+ * (deadline: where the request's thread reached it): 422 budget "cpu"
+ * with the CPU spent and the limit, naming session.integrator.method
+ * (a fresh session; the methods of a fixed step as choices) or session
+ * where the method is adaptive (no estimate knows its steps), else
+ * identify.beta, session.scene.columns or session as
+ * srv_exp_measuring_check; nothing started. Returns API_RANGE. */
+api_err srv_exp_stopped(const srv_experiment *e, const api_spec *spec, double deadline,
+			api_problem *pb);
 /* A closed loop whose session's rotation or omega_ss (status st) is no
  * longer its curve's (lock held): the curve of the scene as it is now,
  * from the cache or measured, its branch taken up (the integral reset,

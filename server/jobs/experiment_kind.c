@@ -53,16 +53,19 @@ static void key_of(const api_spec *spec, curve_key *k)
 	k->p.beta = k->p.beta_rate = 0;
 }
 
-/* v at beta (rad) on spec's scene: a steady measurement. */
-static int measure_at(const api_spec *spec, double beta, double *v, char *msg, size_t len)
+/* v at beta (rad) on spec's scene: a steady measurement, stopped once
+ * this thread's CPU clock passes deadline (INFINITY: never). 0, SIM_ECPU
+ * where stopped, else -1. */
+static int measure_at(const api_spec *spec, double beta, double deadline, double *v, char *msg,
+		      size_t len)
 {
 	sim_params p = spec->params;
 	p.beta = beta;
 	sim_measurement out;
-	int rc = sim_measure(&p, &spec->scene, &spec->method, spec->scene.transient + CURVE_WINDOW,
-			     &out, msg, len);
+	int rc = sim_measure_bounded(&p, &spec->scene, &spec->method,
+				     spec->scene.transient + CURVE_WINDOW, deadline, &out, msg, len);
 	*v = out.transport_velocity;
-	return rc == SIM_OK && isfinite(*v) ? 0 : -1;
+	return rc == SIM_ECPU ? rc : rc == SIM_OK && isfinite(*v) ? 0 : -1;
 }
 
 /* The curve of key k from the cache into v: 0, or -1 when not there. */
@@ -96,16 +99,19 @@ int srv_exp_same_curve(const api_spec *a, const api_spec *b)
 }
 
 /* The curve of spec's scene, from the cache or measured (unlocked while
- * measuring: two requests for a new scene measure it twice). */
-static int curve_of(const api_spec *spec, double *v, char *msg, size_t len)
+ * measuring: two requests for a new scene measure it twice) by deadline
+ * as measure_at; its codes. */
+static int curve_of(const api_spec *spec, double deadline, double *v, char *msg, size_t len)
 {
 	curve_key k;
 	key_of(spec, &k);
 	if (cached(&k, v) == 0)
 		return 0;
-	for (int i = 0; i < API_FF_NODES; i++)
-		if (measure_at(spec, 2.5 * i * DEG, &v[i], msg, len) != 0)
-			return -1;
+	for (int i = 0; i < API_FF_NODES; i++) {
+		int rc = measure_at(spec, 2.5 * i * DEG, deadline, &v[i], msg, len);
+		if (rc != 0)
+			return rc;
+	}
 	pthread_mutex_lock(&cache.lock);
 	int at = cache.next;
 	cache.next = (cache.next + 1) % CURVES;
@@ -127,7 +133,7 @@ static void *measure_thread(void *arg)
 	api_spec *spec = arg;
 	double v[API_FF_NODES];
 	char msg[200];
-	if (curve_of(spec, v, msg, sizeof msg) != 0)
+	if (curve_of(spec, INFINITY, v, msg, sizeof msg) != 0)
 		srv_log(SRV_LOG_WARN, "no v(beta) curve at omega_ss %g rad/s: %s",
 			spec->params.omega_ss, msg);
 	free(spec);
@@ -230,9 +236,10 @@ int srv_exp_dist_specs(const api_exp_ext *x, const api_spec *spec, api_spec *out
 }
 
 /* The curves the scheduled disturbances of rotation or omega_ss lead to,
- * measured now into the cache (the request's thread), so that the worker
+ * measured now into the cache (the request's thread, until deadline: one
+ * stopped is measured when the session gets there), so that the worker
  * finds them there when the session gets there. */
-static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
+static void prefetch_curves(const api_exp_ext *x, const api_spec *spec, double deadline)
 {
 	api_spec *at = malloc(API_EXP_MAX_DIST * sizeof *at);
 	if (!at)
@@ -241,7 +248,7 @@ static void prefetch_curves(const api_exp_ext *x, const api_spec *spec)
 	for (int k = 0; k < n; k++) {
 		double v[API_FF_NODES];
 		char msg[200];
-		curve_of(&at[k], v, msg, sizeof msg);
+		curve_of(&at[k], deadline, v, msg, sizeof msg);
 	}
 	free(at);
 }
@@ -291,16 +298,17 @@ void srv_exp_follow_curve(srv_experiment *e, const sim_status *st)
 
 /* An identification on a scratch instance of spec at beta0 (rad): the
  * schedule an "identify" experiment runs (settle, +d, back, -d, back, each
- * h long), sampled by the same period clock. */
+ * h long), sampled by the same period clock, stopped by deadline as
+ * measure_at; its codes. */
 static int identify_scratch(const api_spec *spec, double beta0, double d, double h,
-			    double rate, api_fopdt *m, char *msg, size_t len)
+			    double rate, double deadline, api_fopdt *m, char *msg, size_t len)
 {
 	sim_params p = spec->params;
 	p.beta = beta0;
 	int err;
-	sim *s = sim_new(&p, &spec->scene, &spec->method, &err, msg, len);
+	sim *s = sim_new_bounded(&p, &spec->scene, &spec->method, deadline, NULL, &err, msg, len);
 	if (!s)
-		return -1;
+		return err == SIM_ECPU ? err : -1;
 	sim_status st;
 	sim_get_status(s, &st);
 	double period = srv_exp_period_of(&st), last[3] = {-1, 0, 0};
@@ -313,7 +321,8 @@ static int identify_scratch(const api_spec *spec, double beta0, double d, double
 	double t_next = st.t + period;
 	while (rc == 0 && n < cap) {
 		double t_step = h * k, target = fmin(t_next, t_step);
-		rc = sim_advance(s, target) == SIM_OK ? 0 : -1;
+		rc = sim_advance_bounded(s, target, deadline);
+		rc = rc == SIM_OK ? 0 : rc == SIM_ECPU ? rc : -1;
 		sim_get_status(s, &st);
 		if (rc == 0 && target == t_next) {
 			double vk = srv_exp_clock_tick(&period, last, &st);
@@ -339,7 +348,7 @@ static int identify_scratch(const api_spec *spec, double beta0, double d, double
 	free(t);
 	free(v);
 	sim_free(s);
-	return rc == 0 && m->ok ? 0 : -1;
+	return rc == SIM_ECPU ? rc : rc == 0 && m->ok ? 0 : -1;
 }
 
 /* Each setpoint within the branch's range, its beta the feedforward's. */
@@ -371,7 +380,8 @@ static api_err check_setpoints(srv_experiment *e, api_problem *pb)
 }
 
 /* "auto": SIMC gains from an identification at the first setpoint. */
-static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *pb)
+static api_err auto_gains(srv_experiment *e, const api_spec *spec, double deadline,
+			  api_problem *pb)
 {
 	api_exp_ext *x = &e->ext;
 	char msg[200] = "";
@@ -380,8 +390,11 @@ static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *
 	m->beta0 = b0 / DEG;
 	m->step = 4;
 	m->slope = NAN; /* no secant measured for it */
-	if (identify_scratch(spec, b0, m->step, SRV_EXP_SCRATCH_HOLD,
-			     rate > 0 ? rate : spec->params.beta_rate, m, msg, sizeof msg) != 0)
+	int rc = identify_scratch(spec, b0, m->step, SRV_EXP_SCRATCH_HOLD,
+				  rate > 0 ? rate : spec->params.beta_rate, deadline, m, msg, sizeof msg);
+	if (rc == SIM_ECPU)
+		return srv_exp_stopped(e, spec, deadline, pb);
+	if (rc != 0)
 		return api_fail(pb, API_INVALID, "control.controller",
 				"control.controller \"auto\": the identification at %g deg gave no "
 				"model (%s); give kp and ki", m->beta0, msg);
@@ -399,7 +412,8 @@ static api_err auto_gains(srv_experiment *e, const api_spec *spec, api_problem *
 				  "and ki");
 }
 
-api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb)
+api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, double deadline,
+			api_problem *pb)
 {
 	api_exp_ext *x = &e->ext;
 	char msg[200] = "";
@@ -413,8 +427,14 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 		for (int i = 0; i < x->npoints; i++) {
 			api_fopdt *m = &x->model[i];
 			double a, b;
-			if (measure_at(spec, (m->beta0 - m->step) * DEG, &a, msg, sizeof msg) == 0 &&
-			    measure_at(spec, (m->beta0 + m->step) * DEG, &b, msg, sizeof msg) == 0)
+			int rc = measure_at(spec, (m->beta0 - m->step) * DEG, deadline, &a, msg,
+					    sizeof msg);
+			if (rc == 0)
+				rc = measure_at(spec, (m->beta0 + m->step) * DEG, deadline, &b, msg,
+						sizeof msg);
+			if (rc == SIM_ECPU)
+				return srv_exp_stopped(e, spec, deadline, pb);
+			if (rc == 0)
 				m->slope = (b - a) / (2 * m->step);
 		}
 		return API_OK;
@@ -422,7 +442,10 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 	if (x->kind != API_EXP_CONTROL)
 		return API_OK;
 	double v[API_FF_NODES];
-	if (curve_of(spec, v, msg, sizeof msg) != 0)
+	int rc = curve_of(spec, deadline, v, msg, sizeof msg);
+	if (rc == SIM_ECPU)
+		return srv_exp_stopped(e, spec, deadline, pb);
+	if (rc != 0)
 		return api_fail(pb, API_INVALID, "control",
 				"control: the machine's v(beta) curve could not be measured (%s)", msg);
 	if (curve_into(x, v) != 0)
@@ -433,9 +456,9 @@ api_err srv_exp_prepare(srv_experiment *e, const api_spec *spec, api_problem *pb
 	x->curve_changes = 0;
 	api_err err = check_setpoints(e, pb);
 	if (err == API_OK && x->auto_gains)
-		err = auto_gains(e, spec, pb);
+		err = auto_gains(e, spec, deadline, pb);
 	if (err == API_OK)
-		prefetch_curves(x, spec);
+		prefetch_curves(x, spec, deadline);
 	x->integ = 0;
 	x->t_sample = 0;
 	x->period = NAN; /* measured from the start */
