@@ -3,7 +3,8 @@
  * cpu_bound.c - a bound on the calling thread's CPU for the calls that run
  * long in one piece: the steady start's settling in sim_new_bounded (an
  * adaptive method's steps follow the solution, so no estimate before it
- * knows them) and an advance over a long span (sim_advance_bounded). The
+ * knows them) and an advance over a long span (sim_advance_bounded; both
+ * in sim_bounded.c, above sim.c, which reads the bound here). The
  * deadline is a time on the thread's CPU clock (CLOCK_THREAD_CPUTIME_ID,
  * POSIX in libc; no callback into the caller), read after every so many
  * steps: each read sets the next stride from what the steps since the last
@@ -54,23 +55,9 @@ int cpu_bound_read(cpu_bound *b)
 	return 0;
 }
 
-sim *sim_new_bounded(const sim_params *p, const sim_scene *sc, const sim_method *m,
-		     double cpu_deadline, double *settled, int *err, char *msg, size_t msglen)
-{
-	return sim_new_windowed(p, sc, m, 0.0, cpu_deadline, settled, err, msg, msglen);
-}
-
 void sim_bound_cpu(sim *s, double deadline)
 {
 	cpu_bound_start(&s->cpu, deadline);
 	if (s->shadow) /* it steps beside the instance, on the same thread */
 		cpu_bound_start(&s->shadow->cpu, deadline);
-}
-
-int sim_advance_bounded(sim *s, double t_end, double cpu_deadline)
-{
-	sim_bound_cpu(s, cpu_deadline);
-	int e = sim_advance(s, t_end);
-	sim_bound_cpu(s, INFINITY);
-	return e;
 }

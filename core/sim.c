@@ -110,21 +110,6 @@ static void zero_observers(sim *s, int origins)
 	sim_update_status(s);
 }
 
-/* Whether settle_reduced settles s (its conditions; the reduced scene's
- * own checks hold wherever these do). */
-static int reduced_settles(const sim *s)
-{
-	const model *md = &s->md;
-	return md->sc.settle > 0.0 && md->nf > 0 && !md->alpha_fixed &&
-	       md->layout == MODEL_LAYOUT_TROUGH3 && model_machine_symmetric(&md->p) &&
-	       s->ode->info.substeps;
-}
-
-int sim_settle_columns(const sim *s)
-{
-	return s->md.nf == 0 ? 0 : reduced_settles(s) ? 1 : s->md.dk.K;
-}
-
 /* The settling of a full model (trough_rotation) on a symmetric machine
  * with the Kloss drive and dem, done through the symmetric reduction:
  * there alpha = 0 and identical columns are the full model's solution
@@ -138,7 +123,7 @@ int sim_settle_columns(const sim *s)
 static int settle_reduced(sim *s)
 {
 	const model *md = &s->md;
-	if (!reduced_settles(s))
+	if (!sim_reduced_settles(s))
 		return -1;
 	sim_scene rsc = md->sc;
 	rsc.trough_rotation = 0;

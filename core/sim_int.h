@@ -135,6 +135,9 @@ void sim_update_status(sim *s);
  * where it settles through the symmetric reduction (or has it), else every
  * integrated column; 0 without feed. */
 int sim_settle_columns(const sim *s);
+/* Whether the steady start settles s through the symmetric reduction
+ * (sim.c settle_reduced; sim_status.c). */
+int sim_reduced_settles(const sim *s);
 /* What s integrates into st: its step and sub-steps, reductions,
  * coordinates, settle_columns and feed_mass_ratio (sim_status.c; what
  * sim_preview reports and every status carries). */

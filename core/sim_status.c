@@ -197,6 +197,21 @@ void sim_update_status(sim *s)
 	st->rhs_evals = s->sys.rhs_evals;
 	sim_status_shape(s, st);
 }
+/* Whether settle_reduced (sim.c) settles s (its conditions; the reduced
+ * scene's own checks hold wherever these do). */
+int sim_reduced_settles(const sim *s)
+{
+	const model *md = &s->md;
+	return md->sc.settle > 0.0 && md->nf > 0 && !md->alpha_fixed &&
+	       md->layout == MODEL_LAYOUT_TROUGH3 && model_machine_symmetric(&md->p) &&
+	       s->ode->info.substeps;
+}
+
+int sim_settle_columns(const sim *s)
+{
+	return s->md.nf == 0 ? 0 : sim_reduced_settles(s) ? 1 : s->md.dk.K;
+}
+
 
 void sim_status_shape(const sim *s, sim_status *st)
 {

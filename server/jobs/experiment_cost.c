@@ -11,7 +11,7 @@
  * about ten CPU seconds), so they are estimated first with the sessions'
  * cost model (budget_cost.c: each run's settling, then its window and
  * shadow) and refused beyond --max-cpu-seconds, the bound of a steady
- * start's settling in a creating request (docs/hardening.md "Creations
+ * start's settling in a creating request (docs/load.md "Creations
  * that settle").
  */
 #include <stdio.h>
@@ -131,34 +131,6 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 		pb->has_range = 1;
 		pb->min = 1;
 		pb->max = max;
-	}
-	return api_budget(pb, "cpu", bound, 0);
-}
-
-api_err srv_exp_stopped(const srv_experiment *e, const api_spec *spec, double deadline,
-			api_problem *pb)
-{
-	double bound = srv_budget_run_limit(), spent = srv_thread_cpu() - (deadline - bound);
-	const char *what = e->ext.kind == API_EXP_IDENTIFY ? "identify's slopes"
-							    : "control's measurements";
-	char names[96], choices[96];
-	if (srv_budget_fixed_methods(spec, names, sizeof names, choices, sizeof choices)) {
-		const char *field = e->req.fresh ? "session.integrator.method" : "session";
-		api_fail_choices(pb, API_RANGE, field, e->req.fresh ? choices : "",
-				 "%s stopped at %.3g CPU s in this request's thread, past "
-				 "--max-cpu-seconds (%g): no estimate knows the steps of "
-				 "integrator.method %s (adaptive); nothing was started: a session whose "
-				 "integrator.method has a fixed step (%s)", what, spent, bound,
-				 spec->method.name, names);
-	} else {
-		const char *field = e->ext.kind == API_EXP_IDENTIFY ? "identify.beta"
-				    : e->req.fresh			 ? "session.scene.columns"
-									 : "session";
-		api_fail(pb, API_RANGE, field,
-			 "%s stopped at %.3g CPU s in this request's thread, past --max-cpu-seconds "
-			 "(%g), estimated within it; nothing was started: %sa larger integrator.dt or "
-			 "a smaller scene", what, spent, bound,
-			 e->ext.kind == API_EXP_IDENTIFY ? "fewer operating points, " : "");
 	}
 	return api_budget(pb, "cpu", bound, 0);
 }

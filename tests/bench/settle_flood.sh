@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # A burst of large creations beside running sessions, the previous build
 # beside this one in the same minutes (tests/bench/settle_flood.mjs, about
-# a minute): the figures behind docs/hardening.md "Creations that settle".
+# a minute): the figures behind docs/load.md "Creations that settle".
 # The previous build is commit PREV (default 3fec5b4: main before
 # --max-settling), exported with git archive and built once into
 # $BUILD/prev-PREV (`make build/convsimd`); PREV_CONVSIMD names a built one
