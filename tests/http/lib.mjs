@@ -344,3 +344,22 @@ export async function fillPaced(d, limit, held, least = 1e-4) {
   }
   return { ids, cost, fit };
 }
+
+// A POST whose work in the request's thread an adaptive method (dopri5)
+// ran past --max-cpu-seconds (limit): 422 out-of-range naming field with
+// the methods of a fixed step as its choices, budget cpu at limit
+// (settle_stop.test.mjs, measure_stop.test.mjs). Returns the detail, for
+// the caller's own pattern, and the answer's wall time in ms.
+export async function postStoppedAdaptive(base, path, body, field, limit) {
+  const t0 = performance.now();
+  const r = await req(base, 'POST', path, body);
+  const ms = performance.now() - t0;
+  assert.equal(r.status, 422, r.text);
+  assert.equal(r.headers.get('content-type'), 'application/problem+json');
+  const { detail, ...rest } = r.body;
+  assert.deepEqual(rest, {
+    type: '/api/v1/problems/out-of-range', title: 'Value out of range', status: 422,
+    instance: path, field, budget: 'cpu', limit, choices: ['rk4', 'euler', 'dem'],
+  });
+  return { detail, ms };
+}
