@@ -218,9 +218,11 @@ static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Resu
 		atomic_fetch_sub(&srv_stats.stream_clients, 1);
 		srv_session_put(k->s);
 		free(k);
-		*res = srv_fail(r, API_LIMIT, NULL,
-				"%d stream clients are connected, the limit "
-				"(--max-streams)", cfg->max_streams);
+		api_fail(&pb, API_LIMIT, NULL,
+			 "%d stream clients are connected, the limit (--max-streams)",
+			 cfg->max_streams);
+		api_budget(&pb, "streams", cfg->max_streams, 1);
+		*res = srv_reply_problem(r, &pb, NULL);
 		return 0;
 	}
 	srv_session_feed_size(k->s, columns, layers);

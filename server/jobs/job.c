@@ -174,7 +174,9 @@ enum MHD_Result srv_h_job_create(srv_req *r)
 		return srv_reply_problem(r, &pb, NULL);
 	if (srv_registry_reserve_claim(kind->reg, e, kind->evictable, &victim)) {
 		kind->discard(e);
-		return srv_fail(r, API_LIMIT, NULL, "%zu %s", kind->reg->cap, kind->limit);
+		api_fail(&pb, API_LIMIT, NULL, "%zu %s", kind->reg->cap, kind->limit);
+		api_budget(&pb, kind->plural, (double)kind->reg->cap, 1);
+		return srv_reply_problem(r, &pb, NULL);
 	}
 	srv_registry_publish(kind->reg, e);
 	char *text = NULL;

@@ -27,7 +27,8 @@
 typedef struct srv_job_kind {
 	const char *name;      /* "sweep": the word in its problems and logs */
 	const char *plural;    /* "sweeps": /api/v1/{plural}, the listing's
-				  member, the data directory's sub-directory */
+				  member, the data directory's sub-directory,
+				  the 429's budget */
 	srv_registry *reg;     /* where its jobs live (capped) */
 	int created_status;    /* POST's status: 202 (queued) or 201 */
 	const char *limit;     /* the 429's detail after the registry's cap */
