@@ -102,9 +102,35 @@ static api_err admit_session(const srv_session *s, api_problem *pb)
 	return API_OK;
 }
 
+/* A refusal of the paced cores for s at pace (e, *pb): a pace that alone
+ * needs more than the whole budget is 422 stating pace's range, the
+ * greatest pace that fits as max (or "max", pace's one choice, where none
+ * does), so it names the pace, pace_field ("pace" in a PATCH,
+ * "session.pace" in an experiment's body); who, which asked for that pace
+ * without giving it (running, until, cpu_budget, "the experiment"), is
+ * named in the detail. A 503 names who (lock held). */
+static api_err pace_refused(srv_session *s, double pace, const char *pace_field,
+			    const char *who, api_err e, api_problem *pb)
+{
+	if (e != API_RANGE)
+		return e;
+	if (pb->has_range)
+		pb->max = srv_budget_greatest_pace(srv_paced_cost_of, s, srv_budget_paced_limit());
+	else
+		snprintf(pb->choices, sizeof pb->choices, "max");
+	if (strcmp(pb->field, pace_field) != 0) {
+		char detail[sizeof pb->detail];
+		memcpy(detail, pb->detail, sizeof detail);
+		snprintf(pb->detail, sizeof pb->detail, "%.16s would run it at its pace %g: %.260s",
+			 who, pace, detail);
+		snprintf(pb->field, sizeof pb->field, "%s", pace_field);
+	}
+	return e;
+}
+
 /* The paced cores s needs after c: raise its hold before c is queued, or
- * refuse (lock held). The field named is the one that raises it; a pace
- * beyond the whole budget is 422 with the greatest pace that fits it. */
+ * refuse (lock held). A 503 names the member that raises it; a pace beyond
+ * the whole budget is pace_refused's 422. */
 static api_err admit_paced(srv_session *s, const api_control *c,
 			   api_problem *pb)
 {
@@ -119,9 +145,7 @@ static api_err admit_paced(srv_session *s, const api_control *c,
 						       : "until";
 	api_err e = srv_budget_take_paced(&s->budget.paced_held, srv_paced_cost(s, pace), pace,
 					  field, "changed", pb);
-	if (e == API_RANGE && pb->has_range)
-		pb->max = srv_budget_greatest_pace(srv_paced_cost_of, s, srv_budget_paced_limit());
-	return e;
+	return pace_refused(s, pace, "pace", field, e, pb);
 }
 
 /* Admit c to s, the first refusal winning, in this fixed order: the
@@ -204,9 +228,11 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 			      "the session already runs experiment %s",
 			      srv_exp_id(s->exp));
 	else if (s->state == SRV_FINISHED && s->pace != API_PACE_MAX &&
-		 (rc = srv_budget_take_paced(&s->budget.paced_held,
-					     srv_paced_cost(s, s->pace), s->pace, "session", "attached",
-					     pb)) != API_OK)
+		 (rc = pace_refused(s, s->pace, "session.pace", "the experiment",
+				    srv_budget_take_paced(&s->budget.paced_held,
+							  srv_paced_cost(s, s->pace), s->pace,
+							  "session", "attached", pb),
+				    pb)) != API_OK)
 		; /* the experiment would run it on (worker.c extend_until)
 		     past the cores for paced sessions: nothing attached */
 	else {
