@@ -94,8 +94,12 @@ static api_err parse_points(const cJSON *root, fit_request *req, fit_point **pts
 		    SIM_OK) {
 			char what[FIT_MSG + 8];
 			snprintf(what, sizeof what, "csv: %s", msg);
-			return rows.has ? data_count(pb, "csv", what, req, FIT_MAX_POINTS)
-					: api_fail(pb, API_INVALID, "csv", "%s", what);
+			if (rows.has)
+				return data_count(pb, "csv", what, req, FIT_MAX_POINTS);
+			if (rows.choices) /* a row's rotation */
+				return api_fail_choices(pb, API_RANGE, "csv", rows.choices, "%s",
+							what);
+			return api_fail(pb, API_INVALID, "csv", "%s", what);
 		}
 		req->points = *pts;
 		return API_OK;

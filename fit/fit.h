@@ -34,10 +34,13 @@
 /* The range a refused value had to lie in, in its user unit, for answers
  * that give it (the API's min and max): fit_check_range, fit_add_free and fit_set_prior fill it (when
  * not NULL), has 0 for a refusal of another kind. An open end is given as
- * its limit: (0, 0.5] is min 0, max 0.5. */
+ * its limit: (0, 0.5] is min 0, max 0.5. A refused choice (a CSV row's
+ * rotation) has its choices instead ("cw|ccw", the settings table's),
+ * else choices is NULL. */
 typedef struct fit_range {
 	int has;
 	double min, max;
+	const char *choices;
 } fit_range;
 
 /* One measured point: beta (rad), rotation SIM_CW / SIM_CCW, v (m/s) and
@@ -309,7 +312,8 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
  * plain decimal one (decimal.h; spaces around a cell allowed, not 0x10,
  * inf or nan). Returns SIM_OK, or SIM_EPARAM with a message naming the
  * line and column; for more than FIT_MAX_POINTS data rows, with *range
- * (when not NULL) the counts a CSV may hold, 1 to FIT_MAX_POINTS. */
+ * (when not NULL) the counts a CSV may hold, 1 to FIT_MAX_POINTS; for a
+ * rotation neither cw nor ccw, with range->choices. */
 int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_t len,
 		  fit_range *range);
 

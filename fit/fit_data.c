@@ -79,7 +79,7 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 	int err;
 	snprintf(field, flen, "name");
 	if (range)
-		range->has = 0;
+		*range = (fit_range){0};
 	const sim_setting *t = fit_free_param(name, &err, msg, mlen);
 	if (!t)
 		return err;
@@ -99,7 +99,7 @@ int fit_add_free(fit_request *req, const char *name, double lo_user, double hi_u
 		int at_min = !(lo >= t->min && lo < t->max);
 		snprintf(field, flen, "%s", at_min ? "min" : "max");
 		if (range)
-			*range = (fit_range){1, at_min ? t->min : lo, t->max};
+			*range = (fit_range){.has = 1, .min = at_min ? t->min : lo, .max = t->max};
 		snprintf(msg, mlen, "the bounds of '%s' must satisfy %g <= min < max <= %g %s", name,
 			 t->min, t->max, sim_unit_shown(t));
 		return SIM_EPARAM;
@@ -152,9 +152,10 @@ static int parse_header(const char *line, size_t len, int col[NCOLS], char *msg,
 	return k;
 }
 
-/* One data line of ncol cells into *pt. */
+/* One data line of ncol cells into *pt; a rotation that is no sense
+ * with its choices in *range (when not NULL). */
 static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit_point *pt,
-		     char *msg, size_t mlen)
+		     char *msg, size_t mlen, fit_range *range)
 {
 	char *cell[16] = {0};
 	int k = 0;
@@ -187,6 +188,8 @@ static int parse_row(char *line, int lineno, const int col[NCOLS], int ncol, fit
 	r[strcspn(r, " \r")] = '\0';
 	if (strcmp(r, "cw") != 0 && strcmp(r, "ccw") != 0) {
 		snprintf(msg, mlen, "CSV line %d: rotation must be cw or ccw, got '%.40s'", lineno, r);
+		if (range)
+			range->choices = sim_setting_find("rotation")->choices;
 		return -1;
 	}
 	pt->beta = num[COL_BETA] * RAD_PER_DEG;
@@ -203,7 +206,7 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 	*out = NULL;
 	*n = 0;
 	if (range)
-		range->has = 0;
+		*range = (fit_range){0};
 	size_t len = strlen(text);
 	char *buf = malloc(len + 1);
 	fit_point *pts = malloc(sizeof *pts * FIT_MAX_POINTS);
@@ -232,9 +235,9 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 			snprintf(msg, mlen, "CSV line %d: more than %d points", lineno,
 				 FIT_MAX_POINTS);
 			if (range)
-				*range = (fit_range){1, 1, FIT_MAX_POINTS};
+				*range = (fit_range){.has = 1, .min = 1, .max = FIT_MAX_POINTS};
 			rc = SIM_EPARAM;
-		} else if (parse_row(line, lineno, col, ncol, &pts[*n], msg, mlen) == 0) {
+		} else if (parse_row(line, lineno, col, ncol, &pts[*n], msg, mlen, range) == 0) {
 			(*n)++;
 		} else {
 			rc = SIM_EPARAM;
@@ -264,11 +267,11 @@ int fit_parse_csv(const char *text, fit_point **out, size_t *n, char *msg, size_
 	} while (0)
 
 /* A value outside [lo, hi] (user unit): FAIL with the range. */
-#define FAIL_RANGE(f, lo, hi, ...)                           \
-	do {                                                 \
-		if (range)                                   \
-			*range = (fit_range){1, lo, hi};     \
-		FAIL(f, __VA_ARGS__);                        \
+#define FAIL_RANGE(f, lo, hi, ...)                                             \
+	do {                                                                   \
+		if (range)                                                     \
+			*range = (fit_range){.has = 1, .min = lo, .max = hi};  \
+		FAIL(f, __VA_ARGS__);                                          \
 	} while (0)
 
 /* name: the field's ("points[2]"); who: the messages' ("CSV line 4") */
@@ -358,7 +361,7 @@ int fit_check_range(const fit_request *r, char *field, size_t flen, char *msg, s
 		    fit_range *range)
 {
 	if (range)
-		range->has = 0;
+		*range = (fit_range){0};
 	if (sim_validate(&r->p, &r->sc, &r->m, msg, mlen) != SIM_OK) {
 		snprintf(field, flen, "params");
 		return SIM_EPARAM;

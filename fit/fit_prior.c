@@ -54,7 +54,7 @@ static void out_of(const char *name, double lo, double hi, const char **member,
 	if (member)
 		*member = name;
 	if (range)
-		*range = (fit_range){1, lo, hi};
+		*range = (fit_range){.has = 1, .min = lo, .max = hi};
 }
 
 int fit_set_prior(fit_request *req, const char *name, double mean, double sd, double factor,
@@ -63,7 +63,7 @@ int fit_set_prior(fit_request *req, const char *name, double mean, double sd, do
 	if (member)
 		*member = NULL;
 	if (range)
-		range->has = 0;
+		*range = (fit_range){0};
 	fit_free *f = NULL;
 	fit_prior *pr = NULL;
 	for (int j = 0; j < req->nfree && !f; j++)

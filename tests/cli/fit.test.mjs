@@ -35,6 +35,8 @@ test('bad input: exit 2 with a message naming the problem, nothing on stdout', (
      /^convsim fit: --data \S*fast\.csv: CSV line 6: v must be a finite number in \[-100, 100\] m\/s$/m],
     [['--data', file('gap.csv', 'beta,rotation,v\n30,cw,0.1\n\n\n60,cw,abc\n'), '--free', 'e'],
      /^convsim fit: --data \S*gap\.csv: CSV line 5: v must be a number, got 'abc'$/m],
+    [['--data', file('rot.csv', 'beta,rotation,v\n30,cw,0.1\n60, x ,0.05\n'), '--free', 'e'],
+     /^convsim fit: --data \S*rot\.csv: CSV line 3: rotation must be cw or ccw, got 'x'$/m],
     [['--data', good, '--free', 'ee'], /--free: unknown parameter 'ee' \(did you mean 'e'\?\)/],
     [['--data', good, '--free', 'rotation'], /--free: 'rotation' cannot be fitted/],
     [['--data', good, '--free', 'beta'], /--free: 'beta' cannot be fitted/],

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A refusal states what would be taken (docs/api-errors.md), byte for
 // byte: a choice outside its choices carries `choices` (a sweep's
-// rotations, a fit point's or peak's rotation, scene.feed_model where a
+// rotations, a fit point's, peak's or CSV row's rotation, scene.feed_model where a
 // sweep or this daemon takes fewer than the setting has, integrator.method
 // beside a LIGGGHTS bed, a pace no real-time factor can hold), a number
 // outside its range `min` and `max` (an identification's operating point
@@ -70,6 +70,13 @@ test("a fit point's or peak's rotation that is no sense: its choices, the point 
     [fit({ points: undefined, peaks: [{ rotation: 'cw', beta: 38 }, { rotation: 'both', beta: 140 }] }),
       problem('out-of-range', '/api/v1/fits', 'peaks[1].rotation must be "cw" or "ccw"',
         { field: 'peaks[1].rotation', choices: ROTATION })],
+    // a CSV's rotation cell: the csv named, its line in the detail
+    [fit({ points: undefined, csv: 'beta,rotation,v\n20,cw,0.07\n\n40, x ,0.06\n60,cw,0.05\n' }),
+      problem('out-of-range', '/api/v1/fits', "csv: CSV line 4: rotation must be cw or ccw, got 'x'",
+        { field: 'csv', choices: ROTATION })],
+    [fit({ points: undefined, csv: 'v,beta,rotation\n0.07,20,CW\n' }),
+      problem('out-of-range', '/api/v1/fits', "csv: CSV line 2: rotation must be cw or ccw, got 'CW'",
+        { field: 'csv', choices: ROTATION })],
   ]);
   assert.deepEqual(await listed(), was, 'nothing started');
 });

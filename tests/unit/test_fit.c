@@ -209,10 +209,18 @@ static void parses_csv(void **state)
 			      "CSV line 2: v must be a number, got '0x10'",
 			      "CSV line 2: sigma must be a number, got 'inf'"};
 	for (int i = 0; i < 6; i++) {
-		assert_int_equal(fit_parse_csv(bad[i], &pts, &n, msg, sizeof msg, NULL), SIM_EPARAM);
+		fit_range range;
+		assert_int_equal(fit_parse_csv(bad[i], &pts, &n, msg, sizeof msg, &range),
+				 SIM_EPARAM);
 		printf("  %s\n", msg);
 		assert_non_null(strstr(msg, says[i]));
 		assert_null(pts);
+		/* the rotation's refusal has its choices, the others none */
+		assert_false(range.has);
+		if (i == 3)
+			assert_string_equal(range.choices, "cw|ccw");
+		else
+			assert_null(range.choices);
 	}
 }
 
