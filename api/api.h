@@ -244,13 +244,17 @@ api_err api_negotiate(const api_route *rt, const char *format, const char *accep
  * headers (each NULL when absent): ?format= sse or ndjson (without it,
  * an Accept naming application/x-ndjson), ?fields= (api_parse_fields),
  * ?rate= in (0, 100000], ?limit= an integer from 1 to API_STREAM_LIMIT_MAX
- * (its refusal with that range as min and max), and the record to resume
- * after, Last-Event-ID or else ?since=, a non-negative integer. API_OK or
- * a 400 bad-query problem naming the parameter. */
+ * and the record to resume after, Last-Event-ID or else ?since=, an
+ * integer from 0 to API_STREAM_ID_MAX (each refusal with its range as min
+ * and max). API_OK or a 400 bad-query problem naming the parameter. */
 /* The most records ?limit= takes: 2^53, the largest count a JSON number
  * (a double) holds exactly, so that a refusal's max is the number itself
  * (a stream of a million records a second would take 285 years). */
 #define API_STREAM_LIMIT_MAX 9007199254740992
+/* The largest record id Last-Event-ID and ?since= take: 2^53 too, for the
+ * same reason (ids count a session's records from 0; 2^63 - 1, the end
+ * before, is no number JSON states exactly). */
+#define API_STREAM_ID_MAX 9007199254740992
 typedef struct api_stream_query {
 	int ndjson;
 	unsigned fields;   /* API_F_* */

@@ -191,17 +191,20 @@ static cJSON *content(const char *media, cJSON *schema)
 
 /* The operation object of route rt. */
 /* The route's parameters: the path's id, its query parameters, and
- * Last-Event-ID where it resumes. */
+ * Last-Event-ID where it resumes (the schema of ?since=, which it is). */
 static void add_parameters(cJSON *op, const api_route *rt)
 {
 	size_t nq;
 	const api_query *q = api_queries(&nq);
+	const char *since = NULL;
 	cJSON *params = cJSON_AddArrayToObject(op, "parameters");
 	if (strchr(rt->pattern, '*'))
 		cJSON_AddItemToArray(params, ref("parameters", "Id"));
 	for (size_t i = 0; i < nq; i++) {
 		if (!(rt->query & q[i].bit))
 			continue;
+		if (q[i].bit == API_Q_SINCE)
+			since = q[i].schema;
 		cJSON *p = cJSON_CreateObject();
 		cJSON_AddStringToObject(p, "name", q[i].name);
 		cJSON_AddStringToObject(p, "in", "query");
@@ -209,11 +212,11 @@ static void add_parameters(cJSON *op, const api_route *rt)
 		cJSON_AddItemToObject(p, "schema", cJSON_Parse(q[i].schema));
 		cJSON_AddItemToArray(params, p);
 	}
-	if (rt->query & API_Q_SINCE) {
+	if (since) {
 		cJSON *p = cJSON_CreateObject();
 		cJSON_AddStringToObject(p, "name", "Last-Event-ID");
 		cJSON_AddStringToObject(p, "in", "header");
-		cJSON_AddItemToObject(p, "schema", cJSON_Parse("{\"type\":\"integer\",\"minimum\":0}"));
+		cJSON_AddItemToObject(p, "schema", cJSON_Parse(since));
 		cJSON_AddItemToArray(params, p);
 	}
 }

@@ -39,7 +39,8 @@ static const api_query queries[] = {
 	{API_Q_LIMIT, "limit",
 	 "{\"type\":\"integer\",\"minimum\":1,\"maximum\":" TEXT(API_STREAM_LIMIT_MAX) "}",
 	 "end after this many records"},
-	{API_Q_SINCE, "since", "{\"type\":\"integer\",\"minimum\":0}",
+	{API_Q_SINCE, "since",
+	 "{\"type\":\"integer\",\"minimum\":0,\"maximum\":" TEXT(API_STREAM_ID_MAX) "}",
 	 "resume after this record id (as Last-Event-ID)"},
 	{API_Q_SCOPE, "scope", "{\"type\":\"string\",\"enum\":[\"all\",\"local\"]}",
 	 "all (default): this replica's entries and those of its --peers; local: this replica's "
@@ -266,11 +267,14 @@ api_err api_parse_stream_query(const char *format, const char *accept, const cha
 	}
 	const char *v = last_event_id ? last_event_id : since;
 	if (v) {
-		if (!decimal(v, INT64_MAX, &n))
-			return api_fail(pb, API_QUERY, last_event_id ? "Last-Event-ID" : "since",
-					"Last-Event-ID (or since) must be a record "
-					"id, an integer from 0 to %" PRId64, INT64_MAX);
-		q->resume = (int64_t)(n > INT64_MAX - 1 ? INT64_MAX - 1 : n);
+		if (!decimal(v, API_STREAM_ID_MAX, &n)) {
+			api_fail(pb, API_QUERY, last_event_id ? "Last-Event-ID" : "since",
+				 "Last-Event-ID (or since) must be a record id, an integer from 0 "
+				 "to %" PRIu64 " (2^53)", (uint64_t)API_STREAM_ID_MAX);
+			pb->has_range = 1, pb->min = 0, pb->max = (double)API_STREAM_ID_MAX;
+			return API_QUERY;
+		}
+		q->resume = (int64_t)n;
 	}
 	return API_OK;
 }

@@ -85,7 +85,8 @@ static void stream_query(const query *q, const char *accept, const char *last_ev
 	}
 	FUZZ_CHECK(s.fields && !(s.fields & ~(unsigned)API_F_ALL), "fields mask %#x", s.fields);
 	FUZZ_CHECK(s.rate == 0 || (s.rate > 0 && s.rate <= 100000), "rate %g", s.rate);
-	FUZZ_CHECK(s.resume >= -1 && s.resume < INT64_MAX, "resume %" PRId64, s.resume);
+	FUZZ_CHECK(s.resume >= -1 && s.resume <= API_STREAM_ID_MAX, "resume %" PRId64, s.resume);
+	FUZZ_CHECK(s.limit <= API_STREAM_LIMIT_MAX, "limit %" PRIu64, s.limit);
 	char fields[128] = "", rate[40] = "", limit[24] = "", since[24] = "";
 	for (size_t i = 0; i < sizeof groups / sizeof *groups; i++)
 		if (s.fields & groups[i].bit)
