@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api_routes.h"
 #include "json_int.h"
 #include "units.h"
 

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "api_routes.h"
 #include "decimal.h"
 #include "json_int.h"
 #include "suggest.h"

@@ -23,6 +23,7 @@
 #include "cli.h"
 #include "pmap.h"
 #include "sim.h"
+#include "sim_mirror.h"
 #include "spread.h"
 #include "study.h"
 #include "table.h"

@@ -33,6 +33,7 @@
 
 #include "model.h"
 #include "sim.h"
+#include "sim_mirror.h"
 
 /* beta_j counts as pi - beta_i within this (rad): degrees converted to
  * radians land within a few ulps of each other. */

@@ -25,6 +25,7 @@
 
 #include "decimal.h"
 #include "sim.h"
+#include "sim_mirror.h"
 #include "units.h"
 
 typedef struct map_point {

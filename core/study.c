@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sim_mirror.h"
 #include "study.h"
 #include "units.h"
 

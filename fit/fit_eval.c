@@ -21,6 +21,7 @@
 
 #include "fit_int.h"
 #include "pmap.h"
+#include "sim_mirror.h"
 #include "units.h"
 
 int fit_eval_init(fit_eval *ev, const fit_request *req)

@@ -18,6 +18,7 @@
 
 #include "decimal.h"
 #include "fit.h"
+#include "sim_mirror.h"
 #include "units.h"
 
 /* The covariance is finite and its diagonal positive: a band can be made. */

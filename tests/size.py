@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""size.py - the house rule on size (docs/development.md): every C source of
-core/, fit/, cli/, api/, server/ and dem/ at most 500 lines, every function at
+"""size.py - the house rule on size (docs/development.md): every C source and
+header of core/, fit/, cli/, api/, server/ and dem/ at most 500 lines, every function at
 most 80 (from the line that names it to its closing brace), unless the comment
 just above the function gives a reason that starts with "long:".
 
@@ -45,6 +45,7 @@ def self_test():
     assert not over("t.c", "/* long: a table reads better whole */\n" + long_fn), "a reason exempts it"
     assert over("t.c", "x\n" * 501), "a file of 501 lines is over"
     assert not over("t.c", "x\n" * 500), "500 lines is within"
+    assert over("t.h", "x\n" * 501), "a header of 501 lines is over"
     print("size.py: self-test passed")
 
 
@@ -54,7 +55,7 @@ def main():
         return 0
     found = []
     for d in DIRS:
-        for path in sorted(glob.glob(f"{d}/*.c")):
+        for path in sorted(glob.glob(f"{d}/*.c") + glob.glob(f"{d}/*.h")):
             with open(path, encoding="utf-8") as f:
                 found += over(path, f.read())
     for line in found:

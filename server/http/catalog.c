@@ -11,6 +11,7 @@
 #include <pthread.h>
 
 #include "acceptor.h"
+#include "api_routes.h"
 #include "budget.h"
 #include "budget_turns.h"
 #include "catalog.h"

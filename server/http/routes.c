@@ -25,6 +25,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "api_routes.h"
 #include "budget.h"
 #include "catalog.h"
 #include "conns.h"

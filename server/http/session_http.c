@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api_routes.h"
 #include "peers.h"
 #include "session.h"
 #include "session_http.h"

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api_routes.h"
 #include "budget.h"
 #include "metrics.h"
 #include "session.h"

@@ -12,6 +12,7 @@
 
 #include "budget.h"
 #include "fitjob.h"
+#include "sim_mirror.h"
 #include "study.h"
 #include "sweep_int.h"
 #include "units.h"

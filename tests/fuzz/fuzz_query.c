@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api_routes.h"
 #include "fuzz_util.h"
 
 #define MAX_PARAMS 32

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "api_routes.h"
 #include "fuzz_util.h"
 #include "routes.h"
 

@@ -11,6 +11,7 @@
  * integration.
  */
 #include "testutil.h"
+#include "sim_mirror.h"
 
 /* v_ref (m/s) from tests/bench/results/vref.tsv (tests/bench/vref.sh):
  * the full model, rest start, window [16, 32] s, dem with h = 3.125e-6 s;
