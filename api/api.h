@@ -151,6 +151,11 @@ double api_round_inward(double v, int up, int digits);
  * settings table's. Returns API_RANGE. */
 api_err api_fail_range(api_problem *pb, const char *field, double min, double max,
 		       const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+/* A refusal of a body nested in member ("session": a create body within
+ * an experiment's): its field named by the path the client sent,
+ * "member.field", unless it has none or is named so already (a field too
+ * long for the room is left as it was). */
+void api_field_within(api_problem *pb, const char *member);
 /* Copy the id text of field (a session's or a fit's: what names it in
  * the detail) into buf of size bytes, or refuse a length outside 1 to
  * size - 1 bytes with that range (api_fail_range): an id longer than the

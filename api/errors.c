@@ -142,6 +142,17 @@ api_err api_copy_id(api_problem *pb, const char *field, const char *what,
 	return API_OK;
 }
 
+void api_field_within(api_problem *pb, const char *member)
+{
+	size_t m = strlen(member), n = strlen(pb->field);
+	if (!n || (strncmp(pb->field, member, m) == 0 && pb->field[m] == '.') ||
+	    m + 1 + n >= sizeof pb->field)
+		return;
+	memmove(pb->field + m + 1, pb->field, n + 1);
+	memcpy(pb->field, member, m);
+	pb->field[m] = '.';
+}
+
 api_err api_fail_choices(api_problem *pb, api_err code, const char *field, const char *choices,
 			 const char *fmt, ...)
 {

@@ -88,12 +88,8 @@ static api_err parse_session_member(const cJSON *sess, api_experiment_req *req,
 	if (e == API_OK)
 		e = api_validate_spec(&req->spec, pb);
 	cJSON_Delete(empty);
-	/* the member's path in this body: session.scene, not scene */
-	size_t n = strlen(pb->field);
-	if (e != API_OK && n && strncmp(pb->field, "session.", 8) != 0 && n + 8 < sizeof pb->field) {
-		memmove(pb->field + 8, pb->field, n + 1);
-		memcpy(pb->field, "session.", 8);
-	}
+	if (e != API_OK) /* the member's path in this body: session.scene, not scene */
+		api_field_within(pb, "session");
 	return e;
 }
 

@@ -80,8 +80,10 @@ static api_err start_on_session(srv_experiment *e,
 	srv_session *s;
 	if (req->fresh) {
 		s = srv_session_create(&req->spec, e, -1, pb);
-		if (!s)
+		if (!s) { /* its admission names the spec's fields as the client sent them */
+			api_field_within(pb, "session");
 			return pb->code;
+		}
 	} else {
 		s = srv_session_get(req->session_id);
 		if (!s)
