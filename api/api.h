@@ -151,6 +151,10 @@ double api_round_inward(double v, int up, int digits);
  * settings table's. Returns API_RANGE. */
 api_err api_fail_range(api_problem *pb, const char *field, double min, double max,
 		       const char *fmt, ...) __attribute__((format(printf, 5, 6)));
+/* The word for n things in a detail, one when n is 1, else many: "%d
+ * stream client%s %s connected" with api_plural(n, "", "s") and
+ * api_plural(n, "is", "are") reads "1 stream client is connected". */
+const char *api_plural(double n, const char *one, const char *many);
 /* A refusal of a body nested in member ("session": a create body within
  * an experiment's): its field named by the path the client sent,
  * "member.field", unless it has none or is named so already (a field too

@@ -142,6 +142,11 @@ api_err api_copy_id(api_problem *pb, const char *field, const char *what,
 	return API_OK;
 }
 
+const char *api_plural(double n, const char *one, const char *many)
+{
+	return n == 1 ? one : many;
+}
+
 void api_field_within(api_problem *pb, const char *member)
 {
 	size_t m = strlen(member), n = strlen(pb->field);

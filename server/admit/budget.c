@@ -137,10 +137,11 @@ api_err srv_budget_take_session(int columns, int layers, size_t *need,
 		fit--;
 	const char *field = fit > 0 ? "scene.layers" : "scene.columns";
 	api_fail(pb, API_RANGE, field,
-		 "this session needs %.1f MiB (%d x %d feed, %d stream records, "
-		 "%d trajectory rows), more than the whole memory budget of "
+		 "this session needs %.1f MiB (%d x %d feed, %d stream record%s, "
+		 "%d trajectory row%s), more than the whole memory budget of "
 		 "%.1f MiB (--max-memory); %s", mib(*need), columns, layers,
-		 cfg->ring, cfg->history, mib(cfg->max_memory),
+		 cfg->ring, api_plural(cfg->ring, "", "s"), cfg->history,
+		 api_plural(cfg->history, "", "s"), mib(cfg->max_memory),
 		 fit > 0 ? "fewer layers fit" : "fewer columns fit");
 	if (fit == 0) {
 		fit = columns;
@@ -189,9 +190,9 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		int none = !(limit / cpu_per_s >= API_PACE_MIN);
 		api_fail(pb, API_RANGE, field,
 			 "this session needs %.3g cores (%.3g ms of CPU per "
-			 "simulated s at pace %g), more than the %g cores for "
+			 "simulated s at pace %g), more than the %g core%s for "
 			 "paced sessions (--max-paced-cores); nothing was %s, %s",
-			 need, 1e3 * cpu_per_s, pace, limit, verb,
+			 need, 1e3 * cpu_per_s, pace, limit, api_plural(limit, "", "s"), verb,
 			 none ? "no pace from 0.001 fits: run it at pace \"max\""
 			      : "lower the pace");
 		pb->has_range = !none, pb->min = API_PACE_MIN, pb->max = limit / cpu_per_s;
@@ -202,9 +203,9 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 	api_fail(pb, API_UNAVAILABLE, field,
 		 "this session needs %.3g cores (%.3g ms of CPU per simulated s "
 		 "at pace %g) and running paced sessions hold %.3g of the %g "
-		 "cores for paced sessions (--max-paced-cores); nothing was %s, "
+		 "core%s for paced sessions (--max-paced-cores); nothing was %s, "
 		 "retry when paced sessions have ended, paused or slowed down",
-		 need, 1e3 * cpu_per_s, pace, others, limit, verb);
+		 need, 1e3 * cpu_per_s, pace, others, limit, api_plural(limit, "", "s"), verb);
 	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
 }
 
@@ -267,8 +268,8 @@ api_err srv_budget_take_points(size_t n, const char *field, int force,
 	if (n > cap && !force) {
 		api_fail(pb, API_RANGE, field,
 			 "this sweep has %zu points, more than the %zu sweep "
-			 "points that may be queued (--max-queued-points); "
-			 "split it", n, cap);
+			 "point%s that may be queued (--max-queued-points); "
+			 "split it", n, cap, api_plural((double)cap, "", "s"));
 		pb->has_range = 1;
 		pb->min = 1;
 		pb->max = (double)cap;
@@ -283,9 +284,10 @@ api_err srv_budget_take_points(size_t n, const char *field, int force,
 		      (cfg->pool_threads > 0 ? cfg->pool_threads : 1);
 	pthread_mutex_unlock(&lock);
 	api_fail(pb, API_LIMIT, NULL,
-		 "%zu sweep points are queued or running and this sweep adds "
+		 "%zu sweep point%s %s queued or running and this sweep adds "
 		 "%zu: the budget is %zu (--max-queued-points); nothing was "
-		 "queued", queued, n, cap);
+		 "queued", queued, api_plural((double)queued, "", "s"),
+		 api_plural((double)queued, "is", "are"), n, cap);
 	return api_budget(pb, "sweep-points", (double)cap,
 			  wait < 1 ? 1 : wait > 3600 ? 3600 : (int)(wait + 0.999));
 }
@@ -464,10 +466,11 @@ int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
 		return 0;
 	atomic_fetch_add(&client_refused, 1);
 	api_fail(pb, API_LIMIT, NULL,
-		 "this client address has more than %d connections open, its "
+		 "this client address has more than %d connection%s open, its "
 		 "budget (--max-client-connections), and every other one is "
 		 "being answered (an idle or slow one would have been closed to "
-		 "make room); close some and retry", cfg->max_client_connections);
+		 "make room); close some and retry", cfg->max_client_connections,
+		 api_plural(cfg->max_client_connections, "", "s"));
 	api_budget(pb, "connections", cfg->max_client_connections, 1);
 	pb->close = 1; /* one too many: the answer closes it */
 	return 1;

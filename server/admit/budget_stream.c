@@ -52,9 +52,9 @@ api_err srv_budget_take_stream(double *held, double before, double after,
 	api_fail(pb, API_UNAVAILABLE, NULL,
 		 "this stream needs %.3g cores (%.3g ms of CPU per simulated s at "
 		 "pace %g) and running paced sessions and their streams hold %.3g "
-		 "of the %g cores for paced sessions (--max-paced-cores); nothing "
+		 "of the %g core%s for paced sessions (--max-paced-cores); nothing "
 		 "was opened, retry when some have ended or paused, or ask fewer "
 		 "records (rate, fields)",
-		 stream * pace, 1e3 * stream, pace, taken, limit);
+		 stream * pace, 1e3 * stream, pace, taken, limit, api_plural(limit, "", "s"));
 	return api_budget(pb, "cpu", limit, STREAM_RETRY_S);
 }

@@ -435,8 +435,8 @@ enum MHD_Result srv_dispatch(void *cls, struct MHD_Connection *conn,
 	st->r.body_len = st->len;
 	if (st->too_large) {
 		api_problem pb;
-		api_fail(&pb, API_TOOLARGE, NULL, "the body exceeds the limit of %zu bytes "
-			 "(--max-body)", cfg->max_body);
+		api_fail(&pb, API_TOOLARGE, NULL, "the body exceeds the limit of %zu byte%s "
+			 "(--max-body)", cfg->max_body, api_plural((double)cfg->max_body, "", "s"));
 		return too_large(&st->r, &pb);
 	}
 	if (srv_stopping() && strncmp(url, "/api/", 5) == 0)

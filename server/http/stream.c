@@ -220,8 +220,9 @@ static int admit(srv_req *r, stream *k, int *columns, int *layers, enum MHD_Resu
 		srv_session_put(k->s);
 		free(k);
 		api_fail(&pb, API_LIMIT, NULL,
-			 "%d stream clients are connected, the limit (--max-streams)",
-			 cfg->max_streams);
+			 "%d stream client%s %s connected, the limit (--max-streams)",
+			 cfg->max_streams, api_plural(cfg->max_streams, "", "s"),
+			 api_plural(cfg->max_streams, "is", "are"));
 		api_budget(&pb, "streams", cfg->max_streams, 1);
 		*res = srv_reply_problem(r, &pb, NULL);
 		return 0;

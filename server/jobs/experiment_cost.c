@@ -110,14 +110,15 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 	}
 	if (max >= 1) {
 		field = "identify.beta";
-		snprintf(fix, sizeof fix, "at most %g operating points, a larger integrator.dt or a "
-			 "smaller scene", max);
+		snprintf(fix, sizeof fix, "at most %g operating point%s, a larger integrator.dt or "
+			 "a smaller scene", max, api_plural(max, "", "s"));
 	} else if (e->req.fresh) {
 		field = "session.scene.columns";
 		max = columns_that_fit(e, spec, bound);
 		if (max >= 1)
-			snprintf(fix, sizeof fix, "a smaller scene (at most %g columns of %d layers) or "
-				 "a larger integrator.dt", max, spec->scene.layers);
+			snprintf(fix, sizeof fix, "a smaller scene (at most %g column%s of %d "
+				 "layer%s) or a larger integrator.dt", max, api_plural(max, "", "s"),
+				 spec->scene.layers, api_plural(spec->scene.layers, "", "s"));
 		else
 			snprintf(fix, sizeof fix, "fewer layers or a larger integrator.dt");
 	} else {

@@ -174,7 +174,10 @@ enum MHD_Result srv_h_job_create(srv_req *r)
 		return srv_reply_problem(r, &pb, NULL);
 	if (srv_registry_reserve_claim(kind->reg, e, kind->evictable, &victim)) {
 		kind->discard(e);
-		api_fail(&pb, API_LIMIT, NULL, "%zu %s", kind->reg->cap, kind->limit);
+		double cap = (double)kind->reg->cap;
+		api_fail(&pb, API_LIMIT, NULL, "%zu %s %s %s", kind->reg->cap,
+			 api_plural(cap, kind->name, kind->plural), api_plural(cap, "is", "are"),
+			 kind->limit);
 		api_budget(&pb, kind->plural, (double)kind->reg->cap, 1);
 		return srv_reply_problem(r, &pb, NULL);
 	}

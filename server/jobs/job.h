@@ -31,7 +31,8 @@ typedef struct srv_job_kind {
 				  the 429's budget */
 	srv_registry *reg;     /* where its jobs live (capped) */
 	int created_status;    /* POST's status: 202 (queued) or 201 */
-	const char *limit;     /* the 429's detail after the registry's cap */
+	const char *limit;     /* the 429's detail after "N sweeps are" (the
+				  registry's cap, name or plural, is or are) */
 	uint32_t store_kind;   /* framed files {plural}/ID.bin (store.h) */
 	const char *result_file; /* "sweep-%s.csv": a result beside them, or NULL */
 	int restore_evicts;    /* a restore may evict (evictable) to make room */

@@ -225,8 +225,9 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	session_locks_init(s);
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		session_free(s);
-		api_fail(pb, API_LIMIT, NULL, "%d sessions exist, the limit (--max-sessions); "
-			 "delete one first", cfg->max_sessions);
+		api_fail(pb, API_LIMIT, NULL, "%d session%s exist%s, the limit (--max-sessions); "
+			 "delete one first", cfg->max_sessions, api_plural(cfg->max_sessions, "", "s"),
+			 api_plural(cfg->max_sessions, "s", ""));
 		api_budget(pb, "sessions", cfg->max_sessions, 1);
 		return NULL;
 	}

@@ -113,9 +113,9 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 	do {
 		if (n >= cfg->max_dem_sessions) {
 			api_fail(pb, API_LIMIT, "scene.feed_model",
-				 "%d LIGGGHTS sessions run, the limit (--max-dem-sessions %d): each "
-				 "runs a bed process that holds a core; delete one first", n,
-				 cfg->max_dem_sessions);
+				 "%d LIGGGHTS session%s run%s, the limit (--max-dem-sessions %d): "
+				 "each runs a bed process that holds a core; delete one first", n,
+				 api_plural(n, "", "s"), api_plural(n, "s", ""), cfg->max_dem_sessions);
 			return api_budget(pb, "dem-sessions", cfg->max_dem_sessions, 5);
 		}
 	} while (!atomic_compare_exchange_weak(&live, &n, n + 1));

@@ -48,7 +48,7 @@ test('--max-sessions and --max-streams: budget "sessions" and "streams" with the
     const open = await fetch(d.base + path, { signal: ac.signal });
     assert.equal(open.status, 200);
     refused(await req(d.base, 'GET', path), limited(path,
-      '1 stream clients are connected, the limit (--max-streams)', 'streams', 1));
+      '1 stream client is connected, the limit (--max-streams)', 'streams', 1));
   } finally {
     ac.abort();
     for (const id of ids) assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${id}`)).status, 204);
@@ -60,12 +60,12 @@ test('--max-sessions and --max-streams: budget "sessions" and "streams" with the
 // session's deletion, a sweep or a fit with its own).
 const KEPT = [
   ['experiments', { session: { ...NO_FEED, pace: 1 }, schedule: [{ beta: 38, until: 600 }] },
-    'experiments are running or held by their sessions; wait for one to end'],
+    'experiment is running or held by a session; wait for one to end'],
   ['sweeps', { ...CHEAP, beta: [10, 30, 50, 70, 90, 110, 130, 150], rotations: ['cw'], t_end: 600 },
-    'sweeps are running or kept; delete one'],
+    'sweep is running or kept; delete one'],
   ['fits', { ...CHEAP, t_end: 600, free: ['e', 'mu'], curve_step: 45,
     points: [20, 40, 60, 80, 100, 120].map((beta) => ({ beta, rotation: 'cw', v: 0.05 })) },
-  'fits are running or kept; delete one'],
+  'fit is running or kept; delete one'],
 ];
 
 for (const [kind, body, words] of KEPT) {
