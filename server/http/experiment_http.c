@@ -164,13 +164,31 @@ static void experiment_discard(srv_entry *en)
 	srv_exp_free(srv_exp_from_entry(en));
 }
 
+/* DELETE: a running experiment is let go by its session, aborted, as at
+ * its session's end; a fresh session it created and would have removed at
+ * its end is deleted now, one the client made or kept stays. */
+static void experiment_cancel(srv_entry *en)
+{
+	srv_experiment *e = srv_exp_from_entry(en);
+	char sid[SRV_ID_LEN], why[96];
+	if (!srv_exp_cancel(e, sid, sizeof sid))
+		return;
+	srv_session *s = srv_session_get(sid);
+	snprintf(why, sizeof why, "deleted (DELETE /api/v1/experiments/%s)", srv_exp_id(e));
+	if (s && srv_session_detach(s, e, why))
+		srv_session_delete(s);
+	srv_session_put(s);
+}
+
 /* On its session (a fresh one or the one it names), then its record. */
 static api_err experiment_start(srv_entry *en, char **answer, api_problem *pb)
 {
 	srv_experiment *e = srv_exp_from_entry(en);
 	if (start_on_session(e, srv_exp_request(e), pb) != API_OK)
 		return pb->code;
-	srv_exp_persist(e);
+	if (srv_exp_deleted(e)) /* a DELETE came before it was on its session */
+		experiment_cancel(en);
+	srv_exp_persist(e); /* not once deleted */
 	atomic_fetch_add(&srv_stats.experiments, 1);
 	*answer = experiment_json(e, 0);
 	return API_OK;
@@ -203,7 +221,6 @@ static srv_entry *experiment_damaged(const char *id, const char *why)
 	return e ? srv_exp_entry(e) : NULL;
 }
 
-/* No DELETE: an experiment goes with its session's end or is pushed out. */
 const srv_job_kind srv_experiment_job = {
 	.name = "experiment",
 	.plural = "experiments",
@@ -211,6 +228,7 @@ const srv_job_kind srv_experiment_job = {
 	.created_status = 201,
 	.limit = "running or held by a session; wait for one to end",
 	.store_kind = SRV_STORE_EXPERIMENT,
+	.result_file = "experiment-%s.json",
 	.restore_evicts = 1,
 	.create = experiment_create,
 	.discard = experiment_discard,
@@ -221,6 +239,7 @@ const srv_job_kind srv_experiment_job = {
 	.scratch_size = sizeof(srv_exp_scratch),
 	.view = experiment_view,
 	.list_text = experiment_list_text,
+	.cancel = experiment_cancel,
 	.load = experiment_load,
 	.damaged = experiment_damaged,
 };

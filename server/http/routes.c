@@ -57,6 +57,7 @@ static const route routes[API_R_COUNT] = {
 	[API_R_EXPERIMENTS_CREATE] = {srv_h_job_create, &srv_experiment_job},
 	[API_R_EXPERIMENTS_LIST] = {srv_h_job_list, &srv_experiment_job},
 	[API_R_EXPERIMENT_GET] = {srv_h_job_get, &srv_experiment_job},
+	[API_R_EXPERIMENT_DELETE] = {srv_h_job_delete, &srv_experiment_job},
 	[API_R_SWEEPS_CREATE] = {srv_h_job_create, &srv_sweep_job},
 	[API_R_SWEEPS_LIST] = {srv_h_job_list, &srv_sweep_job},
 	[API_R_SWEEP_GET] = {srv_h_job_get, &srv_sweep_job},

@@ -206,10 +206,11 @@ static void queue_write(srv_experiment *e, const char *path, void *buf,
 }
 
 /* experiments/ID.bin (lock held): queued, or now (its creation) written here. Not while the
- * daemon stops: an experiment its session's worker lets go then is resumed next time. */
+ * daemon stops: an experiment its session's worker lets go then is resumed next time; nor
+ * once deleted: its files are being removed. */
 static void persist_locked(srv_experiment *e, int now)
 {
-	if (!e->data_dir || srv_stopping())
+	if (!e->data_dir || srv_stopping() || e->deleted)
 		return;
 	size_t tail = srv_exp_tail_len(e), len;
 	char *rec = malloc(sizeof(exp_record) + tail);
@@ -384,7 +385,7 @@ int srv_exp_interrupt(srv_experiment *e)
 /* The results file DIR/experiment-ID.json and the record (lock held). */
 static void save_results(srv_experiment *e)
 {
-	if (!e->data_dir)
+	if (!e->data_dir || e->deleted)
 		return;
 	persist_locked(e, 0);
 	api_experiment_view v;
@@ -492,4 +493,23 @@ void srv_exp_abort(srv_experiment *e, const char *why)
 	pthread_mutex_lock(&e->lock);
 	abort_locked(e, why);
 	pthread_mutex_unlock(&e->lock);
+}
+
+int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen)
+{
+	pthread_mutex_lock(&e->lock);
+	e->deleted = 1;
+	int on = e->attached && e->session_id[0];
+	if (on)
+		snprintf(sid, sidlen, "%s", e->session_id);
+	pthread_mutex_unlock(&e->lock);
+	return on;
+}
+
+int srv_exp_deleted(srv_experiment *e)
+{
+	pthread_mutex_lock(&e->lock);
+	int gone = e->deleted;
+	pthread_mutex_unlock(&e->lock);
+	return gone;
 }

@@ -79,6 +79,12 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over);
 /* The worker applied (or refused) e's command. Returns 1 when a refusal
  * aborted the experiment (the worker detaches it). */
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd);
+/* DELETE of e: 1 with the id of the session it runs on in sid (the
+ * caller lets it go there, srv_session_detach), else 0 (over, or not yet
+ * on a session: then srv_exp_deleted says so to its start). */
+int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen);
+/* 1 once a DELETE of e came. */
+int srv_exp_deleted(srv_experiment *e);
 /* The session ended before the experiment (deleted, failed, shutdown). */
 void srv_exp_abort(srv_experiment *e, const char *why);
 

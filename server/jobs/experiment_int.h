@@ -51,6 +51,7 @@ struct srv_experiment {
 				    restore: looked up at the next step) */
 	int writes;              /* queued store writes (they refer to e) */
 	int freed;               /* srv_exp_free came while writes > 0 */
+	int deleted;             /* a DELETE came (srv_exp_cancel) */
 };
 
 /* The worker's answer to e's command (lock held): a command that starts a

@@ -100,6 +100,11 @@ double srv_sessions_steps_per_s(void);
  * or API_UNAVAILABLE (not acknowledged; nothing changed), with *pb set. */
 api_err srv_session_control(srv_session *s, api_control *c,
 			    double timeout_s, double *t_eff, api_problem *pb);
+/* Let go of experiment e if s runs it (DELETE of e): e aborted with why,
+ * its queued command taken back, s's controls the client's again and s
+ * running on to the until e gave it. 1 when s was created by e and not
+ * kept (the caller deletes it, as the reaper would at e's end), else 0. */
+int srv_session_detach(srv_session *s, srv_experiment *e, const char *why);
 /* Attach an experiment (borrowed until it detaches) to a running
  * session's worker. API_CONFLICT if it already runs one or has failed;
  * a finished paced session, which the experiment runs on, first takes its

@@ -245,6 +245,19 @@ api_err srv_session_attach(srv_session *s, srv_experiment *e,
 	return rc;
 }
 
+int srv_session_detach(srv_session *s, srv_experiment *e, const char *why)
+{
+	pthread_mutex_lock(&s->lock);
+	int ours = s->exp == e, owned = ours && s->owned;
+	if (ours) {
+		srv_worker_detach_exp(s, why);
+		s->persist.ckpt_dirty = 1; /* its checkpoint no longer carries e */
+		pthread_cond_broadcast(&s->data);
+	}
+	pthread_mutex_unlock(&s->lock);
+	return owned;
+}
+
 /* Whether e, attached again to s as restored, begins where it began
  * before: created with s, which came back from its spec at t = 0; or s
  * stood still at its checkpoint (finished or paused) and nothing but e's

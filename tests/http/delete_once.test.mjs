@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One deletion, one 204 (docs/api-errors.md): DELETE of a session, sweep
-// or fit answers 204 once; a DELETE after it, or one that arrives while
+// One deletion, one 204 (docs/api-errors.md): DELETE of a session, sweep,
+// fit or experiment answers 204 once; a DELETE after it, or one that arrives while
 // another is deleting the same object, gets the 404 a GET of an unknown id
 // gets, body for body. Many DELETEs of one object at the same moment (on
 // connections opened beforehand, so that they reach the daemon together)
-// once answered 204 to two of them. Experiments have no DELETE (405).
+// once answered 204 to two of them. An experiment's run on a fresh
+// session, which goes with the one DELETE that answers 204.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
@@ -43,6 +44,7 @@ const KINDS = {
   sessions: { ...NO_FEED, pace: 1 },
   sweeps: { ...NO_FEED, beta: { from: 10, to: 170, step: 1 }, rotations: ['cw'], t_end: 0.1 },
   fits: { ...CHEAP, free: ['mu'], points: [{ beta: 60, rotation: 'cw', v: 0.1 }], t_end: 1, max_iter: 1 },
+  experiments: { session: { ...NO_FEED, pace: 1 }, schedule: [{ beta: 38, until: 600 }] },
 };
 
 for (const [kind, body] of Object.entries(KINDS)) {
@@ -90,10 +92,3 @@ for (const [kind, body] of Object.entries(KINDS)) {
     assert.deepEqual(twice, [], 'rounds whose DELETEs did not answer exactly one 204');
   });
 }
-
-test('experiments have no DELETE: 405 naming GET', async () => {
-  const r = await req(d.base, 'DELETE', '/api/v1/experiments/0123456789abcdef');
-  assert.equal(r.status, 405, r.text);
-  assert.equal(r.body.type, '/api/v1/problems/method-not-allowed');
-  assert.match(r.headers.get('allow'), /GET/);
-});

@@ -154,6 +154,7 @@ test('every operation answers what the document says', { timeout: 120000 * SLOW 
   // a DELETE without the JSON type: 415, as the document says
   assert.equal((await call('DELETE', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`, undefined, { 'Content-Type': null })).status, 415);
   await call('DELETE', '/api/v1/sweeps/{id}', `/api/v1/sweeps/${w.id}`);
+  await call('DELETE', '/api/v1/experiments/{id}', `/api/v1/experiments/${e.id}`);
   await call('DELETE', '/api/v1/sessions/{id}', `/api/v1/sessions/${s.id}`);
   // the stream: SSE and NDJSON records of every kind it produced
   const s2 = (await call('POST', '/api/v1/sessions', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body;
