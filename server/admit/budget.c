@@ -137,11 +137,10 @@ api_err srv_budget_take_session(int columns, int layers, size_t *need,
 		fit--;
 	const char *field = fit > 0 ? "scene.layers" : "scene.columns";
 	api_fail(pb, API_RANGE, field,
-		 "this session needs %.1f MiB (%d x %d feed, %d stream record%s, "
-		 "%d trajectory row%s), more than the whole memory budget of "
+		 "this session needs %.1f MiB (%d x %d feed, %d stream records, "
+		 "%d trajectory rows), more than the whole memory budget of "
 		 "%.1f MiB (--max-memory); %s", mib(*need), columns, layers,
-		 cfg->ring, api_plural(cfg->ring, "", "s"), cfg->history,
-		 api_plural(cfg->history, "", "s"), mib(cfg->max_memory),
+		 cfg->ring, cfg->history, mib(cfg->max_memory),
 		 fit > 0 ? "fewer layers fit" : "fewer columns fit");
 	if (fit == 0) {
 		fit = columns;
@@ -284,9 +283,8 @@ api_err srv_budget_take_points(size_t n, const char *field, int force,
 		      (cfg->pool_threads > 0 ? cfg->pool_threads : 1);
 	pthread_mutex_unlock(&lock);
 	api_fail(pb, API_LIMIT, NULL,
-		 "%zu sweep point%s %s queued or running and this sweep adds "
-		 "%zu: the budget is %zu (--max-queued-points); nothing was "
-		 "queued", queued, api_plural((double)queued, "", "s"),
+		 "%zu sweep point%s %s queued or running and this sweep adds %zu: the budget is %zu "
+		 "(--max-queued-points); nothing was queued", queued, api_plural((double)queued, "", "s"),
 		 api_plural((double)queued, "is", "are"), n, cap);
 	return api_budget(pb, "sweep-points", (double)cap,
 			  wait < 1 ? 1 : wait > 3600 ? 3600 : (int)(wait + 0.999));
@@ -466,11 +464,10 @@ int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
 		return 0;
 	atomic_fetch_add(&client_refused, 1);
 	api_fail(pb, API_LIMIT, NULL,
-		 "this client address has more than %d connection%s open, its "
-		 "budget (--max-client-connections), and every other one is "
-		 "being answered (an idle or slow one would have been closed to "
-		 "make room); close some and retry", cfg->max_client_connections,
-		 api_plural(cfg->max_client_connections, "", "s"));
+		 "this client address has more than %d connection%s open, its budget "
+		 "(--max-client-connections), and every other one is being answered (an idle or slow "
+		 "one would have been closed to make room); close some and retry",
+		 cfg->max_client_connections, api_plural(cfg->max_client_connections, "", "s"));
 	api_budget(pb, "connections", cfg->max_client_connections, 1);
 	pb->close = 1; /* one too many: the answer closes it */
 	return 1;

@@ -494,22 +494,3 @@ void srv_exp_abort(srv_experiment *e, const char *why)
 	abort_locked(e, why);
 	pthread_mutex_unlock(&e->lock);
 }
-
-int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen)
-{
-	pthread_mutex_lock(&e->lock);
-	e->deleted = 1;
-	int on = e->attached && e->session_id[0];
-	if (on)
-		snprintf(sid, sidlen, "%s", e->session_id);
-	pthread_mutex_unlock(&e->lock);
-	return on;
-}
-
-int srv_exp_deleted(srv_experiment *e)
-{
-	pthread_mutex_lock(&e->lock);
-	int gone = e->deleted;
-	pthread_mutex_unlock(&e->lock);
-	return gone;
-}

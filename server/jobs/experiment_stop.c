@@ -4,7 +4,8 @@
  * loop's measurements stopped at --max-cpu-seconds in the request's thread
  * (srv_exp_stopped, experiment_int.h): experiment_kind.c's measurements
  * stop there, experiment_cost.c bounds them before; apart from both, so
- * that neither calls the other back.
+ * that neither calls the other back. And the stop a DELETE asks
+ * (srv_exp_cancel).
  */
 #include <stdio.h>
 
@@ -38,4 +39,23 @@ api_err srv_exp_stopped(const srv_experiment *e, const api_spec *spec, double de
 			 e->ext.kind == API_EXP_IDENTIFY ? "fewer operating points, " : "");
 	}
 	return api_budget(pb, "cpu", bound, 0);
+}
+
+int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen)
+{
+	pthread_mutex_lock(&e->lock);
+	e->deleted = 1;
+	int on = e->attached && e->session_id[0];
+	if (on)
+		snprintf(sid, sidlen, "%s", e->session_id);
+	pthread_mutex_unlock(&e->lock);
+	return on;
+}
+
+int srv_exp_deleted(srv_experiment *e)
+{
+	pthread_mutex_lock(&e->lock);
+	int gone = e->deleted;
+	pthread_mutex_unlock(&e->lock);
+	return gone;
 }

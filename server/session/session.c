@@ -211,6 +211,15 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	return 0;
 }
 
+/* The 429 of a creation beyond --max-sessions. */
+static void sessions_full(api_problem *pb)
+{
+	int n = cfg->max_sessions;
+	api_fail(pb, API_LIMIT, NULL, "%d session%s exist%s, the limit (--max-sessions); delete one "
+		 "first", n, api_plural(n, "", "s"), api_plural(n, "s", ""));
+	api_budget(pb, "sessions", n, 1);
+}
+
 srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				api_problem *pb)
 {
@@ -225,10 +234,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	session_locks_init(s);
 	if (srv_registry_reserve(&sessions, &s->entry, NULL)) {
 		session_free(s);
-		api_fail(pb, API_LIMIT, NULL, "%d session%s exist%s, the limit (--max-sessions); "
-			 "delete one first", cfg->max_sessions, api_plural(cfg->max_sessions, "", "s"),
-			 api_plural(cfg->max_sessions, "s", ""));
-		api_budget(pb, "sessions", cfg->max_sessions, 1);
+		sessions_full(pb);
 		return NULL;
 	}
 	/* feed_model auto: the model the session runs, picked once here */
