@@ -39,6 +39,9 @@ static void activity_metrics(FILE *f, const srv_gauges *g)
 	       "Sessions created.", (double)srv_stats.sessions_created);
 	metric(f, "convsim_sessions_deleted_total", "counter",
 	       "Sessions deleted.", (double)srv_stats.sessions_deleted);
+	metric(f, "convsim_sessions_abandoned_total", "counter",
+	       "Creations discarded because their client left while they settled.",
+	       (double)srv_stats.sessions_abandoned);
 	metric(f, "convsim_steps_total", "counter",
 	       "Integrator steps taken by all sessions.",
 	       (double)srv_stats.steps);

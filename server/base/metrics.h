@@ -14,6 +14,8 @@
 
 typedef struct srv_metrics {
 	atomic_ullong sessions_created, sessions_deleted;
+	atomic_ullong sessions_abandoned; /* their client left while they
+					     settled: not created */
 	atomic_ullong steps;             /* all sessions */
 	atomic_int stream_clients;
 	atomic_ullong streams_opened, dropped_samples, stream_records;

@@ -66,6 +66,10 @@ enum MHD_Result srv_queue(srv_req *r, int status, struct MHD_Response *resp);
  * connection). */
 const char *srv_query(srv_req *r, const char *key);
 const char *srv_header(srv_req *r, const char *name);
+/* The client's socket (borrowed while the request is handled; -1 if
+ * unknown): a request that settles before it answers looks there whether
+ * its client left (util.h srv_peer_gone). */
+int srv_client_fd(srv_req *r);
 /* How many times the header name (any case) was sent. */
 int srv_header_count(srv_req *r, const char *name);
 /* 200 with a result in the negotiated representation (r->csv): text is

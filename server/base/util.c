@@ -2,9 +2,10 @@
 /*
  * util.c - small services of the daemon: levelled logging to stderr,
  * clocks, timed-wait deadlines, random ids (with the replica's node id)
- * and the stopping flag.
+ * the stopping flag, and whether a client's socket is still there.
  */
 #define _GNU_SOURCE /* gettid, pthread_setname_np */
+#include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -13,6 +14,7 @@
 #include <string.h>
 #include <sys/random.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -87,6 +89,22 @@ struct timespec srv_deadline(double seconds)
 	ts.tv_sec += (time_t)(ns / 1000000000LL);
 	ts.tv_nsec = (long)(ns % 1000000000LL);
 	return ts;
+}
+
+int srv_peer_gone(int fd)
+{
+	if (fd < 0)
+		return 0;
+	char c;
+	ssize_t n;
+	do
+		n = recv(fd, &c, 1, MSG_PEEK | MSG_DONTWAIT);
+	while (n < 0 && errno == EINTR);
+	if (n > 0)
+		return 0; /* its next request waits (pipelined): it is there */
+	if (n == 0)
+		return 1; /* the end of its data: it closed */
+	return errno != EAGAIN && errno != EWOULDBLOCK; /* reset, or worse */
 }
 
 static const char *node_prefix; /* set once, before any thread starts */

@@ -2,7 +2,8 @@
 /*
  * util.h - small services every part of the daemon uses: levelled logging
  * to stderr, clocks, timed-wait deadlines, random ids, the daemon's
- * "stopping" flag. A leaf: it uses nothing else of server/.
+ * "stopping" flag, whether a client's socket is still there. A leaf: it
+ * uses nothing else of server/.
  */
 #ifndef CONVSIM_UTIL_H
 #define CONVSIM_UTIL_H
@@ -33,6 +34,11 @@ void srv_new_id(char *id);
 /* Absolute deadline for pthread_cond_timedwait, seconds from now
  * (clamped to [0, 3600]). */
 struct timespec srv_deadline(double seconds);
+/* 1 when the peer of the connected socket fd has left: it closed (the end
+ * of its data, also a shutdown of its sending half only) or reset it; 0
+ * while it is there (nothing to read, or more requests), and for fd < 0.
+ * Reads nothing (a peek); never blocks. */
+int srv_peer_gone(int fd);
 
 /* The threads that compute (session workers, the sweep and fit pool) run
  * at a nice value above the request and stream threads' 0 (--worker-nice),

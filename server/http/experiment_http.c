@@ -73,13 +73,14 @@ srv_experiment *srv_experiments_readopt(const char *session_id)
 }
 
 /* Run e on a fresh session or attach it to the one it names; the session
- * notes its id in e before its worker can run it. */
-static api_err start_on_session(srv_experiment *e,
-				const api_experiment_req *req, api_problem *pb)
+ * notes its id in e before its worker can run it. A fresh one is not kept
+ * when the client on client_fd left while it settled (session.h). */
+static api_err start_on_session(srv_experiment *e, const api_experiment_req *req,
+				int client_fd, api_problem *pb)
 {
 	srv_session *s;
 	if (req->fresh) {
-		s = srv_session_create(&req->spec, e, -1, pb);
+		s = srv_session_create(&req->spec, e, client_fd, pb);
 		if (!s) { /* its admission names the spec's fields as the client sent them */
 			api_field_within(pb, "session");
 			return pb->code;
@@ -181,10 +182,10 @@ static void experiment_cancel(srv_entry *en)
 }
 
 /* On its session (a fresh one or the one it names), then its record. */
-static api_err experiment_start(srv_entry *en, char **answer, api_problem *pb)
+static api_err experiment_start(srv_entry *en, int client_fd, char **answer, api_problem *pb)
 {
 	srv_experiment *e = srv_exp_from_entry(en);
-	if (start_on_session(e, srv_exp_request(e), pb) != API_OK)
+	if (start_on_session(e, srv_exp_request(e), client_fd, pb) != API_OK)
 		return pb->code;
 	if (srv_exp_deleted(e)) /* a DELETE came before it was on its session */
 		experiment_cancel(en);

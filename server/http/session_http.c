@@ -31,10 +31,10 @@ enum MHD_Result srv_h_sessions_create(srv_req *r)
 	api_problem pb;
 	if (api_parse_session(r->body, r->body_len, &spec, &pb) != API_OK)
 		return srv_reply_problem(r, &pb, NULL);
-	/* the client's socket: a LIGGGHTS bed stops settling when it leaves */
-	const union MHD_ConnectionInfo *ci =
-		MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
-	srv_session *s = srv_session_create(&spec, NULL, ci ? ci->connect_fd : -1, &pb);
+	/* the client's socket: a LIGGGHTS bed stops settling when it leaves,
+	 * and nothing is created for one that left while it settled (its
+	 * answer then goes nowhere and closes the connection) */
+	srv_session *s = srv_session_create(&spec, NULL, srv_client_fd(r), &pb);
 	if (!s)
 		return srv_reply_problem(r, &pb, NULL);
 	api_view v;

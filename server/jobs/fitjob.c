@@ -306,8 +306,9 @@ static void fit_discard(srv_entry *en)
 }
 
 /* Its record first, then its driver: the answer shows it queued. */
-static api_err fitjob_start(srv_entry *en, char **answer, api_problem *pb)
+static api_err fitjob_start(srv_entry *en, int client_fd, char **answer, api_problem *pb)
 {
+	(void)client_fd; /* queued: nothing runs in the request */
 	srv_fit *f = fit_of(en);
 	api_fit_view v;
 	pthread_mutex_lock(&f->lock);

@@ -183,7 +183,7 @@ enum MHD_Result srv_h_job_create(srv_req *r)
 	}
 	srv_registry_publish(kind->reg, e);
 	char *text = NULL;
-	if (kind->start(e, &text, &pb) != API_OK) {
+	if (kind->start(e, srv_client_fd(r), &text, &pb) != API_OK) {
 		if (srv_registry_withdraw(kind->reg, e, victim))
 			forget(kind, e->id);
 		srv_registry_put(kind->reg, e);

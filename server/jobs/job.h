@@ -45,8 +45,10 @@ typedef struct srv_job_kind {
 	void (*discard)(srv_entry *e);
 	/* Start a published job (the caller holds a reference): API_OK with
 	 * its first answer in *answer (JSON, malloc'd; NULL when out of
-	 * memory), or the error in *pb, and the job is removed. */
-	api_err (*start)(srv_entry *e, char **answer, api_problem *pb);
+	 * memory), or the error in *pb, and the job is removed. client_fd:
+	 * the requesting client's socket (borrowed; -1: unknown), for a start
+	 * that settles a session to see whether its client left. */
+	api_err (*start)(srv_entry *e, int client_fd, char **answer, api_problem *pb);
 	/* 1 when the registry may push it out (over); registry lock held. */
 	int (*evictable)(srv_entry *e);
 	/* The job's own lock, which job.c holds around text, view and

@@ -398,9 +398,10 @@ static size_t submit_points(srv_sweep *sw)
 }
 
 /* Queue the points of a published sweep; the answer shows it queued. */
-static api_err sweep_start(srv_entry *en, char **answer, api_problem *pb)
+static api_err sweep_start(srv_entry *en, int client_fd, char **answer, api_problem *pb)
 {
 	(void)pb;
+	(void)client_fd; /* queued: nothing runs in the request */
 	srv_sweep *sw = sweep_of(en);
 	for (size_t i = 0; i < sw->jobs; i++)
 		srv_registry_hold(&sweeps, &sw->entry); /* one per job */

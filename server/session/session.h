@@ -33,11 +33,14 @@ void srv_sessions_shutdown(void);
 
 /* Create a session from spec (copied) and start its worker, with exp
  * (may be NULL; borrowed, must outlive the attachment) attached before
- * the first step. client_fd: -1, or the creating client's socket: a
- * LIGGGHTS bed's settling is cancelled (503, nothing kept) when the client
- * leaves before it ends. Its instance is built, settled and probed in the
- * calling thread, holding a --max-settling slot (not a LIGGGHTS session's:
- * --max-dem-sessions bounds those). Returns a new reference or NULL with
+ * the first step. Its instance is built, settled and probed in the
+ * calling thread, holding a --max-settling slot (not a LIGGGHTS
+ * session's: --max-dem-sessions bounds those). client_fd: -1, or the
+ * creating client's socket (borrowed): a LIGGGHTS bed's settling is
+ * cancelled when the client leaves before it ends, and any creation whose
+ * client has left once settled and probed (srv_peer_gone) is discarded
+ * before its spec is written (503, nothing kept, counted in
+ * convsim_sessions_abandoned_total). Returns a new reference or NULL with
  * *pb set (429 at --max-sessions, 422 when the core refuses the spec, 503:
  * budget "memory", "cpu" or "settling"). */
 srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp, int client_fd,
