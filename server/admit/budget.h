@@ -76,7 +76,11 @@ double srv_budget_cpu_estimate(const api_spec *spec, const sim_status *st,
  * (st->settle_columns, each of layers elements) with the same model, no
  * samples published; the creating request's thread runs it whole. */
 double srv_budget_settle_cpu(const api_spec *spec, const sim_status *st, int layers);
-/* The same estimate before the instance is built: from what sim_new
+/* The settling's estimate (srv_budget_settle_cpu) before the instance is
+ * built, from what sim_new would integrate (sim_preview); 0 for a set it
+ * refuses. */
+double srv_budget_settle_preview(const api_spec *spec);
+/* The same estimates before the instance is built: from what sim_new
  * would integrate (sim_preview: the set validated, nothing settled), so
  * that a creation the cores cannot take is refused for the price of its
  * parse. API_OK and *cpu_per_s, or sim_new's validation error in *pb as a
@@ -85,18 +89,22 @@ double srv_budget_settle_cpu(const api_spec *spec, const sim_status *st, int lay
  * interval, which the worker advances whole, estimated beyond
  * SRV_SAMPLE_CPU_MAX (422 naming integrator.dt, about the least step that
  * fits as min), and the settling of a steady start, which runs in the
- * creating request's thread, beyond --max-cpu-seconds (srv_budget_cost_init; 422 naming
- * scene.settle, the longest that fits as max). */
+ * creating request's thread, beyond --max-cpu-seconds (srv_budget_cost_init)
+ * less before, the CPU s the request's thread spent before it (an
+ * experiment's measurements; 0: none) (422 naming scene.settle, the
+ * longest that fits as max). */
 #define SRV_SAMPLE_CPU_MAX 1.0 /* CPU s: well within a control's 5-s wait */
-api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb);
+api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_per_s,
+			       api_problem *pb);
 /* The refusal of a creation whose settling the core stopped at
- * --max-cpu-seconds (sim_new_bounded's SIM_ECPU) after spent CPU s, with
- * settled of scene.settle's simulated s settled: 422, budget "cpu", naming
- * integrator.method with the methods of a fixed step as choices where the
- * method is adaptive (no estimate knows its steps), else scene.settle with
- * what settled as max. Returns API_RANGE. */
-api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
-				  api_problem *pb);
+ * --max-cpu-seconds less before (as above) (sim_new_bounded's SIM_ECPU)
+ * after spent CPU s of its own, with settled of scene.settle's simulated s
+ * settled: 422, budget "cpu", naming integrator.method with the methods of
+ * a fixed step as choices where the method is adaptive (no estimate knows
+ * its steps), else scene.settle with what settled as max. Returns
+ * API_RANGE. */
+api_err srv_budget_settle_stopped(const api_spec *spec, double before, double spent,
+				  double settled, api_problem *pb);
 /* 1 when spec's method is adaptive; the methods of a fixed step into
  * names ("rk4, euler, dem", for a detail) and choices (api_choices_of's
  * "rk4|euler|dem"), each of its length in bytes. */

@@ -187,13 +187,36 @@ static void dt_range(api_problem *pb, double dt, double cpu_s, double bound)
 	pb->max = t->max * t->scale;
 }
 
-api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_problem *pb)
+double srv_budget_settle_preview(const api_spec *spec)
+{
+	sim_status st;
+	double cpu_per_s, settle_cpu;
+	api_problem pb;
+	return preview(spec, &st, &cpu_per_s, &settle_cpu, &pb) == API_OK ? settle_cpu : 0.0;
+}
+
+/* ", after the S CPU s this request's thread spent before it": what a
+ * settling's bound (--max-cpu-seconds) is less of, in a detail; "" for
+ * none. */
+static const char *spent_before(double before, char *buf, size_t len)
+{
+	buf[0] = '\0';
+	if (before > 0)
+		snprintf(buf, len, " less the %.3g CPU s this request's thread spent before it "
+			 "(an experiment's measurements)", before);
+	return buf;
+}
+
+api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_per_s,
+			       api_problem *pb)
 {
 	sim_status st;
 	double settle_cpu;
 	if (preview(spec, &st, cpu_per_s, &settle_cpu, pb) != API_OK)
 		return pb->code;
 	double cpu = *cpu_per_s, sample = cpu / spec->sample_rate, settle = settling(spec);
+	double left = before > 0 ? fmax(run_limit - before, 0) : run_limit;
+	char less[120];
 	if (sample > SRV_SAMPLE_CPU_MAX) {
 		api_fail(pb, API_RANGE, "integrator.dt",
 			 "a sample interval (%g s) of this session would take about %.3g CPU s "
@@ -202,15 +225,16 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double *cpu_per_s, api_prob
 			 "a larger integrator.dt or a smaller scene", 1.0 / spec->sample_rate,
 			 sample, cpu, st.dt, SRV_SAMPLE_CPU_MAX);
 		dt_range(pb, st.dt, sample, SRV_SAMPLE_CPU_MAX);
-	} else if (settle_cpu > run_limit) {
+	} else if (settle_cpu > left) {
 		double per_s = settle_cpu / settle;
 		api_fail(pb, API_RANGE, "scene.settle",
 			 "the steady start would settle for about %.3g CPU s (%.3g CPU s per "
-			 "simulated s over scene.settle = %g s), more than --max-cpu-seconds (%g); "
+			 "simulated s over scene.settle = %g s), more than --max-cpu-seconds (%g)%s; "
 			 "nothing was created: a larger integrator.dt, a smaller scene, a shorter "
-			 "scene.settle or scene.start \"rest\"", settle_cpu, per_s, settle, run_limit);
+			 "scene.settle or scene.start \"rest\"", settle_cpu, per_s, settle, run_limit,
+			 spent_before(before, less, sizeof less));
 		pb->min = 0;
-		pb->max = run_limit / per_s;
+		pb->max = left / per_s;
 	} else {
 		return API_OK;
 	}
@@ -239,26 +263,27 @@ int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len
 	return adaptive;
 }
 
-api_err srv_budget_settle_stopped(const api_spec *spec, double spent, double settled,
-				  api_problem *pb)
+api_err srv_budget_settle_stopped(const api_spec *spec, double before, double spent,
+				  double settled, api_problem *pb)
 {
 	double settle = settling(spec);
-	char names[96], choices[96];
+	char names[96], choices[96], less[120];
+	spent_before(before, less, sizeof less);
 	if (srv_budget_fixed_methods(spec, names, sizeof names, choices, sizeof choices)) {
 		api_fail_choices(pb, API_RANGE, "integrator.method", choices,
 				 "the steady start's settling stopped at %.3g CPU s, past "
-				 "--max-cpu-seconds (%g), %.3g of scene.settle's %g simulated s "
+				 "--max-cpu-seconds (%g)%s, %.3g of scene.settle's %g simulated s "
 				 "settled: no estimate knows the steps of integrator.method %s "
 				 "(adaptive); nothing was created: a method of a fixed step (%s), a "
 				 "shorter scene.settle or scene.start \"rest\"",
-				 spent, run_limit, settled, settle, spec->method.name, names);
+				 spent, run_limit, less, settled, settle, spec->method.name, names);
 	} else {
 		api_fail(pb, API_RANGE, "scene.settle",
 			 "the steady start's settling stopped at %.3g CPU s, past "
-			 "--max-cpu-seconds (%g), %.3g of scene.settle's %g simulated s settled, "
+			 "--max-cpu-seconds (%g)%s, %.3g of scene.settle's %g simulated s settled, "
 			 "estimated within it; nothing was created: a shorter scene.settle, a larger "
 			 "integrator.dt, a smaller scene or scene.start \"rest\"",
-			 spent, run_limit, settled, settle);
+			 spent, run_limit, less, settled, settle);
 		pb->has_range = 1;
 		pb->min = 0;
 		pb->max = settled; /* what settled within the limit */

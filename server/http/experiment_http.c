@@ -73,14 +73,15 @@ srv_experiment *srv_experiments_readopt(const char *session_id)
 }
 
 /* Run e on a fresh session or attach it to the one it names; the session
- * notes its id in e before its worker can run it. A fresh one is not kept
- * when the client on client_fd left while it settled (session.h). */
+ * notes its id in e before its worker can run it. A fresh one settles
+ * within what e's measurements left of --max-cpu-seconds, and is not kept
+ * when the client on client_fd left meanwhile (session.h). */
 static api_err start_on_session(srv_experiment *e, const api_experiment_req *req,
 				int client_fd, api_problem *pb)
 {
 	srv_session *s;
 	if (req->fresh) {
-		s = srv_session_create(&req->spec, e, client_fd, pb);
+		s = srv_session_create(&req->spec, e, client_fd, srv_exp_measured_cpu(e), pb);
 		if (!s) { /* its admission names the spec's fields as the client sent them */
 			api_field_within(pb, "session");
 			return pb->code;

@@ -34,7 +34,7 @@ enum MHD_Result srv_h_sessions_create(srv_req *r)
 	/* the client's socket: a LIGGGHTS bed stops settling when it leaves,
 	 * and nothing is created for one that left while it settled (its
 	 * answer then goes nowhere and closes the connection) */
-	srv_session *s = srv_session_create(&spec, NULL, srv_client_fd(r), &pb);
+	srv_session *s = srv_session_create(&spec, NULL, srv_client_fd(r), 0, &pb);
 	if (!s)
 		return srv_reply_problem(r, &pb, NULL);
 	api_view v;

@@ -28,8 +28,8 @@ srv_experiment *srv_exp_new(const api_experiment_req *req, const api_exp_ext *ex
 /* An identification or a closed loop measures what it needs on spec (its
  * session's scene) before it starts (experiment_cost.c, experiment_kind.c),
  * holding a --max-settling slot meanwhile: API_OK, or the problem (those
- * measurements estimated beyond --max-cpu-seconds: 422 budget "cpu",
- * nothing measured; a setpoint out of the machine's reach: 422; 503
+ * measurements, and a fresh session's settling after them, estimated
+ * beyond --max-cpu-seconds: 422 budget "cpu", nothing measured; a setpoint out of the machine's reach: 422; 503
  * budget "settling" when every slot is taken, nothing measured). A plain
  * schedule: API_OK at once. */
 api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb);
@@ -41,6 +41,10 @@ const char *srv_exp_id(const srv_experiment *e);
 /* Its request as parsed (borrowed; its schedule's results change while it
  * runs: read it before it starts). */
 const api_experiment_req *srv_exp_request(const srv_experiment *e);
+/* CPU s its request's thread spent on its measurements (srv_exp_ready; 0
+ * without any): what a fresh session's settling has less of
+ * --max-cpu-seconds in the same request. */
+double srv_exp_measured_cpu(const srv_experiment *e);
 /* 1 when its session stays after the end (it was not created by the
  * experiment, or keep_session was asked). */
 int srv_exp_keeps_session(const srv_experiment *e);

@@ -12,7 +12,9 @@
  * cost model (budget_cost.c: each run's settling, then its window and
  * shadow) and refused beyond --max-cpu-seconds, the bound of a steady
  * start's settling in a creating request (docs/load.md "Creations
- * that settle").
+ * that settle"). One request, one bound: a fresh session settles after
+ * them in the same thread, so its settling's estimate counts here too, and
+ * it settles within what they left (session.c).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,23 +30,28 @@ static double one_run(const api_spec *spec)
 	return srv_budget_measure_cpu(spec, spec->scene.transient + SRV_EXP_CURVE_WINDOW);
 }
 
-/* The estimate for e on spec's scene: CPU s, the runs and the curves. */
+/* The estimate for e on spec's scene: CPU s of the measurements, the
+ * runs and the curves, and CPU s of the fresh session's settling after
+ * them (0 on a running session). */
 typedef struct measuring {
 	double cpu;
 	int runs, curves;
+	double settle;
 } measuring;
 
 static measuring estimate(const srv_experiment *e, const api_spec *spec)
 {
 	const api_exp_ext *x = &e->ext;
-	measuring m = {0, 0, 0};
+	measuring m = {0, 0, 0, 0};
+	if (x->kind != API_EXP_IDENTIFY && x->kind != API_EXP_CONTROL)
+		return m;
+	if (e->req.fresh)
+		m.settle = srv_budget_settle_preview(spec);
 	if (x->kind == API_EXP_IDENTIFY) {
 		m.runs = 2 * x->npoints;
 		m.cpu = m.runs * one_run(spec);
 		return m;
 	}
-	if (x->kind != API_EXP_CONTROL)
-		return m;
 	if (!srv_exp_curve_cached(spec)) {
 		m.curves++;
 		m.cpu += API_FF_NODES * one_run(spec);
@@ -80,7 +87,8 @@ static int columns_that_fit(const srv_experiment *e, const api_spec *spec, doubl
 		*at = *spec;
 	for (; c >= 1; c--) {
 		at->scene.columns = c;
-		if (!(estimate(e, at).cpu > bound))
+		measuring m = estimate(e, at);
+		if (!(m.cpu + m.settle > bound))
 			break;
 	}
 	free(at);
@@ -93,16 +101,19 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 	measuring m = estimate(e, spec);
 	double bound = srv_budget_run_limit();
 	*cpu = m.cpu;
-	if (!(m.cpu > bound))
+	if (!(m.cpu + m.settle > bound))
 		return API_OK;
 	const api_exp_ext *x = &e->ext;
 	char what[160], fix[160];
+	/* a problem's detail has room for the settling's name, not its figure */
+	const char *then = m.settle > 0 ? " and its session's settling" : "";
+	const char *when = m.settle > 0 ? "" : " before it answers and";
 	const char *field = "session";
 	double max = 0;
 	if (x->kind == API_EXP_IDENTIFY) {
 		snprintf(what, sizeof what, "identify's slopes (%d runs of the scene: two per operating "
 			 "point)", m.runs);
-		max = (double)(int)(bound / (2 * one_run(spec)));
+		max = (double)(int)((bound - m.settle) / (2 * one_run(spec)));
 	} else {
 		snprintf(what, sizeof what, "control's v(beta) curve%s (%d runs of the scene%s)",
 			 m.curves == 1 ? "" : "s", m.runs,
@@ -125,9 +136,9 @@ api_err srv_exp_measuring_check(const srv_experiment *e, const api_spec *spec, d
 		snprintf(fix, sizeof fix, "a session of a smaller scene or a larger integrator.dt");
 	}
 	api_fail(pb, API_RANGE, field,
-		 "%s would take about %.3g CPU s in this request's thread, before it answers and "
-		 "uninterrupted, more than --max-cpu-seconds (%g); nothing was started: %s",
-		 what, m.cpu, bound, fix);
+		 "%s%s would take about %.3g CPU s in this request's thread,%s uninterrupted, more "
+		 "than --max-cpu-seconds (%g); nothing was started: %s",
+		 what, then, m.cpu + m.settle, when, bound, fix);
 	if (max >= 1) {
 		pb->has_range = 1;
 		pb->min = 1;
@@ -155,7 +166,8 @@ api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
 	 * are beyond the estimate): srv_exp_stopped */
 	api_err err = srv_exp_prepare(e, spec, cpu0 + srv_budget_run_limit(), pb);
 	srv_budget_give_settling(&settling);
+	e->measured_cpu = srv_thread_cpu() - cpu0; /* a fresh session settles within the rest */
 	srv_log(SRV_LOG_DEBUG, "experiment: measured for %.3g CPU s in the request's thread, "
-		"estimated at %.3g", srv_thread_cpu() - cpu0, estimate);
+		"estimated at %.3g", e->measured_cpu, estimate);
 	return err;
 }

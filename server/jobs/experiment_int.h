@@ -52,6 +52,8 @@ struct srv_experiment {
 	int writes;              /* queued store writes (they refer to e) */
 	int freed;               /* srv_exp_free came while writes > 0 */
 	int deleted;             /* a DELETE came (srv_exp_cancel) */
+	double measured_cpu;     /* CPU s its request's thread spent measuring
+				    (srv_exp_ready; not stored) */
 };
 
 /* The worker's answer to e's command (lock held): a command that starts a
@@ -96,7 +98,8 @@ int srv_exp_dist_specs(const api_exp_ext *x, const api_spec *spec, api_spec *out
 /* What e's measurements before it runs would cost the request's thread
  * (experiment_cost.c: the runs srv_exp_prepare makes that the curve cache
  * does not spare, estimated as budget_cost.c's), into *estimate (CPU s).
- * Beyond --max-cpu-seconds: 422 budget "cpu" naming identify.beta (the
+ * With a fresh session's settling after them (its estimate) beyond
+ * --max-cpu-seconds: 422 budget "cpu" naming identify.beta (the
  * most operating points that fit as max), session.scene.columns (a fresh
  * session: the most columns that fit, where any does) or session (a
  * running one's scene), nothing measured or changed. */

@@ -124,12 +124,12 @@ static void destroy(srv_entry *en)
  * work no worker's grant or stop would interrupt (a sample, the settling);
  * last a --max-settling slot, held while its instance is built, settled
  * and probed (srv_session_create gives it back). 1 with *pb. */
-static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
+static int refused_early(srv_session *s, const api_spec *spec, double before, api_problem *pb)
 {
 	double cpu;
 	if (srv_dem_wanted(spec))
 		return 0;
-	if (srv_budget_cpu_preview(spec, &cpu, pb) != API_OK)
+	if (srv_budget_cpu_preview(spec, before, &cpu, pb) != API_OK)
 		return 1;
 	if (spec->pace != API_PACE_MAX &&
 	    srv_budget_take_paced(&s->budget.paced_held, cpu, spec->pace, "pace", "created",
@@ -139,8 +139,10 @@ static int refused_early(srv_session *s, const api_spec *spec, api_problem *pb)
 }
 
 /* Build s for spec: its sim instance, the initial status and the buffers
- * (lock and conditions are initialised). 0, or -1 with *pb. */
-static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
+ * (lock and conditions are initialised), within --max-cpu-seconds less
+ * before, the CPU s this thread spent on the request before. 0, or -1
+ * with *pb. */
+static int session_init(srv_session *s, const api_spec *spec, double before, api_problem *pb)
 {
 	char msg[256] = "";
 	int err = SIM_OK;
@@ -151,17 +153,20 @@ static int session_init(srv_session *s, const api_spec *spec, api_problem *pb)
 	s->state = SRV_RUNNING;
 	s->budget.cpu_limit = cfg->max_cpu_seconds;
 	s->budget.turn.wake = &s->wake;
-	if (refused_early(s, spec, pb))
+	if (refused_early(s, spec, before, pb))
 		return -1;
 	/* the settling and the probe stop at --max-cpu-seconds of this
-	 * thread's CPU whatever the method: the estimate above cannot know an
-	 * adaptive method's steps (core/cpu_bound.c) */
-	double cpu0 = srv_thread_cpu(), deadline = cpu0 + cfg->max_cpu_seconds, settled = 0;
+	 * thread's CPU whatever the method (the estimate above cannot know an
+	 * adaptive method's steps: core/cpu_bound.c), less what the request
+	 * spent before them: one request, one bound */
+	double left = before > 0 ? fmax(cfg->max_cpu_seconds - before, 0) : cfg->max_cpu_seconds;
+	double cpu0 = srv_thread_cpu(), deadline = cpu0 + left, settled = 0;
 	s->sim = sim_new_bounded(&spec->params, &spec->scene, &spec->method, deadline, &settled,
 				 &err, msg, sizeof msg);
 	if (!s->sim) {
 		if (err == SIM_ECPU)
-			srv_budget_settle_stopped(spec, srv_thread_cpu() - cpu0, settled, pb);
+			srv_budget_settle_stopped(spec, before, srv_thread_cpu() - cpu0, settled,
+						  pb);
 		else
 			api_fail(pb, api_from_sim(err ? err : SIM_ENOMEM), NULL, "%s",
 				 msg[0] ? msg : sim_strerror(err));
@@ -238,7 +243,7 @@ static int left_while_settling(const srv_session *s, int client_fd, api_problem 
 }
 
 srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
-				api_problem *pb)
+				double before, api_problem *pb)
 {
 	api_spec copy = *request;
 	const api_spec *spec = &copy;
@@ -272,7 +277,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 		goto fail;
 	}
 	s->create_fd = client_fd;
-	int bad = session_init(s, spec, pb);
+	int bad = session_init(s, spec, before, pb);
 	s->create_fd = -1;
 	srv_budget_give_settling(&s->budget.settling); /* built, or not at all */
 	if (bad || left_while_settling(s, client_fd, pb))

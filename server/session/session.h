@@ -35,7 +35,9 @@ void srv_sessions_shutdown(void);
  * (may be NULL; borrowed, must outlive the attachment) attached before
  * the first step. Its instance is built, settled and probed in the
  * calling thread, holding a --max-settling slot (not a LIGGGHTS
- * session's: --max-dem-sessions bounds those). client_fd: -1, or the
+ * session's: --max-dem-sessions bounds those), within --max-cpu-seconds
+ * of that thread's CPU less before, the CPU s it spent on the request
+ * before (an experiment's measurements; 0: none). client_fd: -1, or the
  * creating client's socket (borrowed): a LIGGGHTS bed's settling is
  * cancelled when the client leaves before it ends, and any creation whose
  * client has left once settled and probed (srv_peer_gone) is discarded
@@ -44,7 +46,7 @@ void srv_sessions_shutdown(void);
  * *pb set (429 at --max-sessions, 422 when the core refuses the spec, 503:
  * budget "memory", "cpu" or "settling"). */
 srv_session *srv_session_create(const api_spec *spec, srv_experiment *exp, int client_fd,
-				api_problem *pb);
+				double before, api_problem *pb);
 /* Look up by id; returns a new reference or NULL. */
 srv_session *srv_session_get(const char *id);
 /* Drop a reference; the last one stops the worker and frees the session.

@@ -6,8 +6,10 @@
 // --max-cpu-seconds, with nothing measured, started or changed (a closed
 // loop on a 16 x 16 scene measured for about ten CPU seconds here
 // whatever the bound), and those admitted are stopped at the bound
-// (measure_stop.test.mjs). Exact bodies: the estimate's figures
-// are server/admit/budget_cost.c's for these scenes.
+// (measure_stop.test.mjs). A fresh session settles after them in the same
+// request's thread, under the same bound: its settling's estimate counts
+// with theirs. Exact bodies: the estimate's figures are
+// server/admit/budget_cost.c's for these scenes.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, metric, SLOW } from './lib.mjs';
@@ -15,6 +17,7 @@ import { startDaemon, req, metric, SLOW } from './lib.mjs';
 const BOUND = 1;
 const SCENE = { scene: { columns: 16, layers: 16 } };
 const WIDE = { scene: { columns: 20, layers: 32 } };
+const LONG = { scene: { columns: 8, layers: 16, settle: 13, transient: 0.5 } };
 const LOOP = { control: { setpoint: [{ v: 0.10, until: 2 }], controller: { kp: 2, ki: 800 } } };
 const refusal = (field, detail, range) => ({
   type: '/api/v1/problems/out-of-range',
@@ -29,6 +32,9 @@ const refusal = (field, detail, range) => ({
 });
 const after = (what, cpu, fix) => `${what} would take about ${cpu} CPU s in this request's thread, ` +
   `before it answers and uninterrupted, more than --max-cpu-seconds (${BOUND}); nothing was started: ${fix}`;
+// on a fresh session, whose settling follows them in the same thread
+const fresh = (what, cpu, fix) => `${what} and its session's settling would take about ${cpu} CPU s ` +
+  `in this request's thread, uninterrupted, more than --max-cpu-seconds (${BOUND}); nothing was started: ${fix}`;
 
 test('identify and control measurements estimated beyond --max-cpu-seconds are refused at once with the most that fits; nothing is measured or changed', { timeout: 90000 * SLOW }, async () => {
   const d = await startDaemon(['--max-cpu-seconds', String(BOUND), '--ring', '64', '--history', '64']);
@@ -48,23 +54,33 @@ test('identify and control measurements estimated beyond --max-cpu-seconds are r
     let r = await quick({ session: SCENE, ...LOOP });
     assert.equal(r.status, 422, r.text);
     assert.deepEqual(r.body, refusal('session.scene.columns',
-      after('control\'s v(beta) curve (73 runs of the scene)', 5.77,
+      fresh('control\'s v(beta) curve (73 runs of the scene)', 5.79,
         'a smaller scene (at most 4 columns of 16 layers) or a larger integrator.dt'),
       { min: 1, max: 4 }));
     // with "auto" gains, their identification is counted too
     r = await quick({ session: SCENE, control: { ...LOOP.control, controller: 'auto' } });
     assert.equal(r.status, 422, r.text);
     assert.deepEqual(r.body, refusal('session.scene.columns',
-      after('control\'s v(beta) curve (74 runs of the scene, one the identification behind "auto" gains)', 6.03,
+      fresh('control\'s v(beta) curve (74 runs of the scene, one the identification behind "auto" gains)', 6.05,
         'a smaller scene (at most 4 columns of 16 layers) or a larger integrator.dt'),
       { min: 1, max: 4 }));
     // an identification of four points on a 20 x 32 scene: eight runs, two points fit
     r = await quick({ session: WIDE, identify: { beta: [30, 38, 45, 60] } });
     assert.equal(r.status, 422, r.text);
     assert.deepEqual(r.body, refusal('identify.beta',
-      after('identify\'s slopes (8 runs of the scene: two per operating point)', 1.88,
+      fresh('identify\'s slopes (8 runs of the scene: two per operating point)', 1.93,
         'at most 2 operating points, a larger integrator.dt or a smaller scene'),
       { min: 1, max: 2 }));
+    // one point on 8 x 16 settled for 13 s: its two runs, about 0.796 CPU s,
+    // fit the bound alone (the build before measured them, then settled
+    // the session, 0.321 CPU s more, under a bound of its own); with the
+    // session's settling they do not
+    r = await quick({ session: LONG, identify: { beta: [30] } });
+    assert.equal(r.status, 422, r.text);
+    assert.deepEqual(r.body, refusal('session.scene.columns',
+      fresh('identify\'s slopes (2 runs of the scene: two per operating point)', 1.12,
+        'a smaller scene (at most 4 columns of 16 layers) or a larger integrator.dt'),
+      { min: 1, max: 4 }));
     // a closed loop attached to a running 16 x 16 session: its scene is the session's
     const s = await req(d.base, 'POST', '/api/v1/sessions', { ...SCENE, pace: 0.01, sample_rate: 1 });
     assert.equal(s.status, 201, s.text);
