@@ -103,11 +103,6 @@ const api_experiment_req *srv_exp_request(const srv_experiment *e)
 	return &e->req;
 }
 
-double srv_exp_measured_cpu(const srv_experiment *e)
-{
-	return e->measured_cpu;
-}
-
 int srv_exp_keeps_session(const srv_experiment *e)
 {
 	return e->req.keep_session || !e->req.fresh;

@@ -171,3 +171,8 @@ api_err srv_exp_ready(srv_experiment *e, const api_spec *spec, api_problem *pb)
 		"estimated at %.3g", e->measured_cpu, estimate);
 	return err;
 }
+
+double srv_exp_measured_cpu(const srv_experiment *e)
+{
+	return e->measured_cpu;
+}
