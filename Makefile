@@ -219,6 +219,7 @@ $(BUILD)/core/model_check.o: $(BUILD)/core/model_map.inc
 # tests/bench/results/fast_feed.md and .csv; the docs' tables follow.
 fast-feed-check: $(BUILD)/convsim $(BUILD)/fast_feed_bed
 	$(Q)python3 tests/bench/fast_feed_check.py $(BUILD)/convsim
+	$(Q)python3 tests/bench/depth_surrogate.py
 	$(Q)python3 tests/docs_bench.py
 $(BUILD)/core/model_check.o: INC_EXTRA := -I$(BUILD)/core
 # the `grains` candidate's bed (tests/bench/fast_feed_bed.c), standalone
