@@ -166,6 +166,12 @@ export async function createLoopExperiment(form) {
 export async function getLoopExperiment(id) {
 	return loopExperiment((await request('GET', `/experiments/${enc(id)}`)).data);
 }
+/* DELETE stops a running experiment and forgets it, running or ended;
+ * its fresh session goes with it unless kept (keep_session). No body: the
+ * daemon refuses a DELETE that carries one (400). */
+export async function deleteExperiment(id) {
+	await request('DELETE', `/experiments/${enc(id)}`);
+}
 
 export async function integratorNames() {
 	return methodEnum((await request('GET', '/openapi.json')).data);

@@ -3,14 +3,15 @@
  * experiment.js - the beta-change experiment panel: runs a fresh session
  * of the new-session form's model with beta1 then beta2, optionally
  * attaches the plots to it, and shows the reversal time, the segments and
- * the feed velocity against time.
+ * the feed velocity against time; its Stop button (stop.js) ends it.
  */
 
 import * as api from './api.js';
 import { Trace } from './series.js';
 import { fmt, fmtGiven, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direction, ARROW, DASH } from './format.js';
-import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
+import { app, $, message, report, setOnline, numberOf, busy, progress } from './ui.js';
 import { readSessionForm, attach } from './session.js';
+import { stopButton } from './stop.js';
 
 /* The inputs behind the schedule's members (api-requests.js
  * experimentRequest): segment 1 is beta1 until t_switch, segment 2 beta2
@@ -18,7 +19,14 @@ import { readSessionForm, attach } from './session.js';
 const SCHEDULE_INPUT = [[/^schedule\[0\]\.beta/, 'beta1'], [/^schedule\[0\]\.until/, 't_switch'],
 	[/^schedule\[1\]\.beta/, 'beta2'], [/^schedule\[1\]\.until/, 't_end']];
 
-export async function runExperiment(ev) {
+let follow = null; /* polls a run until it ends or is stopped (stop.js) */
+
+export function wireExperiment() {
+	$('#experiment-form').addEventListener('submit', runExperiment);
+	follow = stopButton('#experiment-stop', '#experiment-progress');
+}
+
+async function runExperiment(ev) {
 	ev.preventDefault();
 	const f = $('#experiment-form').elements;
 	const base = readSessionForm();
@@ -39,11 +47,12 @@ export async function runExperiment(ev) {
 			attach(j.sessionId, await api.getSession(j.sessionId).catch(() => null));
 			message('ok', `Experiment ${j.id} runs on session ${j.sessionId}; the plots follow it.`);
 		}
-		const end = await poll(api.getExperiment, j.id, u => {
+		const end = await follow(j, api.getExperiment, u => {
 			showExperiment(u, form);
 			const tText = Number.isFinite(u.t) ? ` · t = ${fmtTime(u.t)}` : '';
 			progress(box, Number.isFinite(u.progress) ? u.progress : (u.t / form.tEnd), `${u.state || 'running'}${tText}`);
 		});
+		if (!end) return; /* stopped: stop.js said so */
 		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
 		else message('ok', `Experiment ${end.id} finished.`);
 		const csv = $('#experiment-csv'), traj = $('#experiment-traj');

@@ -9,12 +9,14 @@
  * and the fitted response over the measured one. v(t) is the feed's mean
  * velocity over each excitation period from the session's recorded
  * trajectory (api-loop.js periodVelocity), as the daemon samples it.
+ * Its Stop button (stop.js) ends a run.
  */
 
 import * as api from './api.js';
 import { fmt, fmtGiven, fmtSig, fmtPm, fmtTime } from './format.js';
-import { app, $, $$, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
+import { app, $, $$, message, report, setOnline, numberOf, busy, progress } from './ui.js';
 import { readSessionForm } from './session.js';
+import { stopButton } from './stop.js';
 
 function readLoopForm() {
 	const f = $('#loop-form').elements;
@@ -36,11 +38,14 @@ function showKind() {
 	$('#loop-plot-identify').hidden = kind !== 'identify';
 }
 
+let follow = null; /* polls a run until it ends or is stopped (stop.js) */
+
 export function wireLoop() {
 	const f = $('#loop-form').elements;
 	f.kind.addEventListener('change', showKind);
 	f.controller.addEventListener('change', showKind);
 	$('#loop-form').addEventListener('submit', runLoop);
+	follow = stopButton('#loop-stop', '#loop-progress');
 	showKind();
 }
 
@@ -56,11 +61,12 @@ async function runLoop(ev) {
 		app.loop = { id: j.id, sessionId: j.sessionId, kind: j.kind, done: false };
 		progress(box, 0, 'started');
 		showLoop(j);
-		const end = await poll(api.getLoopExperiment, j.id, u => {
+		const end = await follow(j, api.getLoopExperiment, u => {
 			showLoop(u);
 			const tText = Number.isFinite(u.t) ? ` · t = ${fmtTime(u.t)}` : '';
 			progress(box, u.progress, `${u.state || 'running'}${tText}`);
 		});
+		if (!end) return; /* stopped: stop.js said so */
 		const traj = end.sessionId ? await api.trajectory(end.sessionId).catch(() => null) : null;
 		showLoop(end, traj);
 		const csv = $('#loop-csv'), trajLink = $('#loop-traj');

@@ -10,7 +10,7 @@
  * and draw.js redraws at most every animation frame. ui.js holds the state
  * they share; figures.js says which plot shows what; controls.js wires the
  * live-control card; sweep.js, experiment.js, loop.js and fit.js are the
- * job panels.
+ * job panels, and stop.js the experiment panels' Stop button.
  * api.js (with api-normalize.js, api-requests.js, api-stream.js) is the
  * one link to the daemon; auth.js gives it the token from the URL's
  * fragment (#token=...).
@@ -25,7 +25,7 @@ import { frame } from './draw.js';
 import { wireControls } from './controls.js';
 import { runSweep } from './sweep.js';
 import { wireFit } from './fit.js';
-import { runExperiment } from './experiment.js';
+import { wireExperiment } from './experiment.js';
 import { wireLoop } from './loop.js';
 
 const HEALTH_MS = 3000;
@@ -49,7 +49,7 @@ function wire() {
 	f.preset.addEventListener('change', () => applyPreset(f.preset.value));
 	$('#sweep-form').addEventListener('submit', runSweep);
 	wireFit();
-	$('#experiment-form').addEventListener('submit', runExperiment);
+	wireExperiment();
 	wireLoop();
 }
 

@@ -134,17 +134,27 @@ export function progress(box, frac, text) {
 	box.querySelector('.ptext').textContent = text;
 }
 
-export async function poll(get, id, onUpdate) {
+/* Poll get(id) every JOB_POLL_MS, onUpdate each answer, until the job is
+ * over (its last answer) or signal (an AbortSignal, optional) aborts: null
+ * at once, and an answer or an error still on its way is dropped. */
+export async function poll(get, id, onUpdate, signal) {
 	for (;;) {
-		await new Promise(r => setTimeout(r, JOB_POLL_MS));
+		await new Promise(r => {
+			const wake = () => { clearTimeout(t); signal?.removeEventListener('abort', wake); r(); };
+			const t = setTimeout(wake, JOB_POLL_MS);
+			signal?.addEventListener('abort', wake);
+		});
+		if (signal?.aborted) return null;
 		let j;
 		try {
 			j = await get(id);
 			setOnline(true);
 		} catch (err) {
+			if (signal?.aborted) return null;
 			if (err instanceof api.NetworkError) { setOnline(false); continue; }
 			throw err;
 		}
+		if (signal?.aborted) return null;
 		onUpdate(j);
 		if (j.done) return j;
 	}
