@@ -167,8 +167,8 @@ export async function getLoopExperiment(id) {
 	return loopExperiment((await request('GET', `/experiments/${enc(id)}`)).data);
 }
 /* DELETE stops a running experiment and forgets it, running or ended;
- * its fresh session goes with it unless kept (keep_session). No body: the
- * daemon refuses a DELETE that carries one (400). */
+ * its fresh session goes with it unless kept (keep_session). No body, as
+ * deleteFit. */
 export async function deleteExperiment(id) {
 	await request('DELETE', `/experiments/${enc(id)}`);
 }
@@ -199,10 +199,11 @@ export async function createFit(form) {
 export async function getFit(id) {
 	return normalizeFit((await request('GET', `/fits/${enc(id)}`)).data);
 }
-/* DELETE cancels a running fit; the body is empty JSON, as every mutating
- * request carries Content-Type: application/json. */
+/* DELETE cancels a running fit. Content-Type: application/json as on
+ * every mutating request, but no body: the daemon refuses a DELETE that
+ * carries one (400). */
 export async function deleteFit(id) {
-	await request('DELETE', `/fits/${enc(id)}`, {});
+	await request('DELETE', `/fits/${enc(id)}`);
 }
 export function fitCsvUrl(id) {
 	return `${BASE}/fits/${enc(id)}?format=csv`;
