@@ -25,12 +25,15 @@ after(async () => {
 const messages = () => page.$$eval('#messages .msg-text', m => m.map(x => x.textContent));
 
 test('Cancel stops a running fit', async () => {
-	await page.fill('#fit-form input[name="t_end"]', '500');
+	await page.fill('#fit-form input[name="t_end"]', '30');
 	const answered = page.waitForResponse(r => r.url().endsWith('/api/v1/fits') && r.request().method() === 'POST');
 	await page.click('#fit-run');
 	const fit = await (await answered).json();
 	assert.ok(fit.id, JSON.stringify(fit));
 	await until(() => page.isVisible('#fit-cancel'), 5000, 'Cancel offered');
+	/* evaluations of 30 s each: many seconds of fit, and a shutdown that
+	 * waits for those running at the cancel no longer than the after hook */
+	assert.equal((await apiGet(d, `/api/v1/fits/${fit.id}`)).state, 'running');
 	const sent = page.waitForRequest(r => r.method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}`));
 	const done = page.waitForResponse(r => r.request().method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}`));
 	await page.click('#fit-cancel');

@@ -135,8 +135,8 @@ export function progress(box, frac, text) {
 }
 
 /* Poll get(id) every JOB_POLL_MS, onUpdate each answer, until the job is
- * over (its last answer) or signal (an AbortSignal, optional) aborts: null
- * at once, and an answer or an error still on its way is dropped. */
+ * over (its last answer) or signal (an AbortSignal, optional) aborts: null,
+ * the wait cut short, an answer or an error still on its way dropped. */
 export async function poll(get, id, onUpdate, signal) {
 	for (;;) {
 		await new Promise(r => {
