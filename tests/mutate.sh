@@ -82,6 +82,19 @@ mutations=(
 	"the regularised friction's width doubled|core/feed.c|s|return tanh(v / md->sc.friction_eps);|return tanh(v / (2.0 * md->sc.friction_eps));|"
 	# the deck points the core shows (sim_deck_points): tests/unit/test_feed.c
 	"the deck points shown from the trough's centre, not each one's rest|core/sim_status.c|s|deck_point(dk, dk->d\[k\], \&R0, zero, zero, rest, vel);|deck_point(dk, 0.0, \&R0, zero, zero, rest, vel);|"
+	# each column's displacement from its own origin, where the columns
+	# are integrated apart (a rocking machine): tests/unit/test_feed.c
+	"each column's displacement from the first column's origin|core/sim_status.c|s|- s->X0k\[c\];|- s->X0k[0];|"
+	# the counter-clockwise steady start's rotor speed, on a rotor too heavy
+	# for the settling to hide it: tests/unit/test_power.c
+	"the steady start's motor speed blind to the sense of rotation|core/steady.c|s|tau = (double)ctl->rotation \* need;|tau = need;|"
+	# faults the unit tests caught when they were planted, kept as
+	# representatives: a load step's contacts (test_disturb.c), the deck
+	# load's moment with h_d != 0 (test_deck_load.c), the yielding deck's
+	# turn on a rocking machine (test_feed.c)
+	"a load step's contacts scaled by the inverse ratio|core/disturb.c|s|pow(m_n / md->p.m_n, 1.0 / md->p.p)|pow(md->p.m_n / m_n, 1.0 / md->p.p)|"
+	"the deck load's moment with the wrong sign of its x part|core/model.c|s|rhs\[Q_ALPHA\] += rx \* L\[1\] - ry \* L\[0\] + L\[2\];|rhs[Q_ALPHA] += rx * L[1] + ry * L[0] + L[2];|"
+	"the yielding deck's vertical give with the wrong sign of the turn|core/feed.c|s|(B\[1\]\[q\] + Rd\[0\] \* B\[2\]\[q\])|(B[1][q] - Rd[0] * B[2][q])|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

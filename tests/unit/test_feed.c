@@ -5,8 +5,8 @@
  * symmetry with opposite transport, agreement of the symmetric reduction
  * with the full model, the energy balance, a slide under the regularised
  * friction law against its closed form, the deck points shown from their
- * rest (the hopping theory of VDI 2333 runs through the engine in
- * test_accuracy.c).
+ * rest, each column's displacement from its own origin (the hopping
+ * theory of VDI 2333 runs through the engine in test_accuracy.c).
  */
 #include "sim_int.h" /* the state at t = 0, column by column */
 #include "testutil.h"
@@ -306,6 +306,38 @@ static void deck_points_from_their_rest(void **state)
 	sim_free(s);
 }
 
+/* The per-column mean feed displacement (sim_column_displacement,
+ * docs/MODEL.md "Observables": xi_k(t) - xi_k(0)) on a machine that rocks
+ * (l2 = 0.9 m: five integrated columns): zero for every column at t = 0,
+ * and, every column holding L elements, their mean is the whole feed's
+ * displacement to round-off at every time. Columns counted from the first
+ * column's origin would stand 0.4 m apart. */
+static void column_displacements_from_their_own_origins(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	set(&u, "l2", "0.9");
+	sim *s = make(&u);
+	int K = sim_columns(s);
+	assert_int_equal(K, 5);
+	assert_false(status(s).reductions & SIM_RED_SYMMETRIC);
+	for (int i = 0; i < 3; i++) {
+		advance(s, 0.25 * i);
+		double cd[5], mean = 0.0;
+		sim_column_displacement(s, cd);
+		for (int c = 0; c < K; c++) {
+			if (i == 0)
+				assert_close(cd[c], 0.0, 0.0);
+			mean += cd[c] / K;
+		}
+		sim_status st = status(s);
+		assert_close(mean, st.feed_displacement, 1e-12);
+		if (i > 0)
+			assert_true(fabs(st.feed_displacement) > 1e-3);
+	}
+	sim_free(s);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -317,6 +349,7 @@ int main(void)
 		cmocka_unit_test(energy_balance_with_feed),
 		cmocka_unit_test(regularised_slide_slows_as_tanh),
 		cmocka_unit_test(deck_points_from_their_rest),
+		cmocka_unit_test(column_displacements_from_their_own_origins),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -173,6 +173,43 @@ static void kloss_against_drag_and_load(void **state)
 	}
 }
 
+/* The steady start (docs/MODEL.md "Parameters": the rotor at the speed
+ * where M_el balances the mean load) puts the rotor alone (e = 0) at
+ * kloss_against_drag_and_load's speed at t = 0, both senses: the
+ * counter-clockwise motor, M_el,ccw(w) = -M_el(-w), on its stable branch
+ * below the synchronous speed in magnitude, and where it starts it stays.
+ * A heavy rotor (J_w = 10 kg m^2: its slip mode decays at 0.65 1/s) keeps
+ * the settling before t = 0 from correcting a wrong start. */
+static void steady_start_at_the_loaded_speed(void **state)
+{
+	(void)state;
+	const double Mut = 50.0, wss = 157.08, sut = 15.5, b = 4e-4, ML = 2.0;
+	double lo = wss - sut, hi = wss;
+	for (int i = 0; i < 200; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (kloss(mid, Mut, wss, sut) > b * mid * mid + ML)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	const double w = 0.5 * (lo + hi);
+	for (int r = 0; r < 2; r++) {
+		setup u = preset_defaults();
+		set(&u, "feed", "false");
+		set(&u, "e", "0");
+		set(&u, "b_phi", "4e-4");
+		set(&u, "M_load", "2");
+		set(&u, "J_w", "10");
+		set(&u, "rotation", r ? "ccw" : "cw");
+		sim *s = make(&u);
+		double sign = r ? -1.0 : 1.0;
+		assert_close(status(s).rotor_speed, sign * w, 1e-6 * w);
+		advance(s, 0.2);
+		assert_close(status(s).rotor_speed, sign * w, 1e-6 * w);
+		sim_free(s);
+	}
+}
+
 /* The slip mode's rate that bounds a fixed step (model_slip_rate: the
  * torque's slope at the synchronous speed over the rotor's inertia) takes
  * the bearing drag's slope 2 b_phi w_ss with the motor's 2 M_ut / s_ut:
@@ -306,6 +343,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
+		cmocka_unit_test(steady_start_at_the_loaded_speed),
 		cmocka_unit_test(slip_bound_counts_the_drag),
 		cmocka_unit_test(deck_point_shown),
 		cmocka_unit_test(observation_is_the_evaluation),
