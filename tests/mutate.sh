@@ -66,6 +66,7 @@ mutations=(
 	"the period shown from the first boundary, not the last period|core/estimator.c|s|out->period = e->tb_last - e->tb_prev;|out->period = e->tb_last - e->tb_first;|"
 	"the deck point shown from G's height, not its rest (h_d)|core/sim_status.c|s|st->deck\[1\] -= md->dk.h_d;|st->deck[1] -= 0.0;|"
 	"steady blind to the drift (only the bar's size)|core/estimator.c|s|fabs(e->bar.drift) <= 3.0 \* e->bar.se_drift|1|"
+	"the drift's standard error over the centres' sum of squares, not its root|core/estimator.c|s|e->bar.se_drift = s / sqrt(scc) \* window;|e->bar.se_drift = s / scc * window;|"
 	# the symmetric reduction where the machine is not symmetric:
 	# tests/unit/test_asymmetry.c
 	"the symmetric reduction blind to unequal eliminator dampers|core/setup.c|s|p->b_s1 == p->b_s2 \&\&|1 \&\&|"

@@ -105,6 +105,11 @@ static void v_is_dX_over_dt_between_its_crossings(void **state)
 	double se = sqrt(ss / (nb - 2)) / sqrt((double)nb), D = scv / scc * (t_last - t_first);
 	double bar = sqrt(se * se + 0.25 * D * D);
 	assert_close(st.transport_velocity_uncertainty - st.step_error, bar, 1e-6 * bar); /* 1e-13 seen */
+	/* the drift and its standard error, which the steady flag compares:
+	 * the slope's, s / sqrt(sum (c_i - c)^2), times the window */
+	double se_D = sqrt(ss / (nb - 2)) / sqrt(scc) * (t_last - t_first);
+	assert_close(e->bar.drift, D, 1e-6 * fabs(D));
+	assert_close(e->bar.se_drift, se_D, 1e-6 * se_D);
 	sim_free(s);
 }
 
