@@ -58,9 +58,11 @@ dem_feed *dem_feed_local(const dem_bed_spec *spec, const void *comm, char *msg, 
  * whose peer's leaving while the bed settles ends the child and fails the
  * request, so that an abandoned create holds nothing. NULL with msg on
  * error (the program missing, the child refusing, ending or hanging, the
- * client gone). */
+ * client gone); *left (NULL: not asked) then says which: 1 when the
+ * watched socket's peer left, 0 for every other error. */
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, double timeout, int watch_fd, char *msg, size_t msglen);
+			  int ranks, double timeout, int watch_fd, int *left, char *msg,
+			  size_t msglen);
 /* The child's process id (remote; 0 for local, NULL, or once it ended
  * and was reaped). */
 long dem_feed_pid(const dem_feed *f);

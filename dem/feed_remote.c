@@ -169,7 +169,9 @@ static int remote_receive(remote *r, char *line, size_t len)
 	}
 }
 
-/* One request, one state answer into r->base: 0, or -1 with msg. */
+/* One request, one state answer into r->base: 0, or with msg -1, or -2
+ * when the watched socket's peer left while it waited (the child ended
+ * and reaped either way). */
 static int remote_exchange(remote *r, const char *req, int n, char *msg, size_t msglen)
 {
 	char line[DEM_PROTO_LINE];
@@ -188,7 +190,7 @@ static int remote_exchange(remote *r, const char *req, int n, char *msg, size_t 
 		if (rc == -3)
 			snprintf(msg, msglen, "the client went away while the bed settled: the bed "
 					      "process (pid %ld) was ended", pid);
-		return -1;
+		return rc == -3 ? -2 : -1;
 	}
 	if (!strncmp(line, "error ", 6)) {
 		snprintf(msg, msglen, "bed process: %s", line + 6);
@@ -333,7 +335,8 @@ fail:
 }
 
 dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int nice_value,
-			  int ranks, double timeout, int watch_fd, char *msg, size_t msglen)
+			  int ranks, double timeout, int watch_fd, int *left, char *msg,
+			  size_t msglen)
 {
 	char req[DEM_PROTO_LINE];
 	if (spec->wiggle_period > 0) {
@@ -352,8 +355,12 @@ dem_feed *dem_feed_remote(const char *bed_path, const dem_bed_spec *spec, int ni
 	r->timeout = timeout > 0 && isfinite(timeout) ? timeout : 0;
 	r->watch = watch_fd;
 	pthread_mutex_init(&r->lock, NULL);
-	if (remote_spawn(r, bed_path, nice_value, ranks, msg, msglen) ||
-	    remote_exchange(r, req, dem_proto_bed_line(req, sizeof req, spec), msg, msglen)) {
+	int rc = remote_spawn(r, bed_path, nice_value, ranks, msg, msglen);
+	if (!rc)
+		rc = remote_exchange(r, req, dem_proto_bed_line(req, sizeof req, spec), msg, msglen);
+	if (rc) {
+		if (left)
+			*left = rc == -2;
 		remote_free(&r->base);
 		return NULL;
 	}

@@ -141,7 +141,7 @@ static int refused_early(srv_session *s, const api_spec *spec, double before, ap
 /* Build s for spec: its sim instance, the initial status and the buffers
  * (lock and conditions are initialised), within --max-cpu-seconds less
  * before, the CPU s this thread spent on the request before. 0, or -1
- * with *pb. */
+ * with *pb, or 1 when its client left while its LIGGGHTS bed settled. */
 static int session_init(srv_session *s, const api_spec *spec, double before, api_problem *pb)
 {
 	char msg[256] = "";
@@ -182,11 +182,12 @@ static int session_init(srv_session *s, const api_spec *spec, double before, api
 	srv_log(SRV_LOG_DEBUG, "session %s: built and settled in %.3g CPU s, settling estimated "
 		"at %.3g", s->entry.id, srv_thread_cpu() - cpu0,
 		srv_budget_settle_cpu(spec, &s->st, s->layers));
-	if (srv_dem_wanted(spec) && srv_dem_start(s, 0, msg, sizeof msg)) {
+	int bed = srv_dem_wanted(spec) ? srv_dem_start(s, 0, msg, sizeof msg) : 0;
+	if (bed < 0)
 		api_fail(pb, API_UNAVAILABLE, "scene.feed_model",
 			 "the LIGGGHTS bed did not start: %s", msg);
-		return -1;
-	}
+	if (bed) /* or 1: its client left while the bed settled */
+		return bed;
 	/* what a simulated second costs: the larger of the estimate and a short
 	 * run of a copy (cpu_probe.c). A threshold (the measurement only beyond
 	 * twice the estimate) made a large scene's hold jump to the estimate
@@ -226,12 +227,14 @@ static void sessions_full(api_problem *pb)
 }
 
 /* 1 with *pb when the client whose socket is client_fd (-1: none, a
- * restore) left while s settled: nobody would read its 201, so nothing is
- * kept (a LIGGGHTS bed's settling already stops when it leaves). A client
- * that leaves after this look still gets its session. */
-static int left_while_settling(const srv_session *s, int client_fd, api_problem *pb)
+ * restore) left while s settled (left: its LIGGGHTS bed saw it go and
+ * stopped settling; else a look now): nobody would read its 201, so
+ * nothing is kept. A client that leaves after this look still gets its
+ * session. */
+static int left_while_settling(const srv_session *s, int client_fd, int left,
+			       api_problem *pb)
 {
-	if (!srv_peer_gone(client_fd))
+	if (!left && !srv_peer_gone(client_fd))
 		return 0;
 	atomic_fetch_add(&srv_stats.sessions_abandoned, 1);
 	srv_log(SRV_LOG_INFO, "session %s not created: its client left while it settled",
@@ -280,7 +283,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	int bad = session_init(s, spec, before, pb);
 	s->create_fd = -1;
 	srv_budget_give_settling(&s->budget.settling); /* built, or not at all */
-	if (bad || left_while_settling(s, client_fd, pb))
+	if (bad < 0 || left_while_settling(s, client_fd, bad > 0, pb))
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&

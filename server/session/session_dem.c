@@ -163,10 +163,12 @@ int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen)
 	const api_spec *sp = &s->spec;
 	dem_bed_spec bed;
 	dem_bed_spec_default(&sp->params, (double)sp->scene.layers, &bed);
+	int left = 0;
 	dem_feed *f = dem_feed_remote(bed_path, &bed, cfg->worker_nice, cfg->dem_ranks,
-				      cfg->dem_timeout, restored ? -1 : s->create_fd, msg, msglen);
+				      cfg->dem_timeout, restored ? -1 : s->create_fd, &left, msg,
+				      msglen);
 	if (!f)
-		return -1;
+		return left ? 1 : -1;
 	s->dem.link = dem_coupled_attach(s->sim, 0, f, &sp->params, &sp->scene, 1,
 				    sp->scene.transient, msg, msglen);
 	if (!s->dem.link)

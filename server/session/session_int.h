@@ -243,7 +243,9 @@ void srv_dem_hold(void);
 void srv_dem_release(void);
 /* Start s's bed process and couple it to s->sim (at t = 0, or at a
  * restored machine's time: restored = 1, the bed settled anew); s->st and
- * s->dem.bed show it. 0, or -1 with msg (s->dem.link stays NULL). */
+ * s->dem.bed show it. 0, or -1 with msg, or 1 when the creating client
+ * (s->create_fd) left while the bed settled; either way the bed process
+ * is ended and reaped and s->dem.link stays NULL. */
 int srv_dem_start(srv_session *s, int restored, char *msg, size_t msglen);
 /* Worker, lock released: advance machine and bed to the end of the
  * coupling interval at or after t_next (s). 0, or -1 with msg (the bed
