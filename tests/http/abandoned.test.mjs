@@ -6,6 +6,10 @@
 // session is not listed, holds no memory, no cores for its pace and no
 // slot, and convsim_sessions_abandoned_total counts it; the same for an
 // experiment on a fresh session. A client that waits is answered 201.
+// An identification on an existing session measures its scene in the
+// request's thread too, holding a settling slot: one whose client leaves
+// meanwhile is withdrawn before it is attached, the session left as it
+// was, and convsim_experiments_abandoned_total counts it.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { once } from 'node:events';
@@ -78,6 +82,38 @@ test('a creation or a fresh experiment whose client leaves while it settles crea
     m = await metrics(d);
     assert.equal(metric(m, 'convsim_sessions_abandoned_total'), 2);
     assert.equal(metric(m, 'convsim_sessions_created_total'), 2);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('an identification on an existing session whose client leaves while it measures is withdrawn; the session stays the client\'s', { timeout: 180000 * SLOW }, async () => {
+  const d = await startDaemon(['--ring', '64', '--history', '64', '--log-level', 'info']);
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions',
+      { scene: { columns: 16, layers: 16 }, pace: 0.01, sample_rate: 1 });
+    assert.equal(s.status, 201, s.text);
+    const id = s.body.id;
+    // two operating points of a 16 x 16 scene: four runs, about a second
+    assert.equal(await leaveWhileSettling(d, '/api/v1/experiments',
+      { session: id, identify: { beta: [30, 38] } }), '');
+    const m = await until(async () => {
+      const t = await metrics(d);
+      return (metric(t, 'convsim_experiments_abandoned_total') >= 1 ||
+              metric(t, 'convsim_experiments_total') >= 1) &&
+        metric(t, 'convsim_settling') === 0 && t;
+    }, 30000, 'the abandoned identification over');
+    assert.deepEqual(await listed(d, 'experiments'), []);
+    assert.equal(metric(m, 'convsim_experiments_abandoned_total'), 1);
+    assert.equal(metric(m, 'convsim_experiments_total'), 0);
+    assert.equal(metric(m, 'convsim_sessions_abandoned_total'), 0);
+    // the session runs on as before, nothing attached, its controls the client's
+    const g = await req(d.base, 'GET', `/api/v1/sessions/${id}`);
+    assert.equal(g.body.state, 'running', g.text);
+    assert.equal(g.body.experiment, null);
+    const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 38 });
+    assert.equal(p.status, 200, p.text);
+    assert.match(d.stderr(), /experiment \w+ not started: its client left while it measured/);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
