@@ -155,7 +155,7 @@ $(BUILD)/.deps-bench: Makefile
 # fit/, api/ and the floors below it (session/ and up also dem/'s headers:
 # the LIGGGHTS-free client of the bed process, libdemlink.a); dem/ core/
 # and LIGGGHTS, its programs dem/cli/ also cli/ (convsim's coupled run);
-# the unit tests core/ and fit/.
+# the unit tests core/, fit/ and api/ (the libraries they link).
 INC_core   := -Icore
 INC_fit    := -Icore -Ifit
 INC_api    := -Icore -Ifit -Iapi
@@ -167,7 +167,7 @@ INC_server_jobs    := $(INC_server_admit) -Iserver/jobs
 INC_server_session := $(INC_server_jobs) -Iserver/session -Idem
 INC_server_http    := $(INC_server_session) -Iserver/http
 INC_server := $(INC_server_http)
-INC_tests  := -Icore -Ifit
+INC_tests  := $(INC_api)
 INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 INC_dem_cli := $(INC_dem) -Icli
 $(BUILD)/cli/spread_mpi.o: INC_EXTRA := $(MPI_CFLAGS)

@@ -155,6 +155,9 @@ api_err api_fail_range(api_problem *pb, const char *field, double min, double ma
  * stream client%s %s connected" with api_plural(n, "", "s") and
  * api_plural(n, "is", "are") reads "1 stream client is connected". */
 const char *api_plural(double n, const char *one, const char *many);
+/* The same for a figure the detail prints with "%.<digits>g": one when
+ * it reads "1" there (0.9996 at 3 digits: "1 core"), else many. */
+const char *api_plural_g(double n, int digits, const char *one, const char *many);
 /* A refusal of a body nested in member ("session": a create body within
  * an experiment's): its field named by the path the client sent,
  * "member.field", unless it has none or is named so already (a field too

@@ -147,6 +147,13 @@ const char *api_plural(double n, const char *one, const char *many)
 	return n == 1 ? one : many;
 }
 
+const char *api_plural_g(double n, int digits, const char *one, const char *many)
+{
+	char printed[32];
+	snprintf(printed, sizeof printed, "%.*g", digits, n);
+	return strcmp(printed, "1") == 0 ? one : many;
+}
+
 void api_field_within(api_problem *pb, const char *member)
 {
 	size_t m = strlen(member), n = strlen(pb->field);

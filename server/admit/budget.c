@@ -121,8 +121,7 @@ api_err srv_budget_take(size_t bytes, const char *what, int force,
 		 "%.1f MiB (--max-memory) are taken; nothing was created, "
 		 "retry when sessions or streams have ended", what, mib(bytes),
 		 mib(used), mib(cfg->max_memory));
-	return api_budget(pb, "memory", (double)cfg->max_memory,
-			  MEMORY_RETRY_S);
+	return api_budget(pb, "memory", (double)cfg->max_memory, MEMORY_RETRY_S);
 }
 
 api_err srv_budget_take_session(int columns, int layers, size_t *need,
@@ -188,23 +187,24 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 		/* none from the least pace up fits: "max" only, pace's one choice (no range) */
 		int none = !(limit / cpu_per_s >= API_PACE_MIN);
 		api_fail(pb, API_RANGE, field,
-			 "this session needs %.3g cores (%.3g ms of CPU per "
+			 "this session needs %.3g core%s (%.3g ms of CPU per "
 			 "simulated s at pace %g), more than the %g core%s for "
 			 "paced sessions (--max-paced-cores); nothing was %s, %s",
-			 need, 1e3 * cpu_per_s, pace, limit, api_plural(limit, "", "s"), verb,
-			 none ? "no pace from 0.001 fits: run it at pace \"max\""
-			      : "lower the pace");
+			 need, api_plural_g(need, 3, "", "s"), 1e3 * cpu_per_s, pace, limit,
+			 api_plural_g(limit, 6, "", "s"), verb,
+			 none ? "no pace from 0.001 fits: run it at pace \"max\"" : "lower the pace");
 		pb->has_range = !none, pb->min = API_PACE_MIN, pb->max = limit / cpu_per_s;
 		if (none && strcmp(field, "pace") == 0)
 			snprintf(pb->choices, sizeof pb->choices, "max");
 		return api_budget(pb, "cpu", limit, 0);
 	}
 	api_fail(pb, API_UNAVAILABLE, field,
-		 "this session needs %.3g cores (%.3g ms of CPU per simulated s "
+		 "this session needs %.3g core%s (%.3g ms of CPU per simulated s "
 		 "at pace %g) and running paced sessions hold %.3g of the %g "
 		 "core%s for paced sessions (--max-paced-cores); nothing was %s, "
 		 "retry when paced sessions have ended, paused or slowed down",
-		 need, 1e3 * cpu_per_s, pace, others, limit, api_plural(limit, "", "s"), verb);
+		 need, api_plural_g(need, 3, "", "s"), 1e3 * cpu_per_s, pace, others, limit,
+		 api_plural_g(limit, 6, "", "s"), verb);
 	return api_budget(pb, "cpu", limit, CPU_RETRY_S);
 }
 

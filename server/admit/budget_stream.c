@@ -50,11 +50,12 @@ api_err srv_budget_take_stream(double *held, double before, double after,
 	if (srv_budget_raise_paced(held, after * pace, &taken))
 		return API_OK;
 	api_fail(pb, API_UNAVAILABLE, NULL,
-		 "this stream needs %.3g cores (%.3g ms of CPU per simulated s at "
+		 "this stream needs %.3g core%s (%.3g ms of CPU per simulated s at "
 		 "pace %g) and running paced sessions and their streams hold %.3g "
 		 "of the %g core%s for paced sessions (--max-paced-cores); nothing "
 		 "was opened, retry when some have ended or paused, or ask fewer "
 		 "records (rate, fields)",
-		 stream * pace, 1e3 * stream, pace, taken, limit, api_plural(limit, "", "s"));
+		 stream * pace, api_plural_g(stream * pace, 3, "", "s"), 1e3 * stream, pace, taken,
+		 limit, api_plural_g(limit, 6, "", "s"));
 	return api_budget(pb, "cpu", limit, STREAM_RETRY_S);
 }

@@ -287,6 +287,8 @@ export async function startCluster(n, dir, env = {}) {
 
 // printf's %.3g for the magnitudes the budgets' answers carry (1e-4 .. 1e3)
 export const g3 = (x) => String(Number(x.toPrecision(3)));
+// a need in cores as a detail words it: "1 core" where %.3g reads 1
+export const cores = (x) => `${g3(x)} core${g3(x) === '1' ? '' : 's'}`;
 
 // The 503 a creation gets when the cores for paced sessions cannot take it
 // (server/admit/budget.c's words): it needs `need` cores, `cpu` CPU s a
@@ -295,7 +297,7 @@ export const pacedBusy = (need, cpu, pace, sum, limit) => ({
   type: '/api/v1/problems/unavailable',
   title: 'Service unavailable',
   status: 503,
-  detail: `this session needs ${g3(need)} cores (${g3(1e3 * cpu)} ms of CPU per simulated s at pace ${pace}) ` +
+  detail: `this session needs ${cores(need)} (${g3(1e3 * cpu)} ms of CPU per simulated s at pace ${pace}) ` +
     `and running paced sessions hold ${g3(sum)} of the ${limit} cores for paced sessions ` +
     '(--max-paced-cores); nothing was created, retry when paced sessions have ended, paused or slowed down',
   instance: '/api/v1/sessions',

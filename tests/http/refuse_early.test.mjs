@@ -12,7 +12,7 @@
 // no worker's measure replaces its hold before the test ends.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, req, metric, SLOW, g3, pacedBusy, pacedEstimates } from './lib.mjs';
+import { startDaemon, req, metric, SLOW, g3, cores, pacedBusy, pacedEstimates } from './lib.mjs';
 
 const DEFAULT = {};
 const LIGHT = { scene: { drive: 'ideal', feed: false }, sample_rate: 10 };
@@ -55,7 +55,7 @@ test('with the paced cores full, the early refusal answers as the whole path and
       type: '/api/v1/problems/out-of-range',
       title: 'Value out of range',
       status: 422,
-      detail: `this session needs ${g3(c.HEAVY)} cores (${g3(1e3 * c.HEAVY)} ms of CPU per simulated s at pace 1), ` +
+      detail: `this session needs ${cores(c.HEAVY)} (${g3(1e3 * c.HEAVY)} ms of CPU per simulated s at pace 1), ` +
         `more than the ${limit} cores for paced sessions (--max-paced-cores); nothing was created, lower the pace`,
       instance: '/api/v1/sessions',
       field: 'pace',

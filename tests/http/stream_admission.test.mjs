@@ -10,7 +10,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import http from 'node:http';
-import { startDaemon, req, metric, until, SLOW, g3, fillPaced, pacedEstimates } from './lib.mjs';
+import { startDaemon, req, metric, until, SLOW, g3, cores, fillPaced, pacedEstimates } from './lib.mjs';
 
 // A stream's charge (server/admit/budget_stream.c): a wake-up and a number
 // formatted, CPU s. That of a ?fields=trough&rate=10 stream of a default
@@ -79,7 +79,7 @@ test('paced budget: a stream beyond it gets 503 naming the budget, the running s
       type: '/api/v1/problems/unavailable',
       title: 'Service unavailable',
       status: 503,
-      detail: `this stream needs ${g3(STREAM)} cores (${g3(1e3 * STREAM)} ms of CPU per simulated s at pace 1) ` +
+      detail: `this stream needs ${cores(STREAM)} (${g3(1e3 * STREAM)} ms of CPU per simulated s at pace 1) ` +
         `and running paced sessions and their streams hold ${g3(taken)} of the ${limit} cores for paced sessions ` +
         '(--max-paced-cores); nothing was opened, retry when some have ended or paused, or ask fewer records ' +
         '(rate, fields)',
@@ -187,7 +187,7 @@ test('paced budget: a stream is charged its wake-ups a wall second, at most 50, 
     const r = await req(d.base, 'PATCH', `/api/v1/sessions/${fast.body.id}`, { pace: 10 });
     assert.equal(r.status, 422, r.text);
     assert.equal(r.body.field, 'pace');
-    assert.equal(r.body.detail, `this session needs ${g3(10 * perS)} cores (${g3(1e3 * perS)} ms of CPU per ` +
+    assert.equal(r.body.detail, `this session needs ${cores(10 * perS)} (${g3(1e3 * perS)} ms of CPU per ` +
       `simulated s at pace 10), more than the ${limit} cores for paced sessions (--max-paced-cores); ` +
       'nothing was changed, lower the pace');
     // the greatest pace the cores allow, with the stream's wake-ups capped
