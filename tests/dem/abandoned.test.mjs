@@ -45,8 +45,11 @@ test('a LIGGGHTS creation whose client leaves while its bed settles creates noth
     sock.write(`POST /api/v1/sessions HTTP/1.1\r\nHost: 127.0.0.1:${d.port}\r\n` +
       `Content-Type: application/json\r\nContent-Length: ${Buffer.byteLength(text)}\r\n\r\n${text}`);
     // its bed process started and settles: leave
-    const [bed] = await until(async () => { const c = children(d.proc.pid); return c.length && c; },
-      30000, 'the bed process');
+    const [bed] = await until(async () => {
+      const c = children(d.proc.pid);
+      if (got.length) assert.fail(`answered before a bed process started: ${Buffer.concat(got)}`);
+      return c.length && c;
+    }, 30000, 'the bed process');
     sock.destroy();
     // answered (to nobody) once its bed process is gone
     await until(async () => { const m = await metrics(d); return metric(m, 'convsim_http_requests_total{status="503"}') +
