@@ -5,9 +5,12 @@
 // (DELETE /api/v1/experiments/ID with the token), and what the page says
 // is checked against the API: the experiment is gone (404), its fresh
 // session removed, or kept and running when the plots follow it; the
-// polling ends and the panel is ready for a new run. An experiment that
-// ended disables Stop and keeps its result; a Stop refused (the experiment
-// deleted meanwhile) is shown as a message, never thrown.
+// polling ends and the panel is ready for a new run. Idle, every panel's
+// Stop (the fit's too) is shown and disabled. An experiment that ended
+// disables Stop and keeps its result; so does a Stop pressed after the
+// experiment ended but before the page's poll saw it (no DELETE, one
+// message that it had finished); a Stop refused (the experiment deleted
+// meanwhile) is shown as a message, never thrown.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, stopDaemon, openDashboard, apiGet, until } from './lib.mjs';
@@ -31,6 +34,14 @@ const status = async p => (await fetch(d.base + p, { headers: d.auth })).status;
 const sessionIds = async () => (await apiGet(d, '/api/v1/sessions')).sessions.map(s => s.id);
 const disabled = sel => page.$eval(sel, b => b.disabled);
 const messages = () => page.$$eval('#messages .msg-text', m => m.map(x => x.textContent));
+/* A Stop button's look: shown, disabled, its label. */
+const look = sel => page.$eval(sel, b => ({ shown: b.checkVisibility(), disabled: b.disabled, label: b.textContent.trim() }));
+const IDLE = { shown: true, disabled: true, label: 'Stop' };
+
+test('idle, every panel\'s Stop is shown, disabled and labelled alike', async () => {
+	for (const sel of ['#fit-stop', '#experiment-stop', '#loop-stop'])
+		assert.deepEqual(await look(sel), IDLE, sel);
+});
 
 /* Click the panel's run button; the experiment's {id, session} from the
  * POST's answer, once the daemon runs it and Stop is offered. */
@@ -71,7 +82,7 @@ async function stopFromPage(stop, ex, text) {
  * line saying so. */
 async function ready(run, stop, box) {
 	await until(async () => !(await disabled(run)), 5000, `${run} enabled`);
-	assert.equal(await disabled(stop), true, `${stop} disabled again`);
+	assert.deepEqual(await look(stop), IDLE, `${stop} shown and disabled again`);
 	assert.equal(await page.$eval(`${box} .ptext`, e => e.textContent), 'stopped');
 }
 
@@ -131,6 +142,49 @@ test('an experiment that ended disables Stop and keeps its result', async () => 
 	assert.equal(await disabled('#experiment-stop'), true, 'Stop disabled once it ended');
 	assert.equal((await apiGet(d, `/api/v1/experiments/${ex.id}`)).state, 'done');
 	assert.ok((await sessionIds()).includes(ex.session), 'its kept session stays');
+	await fetch(`${d.base}/api/v1/sessions/${ex.session}`, { method: 'DELETE', headers: { ...d.auth, 'Content-Type': 'application/json' } });
+});
+
+test('Stop pressed after the experiment ended, before the page saw it, keeps it and says it had finished', async () => {
+	await page.uncheck('#experiment-form input[name="watch"]');
+	await page.fill('#experiment-form input[name="t_switch"]', '0.3');
+	await page.fill('#experiment-form input[name="t_end"]', '0.6');
+	/* the page's polls of the experiment wait here until Stop is pressed:
+	 * the experiment ends (pace max) while the page still thinks it runs */
+	const one = /\/api\/v1\/experiments\/[^/?]+$/;
+	let hold = true;
+	const held = [], deletes = [];
+	await page.route(one, route => {
+		if (hold && route.request().method() === 'GET') held.push(route);
+		else route.continue();
+	});
+	const seeDelete = r => { if (r.method() === 'DELETE' && one.test(r.url())) deletes.push(r.url()); };
+	page.on('request', seeDelete);
+	const answered = page.waitForResponse(r => r.url().endsWith('/api/v1/experiments') && r.request().method() === 'POST');
+	await page.click('#experiment-run');
+	const ex = await (await answered).json();
+	await until(async () => (await apiGet(d, `/api/v1/experiments/${ex.id}`)).state === 'done', 30000, 'the daemon saying it is done');
+	assert.equal(await disabled('#experiment-stop'), false, 'Stop still offered: the page has not seen the end');
+	await page.click('#experiment-stop');
+	hold = false;
+	for (const route of held.splice(0)) await route.continue();
+	await until(async () => !(await disabled('#experiment-run')), 10000, 'Run enabled');
+	await new Promise(r => setTimeout(r, 1000));
+	page.off('request', seeDelete);
+	await page.unroute(one);
+	assert.deepEqual(deletes, [], 'no DELETE of an experiment that had ended');
+	assert.equal(await status(`/api/v1/experiments/${ex.id}`), 200, 'the experiment still there');
+	const text = `Experiment ${ex.id} had already finished; nothing was stopped.`;
+	const said = (await messages()).filter(m => m.includes(`Experiment ${ex.id} `));
+	assert.deepEqual(said, [text], 'one message, once, and not "stopped"');
+	const kept = await apiGet(d, `/api/v1/experiments/${ex.id}`);
+	assert.equal(kept.state, 'done');
+	assert.equal(kept.segments?.length, 2, 'its result kept');
+	assert.ok((await sessionIds()).includes(ex.session), 'its kept session stays');
+	/* the panel as at a normal end: progress, result and downloads */
+	assert.match(await page.$eval('#experiment-progress .ptext', e => e.textContent), /^done/);
+	assert.equal(await page.isVisible('#experiment-downloads'), true);
+	assert.deepEqual(await look('#experiment-stop'), IDLE);
 	await fetch(`${d.base}/api/v1/sessions/${ex.session}`, { method: 'DELETE', headers: { ...d.auth, 'Content-Type': 'application/json' } });
 });
 
