@@ -11,7 +11,7 @@ import { Trace } from './series.js';
 import { fmt, fmtGiven, fmtTime, fmtVelocity, fmtVelocityPm, steadyLabel, direction, ARROW, DASH } from './format.js';
 import { app, $, message, report, setOnline, numberOf, busy, progress } from './ui.js';
 import { readSessionForm, attach } from './session.js';
-import { stopButton } from './stop.js';
+import { stopButton, experimentEnded } from './stop.js';
 
 /* The inputs behind the schedule's members (api-requests.js
  * experimentRequest): segment 1 is beta1 until t_switch, segment 2 beta2
@@ -53,8 +53,7 @@ async function runExperiment(ev) {
 			progress(box, Number.isFinite(u.progress) ? u.progress : (u.t / form.tEnd), `${u.state || 'running'}${tText}`);
 		});
 		if (!end) return; /* stopped: stop.js said so */
-		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
-		else message('ok', `Experiment ${end.id} finished.`);
+		experimentEnded(end);
 		const csv = $('#experiment-csv'), traj = $('#experiment-traj');
 		csv.href = api.experimentCsvUrl(end.id);
 		csv.download = `experiment-${end.id}.csv`;

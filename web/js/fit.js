@@ -3,17 +3,19 @@
  * fit.js - the calibration panel: measured points pasted or loaded as CSV,
  * free parameters by name, POST /api/v1/fits on the new-session form's
  * model; follows the fit's progress (iteration, evaluations, current
- * values), can cancel it, and shows the data with their sigma, the fitted
- * and the original curve with the fitted curve's 95 % band shaded, the
- * values with standard errors and the warnings, and the result's CSV link.
+ * values), can stop it (its Stop button: stop.js), and shows the data with
+ * their sigma, the fitted and the original curve with the fitted curve's
+ * 95 % band shaded, the values with standard errors and the warnings, and
+ * the result's CSV link.
  */
 
 import * as api from './api.js';
 import { fitProgressText, fitChi2Text, priorText } from './format.js';
-import { app, $, message, report, setOnline, numberOf, busy, progress, poll } from './ui.js';
+import { app, $, message, report, setOnline, numberOf, busy, progress } from './ui.js';
 import { readSessionForm } from './session.js';
+import { stopButton, stopFit } from './stop.js';
 
-let running = null;
+let follow = null; /* polls a fit until it ends or is stopped (stop.js) */
 
 export function wireFit() {
 	$('#fit-form').addEventListener('submit', runFit);
@@ -21,13 +23,7 @@ export function wireFit() {
 		const file = ev.target.files[0];
 		if (file) $('#fit-form').elements.csv.value = await file.text();
 	});
-	$('#fit-cancel').addEventListener('click', async () => {
-		if (!running) return;
-		try {
-			await api.deleteFit(running);
-			message('warn', `Fit ${running} cancelled`);
-		} catch (err) { report(err, 'Cancel'); }
-	});
+	follow = stopButton('#fit-stop', '#fit-progress', stopFit);
 }
 
 async function runFit(ev) {
@@ -35,34 +31,31 @@ async function runFit(ev) {
 	const f = $('#fit-form').elements;
 	const form = { ...readSessionForm(), csv: f.csv.value, free: f.free.value, priors: f.priors.value,
 		tEnd: numberOf(f.t_end), curveStep: numberOf(f.curve_step) };
-	const btn = $('#fit-run'), cancel = $('#fit-cancel'), box = $('#fit-progress');
+	const btn = $('#fit-run'), box = $('#fit-progress');
 	for (const el of f) el.removeAttribute?.('aria-invalid');
 	busy(btn, true);
 	try {
 		const j = await api.createFit(form);
 		setOnline(true);
-		running = j.id;
-		cancel.hidden = false;
 		const csv = $('#fit-csv');
 		csv.href = api.fitCsvUrl(j.id);
 		csv.download = `fit-${j.id}.csv`;
 		progress(box, 0, 'started');
-		const end = await poll(api.getFit, j.id, u => progress(box, u.progress, fitProgressText(u)));
+		const end = await follow(j, api.getFit, u => progress(box, u.progress, fitProgressText(u)));
+		if (!end) return; /* stopped: stop.js said so */
 		if (end.result) showFit(end.result);
 		if (end.state === 'done') offerBand(end.id);
 		csv.hidden = !end.result;
 		const r = end.result;
 		const why = end.error || r?.error;
-		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${why ? ': ' + why : ''}`);
+		const late = end.endedBeforeStop ? ' (it had already ended: nothing was stopped)' : '';
+		if (end.state !== 'done') message('error', `Fit ${end.id} ${end.state}${why ? ': ' + why : ''}${late}`);
 		else message(r.warnings.length ? 'warn' : 'ok', `Fit ${end.id} ${r.status} after ${r.iterations} iterations, ` +
-			`${r.evaluations} evaluations` + (r.warnings.length ? `: ${r.warnings.length} warning(s) below` : ''));
+			`${r.evaluations} evaluations` + (r.warnings.length ? `: ${r.warnings.length} warning(s) below` : '') + late);
 	} catch (err) {
-		if (err instanceof api.ApiError && err.status === 404 && running) message('warn', 'The fit was cancelled');
-		else report(err, 'Fit', $('#fit-form'));
+		report(err, 'Fit', $('#fit-form'));
 	} finally {
 		busy(btn, false);
-		cancel.hidden = true;
-		running = null;
 	}
 }
 

@@ -14,9 +14,9 @@
 
 import * as api from './api.js';
 import { fmt, fmtGiven, fmtSig, fmtPm, fmtTime } from './format.js';
-import { app, $, $$, message, report, setOnline, numberOf, busy, progress } from './ui.js';
+import { app, $, $$, report, setOnline, numberOf, busy, progress } from './ui.js';
 import { readSessionForm } from './session.js';
-import { stopButton } from './stop.js';
+import { stopButton, experimentEnded } from './stop.js';
 
 function readLoopForm() {
 	const f = $('#loop-form').elements;
@@ -79,8 +79,7 @@ async function runLoop(ev) {
 		trajLink.hidden = !end.sessionId;
 		$('#loop-downloads').hidden = false;
 		app.loop.done = true;
-		if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
-		else message('ok', `Experiment ${end.id} finished.`);
+		experimentEnded(end);
 	} catch (err) {
 		report(err, 'Experiment', $('#loop-form'), FIELD_INPUT);
 	} finally {
