@@ -43,7 +43,7 @@ test('with --max-experiments full of finished ones, refused starts evict none; a
     const large = await req(d.base, 'POST', '/api/v1/experiments',
       { ...SHORT, session: { scene: { columns: 64, layers: 64 }, pace: 'max' } });
     assert.equal(large.status, 422, large.text);
-    assert.equal(large.body.field, 'scene.settle', large.text);
+    assert.equal(large.body.field, 'session.scene.settle', large.text);
     // every finished experiment is still there, as it was
     assert.deepEqual(await listed(d, 'experiments'), [...kept].sort());
     for (const [i, id] of kept.entries()) {

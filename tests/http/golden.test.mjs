@@ -161,7 +161,6 @@ test('every job route answers as recorded, and the data directory holds the same
   await record('sweeps: delete the defaults', base(), 'DELETE', `/api/v1/sweeps/${defaults}`);
   await record('sweeps: delete', base(), 'DELETE', `/api/v1/sweeps/${sw[1]}`);
   await record('sweeps: deleted', base(), 'GET', `/api/v1/sweeps/${sw[1]}`);
-  await record('experiments: DELETE', base(), 'DELETE', `/api/v1/experiments/${ex.body.id}`);
   // the experiment's session is removed within a second of its end
   await until(async () => (await req(base(), 'GET', `/api/v1/sessions/${ex.body.session}`)).status === 404, 5000, 'the session to go');
   await record('after delete: sweeps list', base(), 'GET', '/api/v1/sweeps');
@@ -192,6 +191,8 @@ test('every job route answers as recorded, and the data directory holds the same
   }
   await record('restarted: fits: delete', base(), 'DELETE', `/api/v1/fits/${fit.body.id}`);
   await record('restarted: sweeps: delete', base(), 'DELETE', `/api/v1/sweeps/${sw[0]}`);
+  await record('restarted: experiments: delete', base(), 'DELETE', `/api/v1/experiments/${ex.body.id}`);
+  await record('restarted: experiments: deleted', base(), 'GET', `/api/v1/experiments/${ex.body.id}`);
   assert.equal((await d.stop()).code, 0, d.stderr());
   const filesAfter = dataDir();
 
