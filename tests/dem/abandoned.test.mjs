@@ -11,26 +11,12 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { once } from 'node:events';
 import { connect } from 'node:net';
-import { readFileSync, readdirSync } from 'node:fs';
-import { startDaemon, req, metric, until, SLOW } from '../http/lib.mjs';
+import { startDaemon, req, metric, until, children, procState, SLOW } from '../http/lib.mjs';
 
 // two layers: a bed of a few hundred grains that settles for a second or
 // more, long enough to leave while it does
 const BED = { scene: { feed_model: 'liggghts', layers: 2 }, pace: 'max', until: 0.01 };
 
-// the daemon's children now (its bed processes)
-const children = (pid) => {
-  const out = [];
-  for (const task of readdirSync(`/proc/${pid}/task`)) {
-    const text = readFileSync(`/proc/${pid}/task/${task}/children`, 'utf8').trim();
-    if (text) out.push(...text.split(/\s+/).map(Number));
-  }
-  return out;
-};
-// a process's state letter (Z: a zombie), or null when it is gone
-const procState = (pid) => {
-  try { return readFileSync(`/proc/${pid}/stat`, 'utf8').replace(/^.*\) /, '')[0]; } catch { return null; }
-};
 const metrics = async (d) => (await req(d.base, 'GET', '/metrics')).text;
 
 test('a LIGGGHTS creation whose client leaves while its bed settles creates nothing, is counted abandoned and frees its slot', { timeout: 180000 * SLOW }, async () => {

@@ -18,10 +18,10 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync, readdirSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, openStream, SLOW } from '../http/lib.mjs';
+import { startDaemon, req, until, openStream, children, procState, SLOW } from '../http/lib.mjs';
 
 const BUILD = process.env.BUILD || 'build';
 const ROOT = new URL('../..', import.meta.url).pathname;
@@ -40,19 +40,6 @@ before(async () => { d = await startDaemon(['--worker-nice', '15', '--max-paced-
 after(async () => { await d.stop(); });
 
 const get = async (id) => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
-// the daemon's children now (its bed processes)
-const children = (pid) => {
-  const out = [];
-  for (const task of readdirSync(`/proc/${pid}/task`)) {
-    const text = readFileSync(`/proc/${pid}/task/${task}/children`, 'utf8').trim();
-    if (text) out.push(...text.split(/\s+/).map(Number));
-  }
-  return out;
-};
-// a process's state letter (Z: a zombie), or null when it is gone
-const procState = (pid) => {
-  try { return readFileSync(`/proc/${pid}/stat`, 'utf8').replace(/^.*\) /, '')[0]; } catch { return null; }
-};
 
 test('created, runs, and at until = 0.5 s gives the CLI\'s v bit for bit', { timeout: 120000 * SLOW }, async () => {
   const r = await req(d.base, 'POST', '/api/v1/sessions', { ...BED, pace: 'max', until: 0.5 });

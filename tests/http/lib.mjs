@@ -5,7 +5,7 @@
 // sanitizer build is slower, so timeouts scale with SLOW.
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
-import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -345,6 +345,22 @@ export async function fillPaced(d, limit, held, least = 1e-4) {
     ids.push(r.body.id);
   }
   return { ids, cost, fit };
+}
+
+// Process pid's children now (a daemon's bed processes), from every
+// thread's /proc list.
+export function children(pid) {
+  const out = [];
+  for (const task of readdirSync(`/proc/${pid}/task`)) {
+    const text = readFileSync(`/proc/${pid}/task/${task}/children`, 'utf8').trim();
+    if (text) out.push(...text.split(/\s+/).map(Number));
+  }
+  return out;
+}
+
+// A process's state letter (Z: a zombie), or null when it is gone.
+export function procState(pid) {
+  try { return readFileSync(`/proc/${pid}/stat`, 'utf8').replace(/^.*\) /, '')[0]; } catch { return null; }
 }
 
 // The user + system CPU seconds process pid has spent (its every thread;

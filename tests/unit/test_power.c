@@ -131,13 +131,11 @@ static double kloss(double w, double Mut, double wss, double sut)
 	return 2.0 * Mut * s * sut / (sut * sut + s * s);
 }
 
-/* The rotor alone (e = 0) under bearing drag b_phi w |w| and a load
- * torque: its steady speed solves M_el(w) = b_phi w^2 + M_L (bisection
- * on the stable branch, slip below the breakdown slip), both senses. */
-static void kloss_against_drag_and_load(void **state)
+/* The rotor's steady speed under bearing drag b w^2 and a load torque
+ * ML: M_el(w) = b w^2 + ML by bisection on Kloss's stable branch (slip
+ * below the breakdown slip sut). */
+static double loaded_speed(double Mut, double wss, double sut, double b, double ML)
 {
-	(void)state;
-	const double Mut = 50.0, wss = 157.08, sut = 15.5, b = 4e-4, ML = 2.0;
 	double lo = wss - sut, hi = wss;
 	for (int i = 0; i < 200; i++) {
 		double mid = 0.5 * (lo + hi);
@@ -146,7 +144,17 @@ static void kloss_against_drag_and_load(void **state)
 		else
 			hi = mid;
 	}
-	const double w = 0.5 * (lo + hi); /* 155.25 rad/s: drag 9.64 N m, load 2 */
+	return 0.5 * (lo + hi);
+}
+
+/* The rotor alone (e = 0) under bearing drag b_phi w |w| and a load
+ * torque: its steady speed solves M_el(w) = b_phi w^2 + M_L (bisection
+ * on the stable branch, slip below the breakdown slip), both senses. */
+static void kloss_against_drag_and_load(void **state)
+{
+	(void)state;
+	const double Mut = 50.0, wss = 157.08, sut = 15.5, b = 4e-4, ML = 2.0;
+	const double w = loaded_speed(Mut, wss, sut, b, ML); /* 155.25 rad/s: drag 9.64 N m, load 2 */
 	for (int r = 0; r < 2; r++) {
 		setup u = preset();
 		set(&u, "feed", "false");
@@ -184,15 +192,7 @@ static void steady_start_at_the_loaded_speed(void **state)
 {
 	(void)state;
 	const double Mut = 50.0, wss = 157.08, sut = 15.5, b = 4e-4, ML = 2.0;
-	double lo = wss - sut, hi = wss;
-	for (int i = 0; i < 200; i++) {
-		double mid = 0.5 * (lo + hi);
-		if (kloss(mid, Mut, wss, sut) > b * mid * mid + ML)
-			lo = mid;
-		else
-			hi = mid;
-	}
-	const double w = 0.5 * (lo + hi);
+	const double w = loaded_speed(Mut, wss, sut, b, ML);
 	for (int r = 0; r < 2; r++) {
 		setup u = preset_defaults();
 		set(&u, "feed", "false");

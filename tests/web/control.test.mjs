@@ -12,7 +12,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdirSync } from 'node:fs';
 import path from 'node:path';
-import { ROOT, startDaemon, stopDaemon, openDashboard, apiGet, until, download } from './lib.mjs';
+import { ROOT, startDaemon, stopDaemon, openSmallScene, apiGet, until, download } from './lib.mjs';
 
 const OUT = path.join(ROOT, 'tests/out');
 
@@ -20,11 +20,8 @@ let d, ui, page;
 before(async () => {
 	mkdirSync(OUT, { recursive: true });
 	d = await startDaemon();
-	ui = await openDashboard(d);
+	ui = await openSmallScene(d);
 	page = ui.page;
-	await page.selectOption('select[name="drive"]', 'ideal');
-	await page.fill('#session-form input[name="layers"]', '2');
-	await page.fill('#session-form input[name="columns"]', '5');
 	await page.fill('#session-form input[name="rate"]', '500');
 });
 after(async () => {

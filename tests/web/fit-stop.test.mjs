@@ -7,16 +7,13 @@
 // message, once, and is ready for a new fit, Stop disabled again.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startDaemon, stopDaemon, openDashboard, apiGet, until } from './lib.mjs';
+import { startDaemon, stopDaemon, openSmallScene, apiGet, until } from './lib.mjs';
 
 let d, ui, page;
 before(async () => {
 	d = await startDaemon();
-	ui = await openDashboard(d);
+	ui = await openSmallScene(d);
 	page = ui.page;
-	await page.selectOption('select[name="drive"]', 'ideal');
-	await page.fill('#session-form input[name="layers"]', '2');
-	await page.fill('#session-form input[name="columns"]', '5');
 });
 after(async () => {
 	await ui?.browser.close();

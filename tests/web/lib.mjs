@@ -81,6 +81,16 @@ export async function openDashboard(d, width = 1600, height = 1300) {
 	return { browser, page, pageErrors, consoleErrors };
 }
 
+/* The dashboard of d, its new-session form set to a small scene: the
+ * ideal drive, 5 columns of 2 layers (the panels' tests that run jobs). */
+export async function openSmallScene(d) {
+	const ui = await openDashboard(d);
+	await ui.page.selectOption('select[name="drive"]', 'ideal');
+	await ui.page.fill('#session-form input[name="layers"]', '2');
+	await ui.page.fill('#session-form input[name="columns"]', '5');
+	return ui;
+}
+
 /* GET path's JSON with the token; a status other than 200 fails. */
 export async function apiGet(d, p) {
 	const res = await fetch(d.base + p, { headers: d.auth });
