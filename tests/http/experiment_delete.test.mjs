@@ -66,7 +66,10 @@ test("a running experiment on the client's session: DELETE stops it, the session
     const spath = `/api/v1/sessions/${s.body.id}`;
     const ex = await req(d.base, 'POST', '/api/v1/experiments', { session: s.body.id, schedule: LONG });
     assert.equal(ex.status, 201, ex.text);
-    // the experiment holds the session: an earlier until and a second one refused
+    // once its worker has taken it (the 201 may come before), the
+    // experiment holds the session: an earlier until and a second one refused
+    await until(async () => (await req(d.base, 'GET', `/api/v1/experiments/${ex.body.id}`)).body.state === 'running',
+      20000 * SLOW, 'the experiment running');
     assert.equal((await req(d.base, 'PATCH', spath, { until: 100 })).status, 409);
     assert.equal((await req(d.base, 'POST', '/api/v1/experiments', { session: s.body.id, schedule: LONG })).status, 409);
     await deleted(d, ex.body.id);
