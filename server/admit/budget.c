@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
  * budget.c - the daemon's resource budgets: memory reservations, the cores
- * of paced sessions, CPU turns for pace "max" sessions, connections per
- * client address.
+ * of paced sessions, CPU turns for pace "max" sessions (connections per client address:
+ * budget_clients.c).
  *
  * Memory is an estimate made before anything is allocated: the buffers the
  * server allocates are counted exactly from their sizes (record ring,
@@ -16,21 +16,15 @@
  * times its pace) while it runs. CPU turns are a first-come-first-served
  * queue of at most --max-busy holders, each holding for a time slice while
  * others wait (round robin: each gets an equal share of the cores).
- * Connections are counted per client address in a small table sized by
- * --max-connections (libmicrohttpd never holds more). The CPU estimate of
- * a session is budget_cost.c's.
+ * The CPU estimate of a session is budget_cost.c's.
  */
-#include <arpa/inet.h>
 #include <math.h>
-#include <netinet/in.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "budget.h"
 #include "budget_turns.h"
-#include "conns.h"
 #include "util.h"
 
 /* Calibrated once against resident memory (the formula in docs/budgets.md): bytes a session holds
@@ -54,6 +48,7 @@ void srv_budget_init(const srv_config *config)
 	cfg = config;
 	srv_cpu_turns_init(config);
 	srv_budget_cost_init(config->max_cpu_seconds);
+	srv_budget_clients_init(config);
 }
 
 /* ---- memory ---------------------------------------------------------------- */
@@ -193,7 +188,9 @@ api_err srv_budget_take_paced(double *held, double cpu_per_s, double pace,
 			 need, api_plural_g(need, 3, "", "s"), 1e3 * cpu_per_s, pace, limit,
 			 api_plural_g(limit, 6, "", "s"), verb,
 			 none ? "no pace from 0.001 fits: run it at pace \"max\"" : "lower the pace");
-		pb->has_range = !none, pb->min = API_PACE_MIN, pb->max = limit / cpu_per_s;
+		pb->has_range = !none;
+		pb->min = API_PACE_MIN;
+		pb->max = limit / cpu_per_s;
 		if (none && strcmp(field, "pace") == 0)
 			snprintf(pb->choices, sizeof pb->choices, "max");
 		return api_budget(pb, "cpu", limit, 0);
@@ -313,188 +310,4 @@ size_t srv_budget_points(void)
 	size_t n = points;
 	pthread_mutex_unlock(&lock);
 	return n;
-}
-
-/* ---- connections per client -------------------------------------------------------- */
-
-typedef struct client {
-	unsigned char addr[16]; /* IPv4 in the first 4 bytes */
-	int family;
-	int count;              /* lock; 0: a free entry */
-	srv_conn_group *group;  /* its connections (conns.c), kept for the
-				   next address the entry serves */
-} client;
-
-/* What a connection's socket context holds. */
-typedef struct client_conn {
-	client *c;
-	int over;
-	srv_conn *live; /* conns.c: deadlines, room at the global cap */
-} client_conn;
-
-static client *clients;  /* lock; cfg->max_connections + 1 entries */
-static atomic_ullong client_refused, connections_dropped;
-
-/* The address bytes of a connection's peer; 0 if it has none. */
-static int peer(struct MHD_Connection *conn, unsigned char addr[16],
-		int *family)
-{
-	const union MHD_ConnectionInfo *ci =
-		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-	if (!ci || !ci->client_addr)
-		return 0;
-	memset(addr, 0, 16);
-	*family = ci->client_addr->sa_family;
-	if (*family == AF_INET)
-		memcpy(addr, &((const struct sockaddr_in *)(const void *)ci->client_addr)
-				      ->sin_addr, 4);
-	else if (*family == AF_INET6)
-		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)ci->client_addr)
-				      ->sin6_addr, 16);
-	else
-		return 0;
-	return 1;
-}
-
-/* The entry of addr, or a free one for it; NULL when full (lock held). */
-static client *find_client(const unsigned char addr[16], int family)
-{
-	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
-	client *free_one = NULL;
-	if (!clients && !(clients = calloc(n, sizeof *clients)))
-		return NULL;
-	for (size_t i = 0; i < n; i++) {
-		client *c = &clients[i];
-		if (c->count && c->family == family && memcmp(c->addr, addr, 16) == 0)
-			return c;
-		if (!c->count && !free_one)
-			free_one = c;
-	}
-	if (free_one && !free_one->group)
-		free_one->group = srv_conn_group_new();
-	if (free_one && !free_one->group)
-		return NULL;
-	if (free_one) {
-		memcpy(free_one->addr, addr, 16);
-		free_one->family = family;
-	}
-	return free_one;
-}
-
-int srv_budget_open_from(const struct sockaddr *sa)
-{
-	unsigned char addr[16] = {0};
-	if (sa->sa_family == AF_INET)
-		memcpy(addr, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, 4);
-	else if (sa->sa_family == AF_INET6)
-		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, 16);
-	else
-		return 0;
-	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
-	int count = 0;
-	pthread_mutex_lock(&lock);
-	for (size_t i = 0; clients && i < n && !count; i++)
-		if (clients[i].count && clients[i].family == sa->sa_family &&
-		    memcmp(clients[i].addr, addr, 16) == 0)
-			count = clients[i].count;
-	pthread_mutex_unlock(&lock);
-	return count;
-}
-
-void srv_budget_count_dropped(void)
-{
-	atomic_fetch_add(&connections_dropped, 1);
-}
-
-void srv_budget_connection(void *cls, struct MHD_Connection *conn,
-			   void **socket_context,
-			   enum MHD_ConnectionNotificationCode code)
-{
-	(void)cls;
-	client_conn *cc = *socket_context;
-	if (code == MHD_CONNECTION_NOTIFY_CLOSED) {
-		if (cc) /* out of its group before the entry can go */
-			srv_conn_close(cc->live);
-		if (cc && cc->c) {
-			pthread_mutex_lock(&lock);
-			cc->c->count--;
-			pthread_mutex_unlock(&lock);
-		}
-		free(cc);
-		*socket_context = NULL;
-		return;
-	}
-	unsigned char addr[16];
-	int family, over = SRV_CONN_OK;
-	cc = calloc(1, sizeof *cc);
-	if (!cc) {
-		*socket_context = NULL;
-		return;
-	}
-	if (peer(conn, addr, &family)) {
-		pthread_mutex_lock(&lock);
-		cc->c = find_client(addr, family);
-		if (cc->c)
-			cc->c->count++; /* the entry stays its address's */
-		pthread_mutex_unlock(&lock);
-	}
-	/* room at the caps: the least progressing connection, of all or of
-	 * this address, is closed; over only when its others are all busy */
-	cc->live = srv_conn_open(conn, cc->c ? cc->c->group : NULL, &over);
-	cc->over = over != SRV_CONN_OK;
-	if (over == SRV_CONN_DROPPED)
-		atomic_fetch_add(&connections_dropped, 1);
-	*socket_context = cc;
-}
-
-srv_conn *srv_budget_live(struct MHD_Connection *conn)
-{
-	const union MHD_ConnectionInfo *ci =
-		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-	const client_conn *cc = ci ? ci->socket_context : NULL;
-	return cc ? cc->live : NULL;
-}
-
-int srv_budget_client_over(struct MHD_Connection *conn, api_problem *pb)
-{
-	const union MHD_ConnectionInfo *ci =
-		MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-	const client_conn *cc = ci ? ci->socket_context : NULL;
-	if (!cc || !cc->over)
-		return 0;
-	atomic_fetch_add(&client_refused, 1);
-	api_fail(pb, API_LIMIT, NULL,
-		 "this client address has more than %d connection%s open, its budget "
-		 "(--max-client-connections), and every other one is being answered (an idle or slow "
-		 "one would have been closed to make room); close some and retry",
-		 cfg->max_client_connections, api_plural(cfg->max_client_connections, "", "s"));
-	api_budget(pb, "connections", cfg->max_client_connections, 1);
-	pb->close = 1; /* one too many: the answer closes it */
-	return 1;
-}
-
-unsigned long long srv_budget_client_refused(void)
-{
-	return atomic_load(&client_refused);
-}
-
-unsigned long long srv_budget_connections_dropped(void)
-{
-	return atomic_load(&connections_dropped);
-}
-
-void srv_budget_mhd_log(void *cls, const char *fmt, va_list ap)
-{
-	(void)cls;
-	char line[512];
-	vsnprintf(line, sizeof line, fmt, ap);
-	size_t n = strlen(line);
-	while (n && line[n - 1] == '\n')
-		line[--n] = '\0';
-	int refused = strstr(line, "connection limit") != NULL ||
-		      strstr(line, "connections from this IP") != NULL;
-	if (refused)
-		atomic_fetch_add(&connections_dropped, 1);
-	srv_log(refused ? SRV_LOG_DEBUG : SRV_LOG_WARN, "libmicrohttpd: %s",
-		line);
 }

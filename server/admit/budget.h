@@ -29,6 +29,9 @@
 
 /* Keep cfg (borrowed for the daemon's life). */
 void srv_budget_init(const srv_config *cfg);
+/* The connections' counts per client address (budget_clients.c); called
+ * by srv_budget_init. */
+void srv_budget_clients_init(const srv_config *cfg);
 
 /* ---- memory ---------------------------------------------------------------- */
 
