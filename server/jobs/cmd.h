@@ -26,6 +26,9 @@ typedef struct srv_cmd {
 	/* set by the worker, under the session lock */
 	int done;                /* applied (or refused): rc and t_eff hold */
 	int rc;                  /* SIM_OK or the core's refusal */
+	int overtaken;           /* refused, nothing applied: an until the
+				    experiment begun since it was admitted
+				    would cut short (session_control.c) */
 	double t_eff;            /* s: sim_effective_time() when applied */
 	size_t logged;           /* the control log's length with its line
 				    (0: not logged): durable before a 200 */

@@ -44,6 +44,12 @@ static api_err admit_cpu_limit(const srv_session *s, const api_control *c,
 	return e;
 }
 
+int srv_until_cuts_experiment(const srv_session *s, double until)
+{
+	double end = s->exp ? srv_exp_end(s->exp) : NAN;
+	return until > 0 && end > until;
+}
+
 static api_err admit_until(const srv_session *s, const api_control *c,
 			   api_problem *pb)
 {
@@ -53,13 +59,14 @@ static api_err admit_until(const srv_session *s, const api_control *c,
 				"t = %g s", c->until, s->st.t);
 	/* an experiment runs its session to its schedule's end (worker.c
 	 * extend_until); an until before that would end the session under
-	 * it. One not yet begun raises until when it begins. */
-	double end = s->exp ? srv_exp_end(s->exp) : NAN;
-	if (c->until > 0 && end > c->until)
+	 * it. One attached but not yet begun raises until when it begins,
+	 * before the worker applies this control, which it then refuses
+	 * (worker_control.c; srv_session_control answers it here again). */
+	if (srv_until_cuts_experiment(s, c->until))
 		return api_fail(pb, API_CONFLICT, "until",
 				"experiment %s runs the session to t = %g s: until "
 				"(%g s) must be at least that, or null, until it ends",
-				srv_exp_id(s->exp), end, c->until);
+				srv_exp_id(s->exp), srv_exp_end(s->exp), c->until);
 	return API_OK;
 }
 
@@ -192,6 +199,12 @@ api_err srv_session_control(srv_session *s, api_control *c,
 		return api_fail(pb, API_UNAVAILABLE, NULL,
 				"the session's worker did not take the change "
 				"within %g s; nothing was changed", timeout_s);
+	}
+	if (cmd.overtaken) { /* an experiment began under it: nothing applied */
+		srv_budget_set_paced(&s->budget.paced_held, srv_paced_need(s));
+		e = admit_until(s, c, pb);
+		pthread_mutex_unlock(&s->lock);
+		return e;
 	}
 	pthread_mutex_unlock(&s->lock);
 	if (cmd.rc != SIM_OK)

@@ -220,6 +220,12 @@ struct srv_session {
 /* cfg (borrowed for the daemon's life) gives --max-cpu-seconds. */
 void srv_session_control_init(const srv_config *cfg);
 
+/* Whether an until of `until` s (> 0) would end s before the end of its
+ * experiment, begun (lock held): admission refuses it, and so does the
+ * worker where the experiment began after the control was admitted (an
+ * experiment attached but still waiting has no end yet). */
+int srv_until_cuts_experiment(const srv_session *s, double until);
+
 /* ---- session_dem.c: a LIGGGHTS session's bed process ------------------ */
 
 /* Find the bed program (--dem-bed, or convsim-bed next to the daemon). */

@@ -179,7 +179,13 @@ int srv_worker_apply_commands(srv_session *s)
 		if (!s->cmd_head)
 			s->cmd_tail = NULL;
 		double t_eff = sim_effective_time(s->sim);
-		int rc = apply_command(s, cmd, &reanchor);
+		/* an until admitted while the experiment attached since was
+		 * still waiting, now begun, that it would cut short: refused
+		 * whole, as admission refuses it */
+		cmd->overtaken = !cmd->from_experiment && !cmd->replay &&
+				 (cmd->c.set & API_C_UNTIL) &&
+				 srv_until_cuts_experiment(s, cmd->c.until);
+		int rc = cmd->overtaken ? SIM_EPARAM : apply_command(s, cmd, &reanchor);
 		if (s->pace == API_PACE_MAX && s->until == 0) {
 			/* an end for pace "max" (api.h): part of what this
 			 * control did, so its answer, event and log line say it */

@@ -134,3 +134,39 @@ test('until during an experiment: one before its end is 409 naming until and cha
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
 });
+
+test('until between an experiment\'s 201 and its start: one before its end is 409 and changes nothing', { timeout: 60000 * SLOW }, async () => {
+  // a session whose worker spends about a tenth of a second a sample outside
+  // its lock, so that a PATCH right after the experiment's 201 arrives
+  // before the worker has begun it (the experiment still waiting)
+  const d = await startDaemon([]);
+  try {
+    const s = await req(d.base, 'POST', '/api/v1/sessions', {
+      scene: { drive: 'ideal', columns: 16, layers: 32 }, sample_rate: 1, pace: 'max', until: 1e4,
+    });
+    assert.equal(s.status, 201, s.text);
+    const spath = `/api/v1/sessions/${s.body.id}`;
+    await until(async () => (await req(d.base, 'GET', spath)).body.status.t >= 1, 20000, 'the session running');
+    for (let round = 0; round < 3; round++) {
+      const before = (await req(d.base, 'GET', spath)).body;
+      const ex = await req(d.base, 'POST', '/api/v1/experiments', {
+        session: s.body.id, schedule: [{ beta: 40, until: 5000 }],
+      });
+      assert.equal(ex.status, 201, ex.text);
+      const r = await req(d.base, 'PATCH', spath, { beta: 100, until: before.status.t + 1000 });
+      assert.equal(r.status, 409, r.text);
+      assert.equal(r.body.field, 'until');
+      const exp = (await req(d.base, 'GET', `/api/v1/experiments/${ex.body.id}`)).body;
+      assert.equal(exp.state, 'running');
+      const end = exp.t_start + 5000;
+      assert.equal(r.body.detail, `experiment ${ex.body.id} runs the session to t = ${+end.toPrecision(6)} s: ` +
+        `until (${+(before.status.t + 1000).toPrecision(6)} s) must be at least that, or null, until it ends`);
+      const after = (await req(d.base, 'GET', spath)).body;
+      assert.equal(after.until, 1e4, 'until unchanged');
+      assert.equal(after.status.beta_target, 40, 'beta: the experiment\'s');
+      assert.equal((await req(d.base, 'DELETE', `/api/v1/experiments/${ex.body.id}`)).status, 204);
+    }
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
