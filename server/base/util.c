@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "api.h"
 #include "util.h"
 
 static atomic_int log_level = SRV_LOG_INFO;
@@ -166,4 +167,17 @@ int srv_stopping(void)
 void srv_stop(void)
 {
 	atomic_store(&stopping, 1);
+}
+
+int srv_client_left(int fd, int left, atomic_ullong *abandoned, const char *what,
+		    const char *id, const char *done, const char *while_, struct api_problem *pb)
+{
+	if (!left && !srv_peer_gone(fd))
+		return 0;
+	atomic_fetch_add(abandoned, 1);
+	srv_log(SRV_LOG_INFO, "%s %s not %s: its client left while it %s", what, id, done, while_);
+	api_fail(pb, API_UNAVAILABLE, NULL, "the client left while its %s %s; nothing was %s",
+		 what, while_, done);
+	pb->close = 1;
+	return 1;
 }

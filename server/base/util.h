@@ -8,7 +8,10 @@
 #ifndef CONVSIM_UTIL_H
 #define CONVSIM_UTIL_H
 
+#include <stdatomic.h>
 #include <time.h>
+
+struct api_problem; /* api.h */
 
 enum { SRV_LOG_ERROR, SRV_LOG_WARN, SRV_LOG_INFO, SRV_LOG_DEBUG };
 
@@ -39,6 +42,12 @@ struct timespec srv_deadline(double seconds);
  * while it is there (nothing to read, or more requests), and for fd < 0.
  * Reads nothing (a peek); never blocks. */
 int srv_peer_gone(int fd);
+/* Whether the client on fd left (or left says it did) while the daemon
+ * worked for it before its answer: then counted in *abandoned, logged at
+ * info ("WHAT ID not DONE: its client left while it WHILE"), and *pb the
+ * 503 that ends the connection (an answer to nobody); 1, else 0. */
+int srv_client_left(int fd, int left, atomic_ullong *abandoned, const char *what,
+		    const char *id, const char *done, const char *while_, struct api_problem *pb);
 
 /* The threads that compute (session workers, the sweep and fit pool) run
  * at a nice value above the request and stream threads' 0 (--worker-nice),

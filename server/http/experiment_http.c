@@ -72,23 +72,6 @@ srv_experiment *srv_experiments_readopt(const char *session_id)
 	return hit;
 }
 
-/* 1 with *pb when the client on client_fd left while e measured the
- * existing session it names (an identification's slopes, a closed loop's
- * curve, in the request's thread): nobody would read its 201, so it is not
- * attached and the session stays as it was, the client's to control. */
-static int left_while_measuring(const srv_experiment *e, int client_fd, api_problem *pb)
-{
-	if (!srv_peer_gone(client_fd))
-		return 0;
-	atomic_fetch_add(&srv_stats.experiments_abandoned, 1);
-	srv_log(SRV_LOG_INFO, "experiment %s not started: its client left while it measured",
-		srv_exp_id(e));
-	api_fail(pb, API_UNAVAILABLE, NULL, "the client left while its experiment measured; "
-		 "nothing was started");
-	pb->close = 1; /* an answer to nobody: the connection ends */
-	return 1;
-}
-
 /* Run e on a fresh session or attach it to the one it names; the session
  * notes its id in e before its worker can run it. A fresh one settles
  * within what e's measurements left of --max-cpu-seconds, and is not kept
@@ -98,7 +81,8 @@ static api_err start_on_session(srv_experiment *e, const api_experiment_req *req
 				int client_fd, api_problem *pb)
 {
 	srv_session *s;
-	if (!req->fresh && left_while_measuring(e, client_fd, pb))
+	if (!req->fresh && srv_client_left(client_fd, 0, &srv_stats.experiments_abandoned,
+					   "experiment", srv_exp_id(e), "started", "measured", pb))
 		return pb->code;
 	if (req->fresh) {
 		s = srv_session_create(&req->spec, e, client_fd, srv_exp_measured_cpu(e), pb);

@@ -226,25 +226,6 @@ static void sessions_full(api_problem *pb)
 	api_budget(pb, "sessions", n, 1);
 }
 
-/* 1 with *pb when the client whose socket is client_fd (-1: none, a
- * restore) left while s settled (left: its LIGGGHTS bed saw it go and
- * stopped settling; else a look now): nobody would read its 201, so
- * nothing is kept. A client that leaves after this look still gets its
- * session. */
-static int left_while_settling(const srv_session *s, int client_fd, int left,
-			       api_problem *pb)
-{
-	if (!left && !srv_peer_gone(client_fd))
-		return 0;
-	atomic_fetch_add(&srv_stats.sessions_abandoned, 1);
-	srv_log(SRV_LOG_INFO, "session %s not created: its client left while it settled",
-		s->entry.id);
-	api_fail(pb, API_UNAVAILABLE, NULL, "the client left while its session settled; nothing "
-		 "was created");
-	pb->close = 1; /* an answer to nobody: the connection ends */
-	return 1;
-}
-
 srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, int client_fd,
 				double before, api_problem *pb)
 {
@@ -283,7 +264,12 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	int bad = session_init(s, spec, before, pb);
 	s->create_fd = -1;
 	srv_budget_give_settling(&s->budget.settling); /* built, or not at all */
-	if (bad < 0 || left_while_settling(s, client_fd, bad > 0, pb))
+	/* nobody would read the 201 of a client that left while s settled
+	 * (bad > 0: its LIGGGHTS bed saw it go and stopped settling; else a
+	 * look now; client_fd -1: none, a restore), so nothing is kept; one
+	 * that leaves after this look still gets its session */
+	if (bad < 0 || srv_client_left(client_fd, bad > 0, &srv_stats.sessions_abandoned, "session",
+				       s->entry.id, "created", "settled", pb))
 		goto fail;
 	/* the cores it needs at its pace, before it runs */
 	if (s->pace != API_PACE_MAX &&
