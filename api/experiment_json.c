@@ -44,11 +44,9 @@ static api_err parse_segment(const cJSON *it, int i, double prev,
 				"%s must be a number (s after the experiment "
 				"start)", field);
 	if (!(until->valuedouble > prev && until->valuedouble <= 1e4)) {
-		api_fail(pb, API_RANGE, field,
-			 "%s must exceed the previous segment's end (%g s) "
-			 "and be at most 10000 s", field, prev);
-		pb->has_range = 1, pb->min = prev, pb->max = 1e4;
-		return API_RANGE;
+		return api_fail_range(pb, field, prev, 1e4,
+				      "%s must exceed the previous segment's end (%g s) "
+				      "and be at most 10000 s", field, prev);
 	}
 	api_segment_reset(seg, beta_si, until->valuedouble);
 	return API_OK;

@@ -44,9 +44,8 @@ static api_err number_in(const cJSON *obj, const char *name, const char *field, 
 		return api_fail(pb, API_TYPE, field, "%s must be a number (%s)", field, unit);
 	double v = it->valuedouble;
 	if (!(v >= lo && v <= hi)) {
-		api_fail(pb, API_RANGE, field, "%s must lie within [%g, %g] %s", field, lo, hi, unit);
-		pb->has_range = 1, pb->min = lo, pb->max = hi;
-		return API_RANGE;
+		return api_fail_range(pb, field, lo, hi, "%s must lie within [%g, %g] %s", field,
+				      lo, hi, unit);
 	}
 	*out = v;
 	return API_OK;
@@ -192,11 +191,9 @@ static api_err parse_setpoint(const cJSON *it, int i, api_experiment_req *req, a
 	if (e == API_OK)
 		e = number_in(it, "until", field, 0, 1e4, NAN, "s", &until, pb);
 	if (e == API_OK && !(until > prev)) {
-		api_fail(pb, API_RANGE, field,
-			 "%s must exceed the previous setpoint's end (%g s) and be at most 10000 s",
-			 field, prev);
-		pb->has_range = 1, pb->min = prev, pb->max = 1e4;
-		e = API_RANGE;
+		e = api_fail_range(pb, field, prev, 1e4,
+				   "%s must exceed the previous setpoint's end (%g s) and be at "
+				   "most 10000 s", field, prev);
 	}
 	if (e != API_OK)
 		return e;

@@ -262,22 +262,18 @@ api_err api_parse_pace(const cJSON *it, const char *field, double *pace,
 			*pace = API_PACE_MAX;
 			return API_OK;
 		}
-		api_fail(pb, API_RANGE, field,
-			 "%s must be a real-time factor in [0.001, 1000] or "
-			 "\"max\"", field);
-		pb->has_range = 1, pb->min = 0.001, pb->max = 1000;
-		return API_RANGE;
+		return api_fail_range(pb, field, 0.001, 1000,
+				      "%s must be a real-time factor in [0.001, 1000] or "
+				      "\"max\"", field);
 	}
 	if (!cJSON_IsNumber(it))
 		return api_fail(pb, API_TYPE, field,
 				"%s must be a number or \"max\"", field);
 	double v = it->valuedouble;
 	if (!(v >= PACE_MIN && v <= PACE_MAX)) {
-		api_fail(pb, API_RANGE, field,
-			 "%s must be a real-time factor in [0.001, 1000] or "
-			 "\"max\"", field);
-		pb->has_range = 1, pb->min = 0.001, pb->max = 1000;
-		return API_RANGE;
+		return api_fail_range(pb, field, 0.001, 1000,
+				      "%s must be a real-time factor in [0.001, 1000] or "
+				      "\"max\"", field);
 	}
 	*pace = v;
 	return API_OK;
@@ -296,10 +292,8 @@ api_err api_parse_real(const cJSON *it, const char *field, double lo,
 		return api_fail(pb, API_TYPE, field, "%s must be a number",
 				field);
 	if (!(it->valuedouble >= lo && it->valuedouble <= hi)) {
-		api_fail(pb, API_RANGE, field, "%s must lie in [%g, %g]", field,
-			 lo, hi);
-		pb->has_range = 1, pb->min = lo, pb->max = hi;
-		return API_RANGE;
+		return api_fail_range(pb, field, lo, hi, "%s must lie in [%g, %g]", field,
+				      lo, hi);
 	}
 	*out = it->valuedouble;
 	return API_OK;
@@ -346,11 +340,7 @@ static api_err validate_model(api_spec *spec, api_problem *pb)
 	double bound = sim_max_dt(&spec->params, &spec->scene, &spec->method);
 	if (spec->method.dt > bound &&
 	    sim_validate(&spec->params, &spec->scene, &m0, NULL, 0) == SIM_OK) {
-		api_fail(pb, API_RANGE, "integrator.dt", "%s", msg);
-		pb->has_range = 1;
-		pb->min = 0.0;
-		pb->max = bound;
-		return pb->code;
+		return api_fail_range(pb, "integrator.dt", 0.0, bound, "%s", msg);
 	}
 	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }

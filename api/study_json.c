@@ -267,11 +267,11 @@ api_err api_parse_study(const cJSON *vary, const cJSON *lhs, const cJSON *seed,
 	 * checked it against the model's) must exceed the largest varied */
 	double transient = sim_study_largest(&st, "transient", 0);
 	if (e == API_OK && !(req->t_end > transient)) {
-		e = api_fail(pb, API_RANGE, "t_end",
-			     "t_end (%g s) must exceed scene.transient = %g s (the largest of "
-			     "vary.transient: the transport velocity is measured after it) and be "
-			     "at most %g s", req->t_end, transient, API_SWEEP_T_END_MAX);
-		pb->has_range = 1, pb->min = transient, pb->max = API_SWEEP_T_END_MAX;
+		e = api_fail_range(pb, "t_end", transient, API_SWEEP_T_END_MAX,
+				   "t_end (%g s) must exceed scene.transient = %g s (the largest "
+				   "of vary.transient: the transport velocity is measured after "
+				   "it) and be at most %g s", req->t_end, transient,
+				   API_SWEEP_T_END_MAX);
 	}
 	if (e == API_OK)
 		e = take_study(&st, req, pb);

@@ -262,13 +262,10 @@ api_err srv_budget_take_points(size_t n, const char *field, int force,
 {
 	size_t cap = (size_t)cfg->max_queued_points;
 	if (n > cap && !force) {
-		api_fail(pb, API_RANGE, field,
-			 "this sweep has %zu points, more than the %zu sweep "
-			 "point%s that may be queued (--max-queued-points); "
-			 "split it", n, cap, api_plural((double)cap, "", "s"));
-		pb->has_range = 1;
-		pb->min = 1;
-		pb->max = (double)cap;
+		api_fail_range(pb, field, 1, (double)cap,
+			       "this sweep has %zu points, more than the %zu sweep "
+			       "point%s that may be queued (--max-queued-points); "
+			       "split it", n, cap, api_plural((double)cap, "", "s"));
 		return api_budget(pb, "sweep-points", (double)cap, 0);
 	}
 	size_t queued;

@@ -278,15 +278,14 @@ api_err srv_budget_settle_stopped(const api_spec *spec, double before, double sp
 				 "shorter scene.settle or scene.start \"rest\"",
 				 spent, run_limit, less, settled, settle, spec->method.name, names);
 	} else {
-		api_fail(pb, API_RANGE, "scene.settle",
-			 "the steady start's settling stopped at %.3g CPU s, past "
-			 "--max-cpu-seconds (%g)%s, %.3g of scene.settle's %g simulated s settled, "
-			 "estimated within it; nothing was created: a shorter scene.settle, a larger "
-			 "integrator.dt, a smaller scene or scene.start \"rest\"",
-			 spent, run_limit, less, settled, settle);
-		pb->has_range = 1;
-		pb->min = 0;
-		pb->max = settled; /* what settled within the limit */
+		/* the range: what settled within the limit */
+		api_fail_range(pb, "scene.settle", 0, settled,
+			       "the steady start's settling stopped at %.3g CPU s, past "
+			       "--max-cpu-seconds (%g)%s, %.3g of scene.settle's %g simulated s "
+			       "settled, estimated within it; nothing was created: a shorter "
+			       "scene.settle, a larger integrator.dt, a smaller scene or "
+			       "scene.start \"rest\"",
+			       spent, run_limit, less, settled, settle);
 	}
 	return api_budget(pb, "cpu", run_limit, 0);
 }

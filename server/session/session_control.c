@@ -34,14 +34,10 @@ static api_err admit_cpu_limit(const srv_session *s, const api_control *c,
 	(void)s;
 	if (c->cpu_budget >= API_CPU_BUDGET_MIN && c->cpu_budget <= cfg->max_cpu_seconds)
 		return API_OK;
-	api_err e = api_fail(pb, API_RANGE, "cpu_budget",
-			     "cpu_budget must be CPU seconds in [%g, %g] "
-			     "(--max-cpu-seconds); got %g", API_CPU_BUDGET_MIN,
-			     cfg->max_cpu_seconds, c->cpu_budget);
-	pb->has_range = 1;
-	pb->min = API_CPU_BUDGET_MIN;
-	pb->max = cfg->max_cpu_seconds;
-	return e;
+	return api_fail_range(pb, "cpu_budget", API_CPU_BUDGET_MIN, cfg->max_cpu_seconds,
+			      "cpu_budget must be CPU seconds in [%g, %g] "
+			      "(--max-cpu-seconds); got %g", API_CPU_BUDGET_MIN,
+			      cfg->max_cpu_seconds, c->cpu_budget);
 }
 
 int srv_until_cuts_experiment(const srv_session *s, double until)

@@ -98,16 +98,13 @@ api_err srv_dem_admit(api_spec *spec, api_problem *pb)
 		double k_max = spec->params.k_c * (cfg->max_dem_cost / cost) *
 			       (cfg->max_dem_cost / cost);
 		const sim_setting *t = sim_setting_find("k_c");
-		api_fail(pb, API_RANGE, "params.k_c",
-			 "the LIGGGHTS bed of %d grains at k_c/m_n = %.3g 1/s^2 takes DEM steps of "
-			 "%.2g s: about %.3g CPU s a simulated second, more than --max-dem-cost %g; "
-			 "k_c at most %.3g N/m at this m_n (or fewer layers)",
-			 bed.grains, bed.k_over_m, dem_bed_spec_dt(&bed), cost, cfg->max_dem_cost,
-			 k_max);
-		pb->has_range = 1;
-		pb->min = t ? t->min : 0.0;
-		pb->max = k_max;
-		return pb->code;
+		return api_fail_range(pb, "params.k_c", t ? t->min : 0.0, k_max,
+				      "the LIGGGHTS bed of %d grains at k_c/m_n = %.3g 1/s^2 takes "
+				      "DEM steps of %.2g s: about %.3g CPU s a simulated second, more "
+				      "than --max-dem-cost %g; k_c at most %.3g N/m at this m_n (or "
+				      "fewer layers)",
+				      bed.grains, bed.k_over_m, dem_bed_spec_dt(&bed), cost,
+				      cfg->max_dem_cost, k_max);
 	}
 	int n = atomic_load(&live);
 	do {
@@ -136,11 +133,8 @@ api_err srv_dem_pick(srv_session *s, api_spec *spec, api_problem *pb)
 		.limit = "--max-dem-cost",
 	};
 	if (sim_feed_pick(&spec->params, &spec->scene, &lg, pick) != 0) {
-		api_fail(pb, API_RANGE, "scene.model_tol", "%s", pick->why);
-		pb->has_range = 1;
-		pb->min = isfinite(pick->min) ? pick->min : 0.0;
-		pb->max = 1.0;
-		return pb->code;
+		return api_fail_range(pb, "scene.model_tol",
+				      isfinite(pick->min) ? pick->min : 0.0, 1.0, "%s", pick->why);
 	}
 	spec->scene.feed_model = pick->model;
 	s->picked = 1;
