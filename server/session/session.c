@@ -264,10 +264,7 @@ srv_session *srv_session_create(const api_spec *request, srv_experiment *exp, in
 	int bad = session_init(s, spec, before, pb);
 	s->create_fd = -1;
 	srv_budget_give_settling(&s->budget.settling); /* built, or not at all */
-	/* nobody would read the 201 of a client that left while s settled
-	 * (bad > 0: its LIGGGHTS bed saw it go and stopped settling; else a
-	 * look now; client_fd -1: none, a restore), so nothing is kept; one
-	 * that leaves after this look still gets its session */
+	/* a client gone while s settled reads no 201 (bad > 0: its bed saw it go) */
 	if (bad < 0 || srv_client_left(client_fd, bad > 0, &srv_stats.sessions_abandoned, "session",
 				       s->entry.id, "created", "settled", pb))
 		goto fail;
