@@ -315,10 +315,15 @@ N       ?= 3
 cluster: deps-build $(BUILD)/convsimd
 	$(Q)N=$(N) CONVSIMD=$(BUILD)/convsimd bash server/cluster.sh run
 
-test: deps all
-	$(Q)$(MAKE) --no-print-directory dem-build
-	$(Q)$(MAKE) --no-print-directory NO_MPI=1 BUILD=$(BUILD)/nompi $(BUILD)/nompi/convsim
-	$(Q)BUILD=$(BUILD) TESTS_SKIP='$(TESTS_SKIP)' bash tests/run.sh
+# make test, make check and make fuzz build on JOBS cores (every core by
+# default; JOBS=1 one file at a time), once what is missing is installed;
+# tests/run.sh runs the unit tests JOBS at a time, the rest one by one
+JOBS ?= $(shell nproc 2>/dev/null || echo 1)
+test: deps deps-unit
+	$(Q)$(MAKE) --no-print-directory -j$(JOBS) all
+	$(Q)$(MAKE) --no-print-directory -j$(JOBS) dem-build
+	$(Q)$(MAKE) --no-print-directory -j$(JOBS) NO_MPI=1 BUILD=$(BUILD)/nompi $(BUILD)/nompi/convsim
+	$(Q)BUILD=$(BUILD) TESTS_SKIP='$(TESTS_SKIP)' TEST_JOBS=$(JOBS) bash tests/run.sh
 
 check:
 	$(Q)$(MAKE) --no-print-directory BUILD=build-san \
@@ -374,10 +379,10 @@ FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))
 FUZZ_LIBS    := $(FUZZ_SERVER) $(BUILD)/libapi.a $(BUILD)/libdemlink.a $(BUILD)/libfit.a $(BUILD)/libcore.a
 
 fuzz: deps-build
-	$(Q)$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) CC=clang \
+	$(Q)$(MAKE) --no-print-directory -j$(JOBS) BUILD=$(FUZZ_BUILD) CC=clang \
 	  CFLAGS="-O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link" WARN="$(WARN) -Wno-unused-function" fuzz-build
 	$(Q)FUZZ_BUILD=$(FUZZ_BUILD) FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) FUZZ_NAMES="$(FUZZ_NAMES)" \
-	  bash tests/fuzz/run.sh
+	  FUZZ_JOBS=$(JOBS) bash tests/fuzz/run.sh
 
 fuzz-build: $(FUZZ_BINS)
 

@@ -11,22 +11,20 @@ export BUILD CONVSIMD="$PWD/$BUILD/convsimd" CONVSIM="$PWD/$BUILD/convsim" CONVS
 export CONVSIM_NOMPI="$PWD/$BUILD/nompi/convsim" # the convsim of `make NO_MPI=1` (make test builds it)
 mkdir -p tests/out
 log=$(mktemp) times=$(mktemp)
-trap 'rm -f "$log" "$times"' EXIT
 pass=0; fail=0; failed=(); skipped=()
 # TESTS_SKIP: an extended regular expression; the groups whose names match
 # it do not run and are listed at the end (make check-ci)
-run() { # name, command...
-	local name=$1; shift
-	if [ -n "${TESTS_SKIP:-}" ] && printf '%s\n' "$name" | grep -Eq -- "$TESTS_SKIP"; then
-		skipped+=("$name")
-		return
+skip() { # name: 0 (and listed) when TESTS_SKIP names it
+	if [ -n "${TESTS_SKIP:-}" ] && printf '%s\n' "$1" | grep -Eq -- "$TESTS_SKIP"; then
+		skipped+=("$1")
+		return 0
 	fi
-	echo "=== $name"
-	local t0=$EPOCHREALTIME
-	timeout 900 "$@" 2>&1 | tee "$log"
-	local rc=${PIPESTATUS[0]} p f
+	return 1
+}
+count() { # name, exit code, seconds: the group's tests, from $log
+	local name=$1 rc=$2 p f
 	# the group's wall time, for the slowest-groups line at the end
-	awk -v a="$EPOCHREALTIME" -v b="$t0" -v n="$name" 'BEGIN {printf "%.1f\t%s\n", a - b, n}' >>"$times"
+	printf '%s\t%s\n' "$3" "$name" >>"$times"
 	# cmocka: "[  PASSED  ] N test(s)." / "[  FAILED  ] N test(s), listed below:"
 	# node:test: "# pass N" / "# fail N"
 	p=$(sed -n -e 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' -e 's/^# pass \([0-9]*\)$/\1/p' "$log" | tail -1)
@@ -43,12 +41,41 @@ run() { # name, command...
 		exit 1
 	fi
 }
-# the binaries of the sources there are: a binary left in $BUILD by a
-# renamed or removed test file does not run
+since() { awk -v a="$EPOCHREALTIME" -v b="$1" 'BEGIN {printf "%.1f", a - b}'; }
+run() { # name, command...
+	local name=$1; shift
+	skip "$name" && return
+	echo "=== $name"
+	local t0=$EPOCHREALTIME
+	timeout 900 "$@" 2>&1 | tee "$log"
+	local rc=${PIPESTATUS[0]}
+	count "$name" "$rc" "$(since "$t0")"
+}
+# the unit tests of the sources there are (a binary left in $BUILD by a
+# renamed or removed test file does not run), TEST_JOBS at a time: they
+# compute, and time themselves on their threads' CPU clocks only, so they
+# may share the cores; each writes a log of its own, shown and counted in
+# order once all have ended
+units=$(mktemp -d)
+trap 'rm -rf "$log" "$times" "$units"' EXIT
+names=()
 for src in tests/unit/test_*.c; do
-	t="$BUILD/tests/$(basename "$src" .c)"
-	[ -x "$t" ] || continue
-	run "$(basename "$t")" "$t"
+	name=$(basename "$src" .c)
+	[ -x "$BUILD/tests/$name" ] || continue
+	skip "$name" && continue
+	names+=("$name")
+	while [ "$(jobs -rp | wc -l)" -ge "${TEST_JOBS:-1}" ]; do wait -n; done
+	(t0=$EPOCHREALTIME
+	 timeout 900 "$BUILD/tests/$name" >"$units/$name.log" 2>&1
+	 echo "$? $(since "$t0")" >"$units/$name.end") &
+done
+wait
+for name in "${names[@]}"; do
+	echo "=== $name"
+	cp "$units/$name.log" "$log"
+	cat "$log"
+	read -r rc secs <"$units/$name.end"
+	count "$name" "$rc" "$secs"
 done
 # the floors: no dependency loop in core/, fit/, cli/, api/, each of
 # server/'s floors, server/ as a whole or dem/ (where built) (files that use

@@ -9,6 +9,7 @@
 # leak, a sanitizer report, an oracle failure or an input slower than
 # FUZZ_TIMEOUT seconds stops that harness, keeps the input in
 # $FUZZ_BUILD/crashes/ and makes this script exit 1.
+# FUZZ_JOBS harnesses run at a time (make fuzz: JOBS, every core).
 set -u
 cd "$(dirname "$0")/../.."
 B=${FUZZ_BUILD:-build-fuzz}
@@ -51,11 +52,19 @@ for n in $NAMES; do
 		fi
 		;;
 	esac
-	/usr/bin/time -f '%U %S' -o "$B/logs/$n.time" \
+	# FUZZ_JOBS harnesses at a time (each its own corpus, log and times)
+	while [ "$(jobs -rp | wc -l)" -ge "${FUZZ_JOBS:-1}" ]; do wait -n; done
+	(/usr/bin/time -f '%U %S' -o "$B/logs/$n.time" \
 		nice -n 10 "$bin" ${R:+-runs=$R -seed=1} -max_total_time="$S" -timeout="$T" -rss_limit_mb=2048 \
 		-print_final_stats=1 -artifact_prefix="$B/crashes/$n-" ${dict:+-dict=$dict} \
 		"$B/corpus/$n" "tests/fuzz/corpus/$n" >"$log" 2>&1
-	rc=$?
+	 echo $? >"$B/logs/$n.rc") &
+done
+wait
+# the table, in the harnesses' order, once all have ended
+for n in $NAMES; do
+	log=$B/logs/$n.log
+	rc=$(cat "$B/logs/$n.rc")
 	execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
 	rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
 	cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -1)
