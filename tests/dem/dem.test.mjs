@@ -6,7 +6,8 @@
 // `make test` builds after installing LIGGGHTS.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
+import { execFile, execFileSync } from 'node:child_process';
+import { promisify } from 'node:util';
 import '../tether.mjs'; // nothing started here outlives the test
 
 const BUILD = process.env.BUILD || 'build';
@@ -21,16 +22,24 @@ function dem(args) {
   const out = execFileSync('nice', ['-n', '15', DEM, ...args], { encoding: 'utf8', timeout: 120000, env: ENV });
   return JSON.parse(out);
 }
+// The same, started at once: the runs of one test share the cores (each
+// measures its own bed; none times anything)
+const run = promisify(execFile);
+async function demAsync(args) {
+  const { stdout } = await run('nice', ['-n', '15', DEM, ...args], { encoding: 'utf8', timeout: 120000, env: ENV,
+    maxBuffer: 1 << 26 });
+  return JSON.parse(stdout);
+}
 
 const ONE_GRAIN = ['--grains', '1', '--d-min', '0.004', '--d-max', '0.004', '--freeze-rotation',
   '--set', 'layers=1', '--duration', '2', '--transient', '0.5'];
 const CONVSIM = process.env.CONVSIM || `${ROOT}${BUILD}/convsim`;
 
 // The column model's v, one-way, over the same window as ONE_GRAIN's.
-function column(sets) {
+async function column(sets) {
   const args = ['run', '-q', '--set', 'layers=1', '--set', 'feed_coupling=false', '-d', '2', '--set', 'transient=0.5'];
   for (const s of sets) args.push('--set', s);
-  return JSON.parse(execFileSync(CONVSIM, args, { encoding: 'utf8', env: ENV })).transport_velocity;
+  return JSON.parse((await run(CONVSIM, args, { encoding: 'utf8', env: ENV })).stdout).transport_velocity;
 }
 
 // The issue's 0.5 %, at the rigid limit of both contact laws (docs/dem.md
@@ -42,13 +51,14 @@ function column(sets) {
 // (0.23 %), -0.13009 / -0.13031 at 137 deg (0.17 %); each within 0.3 % of
 // the common limit (the DEM moved 0.11 % from 2e9, the column model
 // 0.26 % on to 2e13).
-test('one grain at the rigid limit: LIGGGHTS and the column model with one layer agree within 0.5 %', () => {
-  for (const beta of [30, 137]) {
-    const r = dem([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', 'k_c=1e10', '--tangential', 'viscous',
-      '--motion', 'machine', '--no-column']);
+test('one grain at the rigid limit: LIGGGHTS and the column model with one layer agree within 0.5 %', async () => {
+  const runs = [30, 137].map((beta) => Promise.all([beta,
+    demAsync([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', 'k_c=1e10', '--tangential', 'viscous',
+      '--motion', 'machine', '--no-column']),
+    column([`beta=${beta}`, 'k_c=1e10', 'm_n=0.005', 'dt=1e-4', 'substeps=1000'])]));
+  for (const [beta, r, col] of await Promise.all(runs)) {
     assert.equal(r.k_over_m, 2e10);
     assert.equal(r.tangential, 'viscous');
-    const col = column([`beta=${beta}`, 'k_c=1e10', 'm_n=0.005', 'dt=1e-4', 'substeps=1000']);
     assert.ok(Math.abs(col) > 0.1, `column model v ${col}`);
     const rel = Math.abs(r.v_dem - col) / Math.abs(col);
     assert.ok(rel < 0.005, `β ${beta}: v_dem ${r.v_dem} v_column ${col} (${(100 * rel).toFixed(2)} %)`);
@@ -60,9 +70,12 @@ test('one grain at the rigid limit: LIGGGHTS and the column model with one layer
 // than the vibration's period; LIGGGHTS has a dashpot and, by default, a
 // tangential spring): measured 0.1511 (spring) and 0.1404 (viscous)
 // against 0.1459, 3.6 % and 3.8 % apart (docs/dem.md "One grain").
-test('one grain at the preset stiffness: LIGGGHTS and the column model within 5 % at beta 30 deg, both senses', () => {
-  for (const [rot, beta] of [['cw', 30], ['ccw', 150]]) {
-    const r = dem([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', `rotation=${rot}`]);
+test('one grain at the preset stiffness: LIGGGHTS and the column model within 5 % at beta 30 deg, both senses', async () => {
+  const senses = [['cw', 30], ['ccw', 150]];
+  const runs = await Promise.all(senses.map(([rot, beta]) =>
+    demAsync([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', `rotation=${rot}`])));
+  for (const [i, [rot, beta]] of senses.entries()) {
+    const r = runs[i];
     assert.equal(r.grains, 1);
     assert.ok(r.deck_fit_residual < 1e-3 * r.deck_amplitude, `deck fit residual ${r.deck_fit_residual}`);
     assert.ok(Math.abs(r.v_column) > 0.1, `column model v ${r.v_column}`);
@@ -71,10 +84,11 @@ test('one grain at the preset stiffness: LIGGGHTS and the column model within 5 
   }
 });
 
-test('one grain: the mirror pair (cw, 60 deg) and (ccw, 120 deg) moves at opposite velocities', () => {
+test('one grain: the mirror pair (cw, 60 deg) and (ccw, 120 deg) moves at opposite velocities', async () => {
   // (cw, 60) and (ccw, 120) are mirror images on the symmetric machine
-  const a = dem([...ONE_GRAIN, '--set', 'beta=60', '--set', 'rotation=cw', '--no-column']);
-  const b = dem([...ONE_GRAIN, '--set', 'beta=120', '--set', 'rotation=ccw', '--no-column']);
+  const [a, b] = await Promise.all([
+    demAsync([...ONE_GRAIN, '--set', 'beta=60', '--set', 'rotation=cw', '--no-column']),
+    demAsync([...ONE_GRAIN, '--set', 'beta=120', '--set', 'rotation=ccw', '--no-column'])]);
   assert.ok(Math.abs(a.v_dem) > 0.05, `v ${a.v_dem}`);
   assert.ok(Math.abs(a.v_dem + b.v_dem) < 0.01 * Math.abs(a.v_dem), `cw 60: ${a.v_dem}, ccw 120: ${b.v_dem}`);
 });
@@ -112,10 +126,12 @@ test('liggghts-bed4: the calibrated column model meets the DEM bed within 5 % wh
 // moved by fix move/mesh wiggle): one grain on a floor vibrating 2 mm
 // along 30° (Γ = 2.5) and 1.5 mm along 45°, the same v within 1 %
 // (measured: 0.07 % and 0.03 %; docs/dem.md "The bed and its frame").
-test('frame check: the deck as a body force and as a moving mesh give one v', () => {
-  for (const spec of ['0.002:30', '0.0015:45']) {
-    const r = JSON.parse(execFileSync('nice', ['-n', '15', DEM, '--frame-check', spec, '--duration', '2',
-      '--transient', '0.5'], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'], timeout: 120000, env: ENV }));
+test('frame check: the deck as a body force and as a moving mesh give one v', async () => {
+  const specs = ['0.002:30', '0.0015:45'];
+  const runs = await Promise.all(specs.map((spec) => demAsync(['--frame-check', spec, '--duration', '2',
+    '--transient', '0.5'])));
+  for (const [i, spec] of specs.entries()) {
+    const r = runs[i];
     assert.ok(Math.abs(r.v_mesh) > 0.1, `${spec}: v_mesh ${r.v_mesh}`);
     assert.ok(Math.abs(r.v_body - r.v_mesh) < 0.01 * Math.abs(r.v_mesh), `${spec}: body ${r.v_body}, mesh ${r.v_mesh}`);
   }
