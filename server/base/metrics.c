@@ -62,8 +62,8 @@ static void activity_metrics(FILE *f, const srv_gauges *g)
 	metric(f, "convsim_experiments_total", "counter",
 	       "Experiments started.", (double)srv_stats.experiments);
 	metric(f, "convsim_experiments_abandoned_total", "counter",
-	       "Experiments on an existing session withdrawn because their client left "
-	       "while they measured.", (double)srv_stats.experiments_abandoned);
+	       "Experiments withdrawn because their client left while they measured.",
+	       (double)srv_stats.experiments_abandoned);
 	metric(f, "convsim_sweep_points_total", "counter",
 	       "Sweep points measured.", (double)srv_stats.sweep_points);
 	metric(f, "convsim_store_writes_total", "counter",

@@ -20,8 +20,8 @@ typedef struct srv_metrics {
 	atomic_int stream_clients;
 	atomic_ullong streams_opened, dropped_samples, stream_records;
 	atomic_ullong sweep_points, experiments;
-	atomic_ullong experiments_abandoned; /* on an existing session, their
-						client left while they measured */
+	atomic_ullong experiments_abandoned; /* their client left while they
+						measured */
 	atomic_ullong store_writes, store_errors; /* files the writer wrote, failed */
 	atomic_ullong log_syncs;  /* fdatasyncs of control logs (one a round
 				     of group commit) */

@@ -75,14 +75,16 @@ srv_experiment *srv_experiments_readopt(const char *session_id)
 /* Run e on a fresh session or attach it to the one it names; the session
  * notes its id in e before its worker can run it. A fresh one settles
  * within what e's measurements left of --max-cpu-seconds, and is not kept
- * when the client on client_fd left meanwhile (session.h); nor is e
- * attached to an existing one when the client left while it measured. */
+ * when the client on client_fd left meanwhile (session.h). A client that
+ * left while e measured (an identification's slopes, a closed loop's
+ * curve) gets neither: e is withdrawn before a fresh session is built or
+ * an existing one attached. */
 static api_err start_on_session(srv_experiment *e, const api_experiment_req *req,
 				int client_fd, api_problem *pb)
 {
 	srv_session *s;
-	if (!req->fresh && srv_client_left(client_fd, 0, &srv_stats.experiments_abandoned,
-					   "experiment", srv_exp_id(e), "started", "measured", pb))
+	if (srv_client_left(client_fd, 0, &srv_stats.experiments_abandoned, "experiment",
+			    srv_exp_id(e), "started", "measured", pb))
 		return pb->code;
 	if (req->fresh) {
 		s = srv_session_create(&req->spec, e, client_fd, srv_exp_measured_cpu(e), pb);

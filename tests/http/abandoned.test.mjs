@@ -9,7 +9,8 @@
 // An identification on an existing session measures its scene in the
 // request's thread too, holding a settling slot: one whose client leaves
 // meanwhile is withdrawn before it is attached, the session left as it
-// was, and convsim_experiments_abandoned_total counts it.
+// was, and convsim_experiments_abandoned_total counts it; one on a fresh
+// session is withdrawn before that session is built.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { once } from 'node:events';
@@ -113,6 +114,28 @@ test('an identification on an existing session whose client leaves while it meas
     assert.equal(g.body.experiment, null);
     const p = await req(d.base, 'PATCH', `/api/v1/sessions/${id}`, { beta: 38 });
     assert.equal(p.status, 200, p.text);
+    assert.match(d.stderr(), /experiment \w+ not started: its client left while it measured/);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+test('an identification on a fresh session whose client leaves while it measures is withdrawn before its session settles', { timeout: 180000 * SLOW }, async () => {
+  const d = await startDaemon(['--ring', '64', '--history', '64', '--log-level', 'info']);
+  try {
+    assert.equal(await leaveWhileSettling(d, '/api/v1/experiments',
+      { session: { scene: { columns: 16, layers: 16 }, pace: 0.01, sample_rate: 1 }, identify: { beta: [30, 38] } }), '');
+    const m = await until(async () => {
+      const t = await metrics(d);
+      return (metric(t, 'convsim_experiments_abandoned_total') + metric(t, 'convsim_sessions_abandoned_total') +
+              metric(t, 'convsim_experiments_total') >= 1) && metric(t, 'convsim_settling') === 0 && t;
+    }, 30000, 'the abandoned identification over');
+    assert.deepEqual(await listed(d, 'experiments'), []);
+    assert.deepEqual(await listed(d, 'sessions'), []);
+    // withdrawn once measured: its session was never built nor settled
+    assert.equal(metric(m, 'convsim_experiments_abandoned_total'), 1);
+    assert.equal(metric(m, 'convsim_sessions_abandoned_total'), 0);
+    assert.equal(metric(m, 'convsim_sessions_created_total'), 0);
     assert.match(d.stderr(), /experiment \w+ not started: its client left while it measured/);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
