@@ -13,7 +13,7 @@
 enum {
 	API_Q_FORMAT = 1 << 0, API_Q_FROM = 1 << 1, API_Q_TO = 1 << 2, API_Q_STRIDE = 1 << 3,
 	API_Q_STREAM_FORMAT = 1 << 4, API_Q_FIELDS = 1 << 5, API_Q_RATE = 1 << 6,
-	API_Q_LIMIT = 1 << 7, API_Q_SINCE = 1 << 8, API_Q_SCOPE = 1 << 9,
+	API_Q_LIMIT = 1 << 7, API_Q_SINCE = 1 << 8, API_Q_SCOPE = 1 << 9, API_Q_ONLY = 1 << 10,
 };
 typedef struct api_query {
 	unsigned bit;

@@ -46,6 +46,8 @@ static const api_query queries[] = {
 	{API_Q_SCOPE, "scope", "{\"type\":\"string\",\"enum\":[\"all\",\"local\"]}",
 	 "all (default): this replica's entries and those of its --peers; local: this replica's "
 	 "only"},
+	{API_Q_ONLY, "only", "{\"type\":\"string\",\"enum\":[\"running\"]}",
+	 "running: stop it only while it runs; one that has ended answers 409 and is kept"},
 };
 
 #define TRAJ (API_Q_FORMAT | API_Q_FROM | API_Q_TO | API_Q_STRIDE)
@@ -80,9 +82,9 @@ static const api_route routes[API_R_COUNT] = {
 	[API_R_EXPERIMENT_GET] = {"GET", "/api/v1/experiments/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per segment)", NULL, 200, "Experiment",
 	 "400,404,406"},
-	[API_R_EXPERIMENT_DELETE] = {"DELETE", "/api/v1/experiments/*", 0, 0,
+	[API_R_EXPERIMENT_DELETE] = {"DELETE", "/api/v1/experiments/*", API_Q_ONLY, 0,
 	 "Stop it and forget it (a fresh session it created goes with it)", NULL, 204, "",
-	 "400,404,415"},
+	 "400,404,409,415"},
 	[API_R_SWEEPS_CREATE] = {"POST", "/api/v1/sweeps", 0, 0, "Measure v(beta) for the given rotations on the pool",
 	 "SweepCreate", 202, "Sweep", "400,413,415,422,429,503"},
 	[API_R_SWEEPS_LIST] = {"GET", "/api/v1/sweeps", API_Q_FORMAT | API_Q_SCOPE, 1,
@@ -90,7 +92,8 @@ static const api_route routes[API_R_COUNT] = {
 	[API_R_SWEEP_GET] = {"GET", "/api/v1/sweeps/*", API_Q_FORMAT, 1,
 	 "Progress and results (CSV: one row per point, the CLI's sweep columns)", NULL, 200,
 	 "Sweep", "400,404,406"},
-	[API_R_SWEEP_DELETE] = {"DELETE", "/api/v1/sweeps/*", 0, 0, "Cancel and forget", NULL, 204, "", "400,404,415"},
+	[API_R_SWEEP_DELETE] = {"DELETE", "/api/v1/sweeps/*", API_Q_ONLY, 0, "Cancel and forget", NULL, 204, "",
+	 "400,404,409,415"},
 	[API_R_FITS_CREATE] = {"POST", "/api/v1/fits", 0, 0,
 	 "Fit free parameters to measured v(beta) points or peaks (Levenberg-Marquardt) as a job",
 	 "FitCreate", 202, "Fit", "400,413,415,422,429,503"},
@@ -99,8 +102,8 @@ static const api_route routes[API_R_COUNT] = {
 	[API_R_FIT_GET] = {"GET", "/api/v1/fits/*", API_Q_FORMAT, 1,
 	 "Progress and result (CSV: parameters, data with residuals, curves)", NULL, 200, "Fit",
 	 "400,404,406"},
-	[API_R_FIT_DELETE] = {"DELETE", "/api/v1/fits/*", 0, 0, "Cancel (a running fit stops) and forget", NULL, 204, "",
-	 "400,404,415"},
+	[API_R_FIT_DELETE] = {"DELETE", "/api/v1/fits/*", API_Q_ONLY, 0, "Cancel (a running fit stops) and forget", NULL,
+	 204, "", "400,404,409,415"},
 	[API_R_PRESETS] = {"GET", "/api/v1/presets", 0, 0, "Presets, the settings table, integrators", NULL, 200,
 	 "Presets", "400"},
 	[API_R_HEALTH] = {"GET", "/api/v1/health", 0, 0, "Liveness (503 with the same body while shutting down)",

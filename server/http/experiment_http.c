@@ -175,17 +175,21 @@ static void experiment_discard(srv_entry *en)
 /* DELETE: a running experiment is let go by its session, aborted, as at
  * its session's end; a fresh session it created and would have removed at
  * its end is deleted now, one the client made or kept stays. */
-static void experiment_cancel(srv_entry *en)
+static int experiment_cancel(srv_entry *en, int only_running)
 {
 	srv_experiment *e = srv_exp_from_entry(en);
 	char sid[SRV_ID_LEN], why[96];
-	if (!srv_exp_cancel(e, sid, sizeof sid))
-		return;
+	int on = srv_exp_cancel(e, only_running, sid, sizeof sid);
+	if (on < 0)
+		return 0;
+	if (!on)
+		return 1;
 	srv_session *s = srv_session_get(sid);
 	snprintf(why, sizeof why, "deleted (DELETE /api/v1/experiments/%s)", srv_exp_id(e));
 	if (s && srv_session_detach(s, e, why))
 		srv_session_delete(s);
 	srv_session_put(s);
+	return 1;
 }
 
 /* On its session (a fresh one or the one it names), then its record. */
@@ -195,7 +199,7 @@ static api_err experiment_start(srv_entry *en, int client_fd, char **answer, api
 	if (start_on_session(e, srv_exp_request(e), client_fd, pb) != API_OK)
 		return pb->code;
 	if (srv_exp_deleted(e)) /* a DELETE came before it was on its session */
-		experiment_cancel(en);
+		experiment_cancel(en, 0);
 	srv_exp_persist(e); /* not once deleted */
 	atomic_fetch_add(&srv_stats.experiments, 1);
 	*answer = experiment_json(e, 0);

@@ -85,8 +85,9 @@ srv_cmd *srv_exp_step(srv_experiment *e, const sim_status *st, int *over);
 int srv_exp_commanded(srv_experiment *e, const srv_cmd *cmd);
 /* DELETE of e: 1 with the id of the session it runs on in sid (the
  * caller lets it go there, srv_session_detach), else 0 (over, or not yet
- * on a session: then srv_exp_deleted says so to its start). */
-int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen);
+ * on a session: then srv_exp_deleted says so to its start); -1, nothing
+ * done, when only_running and e has ended (done, aborted, interrupted). */
+int srv_exp_cancel(srv_experiment *e, int only_running, char *sid, size_t sidlen);
 /* 1 once a DELETE of e came. */
 int srv_exp_deleted(srv_experiment *e);
 /* The session ended before the experiment (deleted, failed, shutdown). */

@@ -41,9 +41,13 @@ api_err srv_exp_stopped(const srv_experiment *e, const api_spec *spec, double de
 	return api_budget(pb, "cpu", bound, 0);
 }
 
-int srv_exp_cancel(srv_experiment *e, char *sid, size_t sidlen)
+int srv_exp_cancel(srv_experiment *e, int only_running, char *sid, size_t sidlen)
 {
 	pthread_mutex_lock(&e->lock);
+	if (only_running && e->state >= EXP_DONE) {
+		pthread_mutex_unlock(&e->lock);
+		return -1;
+	}
 	e->deleted = 1;
 	int on = e->attached && e->session_id[0];
 	if (on)

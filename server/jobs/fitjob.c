@@ -349,9 +349,13 @@ static char *fit_list_text(const void *views, size_t n, int csv)
 }
 
 /* DELETE: the driver's evaluations return at once. */
-static void fit_cancel(srv_entry *en)
+static int fit_cancel(srv_entry *en, int only_running)
 {
-	fit_of(en)->cancelled = 1;
+	srv_fit *f = fit_of(en);
+	if (only_running && (f->over || f->cancelled))
+		return 0;
+	f->cancelled = 1;
+	return 1;
 }
 
 /* A fit from its record (taken): over with its progress and result, or

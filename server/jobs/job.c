@@ -247,9 +247,20 @@ enum MHD_Result srv_h_job_delete(srv_req *r)
 		srv_registry_put(kind->reg, e);
 		return srv_reply_problem(r, &pb, NULL);
 	}
+	/* ?only=running: a job that has ended is kept and said (409) */
+	const char *only = srv_query(r, "only");
+	if (only && strcmp(only, "running") != 0) {
+		srv_registry_put(kind->reg, e);
+		return srv_fail(r, API_QUERY, "only", "only must be running, not \"%.40s\"", only);
+	}
 	job_lock(kind, e);
-	kind->cancel(e);
+	int stopped = kind->cancel(e, only != NULL);
 	job_unlock(kind, e);
+	if (!stopped) {
+		srv_registry_put(kind->reg, e);
+		return srv_fail(r, API_CONFLICT, "only", "the %s has ended already; nothing was "
+				"stopped or deleted (only=running)", kind->name);
+	}
 	int removed = srv_registry_remove(kind->reg, e);
 	if (removed)
 		forget(kind, e->id);

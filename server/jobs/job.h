@@ -62,8 +62,11 @@ typedef struct srv_job_kind {
 	size_t view_size, scratch_size;
 	void (*view)(srv_entry *e, void *view, void *scratch);
 	char *(*list_text)(const void *views, size_t n, int csv);
-	/* DELETE: stop a job before it is unlinked; NULL: no DELETE route. */
-	void (*cancel)(srv_entry *e);
+	/* DELETE: stop a job before it is unlinked, and 1; 0, nothing done,
+	 * when only_running and it has ended (?only=running); NULL: no
+	 * DELETE route. Under its lock: no end comes between the look and
+	 * the stop. */
+	int (*cancel)(srv_entry *e, int only_running);
 	/* Restore: a job from the payload of {plural}/ID.bin (taken), not
 	 * yet in the registry, or NULL with the reason in why. */
 	srv_entry *(*load)(void *payload, size_t len, char *why, size_t whylen);

@@ -464,11 +464,13 @@ static srv_entry *sweep_damaged(const char *id, const char *why)
 }
 
 /* DELETE: the points not yet run are skipped. */
-static void sweep_cancel(srv_entry *en)
+static int sweep_cancel(srv_entry *en, int only_running)
 {
 	srv_sweep *sw = sweep_of(en);
+	int running = sw->done < sw->total && !sw->cancelled;
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
+	return running || !only_running;
 }
 
 const srv_job_kind srv_sweep_job = {

@@ -2,14 +2,15 @@
 // Browser test of the experiment panels' Stop button (docs/getting-started.md)
 // against the real daemon: a β-change experiment, a closed loop and an
 // identification long enough to be still running are stopped from the page
-// (DELETE /api/v1/experiments/ID with the token), and what the page says
+// (DELETE /api/v1/experiments/ID?only=running with the token), and what the page says
 // is checked against the API: the experiment is gone (404), its fresh
 // session removed, or kept and running when the plots follow it; the
 // polling ends and the panel is ready for a new run. Idle, every panel's
 // Stop (the fit's too) is shown and disabled. An experiment that ended
 // disables Stop and keeps its result; so does a Stop pressed after the
-// experiment ended but before the page's poll saw it (no DELETE, one
-// message that it had finished); a Stop refused (the experiment deleted
+// experiment ended but before the page's poll saw it (its DELETE only
+// while running, which the daemon refuses, 409: one message that it had
+// finished); a Stop refused (the experiment deleted
 // meanwhile) is shown as a message, never thrown.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -57,8 +58,8 @@ async function start(run, stop) {
 /* Click Stop: the DELETE it sends (token, JSON type, no body), its
  * 204, then the message text; after it no more polls of the experiment. */
 async function stopFromPage(stop, ex, text) {
-	const sent = page.waitForRequest(r => r.method() === 'DELETE' && r.url().endsWith(`/api/v1/experiments/${ex.id}`));
-	const answered = page.waitForResponse(r => r.request().method() === 'DELETE' && r.url().endsWith(`/api/v1/experiments/${ex.id}`));
+	const sent = page.waitForRequest(r => r.method() === 'DELETE' && r.url().endsWith(`/api/v1/experiments/${ex.id}?only=running`));
+	const answered = page.waitForResponse(r => r.request().method() === 'DELETE' && r.url().endsWith(`/api/v1/experiments/${ex.id}?only=running`));
 	await page.click(stop);
 	const req = await sent;
 	const h = await req.allHeaders();
@@ -155,7 +156,7 @@ test('Stop pressed after the experiment ended, before the page saw it, keeps it 
 		if (hold && route.request().method() === 'GET') held.push(route);
 		else route.continue();
 	});
-	const seeDelete = r => { if (r.method() === 'DELETE' && one.test(r.url())) deletes.push(r.url()); };
+	const seeDelete = r => { if (r.method() === 'DELETE' && /\/api\/v1\/experiments\/[^/?]+(\?|$)/.test(r.url())) deletes.push(r.url()); };
 	page.on('request', seeDelete);
 	const answered = page.waitForResponse(r => r.url().endsWith('/api/v1/experiments') && r.request().method() === 'POST');
 	await page.click('#experiment-run');
@@ -169,7 +170,9 @@ test('Stop pressed after the experiment ended, before the page saw it, keeps it 
 	await new Promise(r => setTimeout(r, 1000));
 	page.off('request', seeDelete);
 	await page.unroute(one);
-	assert.deepEqual(deletes, [], 'no DELETE of an experiment that had ended');
+	/* the page did not know it had ended: its one DELETE asked to stop it
+	 * only while it runs, and the daemon kept it */
+	assert.deepEqual(deletes, [`${d.base}/api/v1/experiments/${ex.id}?only=running`], 'one DELETE, only while running');
 	assert.equal(await status(`/api/v1/experiments/${ex.id}`), 200, 'the experiment still there');
 	const text = `Experiment ${ex.id} had already finished; nothing was stopped.`;
 	const said = (await messages()).filter(m => m.includes(`Experiment ${ex.id} `));
@@ -189,7 +192,7 @@ test('a Stop refused (the experiment deleted meanwhile) is a message, and the pa
 	await page.fill('#experiment-form input[name="t_end"]', '10000');
 	const ex = await start('#experiment-run', '#experiment-stop');
 	/* another client deletes it just before the page's DELETE arrives */
-	await page.route(`**/api/v1/experiments/${ex.id}`, async route => {
+	await page.route(`**/api/v1/experiments/${ex.id}*`, async route => {
 		if (route.request().method() === 'DELETE')
 			await fetch(`${d.base}/api/v1/experiments/${ex.id}`, { method: 'DELETE', headers: { ...d.auth, 'Content-Type': 'application/json' } });
 		await route.continue();
@@ -197,13 +200,15 @@ test('a Stop refused (the experiment deleted meanwhile) is a message, and the pa
 	await page.click('#experiment-stop');
 	const text = `Stop refused: 404 Not found: no experiment with id "${ex.id}"`;
 	await until(async () => (await messages()).includes(text), 10000, `the message "${text}"`);
-	await page.unroute(`**/api/v1/experiments/${ex.id}`);
+	await page.unroute(`**/api/v1/experiments/${ex.id}*`);
 	await ready('#experiment-run', '#experiment-stop', '#experiment-progress');
 	await fetch(`${d.base}/api/v1/sessions/${ex.session}`, { method: 'DELETE', headers: { ...d.auth, 'Content-Type': 'application/json' } });
 });
 
-test('no page errors; console errors only the refused DELETE\'s 404', () => {
+test('no page errors; console errors only the refused DELETEs\' 404 and 409', () => {
 	assert.deepEqual(ui.pageErrors, []);
-	assert.deepEqual(ui.consoleErrors.filter(e => !/status of 404/.test(e)), []);
-	assert.ok(ui.consoleErrors.length <= 1, ui.consoleErrors.join('\n'));
+	/* the browser logs a refused request: the experiment deleted by
+	 * another client (404) and the one that had ended first (409) */
+	assert.deepEqual(ui.consoleErrors.filter(e => !/status of 40[49] .*\?only=running\)$/.test(e)), []);
+	assert.ok(ui.consoleErrors.length <= 2, ui.consoleErrors.join('\n'));
 });

@@ -2,8 +2,8 @@
 // Browser test of the calibration panel's Stop (docs/getting-started.md)
 // against the real daemon: idle, Stop is shown and disabled, as the
 // experiment panels' Stop is; a fit still running is stopped from the page
-// with a DELETE that carries the token and no body (the daemon refuses a
-// DELETE with one, 400), the fit is gone (404), the panel says so in one
+// with a DELETE ?only=running that carries the token and no body (the
+// daemon refuses a DELETE with one, 400), the fit is gone (404), the panel says so in one
 // message, once, and is ready for a new fit, Stop disabled again.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -35,8 +35,9 @@ test('Stop ends a running fit with one message', async () => {
 	/* evaluations of 30 s each: many seconds of fit, and a shutdown that
 	 * waits for those running at the stop no longer than the after hook */
 	assert.equal((await apiGet(d, `/api/v1/fits/${fit.id}`)).state, 'running');
-	const sent = page.waitForRequest(r => r.method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}`));
-	const done = page.waitForResponse(r => r.request().method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}`));
+	/* only while it runs: a fit that ended first would be kept (409) */
+	const sent = page.waitForRequest(r => r.method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}?only=running`));
+	const done = page.waitForResponse(r => r.request().method() === 'DELETE' && r.url().endsWith(`/api/v1/fits/${fit.id}?only=running`));
 	await page.click('#fit-stop');
 	const req = await sent;
 	assert.equal((await req.allHeaders()).authorization, `Bearer ${d.token}`);

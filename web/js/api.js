@@ -168,9 +168,10 @@ export async function getLoopExperiment(id) {
 }
 /* DELETE stops a running experiment and forgets it, running or ended;
  * its fresh session goes with it unless kept (keep_session). No body, as
- * deleteFit. */
-export async function deleteExperiment(id) {
-	await request('DELETE', `/experiments/${enc(id)}`);
+ * deleteFit. onlyRunning: only while it runs (?only=running; an ended one
+ * is kept and answered 409). */
+export async function deleteExperiment(id, onlyRunning = false) {
+	await request('DELETE', `/experiments/${enc(id)}${onlyRunning ? '?only=running' : ''}`);
 }
 
 export async function integratorNames() {
@@ -202,8 +203,8 @@ export async function getFit(id) {
 /* DELETE cancels a running fit. Content-Type: application/json as on
  * every mutating request, but no body: the daemon refuses a DELETE that
  * carries one (400). */
-export async function deleteFit(id) {
-	await request('DELETE', `/fits/${enc(id)}`);
+export async function deleteFit(id, onlyRunning = false) {
+	await request('DELETE', `/fits/${enc(id)}${onlyRunning ? '?only=running' : ''}`);
 }
 export function fitCsvUrl(id) {
 	return `${BASE}/fits/${enc(id)}?format=csv`;

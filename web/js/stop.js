@@ -2,10 +2,11 @@
 /*
  * stop.js - the Stop button of a job's panel: the fit (fit.js) and the
  * experiments (experiment.js, loop.js). Shown always, it is enabled while
- * the panel follows a running job; a click ends the panel's polling, reads
- * the job once more and, if it is still running, sends its DELETE. A job
- * that had ended before the click is left as it is: the panel shows its
- * end as at any end, its message saying nothing was stopped.
+ * the panel follows a running job; a click ends the panel's polling and
+ * sends the job's DELETE only while it runs (?only=running). A job that
+ * had ended before the DELETE came is kept by the daemon (409): the page
+ * reads it and shows its end as at any end, its message saying nothing
+ * was stopped.
  *
  * An experiment's fresh session, which the page asks the daemon to keep
  * for its plots (keep_session), stays when the plots follow it, its
@@ -19,8 +20,9 @@ import { app, $, message, report, setOnline, poll } from './ui.js';
 import { detach, refreshSessionList } from './session.js';
 
 /* The follower of the panel whose Stop button is sel and progress box
- * box; stop(j) ends job j (its DELETE and the message, default an
- * experiment's: stopExperiment) and is true once the job is gone.
+ * box; stop(j) ends job j while it runs (its DELETE and the message,
+ * default an experiment's: stopExperiment): true once the job is gone,
+ * 'ended' where it had ended first, else false.
  * follow(j, get, onUpdate) polls job j ({id, sessionId}) as ui.js poll
  * does, Stop enabled meanwhile, and returns the job's last answer once it
  * is over, or null once Stop has ended it. An answer whose job had ended
@@ -46,16 +48,14 @@ export function stopButton(sel, box, stop = stopExperiment) {
 				button.disabled = true;
 			}
 			if (end) return end;
-			const ended = await endedAlready(j, get);
-			if (ended) {
-				onUpdate(ended);
-				return { ...ended, endedBeforeStop: true };
-			}
-			/* The job may still end between that GET and the DELETE, a
-			 * window of one round trip: its DELETE then forgets a job
-			 * that had just ended. The daemon has no conditional DELETE
-			 * to close it. */
-			if (await stop(j)) {
+			const stopped = await stop(j);
+			if (stopped === 'ended') {
+				const ended = await endedAlready(j, get);
+				if (ended) {
+					onUpdate(ended);
+					return { ...ended, endedBeforeStop: true };
+				}
+			} else if (stopped) {
 				$(box).querySelector('.ptext').textContent = 'stopped';
 				return null;
 			}
@@ -63,9 +63,8 @@ export function stopButton(sel, box, stop = stopExperiment) {
 	};
 }
 
-/* Job j's answer if it has ended already (the page's last poll may
- * predate its end), else null: still running, or the GET failed (the
- * DELETE then says why). */
+/* Job j's answer once it has ended (the page's last poll may predate its
+ * end), else null: the GET failed (the panel follows it again). */
 async function endedAlready(j, get) {
 	try {
 		const now = await get(j.id);
@@ -76,6 +75,15 @@ async function endedAlready(j, get) {
 	}
 }
 
+/* What a refused DELETE ?only=running means to stop(): 'ended' (409: the
+ * job had ended first, and is kept), true (404: it is gone already) or
+ * false (another refusal, said). */
+function refusedStop(err) {
+	if (err instanceof api.ApiError && err.status === 409) return 'ended';
+	report(err, 'Stop');
+	return err instanceof api.ApiError && err.status === 404;
+}
+
 /* The message at the end of experiment end, as the follower returns it. */
 export function experimentEnded(end) {
 	if (end.failed) message('error', `Experiment ${end.id} ${end.state}${end.error ? ': ' + end.error : ''}`);
@@ -83,29 +91,28 @@ export function experimentEnded(end) {
 	else message('ok', `Experiment ${end.id} finished.`);
 }
 
-/* DELETE the fit; true once it is gone. */
+/* DELETE the fit while it runs; true once it is gone, 'ended' where it
+ * had ended first. */
 export async function stopFit({ id }) {
 	try {
-		await api.deleteFit(id);
+		await api.deleteFit(id, true);
 		setOnline(true);
 	} catch (err) {
-		report(err, 'Stop');
-		return err instanceof api.ApiError && err.status === 404;
+		return refusedStop(err);
 	}
 	message('warn', `Fit ${id} stopped.`);
 	return true;
 }
 
-/* DELETE the experiment, then see to its session: kept while the plots
- * follow it (and it still exists), else deleted. True once the experiment
- * is gone. */
+/* DELETE the experiment while it runs, then see to its session: kept
+ * while the plots follow it (and it still exists), else deleted. True once
+ * the experiment is gone, 'ended' where it had ended first. */
 async function stopExperiment({ id, sessionId }) {
 	try {
-		await api.deleteExperiment(id);
+		await api.deleteExperiment(id, true);
 		setOnline(true);
 	} catch (err) {
-		report(err, 'Stop');
-		return err instanceof api.ApiError && err.status === 404;
+		return refusedStop(err);
 	}
 	const removed = `Experiment ${id} stopped; its session was removed.`;
 	if (!sessionId) {
