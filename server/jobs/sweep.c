@@ -467,10 +467,11 @@ static srv_entry *sweep_damaged(const char *id, const char *why)
 static int sweep_cancel(srv_entry *en, int only_running)
 {
 	srv_sweep *sw = sweep_of(en);
-	int running = sw->done < sw->total && !sw->cancelled;
+	if (only_running && (sw->done == sw->total || sw->cancelled))
+		return 0;
 	if (sw->done < sw->total)
 		sw->cancelled = 1;
-	return running || !only_running;
+	return 1;
 }
 
 const srv_job_kind srv_sweep_job = {
