@@ -24,7 +24,8 @@ const POINTS = [
 const KINDS = {
   sweeps: {
     short: { ...NO_FEED, beta: [30], rotations: ['cw'], t_end: 0.5 },
-    long: { ...NO_FEED, beta: [10, 20, 30, 40], rotations: ['cw'], t_end: 300 },
+    // 8 points of 600 s with the feed: several CPU seconds on one pool thread
+    long: { ...CHEAP, beta: [10, 20, 30, 40, 50, 60, 70, 80], rotations: ['cw'], t_end: 600 },
     ended: (b) => b.state === 'done',
   },
   fits: {
