@@ -386,14 +386,15 @@ test('sweep points: 422 beyond the whole budget, 429 + Retry-After when queued p
   try {
     // the first sweep's points take about 0.1 s of CPU each (300 s of the machine alone), so
     // that none is done before the next request asks for room: at 2 s each, a quiet machine
-    // finished two of them within the 17 ms between the requests and made room
+    // finished two of them within the 17 ms between the requests and made room (under the
+    // sanitizers, SLOW 4, a quarter as long: about 0.6 s a point there, 20 s less to wait)
     const body = (n, t_end = 2) => ({ ...NO_FEED, beta: Array.from({ length: n }, (_, i) => 10 * i), rotations: ['cw'], t_end });
     const huge = await req(d.base, 'POST', '/api/v1/sweeps', body(11));
     assert.equal(huge.status, 422, huge.text);
     assert.equal(huge.body.field, 'beta');
     assert.equal(huge.body.max, 10);
     assert.equal(huge.body.budget, 'sweep-points');
-    const first = await req(d.base, 'POST', '/api/v1/sweeps', body(8, 300));
+    const first = await req(d.base, 'POST', '/api/v1/sweeps', body(8, 300 / SLOW));
     assert.equal(first.status, 202, first.text);
     assert.equal(metric(await metrics(d.base), 'convsim_sweep_points_queued') <= 8, true);
     const full = await req(d.base, 'POST', '/api/v1/sweeps', body(4));

@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, near, metric, CHEAP, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, until, near, metric, processCpu, sleep, CHEAP, NO_FEED, SLOW } from './lib.mjs';
 
 let d;
 before(async () => { d = await startDaemon(); });
@@ -359,7 +359,12 @@ test('a sweep deleted while its points run leaves no record behind', { timeout: 
   assert.equal((await req(dd.base, 'DELETE', path, undefined, { 'Content-Type': 'application/json' })).status, 204);
   // the points that were running end (the others are skipped)
   await until(async () => (await req(dd.base, 'GET', '/api/v1/health')).body.pool_queued === 0, 60000, 'the pool to drain');
-  await new Promise((res) => setTimeout(res, 5000 * SLOW)); // and the ones running then
+  // and the ones running then: once the daemon idles (its CPU still over 0.3 s)
+  await until(async () => {
+    const cpu0 = processCpu(dd.proc.pid);
+    await sleep(300);
+    return processCpu(dd.proc.pid) - cpu0 < 0.02;
+  }, 60000 * SLOW, 'the running points to end');
   const again = await restart();
   assert.ok(!existsSync(join(dir, 'sweeps', `${sw.body.id}.bin`)), 'the record is gone');
   assert.equal((await req(again.base, 'GET', path)).status, 404);
