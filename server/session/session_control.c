@@ -199,6 +199,11 @@ api_err srv_session_control(srv_session *s, api_control *c,
 	if (cmd.overtaken) { /* an experiment began under it: nothing applied */
 		srv_budget_set_paced(&s->budget.paced_held, srv_paced_need(s));
 		e = admit_until(s, c, pb);
+		if (e == API_OK) /* that experiment is gone since: still nothing applied */
+			e = api_fail(pb, API_CONFLICT, "until",
+				     "an experiment that began after this control was admitted "
+				     "ran the session past until (%g s); nothing was applied: "
+				     "send it again", c->until);
 		pthread_mutex_unlock(&s->lock);
 		return e;
 	}
