@@ -75,15 +75,6 @@ static struct {
 
 /* ---- the waiting addresses ------------------------------------------------- */
 
-static void addr_bytes(const struct sockaddr_storage *ss, unsigned char b[16])
-{
-	memset(b, 0, 16);
-	if (ss->ss_family == AF_INET)
-		memcpy(b, &((const struct sockaddr_in *)(const void *)ss)->sin_addr, 4);
-	else if (ss->ss_family == AF_INET6)
-		memcpy(b, &((const struct sockaddr_in6 *)(const void *)ss)->sin6_addr, 16);
-}
-
 static size_t home(const unsigned char b[16])
 {
 	unsigned long long h = 1469598103934665603ULL; /* FNV-1a */
@@ -96,7 +87,7 @@ static size_t home(const unsigned char b[16])
 static size_t find_slot(const struct sockaddr_storage *ss)
 {
 	unsigned char b[16];
-	addr_bytes(ss, b);
+	srv_addr_bytes((const struct sockaddr *)(const void *)ss, b);
 	size_t i = home(b);
 	while (A.slots[i].n &&
 	       (A.slots[i].family != ss->ss_family || memcmp(A.slots[i].addr, b, 16)))

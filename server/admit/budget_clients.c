@@ -5,8 +5,6 @@
  * budget of --max-client-connections, what libmicrohttpd itself refused,
  * and each connection's deadlines and room at the global cap (conns.c).
  */
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,20 +40,6 @@ typedef struct client_conn {
 static client *clients;  /* lock; cfg->max_connections + 1 entries */
 static atomic_ullong client_refused, connections_dropped;
 
-/* The address bytes of sa (IPv4 in the first 4, the rest 0); 0 for
- * another family. */
-static int addr_of(const struct sockaddr *sa, unsigned char addr[16])
-{
-	memset(addr, 0, 16);
-	if (sa->sa_family == AF_INET)
-		memcpy(addr, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, 4);
-	else if (sa->sa_family == AF_INET6)
-		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, 16);
-	else
-		return 0;
-	return 1;
-}
-
 /* The address bytes of a connection's peer; 0 if it has none. */
 static int peer(struct MHD_Connection *conn, unsigned char addr[16],
 		int *family)
@@ -65,7 +49,7 @@ static int peer(struct MHD_Connection *conn, unsigned char addr[16],
 	if (!ci || !ci->client_addr)
 		return 0;
 	*family = ci->client_addr->sa_family;
-	return addr_of(ci->client_addr, addr);
+	return srv_addr_bytes(ci->client_addr, addr);
 }
 
 /* The entry of addr, or a free one for it; NULL when full (lock held). */
@@ -96,7 +80,7 @@ static client *find_client(const unsigned char addr[16], int family)
 int srv_budget_open_from(const struct sockaddr *sa)
 {
 	unsigned char addr[16];
-	if (!addr_of(sa, addr))
+	if (!srv_addr_bytes(sa, addr))
 		return 0;
 	size_t n = (size_t)cfg->max_connections + SRV_CONN_HEADROOM + 1;
 	int count = 0;

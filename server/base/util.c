@@ -7,6 +7,7 @@
 #define _GNU_SOURCE /* gettid, pthread_setname_np */
 #include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -167,6 +168,18 @@ int srv_stopping(void)
 void srv_stop(void)
 {
 	atomic_store(&stopping, 1);
+}
+
+int srv_addr_bytes(const struct sockaddr *sa, unsigned char addr[16])
+{
+	memset(addr, 0, 16);
+	if (sa->sa_family == AF_INET)
+		memcpy(addr, &((const struct sockaddr_in *)(const void *)sa)->sin_addr, 4);
+	else if (sa->sa_family == AF_INET6)
+		memcpy(addr, &((const struct sockaddr_in6 *)(const void *)sa)->sin6_addr, 16);
+	else
+		return 0;
+	return 1;
 }
 
 int srv_client_left(int fd, int left, atomic_ullong *abandoned, const char *what,

@@ -12,6 +12,7 @@
 #include <time.h>
 
 struct api_problem; /* api.h */
+struct sockaddr;    /* sys/socket.h */
 
 enum { SRV_LOG_ERROR, SRV_LOG_WARN, SRV_LOG_INFO, SRV_LOG_DEBUG };
 
@@ -42,6 +43,9 @@ struct timespec srv_deadline(double seconds);
  * while it is there (nothing to read, or more requests), and for fd < 0.
  * Reads nothing (a peek); never blocks. */
 int srv_peer_gone(int fd);
+/* The address bytes of sa in addr (IPv4 in the first 4, the rest 0): 1,
+ * or 0 (all 0) for another family. */
+int srv_addr_bytes(const struct sockaddr *sa, unsigned char addr[16]);
 /* Whether the client on fd left (or left says it did) while the daemon
  * worked for it before its answer: then counted in *abandoned, logged at
  * info ("WHAT ID not DONE: its client left while it WHILE"), and *pb the
