@@ -58,12 +58,15 @@ run() { # name, command...
 # order once all have ended
 units=$(mktemp -d)
 trap 'rm -rf "$log" "$times" "$units"' EXIT
-names=()
 # the longest first (by CI's logs), so that the last to start end together
 longest="test_fit_band test_fit test_checkpoint test_fit_robust test_table"
+order=()
 for name in $longest $(ls tests/unit/test_*.c | xargs -n1 basename | sed 's/\.c$//'); do
-	case " ${names[*]} " in *" $name "*) continue ;; esac
-	[ -e "tests/unit/$name.c" ] || continue
+	case " ${order[*]} " in *" $name "*) continue ;; esac
+	[ -e "tests/unit/$name.c" ] && order+=("$name")
+done
+names=()
+for name in "${order[@]}"; do
 	[ -x "$BUILD/tests/$name" ] || continue
 	skip "$name" && continue
 	names+=("$name")
