@@ -18,14 +18,11 @@ const DEM = process.env.CONVSIM_DEM || `${ROOT}${BUILD}/convsim-dem`;
 // these processes, every other check stays on.
 const ENV = { ...process.env, ASAN_OPTIONS: [process.env.ASAN_OPTIONS, 'detect_leaks=0'].filter(Boolean).join(':') };
 
-function dem(args) {
-  const out = execFileSync('nice', ['-n', '15', DEM, ...args], { encoding: 'utf8', timeout: 120000, env: ENV });
-  return JSON.parse(out);
-}
-// The same, started at once: the runs of one test share the cores (each
-// measures its own bed; none times anything)
+// A run of convsim-dem, its JSON summary. The runs of one test may be
+// started at once and share the cores (each measures its own bed; none
+// times anything).
 const run = promisify(execFile);
-async function demAsync(args) {
+async function dem(args) {
   const { stdout } = await run('nice', ['-n', '15', DEM, ...args], { encoding: 'utf8', timeout: 120000, env: ENV,
     maxBuffer: 1 << 26 });
   return JSON.parse(stdout);
@@ -53,7 +50,7 @@ async function column(sets) {
 // 0.26 % on to 2e13).
 test('one grain at the rigid limit: LIGGGHTS and the column model with one layer agree within 0.5 %', async () => {
   const runs = [30, 137].map((beta) => Promise.all([beta,
-    demAsync([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', 'k_c=1e10', '--tangential', 'viscous',
+    dem([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', 'k_c=1e10', '--tangential', 'viscous',
       '--motion', 'machine', '--no-column']),
     column([`beta=${beta}`, 'k_c=1e10', 'm_n=0.005', 'dt=1e-4', 'substeps=1000'])]));
   for (const [beta, r, col] of await Promise.all(runs)) {
@@ -73,7 +70,7 @@ test('one grain at the rigid limit: LIGGGHTS and the column model with one layer
 test('one grain at the preset stiffness: LIGGGHTS and the column model within 5 % at beta 30 deg, both senses', async () => {
   const senses = [['cw', 30], ['ccw', 150]];
   const runs = await Promise.all(senses.map(([rot, beta]) =>
-    demAsync([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', `rotation=${rot}`])));
+    dem([...ONE_GRAIN, '--set', `beta=${beta}`, '--set', `rotation=${rot}`])));
   for (const [i, [rot, beta]] of senses.entries()) {
     const r = runs[i];
     assert.equal(r.grains, 1);
@@ -87,20 +84,20 @@ test('one grain at the preset stiffness: LIGGGHTS and the column model within 5 
 test('one grain: the mirror pair (cw, 60 deg) and (ccw, 120 deg) moves at opposite velocities', async () => {
   // (cw, 60) and (ccw, 120) are mirror images on the symmetric machine
   const [a, b] = await Promise.all([
-    demAsync([...ONE_GRAIN, '--set', 'beta=60', '--set', 'rotation=cw', '--no-column']),
-    demAsync([...ONE_GRAIN, '--set', 'beta=120', '--set', 'rotation=ccw', '--no-column'])]);
+    dem([...ONE_GRAIN, '--set', 'beta=60', '--set', 'rotation=cw', '--no-column']),
+    dem([...ONE_GRAIN, '--set', 'beta=120', '--set', 'rotation=ccw', '--no-column'])]);
   assert.ok(Math.abs(a.v_dem) > 0.05, `v ${a.v_dem}`);
   assert.ok(Math.abs(a.v_dem + b.v_dem) < 0.01 * Math.abs(a.v_dem), `cw 60: ${a.v_dem}, ccw 120: ${b.v_dem}`);
 });
 
-test('the contact damping gives the restitution asked for, and a bad option is refused with its range', () => {
-  const r = dem([...ONE_GRAIN, '--set', 'beta=30', '--restitution', '0.5', '--duration', '0.2', '--transient', '0',
+test('the contact damping gives the restitution asked for, and a bad option is refused with its range', async () => {
+  const r = await dem([...ONE_GRAIN, '--set', 'beta=30', '--restitution', '0.5', '--duration', '0.2', '--transient', '0',
     '--no-column']);
   assert.equal(r.restitution_floor, 0.5);
   assert.ok(r.restitution_pair > 0.5, `pair ${r.restitution_pair}`);
   // the preset's R = 0.05 needs an overdamped contact (damping ratio 1.95):
   // a bracket that stopped at critical damping gave 0.135 (pair 0.21)
-  const p = dem([...ONE_GRAIN, '--set', 'beta=30', '--duration', '0.2', '--transient', '0', '--no-column']);
+  const p = await dem([...ONE_GRAIN, '--set', 'beta=30', '--duration', '0.2', '--transient', '0', '--no-column']);
   assert.equal(p.restitution_floor, 0.05);
   assert.ok(p.restitution_pair > 0.05 && p.restitution_pair < 0.12, `pair ${p.restitution_pair}`);
   assert.throws(() => execFileSync(DEM, ['--grains', '0'], { encoding: 'utf8', stdio: 'pipe', env: ENV }),
@@ -128,7 +125,7 @@ test('liggghts-bed4: the calibrated column model meets the DEM bed within 5 % wh
 // (measured: 0.07 % and 0.03 %; docs/dem.md "The bed and its frame").
 test('frame check: the deck as a body force and as a moving mesh give one v', async () => {
   const specs = ['0.002:30', '0.0015:45'];
-  const runs = await Promise.all(specs.map((spec) => demAsync(['--frame-check', spec, '--duration', '2',
+  const runs = await Promise.all(specs.map((spec) => dem(['--frame-check', spec, '--duration', '2',
     '--transient', '0.5'])));
   for (const [i, spec] of specs.entries()) {
     const r = runs[i];
@@ -146,8 +143,8 @@ test('frame check: the deck as a body force and as a moving mesh give one v', as
 // the settling's bounce is gone; the largest overlap sampled over the run
 // is within 2 % of it. A modulus or Poisson's ratio that does not reach the
 // wall, or a linear contact, misses it by far.
-test('hertz contacts: one grain at rest sinks into the deck by the Hertz overlap of its weight', () => {
-  const r = dem(['--grains', '1', '--d-min', '0.004', '--d-max', '0.004', '--set', 'e=0',
+test('hertz contacts: one grain at rest sinks into the deck by the Hertz overlap of its weight', async () => {
+  const r = await dem(['--grains', '1', '--d-min', '0.004', '--d-max', '0.004', '--set', 'e=0',
     '--hertz', '5e6:0.25', '--wall', '0.1:0.3:0', '--pair', '0.1:0.3:0', '--duration', '0.3',
     '--transient', '0.1', '--no-column']);
   assert.equal(r.contacts, 'hertz');
