@@ -12,23 +12,16 @@
 // whole grant again.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, getReady, near, sleep, CHEAP, SLOW } from './lib.mjs';
+import { startDaemon, req, until, getReady, near, sleep, processCpu, CHEAP, SLOW } from './lib.mjs';
 
 const MAX = 300;  // --max-cpu-seconds
 const SPEND = 1;  // CPU s each session spends before its grant
 const GRANT = 4;  // CPU s of the grant (cpu_budget)
 const INTO = 2;   // CPU s of the grant spent before the restart
 
-const TICK = Number(execFileSync('getconf', ['CLK_TCK'], { encoding: 'utf8' }));
-// the daemon's CPU time so far, s (utime + stime of /proc/PID/stat)
-const daemonCpu = (pid) => {
-  const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-  return (Number(f[11]) + Number(f[12])) / TICK;
-};
 
 // What the checkpoint on disk of session id kept of its CPU budget: its
 // frame's format (null: no file) and, in format 3, the trailer
@@ -93,7 +86,7 @@ for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
       const kp = kept(dir, ids.paused), kr = kept(dir, ids.running);
 
       d = await startDaemon(args);
-      const cpuAtStart = daemonCpu(d.proc.pid);
+      const cpuAtStart = processCpu(d.proc.pid);
       const p = await get(d, ids.paused);
       assert.equal(p.state, 'paused');
       assert.equal(p.pause_reason, 'client');
@@ -117,7 +110,7 @@ for (const [signal, interval] of [['SIGTERM', '3600'], ['SIGKILL', '0.2']]) {
       for (const [name, id] of Object.entries(ids))
         await until(async () => (await get(d, id)).pause_reason === 'cpu-budget', 60000, `${name}'s budget to pause it`);
       const left = (limit.paused - kp.cpu) + (limit.running - kr.cpu);
-      const spentAfter = daemonCpu(d.proc.pid) - cpuAtStart;
+      const spentAfter = processCpu(d.proc.pid) - cpuAtStart;
       assert.ok(spentAfter < left + 1, `the daemon spent ${spentAfter} CPU s after the restart; what was left of the grants: ${left} s (a new grant each: ${2 * GRANT} s)`);
       for (const [name, id] of Object.entries(ids)) {
         const s = await get(d, id);

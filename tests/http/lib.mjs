@@ -4,7 +4,7 @@
 // CONVSIMD names the binary (build/convsimd or build-san/convsimd); the
 // sanitizer build is slower, so timeouts scale with SLOW.
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -364,13 +364,14 @@ export function procState(pid) {
 }
 
 // The user + system CPU seconds process pid has spent (its every thread;
-// /proc/PID/stat in clock ticks of 1/100 s): what a request cost the
+// /proc/PID/stat in clock ticks, CLK_TCK a second): what a request cost the
 // daemon, which the machine's other load does not stretch as it does the
 // wall time.
+const TICK = Number(execFileSync('getconf', ['CLK_TCK'], { encoding: 'utf8' }));
 export function processCpu(pid) {
   const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
   const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
-  return (Number(f[11]) + Number(f[12])) / 100;
+  return (Number(f[11]) + Number(f[12])) / TICK;
 }
 
 // A POST to the daemon d whose work in the request's thread an adaptive
