@@ -7,8 +7,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { readdirSync, readFileSync } from 'node:fs';
-import { startDaemon, req, until, SLOW } from '../http/lib.mjs';
+import { startDaemon, req, until, children, procState, SLOW } from '../http/lib.mjs';
 
 const BUILD = process.env.BUILD || 'build';
 const ROOT = new URL('../..', import.meta.url).pathname;
@@ -18,13 +17,6 @@ const CONVSIM = process.env.CONVSIM || `${ROOT}${BUILD}/convsim`;
 Object.assign(process.env, { OMPI_ALLOW_RUN_AS_ROOT: '1', OMPI_ALLOW_RUN_AS_ROOT_CONFIRM: '1', OMPI_MCA_rmaps_base_oversubscribe: '1',
   ASAN_OPTIONS: [process.env.ASAN_OPTIONS, 'detect_leaks=0'].filter(Boolean).join(':') });
 
-// a process's children now (mpirun's ranks)
-const children = (pid) => readdirSync(`/proc/${pid}/task`).flatMap((t) =>
-  readFileSync(`/proc/${pid}/task/${t}/children`, 'utf8').trim().split(/\s+/).filter(Boolean).map(Number));
-// a process's state letter (Z: a zombie), or null when it is gone
-const procState = (pid) => {
-  try { return readFileSync(`/proc/${pid}/stat`, 'utf8').replace(/^.*\) /, '')[0]; } catch { return null; }
-};
 
 let d;
 before(async () => { d = await startDaemon(['--worker-nice', '15', '--dem-ranks', '2']); });
