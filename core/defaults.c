@@ -180,11 +180,24 @@ double sim_default_dt(const sim_params *p, const sim_scene *s, const sim_method 
 
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
+	double slip, machine;
+	return sim_max_dt_modes(p, s, m, &slip, &machine);
+}
+
+double sim_max_dt_modes(const sim_params *p, const sim_scene *s, const sim_method *m,
+			double *slip, double *machine)
+{
 	const ode_method *om = ode_find(m->name);
-	double rate = model_slip_rate(p, s);
-	if (!om || !(om->info.real_limit > 0.0) || !(rate > 0.0))
+	*slip = *machine = INFINITY;
+	if (!om || !(om->info.real_limit > 0.0))
 		return INFINITY;
-	return om->info.real_limit / rate;
+	double rate = model_slip_rate(p, s);
+	if (rate > 0.0)
+		*slip = om->info.real_limit / rate;
+	rate = model_machine_rate(p, s);
+	if (rate > 0.0)
+		*machine = om->info.radius_limit / rate;
+	return fmin(*slip, *machine);
 }
 
 double sim_default_feed_step(const sim_params *p, const sim_scene *s, const sim_method *m)

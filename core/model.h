@@ -146,6 +146,14 @@ void model_reduced_to_full(const model *md, const double *qr, double full[NQ_FUL
  * rotor's angle and over beta). 0 under the ideal drive. setup.c */
 double model_slip_rate(const sim_params *p, const sim_scene *sc);
 
+/* The largest |lambda| (1/s) of the machine's linear modes about rest
+ * (the springs and dampers of suspension and eliminators over the masses
+ * they move, the settling's damper included; the feed and the motor's
+ * slip apart): the spectral radius of the Jacobian of model_machine_rhs,
+ * the largest over beta as model_slip_rate. czubak2016: about the
+ * eliminators' 157 rad/s. setup.c */
+double model_machine_rate(const sim_params *p, const sim_scene *sc);
+
 /* Build the reduced model (with its suspension preload) and the initial
  * controls from parameters and scene (validated already). setup.c */
 void model_init(model *md, model_ctl *ctl, const sim_params *p, const sim_scene *sc);

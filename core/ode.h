@@ -16,6 +16,11 @@
 /* Classical RK4's stability region along the negative real axis: the
  * real root of 1 + z/2 + z^2/6 + z^3/24 (where |R(z)| returns to 1). */
 #define RK4_REAL_LIMIT 2.785293563405282
+/* ... and the radius of the largest half-disc of the left half-plane
+ * inside it (|R(z)| = 1 nearest the origin at arg z = 122.5 deg: 2.616),
+ * rounded down: h |lambda| within it keeps any decaying or oscillating
+ * mode bounded, however damped. */
+#define RK4_RADIUS_LIMIT 2.6
 
 typedef struct ode_method {
 	/* name, order, adaptive, doc: the public description. First member,

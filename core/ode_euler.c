@@ -64,6 +64,9 @@ const ode_method ode_euler = {
 		 .order = 1,
 		 .adaptive = 0,
 		 .real_limit = 2.0,
+		 /* on x'' = -k x - c x' it holds h |lambda| <= 2 undamped but
+		  * only 2 (sqrt 2 - 1) = 0.828 at critical damping */
+		 .radius_limit = 0.82,
 		 .doc = "semi-implicit (symplectic) Euler, fixed step dt",
 		 .dt_feed = 5e-6,
 		 .dt_free = 1e-5,

@@ -73,6 +73,7 @@ const ode_method ode_rk4 = {
 		 .order = 4,
 		 .adaptive = 0,
 		 .real_limit = RK4_REAL_LIMIT,
+		 .radius_limit = RK4_RADIUS_LIMIT,
 		 .doc = "classical Runge-Kutta, fixed step dt, whole state",
 		 .dt_feed = 1e-5,
 		 .dt_free = 1e-3,

@@ -452,6 +452,7 @@ const ode_method ode_split = {
 		 .order = 1,
 		 .adaptive = 0,
 		 .real_limit = RK4_REAL_LIMIT,
+		 .radius_limit = RK4_RADIUS_LIMIT,
 		 .doc = "machine RK4 macro step dt, feed sub-stepped with implicit Coulomb friction",
 		 .substeps = 1,
 		 .shadow = 1,

@@ -361,14 +361,21 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 	}
 	if (p->rotation != SIM_CW && p->rotation != SIM_CCW)
 		return range_error((size_t)find("rotation"), msg, msglen);
-	double bound = sim_max_dt(p, s, m);
+	double slip, machine;
+	double bound = sim_max_dt_modes(p, s, m, &slip, &machine);
 	if (m->dt > bound) {
-		if (msg)
+		if (msg && slip <= machine)
 			snprintf(msg, msglen,
 				 "dt must be at most %.3g s for %s with these parameters: above it "
 				 "the motor's slip mode (decay rate %.4g 1/s: 2 M_ut / slip_ut over "
 				 "the rotor's inertia) makes the step unstable",
 				 bound, m->name, model_slip_rate(p, s));
+		else if (msg)
+			snprintf(msg, msglen,
+				 "dt must be at most %.3g s for %s with these parameters: above it "
+				 "the machine's fastest mode (|lambda| %.4g 1/s: its stiffest spring "
+				 "or damper over the mass it moves) makes the step unstable",
+				 bound, m->name, model_machine_rate(p, s));
 		return SIM_EPARAM;
 	}
 	return SIM_OK;

@@ -141,6 +141,10 @@ typedef struct sim_method_info {
 	 * y' = -lambda y stays bounded (the stability region's reach along
 	 * the negative real axis); 0 for the adaptive ones */
 	double real_limit;
+	/* ... and the largest h |lambda| for which every mode of a linear
+	 * damped oscillator (lambda its eigenvalue, any damping) stays
+	 * bounded; 0 for the adaptive ones */
+	double radius_limit;
 	const char *doc;
 	/* What the method can do; generic code asks these, never its name. */
 	int substeps; /* steps the feed apart in sub-steps of the machine step

@@ -13,6 +13,7 @@
  *   one-way coupling   -> the feed does not act on the trough.
  */
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "model.h"
@@ -32,6 +33,21 @@ double model_feed_mass_ratio(const sim_params *p, const sim_scene *sc)
 	return feed / (p->M_r + p->m + p->m1 + p->m2);
 }
 
+/* The machine alone (no feed) of p and sc with its guides at the b-th of
+ * BOUND_BETAS angles, 0 to 135 deg: the step bounds take the largest rate
+ * over them, so that one bound holds for every beta a session, sweep or
+ * experiment may take. */
+#define BOUND_BETAS 4
+static void bare_machine(const sim_params *p, const sim_scene *sc, int b, model *md,
+			 model_ctl *ctl)
+{
+	sim_scene bare = *sc;
+	bare.feed = 0;
+	sim_params pb = *p;
+	pb.beta = (double)b * M_PI / BOUND_BETAS;
+	model_init(md, ctl, &pb, &bare);
+}
+
 double model_slip_rate(const sim_params *p, const sim_scene *sc)
 {
 	if (sc->drive != SIM_DRIVE_MOTOR)
@@ -40,15 +56,11 @@ double model_slip_rate(const sim_params *p, const sim_scene *sc)
 	 * the largest over the rotor's angle and the guides' (beta moves
 	 * the eliminators' masses: 0.15 % for czubak2016), so that one bound
 	 * holds for every beta a session, sweep or experiment may take */
-	sim_scene bare = *sc;
-	bare.feed = 0;
 	double inv_inertia = 0.0;
-	for (int b = 0; b < 4; b++) {
-		sim_params pb = *p;
-		pb.beta = (double)b * M_PI / 4.0;
+	for (int b = 0; b < BOUND_BETAS; b++) {
 		model md;
 		model_ctl ctl;
-		model_init(&md, &ctl, &pb, &bare);
+		bare_machine(p, sc, b, &md, &ctl);
 		int r_phi = -1;
 		for (int r = 0; r < md.nq; r++)
 			for (int a = 0; a < md.ncol[r]; a++)
@@ -69,6 +81,113 @@ double model_slip_rate(const sim_params *p, const sim_scene *sc)
 	}
 	double slope = 2.0 * p->M_ut / p->slip_ut + 2.0 * p->b_phi * p->omega_ss;
 	return slope * inv_inertia;
+}
+
+/* The spectral radius of the n x n matrix a (row-major; overwritten):
+ * |a^(2^k)|^(1/2^k) by repeated squaring, each square scaled to norm 1,
+ * so that a defective or complex dominant pair converges as well as a
+ * real one (to the power 2^-k of the eigenvectors' conditioning). */
+#define RADIUS_SQUARINGS 14
+static double spectral_radius(double *a, int n)
+{
+	double b[4 * NQ_FULL * NQ_FULL];
+	double log_scale = 0.0; /* log |a0^(2^k)| less log of a's norm now */
+	for (int k = 0; k <= RADIUS_SQUARINGS; k++) {
+		double norm = 0.0;
+		for (int i = 0; i < n * n; i++)
+			norm += a[i] * a[i];
+		norm = sqrt(norm);
+		if (!(norm > 0.0) || !isfinite(norm))
+			return norm > 0.0 ? INFINITY : 0.0;
+		for (int i = 0; i < n * n; i++)
+			a[i] /= norm;
+		log_scale += log(norm) / ldexp(1.0, k);
+		if (k == RADIUS_SQUARINGS)
+			break;
+		for (int i = 0; i < n; i++) {
+			double *row = b + i * n;
+			for (int j = 0; j < n; j++)
+				row[j] = 0.0;
+			for (int l = 0; l < n; l++) {
+				double ail = a[i * n + l];
+				for (int j = 0; j < n; j++)
+					row[j] += ail * a[l * n + j];
+			}
+		}
+		memcpy(a, b, sizeof(double) * (size_t)(n * n));
+	}
+	return exp(log_scale);
+}
+
+static double machine_rate(const sim_params *p, const sim_scene *sc)
+{
+	double rate = 0.0;
+	for (int b = 0; b < BOUND_BETAS; b++) {
+		model md;
+		model_ctl ctl;
+		bare_machine(p, sc, b, &md, &ctl);
+		/* the motor off (its slip mode is model_slip_rate's), the
+		 * settling's damper on in full (it only adds damping) */
+		ctl.drive_on = 0;
+		ctl.settle_b = 1.0;
+		ctl.settle_t0 = -1.0;
+		md.settle_orbit.sense = 0;
+		/* forward differences: the machine is linear about rest but for
+		 * its geometry's rotation, an error of h relative */
+		const double t = -2.0, h = 1e-6;
+		int n = 2 * md.nq;
+		double jac[4 * NQ_FULL * NQ_FULL], y[2 * NQ_FULL + ACC_N] = {0},
+		       f0[2 * NQ_FULL + ACC_N], f[2 * NQ_FULL + ACC_N];
+		model_machine_rhs(&md, &ctl, t, y, NULL, f0, NULL);
+		for (int j = 0; j < n; j++) {
+			y[j] = h;
+			model_machine_rhs(&md, &ctl, t, y, NULL, f, NULL);
+			y[j] = 0.0;
+			for (int i = 0; i < n; i++)
+				jac[i * n + j] = (f[i] - f0[i]) / h;
+		}
+		rate = fmax(rate, spectral_radius(jac, n));
+	}
+	return rate;
+}
+
+/* What model_machine_rate reads: the parameters but beta (its own four)
+ * and its ramps', with rotation's padding zeroed, and the scene's drive,
+ * reduction and motor. */
+typedef struct machine_rate_key {
+	sim_params p;
+	int drive, trough_rotation, motor_on;
+} machine_rate_key;
+
+static void machine_rate_key_of(const sim_params *p, const sim_scene *sc, machine_rate_key *k)
+{
+	memset(k, 0, sizeof *k);
+	size_t a = offsetof(sim_params, rotation) + sizeof p->rotation, b = offsetof(sim_params, m1);
+	memcpy(&k->p, p, a);
+	memcpy((char *)&k->p + b, (const char *)p + b, sizeof *p - b);
+	k->p.beta = k->p.beta_rate = k->p.beta_accel = 0.0;
+	k->drive = sc->drive;
+	k->trough_rotation = sc->trough_rotation;
+	k->motor_on = sc->motor_on;
+}
+
+double model_machine_rate(const sim_params *p, const sim_scene *sc)
+{
+	/* a run asks several times and a sweep at every point for the same
+	 * machine: the last answer is kept, per thread */
+	static _Thread_local struct {
+		int valid;
+		machine_rate_key key;
+		double rate;
+	} memo;
+	machine_rate_key key;
+	machine_rate_key_of(p, sc, &key);
+	if (!memo.valid || memcmp(&key, &memo.key, sizeof key) != 0) {
+		memo.rate = machine_rate(p, sc);
+		memcpy(&memo.key, &key, sizeof key);
+		memo.valid = 1;
+	}
+	return memo.rate;
 }
 
 void model_static_strokes(const sim_params *p, double s[2])

@@ -149,10 +149,17 @@ int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_meth
 double sim_contact_period(const sim_params *p, const sim_scene *s);
 
 /* The largest fixed step (s) method m keeps stable on the machine's
- * stiffest mode, the Kloss motor's slip (its real_limit over the slip
- * mode's decay rate); INFINITY for an adaptive method or the ideal drive.
- * Above it the run blows up within a few seconds (docs/integrators.md "Stability"). */
+ * stiffest modes: the Kloss motor's slip (the method's real_limit over the
+ * slip mode's decay rate, model_slip_rate) and the machine's oscillations
+ * and dampers (its radius_limit over their largest |lambda|,
+ * model_machine_rate), whichever is shorter; INFINITY for an adaptive
+ * method. Above it the run blows up within a few seconds
+ * (docs/integrators.md "Stability"). */
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
+/* The same, with each mode's own bound (s; INFINITY where it has none)
+ * into *slip and *machine. */
+double sim_max_dt_modes(const sim_params *p, const sim_scene *s, const sim_method *m,
+			double *slip, double *machine);
 
 /* Whole-set consistency checks (ranges, sizes, known integrator, dt within
  * the method's stability bound, sim_max_dt). Same error convention as

@@ -76,6 +76,13 @@ test('bad session bodies: 400/413/415/422 and nothing is created', { timeout: 20
     'out-of-range');
   assert.equal(b.field, 'integrator.dt');
   assert.ok(b.max > 0.0006 && b.max < 0.00063, String(b.max));
+  // 10-g eliminators on 300 N s/m dampers: their own fast root (28,456
+  // 1/s) bounds the step, not the motor's slip: 2.6 / 28,456 = 9.14e-5 s
+  b = problem(await post({ params: { m1: 0.01, m2: 0.01, b_s1: 300, b_s2: 300 },
+    integrator: { method: 'dem', dt: 0.0001 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'integrator.dt');
+  assert.ok(b.max > 0.0000913 && b.max < 0.0000915, String(b.max));
+  assert.match(b.detail, /dt must be at most 9\.14e-05 s for dem .* the machine's fastest mode \(\|lambda\| 2\.846e\+04 1\/s/);
   // another setting wrong as well: that one is named, not the step
   b = problem(await post({ params: { k_s1: -5 }, integrator: { dt: 0.0019 } }), 422, 'out-of-range');
   assert.equal(b.field, 'params.k_s1');
@@ -183,4 +190,20 @@ test('bad query parameters are 400', { timeout: 20000 * SLOW }, async () => {
   problem(await req(d.base, 'GET', `/api/v1/sessions/${id}/trajectory?from=x`), 400, 'bad-query');
   problem(await req(d.base, 'GET', `/api/v1/sessions/${id}/trajectory?format=xml`), 400, 'bad-query');
   await req(d.base, 'DELETE', `/api/v1/sessions/${id}`);
+});
+
+test('a machine whose fastest mode is its eliminators\': created, its default step within that mode\'s bound, and it runs', { timeout: 20000 * SLOW }, async () => {
+  // 10-g eliminators on 300 N s/m dampers (fast root 28,456 1/s): the
+  // preset's 1.25e-3-s step made the settling diverge and the creation
+  // was refused (422, "diverged at t = -0.596 s"); the default step is
+  // now 0.7 of the bound 9.14e-5 s
+  const r = await req(d.base, 'POST', '/api/v1/sessions',
+    { params: { m1: 0.01, m2: 0.01, b_s1: 300, b_s2: 300 } });
+  assert.equal(r.status, 201, r.text);
+  assert.equal(r.body.status.dt, 6.3e-5);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body.status.t >= 0.2);
+  const s = (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
+  assert.equal(s.state, 'running');
+  assert.ok(Number.isFinite(s.status.feed_displacement));
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
 });

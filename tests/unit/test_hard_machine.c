@@ -246,39 +246,67 @@ static void divergence_is_reported(void **state)
 	sim_free(s);
 }
 
-/* The machine alone (scene of u) from rest with the motor on, stepped by
- * method's own step at factor times sim_max_dt (past sim_validate, which
- * refuses a step above the bound): the motor's mean slip (omega_ss less
- * the rotor's relative speed) over [3, 4] s, once the run-up is over, and
- * into *kink the largest second difference of that speed from step to step
- * there (a mode that alternates from step to step shows in it). */
-static double slip_mean(setup u, const char *method, double factor, double *kink)
+/* The machine alone (scene of u without feed) from its equilibrium with the
+ * motor on, to be stepped by method at dt (past sim_validate, which
+ * refuses a step above sim_max_dt). */
+typedef struct alone {
+	model md;
+	model_ctl ctl;
+	double *y, t;
+	const ode_method *om;
+	void *ws;
+	dyn sys;
+} alone;
+
+static void alone_start(alone *a, setup u, const char *method, double dt)
 {
 	set(&u, "feed", "false");
 	set(&u, "method", method);
-	double dt = factor * sim_max_dt(&u.p, &u.sc, &u.m);
-	model md;
-	model_ctl ctl;
-	model_init(&md, &ctl, &u.p, &u.sc);
-	double *y = calloc((size_t)md.n, sizeof *y);
-	assert_non_null(y);
-	dynamics_equilibrium(&md, &ctl, y);
-	const ode_method *om = ode_find(method);
+	model_init(&a->md, &a->ctl, &u.p, &u.sc);
+	a->y = calloc((size_t)a->md.n, sizeof *a->y);
+	assert_non_null(a->y);
+	dynamics_equilibrium(&a->md, &a->ctl, a->y);
+	a->om = ode_find(method);
 	sim_method cfg = u.m;
 	cfg.dt = dt;
 	cfg.substeps = 1;
-	void *ws = om->alloc(&md, &cfg);
-	assert_non_null(ws);
-	dyn sys = {.md = &md, .ctl = &ctl, .rhs_evals = 0};
-	double t = 0.0, sum = 0.0, w1 = NAN, w2 = NAN;
-	int n = 0;
+	a->ws = a->om->alloc(&a->md, &cfg);
+	assert_non_null(a->ws);
+	a->sys = (dyn){.md = &a->md, .ctl = &a->ctl, .rhs_evals = 0};
+	a->t = 0.0;
+}
+
+/* One step; 0 once the run has blown up. */
+static int alone_step(alone *a, double t_max)
+{
+	a->om->step(a->ws, &a->sys, &a->t, a->y, t_max);
+	return isfinite(a->y[0]) && fabs(a->y[0]) < 1e3;
+}
+
+static void alone_free(alone *a)
+{
+	a->om->free(a->ws);
+	free(a->y);
+}
+
+/* The machine alone stepped by method at factor times sim_max_dt: the
+ * motor's mean slip (omega_ss less the rotor's relative speed) over
+ * [3, 4] s, once the run-up is over, and into *kink the largest second
+ * difference of that speed from step to step there (a mode that
+ * alternates from step to step shows in it). */
+static double slip_mean(setup u, const char *method, double factor, double *kink)
+{
+	set(&u, "method", method);
+	alone a;
+	alone_start(&a, u, method, factor * sim_max_dt(&u.p, &u.sc, &u.m));
+	double sum = 0.0, w1 = NAN, w2 = NAN;
+	int n = 0, ok = 1;
 	*kink = 0.0;
-	while (t < 4.0 && isfinite(y[0])) {
-		om->step(ws, &sys, &t, y, INFINITY);
+	while (a.t < 4.0 && (ok = alone_step(&a, INFINITY))) {
 		double q[NQ_FULL], qd[NQ_FULL];
-		model_full_coords(&md, &ctl, t, y, q, qd);
+		model_full_coords(&a.md, &a.ctl, a.t, a.y, q, qd);
 		double w = qd[Q_PHI] - qd[Q_ALPHA];
-		if (t >= 3.0) {
+		if (a.t >= 3.0) {
 			sum += w;
 			n++;
 			*kink = fmax(*kink, fabs(w - 2.0 * w1 + w2));
@@ -286,9 +314,8 @@ static double slip_mean(setup u, const char *method, double factor, double *kink
 		w2 = w1;
 		w1 = w;
 	}
-	double slip = isfinite(y[0]) && n > 0 ? u.p.omega_ss - sum / n : INFINITY;
-	om->free(ws);
-	free(y);
+	double slip = ok && n > 0 ? u.p.omega_ss - sum / n : INFINITY;
+	alone_free(&a);
 	return slip;
 }
 
@@ -344,9 +371,12 @@ static void slip_mode_bounds_the_step(void **state)
 	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_OK);
 	set(&u, "method", "dopri5");
 	assert_true(isinf(sim_max_dt(&u.p, &u.sc, &u.m)));
-	/* the ideal drive has no slip mode */
+	/* the ideal drive has no slip mode: its bound is the machine's
+	 * oscillations' (machine_modes_bound_the_step), far above its step */
 	setup v = reduced_ideal();
-	assert_true(isinf(sim_max_dt(&v.p, &v.sc, &v.m)));
+	double ideal = sim_max_dt(&v.p, &v.sc, &v.m);
+	assert_close(ideal, RK4_RADIUS_LIMIT / model_machine_rate(&v.p, &v.sc), 1e-12);
+	assert_true(ideal > 10.0 * sim_default_dt(&v.p, &v.sc, &v.m));
 	/* a small eccentricity: the bound falls below 1e-3 s and the default
 	 * step with it, to 0.7 of the bound rounded down to two digits */
 	set(&u, "method", "dem");
@@ -356,6 +386,81 @@ static void slip_mode_bounds_the_step(void **state)
 	assert_true(b < 1e-3);
 	assert_true(d <= 0.7 * b && d > 0.6 * b);
 	assert_close(d * 1e5, round(d * 1e5), 1e-9);
+}
+
+/* The machine alone stepped by RK4 at dt for T s: the eliminator's
+ * stroke s1 at the end (m; not finite where the run blew up). */
+static double stroke_after(setup u, double dt, double T)
+{
+	alone a;
+	alone_start(&a, u, "rk4", dt);
+	int ok = 1;
+	while (a.t < T && (ok = alone_step(&a, T)))
+		;
+	double q[NQ_FULL], qd[NQ_FULL];
+	model_full_coords(&a.md, &a.ctl, a.t, a.y, q, qd);
+	alone_free(&a);
+	return ok ? q[Q_S1] : INFINITY;
+}
+
+/* Light eliminators (10 g on the preset's springs, undamped, then on 300 N
+ * s/m dampers): the machine's fastest mode is theirs, not the motor's slip,
+ * and bounds the fixed step (model_machine_rate, the Jacobian's spectral
+ * radius). Its |lambda| is the eliminator's alone to within the trough's
+ * share (m1 / M: 1e-4): sqrt(k_s / m) undamped, the fast root (b +
+ * sqrt(b^2 - 4 m k)) / 2m overdamped. On the dynamics, RK4 at 0.95 of the
+ * bound follows a step 20 x finer, at 1.15 it blows up (h lambda 2.99 past
+ * the real axis' 2.785: the overdamped root). The preset's defaults then
+ * take a step within 0.7 of the bound and run (before: 1.25e-3 s, diverged
+ * in the settling), and sim_validate names this mode. */
+static void machine_modes_bound_the_step(void **state)
+{
+	(void)state;
+	setup u = preset_defaults();
+	set(&u, "m1", "0.01");
+	set(&u, "m2", "0.01");
+	set(&u, "b_s1", "0");
+	set(&u, "b_s2", "0");
+	double k = u.p.k_s1, m = 0.01;
+	double undamped = model_machine_rate(&u.p, &u.sc);
+	print_message("10-g eliminators, undamped: |lambda| %.6g 1/s, sqrt(k/m) %.6g\n", undamped,
+		      sqrt(k / m));
+	assert_close(undamped / sqrt(k / m), 1.0, 1e-3);
+	set(&u, "b_s1", "300");
+	set(&u, "b_s2", "300");
+	double b = 300.0, fast = (b + sqrt(b * b - 4.0 * m * k)) / (2.0 * m);
+	double rate = model_machine_rate(&u.p, &u.sc);
+	print_message("on 300 N s/m: |lambda| %.6g 1/s, the fast root %.6g\n", rate, fast);
+	assert_close(rate / fast, 1.0, 1e-3);
+	double bound = sim_max_dt(&u.p, &u.sc, &u.m);
+	assert_close(bound, RK4_RADIUS_LIMIT / rate, 1e-12);
+	assert_true(bound < 0.1 * RK4_REAL_LIMIT / model_slip_rate(&u.p, &u.sc));
+
+	double fine = stroke_after(u, 0.05 * bound, 0.3), below = stroke_after(u, 0.95 * bound, 0.3),
+	       above = stroke_after(u, 1.15 * bound, 0.3);
+	print_message("s1 after 0.3 s: %.9g m at 0.05 of the bound, %.9g at 0.95, %g at 1.15\n",
+		      fine, below, above);
+	assert_true(isfinite(fine) && fabs(fine) > 1e-8);
+	assert_true(fabs(below - fine) < 1e-3 * fabs(fine));
+	assert_false(isfinite(above));
+
+	double d = sim_default_dt(&u.p, &u.sc, &u.m);
+	assert_true(d <= 0.7 * bound && d > 0.6 * bound);
+	sim *s = make(&u);
+	assert_int_equal(sim_advance(s, 0.3), SIM_OK);
+	sim_status st = status(s);
+	assert_status_finite(&st);
+	sim_free(s);
+
+	char msg[256] = "";
+	u.m.dt = 1.01 * bound;
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_EPARAM);
+	char text[32];
+	snprintf(text, sizeof text, "%.3g s", bound);
+	assert_non_null(strstr(msg, text));
+	assert_non_null(strstr(msg, "fastest mode"));
+	u.m.dt = 0.99 * bound;
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_OK);
 }
 
 int main(void)
@@ -368,6 +473,7 @@ int main(void)
 		cmocka_unit_test(eliminators_undamped),
 		cmocka_unit_test(divergence_is_reported),
 		cmocka_unit_test(slip_mode_bounds_the_step),
+		cmocka_unit_test(machine_modes_bound_the_step),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
