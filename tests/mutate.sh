@@ -61,6 +61,7 @@ mutations=(
 	"the mean torque unsigned (ccw)|core/estimator.c|s|out->torque_mean = out->power_mean / out->rotor_speed_mean + 0.0;|out->torque_mean = out->power_mean / fabs(out->rotor_speed_mean) + 0.0;|"
 	"the error bar's scatter over n, not n - 2 degrees of freedom|core/estimator.c|s|sqrt(ss / (nb - 2))|sqrt(ss / nb)|"
 	"the slip mode's step bound without the bearing drag's slope|core/setup.c|s|+ 2.0 \* p->b_phi \* p->omega_ss;|+ 0.0 * p->b_phi * p->omega_ss;|"
+	"dopri5's error estimate halved|core/ode_dopri5.c|s|err = sqrt(err / (double)w->nerr);|err = 0.5 * sqrt(err / (double)w->nerr);|"
 	"dem's step bound on the machine's own modes at twice its stability region's radius|core/ode_split.c|s|.radius_limit = RK4_RADIUS_LIMIT,|.radius_limit = 2.0 * RK4_RADIUS_LIMIT,|"
 	"the mean feed rate over one column's elements (full model)|core/feed.c|s|return md->nf > 0 ? s / md->nf : 0.0;|return md->nf > 0 ? s / md->L : 0.0;|"
 	"the contacts' elastic energy as if p = 1|core/feed.c|s|(md->p.p + 1.0);|2.0;|"
