@@ -11,8 +11,7 @@
 // 1 to 3 characters; the same in an object nested 32 deep; 8,192 distinct
 // names with one 32-bit FNV-1a hash of their code points (the hash
 // json_check.c sorts by first), so that only their text tells them apart.
-import { readFileSync } from 'node:fs';
-import { startDaemon } from '../http/lib.mjs';
+import { startDaemon, processCpu as cpuSeconds } from '../http/lib.mjs';
 
 const REQUESTS = Number(process.env.REQUESTS || 20);
 const MIB = 1 << 20;
@@ -71,12 +70,6 @@ function collidingNames(stages) {
     members.push(`"${pairs.map((p, s) => p[(m >> s) & 1]).join('')}":0`);
   }
   return { text: `{${members.join(',')}}`, names: members.length };
-}
-
-function cpuSeconds(pid) {
-  const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
-  const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
-  return (Number(fields[11]) + Number(fields[12])) / 100; // USER_HZ
 }
 
 const flat = manyNames(MIB);

@@ -25,16 +25,9 @@
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { startCluster, req, openStream, sleep, CHEAP } from '../http/lib.mjs';
+import { startCluster, req, openStream, sleep, CHEAP, processCpu as cpuSeconds } from '../http/lib.mjs';
 import { heldInRealTime } from './realtime.mjs';
 
-const TICK = 100; // USER_HZ: /proc's clock ticks per second on Linux
-
-// CPU seconds (user + sys) a process has used, from /proc.
-function cpuSeconds(pid) {
-  const f = fs.readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-  return (Number(f[11]) + Number(f[12])) / TICK;
-}
 const cpuOf = (pids) => pids.reduce((s, p) => s + cpuSeconds(p), 0);
 
 const quantile = (xs, q) => {

@@ -14,7 +14,7 @@
 import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
-import { startDaemon, req, until } from '../http/lib.mjs';
+import { startDaemon, req, until, processCpu as cpuSeconds } from '../http/lib.mjs';
 
 const NEW = process.env.CONVSIMD || 'build/convsimd';
 const OLD = process.env.OLD || '';
@@ -24,10 +24,6 @@ const SECONDS = Number(process.env.SECONDS || 60);
 const syncs = async (base) => {
   const m = (await req(base, 'GET', '/metrics')).text.match(/^convsim_control_log_syncs_total (\d+)/m);
   return m ? Number(m[1]) : NaN;
-};
-const cpuSeconds = (pid) => {
-  const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-  return (Number(f[11]) + Number(f[12])) / 100;
 };
 const setpoint = [0.10, -0.08, 0.05].map((v, i) => ({ v, until: (SECONDS / 3) * (i + 1) }));
 

@@ -10,10 +10,10 @@
 // the table. Loopback and temporary directories only; bounded in time.
 //
 //   CONVSIMD=build/convsimd [OLD=old/convsimd] [SESSIONS=8] [INFLIGHT=1,4] [WINDOW=5] [CLIENT=lean,fetch] node tests/bench/controls.mjs
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
-import { startDaemon } from '../http/lib.mjs'; // its tether: the daemons end with this script
+import { startDaemon, processCpu } from '../http/lib.mjs'; // its tether: the daemons end with this script
 import { client } from './patch_client.mjs';
 
 const NEW = process.env.CONVSIMD || 'build/convsimd';
@@ -29,11 +29,10 @@ async function syncs(base) {
   return m ? Number(m[1]) : NaN;
 }
 
-// The daemon's CPU seconds so far (Linux /proc).
+// The daemon's CPU seconds so far (Linux /proc; NaN once it has ended).
 function cpuSeconds(pid) {
   try {
-    const f = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-    return (Number(f[11]) + Number(f[12])) / 100;
+    return processCpu(pid);
   } catch { return NaN; }
 }
 

@@ -11,6 +11,7 @@
 // delivers late, shows a growing lag.
 import http from 'node:http';
 import { readFileSync } from 'node:fs';
+import { processCpu } from '../http/lib.mjs';
 
 export const JSON_TYPE = { 'Content-Type': 'application/json' };
 
@@ -98,11 +99,7 @@ export function quantile(values, q) {
 export function procUsage(pid) {
   const status = readFileSync(`/proc/${pid}/status`, 'utf8');
   const rss = Number(status.match(/VmRSS:\s+(\d+) kB/)[1]) * 1024;
-  const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
-  const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
-  const hz = 100; // USER_HZ on Linux
-  const cpu = (Number(fields[11]) + Number(fields[12])) / hz;
-  return { rss, cpu };
+  return { rss, cpu: processCpu(pid) };
 }
 
 export const fmt = (x, digits = 1) => (Number.isFinite(x) ? x.toFixed(digits) : 'n/a');
