@@ -216,6 +216,7 @@ typedef struct api_value {
 #define API_CPU_BUDGET_MIN 0.001 /* CPU s: the least grant a PATCH may set */
 #define API_DEFAULT_MAX_UNTIL 60.0 /* s: "until" for pace "max" if none given */
 #define API_DEFAULT_SAMPLE_RATE 250.0
+#define API_SAMPLE_RATE_MAX 10000.0 /* 1/s: the most samples a simulated second */
 
 /* A session as created: preset, settings, pace, optional end time. */
 typedef struct api_spec {

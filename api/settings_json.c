@@ -27,7 +27,7 @@ const char *const api_members_session_create[] = {"preset", "params", "scene", "
 #define UNTIL_MIN 1e-6
 #define UNTIL_MAX 1e6
 #define RATE_MIN 1.0
-#define RATE_MAX 10000.0
+#define RATE_MAX API_SAMPLE_RATE_MAX
 
 /* The name of choice idx in "a|b|c" into out; 0 if there is none. */
 static int choice_name(const char *choices, int idx, char *out, size_t len)

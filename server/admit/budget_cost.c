@@ -217,7 +217,21 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_
 	double cpu = *cpu_per_s, sample = cpu / spec->sample_rate, settle = settling(spec);
 	double left = before > 0 ? fmax(run_limit - before, 0) : run_limit;
 	char less[120];
-	if (sample > SRV_SAMPLE_CPU_MAX) {
+	double need_dt = st.dt * sample / SRV_SAMPLE_CPU_MAX,
+	       stable_dt = sim_max_dt(&spec->params, &spec->scene, &spec->method);
+	if (sample > SRV_SAMPLE_CPU_MAX && need_dt > stable_dt) {
+		/* no step both stable and short enough: more samples a
+		 * simulated second make each interval shorter */
+		api_fail(pb, API_RANGE, "sample_rate",
+			 "a sample interval (%g s) would take about %.3g CPU s, more than the %g s a "
+			 "worker may go without taking a control, and no stable step is long enough "
+			 "(integrator.dt %.3g s needed, this machine's bound %.3g s); nothing was "
+			 "created: a sample_rate of at least %.4g 1/s or a smaller scene",
+			 1.0 / spec->sample_rate, sample, SRV_SAMPLE_CPU_MAX, need_dt, stable_dt,
+			 cpu / SRV_SAMPLE_CPU_MAX);
+		pb->min = cpu / SRV_SAMPLE_CPU_MAX;
+		pb->max = API_SAMPLE_RATE_MAX;
+	} else if (sample > SRV_SAMPLE_CPU_MAX) {
 		api_fail(pb, API_RANGE, "integrator.dt",
 			 "a sample interval (%g s) of this session would take about %.3g CPU s "
 			 "(%.3g CPU s per simulated s at integrator.dt = %g s), more than the %g s a "

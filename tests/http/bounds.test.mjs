@@ -175,6 +175,10 @@ test('a session whose sample or steady start would outlast what a worker can int
     ['/api/v1/sessions', { ...tiny, scene: { ...CHEAP.scene, start: 'rest' }, pace: 'max', until: 1 }, /^integrator\.dt$/],
     ['/api/v1/experiments', { session: tiny, schedule: [{ beta: 38, until: 1 }] }, /integrator\.dt$/],
     ['/api/v1/sessions', { scene: { ...CHEAP.scene, settle: 10 }, integrator: { dt: 1e-8 }, pace: 'max' }, /^scene\.settle$/],
+    // a 1-g eliminator on a 1e6 N s/m damper (|lambda| 1e9 1/s): no step
+    // is both stable (2.6e-9 s) and long enough, so the remedy named is
+    // more samples a simulated second (each interval shorter)
+    ['/api/v1/sessions', { params: { b_s2: 1e6, m2: 0.001 }, pace: 'max' }, /^sample_rate$/],
   ]) {
     const t0 = Date.now();
     const r = await req(d.base, 'POST', url, body);
@@ -184,6 +188,11 @@ test('a session whose sample or steady start would outlast what a worker can int
     assert.match(r.body.field, field, r.text);
     assert.equal(r.body.budget, 'cpu', r.text);
     assert.ok(r.body.min < r.body.max, r.text);
+    if (r.body.field === 'sample_rate') {
+      assert.equal(r.body.max, 10000);
+      assert.ok(r.body.min > 250, r.text);
+      assert.match(r.body.detail, /no stable step is long enough \(integrator\.dt [0-9.e-]+ s needed, this machine's bound 2\.6e-09 s\); nothing was created: a sample_rate of at least/);
+    }
   }
   assert.equal(await count(), before);
 });
