@@ -217,28 +217,34 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_
 	double cpu = *cpu_per_s, sample = cpu / spec->sample_rate, settle = settling(spec);
 	double left = before > 0 ? fmax(run_limit - before, 0) : run_limit;
 	char less[120];
-	double need_dt = st.dt * sample / SRV_SAMPLE_CPU_MAX,
-	       stable_dt = sim_max_dt(&spec->params, &spec->scene, &spec->method);
-	if (sample > SRV_SAMPLE_CPU_MAX && need_dt > stable_dt) {
-		/* no step both stable and short enough: more samples a
-		 * simulated second make each interval shorter */
-		api_fail(pb, API_RANGE, "sample_rate",
-			 "a sample interval (%g s) would take about %.3g CPU s, more than the %g s a "
-			 "worker may go without taking a control, and no stable step is long enough "
-			 "(integrator.dt %.3g s needed, this machine's bound %.3g s); nothing was "
-			 "created: a sample_rate of at least %.4g 1/s or a smaller scene",
-			 1.0 / spec->sample_rate, sample, SRV_SAMPLE_CPU_MAX, need_dt, stable_dt,
-			 cpu / SRV_SAMPLE_CPU_MAX);
-		pb->min = cpu / SRV_SAMPLE_CPU_MAX;
-		pb->max = API_SAMPLE_RATE_MAX;
-	} else if (sample > SRV_SAMPLE_CPU_MAX) {
-		api_fail(pb, API_RANGE, "integrator.dt",
-			 "a sample interval (%g s) of this session would take about %.3g CPU s "
-			 "(%.3g CPU s per simulated s at integrator.dt = %g s), more than the %g s a "
-			 "worker may go without taking a control or its stop; nothing was created: "
-			 "a larger integrator.dt or a smaller scene", 1.0 / spec->sample_rate,
-			 sample, cpu, st.dt, SRV_SAMPLE_CPU_MAX);
-		dt_range(pb, st.dt, sample, SRV_SAMPLE_CPU_MAX);
+	if (sample > SRV_SAMPLE_CPU_MAX) {
+		/* the least step whose interval fits (dt_range's min), and
+		 * the longest that is stable: asked only of a session over */
+		double need_dt = st.dt * sample / SRV_SAMPLE_CPU_MAX,
+		       stable_dt = sim_max_dt(&spec->params, &spec->scene, &spec->method);
+		if (need_dt > stable_dt) {
+			/* no step both stable and short enough: more samples
+			 * a simulated second make each interval shorter */
+			api_fail(pb, API_RANGE, "sample_rate",
+				 "a sample interval (%g s) would take about %.3g CPU s, more than "
+				 "the %g s a worker may go without taking a control, and no stable "
+				 "step is long enough (integrator.dt %.3g s needed, this machine's "
+				 "bound %.3g s); nothing was created: a sample_rate of at least "
+				 "%.4g 1/s or a smaller scene",
+				 1.0 / spec->sample_rate, sample, SRV_SAMPLE_CPU_MAX, need_dt,
+				 stable_dt, cpu / SRV_SAMPLE_CPU_MAX);
+			pb->min = cpu / SRV_SAMPLE_CPU_MAX;
+			pb->max = API_SAMPLE_RATE_MAX;
+		} else {
+			api_fail(pb, API_RANGE, "integrator.dt",
+				 "a sample interval (%g s) of this session would take about %.3g "
+				 "CPU s (%.3g CPU s per simulated s at integrator.dt = %g s), more "
+				 "than the %g s a worker may go without taking a control or its "
+				 "stop; nothing was created: a larger integrator.dt or a smaller "
+				 "scene", 1.0 / spec->sample_rate, sample, cpu, st.dt,
+				 SRV_SAMPLE_CPU_MAX);
+			dt_range(pb, st.dt, sample, SRV_SAMPLE_CPU_MAX);
+		}
 	} else if (settle_cpu > left) {
 		double per_s = settle_cpu / settle;
 		api_fail(pb, API_RANGE, "scene.settle",
