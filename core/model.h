@@ -150,8 +150,8 @@ double model_slip_rate(const sim_params *p, const sim_scene *sc);
  * (the springs and dampers of suspension and eliminators over the masses
  * they move, the settling's damper included; the feed and the motor's
  * slip apart): the spectral radius of the Jacobian of model_machine_rhs,
- * the largest over beta as model_slip_rate. czubak2016: about the
- * eliminators' 157 rad/s. setup.c */
+ * the largest over beta and over the rotor's angle as model_slip_rate.
+ * czubak2016: about the eliminators' 157 rad/s. setup.c */
 double model_machine_rate(const sim_params *p, const sim_scene *sc);
 
 /* Build the reduced model (with its suspension preload) and the initial

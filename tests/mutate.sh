@@ -98,6 +98,9 @@ mutations=(
 	"a load step's contacts scaled by the inverse ratio|core/disturb.c|s|pow(m_n / md->p.m_n, 1.0 / md->p.p)|pow(md->p.m_n / m_n, 1.0 / md->p.p)|"
 	"the deck load's moment with the wrong sign of its x part|core/model.c|s|rhs\[Q_ALPHA\] += rx \* L\[1\] - ry \* L\[0\] + L\[2\];|rhs[Q_ALPHA] += rx * L[1] + ry * L[0] + L[2];|"
 	"the yielding deck's vertical give with the wrong sign of the turn|core/feed.c|s|(B\[1\]\[q\] + Rd\[0\] \* B\[2\]\[q\])|(B[1][q] - Rd[0] * B[2][q])|"
+	# the machine's modes with the rotor at rest only: a light trough's
+	# damper across the unbalance's arm (tests/unit/test_hard_machine.c)
+	"the machine's step bound read with the rotor at one angle|core/setup.c|s|a < (r_phi < 0 ? 1 : RATE_ROTOR_ANGLES)|a < 1|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.
