@@ -52,8 +52,9 @@ typedef struct sim_params {
 	double m, e, J_w;         /* kg, m, kg m^2 */
 	double w_x, w_y;          /* m: axle, body frame */
 	double b_phi;             /* N m s^2: bearing drag b_phi*w|w| */
-	double M_load;            /* N m: constant load torque on the rotor,
-				     against the commanded rotation */
+	double M_load;            /* N m: load torque on the rotor against its
+				     turning (in proportion within 1 rad/s of
+				     standstill: core/model.c LOAD_BAND) */
 	/* motor (Kloss) */
 	double M_ut;              /* N m breakdown torque */
 	double omega_ss;          /* rad/s synchronous speed (>0) */

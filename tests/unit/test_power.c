@@ -181,6 +181,59 @@ static void kloss_against_drag_and_load(void **state)
 	}
 }
 
+/* The load torque acts against the rotor's turning and holds a standing
+ * rotor, it does not drive one (core/model.c, LOAD_BAND = 1 rad/s: in
+ * proportion below it). The rotor alone (e = 0, J_w = 0.01 kg m^2), both
+ * senses: with the motor switched off at 155 rad/s under M_L = 2 N m it
+ * slows at M_L / J_w and stops at (w0 - 1) J_w / M_L to the sample, and
+ * stays stopped, but for the trough's rocking against it (before: it turned backwards, at -244 rad/s 2 s on); under
+ * M_L = 100 N m, twice the breakdown torque, the motor holds it creeping
+ * at the speed w = M_el(w) / M_L rad/s (before: diverged). */
+static void load_holds_a_standing_rotor(void **state)
+{
+	(void)state;
+	const double Mut = 50.0, wss = 157.08, sut = 15.5, J = 0.01;
+	for (int r = 0; r < 2; r++) {
+		double sign = r ? -1.0 : 1.0;
+		setup u = preset();
+		set(&u, "feed", "false");
+		set(&u, "method", "rk4");
+		set(&u, "dt", "1e-4");
+		set(&u, "e", "0");
+		set(&u, "J_w", "0.01");
+		set(&u, "M_load", "2");
+		set(&u, "rotation", r ? "ccw" : "cw");
+		sim *s = make(&u);
+		advance(s, 2.0);
+		double w0 = sign * status(s).rotor_speed, t0 = status(s).t, stop = NAN;
+		assert_true(w0 > 150.0);
+		assert_int_equal(sim_set_drive_on(s, 0), SIM_OK);
+		for (int i = 1; i <= 2000; i++) {
+			advance(s, t0 + 1e-3 * i);
+			double w = sign * status(s).rotor_speed;
+			assert_true(w > -1e-3); /* the trough's rocking: 3e-5 */
+			if (isnan(stop) && w < 1.0)
+				stop = 1e-3 * i;
+		}
+		print_message("stopped after %.3f s (%.3f s from M_L / J_w)\n", stop,
+			      (w0 - 1.0) * J / 2.0);
+		assert_true(fabs(stop - (w0 - 1.0) * J / 2.0) <= 1e-3);
+		assert_true(fabs(status(s).rotor_speed) < 1e-3);
+		sim_free(s);
+
+		set(&u, "M_load", "100");
+		s = make(&u);
+		advance(s, 2.0);
+		double w = 0.1;
+		for (int i = 0; i < 50; i++)
+			w = kloss(w, Mut, wss, sut) / 100.0;
+		print_message("under 100 N m: %.9g rad/s (M_el(w) / M_L: %.9g)\n",
+			      sign * status(s).rotor_speed, w);
+		assert_close(sign * status(s).rotor_speed, w, 1e-9);
+		sim_free(s);
+	}
+}
+
 /* The steady start (docs/MODEL.md "Parameters": the rotor at the speed
  * where M_el balances the mean load) puts the rotor alone (e = 0) at
  * kloss_against_drag_and_load's speed at t = 0, both senses: the
@@ -343,6 +396,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
+		cmocka_unit_test(load_holds_a_standing_rotor),
 		cmocka_unit_test(steady_start_at_the_loaded_speed),
 		cmocka_unit_test(slip_bound_counts_the_drag),
 		cmocka_unit_test(deck_point_shown),
