@@ -342,6 +342,21 @@ static api_err validate_model(api_spec *spec, api_problem *pb)
 	    sim_validate(&spec->params, &spec->scene, &m0, NULL, 0) == SIM_OK) {
 		return api_fail_range(pb, "integrator.dt", 0.0, bound, "%s", msg);
 	}
+	/* and k_c against the column's weight (sim_k_c_least), its range from
+	 * that least stiffness to the setting's maximum */
+	double least = sim_k_c_least(&spec->params, &spec->scene);
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n), *k_c = NULL;
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(tab[i].name, "k_c") == 0)
+			k_c = &tab[i];
+	sim_params stiff = spec->params;
+	if (k_c && least > spec->params.k_c && least < k_c->max) {
+		stiff.k_c = k_c->max;
+		if (sim_validate(&stiff, &spec->scene, &spec->method, NULL, 0) == SIM_OK)
+			return api_fail_range(pb, "params.k_c", fmax(least, k_c->min), k_c->max,
+					      "%s", msg);
+	}
 	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }
 

@@ -179,6 +179,16 @@ void model_reduced_solves(const model *md, const double M[NQ_FULL][NQ_FULL], int
  * beta (written). setup.c */
 void model_static_strokes(const sim_params *p, double s[2]);
 
+/* m: how far a column's top element rests below its deck point under the
+ * column's weight (each contact carries the elements above it: the sum of
+ * (i m_n g / k_c)^(1/p) over i = 1..layers); 0 without feed. Where it
+ * reaches MODEL_SAG_MAX, the feed's divergence guard (sim_check.h: an
+ * element 5 cm into the deck) trips at rest: sim_validate refuses k_c
+ * below model_k_c_least, the stiffness at which it would. setup.c */
+#define MODEL_SAG_MAX 0.05
+double model_column_sag(const sim_params *p, const sim_scene *sc);
+double model_k_c_least(const sim_params *p, const sim_scene *sc);
+
 /* Full coordinates from y at time t. */
 void model_full_coords(const model *md, const model_ctl *ctl, double t, const double *y,
 		       double q[NQ_FULL], double qd[NQ_FULL]);

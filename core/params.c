@@ -342,6 +342,11 @@ int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, c
 	return SIM_OK;
 }
 
+double sim_k_c_least(const sim_params *p, const sim_scene *s)
+{
+	return model_k_c_least(p, s);
+}
+
 int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, char *msg,
 		 size_t msglen)
 {
@@ -361,6 +366,19 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 	}
 	if (p->rotation != SIM_CW && p->rotation != SIM_CCW)
 		return range_error((size_t)find("rotation"), msg, msglen);
+	if (model_column_sag(p, s) >= MODEL_SAG_MAX) {
+		char unit[24] = "N/m";
+		if (p->p != 1.0)
+			snprintf(unit, sizeof unit, "N/m^%g", p->p);
+		if (msg)
+			snprintf(msg, msglen,
+				 "k_c must be at least %.4g %s here: below it a column of %d "
+				 "layers of %.4g-kg elements sinks %.3g cm under its own weight at "
+				 "rest (the feed model holds %g cm)",
+				 model_k_c_least(p, s), unit, s->layers, p->m_n,
+				 100.0 * model_column_sag(p, s), 100.0 * MODEL_SAG_MAX);
+		return SIM_EPARAM;
+	}
 	double slip, machine;
 	double bound = sim_max_dt_modes(p, s, m, &slip, &machine);
 	if (m->dt > bound) {

@@ -156,6 +156,12 @@ double sim_contact_period(const sim_params *p, const sim_scene *s);
  * method. Above it the run blows up within a few seconds
  * (docs/integrators.md "Stability"). */
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
+
+/* N/m^p: the least contact stiffness k_c that sim_validate accepts for the
+ * column's weight (below it a column rests 5 cm or more into the deck under
+ * its own weight, where the feed's divergence guard trips); 0 without
+ * feed. */
+double sim_k_c_least(const sim_params *p, const sim_scene *s);
 /* The same, with each mode's own bound (s; INFINITY where it has none)
  * into *slip and *machine. */
 double sim_max_dt_modes(const sim_params *p, const sim_scene *s, const sim_method *m,

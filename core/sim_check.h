@@ -49,13 +49,14 @@ static const char *feed_runaway(const model *md, const double *y, const double q
 			lo = col[j] < lo ? col[j] : lo;
 			hi = col[j] > hi ? col[j] : hi;
 		}
-		if (!(lo - pos[1] < -0.05 || hi - pos[1] > 100.0))
+		if (!(lo - pos[1] < -MODEL_SAG_MAX || hi - pos[1] > 100.0))
 			continue;
 		for (int j = 0; j < md->L; j++) {
 			double rel = eta[k * md->L + j] - pos[1];
-			if (rel < -0.05)
-				return "feed element sank 5 cm into the deck "
-				       "(step too large for the contact stiffness)";
+			if (rel < -MODEL_SAG_MAX)
+				return "feed element sank 5 cm into the deck (contacts too "
+				       "soft for the column's weight, or the step too long "
+				       "for them)";
 			if (rel > 100.0)
 				return "feed element thrown beyond 100 m";
 		}

@@ -83,6 +83,18 @@ test('bad session bodies: 400/413/415/422 and nothing is created', { timeout: 20
   assert.equal(b.field, 'integrator.dt');
   assert.ok(b.max > 0.0000913 && b.max < 0.0000915, String(b.max));
   assert.match(b.detail, /dt must be at most 9\.14e-05 s for dem .* the machine's fastest mode \(\|lambda\| 2\.846e\+04 1\/s/);
+  // contacts too soft for the column's weight: 8 layers of 0.5-kg
+  // elements on k_c = 1000 N/m rest 36 x 4.905 mm = 17.7 cm deep, beyond the
+  // feed's 5 cm; the least k_c is 36 x 4.905 N / 5 cm = 3531.6 N/m
+  b = problem(await post({ params: { k_c: 1000 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'params.k_c');
+  assert.ok(Math.abs(b.min - 3531.6) < 0.1, String(b.min));
+  assert.equal(b.max, 1e10);
+  assert.match(b.detail, /^k_c must be at least 3532 N\/m here: below it a column of 8 layers of 0\.5-kg elements sinks 17\.7 cm under its own weight at rest/);
+  // with p = 2 the unit follows it: sqrt(i 4.905e-6 / 1e4) over i = 1..8
+  b = problem(await post({ params: { p: 2, k_c: 10000 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'params.k_c');
+  assert.match(b.detail, /^k_c must be at least 5\.217e\+05 N\/m\^2 here: .* sinks 36\.1 cm/);
   // another setting wrong as well: that one is named, not the step
   b = problem(await post({ params: { k_s1: -5 }, integrator: { dt: 0.0019 } }), 422, 'out-of-range');
   assert.equal(b.field, 'params.k_s1');

@@ -9,6 +9,7 @@
  * one-column scene keep the file fast (it also runs under ASan+UBSan in
  * `make check`). The machine's hard cases are in test_hard_machine.c.
  */
+#include "model.h"
 #include "testutil.h"
 
 /* One element on a still deck (testutil.h), stepped by dem with fine
@@ -310,20 +311,41 @@ static void one_way_machine_ignores_the_feed(void **state)
 	sim_free(b);
 }
 
-/* The divergence guard's feed check: contacts far too soft for the feed's
- * weight let the bottom layers sink through the deck, and the run stops
- * with SIM_EDIVERGED naming that cause (the check runs after every step). */
+/* Contacts far too soft for the feed's weight: at k_c = 1e3 N/m the
+ * preset's column of 8 half-kilogram elements rests sum i m_n g / k_c =
+ * 36 x 4.905 mm = 17.7 cm into the deck, beyond the feed's 5-cm guard,
+ * so sim_validate refuses it naming the least k_c, 36 x 4.905 N / 5 cm =
+ * 3531.6 N/m (p = 2: the sum of the roots). Just above it (4e3 N/m:
+ * 4.4 cm at rest) the deck's motion presses the column past 5 cm, and the run
+ * stops with SIM_EDIVERGED naming that cause (the check runs after every
+ * step). */
 static void sinking_feed_is_reported(void **state)
 {
 	(void)state;
 	setup u = preset();
 	set(&u, "start", "rest");
 	set(&u, "k_c", "1e3");
+	double w = u.p.m_n * u.p.g;
+	assert_close(model_column_sag(&u.p, &u.sc), 36.0 * w / 1e3, 1e-12);
+	assert_close(sim_k_c_least(&u.p, &u.sc), 36.0 * w / MODEL_SAG_MAX, 1e-12);
+	char msg[256] = "";
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_EPARAM);
+	assert_non_null(strstr(msg, "k_c must be at least 3532 N/m"));
+	assert_non_null(strstr(msg, "sinks 17.7 cm"));
+	set(&u, "p", "2");
+	set(&u, "k_c", "1e4");
+	double roots = 0.0;
+	for (int i = 1; i <= 8; i++)
+		roots += sqrt(i * w);
+	assert_close(sim_k_c_least(&u.p, &u.sc), pow(roots / MODEL_SAG_MAX, 2.0), 1e-12);
+	set(&u, "p", "1");
+	set(&u, "k_c", "4e3");
+	assert_int_equal(sim_validate(&u.p, &u.sc, &u.m, msg, sizeof msg), SIM_OK);
 	sim *s = make(&u);
 	int e = sim_advance(s, 1.0);
-	const char *msg = sim_last_error(s);
+	const char *err = sim_last_error(s);
 	assert_int_equal(e, SIM_EDIVERGED);
-	assert_non_null(strstr(msg, "sank 5 cm into the deck"));
+	assert_non_null(strstr(err, "sank 5 cm into the deck (contacts too soft"));
 	assert_true(status(s).t < 1.0);
 	sim_free(s);
 }
