@@ -272,12 +272,6 @@ static void eliminators(const sim_params *p, const config *cf, double rhs[NQ_FUL
 	*damp_power += p->b_s1 * qd[Q_S1] * qd[Q_S1] + p->b_s2 * qd[Q_S2] * qd[Q_S2];
 }
 
-/* rad/s: the rotor speed below which the load torque M_load falls in
- * proportion to zero (a load holds a standing rotor, it does not drive it);
- * at the preset's 157 rad/s and any speed beyond it the load is M_load
- * against the turning, as a constant torque. */
-#define LOAD_BAND 1.0
-
 /* The drive's terms at one evaluation. */
 typedef struct drive_terms {
 	double omega;   /* rad/s rotor speed relative to the trough */
@@ -296,12 +290,15 @@ drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FUL
 	const sim_params *p = &md->p;
 	dt->omega = cf->qd[Q_PHI] - cf->qd[Q_ALPHA];
 	dt->drag = p->b_phi * dt->omega * fabs(dt->omega);
-	/* against the rotor's turning, whichever way it turns; within
-	 * LOAD_BAND of standstill in proportion, so that a load the motor
-	 * cannot turn (or any load with the motor off) holds the rotor
-	 * rather than turning it backwards */
-	double turn = dt->omega / LOAD_BAND;
-	dt->load = -p->M_load * (turn > 1.0 ? 1.0 : turn < -1.0 ? -1.0 : turn);
+	/* against the rotor's turning, whichever way it turns, at most
+	 * M_load: near standstill the motor's own slip slope times the speed
+	 * (2 M_ut / slip_ut: a stiffness the step already keeps stable), so
+	 * that a load the motor cannot turn (or any load with the motor off)
+	 * holds the rotor rather than turning it backwards; from M_load
+	 * slip_ut / (2 M_ut) on (0.31 rad/s per N m for czubak2016's motor) a
+	 * constant torque */
+	double held = 2.0 * p->M_ut / p->slip_ut * dt->omega;
+	dt->load = -(held > p->M_load ? p->M_load : held < -p->M_load ? -p->M_load : held);
 	dt->torque = 0.0;
 	if (!md->phi_prescribed)
 		dt->torque = motor_torque(md, ctl, dt->omega);

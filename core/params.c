@@ -38,7 +38,7 @@ enum { G_PARAM, G_SCENE, G_METHOD };
 	X(G_PARAM, w_x, REAL, "m", -5, 5, NULL, 1, "vibrator axle, body x")                    \
 	X(G_PARAM, w_y, REAL, "m", -5, 5, NULL, 1, "vibrator axle, body y")                    \
 	X(G_PARAM, b_phi, REAL, "N m s^2", 0, 1, NULL, 1, "bearing drag b_phi w|w|")           \
-	X(G_PARAM, M_load, REAL, "N m", 0, 1e5, NULL, 1, "load torque against the rotor's turning (holds a standing rotor: in proportion within 1 rad/s of standstill)") \
+	X(G_PARAM, M_load, REAL, "N m", 0, 1e5, NULL, 1, "load torque against the rotor's turning, constant but near standstill (where it holds the rotor, not turns it)") \
 	X(G_PARAM, M_ut, REAL, "N m", 0.1, 1e5, NULL, 1, "motor breakdown torque")            \
 	X(G_PARAM, omega_ss, REAL, "rad/s", 1, 1000, NULL, 1, "motor synchronous speed")       \
 	X(G_PARAM, slip_ut, REAL, "rad/s", 0.1, 500, NULL, 1, "breakdown slip omega_ss - omega_ut") \

@@ -53,8 +53,8 @@ typedef struct sim_params {
 	double w_x, w_y;          /* m: axle, body frame */
 	double b_phi;             /* N m s^2: bearing drag b_phi*w|w| */
 	double M_load;            /* N m: load torque on the rotor against its
-				     turning (in proportion within 1 rad/s of
-				     standstill: core/model.c LOAD_BAND) */
+				     turning (near standstill the motor's slip
+				     slope times the speed: core/model.c) */
 	/* motor (Kloss) */
 	double M_ut;              /* N m breakdown torque */
 	double omega_ss;          /* rad/s synchronous speed (>0) */

@@ -143,7 +143,11 @@ static double machine_rate(const sim_params *p, const sim_scene *sc)
 	for (int b = 0; b < BOUND_BETAS; b++) {
 		model md;
 		model_ctl ctl;
-		bare_machine(p, sc, b, &md, &ctl);
+		/* the load torque apart: its slope at standstill is the
+		 * motor's slip slope, model_slip_rate's */
+		sim_params unloaded = *p;
+		unloaded.M_load = 0.0;
+		bare_machine(&unloaded, sc, b, &md, &ctl);
 		/* the motor off (its slip mode is model_slip_rate's), the
 		 * settling's damper on in full (it only adds damping) */
 		ctl.drive_on = 0;
