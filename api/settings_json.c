@@ -342,20 +342,36 @@ static api_err validate_model(api_spec *spec, api_problem *pb)
 	    sim_validate(&spec->params, &spec->scene, &m0, NULL, 0) == SIM_OK) {
 		return api_fail_range(pb, "integrator.dt", 0.0, bound, "%s", msg);
 	}
-	/* and k_c against the column's weight (sim_k_c_least), its range from
-	 * that least stiffness to the setting's maximum */
-	double least = sim_k_c_least(&spec->params, &spec->scene);
-	size_t n = 0;
-	const sim_setting *tab = sim_settings(&n), *k_c = NULL;
-	for (size_t i = 0; i < n; i++)
-		if (strcmp(tab[i].name, "k_c") == 0)
-			k_c = &tab[i];
+	/* and the springs the weights ask for: the eliminators' (sim_k_s_least)
+	 * and the column's contacts (sim_k_c_least), each range from that
+	 * least stiffness to the setting's maximum */
+	struct {
+		const char *name, *field;
+		double *value, least;
+	} soft[3] = {
+		{"k_s1", "params.k_s1", NULL, sim_k_s_least(&spec->params, 1)},
+		{"k_s2", "params.k_s2", NULL, sim_k_s_least(&spec->params, 2)},
+		{"k_c", "params.k_c", NULL, sim_k_c_least(&spec->params, &spec->scene)},
+	};
 	sim_params stiff = spec->params;
-	if (k_c && least > spec->params.k_c && least < k_c->max) {
-		stiff.k_c = k_c->max;
+	soft[0].value = &stiff.k_s1;
+	soft[1].value = &stiff.k_s2;
+	soft[2].value = &stiff.k_c;
+	size_t n = 0;
+	const sim_setting *tab = sim_settings(&n);
+	for (int k = 0; k < 3; k++) {
+		const sim_setting *t = NULL;
+		for (size_t i = 0; i < n; i++)
+			if (strcmp(tab[i].name, soft[k].name) == 0)
+				t = &tab[i];
+		if (!t || !(soft[k].least >= *soft[k].value) || !(soft[k].least < t->max))
+			continue;
+		double given = *soft[k].value;
+		*soft[k].value = t->max;
 		if (sim_validate(&stiff, &spec->scene, &spec->method, NULL, 0) == SIM_OK)
-			return api_fail_range(pb, "params.k_c", fmax(least, k_c->min), k_c->max,
+			return api_fail_range(pb, soft[k].field, fmax(soft[k].least, t->min), t->max,
 					      "%s", msg);
+		*soft[k].value = given;
 	}
 	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }

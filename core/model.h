@@ -186,6 +186,11 @@ void model_static_strokes(const sim_params *p, double s[2]);
  * element 5 cm into the deck) trips at rest: sim_validate refuses k_c
  * below model_k_c_least, the stiffness at which it would. setup.c */
 #define MODEL_SAG_MAX 0.05
+/* m: the eliminators' largest stroke (sim_check.h's guard). At rest an
+ * eliminator i sits m_i g cos(beta) / k_si down its guide: sim_validate
+ * refuses a spring on which it would sit that far at beta = 0 or 180 deg
+ * (any beta a session may be turned to), sim_k_s_least the least one. */
+#define MODEL_STROKE_MAX 1.0
 double model_column_sag(const sim_params *p, const sim_scene *sc);
 double model_k_c_least(const sim_params *p, const sim_scene *sc);
 

@@ -347,6 +347,11 @@ double sim_k_c_least(const sim_params *p, const sim_scene *s)
 	return model_k_c_least(p, s);
 }
 
+double sim_k_s_least(const sim_params *p, int which)
+{
+	return (which == 1 ? p->m1 : p->m2) * p->g / MODEL_STROKE_MAX;
+}
+
 int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, char *msg,
 		 size_t msglen)
 {
@@ -366,6 +371,19 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 	}
 	if (p->rotation != SIM_CW && p->rotation != SIM_CCW)
 		return range_error((size_t)find("rotation"), msg, msglen);
+	for (int i = 1; i <= 2; i++) {
+		double k = i == 1 ? p->k_s1 : p->k_s2, least = sim_k_s_least(p, i);
+		if (k > least)
+			continue;
+		if (msg)
+			snprintf(msg, msglen,
+				 "k_s%d must be above %.4g N/m here: on %.4g N/m eliminator %d "
+				 "(%.4g kg) would sit %.3g m down its guide at beta 0 or 180 deg "
+				 "(the model holds strokes within %g m)",
+				 i, least, k, i, i == 1 ? p->m1 : p->m2, least / k * MODEL_STROKE_MAX,
+				 MODEL_STROKE_MAX);
+		return SIM_EPARAM;
+	}
 	if (model_column_sag(p, s) >= MODEL_SAG_MAX) {
 		char unit[24] = "N/m";
 		if (p->p != 1.0)

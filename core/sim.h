@@ -162,6 +162,11 @@ double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
  * its own weight, where the feed's divergence guard trips); 0 without
  * feed. */
 double sim_k_c_least(const sim_params *p, const sim_scene *s);
+
+/* N/m: the least spring k_s1 (which 1) or k_s2 (2) that sim_validate
+ * accepts: on a softer one the eliminator sits 1 m or more down its guide
+ * under gravity at beta = 0 or 180 deg, where the divergence guard trips. */
+double sim_k_s_least(const sim_params *p, int which);
 /* The same, with each mode's own bound (s; INFINITY where it has none)
  * into *slip and *machine. */
 double sim_max_dt_modes(const sim_params *p, const sim_scene *s, const sim_method *m,

@@ -24,7 +24,7 @@ static const char *machine_runaway(const model *md, const double q[NQ_FULL],
 		return "trough displacement beyond 1 m";
 	if (fabs(q[Q_ALPHA]) > 0.5)
 		return "trough rotation beyond 0.5 rad";
-	if (fabs(q[Q_S1]) > 1.0 || fabs(q[Q_S2]) > 1.0)
+	if (fabs(q[Q_S1]) > MODEL_STROKE_MAX || fabs(q[Q_S2]) > MODEL_STROKE_MAX)
 		return "eliminator stroke beyond 1 m";
 	if (fabs(qd[Q_PHI] - qd[Q_ALPHA]) > 100.0 * md->p.omega_ss + 1e3)
 		return "rotor speed beyond 100 omega_ss";

@@ -95,6 +95,16 @@ test('bad session bodies: 400/413/415/422 and nothing is created', { timeout: 20
   b = problem(await post({ params: { p: 2, k_c: 10000 } }), 422, 'out-of-range');
   assert.equal(b.field, 'params.k_c');
   assert.match(b.detail, /^k_c must be at least 5\.217e\+05 N\/m\^2 here: .* sinks 36\.1 cm/);
+  // an eliminator spring too soft for its mass: 18 kg on 1 N/m would sit
+  // 18 x 9.81 / 1 = 177 m down its guide at beta 0; the least is 176.58 N/m
+  b = problem(await post({ params: { k_s1: 1 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'params.k_s1');
+  assert.ok(Math.abs(b.min - 176.58) < 1e-9, String(b.min));
+  assert.equal(b.max, 1e9);
+  assert.match(b.detail, /^k_s1 must be above 176\.6 N\/m here: on 1 N\/m eliminator 1 \(18 kg\) would sit 177 m down its guide/);
+  b = problem(await post({ params: { m2: 50, k_s2: 400 } }), 422, 'out-of-range');
+  assert.equal(b.field, 'params.k_s2');
+  assert.ok(Math.abs(b.min - 490.5) < 1e-9, String(b.min));
   // another setting wrong as well: that one is named, not the step
   b = problem(await post({ params: { k_s1: -5 }, integrator: { dt: 0.0019 } }), 422, 'out-of-range');
   assert.equal(b.field, 'params.k_s1');
