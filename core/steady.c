@@ -339,8 +339,14 @@ void dynamics_steady_start(const model *md, model_ctl *ctl, double *y, trough_or
 		if (!linear || harmonic_orbit(&sh, z) != 0)
 			shoot(&sh, z, J, &have_J);
 		double next = motor_speed_for(md, ctl, sh.mean_torque);
-		if (md->phi_prescribed || !isfinite(next) ||
-		    fabs(next - Omega) <= OMEGA_TOL * fabs(Omega))
+		/* an orbit whose mean torque the motor cannot give at any
+		 * speed of its stable branch is no steady state of this
+		 * machine (it stays below its resonance, or stalls): the
+		 * machine starts from its static equilibrium, at rest, and the
+		 * settling runs it up */
+		if (!md->phi_prescribed && !isfinite(next))
+			return;
+		if (md->phi_prescribed || fabs(next - Omega) <= OMEGA_TOL * fabs(Omega))
 			break;
 		Omega = next;
 	}

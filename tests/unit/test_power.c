@@ -235,6 +235,49 @@ static void load_holds_a_standing_rotor(void **state)
 	}
 }
 
+/* A steady start whose orbit at the synchronous speed asks more torque
+ * than the motor's breakdown torque is no steady state of the machine
+ * (steady.c): it starts from its static equilibrium, at rest, and the
+ * settling runs it up. The preset's rotor alone (e = 0) under M_L = 60 N m
+ * (M_ut 50) creeps where M_el(w) = k w (the load near
+ * standstill, k = 2 M_ut / slip_ut); the energy dissipated is positive
+ * (before: the rotor placed at 157 rad/s on an orbit it could not hold;
+ * its load turned it backwards). A machine whose rocking asks 73 N m at
+ * 157 rad/s (the axle 2.45 m off G, l2 = 4.41 m, beta 70 deg) runs up
+ * from rest (before: diverged at once, at any step). */
+static void orbit_beyond_the_motor_starts_at_rest(void **state)
+{
+	(void)state;
+	const double Mut = 50.0, wss = 157.08, sut = 15.5, k = 2.0 * Mut / sut;
+	setup u = preset_defaults();
+	set(&u, "feed", "false");
+	set(&u, "e", "0");
+	set(&u, "M_load", "60");
+	sim *s = make(&u);
+	advance(s, 1.0);
+	double w = 1.0;
+	for (int i = 0; i < 100; i++)
+		w = kloss(w, Mut, wss, sut) / k;
+	sim_status st = status(s);
+	print_message("M_L 60 N m: %.6g rad/s (M_el(w) = k w: %.6g), dissipated %.4g J\n",
+		      st.rotor_speed, w, st.e_dissipated);
+	assert_true(fabs(st.rotor_speed - w) < 1e-3 * w);
+	assert_true(st.e_dissipated > 0.0);
+	sim_free(s);
+
+	u = preset_defaults();
+	set(&u, "w_x", "2.44614");
+	set(&u, "l2", "4.4134");
+	set(&u, "beta", "70.1463");
+	s = make(&u);
+	advance(s, 0.5);
+	st = status(s);
+	print_message("rocking machine: %.6g rad/s at t = 0.5 s\n", st.rotor_speed);
+	assert_true(isfinite(st.q[0]) && isfinite(st.q[1]) && isfinite(st.rotor_speed));
+	assert_true(st.rotor_speed > 0.0 && st.rotor_speed < 2.0 * wss);
+	sim_free(s);
+}
+
 /* The steady start (docs/MODEL.md "Parameters": the rotor at the speed
  * where M_el balances the mean load) puts the rotor alone (e = 0) at
  * kloss_against_drag_and_load's speed at t = 0, both senses: the
@@ -398,6 +441,7 @@ int main(void)
 		cmocka_unit_test(power_balance_at_every_state),
 		cmocka_unit_test(kloss_against_drag_and_load),
 		cmocka_unit_test(load_holds_a_standing_rotor),
+		cmocka_unit_test(orbit_beyond_the_motor_starts_at_rest),
 		cmocka_unit_test(steady_start_at_the_loaded_speed),
 		cmocka_unit_test(slip_bound_counts_the_drag),
 		cmocka_unit_test(deck_point_shown),
