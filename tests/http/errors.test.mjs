@@ -229,3 +229,18 @@ test('a machine whose fastest mode is its eliminators\': created, its default st
   assert.ok(Number.isFinite(s.status.feed_displacement));
   assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
 });
+
+test('a load beyond the motor\'s breakdown torque: created, and the rotor stands, neither running on nor turning backwards', { timeout: 20000 * SLOW }, async () => {
+  // M_load 60 N m against a 50-N m motor: the creation's steady start put
+  // the rotor at 157 rad/s on an orbit it could not hold, the load turned
+  // it backwards and the settling diverged (422, "rotor speed beyond 100
+  // omega_ss"); now the machine starts at rest and the motor holds the
+  // load near standstill (a creep of a few rad/s)
+  const r = await req(d.base, 'POST', '/api/v1/sessions', { params: { M_load: 60 } });
+  assert.equal(r.status, 201, r.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body.status.t >= 0.5);
+  const s = (await req(d.base, 'GET', `/api/v1/sessions/${r.body.id}`)).body;
+  assert.equal(s.state, 'running');
+  assert.ok(s.status.rotor_speed > 0 && s.status.rotor_speed < 5, String(s.status.rotor_speed));
+  assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${r.body.id}`)).status, 204);
+});
