@@ -147,6 +147,20 @@ static double loaded_speed(double Mut, double wss, double sut, double b, double 
 	return 0.5 * (lo + hi);
 }
 
+/* The preset's rotor alone (e = 0: the trough is not shaken; J_w = 0.01
+ * kg m^2, no feed, RK4 at 1e-4 s), turning cw (ccw if ccw). */
+static setup rotor_alone(int ccw)
+{
+	setup u = preset();
+	set(&u, "feed", "false");
+	set(&u, "method", "rk4");
+	set(&u, "dt", "1e-4");
+	set(&u, "e", "0");
+	set(&u, "J_w", "0.01");
+	set(&u, "rotation", ccw ? "ccw" : "cw");
+	return u;
+}
+
 /* The rotor alone (e = 0) under bearing drag b_phi w |w| and a load
  * torque: its steady speed solves M_el(w) = b_phi w^2 + M_L (bisection
  * on the stable branch, slip below the breakdown slip), both senses. */
@@ -156,15 +170,9 @@ static void kloss_against_drag_and_load(void **state)
 	const double Mut = 50.0, wss = 157.08, sut = 15.5, b = 4e-4, ML = 2.0;
 	const double w = loaded_speed(Mut, wss, sut, b, ML); /* 155.25 rad/s: drag 9.64 N m, load 2 */
 	for (int r = 0; r < 2; r++) {
-		setup u = preset();
-		set(&u, "feed", "false");
-		set(&u, "method", "rk4");
-		set(&u, "dt", "1e-4");
-		set(&u, "e", "0");
-		set(&u, "J_w", "0.01");
+		setup u = rotor_alone(r);
 		set(&u, "b_phi", "4e-4");
 		set(&u, "M_load", "2");
-		set(&u, "rotation", r ? "ccw" : "cw");
 		sim *s = make(&u);
 		advance(s, 5.0); /* the trough's rocking from the start decays in ~0.5 s */
 		sim_status st = status(s);
@@ -196,14 +204,8 @@ static void load_holds_a_standing_rotor(void **state)
 	const double Mut = 50.0, wss = 157.08, sut = 15.5, J = 0.01, k = 2.0 * Mut / sut;
 	for (int r = 0; r < 2; r++) {
 		double sign = r ? -1.0 : 1.0;
-		setup u = preset();
-		set(&u, "feed", "false");
-		set(&u, "method", "rk4");
-		set(&u, "dt", "1e-4");
-		set(&u, "e", "0");
-		set(&u, "J_w", "0.01");
+		setup u = rotor_alone(r);
 		set(&u, "M_load", "2");
-		set(&u, "rotation", r ? "ccw" : "cw");
 		sim *s = make(&u);
 		advance(s, 2.0);
 		double w0 = sign * status(s).rotor_speed, t0 = status(s).t, stop = NAN;
