@@ -281,8 +281,9 @@ typedef struct drive_terms {
 } drive_terms;
 
 /* Stage drive: motor torque (Kloss; none for the ideal drive), drag and
- * load on phi and their reaction on alpha; drag and load power added to
- * *damp_power. */
+ * load (against the turning, at most M_load, near standstill the motor's
+ * slip slope times the speed: it holds a standing rotor) on phi and their
+ * reaction on alpha; drag and load power added to *damp_power. */
 static inline __attribute__((always_inline)) void
 drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FULL],
       double *damp_power, drive_terms *dt)
@@ -290,15 +291,7 @@ drive(const model *md, const model_ctl *ctl, const config *cf, double rhs[NQ_FUL
 	const sim_params *p = &md->p;
 	dt->omega = cf->qd[Q_PHI] - cf->qd[Q_ALPHA];
 	dt->drag = p->b_phi * dt->omega * fabs(dt->omega);
-	/* against the rotor's turning, whichever way it turns, at most
-	 * M_load: near standstill the motor's own slip slope times the speed
-	 * (2 M_ut / slip_ut: a stiffness the step already keeps stable), so
-	 * that a load the motor cannot turn (or any load with the motor off)
-	 * holds the rotor rather than turning it backwards; from M_load
-	 * slip_ut / (2 M_ut) on (0.31 rad/s per N m for czubak2016's motor) a
-	 * constant torque */
-	double held = 2.0 * p->M_ut / p->slip_ut * dt->omega;
-	dt->load = -(held > p->M_load ? p->M_load : held < -p->M_load ? -p->M_load : held);
+	dt->load = -fmax(-p->M_load, fmin(p->M_load, 2.0 * p->M_ut / p->slip_ut * dt->omega));
 	dt->torque = 0.0;
 	if (!md->phi_prescribed)
 		dt->torque = motor_torque(md, ctl, dt->omega);

@@ -103,7 +103,7 @@ mutations=(
 	"the machine's step bound read with the rotor at one angle|core/setup.c|s|a < (r_phi < 0 ? 1 : RATE_ROTOR_ANGLES)|a < 1|"
 	# a load that turns a standing rotor backwards, and a steady start on
 	# an orbit the motor cannot drive (tests/unit/test_power.c)
-	"the load torque constant whatever way the rotor turns|core/model.c|s|double held = 2.0 \* p->M_ut / p->slip_ut \* dt->omega;|double held = (double)ctl->rotation * 1e300;|"
+	"the load torque constant whatever way the rotor turns|core/model.c|s|fmin(p->M_load, 2.0 \* p->M_ut / p->slip_ut \* dt->omega)|fmin(p->M_load, (double)ctl->rotation * 1e300)|"
 	"the steady start on an orbit the motor cannot drive|core/steady.c|s|if (!md->phi_prescribed \&\& !isfinite(next))|if (0)|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
