@@ -102,6 +102,16 @@ static api_err parse_m_n(const cJSON *it, const api_spec *spec, const char *name
 				      v.si, light ? "at most" : "more than",
 				      light ? "with its corrector" : "without it");
 	}
+	/* and the column's weight on its contacts (sim_m_n_most) */
+	double most = sim_m_n_most(&spec->params, &spec->scene);
+	if (!(v.si < most)) {
+		double hi_shown = api_round_inward(nextafter(most, 0.0), 0, 6);
+		return api_fail_range(pb, name, api_round_inward(lo, 1, 6), hi_shown,
+				      "m_n must be below %.6g kg in this session; got %g: its column "
+				      "of %d layers would rest 5 cm or more into the deck on k_c = "
+				      "%g, where the feed model ends", most, v.si, spec->scene.layers,
+				      spec->params.k_c);
+	}
 	c->m_n = v.si;
 	return API_OK;
 }

@@ -53,7 +53,8 @@ int sim_set_feed(sim *s, double m_n, double mu)
 	double lo, hi;
 	sim_feed_mass_range(&md->p, &md->sc, &s->cfg, &lo, &hi);
 	if (!sim_setting_check(sim_setting_find("m_n"), m_n) ||
-	    !sim_setting_check(sim_setting_find("mu"), mu) || m_n < lo || m_n > hi)
+	    !sim_setting_check(sim_setting_find("mu"), mu) || m_n < lo || m_n > hi ||
+	    !(m_n < sim_m_n_most(&md->p, &md->sc)))
 		return SIM_EPARAM;
 	double kp0, el0 = stored(s, s->y, &kp0);
 	if (m_n != md->p.m_n) {

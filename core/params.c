@@ -347,6 +347,14 @@ double sim_k_c_least(const sim_params *p, const sim_scene *s)
 	return model_k_c_least(p, s);
 }
 
+double sim_m_n_most(const sim_params *p, const sim_scene *s)
+{
+	sim_params unit = *p;
+	unit.m_n = 1.0;
+	double sag = model_column_sag(&unit, s);
+	return sag > 0.0 ? pow(MODEL_SAG_MAX / sag, p->p) : INFINITY;
+}
+
 double sim_k_s_least(const sim_params *p, int which)
 {
 	return (which == 1 ? p->m1 : p->m2) * p->g / MODEL_STROKE_MAX;

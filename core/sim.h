@@ -162,6 +162,11 @@ double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
  * its own weight, where the feed's divergence guard trips); 0 without
  * feed. */
 double sim_k_c_least(const sim_params *p, const sim_scene *s);
+/* kg: the element mass m_n at which the column would rest 5 cm into the
+ * deck on the present k_c (sim_k_c_least's bound the other way): a
+ * disturbance (sim_set_feed, PATCH m_n) must stay below it; INFINITY
+ * without feed. */
+double sim_m_n_most(const sim_params *p, const sim_scene *s);
 
 /* N/m: the least spring k_s1 (which 1) or k_s2 (2) that sim_validate
  * accepts: on a softer one the eliminator sits 1 m or more down its guide

@@ -82,6 +82,22 @@ test('PATCH m_n and mu: applied, in the status and the stream; out of range a 42
     assert.equal(st.mu, 0.6);
     assert.equal(st.beta_target, 40);
 
+    // heavier elements than its contacts hold: on k_c = 5000 N/m a column
+    // of 2 layers rests 3 m_n g / k_c deep, 5 cm at m_n = 0.05 x 5000 /
+    // (3 x 9.81) = 8.49473 kg (below the corrector's 16.6): 10 kg is refused
+    // with that as max, 8 kg applied
+    const soft = await req(d.base, 'POST', '/api/v1/sessions',
+      { ...CHEAP, pace: 1, params: { ...(CHEAP.params || {}), k_c: 5000 } });
+    assert.equal(soft.status, 201, soft.text);
+    const heavy = await req(d.base, 'PATCH', `/api/v1/sessions/${soft.body.id}`, { m_n: 10 });
+    assert.equal(heavy.status, 422, heavy.text);
+    assert.equal(heavy.body.field, 'm_n');
+    assert.ok(Math.abs(heavy.body.max - 8.49473) < 1e-5, String(heavy.body.max));
+    assert.match(heavy.body.detail, /^m_n must be below 8\.49473 kg in this session; got 10: its column of 2 layers would rest 5 cm or more into the deck on k_c = 5000/);
+    assert.equal((await get(d, soft.body.id)).status.m_n, 0.5, 'nothing changed');
+    const ok = await req(d.base, 'PATCH', `/api/v1/sessions/${soft.body.id}`, { m_n: 8 });
+    assert.equal(ok.status, 200, ok.text);
+
     // a session without a feed has none to disturb
     const n = await req(d.base, 'POST', '/api/v1/sessions', { ...NO_FEED, pace: 1 });
     assert.equal(n.status, 201);

@@ -175,6 +175,16 @@ static void refusals_change_nothing(void **state)
 	s = make(&v);
 	assert_int_equal(sim_set_feed(s, 0.6, NAN), SIM_EPARAM);
 	sim_free(s);
+	/* heavier than the contacts hold: on k_c = 2e4 N/m the column of 8
+	 * rests 36 m_n g / k_c deep, 5 cm at m_n = 0.05 x 2e4 / (36 g) =
+	 * 2.83 kg (u runs rk4 now: no corrector's bound below it) */
+	set(&u, "k_c", "2e4");
+	double most = 0.05 * 2e4 / (36.0 * u.p.g);
+	assert_close(sim_m_n_most(&u.p, &u.sc), most, 1e-12);
+	s = make(&u);
+	assert_int_equal(sim_set_feed(s, 1.01 * most, NAN), SIM_EPARAM);
+	assert_int_equal(sim_set_feed(s, 0.99 * most, NAN), SIM_OK);
+	sim_free(s);
 }
 
 /* A checkpoint after a change restores the changed feed and continues bit
