@@ -157,20 +157,14 @@ double sim_contact_period(const sim_params *p, const sim_scene *s);
  * (docs/integrators.md "Stability"). */
 double sim_max_dt(const sim_params *p, const sim_scene *s, const sim_method *m);
 
-/* N/m^p: the least contact stiffness k_c that sim_validate accepts for the
- * column's weight (below it a column rests 5 cm or more into the deck under
- * its own weight, where the feed's divergence guard trips); 0 without
- * feed. */
+/* The weights' bounds, where the divergence guards would trip at rest:
+ * the least k_c (N/m^p; 0 without feed) on which the column rests less
+ * than 5 cm into the deck, and the most m_n (kg; INFINITY without feed) a
+ * disturbance may bring to the present k_c; the least eliminator spring
+ * k_s1 (which 1) or k_s2 (2), N/m, on which it sits less than its 1-m
+ * stroke down its guide at beta = 0 or 180 deg. */
 double sim_k_c_least(const sim_params *p, const sim_scene *s);
-/* kg: the element mass m_n at which the column would rest 5 cm into the
- * deck on the present k_c (sim_k_c_least's bound the other way): a
- * disturbance (sim_set_feed, PATCH m_n) must stay below it; INFINITY
- * without feed. */
 double sim_m_n_most(const sim_params *p, const sim_scene *s);
-
-/* N/m: the least spring k_s1 (which 1) or k_s2 (2) that sim_validate
- * accepts: on a softer one the eliminator sits 1 m or more down its guide
- * under gravity at beta = 0 or 180 deg, where the divergence guard trips. */
 double sim_k_s_least(const sim_params *p, int which);
 /* The same, with each mode's own bound (s; INFINITY where it has none)
  * into *slip and *machine. */
