@@ -344,34 +344,27 @@ static api_err validate_model(api_spec *spec, api_problem *pb)
 	}
 	/* and the springs the weights ask for: the eliminators' (sim_k_s_least)
 	 * and the column's contacts (sim_k_c_least), each range from that
-	 * least stiffness to the setting's maximum */
-	struct {
+	 * least stiffness to the setting's maximum (N/m: SI and the user's) */
+	const struct {
 		const char *name, *field;
-		double *value, least;
-	} soft[3] = {
-		{"k_s1", "params.k_s1", NULL, sim_k_s_least(&spec->params, 1)},
-		{"k_s2", "params.k_s2", NULL, sim_k_s_least(&spec->params, 2)},
-		{"k_c", "params.k_c", NULL, sim_k_c_least(&spec->params, &spec->scene)},
+		double least;
+	} soft[] = {
+		{"k_s1", "params.k_s1", sim_k_s_least(&spec->params, 1)},
+		{"k_s2", "params.k_s2", sim_k_s_least(&spec->params, 2)},
+		{"k_c", "params.k_c", sim_k_c_least(&spec->params, &spec->scene)},
 	};
-	sim_params stiff = spec->params;
-	soft[0].value = &stiff.k_s1;
-	soft[1].value = &stiff.k_s2;
-	soft[2].value = &stiff.k_c;
-	size_t n = 0;
-	const sim_setting *tab = sim_settings(&n);
-	for (int k = 0; k < 3; k++) {
-		const sim_setting *t = NULL;
-		for (size_t i = 0; i < n; i++)
-			if (strcmp(tab[i].name, soft[k].name) == 0)
-				t = &tab[i];
-		if (!t || !(soft[k].least >= *soft[k].value) || !(soft[k].least < t->max))
+	for (size_t k = 0; k < sizeof soft / sizeof soft[0]; k++) {
+		const sim_setting *t = sim_setting_find(soft[k].name);
+		double given = NAN;
+		sim_get(&spec->params, &spec->scene, &spec->method, soft[k].name, &given);
+		if (!(soft[k].least >= given) || !(soft[k].least < t->max))
 			continue;
-		double given = *soft[k].value;
-		*soft[k].value = t->max;
-		if (sim_validate(&stiff, &spec->scene, &spec->method, NULL, 0) == SIM_OK)
+		api_spec stiff = *spec;
+		if (sim_set(&stiff.params, &stiff.scene, &stiff.method, soft[k].name, t->max, NULL,
+			    0) == SIM_OK &&
+		    sim_validate(&stiff.params, &stiff.scene, &stiff.method, NULL, 0) == SIM_OK)
 			return api_fail_range(pb, soft[k].field, fmax(soft[k].least, t->min), t->max,
 					      "%s", msg);
-		*soft[k].value = given;
 	}
 	return api_fail(pb, api_from_sim(rc), NULL, "%s", msg[0] ? msg : sim_strerror(rc));
 }

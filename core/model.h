@@ -184,7 +184,7 @@ void model_static_strokes(const sim_params *p, double s[2]);
  * (i m_n g / k_c)^(1/p) over i = 1..layers); 0 without feed. Where it
  * reaches MODEL_SAG_MAX, the feed's divergence guard (sim_check.h: an
  * element 5 cm into the deck) trips at rest: sim_validate refuses k_c
- * below model_k_c_least, the stiffness at which it would. setup.c */
+ * below sim_k_c_least, the stiffness at which it would. setup.c */
 #define MODEL_SAG_MAX 0.05
 /* m: the eliminators' largest stroke (sim_check.h's guard). At rest an
  * eliminator i sits m_i g cos(beta) / k_si down its guide: sim_validate
@@ -192,7 +192,6 @@ void model_static_strokes(const sim_params *p, double s[2]);
  * (any beta a session may be turned to), sim_k_s_least the least one. */
 #define MODEL_STROKE_MAX 1.0
 double model_column_sag(const sim_params *p, const sim_scene *sc);
-double model_k_c_least(const sim_params *p, const sim_scene *sc);
 
 /* Full coordinates from y at time t. */
 void model_full_coords(const model *md, const model_ctl *ctl, double t, const double *y,

@@ -344,7 +344,10 @@ int sim_get_user(const sim_params *p, const sim_scene *s, const sim_method *m, c
 
 double sim_k_c_least(const sim_params *p, const sim_scene *s)
 {
-	return model_k_c_least(p, s);
+	sim_params unit = *p;
+	unit.k_c = 1.0;
+	double sag = model_column_sag(&unit, s);
+	return sag > 0.0 ? pow(sag / MODEL_SAG_MAX, p->p) : 0.0;
 }
 
 double sim_m_n_most(const sim_params *p, const sim_scene *s)
@@ -401,7 +404,7 @@ int sim_validate(const sim_params *p, const sim_scene *s, const sim_method *m, c
 				 "k_c must be at least %.4g %s here: below it a column of %d "
 				 "layers of %.4g-kg elements sinks %.3g cm under its own weight at "
 				 "rest (the feed model holds %g cm)",
-				 model_k_c_least(p, s), unit, s->layers, p->m_n,
+				 sim_k_c_least(p, s), unit, s->layers, p->m_n,
 				 100.0 * model_column_sag(p, s), 100.0 * MODEL_SAG_MAX);
 		return SIM_EPARAM;
 	}

@@ -229,14 +229,6 @@ double model_column_sag(const sim_params *p, const sim_scene *sc)
 	return sag;
 }
 
-double model_k_c_least(const sim_params *p, const sim_scene *sc)
-{
-	sim_params unit = *p;
-	unit.k_c = 1.0;
-	double sag = model_column_sag(&unit, sc);
-	return sag > 0.0 ? pow(sag / MODEL_SAG_MAX, p->p) : 0.0;
-}
-
 void model_static_strokes(const sim_params *p, double s[2])
 {
 	double cb = cos(p->beta);
