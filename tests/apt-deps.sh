@@ -4,7 +4,12 @@
 # FILE is missing, saying which and why ($WHY). apt-get needs root: as root
 # it runs directly, otherwise through sudo if there is one; without either
 # it prints the command to run and fails. Used by the Makefile's deps rules.
+# Two of them at once (make -j) take turns on a lock: apt-get refuses to run
+# beside another, and the second then finds what the first installed.
 set -u
+if [ -z "${CONVSIM_APT_LOCKED:-}" ] && command -v flock >/dev/null 2>&1; then
+	CONVSIM_APT_LOCKED=1 exec flock "${TMPDIR:-/tmp}/convsim-apt-deps.lock" sh "$0"
+fi
 missing=""
 for pair in $NEEDS; do
 	f=${pair%%:*}; p=${pair##*:}
@@ -25,4 +30,5 @@ else
 	exit 1
 fi
 echo "+ ${sudo:+$sudo }apt-get update && ${sudo:+$sudo }apt-get install -y$missing"
-$sudo apt-get update -q && $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q $missing
+$sudo apt-get -o DPkg::Lock::Timeout=600 update -q &&
+	$sudo env DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 install -y -q $missing
