@@ -1,16 +1,15 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * sweep_cmd.c - convsim sweep: a study of v over any number settings
- * (--vary NAME=FROM:TO:STEP or NAME=V1,V2,..., --beta as the shorthand
- * for --vary beta=..., a grid or a --lhs sample; core/study.h) per
- * rotation sense, one fresh sim_measure per point and sense on the
- * library's parallel map (pmap.h), the mirror reduction's images taken
- * from their sources. The table has the varied settings' columns, then
- * the daemon's point columns (core/table.h); with --band-from a band per
- * point (band_from.h). Under mpirun the points to measure are spread
- * over the ranks (spread.h) and rank 0 writes the table, the same bytes
- * as one process writes. The options' study is study_opts.c's.
- */
+ * sweep_cmd.c - convsim sweep: a study of v over any number settings (--vary
+ * NAME=FROM:TO:STEP or NAME=V1,V2,..., --beta as the shorthand for --vary
+ * beta=..., a grid or a --lhs sample; core/study.h) per rotation sense, one
+ * fresh sim_measure per point and sense on the library's parallel map
+ * (pmap.h), the mirror reduction's images taken from their sources. The
+ * table has the varied settings' columns, then the daemon's point columns
+ * (core/table.h); with --band-from a band per point (band_from.h). Under
+ * mpirun the points to measure are spread over the ranks (spread.h) and
+ * rank 0 writes the table, the same bytes as one process writes. The
+ * options' study is study_opts.c's. */
 #include <fcntl.h>
 #include <math.h>
 #include <signal.h>
@@ -27,8 +26,6 @@
 #include "spread.h"
 #include "study.h"
 #include "table.h"
-
-/* ---- sweep ---- */
 
 typedef struct task {
 	long source; /* -1: measured; else the task it mirrors (sim_study_mirror_plan) */
@@ -128,9 +125,12 @@ static double task_beta(const pool *pl, size_t k)
 	return sim_table_user("beta", pl->o->p.beta);
 }
 
-/* Fill every mirrored task from the task it mirrors (after the runs). */
+/* Fill every mirrored task from the task it mirrors (after the runs), then
+ * judge tol_met again with a curve's own peak (core/study.h). */
 static void mirror_tasks(const pool *pl, int ntasks)
 {
+	double peak = 0.0;
+	int curve = sim_study_curve(pl->st);
 	for (int k = 0; k < ntasks; k++) {
 		task *t = &pl->tasks[k];
 		if (t->source < 0)
@@ -146,6 +146,11 @@ static void mirror_tasks(const pool *pl, int ntasks)
 					   pl->st->rotation[(size_t)t->source / pl->st->npoints],
 					   src->msg);
 	}
+	for (int k = 0; curve && k < ntasks; k++)
+		if (pl->tasks[k].err == SIM_OK && !pl->tasks[k].cancelled)
+			peak = fmax(peak, fabs(pl->tasks[k].r.transport_velocity));
+	for (int k = 0; curve && k < ntasks; k++)
+		pl->tasks[k].r.tol_met = sim_tol_met_at_peak(&pl->tasks[k].r, pl->o->m.tol, peak);
 }
 
 /* The JSON table's head: the run's settings, the varied settings (name,

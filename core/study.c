@@ -379,6 +379,46 @@ done:
 	return measured;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+int sim_curve_covers(const double *beta_deg, size_t n)
+{
+	if (n < 2)
+		return 0;
+	double *b = malloc(n * sizeof *b);
+	if (!b)
+		return 0;
+	memcpy(b, beta_deg, n * sizeof *b);
+	qsort(b, n, sizeof *b, cmp_double);
+	int ok = b[0] <= 1e-9 && b[n - 1] >= 180.0 - 1e-9;
+	for (size_t i = 1; ok && i < n; i++)
+		ok = b[i] - b[i - 1] <= SIM_CURVE_GAP_MAX + 1e-9;
+	free(b);
+	return ok;
+}
+
+int sim_study_curve(const sim_study *st)
+{
+	if (st->naxes != 1 || strcmp(st->axis[0].setting->name, "beta") != 0)
+		return 0;
+	double *b = malloc(st->npoints * sizeof *b);
+	for (size_t k = 0; b && k < st->npoints; k++)
+		b[k] = sim_study_value(st, k, 0);
+	int curve = b && sim_curve_covers(b, st->npoints);
+	free(b);
+	return curve;
+}
+
+int sim_tol_met_at_peak(const sim_measurement *r, double tol, double peak)
+{
+	double v = fabs(r->transport_velocity);
+	return r->tol_met && r->uncertainty <= tol * (v >= 0.3 * peak ? v : peak);
+}
+
 void sim_study_free(sim_study *st)
 {
 	if (!st)

@@ -118,6 +118,21 @@ int sim_study_apply(const sim_study *st, size_t t, sim_params *p, sim_scene *s, 
 size_t sim_study_mirror_plan(const sim_study *st, const sim_params *p, const sim_scene *s,
 			     const sim_method *m, long *source);
 
+/* A curve's tol_met (docs/accuracy.md "A curve's own peak"): a point's run
+ * judged tol by docs/MODEL.md's convention with the peak estimated from the
+ * trough's vibration speed, which overestimates it where the feed barely
+ * throws (below a throw number of about one: 2 to 8 times). Where beta
+ * alone is varied over a curve that finds its peak (sim_curve_covers: beta
+ * from 0 to 180 deg, no gap wider than SIM_CURVE_GAP_MAX), the largest |v|
+ * measured (a lower bound of the peak) judges again: tol_met stays true
+ * only where the bar is also within tol with that peak. Never from false
+ * to true. beta_deg: the points' beta, deg. */
+#define SIM_CURVE_GAP_MAX 30.0
+int sim_curve_covers(const double *beta_deg, size_t n);
+/* beta the study's only axis and its values sim_curve_covers. */
+int sim_study_curve(const sim_study *st);
+int sim_tol_met_at_peak(const sim_measurement *r, double tol, double peak);
+
 /* Free what the study owns (NULL is fine); the struct itself is the
  * caller's. */
 void sim_study_free(sim_study *st);

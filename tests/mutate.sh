@@ -105,6 +105,9 @@ mutations=(
 	# an orbit the motor cannot drive (tests/unit/test_power.c)
 	"the load torque constant whatever way the rotor turns|core/model.c|s|fmin(p->M_load, 2.0 \* p->M_ut / p->slip_ut \* dt->omega)|fmin(p->M_load, (double)ctl->rotation * 1e300)|"
 	"the steady start on an orbit the motor cannot drive|core/steady.c|s|if (!md->phi_prescribed \&\& !isfinite(next))|if (0)|"
+	# a curve's tol_met judged with the run's peak estimate alone
+	# (tests/unit/test_measure_point.c, tests/http/jobs.test.mjs)
+	"a curve's own peak allowing tol times it everywhere|core/study.c|s|tol \* (v >= 0.3 \* peak ? v : peak)|tol * (v >= 0.3 * peak ? peak : peak)|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

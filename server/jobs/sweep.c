@@ -213,6 +213,7 @@ static void run_point(void *arg)
 		atomic_fetch_add(&srv_stats.sweep_points, 1);
 		/* a deleted sweep's files are gone: none are written again */
 		if (!sw->cancelled) {
+			srv_sweep_curve_tol(sw);
 			persist_locked(sw, 0);
 			if (sw->done == sw->total)
 				save_results(sw);

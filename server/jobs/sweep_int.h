@@ -44,6 +44,10 @@ int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, si
 /* Point i is over (done or failed): its mirror image, if it has one, is
  * too (lock held). */
 void srv_sweep_fill_image(srv_sweep *sw, size_t i);
+/* Once every point is over, a v(beta) curve's tol_met judged again with
+ * its own peak (sim_tol_met_at_peak, core/study.h; lock held): a point
+ * shows its run's until then. */
+void srv_sweep_curve_tol(srv_sweep *sw);
 /* band_from_fit (sweep_plan.c): the fit's result as the band source and
  * the request's model prepared for it (its fitted values, the varied ones
  * skipped); API_OK or the problem (srv_fit_band_source's, or a 422

@@ -6,6 +6,7 @@
  * over; a point's varied settings applied to its model; and the band
  * source of a sweep with band_from_fit.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -107,6 +108,24 @@ void srv_sweep_fill_image(srv_sweep *sw, size_t i)
 		sim_mirror_failure(p->error, sizeof p->error, src->beta.user, src->rotation,
 				   src->error);
 	sw->done++;
+}
+
+void srv_sweep_curve_tol(srv_sweep *sw)
+{
+	if (sw->done != sw->total || sw->req.nvary != 1 || strcmp(sw->req.vary[0], "beta") != 0)
+		return;
+	double *b = malloc(sw->total * sizeof *b), peak = 0.0;
+	for (size_t k = 0; b && k < sw->total; k++)
+		b[k] = sw->pt[k].beta.user;
+	int curve = b && sim_curve_covers(b, sw->total);
+	free(b);
+	for (size_t k = 0; curve && k < sw->total; k++)
+		if (sw->pt[k].state == 2)
+			peak = fmax(peak, fabs(sw->pt[k].m.transport_velocity));
+	for (size_t k = 0; curve && k < sw->total; k++)
+		if (sw->pt[k].state == 2)
+			sw->pt[k].m.tol_met = sim_tol_met_at_peak(&sw->pt[k].m,
+								  sw->req.spec.method.tol, peak);
 }
 
 /* band_from_fit: the fit's result as the band source and the sweep's

@@ -6,9 +6,10 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { execFileSync } from 'node:child_process';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, until, near, metric, processCpu, sleep, CHEAP, NO_FEED, SLOW } from './lib.mjs';
+import { startDaemon, req, until, near, metric, processCpu, sleep, CHEAP, NO_FEED, SLOW, CLI } from './lib.mjs';
 
 let d;
 before(async () => { d = await startDaemon(); });
@@ -369,3 +370,30 @@ test('a sweep deleted while its points run leaves no record behind', { timeout: 
   assert.ok(!existsSync(join(dir, 'sweeps', `${sw.body.id}.bin`)), 'the record is gone');
   assert.equal((await req(again.base, 'GET', path)).status, 404);
 }));
+
+// A v(beta) curve judges tol_met again with its own peak (docs/accuracy.md
+// "A curve's own peak"): with g = 60 m/s^2 the feed barely throws, the
+// run's peak estimate (half the trough's largest speed) is eight times the
+// curve's, and the points near the curve's peak, whose bars exceed 1 % of
+// |v|, said tol_met true by it. The daemon's curve and the CLI's agree to
+// the byte; a point alone (no curve) keeps its run's judgement.
+test('a v(beta) curve judges tol_met with its own peak, the daemon as the CLI', { timeout: 60000 * SLOW }, async () => {
+  const r = await req(d.base, 'POST', '/api/v1/sweeps',
+    { params: { g: 60 }, beta: { from: 0, to: 180, step: 30 }, rotations: ['cw'] });
+  assert.equal(r.status, 202, r.text);
+  await until(async () => (await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}`)).body.state === 'done', 50000, 'the sweep');
+  const daemon = (await req(d.base, 'GET', `/api/v1/sweeps/${r.body.id}?format=csv`)).text.trim().split('\n');
+  const cli = execFileSync(CLI, ['sweep', '--set', 'g=60', '--beta', '0:180:30', '--rotation', 'cw', '-q'])
+    .toString().trim().split('\n');
+  assert.deepEqual(daemon, cli);
+  const col = cli[0].split(',');
+  const rows = cli.slice(1).map((l) => Object.fromEntries(l.split(',').map((x, i) => [col[i], x])));
+  const peak = Math.max(...rows.map((x) => Math.abs(+x.velocity)));
+  for (const x of rows) {
+    const v = Math.abs(+x.velocity), allowed = 0.01 * (v >= 0.3 * peak ? v : peak);
+    assert.equal(x.tol_met, String(+x.uncertainty <= allowed), `beta ${x.beta}: ${x.uncertainty} against ${allowed}`);
+  }
+  assert.deepEqual(rows.map((x) => x.tol_met), ['false', 'false', 'true', 'true', 'true', 'false', 'false']);
+  const one = execFileSync(CLI, ['sweep', '--set', 'g=60', '--beta', '150', '--rotation', 'cw', '-q']).toString().trim().split('\n');
+  assert.equal(one[1].split(',')[col.indexOf('tol_met')], 'true');
+});
