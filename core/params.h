@@ -134,6 +134,8 @@ typedef struct sim_method {
 } sim_method;
 
 /* One integrator as its descriptor describes it (sim_methods lists them). */
+/* The fewest feed sub-steps a shadow runs beside (at half of them). */
+#define SIM_SHADOW_SUBSTEPS 3
 typedef struct sim_method_info {
 	const char *name;
 	int order;        /* classical order on smooth problems */
@@ -152,7 +154,7 @@ typedef struct sim_method_info {
 			 (sim_method.substeps): its energy is booked apart, its
 			 step error modelled, the symmetric machine settles reduced */
 	int shadow;   /* a shadow run at half the sub-steps measures the feed
-			 step's error (shadow.c) */
+			 step's error (shadow.c), from SIM_SHADOW_SUBSTEPS up */
 	double dt_feed, dt_free; /* the default step with a feed and without,
 				    s; 0: from the scene's time scales
 				    (sim_default_dt), refined by sim_measure

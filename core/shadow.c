@@ -69,7 +69,8 @@ void sim_drop_shadow(sim *s)
 void shadow_begin(sim *s)
 {
 	shadow_stop(s);
-	if (!s->ode->info.shadow || !s->cfg.feed_events || s->md.nf == 0 || s->cfg.substeps < 3 ||
+	if (!s->ode->info.shadow || !s->cfg.feed_events || s->md.nf == 0 ||
+	    s->cfg.substeps < SIM_SHADOW_SUBSTEPS ||
 	    s->failed)
 		return;
 	sim_method m = s->cfg;

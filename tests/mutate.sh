@@ -107,6 +107,9 @@ mutations=(
 	"the steady start on an orbit the motor cannot drive|core/steady.c|s|if (!md->phi_prescribed \&\& !isfinite(next))|if (0)|"
 	# a curve's tol_met judged with the run's peak estimate alone
 	# (tests/unit/test_measure_point.c, tests/http/jobs.test.mjs)
+	# a fast machine's step with one feed sub-step and no shadow
+	# (tests/unit/test_measure_point.c)
+	"a fast machine's sub-steps below the shadow's least|core/defaults.c|s|if (n < SIM_SHADOW_SUBSTEPS \&\& om|if (n < 1 \&\& om|"
 	"a curve's own peak allowing tol times it everywhere|core/study.c|s|tol \* (v >= 0.3 \* peak ? v : peak)|tol * (v >= 0.3 * peak ? peak : peak)|"
 )
 # --check: only that every fault applies (each to a copy of its file), no

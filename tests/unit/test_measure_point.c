@@ -186,6 +186,29 @@ static void curve_peak_judges_tol_again(void **state)
 	assert_true(m[3].tol_met && sim_tol_met_at_peak(&m[3], 0.01, peak));
 }
 
+/* A fast machine whose stability bound cuts the machine step below two
+ * feed steps (M_ut 269.4 N m, k_y 27670 N/m, mu 0.4803: 2.4e-4 s) gets
+ * the shadow's least sub-steps, 3, not 1, so that its bar is measured
+ * (sim_default_substeps): with 1 it was the preset's calibrated term, and
+ * 60 deg cw read 0.08327 m/s with a bar of 7.2e-4 against v_ref 0.082321
+ * (dem 1.25e-4 s / 40 sub-steps without events, the same to 1e-7 m/s over
+ * [0, 8], [10, 18] and [20, 28] s after the steady start). */
+static void fast_machine_gets_a_shadow(void **state)
+{
+	(void)state;
+	static const char *const fast[] = {"M_ut", "269.4", "k_y", "27670", "mu", "0.4803", NULL};
+	setup u = preset_defaults();
+	for (int i = 0; fast[i]; i += 2)
+		set(&u, fast[i], fast[i + 1]);
+	double dt = sim_default_dt(&u.p, &u.sc, &u.m);
+	assert_true(dt == 2.4e-4);
+	assert_int_equal(sim_default_substeps(&u.p, &u.sc, &u.m, dt), 3);
+	sim_measurement m = point(60.0, "cw", fast);
+	assert_int_equal(m.substeps, 3);
+	assert_true(m.tol_met);
+	holds(&m, 0.082321, 0.1505, 60.0);
+}
+
 /* The machine step's a-priori term (sim_status.c) is first order in the
  * step counted in the machine's own excitation periods: 0.5 % of |v| plus
  * 0.025 % of the trough's largest speed at 32 steps a period, that times
@@ -302,6 +325,7 @@ int main(void)
 		cmocka_unit_test(own_shadow_where_the_run_before_misses),
 		cmocka_unit_test(tol_allows_the_conventions_error),
 		cmocka_unit_test(curve_peak_judges_tol_again),
+		cmocka_unit_test(fast_machine_gets_a_shadow),
 		cmocka_unit_test(machine_step_term_in_the_machines_own_period),
 		cmocka_unit_test(chaotic_feed_long_run),
 		cmocka_unit_test(peek_is_what_the_shadows_end_sets),
