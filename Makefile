@@ -172,6 +172,13 @@ INC_dem    := -Icore -Idem -I/usr/include/liggghts $(MPI_CFLAGS)
 INC_dem_cli := $(INC_dem) -Icli
 $(BUILD)/cli/spread_mpi.o: INC_EXTRA := $(MPI_CFLAGS)
 $(BUILD)/cli/handover.o: INC_EXTRA := -DCLI_MPI_BUILD=$(CLI_MPI_HAS)
+# CLI_MPI_HAS follows what is installed when make starts: `make run` builds
+# convsim before `make test` installs MPI and LIGGGHTS. The value is kept in
+# a file rewritten only when it changes, and handover.o depends on it, so
+# the hand-over is compiled again when the packages arrive.
+HANDOVER_MPI := $(BUILD)/cli/handover.mpi
+$(shell mkdir -p $(BUILD)/cli && { [ "$$(cat $(HANDOVER_MPI) 2>/dev/null)" = "$(CLI_MPI_HAS)" ] || echo $(CLI_MPI_HAS) > $(HANDOVER_MPI); })
+$(BUILD)/cli/handover.o: $(HANDOVER_MPI)
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)

@@ -15,7 +15,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { copyFileSync, existsSync, mkdtempSync, writeFileSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join } from 'node:path';
 import '../tether.mjs'; // nothing started here outlives the test
@@ -53,6 +53,22 @@ test('the plain convsim links neither MPI nor LIGGGHTS, convsim-mpi beside it li
   assert.doesNotMatch(ldd(CLI), /libmpi|liggghts|libopen-|libpmix|libvtk/);
   assert.match(ldd(join(dirname(CLI), 'convsim-mpi')), /libmpi\.so/);
   assert.doesNotMatch(ldd(NOMPI), /libmpi/);
+});
+
+// `make run` builds convsim before `make test` installs MPI: the hand-over
+// (cli/handover.o, -DCLI_MPI_BUILD) is compiled again once MPI is there
+// (it was kept, and the plain convsim then ran every rank alone, each
+// writing the whole table).
+test('the hand-over is compiled again when MPI arrives after a build without it', () => {
+  const b = mkdtempSync(join(tmpdir(), 'convsim-build-'));
+  const make = (...args) => spawnSync('make', ['--no-print-directory', `BUILD=${b}`, ...args, `${b}/cli/handover.o`],
+    { cwd: ROOT, encoding: 'utf8', timeout: 120000 });
+  assert.equal(make('NO_MPI=1').status, 0);
+  assert.equal(make('NO_MPI=1', '-q').status, 0, 'up to date without MPI');
+  assert.equal(make('-q').status, 1, 'MPI installed since: handover.o is out of date');
+  assert.equal(make().status, 0);
+  assert.equal(make('-q').status, 0);
+  assert.equal(readFileSync(join(b, 'cli/handover.mpi'), 'utf8').trim(), existsSync('/usr/include/liggghts/library.h') ? '3' : '1');
 });
 
 test('under mpirun a convsim without convsim-mpi beside it says what it needs and stops (exit 1), no table', () => {
