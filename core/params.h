@@ -133,9 +133,9 @@ typedef struct sim_method {
 			 refines until the estimated step error is within it */
 } sim_method;
 
-/* One integrator as its descriptor describes it (sim_methods lists them). */
 /* The fewest feed sub-steps a shadow runs beside (at half of them). */
 #define SIM_SHADOW_SUBSTEPS 3
+/* One integrator as its descriptor describes it (sim_methods lists them). */
 typedef struct sim_method_info {
 	const char *name;
 	int order;        /* classical order on smooth problems */
