@@ -148,6 +148,13 @@ static double two_digits(double dt)
 	return floor(dt * scale * (1.0 + 1e-12)) / scale;
 }
 
+/* A coupled feed too heavy for dem's corrector: single steps of
+ * HEAVY_FEED_STEP (kind_default_dt), no sub-steps (sim_default_substeps). */
+static int heavy_feed(const sim_params *p, const sim_scene *s)
+{
+	return s->feed_coupling && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO;
+}
+
 static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim_method *m)
 {
 	int feed = s->feed && s->columns > 0 && s->layers > 0;
@@ -155,7 +162,7 @@ static double kind_default_dt(const sim_params *p, const sim_scene *s, const sim
 	if (om && om->info.dt_feed > 0)
 		return feed ? om->info.dt_feed : om->info.dt_free;
 	double dt, top;
-	if (s->feed_coupling && feed && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO) {
+	if (feed && heavy_feed(p, s)) {
 		top = HEAVY_FEED_STEP;
 		dt = fmin(top, sim_contact_period(p, s) / CONTACT_STEPS) * tol_scale(m);
 	} else if (feed && m->feed_events) {
@@ -212,13 +219,13 @@ double sim_default_feed_step(const sim_params *p, const sim_scene *s, const sim_
  * the preset's calibrated term stood for it (M_ut 269 N m, k_y 27670 N/m,
  * mu 0.48 at 60 deg cw: 2.4e-4 s with 1 sub-step, 1.16 % of |v| off with
  * a bar of 0.87 %; with 3, 0.06 % off and its bar measured). A heavy feed
- * keeps its single steps (kind_default_dt). */
+ * keeps its single steps. */
 int sim_default_substeps(const sim_params *p, const sim_scene *s, const sim_method *m, double dt)
 {
 	int n = (int)ceil(dt / sim_default_feed_step(p, s, m) - 1e-9);
 	const ode_method *om = ode_find(m->name);
 	if (n < SIM_SHADOW_SUBSTEPS && om && om->info.shadow && m->feed_events &&
-	    !(s->feed_coupling && model_feed_mass_ratio(p, s) > MODEL_CORRECTOR_MAX_RATIO))
+	    !heavy_feed(p, s))
 		n = SIM_SHADOW_SUBSTEPS;
 	return n < 1 ? 1 : n > 1000 ? 1000 : n;
 }
