@@ -234,3 +234,23 @@ void estimator_read(const estimator *e, estimate *out)
 		out->rotor_speed_mean = out->torque_mean = out->power_mean = NAN;
 	}
 }
+
+double estimator_blocked_bar(const estimator *e, int min_blocks)
+{
+	double u = e->bar.uncertainty, half = 0.5 * e->bar.drift, se2 = u * u - half * half;
+	for (int k = 2; k <= 4 && (e->n_rec - 1) / k >= min_blocks; k *= 2) {
+		int nb = (e->n_rec - 1) / k;
+		double v[EST_RECORDS], mean = 0.0, span = 0.0, ss = 0.0;
+		for (int i = 0; i < nb; i++) {
+			double dt = e->rec_t[(i + 1) * k] - e->rec_t[i * k];
+			v[i] = (e->rec_X[(i + 1) * k] - e->rec_X[i * k]) / dt;
+			mean += v[i] * dt;
+			span += dt;
+		}
+		mean /= span;
+		for (int i = 0; i < nb; i++)
+			ss += (v[i] - mean) * (v[i] - mean);
+		se2 = fmax(se2, ss / (nb - 1) / nb);
+	}
+	return sqrt(se2 + half * half);
+}

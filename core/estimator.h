@@ -63,4 +63,11 @@ typedef struct estimate {
 } estimate;
 void estimator_read(const estimator *e, estimate *out);
 
+/* The estimate's bar (the standard error of the batches' mean and half the
+ * drift, in quadrature) with that standard error taken as the largest of
+ * the batches' own and that of the batches merged 2 and 4 at a time, where
+ * at least min_blocks merged ones remain: against a motion correlated
+ * beyond a batch (a blocked standard error). */
+double estimator_blocked_bar(const estimator *e, int min_blocks);
+
 #endif

@@ -11,7 +11,8 @@
  * shadow differ by scatter, it is measured over a longer window instead,
  * its bar holding a long-window reference, and the long run's check reads
  * the running shadow as its end would. The machine step's a-priori term
- * in the bar is held to its formula on a machine with its own period.
+ * in the bar is held to its formula on a machine with its own period. A
+ * feed thrown hard is measured over a later window.
  */
 #include "testutil.h"
 
@@ -241,6 +242,36 @@ static void machine_step_term_in_the_machines_own_period(void **state)
 	}
 }
 
+/* A feed thrown hard (e 0.05195 m, k_c 3.827e6: the trough's acceleration
+ * about 8.5 g): on the steady start's orbit the machine is steady for 3 s,
+ * then leaves it (v -0.2906 m/s over [0, 4] s, -0.2708 from 5 s on), and
+ * a sweep's point over [0, 4] s was within tol at -0.2916. Measured over
+ * [8, 12] s instead (measure.c, MEASURE_LATE_THROW): the same bits as the
+ * point asked for that window itself, and within 1 % of the reference (dt
+ * 1.25e-4 s / 40 sub-steps without feed events over [10, 18] s: -0.27101;
+ * 6.25e-5 s: -0.27097; the same steps over [20, 30] s: -0.27099), inside
+ * its bar. */
+static void hard_throw_measured_late(void **state)
+{
+	(void)state;
+	static const char *const hard[] = {"e", "0.05195", "k_c", "3827000", NULL};
+	sim_measurement m = point(120.0, "cw", hard);
+	holds(&m, -0.27100, 0.45, 120.0);
+	setup u = preset_defaults();
+	for (int i = 0; hard[i]; i += 2)
+		set(&u, hard[i], hard[i + 1]);
+	set(&u, "rotation", "cw");
+	set(&u, "transient", "8");
+	u.p.beta = 120.0 * RAD_PER_DEG;
+	sim_measurement late;
+	char msg[200] = "";
+	assert_int_equal(sim_measure_point(&u.p, &u.sc, &u.m, 12.0, &late, msg, sizeof msg),
+			 SIM_OK);
+	assert_true(late.transport_velocity == m.transport_velocity);
+	assert_true(late.uncertainty == m.uncertainty);
+	assert_true(late.periods == m.periods && late.dt == m.dt && late.substeps == m.substeps);
+}
+
 /* Issue 37's chaotic feed (R = 0.5, mu = 0.6): the run and its shadow
  * drift apart and their difference is scatter, which the shadow's bar
  * divided by r - 1 (up to 7 times the true error on main at f416208, the
@@ -327,6 +358,7 @@ int main(void)
 		cmocka_unit_test(curve_peak_judges_tol_again),
 		cmocka_unit_test(fast_machine_gets_a_shadow),
 		cmocka_unit_test(machine_step_term_in_the_machines_own_period),
+		cmocka_unit_test(hard_throw_measured_late),
 		cmocka_unit_test(chaotic_feed_long_run),
 		cmocka_unit_test(peek_is_what_the_shadows_end_sets),
 	};
