@@ -159,6 +159,19 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 	return s;
 }
 
+/* A feed thrown hard: the trough's acceleration (its largest speed times
+ * omega_ss) beyond MEASURE_LATE_THROW g (the zoo's at most 5.0). Such a
+ * machine may leave the steady start's orbit seconds later, steady and
+ * within tol before (docs/random-machines.md): a sweep's point is measured
+ * again over a window of the same length from MEASURE_LATE_START s, its
+ * first run stopped at its first check. */
+#define MEASURE_LATE_THROW 5.5
+#define MEASURE_LATE_START 8.0
+static int thrown_hard(const sim_params *p, double speed_max)
+{
+	return speed_max * p->omega_ss > MEASURE_LATE_THROW * p->g;
+}
+
 /* The run before a refinement: its own estimate of v at its shadow's end
  * and its feed step. A refinement restored from the same settled start
  * takes it as its shadow (shadow_against): the two estimates span the
@@ -172,7 +185,8 @@ typedef struct coarser_run {
 	 * standard error (shadow.c: step_se; NaN: none) and how far past the
 	 * window's start the run went (s) */
 	double raw, se, ran;
-	double speed_max; /* m/s: the trough's largest speed in its window */
+	double speed_max; /* m/s: the trough's largest in its window */
+	int late_check;   /* stop at the first check once thrown_hard */
 } coarser_run;
 
 /* Whether s's own shadow would be the coarser run itself (the same
@@ -256,6 +270,8 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 		err = sim_advance(s, t);
 		if (err != SIM_OK || t >= t_end)
 			break;
+		if (!s->shadow && coarser->late_check && thrown_hard(p, s->est.speed_max))
+			break;
 		if (!s->shadow && (early_met(&s->st) ||
 				   (may_refine && s->st.step_error > s->st.tol_allowed &&
 				    (refine_asks(&s->st, last) || beyond_tol(&s->st, last)))))
@@ -299,10 +315,7 @@ static int scatter_only(const sim_status *st, const coarser_run *c)
  * tests/bench/zoo/chaos_ref.tsv at 105 deg), which the batches alone read
  * low. */
 #define LONG_BLOCKS 8
-static double long_stat(const sim *s)
-{
-	return estimator_blocked_bar(&s->est, LONG_BLOCKS);
-}
+#define long_stat(s) estimator_blocked_bar(&(s)->est, LONG_BLOCKS)
 
 /* The long run's bar at its present time with the running shadow's raw
  * step error and standard error (shadow_peek): the scatter (long_stat),
@@ -375,10 +388,11 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 
 /* sim_measure, and sim_measure_point if early: its runs stop once their
  * bar is met, and its refinements start from the first run's settled
- * start; *speed_max the first run's largest trough speed. */
+ * start; *moved where its first run is thrown hard and its window starts
+ * before MEASURE_LATE_START (the caller measures it over the later one). */
 static int measure_window(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			  double t_end, int early, double deadline, sim_measurement *out,
-			  double *speed_max, char *msg, size_t msglen)
+			  int *moved, char *msg, size_t msglen)
 {
 	struct timespec c0, c1;
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
@@ -392,14 +406,17 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
 	double last = INFINITY;
 	settled_start start = {NULL, 0};
-	coarser_run coarser = {NAN, NAN, NAN, 0, NAN, NAN, NAN, NAN};
+	coarser_run coarser = {NAN, NAN, NAN, 0, NAN, NAN, NAN, NAN, 0};
+	int late = early && fmax(0.0, sc->transient) < MEASURE_LATE_START;
 	for (int attempt = 0;; attempt++) {
 		int may_refine = own_steps && attempt < MEASURE_REFINEMENTS;
+		coarser.late_check = late && attempt == 0;
 		err = measure_once(p, sc, &run, t_end, deadline, early, may_refine, last,
 				   early && own_steps ? &start : NULL, &coarser, &st, msg, msglen);
 		out->refinements = attempt;
-		if (attempt == 0)
-			*speed_max = coarser.speed_max;
+		*moved = attempt == 0 && late && err == SIM_OK && thrown_hard(p, coarser.speed_max);
+		if (*moved)
+			break;
 		if (err == SIM_OK && attempt == 0 && early && own_steps && start.buf &&
 		    scatter_only(&st, &coarser)) {
 			err = measure_long(p, sc, &run, t_end, deadline, &start, &coarser, &st, msg,
@@ -442,33 +459,16 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 	return err;
 }
 
-/* A sweep's point whose feed is thrown hard: the trough's acceleration
- * (its largest speed in the first run's window times omega_ss) beyond
- * MEASURE_LATE_THROW g. There the machine may leave the state the steady
- * start put it on seconds later (the start's orbit is the machine's with
- * the feed as a weight; a hard-thrown feed changes it, and the orbit
- * found may be unstable; docs/accuracy.md "A feed thrown hard": points
- * at throws of 8 to 16 moved by 2 to 13 % between 3 and 8 s, steady and
- * within tol in the first 4 s). The point is measured again over a
- * window of the same length from MEASURE_LATE_START s. The zoo's and the
- * preset's throws are at most 5.0 (docs/machine-zoo.md). */
-#define MEASURE_LATE_THROW 5.5
-#define MEASURE_LATE_START 8.0
-
 static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		   int early, double deadline, sim_measurement *out, char *msg, size_t msglen)
 {
-	double speed_max = NAN;
-	int err = measure_window(p, sc, m, t_end, early, deadline, out, &speed_max, msg, msglen);
-	double start = fmax(0.0, sc->transient);
-	if (err != SIM_OK || !early || !(speed_max * p->omega_ss > MEASURE_LATE_THROW * p->g) ||
-	    start >= MEASURE_LATE_START)
+	int moved, err = measure_window(p, sc, m, t_end, early, deadline, out, &moved, msg, msglen);
+	if (err != SIM_OK || !moved)
 		return err;
 	sim_scene late = *sc;
 	late.transient = MEASURE_LATE_START;
-	double cpu = out->cpu_seconds;
-	err = measure_window(p, &late, m, t_end + (MEASURE_LATE_START - start), early, deadline,
-			     out, &speed_max, msg, msglen);
+	double cpu = out->cpu_seconds, shift = MEASURE_LATE_START - fmax(0.0, sc->transient);
+	err = measure_window(p, &late, m, t_end + shift, early, deadline, out, &moved, msg, msglen);
 	out->cpu_seconds += cpu;
 	return err;
 }

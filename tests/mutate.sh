@@ -113,7 +113,7 @@ mutations=(
 	"a curve's own peak allowing tol times it everywhere|core/study.c|s|tol \* (v >= 0.3 \* peak ? v : peak)|tol * (v >= 0.3 * peak ? peak : peak)|"
 	# a hard-thrown feed measured over the steady start's first window
 	# (tests/unit/test_measure_point.c)
-	"a feed thrown hard measured from the steady start on|core/measure.c|s|start >= MEASURE_LATE_START)|start >= 0.0)|"
+	"a feed thrown hard measured from the steady start on|core/measure.c|s|int late = early \&\& fmax|int late = 0 \&\& fmax|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.
