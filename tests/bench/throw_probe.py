@@ -13,10 +13,10 @@ where it says steady and tol_met and lies beyond the gate from v_ref.
 
   python3 tests/bench/throw_probe.py [--seeds 1,2,3] [--count 14] [--baseline BIN] [--out MD]
 
-About 40 minutes of two cores for three seeds of 14 machines (the references). Writes the
-table to tests/bench/results/throw_probe.md (docs/accuracy.md "A feed thrown hard").
+Its header gives its wall time (the references take most of it). Writes the table to
+tests/bench/results/throw_probe.md (docs/random-machines.md).
 """
-import argparse, csv, datetime, io, json, math, os, random, subprocess, sys, tempfile
+import argparse, csv, datetime, io, json, math, os, random, subprocess, sys, tempfile, time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -98,6 +98,7 @@ def main():
     o = ap.parse_args()
     rows, tot = [], {"claimed": 0, "base": 0, "this": 0, "flag": 0, "mach_base": 0, "mach_this": 0}
     keep = open(o.jsonl, "a") if o.jsonl else None
+    began = time.time()
     for seed in [int(x) for x in o.seeds.split(",")]:
         rng = random.Random(seed)
         for i in range(o.count):
@@ -141,11 +142,11 @@ def main():
     fmt = lambda ms: "; ".join("%s %s %.4f (v_ref %.4f)" % m for m in ms) or "none"
     with open(o.out, "w") as f:
         f.write("# A feed thrown hard: random machines against converged references\n\n")
-        f.write("Command: `%s`, %s UTC, %s. %s\n\n" % (
+        f.write("Command: `%s`, %s UTC, %s. %s Wall time: %.0f min on %d cores.\n\n" % (
             cmd, datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"),
             rev(ROOT) + " (this build)",
             "Baseline: %s." % rev(os.path.dirname(os.path.dirname(os.path.abspath(o.baseline))))
-            if o.baseline else ""))
+            if o.baseline else "", (time.time() - began) / 60, os.cpu_count()))
         f.write("| machine | seed | throw | points claimed by the references | baseline's misses"
                 " | this build's misses | this build's flagged (not steady or not tol_met) |\n")
         f.write("|---|---|---|---|---|---|---|\n")
