@@ -18,6 +18,8 @@ tests/bench/results/throw_probe.md (docs/random-machines.md).
 """
 import argparse, csv, datetime, io, json, math, os, random, subprocess, sys, tempfile, time
 
+import provenance
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 EXTRA = [("R", 0.05, 0.6, "lin"), ("mu", 0.2, 0.9, "lin"), ("m_n", 0.2, 2.0, "log"),
@@ -142,11 +144,10 @@ def main():
     fmt = lambda ms: "; ".join("%s %s %.4f (v_ref %.4f)" % m for m in ms) or "none"
     with open(o.out, "w") as f:
         f.write("# A feed thrown hard: random machines against converged references\n\n")
-        f.write("Command: `%s`, %s UTC, %s. %s Wall time: %.0f min on %d cores.\n\n" % (
-            cmd, datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"),
-            rev(ROOT) + " (this build)",
-            "Baseline: %s." % rev(os.path.dirname(os.path.dirname(os.path.abspath(o.baseline))))
-            if o.baseline else "", (time.time() - began) / 60, os.cpu_count()))
+        f.write("Command: `%s`, %s UTC, this build: %s%s, %s. Wall time: %.0f min.\n\n" % (
+            cmd, datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M"), rev(ROOT),
+            ", baseline: %s" % rev(os.path.dirname(os.path.dirname(os.path.abspath(o.baseline))))
+            if o.baseline else "", provenance.machine(), (time.time() - began) / 60))
         f.write("| machine | seed | throw | points claimed by the references | baseline's misses"
                 " | this build's misses | this build's flagged (not steady or not tol_met) |\n")
         f.write("|---|---|---|---|---|---|---|\n")
