@@ -315,15 +315,14 @@ static int scatter_only(const sim_status *st, const coarser_run *c)
  * tests/bench/zoo/chaos_ref.tsv at 105 deg), which the batches alone read
  * low. */
 #define LONG_BLOCKS 8
-#define long_stat(s) estimator_blocked_bar(&(s)->est, LONG_BLOCKS)
 
 /* The long run's bar at its present time with the running shadow's raw
- * step error and standard error (shadow_peek): the scatter (long_stat),
+ * step error and standard error (shadow_peek): the scatter (as above),
  * the step error as shadow_finish bounds it, the machine step's term;
  * *shrink the part that shrinks as one over the root of the window. */
 static double long_bar(const sim *s, double raw, double se, double *shrink)
 {
-	double stat = long_stat(s);
+	double stat = estimator_blocked_bar(&s->est, LONG_BLOCKS);
 	int scatter = raw <= SHADOW_SIGNIFICANT * se;
 	*shrink = stat + (scatter ? se : 0.0);
 	return stat + (scatter ? se : raw) + s->st.machine_error;
@@ -380,7 +379,8 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 	if (err != SIM_OK && msg)
 		snprintf(msg, msglen, "%s", s->error);
 	*st = s->st;
-	st->transport_velocity_uncertainty = long_stat(s) + st->step_error;
+	st->transport_velocity_uncertainty =
+		estimator_blocked_bar(&s->est, LONG_BLOCKS) + st->step_error;
 	st->tol_met = st->transport_velocity_uncertainty <= st->tol_allowed;
 	sim_free(s);
 	return err;
