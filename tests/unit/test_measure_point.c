@@ -242,15 +242,15 @@ static void machine_step_term_in_the_machines_own_period(void **state)
 	}
 }
 
-/* A feed thrown hard (e 0.05195 m, k_c 3.827e6: the trough's acceleration
- * about 8.5 g): on the steady start's orbit the machine is steady for 3 s,
- * then leaves it (v -0.2906 m/s over [0, 4] s, -0.2708 from 5 s on), and
- * a sweep's point over [0, 4] s was within tol at -0.2916. Measured over
- * [8, 12] s instead (measure.c, MEASURE_LATE_THROW): the same bits as the
- * point asked for that window itself, and within 1 % of the reference (dt
- * 1.25e-4 s / 40 sub-steps without feed events over [10, 18] s: -0.27101;
- * 6.25e-5 s: -0.27097; the same steps over [20, 30] s: -0.27099), inside
- * its bar. */
+/* A feed thrown hard (e 0.05195 m, k_c 3.827e6: a throw of about 9): on
+ * the steady start's orbit the machine is steady for about 3 s, then
+ * leaves it (at the default steps v -0.2906 m/s over [0, 4] s, -0.2708
+ * over [10, 18] s), and a sweep's point over [0, 4] s was within tol at
+ * -0.2916. Measured over [8, 12] s instead (measure.c,
+ * MEASURE_LATE_THROW): the same bits as the point asked for that window
+ * itself, and within 1 % of the reference (dt 1.25e-4 s / 40 sub-steps
+ * without feed events over [10, 18] s: -0.27101; 6.25e-5 s: -0.27097;
+ * 1.25e-4 s over [20, 30] s: -0.27117), inside its bar. */
 static void hard_throw_measured_late(void **state)
 {
 	(void)state;
