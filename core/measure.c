@@ -18,9 +18,8 @@
 
 #include "sim_int.h"
 
-/* A measurement's shadow runs over this share of its window: long enough
- * for its estimate to settle (30 periods of the preset's 4-s
- * window), short enough to keep the shadow's cost near a fifth. */
+/* A measurement's shadow runs over this share of its window: long enough for its estimate to
+ * settle (30 periods of the preset's 4-s window), short enough to keep its cost near a fifth. */
 #define SHADOW_MEASURE_SHARE 0.3
 
 /* sim_measure's refinements at most: each shrinks the feed step, or the
@@ -159,12 +158,12 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 	return s;
 }
 
-/* A feed thrown hard: the trough's acceleration (its largest speed times
- * omega_ss) beyond MEASURE_LATE_THROW g (the zoo's at most 5.0). Such a
- * machine may leave the steady start's orbit seconds later, steady and
- * within tol before (docs/random-machines.md): a sweep's point is measured
- * again over a window of the same length from MEASURE_LATE_START s, its
- * first run stopped at its first check. */
+/* A feed thrown hard: the trough's acceleration (its largest speed times omega_ss) beyond
+ * MEASURE_LATE_THROW g (the zoo's at most 5.0). Such a machine may leave the steady start's
+ * orbit seconds later, steady and within tol before, and its feed step may pick its motion
+ * (docs/random-machines.md): a sweep's point is measured again over a window of the same
+ * length from MEASURE_LATE_START s at twice the feed sub-steps (its shadow at the scene's
+ * own), its first run stopped at its first check. */
 #define MEASURE_LATE_THROW 5.5
 #define MEASURE_LATE_START 8.0
 static int thrown_hard(const sim_params *p, double speed_max)
@@ -172,12 +171,11 @@ static int thrown_hard(const sim_params *p, double speed_max)
 	return speed_max * p->omega_ss > MEASURE_LATE_THROW * p->g;
 }
 
-/* The run before a refinement: its own estimate of v at its shadow's end
- * and its feed step. A refinement restored from the same settled start
- * takes it as its shadow (shadow_against): the two estimates span the
- * same periods from the same state, as a shadow's do, and the coarser run
- * is already paid for, where the refinement's own shadow would cost it
- * about 0.8 of itself again. v NaN: none (the refinement runs its own). */
+/* The run before a refinement: its own estimate of v at its shadow's end and its feed step. A
+ * refinement restored from the same settled start takes it as its shadow (shadow_against): the
+ * two estimates span the same periods from the same state, as a shadow's do, and the coarser
+ * run is already paid for, where the refinement's own shadow would cost it about 0.8 of itself
+ * again. v NaN: none (the refinement runs its own). */
 typedef struct coarser_run {
 	double v, h, dt;
 	int substeps;
@@ -222,22 +220,18 @@ static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const s
 	sim_update_status(s);
 }
 
-/* One run of sim_measure: a fresh instance to t_end at most, its shadow
- * over the first SHADOW_MEASURE_SHARE of the window (a refinement from
- * the settled start: the run before as its shadow, coarser_run); *st its
- * final status, *coarser this run for the next. If early
- * (sim_measure_point) and with a shadow, the run stops early at the first
- * check after the shadow has finished where the bar is within tol and the
- * estimate steady (the rest of the window would only shrink a bar already
- * met), or, if may_refine, where the step error alone is beyond tol and
- * either a refinement is asked (refine_asks with last) or none can follow
- * (the step error not shrunk to 0.8 of last): the step error does not
- * change after the shadow and no longer window makes room for it, so the
- * refinement the whole window would ask for is asked now, and a bar that
- * no window or refinement brings within tol is not measured on where its
- * scatter is small already (beyond_tol). A step
- * error within tol whose room a longer window's smaller scatter may yet
- * make is left to the window's end, as before. */
+/* One run of sim_measure: a fresh instance to t_end at most, its shadow over the first
+ * SHADOW_MEASURE_SHARE of the window (a refinement from the settled start: the run before as
+ * its shadow, coarser_run); *st its final status, *coarser this run for the next. If early
+ * (sim_measure_point) and with a shadow, the run stops early at the first check after the
+ * shadow has finished where the bar is within tol and the estimate steady (the rest of the
+ * window would only shrink a bar already met), or, if may_refine, where the step error alone
+ * is beyond tol and either a refinement is asked (refine_asks with last) or none can follow
+ * (the step error not shrunk to 0.8 of last): the step error does not change after the shadow
+ * and no longer window makes room for it, so the refinement the whole window would ask for is
+ * asked now, and a bar that no window or refinement brings within tol is not measured on where
+ * its scatter is small already (beyond_tol). A step error within tol whose room a longer
+ * window's smaller scatter may yet make is left to the window's end, as before. */
 static int measure_once(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			double t_end, double deadline, int early, int may_refine, double last,
 			settled_start *start, coarser_run *coarser, sim_status *st, char *msg,
@@ -386,12 +380,12 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 	return err;
 }
 
-/* sim_measure, and sim_measure_point if early: its runs stop once their
- * bar is met, and its refinements start from the first run's settled
- * start; *moved where its first run is thrown hard and its window starts
- * before MEASURE_LATE_START (the caller measures it over the later one). */
+/* sim_measure, and sim_measure_point if early: its runs stop once their bar is met, and its
+ * refinements start from the first run's settled start; *moved where its first run is thrown
+ * hard and its window starts before MEASURE_LATE_START (the caller measures it over the later
+ * one, fine: at twice the scene's feed sub-steps where the steps are the engine's). */
 static int measure_window(const sim_params *p, const sim_scene *sc, const sim_method *m,
-			  double t_end, int early, double deadline, sim_measurement *out,
+			  double t_end, int early, int fine, double deadline, sim_measurement *out,
 			  int *moved, char *msg, size_t msglen)
 {
 	struct timespec c0, c1;
@@ -404,6 +398,10 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 	/* the steps are the engine's to choose only where the user left them */
 	const ode_method *om = ode_find(m->name);
 	int own_steps = m->dt == 0.0 && m->substeps == 0 && om && !(om->info.dt_feed > 0);
+	if (fine && own_steps) {
+		run.dt = sim_default_dt(p, sc, m);
+		run.substeps = 2 * sim_default_substeps(p, sc, m, run.dt);
+	}
 	double last = INFINITY;
 	settled_start start = {NULL, 0};
 	coarser_run coarser = {NAN, NAN, NAN, 0, NAN, NAN, NAN, NAN, 0};
@@ -462,13 +460,15 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 static int measure(const sim_params *p, const sim_scene *sc, const sim_method *m, double t_end,
 		   int early, double deadline, sim_measurement *out, char *msg, size_t msglen)
 {
-	int moved, err = measure_window(p, sc, m, t_end, early, deadline, out, &moved, msg, msglen);
+	int moved, err = measure_window(p, sc, m, t_end, early, 0, deadline, out, &moved, msg,
+					msglen);
 	if (err != SIM_OK || !moved)
 		return err;
 	sim_scene late = *sc;
 	late.transient = MEASURE_LATE_START;
 	double cpu = out->cpu_seconds, shift = MEASURE_LATE_START - fmax(0.0, sc->transient);
-	err = measure_window(p, &late, m, t_end + shift, early, deadline, out, &moved, msg, msglen);
+	err = measure_window(p, &late, m, t_end + shift, early, 1, deadline, out, &moved, msg,
+			     msglen);
 	out->cpu_seconds += cpu;
 	return err;
 }

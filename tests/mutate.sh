@@ -114,6 +114,9 @@ mutations=(
 	# a hard-thrown feed measured over the steady start's first window
 	# (tests/unit/test_measure_point.c)
 	"a feed thrown hard measured from the steady start on|core/measure.c|s|int late = early \&\& fmax|int late = 0 \&\& fmax|"
+	# its later window at the scene's own feed step, which may pick a
+	# motion its shadow agrees with (tests/unit/test_measure_point.c)
+	"a hard-thrown feed's later window at the scene's own sub-steps|core/measure.c|s|run.substeps = 2 \* sim_default_substeps|run.substeps = sim_default_substeps|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.
