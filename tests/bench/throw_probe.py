@@ -85,6 +85,11 @@ def misses(curve, ref):
 
 
 def rev(tree):
+    """The commit a tree was built from: a prev-REV directory's (tests/bench/prev_build.sh
+    exports one with git archive, no repository of its own), else the repository's HEAD."""
+    for part in reversed(os.path.abspath(tree).split(os.sep)):
+        if part.startswith("prev-"):
+            return part[len("prev-"):]
     return subprocess.run(["git", "-C", tree, "rev-parse", "--short", "HEAD"],
                           capture_output=True, text=True).stdout.strip() or tree
 
