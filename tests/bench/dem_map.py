@@ -11,18 +11,20 @@ convsim-dem on the deck orbit that the one-way machine computes for that
 scene, over three packing seeds. A row is appended to the CSV whole, in
 one write, when its last seed ends; each seed's JSON line goes to the
 runs file as it ends, so that a row cut short resumes from its finished
-seeds. Rows already in the CSV are skipped. One LIGGGHTS process at a
-time, at nice 19.
+seeds. Rows already in the CSV are skipped. DEM_MAP_JOBS (default 1)
+LIGGGHTS processes at a time, a point's seeds side by side, at nice 19;
+each seed's CPU is its own process's.
 """
+import concurrent.futures
 import csv
 import fcntl
 import io
 import json
 import math
 import os
-import resource
 import subprocess
 import sys
+import tempfile
 import time
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
@@ -180,16 +182,21 @@ def finished_seeds(build, path=None, field="key"):
 
 
 def run_seed(binary, build, p, mats, seed):
+    """One seed's run; its CPU is that process's own (wait4), whatever runs beside it."""
     a = args_of(p, mats, seed)
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.time()
-    proc = subprocess.run(["nice", "-n", "19", binary] + a, capture_output=True, text=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    with tempfile.TemporaryFile("w+") as fo, tempfile.TemporaryFile("w+") as fe:
+        proc = subprocess.Popen(["nice", "-n", "19", binary] + a, stdout=fo, stderr=fe, text=True)
+        _, status, ru = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        fo.seek(0)
+        fe.seek(0)
+        stdout, stderr = fo.read(), fe.read()
+    cpu = ru.ru_utime + ru.ru_stime
     if proc.returncode != 0:
         raise RuntimeError("convsim-dem %s: exit %d: %s" % (" ".join(a), proc.returncode,
-                                                             proc.stderr.strip()[-400:]))
-    out = json.loads(proc.stdout)
+                                                             stderr.strip()[-400:]))
+    out = json.loads(stdout)
     return {"key": point_key(p, mats), "seed": seed, "build": build, "cpu_s": cpu,
             "wall_s": time.time() - t0, "args": " ".join(a), "out": out}
 
@@ -261,25 +268,28 @@ def by_key(k):
     return None
 
 
-def run_point(binary, build, name, p, mats, have):
-    """The point's missing seeds, then its row, appended whole."""
-    for s in SEEDS:
-        if s in have:
-            continue
-        rec = run_seed(binary, build, p, mats, s)
-        append(RUNS, json.dumps(rec, sort_keys=True) + "\n")
-        have[s] = rec
-        o = rec["out"]
-        print("dem-map: %s %s %s %d layers %s beta %g %s E %g seed %d: v %.5f m/s, overlap %.3g d, "
-              "%.0f CPU s" % (name, p["role"], p["material"], p["layers"], p["drive"], p["beta"],
-                              p["rotation"], p["youngs"], s, o["v_dem"],
-                              max(o["overlap_pp_max"], o["overlap_pw_max"]) / o["d_mean"],
-                              rec["cpu_s"]), flush=True)
+def run_point(binary, build, name, p, mats, have, jobs):
+    """The point's missing seeds, jobs of them at once, each kept as it ends; then its row,
+    appended whole."""
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        runs = {pool.submit(run_seed, binary, build, p, mats, s): s for s in SEEDS if s not in have}
+        for done in concurrent.futures.as_completed(runs):
+            s = runs[done]
+            rec = done.result()
+            append(RUNS, json.dumps(rec, sort_keys=True) + "\n")
+            have[s] = rec
+            o = rec["out"]
+            print("dem-map: %s %s %s %d layers %s beta %g %s E %g seed %d: v %.5f m/s, overlap "
+                  "%.3g d, %.0f CPU s" % (name, p["role"], p["material"], p["layers"], p["drive"],
+                                          p["beta"], p["rotation"], p["youngs"], s, o["v_dem"],
+                                          max(o["overlap_pp_max"], o["overlap_pw_max"]) / o["d_mean"],
+                                          rec["cpu_s"]), flush=True)
     append(CSV, csv_line(row_of(p, mats, build, have)))
 
 
 def run(binary, build, wanted):
     mats = materials()
+    jobs = max(1, int(os.environ.get("DEM_MAP_JOBS", "1")))
     os.makedirs(os.path.dirname(CSV), exist_ok=True)
     lock = open(CSV + ".lock", "w")
     try:
@@ -307,7 +317,7 @@ def run(binary, build, wanted):
                 q = todo.pop(0)
                 k = point_key(q, mats)
                 if k not in done:
-                    run_point(binary, build, name, q, mats, seeds.setdefault(k, {}))
+                    run_point(binary, build, name, q, mats, seeds.setdefault(k, {}), jobs)
                     done.add(k)
                 # a map point whose overlap passed the bound gets the stiffer
                 # rungs at once: the map's value there is the softest rung
