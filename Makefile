@@ -477,8 +477,8 @@ bench-dem: all $(BUILD)/.deps-dem
 # The DEM reference map (tests/bench/dem_map.sh, docs/dem.md "The map"):
 # named materials, depths 1-16 grains, beta every 15 deg, two drives, three
 # seeds a point, from one build; many CPU hours, resumable, in parts
-# (DEM_MAP_PARTS="glass-shallow glass-checks"; DEM_MAP_JOBS=2 runs a
-# point's seeds two at a time), into
+# (DEM_MAP_PARTS="glass-shallow glass-checks"; DEM_MAP_JOBS=3 runs a
+# point's three seeds at once), into
 # tests/bench/results/dem_map.csv and dem_map.md.
 bench-dem-map: $(BUILD)/.deps-build $(BUILD)/.deps-dem
 	$(Q)bash tests/bench/dem_map.sh
