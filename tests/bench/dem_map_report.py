@@ -142,7 +142,9 @@ def main():
     w("")
     w("`make bench-dem-map` (tests/bench/dem_map.sh; parts: `DEM_MAP_PARTS=\"...\"`), "
       "report by tests/bench/dem_map_report.py on %s. Build: %s. Rows measured %s to %s, "
-      "one LIGGGHTS process at a time at nice 19 on this report's machine, %s, shared with "
+      "at nice 19, one LIGGGHTS process at a time (from 2026-12-01, a point's three seeds at "
+      "once: `DEM_MAP_JOBS=3`, each seed's CPU its own process's) on this report's machine, %s, "
+      "shared with "
       "other work. Data: tests/bench/results/dem_map.csv (one row a point; the command of each "
       "row in its `command` column)." % (time.strftime("%Y-%m-%d", time.gmtime()),
                                          ", ".join("`%s`" % b[:12] for b in builds) or "none yet",
