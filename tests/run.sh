@@ -96,6 +96,9 @@ run "the map as its own fast model (check)" sh -c "python3 tests/bench/depth_sur
 run "DEM map plot" python3 tests/bench/dem_map_plot.py --check
 # the inputs' rows are the plan's runs and their report what they give
 run "DEM map inputs" python3 tests/bench/dem_inputs.py --check
+# the map's runner: a point's seeds side by side, each seed's CPU its own
+# process's (a stand-in for convsim-dem; no LIGGGHTS)
+run "DEM map runner (self-test)" python3 tests/bench/dem_map.py --self-test
 # the size rule: files of at most 500 lines, functions of at most 80
 run "file and function sizes" sh -c "python3 tests/size.py --self-test && python3 tests/size.py && echo '# pass 1'"
 for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/web/*.test.mjs; do

@@ -4,6 +4,8 @@
 
     dem_map.py run BIN BUILD [PART ...]   run the parts' missing rows
     dem_map.py plan [PART ...]            list the planned rows, by part
+    dem_map.py --self-test                (make test) the runner with a stand-in
+                                          for convsim-dem, three seeds at once
 
 Every row is one map point: a named material (dem/materials.json), a
 depth in grains, a drive, beta and the sense of rotation, measured with
@@ -327,7 +329,54 @@ def run(binary, build, wanted):
                     todo += [dict(q, role="stiffness", youngs=e) for e in rungs_above(mats)]
 
 
+FAKE_DEM = """import json, sys, time
+t = time.process_time()
+while time.process_time() - t < 0.2:
+    pass
+seed = int(sys.argv[sys.argv.index("--seed") + 1])
+print(json.dumps({"v_dem": 0.1 * seed, "d_mean": 0.004, "v_first_half": 0.1 * seed,
+                  "v_second_half": 0.1 * seed, "overlap_pp_max": 4e-6, "overlap_pw_max": 2e-6,
+                  "grains": 92, "deck_amplitude": 0.002, "dem_dt": 1e-6}))
+"""
+
+
+def self_test():
+    """run_point with a stand-in for convsim-dem (0.2 CPU s a seed) and its three seeds at once:
+    one runs line a seed, one CSV row from them, each seed's CPU its own process's (not the
+    three's sum) and the row's their sum. Runs no LIGGGHTS."""
+    global RUNS, CSV
+    with tempfile.TemporaryDirectory() as d:
+        fake = os.path.join(d, "fake-dem")
+        with open(fake, "w") as f:
+            f.write("#!%s\n%s" % (sys.executable, FAKE_DEM))
+        os.chmod(fake, 0o755)
+        RUNS, CSV = os.path.join(d, "runs.jsonl"), os.path.join(d, "map.csv")
+        mats, p, have = materials(), plan()[0][1][0], {}
+        run_point(fake, "b", "part", p, mats, have, 3)
+        runs = [json.loads(x) for x in open(RUNS)]
+        rows = list(csv.reader(open(CSV)))
+        bad = []
+        if sorted(r["seed"] for r in runs) != list(SEEDS):
+            bad.append("seeds %s" % [r["seed"] for r in runs])
+        if not all(0.15 <= r["cpu_s"] <= 0.45 for r in runs):
+            bad.append("a seed's CPU not its own: %s" % [r["cpu_s"] for r in runs])
+        if len(rows) != 1:
+            bad.append("%d rows" % len(rows))
+        else:
+            row = dict(zip(COLUMNS, rows[0]))
+            if abs(float(row["cpu_s"]) - sum(r["cpu_s"] for r in runs)) > 0.06:
+                bad.append("the row's CPU %s, the seeds' %s" % (row["cpu_s"], [r["cpu_s"] for r in runs]))
+            if abs(float(row["v_dem"]) - 0.2) > 1e-9:
+                bad.append("the row's v %s, the seeds' mean 0.2" % row["v_dem"])
+    for b in bad:
+        print("dem_map self-test: %s" % b)
+    print("# pass %d\n# fail %d" % (0 if bad else 1, 1 if bad else 0))
+    return 1 if bad else 0
+
+
 def main():
+    if sys.argv[1:] == ["--self-test"]:
+        sys.exit(self_test())
     if len(sys.argv) >= 2 and sys.argv[1] == "plan":
         wanted = set(sys.argv[2:])
         for name, points in plan():
