@@ -5,9 +5,10 @@
 # commit of the rows already in tests/bench/results/dem_map.csv, else
 # DEM_MAP_BUILD, else HEAD with dem/ and core/ committed), runs the parts'
 # missing rows (DEM_MAP_PARTS="p1 p2", default all, in the plan's order;
-# tests/bench/dem_map.py plan lists them) DEM_MAP_JOBS LIGGGHTS processes
-# at a time (default 1: a point's seeds side by side) at nice 19, and writes the report tests/bench/results/dem_map.md and
-# its plot, dem_map.svg (tests/bench/dem_map_plot.py).
+# tests/bench/dem_map.py plan lists them) at nice 19, one LIGGGHTS process
+# at a time (DEM_MAP_JOBS=N: a point's seeds N at once), and writes the
+# report tests/bench/results/dem_map.md and its plot, dem_map.svg
+# (tests/bench/dem_map_plot.py).
 # Resumable: rows already in the CSV are skipped, a row's finished seeds
 # are kept in dem_map_runs.jsonl. `dem_map.sh inputs` (make
 # bench-dem-inputs) runs tests/bench/dem_inputs.py by the same build instead.
