@@ -116,7 +116,10 @@ mutations=(
 	"a feed thrown hard measured from the steady start on|core/measure.c|s|int late = early \&\& fmax|int late = 0 \&\& fmax|"
 	# its later window at the scene's own feed step, which may pick a
 	# motion its shadow agrees with (tests/unit/test_measure_point.c)
-	"a hard-thrown feed's later window at the scene's own sub-steps|core/measure.c|s|run.substeps = 2 \* sim_default_substeps|run.substeps = sim_default_substeps|"
+	"a hard-thrown feed's later window at the scene's own sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 1|"
+	# at twice them, where the feed step's error stalls between its shadow
+	# and it (tests/unit/test_measure_point.c)
+	"a hard-thrown feed's later window at twice the scene's sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 2|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

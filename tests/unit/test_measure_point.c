@@ -247,8 +247,8 @@ static void machine_step_term_in_the_machines_own_period(void **state)
  * leaves it (at the default steps v -0.2906 m/s over [0, 4] s, -0.2708
  * over [10, 18] s), and a sweep's point over [0, 4] s was within tol at
  * -0.2916. Measured over [8, 12] s instead (measure.c,
- * MEASURE_LATE_THROW), at twice the scene's feed sub-steps (its shadow at
- * the scene's own): within 1 % of the reference (dt 1.25e-4 s / 40 sub-steps
+ * MEASURE_LATE_THROW), at four times the scene's feed sub-steps (its shadow
+ * at twice them): within 1 % of the reference (dt 1.25e-4 s / 40 sub-steps
  * without feed events over [10, 18] s: -0.27101; 6.25e-5 s: -0.27097;
  * 1.25e-4 s over [20, 30] s: -0.27117), inside its bar. */
 static void hard_throw_measured_late(void **state)
@@ -263,7 +263,7 @@ static void hard_throw_measured_late(void **state)
 	u.p.beta = 120.0 * RAD_PER_DEG;
 	double dt = sim_default_dt(&u.p, &u.sc, &u.m);
 	int n = sim_default_substeps(&u.p, &u.sc, &u.m, dt);
-	if (!(m.substeps >= 2 * n))
+	if (!(m.substeps >= 4 * n))
 		fail_msg("%d sub-steps, the scene's %d", m.substeps, n);
 }
 
@@ -274,15 +274,34 @@ static void hard_throw_measured_late(void **state)
  * agrees: a point within tol 11 % off. At 6.25e-5 s and finer it moves
  * at -0.440 to -0.4415 (the references of docs/random-machines.md: dt
  * 1.25e-4 s / 40 sub-steps over [10, 18] s and 6.25e-5 s / 80 over [20,
- * 28] s, -0.4415). The later window at twice the sub-steps, its shadow at
- * the scene's: the point is within 1 % of the reference or says it is
- * not, and its bar holds the reference. */
+ * 28] s, -0.4415). The later window at four times the sub-steps, its
+ * shadow at twice them: the point is within 1 % of the reference or says
+ * it is not, and its bar holds the reference. */
 static void hard_throw_feed_step(void **state)
 {
 	(void)state;
 	static const char *const hard[] = {"e", "0.05593", "R", "0.1926", "k_c", "882600", NULL};
 	sim_measurement m = point(150.0, "cw", hard);
 	double v_ref = -0.4415, e = fabs(m.transport_velocity - v_ref);
+	if (m.tol_met && !(e <= 0.01 * fabs(v_ref)))
+		fail_msg("v %.4f within tol, v_ref %.4f", m.transport_velocity, v_ref);
+	if (!(e <= m.uncertainty))
+		fail_msg("|v - v_ref| = %.3g outside the bar %.3g", e, m.uncertainty);
+}
+
+/* A feed thrown harder still (e 0.09624 m, 30 deg cw, a throw of about
+ * 18) whose feed step error stalls before it shrinks: over [8, 12] s 5
+ * and 10 sub-steps give 0.7101 and 0.7082 m/s, 20, 40, 80 and 160 give
+ * 0.7148, 0.7154, 0.7165 and 0.7172; the references (as above) 0.7194.
+ * At 10 sub-steps against 5 the point was within tol 1.6 % off; at 20
+ * against 10 it is refined, and within 1 % or says it is not, its bar
+ * holding the reference. */
+static void hard_throw_feed_step_stalls(void **state)
+{
+	(void)state;
+	static const char *const hard[] = {"e", "0.09624", NULL};
+	sim_measurement m = point(30.0, "cw", hard);
+	double v_ref = 0.7194, e = fabs(m.transport_velocity - v_ref);
 	if (m.tol_met && !(e <= 0.01 * fabs(v_ref)))
 		fail_msg("v %.4f within tol, v_ref %.4f", m.transport_velocity, v_ref);
 	if (!(e <= m.uncertainty))
@@ -377,6 +396,7 @@ int main(void)
 		cmocka_unit_test(machine_step_term_in_the_machines_own_period),
 		cmocka_unit_test(hard_throw_measured_late),
 		cmocka_unit_test(hard_throw_feed_step),
+		cmocka_unit_test(hard_throw_feed_step_stalls),
 		cmocka_unit_test(chaotic_feed_long_run),
 		cmocka_unit_test(peek_is_what_the_shadows_end_sets),
 	};
