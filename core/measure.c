@@ -1,14 +1,12 @@
 /* SPDX-License-Identifier: GPL-3.0-or-later */
 /*
- * measure.c - sim_measure: one measurement of the transport velocity, a
- * fresh instance run to a time with its shadow (shadow.c) over the first
- * part of the window, repeated at finer steps where the measured step
- * error is beyond what the accuracy target tol allows; sim_measure_point,
- * a sweep's point: the same, stopped early once its bar is met with little
- * scatter; a point whose bar misses tol where the difference between
- * the run and its shadow is scatter (a chaotic feed) measured again over a
- * longer window instead of refined (at twice the sub-steps), its step
- * error bounded statistically.
+ * measure.c - sim_measure: one measurement of the transport velocity, a fresh instance run
+ * to a time with its shadow (shadow.c) over the first part of the window, repeated at finer
+ * steps where the measured step error is beyond what the accuracy target tol allows;
+ * sim_measure_point, a sweep's point: the same, stopped early once its bar is met with little
+ * scatter; a point whose bar misses tol where the difference between the run and its shadow
+ * is scatter (a chaotic feed) measured again over a longer window instead of refined (at
+ * twice the sub-steps), its step error bounded statistically.
  */
 #include <math.h>
 #include <stdio.h>
@@ -22,14 +20,12 @@
  * settle (30 periods of the preset's 4-s window), short enough to keep its cost near a fifth. */
 #define SHADOW_MEASURE_SHARE 0.3
 
-/* sim_measure's refinements at most: each shrinks the feed step, or the
- * machine step where its term is the larger, by the factor the
- * first-order error asks for, within [1/4, 3/5]. */
+/* sim_measure's refinements at most: each shrinks the feed step, or the machine step where
+ * its term is the larger, by the factor the first-order error asks for, within [1/4, 3/5]. */
 #define MEASURE_REFINEMENTS 3
 
-/* How often a measurement with a shadow checks its bar once the shadow
- * has finished (the first check at its end): a fortieth of the preset's
- * 4-s window, two and a half of its periods. */
+/* How often a measurement with a shadow checks its bar once the shadow has finished (the
+ * first check at its end): a fortieth of the preset's 4-s window, 2.5 of its periods. */
 #define MEASURE_CHECK 0.1
 
 /* A scatter-dominated point's long run (measure_long): its first check at
@@ -46,9 +42,8 @@
 #define MEASURE_LONG_MAX 25.0
 #define MEASURE_LONG_MARGIN 1.1
 
-/* scatter_only: the first run's shadow's standard error at least this
- * share of scatter_scale (the preset's steps at most 0.95 of it, the
- * chaotic feed's at least 2.0) */
+/* scatter_only: the first run's shadow's standard error at least this share of
+ * scatter_scale (the preset's steps at most 0.95 of it, the chaotic feed's at least 2.0) */
 #define MEASURE_SCATTER_SE 1.5
 
 /* The scale the scatter and room rules below were read on: tol max(|v|, 0.3
@@ -160,10 +155,10 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 
 /* A feed thrown hard: the trough's acceleration (its largest speed times omega_ss) beyond
  * MEASURE_LATE_THROW g (the zoo's at most 5.0). Such a machine may leave the steady start's
- * orbit seconds later, steady and within tol before, and its feed step may pick its motion
+ * orbit seconds later, steady and within tol before, and either step may pick its motion
  * (docs/random-machines.md): a sweep's point is measured again from MEASURE_LATE_START s at
- * MEASURE_LATE_FINE times the feed sub-steps, its shadow at half (at 10 against 5, e 0.09624
- * at 30 deg cw gave 0.7082 against 0.7101, within tol; 20 and more 0.715-0.717, v_ref 0.7194). */
+ * MEASURE_LATE_FINE times the feed sub-steps (its shadow at half), then refined once at half
+ * the machine step, that run its shadow, whatever its bar; then as any point. */
 #define MEASURE_LATE_THROW 5.5
 #define MEASURE_LATE_START 8.0
 #define MEASURE_LATE_FINE 4
@@ -384,7 +379,8 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
 /* sim_measure, and sim_measure_point if early: its runs stop once their bar is met, and its
  * refinements start from the first run's settled start; *moved where its first run is thrown
  * hard and its window starts before MEASURE_LATE_START (the caller measures it over the later
- * one, fine: at MEASURE_LATE_FINE times the scene's feed sub-steps where the steps are the engine's). */
+ * one, fine: at MEASURE_LATE_FINE times the scene's feed sub-steps, then at half the machine
+ * step, where the steps are the engine's). */
 static int measure_window(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			  double t_end, int early, int fine, double deadline, sim_measurement *out,
 			  int *moved, char *msg, size_t msglen)
@@ -425,13 +421,17 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 		/* done: within tol, the user's own steps, no room the steps could
 		 * fit in, or a refinement that did not shrink the step error as a
 		 * first-order one shrinks: what remains is not the steps' */
+		if (fine && own_steps && attempt == 0 && err == SIM_OK) {
+			last = st.step_error; /* the machine step halved: MEASURE_LATE_FINE */
+			run.dt = st.dt * 0.5;
+			continue;
+		}
 		if (err != SIM_OK || !may_refine || st.tol_met || !refine_asks(&st, last))
 			break;
 		double room = room_of(&st);
 		last = st.step_error;
-		/* first order in both steps: the step whose term is the larger
-		 * shrinks by the factor asked (the machine step with the feed
-		 * step, which the sub-steps keep in proportion) */
+		/* first order in both steps: the step whose term is the larger shrinks by the
+		 * factor asked (the machine step with the feed step, the sub-steps kept) */
 		double f = fmin(0.6, fmax(0.25, 0.7 * room / st.step_error));
 		if (st.machine_error > st.step_error - st.machine_error) {
 			run.dt = st.dt * f;

@@ -120,6 +120,8 @@ mutations=(
 	# at twice them, where the feed step's error stalls between its shadow
 	# and it (tests/unit/test_measure_point.c)
 	"a hard-thrown feed's later window at twice the scene's sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 2|"
+	# and its check at half the machine step (tests/unit/test_measure_point.c)
+	"a hard-thrown feed's later window not checked at half the machine step|core/measure.c|s|if (fine \&\& own_steps \&\& attempt == 0|if (0 \&\& fine \&\& own_steps \&\& attempt == 0|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.

@@ -12,6 +12,10 @@ gate (docs/model-numerics.md section 10); the finer one is v_ref. A point of a c
 where it says steady and tol_met and lies beyond the gate from v_ref.
 
   python3 tests/bench/throw_probe.py [--seeds 1,2,3] [--count 14] [--baseline BIN] [--out MD]
+                                    [--jsonl FILE] [--refs FILE]
+
+--refs takes each machine's references from an earlier run's --jsonl: they run at given steps,
+which a change to the steps the engine picks leaves as they were.
 
 Its header gives its wall time (the references take most of it). Writes the table to
 tests/bench/results/throw_probe.md (docs/random-machines.md).
@@ -102,7 +106,14 @@ def main():
     ap.add_argument("--baseline")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "throw_probe.md"))
     ap.add_argument("--jsonl", help="also keep every machine's points here")
+    ap.add_argument("--refs", help="take the references from an earlier run's --jsonl (their "
+                    "steps are given, so a change to the steps the engine picks leaves them)")
     o = ap.parse_args()
+    kept = {}
+    if o.refs:
+        for line in open(o.refs):
+            d = json.loads(line)
+            kept[json.dumps(d["sets"], sort_keys=True)] = (d["ref1"], d["ref2"])
     rows, tot = [], {"claimed": 0, "base": 0, "this": 0, "flag": 0, "mach_base": 0, "mach_this": 0}
     keep = open(o.jsonl, "a") if o.jsonl else None
     began = time.time()
@@ -110,8 +121,9 @@ def main():
         rng = random.Random(seed)
         for i in range(o.count):
             sets = draw(rng)
-            r1 = sweep(o.build, sets, *REF1)
-            r2 = sweep(o.build, sets, *REF2)
+            key = json.dumps(sets, sort_keys=True)
+            r1, r2 = kept[key] if key in kept else (sweep(o.build, sets, *REF1),
+                                                    sweep(o.build, sets, *REF2))
             this = sweep(o.build, sets)
             base = sweep(o.baseline, sets) if o.baseline else None
             if not (r1 and r2 and this):
@@ -144,8 +156,10 @@ def main():
                 keep.flush()
             print(seed, sets, "throw %.1f" % g, "claimed", claimed, "baseline misses",
                   len(m_base), "misses", len(m_this), file=sys.stderr, flush=True)
-    cmd = "python3 tests/bench/throw_probe.py --seeds %s --count %d%s" % (
-        o.seeds, o.count, " --baseline BIN" if o.baseline else "")
+    cmd = "python3 tests/bench/throw_probe.py --seeds %s --count %d%s%s" % (
+        o.seeds, o.count, " --baseline BIN" if o.baseline else "",
+        " --refs JSONL (the references of %d machines from an earlier run)" % len(kept)
+        if o.refs else "")
     fmt = lambda ms: "; ".join("%s %s %.4f (v_ref %.4f)" % m for m in ms) or "none"
     with open(o.out, "w") as f:
         f.write("# A feed thrown hard: random machines against converged references\n\n")
