@@ -31,7 +31,7 @@ static const cli_opt options[] = {
 	{CMD_RUN, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
 	 "simulated time to run (4 s for czubak2016, whose transient is 0)"},
 	{CMD_SWEEP, OPT_DURATION, "duration", 'd', "S", "s", "transient + 4",
-	 "simulated time per point; v is measured after the transient (a feed thrown hard: over as long a window from 8 s, finer feed steps)"},
+	 "simulated time per point; v is measured after the transient (a feed thrown hard: over as long a window from 8 s, finer steps)"},
 	{CMD_RUN, OPT_OUT, "out", 'o', "FILE", NULL, "none",
 	 "also write the trajectory (the daemon's columns) to FILE"},
 	{CMD_SWEEP, OPT_OUT, "out", 'o', "FILE", NULL, "stdout", "write the v(beta) table to FILE"},
