@@ -118,7 +118,7 @@ mutations=(
 	# motion its shadow agrees with (tests/unit/test_measure_point.c)
 	"a hard-thrown feed's later window at the scene's own sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 1|"
 	# at twice them, where the feed step's error stalls between its shadow
-	# and it (tests/unit/test_measure_point.c)
+	# and it: tol no longer met there (tests/unit/test_measure_point.c)
 	"a hard-thrown feed's later window at twice the scene's sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 2|"
 	# and its check at half the machine step (tests/unit/test_measure_point.c)
 	"a hard-thrown feed's later window not checked at half the machine step|core/measure.c|s|if (fine \&\& own_steps \&\& attempt == 0|if (0 \&\& fine \&\& own_steps \&\& attempt == 0|"
@@ -163,8 +163,12 @@ for m in "${mutations[@]}"; do
 	git ls-files -z | xargs -0 cp --parents -t "$dir"
 	ln -s "$root/tests/node_modules" "$dir/tests/node_modules"
 	apply_fault "$dir/$file" "$from" "$to" "$name"
+	# the DEM tests' binaries too where this tree's build has them: a test
+	# group that fails for want of them would count every fault that
+	# reaches it as killed
 	if ! (cd "$dir" && make -s -j2 BUILD=build-mut build-mut/convsim build-mut/convsimd \
 		$(cd "$dir" && ls tests/unit/test_*.c | sed 's|tests/unit/\(.*\)\.c|build-mut/tests/\1|') \
+		$(for b in convsim-bed convsim-dem convsim-mpi; do [ -x "$root/${BUILD:-build}/$b" ] && echo "build-mut/$b"; done) \
 		>"$work/build.log" 2>&1); then
 		printf '| %s | %s | (does not build) | killed |\n' "$name" "$file"
 		continue
