@@ -418,14 +418,14 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 					   msglen);
 			break;
 		}
-		/* done: within tol, the user's own steps, no room the steps could
-		 * fit in, or a refinement that did not shrink the step error as a
-		 * first-order one shrinks: what remains is not the steps' */
+		/* a hard-thrown point's later window: once at half the machine step, whatever its bar */
 		if (fine && own_steps && attempt == 0 && err == SIM_OK) {
-			last = st.step_error; /* the machine step halved: MEASURE_LATE_FINE */
+			last = st.step_error;
 			run.dt = st.dt * 0.5;
 			continue;
 		}
+		/* done: within tol, the user's own steps, no room the steps could fit in, or a refinement
+		 * that did not shrink the step error as first order does: what remains is not the steps' */
 		if (err != SIM_OK || !may_refine || st.tol_met || !refine_asks(&st, last))
 			break;
 		double room = room_of(&st);
