@@ -13,6 +13,7 @@ Writes tests/bench/results/throw_cost.md (docs/random-machines.md). A minute or 
 import argparse, datetime, os, resource, subprocess
 
 import provenance
+from throw_probe import rev
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -46,11 +47,8 @@ def main():
             base.append(cpu(o.baseline, sets))
             this.append(cpu(o.build, sets))
         rows.append((sets or "the preset", min(base), min(this)))
-    prev = os.path.basename(os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.abspath(o.baseline)))))
-    prev = prev[len("prev-"):] if prev.startswith("prev-") else o.baseline
-    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                          capture_output=True, text=True).stdout.strip()
+    head = rev(ROOT)
+    prev = rev(os.path.dirname(os.path.dirname(os.path.abspath(o.baseline))))
     with open(o.out, "w") as f:
         f.write("# What a hard-thrown machine's curve costs\n\n")
         f.write("Command: `python3 tests/bench/throw_cost.py --baseline BIN`, %s UTC, this build: "
