@@ -28,15 +28,13 @@
  * first check at its end): a fortieth of the preset's 4-s window, 2.5 of its periods. */
 #define MEASURE_CHECK 0.1
 
-/* A scatter-dominated point's long run (measure_long): its first check at
- * the window that the first run's statistical bar and its shadow's
- * standard error (both shrinking as one over the root of the window) say
- * brings the bar to MEASURE_LONG_AIM of scatter_scale, within [1,
- * MEASURE_LONG_FIRST] times the measurement's; where the bar then misses
- * what tol allows, on to the window its shrinking part asks for
- * (MEASURE_LONG_MARGIN over it), at most MEASURE_LONG_MAX windows: a point
- * that would need more stops at its check (on the R = 0.5 machine:
- * tests/bench/results/chaos.md). */
+/* A scatter-dominated point's long run (measure_long): its first check at the window that the
+ * first run's statistical bar and its shadow's standard error (both shrinking as one over the
+ * root of the window) say brings the bar to MEASURE_LONG_AIM of scatter_scale, within [1,
+ * MEASURE_LONG_FIRST] times the measurement's; where the bar then misses what tol allows, on
+ * to the window its shrinking part asks for (MEASURE_LONG_MARGIN over it), at most
+ * MEASURE_LONG_MAX windows: a point that would need more stops at its check (on the R = 0.5
+ * machine: tests/bench/results/chaos.md). */
 #define MEASURE_LONG_AIM 0.8
 #define MEASURE_LONG_FIRST 6.0
 #define MEASURE_LONG_MAX 25.0
@@ -46,30 +44,28 @@
  * scatter_scale (the preset's steps at most 0.95 of it, the chaotic feed's at least 2.0) */
 #define MEASURE_SCATTER_SE 1.5
 
-/* The scale the scatter and room rules below were read on: tol max(|v|, 0.3
- * peak), which is what tol allows where |v| >= 0.3 peak and 0.3 of it
- * nearer v = 0 (sim_status.c: the convention allows tol peak there). A
- * short window's scatter near v = 0 is no better read than elsewhere: on
- * the chaotic feed (R = 0.5, mu = 0.6) at 75 and 80 deg cw a stop at the
+/* The scale the scatter and room rules below were read on: tol max(|v|, 0.3 peak), which is
+ * what tol allows where |v| >= 0.3 peak and 0.3 of it nearer v = 0 (sim_status.c: the
+ * convention allows tol peak there). A short window's scatter near v = 0 is no better read
+ * than elsewhere: on the chaotic feed (R = 0.5, mu = 0.6) at 75 and 80 deg cw a stop at the
  * first check by what tol allows there left v_ref outside the bar. */
 static double scatter_scale(const sim_status *st)
 {
 	return fmax(st->tol * fabs(st->transport_velocity), 0.3 * st->tol_allowed);
 }
 
-/* What scatter_scale leaves the steps: it less the bar's scatter and
- * drift, which finer steps cannot shrink. Near v = 0 a refinement is
- * asked as before the convention's allowance (a chaotic feed's point at
- * 100 deg cw went from 5 to 80 sub-steps for a room its scatter fills);
- * a bar within what tol allows there needs none (tol_met ends it). */
+/* What scatter_scale leaves the steps: it less the bar's scatter and drift, which finer steps
+ * cannot shrink. Near v = 0 a refinement is asked as before the convention's allowance (a
+ * chaotic feed's point at 100 deg cw went from 5 to 80 sub-steps for a room its scatter
+ * fills); a bar within what tol allows there needs none (tol_met ends it). */
 static double room_of(const sim_status *st)
 {
 	return scatter_scale(st) - (st->transport_velocity_uncertainty - st->step_error);
 }
 
-/* Whether sim_measure would refine after a run whose status is st: its
- * step error beyond room_of, and shrunk as a first-order one shrinks (by
- * 0.8 at least) since the last run's, last. */
+/* Whether sim_measure would refine after a run whose status is st: its step error beyond
+ * room_of, and shrunk as a first-order one shrinks (by 0.8 at least) since the last run's,
+ * last. */
 static int refine_asks(const sim_status *st, double last)
 {
 	double room = room_of(st);
@@ -77,16 +73,14 @@ static int refine_asks(const sim_status *st, double last)
 	       st->substeps >= 1;
 }
 
-/* A bar met early enough to stop on: within tol, steady, and its scatter
- * and drift at most MEASURE_EARLY_SCATTER of scatter_scale. A short
- * window's scatter is read from few batches, and where the feed's motion
- * is correlated over many periods it is read low (a 1.2-s window of the
- * zoo's `stiffer` machine said 0.31 % at 140 deg cw where its v was 0.97 %
- * off): a scatter that small a share of tol holds even read low. And a
- * window of MEASURE_EARLY_PERIODS whole periods at least: the preset's
- * shadow spans 29 of them (30 % of 4 s at its loaded 24.5 Hz); a shorter
- * --duration shortens the shadow, and a measurement stopped with it (0.6
- * s at --duration 2) put 2 of the 74 points outside their bars. */
+/* A bar met early enough to stop on: within tol, steady, and its scatter and drift at most
+ * MEASURE_EARLY_SCATTER of scatter_scale. A short window's scatter is read from few batches,
+ * and where the feed's motion is correlated over many periods it is read low (a 1.2-s window
+ * of the zoo's `stiffer` machine said 0.31 % at 140 deg cw where its v was 0.97 % off): a
+ * scatter that small a share of tol holds even read low. And a window of MEASURE_EARLY_PERIODS
+ * whole periods at least: the preset's shadow spans 29 of them (30 % of 4 s at its loaded 24.5
+ * Hz); a shorter --duration shortens the shadow, and a measurement stopped with it (0.6 s at
+ * --duration 2) put 2 of the 74 points outside their bars. */
 #define MEASURE_EARLY_SCATTER 0.25
 #define MEASURE_EARLY_PERIODS 28
 static int early_met(const sim_status *st)
@@ -96,33 +90,29 @@ static int early_met(const sim_status *st)
 	       st->transport_periods >= MEASURE_EARLY_PERIODS;
 }
 
-/* A refinement's bar that neither a longer window nor a further
- * refinement brings within tol (its step error alone beyond it and not
- * shrunk to 0.8 of the run before's, last), measured on no longer where
- * its scatter and drift are already as small as early_met asks: where
- * they are larger (a chaotic feed) the rest of the window still makes v
- * better, if not its bar. */
+/* A refinement's bar that neither a longer window nor a further refinement brings within tol
+ * (its step error alone beyond it and not shrunk to 0.8 of the run before's, last), measured
+ * on no longer where its scatter and drift are already as small as early_met asks: where they
+ * are larger (a chaotic feed) the rest of the window still makes v better, if not its bar. */
 static int beyond_tol(const sim_status *st, double last)
 {
 	double scatter = st->transport_velocity_uncertainty - st->step_error;
 	return st->step_error >= 0.8 * last && scatter <= MEASURE_EARLY_SCATTER * scatter_scale(st);
 }
 
-/* The first run's instance as it starts (settled, at t = 0, its shadow
- * begun), kept for the refinements: a checkpoint of it restored with
- * finer steps starts them where the first run started, without settling
- * again (the settling at the first run's steps: the state at t = 0 is a
- * start like any other, and the estimate and its bar come from the finer
- * steps alone). buf NULL: none kept (yet). */
+/* The first run's instance as it starts (settled, at t = 0, its shadow begun), kept for the
+ * refinements: a checkpoint of it restored with finer steps starts them where the first run
+ * started, without settling again (the settling at the first run's steps: the state at t = 0
+ * is a start like any other, and the estimate and its bar come from the finer steps alone).
+ * buf NULL: none kept (yet). */
 typedef struct settled_start {
 	void *buf;
 	size_t len;
 } settled_start;
 
-/* A run's instance: the first one fresh (its start kept in *start where
- * start is not NULL), a refinement's restored from *start with its own
- * steps (its shadow too; *restored then 1), or fresh where no start could
- * be kept. */
+/* A run's instance: the first one fresh (its start kept in *start where start is not NULL), a
+ * refinement's restored from *start with its own steps (its shadow too; *restored then 1), or
+ * fresh where no start could be kept. */
 static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			   double t_end, double deadline, settled_start *start, int *restored,
 			   int *err, char *msg, size_t msglen)
@@ -162,9 +152,17 @@ static sim *start_instance(const sim_params *p, const sim_scene *sc, const sim_m
 #define MEASURE_LATE_THROW 5.5
 #define MEASURE_LATE_START 8.0
 #define MEASURE_LATE_FINE 4
+/* Beyond MEASURE_CHECK_THROW g the feed's shadow at about half its sub-steps may stall with it
+ * (the two agree, twice the sub-steps move v by more than tol): a sweep's point whose first run
+ * met tol is run again at twice its sub-steps, the first run its shadow, then as any point. */
+#define MEASURE_CHECK_THROW 4.2
+static int thrown(const sim_params *p, double speed_max, double throw)
+{
+	return speed_max * p->omega_ss > throw * p->g;
+}
 static int thrown_hard(const sim_params *p, double speed_max)
 {
-	return speed_max * p->omega_ss > MEASURE_LATE_THROW * p->g;
+	return thrown(p, speed_max, MEASURE_LATE_THROW);
 }
 
 /* The run before a refinement: its own estimate of v at its shadow's end and its feed step. A
@@ -183,17 +181,16 @@ typedef struct coarser_run {
 	int late_check;   /* stop at the first check once thrown_hard */
 } coarser_run;
 
-/* Whether s's own shadow would be the coarser run itself (the same
- * machine step, ceil(n / 2) of s's n sub-steps the coarser run's). */
+/* Whether s's own shadow would be the coarser run itself (the same machine step, ceil(n / 2)
+ * of s's n sub-steps the coarser run's). */
 static int shadow_is(const sim *s, const coarser_run *c)
 {
 	return s->cfg.dt == c->dt && (s->cfg.substeps + 1) / 2 == c->substeps;
 }
 
-/* Where the coarser run as a refinement's shadow leaves its bar beyond
- * tol (the coarser run, pre-asymptotic, is why the point was refined), the
- * refinement's own shadow, run now from the settled start to s's
- * shadow_until (s stands there): the step error as the shadow beside it
+/* Where the coarser run as a refinement's shadow leaves its bar beyond tol (the coarser run,
+ * pre-asymptotic, is why the point was refined), the refinement's own shadow, run now from the
+ * settled start to s's shadow_until (s stands there): the step error as the shadow beside it
  * would have measured it, bit for bit. */
 static void own_shadow(sim *s, const sim_params *p, const sim_scene *sc, const sim_method *m,
 		       const settled_start *start)
@@ -283,13 +280,11 @@ static int measure_once(const sim_params *p, const sim_scene *sc, const sim_meth
 	return err;
 }
 
-/* A first run whose bar is beyond scatter_scale (what tol allows, but
- * near v = 0 0.3 of it: the scale the shares were read on) where its
- * shadow's difference is
- * within SHADOW_SIGNIFICANT of its standard error (a chaotic feed: the
- * run and its shadow drift apart, and their difference is scatter, which
- * finer steps do not shrink): measured again over a longer window with
- * its shadow beside it throughout (measure_long), not refined. */
+/* A first run whose bar is beyond scatter_scale (what tol allows, but near v = 0 0.3 of it:
+ * the scale the shares were read on) where its shadow's difference is within
+ * SHADOW_SIGNIFICANT of its standard error (a chaotic feed: the run and its shadow drift
+ * apart, and their difference is scatter, which finer steps do not shrink): measured again
+ * over a longer window with its shadow beside it throughout (measure_long), not refined. */
 static int scatter_only(const sim_status *st, const coarser_run *c)
 {
 	return st->transport_velocity_uncertainty > scatter_scale(st) && isfinite(c->se) &&
@@ -297,19 +292,16 @@ static int scatter_only(const sim_status *st, const coarser_run *c)
 	       c->se >= MEASURE_SCATTER_SE * scatter_scale(st) && c->ran > 0.0;
 }
 
-/* The long run's scatter: the estimate's bar, its standard error from
- * the batches merged 2 and 4 at a time where larger (estimator_blocked_bar,
- * at least LONG_BLOCKS of them). On the chaotic feed the motion is
- * correlated beyond a batch at some angles (the reference's 16-s windows
- * scatter up to 2.5 times as much as its 4-s windows say,
- * tests/bench/zoo/chaos_ref.tsv at 105 deg), which the batches alone read
- * low. */
+/* The long run's scatter: the estimate's bar, its standard error from the batches merged 2 and
+ * 4 at a time where larger (estimator_blocked_bar, at least LONG_BLOCKS of them). On the
+ * chaotic feed the motion is correlated beyond a batch at some angles (the reference's 16-s
+ * windows scatter up to 2.5 times as much as its 4-s windows say,
+ * tests/bench/zoo/chaos_ref.tsv at 105 deg), which the batches alone read low. */
 #define LONG_BLOCKS 8
 
-/* The long run's bar at its present time with the running shadow's raw
- * step error and standard error (shadow_peek): the scatter (as above),
- * the step error as shadow_finish bounds it, the machine step's term;
- * *shrink the part that shrinks as one over the root of the window. */
+/* The long run's bar at its present time with the running shadow's raw step error and standard
+ * error (shadow_peek): the scatter (as above), the step error as shadow_finish bounds it, the
+ * machine step's term; *shrink the part that shrinks as one over the root of the window. */
 static double long_bar(const sim *s, double raw, double se, double *shrink)
 {
 	double stat = estimator_blocked_bar(&s->est, LONG_BLOCKS);
@@ -318,13 +310,11 @@ static double long_bar(const sim *s, double raw, double se, double *shrink)
 	return stat + (scatter ? se : raw) + s->st.machine_error;
 }
 
-/* The long run of a scatter-dominated point: from the settled start, at
- * the first run's machine step and twice its sub-steps, its shadow beside
- * it throughout, to the first
- * check (MEASURE_LONG_FIRST) and on where the bar misses tol and more
- * window can bring it within (MEASURE_LONG_MAX). The step error is the
- * shadow's difference where significant, else its standard error
- * (s->step_bounded). */
+/* The long run of a scatter-dominated point: from the settled start, at the first run's
+ * machine step and twice its sub-steps, its shadow beside it throughout, to the first check
+ * (MEASURE_LONG_FIRST) and on where the bar misses tol and more window can bring it within
+ * (MEASURE_LONG_MAX). The step error is the shadow's difference where significant, else its
+ * standard error (s->step_bounded). */
 static int measure_long(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			double t_end, double deadline, const settled_start *start, coarser_run *c,
 			sim_status *st, char *msg, size_t msglen)
@@ -380,7 +370,8 @@ static int measure_long(const sim_params *p, const sim_scene *sc, const sim_meth
  * refinements start from the first run's settled start; *moved where its first run is thrown
  * hard and its window starts before MEASURE_LATE_START (the caller measures it over the later
  * one, fine: at MEASURE_LATE_FINE times the scene's feed sub-steps, then at half the machine
- * step, where the steps are the engine's). */
+ * step, where the steps are the engine's); a point thrown beyond MEASURE_CHECK_THROW whose
+ * first run met tol is run again at twice its sub-steps (that check one of the refinements). */
 static int measure_window(const sim_params *p, const sim_scene *sc, const sim_method *m,
 			  double t_end, int early, int fine, double deadline, sim_measurement *out,
 			  int *moved, char *msg, size_t msglen)
@@ -422,6 +413,11 @@ static int measure_window(const sim_params *p, const sim_scene *sc, const sim_me
 		if (fine && own_steps && attempt == 0 && err == SIM_OK) {
 			last = st.step_error;
 			run.dt = st.dt * 0.5;
+			continue;
+		}
+		if (!fine && early && own_steps && attempt == 0 && err == SIM_OK && st.tol_met &&
+		    start.buf && thrown(p, coarser.speed_max, MEASURE_CHECK_THROW)) {
+			run.substeps = 2 * st.substeps;
 			continue;
 		}
 		/* done: within tol, the user's own steps, no room the steps could fit in, or a refinement

@@ -122,6 +122,9 @@ mutations=(
 	"a hard-thrown feed's later window at twice the scene's sub-steps|core/measure.c|s|^#define MEASURE_LATE_FINE 4$|#define MEASURE_LATE_FINE 2|"
 	# and its check at half the machine step (tests/unit/test_measure_point.c)
 	"a hard-thrown feed's later window not checked at half the machine step|core/measure.c|s|if (fine \&\& own_steps \&\& attempt == 0|if (0 \&\& fine \&\& own_steps \&\& attempt == 0|"
+	# a feed thrown beyond the check's threshold not run again at twice
+	# its sub-steps, its shadow stalling with it (tests/unit/test_measure_point.c)
+	"a thrown feed not checked at twice its sub-steps|core/measure.c|s|^#define MEASURE_CHECK_THROW 4.2$|#define MEASURE_CHECK_THROW 5.5|"
 )
 # --check: only that every fault applies (each to a copy of its file), no
 # builds; ONLY=N: run the N-th mutation (1-based) alone.
