@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """What a hard-thrown machine's curve costs: this build against a baseline, in turn.
 
-The machines of docs/random-machines.md whose points take the later window (a throw above 5.5),
-and the preset for scale. Each curve is `convsim sweep --beta 0:180:30 --rotation cw,ccw
+The machines of docs/random-machines.md whose points take the later window (a throw above 5.5)
+or the check at twice the sub-steps (above 4.2), the zoo's `ideal` machine (5.0 at most), and
+the preset for scale. Each curve is `convsim sweep --beta 0:180:30 --rotation cw,ccw
 --threads 1` (14 points); its CPU is the whole process's user + system time, the least of
 --repeats runs, the two builds taking turns on the same machine.
 
@@ -18,7 +19,8 @@ from throw_probe import rev
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 MACHINES = ["e=0.05195 k_c=3827000", "e=0.05593 R=0.1926 k_c=882600", "e=0.07343", "e=0.09624",
-            "e=0.04322 k_c=17170000 mu=0.2682", ""]
+            "e=0.04322 k_c=17170000 mu=0.2682", "e=0.0413 omega_ss=130.1",
+            "drive=ideal e=0.03 k_c=5e6 mu=0.5", ""]
 
 
 def cpu(binary, sets):

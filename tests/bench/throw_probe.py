@@ -12,10 +12,15 @@ gate (docs/model-numerics.md section 10); the finer one is v_ref. A point of a c
 where it says steady and tol_met and lies beyond the gate from v_ref.
 
   python3 tests/bench/throw_probe.py [--seeds 1,2,3] [--count 14] [--baseline BIN] [--out MD]
-                                    [--jsonl FILE] [--refs FILE]
+                                    [--jsonl FILE] [--refs FILE] [--changed]
 
 --refs takes each machine's references from an earlier run's --jsonl: they run at given steps,
 which a change to the steps the engine picks leaves as they were.
+
+--changed (with --baseline) runs the references only for the machines whose curve this build
+changes (any byte of the two builds' CSV), lists those alone and counts the others as
+unchanged: their misses are the baseline's. Default output then
+tests/bench/results/throw_probe_changed.md.
 
 Its header gives its wall time (the references take most of it). Writes the table to
 tests/bench/results/throw_probe.md (docs/random-machines.md).
@@ -81,6 +86,12 @@ def throw(binary, sets):
     return best
 
 
+def flags(curve, ref):
+    """The points claimed by the references that a curve flags: not steady or not tol_met."""
+    return sum(1 for r, (c, _, _) in zip(curve, ref) if c and
+               not (r["steady"] == "true" and r["tol_met"] == "true"))
+
+
 def misses(curve, ref):
     """The points a curve claims (steady, tol_met) beyond the gate from v_ref."""
     return [(r["beta"], r["rotation"], float(r["velocity"]), v) for r, (claimed, v, gate) in
@@ -104,17 +115,25 @@ def main():
     ap.add_argument("--count", type=int, default=14)
     ap.add_argument("--build", default=os.path.join(ROOT, "build", "convsim"))
     ap.add_argument("--baseline")
-    ap.add_argument("--out", default=os.path.join(HERE, "results", "throw_probe.md"))
+    ap.add_argument("--out")
+    ap.add_argument("--changed", action="store_true", help="only the machines whose curve this "
+                    "build changes against --baseline")
     ap.add_argument("--jsonl", help="also keep every machine's points here")
     ap.add_argument("--refs", help="take the references from an earlier run's --jsonl (their "
                     "steps are given, so a change to the steps the engine picks leaves them)")
     o = ap.parse_args()
+    if o.changed and not o.baseline:
+        ap.error("--changed needs --baseline")
+    o.out = o.out or os.path.join(HERE, "results", "throw_probe_changed.md" if o.changed
+                                  else "throw_probe.md")
+    unchanged = 0
     kept = {}
     if o.refs:
         for line in open(o.refs):
             d = json.loads(line)
             kept[json.dumps(d["sets"], sort_keys=True)] = (d["ref1"], d["ref2"])
-    rows, tot = [], {"claimed": 0, "base": 0, "this": 0, "flag": 0, "mach_base": 0, "mach_this": 0}
+    rows, tot = [], {"claimed": 0, "base": 0, "this": 0, "flag": 0, "mach_base": 0,
+                     "mach_this": 0, "bflag": 0}
     keep = open(o.jsonl, "a") if o.jsonl else None
     began = time.time()
     for seed in [int(x) for x in o.seeds.split(",")]:
@@ -122,10 +141,14 @@ def main():
         for i in range(o.count):
             sets = draw(rng)
             key = json.dumps(sets, sort_keys=True)
-            r1, r2 = kept[key] if key in kept else (sweep(o.build, sets, *REF1),
-                                                    sweep(o.build, sets, *REF2))
             this = sweep(o.build, sets)
             base = sweep(o.baseline, sets) if o.baseline else None
+            if o.changed and this and this == base:
+                unchanged += 1
+                print(seed, sets, "unchanged", file=sys.stderr, flush=True)
+                continue
+            r1, r2 = kept[key] if key in kept else (sweep(o.build, sets, *REF1),
+                                                    sweep(o.build, sets, *REF2))
             if not (r1 and r2 and this):
                 rows.append((seed, sets, None))
                 continue
@@ -139,8 +162,8 @@ def main():
                 ref.append((claimed, v, gate))
             m_this = misses(this, ref)
             m_base = misses(base, ref) if base else []
-            flagged = sum(1 for r, (c, _, _) in zip(this, ref) if c and
-                          not (r["steady"] == "true" and r["tol_met"] == "true"))
+            flagged = flags(this, ref)
+            tot["bflag"] += flags(base, ref) if base else 0
             claimed = sum(1 for c, _, _ in ref if c)
             g = throw(o.build, sets)
             rows.append((seed, sets, (g, claimed, m_base, m_this, flagged)))
@@ -156,8 +179,9 @@ def main():
                 keep.flush()
             print(seed, sets, "throw %.1f" % g, "claimed", claimed, "baseline misses",
                   len(m_base), "misses", len(m_this), file=sys.stderr, flush=True)
-    cmd = "python3 tests/bench/throw_probe.py --seeds %s --count %d%s%s" % (
-        o.seeds, o.count, " --baseline BIN" if o.baseline else "",
+    cmd = "python3 tests/bench/throw_probe.py --seeds %s --count %d%s%s%s" % (
+        o.seeds, o.count, " --baseline BIN" if o.baseline else "", " --changed" if o.changed
+        else "",
         " --refs JSONL (the references of %d machines from an earlier run)" % len(kept)
         if o.refs else "")
     fmt = lambda ms: "; ".join("%s %s %.4f (v_ref %.4f)" % m for m in ms) or "none"
@@ -179,11 +203,13 @@ def main():
             f.write("| %s | %d | %.1f | %d of 14 | %s | %s | %d |\n" % (
                 name, seed, g, claimed, fmt(mb) if o.baseline else "-", fmt(mt), fl))
         f.write("\n| total | points claimed | baseline's misses (machines) | this build's misses"
-                " (machines) | this build's flagged |\n|---|---|---|---|---|\n")
-        f.write("| %d machines | %d | %s | %d (%d) | %d |\n" % (
-            len(rows), tot["claimed"],
+                " (machines) | this build's flagged | baseline's flagged |\n"
+                "|---|---|---|---|---|---|\n")
+        f.write("| %d machines%s | %d | %s | %d (%d) | %d | %s |\n" % (
+            len(rows), ", %d more unchanged" % unchanged if o.changed else "", tot["claimed"],
             "%d (%d)" % (tot["base"], tot["mach_base"]) if o.baseline else "-",
-            tot["this"], tot["mach_this"], tot["flag"]))
+            tot["this"], tot["mach_this"], tot["flag"],
+            tot["bflag"] if o.baseline else "-"))
 
 
 if __name__ == "__main__":
