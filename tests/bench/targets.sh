@@ -12,7 +12,8 @@
 #    and the start that leaves;
 #  - the machine alone (feed=false), 20-s runs;
 #  - the 74-point curve (`convsim sweep --beta 0:180:5 --rotation cw,ccw
-#    --threads 1`), user CPU seconds, the least and the median of 4;
+#    --threads 1`), the whole process's CPU (user + sys), the least and the
+#    median of 4, against the target of 0.1 s (issue 37);
 #  - the daemon: 200 default sessions at pace 1 with a stream each
 #    (tests/bench/realtime.mjs 200, the previous build's daemon first as
 #    its baseline, a minute on both cores; skipped
@@ -54,9 +55,10 @@ for ((i = 0; i < RUNS; i++)); do
 		run "$bin" 20 --set feed=false >> "$tmp/machine20$b"
 	done
 done
-TIMEFORMAT=%U
+TIMEFORMAT='%U %S'
 for i in 1 2 3 4; do
 	{ time "$BUILD/convsim" sweep --beta 0:180:5 --rotation cw,ccw --threads 1 -q > /dev/null; } 2>> "$tmp/curve"
+	{ time "$prev" sweep --beta 0:180:5 --rotation cw,ccw --threads 1 -q > /dev/null; } 2>> "$tmp/curve.prev"
 done
 pick() { # column, file: "best median" (best = largest for column 1, least for 2)
 	sort -g -k"$1","$1" "$2" | awk -v c="$1" '{ v[NR] = $c } END {
@@ -78,7 +80,8 @@ row() { # scene, target[, file suffix, label]: the previous build's row with ".p
 	}'
 }
 read -r mb mm <<<"$(pick 1 "$tmp/machine20")"
-read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
+read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 + $2 }' "$tmp/curve"))"
+read -r pl pm <<<"$(pick 2 <(awk '{ print 0, $1 + $2 }' "$tmp/curve.prev"))"
 {
 	echo "# Speed targets"
 	echo
@@ -100,11 +103,12 @@ read -r cl cm <<<"$(pick 2 <(awk '{ print 0, $1 }' "$tmp/curve"))"
 	row full 400 .prev ", the previous build ($PREV)"
 	echo
 	printf -- '- Machine alone (feed=false), 20-s run: best %.0f× (median %.0f×); the previous build %.0f× (median %.0f×).\n' "$mb" "$mm" $(pick 1 "$tmp/machine20.prev")
-	awk -v l="$cl" -v m="$cm" 'BEGIN { printf "- The 74-point curve (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`): %.3f CPU s at least, median %.3f (target <= 0.3 s: %s).\n", l, m, (l <= 0.3 ? "met" : "missed") }'
+	awk -v l="$cl" -v m="$cm" -v pl="$pl" -v pm="$pm" -v p="$PREV" 'BEGIN { printf "- The 74-point curve (`convsim sweep --beta 0:180:5 --rotation cw,ccw --threads 1`): %.3f CPU s (user + sys) at least, median %.3f (target <= 0.1 s: %s); the previous build (%s) %.3f, median %.3f, the two in turn.\n", l, m, (l <= 0.1 ? "met" : "missed"), p, pl, pm }'
 	if [ "${DAEMON:-1}" != 0 ] && command -v node >/dev/null && [ -x "$BUILD/convsimd" ]; then
 		echo
-		echo "The daemon (target: at least 200 default sessions in real time on 2 cores, stream lag"
-		echo "p99 < 50 ms; \"baseline\" is the previous build, $PREV, run first):"
+		echo "The daemon at 200 default sessions (all admitted, in real time on 2 cores, stream lag"
+		echo "p99 < 50 ms; \"baseline\" is the previous build, $PREV, run first). Issue 37's target,"
+		echo "1,000 such sessions, is measured by tests/bench/realtime.sh (realtime.md), at 200, 600 and 1,000:"
 		echo
 		prev_build targets convsimd
 		CONVSIMD="$PWD/$BUILD/convsimd" BASELINE="$PWD/$prev" node tests/bench/realtime.mjs 200
