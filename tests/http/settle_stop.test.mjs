@@ -49,16 +49,22 @@ test('a dopri5 settling is stopped at --max-cpu-seconds 0.2 and refused, nothing
     assert.equal(metric(text, 'convsim_memory_reserved_bytes'), 0);
     assert.equal(metric(text, 'convsim_settling'), 0);
 
-    // rk4 three simulated s: estimated within the bound (about 0.17 CPU s),
-    // settled for more than twice that here: stopped, naming scene.settle
+    // rk4 over one column of 64 layers, 1.9 simulated s: estimated within
+    // the bound (0.19 CPU s), settled for 2.2 to 3.2 times that on this
+    // machine (the estimate's 1 x 64 shortfall, docs/load.md "What
+    // settling costs"), so a machine twice as fast still passes the bound:
+    // stopped, naming scene.settle. The default scene's 3 s (estimated
+    // 0.17, settled in 0.17 to 0.27 here) came within the bound on a quiet
+    // machine and was created.
+    const SETTLE = 1.9;
     const fixed = await req(d.base, 'POST', '/api/v1/sessions',
-      { integrator: { method: 'rk4' }, scene: { settle: 3 } });
+      { integrator: { method: 'rk4' }, scene: { columns: 1, layers: 64, settle: SETTLE } });
     assert.equal(fixed.status, 422, fixed.text);
     assert.equal(fixed.body.field, 'scene.settle', fixed.text);
     const f = fixed.body.detail.match(FIXED);
     assert.ok(f, fixed.body.detail);
     assert.equal(fixed.body.min, 0);
-    assert.ok(fixed.body.max > 0 && fixed.body.max < 3, fixed.text);
+    assert.ok(fixed.body.max > 0 && fixed.body.max < SETTLE, fixed.text);
     assert.ok(Math.abs(fixed.body.max - Number(f[2])) <= 5e-3 * fixed.body.max, fixed.text); // 3 digits
     assert.deepEqual([fixed.body.budget, fixed.body.limit], ['cpu', BOUND]);
 
