@@ -470,6 +470,21 @@ def evaluate(run, pts, peak, unpredicted=None):
     return out
 
 
+def ceiling(run, pts, peak):
+    """Each family's one closure fitted on every bed at once, the points
+    it predicts among them: the most any closure of the family can get on
+    the map, whatever it is fitted on (not a prediction)."""
+    return {f: fit(run, f, pts, peak) for f in FAMILIES}
+
+
+def add_ceiling(run, recs, closures):
+    """recs' f_err_all: the error of family f's whole-map closure."""
+    for r in recs:
+        for f, c in closures.items():
+            r[f + "_err_all"] = (run.get(c, r)[0] - r["v_dem"]) / r["peak"]
+            r[f + "_all"] = name_of(c)
+
+
 def main():
     if sys.argv[1:] == ["--self-test"]:
         import fast_feed_selftest  # noqa: E402 (the harness's own checks)
@@ -493,6 +508,7 @@ def main():
     runner.run_all([args_of(convsim, c, r, p) for c, p in cols for r in c["Rs"]])
     unpredicted = []
     recs = evaluate(runner, pts, peak, unpredicted)
+    add_ceiling(runner, recs, ceiling(runner, pts, peak))
     runner.save()
     from fast_feed_report import pct_of, summary, write_csv, write_md  # noqa: E402 (it imports this)
     write_csv(recs, os.path.join(RESULTS, "fast_feed.csv"))

@@ -10,7 +10,8 @@ import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fast_feed_check import R_FLOOR, dissipation, evaluate, fit, resolve, rests, training  # noqa: E402
+from fast_feed_check import R_FLOOR, add_ceiling, ceiling, dissipation, evaluate, fit, resolve, rests, \
+    training  # noqa: E402
 
 GLASS = {"e_pw": 0.9, "e_pp": 0.97, "mu_pw": 0.15}  # dem/materials.json's, in part
 WHEAT = {"e_pw": 0.5, "e_pp": 0.5, "mu_pw": 0.3}
@@ -71,6 +72,16 @@ def self_test():
     best = fit(FakeRunner(), "layered", train, peak)
     checks.append(("layered held out at depth 1", all(
         abs(x["layered_v"] - statistics.fmean(best["Rs"]) * x["beta"] / 100.0) < 1e-12 for x in lr)))
+    run = FakeRunner()
+    whole = ceiling(run, pts, peak)
+    checks.append(("the ceiling's fit sees every bed", set(run.seen) == {1, 2}))
+    # no one R makes both depths (R 0.15 d): the tie goes to the first grid point, R 0.15,
+    # exact at depth 1 and (0.15 - 0.3) beta / 100 over the peak 0.27 at depth 2
+    add_ceiling(FakeRunner(), recs, whole)
+    errs = sorted(round(x["closure_err_all"], 12) for x in recs)
+    checks.append(("the ceiling: one closure for both depths, right at one of them",
+                   whole["closure"]["Rs"] == (0.15,) and errs == [round(-b / 180, 12) for b in
+                                                             (90, 60, 30)] + [0.0] * 3))
     checks += collapse_checks()
     checks += summary_checks()
     for name, ok in checks:
