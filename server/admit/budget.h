@@ -113,6 +113,8 @@ api_err srv_budget_settle_stopped(const api_spec *spec, double before, double sp
  * "rk4|euler|dem"), each of its length in bytes. */
 int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len,
 			     char *choices, size_t choices_len);
+/* 1 when spec's method is adaptive (its steps are known only once it runs). */
+int srv_budget_adaptive(const api_spec *spec);
 /* A job's run (a sweep's point, a fit's evaluation): a steady start's
  * settling and t_end simulated s, which nothing interrupts once begun (a
  * DELETE, a SIGTERM wait for it). One estimated beyond --max-cpu-seconds

@@ -283,6 +283,16 @@ int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len
 	return adaptive;
 }
 
+int srv_budget_adaptive(const api_spec *spec)
+{
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	for (size_t i = 0; i < n; i++)
+		if (strcmp(all[i]->name, spec->method.name) == 0)
+			return all[i]->adaptive;
+	return 0;
+}
+
 api_err srv_budget_settle_stopped(const api_spec *spec, double before, double spent,
 				  double settled, api_problem *pb)
 {

@@ -10,7 +10,9 @@
  * cost, what it holds once its start is over.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "budget.h"
 #include "cpu_probe.h"
@@ -77,4 +79,29 @@ out:
 	free(feed);
 	free(buf);
 	return cost;
+}
+
+int srv_cpu_settle_peek(const api_spec *spec, double cpu0, double deadline, sim **out,
+			api_problem *pb)
+{
+	*out = NULL;
+	if (spec->pace == API_PACE_MAX || !srv_budget_adaptive(spec) ||
+	    cpu0 + SRV_SETTLE_PEEK_CPU >= deadline)
+		return 0;
+	double settled = 0, held = 0;
+	int err = SIM_OK;
+	char msg[64];
+	*out = sim_new_bounded(&spec->params, &spec->scene, &spec->method,
+			       cpu0 + SRV_SETTLE_PEEK_CPU, &settled, &err, msg, sizeof msg);
+	if (*out || err != SIM_ECPU || !(settled > 0))
+		return 0; /* settled, or failed: the whole settling says why */
+	double per_s = (srv_thread_cpu() - cpu0) / settled;
+	if (per_s * spec->pace < 2 * srv_budget_paced_limit())
+		return 0;
+	srv_budget_take_paced(&held, per_s, spec->pace, "pace", "created", pb);
+	size_t at = strlen(pb->detail);
+	snprintf(pb->detail + at, sizeof pb->detail - at, " (measured over the first %g CPU s of "
+		 "its settling: integrator.method %s is adaptive)", SRV_SETTLE_PEEK_CPU,
+		 spec->method.name);
+	return 1;
 }

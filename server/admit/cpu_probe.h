@@ -33,4 +33,19 @@
 double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int layers,
 		     double cpu_s, double deadline, const char *id);
 
+/* An adaptive method's steps are known only once it runs, so the
+ * estimate before a creation's settling cannot refuse a paced session that
+ * needs far more than the cores for paced sessions: it would settle (up to
+ * --max-cpu-seconds, holding a settling slot) and its probe refuse it
+ * after. Such a session (spec's pace not max) first settles
+ * SRV_SETTLE_PEEK_CPU s of this thread's CPU from cpu0; where that
+ * settling's CPU per simulated s at its pace is at least twice the whole
+ * budget, it is refused there: 1 and *pb (422 naming pace, as after the
+ * probe, its detail saying where the figure comes from). Else 0: *out is
+ * the instance where the peek settled it all, NULL where the settling is
+ * to start again within deadline (or spec is not such a session). */
+#define SRV_SETTLE_PEEK_CPU 0.2
+int srv_cpu_settle_peek(const api_spec *spec, double cpu0, double deadline, sim **out,
+			api_problem *pb);
+
 #endif

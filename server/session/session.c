@@ -161,8 +161,11 @@ static int session_init(srv_session *s, const api_spec *spec, double before, api
 	 * spent before them: one request, one bound */
 	double left = before > 0 ? fmax(cfg->max_cpu_seconds - before, 0) : cfg->max_cpu_seconds;
 	double cpu0 = srv_thread_cpu(), deadline = cpu0 + left, settled = 0;
-	s->sim = sim_new_bounded(&spec->params, &spec->scene, &spec->method, deadline, &settled,
-				 &err, msg, sizeof msg);
+	if (srv_cpu_settle_peek(spec, cpu0, deadline, &s->sim, pb))
+		return -1;
+	if (!s->sim)
+		s->sim = sim_new_bounded(&spec->params, &spec->scene, &spec->method, deadline,
+					 &settled, &err, msg, sizeof msg);
 	if (!s->sim) {
 		if (err == SIM_ECPU)
 			srv_budget_settle_stopped(spec, before, srv_thread_cpu() - cpu0, settled,

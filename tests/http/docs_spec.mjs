@@ -27,6 +27,10 @@ export const SPEC = [
   /* issue 35's stiffness rule */
   ['docs/dem.md', 'within 2 % of the next rung'],
   ['docs/hardening.md', 'target, p99 under 100 ms'],
+  // an adaptive paced session's first settling, SRV_SETTLE_PEEK_CPU in server/admit/cpu_probe.h
+  ['docs/load.md', 'settles its first\n0.2 CPU s'],
+  ['docs/load.md', 'measured over the first 0.2 CPU s of its settling'],
+  ['docs/budgets.md', 'whose first 0.2 CPU s of settling'],
   // the settling slot's wait, SETTLING_WAIT_MS in server/admit/budget_settling.c
   ['docs/load.md', 'waits at most 250 ms for a slot'],
   ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],

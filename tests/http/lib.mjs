@@ -374,6 +374,17 @@ export function processCpu(pid) {
   return (Number(f[11]) + Number(f[12])) / TICK;
 }
 
+// A POST to the daemon d that is refused 422 with a problem+json body:
+// the answer and the daemon's CPU seconds over the request.
+export async function postRefusedCpu(d, path, body) {
+  const cpu0 = processCpu(d.proc.pid);
+  const r = await req(d.base, 'POST', path, body);
+  const cpu = processCpu(d.proc.pid) - cpu0;
+  assert.equal(r.status, 422, r.text);
+  assert.equal(r.headers.get('content-type'), 'application/problem+json');
+  return { r, cpu };
+}
+
 // A POST to the daemon d whose work in the request's thread an adaptive
 // method (dopri5) ran past --max-cpu-seconds (limit): 422 out-of-range
 // naming field with the methods of a fixed step as its choices, budget cpu
@@ -381,11 +392,7 @@ export function processCpu(pid) {
 // detail, for the caller's own pattern, and the daemon's CPU seconds over
 // the request.
 export async function postStoppedAdaptive(d, path, body, field, limit) {
-  const cpu0 = processCpu(d.proc.pid);
-  const r = await req(d.base, 'POST', path, body);
-  const cpu = processCpu(d.proc.pid) - cpu0;
-  assert.equal(r.status, 422, r.text);
-  assert.equal(r.headers.get('content-type'), 'application/problem+json');
+  const { r, cpu } = await postRefusedCpu(d, path, body);
   const { detail, ...rest } = r.body;
   assert.deepEqual(rest, {
     type: '/api/v1/problems/out-of-range', title: 'Value out of range', status: 422,

@@ -13,7 +13,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readdirSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { startDaemon, req, metric, processCpu, SLOW } from './lib.mjs';
+import { startDaemon, req, metric, postRefusedCpu, SLOW } from './lib.mjs';
 
 const LARGE = { scene: { columns: 64, layers: 64 }, pace: 0.01, sample_rate: 1 };
 const BOUND = 0.2;
@@ -42,11 +42,7 @@ test('a 64 x 64 scene is refused under --max-cpu-seconds 0.2 before it settles; 
   const d = await startDaemon(['--max-cpu-seconds', String(BOUND), '--data-dir', dir]);
   const metrics = async () => (await req(d.base, 'GET', '/metrics')).text;
   try {
-    const cpu0 = processCpu(d.proc.pid);
-    const r = await req(d.base, 'POST', '/api/v1/sessions', LARGE);
-    const cpu = processCpu(d.proc.pid) - cpu0;
-    assert.equal(r.status, 422, r.text);
-    assert.equal(r.headers.get('content-type'), 'application/problem+json');
+    const { r, cpu } = await postRefusedCpu(d, '/api/v1/sessions', LARGE);
     assert.deepEqual(r.body, refusal);
     assert.ok(Math.abs(MAX * SETTLE_CPU / 0.6 - BOUND) < 1e-3 * BOUND, 'max is the settle that fits');
     // refused before anything settled (a settling of it takes about a CPU second)
