@@ -108,6 +108,14 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_
  * API_RANGE. */
 api_err srv_budget_settle_stopped(const api_spec *spec, double before, double spent,
 				  double settled, api_problem *pb);
+/* An adaptive method's creation whose first spent CPU s settled settled of
+ * scene.settle's simulated s (cpu_probe.c's peek), with left CPU s of the
+ * request's --max-cpu-seconds from its start: where its whole settling
+ * would take twice left or more at that rate, 1 and *pb (422, budget
+ * "cpu", naming integrator.method with the methods of a fixed step as
+ * choices), refused before it settles; else 0. */
+int srv_budget_settle_peeked(const api_spec *spec, double left, double spent, double settled,
+			     api_problem *pb);
 /* 1 when spec's method is adaptive; the methods of a fixed step into
  * names ("rk4, euler, dem", for a detail) and choices (api_choices_of's
  * "rk4|euler|dem"), each of its length in bytes. */

@@ -293,6 +293,25 @@ int srv_budget_adaptive(const api_spec *spec)
 	return 0;
 }
 
+int srv_budget_settle_peeked(const api_spec *spec, double left, double spent, double settled,
+			     api_problem *pb)
+{
+	double settle = settling(spec), whole = spent / settled * settle;
+	if (!(whole >= 2 * left))
+		return 0;
+	char names[96], choices[96];
+	srv_budget_fixed_methods(spec, names, sizeof names, choices, sizeof choices);
+	api_fail_choices(pb, API_RANGE, "integrator.method", choices,
+			 "the steady start's settling would take about %.3g CPU s, twice what "
+			 "--max-cpu-seconds (%g) leaves or more (its first %.3g CPU s settled "
+			 "%.3g of scene.settle's %g s; %s is adaptive); nothing was created: a "
+			 "method of a fixed step (%s), a shorter scene.settle or scene.start "
+			 "\"rest\"",
+			 whole, run_limit, spent, settled, settle, spec->method.name, names);
+	api_budget(pb, "cpu", run_limit, 0);
+	return 1;
+}
+
 api_err srv_budget_settle_stopped(const api_spec *spec, double before, double spent,
 				  double settled, api_problem *pb)
 {

@@ -85,8 +85,7 @@ int srv_cpu_settle_peek(const api_spec *spec, double cpu0, double deadline, sim 
 			api_problem *pb)
 {
 	*out = NULL;
-	if (spec->pace == API_PACE_MAX || !srv_budget_adaptive(spec) ||
-	    cpu0 + SRV_SETTLE_PEEK_CPU >= deadline)
+	if (!srv_budget_adaptive(spec) || cpu0 + SRV_SETTLE_PEEK_CPU >= deadline)
 		return 0;
 	double settled = 0, held = 0;
 	int err = SIM_OK;
@@ -95,9 +94,9 @@ int srv_cpu_settle_peek(const api_spec *spec, double cpu0, double deadline, sim 
 			       cpu0 + SRV_SETTLE_PEEK_CPU, &settled, &err, msg, sizeof msg);
 	if (*out || err != SIM_ECPU || !(settled > 0))
 		return 0; /* settled, or failed: the whole settling says why */
-	double per_s = (srv_thread_cpu() - cpu0) / settled;
-	if (per_s * spec->pace < 2 * srv_budget_paced_limit())
-		return 0;
+	double spent = srv_thread_cpu() - cpu0, per_s = spent / settled;
+	if (spec->pace == API_PACE_MAX || per_s * spec->pace < 2 * srv_budget_paced_limit())
+		return srv_budget_settle_peeked(spec, deadline - cpu0, spent, settled, pb);
 	srv_budget_take_paced(&held, per_s, spec->pace, "pace", "created", pb);
 	size_t at = strlen(pb->detail);
 	snprintf(pb->detail + at, sizeof pb->detail - at, " (measured over the first %g CPU s of "

@@ -37,13 +37,15 @@ double srv_cpu_probe(const sim *live, const api_spec *spec, int columns, int lay
  * estimate before a creation's settling cannot refuse a paced session that
  * needs far more than the cores for paced sessions: it would settle (up to
  * --max-cpu-seconds, holding a settling slot) and its probe refuse it
- * after. Such a session (spec's pace not max) first settles
- * SRV_SETTLE_PEEK_CPU s of this thread's CPU from cpu0; where that
- * settling's CPU per simulated s at its pace is at least twice the whole
- * budget, it is refused there: 1 and *pb (422 naming pace, as after the
- * probe, its detail saying where the figure comes from). Else 0: *out is
+ * after; nor one whose settling would run to --max-cpu-seconds. Such a
+ * session first settles SRV_SETTLE_PEEK_CPU s of this thread's CPU from
+ * cpu0; where that settling's CPU per simulated s at its pace (not max)
+ * is at least twice the whole budget, it is refused there: 1 and *pb (422
+ * naming pace, as after the probe, its detail saying where the figure
+ * comes from); where its whole settling would take twice what is left to
+ * deadline or more, 1 and srv_budget_settle_peeked's 422. Else 0: *out is
  * the instance where the peek settled it all, NULL where the settling is
- * to start again within deadline (or spec is not such a session). */
+ * to start again within deadline (or spec's method is not adaptive). */
 #define SRV_SETTLE_PEEK_CPU 0.2
 int srv_cpu_settle_peek(const api_spec *spec, double cpu0, double deadline, sim **out,
 			api_problem *pb);

@@ -31,6 +31,7 @@ export const SPEC = [
   ['docs/load.md', 'settles its first\n0.2 CPU s'],
   ['docs/load.md', 'measured over the first 0.2 CPU s of its settling'],
   ['docs/budgets.md', 'whose first 0.2 CPU s of settling'],
+  ['docs/api-errors.md', 'whose first 0.2 CPU s of settling'],
   // the settling slot's wait, SETTLING_WAIT_MS in server/admit/budget_settling.c
   ['docs/load.md', 'waits at most 250 ms for a slot'],
   ['docs/budgets.md', 'after waiting up to 250 ms for a slot'],

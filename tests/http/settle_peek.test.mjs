@@ -6,7 +6,9 @@
 // first and is refused there where that settling alone needs twice the
 // cores for paced sessions (server/admit/cpu_probe.c, srv_cpu_settle_peek;
 // docs/load.md "What settling costs"); one that fits settles again from the
-// start and is created.
+// start and is created. A creation of any pace whose settling would run to
+// twice what --max-cpu-seconds leaves or more is refused there too: it
+// settled up to the bound before.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { startDaemon, req, metric, postRefusedCpu, SLOW } from './lib.mjs';
@@ -47,6 +49,38 @@ test('a paced dopri5 session that needs far more than the paced cores is refused
     assert.equal(ok.body.columns, 5);
     assert.equal(ok.body.layers, 8);
     assert.equal((await req(d.base, 'DELETE', `/api/v1/sessions/${ok.body.id}`)).status, 204);
+  } finally {
+    assert.equal((await d.stop()).code, 0, d.stderr());
+  }
+});
+
+const UNPACED = { scene: { columns: 64, layers: 64, settle: 5 }, integrator: { method: 'dopri5' }, pace: 'max' };
+const WHOLE = new RegExp('^the steady start\'s settling would take about ([0-9.e+]+) CPU s, twice what ' +
+  '--max-cpu-seconds \\(20\\) leaves or more \\(its first ([0-9.e+]+) CPU s settled ([0-9.e+-]+) of ' +
+  'scene\\.settle\'s 5 s; dopri5 is adaptive\\); nothing was created: a method of a fixed step \\(rk4, euler, ' +
+  'dem\\), a shorter scene\\.settle or scene\\.start "rest"$');
+
+test('a dopri5 creation whose settling would take twice --max-cpu-seconds is refused after 0.2 CPU s of it', { timeout: 60000 * SLOW }, async () => {
+  const d = await startDaemon(['--max-cpu-seconds', '20']);
+  try {
+    const { r, cpu } = await postRefusedCpu(d, '/api/v1/sessions', UNPACED);
+    const { detail, ...rest } = r.body;
+    assert.deepEqual(rest, {
+      type: '/api/v1/problems/out-of-range', title: 'Value out of range', status: 422,
+      instance: '/api/v1/sessions', field: 'integrator.method', budget: 'cpu', limit: 20,
+      choices: ['rk4', 'euler', 'dem'],
+    });
+    const m = detail.match(WHOLE);
+    assert.ok(m, detail);
+    const [whole, spent, settled] = m.slice(1).map(Number);
+    // the projection: the peek's rate over the whole scene.settle (three digits each)
+    assert.ok(whole >= 40, detail);
+    assert.ok(spent >= 0.2 && spent < 0.2 + 0.05 * SLOW, detail);
+    assert.ok(settled > 0 && settled < 5 / 2, detail);
+    assert.ok(Math.abs(whole / (spent / settled * 5) - 1) < 0.01, detail);
+    // it settled the peek, not the 20 CPU s of the bound (a 64 x 64 dopri5 step takes milliseconds)
+    assert.ok(cpu < 3 * SLOW, `the daemon spent ${cpu} CPU s over the request`);
+    assert.deepEqual((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions, []);
   } finally {
     assert.equal((await d.stop()).code, 0, d.stderr());
   }
