@@ -108,6 +108,11 @@ test("an identification's operating point whose step leaves [0, 180] deg: the po
     await until(async () => !['waiting', 'running'].includes((await req(d.base, 'GET', path)).body.state),
       60000 * SLOW, 'the identification ends');
     assert.equal((await req(d.base, 'GET', path)).body.state, 'done');
+    assert.match(ok.body.session, /^[0-9a-f]{16}$/, ok.text);
+    // its own session is removed within the daemon's next second once it ended: waited
+    // for here, so that the later tests' lists before and after a refusal do not see it go
+    await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${ok.body.session}`)).status === 404,
+      10000 * SLOW, 'the ended experiment\'s session is removed');
   }
 });
 
