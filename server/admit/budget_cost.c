@@ -262,27 +262,6 @@ api_err srv_budget_cpu_preview(const api_spec *spec, double before, double *cpu_
 	return api_budget(pb, "cpu", run_limit, 0);
 }
 
-int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len,
-			     char *choices, size_t choices_len)
-{
-	size_t n;
-	const sim_method_info *const *all = sim_methods(&n);
-	unsigned fixed = 0;
-	int adaptive = 0;
-	names[0] = '\0';
-	for (size_t i = 0; i < n && i < 32; i++) {
-		if (strcmp(all[i]->name, spec->method.name) == 0)
-			adaptive = all[i]->adaptive;
-		if (all[i]->adaptive)
-			continue;
-		fixed |= 1u << i;
-		size_t at = strlen(names);
-		snprintf(names + at, names_len - at, "%s%s", at ? ", " : "", all[i]->name);
-	}
-	api_choices_of("method", fixed, choices, choices_len);
-	return adaptive;
-}
-
 int srv_budget_adaptive(const api_spec *spec)
 {
 	size_t n;
@@ -291,6 +270,24 @@ int srv_budget_adaptive(const api_spec *spec)
 		if (strcmp(all[i]->name, spec->method.name) == 0)
 			return all[i]->adaptive;
 	return 0;
+}
+
+int srv_budget_fixed_methods(const api_spec *spec, char *names, size_t names_len,
+			     char *choices, size_t choices_len)
+{
+	size_t n;
+	const sim_method_info *const *all = sim_methods(&n);
+	unsigned fixed = 0;
+	names[0] = '\0';
+	for (size_t i = 0; i < n && i < 32; i++) {
+		if (all[i]->adaptive)
+			continue;
+		fixed |= 1u << i;
+		size_t at = strlen(names);
+		snprintf(names + at, names_len - at, "%s%s", at ? ", " : "", all[i]->name);
+	}
+	api_choices_of("method", fixed, choices, choices_len);
+	return srv_budget_adaptive(spec);
 }
 
 int srv_budget_settle_peeked(const api_spec *spec, double left, double spent, double settled,
