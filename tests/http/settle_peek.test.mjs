@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // An adaptive method's steps are known only once it runs, so no estimate
 // before a paced dopri5 session's settling could refuse it: a 64 x 64 one
-// settled for about 48 CPU s, holding the only settling slot, before its
+// settled whole (about 48 s on the clock), holding the only settling slot, before its
 // probe refused it for needing 64 cores. Such a session now settles 0.2 CPU s
 // first and is refused there where that settling alone needs twice the
 // cores for paced sessions (server/admit/cpu_probe.c, srv_cpu_settle_peek;
@@ -34,7 +34,7 @@ test('a paced dopri5 session that needs far more than the paced cores is refused
     assert.ok(need >= 2, detail);
     // (the detail prints three significant digits)
     assert.ok(Math.abs(max * Number(m[2]) / 1e3 - 1) < 5e-3, `max ${max} against ${m[2]} ms`);
-    // the settling stopped at the peek (its whole settling took about 48 CPU s)
+    // the settling stopped at the peek (its whole settling took about 48 s on the clock)
     assert.ok(cpu < 3 * SLOW, `the daemon spent ${cpu} CPU s over the request`);
     // nothing was created or held: the settling slot and the cores are free
     assert.deepEqual((await req(d.base, 'GET', '/api/v1/sessions')).body.sessions, []);
