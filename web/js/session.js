@@ -155,7 +155,9 @@ export async function pollStatus() {
 	}
 }
 
-export async function patch(body, what) {
+/* refused: called before the refusal's message shows, to put the inputs
+ * back on the session as last polled (the refused control changed nothing) */
+export async function patch(body, what, refused) {
 	if (!app.id) return null;
 	try {
 		const r = await api.patchSession(app.id, body);
@@ -164,6 +166,7 @@ export async function patch(body, what) {
 		return r;
 	} catch (err) {
 		/* a refusal changes nothing: the inputs show the session again */
+		if (refused && app.session) refused(app.session);
 		report(err, what, $('#control-card'), CONTROL_INPUT);
 		await pollStatus();
 		return null;
@@ -175,13 +178,14 @@ export async function setBeta(beta) {
 	/* a slew typed goes as typed (a negative one for the daemon to refuse) */
 	const rate = numberOf($('#beta-rate'));
 	if (!Number.isNaN(rate)) body.beta_rate = rate;
-	const r = await patch(body, 'β change');
+	const r = await patch(body, 'β change', showBetaTarget);
 	if (r) {
 		const t = r.control.t;
 		message('ok', `β → ${fmtGiven(beta)}°` + (Number.isFinite(t) ? ` from t = ${fmtTime(t)}` : '') + '.');
 	} else if (app.session) {
 		/* refused (181, -5): the slider and the number field, focused or
-		 * not, show the session's β target again */
+		 * not, show the session's β target again, before its message
+		 * (above) and once more as the poll after it found it */
 		showBetaTarget(app.session);
 	}
 	return r;
