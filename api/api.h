@@ -260,6 +260,10 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
  * sample_rate within the ranges the parser allows, every setting within
  * its range, and the set passes sim_validate. API_OK or the problem (nothing is changed). */
 api_err api_check_spec(const api_spec *spec, api_problem *pb);
+/* api_check_spec of the model alone (preset, settings, the set valid),
+ * not pace, until and sample_rate: a stored sweep's or experiment's, which
+ * are not sessions' settings there. */
+api_err api_check_model(const api_spec *spec, api_problem *pb);
 
 /* The controls of PATCH /sessions/{id}, one row each, in the order they
  * are parsed, echoed in the control event and listed in messages and the

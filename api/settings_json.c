@@ -405,7 +405,8 @@ api_err api_parse_session(const char *body, size_t len, api_spec *spec,
 	return e;
 }
 
-api_err api_check_spec(const api_spec *spec, api_problem *pb)
+/* api_check_spec's first part: the names are strings, the preset known. */
+static api_err check_names(const api_spec *spec, api_problem *pb)
 {
 	if (!memchr(spec->preset, '\0', sizeof spec->preset) ||
 	    !memchr(spec->method.name, '\0', sizeof spec->method.name))
@@ -415,18 +416,12 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb)
 	sim_method m;
 	if (sim_preset(spec->preset, &p, &sc, &m) != SIM_OK)
 		return api_fail(pb, API_RANGE, "preset", "unknown preset \"%.31s\"", spec->preset);
-	if (!(spec->pace == API_PACE_MAX || (spec->pace >= PACE_MIN && spec->pace <= PACE_MAX)))
-		return api_fail(pb, API_RANGE, "pace", "pace %g is no real-time factor in [%g, %g]",
-				spec->pace, PACE_MIN, PACE_MAX);
-	if (!(spec->until == 0 || (spec->until >= UNTIL_MIN && spec->until <= UNTIL_MAX)))
-		return api_fail(pb, API_RANGE, "until", "until %g lies outside [%g, %g] s",
-				spec->until, UNTIL_MIN, UNTIL_MAX);
-	if (spec->pace == API_PACE_MAX && spec->until == 0)
-		return api_fail(pb, API_INVALID, "until", "pace \"max\" without until (the parser "
-				"gives it %g s)", API_DEFAULT_MAX_UNTIL);
-	if (!(spec->sample_rate >= RATE_MIN && spec->sample_rate <= RATE_MAX))
-		return api_fail(pb, API_RANGE, "sample_rate", "sample_rate %g lies outside [%g, %g]",
-				spec->sample_rate, RATE_MIN, RATE_MAX);
+	return API_OK;
+}
+
+/* api_check_spec's last part: every setting in its range, the set valid. */
+static api_err check_settings(const api_spec *spec, api_problem *pb)
+{
 	/* every setting in its range (sim_validate leaves some unused ones,
 	 * such as atol for a fixed step, unchecked; a request cannot set them
 	 * out of range either) */
@@ -443,4 +438,30 @@ api_err api_check_spec(const api_spec *spec, api_problem *pb)
 			return api_fail(pb, API_RANGE, tab[i].name, "%s", msg);
 	}
 	return validate_model(&copy, pb);
+}
+
+api_err api_check_model(const api_spec *spec, api_problem *pb)
+{
+	api_err e = check_names(spec, pb);
+	return e != API_OK ? e : check_settings(spec, pb);
+}
+
+api_err api_check_spec(const api_spec *spec, api_problem *pb)
+{
+	api_err e = check_names(spec, pb);
+	if (e != API_OK)
+		return e;
+	if (!(spec->pace == API_PACE_MAX || (spec->pace >= PACE_MIN && spec->pace <= PACE_MAX)))
+		return api_fail(pb, API_RANGE, "pace", "pace %g is no real-time factor in [%g, %g]",
+				spec->pace, PACE_MIN, PACE_MAX);
+	if (!(spec->until == 0 || (spec->until >= UNTIL_MIN && spec->until <= UNTIL_MAX)))
+		return api_fail(pb, API_RANGE, "until", "until %g lies outside [%g, %g] s",
+				spec->until, UNTIL_MIN, UNTIL_MAX);
+	if (spec->pace == API_PACE_MAX && spec->until == 0)
+		return api_fail(pb, API_INVALID, "until", "pace \"max\" without until (the parser "
+				"gives it %g s)", API_DEFAULT_MAX_UNTIL);
+	if (!(spec->sample_rate >= RATE_MIN && spec->sample_rate <= RATE_MAX))
+		return api_fail(pb, API_RANGE, "sample_rate", "sample_rate %g lies outside [%g, %g]",
+				spec->sample_rate, RATE_MIN, RATE_MAX);
+	return check_settings(spec, pb);
 }

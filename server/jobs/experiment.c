@@ -281,9 +281,10 @@ int srv_exp_resume(srv_experiment *e, const void *buf, size_t len)
 	memcpy(&r, buf, sizeof r);
 	size_t head = sizeof r + 2 * r.rec_n * sizeof(double);
 	if (r.rec_n > EXP_RECORDS || len < head || srv_exp_tail_ok((const char *)buf + head, len - head) ||
-	    r.state != EXP_RUNNING || r.cur < 0 || r.cur >= r.req.nseg ||
-	    r.req.nseg < 1 || r.req.nseg > API_EXP_MAX_SEGMENTS ||
-	    r.seg_first > r.rec_n)
+	    r.state != EXP_RUNNING || r.seg_first > r.rec_n)
+		return -1;
+	char why[160];
+	if (srv_exp_req_check(&r.req, r.cur, why, sizeof why) != 0)
 		return -1;
 	int rc = -1;
 	pthread_mutex_lock(&e->lock);
@@ -330,11 +331,13 @@ srv_experiment *srv_exp_damaged(const char *id, const char *why)
 srv_experiment *srv_exp_load(void *payload, size_t len, char *why, size_t whylen)
 {
 	exp_record *r = payload;
-	if (len < sizeof *r || srv_exp_tail_ok((const char *)payload + sizeof *r, len - sizeof *r) ||
-	    r->state < 0 || r->state >= EXP_NSTATES || r->req.nseg < 1 ||
-	    r->req.nseg > API_EXP_MAX_SEGMENTS) {
-		free(r);
+	int bad = len < sizeof *r || srv_exp_tail_ok((const char *)payload + sizeof *r,
+						      len - sizeof *r) ||
+		  r->state < 0 || r->state >= EXP_NSTATES;
+	if (bad)
 		snprintf(why, whylen, "inconsistent");
+	if (bad || srv_exp_req_check(&r->req, r->cur, why, whylen) != 0) {
+		free(r);
 		return NULL;
 	}
 	r->id[SRV_ID_LEN - 1] = r->session_id[SRV_ID_LEN - 1] = '\0';

@@ -70,6 +70,13 @@ srv_cmd *srv_exp_start_segment(srv_experiment *e, int i, const sim_status *st);
  * velocity and its reversal time from the feed-velocity record. */
 void srv_exp_finish_segment(srv_experiment *e, const sim_status *st);
 
+/* A stored request read back (experiments/ID.bin, or a session's
+ * checkpoint), with the segment it was at, before anything reads it: the
+ * session's model as api_check_model has it, 1 to API_EXP_MAX_SEGMENTS
+ * segments, each a finite beta, a state and an end after the one before,
+ * cur one of them, the beta rate finite and not negative; its strings cut
+ * at their size. 0, or -1 with the reason in why. */
+int srv_exp_req_check(api_experiment_req *req, int cur, char *why, size_t whylen);
 /* The running segment's end (s, simulated; INFINITY when not running). */
 double srv_exp_segment_end(const srv_experiment *e);
 /* The bytes of e's kind that follow its stored record (0 for a plain

@@ -162,3 +162,28 @@ void srv_exp_end_segments(srv_experiment *e)
 		if (e->req.seg[i].state != API_SEG_DONE)
 			e->req.seg[i].state = API_SEG_ABORTED;
 }
+
+int srv_exp_req_check(api_experiment_req *req, int cur, char *why, size_t whylen)
+{
+	req->session_id[sizeof req->session_id - 1] = '\0';
+	api_problem pb;
+	if (api_check_model(&req->spec, &pb) != API_OK) {
+		snprintf(why, whylen, "its session's spec: %.*s",
+			 whylen > 24 ? (int)(whylen - 24) : 0, pb.detail);
+		return -1;
+	}
+	const char *bad = NULL;
+	if (req->nseg < 1 || req->nseg > API_EXP_MAX_SEGMENTS || cur < 0 || cur >= req->nseg)
+		bad = "its segments";
+	else if (!isfinite(req->beta_rate.si) || req->beta_rate.si < 0.0)
+		bad = "beta_rate";
+	for (int i = 0; !bad && i < req->nseg; i++) {
+		const api_segment *s = &req->seg[i];
+		if (!isfinite(s->beta.si) || !(s->until > (i > 0 ? req->seg[i - 1].until : 0.0)) ||
+		    !isfinite(s->until) || s->state < 0 || s->state >= API_SEG_NSTATES)
+			bad = "a segment";
+	}
+	if (bad)
+		snprintf(why, whylen, "inconsistent: %s", bad);
+	return bad ? -1 : 0;
+}

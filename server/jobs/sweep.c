@@ -2,21 +2,21 @@
 /*
  * sweep.c - v(beta) sweeps on the worker pool (POST /api/v1/sweeps).
  *
- * A sweep is a grid of (beta, rotation) points, or of any number
- * settings' values and rotation (a study, core/study.h); each point is one pool
- * job that builds a fresh instance with sim_measure (thread-safe,
- * no session involved) and stores the steady transport velocity. Under
- * the mirror reduction (sim_mirror_plan) a point that is the mirror image
- * of another is no job of its own: it is filled when the other is done. Sweeps
- * live in a registry (registry.c) that holds one reference, and every
- * queued job holds one, so DELETE (cancel) can unlink a sweep while its
- * jobs drain; beyond --max-sweeps the oldest finished one is evicted. A
- * sweep's fields are guarded by its own lock. Results are served as JSON
- * or CSV and, with --data-dir, saved as CSV when done. The sweep is
- * one kind of job (job.h): srv_sweep_job below is its descriptor. The
- * mirror reduction's plan of its points is sweep_plan.c. With band_from_fit
- * each point is measured again per fitted parameter (fit_band_point) for
- * its band from the fit's covariance.
+ * A sweep is a grid of (beta, rotation) points, or of any number settings'
+ * values and rotation (a study, core/study.h); each point is one pool job
+ * that builds a fresh instance with sim_measure (thread-safe, no session
+ * involved) and stores the steady transport velocity. Under the mirror
+ * reduction (sim_mirror_plan) a point that is the mirror image of another
+ * is no job of its own: it is filled when the other is done. Sweeps live in
+ * a registry (registry.c) that holds one reference, and every queued job
+ * holds one, so DELETE (cancel) can unlink a sweep while its jobs drain;
+ * beyond --max-sweeps the oldest finished one is evicted. A sweep's fields
+ * are guarded by its own lock. Results are served as JSON or CSV and, with
+ * --data-dir, saved as CSV when done. The sweep is one kind of job (job.h):
+ * srv_sweep_job below is its descriptor. The mirror reduction's plan of its
+ * points and the check of a record read back are sweep_plan.c. With
+ * band_from_fit each point is measured again per fitted parameter
+ * (fit_band_point) for its band from the fit's covariance.
  */
 #include <math.h>
 #include <pthread.h>
@@ -265,7 +265,6 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 		nb = (size_t)r.req.nbeta * sizeof(api_value);
 		np = r.total * sizeof(api_sweep_point);
 		ok = r.req.nbeta >= 0 && r.req.nbeta <= API_SWEEP_MAX_POINTS &&
-		     r.req.nvary >= 0 && r.req.nvary <= SIM_STUDY_MAX_AXES &&
 		     r.total <= API_SWEEP_MAX_POINTS && len == sizeof r + nb + np;
 	}
 	if (!ok)
@@ -277,13 +276,15 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 		sw->req.values = NULL;
 		sw->req.betas = malloc(nb ? nb : 1);
 		sw->pt = malloc(np ? np : 1);
-		r.id[SRV_ID_LEN - 1] = '\0';
-		snprintf(sw->entry.id, sizeof sw->entry.id, "%s", r.id);
+		snprintf(sw->entry.id, sizeof sw->entry.id, "%.*s", SRV_ID_LEN - 1, r.id);
 	}
-	int planned = 0;
+	int planned = 0, consistent = 1;
 	if (sw && sw->req.betas && sw->pt) {
 		memcpy(sw->req.betas, p + sizeof r, nb);
 		memcpy(sw->pt, p + sizeof r + nb, np);
+		consistent = srv_sweep_record_check(&sw->req, sw->pt, r.total, why, whylen) == 0;
+	}
+	if (consistent && sw && sw->req.betas && sw->pt) {
 		sw->total = r.total;
 		sw->cancelled = r.cancelled;
 		sw->done = 0;
@@ -292,16 +293,16 @@ static srv_entry *sweep_load(void *payload, size_t len, char *why, size_t whylen
 				sw->pt[k].state = 0;
 			sw->done += sw->pt[k].state >= 2;
 		}
-		/* the plan again; an image whose point is over is filled
-		 * (written together, but a stop may fall between the two
-		 * writes) */
+		/* the plan again; an image whose point is over is filled (written
+		 * together, but a stop may fall between the two writes) */
 		planned = srv_sweep_plan(sw) == 0;
 		for (size_t k = 0; planned && k < sw->total; k++)
 			if (sw->pt[k].state >= 2)
 				srv_sweep_fill_image(sw, k);
 	}
 	if (ok && !planned) {
-		snprintf(why, whylen, "out of memory");
+		if (consistent)
+			snprintf(why, whylen, "out of memory");
 		sweep_free(sw);
 		sw = NULL;
 	}

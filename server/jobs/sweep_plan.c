@@ -4,7 +4,7 @@
  * (sim_study_mirror_plan): a point that is the mirror image of another is
  * no job of its own, and is filled, velocity negated, when the other is
  * over; a point's varied settings applied to its model; and the band
- * source of a sweep with band_from_fit.
+ * source of a sweep with band_from_fit; the check of a stored record.
  */
 #include <math.h>
 #include <stdio.h>
@@ -56,6 +56,49 @@ int srv_sweep_plan(srv_sweep *sw)
 	free(st.values);
 	free(source);
 	return rc;
+}
+
+#define CUT(s) ((s)[sizeof(s) - 1] = '\0')
+
+int srv_sweep_record_check(api_sweep_req *req, api_sweep_point *pt, size_t total, char *why,
+			   size_t whylen)
+{
+	CUT(req->band_fit);
+	for (int a = 0; a < SIM_STUDY_MAX_AXES; a++)
+		CUT(req->vary[a]);
+	for (int j = 0; j < FIT_MAX_FREE; j++)
+		CUT(req->band_src.free[j].name);
+	for (size_t k = 0; k < total; k++)
+		CUT(pt[k].error);
+	api_problem pb;
+	if (api_check_model(&req->spec, &pb) != API_OK) {
+		snprintf(why, whylen, "its spec: %.*s", whylen > 12 ? (int)(whylen - 12) : 0,
+			 pb.detail);
+		return -1;
+	}
+	const char *bad = NULL;
+	if (req->nrot < 1 || req->nrot > 2 || total != (size_t)req->nbeta * (size_t)req->nrot)
+		bad = "senses";
+	for (int r = 0; !bad && r < req->nrot; r++)
+		if (req->rotations[r] != SIM_CW && req->rotations[r] != SIM_CCW)
+			bad = "a sense";
+	if (!bad && !(req->t_end > 0.0 && req->t_end <= API_SWEEP_T_END_MAX))
+		bad = "t_end";
+	if (!bad && (req->nvary < 0 || req->nvary > SIM_STUDY_MAX_AXES))
+		bad = "its varied settings";
+	for (int a = 0; !bad && a < req->nvary; a++)
+		if (!sim_setting_find(req->vary[a]))
+			bad = "a varied setting";
+	if (!bad && (req->band_src.nfree < 0 || req->band_src.nfree > FIT_MAX_FREE ||
+		     req->band < 0 || req->band > 1 || req->lhs < 0))
+		bad = "its band or sample";
+	for (size_t k = 0; !bad && k < total; k++)
+		if ((pt[k].rotation != SIM_CW && pt[k].rotation != SIM_CCW) || pt[k].state < 0 ||
+		    pt[k].state > 3)
+			bad = "a point";
+	if (bad)
+		snprintf(why, whylen, "inconsistent: %s", bad);
+	return bad ? -1 : 0;
 }
 
 int srv_sweep_apply(const srv_sweep *sw, size_t i, api_spec *spec, char *msg, size_t msglen)

@@ -27,38 +27,6 @@
 #include "session_int.h"
 #include "store.h"
 
-/* store.c's frame header: magic, version, kind, pad (unused, written as
- * 0), then the payload's length and checksum. */
-enum { FRAME_PAD = 12, FRAME_LEN = 16, FRAME_CHECKSUM = 24, FRAME_SIZE = 32 };
-
-/* Unframe n bytes of data as kind; the payload (malloc'd) or NULL. */
-static char *unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size_t *plen)
-{
-	char *buf = fuzz_exact(data, n);
-	if (fixed)
-		fuzz_fix_checksum(buf, n, FRAME_LEN, FRAME_CHECKSUM, FRAME_SIZE);
-	char *copy = fuzz_exact((const uint8_t *)buf, n);
-	const char *bad = NULL;
-	int older = 0;
-	char *payload = srv_store_unframe(buf, n, kind, plen, &older, &bad);
-	if (!payload) {
-		FUZZ_CHECK(bad && bad[0], "a frame refused without a reason");
-		fuzz_refused("srv_store_unframe", bad);
-		free(copy);
-		return NULL;
-	}
-	size_t len;
-	memset(copy + FRAME_PAD, 0, 4);
-	/* an earlier format comes back upgraded (store_v1.c, store_v2.c):
-	 * framed again, it is this build's */
-	char *again = older ? NULL : srv_store_frame(kind, payload, *plen, &len);
-	FUZZ_CHECK(older || (again && len == n && memcmp(again, copy, n) == 0),
-		   "an accepted file framed again differs");
-	free(again);
-	free(copy);
-	return payload;
-}
-
 static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 {
 	srv_ckpt_record r;
@@ -108,7 +76,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		return 0;
 	}
 	size_t plen;
-	char *payload = unframe(data + 5, spec_len, SRV_STORE_SESSION, data[0] & 1, &plen);
+	char *payload = fuzz_unframe(data + 5, spec_len, SRV_STORE_SESSION, data[0] & 1, &plen);
 	if (!payload)
 		return 0;
 	api_spec spec, again;
@@ -129,7 +97,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	fuzz_same_spec(&spec, &again, 1, "restored spec");
 	free(text);
 	size_t rest = size - 5 - spec_len;
-	payload = unframe(data + 5 + spec_len, rest, SRV_STORE_CHECKPOINT, data[0] & 1, &plen);
+	payload = fuzz_unframe(data + 5 + spec_len, rest, SRV_STORE_CHECKPOINT, data[0] & 1, &plen);
 	if (payload)
 		restore(&spec, payload, plen, data[0] & 2);
 	free(payload);

@@ -10,6 +10,7 @@
 
 #include "fuzz_util.h"
 #include "json_int.h"
+#include "store.h"
 
 void fuzz_fail(const char *fmt, ...)
 {
@@ -194,4 +195,35 @@ const api_spec *fuzz_default_spec(void)
 		made = 1;
 	}
 	return &spec;
+}
+
+/* store.c's frame header: magic, version, kind, pad (unused, written as
+ * 0), then the payload's length and checksum. */
+enum { FRAME_PAD = 12, FRAME_LEN = 16, FRAME_CHECKSUM = 24, FRAME_SIZE = 32 };
+
+char *fuzz_unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size_t *plen)
+{
+	char *buf = fuzz_exact(data, n);
+	if (fixed)
+		fuzz_fix_checksum(buf, n, FRAME_LEN, FRAME_CHECKSUM, FRAME_SIZE);
+	char *copy = fuzz_exact((const uint8_t *)buf, n);
+	const char *bad = NULL;
+	int older = 0;
+	char *payload = srv_store_unframe(buf, n, kind, plen, &older, &bad);
+	if (!payload) {
+		FUZZ_CHECK(bad && bad[0], "a frame refused without a reason");
+		fuzz_refused("srv_store_unframe", bad);
+		free(copy);
+		return NULL;
+	}
+	size_t len;
+	memset(copy + FRAME_PAD, 0, 4);
+	/* an earlier format comes back upgraded (store_v1.c, store_v2.c):
+	 * framed again, it is this build's */
+	char *again = older ? NULL : srv_store_frame(kind, payload, *plen, &len);
+	FUZZ_CHECK(older || (again && len == n && memcmp(again, copy, n) == 0),
+		   "an accepted file framed again differs");
+	free(again);
+	free(copy);
+	return payload;
 }

@@ -44,6 +44,14 @@ void fuzz_fix_checksum(char *buf, size_t n, size_t len_at, size_t sum_at, size_t
  * the payload's length and its checksum. */
 enum { FUZZ_CKPT_PAYLOAD = 32, FUZZ_CKPT_CHECKSUM = 40, FUZZ_CKPT_HEADER = 48 };
 
+/* A framed file of the data directory (store.c's frame: magic, version,
+ * kind, pad, the payload's length and checksum) unframed as kind, its
+ * checksum first made right when fixed: the payload (malloc'd, *plen its
+ * length) or NULL. Fails the oracle where a refusal gives no reason, or
+ * where a file of this build's format, accepted, framed again is not the
+ * same bytes (but the unused pad). */
+char *fuzz_unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size_t *plen);
+
 /* A refused request: code is the one returned, *pb the problem. Checks
  * that code is a 4xx/5xx of API_ERRNO_MAP equal to pb->code, that field
  * and detail are terminated strings and the detail is not empty, and that
