@@ -14,8 +14,9 @@
  * Oracles: a file that is refused says why; one that is accepted, framed
  * again, is the same bytes (but the unused pad); an accepted spec, written back as a create
  * body by the API's writer, is accepted by POST /sessions' parser and is
- * the same spec; a restored instance steps (running, or failed with a
- * reason). The committed seeds are real files of a daemon run with
+ * the same spec; the experiment a checkpoint carries, resumed
+ * (srv_exp_resume), serves its document running; a restored instance steps
+ * (running, or failed with a reason). The committed seeds are real files of a daemon run with
  * --data-dir.
  */
 #include <math.h>
@@ -23,9 +24,40 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "experiment.h"
 #include "fuzz_util.h"
+#include "job.h"
 #include "session_int.h"
 #include "store.h"
+
+/* The experiment a checkpoint carries (its head's exp_len bytes), resumed
+ * on an experiment listed damaged, as a restart resumes it on the one of
+ * experiments/ (srv_exp_resume); resumed, it serves a JSON document in
+ * state "running" with that experiment's id. */
+static void resume_experiment(const char *p, size_t len)
+{
+	static const char id[] = "0123456789abcdef";
+	srv_experiment *e = srv_exp_damaged(id, "stands for the record of experiments/");
+	FUZZ_CHECK(e, "out of memory");
+	srv_entry *en = srv_exp_entry(e);
+	char *copy = fuzz_exact((const uint8_t *)p, len);
+	int rc = srv_exp_resume(e, copy, len);
+	free(copy);
+	if (rc == 0) {
+		char *text = srv_experiment_job.text(en, 0);
+		cJSON *doc = text ? cJSON_Parse(text) : NULL;
+		const cJSON *jid = cJSON_GetObjectItemCaseSensitive(doc, "id");
+		const cJSON *st = cJSON_GetObjectItemCaseSensitive(doc, "state");
+		FUZZ_CHECK(cJSON_IsString(jid) && strcmp(jid->valuestring, id) == 0 &&
+				   cJSON_IsString(st) && strcmp(st->valuestring, "running") == 0,
+			   "a resumed experiment's document:\n%s", text ? text : "(none)");
+		cJSON_Delete(doc);
+		free(text);
+	} else {
+		fuzz_refused("srv_exp_resume", "its experiment");
+	}
+	srv_experiment_job.reg->destroy(en);
+}
 
 static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 {
@@ -42,6 +74,8 @@ static void restore(const api_spec *spec, char *p, size_t len, int fix_core)
 		   "checkpoint head accepted with state %d, lengths %zu + %llu + %llu of %zu",
 		   (int)r.state, sizeof r, (unsigned long long)r.exp_len,
 		   (unsigned long long)r.sim_len, len);
+	if (r.exp_len > 0)
+		resume_experiment(p + sizeof r, r.exp_len);
 	char *core = p + sizeof r + r.exp_len;
 	if (fix_core)
 		fuzz_fix_checksum(core, r.sim_len, FUZZ_CKPT_PAYLOAD, FUZZ_CKPT_CHECKSUM,

@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Makes the real seeds of the `store` fuzz harness again (docs/fuzzing.md
 # "Fuzzing"): runs the daemon ($BUILD/convsimd, from `make`) on a fresh
-# --data-dir with two sessions, a running default one and a finished rk4
-# one without feed (`until` 1 s at pace "max"), stops it with SIGTERM once
+# --data-dir with three sessions, a running default one, a finished rk4
+# one without feed (`until` 1 s at pace "max") and a running one of
+# 2 layers whose checkpoint carries a running experiment, stops it with SIGTERM once
 # each has a checkpoint and its .prev, and frames every session's
 # spec.bin with each checkpoint as the harness reads them: the byte 3, the
 # spec's length as 4 bytes little-endian, spec.bin, then the checkpoint.
@@ -33,18 +34,23 @@ create() { # body: prints the new session's id
 }
 running=$(create '{"preset":"czubak2016","pace":1}')
 finished=$(create '{"preset":"czubak2016","scene":{"feed":false},"integrator":{"method":"rk4"},"pace":"max","until":1}')
+experiment=$(create '{"preset":"czubak2016","scene":{"layers":2},"pace":1}')
+curl -sf -o /dev/null -X POST "$url/api/v1/experiments" -H 'Content-Type: application/json' \
+	-d '{"session":"'"$experiment"'","schedule":[{"beta":38,"until":30},{"beta":128,"until":60}]}'
+
 # the running session writes a checkpoint every 0.5 s of wall time, the
 # finished one when it stops; the shutdown writes each once more, which
 # makes the .prev of both
 for _ in $(seq 100); do
 	[ -f "$data/sessions/$running/checkpoint.bin.prev" ] &&
+		[ -f "$data/sessions/$experiment/checkpoint.bin.prev" ] &&
 		[ -f "$data/sessions/$finished/checkpoint.bin" ] && break
 	sleep 0.1
 done
 kill -TERM "$pid"
 wait "$pid" || true
 rm -f "$out"/*-checkpoint-bin "$out"/*-checkpoint-bin-prev
-for s in "$running" "$finished"; do
+for s in "$running" "$finished" "$experiment"; do
 	for ck in checkpoint.bin checkpoint.bin.prev; do
 		dir=$data/sessions/$s
 		[ -f "$dir/$ck" ] || { echo "store_seeds: $s has no $ck" >&2; exit 1; }
