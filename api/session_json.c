@@ -162,7 +162,8 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
 	cJSON *o = cJSON_ParseWithLength(text, len);
 	const cJSON *f = cJSON_GetObjectItemCaseSensitive(o, "format");
 	*format = f ? -1 : 1; /* format 1 had no member */
-	if (cJSON_IsNumber(f) && f->valuedouble == (int)f->valuedouble)
+	/* an int before the cast (1e300 is none) */
+	if (cJSON_IsNumber(f) && fabs(f->valuedouble) < 1e9 && f->valuedouble == (int)f->valuedouble)
 		*format = (int)f->valuedouble;
 	if (*format < 1 || *format > API_SPEC_FILE_FORMAT) {
 		int n = *format;
@@ -176,12 +177,17 @@ api_err api_parse_spec_file(const char *text, size_t len, api_spec *spec,
 	const cJSON *c = cJSON_GetObjectItemCaseSensitive(o, "created");
 	const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "owned");
 	const cJSON *b = cJSON_GetObjectItemCaseSensitive(o, "session");
-	char *body = cJSON_IsNumber(c) && cJSON_IsBool(w) && cJSON_IsObject(b) ? api_print(b)
-									  : NULL;
+	/* created finite: written again, an infinite one (1e999) would be null */
+	int inf = cJSON_IsNumber(c) && !isfinite(c->valuedouble);
+	char *body = cJSON_IsNumber(c) && !inf && cJSON_IsBool(w) && cJSON_IsObject(b)
+			     ? api_print(b)
+			     : NULL;
 	*created = cJSON_IsNumber(c) ? c->valuedouble : 0;
 	*owned = cJSON_IsTrue(w);
 	*picked = read_pick(o, pick);
 	cJSON_Delete(o);
+	if (inf)
+		return api_fail(pb, API_MALFORMED, "created", "created is no finite time (unix s)");
 	if (!body)
 		return api_fail(pb, API_MALFORMED, NULL, "not a session's spec "
 				"(created, owned and session expected)");

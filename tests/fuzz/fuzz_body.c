@@ -277,6 +277,41 @@ static void fit_body(const char *body, size_t len)
 	free(points);
 }
 
+/* sessions/ID/spec.json as a restart reads it (api_parse_spec_file, the
+ * first file it reads, a text anyone can edit): a refusal is a well-formed
+ * problem; an accepted file, written again (api_spec_file) with what it
+ * read, reads back as the same spec, creation time, owner and pick, in this
+ * build's format. */
+static void specfile_body(const char *body, size_t len)
+{
+	api_spec spec, again;
+	double created, created2;
+	int owned, owned2, format, format2, picked, picked2;
+	sim_feed_choice pick, pick2;
+	api_problem pb;
+	api_err e = api_parse_spec_file(body, len, &spec, &created, &owned, &format, &pick,
+					&picked, &pb);
+	if (e != API_OK) {
+		fuzz_check_problem(e, &pb);
+		return;
+	}
+	FUZZ_CHECK(format >= 1 && format <= API_SPEC_FILE_FORMAT, "format %d accepted", format);
+	char *text = api_spec_file(&spec, created, owned, picked ? &pick : NULL);
+	FUZZ_CHECK(text, "out of memory");
+	e = api_parse_spec_file(text, strlen(text), &again, &created2, &owned2, &format2, &pick2,
+				&picked2, &pb);
+	FUZZ_CHECK(e == API_OK, "spec.json written again is refused: %s\n%s", pb.detail, text);
+	fuzz_same_spec(&spec, &again, 1, "spec.json");
+	FUZZ_CHECK(format2 == API_SPEC_FILE_FORMAT && owned2 == owned && picked2 == picked &&
+			   (created2 == created || (isnan(created2) && isnan(created))),
+		   "spec.json written again: format %d, created %.17g (was %.17g), owned %d (%d), "
+		   "picked %d (%d)\n%s", format2, created2, created, owned2, owned, picked2, picked,
+		   text);
+	FUZZ_CHECK(!picked || (pick2.model == pick.model && strcmp(pick2.why, pick.why) == 0),
+		   "spec.json's pick written again differs\n%s", text);
+	free(text);
+}
+
 typedef struct fuzz_body {
 	const char *name;
 	void (*run)(const char *body, size_t len);
@@ -288,6 +323,7 @@ static const fuzz_body bodies[] = {
 	{"experiment", experiment_body},
 	{"sweep", sweep_body},
 	{"fit", fit_body},
+	{"specfile", specfile_body},
 };
 
 static const fuzz_body *chosen;

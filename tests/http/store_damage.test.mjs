@@ -5,7 +5,8 @@
 // preset name is not terminated, and specs holding what no request can set
 // (a method named rk2, an atol out of its range on a method that does not
 // read it, pace "max" without until: the fuzz harness's regression inputs,
-// as real files). The restart lists every such session as damaged with the
+// as real files), and a spec.json created at 1e999 s (body_specfile's
+// regression input). The restart lists every such session as damaged with the
 // reason (the one whose both checkpoints are refused is re-created from
 // its spec, the reasons logged), reads nothing past a buffer (make check runs
 // this under ASan) and stops cleanly. The offsets are this build's record
@@ -30,7 +31,7 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
   let d = await startDaemon(args);
   try {
     const ids = [];
-    for (let i = 0; i < 5; i++)
+    for (let i = 0; i < 6; i++)
       ids.push((await req(d.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 'max', until: 0.2 })).body.id);
     for (const id of ids)
       await until(async () => (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body.state === 'finished', 20000 * SLOW, id);
@@ -45,7 +46,13 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
       writeFileSync(path, reframe(b));
     }
     // the binary specs an earlier build wrote: this build's spec.json gone
-    for (const id of ids.slice(1)) rmSync(join(dir, 'sessions', id, 'spec.json'));
+    for (const id of ids.slice(1, 5)) rmSync(join(dir, 'sessions', id, 'spec.json'));
+    // a spec.json created at 1e999 s (infinite: written again it would be
+    // null, and the session lost at the restart after)
+    const json = join(dir, 'sessions', ids[5], 'spec.json');
+    const text = readFileSync(json, 'utf8');
+    assert.match(text, /"created":[0-9.e+]+,/, 'the layout this test assumes');
+    writeFileSync(json, text.replace(/"created":[0-9.e+]+,/, '"created":1e999,'));
     const spec = readFileSync(join(dir, 'sessions', ids[1], 'spec.bin'));
     assert.equal(spec.toString('latin1', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 10), 'czubak2016', 'the layout this test assumes');
     spec.fill('x', FRAME + SPEC_PRESET, FRAME + SPEC_PRESET + 32);
@@ -77,7 +84,7 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
     assert.equal(b.state, 'damaged');
     assert.match(b.error, /spec\.bin: the preset or method name is not a string/);
     const why = [];
-    for (const id of ids.slice(2)) {
+    for (const id of ids.slice(2, 6)) {
       const v = (await req(d.base, 'GET', `/api/v1/sessions/${id}`)).body;
       assert.equal(v.state, 'damaged', JSON.stringify(v));
       why.push(v.error);
@@ -85,6 +92,7 @@ test('a checksummed checkpoint with wrapping lengths and specs no request could 
     assert.match(why[0], /spec\.bin: method must be one of rk4\|dopri5\|euler\|dem$/);
     assert.match(why[1], /spec\.bin: atol must be a finite number in \[1e-15, 1\]$/);
     assert.match(why[2], /spec\.bin: pace "max" without until/);
+    assert.match(why[3], /spec\.json: created is no finite time \(unix s\)$/);
     assert.equal((await req(d.base, 'GET', '/api/v1/health')).status, 200);
     assert.equal((await d.stop()).code, 0, `clean stop; stderr: ${d.stderr()}`);
   } finally {
