@@ -210,6 +210,7 @@ $(BUILD)/core/model_map.inc: $(MODEL_MAP) Makefile
 model-check: $(BUILD)/convsim
 	$(Q)python3 tests/bench/model_check.py $(BUILD)/convsim > $(MODEL_MAP).new && mv $(MODEL_MAP).new $(MODEL_MAP)
 	$(Q)python3 tests/bench/dem_map_plot.py > tests/bench/results/dem_map.svg
+	$(Q)python3 tests/bench/model_error_check.py
 # `make bench-dem-calibrate` calibrates the column model on three points of
 # each complete bed of the DEM map (mu the material's, k_c and R fitted),
 # predicts the rest and checks how far a point's seed spread moves the result

@@ -90,6 +90,9 @@ run "dependency loops" sh -c "python3 tests/deps.py --max 1 $BUILD/core $BUILD/f
 # the fast feed model's harness: its leave-one-bed-out never fits on the
 # bed it predicts (no convsim runs; `make fast-feed-check` measures)
 run "fast feed check (self-test)" python3 tests/bench/fast_feed_check.py --self-test
+# model_error between the map's angles: the page is what the table gives and
+# the rule there is the engine's (tests/bench/model_error_check.py)
+run "model_error between the map's angles (check)" python3 tests/bench/model_error_check.py --check
 run "the map as its own fast model (check)" sh -c "python3 tests/bench/depth_surrogate.py --check && echo '# pass 1'"
 # the DEM map's plot is what the committed map and model check give, each
 # mark its point's value (tests/bench/dem_map_plot.py)
