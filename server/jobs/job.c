@@ -144,13 +144,13 @@ static void forget(const srv_job_kind *kind, const char *id)
 }
 
 /* The job's lock around a hook, when its kind has one. */
-static void job_lock(const srv_job_kind *kind, srv_entry *e)
+void srv_job_lock(const srv_job_kind *kind, srv_entry *e)
 {
 	if (kind->lock)
 		pthread_mutex_lock(kind->lock(e));
 }
 
-static void job_unlock(const srv_job_kind *kind, srv_entry *e)
+void srv_job_unlock(const srv_job_kind *kind, srv_entry *e)
 {
 	if (kind->lock)
 		pthread_mutex_unlock(kind->lock(e));
@@ -202,9 +202,9 @@ enum MHD_Result srv_h_job_get(srv_req *r)
 	srv_entry *e = srv_registry_get(r->job->reg, r->arg[0]);
 	if (!e)
 		return not_found(r);
-	job_lock(r->job, e);
+	srv_job_lock(r->job, e);
 	char *text = r->job->text(e, r->csv);
-	job_unlock(r->job, e);
+	srv_job_unlock(r->job, e);
 	srv_registry_put(r->job->reg, e);
 	return srv_reply_result(r, text);
 }
@@ -219,10 +219,10 @@ enum MHD_Result srv_h_job_list(srv_req *r)
 	char *text = NULL;
 	if (views && scratch) {
 		for (size_t i = 0; i < n; i++) {
-			job_lock(kind, all[i]);
+			srv_job_lock(kind, all[i]);
 			kind->view(all[i], views + i * kind->view_size,
 				   scratch + i * kind->scratch_size);
-			job_unlock(kind, all[i]);
+			srv_job_unlock(kind, all[i]);
 		}
 		text = kind->list_text(views, n, r->csv);
 	}
@@ -253,9 +253,9 @@ enum MHD_Result srv_h_job_delete(srv_req *r)
 		srv_registry_put(kind->reg, e);
 		return srv_fail(r, API_QUERY, "only", "only must be running, not \"%.40s\"", only);
 	}
-	job_lock(kind, e);
+	srv_job_lock(kind, e);
 	int stopped = kind->cancel(e, only != NULL);
-	job_unlock(kind, e);
+	srv_job_unlock(kind, e);
 	if (!stopped) {
 		srv_registry_put(kind->reg, e);
 		return srv_fail(r, API_CONFLICT, "only", "the %s has ended already; nothing was "

@@ -100,6 +100,11 @@ int srv_job_save(const srv_job_kind *kind, const char *id, const void *payload, 
 int srv_job_save_now(const srv_job_kind *kind, const char *id, const void *payload, size_t len,
 		     char *msg, size_t msglen);
 
+/* The job's own lock (the kind's lock hook), where its kind has one, as
+ * text, view and cancel are called under it; nothing where it has none. */
+void srv_job_lock(const srv_job_kind *kind, srv_entry *e);
+void srv_job_unlock(const srv_job_kind *kind, srv_entry *e);
+
 /* The handlers; r->job names the kind (the route table's). */
 enum MHD_Result srv_h_job_create(srv_req *r);
 enum MHD_Result srv_h_job_list(srv_req *r);

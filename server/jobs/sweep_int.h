@@ -36,11 +36,11 @@ typedef struct srv_sweep {
 int srv_sweep_plan(srv_sweep *sw);
 /* A request and its points as a restart reads them back from
  * sweeps/ID.bin (sweep_load), before anything else reads them: the model
- * as api_check_model has it, 1 or 2 senses (total = nbeta per
- * sense), each cw or ccw, t_end within (0, API_SWEEP_T_END_MAX], at most
- * SIM_STUDY_MAX_AXES varied settings, each known, at most FIT_MAX_FREE band parameters, every
- * point a sense and a state (0-3); the strings cut at their size. 0, or -1
- * with the reason in why. */
+ * as api_check_model has it, 1 or 2 senses (total = nbeta per sense), each
+ * cw or ccw, t_end within (0, API_SWEEP_T_END_MAX], at most
+ * SIM_STUDY_MAX_AXES varied settings, each known, at most FIT_MAX_FREE band
+ * parameters, every point a sense and a state (0-3); the strings cut at
+ * their size. 0, or -1 with the reason in why. */
 int srv_sweep_record_check(api_sweep_req *req, api_sweep_point *pt, size_t total, char *why,
 			   size_t whylen);
 /* Each point's run within --max-cpu-seconds (srv_budget_run_check, its

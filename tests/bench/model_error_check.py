@@ -119,11 +119,12 @@ def tables(rows):
     ents = entries(rows)
     text = ["| bound | points | bound holds | median bound, m/s | worst miss, m/s | "
             "worst miss, % of the bed's DEM peak |", "|---|---|---|---|---|---|"]
-    for name, share in RULES:
-        n, held, width, over, rel = summary(held_out(ents, share))
+    by_rule = [held_out(ents, share) for _, share in RULES]
+    for (name, _), points in zip(RULES, by_rule):
+        n, held, width, over, rel = summary(points)
         text.append("| %s | %d | %d (%.0f %%) | %.4f | %.4f | %.1f |"
                     % (name, n, held, 100.0 * held / n, width, over, 100.0 * rel))
-    pts = held_out(ents, 0.5)
+    pts = by_rule[0]  # the engine's
     text += ["", "By angle (the engine's bound):", "",
              "| beta | points | bound holds |", "|---|---|---|"]
     for b in sorted({p[1] for p in pts}):

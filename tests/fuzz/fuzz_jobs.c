@@ -14,8 +14,9 @@
  * one) serves a JSON document in state "damaged"; an accepted job serves
  * its JSON document (GET /api/v1/{plural}/ID: an object with the file's
  * id), its CSV, and its row of the listing (GET /api/v1/{plural}: an
- * object whose member {plural} is an array of one row with that id). The committed seeds are real files
- * of a daemon run with --data-dir (the release fixtures' data dirs).
+ * object whose member {plural} is an array of one row with that id). The
+ * committed seeds are real files of a daemon run with --data-dir (the
+ * release fixtures' data dirs).
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,54 +29,21 @@
 static const srv_job_kind *const kinds[3] = {&srv_sweep_job, &srv_fit_job,
 					     &srv_experiment_job};
 
-/* A job's text (JSON or CSV), under its lock as job.c takes it. */
-static char *text(const srv_job_kind *kind, srv_entry *e, int csv)
-{
-	pthread_mutex_t *lock = kind->lock ? kind->lock(e) : NULL;
-	if (lock)
-		pthread_mutex_lock(lock);
-	char *t = kind->text(e, csv);
-	if (lock)
-		pthread_mutex_unlock(lock);
-	return t;
-}
-
-/* The job's JSON document: an object whose "id" is id; its state. */
-static void check_document(const srv_job_kind *kind, srv_entry *e, const char *id,
-			   char *state, size_t statelen)
-{
-	char *t = text(kind, e, 0);
-	FUZZ_CHECK(t, "%s %s: no JSON document", kind->name, id);
-	cJSON *doc = cJSON_Parse(t);
-	FUZZ_CHECK(cJSON_IsObject(doc), "%s %s: its document does not parse:\n%s", kind->name, id,
-		   t);
-	const cJSON *jid = cJSON_GetObjectItemCaseSensitive(doc, "id");
-	FUZZ_CHECK(cJSON_IsString(jid) && strcmp(jid->valuestring, id) == 0,
-		   "%s: the document's id is not %s:\n%s", kind->name, id, t);
-	const cJSON *st = cJSON_GetObjectItemCaseSensitive(doc, "state");
-	snprintf(state, statelen, "%s", cJSON_IsString(st) ? st->valuestring : "");
-	cJSON_Delete(doc);
-	free(t);
-}
-
 /* An accepted job: its document, its CSV and its row of the listing. */
 static void check_served(const srv_job_kind *kind, srv_entry *e)
 {
 	char state[32];
-	check_document(kind, e, e->id, state, sizeof state);
+	fuzz_job_document(kind, e, e->id, state, sizeof state);
 	FUZZ_CHECK(strcmp(state, "damaged") != 0, "%s %s: accepted but damaged", kind->name,
 		   e->id);
-	char *csv = text(kind, e, 1);
-	FUZZ_CHECK(csv, "%s %s: no CSV", kind->name, e->id);
-	free(csv);
 	void *view = calloc(1, kind->view_size), *scratch = calloc(1, kind->scratch_size);
 	FUZZ_CHECK(view && scratch, "out of memory");
-	pthread_mutex_t *lock = kind->lock ? kind->lock(e) : NULL;
-	if (lock)
-		pthread_mutex_lock(lock);
+	srv_job_lock(kind, e);
+	char *csv = kind->text(e, 1);
 	kind->view(e, view, scratch);
-	if (lock)
-		pthread_mutex_unlock(lock);
+	srv_job_unlock(kind, e);
+	FUZZ_CHECK(csv, "%s %s: no CSV", kind->name, e->id);
+	free(csv);
 	char *list = kind->list_text(view, 1, 0);
 	cJSON *doc = list ? cJSON_Parse(list) : NULL;
 	const cJSON *rows = cJSON_GetObjectItemCaseSensitive(doc, kind->plural);
@@ -114,7 +82,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	e = kind->damaged(id, why);
 	FUZZ_CHECK(e, "out of memory");
 	char state[32];
-	check_document(kind, e, id, state, sizeof state);
+	fuzz_job_document(kind, e, id, state, sizeof state);
 	FUZZ_CHECK(strcmp(state, "damaged") == 0, "%s: a damaged job in state '%s'", kind->name,
 		   state);
 	kind->reg->destroy(e);

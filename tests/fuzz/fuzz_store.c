@@ -16,8 +16,8 @@
  * body by the API's writer, is accepted by POST /sessions' parser and is
  * the same spec; the experiment a checkpoint carries, resumed
  * (srv_exp_resume), serves its document running; a restored instance steps
- * (running, or failed with a reason). The committed seeds are real files of a daemon run with
- * --data-dir.
+ * (running, or failed with a reason). The committed seeds are real files
+ * of a daemon run with --data-dir.
  */
 #include <math.h>
 #include <stdio.h>
@@ -26,7 +26,6 @@
 
 #include "experiment.h"
 #include "fuzz_util.h"
-#include "job.h"
 #include "session_int.h"
 #include "store.h"
 
@@ -44,15 +43,9 @@ static void resume_experiment(const char *p, size_t len)
 	int rc = srv_exp_resume(e, copy, len);
 	free(copy);
 	if (rc == 0) {
-		char *text = srv_experiment_job.text(en, 0);
-		cJSON *doc = text ? cJSON_Parse(text) : NULL;
-		const cJSON *jid = cJSON_GetObjectItemCaseSensitive(doc, "id");
-		const cJSON *st = cJSON_GetObjectItemCaseSensitive(doc, "state");
-		FUZZ_CHECK(cJSON_IsString(jid) && strcmp(jid->valuestring, id) == 0 &&
-				   cJSON_IsString(st) && strcmp(st->valuestring, "running") == 0,
-			   "a resumed experiment's document:\n%s", text ? text : "(none)");
-		cJSON_Delete(doc);
-		free(text);
+		char state[32];
+		fuzz_job_document(&srv_experiment_job, en, id, state, sizeof state);
+		FUZZ_CHECK(strcmp(state, "running") == 0, "a resumed experiment in state '%s'", state);
 	} else {
 		fuzz_refused("srv_exp_resume", "its experiment");
 	}

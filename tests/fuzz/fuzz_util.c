@@ -227,3 +227,22 @@ char *fuzz_unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size
 	free(copy);
 	return payload;
 }
+
+void fuzz_job_document(const srv_job_kind *kind, srv_entry *e, const char *id, char *state,
+		       size_t statelen)
+{
+	srv_job_lock(kind, e);
+	char *t = kind->text(e, 0);
+	srv_job_unlock(kind, e);
+	FUZZ_CHECK(t, "%s %s: no JSON document", kind->name, id);
+	cJSON *doc = cJSON_Parse(t);
+	FUZZ_CHECK(cJSON_IsObject(doc), "%s %s: its document does not parse:\n%s", kind->name, id,
+		   t);
+	const cJSON *jid = cJSON_GetObjectItemCaseSensitive(doc, "id");
+	FUZZ_CHECK(cJSON_IsString(jid) && strcmp(jid->valuestring, id) == 0,
+		   "%s: the document's id is not %s:\n%s", kind->name, id, t);
+	const cJSON *st = cJSON_GetObjectItemCaseSensitive(doc, "state");
+	snprintf(state, statelen, "%s", cJSON_IsString(st) ? st->valuestring : "");
+	cJSON_Delete(doc);
+	free(t);
+}

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "api.h"
+#include "job.h"
 
 /* The oracle failed: print the message and abort (libFuzzer saves the
  * input as a crash). */
@@ -51,6 +52,12 @@ enum { FUZZ_CKPT_PAYLOAD = 32, FUZZ_CKPT_CHECKSUM = 40, FUZZ_CKPT_HEADER = 48 };
  * where a file of this build's format, accepted, framed again is not the
  * same bytes (but the unused pad). */
 char *fuzz_unframe(const uint8_t *data, size_t n, uint32_t kind, int fixed, size_t *plen);
+
+/* A job's JSON document as GET /api/v1/{plural}/ID serves it (the kind's
+ * text hook under srv_job_lock): fails the oracle unless it is an object
+ * whose "id" is id; its "state" into state ("" where none). */
+void fuzz_job_document(const srv_job_kind *kind, srv_entry *e, const char *id, char *state,
+		       size_t statelen);
 
 /* A refused request: code is the one returned, *pb the problem. Checks
  * that code is a 4xx/5xx of API_ERRNO_MAP equal to pb->code, that field
