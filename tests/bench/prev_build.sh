@@ -8,7 +8,7 @@
 # the message. LAST_RELEASE is the last stop's final commit, the previous
 # build of the benches that compare with the release before this one
 # (realtime.sh, realtime_over.sh, targets.sh): one place to move it on.
-LAST_RELEASE=c0da41f
+LAST_RELEASE=a9a256a
 prev_build() { # bench name, program
 	local dir="$BUILD/prev-$PREV"
 	prev="$dir/src/build/$2"

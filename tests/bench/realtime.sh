@@ -5,9 +5,9 @@
 # minutes): tests/bench/realtime.mjs for each N of REALTIME_N (default
 # "200 600 1000": within the default --max-paced-cores, beyond it, where the
 # admitted must keep real time and the rest get 503, and issue 37's target). The previous build
-# is commit PREV (default: LAST_RELEASE of tests/bench/prev_build.sh, c0da41f now; the rounds before
+# is commit PREV (default: LAST_RELEASE of tests/bench/prev_build.sh, a9a256a now; the rounds before
 # compared with 03e01ae, main before its streams were charged in the cores
-# for paced sessions, dbe9ffc, 7e56a85, 1b75a01, 4eff261, 357b026, 685132b, b09537b, ac6018f, 21c112d, 4611a1d, 4163b0a, f809dea, 30ec102, 629d0db, f27d350, 902f3ae, 322ab1b and 2c46d6e), exported with git archive and built once
+# for paced sessions, dbe9ffc, 7e56a85, 1b75a01, 4eff261, 357b026, 685132b, b09537b, ac6018f, 21c112d, 4611a1d, 4163b0a, f809dea, 30ec102, 629d0db, f27d350, 902f3ae, 322ab1b, 2c46d6e and c0da41f), exported with git archive and built once
 # into $BUILD/prev-PREV (`make build/convsimd`); PREV_CONVSIMD names a
 # built one instead. Writes $1/realtime.md.
 set -eu

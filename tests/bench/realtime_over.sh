@@ -5,7 +5,7 @@
 # build first in the same minutes (BASELINE), the load average before and
 # after each run: are the admitted sessions in real time while the refused
 # creations' flood arrives? The previous build is PREV_CONVSIMD, or commit
-# PREV (default: LAST_RELEASE, c0da41f now), built by tests/bench/prev_build.sh. Not part of
+# PREV (default: LAST_RELEASE, a9a256a now), built by tests/bench/prev_build.sh. Not part of
 # `make bench` (about a minute a run). Writes $1/realtime_1500.md.
 set -eu
 cd "$(dirname "$0")/../.."

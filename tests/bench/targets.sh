@@ -19,7 +19,7 @@
 #    its baseline, a minute on both cores; skipped
 #    with DAEMON=0 or without node).
 # The runs alternate with those of the previous build, commit PREV (default
-# LAST_RELEASE, c0da41f now; tests/bench/prev_build.sh builds it), whose
+# LAST_RELEASE, a9a256a now; tests/bench/prev_build.sh builds it), whose
 # rows stand beside this build's. The machine is shared: a table is one
 # sample of it, the best figures the least disturbed. Writes $1/targets.md.
 set -eu
