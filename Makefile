@@ -331,7 +331,7 @@ test: deps deps-unit
 	$(Q)$(MAKE) --no-print-directory -j$(JOBS) all
 	$(Q)$(MAKE) --no-print-directory -j$(JOBS) dem-build
 	$(Q)$(MAKE) --no-print-directory -j$(JOBS) NO_MPI=1 BUILD=$(BUILD)/nompi $(BUILD)/nompi/convsim
-	$(Q)BUILD=$(BUILD) TESTS_SKIP='$(TESTS_SKIP)' TEST_JOBS=$(JOBS) bash tests/run.sh
+	$(Q)BUILD=$(BUILD) TESTS_SKIP='$(TESTS_SKIP)' TEST_JOBS=$(JOBS) TEST_LANES=$(or $(TEST_LANES),1) bash tests/run.sh
 
 check:
 	$(Q)$(MAKE) --no-print-directory BUILD=build-san \
@@ -349,10 +349,12 @@ check:
 # restore_exact.test.mjs: bit-exactness after kills, 110 s instrumented in
 # daemon restarts and waits (the same checkpoint and restore paths run
 # instrumented in persistence, durability, upgrade, test_checkpoint and
-# the checkpoint fuzzer)
+# the checkpoint fuzzer). Its node:test files run two at a time
+# (TEST_LANES): a sanitizer build's tests assert no timing (SLOW), and the
+# pass's wall time is mostly theirs waiting on the daemon
 CHECK_CI_SKIP = ^test_fit_band\b|^tests/(web|dem)/|^tests/http/(openapi|docs|cluster|restore_exact)\.test|^tests/cli/(mpi|fit|licences)\.test
 check-ci:
-	$(Q)$(MAKE) --no-print-directory TESTS_SKIP='$(CHECK_CI_SKIP)' check
+	$(Q)$(MAKE) --no-print-directory TESTS_SKIP='$(CHECK_CI_SKIP)' TEST_LANES=2 check
 
 bench: all $(BUILD)/.deps-bench
 	$(Q)BUILD=$(BUILD) bash tests/bench/run.sh

@@ -65,23 +65,33 @@ for name in $longest $(ls tests/unit/test_*.c | xargs -n1 basename | sed 's/\.c$
 	case " ${order[*]} " in *" $name "*) continue ;; esac
 	[ -e "tests/unit/$name.c" ] && order+=("$name")
 done
+# spawn jobs name command...: name's command in the background, at most
+# jobs at a time, its output to a log of its own; shown and counted by shown
+spawn() {
+	local lanes=$1 name=$2 key=${2//\//_}; shift 2
+	while [ "$(jobs -rp | wc -l)" -ge "$lanes" ]; do wait -n; done
+	(t0=$EPOCHREALTIME
+	 timeout 900 "$@" >"$units/$key.log" 2>&1
+	 echo "$? $(since "$t0")" >"$units/$key.end") &
+}
+shown() { # name: its log shown and counted (after wait)
+	local key=${1//\//_} rc secs
+	echo "=== $1"
+	cp "$units/$key.log" "$log"
+	cat "$log"
+	read -r rc secs <"$units/$key.end"
+	count "$1" "$rc" "$secs"
+}
 names=()
 for name in "${order[@]}"; do
 	[ -x "$BUILD/tests/$name" ] || continue
 	skip "$name" && continue
 	names+=("$name")
-	while [ "$(jobs -rp | wc -l)" -ge "${TEST_JOBS:-1}" ]; do wait -n; done
-	(t0=$EPOCHREALTIME
-	 timeout 900 "$BUILD/tests/$name" >"$units/$name.log" 2>&1
-	 echo "$? $(since "$t0")" >"$units/$name.end") &
+	spawn "${TEST_JOBS:-1}" "$name" "$BUILD/tests/$name"
 done
 wait
 for name in $(printf '%s\n' "${names[@]}" | sort); do
-	echo "=== $name"
-	cp "$units/$name.log" "$log"
-	cat "$log"
-	read -r rc secs <"$units/$name.end"
-	count "$name" "$rc" "$secs"
+	shown "$name"
 done
 # the floors: no dependency loop in core/, fit/, cli/, api/, each of
 # server/'s floors, server/ as a whole or dem/ (where built) (files that use
@@ -104,9 +114,23 @@ run "DEM map inputs" python3 tests/bench/dem_inputs.py --check
 run "DEM map runner (self-test)" python3 tests/bench/dem_map.py --self-test
 # the size rule: files of at most 500 lines, functions of at most 80
 run "file and function sizes" sh -c "python3 tests/size.py --self-test && python3 tests/size.py && echo '# pass 1'"
+# the node:test files one at a time (their timing asserts assume a quiet
+# machine), or TEST_LANES at a time (make check-ci: a sanitizer build, whose
+# tests assert no timing), each shown and counted in order once all have ended
+files=()
 for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/web/*.test.mjs; do
 	[ -e "$f" ] || continue
-	run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
+	if [ "${TEST_LANES:-1}" -le 1 ]; then
+		run "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
+		continue
+	fi
+	skip "$f" && continue
+	files+=("$f")
+	spawn "$TEST_LANES" "$f" node --test --test-concurrency=1 --test-timeout=300000 "$f"
+done
+wait
+for f in ${files[@]+"${files[@]}"}; do
+	shown "$f"
 done
 echo
 total=$(awk -F'\t' '{s += $1} END {printf "%.0f", s}' "$times")
