@@ -6,9 +6,11 @@
  * JSON: the entries of each answer's array member ("sessions", ...) in
  * one array, and "unreachable" naming the peers whose entries are missing.
  * CSV: the first answer's header once, then every answer's rows. A peer's
- * answer that does not have the same shape (not JSON with that array, or
- * another CSV header) is refused, and the caller reports that peer as
- * unreachable instead. The one replica's listing of every kind is written
+ * answer that does not have the same shape (not JSON with that array of
+ * entries, each an object with its "id"; or another CSV header, or a row
+ * of another number of fields) is refused whole, and the caller reports
+ * that peer as unreachable instead: what one replica sends cannot put
+ * into a listing what no replica's own listing holds. The one replica's listing of every kind is written
  * here too (api_list_json).
  */
 #include <stdlib.h>
@@ -53,18 +55,63 @@ api_list *api_list_new(const char *member, int csv, const char *local)
 	return NULL;
 }
 
+/* The commas of a CSV line (len bytes; the listings quote nothing). */
+static size_t commas(const char *line, size_t len)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < len; i++)
+		n += line[i] == ',';
+	return n;
+}
+
+/* Whether rows (len bytes after the header) are lines of the header's
+ * fields each: no NUL, carriage return or quote, no empty line. */
+static int rows_fit(const char *rows, size_t len, size_t fields)
+{
+	if (memchr(rows, '\0', len) || memchr(rows, '\r', len) || memchr(rows, '"', len))
+		return 0;
+	for (size_t at = 0; at < len;) {
+		const char *nl = memchr(rows + at, '\n', len - at);
+		size_t n = nl ? (size_t)(nl - (rows + at)) : len - at;
+		if (n == 0 || commas(rows + at, n) != fields)
+			return 0;
+		at += n + 1;
+	}
+	return 1;
+}
+
+/* Whether every entry of a peer's array is an object with an "id" of 1
+ * to API_LIST_ID_MAX characters, as every replica's own entries are. */
+#define API_LIST_ID_MAX 63
+static int entries_fit(const cJSON *items)
+{
+	const cJSON *it;
+	cJSON_ArrayForEach(it, items) {
+		const cJSON *id = cJSON_GetObjectItemCaseSensitive(it, "id");
+		if (!cJSON_IsObject(it) || !cJSON_IsString(id) || !id->valuestring[0] ||
+		    strlen(id->valuestring) > API_LIST_ID_MAX)
+			return 0;
+	}
+	return 1;
+}
+
 int api_list_add(api_list *l, const char *body, size_t len)
 {
 	if (l->csv) {
 		size_t h = header_length(body, len);
-		if (h != l->header_len || memcmp(body, l->text.text, h) != 0)
+		if (h != l->header_len || memcmp(body, l->text.text, h) != 0 ||
+		    !rows_fit(body + h, len - h, commas(body, h)))
 			return -1;
 		api_buf_put(&l->text, body + h, len - h);
+		/* a last row without its newline gets one: the next peer's
+		 * rows start on a line of their own */
+		if (len > h && body[len - 1] != '\n')
+			api_buf_put(&l->text, "\n", 1);
 		return l->text.failed ? -1 : 0;
 	}
 	cJSON *peer = cJSON_ParseWithLength(body, len);
 	cJSON *items = cJSON_GetObjectItemCaseSensitive(peer, l->items->string);
-	int ok = cJSON_IsArray(items);
+	int ok = cJSON_IsArray(items) && entries_fit(items);
 	while (ok && items->child) {
 		cJSON *it = cJSON_DetachItemViaPointer(items, items->child);
 		cJSON_AddItemToArray(l->items, it);

@@ -186,28 +186,34 @@ static void fetch_all(fetch *f, size_t n)
 	}
 }
 
+const char *srv_peer_answer(char *buf, size_t len, size_t *body_len, char *reason,
+			    size_t reasonlen)
+{
+	if (!buf) {
+		snprintf(reason, reasonlen, "empty answer");
+		return NULL;
+	}
+	buf[len] = '\0';
+	int status = 0;
+	char *head_end = strstr(buf, "\r\n\r\n");
+	if (sscanf(buf, "HTTP/1.%*d %d", &status) != 1 || !head_end) {
+		snprintf(reason, reasonlen, "not an HTTP answer");
+		return NULL;
+	}
+	if (status != 200) {
+		snprintf(reason, reasonlen, "HTTP status %d", status);
+		return NULL;
+	}
+	*body_len = len - (size_t)(head_end + 4 - buf);
+	return head_end + 4;
+}
+
 /* The body of f's answer if its status is 200, else NULL and a reason. */
 static const char *fetch_body(fetch *f, size_t *len)
 {
 	if (f->reason[0])
 		return NULL;
-	if (!f->buf) {
-		snprintf(f->reason, sizeof f->reason, "empty answer");
-		return NULL;
-	}
-	f->buf[f->len] = '\0';
-	int status = 0;
-	char *head_end = strstr(f->buf, "\r\n\r\n");
-	if (sscanf(f->buf, "HTTP/1.%*d %d", &status) != 1 || !head_end) {
-		snprintf(f->reason, sizeof f->reason, "not an HTTP answer");
-		return NULL;
-	}
-	if (status != 200) {
-		snprintf(f->reason, sizeof f->reason, "HTTP status %d", status);
-		return NULL;
-	}
-	*len = f->len - (size_t)(head_end + 4 - f->buf);
-	return head_end + 4;
+	return srv_peer_answer(f->buf, f->len, len, f->reason, sizeof f->reason);
 }
 
 enum MHD_Result srv_peers_reply(srv_req *r, char *local, const char *member)

@@ -26,4 +26,10 @@ int srv_peers_init(const srv_config *cfg);
  * comma-separated); the answer is still 200. */
 enum MHD_Result srv_peers_reply(srv_req *r, char *local, const char *member);
 
+/* A peer's whole answer (len bytes in buf, which has room for one more):
+ * its body (*body_len bytes) if it is an HTTP answer of status 200, else
+ * NULL and why in reason (the fan-out names the peer unreachable). */
+const char *srv_peer_answer(char *buf, size_t len, size_t *body_len, char *reason,
+			    size_t reasonlen);
+
 #endif

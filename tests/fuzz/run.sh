@@ -19,7 +19,7 @@ T=${FUZZ_TIMEOUT:-60}
 # (CI: the same amount of fuzzing every run; the inputs kept follow coverage,
 # which can differ between machines)
 R=${FUZZ_RUNS:-}
-NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit body_specfile query route checkpoint store jobs}
+NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit body_specfile query route checkpoint store jobs peers}
 mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
 if [ -n "$R" ]; then
 	echo "fuzzing each harness for $R inputs from seed 1 (at most ${S} s): FUZZ_RUNS=$R make fuzz"
@@ -42,7 +42,7 @@ for n in $NAMES; do
 	# must still be accepted: seeds of a format since changed are refused
 	# at its first check and fuzz nothing behind it
 	case $n in
-	checkpoint | store | jobs)
+	checkpoint | store | jobs | peers)
 		seeds=$(ls "tests/fuzz/corpus/$n"/* | grep -v '/regress-')
 		# shellcheck disable=SC2086
 		if ! FUZZ_MUST_ACCEPT=1 "$bin" $seeds >"$B/logs/$n.seeds.log" 2>&1; then

@@ -126,3 +126,52 @@ test('--peers: lists gather every peer, ?scope=local does not, a dead or wrong p
     await new Promise((r) => odd.close(r));
   }
 });
+
+// What one peer sends cannot put into a listing what no replica's own holds:
+// entries without their id, rows of other fields, text after a NUL. A peer
+// answer of that shape is refused whole and the peer named; a well-formed
+// CSV whose last row lacks its newline is taken, that row on a line of its own.
+test('--peers: a peer\'s entries without ids or rows of other fields are refused whole, the peer named', async () => {
+  const b = await startDaemon(['--node-id', 'b']);
+  const header = (await req(b.base, 'GET', '/api/v1/sessions?scope=local&format=csv')).text;
+  const fields = header.trim().split(',').length;
+  const row = (id) => [id, 'running', ...Array(fields - 2).fill('')].join(',');
+  let answer = {};
+  const odd = http.createServer((q, res) => {
+    const csv = q.url.includes('format=csv');
+    res.writeHead(200, { 'Content-Type': csv ? 'text/csv' : 'application/json' });
+    res.end(csv ? answer.csv : answer.json);
+  });
+  await new Promise((r) => odd.listen(0, '127.0.0.1', r));
+  const oddUrl = `http://127.0.0.1:${odd.address().port}`;
+  const a = await startDaemon(['--node-id', 'a', '--peers', oddUrl]);
+  try {
+    const id = (await req(a.base, 'POST', '/api/v1/sessions', { ...CHEAP, pace: 0.1 })).body.id;
+    // the session runs: its row's figures move, its id and the lines do not
+    const lines = (text) => text.split('\n');
+    for (const [json, csv] of [
+      ['{"sessions":[{"id":"x-1","state":"running"},7]}', `${header}${row('x-1')}\nx-2,running\n`],
+      ['{"sessions":[{"state":"running"}]}', `${header}${row('x-1')}\n\n${row('x-2')}\n`],
+      ['{"sessions":[{"id":""}]}', `${header}${row('x-1')}\0${row('x-2')}\n`],
+    ]) {
+      answer = { json, csv };
+      const list = await req(a.base, 'GET', '/api/v1/sessions');
+      assert.equal(list.status, 200);
+      assert.deepEqual(list.body.sessions.map((s) => s.id), [id], json);
+      assert.deepEqual(list.body.unreachable, [{ peer: oddUrl, reason: 'its answer is not a sessions list' }]);
+      const merged = await req(a.base, 'GET', '/api/v1/sessions?format=csv');
+      assert.equal(merged.status, 200);
+      assert.deepEqual(lines(merged.text).map((l) => l.split(',')[0]), ['id', id, ''], JSON.stringify(csv));
+      assert.equal(merged.headers.get('convsim-unreachable'), oddUrl);
+    }
+    answer = { json: '{"sessions":[]}', csv: `${header}${row('x-1')}` };
+    const merged = await req(a.base, 'GET', '/api/v1/sessions?format=csv');
+    assert.deepEqual(lines(merged.text).slice(2), [row('x-1'), '']);
+    assert.deepEqual(lines(merged.text).map((l) => l.split(',')[0]), ['id', id, 'x-1', '']);
+    assert.equal(merged.headers.get('convsim-unreachable'), null);
+  } finally {
+    await a.stop();
+    await b.stop();
+    await new Promise((r) => odd.close(r));
+  }
+});
