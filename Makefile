@@ -382,7 +382,7 @@ bench-zoo-ref: all
 FUZZ_SECONDS ?= 60
 FUZZ_BUILD   := build-fuzz
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-FUZZ_BODIES  := session control experiment sweep fit specfile
+FUZZ_BODIES  := session control controlline experiment sweep fit specfile
 FUZZ_NAMES   := $(FUZZ_BODIES:%=body_%) query route checkpoint store jobs peers
 FUZZ_BINS    := $(FUZZ_NAMES:%=$(BUILD)/fuzz/%)
 FUZZ_SERVER  := $(filter-out $(BUILD)/server/main.o,$(SERVER_OBJ))

@@ -85,6 +85,32 @@ static void control_body(const char *body, size_t len)
 	free(text);
 }
 
+/* A line of a session's controls.ndjson as a restore reads it back to
+ * replay it (api_parse_control_event, against a default session):
+ * written again with the log's own writer, it parses to the same control,
+ * time and experiment. */
+static void controlline_body(const char *line, size_t len)
+{
+	const api_spec *spec = fuzz_default_spec();
+	api_control c, again;
+	double t, t2;
+	char exp[64], exp2[64];
+	api_problem pb;
+	api_err e = api_parse_control_event(line, len, spec, &c, &t, exp, sizeof exp, &pb);
+	if (e != API_OK) {
+		fuzz_check_problem(e, &pb);
+		return;
+	}
+	FUZZ_CHECK(c.set != 0 && isfinite(t), "an accepted log line changes nothing, or at %g", t);
+	char text[API_EVENT_MAX];
+	int n = api_control_log_line(text, sizeof text, &c, t, exp);
+	FUZZ_CHECK(n > 0 && (size_t)n < sizeof text - 1, "a log line of %d bytes", n);
+	e = api_parse_control_event(text, (size_t)n, spec, &again, &t2, exp2, sizeof exp2, &pb);
+	FUZZ_CHECK(e == API_OK, "a log line written again is refused: %s\n%s", pb.detail, text);
+	FUZZ_CHECK(same_control(&c, &again) && t2 == sim_time_ns(t) && strcmp(exp, exp2) == 0,
+		   "a log line differs written again: %s", text);
+}
+
 /* The request written back: the schedule from the experiment document,
  * the session as an id or as the create body of its spec. */
 static char *experiment_text(const api_experiment_req *req)
@@ -320,6 +346,7 @@ typedef struct fuzz_body {
 static const fuzz_body bodies[] = {
 	{"session", session_body},
 	{"control", control_body},
+	{"controlline", controlline_body},
 	{"experiment", experiment_body},
 	{"sweep", sweep_body},
 	{"fit", fit_body},

@@ -19,7 +19,7 @@ T=${FUZZ_TIMEOUT:-60}
 # (CI: the same amount of fuzzing every run; the inputs kept follow coverage,
 # which can differ between machines)
 R=${FUZZ_RUNS:-}
-NAMES=${FUZZ_NAMES:-body_session body_control body_experiment body_sweep body_fit body_specfile query route checkpoint store jobs peers}
+NAMES=${FUZZ_NAMES:-body_session body_control body_controlline body_experiment body_sweep body_fit body_specfile query route checkpoint store jobs peers}
 mkdir -p "$B/corpus" "$B/crashes" "$B/logs"
 if [ -n "$R" ]; then
 	echo "fuzzing each harness for $R inputs from seed 1 (at most ${S} s): FUZZ_RUNS=$R make fuzz"
