@@ -114,9 +114,10 @@ run "DEM map inputs" python3 tests/bench/dem_inputs.py --check
 run "DEM map runner (self-test)" python3 tests/bench/dem_map.py --self-test
 # the size rule: files of at most 500 lines, functions of at most 80
 run "file and function sizes" sh -c "python3 tests/size.py --self-test && python3 tests/size.py && echo '# pass 1'"
-# the node:test files one at a time (their timing asserts assume a quiet
-# machine), or TEST_LANES at a time (make check-ci: a sanitizer build, whose
-# tests assert no timing), each shown and counted in order once all have ended
+# the node:test files one at a time (some timing asserts assume a quiet
+# machine), or TEST_LANES at a time (make check-ci: a sanitizer build, where
+# timeouts scale and those asserts are relaxed: tests/http/lib.mjs SLOW),
+# each shown and counted in order once all have ended
 files=()
 for f in tests/cli/*.test.mjs tests/dem/*.test.mjs tests/http/*.test.mjs tests/web/*.test.mjs; do
 	[ -e "$f" ] || continue

@@ -95,7 +95,11 @@ export async function catalog() {
 export async function listSessions() {
 	const d = (await request('GET', '/sessions')).data;
 	const list = Array.isArray(d) ? d : (d && (d.sessions ?? d.items)) ?? [];
-	return list.map(normalizeSession);
+	const out = list.map(normalizeSession);
+	/* a cluster's replicas (--peers) that did not answer: [{peer, reason}];
+	 * their sessions are missing from the list */
+	out.unreachable = Array.isArray(d?.unreachable) ? d.unreachable : [];
+	return out;
 }
 export async function createSession(form) {
 	const r = await request('POST', '/sessions', sessionRequest(form));

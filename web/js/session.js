@@ -207,6 +207,17 @@ export async function removeSession() {
 	refreshSessionList();
 }
 
+/* The replicas of a cluster that did not answer the listing (docs/
+ * cluster.md): their sessions are not in the picker, and the note beside
+ * it says so; its title names each and why. */
+function showUnreachable(peers) {
+	const note = $('#peers-note');
+	const n = peers.length;
+	note.hidden = n === 0;
+	note.textContent = n === 0 ? '' : `${n} replica${n > 1 ? 's' : ''} did not answer: ${n > 1 ? 'their' : 'its'} sessions are not listed`;
+	note.title = peers.map(p => `${p.peer}: ${p.reason}`).join('\n');
+}
+
 export async function refreshSessionList() {
 	try {
 		const list = await api.listSessions();
@@ -221,6 +232,7 @@ export async function refreshSessionList() {
 		}
 		if (keep && !list.some(s => s.id === keep)) sel.append(new Option(keep, keep));
 		sel.value = keep;
+		showUnreachable(list.unreachable ?? []);
 	} catch (err) {
 		if (err instanceof api.NetworkError) setOnline(false);
 	}
