@@ -200,23 +200,30 @@ static void machine_rate_key_of(const sim_params *p, const sim_scene *sc, machin
 	k->motor_on = sc->motor_on;
 }
 
+/* The machines whose rate a thread keeps (a few: a daemon's thread that
+ * restores sessions, or checks requests, meets several in turn). */
+#define RATE_MEMO 4
+
 double model_machine_rate(const sim_params *p, const sim_scene *sc)
 {
 	/* a run asks several times and a sweep at every point for the same
-	 * machine: the last answer is kept, per thread */
+	 * machine: the last RATE_MEMO answers are kept, per thread */
 	static _Thread_local struct {
 		int valid;
 		machine_rate_key key;
 		double rate;
-	} memo;
+	} memo[RATE_MEMO];
+	static _Thread_local unsigned next;
 	machine_rate_key key;
 	machine_rate_key_of(p, sc, &key);
-	if (!memo.valid || memcmp(&key, &memo.key, sizeof key) != 0) {
-		memo.rate = machine_rate(p, sc);
-		memcpy(&memo.key, &key, sizeof key);
-		memo.valid = 1;
-	}
-	return memo.rate;
+	for (int i = 0; i < RATE_MEMO; i++)
+		if (memo[i].valid && memcmp(&key, &memo[i].key, sizeof key) == 0)
+			return memo[i].rate;
+	unsigned i = next++ % RATE_MEMO;
+	memo[i].rate = machine_rate(p, sc);
+	memcpy(&memo[i].key, &key, sizeof key);
+	memo[i].valid = 1;
+	return memo[i].rate;
 }
 
 double model_column_sag(const sim_params *p, const sim_scene *sc)
