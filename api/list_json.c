@@ -10,8 +10,8 @@
  * entries, each an object with its "id"; or another CSV header, or a row
  * of another number of fields) is refused whole, and the caller reports
  * that peer as unreachable instead: what one replica sends cannot put
- * into a listing what no replica's own listing holds. The one replica's listing of every kind is written
- * here too (api_list_json).
+ * into a listing what no replica's own listing holds. The one replica's
+ * listing of every kind is written here too (api_list_json).
  */
 #include <stdlib.h>
 #include <string.h>
